@@ -1,0 +1,185 @@
+//! The `impulse` command: run scenes, list and export them, and work with contact LCPs.
+
+mod lcp_command;
+mod run;
+mod trajectory;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use impulse::Scene;
+use impulse::scene::builtin::{builtin_names, builtin_scene};
+use impulse::scene::json::{load_scene_file, to_json_string};
+
+/// Simultaneous contact resolution for animation: piles, stacks and pyramids solved as one
+/// linear complementarity problem per step.
+#[derive(Parser)]
+#[command(name = "impulse", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Step a scene (a JSON file or a built-in name) and print a summary.
+    Run {
+        /// JSON scene file, or the name of a built-in scene (see `impulse scenes`).
+        scene: String,
+        /// Steps to take (default: the scene's, 600 for built-ins).
+        #[arg(long)]
+        steps: Option<u32>,
+        /// Time step in seconds (default: the scene's).
+        #[arg(long)]
+        dt: Option<f32>,
+        /// PGS sweeps per step at most (default: the scene's solver settings).
+        #[arg(long)]
+        iterations: Option<u32>,
+        /// Trajectory file: `.csv` (frame,time,body,x,y,z,qx,qy,qz,qw) or `.jsonl`.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Write every K-th frame (frame 0 and the last are always written).
+        #[arg(long, default_value_t = 1)]
+        every: u32,
+        /// Write the summary as JSON to this file.
+        #[arg(long)]
+        summary_json: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// List the built-in scenes.
+    Scenes,
+    /// Write a scene (built-in name or file) as JSON.
+    Export {
+        /// Built-in name or JSON file.
+        scene: String,
+        /// Output file (default: standard output).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Linear complementarity problems on their own.
+    Lcp {
+        #[command(subcommand)]
+        command: LcpCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum LcpCommand {
+    /// Solve an LCP file: Siconos `.dat` (w = Mz + q) or impulse `.json` (w = Aγ − b).
+    Solve {
+        file: PathBuf,
+        /// pgs, jacobi or lemke.
+        #[arg(long, default_value = "lemke")]
+        solver: String,
+        /// Iteration (or pivot) limit.
+        #[arg(long, default_value_t = 1000)]
+        iterations: usize,
+        /// Natural-map residual (normalised by ‖b‖) that counts as solved.
+        #[arg(long, default_value_t = 1e-6)]
+        tol: f64,
+        /// Relaxation ω of PGS/PSOR, or damping of projected Jacobi.
+        #[arg(long, default_value_t = 1.0)]
+        relaxation: f64,
+        /// Write the result as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
+}
+
+/// A built-in name or a path to a JSON scene file.
+fn resolve_scene(arg: &str) -> Result<Scene> {
+    let path = Path::new(arg);
+    if path.extension().is_some_and(|e| e == "json") || path.exists() {
+        return Ok(load_scene_file(path)?);
+    }
+    match builtin_scene(arg) {
+        Some(scene) => Ok(scene),
+        None => {
+            let names: Vec<&str> = builtin_names().iter().map(|(n, _)| *n).collect();
+            bail!(
+                "no scene file or built-in scene named '{arg}'; built-ins: {}",
+                names.join(", ")
+            )
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match real_main() {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn real_main() -> Result<ExitCode> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run {
+            scene,
+            steps,
+            dt,
+            iterations,
+            out,
+            every,
+            summary_json,
+            quiet,
+        } => {
+            let scene = resolve_scene(&scene)?;
+            let options = run::RunOptions {
+                steps,
+                dt,
+                iterations,
+                out,
+                every,
+                summary_json,
+                quiet,
+            };
+            let summary = run::run(scene, &options)?;
+            println!("{}", summary.line());
+        }
+        Command::Scenes => {
+            for (name, description) in builtin_names() {
+                println!("{name:<14} {description}");
+            }
+        }
+        Command::Export { scene, out } => {
+            let scene = resolve_scene(&scene)?;
+            let text = to_json_string(&scene);
+            match out {
+                Some(path) => std::fs::write(&path, text)
+                    .with_context(|| format!("cannot write {}", path.display()))?,
+                None => print!("{text}"),
+            }
+        }
+        Command::Lcp { command } => match command {
+            LcpCommand::Solve {
+                file,
+                solver,
+                iterations,
+                tol,
+                relaxation,
+                json,
+            } => {
+                let solved = lcp_command::solve_file(
+                    &file,
+                    &solver,
+                    iterations,
+                    tol,
+                    relaxation,
+                    json.as_deref(),
+                )?;
+                if !solved {
+                    return Ok(ExitCode::FAILURE);
+                }
+            }
+        },
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,199 @@
+//! `impulse run`: step a scene, write its trajectory, print and save a summary.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use impulse::{Scene, World, metrics};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+
+use crate::trajectory::TrajectoryWriter;
+
+/// Options of `impulse run` beyond the scene itself.
+pub struct RunOptions {
+    pub steps: Option<u32>,
+    pub dt: Option<f32>,
+    pub iterations: Option<u32>,
+    pub out: Option<PathBuf>,
+    pub every: u32,
+    pub summary_json: Option<PathBuf>,
+    pub quiet: bool,
+}
+
+/// What a run measured. Overlap and sink are measured from poses (DESIGN.md "Metrics").
+#[derive(Debug, Serialize)]
+pub struct Summary {
+    pub scene: String,
+    pub bodies: usize,
+    pub steps: u64,
+    pub dt: f32,
+    /// Median wall time of one step (ms), metric sampling excluded.
+    pub ms_per_step: f64,
+    pub mean_ms_per_step: f64,
+    pub steps_per_second: f64,
+    /// Largest penetration between any two bodies, from poses, over the sampled frames (m).
+    pub max_overlap_m: f32,
+    /// Same at the last step (m).
+    pub final_overlap_m: f32,
+    /// Index of the body with the highest initial y.
+    pub top_body: Option<usize>,
+    /// Initial y − final y of the top body (m).
+    pub top_sink_m: f32,
+    pub kinetic_energy_j: f32,
+    pub mean_contacts: f64,
+    pub mean_iterations: f64,
+    /// Largest natural-map residual of any step's contact LCP at exit.
+    pub max_natural_map_residual: f32,
+    /// Natural-map residual of the last step.
+    pub final_natural_map_residual: f32,
+    pub iterations_limit: u32,
+    /// `completed`, or the error that stopped the run.
+    pub status: String,
+}
+
+impl Summary {
+    /// The one-line summary `impulse run` prints.
+    pub fn line(&self) -> String {
+        format!(
+            "{}: {} bodies, {} steps of {:.4} s, mean contacts {:.0}, {:.3} ms/step ({:.0} steps/s), \
+             max overlap {:.2} mm, top sink {:.2} mm, kinetic energy {:.4} J, \
+             mean iterations {:.1}, LCP residual max {:.2e} last {:.2e}",
+            self.scene,
+            self.bodies,
+            self.steps,
+            self.dt,
+            self.mean_contacts,
+            self.ms_per_step,
+            self.steps_per_second,
+            self.max_overlap_m * 1e3,
+            self.top_sink_m * 1e3,
+            self.kinetic_energy_j,
+            self.mean_iterations,
+            self.max_natural_map_residual,
+            self.final_natural_map_residual,
+        )
+    }
+}
+
+/// Overlap from poses is measured every this many steps (and at the last).
+const OVERLAP_SAMPLE_EVERY: u64 = 10;
+
+/// Runs `scene` under `options`. A blow-up stops the run: the frames written so far stay on
+/// disk, the summary (with `status` naming the step) is still written, and the error returns.
+pub fn run(mut scene: Scene, options: &RunOptions) -> Result<Summary> {
+    if let Some(dt) = options.dt {
+        scene.dt = dt;
+    }
+    if let Some(iterations) = options.iterations {
+        scene.solver.iterations = iterations;
+    }
+    let steps = options.steps.unwrap_or(scene.steps) as u64;
+    let every = options.every.max(1) as u64;
+    let mut world = World::from_scene(&scene).context("cannot build the world")?;
+    let mut writer = match &options.out {
+        Some(path) => Some(TrajectoryWriter::create(path)?),
+        None => None,
+    };
+    if let Some(w) = writer.as_mut() {
+        w.write_frame(0, 0.0, &world.bodies)?;
+    }
+    let top = metrics::top_body(&world.bodies);
+    let top_y0 = top.map(|i| world.bodies.pose[i].translation.y);
+
+    let bar = if options.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(steps)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} steps ({per_sec}, eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message(scene.name.clone());
+
+    let mut step_ms = Vec::with_capacity(steps as usize);
+    let mut contacts_sum = 0u64;
+    let mut iterations_sum = 0u64;
+    let mut max_residual = 0.0f32;
+    let mut max_overlap = metrics::max_overlap(&world.bodies);
+    let mut final_overlap = max_overlap;
+    let mut status = "completed".to_string();
+    let mut failure = None;
+    for step in 1..=steps {
+        let start = Instant::now();
+        let result = world.step().map(|d| d.clone());
+        step_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        let diagnostics = match result {
+            Ok(d) => d,
+            Err(e) => {
+                status = format!("stopped: {e}");
+                failure = Some(e);
+                break;
+            }
+        };
+        contacts_sum += diagnostics.contacts as u64;
+        iterations_sum += diagnostics.iterations as u64;
+        max_residual = max_residual.max(diagnostics.natural_map_residual);
+        if step % OVERLAP_SAMPLE_EVERY == 0 || step == steps {
+            final_overlap = metrics::max_overlap(&world.bodies);
+            max_overlap = max_overlap.max(final_overlap);
+        }
+        if let Some(w) = writer.as_mut()
+            && (step % every == 0 || step == steps)
+        {
+            w.write_frame(step, step as f64 * scene.dt as f64, &world.bodies)?;
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    let taken = step_ms.len().max(1) as f64;
+    let mean_ms = step_ms.iter().sum::<f64>() / taken;
+    let median_ms = median(&mut step_ms);
+    let summary = Summary {
+        scene: scene.name.clone(),
+        bodies: world.bodies.len(),
+        steps: world.step_count(),
+        dt: scene.dt,
+        ms_per_step: median_ms,
+        mean_ms_per_step: mean_ms,
+        steps_per_second: if median_ms > 0.0 { 1e3 / median_ms } else { 0.0 },
+        max_overlap_m: max_overlap,
+        final_overlap_m: final_overlap,
+        top_body: top,
+        top_sink_m: match (top, top_y0) {
+            (Some(i), Some(y0)) => y0 - world.bodies.pose[i].translation.y,
+            _ => 0.0,
+        },
+        kinetic_energy_j: world.diagnostics().kinetic_energy,
+        mean_contacts: contacts_sum as f64 / taken,
+        mean_iterations: iterations_sum as f64 / taken,
+        max_natural_map_residual: max_residual,
+        final_natural_map_residual: world.diagnostics().natural_map_residual,
+        iterations_limit: scene.solver.iterations,
+        status,
+    };
+    if let Some(path) = &options.summary_json {
+        let text = serde_json::to_string_pretty(&summary)?;
+        std::fs::write(path, text + "\n")
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(e) = failure {
+        return Err(anyhow::Error::new(e).context(summary.line()));
+    }
+    Ok(summary)
+}
+
+fn median(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}

@@ -1,0 +1,34 @@
+//! The contact linear complementarity problem (LCP) on its own: problem types, readers and
+//! writers, solvers and merit functions. No physics and no geometry, so that every solver can be
+//! checked on published test problems and on LCPs dumped from real engine steps.
+//!
+//! Convention (the project's seed notes): find `γ` with `w = Aγ − b ≥ 0`, `γ ≥ 0`, `wᵀγ = 0`
+//! ([`Bounds::NonNegative`]); also box bounds (mixed LCP) and ODE-style friction bounds
+//! `|γ_t| ≤ μ·γ_n` ([`Bounds`]). Siconos, Cottle–Pang–Stone and Murty write `w = Mz + q`:
+//! `A = M`, `b = −q`, same `w`.
+//!
+//! ```
+//! use impulse_lcp::{DenseMatrix, Lcp, SolverKind, SolverSettings, Status};
+//! let a = DenseMatrix::from_rows(&[vec![2.0, 1.0], vec![1.0, 2.0]]).unwrap();
+//! let lcp = Lcp::standard(a, vec![5.0, 6.0]).unwrap();
+//! let sol = SolverKind::Lemke.solve(&lcp, None, &SolverSettings::default()).unwrap();
+//! assert_eq!(sol.status, Status::Converged);
+//! assert!((sol.z[0] - 4.0 / 3.0).abs() < 1e-12 && (sol.z[1] - 7.0 / 3.0).abs() < 1e-12);
+//! ```
+
+pub mod io;
+pub mod matrix;
+pub mod merit;
+pub mod problem;
+pub mod solvers;
+
+pub use io::json::{parse_json, read_json, to_json_string, write_json};
+pub use io::siconos::{parse_siconos, read_siconos};
+pub use io::{FileError, FileFormat, read_lcp};
+pub use matrix::{CsrMatrix, DenseMatrix, Matrix};
+pub use merit::{
+    MeritReport, bound_violation, complementarity_gap, fischer_burmeister_residual, merit_report,
+    most_negative, natural_map_residual, normalised_natural_map_residual,
+};
+pub use problem::{Bounds, Lcp, ProblemError};
+pub use solvers::{Solution, SolveError, SolverKind, SolverSettings, Status, UnknownSolver, solve};

@@ -1,0 +1,97 @@
+//! Bodies: mass properties and state, stored as parallel arrays (structure of arrays) so the
+//! stages of the step touch only the fields they need.
+
+use glam::{Mat3, Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::shape::SharedShape;
+
+use crate::scene::BodyKind;
+
+/// All bodies of a world. Index `i` of every array is body `i` in scene order.
+///
+/// Velocities are those of the centre of mass; `pose` is the body frame the scene gave
+/// (trajectories report it), and `local_center_of_mass` locates the centre of mass in it.
+#[derive(Clone, Default)]
+pub struct Bodies {
+    /// Dynamic, static or particle.
+    pub kind: Vec<BodyKind>,
+    /// Body frame in world coordinates.
+    pub pose: Vec<Pose>,
+    /// Centre of mass in the body frame (m).
+    pub local_center_of_mass: Vec<Vec3>,
+    /// Linear velocity of the centre of mass (m/s).
+    pub linear_velocity: Vec<Vec3>,
+    /// Angular velocity, world frame (rad/s). Always zero for particles and static bodies.
+    pub angular_velocity: Vec<Vec3>,
+    /// 1/m (1/kg); 0 for static bodies.
+    pub inverse_mass: Vec<f32>,
+    /// Inverse inertia tensor about the centre of mass, body frame (1/(kg·m²)); zero for
+    /// static bodies and particles (rotation locked).
+    pub local_inverse_inertia: Vec<Mat3>,
+    /// Collision shape in the body frame.
+    pub shape: Vec<SharedShape>,
+    /// Coulomb friction coefficient μ.
+    pub friction: Vec<f32>,
+    /// Restitution coefficient c_r.
+    pub restitution: Vec<f32>,
+}
+
+impl Bodies {
+    /// Number of bodies.
+    pub fn len(&self) -> usize {
+        self.kind.len()
+    }
+
+    /// True when there are no bodies.
+    pub fn is_empty(&self) -> bool {
+        self.kind.is_empty()
+    }
+
+    /// True for bodies that move (dynamic rigid bodies and particles).
+    pub fn is_moving(&self, i: usize) -> bool {
+        self.kind[i] != BodyKind::Static
+    }
+
+    /// World position of body `i`'s centre of mass (m).
+    pub fn center_of_mass(&self, i: usize) -> Vec3 {
+        self.pose[i].transform_point(self.local_center_of_mass[i])
+    }
+
+    /// World-frame inverse inertia R·I⁻¹·Rᵀ of body `i`.
+    pub fn world_inverse_inertia(&self, i: usize) -> Mat3 {
+        rotate_tensor(self.pose[i].rotation, &self.local_inverse_inertia[i])
+    }
+
+    /// Mass (kg) of body `i`; infinity for static bodies.
+    pub fn mass(&self, i: usize) -> f32 {
+        if self.inverse_mass[i] > 0.0 {
+            1.0 / self.inverse_mass[i]
+        } else {
+            f32::INFINITY
+        }
+    }
+
+    /// Kinetic energy ½mv² + ½ωᵀIω of body `i` (J); 0 for static bodies.
+    pub fn kinetic_energy(&self, i: usize) -> f32 {
+        if self.inverse_mass[i] == 0.0 {
+            return 0.0;
+        }
+        let v = self.linear_velocity[i];
+        let mut energy = 0.5 * v.length_squared() / self.inverse_mass[i];
+        let w = self.angular_velocity[i];
+        if w != Vec3::ZERO {
+            // Solve I·x = ω through the inverse tensor: ωᵀIω = ωᵀ(I⁻¹)⁻¹ω.
+            let inv = self.world_inverse_inertia(i);
+            if inv.determinant().abs() > f32::MIN_POSITIVE {
+                energy += 0.5 * w.dot(inv.inverse() * w);
+            }
+        }
+        energy
+    }
+}
+
+/// R·T·Rᵀ: a body-frame tensor expressed in world coordinates.
+pub(crate) fn rotate_tensor(rotation: Quat, tensor: &Mat3) -> Mat3 {
+    let r = Mat3::from_quat(rotation);
+    r * *tensor * r.transpose()
+}

@@ -1,0 +1,43 @@
+//! Stage 2 of the step: axis-aligned bounding boxes → candidate pairs, through Parry's `Bvh`.
+
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
+use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
+
+use crate::body::Bodies;
+
+/// Finds the pairs of bodies whose loosened bounding boxes overlap.
+#[derive(Default)]
+pub struct BroadPhase {
+    aabbs: Vec<Aabb>,
+    workspace: BvhWorkspace,
+}
+
+/// Half-spaces have unbounded boxes; a finite stand-in keeps the tree well-formed.
+const WORLD_BOUND: f32 = 1.0e6;
+
+impl BroadPhase {
+    /// Candidate pairs `(i, j)` with `i < j`, sorted, at least one of them moving. Boxes are
+    /// loosened by `margin` (m) so that speculative contacts within it are found.
+    pub fn candidate_pairs(&mut self, bodies: &Bodies, margin: f32, out: &mut Vec<(u32, u32)>) {
+        out.clear();
+        self.aabbs.clear();
+        for i in 0..bodies.len() {
+            let mut aabb = bodies.shape[i].compute_aabb(&bodies.pose[i]).loosened(margin);
+            aabb.mins = aabb.mins.max(glam::Vec3::splat(-WORLD_BOUND));
+            aabb.maxs = aabb.maxs.min(glam::Vec3::splat(WORLD_BOUND));
+            self.aabbs.push(aabb);
+        }
+        if self.aabbs.len() < 2 {
+            return;
+        }
+        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &self.aabbs);
+        bvh.traverse_bvtt_single_tree::<false>(&mut self.workspace, &mut |a, b| {
+            let (i, j) = if a < b { (a, b) } else { (b, a) };
+            if i != j && (bodies.is_moving(i as usize) || bodies.is_moving(j as usize)) {
+                out.push((i, j));
+            }
+        });
+        out.sort_unstable();
+        out.dedup();
+    }
+}

@@ -1,0 +1,255 @@
+//! Stage 4 of the step: contact points → constraint rows (one normal row and two friction rows
+//! per point), each a flat record of the numbers the solver needs and nothing else.
+//!
+//! Row i of the Jacobian J acting on (v_a, ω_a, v_b, ω_b) is (dᵀ, (r_a×d)ᵀ, −dᵀ, −(r_b×d)ᵀ)
+//! for direction d (seed, "Rigid bodies"); body A is the one the normal points towards.
+
+use glam::{Mat3, Vec3};
+
+use crate::body::Bodies;
+use crate::narrow_phase::NarrowPhase;
+use crate::settings::SolverSettings;
+
+/// One row of J for a direction d, with the products the solver reuses every sweep.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct JacobianRow {
+    /// Linear part d (unit vector) for body A; body B's is −d.
+    pub direction: Vec3,
+    /// Angular part for body A: r_a × d.
+    pub angular_a: Vec3,
+    /// Angular part for body B (with a minus sign in J): r_b × d.
+    pub angular_b: Vec3,
+    /// I_a⁻¹ (r_a × d): change of ω_a per unit impulse.
+    pub inverse_inertia_angular_a: Vec3,
+    /// I_b⁻¹ (r_b × d): change of ω_b per unit impulse (applied with a minus sign).
+    pub inverse_inertia_angular_b: Vec3,
+    /// m_eff = 1 / (J M⁻¹ Jᵀ) of this row alone (kg); 0 when both bodies are immovable.
+    pub effective_mass: f32,
+    /// J M⁻¹ Jᵀ of this row alone (1/kg): the row's velocity change per unit impulse.
+    pub inverse_effective_mass: f32,
+    /// J·v* before any impulse of this step (m/s): the row's v⁻.
+    pub velocity_before: f32,
+}
+
+impl JacobianRow {
+    fn new(
+        direction: Vec3,
+        r_a: Vec3,
+        r_b: Vec3,
+        inverse_mass_a: f32,
+        inverse_mass_b: f32,
+        inverse_inertia_a: &Mat3,
+        inverse_inertia_b: &Mat3,
+    ) -> Self {
+        let angular_a = r_a.cross(direction);
+        let angular_b = r_b.cross(direction);
+        let inverse_inertia_angular_a = *inverse_inertia_a * angular_a;
+        let inverse_inertia_angular_b = *inverse_inertia_b * angular_b;
+        let k = inverse_mass_a
+            + inverse_mass_b
+            + angular_a.dot(inverse_inertia_angular_a)
+            + angular_b.dot(inverse_inertia_angular_b);
+        Self {
+            direction,
+            angular_a,
+            angular_b,
+            inverse_inertia_angular_a,
+            inverse_inertia_angular_b,
+            effective_mass: if k > 0.0 { 1.0 / k } else { 0.0 },
+            inverse_effective_mass: k,
+            velocity_before: 0.0,
+        }
+    }
+
+    /// J·v for the current velocities of A and B (m/s); positive means separating.
+    #[inline(always)]
+    pub fn velocity(&self, linear_a: Vec3, angular_a: Vec3, linear_b: Vec3, angular_b: Vec3) -> f32 {
+        self.direction.dot(linear_a - linear_b) + self.angular_a.dot(angular_a)
+            - self.angular_b.dot(angular_b)
+    }
+}
+
+/// All rows of one contact point.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactConstraint {
+    /// Body the normal points towards.
+    pub body_a: u32,
+    /// The other body.
+    pub body_b: u32,
+    /// 1/m_a and 1/m_b (1/kg).
+    pub inverse_mass_a: f32,
+    /// See `inverse_mass_a`.
+    pub inverse_mass_b: f32,
+    /// Normal row; its impulse γ_n ≥ 0.
+    pub normal: JacobianRow,
+    /// Two friction rows along orthonormal tangents; |γ_t| ≤ μ·γ_n each.
+    pub tangents: [JacobianRow; 2],
+    /// Target normal velocity after the solve (m/s): v⁺ ≥ target, equality where γ_n > 0.
+    /// Restitution −c_r·v⁻, plus overlap repair, or −gap/dt for a speculative contact.
+    pub target_normal_velocity: f32,
+    /// Coulomb coefficient μ of the pair.
+    pub friction: f32,
+    /// Accumulated normal impulse γ_n (N·s).
+    pub normal_impulse: f32,
+    /// Accumulated friction impulses along the two tangents (N·s).
+    pub tangent_impulses: [f32; 2],
+    /// Penetration depth d (m), > 0 when overlapping, < 0 for a speculative gap.
+    pub depth: f32,
+    /// Where the point lives: (pair, manifold, point) in the narrow phase, for write-back.
+    pub source: (u32, u16, u16),
+}
+
+/// Builds one constraint per contact point, in narrow-phase order (pairs sorted by body index),
+/// and the world inverse inertia of every body. `velocity_before` is read from the current
+/// (prospective) velocities, so call this before warm starting.
+pub fn assemble(
+    bodies: &Bodies,
+    narrow_phase: &NarrowPhase,
+    settings: &SolverSettings,
+    dt: f32,
+    world_inverse_inertia: &[Mat3],
+    out: &mut Vec<ContactConstraint>,
+) {
+    out.clear();
+    for (pair_index, pair) in narrow_phase.pairs.iter().enumerate() {
+        // Parry's shape 1 is body1 and its normal n1 points from shape 1 towards shape 2,
+        // so in the seed's convention (n points from B towards A): B = body1, A = body2.
+        let (b, a) = (pair.body1 as usize, pair.body2 as usize);
+        let pose_a = &bodies.pose[a];
+        let pose_b = &bodies.pose[b];
+        let com_a = bodies.center_of_mass(a);
+        let com_b = bodies.center_of_mass(b);
+        let friction = (bodies.friction[a] * bodies.friction[b]).sqrt();
+        let restitution = bodies.restitution[a].max(bodies.restitution[b]);
+        let inverse_mass_a = bodies.inverse_mass[a];
+        let inverse_mass_b = bodies.inverse_mass[b];
+        let inertia_a = &world_inverse_inertia[a];
+        let inertia_b = &world_inverse_inertia[b];
+        for (manifold_index, manifold) in pair.manifolds.iter().enumerate() {
+            if manifold.points.is_empty() {
+                continue;
+            }
+            let normal = pose_b.rotation * manifold.local_n1;
+            for (point_index, point) in manifold.points.iter().enumerate() {
+                // Parry's face-face cuboid manifolds can list a point twice (once per face
+                // clipped against the other); a duplicate row only makes A singular. Which
+                // copy comes first can change between steps, so the warm start takes the
+                // copy that carries an impulse and the write-back goes to every copy.
+                let same = |q: &&parry3d::query::TrackedContact<crate::narrow_phase::ContactImpulse>| {
+                    q.local_p1.distance_squared(point.local_p1) < DUPLICATE_POINT_DISTANCE_SQUARED
+                };
+                if manifold.points[..point_index].iter().any(|q| same(&q)) {
+                    continue;
+                }
+                let warm = manifold.points[point_index..]
+                    .iter()
+                    .filter(same)
+                    .map(|q| q.data)
+                    .max_by(|x, y| x.normal.total_cmp(&y.normal))
+                    .unwrap_or(point.data);
+                let p_b = pose_b.transform_point(point.local_p1);
+                let p_a = pose_a.transform_point(point.local_p2);
+                let contact_point = 0.5 * (p_a + p_b);
+                let r_a = contact_point - com_a;
+                let r_b = contact_point - com_b;
+                let (t1, t2) = tangent_basis(bodies, a, b, r_a, r_b, normal);
+                let row = |d| {
+                    let mut row = JacobianRow::new(
+                        d,
+                        r_a,
+                        r_b,
+                        inverse_mass_a,
+                        inverse_mass_b,
+                        inertia_a,
+                        inertia_b,
+                    );
+                    row.velocity_before = row.velocity(
+                        bodies.linear_velocity[a],
+                        bodies.angular_velocity[a],
+                        bodies.linear_velocity[b],
+                        bodies.angular_velocity[b],
+                    );
+                    row
+                };
+                let normal_row = row(normal);
+                let depth = -point.dist;
+                let target = normal_target(
+                    normal_row.velocity_before,
+                    depth,
+                    restitution,
+                    settings,
+                    dt,
+                );
+                out.push(ContactConstraint {
+                    body_a: a as u32,
+                    body_b: b as u32,
+                    inverse_mass_a,
+                    inverse_mass_b,
+                    normal: normal_row,
+                    tangents: [row(t1), row(t2)],
+                    target_normal_velocity: target,
+                    friction: if settings.friction { friction } else { 0.0 },
+                    normal_impulse: warm.normal,
+                    tangent_impulses: [warm.friction.dot(t1), warm.friction.dot(t2)],
+                    depth,
+                    source: (pair_index as u32, manifold_index as u16, point_index as u16),
+                });
+            }
+        }
+    }
+}
+
+/// Friction directions: t1 along the sliding velocity when there is one, so that the two
+/// independently clamped rows (|γ_t| ≤ μ·γ_n each, a box) bound the sliding friction by exactly
+/// μ·γ_n as Coulomb's cone does; any orthonormal pair otherwise.
+fn tangent_basis(bodies: &Bodies, a: usize, b: usize, r_a: Vec3, r_b: Vec3, normal: Vec3) -> (Vec3, Vec3) {
+    let relative = bodies.linear_velocity[a] + bodies.angular_velocity[a].cross(r_a)
+        - bodies.linear_velocity[b]
+        - bodies.angular_velocity[b].cross(r_b);
+    let sliding = relative - normal * normal.dot(relative);
+    let speed = sliding.length();
+    if speed > SLIDING_SPEED {
+        let t1 = sliding / speed;
+        (t1, normal.cross(t1))
+    } else {
+        normal.any_orthonormal_pair()
+    }
+}
+
+/// Contact points of one manifold closer than 0.1 mm (squared here) are one point.
+pub(crate) const DUPLICATE_POINT_DISTANCE_SQUARED: f32 = 1.0e-8;
+
+/// Below this tangential speed (m/s) a contact is treated as sticking for the tangent basis.
+const SLIDING_SPEED: f32 = 1.0e9;
+
+/// The velocity target of a normal row (m/s), from its pre-solve velocity v⁻ and depth d.
+///
+/// - Restitution (seed): v⁺ = −c_r·v⁻, only when approaching faster than the threshold and
+///   the contact closes within this step (touching, or a gap shorter than −v⁻·dt).
+/// - Overlap repair (seed): + c_d·max(d − slop, 0), capped at `max_repair_speed`.
+/// - Speculative gap g = −d > 0 without restitution: v⁺ ≥ −g/dt (may close, not overlap).
+pub fn normal_target(
+    velocity_before: f32,
+    depth: f32,
+    restitution: f32,
+    settings: &SolverSettings,
+    dt: f32,
+) -> f32 {
+    let gap = -depth;
+    let closes_this_step = gap <= -velocity_before * dt;
+    let bounce = restitution > 0.0
+        && velocity_before < -settings.restitution_threshold
+        && closes_this_step;
+    let restitution_target = if bounce {
+        -restitution * velocity_before
+    } else {
+        0.0
+    };
+    if gap > 0.0 {
+        if bounce { restitution_target } else { -gap / dt }
+    } else {
+        let repair = (settings.overlap_repair_rate * (depth - settings.overlap_slop).max(0.0))
+            .min(settings.max_repair_speed);
+        restitution_target + repair
+    }
+}

@@ -1,0 +1,124 @@
+//! The contact LCP of a step as an explicit problem (A, b, bounds), so any solver of
+//! `impulse-lcp` can be run on a real step and compared with the engine's own PGS.
+//!
+//! Rows are ordered per contact point as the solver orders them: normal, then (with friction)
+//! the two tangents. A = J M⁻¹ Jᵀ is assembled from the same Jacobian rows and inverse masses
+//! the solver used, and b = target − J·v* from the same targets and prospective velocities v*,
+//! so that w = Aγ − b ≥ 0, γ ≥ 0, wᵀγ = 0 is exactly the problem PGS iterated on (seed eq. (2)
+//! with the complementarity of "Resolving a collision in the context of a second collision").
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+use impulse_lcp::{Bounds, CsrMatrix, Lcp, ProblemError};
+
+use crate::constraints::{ContactConstraint, JacobianRow};
+
+/// A step's contact LCP together with what the engine found for it.
+#[derive(Clone, Debug)]
+pub struct ContactLcp {
+    /// The problem in the seed's convention, with friction rows bounded by μ·γ_n (`findex`).
+    pub problem: Lcp,
+    /// The engine's impulses at exit, in row order (N·s).
+    pub engine_solution: Vec<f64>,
+    /// For each row, the index of its contact point in [`crate::World::contact_constraints`].
+    pub contact_of_row: Vec<usize>,
+}
+
+/// Builds the LCP of `constraints` (as left by the solver). Errors only if the assembled data
+/// is not finite, which a blown-up step can cause.
+pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, ProblemError> {
+    let with_friction = |c: &ContactConstraint| c.friction > 0.0;
+    // Row layout and per-body incidence lists.
+    struct Incidence {
+        row: usize,
+        sign: f32,
+        direction: Vec3,
+        angular: Vec3,
+        inverse_inertia_angular: Vec3,
+        inverse_mass: f32,
+    }
+    let mut by_body: BTreeMap<u32, Vec<Incidence>> = BTreeMap::new();
+    let mut b = Vec::new();
+    let mut mu = Vec::new();
+    let mut friction_index = Vec::new();
+    let mut engine_solution = Vec::new();
+    let mut contact_of_row = Vec::new();
+    for (k, c) in constraints.iter().enumerate() {
+        let normal_row = b.len();
+        let mut rows: Vec<(&JacobianRow, f32, f32, Option<usize>)> =
+            vec![(&c.normal, c.target_normal_velocity, c.normal_impulse, None)];
+        if with_friction(c) {
+            for t in 0..2 {
+                rows.push((&c.tangents[t], 0.0, c.tangent_impulses[t], Some(normal_row)));
+            }
+        }
+        for (row, target, impulse, findex) in rows {
+            let index = b.len();
+            b.push((target - row.velocity_before) as f64);
+            mu.push(if findex.is_some() { c.friction as f64 } else { 0.0 });
+            friction_index.push(findex);
+            engine_solution.push(impulse as f64);
+            contact_of_row.push(k);
+            let sides = [
+                (c.body_a, 1.0, row.angular_a, row.inverse_inertia_angular_a, c.inverse_mass_a),
+                (c.body_b, -1.0, row.angular_b, row.inverse_inertia_angular_b, c.inverse_mass_b),
+            ];
+            for (body, sign, angular, inverse_inertia_angular, inverse_mass) in sides {
+                if inverse_mass == 0.0 && inverse_inertia_angular == Vec3::ZERO {
+                    continue; // an immovable body couples nothing
+                }
+                by_body.entry(body).or_default().push(Incidence {
+                    row: index,
+                    sign,
+                    direction: row.direction,
+                    angular,
+                    inverse_inertia_angular,
+                    inverse_mass,
+                });
+            }
+        }
+    }
+    let n = b.len();
+    // A_ij = Σ_bodies s_i s_j (m⁻¹ d_i·d_j + (r×d)_i · I⁻¹(r×d)_j).
+    let mut entries: BTreeMap<(usize, usize), f64> = BTreeMap::new();
+    for incidences in by_body.values() {
+        for p in incidences {
+            for q in incidences {
+                let value = p.sign
+                    * q.sign
+                    * (p.inverse_mass * p.direction.dot(q.direction)
+                        + p.angular.dot(q.inverse_inertia_angular));
+                *entries.entry((p.row, q.row)).or_insert(0.0) += value as f64;
+            }
+        }
+    }
+    let mut indptr = vec![0usize; n + 1];
+    let mut indices = Vec::with_capacity(entries.len());
+    let mut values = Vec::with_capacity(entries.len());
+    for (&(i, j), &v) in &entries {
+        indptr[i + 1] += 1;
+        indices.push(j);
+        values.push(v);
+    }
+    for i in 0..n {
+        indptr[i + 1] += indptr[i];
+    }
+    let a = CsrMatrix::new(n, n, indptr, indices, values)?;
+    let bounds = if friction_index.iter().all(Option::is_none) {
+        Bounds::NonNegative
+    } else {
+        Bounds::Friction {
+            lo: vec![0.0; n],
+            hi: vec![f64::INFINITY; n],
+            friction_index,
+            mu,
+        }
+    };
+    let problem = Lcp::new(a, b, bounds)?;
+    Ok(ContactLcp {
+        problem,
+        engine_solution,
+        contact_of_row,
+    })
+}

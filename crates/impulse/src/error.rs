@@ -1,0 +1,62 @@
+//! Errors of building a world and of stepping it.
+
+use thiserror::Error;
+
+/// A body or setting that cannot be simulated. Raised before any step is taken.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum WorldError {
+    /// A body's description is invalid (`body` is its index in scene order).
+    #[error("body {body}{}: {field}: {message}", name.as_ref().map(|n| format!(" (\"{n}\")")).unwrap_or_default())]
+    InvalidBody {
+        /// Index of the body in scene order.
+        body: usize,
+        /// The body's name, if it has one.
+        name: Option<String>,
+        /// Field path inside the body, e.g. `shape.radius`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A world-wide setting is invalid (time step, gravity, solver settings).
+    #[error("{field}: {message}")]
+    InvalidSetting {
+        /// Field path, e.g. `dt` or `solver.iterations`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// A step that could not be completed. The world is left as it was after the last good step
+/// only for errors raised before integration; a blow-up is detected after integration and the
+/// offending state is kept so it can be inspected.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum StepError {
+    /// A body's position or velocity became non-finite or exceeded the blow-up bound.
+    #[error(
+        "simulation blew up at step {step}: body {body} has {quantity} = {value} (bound {bound})"
+    )]
+    BlowUp {
+        /// The step (counted from 1) during which the blow-up happened.
+        step: u64,
+        /// Index of the first offending body.
+        body: usize,
+        /// `position` or `velocity`.
+        quantity: &'static str,
+        /// The offending magnitude (may be NaN or infinite).
+        value: f32,
+        /// The bound it crossed.
+        bound: f32,
+    },
+    /// A setting was changed to an invalid value between steps.
+    #[error("invalid settings: {0}")]
+    InvalidSettings(String),
+    /// Parry cannot generate contacts for this pair of shapes.
+    #[error("no contact generator for the shapes of bodies {body1} and {body2}")]
+    UnsupportedShapePair {
+        /// First body index.
+        body1: usize,
+        /// Second body index.
+        body2: usize,
+    },
+}

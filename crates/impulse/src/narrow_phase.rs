@@ -1,0 +1,108 @@
+//! Stage 3 of the step: candidate pairs → persistent contact manifolds (Parry).
+//!
+//! Each pair keeps its manifolds from step to step, so Parry can match new contact points to
+//! old ones by feature id and carry the solver's impulses over ([`ContactImpulse`]): that is
+//! what warm starting reads.
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+use parry3d::query::{
+    ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
+};
+
+use crate::body::Bodies;
+use crate::error::StepError;
+
+/// Impulses a contact point received in the last solve, kept with the point across steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactImpulse {
+    /// Normal impulse γ_n ≥ 0 (N·s).
+    pub normal: f32,
+    /// Friction impulse as a world vector (N·s), so it survives a change of tangent basis.
+    pub friction: Vec3,
+}
+
+/// Parry's manifold type with our per-point data.
+pub type Manifold = ContactManifold<(), ContactImpulse>;
+
+/// The contact state of one pair of bodies. Shape 1 belongs to `body1`, shape 2 to `body2`,
+/// and `body1 < body2`.
+pub struct ContactPair {
+    /// Lower body index.
+    pub body1: u32,
+    /// Higher body index.
+    pub body2: u32,
+    /// Manifolds (one for convex-convex pairs) with points in each body's local frame.
+    pub manifolds: Vec<Manifold>,
+    workspace: Option<ContactManifoldsWorkspace>,
+}
+
+impl ContactPair {
+    /// Number of contact points over all manifolds.
+    pub fn point_count(&self) -> usize {
+        self.manifolds.iter().map(|m| m.points.len()).sum()
+    }
+}
+
+/// All pairs that the broad phase reported this step, with their manifolds.
+#[derive(Default)]
+pub struct NarrowPhase {
+    /// This step's pairs, in the broad phase's sorted order.
+    pub pairs: Vec<ContactPair>,
+    previous: HashMap<(u32, u32), ContactPair>,
+}
+
+impl NarrowPhase {
+    /// Updates manifolds for `candidates`; pairs no longer candidates are dropped with their
+    /// history. Points are generated up to `prediction` (m) of separation.
+    pub fn update(
+        &mut self,
+        bodies: &Bodies,
+        candidates: &[(u32, u32)],
+        prediction: f32,
+    ) -> Result<(), StepError> {
+        self.previous.clear();
+        for pair in self.pairs.drain(..) {
+            self.previous.insert((pair.body1, pair.body2), pair);
+        }
+        let dispatcher = DefaultQueryDispatcher;
+        for &(i, j) in candidates {
+            let mut pair = self.previous.remove(&(i, j)).unwrap_or(ContactPair {
+                body1: i,
+                body2: j,
+                manifolds: Vec::new(),
+                workspace: None,
+            });
+            let (a, b) = (i as usize, j as usize);
+            let pos12 = bodies.pose[a].inv_mul(&bodies.pose[b]);
+            dispatcher
+                .contact_manifolds(
+                    &pos12,
+                    bodies.shape[a].as_ref(),
+                    bodies.shape[b].as_ref(),
+                    prediction,
+                    &mut pair.manifolds,
+                    &mut pair.workspace,
+                )
+                .map_err(|_| StepError::UnsupportedShapePair { body1: a, body2: b })?;
+            if pair.point_count() > 0 {
+                self.pairs.push(pair);
+            } else if !pair.manifolds.is_empty() {
+                // Keep the (empty) pair so a returning contact can reuse its workspace.
+                self.pairs.push(pair);
+            }
+        }
+        Ok(())
+    }
+
+    /// Largest penetration depth (m) among current contact points, 0 if none overlap.
+    pub fn max_depth(&self) -> f32 {
+        self.pairs
+            .iter()
+            .flat_map(|p| p.manifolds.iter())
+            .flat_map(|m| m.points.iter())
+            .map(|p| -p.dist)
+            .fold(0.0, f32::max)
+    }
+}

@@ -1,0 +1,419 @@
+//! Semantic checks of a [`Scene`]: everything that would make a simulation meaningless or
+//! crash, rejected before any world is built.
+//!
+//! The rules (also listed in `docs/scene-format.md`):
+//!
+//! - every number is finite (gravity, dt, solver settings, materials, positions, orientations,
+//!   velocities, shape sizes, hull points, mass);
+//! - `dt > 0`; `solver.iterations ≥ 1`; `solver.tolerance`, `restitution_threshold`,
+//!   `overlap_repair_rate`, `overlap_slop`, `max_repair_speed`, `prediction_distance` are ≥ 0;
+//!   `solver.warm_start` is in [0, 1];
+//! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`;
+//! - a body's `mass`, when given, is > 0;
+//! - shapes: sphere and capsule `radius > 0`, capsule `half_height ≥ 0`, every cuboid half
+//!   extent > 0, a convex hull has ≥ 4 points that span a volume (not all coincident,
+//!   collinear or coplanar), a half-space normal is not zero and belongs to a static body;
+//! - a particle's shape is a sphere;
+//! - the orientation quaternion is not zero (norm ≥ [`MIN_NORM`]); a nonzero non-unit
+//!   quaternion is accepted and normalised when the world is built; the same holds for a
+//!   half-space normal;
+//! - a material name refers to an entry of `materials` or is `"default"` (always defined: when
+//!   `materials` has no `"default"` entry it is [`Material::default()`]).
+
+use std::collections::BTreeMap;
+
+use super::error::{BodyRef, FieldPath, SceneError, SceneErrorKind};
+use super::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
+
+/// Smallest norm of an orientation quaternion or a half-space normal that is accepted;
+/// below it the vector counts as zero (its direction is not defined in f32).
+pub const MIN_NORM: f32 = 1e-6;
+
+/// Relative tolerance of the convex-hull volume test: the points count as coincident,
+/// collinear or coplanar when they deviate from a point, line or plane by at most
+/// this fraction of their extent.
+pub const HULL_FLATNESS_TOLERANCE: f64 = 1e-5;
+
+/// Checks `scene` and returns the first problem, in this order: world settings (gravity,
+/// dt, solver), the materials, then the bodies in scene order.
+///
+/// # Errors
+/// A [`SceneError`] of kind [`SceneErrorKind::Invalid`] with `field` set to the path of the
+/// offending value (e.g. `bodies[3].shape.radius`) and `body` set for body errors. It has no
+/// origin or text position; [`parse_scene_str`](crate::scene::json::parse_scene_str) adds them.
+pub fn validate(scene: &Scene) -> Result<(), SceneError> {
+    match validate_all(scene).into_iter().next() {
+        Some(error) => Err(error),
+        None => Ok(()),
+    }
+}
+
+/// Every problem of `scene`, in the order described at [`validate`]; empty if it is valid.
+pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
+    let mut c = Checker {
+        errors: Vec::new(),
+        body: None,
+    };
+    let root = FieldPath::root();
+
+    c.finite_array(&root.key("gravity"), &scene.gravity);
+    c.positive(&root.key("dt"), scene.dt);
+
+    let s = &scene.solver;
+    let solver = root.key("solver");
+    if s.iterations == 0 {
+        c.fail(&solver.key("iterations"), "must be ≥ 1, got 0".to_string());
+    }
+    c.non_negative(&solver.key("tolerance"), s.tolerance);
+    c.non_negative(
+        &solver.key("restitution_threshold"),
+        s.restitution_threshold,
+    );
+    c.non_negative(&solver.key("overlap_repair_rate"), s.overlap_repair_rate);
+    c.non_negative(&solver.key("overlap_slop"), s.overlap_slop);
+    c.non_negative(&solver.key("max_repair_speed"), s.max_repair_speed);
+    c.unit_interval(&solver.key("warm_start"), s.warm_start);
+    c.non_negative(&solver.key("prediction_distance"), s.prediction_distance);
+
+    for (name, material) in &scene.materials {
+        c.material(&root.key("materials").key(name), material);
+    }
+
+    for (index, body) in scene.bodies.iter().enumerate() {
+        c.body = Some(BodyRef {
+            index,
+            name: body.name.clone(),
+        });
+        c.body(&FieldPath::body(index), body, &scene.materials);
+    }
+    c.errors
+}
+
+/// Collects errors; `body` is attached to each error raised while it is set.
+struct Checker {
+    errors: Vec<SceneError>,
+    body: Option<BodyRef>,
+}
+
+impl Checker {
+    fn fail(&mut self, path: &FieldPath, message: String) {
+        let mut error = SceneError::new(SceneErrorKind::Invalid, Some(path.clone()), message);
+        error.body = self.body.clone();
+        self.errors.push(error);
+    }
+
+    fn finite(&mut self, path: &FieldPath, v: f32) -> bool {
+        if v.is_finite() {
+            true
+        } else {
+            self.fail(path, format!("must be finite, got {v}"));
+            false
+        }
+    }
+
+    fn finite_array(&mut self, path: &FieldPath, values: &[f32]) -> bool {
+        let mut ok = true;
+        for (i, &v) in values.iter().enumerate() {
+            ok &= self.finite(&path.index(i), v);
+        }
+        ok
+    }
+
+    fn positive(&mut self, path: &FieldPath, v: f32) {
+        if self.finite(path, v) && v <= 0.0 {
+            self.fail(path, format!("must be > 0, got {v}"));
+        }
+    }
+
+    fn non_negative(&mut self, path: &FieldPath, v: f32) {
+        if self.finite(path, v) && v < 0.0 {
+            self.fail(path, format!("must be ≥ 0, got {v}"));
+        }
+    }
+
+    fn unit_interval(&mut self, path: &FieldPath, v: f32) {
+        if self.finite(path, v) && !(0.0..=1.0).contains(&v) {
+            self.fail(path, format!("must be in [0, 1], got {v}"));
+        }
+    }
+
+    fn material(&mut self, path: &FieldPath, m: &Material) {
+        self.non_negative(&path.key("friction"), m.friction);
+        self.unit_interval(&path.key("restitution"), m.restitution);
+        self.positive(&path.key("density"), m.density);
+    }
+
+    fn body(&mut self, path: &FieldPath, b: &BodyDesc, materials: &BTreeMap<String, Material>) {
+        self.finite_array(&path.key("position"), &b.position);
+        if self.finite_array(&path.key("orientation"), &b.orientation)
+            && norm(&b.orientation) < f64::from(MIN_NORM)
+        {
+            self.fail(
+                &path.key("orientation"),
+                format!(
+                    "quaternion must not be zero (it is normalised), got {:?}",
+                    b.orientation
+                ),
+            );
+        }
+        self.finite_array(&path.key("linear_velocity"), &b.linear_velocity);
+        self.finite_array(&path.key("angular_velocity"), &b.angular_velocity);
+        if let Some(mass) = b.mass {
+            self.positive(&path.key("mass"), mass);
+        }
+        match &b.material {
+            MaterialRef::Named(name) => {
+                if name != "default" && !materials.contains_key(name) {
+                    let mut defined: Vec<&str> = materials.keys().map(String::as_str).collect();
+                    if !materials.contains_key("default") {
+                        defined.insert(0, "default");
+                    }
+                    self.fail(
+                        &path.key("material"),
+                        format!(
+                            "material {name:?} is not defined (defined: {})",
+                            defined.join(", ")
+                        ),
+                    );
+                }
+            }
+            MaterialRef::Inline(m) => self.material(&path.key("material"), m),
+        }
+        self.shape(&path.key("shape"), b.kind, &b.shape);
+    }
+
+    fn shape(&mut self, path: &FieldPath, kind: BodyKind, shape: &ShapeDesc) {
+        if kind == BodyKind::Particle && !matches!(shape, ShapeDesc::Sphere { .. }) {
+            self.fail(
+                &path.key("type"),
+                format!(
+                    "a particle must have a sphere shape, got {}",
+                    shape_type_name(shape)
+                ),
+            );
+        }
+        match shape {
+            ShapeDesc::Sphere { radius } => self.positive(&path.key("radius"), *radius),
+            ShapeDesc::Cuboid { half_extents } => {
+                for (i, &h) in half_extents.iter().enumerate() {
+                    self.positive(&path.key("half_extents").index(i), h);
+                }
+            }
+            ShapeDesc::Capsule {
+                half_height,
+                radius,
+            } => {
+                self.non_negative(&path.key("half_height"), *half_height);
+                self.positive(&path.key("radius"), *radius);
+            }
+            ShapeDesc::ConvexHull { points } => {
+                let points_path = path.key("points");
+                let mut finite = true;
+                for (i, p) in points.iter().enumerate() {
+                    finite &= self.finite_array(&points_path.index(i), p);
+                }
+                if points.len() < 4 {
+                    self.fail(
+                        &points_path,
+                        format!(
+                            "a convex hull needs at least 4 points, got {}",
+                            points.len()
+                        ),
+                    );
+                } else if finite && let Some(problem) = hull_degeneracy(points) {
+                    self.fail(&points_path, problem.to_string());
+                }
+            }
+            ShapeDesc::HalfSpace { normal } => {
+                if kind != BodyKind::Static {
+                    self.fail(
+                        &path.key("type"),
+                        format!(
+                            "a half_space shape is only allowed on a static body, this body is {}",
+                            kind_name(kind)
+                        ),
+                    );
+                }
+                let normal_path = path.key("normal");
+                if self.finite_array(&normal_path, normal) && norm(normal) < f64::from(MIN_NORM) {
+                    self.fail(
+                        &normal_path,
+                        format!("must not be zero (it is normalised), got {normal:?}"),
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn norm(v: &[f32]) -> f64 {
+    v.iter()
+        .map(|&x| f64::from(x) * f64::from(x))
+        .sum::<f64>()
+        .sqrt()
+}
+
+fn shape_type_name(shape: &ShapeDesc) -> &'static str {
+    match shape {
+        ShapeDesc::Sphere { .. } => "sphere",
+        ShapeDesc::Cuboid { .. } => "cuboid",
+        ShapeDesc::Capsule { .. } => "capsule",
+        ShapeDesc::ConvexHull { .. } => "convex_hull",
+        ShapeDesc::HalfSpace { .. } => "half_space",
+    }
+}
+
+fn kind_name(kind: BodyKind) -> &'static str {
+    match kind {
+        BodyKind::Dynamic => "dynamic",
+        BodyKind::Static => "static",
+        BodyKind::Particle => "particle",
+    }
+}
+
+type V = [f64; 3];
+
+fn sub(a: V, b: V) -> V {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: V, b: V) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: V, b: V) -> V {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn len(a: V) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Why finite `points` (at least 4) span no volume, or `None` if they do.
+///
+/// Greedy volume test: from the first point p0, take the farthest point p1 (extent L), then
+/// the point p2 farthest from the line p0p1, then the point p3 farthest from the plane
+/// p0p1p2. The set is degenerate when L = 0, or the distance to the line or plane is at most
+/// [`HULL_FLATNESS_TOLERANCE`]·L. If every point lies on that line (plane), they are all
+/// collinear (coplanar), so the test is exact up to the tolerance.
+pub fn hull_degeneracy(points: &[[f32; 3]]) -> Option<&'static str> {
+    let p: Vec<V> = points
+        .iter()
+        .map(|q| [f64::from(q[0]), f64::from(q[1]), f64::from(q[2])])
+        .collect();
+    let p0 = *p.first()?;
+    let farthest = |f: &dyn Fn(V) -> f64| p.iter().map(|&q| f(q)).fold(0.0_f64, f64::max);
+    let (mut extent, mut p1) = (0.0, p0);
+    for &q in &p {
+        let d = len(sub(q, p0));
+        if d > extent {
+            extent = d;
+            p1 = q;
+        }
+    }
+    if extent == 0.0 {
+        return Some("convex hull points all coincide: they span no volume");
+    }
+    let tol = HULL_FLATNESS_TOLERANCE * extent;
+    let axis = sub(p1, p0);
+    let (mut best, mut p2) = (0.0, p0);
+    for &q in &p {
+        let d = len(cross(axis, sub(q, p0))) / extent;
+        if d > best {
+            best = d;
+            p2 = q;
+        }
+    }
+    if best <= tol {
+        return Some("convex hull points are collinear: they span no volume");
+    }
+    let normal = cross(axis, sub(p2, p0));
+    let normal_len = len(normal);
+    let height = farthest(&|q| (dot(normal, sub(q, p0)) / normal_len).abs());
+    if height <= tol {
+        return Some("convex hull points are coplanar: they span no volume");
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_cube() -> Vec<[f32; 3]> {
+        let mut v = Vec::new();
+        for x in [0.0, 1.0] {
+            for y in [0.0, 1.0] {
+                for z in [0.0, 1.0] {
+                    v.push([x, y, z]);
+                }
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn hull_volume_test() {
+        assert_eq!(hull_degeneracy(&unit_cube()), None);
+        assert_eq!(
+            hull_degeneracy(&[
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0]
+            ]),
+            None
+        );
+        let flat: Vec<_> = unit_cube().into_iter().filter(|p| p[1] == 0.0).collect();
+        assert!(hull_degeneracy(&flat).unwrap().contains("coplanar"));
+        // A tilted plane x + y + z = 1.
+        let tilted = [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.5, 0.5, 0.0],
+            [0.2, 0.3, 0.5],
+        ];
+        assert!(hull_degeneracy(&tilted).unwrap().contains("coplanar"));
+        let line = [
+            [0.0, 0.0, 0.0],
+            [1.0, 1.0, 1.0],
+            [2.0, 2.0, 2.0],
+            [3.0, 3.0, 3.0],
+        ];
+        assert!(hull_degeneracy(&line).unwrap().contains("collinear"));
+        let point = [[1.0, 2.0, 3.0]; 5];
+        assert!(hull_degeneracy(&point).unwrap().contains("coincide"));
+    }
+
+    #[test]
+    fn default_scene_is_valid_and_errors_are_collected() {
+        assert!(validate(&Scene::default()).is_ok());
+        let mut scene = Scene {
+            dt: -1.0,
+            ..Scene::default()
+        };
+        scene.solver.iterations = 0;
+        scene.bodies.push(BodyDesc::new(
+            BodyKind::Particle,
+            ShapeDesc::Cuboid {
+                half_extents: [1.0, 0.0, 1.0],
+            },
+            [0.0; 3],
+        ));
+        let errors: Vec<String> = validate_all(&scene)
+            .iter()
+            .map(ToString::to_string)
+            .collect();
+        assert_eq!(
+            errors,
+            [
+                "dt: must be > 0, got -1",
+                "solver.iterations: must be ≥ 1, got 0",
+                "bodies[0].shape.type: a particle must have a sphere shape, got cuboid",
+                "bodies[0].shape.half_extents[1]: must be > 0, got 0",
+            ]
+        );
+    }
+}

@@ -1,0 +1,51 @@
+//! Solver settings: every number the step pipeline uses that a user may want to tune.
+
+use serde::{Deserialize, Serialize};
+
+/// Settings of the contact solve (DESIGN.md step 4 and 5).
+///
+/// Defaults are chosen for the standard scenes at dt = 1/60 s. Units are SI.
+/// Source of each term: the seed notes (`contact-resolution-notes.md`) unless stated.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSettings {
+    /// Projected Gauss-Seidel sweeps per step, at most. Must be ≥ 1.
+    pub iterations: u32,
+    /// Early exit: stop sweeping once no row's velocity changed by more than this in a sweep
+    /// (m/s), i.e. max |Δγ_i|/m_eff,i ≤ tolerance. 0 disables early exit.
+    pub tolerance: f32,
+    /// Restitution hypothesis v⁺ = −c_r·v⁻ is applied only when the contact approaches faster
+    /// than this (m/s), so resting contacts do not bounce (seed "Spherical particles").
+    pub restitution_threshold: f32,
+    /// Overlap repair coefficient c_d (1/s): target separation speed c_d·max(d − slop, 0)
+    /// (seed, "nudge … proportional to the overlap"; Baumgarte stabilisation).
+    pub overlap_repair_rate: f32,
+    /// Overlap (m) tolerated without repair, so resting contacts do not jitter.
+    pub overlap_slop: f32,
+    /// Cap (m/s) on the repair speed, so deep overlaps separate without an explosion.
+    pub max_repair_speed: f32,
+    /// Fraction of last step's impulses used as this step's starting guess (0 = cold start).
+    /// Impulses are matched by Parry's contact feature ids.
+    pub warm_start: f32,
+    /// Contacts are generated up to this separation (m) ahead of touching ("speculative"
+    /// contacts): a row with gap g > 0 only forbids closing faster than g/dt.
+    pub prediction_distance: f32,
+    /// Apply Coulomb friction rows (two tangents per point, |γ_t| ≤ μ·γ_n).
+    pub friction: bool,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        Self {
+            iterations: 20,
+            tolerance: 1e-5,
+            restitution_threshold: 0.5,
+            overlap_repair_rate: 6.0,
+            overlap_slop: 0.002,
+            max_repair_speed: 1.0,
+            warm_start: 1.0,
+            prediction_distance: 0.02,
+            friction: true,
+        }
+    }
+}

@@ -1,0 +1,540 @@
+//! The world and its step. `World::step` reads as DESIGN.md's pipeline: each call is one stage,
+//! each stage lives in its own module, and data flows one way through them.
+
+use glam::{Mat3, Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::shape::SharedShape;
+
+use crate::body::{Bodies, rotate_tensor};
+use crate::broad_phase::BroadPhase;
+use crate::constraints::{self, ContactConstraint};
+use crate::contact_lcp::{ContactLcp, assemble_lcp};
+use crate::diagnostics::{self, StepDiagnostics};
+use crate::error::{StepError, WorldError};
+use crate::integrate;
+use crate::constraints::DUPLICATE_POINT_DISTANCE_SQUARED;
+use crate::narrow_phase::{ContactImpulse, NarrowPhase};
+use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
+use crate::settings::SolverSettings;
+use crate::solver::{self, Velocities};
+
+/// A body further than this from the origin (m) means the simulation has blown up.
+pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
+/// A body faster than this (m/s) means the simulation has blown up.
+pub const BLOW_UP_SPEED: f32 = 1.0e4;
+
+/// Bodies, settings and the persistent contact state of a simulation.
+pub struct World {
+    /// The bodies, in scene order.
+    pub bodies: Bodies,
+    /// Gravity (m/s²).
+    pub gravity: Vec3,
+    /// Solver settings.
+    pub settings: SolverSettings,
+    dt: f32,
+    step_count: u64,
+    broad_phase: BroadPhase,
+    narrow_phase: NarrowPhase,
+    candidates: Vec<(u32, u32)>,
+    constraints: Vec<ContactConstraint>,
+    world_inverse_inertia: Vec<Mat3>,
+    diagnostics: StepDiagnostics,
+}
+
+impl World {
+    /// An empty world. Errors when `dt` is not finite and > 0, gravity is not finite, or a
+    /// solver setting is out of range.
+    pub fn new(gravity: Vec3, dt: f32, settings: SolverSettings) -> Result<Self, WorldError> {
+        let world = Self {
+            bodies: Bodies::default(),
+            gravity,
+            settings,
+            dt,
+            step_count: 0,
+            broad_phase: BroadPhase::default(),
+            narrow_phase: NarrowPhase::default(),
+            candidates: Vec::new(),
+            constraints: Vec::new(),
+            world_inverse_inertia: Vec::new(),
+            diagnostics: StepDiagnostics::default(),
+        };
+        world.check_settings()?;
+        Ok(world)
+    }
+
+    /// Builds the world a scene describes. Bodies keep scene order. Named materials resolve
+    /// through `scene.materials` (`"default"` is [`Material::default`] unless redefined).
+    pub fn from_scene(scene: &Scene) -> Result<Self, WorldError> {
+        let mut world = Self::new(Vec3::from(scene.gravity), scene.dt, scene.solver.clone())?;
+        for (index, desc) in scene.bodies.iter().enumerate() {
+            let material = match &desc.material {
+                MaterialRef::Inline(m) => m.clone(),
+                MaterialRef::Named(name) => match scene.materials.get(name) {
+                    Some(m) => m.clone(),
+                    None if name == "default" => Material::default(),
+                    None => {
+                        return Err(invalid(
+                            index,
+                            desc,
+                            "material",
+                            format!("no material named \"{name}\""),
+                        ));
+                    }
+                },
+            };
+            world.add_body(desc, &material)?;
+        }
+        Ok(world)
+    }
+
+    /// Adds a body and returns its index. Mass and inertia come from Parry's mass properties
+    /// of the shape at the material's density, scaled to `desc.mass` when given.
+    pub fn add_body(&mut self, desc: &BodyDesc, material: &Material) -> Result<usize, WorldError> {
+        let index = self.bodies.len();
+        let built = build_body(index, desc, material)?;
+        let b = &mut self.bodies;
+        b.kind.push(desc.kind);
+        b.pose.push(built.pose);
+        b.local_center_of_mass.push(built.local_center_of_mass);
+        b.linear_velocity.push(built.linear_velocity);
+        b.angular_velocity.push(built.angular_velocity);
+        b.inverse_mass.push(built.inverse_mass);
+        b.local_inverse_inertia.push(built.local_inverse_inertia);
+        b.shape.push(built.shape);
+        b.friction.push(material.friction);
+        b.restitution.push(material.restitution);
+        Ok(index)
+    }
+
+    /// The time step (s).
+    pub fn dt(&self) -> f32 {
+        self.dt
+    }
+
+    /// Sets the time step; errors unless finite and > 0.
+    pub fn set_dt(&mut self, dt: f32) -> Result<(), WorldError> {
+        check_dt(dt)?;
+        self.dt = dt;
+        Ok(())
+    }
+
+    /// Steps taken so far.
+    pub fn step_count(&self) -> u64 {
+        self.step_count
+    }
+
+    /// The last step's diagnostics.
+    pub fn diagnostics(&self) -> &StepDiagnostics {
+        &self.diagnostics
+    }
+
+    /// The last step's solved contact constraints (impulses as the solver left them).
+    pub fn contact_constraints(&self) -> &[ContactConstraint] {
+        &self.constraints
+    }
+
+    /// The last step's contact LCP, assembled from the rows the solver used, with the engine's
+    /// impulses at exit. Errors only when the step produced non-finite data.
+    pub fn contact_lcp(&self) -> Result<ContactLcp, impulse_lcp::ProblemError> {
+        assemble_lcp(&self.constraints)
+    }
+
+    /// The last step's contact manifolds.
+    pub fn narrow_phase(&self) -> &NarrowPhase {
+        &self.narrow_phase
+    }
+
+    /// Advances the world by dt through the pipeline of DESIGN.md. Settings are checked first;
+    /// a blow-up is reported with the step number, after the state that caused it was written.
+    pub fn step(&mut self) -> Result<&StepDiagnostics, StepError> {
+        if let Err(e) = self.check_settings() {
+            return Err(StepError::InvalidSettings(e.to_string()));
+        }
+        let dt = self.dt;
+        let settings = self.settings.clone();
+        self.step_count += 1;
+
+        integrate::prospective_velocities(&mut self.bodies, self.gravity, dt);
+        let margin = settings.prediction_distance;
+        self.broad_phase
+            .candidate_pairs(&self.bodies, margin, &mut self.candidates);
+        self.narrow_phase
+            .update(&self.bodies, &self.candidates, settings.prediction_distance)?;
+        self.update_world_inverse_inertia();
+        constraints::assemble(
+            &self.bodies,
+            &self.narrow_phase,
+            &settings,
+            dt,
+            &self.world_inverse_inertia,
+            &mut self.constraints,
+        );
+        let report = {
+            let mut velocities = Velocities {
+                linear: &mut self.bodies.linear_velocity,
+                angular: &mut self.bodies.angular_velocity,
+            };
+            solver::warm_start(&mut self.constraints, settings.warm_start, &mut velocities);
+            solver::solve_pgs(
+                &mut self.constraints,
+                settings.iterations,
+                settings.tolerance,
+                &mut velocities,
+            )
+        };
+        self.store_impulses();
+        let residual = diagnostics::natural_map_residual(
+            &self.constraints,
+            &self.bodies.linear_velocity,
+            &self.bodies.angular_velocity,
+        );
+        integrate::integrate_positions(&mut self.bodies, dt);
+
+        let (kinetic_energy, momentum) = diagnostics::energy_and_momentum(&self.bodies);
+        let friction_rows = self.constraints.iter().filter(|c| c.friction > 0.0).count();
+        self.diagnostics = StepDiagnostics {
+            step: self.step_count,
+            contact_pairs: self
+                .narrow_phase
+                .pairs
+                .iter()
+                .filter(|p| p.point_count() > 0)
+                .count(),
+            contacts: self.constraints.len(),
+            rows: self.constraints.len() + 2 * friction_rows,
+            iterations: report.iterations,
+            natural_map_residual: residual,
+            max_depth: self.narrow_phase.max_depth(),
+            kinetic_energy,
+            linear_momentum: momentum.to_array(),
+        };
+        self.check_blow_up()?;
+        Ok(&self.diagnostics)
+    }
+
+    fn update_world_inverse_inertia(&mut self) {
+        self.world_inverse_inertia.clear();
+        for i in 0..self.bodies.len() {
+            let local = &self.bodies.local_inverse_inertia[i];
+            self.world_inverse_inertia.push(if *local == Mat3::ZERO {
+                Mat3::ZERO
+            } else {
+                rotate_tensor(self.bodies.pose[i].rotation, local)
+            });
+        }
+    }
+
+    /// Writes the solved impulses back into the manifolds' points for next step's warm start.
+    fn store_impulses(&mut self) {
+        for c in &self.constraints {
+            let (pair, manifold, point) = c.source;
+            let data = ContactImpulse {
+                normal: c.normal_impulse,
+                friction: c.tangents[0].direction * c.tangent_impulses[0]
+                    + c.tangents[1].direction * c.tangent_impulses[1],
+            };
+            let points = &mut self.narrow_phase.pairs[pair as usize].manifolds[manifold as usize]
+                .points;
+            let location = points[point as usize].local_p1;
+            // Every duplicate copy of the point (see `constraints::assemble`) gets the impulse.
+            for p in points[point as usize..].iter_mut() {
+                if p.local_p1.distance_squared(location) < DUPLICATE_POINT_DISTANCE_SQUARED {
+                    p.data = data;
+                }
+            }
+        }
+    }
+
+    fn check_blow_up(&self) -> Result<(), StepError> {
+        let b = &self.bodies;
+        for i in 0..b.len() {
+            let position = b.pose[i].translation.length();
+            if !(position <= BLOW_UP_DISTANCE) {
+                return Err(StepError::BlowUp {
+                    step: self.step_count,
+                    body: i,
+                    quantity: "position",
+                    value: position,
+                    bound: BLOW_UP_DISTANCE,
+                });
+            }
+            let speed = b.linear_velocity[i]
+                .length()
+                .max(b.angular_velocity[i].length());
+            if !(speed <= BLOW_UP_SPEED) {
+                return Err(StepError::BlowUp {
+                    step: self.step_count,
+                    body: i,
+                    quantity: "velocity",
+                    value: speed,
+                    bound: BLOW_UP_SPEED,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn check_settings(&self) -> Result<(), WorldError> {
+        check_dt(self.dt)?;
+        if !self.gravity.is_finite() {
+            return Err(setting("gravity", "must be finite"));
+        }
+        let s = &self.settings;
+        if s.iterations == 0 {
+            return Err(setting("solver.iterations", "must be at least 1"));
+        }
+        let non_negative = [
+            ("solver.tolerance", s.tolerance),
+            ("solver.restitution_threshold", s.restitution_threshold),
+            ("solver.overlap_repair_rate", s.overlap_repair_rate),
+            ("solver.overlap_slop", s.overlap_slop),
+            ("solver.max_repair_speed", s.max_repair_speed),
+            ("solver.prediction_distance", s.prediction_distance),
+        ];
+        for (field, value) in non_negative {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(setting(field, &format!("must be finite and ≥ 0, got {value}")));
+            }
+        }
+        if !(0.0..=1.0).contains(&s.warm_start) {
+            return Err(setting(
+                "solver.warm_start",
+                &format!("must be in [0, 1], got {}", s.warm_start),
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn check_dt(dt: f32) -> Result<(), WorldError> {
+    if dt.is_finite() && dt > 0.0 {
+        Ok(())
+    } else {
+        Err(setting("dt", &format!("must be finite and > 0, got {dt}")))
+    }
+}
+
+fn setting(field: &str, message: &str) -> WorldError {
+    WorldError::InvalidSetting {
+        field: field.to_string(),
+        message: message.to_string(),
+    }
+}
+
+fn invalid(index: usize, desc: &BodyDesc, field: &str, message: String) -> WorldError {
+    WorldError::InvalidBody {
+        body: index,
+        name: desc.name.clone(),
+        field: field.to_string(),
+        message,
+    }
+}
+
+struct BuiltBody {
+    pose: Pose,
+    local_center_of_mass: Vec3,
+    linear_velocity: Vec3,
+    angular_velocity: Vec3,
+    inverse_mass: f32,
+    local_inverse_inertia: Mat3,
+    shape: SharedShape,
+}
+
+fn positive(index: usize, desc: &BodyDesc, field: &str, value: f32) -> Result<(), WorldError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(
+            index,
+            desc,
+            field,
+            format!("must be finite and > 0, got {value}"),
+        ))
+    }
+}
+
+fn finite(index: usize, desc: &BodyDesc, field: &str, values: &[f32]) -> Result<(), WorldError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(invalid(
+            index,
+            desc,
+            field,
+            format!("must be finite, got {values:?}"),
+        ))
+    }
+}
+
+/// Turns a body description into state, rejecting every value that would make the
+/// simulation meaningless (the library never panics on user input).
+fn build_body(index: usize, desc: &BodyDesc, material: &Material) -> Result<BuiltBody, WorldError> {
+    finite(index, desc, "position", &desc.position)?;
+    finite(index, desc, "orientation", &desc.orientation)?;
+    finite(index, desc, "linear_velocity", &desc.linear_velocity)?;
+    finite(index, desc, "angular_velocity", &desc.angular_velocity)?;
+    let q = Quat::from_array(desc.orientation);
+    if q.length() < 1e-6 {
+        return Err(invalid(
+            index,
+            desc,
+            "orientation",
+            "quaternion must not be zero".into(),
+        ));
+    }
+    if !(material.friction.is_finite() && material.friction >= 0.0) {
+        return Err(invalid(
+            index,
+            desc,
+            "material.friction",
+            format!("must be finite and ≥ 0, got {}", material.friction),
+        ));
+    }
+    if !(0.0..=1.0).contains(&material.restitution) {
+        return Err(invalid(
+            index,
+            desc,
+            "material.restitution",
+            format!("must be in [0, 1], got {}", material.restitution),
+        ));
+    }
+    let shape = match &desc.shape {
+        ShapeDesc::Sphere { radius } => {
+            positive(index, desc, "shape.radius", *radius)?;
+            SharedShape::ball(*radius)
+        }
+        ShapeDesc::Cuboid { half_extents: h } => {
+            for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                positive(index, desc, &format!("shape.half_extents.{axis}"), h[k])?;
+            }
+            SharedShape::cuboid(h[0], h[1], h[2])
+        }
+        ShapeDesc::Capsule {
+            half_height,
+            radius,
+        } => {
+            positive(index, desc, "shape.radius", *radius)?;
+            if !(half_height.is_finite() && *half_height >= 0.0) {
+                return Err(invalid(
+                    index,
+                    desc,
+                    "shape.half_height",
+                    format!("must be finite and ≥ 0, got {half_height}"),
+                ));
+            }
+            SharedShape::capsule_y(*half_height, *radius)
+        }
+        ShapeDesc::ConvexHull { points } => {
+            let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
+            if !points.iter().all(|p| p.is_finite()) {
+                return Err(invalid(
+                    index,
+                    desc,
+                    "shape.points",
+                    "must be finite".into(),
+                ));
+            }
+            let hull = if points.len() >= 4 {
+                SharedShape::convex_hull(&points)
+            } else {
+                None
+            };
+            let volume = hull
+                .as_ref()
+                .map(|h| h.mass_properties(1.0).mass())
+                .unwrap_or(0.0);
+            match hull {
+                Some(h) if volume > 1e-9 => h,
+                _ => {
+                    return Err(invalid(
+                        index,
+                        desc,
+                        "shape.points",
+                        "need at least 4 points spanning a volume".into(),
+                    ));
+                }
+            }
+        }
+        ShapeDesc::HalfSpace { normal } => {
+            let n = Vec3::from(*normal);
+            if desc.kind != BodyKind::Static {
+                return Err(invalid(
+                    index,
+                    desc,
+                    "shape",
+                    "a half-space must be a static body".into(),
+                ));
+            }
+            if !n.is_finite() || n.length() < 1e-6 {
+                return Err(invalid(
+                    index,
+                    desc,
+                    "shape.normal",
+                    "must be a finite non-zero vector".into(),
+                ));
+            }
+            SharedShape::halfspace(n.normalize())
+        }
+    };
+    if desc.kind == BodyKind::Particle && !matches!(desc.shape, ShapeDesc::Sphere { .. }) {
+        return Err(invalid(
+            index,
+            desc,
+            "shape",
+            "a particle must be a sphere".into(),
+        ));
+    }
+    let rotation = q.normalize();
+    let pose = Pose::from_parts(Vec3::from(desc.position), rotation);
+    let (inverse_mass, local_center_of_mass, local_inverse_inertia) = match desc.kind {
+        BodyKind::Static => (0.0, Vec3::ZERO, Mat3::ZERO),
+        BodyKind::Dynamic | BodyKind::Particle => {
+            positive(index, desc, "material.density", material.density)?;
+            let props = shape.mass_properties(material.density);
+            let computed_mass = props.mass();
+            // Scaling mass and inertia together keeps the shape's mass distribution.
+            let scale = match desc.mass {
+                Some(m) => {
+                    positive(index, desc, "mass", m)?;
+                    m / computed_mass
+                }
+                None => 1.0,
+            };
+            let inverse_mass = props.inv_mass / scale;
+            if !(inverse_mass.is_finite() && inverse_mass > 0.0) {
+                return Err(invalid(
+                    index,
+                    desc,
+                    "mass",
+                    format!("mass must be finite and > 0, got {}", 1.0 / inverse_mass),
+                ));
+            }
+            let inertia = if desc.kind == BodyKind::Particle {
+                Mat3::ZERO
+            } else {
+                props.reconstruct_inverse_inertia_matrix() / scale
+            };
+            (inverse_mass, props.local_com, inertia)
+        }
+    };
+    let angular_velocity = if desc.kind == BodyKind::Dynamic {
+        Vec3::from(desc.angular_velocity)
+    } else {
+        Vec3::ZERO
+    };
+    // The scene gives the velocity of the body origin; the solver works at the centre of mass.
+    let linear_velocity = if desc.kind == BodyKind::Static {
+        Vec3::ZERO
+    } else {
+        Vec3::from(desc.linear_velocity) + angular_velocity.cross(rotation * local_center_of_mass)
+    };
+    Ok(BuiltBody {
+        pose,
+        local_center_of_mass,
+        linear_velocity,
+        angular_velocity,
+        inverse_mass,
+        local_inverse_inertia,
+        shape,
+    })
+}

@@ -1,0 +1,311 @@
+//! Behaviour against physics anyone can check: closed forms, conservation laws, the seed's
+//! simultaneous-contact cases and complementarity of the contact LCP at exit.
+
+use glam::{Quat, Vec3};
+use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
+
+const DT: f32 = 1.0 / 60.0;
+
+fn material(friction: f32, restitution: f32) -> Material {
+    Material {
+        friction,
+        restitution,
+        density: 1000.0,
+    }
+}
+
+fn sphere(kind: BodyKind, radius: f32, position: Vec3) -> BodyDesc {
+    BodyDesc::new(kind, ShapeDesc::Sphere { radius }, position.to_array())
+}
+
+fn cuboid(kind: BodyKind, half: Vec3, position: Vec3) -> BodyDesc {
+    BodyDesc::new(
+        kind,
+        ShapeDesc::Cuboid {
+            half_extents: half.to_array(),
+        },
+        position.to_array(),
+    )
+}
+
+/// Static ground box whose top face is at y = 0.
+fn ground(world: &mut World, friction: f32) -> usize {
+    world
+        .add_body(
+            &cuboid(BodyKind::Static, Vec3::new(50.0, 0.5, 50.0), Vec3::new(0.0, -0.5, 0.0)),
+            &material(friction, 0.0),
+        )
+        .unwrap()
+}
+
+fn world(gravity: Vec3) -> World {
+    World::new(gravity, DT, SolverSettings::default()).unwrap()
+}
+
+#[test]
+fn free_fall_matches_the_integrator_closed_form() {
+    let g = Vec3::new(0.0, -9.81, 0.0);
+    let mut w = world(g);
+    let x0 = Vec3::new(1.0, 100.0, -2.0);
+    let v0 = Vec3::new(0.5, 3.0, -0.25);
+    let mut desc = cuboid(BodyKind::Dynamic, Vec3::splat(0.5), x0);
+    desc.linear_velocity = v0.to_array();
+    w.add_body(&desc, &material(0.5, 0.0)).unwrap();
+    for n in 1..=120u32 {
+        w.step().unwrap();
+        let nf = n as f32;
+        // Symplectic Euler: v_n = v0 + n·g·dt, x_n = x0 + n·dt·v0 + g·dt²·n(n+1)/2.
+        let v = v0 + g * (nf * DT);
+        let x = x0 + v0 * (nf * DT) + g * (DT * DT * nf * (nf + 1.0) / 2.0);
+        let got_v = w.bodies.linear_velocity[0];
+        let got_x = w.bodies.pose[0].translation;
+        assert!((got_v - v).abs().max_element() <= 1e-5 * (1.0 + v.abs().max_element()) * nf);
+        assert!((got_x - x).abs().max_element() <= 2e-6 * x.abs().max_element() * nf.sqrt() + 1e-6);
+        assert_eq!(w.diagnostics().contacts, 0);
+    }
+}
+
+/// Head-on collision of unequal spheres: momentum conserved, and the restitution hypothesis
+/// v⁺ = −c_r·v⁻ holds for the relative normal velocity.
+#[test]
+fn head_on_spheres_conserve_momentum_and_obey_restitution() {
+    for c_r in [0.0f32, 0.5, 1.0] {
+        let mut w = world(Vec3::ZERO);
+        let mut a = sphere(BodyKind::Dynamic, 0.5, Vec3::new(-2.0, 0.0, 0.0));
+        a.linear_velocity = [3.0, 0.0, 0.0];
+        a.mass = Some(2.0);
+        let mut b = sphere(BodyKind::Dynamic, 0.3, Vec3::new(2.0, 0.0, 0.0));
+        b.linear_velocity = [-1.0, 0.0, 0.0];
+        b.mass = Some(0.5);
+        w.add_body(&a, &material(0.0, c_r)).unwrap();
+        w.add_body(&b, &material(0.0, c_r)).unwrap();
+        let momentum_before = 2.0 * 3.0 + 0.5 * -1.0;
+        let relative_before = -1.0 - 3.0; // v_b − v_a along +x (b is ahead of a)
+        let mut touched = false;
+        for _ in 0..120 {
+            w.step().unwrap();
+            touched |= w.contact_constraints().iter().any(|c| c.normal_impulse > 0.0);
+            let p = 2.0 * w.bodies.linear_velocity[0].x + 0.5 * w.bodies.linear_velocity[1].x;
+            assert!((p - momentum_before).abs() < 1e-5, "c_r {c_r}: momentum {p}");
+        }
+        assert!(touched, "the spheres must have collided");
+        let relative_after = w.bodies.linear_velocity[1].x - w.bodies.linear_velocity[0].x;
+        assert!(
+            (relative_after - (-c_r * relative_before)).abs() < 1e-4,
+            "c_r {c_r}: relative velocity after {relative_after}, expected {}",
+            -c_r * relative_before
+        );
+        for i in 0..2 {
+            assert!(w.bodies.linear_velocity[i].y.abs() < 1e-6);
+        }
+    }
+}
+
+/// The seed's simultaneous case: a sphere resting on two others. Both contacts push (γ ≥ 0),
+/// each carries the analytic share of the weight, and overlap does not grow over 10 s.
+#[test]
+fn sphere_resting_on_two_spheres() {
+    let g = 9.81f32;
+    let mut w = world(Vec3::new(0.0, -g, 0.0));
+    ground(&mut w, 0.8);
+    let r = 0.5f32;
+    // Particles (rotation locked) cannot roll, so ground friction holds the base.
+    let left = w
+        .add_body(&sphere(BodyKind::Particle, r, Vec3::new(-r, r, 0.0)), &material(0.8, 0.0))
+        .unwrap();
+    let right = w
+        .add_body(&sphere(BodyKind::Particle, r, Vec3::new(r, r, 0.0)), &material(0.8, 0.0))
+        .unwrap();
+    let top_y = r + 2.0 * r * (60f32.to_radians()).sin();
+    // A frictionless top sphere makes the two contact forces statically determinate.
+    let top = w
+        .add_body(&sphere(BodyKind::Dynamic, r, Vec3::new(0.0, top_y, 0.0)), &material(0.0, 0.0))
+        .unwrap();
+    let mass_top = w.bodies.mass(top);
+    let mut depth_after_one_second = 0.0;
+    for step in 1..=600 {
+        w.step().unwrap();
+        let top_contacts: Vec<_> = w
+            .contact_constraints()
+            .iter()
+            .filter(|c| c.body_a as usize == top || c.body_b as usize == top)
+            .collect();
+        assert_eq!(top_contacts.len(), 2, "step {step}");
+        for c in &top_contacts {
+            assert!(c.normal_impulse >= 0.0);
+            assert!(c.body_a as usize == left || c.body_a as usize == right || c.body_a as usize == top);
+        }
+        if step == 60 {
+            depth_after_one_second = w.diagnostics().max_depth;
+        }
+        if step > 60 {
+            // Each contact carries half the weight along a normal 30° from vertical.
+            let expected = mass_top * g * DT / (2.0 * 30f32.to_radians().cos());
+            for c in &top_contacts {
+                assert!(
+                    (c.normal_impulse - expected).abs() < 0.02 * expected,
+                    "step {step}: γ = {}, expected {expected}",
+                    c.normal_impulse
+                );
+            }
+        }
+    }
+    let depth = w.diagnostics().max_depth;
+    assert!(depth <= depth_after_one_second + 1e-4, "overlap grew: {depth_after_one_second} → {depth}");
+    assert!(depth < 0.01);
+    let top_y_now = w.bodies.pose[top].translation.y;
+    assert!((top_y_now - top_y).abs() < 0.01, "top sphere moved to {top_y_now}");
+}
+
+/// The seed's "pulled apart" case: a body moving away from its contact is not held back (γ = 0).
+#[test]
+fn body_moving_away_from_contact_is_not_held_back() {
+    let g = Vec3::new(0.0, -9.81, 0.0);
+    let mut w = world(g);
+    ground(&mut w, 0.5);
+    let lower = w
+        .add_body(&cuboid(BodyKind::Dynamic, Vec3::splat(0.5), Vec3::new(0.0, 0.5, 0.0)), &material(0.5, 0.0))
+        .unwrap();
+    let mut upper_desc = cuboid(BodyKind::Dynamic, Vec3::splat(0.5), Vec3::new(0.0, 1.5, 0.0));
+    upper_desc.linear_velocity = [0.0, 4.0, 0.0];
+    let upper = w.add_body(&upper_desc, &material(0.5, 0.0)).unwrap();
+    w.step().unwrap();
+    let between: Vec<_> = w
+        .contact_constraints()
+        .iter()
+        .filter(|c| c.body_a as usize == upper && c.body_b as usize == lower)
+        .collect();
+    assert!(!between.is_empty(), "the touching boxes must have contact rows");
+    for c in between {
+        assert_eq!(c.normal_impulse, 0.0);
+    }
+    let vy = w.bodies.linear_velocity[upper].y;
+    assert!((vy - (4.0 + g.y * DT)).abs() < 1e-5, "upper box held back: v = {vy}");
+    assert!(w.bodies.linear_velocity[lower].length() < 1e-3);
+}
+
+#[test]
+fn box_resting_on_ground_does_not_drift_or_gain_energy() {
+    let mut w = world(Vec3::new(0.0, -9.81, 0.0));
+    ground(&mut w, 0.6);
+    let start = Vec3::new(0.3, 0.5, -0.2);
+    let b = w
+        .add_body(&cuboid(BodyKind::Dynamic, Vec3::splat(0.5), start), &material(0.6, 0.0))
+        .unwrap();
+    let mut largest_energy = 0.0f32;
+    for _ in 0..600 {
+        w.step().unwrap();
+        largest_energy = largest_energy.max(w.diagnostics().kinetic_energy);
+    }
+    let drift = (w.bodies.pose[b].translation - start).length();
+    assert!(drift < 1e-3, "drift {drift} m");
+    // Energy of one step of gravity-induced velocity is m(g·dt)²/2 ≈ 0.013 J; anything above
+    // means the contact pumps energy in.
+    assert!(largest_energy < 0.02, "kinetic energy reached {largest_energy} J");
+    let angle = w.bodies.pose[b].rotation.angle_between(Quat::IDENTITY);
+    assert!(angle < 1e-3);
+}
+
+/// A box on an incline of angle θ: sticks when tan θ < μ, slides with g(sin θ − μ cos θ) else.
+#[test]
+fn box_on_incline_sticks_or_slides_by_coulomb() {
+    let g = 9.81f32;
+    let mu = 0.4f32;
+    for (theta_deg, slides) in [(15.0f32, false), (35.0, true)] {
+        let theta = theta_deg.to_radians();
+        let mut w = world(Vec3::new(0.0, -g, 0.0));
+        let rotation = Quat::from_rotation_z(theta);
+        let down_slope = rotation * Vec3::new(-1.0, 0.0, 0.0);
+        let up = rotation * Vec3::Y;
+        let mut plane = cuboid(BodyKind::Static, Vec3::new(100.0, 0.5, 5.0), -up * 0.5);
+        plane.orientation = rotation.to_array();
+        w.add_body(&plane, &material(mu, 0.0)).unwrap();
+        let mut block = cuboid(BodyKind::Dynamic, Vec3::splat(0.25), up * 0.25);
+        block.orientation = rotation.to_array();
+        let b = w.add_body(&block, &material(mu, 0.0)).unwrap();
+        // Settle one second, then measure along the slope over the next two.
+        for _ in 0..60 {
+            w.step().unwrap();
+        }
+        let x0 = w.bodies.pose[b].translation.dot(down_slope);
+        let v0 = w.bodies.linear_velocity[b].dot(down_slope);
+        let steps = 120;
+        for _ in 0..steps {
+            w.step().unwrap();
+        }
+        let t = steps as f32 * DT;
+        let x1 = w.bodies.pose[b].translation.dot(down_slope);
+        let v1 = w.bodies.linear_velocity[b].dot(down_slope);
+        if slides {
+            let expected = g * (theta.sin() - mu * theta.cos());
+            let measured = (v1 - v0) / t;
+            assert!(
+                (measured - expected).abs() < 0.02 * expected,
+                "θ = {theta_deg}°: acceleration {measured}, expected {expected}"
+            );
+        } else {
+            assert!((x1 - x0).abs() < 1e-3, "θ = {theta_deg}°: slid {} m", x1 - x0);
+            assert!(v1.abs() < 1e-3);
+        }
+    }
+}
+
+/// A pile of spheres, solved to convergence without friction (the seed's LCP): at exit
+/// γ ≥ 0, w = Aγ − b = J·v⁺ − target ≥ −tol, and wᵀγ ≈ 0, checked directly from velocities.
+#[test]
+fn pile_of_spheres_satisfies_complementarity_at_exit() {
+    let settings = SolverSettings {
+        iterations: 500,
+        tolerance: 0.0,
+        friction: false,
+        ..SolverSettings::default()
+    };
+    let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
+    ground(&mut w, 0.0);
+    // Walls keep the frictionless pile together.
+    for (x, z) in [(2.6, 0.0), (-2.6, 0.0), (0.0, 2.6), (0.0, -2.6)] {
+        let half = if x != 0.0 { Vec3::new(0.5, 3.0, 3.0) } else { Vec3::new(3.0, 3.0, 0.5) };
+        w.add_body(&cuboid(BodyKind::Static, half, Vec3::new(x, 3.0, z)), &material(0.0, 0.0))
+            .unwrap();
+    }
+    let mut count = 0;
+    for layer in 0..4 {
+        for i in 0..4 {
+            for k in 0..4 {
+                let jitter = 0.05 * ((i * 7 + k * 3 + layer) % 5) as f32;
+                let p = Vec3::new(-1.5 + i as f32 + jitter, 0.5 + 1.05 * layer as f32, -1.5 + k as f32);
+                w.add_body(&sphere(BodyKind::Dynamic, 0.45, p), &material(0.0, 0.0)).unwrap();
+                count += 1;
+            }
+        }
+    }
+    assert_eq!(count, 64);
+    let mut checked_steps = 0;
+    for _ in 0..90 {
+        w.step().unwrap();
+        let constraints = w.contact_constraints();
+        if constraints.len() < 50 {
+            continue;
+        }
+        checked_steps += 1;
+        let lin = &w.bodies.linear_velocity;
+        let ang = &w.bodies.angular_velocity;
+        let mut largest_impulse = 0.0f32;
+        for c in constraints {
+            largest_impulse = largest_impulse.max(c.normal_impulse);
+        }
+        for c in constraints {
+            let (a, b) = (c.body_a as usize, c.body_b as usize);
+            let wv = c.normal.velocity(lin[a], ang[a], lin[b], ang[b]) - c.target_normal_velocity;
+            assert!(c.normal_impulse >= 0.0);
+            assert!(wv >= -1e-3, "w = {wv} < 0");
+            assert!(
+                (wv * c.normal_impulse).abs() <= 1e-3 * largest_impulse.max(1e-6),
+                "complementarity: w = {wv}, γ = {}",
+                c.normal_impulse
+            );
+        }
+        assert!(w.diagnostics().natural_map_residual < 1e-2);
+    }
+    assert!(checked_steps > 10);
+}

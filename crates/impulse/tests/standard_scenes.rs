@@ -1,0 +1,61 @@
+//! The standard scenes of DESIGN.md that must hold with default settings: stack30 and
+//! pyramid20 stand for 10 s at dt = 1/60. Measured from poses; the sink is printed.
+
+use glam::Vec3;
+use impulse::World;
+use impulse::metrics;
+use impulse::scene::builtin::builtin_scene;
+
+/// Runs `name` for its 600 steps and returns (top sink, largest overlap, largest horizontal
+/// displacement of any moving body, largest final speed).
+fn run(name: &str) -> (f32, f32, f32, f32) {
+    let scene = builtin_scene(name).expect("built-in scene");
+    let mut world = World::from_scene(&scene).unwrap();
+    let initial: Vec<Vec3> = world.bodies.pose.iter().map(|p| p.translation).collect();
+    let top = metrics::top_body(&world.bodies).unwrap();
+    let mut largest_overlap = 0.0f32;
+    for step in 1..=scene.steps {
+        world.step().unwrap();
+        if step % 60 == 0 {
+            largest_overlap = largest_overlap.max(metrics::max_overlap(&world.bodies));
+        }
+    }
+    let sink = initial[top].y - world.bodies.pose[top].translation.y;
+    let mut horizontal = 0.0f32;
+    let mut speed = 0.0f32;
+    for i in 0..world.bodies.len() {
+        if world.bodies.is_moving(i) {
+            let d = world.bodies.pose[i].translation - initial[i];
+            horizontal = horizontal.max(Vec3::new(d.x, 0.0, d.z).length());
+            speed = speed.max(world.bodies.linear_velocity[i].length());
+        }
+    }
+    println!(
+        "{name}: top sink {:.2} mm, largest overlap {:.2} mm, largest horizontal drift {:.2} mm, largest speed {:.4} m/s",
+        sink * 1e3,
+        largest_overlap * 1e3,
+        horizontal * 1e3,
+        speed
+    );
+    (sink, largest_overlap, horizontal, speed)
+}
+
+#[test]
+fn stack30_stands_for_ten_seconds() {
+    let (sink, overlap, horizontal, speed) = run("stack30");
+    // Standing: no cube left the column, the stack is at rest, and it sank by at most a few
+    // contact slops per contact (30 contacts).
+    assert!(horizontal < 0.05, "a cube moved {horizontal} m sideways");
+    assert!(speed < 0.05, "still moving at {speed} m/s");
+    assert!(sink < 0.15, "top cube sank {sink} m");
+    assert!(overlap < 0.02, "overlap {overlap} m");
+}
+
+#[test]
+fn pyramid20_stands_for_ten_seconds() {
+    let (sink, overlap, horizontal, speed) = run("pyramid20");
+    assert!(horizontal < 0.05, "a cube moved {horizontal} m sideways");
+    assert!(speed < 0.05, "still moving at {speed} m/s");
+    assert!(sink < 0.15, "top cube sank {sink} m");
+    assert!(overlap < 0.02, "overlap {overlap} m");
+}
