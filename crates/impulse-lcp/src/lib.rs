@@ -28,7 +28,8 @@ pub use io::{FileError, FileFormat, read_lcp};
 pub use matrix::{CsrMatrix, DenseMatrix, Matrix};
 pub use merit::{
     MeritReport, bound_violation, complementarity_gap, fischer_burmeister_residual, merit_report,
-    most_negative, natural_map_residual, normalised_natural_map_residual,
+    most_negative, natural_map_norm, natural_map_residual, normalised_natural_map_residual,
+    residual_scale,
 };
 pub use problem::{Bounds, Lcp, ProblemError};
 pub use solvers::{Solution, SolveError, SolverKind, SolverSettings, Status, UnknownSolver, solve};

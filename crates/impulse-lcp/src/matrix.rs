@@ -26,7 +26,7 @@ impl DenseMatrix {
         Ok(m)
     }
 
-    /// All-zero `rows × cols` matrix.
+    /// All-zero `rows × cols` matrix (allocates `rows·cols` values: sizes are the caller's).
     pub fn zeros(rows: usize, cols: usize) -> Self {
         DenseMatrix {
             rows,
@@ -62,7 +62,7 @@ impl DenseMatrix {
         cols: usize,
         column_major: &[f64],
     ) -> Result<Self, ProblemError> {
-        if column_major.len() != rows * cols {
+        if rows.checked_mul(cols) != Some(column_major.len()) {
             return Err(ProblemError::DataLength {
                 rows,
                 cols,
@@ -183,11 +183,11 @@ impl CsrMatrix {
 
     fn check_structure(&self) -> Result<(), ProblemError> {
         let bad = |msg: String| Err(ProblemError::InvalidCsr(msg));
-        if self.indptr.len() != self.rows + 1 {
+        if self.rows.checked_add(1) != Some(self.indptr.len()) {
             return bad(format!(
-                "indptr has {} entries, expected rows + 1 = {}",
+                "indptr has {} entries, expected rows + 1 = {} + 1",
                 self.indptr.len(),
-                self.rows + 1
+                self.rows
             ));
         }
         if self.indptr[0] != 0 {

@@ -3,8 +3,8 @@
 //! The solvers stop on, and report, the **natural-map** (min-map) residual because it is zero
 //! exactly at solutions, costs one mat-vec, and is what Siconos reports (`lcp_compute_error`), so
 //! numbers are comparable with the Siconos test suite. For bounds `[lo, hi]` the natural map is
-//! `F(γ) = γ − mid(lo, γ − w, hi)` (Cottle–Pang–Stone §1.5 / Facchinei–Pang for box-constrained
-//! VIs); with `lo = 0, hi = +∞` it is `min(γ, w)`. Friction bounds are evaluated at `γ` itself.
+//! `F(γ) = γ − mid(lo, γ − w, hi)` (Facchinei–Pang, box-constrained VIs); with `lo = 0`,
+//! `hi = +∞` it is `min(γ, w)`. Friction bounds are evaluated at `γ` itself.
 //!
 //! Sign violations and the complementarity gap are reported separately because a small natural
 //! residual can hide which condition is violated, and the engine's diagnostics want to know.

@@ -14,7 +14,7 @@ use thiserror::Error;
 pub enum ProblemError {
     #[error("A must be square, but it is {rows}×{cols}")]
     NotSquare { rows: usize, cols: usize },
-    #[error("a {rows}×{cols} dense matrix needs {} values, but {len} were given", rows * cols)]
+    #[error("a {rows}×{cols} dense matrix needs {} values, but {len} were given", rows.saturating_mul(*cols))]
     DataLength {
         rows: usize,
         cols: usize,

@@ -181,6 +181,17 @@ fn jacobi_without_enough_damping_reports_divergence() {
 }
 
 #[test]
+fn empty_problem_is_trivially_solved() {
+    let lcp = parse_siconos("0 0 0 0 0 0", "empty.dat").unwrap();
+    assert_eq!(lcp.n(), 0);
+    for kind in SolverKind::ALL {
+        let s = kind.solve(&lcp, None, &SolverSettings::default()).unwrap();
+        assert_eq!(s.status, impulse_lcp::Status::Converged, "{kind}");
+        assert!(s.z.is_empty() && s.w.is_empty());
+    }
+}
+
+#[test]
 fn file_errors_name_the_file_and_place() {
     let err = read_lcp(Path::new("/nonexistent/problem.dat")).unwrap_err();
     assert!(matches!(err, FileError::Io { .. }));
@@ -214,10 +225,37 @@ fn file_errors_name_the_file_and_place() {
         matches!(
             err,
             FileError::Invalid {
-                source: ProblemError::InvalidFriction { index: 1, .. },
+                problem: ProblemError::InvalidFriction { index: 1, .. },
                 ..
             }
         ),
         "{err}"
     );
+}
+
+proptest::proptest! {
+    /// Corrupt files give errors, never panics or huge allocations: token soups that look like
+    /// Siconos headers (both storage types) and mangled JSON.
+    #[test]
+    fn readers_never_panic(
+        tokens in proptest::collection::vec(
+            proptest::sample::select(vec!["0", "1", "2", "3", "4", "-1", "0.5", "1e400", "nan", "x", "99999999999999"]),
+            0..60,
+        ),
+        storage in 0usize..3,
+        cut in 0usize..200,
+    ) {
+        let text = format!("3 {storage} 3 3 {}", tokens.join(" "));
+        let _ = parse_siconos(&text, "fuzz.dat");
+        let _ = parse_siconos(&tokens.join(" "), "fuzz.dat");
+        let json = format!(
+            r#"{{"n":{},"a":{{"csr":{{"indptr":[{}],"indices":[{}],"values":[1,2]}}}},"b":[1,2],"friction_index":[null,{}],"mu":[0,1]}}"#,
+            tokens.first().copied().unwrap_or("2"),
+            tokens.iter().take(3).copied().filter(|t| t.parse::<usize>().is_ok()).collect::<Vec<_>>().join(","),
+            tokens.iter().skip(3).take(2).copied().filter(|t| t.parse::<usize>().is_ok()).collect::<Vec<_>>().join(","),
+            tokens.get(5).copied().filter(|t| t.parse::<usize>().is_ok()).unwrap_or("0"),
+        );
+        let _ = parse_json(&json, "fuzz.json");
+        let _ = parse_json(&json[..cut.min(json.len())], "fuzz.json");
+    }
 }

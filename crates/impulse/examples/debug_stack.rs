@@ -8,11 +8,14 @@ fn main() {
     if let Ok(v) = std::env::var("WARM") { scene.solver.warm_start = v.parse().unwrap(); }
     if let Ok(v) = std::env::var("REPAIR") { scene.solver.overlap_repair_rate = v.parse().unwrap(); }
     if let Ok(v) = std::env::var("PRED") { scene.solver.prediction_distance = v.parse().unwrap(); }
+    if let Ok(v) = std::env::var("MAXREP") { scene.solver.max_repair_speed = v.parse().unwrap(); }
     if let Ok(v) = std::env::var("BODIES") { scene.bodies.truncate(v.parse().unwrap()); }
     let mut world = World::from_scene(&scene).unwrap();
     let n = world.bodies.len();
     for step in 1..=600 {
+        if step == 200 { if let Ok(v) = std::env::var("ITERS_AFTER") { world.settings.iterations = v.parse().unwrap(); } }
         let d = world.step().unwrap().clone();
+        if std::env::var("LAST").is_ok() && step != 600 { continue; }
         if step % 30 == 0 || step < 5 {
             let top = &world.bodies.pose[n - 1];
             let bottom = &world.bodies.pose[1];

@@ -82,11 +82,19 @@ pub struct ContactConstraint {
     pub inverse_mass_b: f32,
     /// Normal row; its impulse γ_n ≥ 0.
     pub normal: JacobianRow,
-    /// Two friction rows along orthonormal tangents; |γ_t| ≤ μ·γ_n each.
+    /// Two friction rows along orthonormal tangents. Solved together, with the friction
+    /// impulse (γ_t1, γ_t2) kept inside Coulomb's disc |γ_t| ≤ μ·γ_n.
     pub tangents: [JacobianRow; 2],
+    /// Inverse of the 2×2 tangent block K = J_t M⁻¹ J_tᵀ, as (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) (kg). The
+    /// two rows are coupled through the bodies' rotation (K₁₂ ≠ 0 off the centre line); solving
+    /// them one at a time leaves a residual that rotates between the tangents and, iterated over
+    /// a tall stack, pumps energy into it.
+    pub tangent_inverse_block: [f32; 3],
     /// Target normal velocity after the solve (m/s): v⁺ ≥ target, equality where γ_n > 0.
     /// Restitution −c_r·v⁻, plus overlap repair, or −gap/dt for a speculative contact.
     pub target_normal_velocity: f32,
+    /// The overlap-repair part of `target_normal_velocity` (m/s), removed for the relax pass.
+    pub repair_velocity: f32,
     /// Coulomb coefficient μ of the pair.
     pub friction: f32,
     /// Accumulated normal impulse γ_n (N·s).
@@ -152,7 +160,8 @@ pub fn assemble(
                 let contact_point = 0.5 * (p_a + p_b);
                 let r_a = contact_point - com_a;
                 let r_b = contact_point - com_b;
-                let (t1, t2) = tangent_basis(bodies, a, b, r_a, r_b, normal);
+                let (t1, t2) =
+                    tangent_basis(bodies, a, b, r_a, r_b, normal, manifold.data.tangent);
                 let row = |d| {
                     let mut row = JacobianRow::new(
                         d,
@@ -172,8 +181,9 @@ pub fn assemble(
                     row
                 };
                 let normal_row = row(normal);
+                let tangents = [row(t1), row(t2)];
                 let depth = -point.dist;
-                let target = normal_target(
+                let (target, repair_velocity) = normal_target(
                     normal_row.velocity_before,
                     depth,
                     restitution,
@@ -186,8 +196,10 @@ pub fn assemble(
                     inverse_mass_a,
                     inverse_mass_b,
                     normal: normal_row,
-                    tangents: [row(t1), row(t2)],
+                    tangents,
+                    tangent_inverse_block: inverse_block(&tangents),
                     target_normal_velocity: target,
+                    repair_velocity,
                     friction: if settings.friction { friction } else { 0.0 },
                     normal_impulse: warm.normal,
                     tangent_impulses: [warm.friction.dot(t1), warm.friction.dot(t2)],
@@ -199,10 +211,37 @@ pub fn assemble(
     }
 }
 
-/// Friction directions: t1 along the sliding velocity when there is one, so that the two
+/// (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) of the tangent block; zeros when the block is singular (both bodies
+/// immovable).
+fn inverse_block(tangents: &[JacobianRow; 2]) -> [f32; 3] {
+    let [t1, t2] = tangents;
+    let k11 = t1.inverse_effective_mass;
+    let k22 = t2.inverse_effective_mass;
+    // Linear parts are orthogonal, so only the angular terms couple the two rows.
+    let k12 = t1.angular_a.dot(t2.inverse_inertia_angular_a)
+        + t1.angular_b.dot(t2.inverse_inertia_angular_b);
+    let determinant = k11 * k22 - k12 * k12;
+    if determinant > f32::EPSILON * (k11 * k22).max(f32::MIN_POSITIVE) {
+        let inverse = 1.0 / determinant;
+        [k22 * inverse, -k12 * inverse, k11 * inverse]
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Friction directions: t1 along the sliding velocity when the point slides, so that the two
 /// independently clamped rows (|γ_t| ≤ μ·γ_n each, a box) bound the sliding friction by exactly
-/// μ·γ_n as Coulomb's cone does; any orthonormal pair otherwise.
-fn tangent_basis(bodies: &Bodies, a: usize, b: usize, r_a: Vec3, r_b: Vec3, normal: Vec3) -> (Vec3, Vec3) {
+/// μ·γ_n as Coulomb's cone does; otherwise last step's t1 made orthogonal to the new normal,
+/// so a sticking contact keeps its basis; any orthonormal pair for a new manifold.
+fn tangent_basis(
+    bodies: &Bodies,
+    a: usize,
+    b: usize,
+    r_a: Vec3,
+    r_b: Vec3,
+    normal: Vec3,
+    previous: Vec3,
+) -> (Vec3, Vec3) {
     let relative = bodies.linear_velocity[a] + bodies.angular_velocity[a].cross(r_a)
         - bodies.linear_velocity[b]
         - bodies.angular_velocity[b].cross(r_b);
@@ -210,6 +249,11 @@ fn tangent_basis(bodies: &Bodies, a: usize, b: usize, r_a: Vec3, r_b: Vec3, norm
     let speed = sliding.length();
     if speed > SLIDING_SPEED {
         let t1 = sliding / speed;
+        return (t1, normal.cross(t1));
+    }
+    let kept = previous - normal * normal.dot(previous);
+    if kept.length_squared() > 0.25 {
+        let t1 = kept.normalize();
         (t1, normal.cross(t1))
     } else {
         normal.any_orthonormal_pair()
@@ -228,13 +272,15 @@ const SLIDING_SPEED: f32 = 1.0e9;
 ///   the contact closes within this step (touching, or a gap shorter than −v⁻·dt).
 /// - Overlap repair (seed): + c_d·max(d − slop, 0), capped at `max_repair_speed`.
 /// - Speculative gap g = −d > 0 without restitution: v⁺ ≥ −g/dt (may close, not overlap).
+///
+/// Returns the target and, separately, its overlap-repair part.
 pub fn normal_target(
     velocity_before: f32,
     depth: f32,
     restitution: f32,
     settings: &SolverSettings,
     dt: f32,
-) -> f32 {
+) -> (f32, f32) {
     let gap = -depth;
     let closes_this_step = gap <= -velocity_before * dt;
     let bounce = restitution > 0.0
@@ -246,10 +292,10 @@ pub fn normal_target(
         0.0
     };
     if gap > 0.0 {
-        if bounce { restitution_target } else { -gap / dt }
+        (if bounce { restitution_target } else { -gap / dt }, 0.0)
     } else {
         let repair = (settings.overlap_repair_rate * (depth - settings.overlap_slop).max(0.0))
             .min(settings.max_repair_speed);
-        restitution_target + repair
+        (restitution_target + repair, repair)
     }
 }

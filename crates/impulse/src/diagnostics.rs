@@ -5,6 +5,7 @@ use serde::Serialize;
 
 use crate::body::Bodies;
 use crate::constraints::ContactConstraint;
+use crate::solver::cap_to_disc;
 
 /// Per-step report. Every step's LCP can be checked: `natural_map_residual` is computed from
 /// the solver's own impulses and the velocities they produce, in the LCP's own units.
@@ -20,9 +21,10 @@ pub struct StepDiagnostics {
     pub rows: usize,
     /// PGS sweeps used.
     pub iterations: u32,
-    /// ‖φ‖₂ of the natural map at exit, φ_i = γ_i − clamp(γ_i − w_i, lo_i, hi_i) with
-    /// w = Aγ − b the post-solve row velocity minus its target (seed convention). For a normal
-    /// row this is min(γ_i, w_i). Mixed units (N·s and m/s), as in the LCP itself.
+    /// ‖φ‖₂ of the natural map at exit, with w = Aγ − b the post-solve row velocity minus its
+    /// target (seed convention): φ_i = min(γ_i, w_i) for a normal row, and
+    /// φ_t = γ_t − Proj(γ_t − w_t) onto the friction disc |γ_t| ≤ μ·γ_n for a tangent pair.
+    /// Mixed units (N·s and m/s), as in the LCP itself.
     pub natural_map_residual: f32,
     /// Largest penetration depth among this step's contact points, before the solve (m).
     pub max_depth: f32,
@@ -48,11 +50,12 @@ pub fn natural_map_residual(
         let phi = c.normal_impulse.min(w) as f64;
         sum += phi * phi;
         if c.friction > 0.0 {
-            let limit = c.friction * c.normal_impulse;
+            // Natural map for the disc: γ_t − Proj_disc(γ_t − w_t).
+            let g = c.tangent_impulses;
+            let w = [velocity(&c.tangents[0]), velocity(&c.tangents[1])];
+            let projected = cap_to_disc([g[0] - w[0], g[1] - w[1]], c.friction * c.normal_impulse);
             for k in 0..2 {
-                let w = velocity(&c.tangents[k]);
-                let g = c.tangent_impulses[k];
-                let phi = (g - (g - w).clamp(-limit, limit)) as f64;
+                let phi = (g[k] - projected[k]) as f64;
                 sum += phi * phi;
             }
         }

@@ -11,6 +11,11 @@ use serde::{Deserialize, Serialize};
 pub struct SolverSettings {
     /// Projected Gauss-Seidel sweeps per step, at most. Must be ≥ 1.
     pub iterations: u32,
+    /// Relax sweeps after position integration, with the overlap repair removed from the
+    /// targets: positions move with the repair velocity, but the velocities carried to the next
+    /// step do not keep it, so repair adds no kinetic energy (Box2D v3's "relax" stage).
+    /// 0 keeps the seed's plain velocity bias.
+    pub relax_iterations: u32,
     /// Early exit: stop sweeping once no row's velocity changed by more than this in a sweep
     /// (m/s), i.e. max |Δγ_i|/m_eff,i ≤ tolerance. 0 disables early exit.
     pub tolerance: f32,
@@ -38,6 +43,7 @@ impl Default for SolverSettings {
     fn default() -> Self {
         Self {
             iterations: 20,
+            relax_iterations: 5,
             tolerance: 1e-5,
             restitution_threshold: 0.5,
             overlap_repair_rate: 6.0,

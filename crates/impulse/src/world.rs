@@ -182,13 +182,28 @@ impl World {
                 &mut velocities,
             )
         };
+        integrate::integrate_positions(&mut self.bodies, dt);
+        let mut iterations = report.iterations;
+        if settings.relax_iterations > 0 {
+            solver::remove_repair(&mut self.constraints);
+            let mut velocities = Velocities {
+                linear: &mut self.bodies.linear_velocity,
+                angular: &mut self.bodies.angular_velocity,
+            };
+            iterations += solver::solve_pgs(
+                &mut self.constraints,
+                settings.relax_iterations,
+                settings.tolerance,
+                &mut velocities,
+            )
+            .iterations;
+        }
         self.store_impulses();
         let residual = diagnostics::natural_map_residual(
             &self.constraints,
             &self.bodies.linear_velocity,
             &self.bodies.angular_velocity,
         );
-        integrate::integrate_positions(&mut self.bodies, dt);
 
         let (kinetic_energy, momentum) = diagnostics::energy_and_momentum(&self.bodies);
         let friction_rows = self.constraints.iter().filter(|c| c.friction > 0.0).count();
@@ -202,7 +217,7 @@ impl World {
                 .count(),
             contacts: self.constraints.len(),
             rows: self.constraints.len() + 2 * friction_rows,
-            iterations: report.iterations,
+            iterations,
             natural_map_residual: residual,
             max_depth: self.narrow_phase.max_depth(),
             kinetic_energy,
@@ -233,8 +248,9 @@ impl World {
                 friction: c.tangents[0].direction * c.tangent_impulses[0]
                     + c.tangents[1].direction * c.tangent_impulses[1],
             };
-            let points = &mut self.narrow_phase.pairs[pair as usize].manifolds[manifold as usize]
-                .points;
+            let manifold = &mut self.narrow_phase.pairs[pair as usize].manifolds[manifold as usize];
+            manifold.data.tangent = c.tangents[0].direction;
+            let points = &mut manifold.points;
             let location = points[point as usize].local_p1;
             // Every duplicate copy of the point (see `constraints::assemble`) gets the impulse.
             for p in points[point as usize..].iter_mut() {

@@ -148,18 +148,18 @@ pub fn parse_json(text: &str, file: &str) -> Result<Lcp, FileError> {
             hi: hi.unwrap_or_else(|| vec![f64::INFINITY; n]),
         },
     };
-    Lcp::new(a, raw.b, bounds).map_err(|source| FileError::Invalid {
+    Lcp::new(a, raw.b, bounds).map_err(|problem| FileError::Invalid {
         file: file.to_string(),
-        source,
+        problem,
     })
 }
 
 /// The problem as JSON text (compact, one line). Errors: the problem is invalid (it could not be
 /// read back), with `file` = `"<json>"`.
 pub fn to_json_string(lcp: &Lcp) -> Result<String, FileError> {
-    lcp.validate().map_err(|source| FileError::Invalid {
+    lcp.validate().map_err(|problem| FileError::Invalid {
         file: "<json>".into(),
-        source,
+        problem,
     })?;
     let a = match &lcp.a {
         Matrix::Dense(m) => Value::from(
@@ -221,13 +221,13 @@ pub fn to_json_string(lcp: &Lcp) -> Result<String, FileError> {
 pub fn write_json(lcp: &Lcp, path: &Path) -> Result<(), FileError> {
     let file = path.display().to_string();
     let text = to_json_string(lcp).map_err(|e| match e {
-        FileError::Invalid { source, .. } => FileError::Invalid {
+        FileError::Invalid { problem, .. } => FileError::Invalid {
             file: file.clone(),
-            source,
+            problem,
         },
         other => other,
     })?;
-    std::fs::write(path, text + "\n").map_err(|source| FileError::Io { file, source })
+    std::fs::write(path, text + "\n").map_err(|error| FileError::Io { file, error })
 }
 
 #[cfg(test)]
@@ -282,5 +282,10 @@ mod tests {
             msg(r#"{"n":1,"a":[[1]],"b":[1],"lo":[2],"hi":[1]}"#)
                 .starts_with("p.json: invalid problem")
         );
+        let huge = format!(
+            r#"{{"n":{},"a":{{"csr":{{"indptr":[0],"indices":[],"values":[]}}}},"b":[]}}"#,
+            usize::MAX
+        );
+        assert!(msg(&huge).contains("indptr"), "{}", msg(&huge));
     }
 }

@@ -15,11 +15,10 @@ use thiserror::Error;
 /// in-memory text).
 #[derive(Debug, Error)]
 pub enum FileError {
-    #[error("{file}: {source}")]
-    Io {
-        file: String,
-        source: std::io::Error,
-    },
+    // The causes are part of the message (not `#[source]`), so that a plain `to_string()` is
+    // complete and error reporters that print the chain do not repeat them.
+    #[error("{file}: {error}")]
+    Io { file: String, error: std::io::Error },
     /// Siconos `.dat`: `token` is the 1-based number of the whitespace-separated token.
     #[error("{file}: token {token}: {message}")]
     Siconos {
@@ -34,8 +33,8 @@ pub enum FileError {
     #[error("{file}: {message}")]
     Json { file: String, message: String },
     /// The file parsed, but the problem it describes is invalid.
-    #[error("{file}: invalid problem: {source}")]
-    Invalid { file: String, source: ProblemError },
+    #[error("{file}: invalid problem: {problem}")]
+    Invalid { file: String, problem: ProblemError },
     #[error("{file}: unknown extension; expected .dat (Siconos) or .json")]
     UnknownFormat { file: String },
 }
@@ -73,8 +72,8 @@ pub fn read_lcp(path: &Path) -> Result<(Lcp, FileFormat), FileError> {
 }
 
 fn read_text(path: &Path) -> Result<String, FileError> {
-    std::fs::read_to_string(path).map_err(|source| FileError::Io {
+    std::fs::read_to_string(path).map_err(|error| FileError::Io {
         file: path.display().to_string(),
-        source,
+        error,
     })
 }

@@ -69,9 +69,9 @@ pub fn parse_siconos(text: &str, file: &str) -> Result<Lcp, FileError> {
     for i in 0..n {
         q.push(tokens.f64(&format!("q[{i}]"))?);
     }
-    Lcp::from_siconos(m, &q).map_err(|source| FileError::Invalid {
+    Lcp::from_siconos(m, &q).map_err(|problem| FileError::Invalid {
         file: file.to_string(),
-        source,
+        problem,
     })
 }
 
@@ -90,9 +90,9 @@ fn read_dense(tokens: &mut Tokens, n: usize) -> Result<DenseMatrix, FileError> {
             values.push(tokens.f64(&format!("M[{i}][{j}] (column-major)"))?);
         }
     }
-    DenseMatrix::from_column_major(n, n, &values).map_err(|source| FileError::Invalid {
+    DenseMatrix::from_column_major(n, n, &values).map_err(|problem| FileError::Invalid {
         file: tokens.file.to_string(),
-        source,
+        problem,
     })
 }
 
@@ -203,9 +203,9 @@ fn read_sparse_block(tokens: &mut Tokens, n: usize) -> Result<CsrMatrix, FileErr
         }
         indptr.push(indices.len());
     }
-    CsrMatrix::new(n, n, indptr, indices, values).map_err(|source| FileError::Invalid {
+    CsrMatrix::new(n, n, indptr, indices, values).map_err(|problem| FileError::Invalid {
         file: tokens.file.to_string(),
-        source,
+        problem,
     })
 }
 

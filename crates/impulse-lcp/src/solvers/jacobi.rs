@@ -1,10 +1,10 @@
 //! Projected Jacobi with damping: every row is updated from the same previous iterate,
 //! `γ ← mid(lo, γ − ω·D⁻¹(Aγ − b), hi)` with `D = diag(A)`.
 //!
-//! Why keep it next to PGS: its update does not depend on row order, so it parallelises and is
-//! the building block of the engine's parallel variants; the price is slower convergence and the
-//! need for damping (for symmetric positive definite `A` it converges when ω < 2/λ_max(D⁻¹A);
-//! contact matrices where one body touches k others typically need ω ≲ 1/k).
+//! Why keep it next to PGS: its update does not depend on row order, so it parallelises
+//! trivially; the price is slower convergence and the need for damping (for symmetric positive
+//! definite `A` it converges when ω < 2/λ_max(D⁻¹A); when one body touches k others, roughly
+//! ω ≲ 1/k). Too little damping shows up as [`Status::Diverged`](super::Status::Diverged).
 //! Friction bounds use the normal values of the previous iterate.
 
 use super::{

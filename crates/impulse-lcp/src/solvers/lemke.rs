@@ -8,9 +8,10 @@
 //! positive entry (a secondary ray: no solution found).
 //!
 //! Why each detail:
-//! - **Lexicographic ratio test** on `[q̄, B⁻¹]` (CPS §4.9): degenerate problems such as Siconos'
-//!   `lcp_tobenna` cycle forever with a plain minimum-ratio test. `B⁻¹` is read off the `w`
-//!   columns of the tableau, which start as the identity. If `z₀` ties for leaving, it leaves.
+//! - **Lexicographic ratio test** on `[q̄, B⁻¹]` (CPS ch. 4, degeneracy): degenerate problems
+//!   such as Siconos' `lcp_tobenna` cycle forever with a plain minimum-ratio test. `B⁻¹` is read
+//!   off the `w` columns of the tableau, which start as the identity. If `z₀` ties for leaving,
+//!   it leaves.
 //! - **Dense tableau** `n × (2n + 2)`, with the tableau recomputed from the original data through
 //!   an LU factorisation of the basis every `max(n, 16)` pivots, so long paths (Murty's `2ⁿ`
 //!   pivots) do not accumulate round-off.
@@ -20,8 +21,9 @@
 //!   tolerance are reported as [`Status`] values; the returned `z` is then not a solution.
 //!
 //! Termination theory (CPS §4.4): Lemke's method solves every LCP whose matrix is a P-matrix
-//! (unique solution), and for copositive-plus matrices (e.g. positive semidefinite) it ray-terminates
-//! only if the LCP is infeasible. For other matrices it may ray-terminate although solutions exist.
+//! (unique solution), and for copositive-plus matrices (e.g. positive semidefinite) it
+//! ray-terminates only if the LCP is infeasible. For other matrices it may ray-terminate although
+//! solutions exist (Siconos' bimatrix game `lcp_CPS_3` is such a case).
 
 use super::lu::Lu;
 use super::{Solution, SolveError, SolverSettings, Status, prepare};
@@ -71,8 +73,6 @@ pub fn solve(
         });
     }
 
-    let mut tableau = Tableau::new(&m, &q);
-    let mut history = Vec::new();
     if settings.max_iterations == 0 {
         let z = vec![0.0; n];
         return Ok(Solution {
@@ -80,10 +80,12 @@ pub fn solve(
             residual: residual_of(&z),
             z,
             iterations: 0,
-            residual_history: history,
+            residual_history: Vec::new(),
             status: Status::PivotLimit,
         });
     }
+    let mut tableau = Tableau::new(&m, &q);
+    let mut history = Vec::new();
     let refresh_every = n.max(16);
 
     // First pivot: z₀ enters at the lexicographically smallest row of [q, I] (the most negative
@@ -128,7 +130,7 @@ pub fn solve(
                 residual = polished_residual;
             }
         }
-        if !(residual <= settings.tolerance) {
+        if residual.is_nan() || residual > settings.tolerance {
             status = Status::Inaccurate;
         }
     }
@@ -225,7 +227,7 @@ impl Tableau {
     /// Lexicographic minimum ratio test for entering column `col`; `None` means a secondary ray.
     fn leaving_row(&self, col: usize) -> Option<usize> {
         let largest = (0..self.n).fold(0.0_f64, |m, i| m.max(self.at(i, col).abs()));
-        if !(largest > 0.0) {
+        if largest.is_nan() || largest <= 0.0 {
             return None;
         }
         let candidates: Vec<usize> = (0..self.n)
@@ -272,10 +274,8 @@ impl Tableau {
         let d_max = rows.iter().fold(0.0_f64, |m, &i| m.max(d(i)));
         let spread = ratios.iter().fold(rhs_scale / d_max, |m, v| m.max(v.abs()));
         let mut rows = keep_min(rows, ratios, spread);
-        if regular {
-            if let Some(&r) = rows.iter().find(|&&i| self.basis[i] == self.z0()) {
-                return r;
-            }
+        if regular && let Some(&r) = rows.iter().find(|&&i| self.basis[i] == self.z0()) {
+            return r;
         }
         let scale = rows.iter().fold(0.0_f64, |m, &i| {
             let row_max = (0..n).fold(0.0_f64, |m, k| m.max(self.at(i, k).abs()));

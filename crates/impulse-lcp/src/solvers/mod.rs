@@ -56,7 +56,7 @@ pub enum Status {
     /// Iterative solver produced a non-finite value (e.g. Jacobi with too little damping).
     Diverged,
     /// Lemke ended on a secondary ray: it found no solution. For copositive-plus `A` (e.g. positive
-    /// semidefinite) this proves the LCP infeasible (Cottle–Pang–Stone Thm 4.4.13); for other
+    /// semidefinite) this proves the LCP infeasible (Cottle–Pang–Stone §4.4); for other
     /// matrices a solution may still exist. `z` is the last almost-complementary point.
     RayTermination,
     /// Lemke used `max_iterations` pivots without terminating.
@@ -110,7 +110,7 @@ pub struct Solution {
 /// Why a solver refused to run. Solver failures to *find* a solution are a [`Status`], not an error.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum SolveError {
-    #[error("invalid problem: {0}")]
+    #[error(transparent)]
     Problem(#[from] ProblemError),
     #[error("initial guess has length {found}, expected {expected}")]
     InitialGuessLength { expected: usize, found: usize },

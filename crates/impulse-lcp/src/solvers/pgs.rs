@@ -1,13 +1,14 @@
-//! Projected Gauss–Seidel / projected SOR (Cottle–Pang–Stone §5.2; the seed's iteration).
+//! Projected Gauss–Seidel / projected SOR (Cottle–Pang–Stone ch. 5; the seed's iteration).
 //!
 //! Row by row, with the newest values of the other unknowns:
 //! `γ_i ← mid(lo_i, γ_i − ω·(Aγ − b)_i / A_ii, hi_i)`. Friction rows take their bounds
 //! `±μ_i·γ_j` from the current normal value `γ_j`, as ODE's `findex` rows do, so a normal row
 //! updated earlier in the sweep already limits its tangent rows in the same sweep.
 //!
-//! Converges for symmetric positive (semi)definite `A` with ω ∈ (0, 2) on the standard and box
-//! problems (CPS Thm 5.2.12); with friction bounds the problem is no longer a symmetric LCP and
-//! convergence is not guaranteed, though it is the usual practice in games and animation.
+//! Converges for symmetric positive definite `A` with ω ∈ (0, 2) on the standard and box
+//! problems (CPS ch. 5), slowly when `A` is ill-conditioned (redundant contacts, mass ratios);
+//! with friction bounds the problem is no longer a symmetric LCP and convergence is not
+//! guaranteed, though it is the usual practice in games and animation.
 //! A zero or negative `A_ii` is an error ([`SolveError::NonPositiveDiagonal`]), never skipped.
 
 use super::{
