@@ -23,8 +23,17 @@ pub struct ContactImpulse {
     pub friction: Vec3,
 }
 
-/// Parry's manifold type with our per-point data.
-pub type Manifold = ContactManifold<(), ContactImpulse>;
+/// Per-manifold state kept across steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ManifoldState {
+    /// First friction direction of the last step (zero before the first solve). Reusing it
+    /// keeps the friction basis continuous: a basis rebuilt from the normal alone can flip
+    /// between steps, and warm-started friction then lands on the wrong axes.
+    pub tangent: Vec3,
+}
+
+/// Parry's manifold type with our per-manifold and per-point data.
+pub type Manifold = ContactManifold<ManifoldState, ContactImpulse>;
 
 /// The contact state of one pair of bodies. Shape 1 belongs to `body1`, shape 2 to `body2`,
 /// and `body1 < body2`.
