@@ -9,6 +9,11 @@ fn main() {
     if let Ok(v) = std::env::var("REPAIR") { scene.solver.overlap_repair_rate = v.parse().unwrap(); }
     let sub: u32 = std::env::var("SUB").ok().map(|v| v.parse().unwrap()).unwrap_or(1);
     scene.dt /= sub as f32;
+    if let Ok(v) = std::env::var("SLOP") { scene.solver.overlap_slop = v.parse().unwrap(); }
+    if let Ok(v) = std::env::var("REPAIR") { scene.solver.overlap_repair_rate = v.parse().unwrap(); }
+    if let Ok(v) = std::env::var("HZ") { scene.solver.soft_contact_hertz = v.parse().unwrap(); }
+    if let Ok(v) = std::env::var("ZETA") { scene.solver.soft_damping_ratio = v.parse().unwrap(); }
+    if let Ok(v) = std::env::var("SUBSTEPS") { scene.solver.substeps = v.parse().unwrap(); }
     if let Ok(v) = std::env::var("RELAX") { scene.solver.relax_iterations = v.parse().unwrap(); }
     if let Ok(v) = std::env::var("WARM") { scene.solver.warm_start = v.parse().unwrap(); }
     if let Ok(v) = std::env::var("KICK") { let k: f32 = v.parse().unwrap(); let last = scene.bodies.len() - 1; scene.bodies[last].linear_velocity = [k, 0.0, 0.0]; }

@@ -90,31 +90,43 @@ pub struct ContactConstraint {
     /// them one at a time leaves a residual that rotates between the tangents and, iterated over
     /// a tall stack, pumps energy into it.
     pub tangent_inverse_block: [f32; 3],
-    /// Target normal velocity after the solve (m/s): v⁺ ≥ target, equality where γ_n > 0.
-    /// Restitution −c_r·v⁻, plus overlap repair, or −gap/dt for a speculative contact.
+    /// The tangent block K itself, (K₁₁, K₁₂, K₂₂) (1/kg), for the friction disc projection.
+    pub tangent_block: [f32; 3],
+    /// Target normal velocity of the current solve (m/s): v⁺ ≥ target, equality where γ_n > 0.
+    /// Set per substep by [`update_targets`] from the current separation, and for bouncing
+    /// contacts by [`restitution_targets`].
     pub target_normal_velocity: f32,
-    /// The overlap-repair part of `target_normal_velocity` (m/s), removed for the relax pass.
-    pub repair_velocity: f32,
+    /// Softness of the normal row in the current solve, (mass scale, impulse scale): the update
+    /// is Δγ = m_eff·mass_scale·(target − v) − impulse_scale·γ. (1, 0) is the seed's rigid row.
+    pub softness: (f32, f32),
+    /// Lever arm r_a from A's centre of mass to the contact point at assembly (m).
+    pub lever_a: Vec3,
+    /// Lever arm r_b from B's centre of mass to the contact point at assembly (m).
+    pub lever_b: Vec3,
+    /// Restitution coefficient c_r of the pair.
+    pub restitution: f32,
     /// Coulomb coefficient μ of the pair.
     pub friction: f32,
     /// Accumulated normal impulse γ_n (N·s).
     pub normal_impulse: f32,
     /// Accumulated friction impulses along the two tangents (N·s).
     pub tangent_impulses: [f32; 2],
-    /// Penetration depth d (m), > 0 when overlapping, < 0 for a speculative gap.
+    /// Penetration depth d (m) at assembly, > 0 when overlapping, < 0 for a speculative gap.
     pub depth: f32,
+    /// Largest normal impulse this point received during the step (N·s): a contact that
+    /// never pushed did not collide, so it does not bounce.
+    pub max_normal_impulse: f32,
     /// Where the point lives: (pair, manifold, point) in the narrow phase, for write-back.
     pub source: (u32, u16, u16),
 }
 
-/// Builds one constraint per contact point, in narrow-phase order (pairs sorted by body index),
-/// and the world inverse inertia of every body. `velocity_before` is read from the current
-/// (prospective) velocities, so call this before warm starting.
+/// Builds one constraint per contact point, in narrow-phase order (pairs sorted by body index).
+/// `velocity_before` is read from the current velocities: called before gravity is applied, it
+/// is the approach velocity v⁻ that restitution reflects. Targets are left at zero.
 pub fn assemble(
     bodies: &Bodies,
     narrow_phase: &NarrowPhase,
     settings: &SolverSettings,
-    dt: f32,
     world_inverse_inertia: &[Mat3],
     out: &mut Vec<ContactConstraint>,
 ) {
@@ -183,13 +195,6 @@ pub fn assemble(
                 let normal_row = row(normal);
                 let tangents = [row(t1), row(t2)];
                 let depth = -point.dist;
-                let (target, repair_velocity) = normal_target(
-                    normal_row.velocity_before,
-                    depth,
-                    restitution,
-                    settings,
-                    dt,
-                );
                 out.push(ContactConstraint {
                     body_a: a as u32,
                     body_b: b as u32,
@@ -198,12 +203,17 @@ pub fn assemble(
                     normal: normal_row,
                     tangents,
                     tangent_inverse_block: inverse_block(&tangents),
-                    target_normal_velocity: target,
-                    repair_velocity,
+                    tangent_block: tangent_block(&tangents),
+                    target_normal_velocity: 0.0,
+                    softness: (1.0, 0.0),
+                    lever_a: r_a,
+                    lever_b: r_b,
+                    restitution,
                     friction: if settings.friction { friction } else { 0.0 },
                     normal_impulse: warm.normal,
                     tangent_impulses: [warm.friction.dot(t1), warm.friction.dot(t2)],
                     depth,
+                    max_normal_impulse: 0.0,
                     source: (pair_index as u32, manifold_index as u16, point_index as u16),
                 });
             }
@@ -211,15 +221,19 @@ pub fn assemble(
     }
 }
 
-/// (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) of the tangent block; zeros when the block is singular (both bodies
-/// immovable).
-fn inverse_block(tangents: &[JacobianRow; 2]) -> [f32; 3] {
+/// (K₁₁, K₁₂, K₂₂) of the tangent block K = J_t M⁻¹ J_tᵀ (1/kg).
+fn tangent_block(tangents: &[JacobianRow; 2]) -> [f32; 3] {
     let [t1, t2] = tangents;
-    let k11 = t1.inverse_effective_mass;
-    let k22 = t2.inverse_effective_mass;
     // Linear parts are orthogonal, so only the angular terms couple the two rows.
     let k12 = t1.angular_a.dot(t2.inverse_inertia_angular_a)
         + t1.angular_b.dot(t2.inverse_inertia_angular_b);
+    [t1.inverse_effective_mass, k12, t2.inverse_effective_mass]
+}
+
+/// (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) of the tangent block; zeros when the block is singular (both bodies
+/// immovable).
+fn inverse_block(tangents: &[JacobianRow; 2]) -> [f32; 3] {
+    let [k11, k12, k22] = tangent_block(tangents);
     let determinant = k11 * k22 - k12 * k12;
     if determinant > f32::EPSILON * (k11 * k22).max(f32::MIN_POSITIVE) {
         let inverse = 1.0 / determinant;
@@ -266,36 +280,106 @@ pub(crate) const DUPLICATE_POINT_DISTANCE_SQUARED: f32 = 1.0e-8;
 /// Below this tangential speed (m/s) a contact is treated as sticking for the tangent basis.
 const SLIDING_SPEED: f32 = 1.0e9;
 
-/// The velocity target of a normal row (m/s), from its pre-solve velocity v⁻ and depth d.
+/// Sets every normal row's target for a solve of duration `h` (s), from the separation the
+/// contact has now: its separation at assembly plus the normal component of the two bodies'
+/// displacement since then, Δp = Δx + Δθ × r (linearised; `displacement` and `rotation` are
+/// per body, m and rad). With separation s (= −depth):
 ///
-/// - Restitution (seed): v⁺ = −c_r·v⁻, only when approaching faster than the threshold and
-///   the contact closes within this step (touching, or a gap shorter than −v⁻·dt).
-/// - Overlap repair (seed): + c_d·max(d − slop, 0), capped at `max_repair_speed`.
-/// - Speculative gap g = −d > 0 without restitution: v⁺ ≥ −g/dt (may close, not overlap).
-///
-/// Returns the target and, separately, its overlap-repair part.
-pub fn normal_target(
-    velocity_before: f32,
-    depth: f32,
-    restitution: f32,
+/// - s > 0, a speculative gap: v⁺ ≥ −s/h, the bodies may close the gap but not overlap;
+/// - s ≤ 0, overlap d = −s, `with_repair`: the seed's overlap repair v⁺ ≥ c_d·max(d − slop, 0),
+///   capped at `max_repair_speed`. With `soft_contact_hertz` > 0, c_d and the row's softness
+///   come from a damped spring instead ([`soft_contact`]);
+/// - s ≤ 0 without repair (the relax solve): v⁺ ≥ 0, rigid.
+pub fn update_targets(
+    constraints: &mut [ContactConstraint],
+    displacement: &[Vec3],
+    rotation: &[Vec3],
     settings: &SolverSettings,
-    dt: f32,
-) -> (f32, f32) {
-    let gap = -depth;
-    let closes_this_step = gap <= -velocity_before * dt;
-    let bounce = restitution > 0.0
-        && velocity_before < -settings.restitution_threshold
-        && closes_this_step;
-    let restitution_target = if bounce {
-        -restitution * velocity_before
+    h: f32,
+    with_repair: bool,
+) {
+    let (repair_rate, softness) = if settings.soft_contact_hertz > 0.0 {
+        soft_contact(settings.soft_contact_hertz, settings.soft_damping_ratio, h)
     } else {
-        0.0
+        (settings.overlap_repair_rate, (1.0, 0.0))
     };
-    if gap > 0.0 {
-        (if bounce { restitution_target } else { -gap / dt }, 0.0)
-    } else {
-        let repair = (settings.overlap_repair_rate * (depth - settings.overlap_slop).max(0.0))
-            .min(settings.max_repair_speed);
-        (restitution_target + repair, repair)
+    for c in constraints.iter_mut() {
+        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let moved = (displacement[a] + rotation[a].cross(c.lever_a))
+            - (displacement[b] + rotation[b].cross(c.lever_b));
+        let separation = -c.depth + c.normal.direction.dot(moved);
+        (c.target_normal_velocity, c.softness) = if separation > 0.0 {
+            (-separation / h, (1.0, 0.0))
+        } else if with_repair {
+            let repair = (repair_rate * (-separation - settings.overlap_slop).max(0.0))
+                .min(settings.max_repair_speed);
+            (repair, softness)
+        } else {
+            (0.0, (1.0, 0.0))
+        };
+    }
+}
+
+/// Soft contact as a damped spring of frequency `hertz` (capped at a quarter of the substep
+/// rate) and damping ratio ζ, discretised implicitly over `h` (Catto, "Solver2D" and Box2D v3
+/// `b2MakeSoft`): returns the repair rate (1/s) and (mass scale, impulse scale).
+pub fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32)) {
+    let hertz = hertz.min(0.25 / h);
+    let omega = 2.0 * std::f32::consts::PI * hertz;
+    let a1 = 2.0 * damping_ratio + h * omega;
+    let a2 = h * omega * a1;
+    let a3 = 1.0 / (1.0 + a2);
+    (omega / a1, (a2 * a3, a3))
+}
+
+/// The restitution hypothesis of the seed, v⁺ = −c_r·v⁻, for the points that collided this
+/// step: approach speed −v⁻ above the threshold and a normal impulse received. Sets their
+/// targets and returns whether any point bounces; other targets are left as they are.
+pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32) -> bool {
+    let mut any = false;
+    for c in constraints.iter_mut() {
+        let approach = c.normal.velocity_before;
+        if c.restitution > 0.0 && approach < -threshold && c.max_normal_impulse > 0.0 {
+            c.target_normal_velocity = -c.restitution * approach;
+            any = true;
+        }
+    }
+    any
+}
+
+/// Rewrites each row's `velocity_before` as J·v* for the solve that produced the current
+/// impulses: v* = v − M⁻¹Jᵀγ, the velocities without this solve's impulses. With it,
+/// (A, b = target − J·v*) is exactly the LCP whose solution the rows now hold, so it can be
+/// exported and checked ([`crate::contact_lcp`]). O(rows); `scratch` holds per-body deltas.
+pub fn record_velocity_before(
+    constraints: &mut [ContactConstraint],
+    linear: &[Vec3],
+    angular: &[Vec3],
+    scratch: &mut Vec<(Vec3, Vec3)>,
+) {
+    scratch.clear();
+    scratch.resize(linear.len(), (Vec3::ZERO, Vec3::ZERO));
+    for c in constraints.iter() {
+        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let rows = [
+            (&c.normal, c.normal_impulse),
+            (&c.tangents[0], c.tangent_impulses[0]),
+            (&c.tangents[1], c.tangent_impulses[1]),
+        ];
+        for (row, impulse) in rows {
+            scratch[a].0 += row.direction * (c.inverse_mass_a * impulse);
+            scratch[a].1 += row.inverse_inertia_angular_a * impulse;
+            scratch[b].0 -= row.direction * (c.inverse_mass_b * impulse);
+            scratch[b].1 -= row.inverse_inertia_angular_b * impulse;
+        }
+    }
+    for c in constraints.iter_mut() {
+        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let (la, aa) = (linear[a] - scratch[a].0, angular[a] - scratch[a].1);
+        let (lb, ab) = (linear[b] - scratch[b].0, angular[b] - scratch[b].1);
+        c.normal.velocity_before = c.normal.velocity(la, aa, lb, ab);
+        for t in &mut c.tangents {
+            t.velocity_before = t.velocity(la, aa, lb, ab);
+        }
     }
 }

@@ -85,6 +85,7 @@ impl NarrowPhase {
             });
             let (a, b) = (i as usize, j as usize);
             let pos12 = bodies.pose[a].inv_mul(&bodies.pose[b]);
+
             dispatcher
                 .contact_manifolds(
                     &pos12,

@@ -2,6 +2,17 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The iterative method run on the contact rows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SolverMethod {
+    /// Projected Gauss-Seidel, the seed's method (sweeps in alternating direction).
+    Pgs,
+    /// Nonsmooth nonlinear conjugate gradient over PGS sweeps (Silcowitz et al. 2010).
+    #[default]
+    Nncg,
+}
+
 /// Settings of the contact solve (DESIGN.md step 4 and 5).
 ///
 /// Defaults are chosen for the standard scenes at dt = 1/60 s. Units are SI.
@@ -9,11 +20,19 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSettings {
-    /// Projected Gauss-Seidel sweeps per step, at most. Must be ≥ 1.
+    /// Iterative method: `pgs` or `nncg`.
+    pub method: SolverMethod,
+    /// Substeps per step. Contacts are found once per step; each substep of h = dt/substeps
+    /// applies gravity, solves, and integrates positions, with each contact's separation
+    /// updated from the bodies' motion (as Box2D v3's soft step and Rapier's TGS do). Shorter
+    /// solves propagate load through a tall stack far better than more sweeps of one long
+    /// solve. Must be ≥ 1; 1 is the seed's one solve per step.
+    pub substeps: u32,
+    /// Projected Gauss-Seidel sweeps per substep, at most (with overlap repair). Must be ≥ 1.
     pub iterations: u32,
-    /// Relax sweeps after position integration, with the overlap repair removed from the
-    /// targets: positions move with the repair velocity, but the velocities carried to the next
-    /// step do not keep it, so repair adds no kinetic energy (Box2D v3's "relax" stage).
+    /// Relax sweeps per substep after position integration, with the overlap repair removed
+    /// from the targets: positions move with the repair velocity, but the velocities carried
+    /// on do not keep it, so repair adds no kinetic energy (Box2D v3's "relax" stage).
     /// 0 keeps the seed's plain velocity bias.
     pub relax_iterations: u32,
     /// Early exit: stop sweeping once no row's velocity changed by more than this in a sweep
@@ -25,6 +44,12 @@ pub struct SolverSettings {
     /// Overlap repair coefficient c_d (1/s): target separation speed c_d·max(d − slop, 0)
     /// (seed, "nudge … proportional to the overlap"; Baumgarte stabilisation).
     pub overlap_repair_rate: f32,
+    /// Soft contact: when > 0, overlap repair is a damped spring of this frequency (Hz, capped
+    /// at a quarter of the substep rate) instead of the seed's rate c_d, and penetrating rows
+    /// are regularised by it (Box2D v3's soft step). 0 = the seed's rigid rows with c_d.
+    pub soft_contact_hertz: f32,
+    /// Damping ratio ζ of the soft contact spring (dimensionless; Box2D v3 uses 10).
+    pub soft_damping_ratio: f32,
     /// Overlap (m) tolerated without repair, so resting contacts do not jitter.
     pub overlap_slop: f32,
     /// Cap (m/s) on the repair speed, so deep overlaps separate without an explosion.
@@ -42,11 +67,15 @@ pub struct SolverSettings {
 impl Default for SolverSettings {
     fn default() -> Self {
         Self {
-            iterations: 20,
-            relax_iterations: 5,
+            method: SolverMethod::default(),
+            substeps: 4,
+            iterations: 8,
+            relax_iterations: 1,
             tolerance: 1e-5,
             restitution_threshold: 0.5,
             overlap_repair_rate: 6.0,
+            soft_contact_hertz: 0.0,
+            soft_damping_ratio: 10.0,
             overlap_slop: 0.002,
             max_repair_speed: 1.0,
             warm_start: 1.0,

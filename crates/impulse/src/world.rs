@@ -16,7 +16,8 @@ use crate::constraints::DUPLICATE_POINT_DISTANCE_SQUARED;
 use crate::narrow_phase::{ContactImpulse, NarrowPhase};
 use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
-use crate::solver::{self, Velocities};
+use crate::settings::SolverMethod;
+use crate::solver::{self, NncgWorkspace, Velocities};
 
 /// A body further than this from the origin (m) means the simulation has blown up.
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
@@ -38,6 +39,10 @@ pub struct World {
     candidates: Vec<(u32, u32)>,
     constraints: Vec<ContactConstraint>,
     world_inverse_inertia: Vec<Mat3>,
+    displacement: Vec<Vec3>,
+    rotation: Vec<Vec3>,
+    scratch: Vec<(Vec3, Vec3)>,
+    nncg: NncgWorkspace,
     diagnostics: StepDiagnostics,
 }
 
@@ -56,6 +61,10 @@ impl World {
             candidates: Vec::new(),
             constraints: Vec::new(),
             world_inverse_inertia: Vec::new(),
+            displacement: Vec::new(),
+            rotation: Vec::new(),
+            scratch: Vec::new(),
+            nncg: NncgWorkspace::default(),
             diagnostics: StepDiagnostics::default(),
         };
         world.check_settings()?;
@@ -154,7 +163,7 @@ impl World {
         let settings = self.settings.clone();
         self.step_count += 1;
 
-        integrate::prospective_velocities(&mut self.bodies, self.gravity, dt);
+        // Stages 2–4 once per step, on the poses and velocities at its start.
         let margin = settings.prediction_distance;
         self.broad_phase
             .candidate_pairs(&self.bodies, margin, &mut self.candidates);
@@ -165,39 +174,89 @@ impl World {
             &self.bodies,
             &self.narrow_phase,
             &settings,
-            dt,
             &self.world_inverse_inertia,
             &mut self.constraints,
         );
-        let report = {
+        solver::scale_impulses(&mut self.constraints, settings.warm_start);
+
+        // Stages 1, 5 and 6 per substep.
+        let n = self.bodies.len();
+        self.displacement.clear();
+        self.displacement.resize(n, Vec3::ZERO);
+        self.rotation.clear();
+        self.rotation.resize(n, Vec3::ZERO);
+        let h = dt / settings.substeps as f32;
+        let mut iterations = 0;
+        for _ in 0..settings.substeps {
+            integrate::prospective_velocities(&mut self.bodies, self.gravity, h);
             let mut velocities = Velocities {
                 linear: &mut self.bodies.linear_velocity,
                 angular: &mut self.bodies.angular_velocity,
             };
-            solver::warm_start(&mut self.constraints, settings.warm_start, &mut velocities);
-            solver::solve_pgs(
+            solver::warm_start(&self.constraints, &mut velocities);
+            constraints::update_targets(
                 &mut self.constraints,
+                &self.displacement,
+                &self.rotation,
+                &settings,
+                h,
+                true,
+            );
+            iterations += solve(
+                &mut self.constraints,
+                &settings,
                 settings.iterations,
-                settings.tolerance,
                 &mut velocities,
-            )
-        };
-        integrate::integrate_positions(&mut self.bodies, dt);
-        let mut iterations = report.iterations;
-        if settings.relax_iterations > 0 {
-            solver::remove_repair(&mut self.constraints);
+                &mut self.nncg,
+            );
+            for i in 0..n {
+                self.displacement[i] += self.bodies.linear_velocity[i] * h;
+                self.rotation[i] += self.bodies.angular_velocity[i] * h;
+            }
+            integrate::integrate_positions(&mut self.bodies, h);
+            if settings.relax_iterations > 0 {
+                constraints::update_targets(
+                    &mut self.constraints,
+                    &self.displacement,
+                    &self.rotation,
+                    &settings,
+                    h,
+                    false,
+                );
+                let mut velocities = Velocities {
+                    linear: &mut self.bodies.linear_velocity,
+                    angular: &mut self.bodies.angular_velocity,
+                };
+                iterations += solve(
+                    &mut self.constraints,
+                    &settings,
+                    settings.relax_iterations,
+                    &mut velocities,
+                    &mut self.nncg,
+                );
+            }
+        }
+        // Restitution after the substeps (the seed's v⁺ = −c_r·v⁻ with v⁻ from the start of
+        // the step), for the points that collided.
+        if constraints::restitution_targets(&mut self.constraints, settings.restitution_threshold) {
             let mut velocities = Velocities {
                 linear: &mut self.bodies.linear_velocity,
                 angular: &mut self.bodies.angular_velocity,
             };
-            iterations += solver::solve_pgs(
+            iterations += solve(
                 &mut self.constraints,
-                settings.relax_iterations,
-                settings.tolerance,
+                &settings,
+                settings.iterations.max(settings.relax_iterations),
                 &mut velocities,
-            )
-            .iterations;
+                &mut self.nncg,
+            );
         }
+        constraints::record_velocity_before(
+            &mut self.constraints,
+            &self.bodies.linear_velocity,
+            &self.bodies.angular_velocity,
+            &mut self.scratch,
+        );
         self.store_impulses();
         let residual = diagnostics::natural_map_residual(
             &self.constraints,
@@ -299,6 +358,9 @@ impl World {
         if s.iterations == 0 {
             return Err(setting("solver.iterations", "must be at least 1"));
         }
+        if s.substeps == 0 {
+            return Err(setting("solver.substeps", "must be at least 1"));
+        }
         let non_negative = [
             ("solver.tolerance", s.tolerance),
             ("solver.restitution_threshold", s.restitution_threshold),
@@ -319,6 +381,31 @@ impl World {
             ));
         }
         Ok(())
+    }
+}
+
+/// Runs the configured method for at most `iterations`; returns the iterations used.
+fn solve(
+    constraints: &mut [ContactConstraint],
+    settings: &SolverSettings,
+    iterations: u32,
+    velocities: &mut Velocities<'_>,
+    workspace: &mut NncgWorkspace,
+) -> u32 {
+    match settings.method {
+        SolverMethod::Pgs => {
+            solver::solve_pgs(constraints, iterations, settings.tolerance, velocities).iterations
+        }
+        SolverMethod::Nncg => {
+            solver::solve_nncg(
+                constraints,
+                iterations,
+                settings.tolerance,
+                velocities,
+                workspace,
+            )
+            .iterations
+        }
     }
 }
 

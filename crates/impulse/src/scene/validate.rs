@@ -5,8 +5,9 @@
 //!
 //! - every number is finite (gravity, dt, solver settings, materials, positions, orientations,
 //!   velocities, shape sizes, hull points, mass);
-//! - `dt > 0`; `solver.iterations ≥ 1`; `solver.tolerance`, `restitution_threshold`,
-//!   `overlap_repair_rate`, `overlap_slop`, `max_repair_speed`, `prediction_distance` are ≥ 0;
+//! - `dt > 0`; `solver.iterations ≥ 1`, `solver.substeps ≥ 1`; `solver.tolerance`,
+//!   `restitution_threshold`, `overlap_repair_rate`, `soft_contact_hertz`,
+//!   `soft_damping_ratio`, `overlap_slop`, `max_repair_speed`, `prediction_distance` are ≥ 0;
 //!   `solver.warm_start` is in [0, 1];
 //! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`;
 //! - a body's `mass`, when given, is > 0;
@@ -64,7 +65,12 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
     if s.iterations == 0 {
         c.fail(&solver.key("iterations"), "must be ≥ 1, got 0".to_string());
     }
+    if s.substeps == 0 {
+        c.fail(&solver.key("substeps"), "must be ≥ 1, got 0".to_string());
+    }
     c.non_negative(&solver.key("tolerance"), s.tolerance);
+    c.non_negative(&solver.key("soft_contact_hertz"), s.soft_contact_hertz);
+    c.non_negative(&solver.key("soft_damping_ratio"), s.soft_damping_ratio);
     c.non_negative(
         &solver.key("restitution_threshold"),
         s.restitution_threshold,
