@@ -122,7 +122,7 @@ pub fn run(mut scene: Scene, options: &RunOptions) -> Result<Summary> {
     let mut failure = None;
     for step in 1..=steps {
         let start = Instant::now();
-        let result = world.step().map(|d| d.clone());
+        let result = world.step().cloned();
         step_ms.push(start.elapsed().as_secs_f64() * 1e3);
         let diagnostics = match result {
             Ok(d) => d,
@@ -158,7 +158,11 @@ pub fn run(mut scene: Scene, options: &RunOptions) -> Result<Summary> {
         dt: scene.dt,
         ms_per_step: median_ms,
         mean_ms_per_step: mean_ms,
-        steps_per_second: if median_ms > 0.0 { 1e3 / median_ms } else { 0.0 },
+        steps_per_second: if median_ms > 0.0 {
+            1e3 / median_ms
+        } else {
+            0.0
+        },
         max_overlap_m: max_overlap,
         final_overlap_m: final_overlap,
         top_body: top,

@@ -22,7 +22,9 @@ impl BroadPhase {
         out.clear();
         self.aabbs.clear();
         for i in 0..bodies.len() {
-            let mut aabb = bodies.shape[i].compute_aabb(&bodies.pose[i]).loosened(margin);
+            let mut aabb = bodies.shape[i]
+                .compute_aabb(&bodies.pose[i])
+                .loosened(margin);
             aabb.mins = aabb.mins.max(glam::Vec3::splat(-WORLD_BOUND));
             aabb.maxs = aabb.maxs.min(glam::Vec3::splat(WORLD_BOUND));
             self.aabbs.push(aabb);

@@ -63,7 +63,13 @@ impl JacobianRow {
 
     /// J·v for the current velocities of A and B (m/s); positive means separating.
     #[inline(always)]
-    pub fn velocity(&self, linear_a: Vec3, angular_a: Vec3, linear_b: Vec3, angular_b: Vec3) -> f32 {
+    pub fn velocity(
+        &self,
+        linear_a: Vec3,
+        angular_a: Vec3,
+        linear_b: Vec3,
+        angular_b: Vec3,
+    ) -> f32 {
         self.direction.dot(linear_a - linear_b) + self.angular_a.dot(angular_a)
             - self.angular_b.dot(angular_b)
     }
@@ -155,7 +161,9 @@ pub fn assemble(
                 // clipped against the other); a duplicate row only makes A singular. Which
                 // copy comes first can change between steps, so the warm start takes the
                 // copy that carries an impulse and the write-back goes to every copy.
-                let same = |q: &&parry3d::query::TrackedContact<crate::narrow_phase::ContactImpulse>| {
+                let same = |q: &&parry3d::query::TrackedContact<
+                    crate::narrow_phase::ContactImpulse,
+                >| {
                     q.local_p1.distance_squared(point.local_p1) < DUPLICATE_POINT_DISTANCE_SQUARED
                 };
                 if manifold.points[..point_index].iter().any(|q| same(&q)) {
@@ -172,8 +180,7 @@ pub fn assemble(
                 let contact_point = 0.5 * (p_a + p_b);
                 let r_a = contact_point - com_a;
                 let r_b = contact_point - com_b;
-                let (t1, t2) =
-                    tangent_basis(bodies, a, b, r_a, r_b, normal, manifold.data.tangent);
+                let (t1, t2) = tangent_basis(bodies, a, b, r_a, r_b, normal, manifold.data.tangent);
                 let row = |d| {
                     let mut row = JacobianRow::new(
                         d,

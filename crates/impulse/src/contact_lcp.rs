@@ -56,13 +56,29 @@ pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, Pro
         for (row, target, impulse, findex) in rows {
             let index = b.len();
             b.push((target - row.velocity_before) as f64);
-            mu.push(if findex.is_some() { c.friction as f64 } else { 0.0 });
+            mu.push(if findex.is_some() {
+                c.friction as f64
+            } else {
+                0.0
+            });
             friction_index.push(findex);
             engine_solution.push(impulse as f64);
             contact_of_row.push(k);
             let sides = [
-                (c.body_a, 1.0, row.angular_a, row.inverse_inertia_angular_a, c.inverse_mass_a),
-                (c.body_b, -1.0, row.angular_b, row.inverse_inertia_angular_b, c.inverse_mass_b),
+                (
+                    c.body_a,
+                    1.0,
+                    row.angular_a,
+                    row.inverse_inertia_angular_a,
+                    c.inverse_mass_a,
+                ),
+                (
+                    c.body_b,
+                    -1.0,
+                    row.angular_b,
+                    row.inverse_inertia_angular_b,
+                    c.inverse_mass_b,
+                ),
             ];
             for (body, sign, angular, inverse_inertia_angular, inverse_mass) in sides {
                 if inverse_mass == 0.0 && inverse_inertia_angular == Vec3::ZERO {

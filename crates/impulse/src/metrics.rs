@@ -6,8 +6,8 @@ use parry3d::math::Pose;
 use parry3d::query;
 use parry3d::shape::SharedShape;
 
-use crate::broad_phase::BroadPhase;
 use crate::body::Bodies;
+use crate::broad_phase::BroadPhase;
 
 /// Largest penetration depth (m) between any two bodies at the given poses, found with Parry's
 /// exact contact query on the pairs whose bounding boxes overlap. 0 when nothing overlaps.
@@ -23,9 +23,13 @@ pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u3
     let mut deepest = 0.0f32;
     for &(i, j) in pairs {
         let (i, j) = (i as usize, j as usize);
-        if let Ok(Some(contact)) =
-            query::contact(&poses[i], shapes[i].as_ref(), &poses[j], shapes[j].as_ref(), 0.0)
-        {
+        if let Ok(Some(contact)) = query::contact(
+            &poses[i],
+            shapes[i].as_ref(),
+            &poses[j],
+            shapes[j].as_ref(),
+            0.0,
+        ) {
             deepest = deepest.max(-contact.dist);
         }
     }

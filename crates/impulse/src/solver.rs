@@ -102,7 +102,7 @@ pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f3
     let half_trace = 0.5 * (a + d);
     let radius = (0.25 * (a - d) * (a - d) + b * b).sqrt();
     let (k1, k2) = (half_trace + radius, half_trace - radius);
-    if !(k2 > 0.0) {
+    if k2.is_nan() || k2 <= 0.0 {
         return cap_to_disc(q, limit);
     }
     let (u1, u2) = if b.abs() > 1e-12 * (a.abs() + d.abs()) {
@@ -187,7 +187,11 @@ pub fn solve_pgs(
 /// Impulses of one contact point as a vector (normal, tangent 1, tangent 2), N·s.
 #[inline(always)]
 fn impulses(c: &ContactConstraint) -> [f32; 3] {
-    [c.normal_impulse, c.tangent_impulses[0], c.tangent_impulses[1]]
+    [
+        c.normal_impulse,
+        c.tangent_impulses[0],
+        c.tangent_impulses[1],
+    ]
 }
 
 /// Work vectors of [`solve_nncg`], kept between calls to avoid reallocating.
@@ -251,16 +255,22 @@ pub fn solve_nncg(
         previous_norm = norm;
         let restart = beta > 1.0 || beta == 0.0;
         let beta = beta as f32;
-        for (c, (previous, direction)) in constraints
-            .iter_mut()
-            .zip(workspace.previous.iter_mut().zip(workspace.direction.iter_mut()))
-        {
+        for (c, (previous, direction)) in constraints.iter_mut().zip(
+            workspace
+                .previous
+                .iter_mut()
+                .zip(workspace.direction.iter_mut()),
+        ) {
             let x = impulses(c);
             let gradient_step = [x[0] - previous[0], x[1] - previous[1], x[2] - previous[2]];
             if restart {
                 *direction = gradient_step;
             } else {
-                let push = [beta * direction[0], beta * direction[1], beta * direction[2]];
+                let push = [
+                    beta * direction[0],
+                    beta * direction[1],
+                    beta * direction[2],
+                ];
                 if push != [0.0; 3] {
                     c.normal_impulse += push[0];
                     c.tangent_impulses[0] += push[1];
@@ -292,7 +302,10 @@ fn solve_point(c: &mut ContactConstraint, velocities: &mut Velocities<'_>) -> f3
         let [i11, i12, i22] = c.tangent_inverse_block;
         let old = c.tangent_impulses;
         let limit = c.friction * c.normal_impulse;
-        let sticking = [old[0] - (i11 * v1 + i12 * v2), old[1] - (i12 * v1 + i22 * v2)];
+        let sticking = [
+            old[0] - (i11 * v1 + i12 * v2),
+            old[1] - (i12 * v1 + i22 * v2),
+        ];
         let new = project_to_friction_disc(sticking, c.tangent_block, limit);
         let delta = [new[0] - old[0], new[1] - old[1]];
         if delta != [0.0, 0.0] {

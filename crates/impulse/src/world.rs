@@ -7,16 +7,16 @@ use parry3d::shape::SharedShape;
 
 use crate::body::{Bodies, rotate_tensor};
 use crate::broad_phase::BroadPhase;
+use crate::constraints::DUPLICATE_POINT_DISTANCE_SQUARED;
 use crate::constraints::{self, ContactConstraint};
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{self, StepDiagnostics};
 use crate::error::{StepError, WorldError};
 use crate::integrate;
-use crate::constraints::DUPLICATE_POINT_DISTANCE_SQUARED;
 use crate::narrow_phase::{ContactImpulse, NarrowPhase};
 use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
-use crate::settings::SolverSettings;
 use crate::settings::SolverMethod;
+use crate::settings::SolverSettings;
 use crate::solver::{self, NncgWorkspace, Velocities};
 
 /// A body further than this from the origin (m) means the simulation has blown up.
@@ -324,7 +324,7 @@ impl World {
         let b = &self.bodies;
         for i in 0..b.len() {
             let position = b.pose[i].translation.length();
-            if !(position <= BLOW_UP_DISTANCE) {
+            if position.is_nan() || position > BLOW_UP_DISTANCE {
                 return Err(StepError::BlowUp {
                     step: self.step_count,
                     body: i,
@@ -336,7 +336,7 @@ impl World {
             let speed = b.linear_velocity[i]
                 .length()
                 .max(b.angular_velocity[i].length());
-            if !(speed <= BLOW_UP_SPEED) {
+            if speed.is_nan() || speed > BLOW_UP_SPEED {
                 return Err(StepError::BlowUp {
                     step: self.step_count,
                     body: i,
@@ -371,7 +371,10 @@ impl World {
         ];
         for (field, value) in non_negative {
             if !(value.is_finite() && value >= 0.0) {
-                return Err(setting(field, &format!("must be finite and ≥ 0, got {value}")));
+                return Err(setting(
+                    field,
+                    &format!("must be finite and ≥ 0, got {value}"),
+                ));
             }
         }
         if !(0.0..=1.0).contains(&s.warm_start) {

@@ -32,7 +32,11 @@ fn cuboid(kind: BodyKind, half: Vec3, position: Vec3) -> BodyDesc {
 fn ground(world: &mut World, friction: f32) -> usize {
     world
         .add_body(
-            &cuboid(BodyKind::Static, Vec3::new(50.0, 0.5, 50.0), Vec3::new(0.0, -0.5, 0.0)),
+            &cuboid(
+                BodyKind::Static,
+                Vec3::new(50.0, 0.5, 50.0),
+                Vec3::new(0.0, -0.5, 0.0),
+            ),
             &material(friction, 0.0),
         )
         .unwrap()
@@ -88,9 +92,15 @@ fn head_on_spheres_conserve_momentum_and_obey_restitution() {
         let mut touched = false;
         for _ in 0..120 {
             w.step().unwrap();
-            touched |= w.contact_constraints().iter().any(|c| c.max_normal_impulse > 0.0);
+            touched |= w
+                .contact_constraints()
+                .iter()
+                .any(|c| c.max_normal_impulse > 0.0);
             let p = 2.0 * w.bodies.linear_velocity[0].x + 0.5 * w.bodies.linear_velocity[1].x;
-            assert!((p - momentum_before).abs() < 1e-5, "c_r {c_r}: momentum {p}");
+            assert!(
+                (p - momentum_before).abs() < 1e-5,
+                "c_r {c_r}: momentum {p}"
+            );
         }
         assert!(touched, "the spheres must have collided");
         let relative_after = w.bodies.linear_velocity[1].x - w.bodies.linear_velocity[0].x;
@@ -115,15 +125,24 @@ fn sphere_resting_on_two_spheres() {
     let r = 0.5f32;
     // Particles (rotation locked) cannot roll, so ground friction holds the base.
     let left = w
-        .add_body(&sphere(BodyKind::Particle, r, Vec3::new(-r, r, 0.0)), &material(0.8, 0.0))
+        .add_body(
+            &sphere(BodyKind::Particle, r, Vec3::new(-r, r, 0.0)),
+            &material(0.8, 0.0),
+        )
         .unwrap();
     let right = w
-        .add_body(&sphere(BodyKind::Particle, r, Vec3::new(r, r, 0.0)), &material(0.8, 0.0))
+        .add_body(
+            &sphere(BodyKind::Particle, r, Vec3::new(r, r, 0.0)),
+            &material(0.8, 0.0),
+        )
         .unwrap();
     let top_y = r + 2.0 * r * (60f32.to_radians()).sin();
     // A frictionless top sphere makes the two contact forces statically determinate.
     let top = w
-        .add_body(&sphere(BodyKind::Dynamic, r, Vec3::new(0.0, top_y, 0.0)), &material(0.0, 0.0))
+        .add_body(
+            &sphere(BodyKind::Dynamic, r, Vec3::new(0.0, top_y, 0.0)),
+            &material(0.0, 0.0),
+        )
         .unwrap();
     let mass_top = w.bodies.mass(top);
     let mut depth_after_one_second = 0.0;
@@ -137,7 +156,9 @@ fn sphere_resting_on_two_spheres() {
         assert_eq!(top_contacts.len(), 2, "step {step}");
         for c in &top_contacts {
             assert!(c.normal_impulse >= 0.0);
-            assert!(c.body_a as usize == left || c.body_a as usize == right || c.body_a as usize == top);
+            assert!(
+                c.body_a as usize == left || c.body_a as usize == right || c.body_a as usize == top
+            );
         }
         if step == 60 {
             depth_after_one_second = w.diagnostics().max_depth;
@@ -157,10 +178,16 @@ fn sphere_resting_on_two_spheres() {
         }
     }
     let depth = w.diagnostics().max_depth;
-    assert!(depth <= depth_after_one_second + 1e-4, "overlap grew: {depth_after_one_second} → {depth}");
+    assert!(
+        depth <= depth_after_one_second + 1e-4,
+        "overlap grew: {depth_after_one_second} → {depth}"
+    );
     assert!(depth < 0.01);
     let top_y_now = w.bodies.pose[top].translation.y;
-    assert!((top_y_now - top_y).abs() < 0.01, "top sphere moved to {top_y_now}");
+    assert!(
+        (top_y_now - top_y).abs() < 0.01,
+        "top sphere moved to {top_y_now}"
+    );
 }
 
 /// The seed's "pulled apart" case: a body moving away from its contact is not held back (γ = 0).
@@ -170,9 +197,20 @@ fn body_moving_away_from_contact_is_not_held_back() {
     let mut w = world(g);
     ground(&mut w, 0.5);
     let lower = w
-        .add_body(&cuboid(BodyKind::Dynamic, Vec3::splat(0.5), Vec3::new(0.0, 0.5, 0.0)), &material(0.5, 0.0))
+        .add_body(
+            &cuboid(
+                BodyKind::Dynamic,
+                Vec3::splat(0.5),
+                Vec3::new(0.0, 0.5, 0.0),
+            ),
+            &material(0.5, 0.0),
+        )
         .unwrap();
-    let mut upper_desc = cuboid(BodyKind::Dynamic, Vec3::splat(0.5), Vec3::new(0.0, 1.5, 0.0));
+    let mut upper_desc = cuboid(
+        BodyKind::Dynamic,
+        Vec3::splat(0.5),
+        Vec3::new(0.0, 1.5, 0.0),
+    );
     upper_desc.linear_velocity = [0.0, 4.0, 0.0];
     let upper = w.add_body(&upper_desc, &material(0.5, 0.0)).unwrap();
     w.step().unwrap();
@@ -181,12 +219,18 @@ fn body_moving_away_from_contact_is_not_held_back() {
         .iter()
         .filter(|c| c.body_a as usize == upper && c.body_b as usize == lower)
         .collect();
-    assert!(!between.is_empty(), "the touching boxes must have contact rows");
+    assert!(
+        !between.is_empty(),
+        "the touching boxes must have contact rows"
+    );
     for c in between {
         assert_eq!(c.normal_impulse, 0.0);
     }
     let vy = w.bodies.linear_velocity[upper].y;
-    assert!((vy - (4.0 + g.y * DT)).abs() < 1e-5, "upper box held back: v = {vy}");
+    assert!(
+        (vy - (4.0 + g.y * DT)).abs() < 1e-5,
+        "upper box held back: v = {vy}"
+    );
     assert!(w.bodies.linear_velocity[lower].length() < 1e-3);
 }
 
@@ -196,7 +240,10 @@ fn box_resting_on_ground_does_not_drift_or_gain_energy() {
     ground(&mut w, 0.6);
     let start = Vec3::new(0.3, 0.5, -0.2);
     let b = w
-        .add_body(&cuboid(BodyKind::Dynamic, Vec3::splat(0.5), start), &material(0.6, 0.0))
+        .add_body(
+            &cuboid(BodyKind::Dynamic, Vec3::splat(0.5), start),
+            &material(0.6, 0.0),
+        )
         .unwrap();
     let mut largest_energy = 0.0f32;
     for _ in 0..600 {
@@ -207,7 +254,10 @@ fn box_resting_on_ground_does_not_drift_or_gain_energy() {
     assert!(drift < 1e-3, "drift {drift} m");
     // Energy of one step of gravity-induced velocity is m(g·dt)²/2 ≈ 0.013 J; anything above
     // means the contact pumps energy in.
-    assert!(largest_energy < 0.02, "kinetic energy reached {largest_energy} J");
+    assert!(
+        largest_energy < 0.02,
+        "kinetic energy reached {largest_energy} J"
+    );
     let angle = w.bodies.pose[b].rotation.angle_between(Quat::IDENTITY);
     assert!(angle < 1e-3);
 }
@@ -250,7 +300,11 @@ fn box_on_incline_sticks_or_slides_by_coulomb() {
                 "θ = {theta_deg}°: acceleration {measured}, expected {expected}"
             );
         } else {
-            assert!((x1 - x0).abs() < 1e-3, "θ = {theta_deg}°: slid {} m", x1 - x0);
+            assert!(
+                (x1 - x0).abs() < 1e-3,
+                "θ = {theta_deg}°: slid {} m",
+                x1 - x0
+            );
             assert!(v1.abs() < 1e-3);
         }
     }
@@ -273,17 +327,29 @@ fn pile_of_spheres_satisfies_complementarity_at_exit() {
     ground(&mut w, 0.0);
     // Walls keep the frictionless pile together.
     for (x, z) in [(2.6, 0.0), (-2.6, 0.0), (0.0, 2.6), (0.0, -2.6)] {
-        let half = if x != 0.0 { Vec3::new(0.5, 3.0, 3.0) } else { Vec3::new(3.0, 3.0, 0.5) };
-        w.add_body(&cuboid(BodyKind::Static, half, Vec3::new(x, 3.0, z)), &material(0.0, 0.0))
-            .unwrap();
+        let half = if x != 0.0 {
+            Vec3::new(0.5, 3.0, 3.0)
+        } else {
+            Vec3::new(3.0, 3.0, 0.5)
+        };
+        w.add_body(
+            &cuboid(BodyKind::Static, half, Vec3::new(x, 3.0, z)),
+            &material(0.0, 0.0),
+        )
+        .unwrap();
     }
     let mut count = 0;
     for layer in 0..4 {
         for i in 0..4 {
             for k in 0..4 {
                 let jitter = 0.05 * ((i * 7 + k * 3 + layer) % 5) as f32;
-                let p = Vec3::new(-1.5 + i as f32 + jitter, 0.5 + 1.05 * layer as f32, -1.5 + k as f32);
-                w.add_body(&sphere(BodyKind::Dynamic, 0.45, p), &material(0.0, 0.0)).unwrap();
+                let p = Vec3::new(
+                    -1.5 + i as f32 + jitter,
+                    0.5 + 1.05 * layer as f32,
+                    -1.5 + k as f32,
+                );
+                w.add_body(&sphere(BodyKind::Dynamic, 0.45, p), &material(0.0, 0.0))
+                    .unwrap();
                 count += 1;
             }
         }
