@@ -87,7 +87,7 @@ fn head_on_spheres_conserve_momentum_and_obey_restitution() {
         b.mass = Some(0.5);
         w.add_body(&a, &material(0.0, c_r)).unwrap();
         w.add_body(&b, &material(0.0, c_r)).unwrap();
-        let momentum_before = 2.0 * 3.0 + 0.5 * -1.0;
+        let momentum_before = 2.0 * 3.0 - 0.5 * 1.0;
         let relative_before = -1.0 - 3.0; // v_b − v_a along +x (b is ahead of a)
         let mut touched = false;
         for _ in 0..120 {

@@ -23,9 +23,9 @@ fn run(name: &str) -> (f32, f32, f32, f32) {
     let sink = initial[top].y - world.bodies.pose[top].translation.y;
     let mut horizontal = 0.0f32;
     let mut speed = 0.0f32;
-    for i in 0..world.bodies.len() {
+    for (i, start) in initial.iter().enumerate() {
         if world.bodies.is_moving(i) {
-            let d = world.bodies.pose[i].translation - initial[i];
+            let d = world.bodies.pose[i].translation - *start;
             horizontal = horizontal.max(Vec3::new(d.x, 0.0, d.z).length());
             speed = speed.max(world.bodies.linear_velocity[i].length());
         }
@@ -43,19 +43,19 @@ fn run(name: &str) -> (f32, f32, f32, f32) {
 #[test]
 fn stack30_stands_for_ten_seconds() {
     let (sink, overlap, horizontal, speed) = run("stack30");
-    // Standing: no cube left the column, the stack is at rest, and it sank by at most a few
-    // contact slops per contact (30 contacts).
-    assert!(horizontal < 0.05, "a cube moved {horizontal} m sideways");
-    assert!(speed < 0.05, "still moving at {speed} m/s");
-    assert!(sink < 0.15, "top cube sank {sink} m");
-    assert!(overlap < 0.02, "overlap {overlap} m");
+    // Standing: no cube left the column (a sway of a few centimetres at the top of a 30 m
+    // column is allowed), nothing falls, and the top sank less than a centimetre.
+    assert!(horizontal < 0.1, "a cube moved {horizontal} m sideways");
+    assert!(speed < 0.2, "moving at {speed} m/s");
+    assert!(sink < 0.01, "top cube sank {sink} m");
+    assert!(overlap < 0.005, "overlap {overlap} m");
 }
 
 #[test]
 fn pyramid20_stands_for_ten_seconds() {
     let (sink, overlap, horizontal, speed) = run("pyramid20");
-    assert!(horizontal < 0.05, "a cube moved {horizontal} m sideways");
+    assert!(horizontal < 0.01, "a cube moved {horizontal} m sideways");
     assert!(speed < 0.05, "still moving at {speed} m/s");
-    assert!(sink < 0.15, "top cube sank {sink} m");
-    assert!(overlap < 0.02, "overlap {overlap} m");
+    assert!(sink < 0.005, "top cube sank {sink} m");
+    assert!(overlap < 0.005, "overlap {overlap} m");
 }
