@@ -12,6 +12,7 @@ use clap::{Parser, Subcommand};
 use impulse::Scene;
 use impulse::scene::builtin::{builtin_names, builtin_scene};
 use impulse::scene::json::{load_scene_file, to_json_string};
+use impulse::settings::SolverMethod;
 
 /// Simultaneous contact resolution for animation: piles, stacks and pyramids solved as one
 /// linear complementarity problem per step.
@@ -34,9 +35,18 @@ enum Command {
         /// Time step in seconds (default: the scene's).
         #[arg(long)]
         dt: Option<f32>,
-        /// PGS sweeps per step at most (default: the scene's solver settings).
+        /// Solver iterations per substep at most (default: the scene's solver settings).
         #[arg(long)]
         iterations: Option<u32>,
+        /// Substeps per step (default: the scene's solver settings).
+        #[arg(long)]
+        substeps: Option<u32>,
+        /// Relax iterations per substep (default: the scene's solver settings).
+        #[arg(long)]
+        relax: Option<u32>,
+        /// Iterative method: pgs or nncg (default: the scene's solver settings).
+        #[arg(long)]
+        method: Option<String>,
         /// Trajectory file: `.csv` (frame,time,body,x,y,z,qx,qy,qz,qw) or `.jsonl`.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -126,12 +136,28 @@ fn real_main() -> Result<ExitCode> {
             steps,
             dt,
             iterations,
+            substeps,
+            relax,
+            method,
             out,
             every,
             summary_json,
             quiet,
         } => {
-            let scene = resolve_scene(&scene)?;
+            let mut scene = resolve_scene(&scene)?;
+            if let Some(substeps) = substeps {
+                scene.solver.substeps = substeps;
+            }
+            if let Some(relax) = relax {
+                scene.solver.relax_iterations = relax;
+            }
+            if let Some(method) = method {
+                scene.solver.method = match method.as_str() {
+                    "pgs" => SolverMethod::Pgs,
+                    "nncg" => SolverMethod::Nncg,
+                    other => bail!("unknown method '{other}': expected pgs or nncg"),
+                };
+            }
             let options = run::RunOptions {
                 steps,
                 dt,

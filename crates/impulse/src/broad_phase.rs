@@ -16,12 +16,14 @@ pub struct BroadPhase {
 const WORLD_BOUND: f32 = 1.0e6;
 
 impl BroadPhase {
-    /// Candidate pairs `(i, j)` with `i < j`, sorted, at least one of them moving. Boxes are
-    /// loosened by `margin` (m) so that speculative contacts within it are found.
-    pub fn candidate_pairs(&mut self, bodies: &Bodies, margin: f32, out: &mut Vec<(u32, u32)>) {
+    /// Candidate pairs `(i, j)` with `i < j`, sorted, at least one of them moving. Body i's box
+    /// is loosened by `margins[i]` (m), or by 0 when `margins` is empty, so that speculative
+    /// contacts within the margins are found.
+    pub fn candidate_pairs(&mut self, bodies: &Bodies, margins: &[f32], out: &mut Vec<(u32, u32)>) {
         out.clear();
         self.aabbs.clear();
         for i in 0..bodies.len() {
+            let margin = margins.get(i).copied().unwrap_or(0.0);
             let mut aabb = bodies.shape[i]
                 .compute_aabb(&bodies.pose[i])
                 .loosened(margin);

@@ -13,7 +13,7 @@ use crate::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{self, StepDiagnostics};
 use crate::error::{StepError, WorldError};
 use crate::integrate;
-use crate::narrow_phase::{ContactImpulse, NarrowPhase};
+use crate::narrow_phase::{self, ContactImpulse, NarrowPhase};
 use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverMethod;
 use crate::settings::SolverSettings;
@@ -43,6 +43,7 @@ pub struct World {
     rotation: Vec<Vec3>,
     scratch: Vec<(Vec3, Vec3)>,
     nncg: NncgWorkspace,
+    margins: Vec<f32>,
     diagnostics: StepDiagnostics,
 }
 
@@ -65,6 +66,7 @@ impl World {
             rotation: Vec::new(),
             scratch: Vec::new(),
             nncg: NncgWorkspace::default(),
+            margins: Vec::new(),
             diagnostics: StepDiagnostics::default(),
         };
         world.check_settings()?;
@@ -164,11 +166,17 @@ impl World {
         self.step_count += 1;
 
         // Stages 2–4 once per step, on the poses and velocities at its start.
-        let margin = settings.prediction_distance;
+        narrow_phase::speculative_margins(
+            &self.bodies,
+            settings.prediction_distance,
+            self.gravity,
+            dt,
+            &mut self.margins,
+        );
         self.broad_phase
-            .candidate_pairs(&self.bodies, margin, &mut self.candidates);
+            .candidate_pairs(&self.bodies, &self.margins, &mut self.candidates);
         self.narrow_phase
-            .update(&self.bodies, &self.candidates, settings.prediction_distance)?;
+            .update(&self.bodies, &self.candidates, &self.margins)?;
         self.update_world_inverse_inertia();
         constraints::assemble(
             &self.bodies,
