@@ -47,6 +47,12 @@ enum Command {
         /// Iterative method: pgs or nncg (default: the scene's solver settings).
         #[arg(long)]
         method: Option<String>,
+        /// Worker threads (default: all cores); 1 runs everything on the calling thread.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Keep every body awake (no sleeping of quiet islands), as benchmarks do.
+        #[arg(long)]
+        no_sleep: bool,
         /// Trajectory file: `.csv` (frame,time,body,x,y,z,qx,qy,qz,qw) or `.jsonl`.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -98,6 +104,31 @@ enum LcpCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// Write the contact LCP of a real step (seed convention, JSON).
+    Dump {
+        /// Built-in name or JSON scene file.
+        scene: String,
+        /// The step whose LCP is written (steps are counted from 1).
+        #[arg(long, default_value_t = 100)]
+        step: u64,
+        /// Output file (.json).
+        #[arg(long)]
+        out: PathBuf,
+        /// Turn friction off so the problem is a standard LCP (Lemke can solve it).
+        #[arg(long)]
+        no_friction: bool,
+    },
+    /// Plot residual against iteration for PGS, projected Jacobi and Lemke (SVG).
+    Convergence {
+        /// LCP file: Siconos `.dat` or impulse `.json`.
+        file: PathBuf,
+        /// Iterations of the iterative solvers.
+        #[arg(long, default_value_t = 200)]
+        iterations: usize,
+        /// Output SVG file.
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 /// A built-in name or a path to a JSON scene file.
@@ -139,6 +170,8 @@ fn real_main() -> Result<ExitCode> {
             substeps,
             relax,
             method,
+            threads,
+            no_sleep,
             out,
             every,
             summary_json,
@@ -150,6 +183,9 @@ fn real_main() -> Result<ExitCode> {
             }
             if let Some(relax) = relax {
                 scene.solver.relax_iterations = relax;
+            }
+            if no_sleep {
+                scene.solver.sleep = false;
             }
             if let Some(method) = method {
                 scene.solver.method = match method.as_str() {
@@ -166,6 +202,7 @@ fn real_main() -> Result<ExitCode> {
                 every,
                 summary_json,
                 quiet,
+                threads,
             };
             let summary = run::run(scene, &options)?;
             println!("{}", summary.line());
@@ -205,6 +242,17 @@ fn real_main() -> Result<ExitCode> {
                     return Ok(ExitCode::FAILURE);
                 }
             }
+            LcpCommand::Dump {
+                scene,
+                step,
+                out,
+                no_friction,
+            } => lcp_command::dump(resolve_scene(&scene)?, step, &out, no_friction)?,
+            LcpCommand::Convergence {
+                file,
+                iterations,
+                out,
+            } => lcp_command::convergence(&file, iterations, &out)?,
         },
     }
     Ok(ExitCode::SUCCESS)

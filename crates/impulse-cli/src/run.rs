@@ -19,6 +19,8 @@ pub struct RunOptions {
     pub every: u32,
     pub summary_json: Option<PathBuf>,
     pub quiet: bool,
+    /// Worker threads; `None` = all cores, 1 = none (everything on the calling thread).
+    pub threads: Option<usize>,
 }
 
 /// What a run measured. Overlap and sink are measured from poses (DESIGN.md "Metrics").
@@ -48,6 +50,10 @@ pub struct Summary {
     /// Natural-map residual of the last step.
     pub final_natural_map_residual: f32,
     pub iterations_limit: u32,
+    /// Worker threads the run used (1 = the calling thread only).
+    pub threads: usize,
+    /// Whether quiet islands were allowed to sleep.
+    pub sleep: bool,
     /// `completed`, or the error that stopped the run.
     pub status: String,
 }
@@ -81,7 +87,19 @@ const OVERLAP_SAMPLE_EVERY: u64 = 10;
 
 /// Runs `scene` under `options`. A blow-up stops the run: the frames written so far stay on
 /// disk, the summary (with `status` naming the step) is still written, and the error returns.
-pub fn run(mut scene: Scene, options: &RunOptions) -> Result<Summary> {
+pub fn run(scene: Scene, options: &RunOptions) -> Result<Summary> {
+    match options.threads {
+        Some(1) => run_on_this_thread(scene, options, false),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .context("cannot start the worker threads")?
+            .install(|| run_on_this_thread(scene, options, true)),
+        None => run_on_this_thread(scene, options, true),
+    }
+}
+
+fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<Summary> {
     if let Some(dt) = options.dt {
         scene.dt = dt;
     }
@@ -91,6 +109,7 @@ pub fn run(mut scene: Scene, options: &RunOptions) -> Result<Summary> {
     let steps = options.steps.unwrap_or(scene.steps) as u64;
     let every = options.every.max(1) as u64;
     let mut world = World::from_scene(&scene).context("cannot build the world")?;
+    world.parallel = parallel;
     let mut writer = match &options.out {
         Some(path) => Some(TrajectoryWriter::create(path)?),
         None => None,
@@ -176,6 +195,12 @@ pub fn run(mut scene: Scene, options: &RunOptions) -> Result<Summary> {
         max_natural_map_residual: max_residual,
         final_natural_map_residual: world.diagnostics().natural_map_residual,
         iterations_limit: scene.solver.iterations,
+        threads: if parallel {
+            rayon::current_num_threads()
+        } else {
+            1
+        },
+        sleep: scene.solver.sleep,
         status,
     };
     if let Some(path) = &options.summary_json {

@@ -34,6 +34,10 @@ pub struct Bodies {
     pub friction: Vec<f32>,
     /// Restitution coefficient c_r.
     pub restitution: Vec<f32>,
+    /// Asleep: skipped by the step until something awake touches its island.
+    pub asleep: Vec<bool>,
+    /// How long (s) the body has been below the sleep thresholds.
+    pub sleep_time: Vec<f32>,
 }
 
 impl Bodies {
@@ -45,6 +49,11 @@ impl Bodies {
     /// True when there are no bodies.
     pub fn is_empty(&self) -> bool {
         self.kind.is_empty()
+    }
+
+    /// True for moving bodies that are awake: the ones the step simulates.
+    pub fn is_awake(&self, i: usize) -> bool {
+        self.kind[i] != BodyKind::Static && !self.asleep[i]
     }
 
     /// True for bodies that move (dynamic rigid bodies and particles).

@@ -82,6 +82,11 @@ pub struct ContactConstraint {
     pub body_a: u32,
     /// The other body.
     pub body_b: u32,
+    /// A's index in its island's local arrays (set by [`crate::island`]); static bodies map to
+    /// the island's immovable slot.
+    pub local_a: u32,
+    /// B's index in its island's local arrays.
+    pub local_b: u32,
     /// 1/m_a and 1/m_b (1/kg).
     pub inverse_mass_a: f32,
     /// See `inverse_mass_a`.
@@ -205,6 +210,8 @@ pub fn assemble(
                 out.push(ContactConstraint {
                     body_a: a as u32,
                     body_b: b as u32,
+                    local_a: 0,
+                    local_b: 0,
                     inverse_mass_a,
                     inverse_mass_b,
                     normal: normal_row,
@@ -311,7 +318,7 @@ pub fn update_targets(
         (settings.overlap_repair_rate, (1.0, 0.0))
     };
     for c in constraints.iter_mut() {
-        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let (a, b) = (c.local_a as usize, c.local_b as usize);
         let moved = (displacement[a] + rotation[a].cross(c.lever_a))
             - (displacement[b] + rotation[b].cross(c.lever_b));
         let separation = -c.depth + c.normal.direction.dot(moved);

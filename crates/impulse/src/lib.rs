@@ -14,6 +14,7 @@ pub mod contact_lcp;
 pub mod diagnostics;
 pub mod error;
 pub mod integrate;
+pub mod island;
 pub mod metrics;
 pub mod narrow_phase;
 pub mod scene;

@@ -10,6 +10,7 @@ use glam::Vec3;
 use parry3d::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
+use rayon::prelude::*;
 
 use crate::body::Bodies;
 use crate::error::StepError;
@@ -102,24 +103,30 @@ impl NarrowPhase {
         bodies: &Bodies,
         candidates: &[(u32, u32)],
         margins: &[f32],
+        parallel: bool,
     ) -> Result<(), StepError> {
         self.previous.clear();
         for pair in self.pairs.drain(..) {
             self.previous.insert((pair.body1, pair.body2), pair);
         }
-        let dispatcher = DefaultQueryDispatcher;
         for &(i, j) in candidates {
-            let mut pair = self.previous.remove(&(i, j)).unwrap_or(ContactPair {
+            let pair = self.previous.remove(&(i, j)).unwrap_or(ContactPair {
                 body1: i,
                 body2: j,
                 manifolds: Vec::new(),
                 workspace: None,
             });
-            let (a, b) = (i as usize, j as usize);
+            self.pairs.push(pair);
+        }
+        let update = |pair: &mut ContactPair| -> Result<(), StepError> {
+            let (a, b) = (pair.body1 as usize, pair.body2 as usize);
+            // A pair with no awake body keeps its manifolds as they were: nothing moved.
+            if !bodies.is_awake(a) && !bodies.is_awake(b) {
+                return Ok(());
+            }
             let prediction = margins[a] + margins[b];
             let pos12 = bodies.pose[a].inv_mul(&bodies.pose[b]);
-
-            dispatcher
+            DefaultQueryDispatcher
                 .contact_manifolds(
                     &pos12,
                     bodies.shape[a].as_ref(),
@@ -128,14 +135,16 @@ impl NarrowPhase {
                     &mut pair.manifolds,
                     &mut pair.workspace,
                 )
-                .map_err(|_| StepError::UnsupportedShapePair { body1: a, body2: b })?;
-            if pair.point_count() > 0 {
-                self.pairs.push(pair);
-            } else if !pair.manifolds.is_empty() {
-                // Keep the (empty) pair so a returning contact can reuse its workspace.
-                self.pairs.push(pair);
-            }
+                .map_err(|_| StepError::UnsupportedShapePair { body1: a, body2: b })
+        };
+        if parallel && rayon::current_num_threads() > 1 {
+            self.pairs.par_iter_mut().try_for_each(update)?;
+        } else {
+            self.pairs.iter_mut().try_for_each(update)?;
         }
+        // Pairs whose manifolds Parry emptied are kept for their workspace; pairs Parry never
+        // gave a manifold are dropped.
+        self.pairs.retain(|p| !p.manifolds.is_empty());
         Ok(())
     }
 

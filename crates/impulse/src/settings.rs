@@ -60,6 +60,14 @@ pub struct SolverSettings {
     /// Contacts are generated up to this separation (m) ahead of touching ("speculative"
     /// contacts): a row with gap g > 0 only forbids closing faster than g/dt.
     pub prediction_distance: f32,
+    /// Let quiet islands sleep (DESIGN.md step 6). Off for benchmarks.
+    pub sleep: bool,
+    /// A body slower than this (m/s) …
+    pub sleep_linear_speed: f32,
+    /// … and spinning slower than this (rad/s) counts as quiet.
+    pub sleep_angular_speed: f32,
+    /// An island sleeps when all its bodies have been quiet this long (s).
+    pub time_to_sleep: f32,
     /// Apply Coulomb friction rows (two tangents per point, |γ_t| ≤ μ·γ_n).
     pub friction: bool,
 }
@@ -80,6 +88,10 @@ impl Default for SolverSettings {
             max_repair_speed: 1.0,
             warm_start: 1.0,
             prediction_distance: 0.02,
+            sleep: true,
+            sleep_linear_speed: 0.05,
+            sleep_angular_speed: 2.0f32.to_radians(),
+            time_to_sleep: 0.5,
             friction: true,
         }
     }

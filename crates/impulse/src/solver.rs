@@ -10,8 +10,9 @@ use glam::Vec3;
 
 use crate::constraints::{ContactConstraint, JacobianRow};
 
-/// Velocities the solver updates in place, indexed by body (static bodies have zero inverse
-/// mass and inertia, so their updates are exact no-ops).
+/// Velocities the solver updates in place: an island's local arrays, indexed by the
+/// constraints' `local_a`/`local_b` (static bodies share an immovable slot; their zero inverse
+/// mass and inertia make its updates exact no-ops).
 pub struct Velocities<'a> {
     /// Linear velocities (m/s).
     pub linear: &'a mut [Vec3],
@@ -35,7 +36,7 @@ fn apply(
     impulse: f32,
     velocities: &mut Velocities<'_>,
 ) {
-    let (a, b) = (constraint.body_a as usize, constraint.body_b as usize);
+    let (a, b) = (constraint.local_a as usize, constraint.local_b as usize);
     velocities.linear[a] += row.direction * (constraint.inverse_mass_a * impulse);
     velocities.angular[a] += row.inverse_inertia_angular_a * impulse;
     velocities.linear[b] -= row.direction * (constraint.inverse_mass_b * impulse);
@@ -48,7 +49,7 @@ fn row_velocity(
     constraint: &ContactConstraint,
     velocities: &Velocities<'_>,
 ) -> f32 {
-    let (a, b) = (constraint.body_a as usize, constraint.body_b as usize);
+    let (a, b) = (constraint.local_a as usize, constraint.local_b as usize);
     row.velocity(
         velocities.linear[a],
         velocities.angular[a],

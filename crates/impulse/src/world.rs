@@ -12,12 +12,12 @@ use crate::constraints::{self, ContactConstraint};
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{self, StepDiagnostics};
 use crate::error::{StepError, WorldError};
-use crate::integrate;
+use crate::island::{self, IslandWorkspace, Islands, StepContext};
 use crate::narrow_phase::{self, ContactImpulse, NarrowPhase};
 use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
-use crate::settings::SolverMethod;
 use crate::settings::SolverSettings;
-use crate::solver::{self, NncgWorkspace, Velocities};
+use crate::solver;
+use rayon::prelude::*;
 
 /// A body further than this from the origin (m) means the simulation has blown up.
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
@@ -39,11 +39,14 @@ pub struct World {
     candidates: Vec<(u32, u32)>,
     constraints: Vec<ContactConstraint>,
     world_inverse_inertia: Vec<Mat3>,
-    displacement: Vec<Vec3>,
-    rotation: Vec<Vec3>,
     scratch: Vec<(Vec3, Vec3)>,
-    nncg: NncgWorkspace,
     margins: Vec<f32>,
+    islands: Islands,
+    island_awake: Vec<bool>,
+    workspaces: Vec<IslandWorkspace>,
+    /// Run islands (and the narrow phase) on rayon's thread pool when it has more than one
+    /// thread. `false` runs everything on the calling thread.
+    pub parallel: bool,
     diagnostics: StepDiagnostics,
 }
 
@@ -62,11 +65,12 @@ impl World {
             candidates: Vec::new(),
             constraints: Vec::new(),
             world_inverse_inertia: Vec::new(),
-            displacement: Vec::new(),
-            rotation: Vec::new(),
             scratch: Vec::new(),
-            nncg: NncgWorkspace::default(),
             margins: Vec::new(),
+            islands: Islands::default(),
+            island_awake: Vec::new(),
+            workspaces: Vec::new(),
+            parallel: true,
             diagnostics: StepDiagnostics::default(),
         };
         world.check_settings()?;
@@ -114,6 +118,8 @@ impl World {
         b.shape.push(built.shape);
         b.friction.push(material.friction);
         b.restitution.push(material.restitution);
+        b.asleep.push(false);
+        b.sleep_time.push(0.0);
         Ok(index)
     }
 
@@ -176,7 +182,7 @@ impl World {
         self.broad_phase
             .candidate_pairs(&self.bodies, &self.margins, &mut self.candidates);
         self.narrow_phase
-            .update(&self.bodies, &self.candidates, &self.margins)?;
+            .update(&self.bodies, &self.candidates, &self.margins, self.parallel)?;
         self.update_world_inverse_inertia();
         constraints::assemble(
             &self.bodies,
@@ -187,78 +193,59 @@ impl World {
         );
         solver::scale_impulses(&mut self.constraints, settings.warm_start);
 
-        // Stages 1, 5 and 6 per substep.
-        let n = self.bodies.len();
-        self.displacement.clear();
-        self.displacement.resize(n, Vec3::ZERO);
-        self.rotation.clear();
-        self.rotation.resize(n, Vec3::ZERO);
-        let h = dt / settings.substeps as f32;
+        // Stages 1, 5 and 6 per island: each island's substep loop touches only its bodies.
+        self.islands.build(&self.bodies, &mut self.constraints);
+        let islands = self.islands.len();
+        self.wake_or_skip_islands();
+        if self.workspaces.len() < islands {
+            self.workspaces
+                .resize_with(islands, IslandWorkspace::default);
+        }
+        {
+            let context = StepContext {
+                bodies: &self.bodies,
+                gravity: self.gravity,
+                dt,
+                settings: &settings,
+            };
+            let mut jobs = Vec::with_capacity(islands);
+            let mut rest: &mut [ContactConstraint] = &mut self.constraints;
+            for ((k, workspace), awake) in self
+                .workspaces
+                .iter_mut()
+                .enumerate()
+                .take(islands)
+                .zip(&self.island_awake)
+            {
+                let (mine, others) = rest.split_at_mut(self.islands.constraint_range(k).len());
+                rest = others;
+                if *awake {
+                    jobs.push((self.islands.bodies(k), mine, workspace));
+                }
+            }
+            let run = |(bodies, constraints, workspace): &mut (
+                &[u32],
+                &mut [ContactConstraint],
+                &mut IslandWorkspace,
+            )| island::step_island(bodies, constraints, &context, workspace);
+            if self.parallel && jobs.len() > 1 && rayon::current_num_threads() > 1 {
+                jobs.par_iter_mut().for_each(run);
+            } else {
+                jobs.iter_mut().for_each(run);
+            }
+        }
         let mut iterations = 0;
-        for _ in 0..settings.substeps {
-            integrate::prospective_velocities(&mut self.bodies, self.gravity, h);
-            let mut velocities = Velocities {
-                linear: &mut self.bodies.linear_velocity,
-                angular: &mut self.bodies.angular_velocity,
-            };
-            solver::warm_start(&self.constraints, &mut velocities);
-            constraints::update_targets(
-                &mut self.constraints,
-                &self.displacement,
-                &self.rotation,
-                &settings,
-                h,
-                true,
-            );
-            iterations += solve(
-                &mut self.constraints,
-                &settings,
-                settings.iterations,
-                &mut velocities,
-                &mut self.nncg,
-            );
-            for i in 0..n {
-                self.displacement[i] += self.bodies.linear_velocity[i] * h;
-                self.rotation[i] += self.bodies.angular_velocity[i] * h;
-            }
-            integrate::integrate_positions(&mut self.bodies, h);
-            if settings.relax_iterations > 0 {
-                constraints::update_targets(
-                    &mut self.constraints,
-                    &self.displacement,
-                    &self.rotation,
-                    &settings,
-                    h,
-                    false,
+        for k in 0..islands {
+            if self.island_awake[k] {
+                island::scatter(
+                    self.islands.bodies(k),
+                    &self.workspaces[k],
+                    &mut self.bodies,
                 );
-                let mut velocities = Velocities {
-                    linear: &mut self.bodies.linear_velocity,
-                    angular: &mut self.bodies.angular_velocity,
-                };
-                iterations += solve(
-                    &mut self.constraints,
-                    &settings,
-                    settings.relax_iterations,
-                    &mut velocities,
-                    &mut self.nncg,
-                );
+                iterations = iterations.max(self.workspaces[k].iterations);
             }
         }
-        // Restitution after the substeps (the seed's v⁺ = −c_r·v⁻ with v⁻ from the start of
-        // the step), for the points that collided.
-        if constraints::restitution_targets(&mut self.constraints, settings.restitution_threshold) {
-            let mut velocities = Velocities {
-                linear: &mut self.bodies.linear_velocity,
-                angular: &mut self.bodies.angular_velocity,
-            };
-            iterations += solve(
-                &mut self.constraints,
-                &settings,
-                settings.iterations.max(settings.relax_iterations),
-                &mut velocities,
-                &mut self.nncg,
-            );
-        }
+        self.update_sleep(dt);
         constraints::record_velocity_before(
             &mut self.constraints,
             &self.bodies.linear_velocity,
@@ -266,11 +253,19 @@ impl World {
             &mut self.scratch,
         );
         self.store_impulses();
-        let residual = diagnostics::natural_map_residual(
-            &self.constraints,
-            &self.bodies.linear_velocity,
-            &self.bodies.angular_velocity,
-        );
+        // Only awake islands were solved this step; sleeping ones keep last step's state.
+        let mut squared = 0.0f64;
+        for k in 0..islands {
+            if self.island_awake[k] {
+                let part = diagnostics::natural_map_residual(
+                    &self.constraints[self.islands.constraint_range(k)],
+                    &self.bodies.linear_velocity,
+                    &self.bodies.angular_velocity,
+                ) as f64;
+                squared += part * part;
+            }
+        }
+        let residual = squared.sqrt() as f32;
 
         let (kinetic_energy, momentum) = diagnostics::energy_and_momentum(&self.bodies);
         let friction_rows = self.constraints.iter().filter(|c| c.friction > 0.0).count();
@@ -292,6 +287,67 @@ impl World {
         };
         self.check_blow_up()?;
         Ok(&self.diagnostics)
+    }
+
+    /// Wakes the whole body `i` belongs to (its island wakes with it at the next step). Call
+    /// after changing a sleeping body's velocity or pose by hand.
+    pub fn wake_up(&mut self, i: usize) {
+        if i < self.bodies.len() {
+            self.bodies.asleep[i] = false;
+            self.bodies.sleep_time[i] = 0.0;
+        }
+    }
+
+    /// Marks which islands run this step: an island with any awake body runs and wakes all its
+    /// bodies (a sleeping pile hit by an awake body wakes whole); an island whose bodies are all
+    /// asleep is skipped.
+    fn wake_or_skip_islands(&mut self) {
+        self.island_awake.clear();
+        for k in 0..self.islands.len() {
+            let bodies = self.islands.bodies(k);
+            let awake = bodies.iter().any(|&i| !self.bodies.asleep[i as usize]);
+            if awake {
+                for &i in bodies {
+                    if self.bodies.asleep[i as usize] {
+                        self.bodies.asleep[i as usize] = false;
+                        self.bodies.sleep_time[i as usize] = 0.0;
+                    }
+                }
+            }
+            self.island_awake.push(awake);
+        }
+    }
+
+    /// Puts an island to sleep once every body in it has been slower than the thresholds for
+    /// `sleep_time` seconds (Box2D's rule); its velocities are zeroed and it costs nothing
+    /// until something touches it.
+    fn update_sleep(&mut self, dt: f32) {
+        let s = &self.settings;
+        for k in 0..self.islands.len() {
+            if !self.island_awake[k] {
+                continue;
+            }
+            let mut quiet_for = f32::INFINITY;
+            for &i in self.islands.bodies(k) {
+                let i = i as usize;
+                let quiet = self.bodies.linear_velocity[i].length() < s.sleep_linear_speed
+                    && self.bodies.angular_velocity[i].length() < s.sleep_angular_speed;
+                self.bodies.sleep_time[i] = if quiet {
+                    self.bodies.sleep_time[i] + dt
+                } else {
+                    0.0
+                };
+                quiet_for = quiet_for.min(self.bodies.sleep_time[i]);
+            }
+            if s.sleep && quiet_for >= s.time_to_sleep {
+                for &i in self.islands.bodies(k) {
+                    let i = i as usize;
+                    self.bodies.asleep[i] = true;
+                    self.bodies.linear_velocity[i] = Vec3::ZERO;
+                    self.bodies.angular_velocity[i] = Vec3::ZERO;
+                }
+            }
+        }
     }
 
     fn update_world_inverse_inertia(&mut self) {
@@ -392,31 +448,6 @@ impl World {
             ));
         }
         Ok(())
-    }
-}
-
-/// Runs the configured method for at most `iterations`; returns the iterations used.
-fn solve(
-    constraints: &mut [ContactConstraint],
-    settings: &SolverSettings,
-    iterations: u32,
-    velocities: &mut Velocities<'_>,
-    workspace: &mut NncgWorkspace,
-) -> u32 {
-    match settings.method {
-        SolverMethod::Pgs => {
-            solver::solve_pgs(constraints, iterations, settings.tolerance, velocities).iterations
-        }
-        SolverMethod::Nncg => {
-            solver::solve_nncg(
-                constraints,
-                iterations,
-                settings.tolerance,
-                velocities,
-                workspace,
-            )
-            .iterations
-        }
     }
 }
 

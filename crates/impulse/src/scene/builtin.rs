@@ -3,9 +3,16 @@
 //!
 //! Common to all: body 0 is the ground, a static cuboid of half extents (150, 0.5, 150) at
 //! (0, −0.5, 0), so its top face is y = 0; gravity (0, −9.81, 0); dt = 1/60 s; 600 steps;
-//! default solver settings; every body uses the scene's `"default"` material, which the scene
-//! defines (cubes: friction 0.6, restitution 0, density 1000; balls: friction 0.3).
-//! Coordinates are computed in f64 from integers and rounded once to f32.
+//! default solver settings; the bodies use the scene's `"default"` material, which the scene
+//! defines (cubes: friction 0.6, restitution 0, density 1000; balls and `vertical_stack15`:
+//! friction 0.3; `card_house`: friction 0.7), except the heavy cubes of the mass-ratio scenes
+//! (material `"heavy"`).
+//! Coordinates are computed in f64 from integers (and, for `card_house` and `arch`, sines and
+//! cosines) and rounded once to f32.
+//!
+//! The scenes whose names `builtin_names` marks "Solver2D" rebuild in 3D the 2D solver test
+//! suite of Erin Catto's Solver2D (vertical stack, mass-ratio pyramids, plate, card house, arch,
+//! overlap recovery); `docs/scenes.md` says how each was carried over to 3D.
 
 use std::collections::BTreeMap;
 
@@ -66,6 +73,38 @@ const NAMES: &[(&str, &str)] = &[
         "balls64k",
         "64000 balls (40x40x40 grid) dropped into a walled box",
     ),
+    (
+        "vertical_stack15",
+        "Solver2D: 15 cubes, alternately offset 1 cm in x, friction 0.3",
+    ),
+    (
+        "mass_ratio_pyramid100",
+        "Solver2D: pyramid of base 10 (55 cubes), top cube 100 times denser",
+    ),
+    (
+        "mass_ratio_pyramid200",
+        "Solver2D: pyramid of base 10 (55 cubes), top cube 200 times denser",
+    ),
+    (
+        "mass_ratio_pyramid300",
+        "Solver2D: pyramid of base 10 (55 cubes), top cube 300 times denser",
+    ),
+    (
+        "plate",
+        "Solver2D: 20x1x20 m plate on two cubes, mass ratio 400:1",
+    ),
+    (
+        "card_house",
+        "Solver2D: two-level house of 8 thin cards (A-frames + flat cards)",
+    ),
+    (
+        "arch",
+        "Solver2D: semicircular arch of 13 convex-hull voussoirs",
+    ),
+    (
+        "overlap_pyramid",
+        "Solver2D: pyramid of base 10 (55 cubes) started 25% overlapping",
+    ),
 ];
 
 /// The named standard scenes as (name, one-line description). [`builtin_scene`] also accepts
@@ -87,8 +126,17 @@ pub fn builtin_names() -> &'static [(&'static str, &'static str)] {
 ///
 /// Numbers are plain decimal without leading zeros (`stack030` is not a scene).
 pub fn builtin_scene(name: &str) -> Option<Scene> {
-    if name == "massratio" {
-        return Some(massratio());
+    match name {
+        "massratio" => return Some(massratio()),
+        "vertical_stack15" => return Some(vertical_stack(name, 15)),
+        "mass_ratio_pyramid100" => return Some(mass_ratio_pyramid(name, 100)),
+        "mass_ratio_pyramid200" => return Some(mass_ratio_pyramid(name, 200)),
+        "mass_ratio_pyramid300" => return Some(mass_ratio_pyramid(name, 300)),
+        "plate" => return Some(plate()),
+        "card_house" => return Some(card_house()),
+        "arch" => return Some(arch()),
+        "overlap_pyramid" => return Some(overlap_pyramid(name, 10)),
+        _ => {}
     }
     // Longest prefix first: "pyramid3d" before "pyramid".
     if let Some(n) = name.strip_prefix("pyramid3d").and_then(parse_count) {
@@ -224,6 +272,207 @@ fn massratio() -> Scene {
     heavy.name = Some("heavy".to_string());
     heavy.material = MaterialRef::Named("heavy".to_string());
     scene.bodies.push(heavy);
+    scene
+}
+
+// ---------------------------------------------------------------------------------------------
+// The Solver2D test suite (Erin Catto) rebuilt in 3D.
+
+/// `n` cubes at (±0.01, 0.5 + i, 0): x = +0.01 for even i, −0.01 for odd i; friction 0.3.
+fn vertical_stack(name: &str, n: usize) -> Scene {
+    let mut scene = base(
+        name,
+        Material {
+            friction: 0.3,
+            ..cube_material()
+        },
+    );
+    scene.bodies.push(ground(GROUND_HALF_WIDTH));
+    for i in 0..n {
+        let x = if i % 2 == 0 { 0.01 } else { -0.01 };
+        scene.bodies.push(cube(x, 0.5 + i as f64, 0.0));
+    }
+    scene
+}
+
+/// The 2D pyramid of base 10 (55 cubes) whose top cube (the last body, named `"heavy"`) has
+/// material `"heavy"`: density `ratio` × 1000.
+fn mass_ratio_pyramid(name: &str, ratio: u32) -> Scene {
+    let mut scene = pyramid(name, 10);
+    scene.materials.insert(
+        "heavy".to_string(),
+        Material {
+            density: f(1000.0 * f64::from(ratio)),
+            ..cube_material()
+        },
+    );
+    let top = scene.bodies.last_mut().expect("the pyramid has cubes");
+    top.name = Some("heavy".to_string());
+    top.material = MaterialRef::Named("heavy".to_string());
+    scene
+}
+
+/// Two cubes at (±9.5, 0.5, 0) under a plate of half extents (10, 0.5, 10) centred at
+/// (0, 1.5, 0), all of density 1000: the plate weighs 400 cubes.
+fn plate() -> Scene {
+    let mut scene = base_cubes("plate");
+    scene.bodies.push(cube(-9.5, 0.5, 0.0));
+    scene.bodies.push(cube(9.5, 0.5, 0.0));
+    let mut plate = BodyDesc::new(
+        BodyKind::Dynamic,
+        ShapeDesc::Cuboid {
+            half_extents: [10.0, 0.5, 10.0],
+        },
+        [0.0, 1.5, 0.0],
+    );
+    plate.name = Some("plate".to_string());
+    scene.bodies.push(plate);
+    scene
+}
+
+/// Half extents (m) of a card of `card_house`: thickness along local x, height along local y,
+/// width along local z.
+pub const CARD_HALF_EXTENTS: [f32; 3] = [0.02, 0.5, 0.35];
+/// Tilt (degrees) of the leaning cards of `card_house` from the vertical.
+pub const CARD_TILT_DEGREES: f64 = 22.5;
+/// Distance (m) in x between the apexes of the two bottom A-frames of `card_house`.
+pub const CARD_APEX_SPACING: f64 = 0.86;
+
+/// A card at `position` turned by `angle` (radians) about the z axis.
+fn card(position: [f64; 3], angle: f64) -> BodyDesc {
+    let mut card = BodyDesc::new(
+        BodyKind::Dynamic,
+        ShapeDesc::Cuboid {
+            half_extents: CARD_HALF_EXTENTS,
+        },
+        position.map(f),
+    );
+    let half = angle / 2.0;
+    card.orientation = [0.0, 0.0, f(half.sin()), f(half.cos())];
+    card
+}
+
+/// Two levels of A-frames of leaning cards, each level covered by flat cards:
+///
+/// - an A-frame with apex at x = a standing on height b is a left card turned by −θ about z
+///   (its top leans towards +x) at (a − h sin θ − t cos θ, b + h cos θ + t sin θ, 0) and a
+///   right card turned by +θ at (a + h sin θ + t cos θ, same y, 0), with (t, h, w) the card's
+///   half extents. The left card's lower inner edge rests on y = b, the two cards' upper inner
+///   edges meet at x = a, y = b + 2h cos θ, and the upper outer edges are the highest points,
+///   at y = b + 2h cos θ + 2t sin θ =: b + H;
+/// - level 0: A-frames at a = ∓ 0.43 on the ground (b = 0), then a flat card (turned by 90°
+///   about z) centred at (0, H + t, 0) resting on their four upper outer edges;
+/// - level 1: one A-frame at a = 0 on top of that card (b = H + 2t), then a flat card at
+///   (0, 2H + 3t, 0) on its two upper outer edges.
+///
+/// Friction 0.7, density 1000. Nothing overlaps; the contacts touch exactly.
+fn card_house() -> Scene {
+    let mut scene = base(
+        "card_house",
+        Material {
+            friction: 0.7,
+            restitution: 0.0,
+            density: 1000.0,
+        },
+    );
+    scene.bodies.push(ground(GROUND_HALF_WIDTH));
+    let theta = CARD_TILT_DEGREES.to_radians();
+    let [t, h, _] = CARD_HALF_EXTENTS.map(f64::from);
+    let dx = h * theta.sin() + t * theta.cos();
+    let dy = h * theta.cos() + t * theta.sin();
+    let frame_height = 2.0 * dy;
+    let flat = std::f64::consts::FRAC_PI_2;
+    let a_frame = |scene: &mut Scene, apex: f64, floor: f64| {
+        scene
+            .bodies
+            .push(card([apex - dx, floor + dy, 0.0], -theta));
+        scene.bodies.push(card([apex + dx, floor + dy, 0.0], theta));
+    };
+    let a = CARD_APEX_SPACING / 2.0;
+    a_frame(&mut scene, -a, 0.0);
+    a_frame(&mut scene, a, 0.0);
+    scene.bodies.push(card([0.0, frame_height + t, 0.0], flat));
+    let floor = frame_height + 2.0 * t;
+    a_frame(&mut scene, 0.0, floor);
+    scene
+        .bodies
+        .push(card([0.0, floor + frame_height + t, 0.0], flat));
+    scene
+}
+
+/// Voussoirs of `arch`.
+pub const ARCH_BLOCKS: usize = 13;
+/// Inner and outer radius (m) of `arch`.
+pub const ARCH_RADII: [f64; 2] = [4.0, 5.0];
+/// Depth (m) of `arch` along z (centred on z = 0).
+pub const ARCH_DEPTH: f64 = 1.0;
+
+/// A semicircular arch standing on the ground, centre of the circle at the origin: block
+/// k = 0 … 12 spans the angles α = kπ/13 … (k + 1)π/13 (from +x over the top to −x) between
+/// the radii 4 and 5 and z = ±0.5. Its 8 corners (r cos α, r sin α, z), in the order α, then
+/// r, then z (z fastest), are the points of a convex hull; the body sits at their mean and the
+/// points are given relative to it. Neighbours share a face; blocks 0 and 12 stand on the
+/// ground. Friction 0.6, density 1000.
+///
+/// The corners at angle j·π/13 with j > 6 are the mirror images (x → −x) of those at
+/// (13 − j)·π/13, and the mean is summed in mirrored pairs, so the arch is exactly symmetric,
+/// the keystone (block 6) sits exactly on x = 0 and block 12 stands exactly on y = 0.
+fn arch() -> Scene {
+    let mut scene = base_cubes("arch");
+    let n = ARCH_BLOCKS;
+    let step = std::f64::consts::PI / n as f64;
+    // (x, y) of the corner at angle j·π/n and radius r.
+    let corner = |j: usize, r: f64| {
+        if 2 * j > n {
+            let alpha = (n - j) as f64 * step;
+            [-r * alpha.cos(), r * alpha.sin()]
+        } else {
+            let alpha = j as f64 * step;
+            [r * alpha.cos(), r * alpha.sin()]
+        }
+    };
+    let half_depth = ARCH_DEPTH / 2.0;
+    for k in 0..n {
+        let [inner, outer] = ARCH_RADII;
+        let mean = |axis: usize| {
+            ((corner(k, inner)[axis] + corner(k + 1, inner)[axis])
+                + (corner(k, outer)[axis] + corner(k + 1, outer)[axis]))
+                / 4.0
+        };
+        let centre = [mean(0), mean(1), 0.0];
+        let mut points = Vec::with_capacity(8);
+        for j in [k, k + 1] {
+            for r in ARCH_RADII {
+                let [x, y] = corner(j, r);
+                for z in [-half_depth, half_depth] {
+                    points.push([f(x - centre[0]), f(y - centre[1]), f(z)]);
+                }
+            }
+        }
+        scene.bodies.push(BodyDesc::new(
+            BodyKind::Dynamic,
+            ShapeDesc::ConvexHull { points },
+            centre.map(f),
+        ));
+    }
+    scene
+}
+
+/// The 2D pyramid of base `base` squeezed to a spacing of 0.75 m: cube i of row r (n = base − r
+/// cubes) at x = (i − (n − 1)/2)·0.75, y = 0.375 + 0.75·r, z = 0. Neighbours overlap by 0.25 m,
+/// the bottom row overlaps the ground by 0.125 m.
+fn overlap_pyramid(name: &str, base: usize) -> Scene {
+    let mut scene = base_cubes(name);
+    for r in 0..base {
+        let n = base - r;
+        for i in 0..n {
+            scene.bodies.push(cube(
+                (i as f64 - (n as f64 - 1.0) / 2.0) * 0.75,
+                0.375 + 0.75 * r as f64,
+                0.0,
+            ));
+        }
+    }
     scene
 }
 

@@ -1,0 +1,330 @@
+//! Islands: the connected components of the contact graph, and the part of the step that runs
+//! on each of them (DESIGN.md step 5: "Islands solve independently").
+//!
+//! Two moving bodies are in one island when a chain of contacts joins them; static bodies join
+//! nothing (they take no impulse). Each island's substep loop (gravity, warm start, solve,
+//! position integration, relax, restitution) reads and writes only its own bodies, through
+//! local arrays gathered at the start and scattered at the end, so islands can run on
+//! separate threads without sharing anything mutable. Quiet islands fall asleep.
+
+use glam::{Quat, Vec3};
+
+use crate::body::Bodies;
+use crate::constraints::{self, ContactConstraint};
+use crate::settings::{SolverMethod, SolverSettings};
+use crate::solver::{self, NncgWorkspace, Velocities};
+
+/// Islands of one step: body lists and constraint ranges, with constraints sorted by island.
+#[derive(Default)]
+pub struct Islands {
+    /// Island k's bodies are `bodies[body_start[k]..body_start[k + 1]]`.
+    body_start: Vec<u32>,
+    bodies: Vec<u32>,
+    /// Island k's constraints are `constraint_start[k]..constraint_start[k + 1]`.
+    constraint_start: Vec<u32>,
+    /// Island of each body; `u32::MAX` for static bodies.
+    pub island_of_body: Vec<u32>,
+    parent: Vec<u32>,
+}
+
+impl Islands {
+    /// Number of islands.
+    pub fn len(&self) -> usize {
+        self.constraint_start.len().saturating_sub(1)
+    }
+
+    /// True when there is no island.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Bodies of island `k`, in increasing index order.
+    pub fn bodies(&self, k: usize) -> &[u32] {
+        &self.bodies[self.body_start[k] as usize..self.body_start[k + 1] as usize]
+    }
+
+    /// Constraint index range of island `k`.
+    pub fn constraint_range(&self, k: usize) -> std::ops::Range<usize> {
+        self.constraint_start[k] as usize..self.constraint_start[k + 1] as usize
+    }
+
+    /// Finds the islands of `constraints` (union-find over contacts between moving bodies),
+    /// sorts the constraints by island (stably, so each island keeps narrow-phase order) and
+    /// sets every constraint's local body indices.
+    pub fn build(&mut self, bodies: &Bodies, constraints: &mut [ContactConstraint]) {
+        let n = bodies.len();
+        self.parent.clear();
+        self.parent.extend(0..n as u32);
+        for c in constraints.iter() {
+            let (a, b) = (c.body_a as usize, c.body_b as usize);
+            if bodies.is_moving(a) && bodies.is_moving(b) {
+                let (ra, rb) = (find(&mut self.parent, a), find(&mut self.parent, b));
+                if ra != rb {
+                    // Union by index keeps the result independent of constraint order.
+                    let (low, high) = if ra < rb { (ra, rb) } else { (rb, ra) };
+                    self.parent[high as usize] = low;
+                }
+            }
+        }
+        // Number islands by their lowest body, in body order (deterministic).
+        self.island_of_body.clear();
+        self.island_of_body.resize(n, u32::MAX);
+        let mut count = 0u32;
+        for i in 0..n {
+            if bodies.is_moving(i) {
+                let root = find(&mut self.parent, i) as usize;
+                if self.island_of_body[root] == u32::MAX {
+                    self.island_of_body[root] = count;
+                    count += 1;
+                }
+                self.island_of_body[i] = self.island_of_body[root];
+            }
+        }
+        let islands = count as usize;
+        // Bodies per island (counting sort), and each body's local index.
+        self.body_start.clear();
+        self.body_start.resize(islands + 1, 0);
+        for i in 0..n {
+            let k = self.island_of_body[i];
+            if k != u32::MAX {
+                self.body_start[k as usize + 1] += 1;
+            }
+        }
+        for k in 0..islands {
+            self.body_start[k + 1] += self.body_start[k];
+        }
+        let mut fill: Vec<u32> = self.body_start[..islands].to_vec();
+        self.bodies.clear();
+        self.bodies.resize(self.body_start[islands] as usize, 0);
+        // `parent` is free again: reuse it for local indices.
+        let local = &mut self.parent;
+        for i in 0..n {
+            let k = self.island_of_body[i];
+            if k != u32::MAX {
+                let slot = fill[k as usize];
+                self.bodies[slot as usize] = i as u32;
+                local[i] = slot - self.body_start[k as usize];
+                fill[k as usize] += 1;
+            }
+        }
+        let island_of = |c: &ContactConstraint, island_of_body: &[u32]| {
+            let a = island_of_body[c.body_a as usize];
+            if a != u32::MAX {
+                a
+            } else {
+                island_of_body[c.body_b as usize]
+            }
+        };
+        constraints.sort_by_key(|c| island_of(c, &self.island_of_body));
+        self.constraint_start.clear();
+        self.constraint_start.resize(islands + 1, 0);
+        for c in constraints.iter_mut() {
+            let k = island_of(c, &self.island_of_body) as usize;
+            self.constraint_start[k + 1] += 1;
+            let size = self.body_start[k + 1] - self.body_start[k];
+            // Static bodies use the immovable slot after the island's bodies.
+            let local_of = |body: u32| {
+                if self.island_of_body[body as usize] == u32::MAX {
+                    size
+                } else {
+                    local[body as usize]
+                }
+            };
+            c.local_a = local_of(c.body_a);
+            c.local_b = local_of(c.body_b);
+        }
+        for k in 0..islands {
+            self.constraint_start[k + 1] += self.constraint_start[k];
+        }
+    }
+}
+
+fn find(parent: &mut [u32], mut i: usize) -> u32 {
+    while parent[i] as usize != i {
+        let grandparent = parent[parent[i] as usize];
+        parent[i] = grandparent;
+        i = grandparent as usize;
+    }
+    i as u32
+}
+
+/// Local state of one island during a step.
+#[derive(Default)]
+pub struct IslandWorkspace {
+    /// Linear velocities (m/s) of the island's bodies, then the immovable slot.
+    pub linear: Vec<Vec3>,
+    /// Angular velocities (rad/s), same layout.
+    pub angular: Vec<Vec3>,
+    /// Centre-of-mass displacement since the start of the step (m).
+    pub displacement: Vec<Vec3>,
+    /// Rotation vector accumulated since the start of the step (rad), for separations.
+    pub rotation: Vec<Vec3>,
+    /// Orientations, integrated substep by substep.
+    pub orientation: Vec<Quat>,
+    nncg: NncgWorkspace,
+    /// Solver iterations used in the step.
+    pub iterations: u32,
+}
+
+/// Everything an island's step reads besides its own bodies and constraints.
+pub struct StepContext<'a> {
+    /// All bodies (read only).
+    pub bodies: &'a Bodies,
+    /// Gravity (m/s²).
+    pub gravity: Vec3,
+    /// Step (s).
+    pub dt: f32,
+    /// Solver settings.
+    pub settings: &'a SolverSettings,
+}
+
+/// Runs stages 1, 5 and 6 of one step on one island: per substep of h = dt/substeps, gravity,
+/// warm start, the solve with overlap repair, position integration, and the relax solve; then
+/// the restitution solve. Results stay in `workspace` until [`scatter`].
+pub fn step_island(
+    island_bodies: &[u32],
+    constraints: &mut [ContactConstraint],
+    context: &StepContext<'_>,
+    workspace: &mut IslandWorkspace,
+) {
+    let StepContext {
+        bodies,
+        gravity,
+        dt,
+        settings,
+    } = *context;
+    let slots = island_bodies.len() + 1;
+    let w = workspace;
+    w.linear.clear();
+    w.angular.clear();
+    w.orientation.clear();
+    for &i in island_bodies {
+        w.linear.push(bodies.linear_velocity[i as usize]);
+        w.angular.push(bodies.angular_velocity[i as usize]);
+        w.orientation.push(bodies.pose[i as usize].rotation);
+    }
+    w.linear.push(Vec3::ZERO);
+    w.angular.push(Vec3::ZERO);
+    w.displacement.clear();
+    w.displacement.resize(slots, Vec3::ZERO);
+    w.rotation.clear();
+    w.rotation.resize(slots, Vec3::ZERO);
+    w.iterations = 0;
+
+    let h = dt / settings.substeps as f32;
+    let gravity_step = gravity * h;
+    for _ in 0..settings.substeps {
+        // Stage 1: prospective velocities (every body of an island moves).
+        for v in &mut w.linear[..slots - 1] {
+            *v += gravity_step;
+        }
+        let mut velocities = Velocities {
+            linear: &mut w.linear,
+            angular: &mut w.angular,
+        };
+        solver::warm_start(constraints, &mut velocities);
+        constraints::update_targets(constraints, &w.displacement, &w.rotation, settings, h, true);
+        w.iterations += solve(
+            constraints,
+            settings,
+            settings.iterations,
+            &mut velocities,
+            &mut w.nncg,
+        );
+        // Stage 6: positions, substep by substep.
+        for k in 0..slots - 1 {
+            w.displacement[k] += w.linear[k] * h;
+            let omega = w.angular[k];
+            w.rotation[k] += omega * h;
+            if omega != Vec3::ZERO {
+                w.orientation[k] = integrate_orientation(w.orientation[k], omega, h);
+            }
+        }
+        if settings.relax_iterations > 0 {
+            constraints::update_targets(
+                constraints,
+                &w.displacement,
+                &w.rotation,
+                settings,
+                h,
+                false,
+            );
+            let mut velocities = Velocities {
+                linear: &mut w.linear,
+                angular: &mut w.angular,
+            };
+            w.iterations += solve(
+                constraints,
+                settings,
+                settings.relax_iterations,
+                &mut velocities,
+                &mut w.nncg,
+            );
+        }
+    }
+    // Restitution after the substeps (the seed's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
+    // for the points that collided.
+    if constraints::restitution_targets(constraints, settings.restitution_threshold) {
+        let mut velocities = Velocities {
+            linear: &mut w.linear,
+            angular: &mut w.angular,
+        };
+        w.iterations += solve(
+            constraints,
+            settings,
+            settings.iterations.max(settings.relax_iterations),
+            &mut velocities,
+            &mut w.nncg,
+        );
+    }
+}
+
+/// q ← normalize(q + h/2·ω⊗q): first-order orientation update (DESIGN.md step 6).
+pub fn integrate_orientation(q: Quat, omega: Vec3, h: f32) -> Quat {
+    let spin = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0) * q;
+    Quat::from_xyzw(
+        q.x + 0.5 * h * spin.x,
+        q.y + 0.5 * h * spin.y,
+        q.z + 0.5 * h * spin.z,
+        q.w + 0.5 * h * spin.w,
+    )
+    .normalize()
+}
+
+/// Writes an island's velocities and poses back into the bodies.
+pub fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut Bodies) {
+    for (k, &i) in island_bodies.iter().enumerate() {
+        let i = i as usize;
+        let com = bodies.center_of_mass(i) + workspace.displacement[k];
+        let rotation = workspace.orientation[k];
+        bodies.linear_velocity[i] = workspace.linear[k];
+        bodies.angular_velocity[i] = workspace.angular[k];
+        bodies.pose[i].rotation = rotation;
+        bodies.pose[i].translation = com - rotation * bodies.local_center_of_mass[i];
+    }
+}
+
+/// Runs the configured method for at most `iterations`; returns the iterations used.
+fn solve(
+    constraints: &mut [ContactConstraint],
+    settings: &SolverSettings,
+    iterations: u32,
+    velocities: &mut Velocities<'_>,
+    workspace: &mut NncgWorkspace,
+) -> u32 {
+    match settings.method {
+        SolverMethod::Pgs => {
+            solver::solve_pgs(constraints, iterations, settings.tolerance, velocities).iterations
+        }
+        SolverMethod::Nncg => {
+            solver::solve_nncg(
+                constraints,
+                iterations,
+                settings.tolerance,
+                velocities,
+                workspace,
+            )
+            .iterations
+        }
+    }
+}
