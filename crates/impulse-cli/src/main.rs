@@ -47,6 +47,9 @@ enum Command {
         /// Iterative method: pgs or nncg (default: the scene's solver settings).
         #[arg(long)]
         method: Option<String>,
+        /// Soft contact frequency in Hz (0 = the seed's rigid rows with overlap repair c_d).
+        #[arg(long)]
+        soft_hertz: Option<f32>,
         /// Worker threads (default: all cores); 1 runs everything on the calling thread.
         #[arg(long)]
         threads: Option<usize>,
@@ -170,6 +173,7 @@ fn real_main() -> Result<ExitCode> {
             substeps,
             relax,
             method,
+            soft_hertz,
             threads,
             no_sleep,
             out,
@@ -183,6 +187,9 @@ fn real_main() -> Result<ExitCode> {
             }
             if let Some(relax) = relax {
                 scene.solver.relax_iterations = relax;
+            }
+            if let Some(hertz) = soft_hertz {
+                scene.solver.soft_contact_hertz = hertz;
             }
             if no_sleep {
                 scene.solver.sleep = false;

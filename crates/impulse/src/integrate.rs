@@ -1,42 +1,47 @@
-//! Stages 1 and 6 of the step: prospective velocities and position integration.
+//! Stages 1 and 6 of the step, on an island's local arrays: prospective velocities and
+//! position integration (symplectic Euler, per substep).
 
 use glam::{Quat, Vec3};
 
-use crate::body::Bodies;
-use crate::scene::BodyKind;
+/// Stage 1: v* = v + h·M⁻¹·f_ext with gravity the only external force (seed: "compute
+/// prospective velocities of all objects for this time step"). `linear` holds moving bodies
+/// only.
+pub fn prospective_velocities(linear: &mut [Vec3], gravity: Vec3, h: f32) {
+    let dv = gravity * h;
+    for v in linear {
+        *v += dv;
+    }
+}
 
-/// Stage 1: v* = v + dt·M⁻¹·f_ext with gravity the only external force (seed: "compute
-/// prospective velocities of all objects for this time step"). Static bodies are untouched.
-pub fn prospective_velocities(bodies: &mut Bodies, gravity: Vec3, dt: f32) {
-    let dv = gravity * dt;
-    for (v, kind) in bodies.linear_velocity.iter_mut().zip(&bodies.kind) {
-        if *kind != BodyKind::Static {
-            *v += dv;
+/// Stage 6: x += h·v for the centres of mass (accumulated in `displacement`, m), the rotation
+/// vector Σ h·ω (`rotation`, rad, used for contact separations), and
+/// q ← normalize(q + h/2·ω⊗q) for the orientations. All slices are indexed alike.
+pub fn integrate_positions(
+    linear: &[Vec3],
+    angular: &[Vec3],
+    displacement: &mut [Vec3],
+    rotation: &mut [Vec3],
+    orientation: &mut [Quat],
+    h: f32,
+) {
+    for k in 0..orientation.len() {
+        displacement[k] += linear[k] * h;
+        let omega = angular[k];
+        if omega != Vec3::ZERO {
+            rotation[k] += omega * h;
+            orientation[k] = integrate_orientation(orientation[k], omega, h);
         }
     }
 }
 
-/// Stage 6: symplectic Euler on positions, x += dt·v, and q ← normalize(q + dt/2·ω⊗q) on
-/// orientations, both about the centre of mass.
-pub fn integrate_positions(bodies: &mut Bodies, dt: f32) {
-    for i in 0..bodies.len() {
-        if bodies.kind[i] == BodyKind::Static {
-            continue;
-        }
-        let com = bodies.center_of_mass(i) + bodies.linear_velocity[i] * dt;
-        let pose = &mut bodies.pose[i];
-        let w = bodies.angular_velocity[i];
-        if w != Vec3::ZERO {
-            let q = pose.rotation;
-            let spin = Quat::from_xyzw(w.x, w.y, w.z, 0.0) * q;
-            pose.rotation = Quat::from_xyzw(
-                q.x + 0.5 * dt * spin.x,
-                q.y + 0.5 * dt * spin.y,
-                q.z + 0.5 * dt * spin.z,
-                q.w + 0.5 * dt * spin.w,
-            )
-            .normalize();
-        }
-        pose.translation = com - pose.rotation * bodies.local_center_of_mass[i];
-    }
+/// q ← normalize(q + h/2·ω⊗q): first-order orientation update (DESIGN.md step 6).
+pub fn integrate_orientation(q: Quat, omega: Vec3, h: f32) -> Quat {
+    let spin = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0) * q;
+    Quat::from_xyzw(
+        q.x + 0.5 * h * spin.x,
+        q.y + 0.5 * h * spin.y,
+        q.z + 0.5 * h * spin.z,
+        q.w + 0.5 * h * spin.w,
+    )
+    .normalize()
 }

@@ -11,6 +11,7 @@ use glam::{Quat, Vec3};
 
 use crate::body::Bodies;
 use crate::constraints::{self, ContactConstraint};
+use crate::integrate;
 use crate::settings::{SolverMethod, SolverSettings};
 use crate::solver::{self, NncgWorkspace, Velocities};
 
@@ -212,12 +213,9 @@ pub fn step_island(
     w.iterations = 0;
 
     let h = dt / settings.substeps as f32;
-    let gravity_step = gravity * h;
+    let moving = slots - 1;
     for _ in 0..settings.substeps {
-        // Stage 1: prospective velocities (every body of an island moves).
-        for v in &mut w.linear[..slots - 1] {
-            *v += gravity_step;
-        }
+        integrate::prospective_velocities(&mut w.linear[..moving], gravity, h);
         let mut velocities = Velocities {
             linear: &mut w.linear,
             angular: &mut w.angular,
@@ -231,15 +229,14 @@ pub fn step_island(
             &mut velocities,
             &mut w.nncg,
         );
-        // Stage 6: positions, substep by substep.
-        for k in 0..slots - 1 {
-            w.displacement[k] += w.linear[k] * h;
-            let omega = w.angular[k];
-            w.rotation[k] += omega * h;
-            if omega != Vec3::ZERO {
-                w.orientation[k] = integrate_orientation(w.orientation[k], omega, h);
-            }
-        }
+        integrate::integrate_positions(
+            &w.linear[..moving],
+            &w.angular[..moving],
+            &mut w.displacement[..moving],
+            &mut w.rotation[..moving],
+            &mut w.orientation,
+            h,
+        );
         if settings.relax_iterations > 0 {
             constraints::update_targets(
                 constraints,
@@ -277,18 +274,6 @@ pub fn step_island(
             &mut w.nncg,
         );
     }
-}
-
-/// q ← normalize(q + h/2·ω⊗q): first-order orientation update (DESIGN.md step 6).
-pub fn integrate_orientation(q: Quat, omega: Vec3, h: f32) -> Quat {
-    let spin = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0) * q;
-    Quat::from_xyzw(
-        q.x + 0.5 * h * spin.x,
-        q.y + 0.5 * h * spin.y,
-        q.z + 0.5 * h * spin.z,
-        q.w + 0.5 * h * spin.w,
-    )
-    .normalize()
 }
 
 /// Writes an island's velocities and poses back into the bodies.
