@@ -99,12 +99,11 @@ impl Islands {
         self.bodies.resize(self.body_start[islands] as usize, 0);
         // `parent` is free again: reuse it for local indices.
         let local = &mut self.parent;
-        for i in 0..n {
-            let k = self.island_of_body[i];
+        for (i, (&k, local)) in self.island_of_body.iter().zip(local.iter_mut()).enumerate() {
             if k != u32::MAX {
                 let slot = fill[k as usize];
                 self.bodies[slot as usize] = i as u32;
-                local[i] = slot - self.body_start[k as usize];
+                *local = slot - self.body_start[k as usize];
                 fill[k as usize] += 1;
             }
         }
