@@ -8,7 +8,7 @@
 
 use glam::Vec3;
 
-use crate::constraints::{ContactConstraint, JacobianRow};
+use crate::constraints::ContactConstraint;
 
 /// Velocities the solver updates in place: an island's local arrays, indexed by the
 /// constraints' `local_a`/`local_b` (static bodies share an immovable slot; their zero inverse
@@ -29,35 +29,6 @@ pub struct SolveReport {
     pub last_change: f32,
 }
 
-#[inline(always)]
-fn apply(
-    row: &JacobianRow,
-    constraint: &ContactConstraint,
-    impulse: f32,
-    velocities: &mut Velocities<'_>,
-) {
-    let (a, b) = (constraint.local_a as usize, constraint.local_b as usize);
-    velocities.linear[a] += row.direction * (constraint.inverse_mass_a * impulse);
-    velocities.angular[a] += row.inverse_inertia_angular_a * impulse;
-    velocities.linear[b] -= row.direction * (constraint.inverse_mass_b * impulse);
-    velocities.angular[b] -= row.inverse_inertia_angular_b * impulse;
-}
-
-#[inline(always)]
-fn row_velocity(
-    row: &JacobianRow,
-    constraint: &ContactConstraint,
-    velocities: &Velocities<'_>,
-) -> f32 {
-    let (a, b) = (constraint.local_a as usize, constraint.local_b as usize);
-    row.velocity(
-        velocities.linear[a],
-        velocities.angular[a],
-        velocities.linear[b],
-        velocities.angular[b],
-    )
-}
-
 /// Scales the impulses carried over from the last step by `fraction` (0 = cold start) and
 /// keeps the friction impulse inside its disc.
 pub fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
@@ -74,9 +45,7 @@ pub fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
 /// solution (warm starting).
 pub fn warm_start(constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
     for c in constraints {
-        apply(&c.normal, c, c.normal_impulse, velocities);
-        apply(&c.tangents[0], c, c.tangent_impulses[0], velocities);
-        apply(&c.tangents[1], c, c.tangent_impulses[1], velocities);
+        apply_impulses(c, impulses(c), velocities);
     }
 }
 
@@ -276,10 +245,7 @@ pub fn solve_nncg(
                     c.normal_impulse += push[0];
                     c.tangent_impulses[0] += push[1];
                     c.tangent_impulses[1] += push[2];
-                    let cc = *c;
-                    apply(&cc.normal, &cc, push[0], velocities);
-                    apply(&cc.tangents[0], &cc, push[1], velocities);
-                    apply(&cc.tangents[1], &cc, push[2], velocities);
+                    apply_impulses(c, push, velocities);
                 }
                 for k in 0..3 {
                     direction[k] = push[k] + gradient_step[k];
@@ -293,13 +259,19 @@ pub fn solve_nncg(
 
 /// One Gauss-Seidel update of a contact point's rows: the friction pair as a 2×2 block
 /// projected onto Coulomb's disc, then the normal row clamped to γ_n ≥ 0. Returns the largest
-/// row velocity change it caused (m/s).
+/// row velocity change it caused (m/s). The two bodies' velocities are loaded once, updated
+/// in registers and stored once.
 #[inline(always)]
 fn solve_point(c: &mut ContactConstraint, velocities: &mut Velocities<'_>) -> f32 {
+    let (a, b) = (c.local_a as usize, c.local_b as usize);
+    let (mut la, mut aa) = (velocities.linear[a], velocities.angular[a]);
+    let (mut lb, mut ab) = (velocities.linear[b], velocities.angular[b]);
+    let (ima, imb) = (c.inverse_mass_a, c.inverse_mass_b);
     let mut largest_change = 0.0f32;
     if c.friction > 0.0 {
-        let v1 = row_velocity(&c.tangents[0], c, velocities);
-        let v2 = row_velocity(&c.tangents[1], c, velocities);
+        let [t1, t2] = &c.tangents;
+        let v1 = t1.velocity(la, aa, lb, ab);
+        let v2 = t2.velocity(la, aa, lb, ab);
         let [i11, i12, i22] = c.tangent_inverse_block;
         let old = c.tangent_impulses;
         let limit = c.friction * c.normal_impulse;
@@ -308,19 +280,20 @@ fn solve_point(c: &mut ContactConstraint, velocities: &mut Velocities<'_>) -> f3
             old[1] - (i12 * v1 + i22 * v2),
         ];
         let new = project_to_friction_disc(sticking, c.tangent_block, limit);
-        let delta = [new[0] - old[0], new[1] - old[1]];
-        if delta != [0.0, 0.0] {
+        let (d1, d2) = (new[0] - old[0], new[1] - old[1]);
+        if d1 != 0.0 || d2 != 0.0 {
             c.tangent_impulses = new;
-            let cc = *c;
-            apply(&cc.tangents[0], &cc, delta[0], velocities);
-            apply(&cc.tangents[1], &cc, delta[1], velocities);
-            largest_change = largest_change
-                .max(delta[0].abs() * cc.tangents[0].inverse_effective_mass)
-                .max(delta[1].abs() * cc.tangents[1].inverse_effective_mass);
+            let linear = t1.direction * d1 + t2.direction * d2;
+            la += linear * ima;
+            lb -= linear * imb;
+            aa += t1.inverse_inertia_angular_a * d1 + t2.inverse_inertia_angular_a * d2;
+            ab -= t1.inverse_inertia_angular_b * d1 + t2.inverse_inertia_angular_b * d2;
+            largest_change =
+                (d1.abs() * t1.inverse_effective_mass).max(d2.abs() * t2.inverse_effective_mass);
         }
     }
     let row = &c.normal;
-    let v = row_velocity(row, c, velocities);
+    let v = row.velocity(la, aa, lb, ab);
     let old = c.normal_impulse;
     let (mass_scale, impulse_scale) = c.softness;
     let new = (old + row.effective_mass * mass_scale * (c.target_normal_velocity - v)
@@ -330,8 +303,33 @@ fn solve_point(c: &mut ContactConstraint, velocities: &mut Velocities<'_>) -> f3
     if delta != 0.0 {
         c.normal_impulse = new;
         c.max_normal_impulse = c.max_normal_impulse.max(new);
-        apply(row, c, delta, velocities);
+        let linear = row.direction * delta;
+        la += linear * ima;
+        lb -= linear * imb;
+        aa += row.inverse_inertia_angular_a * delta;
+        ab -= row.inverse_inertia_angular_b * delta;
         largest_change = largest_change.max(delta.abs() * row.inverse_effective_mass);
     }
+    velocities.linear[a] = la;
+    velocities.angular[a] = aa;
+    velocities.linear[b] = lb;
+    velocities.angular[b] = ab;
     largest_change
+}
+
+/// Applies impulses (normal, tangent 1, tangent 2) of one contact point to its two bodies.
+#[inline(always)]
+fn apply_impulses(c: &ContactConstraint, impulses: [f32; 3], velocities: &mut Velocities<'_>) {
+    let (a, b) = (c.local_a as usize, c.local_b as usize);
+    let [n, t1, t2] = [&c.normal, &c.tangents[0], &c.tangents[1]];
+    let linear =
+        n.direction * impulses[0] + t1.direction * impulses[1] + t2.direction * impulses[2];
+    velocities.linear[a] += linear * c.inverse_mass_a;
+    velocities.linear[b] -= linear * c.inverse_mass_b;
+    velocities.angular[a] += n.inverse_inertia_angular_a * impulses[0]
+        + t1.inverse_inertia_angular_a * impulses[1]
+        + t2.inverse_inertia_angular_a * impulses[2];
+    velocities.angular[b] -= n.inverse_inertia_angular_b * impulses[0]
+        + t1.inverse_inertia_angular_b * impulses[1]
+        + t2.inverse_inertia_angular_b * impulses[2];
 }
