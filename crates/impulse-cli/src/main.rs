@@ -216,7 +216,7 @@ fn real_main() -> Result<ExitCode> {
         }
         Command::Scenes => {
             for (name, description) in builtin_names() {
-                println!("{name:<14} {description}");
+                println!("{name:<22} {description}");
             }
         }
         Command::Export { scene, out } => {
