@@ -50,6 +50,12 @@ enum Command {
         /// Soft contact frequency in Hz (0 = the seed's rigid rows with overlap repair c_d).
         #[arg(long)]
         soft_hertz: Option<f32>,
+        /// Overlap repair rate c_d in 1/s (the seed's "nudge" coefficient).
+        #[arg(long)]
+        repair_rate: Option<f32>,
+        /// Overlap repair by split impulse (a separate position solve) instead of a velocity bias.
+        #[arg(long)]
+        split_impulse: bool,
         /// Worker threads (default: all cores); 1 runs everything on the calling thread.
         #[arg(long)]
         threads: Option<usize>,
@@ -174,6 +180,8 @@ fn real_main() -> Result<ExitCode> {
             relax,
             method,
             soft_hertz,
+            repair_rate,
+            split_impulse,
             threads,
             no_sleep,
             out,
@@ -190,6 +198,12 @@ fn real_main() -> Result<ExitCode> {
             }
             if let Some(hertz) = soft_hertz {
                 scene.solver.soft_contact_hertz = hertz;
+            }
+            if let Some(rate) = repair_rate {
+                scene.solver.overlap_repair_rate = rate;
+            }
+            if split_impulse {
+                scene.solver.split_impulse = true;
             }
             if no_sleep {
                 scene.solver.sleep = false;

@@ -43,6 +43,8 @@ pub struct Summary {
     /// Initial y − final y of the top body (m).
     pub top_sink_m: f32,
     pub kinetic_energy_j: f32,
+    /// Largest speed of any body at any step (m/s): a blow-up or an over-eager repair shows here.
+    pub max_speed_m_s: f32,
     pub mean_contacts: f64,
     pub mean_iterations: f64,
     /// Largest natural-map residual of any step's contact LCP at exit.
@@ -63,7 +65,7 @@ impl Summary {
     pub fn line(&self) -> String {
         format!(
             "{}: {} bodies, {} steps of {:.4} s, mean contacts {:.0}, {:.3} ms/step ({:.0} steps/s), \
-             max overlap {:.2} mm, top sink {:.2} mm, kinetic energy {:.4} J, \
+             max overlap {:.2} mm, top sink {:.2} mm, kinetic energy {:.4} J, max speed {:.2} m/s, \
              mean iterations {:.1}, LCP residual max {:.2e} last {:.2e}",
             self.scene,
             self.bodies,
@@ -75,6 +77,7 @@ impl Summary {
             self.max_overlap_m * 1e3,
             self.top_sink_m * 1e3,
             self.kinetic_energy_j,
+            self.max_speed_m_s,
             self.mean_iterations,
             self.max_natural_map_residual,
             self.final_natural_map_residual,
@@ -135,6 +138,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
     let mut contacts_sum = 0u64;
     let mut iterations_sum = 0u64;
     let mut max_residual = 0.0f32;
+    let mut max_speed = 0.0f32;
     let mut max_overlap = metrics::max_overlap(&world.bodies);
     let mut final_overlap = max_overlap;
     let mut status = "completed".to_string();
@@ -154,6 +158,9 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         contacts_sum += diagnostics.contacts as u64;
         iterations_sum += diagnostics.iterations as u64;
         max_residual = max_residual.max(diagnostics.natural_map_residual);
+        for v in &world.bodies.linear_velocity {
+            max_speed = max_speed.max(v.length());
+        }
         if step % OVERLAP_SAMPLE_EVERY == 0 || step == steps {
             final_overlap = metrics::max_overlap(&world.bodies);
             max_overlap = max_overlap.max(final_overlap);
@@ -190,6 +197,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             _ => 0.0,
         },
         kinetic_energy_j: world.diagnostics().kinetic_energy,
+        max_speed_m_s: max_speed,
         mean_contacts: contacts_sum as f64 / taken,
         mean_iterations: iterations_sum as f64 / taken,
         max_natural_map_residual: max_residual,

@@ -110,6 +110,11 @@ pub struct ContactConstraint {
     /// Softness of the normal row in the current solve, (mass scale, impulse scale): the update
     /// is Δγ = m_eff·mass_scale·(target − v) − impulse_scale·γ. (1, 0) is the seed's rigid row.
     pub softness: (f32, f32),
+    /// Split impulse: the repair speed the position solve aims for (m/s, ≥ 0; 0 = no push),
+    /// and the pseudo-impulse it has accumulated this substep (N·s).
+    pub position_target: f32,
+    /// See `position_target`.
+    pub position_impulse: f32,
     /// Lever arm r_a from A's centre of mass to the contact point at assembly (m).
     pub lever_a: Vec3,
     /// Lever arm r_b from B's centre of mass to the contact point at assembly (m).
@@ -220,6 +225,8 @@ pub fn assemble(
                     tangent_block: tangent_block(&tangents),
                     target_normal_velocity: 0.0,
                     softness: (1.0, 0.0),
+                    position_target: 0.0,
+                    position_impulse: 0.0,
                     lever_a: r_a,
                     lever_b: r_b,
                     restitution,
@@ -322,11 +329,23 @@ pub fn update_targets(
         let moved = (displacement[a] + rotation[a].cross(c.lever_a))
             - (displacement[b] + rotation[b].cross(c.lever_b));
         let separation = -c.depth + c.normal.direction.dot(moved);
+        let repair = (repair_rate * (-separation - settings.overlap_slop).max(0.0))
+            .min(settings.max_repair_speed);
+        if settings.split_impulse {
+            // The repair goes to the position solve; the velocity rows stay rigid.
+            c.position_target = repair;
+            c.position_impulse = 0.0;
+            c.target_normal_velocity = if separation > 0.0 {
+                -separation / h
+            } else {
+                0.0
+            };
+            c.softness = (1.0, 0.0);
+            continue;
+        }
         (c.target_normal_velocity, c.softness) = if separation > 0.0 {
             (-separation / h, (1.0, 0.0))
         } else if with_repair {
-            let repair = (repair_rate * (-separation - settings.overlap_slop).max(0.0))
-                .min(settings.max_repair_speed);
             (repair, softness)
         } else {
             (0.0, (1.0, 0.0))

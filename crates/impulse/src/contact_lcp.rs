@@ -6,6 +6,8 @@
 //! the solver used, and b = target − J·v* from the same targets and prospective velocities v*,
 //! so that w = Aγ − b ≥ 0, γ ≥ 0, wᵀγ = 0 is exactly the problem PGS iterated on (seed eq. (2)
 //! with the complementarity of "Resolving a collision in the context of a second collision").
+//! Normal rows that were soft in the last solve (soft contact without a relax solve) add their
+//! regularisation to A's diagonal, so the problem stays the one the engine solved.
 
 use std::collections::BTreeMap;
 
@@ -44,7 +46,17 @@ pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, Pro
     let mut friction_index = Vec::new();
     let mut engine_solution = Vec::new();
     let mut contact_of_row = Vec::new();
+    let mut entries: BTreeMap<(usize, usize), f64> = BTreeMap::new();
     for (k, c) in constraints.iter().enumerate() {
+        // A soft normal row (see `ContactConstraint::softness`) updates by
+        // Δγ = m_eff·s·(target − v) − i·γ, whose fixed point with γ > 0 is
+        // (v − target) + (i/s)·(1/m_eff)·γ = 0: the rigid row plus a diagonal term (ODE's
+        // constraint force mixing). Rigid rows, (1, 0), get none.
+        let (mass_scale, impulse_scale) = c.softness;
+        if impulse_scale != 0.0 && mass_scale > 0.0 {
+            let softness = impulse_scale / mass_scale * c.normal.inverse_effective_mass;
+            entries.insert((b.len(), b.len()), softness as f64);
+        }
         let normal_row = b.len();
         let mut rows: Vec<(&JacobianRow, f32, f32, Option<usize>)> =
             vec![(&c.normal, c.target_normal_velocity, c.normal_impulse, None)];
@@ -96,8 +108,7 @@ pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, Pro
         }
     }
     let n = b.len();
-    // A_ij = Σ_bodies s_i s_j (m⁻¹ d_i·d_j + (r×d)_i · I⁻¹(r×d)_j).
-    let mut entries: BTreeMap<(usize, usize), f64> = BTreeMap::new();
+    // A_ij = Σ_bodies s_i s_j (m⁻¹ d_i·d_j + (r×d)_i · I⁻¹(r×d)_j), plus the soft rows' terms.
     for incidences in by_body.values() {
         for p in incidences {
             for q in incidences {

@@ -161,6 +161,8 @@ pub struct IslandWorkspace {
     pub rotation: Vec<Vec3>,
     /// Orientations, integrated substep by substep.
     pub orientation: Vec<Quat>,
+    pseudo_linear: Vec<Vec3>,
+    pseudo_angular: Vec<Vec3>,
     nncg: NncgWorkspace,
     /// Solver iterations used in the step.
     pub iterations: u32,
@@ -228,15 +230,40 @@ pub fn step_island(
             &mut velocities,
             &mut w.nncg,
         );
-        integrate::integrate_positions(
-            &w.linear[..moving],
-            &w.angular[..moving],
-            &mut w.displacement[..moving],
-            &mut w.rotation[..moving],
-            &mut w.orientation,
-            h,
-        );
-        if settings.relax_iterations > 0 {
+        if settings.split_impulse {
+            // Positions move with v + the pseudo-velocity of the repair solve.
+            w.pseudo_linear.clear();
+            w.pseudo_linear.resize(slots, Vec3::ZERO);
+            w.pseudo_angular.clear();
+            w.pseudo_angular.resize(slots, Vec3::ZERO);
+            let mut pseudo = Velocities {
+                linear: &mut w.pseudo_linear,
+                angular: &mut w.pseudo_angular,
+            };
+            solver::solve_positions(constraints, settings.iterations, &mut pseudo);
+            for k in 0..moving {
+                w.pseudo_linear[k] += w.linear[k];
+                w.pseudo_angular[k] += w.angular[k];
+            }
+            integrate::integrate_positions(
+                &w.pseudo_linear[..moving],
+                &w.pseudo_angular[..moving],
+                &mut w.displacement[..moving],
+                &mut w.rotation[..moving],
+                &mut w.orientation,
+                h,
+            );
+        } else {
+            integrate::integrate_positions(
+                &w.linear[..moving],
+                &w.angular[..moving],
+                &mut w.displacement[..moving],
+                &mut w.rotation[..moving],
+                &mut w.orientation,
+                h,
+            );
+        }
+        if settings.relax_iterations > 0 && !settings.split_impulse {
             constraints::update_targets(
                 constraints,
                 &w.displacement,

@@ -44,6 +44,11 @@ pub struct SolverSettings {
     /// Overlap repair coefficient c_d (1/s): target separation speed c_d·max(d − slop, 0)
     /// (seed, "nudge … proportional to the overlap"; Baumgarte stabilisation).
     pub overlap_repair_rate: f32,
+    /// Split impulse: overlap repair runs as a separate solve on pseudo-velocities that move
+    /// positions and are then discarded, so repair never becomes kinetic energy (Catto 2006,
+    /// Bullet's split impulse). The velocity rows are then rigid (target 0 when touching), and
+    /// `soft_contact_hertz` and the relax pass have nothing left to do.
+    pub split_impulse: bool,
     /// Soft contact: when > 0, overlap repair is a damped spring of this frequency (Hz, capped
     /// at a quarter of the substep rate) instead of the seed's rate c_d, and penetrating rows
     /// are regularised by it (Box2D v3's soft step). 0 = the seed's rigid rows with c_d.
@@ -82,6 +87,7 @@ impl Default for SolverSettings {
             tolerance: 1e-5,
             restitution_threshold: 0.5,
             overlap_repair_rate: 6.0,
+            split_impulse: true,
             soft_contact_hertz: 0.0,
             soft_damping_ratio: 10.0,
             overlap_slop: 0.002,

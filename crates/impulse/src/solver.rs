@@ -333,3 +333,34 @@ fn apply_impulses(c: &ContactConstraint, impulses: [f32; 3], velocities: &mut Ve
         + t1.inverse_inertia_angular_b * impulses[1]
         + t2.inverse_inertia_angular_b * impulses[2];
 }
+
+/// The position solve of split impulse: PGS over the normal rows alone, on pseudo-velocities
+/// (`velocities` holds them, starting at zero), towards each row's `position_target`, with
+/// pseudo-impulses clamped ≥ 0. Rows with no target take part only as non-penetration
+/// (target 0), so a push on one body does not drive it into another.
+pub fn solve_positions(
+    constraints: &mut [ContactConstraint],
+    iterations: u32,
+    velocities: &mut Velocities<'_>,
+) {
+    for _ in 0..iterations {
+        for c in constraints.iter_mut() {
+            let (a, b) = (c.local_a as usize, c.local_b as usize);
+            let row = &c.normal;
+            let (la, aa) = (velocities.linear[a], velocities.angular[a]);
+            let (lb, ab) = (velocities.linear[b], velocities.angular[b]);
+            let v = row.velocity(la, aa, lb, ab);
+            let old = c.position_impulse;
+            let new = (old + row.effective_mass * (c.position_target - v)).max(0.0);
+            let delta = new - old;
+            if delta != 0.0 {
+                c.position_impulse = new;
+                let linear = row.direction * delta;
+                velocities.linear[a] = la + linear * c.inverse_mass_a;
+                velocities.linear[b] = lb - linear * c.inverse_mass_b;
+                velocities.angular[a] = aa + row.inverse_inertia_angular_a * delta;
+                velocities.angular[b] = ab - row.inverse_inertia_angular_b * delta;
+            }
+        }
+    }
+}
