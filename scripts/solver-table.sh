@@ -11,10 +11,11 @@ if [ ${#scenes[@]} -eq 0 ]; then
   scenes=(pyramid20 stack30 massratio vertical_stack15 mass_ratio_pyramid100 mass_ratio_pyramid300 plate card_house arch overlap_pyramid)
 fi
 configs=(
-  "seed PGS (1 solve/step, no relax)|--substeps 1 --relax 0 --method pgs --iterations 20"
-  "PGS, 4 substeps + relax|--method pgs"
-  "soft step (30 Hz, ζ = 10), NNCG|--soft-hertz 30"
-  "default: NNCG, 4 substeps + relax|"
+  "seed: PGS, 1 solve/step, velocity bias|--substeps 1 --relax 0 --method pgs --iterations 20 --repair bias"
+  "PGS, 4 substeps, bias + relax|--method pgs --repair bias"
+  "NNCG, 4 substeps, bias + relax|--repair bias"
+  "NNCG, 4 substeps, soft step (30 Hz, ζ = 10)|--repair soft"
+  "default: NNCG, 4 substeps, split impulse|"
 )
 tmp=$(mktemp -d)
 echo "| scene | solver | top sink (mm) | largest overlap (mm) | kinetic energy at 10 s (J) | largest LCP residual | ms/step |"

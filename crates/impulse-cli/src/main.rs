@@ -53,9 +53,10 @@ enum Command {
         /// Overlap repair rate c_d in 1/s (the seed's "nudge" coefficient).
         #[arg(long)]
         repair_rate: Option<f32>,
-        /// Overlap repair by split impulse (a separate position solve) instead of a velocity bias.
+        /// Overlap repair: `bias` (the seed's velocity bias c_d·d, with relax), `split` (split
+        /// impulse: a separate position solve) or `soft` (soft contact springs, with relax).
         #[arg(long)]
-        split_impulse: bool,
+        repair: Option<String>,
         /// Worker threads (default: all cores); 1 runs everything on the calling thread.
         #[arg(long)]
         threads: Option<usize>,
@@ -181,7 +182,7 @@ fn real_main() -> Result<ExitCode> {
             method,
             soft_hertz,
             repair_rate,
-            split_impulse,
+            repair,
             threads,
             no_sleep,
             out,
@@ -196,14 +197,31 @@ fn real_main() -> Result<ExitCode> {
             if let Some(relax) = relax {
                 scene.solver.relax_iterations = relax;
             }
-            if let Some(hertz) = soft_hertz {
-                scene.solver.soft_contact_hertz = hertz;
-            }
             if let Some(rate) = repair_rate {
                 scene.solver.overlap_repair_rate = rate;
             }
-            if split_impulse {
-                scene.solver.split_impulse = true;
+            if let Some(repair) = repair {
+                let s = &mut scene.solver;
+                match repair.as_str() {
+                    "bias" => {
+                        s.split_impulse = false;
+                        s.soft_contact_hertz = 0.0;
+                    }
+                    "split" => {
+                        s.split_impulse = true;
+                        s.soft_contact_hertz = 0.0;
+                    }
+                    "soft" => {
+                        s.split_impulse = false;
+                        if s.soft_contact_hertz == 0.0 {
+                            s.soft_contact_hertz = 30.0;
+                        }
+                    }
+                    other => bail!("unknown repair '{other}': expected bias, split or soft"),
+                }
+            }
+            if let Some(hertz) = soft_hertz {
+                scene.solver.soft_contact_hertz = hertz;
             }
             if no_sleep {
                 scene.solver.sleep = false;
