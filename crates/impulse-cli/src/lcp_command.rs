@@ -6,9 +6,15 @@
 //! (`A = M`, `b = −q`), so results are reported in the file's own terms without conversion.
 
 use std::path::Path;
+use std::time::Instant;
 
-use anyhow::{Context, Result};
-use impulse_lcp::{FileFormat, SolverKind, SolverSettings, read_lcp};
+use anyhow::{Context, Result, bail};
+use impulse::{Scene, World};
+use impulse_lcp::solvers::{jacobi, lemke, pgs};
+use impulse_lcp::{
+    Bounds, FileFormat, Lcp, Matrix, Solution, SolverKind, SolverSettings, Status, merit_report,
+    natural_map_residual, normalised_natural_map_residual, read_lcp, residual_scale, write_json,
+};
 
 /// Largest `n` for which the summary prints `z` in full.
 const PRINT_Z_UP_TO: usize = 20;
@@ -98,4 +104,709 @@ fn abbreviate(history: &[f64]) -> String {
         history.len() - 2 * half,
         show(&history[history.len() - half..])
     )
+}
+
+// ---------------------------------------------------------------------------------------------
+// `impulse lcp dump`: the contact LCP of a scene's step as a file.
+// ---------------------------------------------------------------------------------------------
+
+/// Steps `scene` `step` times and writes the contact LCP of the last step to `out` in impulse's
+/// JSON format (seed convention `w = Aγ − b`, `A` as CSR, friction rows with `friction_index` /
+/// `mu`). Prints rows, non-zeros, `‖b‖₂` and the engine's own natural-map residual on the
+/// exported problem (absolute, and normalised by `‖b‖₂` as the solvers report it).
+///
+/// With `no_friction`, the scene's `solver.friction` is switched off before the world is built,
+/// so the problem is a standard LCP (`γ ≥ 0`) that Lemke's method accepts. With friction the
+/// tangent rows carry ODE-style bounds `|γ_ti| ≤ μ·γ_n` each (the friction *pyramid*), while the
+/// engine keeps `(γ_t1, γ_t2)` in Coulomb's *disc*; the residual printed is then the pyramid
+/// problem's and need not be small even when the engine converged (see docs/lcp.md).
+///
+/// Sleeping is switched off (an island asleep at `step` would not have been solved, and its
+/// exported rows would be a trivial LCP), so the run can differ from `impulse run`'s default.
+///
+/// Errors: `step` = 0, a step that blows up, a step with no contacts, an unwritable file.
+pub fn dump(mut scene: Scene, step: u64, out: &Path, no_friction: bool) -> Result<()> {
+    if step == 0 {
+        bail!("--step must be at least 1: contacts are found by the first step");
+    }
+    if no_friction {
+        scene.solver.friction = false;
+    }
+    // A sleeping island is not solved: its rows would hold last step's impulses with zero
+    // velocities, a trivial LCP (w = 0) rather than the step's.
+    scene.solver.sleep = false;
+    let name = scene.name.clone();
+    let mut world = World::from_scene(&scene).context("cannot build the scene's world")?;
+    for _ in 0..step {
+        world
+            .step()
+            .with_context(|| format!("scene {name}: stepping to step {step}"))?;
+    }
+    let contact_lcp = world
+        .contact_lcp()
+        .with_context(|| format!("scene {name}: step {step} has no valid contact LCP"))?;
+    let lcp = &contact_lcp.problem;
+    if lcp.n() == 0 {
+        bail!("scene {name}: step {step} has no contacts, so there is no LCP to write");
+    }
+    write_json(lcp, out)?;
+
+    let z = &contact_lcp.engine_solution;
+    let report = merit_report(lcp, z);
+    let friction = !lcp.bounds.is_nonnegative();
+    let contacts = world.contact_constraints().len();
+    println!("scene       {name}, step {step}");
+    println!(
+        "file        {} (impulse JSON, w = Aγ − b, A as CSR)",
+        out.display()
+    );
+    println!(
+        "rows        {} ({contacts} contact points{})",
+        lcp.n(),
+        if friction {
+            ", normal + 2 tangents each"
+        } else {
+            ", normal rows only"
+        }
+    );
+    println!("nonzeros    {} in A", nonzeros(&lcp.a));
+    println!(
+        "bounds      {}",
+        if friction {
+            "friction rows |γ_ti| ≤ μ·γ_n (pyramid; the engine used the disc)"
+        } else {
+            "γ ≥ 0 (standard LCP)"
+        }
+    );
+    println!("‖b‖₂        {:.6e}", residual_scale(&lcp.b));
+    println!(
+        "engine      natural-map residual {:.3e} (normalised {:.3e}), most negative w {:.3e}, \
+         bound violation {:.3e}",
+        natural_map_residual(lcp, z),
+        report.natural_map_normalised,
+        report.most_negative_w,
+        report.bound_violation,
+    );
+    println!(
+        "engine      diagnostics residual {:.3e} (disc, f32), {} iterations",
+        world.diagnostics().natural_map_residual,
+        world.diagnostics().iterations
+    );
+    Ok(())
+}
+
+/// How a problem's bounds read in a summary or a plot's subtitle.
+fn bounds_name(bounds: &Bounds) -> &'static str {
+    match bounds {
+        _ if bounds.is_nonnegative() => "γ ≥ 0",
+        Bounds::Friction { .. } => "friction (pyramid) bounds",
+        _ => "box bounds",
+    }
+}
+
+/// Stored entries of `A` (all `n²` for a dense matrix).
+fn nonzeros(a: &Matrix) -> usize {
+    match a {
+        Matrix::Dense(m) => m.data.len(),
+        Matrix::Csr(m) => m.values.len(),
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// `impulse lcp convergence`: residual histories of the solvers on one problem, as an SVG plot.
+// ---------------------------------------------------------------------------------------------
+
+/// Largest `n` on which [`convergence`] runs Lemke's method. Its dense tableau has `n × (2n + 2)`
+/// doubles and every pivot touches all of it: pyramid20's frictionless LCP (n = 2435, 95 MB)
+/// took 59–76 s for 2443 pivots on a 2-core machine, pyramid10's (n = 602) 5 s for 6020.
+/// Beyond this size the plot shows PGS and Jacobi only (`impulse lcp solve --solver lemke`
+/// still runs Lemke on any size).
+pub const LEMKE_MAX_ROWS: usize = 2000;
+/// When Lemke fails on a problem of at most this many rows, it is rerun on `A + εD` (see
+/// [`LEMKE_REGULARISATION`]); beyond it the second run costs too much (pyramid20: > 1 min).
+pub const LEMKE_REGULARISED_MAX_ROWS: usize = 1500;
+/// ε of the regularised rerun `A + ε·diag(A)`: a P-matrix, so Lemke's path is well posed even
+/// when redundant contacts make `A` singular; its solution misses the original problem by about
+/// ε·‖Aγ‖ (measured 3e-7, normalised, on pyramid10). ODE calls this constraint force mixing.
+pub const LEMKE_REGULARISATION: f64 = 1e-6;
+/// Lemke's pivot budget per row (contact LCPs need about one pivot per active row).
+const LEMKE_PIVOTS_PER_ROW: usize = 10;
+/// The iterative solvers stop below this normalised residual (f64 round-off on contact data).
+const ITERATIVE_TOLERANCE: f64 = 1e-14;
+/// Lemke's solution counts as accurate at or below this normalised residual.
+const LEMKE_TOLERANCE: f64 = 1e-9;
+/// Residuals are plotted as log10(max(r, this)), so an exact 0 stays on the plot.
+const PLOT_FLOOR: f64 = 1e-17;
+/// Power-iteration steps for Jacobi's damping.
+const POWER_ITERATIONS: usize = 100;
+/// How often Jacobi is retried with half the damping after diverging.
+const JACOBI_RETRIES: usize = 4;
+
+/// One solver's run as plotted: `(x, residual)` with x the sweep or pivot count (0 = start).
+struct Series {
+    label: String,
+    colour: &'static str,
+    dashed: bool,
+    points: Vec<(f64, f64)>,
+    /// Lemke's final (polished) residual, drawn as a marker at its pivot count.
+    marker: Option<(f64, f64)>,
+}
+
+/// Reads an LCP (`.json` or Siconos `.dat`), runs projected Gauss–Seidel, damped projected
+/// Jacobi and, when the bounds are plain `γ ≥ 0` and `n ≤` [`LEMKE_MAX_ROWS`], Lemke's method,
+/// each from `γ = 0`, and writes `out_svg`: log10 of the normalised natural-map residual
+/// `‖min-map(γ)‖₂ / ‖b‖₂` against sweeps (PGS, Jacobi, at most `iterations` each) or pivots
+/// (Lemke), with its final polished residual as a marker. Prints each solver's status, count,
+/// final residual and time. When Lemke does not converge (redundant contacts: `A` singular) and
+/// `n ≤` [`LEMKE_REGULARISED_MAX_ROWS`], it is rerun on `A + ε·diag(A)` and that curve is added,
+/// its marker at the residual of its solution on the original problem.
+///
+/// Jacobi's damping is ω = 1/λ̂ with λ̂ the power-iteration estimate of λ_max(D⁻¹A) (theory
+/// asks ω < 2/λ_max for symmetric positive semidefinite `A`); if it still diverges, ω is halved
+/// and Jacobi rerun (at most 4 times). Non-symmetric `A` (Siconos files) uses the Gershgorin
+/// bound instead of power iteration.
+///
+/// Errors: unreadable or invalid file, an empty problem, no solver able to run, unwritable SVG.
+pub fn convergence(path: &Path, iterations: usize, out_svg: &Path) -> Result<()> {
+    let (lcp, format) = read_lcp(path)?;
+    let n = lcp.n();
+    if n == 0 {
+        bail!("{}: the problem has no unknowns", path.display());
+    }
+    let start = normalised_natural_map_residual(&lcp, &vec![0.0; n]);
+    let bounds = bounds_name(&lcp.bounds);
+    println!(
+        "file        {} ({}, n = {n}, {} nonzeros, {bounds})",
+        path.display(),
+        match format {
+            FileFormat::Siconos => "Siconos",
+            FileFormat::Json => "impulse JSON",
+        },
+        nonzeros(&lcp.a),
+    );
+    println!("start       residual {start:.3e} at γ = 0 (normalised by ‖b‖₂)");
+
+    let mut series = Vec::new();
+    let iterative = |relaxation: f64| SolverSettings {
+        max_iterations: iterations,
+        tolerance: ITERATIVE_TOLERANCE,
+        relaxation,
+    };
+    let with_start = |history: &[f64]| {
+        std::iter::once((0.0, start))
+            .chain(
+                history
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &r)| ((k + 1) as f64, r)),
+            )
+            .collect::<Vec<_>>()
+    };
+
+    // Projected Gauss–Seidel, ω = 1.
+    let timer = Instant::now();
+    match pgs::solve(&lcp, None, &iterative(1.0)) {
+        Ok(s) => {
+            print_run("pgs", "ω = 1", &s, timer.elapsed().as_secs_f64());
+            series.push(Series {
+                label: format!("projected Gauss–Seidel: {:.1e}", s.residual),
+                colour: "#1f77b4",
+                dashed: false,
+                points: with_start(&s.residual_history),
+                marker: None,
+            });
+        }
+        Err(e) => println!("pgs         not run: {e}"),
+    }
+
+    // Damped projected Jacobi.
+    let mut omega = jacobi_damping(&lcp.a);
+    let timer = Instant::now();
+    let mut attempt = 0;
+    loop {
+        match jacobi::solve(&lcp, None, &iterative(omega)) {
+            Ok(s) if s.status == Status::Diverged && attempt < JACOBI_RETRIES => {
+                println!("jacobi      diverged with ω = {omega:.4}; halving ω");
+                omega *= 0.5;
+                attempt += 1;
+            }
+            Ok(s) => {
+                print_run(
+                    "jacobi",
+                    &format!("ω = {omega:.4}"),
+                    &s,
+                    timer.elapsed().as_secs_f64(),
+                );
+                series.push(Series {
+                    label: format!("projected Jacobi, ω = {omega:.3}: {:.1e}", s.residual),
+                    colour: "#d62728",
+                    dashed: false,
+                    points: with_start(&s.residual_history),
+                    marker: None,
+                });
+                break;
+            }
+            Err(e) => {
+                println!("jacobi      not run: {e}");
+                break;
+            }
+        }
+    }
+
+    // Lemke, if it applies and is affordable.
+    if !lcp.bounds.is_nonnegative() {
+        println!("lemke       not run: it solves only γ ≥ 0, and this problem has other bounds");
+    } else if n > LEMKE_MAX_ROWS {
+        println!(
+            "lemke       not run: n = {n} > {LEMKE_MAX_ROWS} (dense tableau of {:.0} MB, O(n²) per pivot)",
+            (n * (2 * n + 2) * 8) as f64 / 1e6
+        );
+    } else {
+        let settings = SolverSettings {
+            max_iterations: (LEMKE_PIVOTS_PER_ROW * n).max(1000),
+            tolerance: LEMKE_TOLERANCE,
+            relaxation: 1.0,
+        };
+        let timer = Instant::now();
+        match lemke::solve(&lcp, None, &settings) {
+            Ok(s) => {
+                print_run("lemke", "", &s, timer.elapsed().as_secs_f64());
+                let converged = s.status.is_converged();
+                series.push(Series {
+                    label: format!(
+                        "Lemke vs pivots ({}, {} pivots): {:.1e}",
+                        s.status, s.iterations, s.residual
+                    ),
+                    colour: "#2ca02c",
+                    dashed: true,
+                    points: with_start(&s.residual_history),
+                    marker: Some((s.iterations as f64, s.residual)),
+                });
+                if !converged && n <= LEMKE_REGULARISED_MAX_ROWS {
+                    // Redundant contacts make A singular, and Lemke's pivots on its null space
+                    // are round-off; on A + εD (D = diag A, a P-matrix) the path is well posed.
+                    let regularised = Lcp {
+                        a: with_scaled_diagonal(&lcp.a, 1.0 + LEMKE_REGULARISATION),
+                        ..lcp.clone()
+                    };
+                    let timer = Instant::now();
+                    if let Ok(r) = lemke::solve(&regularised, None, &settings) {
+                        let on_original = normalised_natural_map_residual(&lcp, &r.z);
+                        print_run(
+                            "lemke+εD",
+                            &format!(
+                                "on A + {LEMKE_REGULARISATION:.0e}·diag(A); residual on the \
+                                 original problem {on_original:.3e}"
+                            ),
+                            &r,
+                            timer.elapsed().as_secs_f64(),
+                        );
+                        series.push(Series {
+                            label: format!(
+                                "Lemke on A + {LEMKE_REGULARISATION:.0e}·diag A ({}, {} pivots): \
+                                 {on_original:.1e} on A",
+                                r.status, r.iterations
+                            ),
+                            colour: "#9467bd",
+                            dashed: true,
+                            points: with_start(&r.residual_history),
+                            marker: Some((r.iterations as f64, on_original)),
+                        });
+                    }
+                }
+            }
+            Err(e) => println!("lemke       not run: {e}"),
+        }
+    }
+    if series.is_empty() {
+        bail!("{}: no solver could run on this problem", path.display());
+    }
+
+    let file_name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |f| f.to_string_lossy().into(),
+    );
+    let title = format!("Natural-map residual: {file_name}");
+    let subtitle = format!(
+        "n = {n}, {} nonzeros, {bounds}; every solver starts from γ = 0",
+        nonzeros(&lcp.a)
+    );
+    let svg = svg_plot(&title, &subtitle, &series);
+    std::fs::write(out_svg, svg).with_context(|| format!("cannot write {}", out_svg.display()))?;
+    println!("plot        {}", out_svg.display());
+    Ok(())
+}
+
+fn print_run(name: &str, note: &str, s: &Solution, seconds: f64) {
+    let unit = if name.starts_with("lemke") {
+        "pivots"
+    } else {
+        "sweeps"
+    };
+    let note = if note.is_empty() {
+        String::new()
+    } else {
+        format!(" ({note})")
+    };
+    println!(
+        "{name:<11} {:<15} {:>6} {unit}{note}, final residual {:.3e}, {seconds:.3} s",
+        s.status.as_str(),
+        s.iterations,
+        s.residual,
+    );
+}
+
+/// `A` with every diagonal entry multiplied by `factor` (a CSR row without a stored diagonal
+/// keeps it at 0).
+fn with_scaled_diagonal(a: &Matrix, factor: f64) -> Matrix {
+    let mut a = a.clone();
+    match &mut a {
+        Matrix::Dense(m) => {
+            let n = m.rows.min(m.cols);
+            for i in 0..n {
+                m.data[i * m.cols + i] *= factor;
+            }
+        }
+        Matrix::Csr(m) => {
+            for i in 0..m.rows {
+                for k in m.indptr[i]..m.indptr[i + 1] {
+                    if m.indices[k] == i {
+                        m.values[k] *= factor;
+                    }
+                }
+            }
+        }
+    }
+    a
+}
+
+/// Damping ω = 1/λ̂ for projected Jacobi, λ̂ ≈ λ_max(D⁻¹A) (≥ 1 when the diagonal is positive).
+/// Symmetric `A`: power iteration on the similar symmetric D^{-1/2} A D^{-1/2}, whose Rayleigh
+/// quotients approach λ_max from below. Otherwise the Gershgorin bound max_i Σ_j |A_ij| / A_ii.
+/// A non-positive diagonal gives 1 (Jacobi then refuses to run anyway).
+fn jacobi_damping(a: &Matrix) -> f64 {
+    let diagonal = a.diagonal();
+    if diagonal
+        .iter()
+        .any(|&d| d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+    {
+        return 1.0;
+    }
+    let n = diagonal.len();
+    let estimate = if is_symmetric(a) {
+        let scale: Vec<f64> = diagonal.iter().map(|d| 1.0 / d.sqrt()).collect();
+        // A deterministic start with components of both signs and varied sizes.
+        let mut x: Vec<f64> = (0..n)
+            .map(|i| 1.0 + 0.5 * ((i as f64) * 0.618_033_988_75).fract())
+            .collect();
+        let (mut scaled, mut y) = (vec![0.0; n], vec![0.0; n]);
+        let mut lambda = 1.0_f64;
+        for _ in 0..POWER_ITERATIONS {
+            let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if !(norm > 0.0 && norm.is_finite()) {
+                break;
+            }
+            for i in 0..n {
+                x[i] /= norm;
+                scaled[i] = x[i] * scale[i];
+            }
+            a.mul_vec(&scaled, &mut y);
+            for i in 0..n {
+                y[i] *= scale[i];
+            }
+            lambda = x.iter().zip(&y).map(|(p, q)| p * q).sum::<f64>();
+            std::mem::swap(&mut x, &mut y);
+        }
+        lambda
+    } else {
+        let row_sum = |i: usize| match a {
+            Matrix::Dense(m) => m.row(i).iter().map(|v| v.abs()).sum::<f64>(),
+            Matrix::Csr(m) => m.row(i).1.iter().map(|v| v.abs()).sum::<f64>(),
+        };
+        diagonal
+            .iter()
+            .enumerate()
+            .fold(0.0_f64, |bound, (i, d)| bound.max(row_sum(i) / d))
+    };
+    if estimate.is_finite() && estimate >= 1.0 {
+        1.0 / estimate
+    } else {
+        1.0
+    }
+}
+
+/// `A = Aᵀ` up to 1e-12 of the largest entry.
+fn is_symmetric(a: &Matrix) -> bool {
+    let n = a.rows();
+    match a {
+        Matrix::Dense(m) => {
+            let scale = m.data.iter().fold(0.0_f64, |s, v| s.max(v.abs()));
+            (0..n).all(|i| (0..i).all(|j| (m.get(i, j) - m.get(j, i)).abs() <= 1e-12 * scale))
+        }
+        Matrix::Csr(m) => {
+            let scale = m.values.iter().fold(0.0_f64, |s, v| s.max(v.abs()));
+            let get = |i: usize, j: usize| {
+                let (cols, vals) = m.row(i);
+                cols.binary_search(&j).map_or(0.0, |k| vals[k])
+            };
+            (0..n).all(|i| {
+                let (cols, vals) = m.row(i);
+                cols.iter()
+                    .zip(vals)
+                    .all(|(&j, &v)| (v - get(j, i)).abs() <= 1e-12 * scale)
+            })
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// A small SVG line plot: linear x, log10 y, decade ticks, legend. Plain text, no dependencies.
+// ---------------------------------------------------------------------------------------------
+
+const WIDTH: f64 = 820.0;
+/// Height of the plot itself; the legend adds [`LEGEND_ROW`] per series below it.
+const HEIGHT: f64 = 520.0;
+const LEGEND_ROW: f64 = 20.0;
+const LEFT: f64 = 80.0;
+const RIGHT: f64 = 30.0;
+const TOP: f64 = 70.0;
+const BOTTOM: f64 = 60.0;
+
+fn svg_plot(title: &str, subtitle: &str, series: &[Series]) -> String {
+    use std::fmt::Write;
+    let log = |r: f64| r.max(PLOT_FLOOR).log10();
+    // The x axis spans the iterative solvers' sweeps; a longer Lemke path is cut at its end and
+    // its final dot drawn on the edge with the pivot count. Without iterative series, all of it.
+    let sweeps = series
+        .iter()
+        .filter(|s| s.marker.is_none())
+        .flat_map(|s| s.points.iter())
+        .fold(0.0_f64, |m, &(x, _)| m.max(x));
+    let x_max_data = if sweeps > 0.0 {
+        sweeps
+    } else {
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().chain(s.marker.iter()))
+            .fold(1.0_f64, |m, &(x, _)| m.max(x))
+    };
+    let (x_step, x_max) = nice_axis(x_max_data);
+    let visible = || {
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().filter(|&&(x, _)| x <= x_max))
+            .chain(series.iter().filter_map(|s| s.marker.as_ref()))
+            .filter(|(_, r)| !r.is_nan())
+    };
+    let y_lo = visible().fold(f64::INFINITY, |m, &(_, r)| m.min(log(r)));
+    let y_hi = visible().fold(f64::NEG_INFINITY, |m, &(_, r)| m.max(log(r)));
+    let (mut y_min, mut y_max) = (y_lo.floor(), y_hi.ceil());
+    if !(y_min.is_finite() && y_max.is_finite()) {
+        (y_min, y_max) = (-1.0, 0.0);
+    }
+    if y_max - y_min < 1.0 {
+        y_max = y_min + 1.0;
+    }
+    let plot_w = WIDTH - LEFT - RIGHT;
+    let plot_h = HEIGHT - TOP - BOTTOM;
+    let total_h = HEIGHT + 10.0 + LEGEND_ROW * series.len() as f64;
+    let px = |x: f64| LEFT + plot_w * x / x_max;
+    let py = |y: f64| TOP + plot_h * (y_max - y.clamp(y_min, y_max)) / (y_max - y_min);
+
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{total_h}" viewBox="0 0 {WIDTH} {total_h}" font-family="sans-serif" font-size="12">"#
+    );
+    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="24" text-anchor="middle" font-size="16">{}</text>"#,
+        WIDTH / 2.0,
+        escape(title)
+    );
+    let _ = writeln!(
+        s,
+        r##"<text x="{}" y="44" text-anchor="middle" fill="#555">{}</text>"##,
+        WIDTH / 2.0,
+        escape(subtitle)
+    );
+    // Grid and ticks: every decade on y, nice steps on x.
+    let decade_step = ((y_max - y_min) / 12.0).ceil().max(1.0);
+    let mut y = y_min;
+    while y <= y_max + 1e-9 {
+        let p = py(y);
+        let _ = writeln!(
+            s,
+            r##"<line x1="{LEFT}" y1="{p:.1}" x2="{:.1}" y2="{p:.1}" stroke="#ddd"/>"##,
+            LEFT + plot_w
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{:.1}" y="{:.1}" text-anchor="end">1e{}</text>"#,
+            LEFT - 6.0,
+            p + 4.0,
+            y as i64
+        );
+        y += decade_step;
+    }
+    let mut x = 0.0;
+    while x <= x_max + 1e-9 {
+        let p = px(x);
+        let _ = writeln!(
+            s,
+            r##"<line x1="{p:.1}" y1="{TOP}" x2="{p:.1}" y2="{:.1}" stroke="#eee"/>"##,
+            TOP + plot_h
+        );
+        let _ = writeln!(
+            s,
+            r#"<line x1="{p:.1}" y1="{:.1}" x2="{p:.1}" y2="{:.1}" stroke="black"/>"#,
+            TOP + plot_h,
+            TOP + plot_h + 5.0
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{p:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
+            TOP + plot_h + 19.0,
+            x
+        );
+        x += x_step;
+    }
+    let _ = writeln!(
+        s,
+        r#"<rect x="{LEFT}" y="{TOP}" width="{plot_w}" height="{plot_h}" fill="none" stroke="black"/>"#
+    );
+    let _ = writeln!(
+        s,
+        r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">iteration (sweeps; Lemke: pivots)</text>"#,
+        LEFT + plot_w / 2.0,
+        HEIGHT - 16.0
+    );
+    let _ = writeln!(
+        s,
+        r#"<text x="18" y="{:.1}" text-anchor="middle" transform="rotate(-90 18 {:.1})">‖γ − mid(lo, γ − w, hi)‖₂ / ‖b‖₂ (log scale)</text>"#,
+        TOP + plot_h / 2.0,
+        TOP + plot_h / 2.0
+    );
+    // Curves.
+    for series in series {
+        let mut path = String::new();
+        for &(x, r) in &series.points {
+            if r.is_nan() || x > x_max {
+                continue;
+            }
+            let _ = write!(path, "{:.1},{:.1} ", px(x), py(log(r)));
+        }
+        let _ = writeln!(
+            s,
+            r#"<polyline fill="none" stroke="{}" stroke-width="1.8"{} points="{}"/>"#,
+            series.colour,
+            if series.dashed {
+                r#" stroke-dasharray="6 4""#
+            } else {
+                ""
+            },
+            path.trim_end()
+        );
+        if let Some((x, r)) = series.marker {
+            let (cx, cy) = (px(x.min(x_max)), py(log(r)));
+            let _ = writeln!(
+                s,
+                r#"<circle cx="{cx:.1}" cy="{cy:.1}" r="5" fill="{}" stroke="black"/>"#,
+                series.colour
+            );
+            if x > x_max {
+                let _ = writeln!(
+                    s,
+                    r#"<text x="{:.1}" y="{:.1}" text-anchor="end" fill="{}" stroke="white" stroke-width="4" paint-order="stroke">after {x} pivots</text>"#,
+                    cx - 4.0,
+                    cy + 20.0,
+                    series.colour
+                );
+            }
+        }
+    }
+    // Legend below the x-axis label, one row per series, so it never hides a curve.
+    let legend_x = LEFT;
+    let legend_y = HEIGHT;
+    let _ = writeln!(
+        s,
+        r##"<rect x="{legend_x:.1}" y="{:.1}" width="{plot_w}" height="{:.1}" fill="none" stroke="#999"/>"##,
+        legend_y - 4.0,
+        6.0 + LEGEND_ROW * series.len() as f64
+    );
+    for (k, series) in series.iter().enumerate() {
+        let y = legend_y + 12.0 + LEGEND_ROW * k as f64;
+        let _ = writeln!(
+            s,
+            r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="2"{}/>"#,
+            legend_x + 10.0,
+            y - 4.0,
+            legend_x + 40.0,
+            y - 4.0,
+            series.colour,
+            if series.dashed {
+                r#" stroke-dasharray="6 4""#
+            } else {
+                ""
+            }
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{:.1}" y="{y:.1}">{}</text>"#,
+            legend_x + 48.0,
+            escape(&series.label)
+        );
+    }
+    let _ = writeln!(s, "</svg>");
+    s
+}
+
+/// A tick step of 1, 2 or 5 × 10^k giving about 4–8 ticks up to at least `max`, and the axis
+/// end (a multiple of the step).
+fn nice_axis(max: f64) -> (f64, f64) {
+    let raw = (max / 8.0).max(1e-12);
+    let magnitude = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * magnitude)
+        .find(|&s| s >= raw)
+        .unwrap_or(10.0 * magnitude)
+        .max(1.0);
+    (step, (max / step).ceil().max(1.0) * step)
+}
+
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use impulse::scene::builtin::builtin_scene;
+    use std::path::PathBuf;
+
+    fn docs() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs")
+    }
+
+    /// Makes the plots of docs/lcp.md through the same functions as `impulse lcp dump` and
+    /// `impulse lcp convergence` (the commands docs/lcp.md shows). Takes about a minute:
+    /// `cargo test --release -p impulse-cli -- --ignored --nocapture docs_plots`.
+    #[test]
+    #[ignore = "writes docs/lcp-*.svg; slow"]
+    fn docs_plots() {
+        let dir = std::env::temp_dir();
+        for (scene, no_friction, svg) in [
+            ("pyramid20", true, "lcp-pyramid20.svg"),
+            ("pyramid20", false, "lcp-pyramid20-friction.svg"),
+            ("pyramid10", true, "lcp-pyramid10.svg"),
+        ] {
+            let file = dir.join(format!("{scene}-step100-{no_friction}.json"));
+            dump(builtin_scene(scene).unwrap(), 100, &file, no_friction).unwrap();
+            convergence(&file, 1000, &docs().join(svg)).unwrap();
+        }
+    }
 }

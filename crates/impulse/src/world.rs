@@ -245,7 +245,6 @@ impl World {
                 iterations = iterations.max(self.workspaces[k].iterations);
             }
         }
-        self.update_sleep(dt);
         constraints::record_velocity_before(
             &mut self.constraints,
             &self.bodies.linear_velocity,
@@ -266,6 +265,8 @@ impl World {
             }
         }
         let residual = squared.sqrt() as f32;
+        // Sleep last: it zeroes velocities, which must not leak into this step's LCP.
+        self.update_sleep(dt);
 
         let (kinetic_energy, momentum) = diagnostics::energy_and_momentum(&self.bodies);
         let friction_rows = self.constraints.iter().filter(|c| c.friction > 0.0).count();
