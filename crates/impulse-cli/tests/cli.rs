@@ -1,0 +1,228 @@
+//! The `impulse` binary end to end: trajectories, summaries, scene errors and LCP commands.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn impulse() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_impulse"))
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("impulse-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn repo(path: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(path)
+}
+
+#[test]
+fn run_writes_csv_trajectory_and_summary_json() {
+    let csv = temp("stack.csv");
+    let summary = temp("stack.json");
+    let out = impulse()
+        .args([
+            "run", "stack30", "--steps", "20", "--every", "10", "--quiet",
+        ])
+        .arg("--out")
+        .arg(&csv)
+        .arg("--summary-json")
+        .arg(&summary)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("frame,time,body,x,y,z,qx,qy,qz,qw"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    // Frames 0, 10 and 20, each with 31 bodies (ground + 30 cubes) in scene order.
+    assert_eq!(rows.len(), 3 * 31);
+    assert_eq!(rows[0][0], 0.0);
+    assert_eq!(rows[31][0], 10.0);
+    assert_eq!(rows[62][0], 20.0);
+    for (k, row) in rows.iter().take(31).enumerate() {
+        assert_eq!(row[2], k as f64);
+        assert_eq!(row[9], 1.0, "identity orientation, scalar last");
+    }
+    // Body 30 starts at y = 29.5.
+    assert!((rows[30][4] - 29.5).abs() < 1e-6);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    for key in [
+        "scene",
+        "bodies",
+        "steps",
+        "dt",
+        "ms_per_step",
+        "max_overlap_m",
+        "top_sink_m",
+        "kinetic_energy_j",
+        "mean_contacts",
+    ] {
+        assert!(json.get(key).is_some(), "summary lacks {key}");
+    }
+    assert_eq!(json["bodies"], 31);
+    assert_eq!(json["steps"], 20);
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("stack30: 31 bodies, 20 steps"));
+}
+
+#[test]
+fn jsonl_has_one_object_per_frame() {
+    let path = temp("example.jsonl");
+    let out = impulse()
+        .arg("run")
+        .arg(repo("scenes/example-three-spheres.json"))
+        .args(["--steps", "5", "--quiet", "--out"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&path).unwrap();
+    let frames: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(frames.len(), 6);
+    assert_eq!(frames[5]["frame"], 5);
+    assert_eq!(
+        frames[0]["bodies"].as_array().unwrap()[0]
+            .as_array()
+            .unwrap()
+            .len(),
+        7
+    );
+}
+
+#[test]
+fn a_malformed_scene_names_file_line_body_and_field() {
+    let path = temp("bad.json");
+    std::fs::write(
+        &path,
+        "{\n  \"bodies\": [\n    {\"kind\": \"dynamic\", \"shape\": {\"type\": \"sphere\", \"radius\": -1}}\n  ]\n}\n",
+    )
+    .unwrap();
+    let out = impulse().arg("run").arg(&path).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.json:3:"), "{err}");
+    assert!(err.contains("bodies[0]"), "{err}");
+    assert!(err.contains("shape.radius"), "{err}");
+}
+
+#[test]
+fn unknown_scene_lists_the_builtins() {
+    let out = impulse().args(["run", "no-such-scene"]).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("pyramid20") && err.contains("stack30"),
+        "{err}"
+    );
+}
+
+#[test]
+fn lcp_solve_reports_success_and_failure_through_the_exit_code() {
+    let data = repo("../shared/lcp-data/siconos");
+    let json = temp("deudeu.json");
+    let ok = impulse()
+        .args(["lcp", "solve"])
+        .arg(data.join("lcp_deudeu.dat"))
+        .args(["--solver", "lemke", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let z = result["z"].as_array().unwrap();
+    assert!((z[0].as_f64().unwrap() - 4.0 / 3.0).abs() < 1e-9);
+    assert!((z[1].as_f64().unwrap() - 7.0 / 3.0).abs() < 1e-9);
+    // Too few PGS sweeps for mmc: not converged, so the command fails.
+    let fail = impulse()
+        .args(["lcp", "solve"])
+        .arg(data.join("lcp_mmc.dat"))
+        .args(["--solver", "pgs", "--iterations", "3"])
+        .output()
+        .unwrap();
+    assert!(!fail.status.success());
+}
+
+#[test]
+fn lcp_dump_writes_a_step_problem_that_solve_reads() {
+    let path = temp("stack-lcp.json");
+    let out = impulse()
+        .args([
+            "lcp",
+            "dump",
+            "stack30",
+            "--step",
+            "20",
+            "--no-friction",
+            "--out",
+        ])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let solved = impulse()
+        .args(["lcp", "solve"])
+        .arg(&path)
+        .args(["--solver", "pgs", "--iterations", "20000", "--tol", "1e-5"])
+        .output()
+        .unwrap();
+    assert!(
+        solved.status.success(),
+        "{}",
+        String::from_utf8_lossy(&solved.stdout)
+    );
+}
+
+#[test]
+fn a_blow_up_stops_with_the_step_and_keeps_the_frames_written() {
+    // A body flying out of the world: 600 m/s from x = 99 000 m crosses the 100 km bound
+    // during step 101 (10 m per step).
+    let scene = temp("runaway.json");
+    std::fs::write(
+        &scene,
+        r#"{"gravity": [0, 0, 0], "bodies": [
+  {"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5},
+   "position": [99000, 0, 0], "linear_velocity": [600, 0, 0]}
+]}"#,
+    )
+    .unwrap();
+    let csv = temp("runaway.csv");
+    let out = impulse()
+        .arg("run")
+        .arg(&scene)
+        .args(["--steps", "200", "--quiet", "--out"])
+        .arg(&csv)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("blew up at step 101"), "{err}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let last = text.lines().last().unwrap();
+    assert!(last.starts_with("100,"), "last frame written: {last}");
+}
