@@ -240,7 +240,12 @@ pub fn step_island(
                 linear: &mut w.pseudo_linear,
                 angular: &mut w.pseudo_angular,
             };
-            solver::solve_positions(constraints, settings.iterations, &mut pseudo);
+            solver::solve_positions(
+                constraints,
+                settings.iterations,
+                settings.tolerance,
+                &mut pseudo,
+            );
             for k in 0..moving {
                 w.pseudo_linear[k] += w.linear[k];
                 w.pseudo_angular[k] += w.angular[k];

@@ -337,13 +337,16 @@ fn apply_impulses(c: &ContactConstraint, impulses: [f32; 3], velocities: &mut Ve
 /// The position solve of split impulse: PGS over the normal rows alone, on pseudo-velocities
 /// (`velocities` holds them, starting at zero), towards each row's `position_target`, with
 /// pseudo-impulses clamped ≥ 0. Rows with no target take part only as non-penetration
-/// (target 0), so a push on one body does not drive it into another.
+/// (target 0), so a push on one body does not drive it into another. Stops early when no row's
+/// pseudo-velocity changed by more than `tolerance` (m/s); returns the sweeps used.
 pub fn solve_positions(
     constraints: &mut [ContactConstraint],
     iterations: u32,
+    tolerance: f32,
     velocities: &mut Velocities<'_>,
-) {
-    for _ in 0..iterations {
+) -> u32 {
+    for iteration in 0..iterations {
+        let mut largest_change = 0.0f32;
         for c in constraints.iter_mut() {
             let (a, b) = (c.local_a as usize, c.local_b as usize);
             let row = &c.normal;
@@ -360,7 +363,12 @@ pub fn solve_positions(
                 velocities.linear[b] = lb - linear * c.inverse_mass_b;
                 velocities.angular[a] = aa + row.inverse_inertia_angular_a * delta;
                 velocities.angular[b] = ab - row.inverse_inertia_angular_b * delta;
+                largest_change = largest_change.max(delta.abs() * row.inverse_effective_mass);
             }
         }
+        if largest_change <= tolerance {
+            return iteration + 1;
+        }
     }
+    iterations
 }
