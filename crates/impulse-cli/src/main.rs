@@ -86,6 +86,19 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Time impulse on built-in scenes (sleeping off, median ms/step) and measure quality from
+    /// poses; `cargo run --release -p impulse-bench` adds Rapier side by side.
+    Bench {
+        /// Built-in scene names (default: pyramid20 pyramid100 pyramid3d10 stack30 massratio
+        /// balls4096).
+        scenes: Vec<String>,
+        /// Steps per scene.
+        #[arg(long, default_value_t = impulse_bench::DEFAULT_STEPS)]
+        steps: u32,
+        /// Worker threads.
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+    },
     /// Linear complementarity problems on their own.
     Lcp {
         #[command(subcommand)]
@@ -259,6 +272,29 @@ fn real_main() -> Result<ExitCode> {
                     .with_context(|| format!("cannot write {}", path.display()))?,
                 None => print!("{text}"),
             }
+        }
+        Command::Bench {
+            scenes,
+            steps,
+            threads,
+        } => {
+            let mut config = impulse_bench::BenchConfig {
+                steps,
+                threads,
+                rapier: false,
+                ..impulse_bench::BenchConfig::default()
+            };
+            if !scenes.is_empty() {
+                config.scenes = scenes;
+            }
+            let machine = impulse_bench::MachineInfo::current();
+            let rows = impulse_bench::run_benchmarks(
+                &config,
+                &mut |row| eprintln!("measured {} on {}", row.engine, row.scene),
+                &mut |e| eprintln!("failed: {e:#}"),
+            )?;
+            println!("{}", impulse_bench::format_table(&rows));
+            println!("{machine}");
         }
         Command::Lcp { command } => match command {
             LcpCommand::Solve {

@@ -1,0 +1,117 @@
+//! The impulse side of the comparison.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use impulse::settings::SolverMethod;
+use impulse::{Scene, SolverSettings, World};
+
+use crate::BenchRow;
+use crate::quality::{self, Quality};
+
+/// Engine name in [`BenchRow::engine`].
+pub const ENGINE: &str = "impulse";
+
+/// Steps `scene` `steps` times with impulse inside a rayon pool of `threads` threads, timing
+/// each `World::step`, and measures quality from the poses (metric time is not timed).
+/// The scene's solver settings are used as they are, except that sleeping is turned off.
+pub fn bench_impulse(scene: &Scene, steps: u32, threads: usize) -> Result<BenchRow> {
+    crate::thread_pool(threads)?.install(|| {
+        let mut run = ImpulseRun::new(scene, steps, threads)?;
+        run.advance(steps)?;
+        Ok(run.finish())
+    })
+}
+
+/// An impulse run that can be advanced a few steps at a time, so that several engines can
+/// take turns on the same scene (see `run_benchmarks`).
+pub(crate) struct ImpulseRun {
+    scene: String,
+    world: World,
+    quality: Quality,
+    times_ms: Vec<f64>,
+    step: u32,
+    steps: u32,
+    threads: usize,
+}
+
+impl ImpulseRun {
+    /// Builds the world; `threads` is only reported (the caller installs the pool).
+    pub(crate) fn new(scene: &Scene, steps: u32, threads: usize) -> Result<Self> {
+        let mut world = World::from_scene(scene)
+            .with_context(|| format!("building scene {} in impulse", scene.name))?;
+        world.settings.sleep = false;
+        Ok(Self {
+            scene: scene.name.clone(),
+            quality: Quality::new(&world.bodies),
+            world,
+            times_ms: Vec::with_capacity(steps as usize),
+            step: 0,
+            steps,
+            threads,
+        })
+    }
+
+    /// Takes up to `n` more steps (never past `steps`).
+    pub(crate) fn advance(&mut self, n: u32) -> Result<()> {
+        let end = self.steps.min(self.step.saturating_add(n));
+        while self.step < end {
+            self.step += 1;
+            let start = Instant::now();
+            let result = self.world.step().map(|_| ());
+            self.times_ms.push(start.elapsed().as_secs_f64() * 1e3);
+            result.with_context(|| format!("impulse, scene {}, step {}", self.scene, self.step))?;
+            if quality::is_sample_step(self.step, self.steps) {
+                self.quality.sample(&self.world.bodies);
+            }
+        }
+        Ok(())
+    }
+
+    /// The row of the steps taken so far.
+    pub(crate) fn finish(mut self) -> BenchRow {
+        let report = self.quality.finish(&self.world.bodies);
+        BenchRow::new(
+            &self.scene,
+            ENGINE,
+            self.world.bodies.len(),
+            self.step,
+            &mut self.times_ms,
+            report,
+            settings_text(&self.world.settings, self.threads),
+        )
+    }
+}
+
+/// The solver settings as one line: method, substeps, iterations, overlap repair, sleeping,
+/// threads.
+pub fn settings_text(s: &SolverSettings, threads: usize) -> String {
+    let method = match s.method {
+        SolverMethod::Pgs => "PGS",
+        SolverMethod::Nncg => "NNCG",
+    };
+    // As the step runs them: split impulse leaves no work to soft rows or the relax pass.
+    let repair = if s.split_impulse {
+        format!("split-impulse repair {}/s", s.overlap_repair_rate)
+    } else if s.soft_contact_hertz > 0.0 {
+        format!(
+            "soft contact {} Hz + {} relax",
+            s.soft_contact_hertz, s.relax_iterations
+        )
+    } else {
+        format!(
+            "bias repair {}/s + {} relax",
+            s.overlap_repair_rate, s.relax_iterations
+        )
+    };
+    format!(
+        "{method}, {} substeps × ≤{} iterations, {repair}, tol {:e}, warm start {}, sleeping {}, \
+         {threads} thread{}",
+        s.substeps,
+        s.iterations,
+        s.tolerance,
+        s.warm_start,
+        if s.sleep { "on" } else { "off" },
+        if threads == 1 { "" } else { "s" },
+    )
+}

@@ -1,0 +1,483 @@
+//! Benchmarks of impulse, and the side-by-side harness against Rapier (DESIGN.md, "Standard
+//! scenes" and "Metrics").
+//!
+//! Both engines get the same scene, body for body and in scene order; time is the median
+//! wall-clock time of one step with sleeping off; quality is measured from poses alone with
+//! `impulse::metrics`, never from an engine's own contact report, and metric time is not
+//! timed. The claim to make from a run is the ratio of the two engines' times measured in
+//! that run, on that machine, next to the quality each reached.
+//!
+//! - [`bench_impulse`]: impulse on a scene, inside a rayon pool of a given size.
+//! - [`bench_rapier`] (feature `rapier`, on by default): Rapier 0.36 on the same scene.
+//! - [`format_table`]: the results as one Markdown table.
+//! - [`run_benchmarks`]: a list of built-in scenes through both engines.
+
+mod impulse_engine;
+pub mod machine;
+pub mod quality;
+#[cfg(feature = "rapier")]
+mod rapier_engine;
+
+use std::fmt::Write as _;
+
+use anyhow::{Context, Result, bail};
+use impulse::Scene;
+
+pub use impulse_engine::{bench_impulse, settings_text as impulse_settings_text};
+pub use machine::MachineInfo;
+pub use quality::QualityReport;
+#[cfg(feature = "rapier")]
+pub use rapier_engine::{
+    FRICTION_COMBINE, RESTITUTION_COMBINE, bench_rapier, bench_rapier_with,
+    settings_text as rapier_settings_text,
+};
+
+/// Scenes measured when none are named: DESIGN.md's standard scenes plus `pyramid100`.
+pub const DEFAULT_SCENES: &[&str] = &[
+    "pyramid20",
+    "pyramid100",
+    "pyramid3d10",
+    "stack30",
+    "massratio",
+    "balls4096",
+];
+
+/// Steps per scene when not told otherwise (10 s at dt = 1/60 s).
+pub const DEFAULT_STEPS: u32 = 600;
+
+/// One engine on one scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchRow {
+    /// Scene name.
+    pub scene: String,
+    /// `"impulse"` or `"rapier"`.
+    pub engine: String,
+    /// Bodies, static ones included.
+    pub bodies: usize,
+    /// Steps taken.
+    pub steps: u32,
+    /// Median wall-clock time of one step (ms).
+    pub ms_per_step_median: f64,
+    /// 1000 / `ms_per_step_median`.
+    pub steps_per_second: f64,
+    /// Initial y − final y of the moving body that started highest (m).
+    pub top_sink_m: f64,
+    /// Largest penetration depth between two bodies, sampled every 10 steps and after the
+    /// last (m).
+    pub max_overlap_m: f64,
+    /// Largest distance of a moving body from its start, at the same samples (m).
+    pub max_drift_m: f64,
+    /// The engine's settings: iterations, substeps, threads, and anything else that matters.
+    pub settings: String,
+}
+
+impl BenchRow {
+    /// A row from per-step times (ms; reordered in place) and a quality report.
+    pub fn new(
+        scene: &str,
+        engine: &str,
+        bodies: usize,
+        steps: u32,
+        times_ms: &mut [f64],
+        quality: QualityReport,
+        settings: String,
+    ) -> Self {
+        let median = quality::median(times_ms);
+        Self {
+            scene: scene.to_string(),
+            engine: engine.to_string(),
+            bodies,
+            steps,
+            ms_per_step_median: median,
+            steps_per_second: if median > 0.0 { 1e3 / median } else { 0.0 },
+            top_sink_m: quality.top_sink.into(),
+            max_overlap_m: quality.max_overlap.into(),
+            max_drift_m: quality.max_drift.into(),
+            settings,
+        }
+    }
+}
+
+/// The rows as one Markdown table, in the given order. The ratio column is impulse's median
+/// time divided by Rapier's for the same scene (< 1: impulse is faster), shown on impulse rows
+/// when a Rapier row of the same scene exists.
+pub fn format_table(rows: &[BenchRow]) -> String {
+    let mut out = String::new();
+    out.push_str(
+        "| scene | engine | bodies | steps | ms/step (median) | steps/s | time impulse/rapier \
+         | top sink (mm) | largest overlap (mm) | largest drift (mm) | settings |\n",
+    );
+    out.push_str("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+    for row in rows {
+        let ratio = if row.engine == impulse_engine::ENGINE {
+            rows.iter()
+                .find(|r| r.scene == row.scene && r.engine == "rapier")
+                .filter(|r| r.ms_per_step_median > 0.0)
+                .map(|r| format!("{:.2}", row.ms_per_step_median / r.ms_per_step_median))
+                .unwrap_or_default()
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} | {:.0} | {} | {:.1} | {:.1} | {:.1} | {} |",
+            row.scene,
+            row.engine,
+            row.bodies,
+            row.steps,
+            format_ms(row.ms_per_step_median),
+            row.steps_per_second,
+            ratio,
+            row.top_sink_m * 1e3,
+            row.max_overlap_m * 1e3,
+            row.max_drift_m * 1e3,
+            row.settings.replace('|', "\\|"),
+        );
+    }
+    out
+}
+
+/// Milliseconds with three significant digits at least (0.123, 1.23, 12.3, 123).
+fn format_ms(ms: f64) -> String {
+    if ms < 1.0 {
+        format!("{ms:.3}")
+    } else if ms < 10.0 {
+        format!("{ms:.2}")
+    } else if ms < 100.0 {
+        format!("{ms:.1}")
+    } else {
+        format!("{ms:.0}")
+    }
+}
+
+/// What [`run_benchmarks`] measures.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchConfig {
+    /// Built-in scene names (`impulse::scene::builtin::builtin_scene`).
+    pub scenes: Vec<String>,
+    /// Steps per scene.
+    pub steps: u32,
+    /// Threads of impulse's rayon pool (Rapier always runs on one).
+    pub threads: usize,
+    /// Also measure Rapier (needs the `rapier` feature).
+    pub rapier: bool,
+    /// Extra Rapier rows with other settings than the defaults (needs `rapier`).
+    pub rapier_variants: Vec<RapierVariant>,
+}
+
+/// Rapier with other settings than its defaults, to compare the engines at similar quality.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RapierVariant {
+    /// `IntegrationParameters::num_solver_iterations` (Rapier's substeps; default 4).
+    pub substeps: usize,
+    /// `contact_softness.natural_frequency` (Hz; default 30); contacts with a fixed body get
+    /// twice this (`static_contact_softness`), as in Rapier's defaults.
+    pub contact_hz: f32,
+}
+
+impl RapierVariant {
+    /// Engine name of its rows, e.g. `rapier 8×120Hz`.
+    pub fn engine_name(&self) -> String {
+        format!("rapier {}×{}Hz", self.substeps, self.contact_hz)
+    }
+}
+
+#[cfg(feature = "rapier")]
+impl RapierVariant {
+    /// Rapier's default integration parameters with this variant's substeps and springs.
+    pub fn integration_parameters(&self) -> rapier3d::prelude::IntegrationParameters {
+        let mut params = rapier3d::prelude::IntegrationParameters {
+            num_solver_iterations: self.substeps,
+            ..Default::default()
+        };
+        params.contact_softness.natural_frequency = self.contact_hz;
+        params.static_contact_softness.natural_frequency = 2.0 * self.contact_hz;
+        params
+    }
+}
+
+impl std::str::FromStr for RapierVariant {
+    type Err = String;
+
+    /// `SUBSTEPS:HZ`, e.g. `8:120`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (substeps, hz) = s
+            .split_once(':')
+            .ok_or_else(|| format!("expected SUBSTEPS:HZ (e.g. 8:120), got \"{s}\""))?;
+        let substeps: usize = substeps
+            .trim()
+            .parse()
+            .map_err(|e| format!("substeps \"{substeps}\": {e}"))?;
+        let contact_hz: f32 = hz.trim().parse().map_err(|e| format!("hz \"{hz}\": {e}"))?;
+        if substeps == 0 || !(contact_hz.is_finite() && contact_hz > 0.0) {
+            return Err(format!("substeps must be ≥ 1 and hz > 0, got \"{s}\""));
+        }
+        Ok(Self {
+            substeps,
+            contact_hz,
+        })
+    }
+}
+
+impl Default for BenchConfig {
+    fn default() -> Self {
+        Self {
+            scenes: DEFAULT_SCENES.iter().map(|s| s.to_string()).collect(),
+            steps: DEFAULT_STEPS,
+            threads: 1,
+            rapier: cfg!(feature = "rapier"),
+            rapier_variants: Vec::new(),
+        }
+    }
+}
+
+/// The built-in scene `name`, or an error naming it.
+pub fn scene_by_name(name: &str) -> Result<Scene> {
+    impulse::scene::builtin::builtin_scene(name)
+        .with_context(|| format!("no built-in scene named \"{name}\""))
+}
+
+/// Steps per turn when engines take turns on a scene (the metrics' sampling interval).
+pub const TURN_STEPS: u32 = quality::SAMPLE_EVERY;
+
+/// A rayon pool of `threads` threads.
+pub(crate) fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("building the rayon thread pool")
+}
+
+/// One engine's run of a scene, advanced a turn at a time.
+enum EngineRun {
+    Impulse(Box<impulse_engine::ImpulseRun>),
+    #[cfg(feature = "rapier")]
+    Rapier(Box<rapier_engine::RapierRun>),
+}
+
+impl EngineRun {
+    fn advance(&mut self, n: u32) -> Result<()> {
+        match self {
+            EngineRun::Impulse(run) => run.advance(n),
+            #[cfg(feature = "rapier")]
+            EngineRun::Rapier(run) => run.advance(n),
+        }
+    }
+
+    fn finish(self) -> BenchRow {
+        match self {
+            EngineRun::Impulse(run) => run.finish(),
+            #[cfg(feature = "rapier")]
+            EngineRun::Rapier(run) => run.finish(),
+        }
+    }
+}
+
+/// Runs one scene through impulse and, as `config` asks, Rapier and its variants. The
+/// engines take turns of [`TURN_STEPS`] steps on the same thread, so that other work on the
+/// machine slows all of them alike and the ratio of their times stays meaningful. Everything
+/// runs inside a rayon pool of `config.threads` (Rapier does not use it). One result per
+/// engine, in the order impulse, Rapier, variants; an engine that fails (a blow-up, say) is
+/// dropped from the turns and the others go on.
+pub fn bench_scene(scene: &Scene, config: &BenchConfig) -> Result<Vec<Result<BenchRow>>> {
+    if (config.rapier || !config.rapier_variants.is_empty()) && !cfg!(feature = "rapier") {
+        bail!("Rapier was asked for, but impulse-bench was built without the `rapier` feature");
+    }
+    let steps = config.steps;
+    thread_pool(config.threads)?.install(|| {
+        let mut runs: Vec<Result<EngineRun>> = vec![
+            impulse_engine::ImpulseRun::new(scene, steps, config.threads)
+                .map(|run| EngineRun::Impulse(Box::new(run))),
+        ];
+        #[cfg(feature = "rapier")]
+        {
+            if config.rapier {
+                let params = rapier3d::prelude::IntegrationParameters::default();
+                runs.push(
+                    rapier_engine::RapierRun::new(scene, steps, &params, rapier_engine::ENGINE)
+                        .map(|run| EngineRun::Rapier(Box::new(run))),
+                );
+            }
+            for variant in &config.rapier_variants {
+                runs.push(
+                    rapier_engine::RapierRun::new(
+                        scene,
+                        steps,
+                        &variant.integration_parameters(),
+                        &variant.engine_name(),
+                    )
+                    .map(|run| EngineRun::Rapier(Box::new(run))),
+                );
+            }
+        }
+        let mut done = 0;
+        while done < steps {
+            for slot in runs.iter_mut() {
+                if let Ok(run) = slot
+                    && let Err(e) = run.advance(TURN_STEPS)
+                {
+                    *slot = Err(e);
+                }
+            }
+            done = done.saturating_add(TURN_STEPS);
+        }
+        Ok(runs
+            .into_iter()
+            .map(|run| run.map(EngineRun::finish))
+            .collect())
+    })
+}
+
+/// Runs every scene of `config` (see [`bench_scene`]), calling `on_row` as each row is
+/// measured. A failed run is passed to `on_error` and left out of the rows; unknown scene
+/// names, zero steps or threads, and a Rapier request without the feature fail before
+/// anything runs.
+pub fn run_benchmarks(
+    config: &BenchConfig,
+    on_row: &mut dyn FnMut(&BenchRow),
+    on_error: &mut dyn FnMut(&anyhow::Error),
+) -> Result<Vec<BenchRow>> {
+    if (config.rapier || !config.rapier_variants.is_empty()) && !cfg!(feature = "rapier") {
+        bail!("Rapier was asked for, but impulse-bench was built without the `rapier` feature");
+    }
+    if config.steps == 0 {
+        bail!("steps must be at least 1");
+    }
+    if config.threads == 0 {
+        bail!("threads must be at least 1");
+    }
+    let scenes = config
+        .scenes
+        .iter()
+        .map(|name| scene_by_name(name))
+        .collect::<Result<Vec<_>>>()?;
+    let mut rows = Vec::new();
+    for scene in &scenes {
+        for result in bench_scene(scene, config)? {
+            match result {
+                Ok(row) => {
+                    on_row(&row);
+                    rows.push(row);
+                }
+                Err(e) => on_error(&e),
+            }
+        }
+    }
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(scene: &str, engine: &str, ms: f64) -> BenchRow {
+        BenchRow {
+            scene: scene.into(),
+            engine: engine.into(),
+            bodies: 2,
+            steps: 10,
+            ms_per_step_median: ms,
+            steps_per_second: 1e3 / ms,
+            top_sink_m: 0.0012,
+            max_overlap_m: 0.0,
+            max_drift_m: 0.5,
+            settings: "a | b".into(),
+        }
+    }
+
+    #[test]
+    fn table_has_ratio_on_impulse_rows_only() {
+        let rows = [
+            row("s", "impulse", 2.0),
+            row("s", "rapier", 4.0),
+            row("t", "impulse", 1.0),
+        ];
+        let table = format_table(&rows);
+        let lines: Vec<&str> = table.lines().collect();
+        assert_eq!(lines.len(), 5);
+        assert!(lines[2].contains("| 2.00 | 500 | 0.50 | 1.2 | 0.0 | 500.0 | a \\| b |"));
+        assert!(lines[3].contains("| rapier |"));
+        assert!(lines[3].contains("| 250 |  | 1.2 |"));
+        assert!(lines[4].contains("| 1000 |  |"));
+    }
+
+    #[test]
+    fn rapier_variant_parses() {
+        let v: RapierVariant = "8:120".parse().unwrap();
+        assert_eq!(
+            v,
+            RapierVariant {
+                substeps: 8,
+                contact_hz: 120.0
+            }
+        );
+        assert_eq!(v.engine_name(), "rapier 8×120Hz");
+        assert!("8".parse::<RapierVariant>().is_err());
+        assert!("0:30".parse::<RapierVariant>().is_err());
+        assert!("4:-1".parse::<RapierVariant>().is_err());
+    }
+
+    #[test]
+    fn turns_give_the_same_results_as_single_runs() {
+        let scene = scene_by_name("stack3").unwrap();
+        let config = BenchConfig {
+            scenes: vec!["stack3".into()],
+            steps: 25,
+            threads: 1,
+            rapier: cfg!(feature = "rapier"),
+            rapier_variants: if cfg!(feature = "rapier") {
+                vec!["8:60".parse().unwrap()]
+            } else {
+                Vec::new()
+            },
+        };
+        let rows: Vec<BenchRow> = bench_scene(&scene, &config)
+            .unwrap()
+            .into_iter()
+            .map(|r| r.unwrap())
+            .collect();
+        let alone = bench_impulse(&scene, 25, 1).unwrap();
+        assert_eq!(rows[0].engine, "impulse");
+        assert_eq!(rows[0].steps, 25);
+        assert_eq!(rows[0].top_sink_m, alone.top_sink_m);
+        assert_eq!(rows[0].max_drift_m, alone.max_drift_m);
+        #[cfg(feature = "rapier")]
+        {
+            assert_eq!(rows.len(), 3);
+            let alone = bench_rapier(&scene, 25).unwrap();
+            assert_eq!(rows[1].engine, "rapier");
+            assert_eq!(rows[1].top_sink_m, alone.top_sink_m);
+            assert_eq!(rows[2].engine, "rapier 8×60Hz");
+            assert_eq!(rows[2].steps, 25);
+        }
+    }
+
+    #[test]
+    fn unknown_scene_is_an_error() {
+        let config = BenchConfig {
+            scenes: vec!["nosuchscene".into()],
+            ..BenchConfig::default()
+        };
+        let err = run_benchmarks(&config, &mut |_| {}, &mut |_| {}).unwrap_err();
+        assert!(err.to_string().contains("nosuchscene"));
+    }
+
+    #[test]
+    fn both_engines_measure_a_small_stack() {
+        let scene = scene_by_name("stack3").unwrap();
+        let impulse_row = bench_impulse(&scene, 30, 1).unwrap();
+        assert_eq!(impulse_row.bodies, 4);
+        assert_eq!(impulse_row.steps, 30);
+        assert!(impulse_row.ms_per_step_median > 0.0);
+        assert!(impulse_row.max_overlap_m < 0.05);
+        assert!(impulse_row.top_sink_m.abs() < 0.05);
+        #[cfg(feature = "rapier")]
+        {
+            let rapier_row = bench_rapier(&scene, 30).unwrap();
+            assert_eq!(rapier_row.bodies, 4);
+            assert!(rapier_row.max_overlap_m < 0.05);
+            assert!(rapier_row.top_sink_m.abs() < 0.05);
+            assert!(rapier_row.settings.contains("4 substeps"));
+        }
+    }
+}

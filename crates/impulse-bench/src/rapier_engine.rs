@@ -1,0 +1,403 @@
+//! The Rapier side of the comparison: the same scene built body for body in rapier3d, stepped
+//! with Rapier's default integration parameters on one thread, measured with impulse's metrics
+//! from Rapier's poses.
+//!
+//! Rapier 0.36 and impulse share parry3d 0.31, so Rapier's poses are `parry3d::math::Pose`
+//! values already (glam-based); they are copied into a `Bodies` in scene order.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use impulse::body::Bodies;
+use impulse::scene::{BodyKind, Material, MaterialRef, ShapeDesc};
+use impulse::{Scene, World};
+use parry3d::shape::SharedShape;
+use rapier3d::prelude::{
+    CCDSolver, CoefficientCombineRule, ColliderBuilder, ColliderSet, DefaultBroadPhase,
+    ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet, NarrowPhase,
+    PhysicsPipeline, RigidBodyBuilder, RigidBodyHandle, RigidBodySet, SoftBodySet, Vector,
+};
+
+use crate::BenchRow;
+use crate::quality::{self, Quality};
+
+/// Engine name in [`BenchRow::engine`].
+pub const ENGINE: &str = "rapier";
+
+/// Rapier's friction combine rule here: the geometric mean, as impulse combines friction.
+pub const FRICTION_COMBINE: CoefficientCombineRule = CoefficientCombineRule::GeometricMean;
+/// Rapier's restitution combine rule here: the maximum, as impulse combines restitution.
+pub const RESTITUTION_COMBINE: CoefficientCombineRule = CoefficientCombineRule::Max;
+
+/// Builds `scene` in rapier3d, steps it `steps` times on the calling thread, timing each
+/// `PhysicsPipeline::step`, and measures quality from Rapier's poses with impulse's metrics.
+/// Rapier runs with its default [`IntegrationParameters`] (dt from the scene).
+pub fn bench_rapier(scene: &Scene, steps: u32) -> Result<BenchRow> {
+    bench_rapier_with(scene, steps, &IntegrationParameters::default(), ENGINE)
+}
+
+/// [`bench_rapier`] with other integration parameters (their `dt` is replaced by the scene's),
+/// reported under the engine name `engine`: e.g. Rapier with more substeps, to compare the
+/// engines at similar quality.
+pub fn bench_rapier_with(
+    scene: &Scene,
+    steps: u32,
+    params: &IntegrationParameters,
+    engine: &str,
+) -> Result<BenchRow> {
+    let mut run = RapierRun::new(scene, steps, params, engine)?;
+    run.advance(steps)?;
+    Ok(run.finish())
+}
+
+/// A Rapier run that can be advanced a few steps at a time (see `ImpulseRun`).
+pub(crate) struct RapierRun {
+    scene: String,
+    engine: String,
+    sim: RapierScene,
+    /// The impulse world's bodies with Rapier's poses written in, for the metrics.
+    bodies: Bodies,
+    quality: Quality,
+    times_ms: Vec<f64>,
+    step: u32,
+    steps: u32,
+}
+
+impl RapierRun {
+    pub(crate) fn new(
+        scene: &Scene,
+        steps: u32,
+        params: &IntegrationParameters,
+        engine: &str,
+    ) -> Result<Self> {
+        // The impulse world validates the scene and gives the shapes, the body kinds and the
+        // initial state in scene order; the metrics read a copy of its bodies.
+        let world = World::from_scene(scene)
+            .with_context(|| format!("building scene {} in impulse", scene.name))?;
+        let sim = RapierScene::build(scene, &world, params)?;
+        let bodies = world.bodies;
+        Ok(Self {
+            scene: scene.name.clone(),
+            engine: engine.to_string(),
+            sim,
+            quality: Quality::new(&bodies),
+            bodies,
+            times_ms: Vec::with_capacity(steps as usize),
+            step: 0,
+            steps,
+        })
+    }
+
+    /// Takes up to `n` more steps (never past `steps`).
+    pub(crate) fn advance(&mut self, n: u32) -> Result<()> {
+        let end = self.steps.min(self.step.saturating_add(n));
+        while self.step < end {
+            self.step += 1;
+            let start = Instant::now();
+            self.sim.step();
+            self.times_ms.push(start.elapsed().as_secs_f64() * 1e3);
+            if quality::is_sample_step(self.step, self.steps) {
+                self.sim.copy_poses(&mut self.bodies);
+                check_finite(&self.bodies, &self.engine, &self.scene, self.step)?;
+                self.quality.sample(&self.bodies);
+            }
+        }
+        Ok(())
+    }
+
+    /// The row of the steps taken so far.
+    pub(crate) fn finish(mut self) -> BenchRow {
+        self.sim.copy_poses(&mut self.bodies);
+        let report = self.quality.finish(&self.bodies);
+        BenchRow::new(
+            &self.scene,
+            &self.engine,
+            self.bodies.len(),
+            self.step,
+            &mut self.times_ms,
+            report,
+            settings_text(&self.sim.params),
+        )
+    }
+}
+
+/// Rapier's state for one scene; `handles[i]` is scene body `i`.
+struct RapierScene {
+    gravity: Vector,
+    params: IntegrationParameters,
+    pipeline: PhysicsPipeline,
+    islands: IslandManager,
+    broad_phase: DefaultBroadPhase,
+    narrow_phase: NarrowPhase,
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    ccd: CCDSolver,
+    handles: Vec<RigidBodyHandle>,
+}
+
+impl RapierScene {
+    fn build(scene: &Scene, world: &World, params: &IntegrationParameters) -> Result<Self> {
+        let mut bodies = RigidBodySet::new();
+        let mut colliders = ColliderSet::new();
+        let mut handles = Vec::with_capacity(scene.bodies.len());
+        let built = &world.bodies;
+        for (i, desc) in scene.bodies.iter().enumerate() {
+            let material = resolve_material(scene, &desc.material)?;
+            let body = match desc.kind {
+                BodyKind::Static => RigidBodyBuilder::fixed(),
+                BodyKind::Dynamic => RigidBodyBuilder::dynamic(),
+                BodyKind::Particle => RigidBodyBuilder::dynamic().lock_rotations(),
+            }
+            // The pose as impulse built it (quaternion normalised), velocities of the centre
+            // of mass (Rapier's convention too), no sleeping.
+            .pose(built.pose[i])
+            .linvel(built.linear_velocity[i])
+            .angvel(built.angular_velocity[i])
+            .can_sleep(false)
+            .build();
+            let handle = bodies.insert(body);
+            let collider =
+                collider_builder(&desc.shape).with_context(|| format!("body {i}: shape"))?;
+            let collider = match desc.mass {
+                Some(mass) => collider.mass(mass),
+                None => collider.density(material.density),
+            }
+            .friction(material.friction)
+            .friction_combine_rule(FRICTION_COMBINE)
+            .restitution(material.restitution)
+            .restitution_combine_rule(RESTITUTION_COMBINE)
+            .build();
+            colliders.insert_with_parent(collider, handle, &mut bodies);
+            handles.push(handle);
+        }
+        let params = IntegrationParameters {
+            dt: scene.dt,
+            ..*params
+        };
+        Ok(Self {
+            gravity: Vector::from(scene.gravity),
+            params,
+            pipeline: PhysicsPipeline::new(),
+            islands: IslandManager::new(),
+            broad_phase: DefaultBroadPhase::new(),
+            narrow_phase: NarrowPhase::new(),
+            bodies,
+            colliders,
+            impulse_joints: ImpulseJointSet::new(),
+            multibody_joints: MultibodyJointSet::new(),
+            soft_bodies: SoftBodySet::new(),
+            ccd: CCDSolver::new(),
+            handles,
+        })
+    }
+
+    fn step(&mut self) {
+        self.pipeline.step(
+            self.gravity,
+            &self.params,
+            &mut self.islands,
+            &mut self.broad_phase,
+            &mut self.narrow_phase,
+            &mut self.bodies,
+            &mut self.colliders,
+            &mut self.impulse_joints,
+            &mut self.multibody_joints,
+            &mut self.soft_bodies,
+            &mut self.ccd,
+            &(),
+            &(),
+        );
+    }
+
+    /// Writes Rapier's body poses into `out` (scene order).
+    fn copy_poses(&self, out: &mut Bodies) {
+        for (i, &handle) in self.handles.iter().enumerate() {
+            out.pose[i] = *self.bodies[handle].position();
+        }
+    }
+}
+
+/// The material a body refers to, resolved as `World::from_scene` does.
+fn resolve_material(scene: &Scene, material: &MaterialRef) -> Result<Material> {
+    Ok(match material {
+        MaterialRef::Inline(m) => m.clone(),
+        MaterialRef::Named(name) => match scene.materials.get(name) {
+            Some(m) => m.clone(),
+            None if name == "default" => Material::default(),
+            None => bail!("no material named \"{name}\""),
+        },
+    })
+}
+
+/// The Rapier collider of a scene shape (the same Parry shape impulse builds).
+fn collider_builder(shape: &ShapeDesc) -> Result<ColliderBuilder> {
+    Ok(match shape {
+        ShapeDesc::Sphere { radius } => ColliderBuilder::ball(*radius),
+        ShapeDesc::Cuboid { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
+        ShapeDesc::Capsule {
+            half_height,
+            radius,
+        } => ColliderBuilder::capsule_y(*half_height, *radius),
+        ShapeDesc::ConvexHull { points } => {
+            let points: Vec<Vector> = points.iter().map(|p| Vector::from(*p)).collect();
+            match ColliderBuilder::convex_hull(&points) {
+                Some(builder) => builder,
+                None => bail!("convex hull of {} points failed", points.len()),
+            }
+        }
+        ShapeDesc::HalfSpace { normal } => {
+            ColliderBuilder::new(SharedShape::halfspace(Vector::from(*normal).normalize()))
+        }
+    })
+}
+
+fn check_finite(bodies: &Bodies, engine: &str, scene: &str, step: u32) -> Result<()> {
+    for (i, pose) in bodies.pose.iter().enumerate() {
+        if !(pose.translation.is_finite() && pose.rotation.is_finite()) {
+            bail!("{engine}, scene {scene}, step {step}: body {i} has a non-finite pose");
+        }
+    }
+    Ok(())
+}
+
+/// Rapier's integration parameters as one line, read from the struct (the Rapier version,
+/// combine rules and sleeping are the same in every run: see docs/benchmarks.md).
+pub fn settings_text(p: &IntegrationParameters) -> String {
+    format!(
+        "TGS soft, {} substeps × {} PGS + {} stabilization iterations, contacts {} Hz (fixed {} Hz) \
+         ζ {}, {:?} friction, clustering {}, recycling {}, 1 thread",
+        p.num_solver_iterations,
+        p.num_internal_pgs_iterations,
+        p.num_internal_stabilization_iterations,
+        p.contact_softness.natural_frequency,
+        p.static_contact_softness.natural_frequency,
+        p.contact_softness.damping_ratio,
+        p.friction_model,
+        on_off(p.contact_clustering),
+        on_off(p.contact_recycling),
+    )
+}
+
+fn on_off(b: bool) -> &'static str {
+    if b { "on" } else { "off" }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use impulse::scene::BodyDesc;
+
+    /// One body of every shape and kind, apart from each other, above a half-space ground.
+    fn zoo() -> Scene {
+        let mut scene = Scene {
+            name: "zoo".into(),
+            ..Scene::default()
+        };
+        scene.materials.insert(
+            "light".into(),
+            Material {
+                friction: 0.2,
+                restitution: 0.3,
+                density: 300.0,
+            },
+        );
+        scene.bodies.push(BodyDesc::new(
+            BodyKind::Static,
+            ShapeDesc::HalfSpace {
+                normal: [0.0, 2.0, 0.0],
+            },
+            [0.0, 0.0, 0.0],
+        ));
+        let shapes = [
+            ShapeDesc::Sphere { radius: 0.5 },
+            ShapeDesc::Cuboid {
+                half_extents: [0.5, 0.25, 1.0],
+            },
+            ShapeDesc::Capsule {
+                half_height: 0.5,
+                radius: 0.25,
+            },
+            ShapeDesc::ConvexHull {
+                points: vec![
+                    [0.0, 0.0, 0.0],
+                    [1.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0],
+                    [0.0, 0.0, 1.0],
+                ],
+            },
+        ];
+        for (k, shape) in shapes.into_iter().enumerate() {
+            let mut body = BodyDesc::new(BodyKind::Dynamic, shape, [3.0 * k as f32, 5.0, 0.0]);
+            body.orientation = [0.0, 0.0, 0.38268343, 0.9238795];
+            body.angular_velocity = [0.0, 1.0, 0.0];
+            body.material = MaterialRef::Named("light".into());
+            scene.bodies.push(body);
+        }
+        let mut particle = BodyDesc::new(
+            BodyKind::Particle,
+            ShapeDesc::Sphere { radius: 0.25 },
+            [-3.0, 6.0, 0.0],
+        );
+        particle.mass = Some(7.0);
+        particle.linear_velocity = [0.0, 0.0, 1.0];
+        scene.bodies.push(particle);
+        scene
+    }
+
+    #[test]
+    fn rapier_bodies_match_impulse_bodies() {
+        let scene = zoo();
+        let world = World::from_scene(&scene).unwrap();
+        let sim = RapierScene::build(&scene, &world, &IntegrationParameters::default()).unwrap();
+        assert_eq!(sim.handles.len(), scene.bodies.len());
+        for (i, &handle) in sim.handles.iter().enumerate() {
+            let body = &sim.bodies[handle];
+            assert_eq!(*body.position(), world.bodies.pose[i], "body {i} pose");
+            let expected_mass = if world.bodies.inverse_mass[i] > 0.0 {
+                1.0 / world.bodies.inverse_mass[i]
+            } else {
+                0.0
+            };
+            let mass = if body.is_dynamic() { body.mass() } else { 0.0 };
+            assert!(
+                (mass - expected_mass).abs() <= 1e-4 * expected_mass.max(1.0),
+                "body {i}: rapier mass {mass}, impulse mass {expected_mass}"
+            );
+            assert!((body.linvel() - world.bodies.linear_velocity[i]).length() < 1e-6);
+            let collider = &sim.colliders[body.colliders()[0]];
+            assert_eq!(collider.friction(), world.bodies.friction[i]);
+            assert_eq!(collider.restitution(), world.bodies.restitution[i]);
+            assert_eq!(collider.friction_combine_rule(), FRICTION_COMBINE);
+            assert_eq!(collider.restitution_combine_rule(), RESTITUTION_COMBINE);
+        }
+        let particle = &sim.bodies[sim.handles[5]];
+        assert!(particle.is_rotation_locked().iter().all(|&locked| locked));
+        assert!((particle.mass() - 7.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn free_fall_is_measured_from_rapier_poses() {
+        let scene = zoo();
+        // 0.5 s of free fall: g·t²/2 = 1.226 m, up to the integrator's O(dt) error (semi-implicit
+        // Euler over 120 substeps gives 1.236 m).
+        let fall = 0.5 * 9.81 * 0.25;
+        let row = bench_rapier(&scene, 30).unwrap();
+        assert_eq!(row.bodies, 6);
+        assert!(
+            (row.top_sink_m - fall).abs() < 0.03,
+            "sink {}",
+            row.top_sink_m
+        );
+        // The particle also moves sideways at 1 m/s for 0.5 s.
+        let particle = (fall * fall + 0.25f64).sqrt();
+        assert!(
+            (row.max_drift_m - particle).abs() < 0.03,
+            "drift {}",
+            row.max_drift_m
+        );
+        assert_eq!(row.max_overlap_m, 0.0);
+    }
+}
