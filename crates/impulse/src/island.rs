@@ -168,6 +168,28 @@ pub struct IslandWorkspace {
     pub iterations: u32,
 }
 
+impl IslandWorkspace {
+    /// Runs the configured method on the island's velocities for at most `iterations`.
+    fn solve(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        settings: &SolverSettings,
+        iterations: u32,
+    ) {
+        let mut velocities = Velocities {
+            linear: &mut self.linear,
+            angular: &mut self.angular,
+        };
+        self.iterations += solve(
+            constraints,
+            settings,
+            iterations,
+            &mut velocities,
+            &mut self.nncg,
+        );
+    }
+}
+
 /// Everything an island's step reads besides its own bodies and constraints.
 pub struct StepContext<'a> {
     /// All bodies (read only).
@@ -217,19 +239,15 @@ pub fn step_island(
     let moving = slots - 1;
     for _ in 0..settings.substeps {
         integrate::prospective_velocities(&mut w.linear[..moving], gravity, h);
-        let mut velocities = Velocities {
-            linear: &mut w.linear,
-            angular: &mut w.angular,
-        };
-        solver::warm_start(constraints, &mut velocities);
-        constraints::update_targets(constraints, &w.displacement, &w.rotation, settings, h, true);
-        w.iterations += solve(
+        solver::warm_start(
             constraints,
-            settings,
-            settings.iterations,
-            &mut velocities,
-            &mut w.nncg,
+            &mut Velocities {
+                linear: &mut w.linear,
+                angular: &mut w.angular,
+            },
         );
+        constraints::update_targets(constraints, &w.displacement, &w.rotation, settings, h, true);
+        w.solve(constraints, settings, settings.iterations);
         if settings.split_impulse {
             // Positions move with v + the pseudo-velocity of the repair solve.
             w.pseudo_linear.clear();
@@ -277,32 +295,16 @@ pub fn step_island(
                 h,
                 false,
             );
-            let mut velocities = Velocities {
-                linear: &mut w.linear,
-                angular: &mut w.angular,
-            };
-            w.iterations += solve(
-                constraints,
-                settings,
-                settings.relax_iterations,
-                &mut velocities,
-                &mut w.nncg,
-            );
+            w.solve(constraints, settings, settings.relax_iterations);
         }
     }
     // Restitution after the substeps (the seed's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
     // for the points that collided.
     if constraints::restitution_targets(constraints, settings.restitution_threshold) {
-        let mut velocities = Velocities {
-            linear: &mut w.linear,
-            angular: &mut w.angular,
-        };
-        w.iterations += solve(
+        w.solve(
             constraints,
             settings,
             settings.iterations.max(settings.relax_iterations),
-            &mut velocities,
-            &mut w.nncg,
         );
     }
 }
