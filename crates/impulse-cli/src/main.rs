@@ -50,6 +50,9 @@ enum Command {
         /// Soft contact frequency in Hz (0 = the seed's rigid rows with overlap repair c_d).
         #[arg(long)]
         soft_hertz: Option<f32>,
+        /// Fraction of last step's impulses to start from (0 = cold start, 1 = full warm start).
+        #[arg(long)]
+        warm_start: Option<f32>,
         /// Overlap repair rate c_d in 1/s (the seed's "nudge" coefficient).
         #[arg(long)]
         repair_rate: Option<f32>,
@@ -194,6 +197,7 @@ fn real_main() -> Result<ExitCode> {
             relax,
             method,
             soft_hertz,
+            warm_start,
             repair_rate,
             repair,
             threads,
@@ -209,6 +213,9 @@ fn real_main() -> Result<ExitCode> {
             }
             if let Some(relax) = relax {
                 scene.solver.relax_iterations = relax;
+            }
+            if let Some(fraction) = warm_start {
+                scene.solver.warm_start = fraction;
             }
             if let Some(rate) = repair_rate {
                 scene.solver.overlap_repair_rate = rate;

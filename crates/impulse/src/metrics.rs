@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use parry3d::math::Pose;
-use parry3d::query;
+use parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d::shape::SharedShape;
 
 use crate::body::Bodies;
@@ -18,19 +18,34 @@ pub fn max_overlap(bodies: &Bodies) -> f32 {
     max_overlap_of_pairs(&bodies.shape, &bodies.pose, &pairs)
 }
 
-/// Largest penetration depth (m) among `pairs` of shapes at `poses`.
+/// Largest penetration depth (m) among `pairs` of shapes at `poses`, from fresh Parry contact
+/// manifolds (no history, no prediction) of each pair at these poses.
+///
+/// Manifolds rather than Parry's single-point `query::contact`: for two nearly aligned boxes the
+/// latter can return a separating axis from nearly parallel edges with a depth of the boxes'
+/// full size (seen: 2.0 m for a cube resting on the ground).
 pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u32, u32)]) -> f32 {
     let mut deepest = 0.0f32;
+    let mut manifolds: Vec<ContactManifold<(), ()>> = Vec::new();
     for &(i, j) in pairs {
         let (i, j) = (i as usize, j as usize);
-        if let Ok(Some(contact)) = query::contact(
-            &poses[i],
-            shapes[i].as_ref(),
-            &poses[j],
-            shapes[j].as_ref(),
-            0.0,
-        ) {
-            deepest = deepest.max(-contact.dist);
+        manifolds.clear();
+        let mut workspace = None;
+        let pos12 = poses[i].inv_mul(&poses[j]);
+        if DefaultQueryDispatcher
+            .contact_manifolds(
+                &pos12,
+                shapes[i].as_ref(),
+                shapes[j].as_ref(),
+                0.0,
+                &mut manifolds,
+                &mut workspace,
+            )
+            .is_ok()
+        {
+            for point in manifolds.iter().flat_map(|m| m.points.iter()) {
+                deepest = deepest.max(-point.dist);
+            }
         }
     }
     deepest
