@@ -433,6 +433,11 @@ impl World {
             ("solver.overlap_slop", s.overlap_slop),
             ("solver.max_repair_speed", s.max_repair_speed),
             ("solver.prediction_distance", s.prediction_distance),
+            ("solver.soft_contact_hertz", s.soft_contact_hertz),
+            ("solver.soft_damping_ratio", s.soft_damping_ratio),
+            ("solver.sleep_linear_speed", s.sleep_linear_speed),
+            ("solver.sleep_angular_speed", s.sleep_angular_speed),
+            ("solver.time_to_sleep", s.time_to_sleep),
         ];
         for (field, value) in non_negative {
             if !(value.is_finite() && value >= 0.0) {

@@ -384,3 +384,34 @@ fn pile_of_spheres_satisfies_complementarity_at_exit() {
     }
     assert!(checked_steps > 10);
 }
+
+/// Settings that would make the step meaningless are refused before any step.
+#[test]
+fn invalid_settings_are_rejected_before_stepping() {
+    let bad = [
+        SolverSettings {
+            substeps: 0,
+            ..SolverSettings::default()
+        },
+        SolverSettings {
+            time_to_sleep: f32::NAN,
+            ..SolverSettings::default()
+        },
+        SolverSettings {
+            soft_contact_hertz: -1.0,
+            ..SolverSettings::default()
+        },
+    ];
+    for settings in bad {
+        assert!(World::new(Vec3::ZERO, DT, settings).is_err());
+    }
+    assert!(World::new(Vec3::ZERO, 0.0, SolverSettings::default()).is_err());
+    assert!(World::new(Vec3::ZERO, -DT, SolverSettings::default()).is_err());
+    let mut w = world(Vec3::ZERO);
+    assert!(w.set_dt(f32::NAN).is_err());
+    w.settings.iterations = 0;
+    assert!(
+        w.step().is_err(),
+        "a bad setting changed between steps is refused"
+    );
+}

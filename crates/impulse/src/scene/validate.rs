@@ -7,7 +7,8 @@
 //!   velocities, shape sizes, hull points, mass);
 //! - `dt > 0`; `solver.iterations ≥ 1`, `solver.substeps ≥ 1`; `solver.tolerance`,
 //!   `restitution_threshold`, `overlap_repair_rate`, `soft_contact_hertz`,
-//!   `soft_damping_ratio`, `overlap_slop`, `max_repair_speed`, `prediction_distance` are ≥ 0;
+//!   `soft_damping_ratio`, `overlap_slop`, `max_repair_speed`, `prediction_distance`,
+//!   `sleep_linear_speed`, `sleep_angular_speed`, `time_to_sleep` are ≥ 0;
 //!   `solver.warm_start` is in [0, 1];
 //! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`;
 //! - a body's `mass`, when given, is > 0;
@@ -71,6 +72,9 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
     c.non_negative(&solver.key("tolerance"), s.tolerance);
     c.non_negative(&solver.key("soft_contact_hertz"), s.soft_contact_hertz);
     c.non_negative(&solver.key("soft_damping_ratio"), s.soft_damping_ratio);
+    c.non_negative(&solver.key("sleep_linear_speed"), s.sleep_linear_speed);
+    c.non_negative(&solver.key("sleep_angular_speed"), s.sleep_angular_speed);
+    c.non_negative(&solver.key("time_to_sleep"), s.time_to_sleep);
     c.non_negative(
         &solver.key("restitution_threshold"),
         s.restitution_threshold,
