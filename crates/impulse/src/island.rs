@@ -268,24 +268,20 @@ pub fn step_island(
                 w.pseudo_linear[k] += w.linear[k];
                 w.pseudo_angular[k] += w.angular[k];
             }
-            integrate::integrate_positions(
-                &w.pseudo_linear[..moving],
-                &w.pseudo_angular[..moving],
-                &mut w.displacement[..moving],
-                &mut w.rotation[..moving],
-                &mut w.orientation,
-                h,
-            );
-        } else {
-            integrate::integrate_positions(
-                &w.linear[..moving],
-                &w.angular[..moving],
-                &mut w.displacement[..moving],
-                &mut w.rotation[..moving],
-                &mut w.orientation,
-                h,
-            );
         }
+        let (linear, angular) = if settings.split_impulse {
+            (&w.pseudo_linear[..moving], &w.pseudo_angular[..moving])
+        } else {
+            (&w.linear[..moving], &w.angular[..moving])
+        };
+        integrate::integrate_positions(
+            linear,
+            angular,
+            &mut w.displacement[..moving],
+            &mut w.rotation[..moving],
+            &mut w.orientation,
+            h,
+        );
         if settings.relax_iterations > 0 && !settings.split_impulse {
             constraints::update_targets(
                 constraints,
