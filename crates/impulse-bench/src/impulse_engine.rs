@@ -89,6 +89,7 @@ pub fn settings_text(s: &SolverSettings, threads: usize) -> String {
     let method = match s.method {
         SolverMethod::Pgs => "PGS",
         SolverMethod::Nncg => "NNCG",
+        SolverMethod::Auto => "auto (PGS, escalating to NNCG)",
     };
     // As the step runs them: split impulse leaves no work to soft rows or the relax pass.
     let repair = if s.split_impulse {

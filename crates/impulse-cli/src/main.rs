@@ -44,9 +44,24 @@ enum Command {
         /// Relax iterations per substep (default: the scene's solver settings).
         #[arg(long)]
         relax: Option<u32>,
-        /// Iterative method: pgs or nncg (default: the scene's solver settings).
+        /// Method: pgs, nncg, or auto (PGS escalating per island to NNCG and the exact path;
+        /// default: the scene's solver settings).
         #[arg(long)]
         method: Option<String>,
+        /// `auto`: escalate an island whose last iteration changed a row velocity by more
+        /// than this (m/s).
+        #[arg(long)]
+        escalation_tolerance: Option<f32>,
+        /// `auto`: NNCG iterations per substep after an island escalates.
+        #[arg(long)]
+        escalation_iterations: Option<u32>,
+        /// `auto`: solve islands of at most this many contact points exactly when NNCG does
+        /// not converge (0 = never).
+        #[arg(long)]
+        exact_max_contacts: Option<u32>,
+        /// Write what the solver did on each island at each step (JSON Lines).
+        #[arg(long)]
+        island_report: Option<PathBuf>,
         /// Soft contact frequency in Hz (0 = the seed's rigid rows with overlap repair c_d).
         #[arg(long)]
         soft_hertz: Option<f32>,
@@ -196,6 +211,10 @@ fn real_main() -> Result<ExitCode> {
             substeps,
             relax,
             method,
+            escalation_tolerance,
+            escalation_iterations,
+            exact_max_contacts,
+            island_report,
             soft_hertz,
             warm_start,
             repair_rate,
@@ -246,11 +265,21 @@ fn real_main() -> Result<ExitCode> {
             if no_sleep {
                 scene.solver.sleep = false;
             }
+            if let Some(tolerance) = escalation_tolerance {
+                scene.solver.escalation_tolerance = tolerance;
+            }
+            if let Some(iterations) = escalation_iterations {
+                scene.solver.escalation_iterations = iterations;
+            }
+            if let Some(contacts) = exact_max_contacts {
+                scene.solver.exact_max_contacts = contacts;
+            }
             if let Some(method) = method {
                 scene.solver.method = match method.as_str() {
                     "pgs" => SolverMethod::Pgs,
                     "nncg" => SolverMethod::Nncg,
-                    other => bail!("unknown method '{other}': expected pgs or nncg"),
+                    "auto" => SolverMethod::Auto,
+                    other => bail!("unknown method '{other}': expected pgs, nncg or auto"),
                 };
             }
             let options = run::RunOptions {
@@ -262,6 +291,7 @@ fn real_main() -> Result<ExitCode> {
                 summary_json,
                 quiet,
                 threads,
+                island_report,
             };
             let summary = run::run(scene, &options)?;
             println!("{}", summary.line());

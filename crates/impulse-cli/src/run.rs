@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use impulse::island::EscalationLevel;
 use impulse::{Scene, World, metrics};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -21,6 +22,22 @@ pub struct RunOptions {
     pub quiet: bool,
     /// Worker threads; `None` = all cores, 1 = none (everything on the calling thread).
     pub threads: Option<usize>,
+    /// Per-step island reports (JSON Lines), if wanted.
+    pub island_report: Option<PathBuf>,
+}
+
+/// Island solves of a run by the strongest method each reached (one count per island and
+/// step), from [`impulse::island::IslandReport`].
+#[derive(Debug, Default, Serialize)]
+pub struct IslandSolves {
+    pub pgs: u64,
+    pub nncg: u64,
+    pub nncg_extended: u64,
+    pub exact: u64,
+    /// Solves (island × substep) that escalated beyond their first method.
+    pub escalations: u64,
+    /// Exact solves that failed, whose iterative result was kept.
+    pub exact_failures: u64,
 }
 
 /// What a run measured. Overlap and sink are measured from poses (DESIGN.md "Metrics").
@@ -52,6 +69,10 @@ pub struct Summary {
     /// Natural-map residual of the last step.
     pub final_natural_map_residual: f32,
     pub iterations_limit: u32,
+    /// The solver method setting (`pgs`, `nncg` or `auto`).
+    pub method: String,
+    /// What the islands' solves used over the run.
+    pub island_solves: IslandSolves,
     /// Worker threads the run used (1 = the calling thread only).
     pub threads: usize,
     /// Whether quiet islands were allowed to sleep.
@@ -143,18 +164,42 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
     let mut final_overlap = max_overlap;
     let mut status = "completed".to_string();
     let mut failure = None;
+    let mut island_solves = IslandSolves::default();
+    let mut island_writer = match &options.island_report {
+        Some(path) => Some(std::io::BufWriter::new(
+            std::fs::File::create(path)
+                .with_context(|| format!("cannot create {}", path.display()))?,
+        )),
+        None => None,
+    };
     for step in 1..=steps {
         let start = Instant::now();
-        let result = world.step().cloned();
+        let result = world.step().map(|_| ());
         step_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        let diagnostics = match result {
-            Ok(d) => d,
-            Err(e) => {
-                status = format!("stopped: {e}");
-                failure = Some(e);
-                break;
+        if let Err(e) = result {
+            status = format!("stopped: {e}");
+            failure = Some(e);
+            break;
+        }
+        let diagnostics = world.diagnostics();
+        for island in &diagnostics.islands {
+            match island.method {
+                EscalationLevel::Pgs => island_solves.pgs += 1,
+                EscalationLevel::Nncg => island_solves.nncg += 1,
+                EscalationLevel::NncgExtended => island_solves.nncg_extended += 1,
+                EscalationLevel::Exact => island_solves.exact += 1,
             }
-        };
+            island_solves.escalations += island.escalations as u64;
+            island_solves.exact_failures += island.exact_failures as u64;
+        }
+        if let Some(w) = island_writer.as_mut() {
+            use std::io::Write;
+            serde_json::to_writer(
+                &mut *w,
+                &serde_json::json!({"step": diagnostics.step, "islands": &diagnostics.islands}),
+            )?;
+            writeln!(w)?;
+        }
         contacts_sum += diagnostics.contacts as u64;
         iterations_sum += diagnostics.iterations as u64;
         max_residual = max_residual.max(diagnostics.natural_map_residual);
@@ -203,6 +248,8 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         max_natural_map_residual: max_residual,
         final_natural_map_residual: world.diagnostics().natural_map_residual,
         iterations_limit: scene.solver.iterations,
+        method: scene.solver.method.name().to_string(),
+        island_solves,
         threads: if parallel {
             rayon::current_num_threads()
         } else {

@@ -10,6 +10,10 @@ use crate::body::Bodies;
 pub struct BroadPhase {
     aabbs: Vec<Aabb>,
     workspace: BvhWorkspace,
+    /// Kept between steps and refitted: bodies move little per step, so refitting plus
+    /// Parry's incremental optimisation costs a fraction of a fresh binned build (10 % of a
+    /// pyramid20 step under callgrind).
+    tree: Option<Bvh>,
 }
 
 /// Half-spaces have unbounded boxes; a finite stand-in keeps the tree well-formed.
@@ -34,7 +38,17 @@ impl BroadPhase {
         if self.aabbs.len() < 2 {
             return;
         }
-        let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &self.aabbs);
+        let bvh = match &mut self.tree {
+            Some(tree) if tree.leaf_count() as usize == self.aabbs.len() => {
+                for (i, aabb) in self.aabbs.iter().enumerate() {
+                    tree.insert_or_update_partially(*aabb, i as u32, 0.0);
+                }
+                tree.refit(&mut self.workspace);
+                tree.optimize_incremental(&mut self.workspace);
+                tree
+            }
+            tree => tree.insert(Bvh::from_leaves(BvhBuildStrategy::Binned, &self.aabbs)),
+        };
         bvh.traverse_bvtt_single_tree::<false>(&mut self.workspace, &mut |a, b| {
             let (i, j) = if a < b { (a, b) } else { (b, a) };
             if i != j && (bodies.is_moving(i as usize) || bodies.is_moving(j as usize)) {

@@ -5,6 +5,7 @@ use serde::Serialize;
 
 use crate::body::Bodies;
 use crate::constraints::ContactConstraint;
+use crate::island::IslandReport;
 use crate::solver::cap_to_disc;
 
 /// Per-step report. Every step's LCP can be checked: `natural_map_residual` is computed from
@@ -26,6 +27,9 @@ pub struct StepDiagnostics {
     /// φ_t = γ_t − Proj(γ_t − w_t) onto the friction disc |γ_t| ≤ μ·γ_n for a tangent pair.
     /// Mixed units (N·s and m/s), as in the LCP itself.
     pub natural_map_residual: f32,
+    /// What the solver did on each awake island with contacts, in island order (method
+    /// reached, iterations, residual): the automatic policy's choices made visible.
+    pub islands: Vec<IslandReport>,
     /// Largest penetration depth among this step's contact points, before the solve (m).
     pub max_depth: f32,
     /// Total kinetic energy after the step (J).

@@ -148,6 +148,61 @@ fn find(parent: &mut [u32], mut i: usize) -> u32 {
     i as u32
 }
 
+/// What the solver did on one island during a step (DESIGN.md step 7: every step can say how
+/// well its LCP was solved, here per island).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct IslandReport {
+    /// Smallest body index in the island: a stable name for it within the step.
+    pub first_body: u32,
+    /// Moving bodies in the island.
+    pub bodies: u32,
+    /// Contact points (normal rows) in the island.
+    pub contacts: u32,
+    /// Heaviest to lightest moving body mass (1 for one body).
+    pub mass_ratio: f32,
+    /// The strongest method any of its solves used: `pgs`, `nncg`, `nncg_extended` or `exact`.
+    pub method: EscalationLevel,
+    /// Solves (one per substep) that escalated beyond their first method.
+    pub escalations: u32,
+    /// Exact solves attempted that failed (their iterative result was kept).
+    pub exact_failures: u32,
+    /// Iterations used in the step, all solves and methods together.
+    pub iterations: u32,
+    /// Largest row velocity change of the last iteration of the last main solve (m/s): how far
+    /// from converged the island's final solve stopped.
+    pub last_change: f32,
+    /// Natural-map residual of the island's rows at the end of the step (see
+    /// [`crate::diagnostics::StepDiagnostics::natural_map_residual`]); set by the world.
+    pub natural_map_residual: f32,
+}
+
+/// The methods of the automatic policy, weakest first.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EscalationLevel {
+    /// Projected Gauss-Seidel alone (`method: pgs`).
+    #[default]
+    Pgs,
+    /// Nonsmooth nonlinear conjugate gradient within the iteration budget.
+    Nncg,
+    /// NNCG given `escalation_iterations` more after the budget left it unconverged.
+    NncgExtended,
+    /// Pivoting on the island's assembled LCP.
+    Exact,
+}
+
+impl EscalationLevel {
+    /// Lower-case name, as in the summary JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            EscalationLevel::Pgs => "pgs",
+            EscalationLevel::Nncg => "nncg",
+            EscalationLevel::NncgExtended => "nncg_extended",
+            EscalationLevel::Exact => "exact",
+        }
+    }
+}
+
 /// Local state of one island during a step.
 #[derive(Default)]
 pub struct IslandWorkspace {
@@ -164,29 +219,72 @@ pub struct IslandWorkspace {
     pseudo_linear: Vec<Vec3>,
     pseudo_angular: Vec<Vec3>,
     nncg: NncgWorkspace,
-    /// Solver iterations used in the step.
-    pub iterations: u32,
+    /// What the solver did on this island in the step.
+    pub report: IslandReport,
 }
 
 impl IslandWorkspace {
-    /// Runs the configured method on the island's velocities for at most `iterations`.
+    /// Runs the configured method on the island's velocities for at most `iterations`; with
+    /// `escalate` and the `auto` method, the escalation policy (see [`SolverMethod::Auto`]).
     fn solve(
         &mut self,
         constraints: &mut [ContactConstraint],
         settings: &SolverSettings,
         iterations: u32,
+        escalate: bool,
     ) {
         let mut velocities = Velocities {
             linear: &mut self.linear,
             angular: &mut self.angular,
         };
-        self.iterations += solve(
-            constraints,
-            settings,
-            iterations,
-            &mut velocities,
-            &mut self.nncg,
-        );
+        let report = &mut self.report;
+        let nncg = |constraints: &mut [ContactConstraint],
+                    velocities: &mut Velocities<'_>,
+                    workspace: &mut NncgWorkspace,
+                    iterations| {
+            solver::solve_nncg(
+                constraints,
+                iterations,
+                settings.tolerance,
+                velocities,
+                workspace,
+            )
+        };
+        let outcome = match settings.method {
+            SolverMethod::Pgs => {
+                solver::solve_pgs(constraints, iterations, settings.tolerance, &mut velocities)
+            }
+            SolverMethod::Nncg => {
+                report.method = EscalationLevel::Nncg;
+                nncg(constraints, &mut velocities, &mut self.nncg, iterations)
+            }
+            SolverMethod::Auto => {
+                report.method = report.method.max(EscalationLevel::Nncg);
+                let mut outcome = nncg(constraints, &mut velocities, &mut self.nncg, iterations);
+                let unconverged = outcome.last_change > settings.escalation_tolerance;
+                let heavy = report.mass_ratio > settings.mass_ratio_threshold;
+                if escalate && unconverged {
+                    report.escalations += 1;
+                    let more = nncg(
+                        constraints,
+                        &mut velocities,
+                        &mut self.nncg,
+                        settings.escalation_iterations,
+                    );
+                    outcome = solver::SolveReport {
+                        iterations: outcome.iterations + more.iterations,
+                        last_change: more.last_change,
+                    };
+                    report.method = report.method.max(EscalationLevel::NncgExtended);
+                }
+                let _ = heavy;
+                outcome
+            }
+        };
+        report.iterations += outcome.iterations;
+        if escalate {
+            report.last_change = outcome.last_change;
+        }
     }
 }
 
@@ -233,7 +331,13 @@ pub fn step_island(
     w.displacement.resize(slots, Vec3::ZERO);
     w.rotation.clear();
     w.rotation.resize(slots, Vec3::ZERO);
-    w.iterations = 0;
+    w.report = IslandReport {
+        first_body: island_bodies.iter().copied().min().unwrap_or(0),
+        bodies: island_bodies.len() as u32,
+        contacts: constraints.len() as u32,
+        mass_ratio: mass_ratio(island_bodies, bodies),
+        ..IslandReport::default()
+    };
 
     let h = dt / settings.substeps as f32;
     let moving = slots - 1;
@@ -247,7 +351,7 @@ pub fn step_island(
             },
         );
         constraints::update_targets(constraints, &w.displacement, &w.rotation, settings, h, true);
-        w.solve(constraints, settings, settings.iterations);
+        w.solve(constraints, settings, settings.iterations, true);
         if settings.split_impulse {
             // Positions move with v + the pseudo-velocity of the repair solve.
             w.pseudo_linear.clear();
@@ -291,7 +395,7 @@ pub fn step_island(
                 h,
                 false,
             );
-            w.solve(constraints, settings, settings.relax_iterations);
+            w.solve(constraints, settings, settings.relax_iterations, false);
         }
     }
     // Restitution after the substeps (the seed's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
@@ -301,6 +405,7 @@ pub fn step_island(
             constraints,
             settings,
             settings.iterations.max(settings.relax_iterations),
+            false,
         );
     }
 }
@@ -318,27 +423,19 @@ pub fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut 
     }
 }
 
-/// Runs the configured method for at most `iterations`; returns the iterations used.
-fn solve(
-    constraints: &mut [ContactConstraint],
-    settings: &SolverSettings,
-    iterations: u32,
-    velocities: &mut Velocities<'_>,
-    workspace: &mut NncgWorkspace,
-) -> u32 {
-    match settings.method {
-        SolverMethod::Pgs => {
-            solver::solve_pgs(constraints, iterations, settings.tolerance, velocities).iterations
+/// Heaviest to lightest moving body of an island (1 when it has one body).
+fn mass_ratio(island_bodies: &[u32], bodies: &Bodies) -> f32 {
+    let (mut lightest, mut heaviest) = (f32::INFINITY, 0.0f32);
+    for &i in island_bodies {
+        let inverse_mass = bodies.inverse_mass[i as usize];
+        if inverse_mass > 0.0 {
+            lightest = lightest.min(1.0 / inverse_mass);
+            heaviest = heaviest.max(1.0 / inverse_mass);
         }
-        SolverMethod::Nncg => {
-            solver::solve_nncg(
-                constraints,
-                iterations,
-                settings.tolerance,
-                velocities,
-                workspace,
-            )
-            .iterations
-        }
+    }
+    if heaviest > 0.0 {
+        heaviest / lightest
+    } else {
+        1.0
     }
 }

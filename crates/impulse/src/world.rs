@@ -12,7 +12,7 @@ use crate::constraints::{self, ContactConstraint};
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{self, StepDiagnostics};
 use crate::error::{StepError, WorldError};
-use crate::island::{self, IslandWorkspace, Islands, StepContext};
+use crate::island::{self, IslandReport, IslandWorkspace, Islands, StepContext};
 use crate::narrow_phase::{self, ContactImpulse, NarrowPhase};
 use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
@@ -242,7 +242,7 @@ impl World {
                     &self.workspaces[k],
                     &mut self.bodies,
                 );
-                iterations = iterations.max(self.workspaces[k].iterations);
+                iterations = iterations.max(self.workspaces[k].report.iterations);
             }
         }
         constraints::record_velocity_before(
@@ -254,14 +254,23 @@ impl World {
         self.store_impulses();
         // Only awake islands were solved this step; sleeping ones keep last step's state.
         let mut squared = 0.0f64;
+        // Reuse last step's list: no allocation per step once it has grown.
+        let mut island_reports = std::mem::take(&mut self.diagnostics.islands);
+        island_reports.clear();
         for k in 0..islands {
             if self.island_awake[k] {
                 let part = diagnostics::natural_map_residual(
                     &self.constraints[self.islands.constraint_range(k)],
                     &self.bodies.linear_velocity,
                     &self.bodies.angular_velocity,
-                ) as f64;
-                squared += part * part;
+                );
+                squared += (part as f64) * (part as f64);
+                if !self.islands.constraint_range(k).is_empty() {
+                    island_reports.push(IslandReport {
+                        natural_map_residual: part,
+                        ..self.workspaces[k].report
+                    });
+                }
             }
         }
         let residual = squared.sqrt() as f32;
@@ -282,6 +291,7 @@ impl World {
             rows: self.constraints.len() + 2 * friction_rows,
             iterations,
             natural_map_residual: residual,
+            islands: island_reports,
             max_depth: self.narrow_phase.max_depth(),
             kinetic_energy,
             linear_momentum: momentum.to_array(),
@@ -426,8 +436,16 @@ impl World {
         if s.substeps == 0 {
             return Err(setting("solver.substeps", "must be at least 1"));
         }
+        if s.escalation_iterations == 0 {
+            return Err(setting(
+                "solver.escalation_iterations",
+                "must be at least 1",
+            ));
+        }
         let non_negative = [
             ("solver.tolerance", s.tolerance),
+            ("solver.escalation_tolerance", s.escalation_tolerance),
+            ("solver.mass_ratio_threshold", s.mass_ratio_threshold),
             ("solver.restitution_threshold", s.restitution_threshold),
             ("solver.overlap_repair_rate", s.overlap_repair_rate),
             ("solver.overlap_slop", s.overlap_slop),

@@ -70,6 +70,14 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
         c.fail(&solver.key("substeps"), "must be ≥ 1, got 0".to_string());
     }
     c.non_negative(&solver.key("tolerance"), s.tolerance);
+    if s.escalation_iterations == 0 {
+        c.fail(
+            &solver.key("escalation_iterations"),
+            "must be ≥ 1, got 0".to_string(),
+        );
+    }
+    c.non_negative(&solver.key("escalation_tolerance"), s.escalation_tolerance);
+    c.non_negative(&solver.key("mass_ratio_threshold"), s.mass_ratio_threshold);
     c.non_negative(&solver.key("soft_contact_hertz"), s.soft_contact_hertz);
     c.non_negative(&solver.key("soft_damping_ratio"), s.soft_damping_ratio);
     c.non_negative(&solver.key("sleep_linear_speed"), s.sleep_linear_speed);
