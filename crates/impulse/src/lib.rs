@@ -7,6 +7,7 @@
 //! [`integrate`] (1, 6) → [`broad_phase`] (2) → [`narrow_phase`] (3) → [`constraints`] (4) →
 //! [`solver`] (5) → [`diagnostics`] (7), driven by [`World::step`].
 
+pub mod apgd;
 pub mod body;
 pub mod broad_phase;
 pub mod constraints;

@@ -156,7 +156,7 @@ pub fn solve_pgs(
 
 /// Impulses of one contact point as a vector (normal, tangent 1, tangent 2), N·s.
 #[inline(always)]
-fn impulses(c: &ContactConstraint) -> [f32; 3] {
+pub(crate) fn impulses(c: &ContactConstraint) -> [f32; 3] {
     [
         c.normal_impulse,
         c.tangent_impulses[0],
@@ -319,7 +319,11 @@ fn solve_point(c: &mut ContactConstraint, velocities: &mut Velocities<'_>) -> f3
 
 /// Applies impulses (normal, tangent 1, tangent 2) of one contact point to its two bodies.
 #[inline(always)]
-fn apply_impulses(c: &ContactConstraint, impulses: [f32; 3], velocities: &mut Velocities<'_>) {
+pub(crate) fn apply_impulses(
+    c: &ContactConstraint,
+    impulses: [f32; 3],
+    velocities: &mut Velocities<'_>,
+) {
     let (a, b) = (c.local_a as usize, c.local_b as usize);
     let [n, t1, t2] = [&c.normal, &c.tangents[0], &c.tangents[1]];
     let linear =
