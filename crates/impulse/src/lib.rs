@@ -14,6 +14,7 @@ pub mod constraints;
 pub mod contact_lcp;
 pub mod diagnostics;
 pub mod error;
+pub mod exact;
 pub mod integrate;
 pub mod island;
 pub mod metrics;
