@@ -89,7 +89,8 @@ pub fn settings_text(s: &SolverSettings, threads: usize) -> String {
     let method = match s.method {
         SolverMethod::Pgs => "PGS",
         SolverMethod::Nncg => "NNCG",
-        SolverMethod::Auto => "auto (PGS, escalating to NNCG)",
+        SolverMethod::Apgd => "APGD",
+        SolverMethod::Auto => "auto (NNCG, escalating per island)",
     };
     // As the step runs them: split impulse leaves no work to soft rows or the relax pass.
     let repair = if s.split_impulse {

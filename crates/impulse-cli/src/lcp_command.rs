@@ -243,13 +243,13 @@ const POWER_ITERATIONS: usize = 100;
 const JACOBI_RETRIES: usize = 4;
 
 /// One solver's run as plotted: `(x, residual)` with x the sweep or pivot count (0 = start).
-struct Series {
-    label: String,
-    colour: &'static str,
-    dashed: bool,
-    points: Vec<(f64, f64)>,
+pub(crate) struct Series {
+    pub(crate) label: String,
+    pub(crate) colour: &'static str,
+    pub(crate) dashed: bool,
+    pub(crate) points: Vec<(f64, f64)>,
     /// Lemke's final (polished) residual, drawn as a marker at its pivot count.
-    marker: Option<(f64, f64)>,
+    pub(crate) marker: Option<(f64, f64)>,
 }
 
 /// Reads an LCP (`.json` or Siconos `.dat`), runs projected Gauss–Seidel, damped projected
@@ -572,7 +572,7 @@ const RIGHT: f64 = 30.0;
 const TOP: f64 = 70.0;
 const BOTTOM: f64 = 60.0;
 
-fn svg_plot(title: &str, subtitle: &str, series: &[Series]) -> String {
+pub(crate) fn svg_plot(title: &str, subtitle: &str, series: &[Series]) -> String {
     use std::fmt::Write;
     let log = |r: f64| r.max(PLOT_FLOOR).log10();
     // The x axis spans the iterative solvers' sweeps; a longer Lemke path is cut at its end and

@@ -1,5 +1,6 @@
 //! The `impulse` command: run scenes, list and export them, and work with contact LCPs.
 
+mod engine_convergence;
 mod lcp_command;
 mod run;
 mod trajectory;
@@ -44,7 +45,7 @@ enum Command {
         /// Relax iterations per substep (default: the scene's solver settings).
         #[arg(long)]
         relax: Option<u32>,
-        /// Method: pgs, nncg, or auto (PGS escalating per island to NNCG and the exact path;
+        /// Method: pgs, nncg, apgd, or auto (PGS escalating per island to NNCG and the exact path;
         /// default: the scene's solver settings).
         #[arg(long)]
         method: Option<String>,
@@ -158,6 +159,21 @@ enum LcpCommand {
         /// Turn friction off so the problem is a standard LCP (Lemke can solve it).
         #[arg(long)]
         no_friction: bool,
+    },
+    /// Plot residual against iterations for the engine's own solvers (PGS, NNCG, APGD on the
+    /// contact rows) on one step of a scene (SVG).
+    EngineConvergence {
+        /// JSON scene file, or the name of a built-in scene.
+        scene: String,
+        /// The step whose LCP is plotted (the run before it uses the scene's settings).
+        #[arg(long, default_value_t = 60)]
+        step: u64,
+        /// Largest iteration count plotted.
+        #[arg(long, default_value_t = 40)]
+        iterations: u32,
+        /// Output SVG file.
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Plot residual against iteration for PGS, projected Jacobi and Lemke (SVG).
     Convergence {
@@ -278,8 +294,9 @@ fn real_main() -> Result<ExitCode> {
                 scene.solver.method = match method.as_str() {
                     "pgs" => SolverMethod::Pgs,
                     "nncg" => SolverMethod::Nncg,
+                    "apgd" => SolverMethod::Apgd,
                     "auto" => SolverMethod::Auto,
-                    other => bail!("unknown method '{other}': expected pgs, nncg or auto"),
+                    other => bail!("unknown method '{other}': expected pgs, nncg, apgd or auto"),
                 };
             }
             let options = run::RunOptions {
@@ -365,6 +382,17 @@ fn real_main() -> Result<ExitCode> {
                 iterations,
                 out,
             } => lcp_command::convergence(&file, iterations, &out)?,
+            LcpCommand::EngineConvergence {
+                scene,
+                step,
+                iterations,
+                out,
+            } => engine_convergence::engine_convergence(
+                &resolve_scene(&scene)?,
+                step,
+                iterations,
+                &out,
+            )?,
         },
     }
     Ok(ExitCode::SUCCESS)

@@ -33,6 +33,7 @@ pub struct IslandSolves {
     pub pgs: u64,
     pub nncg: u64,
     pub nncg_extended: u64,
+    pub apgd: u64,
     pub exact: u64,
     /// Solves (island × substep) that escalated beyond their first method.
     pub escalations: u64,
@@ -187,6 +188,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
                 EscalationLevel::Pgs => island_solves.pgs += 1,
                 EscalationLevel::Nncg => island_solves.nncg += 1,
                 EscalationLevel::NncgExtended => island_solves.nncg_extended += 1,
+                EscalationLevel::Apgd => island_solves.apgd += 1,
                 EscalationLevel::Exact => island_solves.exact += 1,
             }
             island_solves.escalations += island.escalations as u64;

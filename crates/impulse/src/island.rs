@@ -9,8 +9,10 @@
 
 use glam::{Quat, Vec3};
 
+use crate::apgd::{self, ApgdWorkspace};
 use crate::body::Bodies;
 use crate::constraints::{self, ContactConstraint};
+use crate::exact::{self, ExactWorkspace};
 use crate::integrate;
 use crate::settings::{SolverMethod, SolverSettings};
 use crate::solver::{self, NncgWorkspace, Velocities};
@@ -160,12 +162,16 @@ pub struct IslandReport {
     pub contacts: u32,
     /// Heaviest to lightest moving body mass (1 for one body).
     pub mass_ratio: f32,
-    /// The strongest method any of its solves used: `pgs`, `nncg`, `nncg_extended` or `exact`.
+    /// The strongest method any of its solves used: `pgs`, `nncg`, `apgd`, `nncg_extended` or
+    /// `exact`. For `auto`: `exact` if any solve was exact, as `last_change` is then the exact
+    /// solve's residual (m/s).
     pub method: EscalationLevel,
     /// Solves (one per substep) that escalated beyond their first method.
     pub escalations: u32,
     /// Exact solves attempted that failed (their iterative result was kept).
     pub exact_failures: u32,
+    /// Lemke pivots of the exact solves.
+    pub exact_pivots: u32,
     /// Iterations used in the step, all solves and methods together.
     pub iterations: u32,
     /// Largest row velocity change of the last iteration of the last main solve (m/s): how far
@@ -185,6 +191,8 @@ pub enum EscalationLevel {
     Pgs,
     /// Nonsmooth nonlinear conjugate gradient within the iteration budget.
     Nncg,
+    /// Accelerated projected gradient (`method: apgd`).
+    Apgd,
     /// NNCG given `escalation_iterations` more after the budget left it unconverged.
     NncgExtended,
     /// Pivoting on the island's assembled LCP.
@@ -197,6 +205,7 @@ impl EscalationLevel {
         match self {
             EscalationLevel::Pgs => "pgs",
             EscalationLevel::Nncg => "nncg",
+            EscalationLevel::Apgd => "apgd",
             EscalationLevel::NncgExtended => "nncg_extended",
             EscalationLevel::Exact => "exact",
         }
@@ -219,6 +228,8 @@ pub struct IslandWorkspace {
     pseudo_linear: Vec<Vec3>,
     pseudo_angular: Vec<Vec3>,
     nncg: NncgWorkspace,
+    apgd: ApgdWorkspace,
+    exact: ExactWorkspace,
     /// What the solver did on this island in the step.
     pub report: IslandReport,
 }
@@ -258,12 +269,39 @@ impl IslandWorkspace {
                 report.method = EscalationLevel::Nncg;
                 nncg(constraints, &mut velocities, &mut self.nncg, iterations)
             }
+            SolverMethod::Apgd => {
+                report.method = EscalationLevel::Apgd;
+                apgd::solve_apgd(
+                    constraints,
+                    iterations,
+                    settings.tolerance,
+                    &mut velocities,
+                    &mut self.apgd,
+                )
+            }
             SolverMethod::Auto => {
                 report.method = report.method.max(EscalationLevel::Nncg);
                 let mut outcome = nncg(constraints, &mut velocities, &mut self.nncg, iterations);
                 let unconverged = outcome.last_change > settings.escalation_tolerance;
                 let heavy = report.mass_ratio > settings.mass_ratio_threshold;
-                if escalate && unconverged {
+                let small = constraints.len() <= settings.exact_max_contacts as usize;
+                if escalate && small && (unconverged || heavy) {
+                    report.escalations += 1;
+                    match exact::solve_exact(
+                        constraints,
+                        &mut velocities,
+                        settings.exact_max_contacts as usize,
+                        &mut self.exact,
+                    ) {
+                        Ok(exact) => {
+                            report.method = EscalationLevel::Exact;
+                            report.exact_pivots += exact.pivots;
+                            outcome.last_change = exact.residual;
+                        }
+                        // The iterative result stands; the failure is counted and reported.
+                        Err(_) => report.exact_failures += 1,
+                    }
+                } else if escalate && unconverged {
                     report.escalations += 1;
                     let more = nncg(
                         constraints,
@@ -277,7 +315,6 @@ impl IslandWorkspace {
                     };
                     report.method = report.method.max(EscalationLevel::NncgExtended);
                 }
-                let _ = heavy;
                 outcome
             }
         };
@@ -364,7 +401,7 @@ pub fn step_island(
             };
             solver::solve_positions(
                 constraints,
-                settings.iterations,
+                settings.position_iterations,
                 settings.tolerance,
                 &mut pseudo,
             );

@@ -10,6 +10,8 @@ pub enum SolverMethod {
     Pgs,
     /// Nonsmooth nonlinear conjugate gradient over PGS sweeps (Silcowitz et al. 2010).
     Nncg,
+    /// Accelerated projected gradient descent with adaptive restart (Mazhar et al. 2015).
+    Apgd,
     /// The automatic policy, per island and solve (the default): NNCG within the iteration
     /// budget; an island whose last iteration still changed a row's velocity by more than
     /// `escalation_tolerance`, or whose mass ratio exceeds `mass_ratio_threshold`, escalates:
@@ -29,6 +31,7 @@ impl SolverMethod {
         match self {
             SolverMethod::Pgs => "pgs",
             SolverMethod::Nncg => "nncg",
+            SolverMethod::Apgd => "apgd",
             SolverMethod::Auto => "auto",
         }
     }
@@ -41,7 +44,7 @@ impl SolverMethod {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSettings {
-    /// Method: `pgs`, `nncg`, or `auto` (the escalation policy).
+    /// Method: `pgs`, `nncg`, `apgd`, or `auto` (the escalation policy).
     pub method: SolverMethod,
     /// Substeps per step. Contacts are found once per step; each substep of h = dt/substeps
     /// applies gravity, solves, and integrates positions, with each contact's separation
@@ -83,6 +86,10 @@ pub struct SolverSettings {
     /// Bullet's split impulse). The velocity rows are then rigid (target 0 when touching), and
     /// `soft_contact_hertz` and the relax pass have nothing left to do.
     pub split_impulse: bool,
+    /// Split impulse: PGS sweeps of the position solve per substep, at most (early exit at
+    /// `tolerance`). A deep overlap in a tall pile is a chain the repair has to carry through,
+    /// so this budget is separate from (and larger than) the velocity solve's. Must be ≥ 1.
+    pub position_iterations: u32,
     /// Soft contact: when > 0, overlap repair is a damped spring of this frequency (Hz, capped
     /// at a quarter of the substep rate) instead of the seed's rate c_d, and penetrating rows
     /// are regularised by it (Box2D v3's soft step). 0 = the seed's rigid rows with c_d.
@@ -122,10 +129,11 @@ impl Default for SolverSettings {
             escalation_tolerance: 3e-4,
             escalation_iterations: 8,
             mass_ratio_threshold: 10.0,
-            exact_max_contacts: 0,
+            exact_max_contacts: 32,
             restitution_threshold: 0.5,
-            overlap_repair_rate: 6.0,
+            overlap_repair_rate: 12.0,
             split_impulse: true,
+            position_iterations: 16,
             soft_contact_hertz: 0.0,
             soft_damping_ratio: 10.0,
             overlap_slop: 0.002,

@@ -436,6 +436,9 @@ impl World {
         if s.substeps == 0 {
             return Err(setting("solver.substeps", "must be at least 1"));
         }
+        if s.position_iterations == 0 {
+            return Err(setting("solver.position_iterations", "must be at least 1"));
+        }
         if s.escalation_iterations == 0 {
             return Err(setting(
                 "solver.escalation_iterations",

@@ -70,6 +70,12 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
         c.fail(&solver.key("substeps"), "must be ≥ 1, got 0".to_string());
     }
     c.non_negative(&solver.key("tolerance"), s.tolerance);
+    if s.position_iterations == 0 {
+        c.fail(
+            &solver.key("position_iterations"),
+            "must be ≥ 1, got 0".to_string(),
+        );
+    }
     if s.escalation_iterations == 0 {
         c.fail(
             &solver.key("escalation_iterations"),
