@@ -13,13 +13,16 @@ fi
 configs=(
   "seed: PGS, 1 solve/step, velocity bias|--substeps 1 --relax 0 --method pgs --iterations 20 --repair bias"
   "PGS, 4 substeps, bias + relax|--method pgs --repair bias"
-  "NNCG, 4 substeps, bias + relax|--repair bias"
-  "NNCG, 4 substeps, soft step (30 Hz, ζ = 10)|--repair soft"
-  "default: NNCG, 4 substeps, split impulse|"
+  "NNCG, 4 substeps, bias + relax|--method nncg --repair bias"
+  "NNCG, 4 substeps, soft step (30 Hz, ζ = 10)|--method nncg --repair soft"
+  "PGS, 4 substeps, split impulse|--method pgs"
+  "NNCG, 4 substeps, split impulse|--method nncg"
+  "APGD, 4 substeps, split impulse|--method apgd"
+  "default: auto (NNCG → exact or more NNCG), split impulse|"
 )
 tmp=$(mktemp -d)
-echo "| scene | solver | top sink (mm) | largest overlap (mm) | kinetic energy at 10 s (J) | largest LCP residual | ms/step |"
-echo "|---|---|---:|---:|---:|---:|---:|"
+echo "| scene | solver | top sink (mm) | largest overlap (mm) | kinetic energy at 10 s (J) | largest speed (m/s) | largest LCP residual | island solves | ms/step |"
+echo "|---|---|---:|---:|---:|---:|---:|---|---:|"
 for scene in "${scenes[@]}"; do
   for config in "${configs[@]}"; do
     name=${config%%|*}
@@ -35,8 +38,12 @@ import json, sys
 path, scene, name, status = sys.argv[1:]
 s = json.load(open(path))
 note = "" if s["status"] == "completed" else " (" + s["status"] + ")"
+solves = ", ".join(f"{k} {v}" for k, v in s["island_solves"].items()
+                   if v and k not in ("escalations", "exact_failures"))
+if s["island_solves"]["exact_failures"]:
+    solves += f" ({s['island_solves']['exact_failures']} exact failed)"
 print(f"| {scene} | {name}{note} | {s['top_sink_m']*1e3:.2f} | {s['max_overlap_m']*1e3:.2f} | "
-      f"{s['kinetic_energy_j']:.3g} | {s['max_natural_map_residual']:.2e} | {s['ms_per_step']:.3f} |")
+      f"{s['kinetic_energy_j']:.3g} | {s['max_speed_m_s']:.2f} | {s['max_natural_map_residual']:.2e} | {solves} | {s['ms_per_step']:.3f} |")
 PY
   done
 done

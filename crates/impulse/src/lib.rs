@@ -5,7 +5,8 @@
 //! Gauss-Seidel, following `contact-resolution-notes.md` (the "seed"). See DESIGN.md for the
 //! pipeline; each stage is one module:
 //! [`integrate`] (1, 6) → [`broad_phase`] (2) → [`narrow_phase`] (3) → [`constraints`] (4) →
-//! [`solver`] (5) → [`diagnostics`] (7), driven by [`World::step`].
+//! [`solver`] (5; with [`apgd`], [`exact`] and the per-island policy of [`island`]) →
+//! [`diagnostics`] (7), driven by [`World::step`].
 
 pub mod apgd;
 pub mod body;

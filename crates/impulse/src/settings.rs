@@ -127,7 +127,7 @@ impl Default for SolverSettings {
             relax_iterations: 1,
             tolerance: 1e-5,
             escalation_tolerance: 3e-4,
-            escalation_iterations: 8,
+            escalation_iterations: 4,
             mass_ratio_threshold: 10.0,
             exact_max_contacts: 32,
             restitution_threshold: 0.5,
