@@ -153,7 +153,7 @@ pub fn solve_apgd(
             continue;
         }
         let mut a = row_velocities(c, scratch.linear, scratch.angular);
-        a[0] += soft_diagonal(c) * d[0];
+        a[0] += c.soft_diagonal() * d[0];
         for k in 0..3 {
             if d[k] != 0.0 {
                 product += (a[k] as f64).powi(2);
@@ -161,7 +161,7 @@ pub fn solve_apgd(
             }
         }
         diagonal = diagonal
-            .max(c.normal.inverse_effective_mass + soft_diagonal(c))
+            .max(c.normal.inverse_effective_mass + c.soft_diagonal())
             .max(c.tangents[0].inverse_effective_mass * d[1])
             .max(c.tangents[1].inverse_effective_mass * d[2]);
     }
@@ -306,17 +306,6 @@ fn is_active(c: &ContactConstraint) -> bool {
     c.normal.inverse_effective_mass > 0.0
 }
 
-/// The soft normal row's extra diagonal term of A, (impulse_scale/mass_scale)/m_eff (1/kg).
-#[inline(always)]
-fn soft_diagonal(c: &ContactConstraint) -> f32 {
-    let (mass_scale, impulse_scale) = c.softness;
-    if impulse_scale != 0.0 && mass_scale > 0.0 {
-        impulse_scale / mass_scale * c.normal.inverse_effective_mass
-    } else {
-        0.0
-    }
-}
-
 /// ∇f at γ = the point's rows of Aγ − b: J·v − target plus the soft term (m/s), where `linear`
 /// and `angular` are v(γ). Zero for rows that do not exist (no friction) or cannot move.
 #[inline(always)]
@@ -330,7 +319,7 @@ fn gradient_at(
         return [0.0; 3];
     }
     let mut g = row_velocities(c, linear, angular);
-    g[0] += soft_diagonal(c) * gamma[0] - c.target_normal_velocity;
+    g[0] += c.soft_diagonal() * gamma[0] - c.target_normal_velocity;
     g
 }
 

@@ -136,6 +136,22 @@ pub struct ContactConstraint {
     pub source: (u32, u16, u16),
 }
 
+impl ContactConstraint {
+    /// The soft normal row's extra diagonal term of A (1/kg): a row with softness (s, i)
+    /// updates by Δγ = m_eff·s·(target − v) − i·γ, whose fixed point with γ > 0 is
+    /// (v − target) + (i/s)·(1/m_eff)·γ = 0, the rigid row plus (i/s)/m_eff on the diagonal
+    /// (ODE's constraint force mixing). 0 for a rigid row, (1, 0).
+    #[inline]
+    pub fn soft_diagonal(&self) -> f32 {
+        let (mass_scale, impulse_scale) = self.softness;
+        if impulse_scale != 0.0 && mass_scale > 0.0 {
+            impulse_scale / mass_scale * self.normal.inverse_effective_mass
+        } else {
+            0.0
+        }
+    }
+}
+
 /// Builds one constraint per contact point, in narrow-phase order (pairs sorted by body index).
 /// `velocity_before` is read from the current velocities: called before gravity is applied, it
 /// is the approach velocity v⁻ that restitution reflects. Targets are left at zero.

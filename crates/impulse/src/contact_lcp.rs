@@ -48,13 +48,9 @@ pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, Pro
     let mut contact_of_row = Vec::new();
     let mut entries: BTreeMap<(usize, usize), f64> = BTreeMap::new();
     for (k, c) in constraints.iter().enumerate() {
-        // A soft normal row (see `ContactConstraint::softness`) updates by
-        // Δγ = m_eff·s·(target − v) − i·γ, whose fixed point with γ > 0 is
-        // (v − target) + (i/s)·(1/m_eff)·γ = 0: the rigid row plus a diagonal term (ODE's
-        // constraint force mixing). Rigid rows, (1, 0), get none.
-        let (mass_scale, impulse_scale) = c.softness;
-        if impulse_scale != 0.0 && mass_scale > 0.0 {
-            let softness = impulse_scale / mass_scale * c.normal.inverse_effective_mass;
+        // A soft normal row is the rigid row plus a diagonal term (see `soft_diagonal`).
+        let softness = c.soft_diagonal();
+        if softness != 0.0 {
             entries.insert((b.len(), b.len()), softness as f64);
         }
         let normal_row = b.len();

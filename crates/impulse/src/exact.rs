@@ -245,7 +245,10 @@ pub fn solve_exact(
         });
     }
     let entry = normal_residual(constraints, velocities.linear, velocities.angular, |k| {
-        (constraints[k].normal_impulse, softness_of(&constraints[k]))
+        (
+            constraints[k].normal_impulse,
+            constraints[k].soft_diagonal(),
+        )
     });
     if n == 0 {
         return Ok(ExactReport {
@@ -268,7 +271,8 @@ pub fn solve_exact(
     w.angular.clear();
     w.angular.extend_from_slice(velocities.angular);
     w.softness.clear();
-    w.softness.extend(constraints.iter().map(softness_of));
+    w.softness
+        .extend(constraints.iter().map(ContactConstraint::soft_diagonal));
     assemble(constraints, w);
 
     // Lemke takes the problem by value; the buffers go back into the workspace afterwards.
@@ -719,16 +723,6 @@ fn friction_passes(constraints: &[ContactConstraint], w: &mut ExactWorkspace) {
 fn velocity(row: &JacobianRow, c: &ContactConstraint, linear: &[Vec3], angular: &[Vec3]) -> f32 {
     let (a, b) = (c.local_a as usize, c.local_b as usize);
     row.velocity(linear[a], angular[a], linear[b], angular[b])
-}
-
-/// The soft row's diagonal term (impulse_scale / mass_scale)·k (1/kg); 0 for a rigid row.
-fn softness_of(c: &ContactConstraint) -> f32 {
-    let (mass_scale, impulse_scale) = c.softness;
-    if impulse_scale != 0.0 && mass_scale > 0.0 {
-        impulse_scale / mass_scale * c.normal.inverse_effective_mass
-    } else {
-        0.0
-    }
 }
 
 /// max_i |min(w_i, γ_i·k_i)| (m/s) for (normal impulse, soft term) = `state(i)`; see

@@ -9,12 +9,14 @@
 //! folded into the rows, like the island's immovable slot), so a solver can be run on them
 //! from any starting impulses.
 
+mod common;
+use common::{material, static_box};
 use glam::Vec3;
 use impulse::apgd::{ApgdWorkspace, solve_apgd};
 use impulse::constraints::ContactConstraint;
 use impulse::contact_lcp::assemble_lcp;
 use impulse::solver::{NncgWorkspace, SolveReport, Velocities, solve_nncg, solve_pgs};
-use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
+use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::lemke;
 use impulse_lcp::{
     Bounds, Lcp, SolverSettings as LcpSettings, Status, normalised_natural_map_residual,
@@ -22,24 +24,6 @@ use impulse_lcp::{
 };
 
 const DT: f32 = 1.0 / 60.0;
-
-fn material(friction: f32) -> Material {
-    Material {
-        friction,
-        restitution: 0.0,
-        density: 1000.0,
-    }
-}
-
-fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
-    BodyDesc::new(
-        BodyKind::Static,
-        ShapeDesc::Cuboid {
-            half_extents: half.to_array(),
-        },
-        position.to_array(),
-    )
-}
 
 fn sphere(radius: f32, position: Vec3) -> BodyDesc {
     BodyDesc::new(

@@ -5,9 +5,11 @@
 //! Convention (seed notes): find γ with w = Aγ − b ≥ 0, γ ≥ 0, wᵀγ = 0, where A = J M⁻¹ Jᵀ and
 //! b = target − J·v*. w is a velocity (m/s), γ an impulse (N·s).
 
+mod common;
+use common::{material, static_box};
 use glam::Vec3;
 use impulse::constraints::ContactConstraint;
-use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
+use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::{lemke, pgs};
 use impulse_lcp::{
     Bounds, Lcp, Matrix, SolverSettings as LcpSettings, Status, bound_violation,
@@ -25,24 +27,6 @@ const VELOCITY_TOLERANCE: f64 = 1e-5;
 
 /// Lemke's f64 solution must meet the natural-map residual (normalised by ‖b‖₂) to this.
 const LEMKE_TOLERANCE: f64 = 1e-9;
-
-fn material(friction: f32) -> Material {
-    Material {
-        friction,
-        restitution: 0.0,
-        density: 1000.0,
-    }
-}
-
-fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
-    BodyDesc::new(
-        BodyKind::Static,
-        ShapeDesc::Cuboid {
-            half_extents: half.to_array(),
-        },
-        position.to_array(),
-    )
-}
 
 /// 36 spheres of radii 0.35–0.5 m (so that no two rows of contacts line up exactly and no chain
 /// of contacts spans wall to wall), started almost touching on a 3 × 3 grid, 4 layers, inside

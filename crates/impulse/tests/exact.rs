@@ -8,6 +8,8 @@
 //! Timings: `cargo test --release -p impulse --test exact -- --nocapture` prints, per island,
 //! rows, pivots and the median time of `solve_exact` over repeated runs from the same entry.
 
+mod common;
+use common::material;
 use std::time::Instant;
 
 use glam::{DVec3, Vec3};
@@ -15,7 +17,7 @@ use impulse::constraints::ContactConstraint;
 use impulse::exact::{ExactFailure, ExactReport, ExactWorkspace, solve_exact};
 use impulse::settings::SolverMethod;
 use impulse::solver::Velocities;
-use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
+use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::lemke;
 use impulse_lcp::{Bounds, SolverSettings as LcpSettings, Status};
 
@@ -172,14 +174,6 @@ fn stored(c: &ContactConstraint) -> [f32; 3] {
         c.tangent_impulses[0],
         c.tangent_impulses[1],
     ]
-}
-
-fn material(friction: f32) -> Material {
-    Material {
-        friction,
-        restitution: 0.0,
-        density: 1000.0,
-    }
 }
 
 /// The engine's iterative solve only (its automatic policy may itself call the exact path),
