@@ -45,10 +45,17 @@ enum Command {
         /// Relax iterations per substep (default: the scene's solver settings).
         #[arg(long)]
         relax: Option<u32>,
-        /// Method: pgs, nncg, apgd, or auto (PGS escalating per island to NNCG and the exact path;
-        /// default: the scene's solver settings).
+        /// Method: pgs, nncg, apgd, or auto (NNCG escalating per island to more iterations or
+        /// the exact path; default: the scene's solver settings).
         #[arg(long)]
         method: Option<String>,
+        /// Early exit: a solve stops when no row's velocity changed by more than this in a
+        /// sweep (m/s; default: the scene's solver settings).
+        #[arg(long)]
+        tolerance: Option<f32>,
+        /// Split impulse: position-solve sweeps per substep at most (default: the scene's).
+        #[arg(long)]
+        position_iterations: Option<u32>,
         /// `auto`: escalate an island whose last iteration changed a row velocity by more
         /// than this (m/s).
         #[arg(long)]
@@ -227,6 +234,8 @@ fn real_main() -> Result<ExitCode> {
             substeps,
             relax,
             method,
+            tolerance,
+            position_iterations,
             escalation_tolerance,
             escalation_iterations,
             exact_max_contacts,
@@ -280,6 +289,12 @@ fn real_main() -> Result<ExitCode> {
             }
             if no_sleep {
                 scene.solver.sleep = false;
+            }
+            if let Some(tolerance) = tolerance {
+                scene.solver.tolerance = tolerance;
+            }
+            if let Some(iterations) = position_iterations {
+                scene.solver.position_iterations = iterations;
             }
             if let Some(tolerance) = escalation_tolerance {
                 scene.solver.escalation_tolerance = tolerance;
