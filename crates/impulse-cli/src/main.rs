@@ -56,6 +56,10 @@ enum Command {
         /// Split impulse: position-solve sweeps per substep at most (default: the scene's).
         #[arg(long)]
         position_iterations: Option<u32>,
+        /// Sweep islands of at least this many contact points colour by colour, one colour
+        /// over all threads (0 = never; default: the scene's solver settings).
+        #[arg(long)]
+        parallel_island_contacts: Option<u32>,
         /// `auto`: escalate an island whose last iteration changed a row velocity by more
         /// than this (m/s).
         #[arg(long)]
@@ -236,6 +240,7 @@ fn real_main() -> Result<ExitCode> {
             method,
             tolerance,
             position_iterations,
+            parallel_island_contacts,
             escalation_tolerance,
             escalation_iterations,
             exact_max_contacts,
@@ -295,6 +300,9 @@ fn real_main() -> Result<ExitCode> {
             }
             if let Some(iterations) = position_iterations {
                 scene.solver.position_iterations = iterations;
+            }
+            if let Some(contacts) = parallel_island_contacts {
+                scene.solver.parallel_island_contacts = contacts;
             }
             if let Some(tolerance) = escalation_tolerance {
                 scene.solver.escalation_tolerance = tolerance;

@@ -15,7 +15,7 @@ use crate::constraints::{self, ContactConstraint};
 use crate::exact::{self, ExactWorkspace};
 use crate::integrate;
 use crate::settings::{SolverMethod, SolverSettings};
-use crate::solver::{self, NncgWorkspace, Velocities};
+use crate::solver::{self, NncgWorkspace, Sweep, Velocities};
 
 /// Islands of one step: body lists and constraint ranges, with constraints sorted by island.
 #[derive(Default)]
@@ -227,6 +227,13 @@ pub struct IslandWorkspace {
     pub orientation: Vec<Quat>,
     pseudo_linear: Vec<Vec3>,
     pseudo_angular: Vec<Vec3>,
+    /// Colour offsets of the island's constraints when it is coloured (see [`Sweep`]).
+    colour_starts: Vec<u32>,
+    used_colours: Vec<u64>,
+    colours: Vec<u8>,
+    colour_scratch: Vec<ContactConstraint>,
+    /// Whether one colour may be solved on several threads.
+    parallel: bool,
     nncg: NncgWorkspace,
     apgd: ApgdWorkspace,
     exact: ExactWorkspace,
@@ -248,6 +255,10 @@ impl IslandWorkspace {
             linear: &mut self.linear,
             angular: &mut self.angular,
         };
+        let sweep = Sweep {
+            starts: &self.colour_starts,
+            parallel: self.parallel,
+        };
         let report = &mut self.report;
         let nncg = |constraints: &mut [ContactConstraint],
                     velocities: &mut Velocities<'_>,
@@ -255,6 +266,7 @@ impl IslandWorkspace {
                     iterations| {
             solver::solve_nncg(
                 constraints,
+                sweep,
                 iterations,
                 settings.tolerance,
                 velocities,
@@ -262,9 +274,13 @@ impl IslandWorkspace {
             )
         };
         let outcome = match settings.method {
-            SolverMethod::Pgs => {
-                solver::solve_pgs(constraints, iterations, settings.tolerance, &mut velocities)
-            }
+            SolverMethod::Pgs => solver::solve_pgs(
+                constraints,
+                sweep,
+                iterations,
+                settings.tolerance,
+                &mut velocities,
+            ),
             SolverMethod::Nncg => {
                 report.method = EscalationLevel::Nncg;
                 nncg(constraints, &mut velocities, &mut self.nncg, iterations)
@@ -335,6 +351,8 @@ pub struct StepContext<'a> {
     pub dt: f32,
     /// Solver settings.
     pub settings: &'a SolverSettings,
+    /// Whether a large island may spread one colour's points over rayon's threads.
+    pub parallel: bool,
 }
 
 /// Runs stages 1, 5 and 6 of one step on one island: per substep of h = dt/substeps, gravity,
@@ -351,6 +369,7 @@ pub fn step_island(
         gravity,
         dt,
         settings,
+        parallel,
     } = *context;
     let slots = island_bodies.len() + 1;
     let w = workspace;
@@ -375,6 +394,20 @@ pub fn step_island(
         mass_ratio: mass_ratio(island_bodies, bodies),
         ..IslandReport::default()
     };
+
+    w.parallel = parallel;
+    w.colour_starts.clear();
+    let threshold = settings.parallel_island_contacts as usize;
+    if threshold > 0 && constraints.len() >= threshold {
+        solver::colour_constraints(
+            constraints,
+            slots,
+            &mut w.used_colours,
+            &mut w.colours,
+            &mut w.colour_scratch,
+            &mut w.colour_starts,
+        );
+    }
 
     let h = dt / settings.substeps as f32;
     let moving = slots - 1;
@@ -401,6 +434,10 @@ pub fn step_island(
             };
             solver::solve_positions(
                 constraints,
+                Sweep {
+                    starts: &w.colour_starts,
+                    parallel: w.parallel,
+                },
                 settings.position_iterations,
                 settings.tolerance,
                 &mut pseudo,

@@ -116,6 +116,13 @@ pub struct SolverSettings {
     pub time_to_sleep: f32,
     /// Apply Coulomb friction rows (two tangents per point, |γ_t| ≤ μ·γ_n).
     pub friction: bool,
+    /// Islands with at least this many contact points are swept colour by colour (greedy graph
+    /// colouring: no two points of a colour share a moving body), one colour's points spread
+    /// over all worker threads; 0 = never (default). Colour order converges more slowly than
+    /// narrow-phase order on piles (pyramid100: 18.5 mm sink after 30 steps against 8.3 mm) and
+    /// costs ~20 % on one thread; on two threads pyramid100 steps 1.17× faster than in
+    /// narrow-phase order (docs/benchmarks.md). Results do not depend on the thread count.
+    pub parallel_island_contacts: u32,
 }
 
 impl Default for SolverSettings {
@@ -145,6 +152,7 @@ impl Default for SolverSettings {
             sleep_angular_speed: 2.0f32.to_radians(),
             time_to_sleep: 0.5,
             friction: true,
+            parallel_island_contacts: 0,
         }
     }
 }

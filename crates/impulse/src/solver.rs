@@ -29,6 +29,245 @@ pub struct SolveReport {
     pub last_change: f32,
 }
 
+/// How a sweep visits an island's points: in constraint order, or colour by colour.
+///
+/// A coloured island has its constraints sorted by colour (see [`colour_constraints`]);
+/// colour k is `starts[k]..starts[k + 1]`. Points of one colour below [`COLOURS`] share no
+/// moving body, so with `parallel` their updates run on rayon's threads at once; the
+/// forward sweep visits colours in order, the backward sweep in reverse. Colour [`COLOURS`]
+/// (when present) holds the points the greedy colouring could not place and always runs
+/// sequentially.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Sweep<'a> {
+    /// Colour offsets into the constraints (empty: not coloured).
+    pub starts: &'a [u32],
+    /// Whether one colour's points may be updated on several threads.
+    pub parallel: bool,
+}
+
+impl Sweep<'_> {
+    /// Constraint order, one thread: the sweep of [`solve_pgs`]'s documentation.
+    pub const SEQUENTIAL: Sweep<'static> = Sweep {
+        starts: &[],
+        parallel: false,
+    };
+}
+
+/// Independent colours of a [`Sweep`]; points past them share one sequential colour.
+pub const COLOURS: usize = 64;
+
+/// Points of one colour per parallel task: below twice this a colour runs on one thread.
+const POINTS_PER_TASK: usize = 256;
+
+/// Greedy graph colouring of an island's points: each point takes the lowest colour that
+/// neither of its moving bodies has yet (the immovable slot, `slots − 1`, never conflicts);
+/// the constraints are then sorted by colour (stably, so each colour keeps narrow-phase
+/// order) and the colour offsets written to `starts`. `scratch` holds the sorted copy.
+pub fn colour_constraints(
+    constraints: &mut [ContactConstraint],
+    slots: usize,
+    used: &mut Vec<u64>,
+    colours: &mut Vec<u8>,
+    scratch: &mut Vec<ContactConstraint>,
+    starts: &mut Vec<u32>,
+) {
+    let immovable = slots - 1;
+    used.clear();
+    used.resize(slots, 0);
+    colours.clear();
+    let mut counts = [0u32; COLOURS + 2];
+    for c in constraints.iter() {
+        let (a, b) = (c.local_a as usize, c.local_b as usize);
+        let mask =
+            (if a != immovable { used[a] } else { 0 }) | (if b != immovable { used[b] } else { 0 });
+        let colour = ((!mask).trailing_zeros() as usize).min(COLOURS);
+        if colour < COLOURS {
+            for slot in [a, b] {
+                if slot != immovable {
+                    used[slot] |= 1 << colour;
+                }
+            }
+        }
+        colours.push(colour as u8);
+        counts[colour + 1] += 1;
+    }
+    for k in 0..=COLOURS {
+        counts[k + 1] += counts[k];
+    }
+    let used_colours = (0..=COLOURS)
+        .rev()
+        .find(|&k| counts[k + 1] > counts[k])
+        .map_or(0, |k| k + 1);
+    starts.clear();
+    starts.extend_from_slice(&counts[..=used_colours]);
+    scratch.clear();
+    scratch.extend_from_slice(constraints);
+    let mut fill = counts;
+    for (c, &colour) in scratch.iter().zip(colours.iter()) {
+        let slot = &mut fill[colour as usize];
+        constraints[*slot as usize] = *c;
+        *slot += 1;
+    }
+}
+
+/// Velocity slots shared by the threads of one colour. Safety rests on the colouring: within
+/// a colour no two points share a slot other than the immovable one, which is only read.
+#[derive(Clone, Copy)]
+struct SharedVelocities {
+    linear: *mut Vec3,
+    angular: *mut Vec3,
+    immovable: usize,
+}
+
+// SAFETY: see the type's documentation; each thread touches a disjoint set of slots.
+unsafe impl Send for SharedVelocities {}
+// SAFETY: as above.
+unsafe impl Sync for SharedVelocities {}
+
+/// One point's update in a sweep: takes the point and its two bodies' velocities (linear and
+/// angular of A, then of B) and returns them updated, with the largest row velocity change
+/// (m/s). A trait rather than a closure so that the update is inlined into the sweep loop.
+trait PointUpdate: Copy + Sync {
+    fn update(self, c: &mut ContactConstraint, velocities: [Vec3; 4]) -> ([Vec3; 4], f32);
+}
+
+/// The velocity rows of a point ([`solve_point`]).
+#[derive(Clone, Copy)]
+struct VelocityRows;
+
+impl PointUpdate for VelocityRows {
+    #[inline(always)]
+    fn update(self, c: &mut ContactConstraint, velocities: [Vec3; 4]) -> ([Vec3; 4], f32) {
+        solve_point(c, velocities)
+    }
+}
+
+/// The position row of a point ([`solve_position_point`]).
+#[derive(Clone, Copy)]
+struct PositionRows;
+
+impl PointUpdate for PositionRows {
+    #[inline(always)]
+    fn update(self, c: &mut ContactConstraint, velocities: [Vec3; 4]) -> ([Vec3; 4], f32) {
+        solve_position_point(c, velocities)
+    }
+}
+
+/// Runs `update` on `points` in the iterator's order on this thread; returns the largest change.
+#[inline(always)]
+fn sweep_sequential<'c, I, F>(points: I, velocities: &mut Velocities<'_>, update: F) -> f32
+where
+    I: Iterator<Item = &'c mut ContactConstraint>,
+    F: PointUpdate,
+{
+    let mut largest = 0.0f32;
+    for c in points {
+        let (a, b) = (c.local_a as usize, c.local_b as usize);
+        let loaded = [
+            velocities.linear[a],
+            velocities.angular[a],
+            velocities.linear[b],
+            velocities.angular[b],
+        ];
+        let ([la, aa, lb, ab], change) = update.update(c, loaded);
+        velocities.linear[a] = la;
+        velocities.angular[a] = aa;
+        velocities.linear[b] = lb;
+        velocities.angular[b] = ab;
+        largest = largest.max(change);
+    }
+    largest
+}
+
+/// Runs `update` on the points of `constraints` in sweep order (`forward` or backward) and
+/// returns the largest change it reported. `update` gets the point and the two bodies'
+/// velocities (linear a, angular a, linear b, angular b) and returns them updated.
+fn sweep_points<F>(
+    constraints: &mut [ContactConstraint],
+    sweep: Sweep<'_>,
+    forward: bool,
+    velocities: &mut Velocities<'_>,
+    update: F,
+) -> f32
+where
+    F: PointUpdate,
+{
+    let sequential =
+        |constraints: &mut [ContactConstraint], velocities: &mut Velocities<'_>, forward: bool| {
+            if forward {
+                sweep_sequential(constraints.iter_mut(), velocities, update)
+            } else {
+                sweep_sequential(constraints.iter_mut().rev(), velocities, update)
+            }
+        };
+    let colours = sweep.starts.len().saturating_sub(1);
+    let slots = velocities.linear.len().min(velocities.angular.len());
+    let coloured = colours > 0
+        && sweep.starts[colours] as usize == constraints.len()
+        && constraints
+            .iter()
+            .all(|c| (c.local_a as usize) < slots && (c.local_b as usize) < slots);
+    if !coloured || !sweep.parallel || rayon::current_num_threads() < 2 {
+        return sequential(constraints, velocities, forward);
+    }
+    let shared = SharedVelocities {
+        linear: velocities.linear.as_mut_ptr(),
+        angular: velocities.angular.as_mut_ptr(),
+        immovable: slots - 1,
+    };
+    let mut largest = 0.0f32;
+    for step in 0..colours {
+        let k = if forward { step } else { colours - 1 - step };
+        let range = sweep.starts[k] as usize..sweep.starts[k + 1] as usize;
+        let part = &mut constraints[range];
+        if k >= COLOURS || part.len() < 2 * POINTS_PER_TASK {
+            largest = largest.max(sequential(part, velocities, forward));
+            continue;
+        }
+        use rayon::prelude::*;
+        let change = part
+            .par_chunks_mut(POINTS_PER_TASK)
+            .map(|chunk| {
+                // Capture the whole wrapper (Sync), not its raw-pointer fields (not Sync).
+                #[allow(clippy::redundant_locals)]
+                let shared = shared;
+                let mut largest = 0.0f32;
+                let mut one = |c: &mut ContactConstraint| {
+                    let (a, b) = (c.local_a as usize, c.local_b as usize);
+                    // SAFETY: a, b < slots (checked above); within this colour only this
+                    // point touches slots a and b, except the immovable slot, never written.
+                    unsafe {
+                        let loaded = [
+                            *shared.linear.add(a),
+                            *shared.angular.add(a),
+                            *shared.linear.add(b),
+                            *shared.angular.add(b),
+                        ];
+                        let ([la, aa, lb, ab], change) = update.update(c, loaded);
+                        if a != shared.immovable {
+                            *shared.linear.add(a) = la;
+                            *shared.angular.add(a) = aa;
+                        }
+                        if b != shared.immovable {
+                            *shared.linear.add(b) = lb;
+                            *shared.angular.add(b) = ab;
+                        }
+                        largest = largest.max(change);
+                    }
+                };
+                if forward {
+                    chunk.iter_mut().for_each(&mut one);
+                } else {
+                    chunk.iter_mut().rev().for_each(&mut one);
+                }
+                largest
+            })
+            .reduce(|| 0.0f32, f32::max);
+        largest = largest.max(change);
+    }
+    largest
+}
+
 /// Scales the impulses carried over from the last step by `fraction` (0 = cold start) and
 /// keeps the friction impulse inside its disc.
 pub fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
@@ -58,7 +297,7 @@ pub fn warm_start(constraints: &[ContactConstraint], velocities: &mut Velocities
 ///
 /// With K = U diag(k) Uᵀ, λ(ν) = (K + νI)⁻¹ K q and ‖λ(ν)‖ = limit is found by Newton's method
 /// on 1/‖λ(ν)‖ (Moré and Sorensen's trust-region iteration), which converges in a few steps.
-#[inline]
+#[inline(always)]
 pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f32; 2] {
     let squared = q[0] * q[0] + q[1] * q[1];
     if squared <= limit * limit {
@@ -126,25 +365,23 @@ pub fn cap_to_disc(impulse: [f32; 2], limit: f32) -> [f32; 2] {
 /// (clamped to γ_n ≥ 0), so the normal row, the one that prevents overlap, has the last word.
 pub fn solve_pgs(
     constraints: &mut [ContactConstraint],
+    sweep: Sweep<'_>,
     iterations: u32,
     tolerance: f32,
     velocities: &mut Velocities<'_>,
 ) -> SolveReport {
     let mut report = SolveReport::default();
     for iteration in 0..iterations {
-        let mut largest_change = 0.0f32;
         // Alternating sweep direction (symmetric Gauss-Seidel): on a stack, a sweep from the
         // ground up carries support upwards and one from the top down carries weight downwards,
         // so alternating converges far faster than either direction alone.
-        if iteration % 2 == 0 {
-            for c in constraints.iter_mut() {
-                largest_change = largest_change.max(solve_point(c, velocities));
-            }
-        } else {
-            for c in constraints.iter_mut().rev() {
-                largest_change = largest_change.max(solve_point(c, velocities));
-            }
-        }
+        let largest_change = sweep_points(
+            constraints,
+            sweep,
+            iteration % 2 == 0,
+            velocities,
+            VelocityRows,
+        );
         report.iterations += 1;
         report.last_change = largest_change;
         if largest_change <= tolerance {
@@ -181,6 +418,7 @@ pub struct NncgWorkspace {
 /// Matrix-free: the momentum step updates velocities through M⁻¹Jᵀ like any impulse.
 pub fn solve_nncg(
     constraints: &mut [ContactConstraint],
+    sweep: Sweep<'_>,
     iterations: u32,
     tolerance: f32,
     velocities: &mut Velocities<'_>,
@@ -196,13 +434,9 @@ pub fn solve_nncg(
     for iteration in 0..iterations {
         // One fixed symmetric sweep (forward then backward) is the "PGS step": conjugate
         // directions need the same operator every iteration.
-        let mut largest_change = 0.0f32;
-        for c in constraints.iter_mut() {
-            largest_change = largest_change.max(solve_point(c, velocities));
-        }
-        for c in constraints.iter_mut().rev() {
-            largest_change = largest_change.max(solve_point(c, velocities));
-        }
+        let forward = sweep_points(constraints, sweep, true, velocities, VelocityRows);
+        let backward = sweep_points(constraints, sweep, false, velocities, VelocityRows);
+        let largest_change = forward.max(backward);
         report.iterations += 1;
         report.last_change = largest_change;
         if largest_change <= tolerance || iteration + 1 == iterations {
@@ -259,13 +493,13 @@ pub fn solve_nncg(
 
 /// One Gauss-Seidel update of a contact point's rows: the friction pair as a 2×2 block
 /// projected onto Coulomb's disc, then the normal row clamped to γ_n ≥ 0. Returns the largest
-/// row velocity change it caused (m/s). The two bodies' velocities are loaded once, updated
-/// in registers and stored once.
+/// row velocity change it caused (m/s). The two bodies' velocities (linear and angular of A,
+/// then of B) come in and go out by value, so they stay in registers.
 #[inline(always)]
-fn solve_point(c: &mut ContactConstraint, velocities: &mut Velocities<'_>) -> f32 {
-    let (a, b) = (c.local_a as usize, c.local_b as usize);
-    let (mut la, mut aa) = (velocities.linear[a], velocities.angular[a]);
-    let (mut lb, mut ab) = (velocities.linear[b], velocities.angular[b]);
+fn solve_point(
+    c: &mut ContactConstraint,
+    [mut la, mut aa, mut lb, mut ab]: [Vec3; 4],
+) -> ([Vec3; 4], f32) {
     let (ima, imb) = (c.inverse_mass_a, c.inverse_mass_b);
     let mut largest_change = 0.0f32;
     if c.friction > 0.0 {
@@ -310,11 +544,7 @@ fn solve_point(c: &mut ContactConstraint, velocities: &mut Velocities<'_>) -> f3
         ab -= row.inverse_inertia_angular_b * delta;
         largest_change = largest_change.max(delta.abs() * row.inverse_effective_mass);
     }
-    velocities.linear[a] = la;
-    velocities.angular[a] = aa;
-    velocities.linear[b] = lb;
-    velocities.angular[b] = ab;
-    largest_change
+    ([la, aa, lb, ab], largest_change)
 }
 
 /// Applies impulses (normal, tangent 1, tangent 2) of one contact point to its two bodies.
@@ -345,34 +575,44 @@ pub(crate) fn apply_impulses(
 /// pseudo-velocity changed by more than `tolerance` (m/s); returns the sweeps used.
 pub fn solve_positions(
     constraints: &mut [ContactConstraint],
+    sweep: Sweep<'_>,
     iterations: u32,
     tolerance: f32,
     velocities: &mut Velocities<'_>,
 ) -> u32 {
     for iteration in 0..iterations {
-        let mut largest_change = 0.0f32;
-        for c in constraints.iter_mut() {
-            let (a, b) = (c.local_a as usize, c.local_b as usize);
-            let row = &c.normal;
-            let (la, aa) = (velocities.linear[a], velocities.angular[a]);
-            let (lb, ab) = (velocities.linear[b], velocities.angular[b]);
-            let v = row.velocity(la, aa, lb, ab);
-            let old = c.position_impulse;
-            let new = (old + row.effective_mass * (c.position_target - v)).max(0.0);
-            let delta = new - old;
-            if delta != 0.0 {
-                c.position_impulse = new;
-                let linear = row.direction * delta;
-                velocities.linear[a] = la + linear * c.inverse_mass_a;
-                velocities.linear[b] = lb - linear * c.inverse_mass_b;
-                velocities.angular[a] = aa + row.inverse_inertia_angular_a * delta;
-                velocities.angular[b] = ab - row.inverse_inertia_angular_b * delta;
-                largest_change = largest_change.max(delta.abs() * row.inverse_effective_mass);
-            }
-        }
+        let largest_change = sweep_points(constraints, sweep, true, velocities, PositionRows);
         if largest_change <= tolerance {
             return iteration + 1;
         }
     }
     iterations
+}
+
+/// One update of a point's position row (see [`solve_positions`]); same contract as
+/// [`solve_point`].
+#[inline(always)]
+fn solve_position_point(
+    c: &mut ContactConstraint,
+    [la, aa, lb, ab]: [Vec3; 4],
+) -> ([Vec3; 4], f32) {
+    let row = &c.normal;
+    let v = row.velocity(la, aa, lb, ab);
+    let old = c.position_impulse;
+    let new = (old + row.effective_mass * (c.position_target - v)).max(0.0);
+    let delta = new - old;
+    if delta == 0.0 {
+        return ([la, aa, lb, ab], 0.0);
+    }
+    c.position_impulse = new;
+    let linear = row.direction * delta;
+    (
+        [
+            la + linear * c.inverse_mass_a,
+            aa + row.inverse_inertia_angular_a * delta,
+            lb - linear * c.inverse_mass_b,
+            ab - row.inverse_inertia_angular_b * delta,
+        ],
+        delta.abs() * row.inverse_effective_mass,
+    )
 }

@@ -207,6 +207,7 @@ impl World {
                 gravity: self.gravity,
                 dt,
                 settings: &settings,
+                parallel: self.parallel,
             };
             let mut jobs = Vec::with_capacity(islands);
             let mut rest: &mut [ContactConstraint] = &mut self.constraints;

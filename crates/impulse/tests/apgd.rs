@@ -15,7 +15,7 @@ use glam::Vec3;
 use impulse::apgd::{ApgdWorkspace, solve_apgd};
 use impulse::constraints::ContactConstraint;
 use impulse::contact_lcp::assemble_lcp;
-use impulse::solver::{NncgWorkspace, SolveReport, Velocities, solve_nncg, solve_pgs};
+use impulse::solver::{NncgWorkspace, SolveReport, Sweep, Velocities, solve_nncg, solve_pgs};
 use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::lemke;
 use impulse_lcp::{
@@ -207,9 +207,16 @@ fn run(
         angular: &mut angular,
     };
     let report = match method {
-        Method::Pgs => solve_pgs(&mut constraints, iterations, tolerance, &mut velocities),
+        Method::Pgs => solve_pgs(
+            &mut constraints,
+            Sweep::SEQUENTIAL,
+            iterations,
+            tolerance,
+            &mut velocities,
+        ),
         Method::Nncg => solve_nncg(
             &mut constraints,
+            Sweep::SEQUENTIAL,
             iterations,
             tolerance,
             &mut velocities,
