@@ -31,18 +31,22 @@ pub struct SolveReport {
 
 /// How a sweep visits an island's points: in constraint order, or colour by colour.
 ///
-/// A coloured island has its constraints sorted by colour (see [`colour_constraints`]);
+/// A coloured island has its constraints sorted by colour (`colour_constraints`);
 /// colour k is `starts[k]..starts[k + 1]`. Points of one colour below [`COLOURS`] share no
 /// moving body, so with `parallel` their updates run on rayon's threads at once; the
 /// forward sweep visits colours in order, the backward sweep in reverse. Colour [`COLOURS`]
 /// (when present) holds the points the greedy colouring could not place and always runs
 /// sequentially.
+///
+/// Outside the crate only [`Sweep::SEQUENTIAL`] can be made: the parallel sweep writes the
+/// bodies' velocities from several threads, which is sound only for constraints that
+/// `colour_constraints` has just sorted, as the island step does.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Sweep<'a> {
     /// Colour offsets into the constraints (empty: not coloured).
-    pub starts: &'a [u32],
+    pub(crate) starts: &'a [u32],
     /// Whether one colour's points may be updated on several threads.
-    pub parallel: bool,
+    pub(crate) parallel: bool,
 }
 
 impl Sweep<'_> {
@@ -63,7 +67,8 @@ const POINTS_PER_TASK: usize = 256;
 /// neither of its moving bodies has yet (the immovable slot, `slots − 1`, never conflicts);
 /// the constraints are then sorted by colour (stably, so each colour keeps narrow-phase
 /// order) and the colour offsets written to `starts`. `scratch` holds the sorted copy.
-pub fn colour_constraints(
+/// Panics if a point's slot is not below `slots` (the island step sets them so).
+pub(crate) fn colour_constraints(
     constraints: &mut [ContactConstraint],
     slots: usize,
     used: &mut Vec<u64>,
@@ -202,11 +207,15 @@ where
         };
     let colours = sweep.starts.len().saturating_sub(1);
     let slots = velocities.linear.len().min(velocities.angular.len());
-    let coloured = colours > 0
-        && sweep.starts[colours] as usize == constraints.len()
-        && constraints
-            .iter()
-            .all(|c| (c.local_a as usize) < slots && (c.local_b as usize) < slots);
+    // A coloured sweep comes from the island step, right after `colour_constraints` checked
+    // every slot against the island's `slots` arrays (see `Sweep`).
+    let coloured = colours > 0 && sweep.starts[colours] as usize == constraints.len();
+    debug_assert!(
+        !coloured
+            || constraints
+                .iter()
+                .all(|c| (c.local_a as usize) < slots && (c.local_b as usize) < slots)
+    );
     if !coloured || !sweep.parallel || rayon::current_num_threads() < 2 {
         return sequential(constraints, velocities, forward);
     }
@@ -234,7 +243,7 @@ where
                 let mut largest = 0.0f32;
                 let mut one = |c: &mut ContactConstraint| {
                     let (a, b) = (c.local_a as usize, c.local_b as usize);
-                    // SAFETY: a, b < slots (checked above); within this colour only this
+                    // SAFETY: a, b < slots (see `Sweep`); within this colour only this
                     // point touches slots a and b, except the immovable slot, never written.
                     unsafe {
                         let loaded = [
