@@ -15,6 +15,7 @@ use crate::constraints::{self, ContactConstraint};
 use crate::exact::{self, ExactWorkspace};
 use crate::integrate;
 use crate::settings::{SolverMethod, SolverSettings};
+use crate::simd::Bundles;
 use crate::solver::{self, NncgWorkspace, Sweep, Velocities};
 
 /// Islands of one step: body lists and constraint ranges, with constraints sorted by island.
@@ -177,6 +178,8 @@ pub struct IslandReport {
     /// Largest row velocity change of the last iteration of the last main solve (m/s): how far
     /// from converged the island's final solve stopped.
     pub last_change: f32,
+    /// Whether the substeps' solves ran in SIMD lanes ([`crate::simd`]).
+    pub simd: bool,
     /// Natural-map residual of the island's rows at the end of the step (see
     /// [`crate::diagnostics::StepDiagnostics::natural_map_residual`]); set by the world.
     pub natural_map_residual: f32,
@@ -237,11 +240,29 @@ pub struct IslandWorkspace {
     nncg: NncgWorkspace,
     apgd: ApgdWorkspace,
     exact: ExactWorkspace,
+    /// The island's points in SIMD bundles, when it is solved in lanes.
+    bundles: Bundles,
     /// What the solver did on this island in the step.
     pub report: IslandReport,
 }
 
 impl IslandWorkspace {
+    /// PGS on the island's bundles (see [`crate::simd`]), with the bookkeeping of [`Self::solve`].
+    fn solve_bundled(&mut self, settings: &SolverSettings, iterations: u32, escalate: bool) {
+        let outcome = self.bundles.solve_pgs(
+            iterations,
+            settings.tolerance,
+            &mut Velocities {
+                linear: &mut self.linear,
+                angular: &mut self.angular,
+            },
+        );
+        self.report.iterations += outcome.iterations;
+        if escalate {
+            self.report.last_change = outcome.last_change;
+        }
+    }
+
     /// Runs the configured method on the island's velocities for at most `iterations`; with
     /// `escalate` and the `auto` method, the escalation policy (see [`SolverMethod::Auto`]).
     fn solve(
@@ -395,10 +416,18 @@ pub fn step_island(
         ..IslandReport::default()
     };
 
+    // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
+    let bundled = settings.method == SolverMethod::Pgs
+        && !settings.split_impulse
+        && settings.simd_island_contacts > 0
+        && constraints.len() >= settings.simd_island_contacts as usize;
     w.parallel = parallel;
     w.colour_starts.clear();
     let threshold = settings.parallel_island_contacts as usize;
-    if threshold > 0 && constraints.len() >= threshold {
+    w.report.simd = bundled;
+    if bundled {
+        w.bundles.pack(constraints, slots);
+    } else if threshold > 0 && constraints.len() >= threshold {
         solver::colour_constraints(
             constraints,
             slots,
@@ -413,15 +442,27 @@ pub fn step_island(
     let moving = slots - 1;
     for _ in 0..settings.substeps {
         integrate::prospective_velocities(&mut w.linear[..moving], gravity, h);
-        solver::warm_start(
-            constraints,
-            &mut Velocities {
-                linear: &mut w.linear,
-                angular: &mut w.angular,
-            },
-        );
-        constraints::update_targets(constraints, &w.displacement, &w.rotation, settings, h, true);
-        w.solve(constraints, settings, settings.iterations, true);
+        let mut velocities = Velocities {
+            linear: &mut w.linear,
+            angular: &mut w.angular,
+        };
+        if bundled {
+            w.bundles.warm_start(&mut velocities);
+            w.bundles
+                .update_targets(&w.displacement, &w.rotation, settings, h, true);
+            w.solve_bundled(settings, settings.iterations, true);
+        } else {
+            solver::warm_start(constraints, &mut velocities);
+            constraints::update_targets(
+                constraints,
+                &w.displacement,
+                &w.rotation,
+                settings,
+                h,
+                true,
+            );
+            w.solve(constraints, settings, settings.iterations, true);
+        }
         if settings.split_impulse {
             // Positions move with v + the pseudo-velocity of the repair solve.
             w.pseudo_linear.clear();
@@ -461,16 +502,25 @@ pub fn step_island(
             h,
         );
         if settings.relax_iterations > 0 && !settings.split_impulse {
-            constraints::update_targets(
-                constraints,
-                &w.displacement,
-                &w.rotation,
-                settings,
-                h,
-                false,
-            );
-            w.solve(constraints, settings, settings.relax_iterations, false);
+            if bundled {
+                w.bundles
+                    .update_targets(&w.displacement, &w.rotation, settings, h, false);
+                w.solve_bundled(settings, settings.relax_iterations, false);
+            } else {
+                constraints::update_targets(
+                    constraints,
+                    &w.displacement,
+                    &w.rotation,
+                    settings,
+                    h,
+                    false,
+                );
+                w.solve(constraints, settings, settings.relax_iterations, false);
+            }
         }
+    }
+    if bundled {
+        w.bundles.unpack(constraints);
     }
     // Restitution after the substeps (the seed's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
     // for the points that collided.

@@ -5,7 +5,7 @@
 //! Gauss-Seidel, following `contact-resolution-notes.md` (the "seed"). See DESIGN.md for the
 //! pipeline; each stage is one module:
 //! [`integrate`] (1, 6) → [`broad_phase`] (2) → [`narrow_phase`] (3) → [`constraints`] (4) →
-//! [`solver`] (5; with [`apgd`], [`exact`] and the per-island policy of [`island`]) →
+//! [`solver`] (5; in SIMD lanes [`simd`]; with [`apgd`], [`exact`] and the per-island policy of [`island`]) →
 //! [`diagnostics`] (7), driven by [`World::step`].
 
 pub mod apgd;
@@ -22,6 +22,7 @@ pub mod metrics;
 pub mod narrow_phase;
 pub mod scene;
 pub mod settings;
+pub mod simd;
 pub mod solver;
 pub mod world;
 

@@ -1,0 +1,200 @@
+//! The SIMD-lane solver (`impulse::simd`): the same LCP conditions as the scalar sweep, exact
+//! momentum with padding lanes, and the `fast` preset standing on a standard scene.
+
+use glam::Vec3;
+use impulse::scene::builtin::builtin_scene;
+use impulse::settings::SolverMethod;
+use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
+
+const DT: f32 = 1.0 / 60.0;
+
+fn material(friction: f32, restitution: f32) -> Material {
+    Material {
+        friction,
+        restitution,
+        density: 1000.0,
+    }
+}
+
+fn sphere(radius: f32, position: Vec3) -> BodyDesc {
+    BodyDesc::new(
+        BodyKind::Dynamic,
+        ShapeDesc::Sphere { radius },
+        position.to_array(),
+    )
+}
+
+fn cuboid(kind: BodyKind, half: Vec3, position: Vec3) -> BodyDesc {
+    BodyDesc::new(
+        kind,
+        ShapeDesc::Cuboid {
+            half_extents: half.to_array(),
+        },
+        position.to_array(),
+    )
+}
+
+/// PGS on rigid rows (`repair: bias`), every island in lanes however small.
+fn bundled(iterations: u32) -> SolverSettings {
+    SolverSettings {
+        method: SolverMethod::Pgs,
+        split_impulse: false,
+        soft_contact_hertz: 0.0,
+        iterations,
+        relax_iterations: iterations,
+        simd_island_contacts: 1,
+        sleep: false,
+        ..SolverSettings::default()
+    }
+}
+
+/// One contact in a bundle of four: three padding lanes must change nothing, so momentum is
+/// exact and the restitution hypothesis holds as in the scalar test.
+#[test]
+fn head_on_spheres_in_lanes_conserve_momentum_and_obey_restitution() {
+    for c_r in [0.0f32, 0.5, 1.0] {
+        let mut w = World::new(Vec3::ZERO, DT, bundled(8)).unwrap();
+        let mut a = sphere(0.5, Vec3::new(-2.0, 0.0, 0.0));
+        a.linear_velocity = [3.0, 0.0, 0.0];
+        a.mass = Some(2.0);
+        let mut b = sphere(0.3, Vec3::new(2.0, 0.0, 0.0));
+        b.linear_velocity = [-1.0, 0.0, 0.0];
+        b.mass = Some(0.5);
+        w.add_body(&a, &material(0.0, c_r)).unwrap();
+        w.add_body(&b, &material(0.0, c_r)).unwrap();
+        let momentum_before = 2.0 * 3.0 - 0.5 * 1.0;
+        let mut in_lanes = false;
+        for _ in 0..120 {
+            w.step().unwrap();
+            in_lanes |= w.diagnostics().islands.iter().any(|island| island.simd);
+            let p = 2.0 * w.bodies.linear_velocity[0].x + 0.5 * w.bodies.linear_velocity[1].x;
+            assert!(
+                (p - momentum_before).abs() < 1e-5,
+                "c_r {c_r}: momentum {p}"
+            );
+        }
+        assert!(in_lanes, "the contact must have been solved in lanes");
+        let relative_after = w.bodies.linear_velocity[1].x - w.bodies.linear_velocity[0].x;
+        assert!(
+            (relative_after - 4.0 * c_r).abs() < 1e-4,
+            "c_r {c_r}: relative velocity after {relative_after}, expected {}",
+            4.0 * c_r
+        );
+    }
+}
+
+/// The complementarity test of the scalar solver on a 64-sphere pile, solved in lanes: at exit
+/// γ ≥ 0, w ≥ 0 and wᵀγ ≈ 0 for the engine's own LCP.
+#[test]
+fn pile_of_spheres_solved_in_lanes_satisfies_complementarity() {
+    let settings = SolverSettings {
+        tolerance: 0.0,
+        friction: false,
+        ..bundled(500)
+    };
+    let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
+    w.add_body(
+        &cuboid(
+            BodyKind::Static,
+            Vec3::new(10.0, 0.5, 10.0),
+            Vec3::new(0.0, -0.5, 0.0),
+        ),
+        &material(0.0, 0.0),
+    )
+    .unwrap();
+    for (x, z) in [(2.6, 0.0), (-2.6, 0.0), (0.0, 2.6), (0.0, -2.6)] {
+        let half = if x != 0.0 {
+            Vec3::new(0.5, 3.0, 3.0)
+        } else {
+            Vec3::new(3.0, 3.0, 0.5)
+        };
+        w.add_body(
+            &cuboid(BodyKind::Static, half, Vec3::new(x, 3.0, z)),
+            &material(0.0, 0.0),
+        )
+        .unwrap();
+    }
+    for layer in 0..4 {
+        for i in 0..4 {
+            for k in 0..4 {
+                let jitter = 0.05 * ((i * 7 + k * 3 + layer) % 5) as f32;
+                let p = Vec3::new(
+                    -1.5 + i as f32 + jitter,
+                    0.5 + 1.05 * layer as f32,
+                    -1.5 + k as f32,
+                );
+                w.add_body(&sphere(0.45, p), &material(0.0, 0.0)).unwrap();
+            }
+        }
+    }
+    let mut checked_steps = 0;
+    for _ in 0..90 {
+        w.step().unwrap();
+        let constraints = w.contact_constraints();
+        if constraints.len() < 50 {
+            continue;
+        }
+        assert!(w.diagnostics().islands.iter().all(|island| island.simd));
+        checked_steps += 1;
+        let lin = &w.bodies.linear_velocity;
+        let ang = &w.bodies.angular_velocity;
+        let largest = constraints
+            .iter()
+            .map(|c| c.normal_impulse)
+            .fold(0.0f32, f32::max);
+        for c in constraints {
+            let (a, b) = (c.body_a as usize, c.body_b as usize);
+            let wv = c.normal.velocity(lin[a], ang[a], lin[b], ang[b]) - c.target_normal_velocity;
+            assert!(c.normal_impulse >= 0.0);
+            assert!(wv >= -1e-3, "w = {wv} < 0");
+            assert!(
+                (wv * c.normal_impulse).abs() <= 1e-3 * largest.max(1e-6),
+                "complementarity: w = {wv}, γ = {}",
+                c.normal_impulse
+            );
+        }
+        assert!(w.diagnostics().natural_map_residual < 1e-2);
+    }
+    assert!(checked_steps > 10);
+}
+
+/// `SolverSettings::fast()` keeps pyramid20 standing for 5 s, and whatever the loose solve
+/// leaves, every point's impulses stay inside their bounds: γ_n ≥ 0, and the friction impulse
+/// inside the disc of the largest normal impulse of the step, |γ_t| ≤ μ·max γ_n (friction is
+/// projected with the normal impulse of the moment, which the normal row may lower after).
+#[test]
+fn fast_preset_keeps_pyramid20_standing_with_impulses_inside_their_bounds() {
+    let mut scene = builtin_scene("pyramid20").unwrap();
+    scene.solver = SolverSettings {
+        sleep: false,
+        ..SolverSettings::fast()
+    };
+    let mut w = World::from_scene(&scene).unwrap();
+    let top = (0..w.bodies.len())
+        .max_by(|&i, &j| {
+            let (a, b) = (
+                w.bodies.pose[i].translation.y,
+                w.bodies.pose[j].translation.y,
+            );
+            a.total_cmp(&b)
+        })
+        .unwrap();
+    let top_y = w.bodies.pose[top].translation.y;
+    for _ in 0..300 {
+        w.step().unwrap();
+        assert!(w.diagnostics().islands.iter().any(|island| island.simd));
+        for c in w.contact_constraints() {
+            assert!(c.normal_impulse >= 0.0);
+            let [t1, t2] = c.tangent_impulses;
+            let friction = (t1 * t1 + t2 * t2).sqrt();
+            assert!(
+                friction <= c.friction * c.max_normal_impulse * (1.0 + 1e-5) + 1e-9,
+                "|γ_t| = {friction} > μ·max γ_n = {}",
+                c.friction * c.max_normal_impulse
+            );
+        }
+    }
+    let sink = top_y - w.bodies.pose[top].translation.y;
+    assert!(sink < 0.1, "top sank {sink} m");
+    assert!(w.diagnostics().max_depth < 0.01);
+}
