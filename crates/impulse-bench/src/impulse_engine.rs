@@ -12,12 +12,15 @@ use crate::quality::{self, Quality};
 /// Engine name in [`BenchRow::engine`].
 pub const ENGINE: &str = "impulse";
 
+/// Engine name of the rows run with `SolverSettings::fast()`.
+pub const FAST_ENGINE: &str = "impulse fast";
+
 /// Steps `scene` `steps` times with impulse inside a rayon pool of `threads` threads, timing
 /// each `World::step`, and measures quality from the poses (metric time is not timed).
 /// The scene's solver settings are used as they are, except that sleeping is turned off.
 pub fn bench_impulse(scene: &Scene, steps: u32, threads: usize) -> Result<BenchRow> {
     crate::thread_pool(threads)?.install(|| {
-        let mut run = ImpulseRun::new(scene, steps, threads)?;
+        let mut run = ImpulseRun::new(scene, steps, threads, None)?;
         run.advance(steps)?;
         Ok(run.finish())
     })
@@ -27,6 +30,7 @@ pub fn bench_impulse(scene: &Scene, steps: u32, threads: usize) -> Result<BenchR
 /// take turns on the same scene (see `run_benchmarks`).
 pub(crate) struct ImpulseRun {
     scene: String,
+    engine: &'static str,
     world: World,
     quality: Quality,
     times_ms: Vec<f64>,
@@ -36,13 +40,28 @@ pub(crate) struct ImpulseRun {
 }
 
 impl ImpulseRun {
-    /// Builds the world; `threads` is only reported (the caller installs the pool).
-    pub(crate) fn new(scene: &Scene, steps: u32, threads: usize) -> Result<Self> {
-        let mut world = World::from_scene(scene)
-            .with_context(|| format!("building scene {} in impulse", scene.name))?;
+    /// Builds the world with the scene's solver settings, or with `settings` instead (named
+    /// [`FAST_ENGINE`]); `threads` is only reported (the caller installs the pool).
+    pub(crate) fn new(
+        scene: &Scene,
+        steps: u32,
+        threads: usize,
+        settings: Option<SolverSettings>,
+    ) -> Result<Self> {
+        let mut scene = scene.clone();
+        let engine = match settings {
+            Some(settings) => {
+                scene.solver = settings;
+                FAST_ENGINE
+            }
+            None => ENGINE,
+        };
+        let mut world = World::from_scene(&scene)
+            .with_context(|| format!("building scene {} in {engine}", scene.name))?;
         world.settings.sleep = false;
         Ok(Self {
             scene: scene.name.clone(),
+            engine,
             quality: Quality::new(&world.bodies),
             world,
             times_ms: Vec::with_capacity(steps as usize),
@@ -60,7 +79,9 @@ impl ImpulseRun {
             let start = Instant::now();
             let result = self.world.step().map(|_| ());
             self.times_ms.push(start.elapsed().as_secs_f64() * 1e3);
-            result.with_context(|| format!("impulse, scene {}, step {}", self.scene, self.step))?;
+            result.with_context(|| {
+                format!("{}, scene {}, step {}", self.engine, self.scene, self.step)
+            })?;
             if quality::is_sample_step(self.step, self.steps) {
                 self.quality.sample(&self.world.bodies);
             }
@@ -73,7 +94,7 @@ impl ImpulseRun {
         let report = self.quality.finish(&self.world.bodies);
         BenchRow::new(
             &self.scene,
-            ENGINE,
+            self.engine,
             self.world.bodies.len(),
             self.step,
             &mut self.times_ms,

@@ -109,15 +109,16 @@ pub fn format_table(rows: &[BenchRow]) -> String {
     );
     out.push_str("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
     for row in rows {
-        let ratio = if row.engine == impulse_engine::ENGINE {
-            rows.iter()
-                .find(|r| r.scene == row.scene && r.engine == "rapier")
-                .filter(|r| r.ms_per_step_median > 0.0)
-                .map(|r| format!("{:.2}", row.ms_per_step_median / r.ms_per_step_median))
-                .unwrap_or_default()
-        } else {
-            String::new()
-        };
+        let ratio =
+            if row.engine == impulse_engine::ENGINE || row.engine == impulse_engine::FAST_ENGINE {
+                rows.iter()
+                    .find(|r| r.scene == row.scene && r.engine == "rapier")
+                    .filter(|r| r.ms_per_step_median > 0.0)
+                    .map(|r| format!("{:.2}", row.ms_per_step_median / r.ms_per_step_median))
+                    .unwrap_or_default()
+            } else {
+                String::new()
+            };
         let _ = writeln!(
             out,
             "| {} | {} | {} | {} | {} | {:.0} | {} | {:.1} | {:.1} | {:.1} | {} |",
@@ -163,6 +164,8 @@ pub struct BenchConfig {
     pub rapier: bool,
     /// Extra Rapier rows with other settings than the defaults (needs `rapier`).
     pub rapier_variants: Vec<RapierVariant>,
+    /// Also measure impulse with `SolverSettings::fast()` (row "impulse fast").
+    pub impulse_fast: bool,
 }
 
 /// Rapier with other settings than its defaults, to compare the engines at similar quality.
@@ -227,6 +230,7 @@ impl Default for BenchConfig {
             threads: 1,
             rapier: cfg!(feature = "rapier"),
             rapier_variants: Vec::new(),
+            impulse_fast: false,
         }
     }
 }
@@ -286,9 +290,16 @@ pub fn bench_scene(scene: &Scene, config: &BenchConfig) -> Result<Vec<Result<Ben
     let steps = config.steps;
     thread_pool(config.threads)?.install(|| {
         let mut runs: Vec<Result<EngineRun>> = vec![
-            impulse_engine::ImpulseRun::new(scene, steps, config.threads)
+            impulse_engine::ImpulseRun::new(scene, steps, config.threads, None)
                 .map(|run| EngineRun::Impulse(Box::new(run))),
         ];
+        if config.impulse_fast {
+            let fast = impulse::SolverSettings::fast();
+            runs.push(
+                impulse_engine::ImpulseRun::new(scene, steps, config.threads, Some(fast))
+                    .map(|run| EngineRun::Impulse(Box::new(run))),
+            );
+        }
         #[cfg(feature = "rapier")]
         {
             if config.rapier {
@@ -430,6 +441,7 @@ mod tests {
             } else {
                 Vec::new()
             },
+            impulse_fast: true,
         };
         let rows: Vec<BenchRow> = bench_scene(&scene, &config)
             .unwrap()
@@ -441,14 +453,16 @@ mod tests {
         assert_eq!(rows[0].steps, 25);
         assert_eq!(rows[0].top_sink_m, alone.top_sink_m);
         assert_eq!(rows[0].max_drift_m, alone.max_drift_m);
+        assert_eq!(rows[1].engine, "impulse fast");
+        assert!(rows[1].settings.starts_with("PGS"), "{}", rows[1].settings);
         #[cfg(feature = "rapier")]
         {
-            assert_eq!(rows.len(), 3);
+            assert_eq!(rows.len(), 4);
             let alone = bench_rapier(&scene, 25).unwrap();
-            assert_eq!(rows[1].engine, "rapier");
-            assert_eq!(rows[1].top_sink_m, alone.top_sink_m);
-            assert_eq!(rows[2].engine, "rapier 8×60Hz");
-            assert_eq!(rows[2].steps, 25);
+            assert_eq!(rows[2].engine, "rapier");
+            assert_eq!(rows[2].top_sink_m, alone.top_sink_m);
+            assert_eq!(rows[3].engine, "rapier 8×60Hz");
+            assert_eq!(rows[3].steps, 25);
         }
     }
 

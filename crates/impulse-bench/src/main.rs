@@ -1,7 +1,7 @@
 //! `impulse-bench`: impulse and Rapier on the same built-in scenes, one Markdown table.
 //!
 //! ```text
-//! cargo run --release -p impulse-bench -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--markdown FILE]
+//! cargo run --release -p impulse-bench -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--impulse-fast] [--markdown FILE]
 //! ```
 
 use std::path::PathBuf;
@@ -34,6 +34,10 @@ struct Args {
     /// contacts 2·HZ), e.g. `--rapier-variant 8:120`; repeatable. Rapier's defaults are 4:30.
     #[arg(long, value_name = "SUBSTEPS:HZ")]
     rapier_variant: Vec<RapierVariant>,
+    /// Also measure impulse with `SolverSettings::fast()` (rows "impulse fast", ratio against
+    /// default Rapier too).
+    #[arg(long)]
+    impulse_fast: bool,
     /// Also write the table, the command and the machine to this Markdown file.
     #[arg(long)]
     markdown: Option<PathBuf>,
@@ -62,6 +66,7 @@ fn run(args: Args) -> Result<bool> {
         threads: args.threads,
         rapier: !args.no_rapier,
         rapier_variants: args.rapier_variant,
+        impulse_fast: args.impulse_fast,
     };
     let machine = MachineInfo::current();
     let command = std::iter::once("impulse-bench".to_string())
