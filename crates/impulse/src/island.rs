@@ -425,9 +425,11 @@ pub fn step_island(
     w.colour_starts.clear();
     let threshold = settings.parallel_island_contacts as usize;
     w.report.simd = bundled;
+    let coloured_threads = threshold > 0 && constraints.len() >= threshold;
     if bundled {
-        w.bundles.pack(constraints, slots);
-    } else if threshold > 0 && constraints.len() >= threshold {
+        w.bundles
+            .pack(constraints, slots, parallel && coloured_threads);
+    } else if coloured_threads {
         solver::colour_constraints(
             constraints,
             slots,

@@ -84,6 +84,11 @@ struct BundleGeometry {
 pub struct Bundles {
     bundles: Vec<Bundle>,
     geometry: Vec<BundleGeometry>,
+    /// Bundles of colour k are `colour_starts[k]..colour_starts[k + 1]`; the last colour holds
+    /// the points the colouring could not place, one per bundle, and always runs on one thread.
+    colour_starts: Vec<usize>,
+    /// Whether one colour's bundles may be updated on several threads.
+    parallel: bool,
     /// Constraint index of each lane of each bundle; `u32::MAX` for padding.
     sources: Vec<[u32; LANES]>,
     /// Greedy colouring scratch: per slot, the colours its points use; per point, its colour.
@@ -206,12 +211,8 @@ impl BodyLanes {
         linear: &mut [Vec3],
         angular: &mut [Vec3],
     ) {
-        let unpack = |v: &LaneVec| {
-            let [x, y, z] = [v[0].to_array(), v[1].to_array(), v[2].to_array()];
-            std::array::from_fn::<Vec3, LANES, _>(|i| Vec3::new(x[i], y[i], z[i]))
-        };
-        let (la, aa) = (unpack(&self.linear_a), unpack(&self.angular_a));
-        let (lb, ab) = (unpack(&self.linear_b), unpack(&self.angular_b));
+        let (la, aa) = (unlane(&self.linear_a), unlane(&self.angular_a));
+        let (lb, ab) = (unlane(&self.linear_b), unlane(&self.angular_b));
         for i in 0..LANES {
             let (a, b) = (bundle_a[i] as usize, bundle_b[i] as usize);
             if a != immovable {
@@ -231,7 +232,11 @@ impl Bundles {
     /// immovable one) and packs them, with their current impulses, colour by colour into
     /// bundles. Points the colouring cannot place (a body in more than [`COLOURS`] colours)
     /// get a bundle each. O(points).
-    pub fn pack(&mut self, constraints: &[ContactConstraint], slots: usize) {
+    ///
+    /// With `parallel`, each colour's bundles are later spread over rayon's threads; the result
+    /// is the same bit for bit, as the bundles of one colour touch disjoint bodies.
+    pub fn pack(&mut self, constraints: &[ContactConstraint], slots: usize, parallel: bool) {
+        self.parallel = parallel;
         let immovable = (slots - 1) as u32;
         self.used.clear();
         self.used.resize(slots, 0);
@@ -264,6 +269,8 @@ impl Bundles {
             bundle_start[colour + 1] = bundle_start[colour] + points.div_ceil(per_bundle(colour));
         }
         let total = bundle_start[COLOURS + 1];
+        self.colour_starts.clear();
+        self.colour_starts.extend_from_slice(&bundle_start);
         let empty = Bundle {
             local_a: [immovable; LANES],
             local_b: [immovable; LANES],
@@ -314,27 +321,94 @@ impl Bundles {
     }
 
     /// Applies the accumulated impulses to the velocities ([`crate::solver::warm_start`]).
-    pub fn warm_start(&self, velocities: &mut Velocities<'_>) {
-        let immovable = velocities.linear.len() - 1;
-        for b in &self.bundles {
-            let mut v = BodyLanes::gather(
-                &b.local_a,
-                &b.local_b,
-                velocities.linear,
-                velocities.angular,
-            );
+    pub fn warm_start(&mut self, velocities: &mut Velocities<'_>) {
+        self.sweep(true, velocities, |b, v| {
             let masses = (b.inverse_mass_a, b.inverse_mass_b);
-            b.normal.apply(b.normal_impulse, masses, &mut v);
-            b.tangents[0].apply(b.tangent_impulses[0], masses, &mut v);
-            b.tangents[1].apply(b.tangent_impulses[1], masses, &mut v);
-            v.scatter(
-                &b.local_a,
-                &b.local_b,
-                immovable,
-                velocities.linear,
-                velocities.angular,
-            );
+            b.normal.apply(b.normal_impulse, masses, v);
+            b.tangents[0].apply(b.tangent_impulses[0], masses, v);
+            b.tangents[1].apply(b.tangent_impulses[1], masses, v);
+            Lane::splat(0.0)
+        });
+    }
+
+    /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), with the
+    /// bundle's bodies gathered into lanes and scattered back; returns the lane-wise largest of
+    /// what `update` returned. With `parallel` (see [`Bundles::pack`]) a colour of at least
+    /// twice [`BUNDLES_PER_TASK`] bundles runs in chunks on rayon's threads.
+    fn sweep<F>(&mut self, forward: bool, velocities: &mut Velocities<'_>, update: F) -> Lane
+    where
+        F: Fn(&mut Bundle, &mut BodyLanes) -> Lane + Copy + Sync,
+    {
+        let immovable = velocities.linear.len() - 1;
+        if !self.parallel || rayon::current_num_threads() < 2 {
+            let mut largest = Lane::splat(0.0);
+            let mut one = |b: &mut Bundle| {
+                let mut v = BodyLanes::gather(
+                    &b.local_a,
+                    &b.local_b,
+                    velocities.linear,
+                    velocities.angular,
+                );
+                largest = largest.max(update(b, &mut v));
+                v.scatter(
+                    &b.local_a,
+                    &b.local_b,
+                    immovable,
+                    velocities.linear,
+                    velocities.angular,
+                );
+            };
+            if forward {
+                self.bundles.iter_mut().for_each(&mut one);
+            } else {
+                self.bundles.iter_mut().rev().for_each(&mut one);
+            }
+            return largest;
         }
+        let shared = SharedSlots {
+            linear: velocities.linear.as_mut_ptr(),
+            angular: velocities.angular.as_mut_ptr(),
+            immovable,
+        };
+        // Runs `update` on a run of bundles of one colour, in order or in reverse.
+        let run = |part: &mut [Bundle], forward: bool| {
+            // Capture the whole wrapper (Sync), not its raw-pointer fields.
+            #[allow(clippy::redundant_locals)]
+            let shared = shared;
+            let mut largest = Lane::splat(0.0);
+            let mut one = |b: &mut Bundle| {
+                // SAFETY: slots are below the arrays' length (the island step sets them so);
+                // within one colour no other bundle touches b's moving slots, and the
+                // immovable slot is only read.
+                unsafe {
+                    let mut v = shared.gather(b);
+                    largest = largest.max(update(b, &mut v));
+                    shared.scatter(b, &v);
+                }
+            };
+            if forward {
+                part.iter_mut().for_each(&mut one);
+            } else {
+                part.iter_mut().rev().for_each(&mut one);
+            }
+            largest
+        };
+        let colours = self.colour_starts.len() - 1;
+        let mut largest = Lane::splat(0.0);
+        for step in 0..colours {
+            let k = if forward { step } else { colours - 1 - step };
+            let part = &mut self.bundles[self.colour_starts[k]..self.colour_starts[k + 1]];
+            let colour_largest = if k >= COLOURS || part.len() < 2 * BUNDLES_PER_TASK {
+                run(part, forward)
+            } else {
+                use rayon::prelude::*;
+                part.par_chunks_mut(BUNDLES_PER_TASK)
+                    .map(|chunk| run(chunk, forward))
+                    .reduce(|| Lane::splat(0.0), |x, y| x.max(y))
+            };
+            largest = largest.max(colour_largest);
+        }
+        largest
     }
 
     /// Sets every point's target normal velocity and softness for a solve of `h` seconds, as
@@ -386,30 +460,8 @@ impl Bundles {
         velocities: &mut Velocities<'_>,
     ) -> SolveReport {
         let mut report = SolveReport::default();
-        let immovable = velocities.linear.len() - 1;
         for iteration in 0..iterations {
-            let mut largest = Lane::splat(0.0);
-            let mut one = |b: &mut Bundle| {
-                let mut v = BodyLanes::gather(
-                    &b.local_a,
-                    &b.local_b,
-                    velocities.linear,
-                    velocities.angular,
-                );
-                largest = largest.max(solve_bundle(b, &mut v));
-                v.scatter(
-                    &b.local_a,
-                    &b.local_b,
-                    immovable,
-                    velocities.linear,
-                    velocities.angular,
-                );
-            };
-            if iteration % 2 == 0 {
-                self.bundles.iter_mut().for_each(&mut one);
-            } else {
-                self.bundles.iter_mut().rev().for_each(&mut one);
-            }
+            let largest = self.sweep(iteration % 2 == 0, velocities, solve_bundle);
             let largest_change = largest.to_array().into_iter().fold(0.0f32, f32::max);
             report.iterations += 1;
             report.last_change = largest_change;
@@ -419,6 +471,73 @@ impl Bundles {
         }
         report
     }
+}
+
+/// Bundles of one colour per parallel task.
+const BUNDLES_PER_TASK: usize = 32;
+
+/// Velocity slots shared by the threads of one colour. Safety rests on the colouring: within a
+/// colour no two bundles share a slot other than the immovable one, which is only read.
+#[derive(Clone, Copy)]
+struct SharedSlots {
+    linear: *mut Vec3,
+    angular: *mut Vec3,
+    immovable: usize,
+}
+
+// SAFETY: see the type's documentation; each thread touches a disjoint set of slots.
+unsafe impl Send for SharedSlots {}
+// SAFETY: as above.
+unsafe impl Sync for SharedSlots {}
+
+impl SharedSlots {
+    /// [`BodyLanes::gather`] through the shared pointers.
+    ///
+    /// # Safety
+    /// Every slot of `b` is in bounds, and no other thread writes them meanwhile.
+    #[inline(always)]
+    unsafe fn gather(&self, b: &Bundle) -> BodyLanes {
+        // SAFETY: the caller's contract.
+        let load = |p: *mut Vec3, slots: &[u32; LANES]| {
+            lane_vec(slots.map(|k| unsafe { *p.add(k as usize) }))
+        };
+        BodyLanes {
+            linear_a: load(self.linear, &b.local_a),
+            angular_a: load(self.angular, &b.local_a),
+            linear_b: load(self.linear, &b.local_b),
+            angular_b: load(self.angular, &b.local_b),
+        }
+    }
+
+    /// [`BodyLanes::scatter`] through the shared pointers; the immovable slot is not written.
+    ///
+    /// # Safety
+    /// As [`SharedSlots::gather`], and no other thread reads b's moving slots meanwhile.
+    #[inline(always)]
+    unsafe fn scatter(&self, b: &Bundle, v: &BodyLanes) {
+        let [la, aa, lb, ab] = [&v.linear_a, &v.angular_a, &v.linear_b, &v.angular_b].map(unlane);
+        for i in 0..LANES {
+            let (a, bb) = (b.local_a[i] as usize, b.local_b[i] as usize);
+            // SAFETY: the caller's contract.
+            unsafe {
+                if a != self.immovable {
+                    *self.linear.add(a) = la[i];
+                    *self.angular.add(a) = aa[i];
+                }
+                if bb != self.immovable {
+                    *self.linear.add(bb) = lb[i];
+                    *self.angular.add(bb) = ab[i];
+                }
+            }
+        }
+    }
+}
+
+/// The lanes of a vector as [`LANES`] vectors.
+#[inline(always)]
+fn unlane(v: &LaneVec) -> [Vec3; LANES] {
+    let [x, y, z] = [v[0].to_array(), v[1].to_array(), v[2].to_array()];
+    std::array::from_fn(|i| Vec3::new(x[i], y[i], z[i]))
 }
 
 /// Δx + Δθ × r per lane.

@@ -122,42 +122,57 @@ fn a_quiet_island_sleeps_and_a_falling_box_wakes_it() {
 
 /// One large island swept colour by colour: the colouring keeps every colour free of shared
 /// moving bodies (checked through the result: spreading each colour over two threads gives
-/// exactly the one-thread trajectory), and the pyramid still stands.
+/// exactly the one-thread trajectory), and the pyramid still stands. Once with the default
+/// scalar sweeps, once with `SolverSettings::fast()`, whose island is solved in SIMD bundles.
 #[test]
 fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
-    let mut scene = impulse::scene::builtin::builtin_scene("pyramid3d10").unwrap();
-    scene.solver.sleep = false;
-    // pyramid3d10 is one island of ~8700 points: colours of over 512 points run in parallel.
-    scene.solver.parallel_island_contacts = 1000;
-    let mut one = World::from_scene(&scene).unwrap();
-    one.parallel = false;
-    let mut two = World::from_scene(&scene).unwrap();
-    two.parallel = true;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
-    let top = (0..one.bodies.len())
-        .max_by(|&i, &j| {
-            let (a, b) = (
-                one.bodies.pose[i].translation.y,
-                one.bodies.pose[j].translation.y,
+    let default = SolverSettings::default();
+    for (settings, largest_sink) in [(default, 0.005), (SolverSettings::fast(), 0.05)] {
+        let mut scene = impulse::scene::builtin::builtin_scene("pyramid3d10").unwrap();
+        let simd = !settings.split_impulse;
+        scene.solver = SolverSettings {
+            sleep: false,
+            // pyramid3d10 is one island of ~8700 points: colours of over 512 points (or 64
+            // bundles) run in parallel.
+            parallel_island_contacts: 1000,
+            ..settings
+        };
+        let mut one = World::from_scene(&scene).unwrap();
+        one.parallel = false;
+        let mut two = World::from_scene(&scene).unwrap();
+        two.parallel = true;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let top = (0..one.bodies.len())
+            .max_by(|&i, &j| {
+                let (a, b) = (
+                    one.bodies.pose[i].translation.y,
+                    one.bodies.pose[j].translation.y,
+                );
+                a.total_cmp(&b)
+            })
+            .unwrap();
+        let top_y = one.bodies.pose[top].translation.y;
+        for _ in 0..30 {
+            one.step().unwrap();
+            pool.install(|| two.step().unwrap());
+            assert!(
+                two.diagnostics()
+                    .islands
+                    .iter()
+                    .all(|island| island.simd == simd)
             );
-            a.total_cmp(&b)
-        })
-        .unwrap();
-    let top_y = one.bodies.pose[top].translation.y;
-    for _ in 0..30 {
-        one.step().unwrap();
-        pool.install(|| two.step().unwrap());
+        }
+        for i in 0..one.bodies.len() {
+            assert_eq!(one.bodies.pose[i], two.bodies.pose[i], "body {i}");
+            assert_eq!(
+                one.bodies.angular_velocity[i],
+                two.bodies.angular_velocity[i]
+            );
+        }
+        let sink = top_y - one.bodies.pose[top].translation.y;
+        assert!(sink < largest_sink, "top cube sank {sink} m in 0.5 s");
     }
-    for i in 0..one.bodies.len() {
-        assert_eq!(one.bodies.pose[i], two.bodies.pose[i], "body {i}");
-        assert_eq!(
-            one.bodies.angular_velocity[i],
-            two.bodies.angular_velocity[i]
-        );
-    }
-    let sink = top_y - one.bodies.pose[top].translation.y;
-    assert!(sink < 0.005, "top cube sank {sink} m in 0.5 s");
 }
