@@ -247,8 +247,37 @@ pub struct IslandWorkspace {
 }
 
 impl IslandWorkspace {
-    /// PGS on the island's bundles (see [`crate::simd`]), with the bookkeeping of [`Self::solve`].
-    fn solve_bundled(&mut self, settings: &SolverSettings, iterations: u32, escalate: bool) {
+    /// One solve of a substep of `h` seconds: targets from the current separation, then the
+    /// main solve (`with_repair`: overlap repair, `iterations`, escalation allowed) or the relax
+    /// solve (`relax_iterations`), on the bundles when the island is `bundled` (see
+    /// [`crate::simd`]) and on the constraints otherwise.
+    fn targets_and_solve(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        settings: &SolverSettings,
+        h: f32,
+        bundled: bool,
+        with_repair: bool,
+    ) {
+        let iterations = if with_repair {
+            settings.iterations
+        } else {
+            settings.relax_iterations
+        };
+        if !bundled {
+            constraints::update_targets(
+                constraints,
+                &self.displacement,
+                &self.rotation,
+                settings,
+                h,
+                with_repair,
+            );
+            self.solve(constraints, settings, iterations, with_repair);
+            return;
+        }
+        self.bundles
+            .update_targets(&self.displacement, &self.rotation, settings, h, with_repair);
         let outcome = self.bundles.solve_pgs(
             iterations,
             settings.tolerance,
@@ -258,7 +287,7 @@ impl IslandWorkspace {
             },
         );
         self.report.iterations += outcome.iterations;
-        if escalate {
+        if with_repair {
             self.report.last_change = outcome.last_change;
         }
     }
@@ -450,21 +479,10 @@ pub fn step_island(
         };
         if bundled {
             w.bundles.warm_start(&mut velocities);
-            w.bundles
-                .update_targets(&w.displacement, &w.rotation, settings, h, true);
-            w.solve_bundled(settings, settings.iterations, true);
         } else {
             solver::warm_start(constraints, &mut velocities);
-            constraints::update_targets(
-                constraints,
-                &w.displacement,
-                &w.rotation,
-                settings,
-                h,
-                true,
-            );
-            w.solve(constraints, settings, settings.iterations, true);
         }
+        w.targets_and_solve(constraints, settings, h, bundled, true);
         if settings.split_impulse {
             // Positions move with v + the pseudo-velocity of the repair solve.
             w.pseudo_linear.clear();
@@ -504,21 +522,7 @@ pub fn step_island(
             h,
         );
         if settings.relax_iterations > 0 && !settings.split_impulse {
-            if bundled {
-                w.bundles
-                    .update_targets(&w.displacement, &w.rotation, settings, h, false);
-                w.solve_bundled(settings, settings.relax_iterations, false);
-            } else {
-                constraints::update_targets(
-                    constraints,
-                    &w.displacement,
-                    &w.rotation,
-                    settings,
-                    h,
-                    false,
-                );
-                w.solve(constraints, settings, settings.relax_iterations, false);
-            }
+            w.targets_and_solve(constraints, settings, h, bundled, false);
         }
     }
     if bundled {

@@ -24,7 +24,7 @@ use wide::f32x4;
 
 use crate::constraints::{ContactConstraint, JacobianRow, soft_contact};
 use crate::settings::SolverSettings;
-use crate::solver::{COLOURS, SolveReport, Velocities};
+use crate::solver::{COLOURS, SharedVelocities, SolveReport, Velocities, greedy_colours};
 
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
 /// AArch64), so no target feature is needed.
@@ -238,29 +238,7 @@ impl Bundles {
     pub fn pack(&mut self, constraints: &[ContactConstraint], slots: usize, parallel: bool) {
         self.parallel = parallel;
         let immovable = (slots - 1) as u32;
-        self.used.clear();
-        self.used.resize(slots, 0);
-        self.colours.clear();
-        let mut counts = [0u32; COLOURS + 2];
-        for c in constraints {
-            let (a, b) = (c.local_a as usize, c.local_b as usize);
-            let moving = |k: usize| k as u32 != immovable;
-            let mask = (if moving(a) { self.used[a] } else { 0 })
-                | (if moving(b) { self.used[b] } else { 0 });
-            let colour = ((!mask).trailing_zeros() as usize).min(COLOURS);
-            if colour < COLOURS {
-                for k in [a, b] {
-                    if moving(k) {
-                        self.used[k] |= 1 << colour;
-                    }
-                }
-            }
-            self.colours.push(colour as u8);
-            counts[colour + 1] += 1;
-        }
-        for k in 0..=COLOURS {
-            counts[k + 1] += counts[k];
-        }
+        let counts = greedy_colours(constraints, slots, &mut self.used, &mut self.colours);
         // Bundles per colour (the last colour: one point each) and where each colour starts.
         let per_bundle = |colour: usize| if colour < COLOURS { LANES } else { 1 };
         let mut bundle_start = [0usize; COLOURS + 2];
@@ -322,13 +300,7 @@ impl Bundles {
 
     /// Applies the accumulated impulses to the velocities ([`crate::solver::warm_start`]).
     pub fn warm_start(&mut self, velocities: &mut Velocities<'_>) {
-        self.sweep(true, velocities, |b, v| {
-            let masses = (b.inverse_mass_a, b.inverse_mass_b);
-            b.normal.apply(b.normal_impulse, masses, v);
-            b.tangents[0].apply(b.tangent_impulses[0], masses, v);
-            b.tangents[1].apply(b.tangent_impulses[1], masses, v);
-            Lane::splat(0.0)
-        });
+        self.sweep(true, velocities, WarmStart);
     }
 
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), with the
@@ -337,7 +309,7 @@ impl Bundles {
     /// twice [`BUNDLES_PER_TASK`] bundles runs in chunks on rayon's threads.
     fn sweep<F>(&mut self, forward: bool, velocities: &mut Velocities<'_>, update: F) -> Lane
     where
-        F: Fn(&mut Bundle, &mut BodyLanes) -> Lane + Copy + Sync,
+        F: BundleUpdate,
     {
         let immovable = velocities.linear.len() - 1;
         if !self.parallel || rayon::current_num_threads() < 2 {
@@ -349,7 +321,7 @@ impl Bundles {
                     velocities.linear,
                     velocities.angular,
                 );
-                largest = largest.max(update(b, &mut v));
+                largest = largest.max(update.update(b, &mut v));
                 v.scatter(
                     &b.local_a,
                     &b.local_b,
@@ -365,7 +337,7 @@ impl Bundles {
             }
             return largest;
         }
-        let shared = SharedSlots {
+        let shared = SharedVelocities {
             linear: velocities.linear.as_mut_ptr(),
             angular: velocities.angular.as_mut_ptr(),
             immovable,
@@ -382,7 +354,7 @@ impl Bundles {
                 // immovable slot is only read.
                 unsafe {
                     let mut v = shared.gather(b);
-                    largest = largest.max(update(b, &mut v));
+                    largest = largest.max(update.update(b, &mut v));
                     shared.scatter(b, &v);
                 }
             };
@@ -461,7 +433,7 @@ impl Bundles {
     ) -> SolveReport {
         let mut report = SolveReport::default();
         for iteration in 0..iterations {
-            let largest = self.sweep(iteration % 2 == 0, velocities, solve_bundle);
+            let largest = self.sweep(iteration % 2 == 0, velocities, VelocityRows);
             let largest_change = largest.to_array().into_iter().fold(0.0f32, f32::max);
             report.iterations += 1;
             report.last_change = largest_change;
@@ -473,28 +445,59 @@ impl Bundles {
     }
 }
 
+/// One bundle's update in a sweep: takes the bundle and its bodies' velocities in lanes,
+/// updates both, and returns each lane's largest row velocity change (m/s). A trait rather
+/// than a closure or function pointer so that the update is inlined into the sweep loop (as a
+/// closure it was not, and pyramid20's `fast` step took 30 % longer).
+trait BundleUpdate: Copy + Sync {
+    fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane;
+}
+
+/// The velocity rows ([`solve_bundle`]).
+#[derive(Clone, Copy)]
+struct VelocityRows;
+
+impl BundleUpdate for VelocityRows {
+    #[inline(always)]
+    fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane {
+        solve_bundle(b, v)
+    }
+}
+
+/// The accumulated impulses applied to the bodies (warm start); changes no impulse.
+#[derive(Clone, Copy)]
+struct WarmStart;
+
+impl BundleUpdate for WarmStart {
+    #[inline(always)]
+    fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane {
+        let masses = (b.inverse_mass_a, b.inverse_mass_b);
+        b.normal.apply(b.normal_impulse, masses, v);
+        b.tangents[0].apply(b.tangent_impulses[0], masses, v);
+        b.tangents[1].apply(b.tangent_impulses[1], masses, v);
+        Lane::splat(0.0)
+    }
+}
+
 /// Bundles of one colour per parallel task.
 const BUNDLES_PER_TASK: usize = 32;
 
-/// Velocity slots shared by the threads of one colour. Safety rests on the colouring: within a
-/// colour no two bundles share a slot other than the immovable one, which is only read.
-#[derive(Clone, Copy)]
-struct SharedSlots {
-    linear: *mut Vec3,
-    angular: *mut Vec3,
-    immovable: usize,
-}
-
-// SAFETY: see the type's documentation; each thread touches a disjoint set of slots.
-unsafe impl Send for SharedSlots {}
-// SAFETY: as above.
-unsafe impl Sync for SharedSlots {}
-
-impl SharedSlots {
+/// [`BodyLanes`] through the velocity pointers that one colour's threads share.
+trait SharedLanes {
     /// [`BodyLanes::gather`] through the shared pointers.
     ///
     /// # Safety
     /// Every slot of `b` is in bounds, and no other thread writes them meanwhile.
+    unsafe fn gather(&self, b: &Bundle) -> BodyLanes;
+
+    /// [`BodyLanes::scatter`] through the shared pointers; the immovable slot is not written.
+    ///
+    /// # Safety
+    /// As [`SharedLanes::gather`], and no other thread reads b's moving slots meanwhile.
+    unsafe fn scatter(&self, b: &Bundle, v: &BodyLanes);
+}
+
+impl SharedLanes for SharedVelocities {
     #[inline(always)]
     unsafe fn gather(&self, b: &Bundle) -> BodyLanes {
         // SAFETY: the caller's contract.
@@ -509,10 +512,6 @@ impl SharedSlots {
         }
     }
 
-    /// [`BodyLanes::scatter`] through the shared pointers; the immovable slot is not written.
-    ///
-    /// # Safety
-    /// As [`SharedSlots::gather`], and no other thread reads b's moving slots meanwhile.
     #[inline(always)]
     unsafe fn scatter(&self, b: &Bundle, v: &BodyLanes) {
         let [la, aa, lb, ab] = [&v.linear_a, &v.angular_a, &v.linear_b, &v.angular_b].map(unlane);

@@ -76,12 +76,39 @@ pub(crate) fn colour_constraints(
     scratch: &mut Vec<ContactConstraint>,
     starts: &mut Vec<u32>,
 ) {
+    let counts = greedy_colours(constraints, slots, used, colours);
+    let used_colours = (0..=COLOURS)
+        .rev()
+        .find(|&k| counts[k + 1] > counts[k])
+        .map_or(0, |k| k + 1);
+    starts.clear();
+    starts.extend_from_slice(&counts[..=used_colours]);
+    scratch.clear();
+    scratch.extend_from_slice(constraints);
+    let mut fill = counts;
+    for (c, &colour) in scratch.iter().zip(colours.iter()) {
+        let slot = &mut fill[colour as usize];
+        constraints[*slot as usize] = *c;
+        *slot += 1;
+    }
+}
+
+/// The greedy colouring of [`colour_constraints`] without the sort: each point's colour (the
+/// lowest neither of its moving bodies has; [`COLOURS`] when none is left) in `colours`, and
+/// the colour offsets in point order, colour k at `counts[k]..counts[k + 1]`. `used` holds each
+/// slot's colours. Panics if a point's slot is not below `slots`.
+pub(crate) fn greedy_colours(
+    constraints: &[ContactConstraint],
+    slots: usize,
+    used: &mut Vec<u64>,
+    colours: &mut Vec<u8>,
+) -> [u32; COLOURS + 2] {
     let immovable = slots - 1;
     used.clear();
     used.resize(slots, 0);
     colours.clear();
     let mut counts = [0u32; COLOURS + 2];
-    for c in constraints.iter() {
+    for c in constraints {
         let (a, b) = (c.local_a as usize, c.local_b as usize);
         let mask =
             (if a != immovable { used[a] } else { 0 }) | (if b != immovable { used[b] } else { 0 });
@@ -99,29 +126,16 @@ pub(crate) fn colour_constraints(
     for k in 0..=COLOURS {
         counts[k + 1] += counts[k];
     }
-    let used_colours = (0..=COLOURS)
-        .rev()
-        .find(|&k| counts[k + 1] > counts[k])
-        .map_or(0, |k| k + 1);
-    starts.clear();
-    starts.extend_from_slice(&counts[..=used_colours]);
-    scratch.clear();
-    scratch.extend_from_slice(constraints);
-    let mut fill = counts;
-    for (c, &colour) in scratch.iter().zip(colours.iter()) {
-        let slot = &mut fill[colour as usize];
-        constraints[*slot as usize] = *c;
-        *slot += 1;
-    }
+    counts
 }
 
 /// Velocity slots shared by the threads of one colour. Safety rests on the colouring: within
 /// a colour no two points share a slot other than the immovable one, which is only read.
 #[derive(Clone, Copy)]
-struct SharedVelocities {
-    linear: *mut Vec3,
-    angular: *mut Vec3,
-    immovable: usize,
+pub(crate) struct SharedVelocities {
+    pub(crate) linear: *mut Vec3,
+    pub(crate) angular: *mut Vec3,
+    pub(crate) immovable: usize,
 }
 
 // SAFETY: see the type's documentation; each thread touches a disjoint set of slots.

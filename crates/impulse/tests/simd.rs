@@ -1,6 +1,8 @@
 //! The SIMD-lane solver (`impulse::simd`): the same LCP conditions as the scalar sweep, exact
 //! momentum with padding lanes, and the `fast` preset standing on a standard scene.
 
+mod common;
+
 use glam::Vec3;
 use impulse::scene::builtin::builtin_scene;
 use impulse::settings::SolverMethod;
@@ -20,16 +22,6 @@ fn sphere(radius: f32, position: Vec3) -> BodyDesc {
     BodyDesc::new(
         BodyKind::Dynamic,
         ShapeDesc::Sphere { radius },
-        position.to_array(),
-    )
-}
-
-fn cuboid(kind: BodyKind, half: Vec3, position: Vec3) -> BodyDesc {
-    BodyDesc::new(
-        kind,
-        ShapeDesc::Cuboid {
-            half_extents: half.to_array(),
-        },
         position.to_array(),
     )
 }
@@ -92,68 +84,14 @@ fn pile_of_spheres_solved_in_lanes_satisfies_complementarity() {
         friction: false,
         ..bundled(500)
     };
-    let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
-    w.add_body(
-        &cuboid(
-            BodyKind::Static,
-            Vec3::new(10.0, 0.5, 10.0),
-            Vec3::new(0.0, -0.5, 0.0),
-        ),
-        &material(0.0, 0.0),
-    )
-    .unwrap();
-    for (x, z) in [(2.6, 0.0), (-2.6, 0.0), (0.0, 2.6), (0.0, -2.6)] {
-        let half = if x != 0.0 {
-            Vec3::new(0.5, 3.0, 3.0)
-        } else {
-            Vec3::new(3.0, 3.0, 0.5)
-        };
-        w.add_body(
-            &cuboid(BodyKind::Static, half, Vec3::new(x, 3.0, z)),
-            &material(0.0, 0.0),
-        )
-        .unwrap();
-    }
-    for layer in 0..4 {
-        for i in 0..4 {
-            for k in 0..4 {
-                let jitter = 0.05 * ((i * 7 + k * 3 + layer) % 5) as f32;
-                let p = Vec3::new(
-                    -1.5 + i as f32 + jitter,
-                    0.5 + 1.05 * layer as f32,
-                    -1.5 + k as f32,
-                );
-                w.add_body(&sphere(0.45, p), &material(0.0, 0.0)).unwrap();
-            }
-        }
-    }
+    let mut w = common::sphere_pile(settings);
     let mut checked_steps = 0;
     for _ in 0..90 {
         w.step().unwrap();
-        let constraints = w.contact_constraints();
-        if constraints.len() < 50 {
-            continue;
+        if common::check_complementarity_at_exit(&w) {
+            assert!(w.diagnostics().islands.iter().all(|island| island.simd));
+            checked_steps += 1;
         }
-        assert!(w.diagnostics().islands.iter().all(|island| island.simd));
-        checked_steps += 1;
-        let lin = &w.bodies.linear_velocity;
-        let ang = &w.bodies.angular_velocity;
-        let largest = constraints
-            .iter()
-            .map(|c| c.normal_impulse)
-            .fold(0.0f32, f32::max);
-        for c in constraints {
-            let (a, b) = (c.body_a as usize, c.body_b as usize);
-            let wv = c.normal.velocity(lin[a], ang[a], lin[b], ang[b]) - c.target_normal_velocity;
-            assert!(c.normal_impulse >= 0.0);
-            assert!(wv >= -1e-3, "w = {wv} < 0");
-            assert!(
-                (wv * c.normal_impulse).abs() <= 1e-3 * largest.max(1e-6),
-                "complementarity: w = {wv}, γ = {}",
-                c.normal_impulse
-            );
-        }
-        assert!(w.diagnostics().natural_map_residual < 1e-2);
     }
     assert!(checked_steps > 10);
 }

@@ -23,3 +23,73 @@ pub fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
         position.to_array(),
     )
 }
+
+/// The 64-sphere pile of the complementarity tests: 4 layers of 4×4 frictionless spheres
+/// (r = 0.45 m, jittered) on a static ground inside four static walls, with `settings`,
+/// dt = 1/60 s, gravity −9.81 m/s² along y.
+pub fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
+    let mut w = impulse::World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
+    w.add_body(
+        &static_box(Vec3::new(50.0, 0.5, 50.0), Vec3::new(0.0, -0.5, 0.0)),
+        &material(0.0),
+    )
+    .unwrap();
+    // Walls keep the frictionless pile together.
+    for (x, z) in [(2.6, 0.0), (-2.6, 0.0), (0.0, 2.6), (0.0, -2.6)] {
+        let half = if x != 0.0 {
+            Vec3::new(0.5, 3.0, 3.0)
+        } else {
+            Vec3::new(3.0, 3.0, 0.5)
+        };
+        w.add_body(&static_box(half, Vec3::new(x, 3.0, z)), &material(0.0))
+            .unwrap();
+    }
+    for layer in 0..4 {
+        for i in 0..4 {
+            for k in 0..4 {
+                let jitter = 0.05 * ((i * 7 + k * 3 + layer) % 5) as f32;
+                let p = Vec3::new(
+                    -1.5 + i as f32 + jitter,
+                    0.5 + 1.05 * layer as f32,
+                    -1.5 + k as f32,
+                );
+                let sphere = BodyDesc::new(
+                    BodyKind::Dynamic,
+                    ShapeDesc::Sphere { radius: 0.45 },
+                    p.to_array(),
+                );
+                w.add_body(&sphere, &material(0.0)).unwrap();
+            }
+        }
+    }
+    w
+}
+
+/// Checks the engine's own LCP at exit of the last step: for every point γ ≥ 0, w = J·v −
+/// target ≥ −1e-3 m/s and |w·γ| ≤ 1e-3 of the largest γ, and the natural-map residual is
+/// below 1e-2. Returns false (checks nothing) while the pile has fewer than 50 contacts.
+pub fn check_complementarity_at_exit(w: &impulse::World) -> bool {
+    let constraints = w.contact_constraints();
+    if constraints.len() < 50 {
+        return false;
+    }
+    let lin = &w.bodies.linear_velocity;
+    let ang = &w.bodies.angular_velocity;
+    let largest = constraints
+        .iter()
+        .map(|c| c.normal_impulse)
+        .fold(0.0f32, f32::max);
+    for c in constraints {
+        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let wv = c.normal.velocity(lin[a], ang[a], lin[b], ang[b]) - c.target_normal_velocity;
+        assert!(c.normal_impulse >= 0.0);
+        assert!(wv >= -1e-3, "w = {wv} < 0");
+        assert!(
+            (wv * c.normal_impulse).abs() <= 1e-3 * largest.max(1e-6),
+            "complementarity: w = {wv}, γ = {}",
+            c.normal_impulse
+        );
+    }
+    assert!(w.diagnostics().natural_map_residual < 1e-2);
+    true
+}
