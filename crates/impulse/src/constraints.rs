@@ -7,8 +7,9 @@
 use glam::{Mat3, Vec3};
 
 use crate::body::Bodies;
-use crate::narrow_phase::NarrowPhase;
+use crate::narrow_phase::{ContactPair, NarrowPhase, repeats_earlier_point, same_point};
 use crate::settings::SolverSettings;
+use rayon::prelude::*;
 
 /// One row of J for a direction d, with the products the solver reuses every sweep.
 #[derive(Clone, Copy, Debug, Default)]
@@ -76,7 +77,7 @@ impl JacobianRow {
 }
 
 /// All rows of one contact point.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct ContactConstraint {
     /// Body the normal points towards.
     pub body_a: u32,
@@ -155,106 +156,152 @@ impl ContactConstraint {
 /// Builds one constraint per contact point, in narrow-phase order (pairs sorted by body index).
 /// `velocity_before` is read from the current velocities: called before gravity is applied, it
 /// is the approach velocity v⁻ that restitution reflects. Targets are left at zero.
+///
+/// With `parallel`, runs of [`PAIRS_PER_TASK`] pairs are assembled on rayon's threads, each
+/// into its own slice of `out` (the narrow phase knows every pair's row count); the result is
+/// the same as on one thread.
 pub fn assemble(
     bodies: &Bodies,
     narrow_phase: &NarrowPhase,
     settings: &SolverSettings,
     world_inverse_inertia: &[Mat3],
+    parallel: bool,
     out: &mut Vec<ContactConstraint>,
 ) {
-    out.clear();
-    for (pair_index, pair) in narrow_phase.pairs.iter().enumerate() {
-        // Parry's shape 1 is body1 and its normal n1 points from shape 1 towards shape 2,
-        // so in the seed's convention (n points from B towards A): B = body1, A = body2.
-        let (b, a) = (pair.body1 as usize, pair.body2 as usize);
-        let pose_a = &bodies.pose[a];
-        let pose_b = &bodies.pose[b];
-        let com_a = bodies.center_of_mass(a);
-        let com_b = bodies.center_of_mass(b);
-        let friction = (bodies.friction[a] * bodies.friction[b]).sqrt();
-        let restitution = bodies.restitution[a].max(bodies.restitution[b]);
-        let inverse_mass_a = bodies.inverse_mass[a];
-        let inverse_mass_b = bodies.inverse_mass[b];
-        let inertia_a = &world_inverse_inertia[a];
-        let inertia_b = &world_inverse_inertia[b];
-        for (manifold_index, manifold) in pair.manifolds.iter().enumerate() {
-            if manifold.points.is_empty() {
-                continue;
-            }
-            let normal = pose_b.rotation * manifold.local_n1;
-            for (point_index, point) in manifold.points.iter().enumerate() {
-                // Parry's face-face cuboid manifolds can list a point twice (once per face
-                // clipped against the other); a duplicate row only makes A singular. Which
-                // copy comes first can change between steps, so the warm start takes the
-                // copy that carries an impulse and the write-back goes to every copy.
-                let same = |q: &&parry3d::query::TrackedContact<
-                    crate::narrow_phase::ContactImpulse,
-                >| {
-                    q.local_p1.distance_squared(point.local_p1) < DUPLICATE_POINT_DISTANCE_SQUARED
-                };
-                if manifold.points[..point_index].iter().any(|q| same(&q)) {
+    let pairs = &narrow_phase.pairs;
+    let total: usize = pairs.iter().map(ContactPair::row_count).sum();
+    // Every slot is overwritten below; resizing only fills slots the vector did not have.
+    out.truncate(total);
+    out.resize(total, ContactConstraint::default());
+    let context = Assembly {
+        bodies,
+        settings,
+        world_inverse_inertia,
+    };
+    if parallel && rayon::current_num_threads() > 1 && pairs.len() > PAIRS_PER_TASK {
+        let mut jobs = Vec::with_capacity(pairs.len().div_ceil(PAIRS_PER_TASK));
+        let mut rest: &mut [ContactConstraint] = out;
+        for (k, chunk) in pairs.chunks(PAIRS_PER_TASK).enumerate() {
+            let rows = chunk.iter().map(ContactPair::row_count).sum();
+            let (mine, others) = rest.split_at_mut(rows);
+            rest = others;
+            jobs.push((k * PAIRS_PER_TASK, chunk, mine));
+        }
+        jobs.into_par_iter()
+            .for_each(|(first, chunk, slots)| context.pairs(first, chunk, slots));
+    } else {
+        context.pairs(0, pairs, out);
+    }
+}
+
+/// Pairs per parallel assembly task: large enough that a task outweighs rayon's hand-off.
+pub const PAIRS_PER_TASK: usize = 1024;
+
+struct Assembly<'a> {
+    bodies: &'a Bodies,
+    settings: &'a SolverSettings,
+    world_inverse_inertia: &'a [Mat3],
+}
+
+impl Assembly<'_> {
+    /// Assembles `pairs` (narrow-phase pairs `first..`) into `out`, which has exactly their
+    /// row count.
+    fn pairs(&self, first: usize, pairs: &[ContactPair], out: &mut [ContactConstraint]) {
+        let (bodies, settings) = (self.bodies, self.settings);
+        let mut slots = out.iter_mut();
+        for (pair_index, pair) in (first..).zip(pairs) {
+            // Parry's shape 1 is body1 and its normal n1 points from shape 1 towards shape 2,
+            // so in the seed's convention (n points from B towards A): B = body1, A = body2.
+            let (b, a) = (pair.body1 as usize, pair.body2 as usize);
+            let pose_a = &bodies.pose[a];
+            let pose_b = &bodies.pose[b];
+            let com_a = bodies.center_of_mass(a);
+            let com_b = bodies.center_of_mass(b);
+            let friction = (bodies.friction[a] * bodies.friction[b]).sqrt();
+            let restitution = bodies.restitution[a].max(bodies.restitution[b]);
+            let inverse_mass_a = bodies.inverse_mass[a];
+            let inverse_mass_b = bodies.inverse_mass[b];
+            let inertia_a = &self.world_inverse_inertia[a];
+            let inertia_b = &self.world_inverse_inertia[b];
+            for (manifold_index, manifold) in pair.manifolds.iter().enumerate() {
+                if manifold.points.is_empty() {
                     continue;
                 }
-                let warm = manifold.points[point_index..]
-                    .iter()
-                    .filter(same)
-                    .map(|q| q.data)
-                    .max_by(|x, y| x.normal.total_cmp(&y.normal))
-                    .unwrap_or(point.data);
-                let p_b = pose_b.transform_point(point.local_p1);
-                let p_a = pose_a.transform_point(point.local_p2);
-                let contact_point = 0.5 * (p_a + p_b);
-                let r_a = contact_point - com_a;
-                let r_b = contact_point - com_b;
-                let (t1, t2) = tangent_basis(bodies, a, b, r_a, r_b, normal, manifold.data.tangent);
-                let row = |d| {
-                    let mut row = JacobianRow::new(
-                        d,
-                        r_a,
-                        r_b,
+                let normal = pose_b.rotation * manifold.local_n1;
+                for (point_index, point) in manifold.points.iter().enumerate() {
+                    // Which copy of a duplicated point comes first can change between steps, so
+                    // the warm start takes the copy that carries an impulse and the write-back
+                    // goes to every copy.
+                    if repeats_earlier_point(&manifold.points, point_index) {
+                        continue;
+                    }
+                    let warm = manifold.points[point_index..]
+                        .iter()
+                        .filter(|q| same_point(q.local_p1, point.local_p1))
+                        .map(|q| q.data)
+                        .max_by(|x, y| x.normal.total_cmp(&y.normal))
+                        .unwrap_or(point.data);
+                    let p_b = pose_b.transform_point(point.local_p1);
+                    let p_a = pose_a.transform_point(point.local_p2);
+                    let contact_point = 0.5 * (p_a + p_b);
+                    let r_a = contact_point - com_a;
+                    let r_b = contact_point - com_b;
+                    let (t1, t2) =
+                        tangent_basis(bodies, a, b, r_a, r_b, normal, manifold.data.tangent);
+                    let row = |d| {
+                        let mut row = JacobianRow::new(
+                            d,
+                            r_a,
+                            r_b,
+                            inverse_mass_a,
+                            inverse_mass_b,
+                            inertia_a,
+                            inertia_b,
+                        );
+                        row.velocity_before = row.velocity(
+                            bodies.linear_velocity[a],
+                            bodies.angular_velocity[a],
+                            bodies.linear_velocity[b],
+                            bodies.angular_velocity[b],
+                        );
+                        row
+                    };
+                    let normal_row = row(normal);
+                    let tangents = [row(t1), row(t2)];
+                    let depth = -point.dist;
+                    let Some(slot) = slots.next() else {
+                        debug_assert!(false, "fewer slots than the narrow phase's row count");
+                        return;
+                    };
+                    *slot = ContactConstraint {
+                        body_a: a as u32,
+                        body_b: b as u32,
+                        local_a: 0,
+                        local_b: 0,
                         inverse_mass_a,
                         inverse_mass_b,
-                        inertia_a,
-                        inertia_b,
-                    );
-                    row.velocity_before = row.velocity(
-                        bodies.linear_velocity[a],
-                        bodies.angular_velocity[a],
-                        bodies.linear_velocity[b],
-                        bodies.angular_velocity[b],
-                    );
-                    row
-                };
-                let normal_row = row(normal);
-                let tangents = [row(t1), row(t2)];
-                let depth = -point.dist;
-                out.push(ContactConstraint {
-                    body_a: a as u32,
-                    body_b: b as u32,
-                    local_a: 0,
-                    local_b: 0,
-                    inverse_mass_a,
-                    inverse_mass_b,
-                    normal: normal_row,
-                    tangents,
-                    tangent_inverse_block: inverse_block(&tangents),
-                    tangent_block: tangent_block(&tangents),
-                    target_normal_velocity: 0.0,
-                    softness: (1.0, 0.0),
-                    position_target: 0.0,
-                    position_impulse: 0.0,
-                    lever_a: r_a,
-                    lever_b: r_b,
-                    restitution,
-                    friction: if settings.friction { friction } else { 0.0 },
-                    normal_impulse: warm.normal,
-                    tangent_impulses: [warm.friction.dot(t1), warm.friction.dot(t2)],
-                    depth,
-                    max_normal_impulse: 0.0,
-                    source: (pair_index as u32, manifold_index as u16, point_index as u16),
-                });
+                        normal: normal_row,
+                        tangents,
+                        tangent_inverse_block: inverse_block(&tangents),
+                        tangent_block: tangent_block(&tangents),
+                        target_normal_velocity: 0.0,
+                        softness: (1.0, 0.0),
+                        position_target: 0.0,
+                        position_impulse: 0.0,
+                        lever_a: r_a,
+                        lever_b: r_b,
+                        restitution,
+                        friction: if settings.friction { friction } else { 0.0 },
+                        normal_impulse: warm.normal,
+                        tangent_impulses: [warm.friction.dot(t1), warm.friction.dot(t2)],
+                        depth,
+                        max_normal_impulse: 0.0,
+                        source: (pair_index as u32, manifold_index as u16, point_index as u16),
+                    };
+                }
             }
         }
+        debug_assert!(slots.next().is_none(), "more slots than rows");
     }
 }
 
@@ -310,9 +357,6 @@ fn tangent_basis(
         normal.any_orthonormal_pair()
     }
 }
-
-/// Contact points of one manifold closer than 0.1 mm (squared here) are one point.
-pub(crate) const DUPLICATE_POINT_DISTANCE_SQUARED: f32 = 1.0e-8;
 
 /// Below this tangential speed (m/s) a contact is treated as sticking for the tangent basis.
 const SLIDING_SPEED: f32 = 1.0e9;

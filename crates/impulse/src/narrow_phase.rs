@@ -4,11 +4,10 @@
 //! old ones by feature id and carry the solver's impulses over ([`ContactImpulse`]): that is
 //! what warm starting reads.
 
-use std::collections::HashMap;
-
 use glam::Vec3;
 use parry3d::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
+    TrackedContact,
 };
 use rayon::prelude::*;
 
@@ -46,12 +45,71 @@ pub struct ContactPair {
     /// Manifolds (one for convex-convex pairs) with points in each body's local frame.
     pub manifolds: Vec<Manifold>,
     workspace: Option<ContactManifoldsWorkspace>,
+    /// Point count and deepest penetration (m, ≥ 0) as of the last update, kept here so the
+    /// step's diagnostics need not chase every manifold's heap block again (on balls16k that
+    /// second pass over cold memory cost 5 % of the step).
+    summary: PairSummary,
+}
+
+#[derive(Clone, Copy, Default)]
+struct PairSummary {
+    points: u32,
+    rows: u32,
+    max_depth: f32,
+}
+
+impl PairSummary {
+    fn of(manifolds: &[Manifold]) -> Self {
+        let mut summary = Self::default();
+        for manifold in manifolds {
+            summary.points += manifold.points.len() as u32;
+            for (index, point) in manifold.points.iter().enumerate() {
+                summary.max_depth = summary.max_depth.max(-point.dist);
+                summary.rows += u32::from(!repeats_earlier_point(&manifold.points, index));
+            }
+        }
+        summary
+    }
+}
+
+/// Contact points of one manifold closer than 0.1 mm (squared here) are one point.
+const DUPLICATE_POINT_DISTANCE_SQUARED: f32 = 1.0e-8;
+
+/// True when two points of one manifold (in body 1's frame, m) are one point.
+pub(crate) fn same_point(p: Vec3, q: Vec3) -> bool {
+    p.distance_squared(q) < DUPLICATE_POINT_DISTANCE_SQUARED
+}
+
+/// True when point `index` repeats an earlier point of its manifold. Parry's face-face cuboid
+/// manifolds can list a point twice (once per face clipped against the other); a duplicate
+/// row would only make A singular, so constraints are built for first copies only.
+pub(crate) fn repeats_earlier_point(
+    points: &[TrackedContact<ContactImpulse>],
+    index: usize,
+) -> bool {
+    let p = points[index].local_p1;
+    points[..index].iter().any(|q| same_point(q.local_p1, p))
 }
 
 impl ContactPair {
+    fn new(body1: u32, body2: u32) -> Self {
+        Self {
+            body1,
+            body2,
+            manifolds: Vec::new(),
+            workspace: None,
+            summary: PairSummary::default(),
+        }
+    }
+
     /// Number of contact points over all manifolds.
     pub fn point_count(&self) -> usize {
-        self.manifolds.iter().map(|m| m.points.len()).sum()
+        self.summary.points as usize
+    }
+
+    /// Number of contact constraints the pair yields: its points less repeated ones.
+    pub fn row_count(&self) -> usize {
+        self.summary.rows as usize
     }
 }
 
@@ -91,7 +149,7 @@ pub const MAX_SPECULATIVE_MARGIN: f32 = 2.0;
 pub struct NarrowPhase {
     /// This step's pairs, in the broad phase's sorted order.
     pub pairs: Vec<ContactPair>,
-    previous: HashMap<(u32, u32), ContactPair>,
+    previous: Vec<ContactPair>,
 }
 
 impl NarrowPhase {
@@ -105,19 +163,20 @@ impl NarrowPhase {
         margins: &[f32],
         parallel: bool,
     ) -> Result<(), StepError> {
-        self.previous.clear();
-        for pair in self.pairs.drain(..) {
-            self.previous.insert((pair.body1, pair.body2), pair);
-        }
+        // Last step's pairs and this step's candidates are both sorted by (body1, body2): a
+        // merge join carries each surviving pair over without hashing (a hash map here was 11 %
+        // of a balls16k step).
+        debug_assert!(candidates.windows(2).all(|w| w[0] < w[1]));
+        std::mem::swap(&mut self.previous, &mut self.pairs);
+        let mut previous = self.previous.drain(..).peekable();
         for &(i, j) in candidates {
-            let pair = self.previous.remove(&(i, j)).unwrap_or(ContactPair {
-                body1: i,
-                body2: j,
-                manifolds: Vec::new(),
-                workspace: None,
-            });
+            while previous.next_if(|p| (p.body1, p.body2) < (i, j)).is_some() {}
+            let pair = previous
+                .next_if(|p| (p.body1, p.body2) == (i, j))
+                .unwrap_or_else(|| ContactPair::new(i, j));
             self.pairs.push(pair);
         }
+        drop(previous);
         let update = |pair: &mut ContactPair| -> Result<(), StepError> {
             let (a, b) = (pair.body1 as usize, pair.body2 as usize);
             // A pair with no awake body keeps its manifolds as they were: nothing moved.
@@ -135,7 +194,9 @@ impl NarrowPhase {
                     &mut pair.manifolds,
                     &mut pair.workspace,
                 )
-                .map_err(|_| StepError::UnsupportedShapePair { body1: a, body2: b })
+                .map_err(|_| StepError::UnsupportedShapePair { body1: a, body2: b })?;
+            pair.summary = PairSummary::of(&pair.manifolds);
+            Ok(())
         };
         if parallel && rayon::current_num_threads() > 1 {
             self.pairs.par_iter_mut().try_for_each(update)?;
@@ -152,9 +213,7 @@ impl NarrowPhase {
     pub fn max_depth(&self) -> f32 {
         self.pairs
             .iter()
-            .flat_map(|p| p.manifolds.iter())
-            .flat_map(|m| m.points.iter())
-            .map(|p| -p.dist)
+            .map(|p| p.summary.max_depth)
             .fold(0.0, f32::max)
     }
 }

@@ -7,7 +7,6 @@ use parry3d::shape::SharedShape;
 
 use crate::body::{Bodies, rotate_tensor};
 use crate::broad_phase::BroadPhase;
-use crate::constraints::DUPLICATE_POINT_DISTANCE_SQUARED;
 use crate::constraints::{self, ContactConstraint};
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{self, StepDiagnostics};
@@ -189,6 +188,7 @@ impl World {
             &self.narrow_phase,
             &settings,
             &self.world_inverse_inertia,
+            self.parallel,
             &mut self.constraints,
         );
         solver::scale_impulses(&mut self.constraints, settings.warm_start);
@@ -389,7 +389,7 @@ impl World {
             let location = points[point as usize].local_p1;
             // Every duplicate copy of the point (see `constraints::assemble`) gets the impulse.
             for p in points[point as usize..].iter_mut() {
-                if p.local_p1.distance_squared(location) < DUPLICATE_POINT_DISTANCE_SQUARED {
+                if narrow_phase::same_point(p.local_p1, location) {
                     p.data = data;
                 }
             }

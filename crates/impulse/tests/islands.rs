@@ -122,7 +122,8 @@ fn a_quiet_island_sleeps_and_a_falling_box_wakes_it() {
 
 /// One large island swept colour by colour: the colouring keeps every colour free of shared
 /// moving bodies (checked through the result: spreading each colour over two threads gives
-/// exactly the one-thread trajectory), and the pyramid still stands. Once with the default
+/// exactly the one-thread trajectory), and the pyramid still stands. Its ~3000 pairs also take
+/// the parallel assembly path (`constraints::PAIRS_PER_TASK`). Once with the default
 /// scalar sweeps, once with `SolverSettings::fast()`, whose island is solved in SIMD bundles.
 #[test]
 fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
