@@ -444,10 +444,13 @@ pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32
 /// impulses: v* = v − M⁻¹Jᵀγ, the velocities without this solve's impulses. With it,
 /// (A, b = target − J·v*) is exactly the LCP whose solution the rows now hold, so it can be
 /// exported and checked ([`crate::contact_lcp`]). O(rows); `scratch` holds per-body deltas.
+/// With `parallel`, the second pass (one row at a time, no shared writes) runs on rayon's
+/// threads.
 pub fn record_velocity_before(
     constraints: &mut [ContactConstraint],
     linear: &[Vec3],
     angular: &[Vec3],
+    parallel: bool,
     scratch: &mut Vec<(Vec3, Vec3)>,
 ) {
     scratch.clear();
@@ -466,7 +469,8 @@ pub fn record_velocity_before(
             scratch[b].1 -= row.inverse_inertia_angular_b * impulse;
         }
     }
-    for c in constraints.iter_mut() {
+    let scratch = &scratch[..];
+    let record = |c: &mut ContactConstraint| {
         let (a, b) = (c.body_a as usize, c.body_b as usize);
         let (la, aa) = (linear[a] - scratch[a].0, angular[a] - scratch[a].1);
         let (lb, ab) = (linear[b] - scratch[b].0, angular[b] - scratch[b].1);
@@ -474,5 +478,13 @@ pub fn record_velocity_before(
         for t in &mut c.tangents {
             t.velocity_before = t.velocity(la, aa, lb, ab);
         }
+    };
+    if parallel && rayon::current_num_threads() > 1 {
+        constraints
+            .par_iter_mut()
+            .with_min_len(PAIRS_PER_TASK)
+            .for_each(record);
+    } else {
+        constraints.iter_mut().for_each(record);
     }
 }

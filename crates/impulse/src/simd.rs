@@ -408,7 +408,7 @@ impl Bundles {
         } else {
             (one, zero)
         };
-        for (b, g) in self.bundles.iter_mut().zip(&self.geometry) {
+        let update = |(b, g): (&mut Bundle, &BundleGeometry)| {
             let moved = BodyLanes::gather(&b.local_a, &b.local_b, displacement, rotation);
             let at_a = add_cross(moved.linear_a, moved.angular_a, g.lever_a);
             let at_b = add_cross(moved.linear_b, moved.angular_b, g.lever_b);
@@ -419,6 +419,19 @@ impl Bundles {
             b.target = gap.select(-separation * inverse_h, overlap_target);
             b.mass_scale = gap.select(one, soft_mass);
             b.impulse_scale = gap.select(zero, soft_impulse);
+        };
+        // Each bundle reads only the bodies' displacements: any split over threads gives the
+        // same targets. Serial, this pass was 5 % of a two-thread pyramid100 step.
+        if self.parallel && rayon::current_num_threads() > 1 {
+            use rayon::prelude::*;
+            self.bundles
+                .par_chunks_mut(TARGET_BUNDLES_PER_TASK)
+                .zip(self.geometry.par_chunks(TARGET_BUNDLES_PER_TASK))
+                .for_each(|(bundles, geometry)| {
+                    bundles.iter_mut().zip(geometry).for_each(update);
+                });
+        } else {
+            self.bundles.iter_mut().zip(&self.geometry).for_each(update);
         }
     }
 
@@ -481,6 +494,9 @@ impl BundleUpdate for WarmStart {
 
 /// Bundles of one colour per parallel task.
 const BUNDLES_PER_TASK: usize = 32;
+
+/// Bundles per task of the (cheaper) target update.
+const TARGET_BUNDLES_PER_TASK: usize = 256;
 
 /// [`BodyLanes`] through the velocity pointers that one colour's threads share.
 trait SharedLanes {
