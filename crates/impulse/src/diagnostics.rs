@@ -44,6 +44,44 @@ pub fn natural_map_residual(
     linear: &[Vec3],
     angular: &[Vec3],
 ) -> f32 {
+    natural_map_residual_on(constraints, linear, angular, false)
+}
+
+/// Rows per partial sum of [`natural_map_residual_on`].
+const RESIDUAL_ROWS_PER_TASK: usize = 4096;
+
+/// [`natural_map_residual`], with `parallel` spreading runs of [`RESIDUAL_ROWS_PER_TASK`]
+/// rows over rayon's threads. The runs' partial sums are added in order on either path, so
+/// the result does not depend on the thread count.
+pub fn natural_map_residual_on(
+    constraints: &[ContactConstraint],
+    linear: &[Vec3],
+    angular: &[Vec3],
+    parallel: bool,
+) -> f32 {
+    let run = |rows: &[ContactConstraint]| squared_natural_map(rows, linear, angular);
+    let sum: f64 = if parallel
+        && constraints.len() > RESIDUAL_ROWS_PER_TASK
+        && rayon::current_num_threads() > 1
+    {
+        use rayon::prelude::*;
+        let parts: Vec<f64> = constraints
+            .par_chunks(RESIDUAL_ROWS_PER_TASK)
+            .map(run)
+            .collect();
+        parts.iter().sum()
+    } else {
+        constraints.chunks(RESIDUAL_ROWS_PER_TASK).map(run).sum()
+    };
+    sum.sqrt() as f32
+}
+
+/// Σ φ² over `constraints` (see [`StepDiagnostics::natural_map_residual`]).
+fn squared_natural_map(
+    constraints: &[ContactConstraint],
+    linear: &[Vec3],
+    angular: &[Vec3],
+) -> f64 {
     let mut sum = 0.0f64;
     for c in constraints {
         let (a, b) = (c.body_a as usize, c.body_b as usize);
@@ -64,7 +102,7 @@ pub fn natural_map_residual(
             }
         }
     }
-    sum.sqrt() as f32
+    sum
 }
 
 /// Total kinetic energy (J) and linear momentum (kg·m/s) of the moving bodies.

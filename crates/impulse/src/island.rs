@@ -8,6 +8,7 @@
 //! separate threads without sharing anything mutable. Quiet islands fall asleep.
 
 use glam::{Quat, Vec3};
+use parry3d::math::Pose;
 
 use crate::apgd::{self, ApgdWorkspace};
 use crate::body::Bodies;
@@ -50,6 +51,11 @@ impl Islands {
     /// Bodies of island `k`, in increasing index order.
     pub fn bodies(&self, k: usize) -> &[u32] {
         &self.bodies[self.body_start[k] as usize..self.body_start[k + 1] as usize]
+    }
+
+    /// Index of moving body `body` among its island's bodies ([`Islands::bodies`]).
+    pub fn local_index(&self, body: usize) -> usize {
+        self.parent[body] as usize
     }
 
     /// Position after [`Islands::build`] of the constraint that was at `index` before it.
@@ -576,13 +582,34 @@ pub fn step_island(
 pub fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut Bodies) {
     for (k, &i) in island_bodies.iter().enumerate() {
         let i = i as usize;
-        let com = bodies.center_of_mass(i) + workspace.displacement[k];
-        let rotation = workspace.orientation[k];
-        bodies.linear_velocity[i] = workspace.linear[k];
-        bodies.angular_velocity[i] = workspace.angular[k];
-        bodies.pose[i].rotation = rotation;
-        bodies.pose[i].translation = com - rotation * bodies.local_center_of_mass[i];
+        scatter_body(
+            workspace,
+            k,
+            bodies.local_center_of_mass[i],
+            &mut bodies.pose[i],
+            &mut bodies.linear_velocity[i],
+            &mut bodies.angular_velocity[i],
+        );
     }
+}
+
+/// Writes the body at local index `k` of `workspace`'s island back: its velocities and its
+/// pose (the centre of mass moved by the island's displacement, at its new orientation).
+#[inline]
+pub fn scatter_body(
+    workspace: &IslandWorkspace,
+    k: usize,
+    local_center_of_mass: Vec3,
+    pose: &mut Pose,
+    linear: &mut Vec3,
+    angular: &mut Vec3,
+) {
+    let com = pose.transform_point(local_center_of_mass) + workspace.displacement[k];
+    let rotation = workspace.orientation[k];
+    *linear = workspace.linear[k];
+    *angular = workspace.angular[k];
+    pose.rotation = rotation;
+    pose.translation = com - rotation * local_center_of_mass;
 }
 
 /// Heaviest to lightest moving body of an island (1 when it has one body).

@@ -43,6 +43,7 @@ pub struct World {
     islands: Islands,
     island_awake: Vec<bool>,
     workspaces: Vec<IslandWorkspace>,
+    island_residuals: Vec<f32>,
     /// Run islands (and the narrow phase) on rayon's thread pool when it has more than one
     /// thread. `false` runs everything on the calling thread.
     pub parallel: bool,
@@ -69,6 +70,7 @@ impl World {
             islands: Islands::default(),
             island_awake: Vec::new(),
             workspaces: Vec::new(),
+            island_residuals: Vec::new(),
             parallel: true,
             diagnostics: StepDiagnostics::default(),
         };
@@ -235,14 +237,10 @@ impl World {
                 jobs.iter_mut().for_each(run);
             }
         }
+        self.scatter_islands();
         let mut iterations = 0;
         for k in 0..islands {
             if self.island_awake[k] {
-                island::scatter(
-                    self.islands.bodies(k),
-                    &self.workspaces[k],
-                    &mut self.bodies,
-                );
                 iterations = iterations.max(self.workspaces[k].report.iterations);
             }
         }
@@ -259,13 +257,36 @@ impl World {
         // Reuse last step's list: no allocation per step once it has grown.
         let mut island_reports = std::mem::take(&mut self.diagnostics.islands);
         island_reports.clear();
-        for k in 0..islands {
+        let mut parts = std::mem::take(&mut self.island_residuals);
+        {
+            let (constraints, islands_of, awake) =
+                (&self.constraints, &self.islands, &self.island_awake);
+            let (linear, angular) = (&self.bodies.linear_velocity, &self.bodies.angular_velocity);
+            let parallel = self.parallel && rayon::current_num_threads() > 1;
+            let part = |k: usize| {
+                if awake[k] {
+                    diagnostics::natural_map_residual_on(
+                        &constraints[islands_of.constraint_range(k)],
+                        linear,
+                        angular,
+                        parallel,
+                    )
+                } else {
+                    0.0
+                }
+            };
+            if parallel {
+                (0..islands)
+                    .into_par_iter()
+                    .map(part)
+                    .collect_into_vec(&mut parts);
+            } else {
+                parts.clear();
+                parts.extend((0..islands).map(part));
+            }
+        }
+        for (k, &part) in parts.iter().enumerate() {
             if self.island_awake[k] {
-                let part = diagnostics::natural_map_residual(
-                    &self.constraints[self.islands.constraint_range(k)],
-                    &self.bodies.linear_velocity,
-                    &self.bodies.angular_velocity,
-                );
                 squared += (part as f64) * (part as f64);
                 if !self.islands.constraint_range(k).is_empty() {
                     island_reports.push(IslandReport {
@@ -275,6 +296,7 @@ impl World {
                 }
             }
         }
+        self.island_residuals = parts;
         let residual = squared.sqrt() as f32;
         // Sleep last: it zeroes velocities, which must not leak into this step's LCP.
         self.update_sleep(dt);
@@ -376,7 +398,7 @@ impl World {
         if self.parallel && rayon::current_num_threads() > 1 {
             (0..bodies.len())
                 .into_par_iter()
-                .with_min_len(1024)
+                .with_min_len(BODIES_PER_TASK)
                 .map(world)
                 .collect_into_vec(&mut self.world_inverse_inertia);
         } else {
@@ -384,6 +406,53 @@ impl World {
             self.world_inverse_inertia
                 .extend((0..bodies.len()).map(world));
         }
+    }
+
+    /// Writes every awake island's velocities and poses back into the bodies. In parallel,
+    /// runs of bodies each look up their island and local index (islands can be many and
+    /// small, or one and large; body runs split either evenly).
+    fn scatter_islands(&mut self) {
+        let islands = &self.islands;
+        let (workspaces, awake) = (&self.workspaces, &self.island_awake);
+        if !(self.parallel
+            && rayon::current_num_threads() > 1
+            && self.bodies.len() > BODIES_PER_TASK)
+        {
+            for k in 0..islands.len() {
+                if awake[k] {
+                    island::scatter(islands.bodies(k), &workspaces[k], &mut self.bodies);
+                }
+            }
+            return;
+        }
+        let Bodies {
+            pose,
+            linear_velocity,
+            angular_velocity,
+            local_center_of_mass,
+            ..
+        } = &mut self.bodies;
+        pose.par_iter_mut()
+            .zip(linear_velocity.par_iter_mut())
+            .zip(angular_velocity.par_iter_mut())
+            .enumerate()
+            .with_min_len(BODIES_PER_TASK)
+            .for_each(|(i, ((pose, linear), angular))| {
+                let Some(&k) = islands.island_of_body.get(i) else {
+                    return;
+                };
+                if k == u32::MAX || !awake[k as usize] {
+                    return;
+                }
+                island::scatter_body(
+                    &workspaces[k as usize],
+                    islands.local_index(i),
+                    local_center_of_mass[i],
+                    pose,
+                    linear,
+                    angular,
+                );
+            });
     }
 
     /// Writes the solved impulses back into the manifolds' points for next step's warm start.
@@ -541,6 +610,9 @@ fn write_impulse(c: &ContactConstraint, manifolds: &mut [narrow_phase::Manifold]
         }
     }
 }
+
+/// Bodies per parallel task of the per-body passes.
+const BODIES_PER_TASK: usize = 1024;
 
 fn check_dt(dt: f32) -> Result<(), WorldError> {
     if dt.is_finite() && dt > 0.0 {
