@@ -91,6 +91,8 @@ pub struct Bundles {
     parallel: bool,
     /// Constraint index of each lane of each bundle; `u32::MAX` for padding.
     sources: Vec<[u32; LANES]>,
+    /// Where each constraint went: bundle index × [`LANES`] + lane.
+    slots: Vec<u32>,
     /// Greedy colouring scratch: per slot, the colours its points use; per point, its colour.
     used: Vec<u64>,
     colours: Vec<u8>,
@@ -260,10 +262,10 @@ impl Bundles {
         self.geometry.resize(total, BundleGeometry::default());
         self.sources.clear();
         self.sources.resize(total, [u32::MAX; LANES]);
-        // Points in constraint order, each to the next free lane of its colour: the reads
-        // stream, and the writes go to one open bundle per colour (a few KiB).
+        // Each point to the next free lane of its colour, in constraint order.
+        self.slots.clear();
         let mut filled = [0usize; COLOURS + 1];
-        for (k, (c, &colour)) in constraints.iter().zip(&self.colours).enumerate() {
+        for (k, &colour) in self.colours.iter().enumerate() {
             let colour = colour as usize;
             let position = filled[colour];
             filled[colour] += 1;
@@ -271,30 +273,95 @@ impl Bundles {
             let index = bundle_start[colour] + position / per;
             let lane = position % per;
             self.sources[index][lane] = k as u32;
-            set_lane(&mut self.bundles[index], &mut self.geometry[index], lane, c);
+            self.slots.push((index * LANES + lane) as u32);
+        }
+        if self.parallel
+            && rayon::current_num_threads() > 1
+            && constraints.len() >= PARALLEL_PACK_POINTS
+        {
+            self.fill_parallel(constraints, &bundle_start);
+        } else {
+            // The reads stream, and the writes go to one open bundle per colour (a few KiB).
+            for (c, &slot) in constraints.iter().zip(&self.slots) {
+                let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
+                set_lane(&mut self.bundles[index], &mut self.geometry[index], lane, c);
+            }
         }
     }
 
-    /// Writes the bundles' impulses (and largest normal impulses) back to `constraints`, the
-    /// slice [`Bundles::pack`] read.
-    pub fn unpack(&self, constraints: &mut [ContactConstraint]) {
-        for (bundle, source) in self.bundles.iter().zip(&self.sources) {
-            let normal = bundle.normal_impulse.to_array();
-            let t1 = bundle.tangent_impulses[0].to_array();
-            let t2 = bundle.tangent_impulses[1].to_array();
-            let largest = bundle.max_normal_impulse.to_array();
-            let target = bundle.target.to_array();
-            let mass_scale = bundle.mass_scale.to_array();
-            let impulse_scale = bundle.impulse_scale.to_array();
-            for (i, &k) in source.iter().enumerate() {
-                if let Some(c) = constraints.get_mut(k as usize) {
-                    c.normal_impulse = normal[i];
-                    c.tangent_impulses = [t1[i], t2[i]];
-                    c.max_normal_impulse = largest[i];
-                    c.target_normal_velocity = target[i];
-                    c.softness = (mass_scale[i], impulse_scale[i]);
+    /// The lane writes of [`Bundles::pack`] on rayon's threads. Task t owns the t-th part of
+    /// every colour's bundles (so no two tasks write one bundle) and streams the constraints
+    /// from the first to the last one it owns: as each colour is spread evenly over the
+    /// constraints, that range is about a 1/tasks share and the tasks' ranges barely overlap.
+    /// Every lane gets the same value on any split.
+    fn fill_parallel(&mut self, constraints: &[ContactConstraint], bundle_start: &[usize]) {
+        use rayon::prelude::*;
+        let tasks = 2 * rayon::current_num_threads();
+        // Per task, per colour: (first bundle index, bundles, geometry).
+        type Part<'a> = (usize, &'a mut [Bundle], &'a mut [BundleGeometry]);
+        let mut parts: Vec<Vec<Part<'_>>> = (0..tasks).map(|_| Vec::new()).collect();
+        let (mut bundles, mut geometry) = (&mut self.bundles[..], &mut self.geometry[..]);
+        let mut first = 0;
+        for colour in 0..=COLOURS {
+            let count = bundle_start[colour + 1] - bundle_start[colour];
+            for (t, task_parts) in parts.iter_mut().enumerate() {
+                let size = count * (t + 1) / tasks - count * t / tasks;
+                let (mine, rest) = std::mem::take(&mut bundles).split_at_mut(size);
+                let (mine_geometry, rest_geometry) =
+                    std::mem::take(&mut geometry).split_at_mut(size);
+                bundles = rest;
+                geometry = rest_geometry;
+                task_parts.push((first, mine, mine_geometry));
+                first += size;
+            }
+        }
+        let (sources, slots, colours) = (&self.sources, &self.slots, &self.colours);
+        parts.into_par_iter().for_each(|mut task_parts| {
+            // Constraint range: lanes fill in constraint order within a colour, so a part's
+            // first lane holds its smallest index and its last real lane its largest.
+            let mut low = usize::MAX;
+            let mut high = 0;
+            for (start, part, _) in task_parts.iter().filter(|(_, part, _)| !part.is_empty()) {
+                low = low.min(sources[*start][0] as usize);
+                let last = sources[*start + part.len() - 1];
+                let largest = last.iter().filter(|&&k| k != u32::MAX).max();
+                high = high.max(largest.map_or(0, |&k| k as usize + 1));
+            }
+            for k in low..high.min(constraints.len()) {
+                let (index, lane) = (slots[k] as usize / LANES, slots[k] as usize % LANES);
+                let (start, part, geometry) = &mut task_parts[colours[k] as usize];
+                if let Some(i) = index.checked_sub(*start).filter(|&i| i < part.len()) {
+                    set_lane(&mut part[i], &mut geometry[i], lane, &constraints[k]);
                 }
             }
+        });
+    }
+
+    /// Writes the bundles' impulses (and largest normal impulses) back to `constraints`, the
+    /// slice [`Bundles::pack`] read. On rayon's threads when packing was.
+    pub fn unpack(&self, constraints: &mut [ContactConstraint]) {
+        let write = |(c, &slot): (&mut ContactConstraint, &u32)| {
+            let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
+            let b = &self.bundles[index];
+            let at = |x: &Lane| x.as_array()[lane];
+            c.normal_impulse = at(&b.normal_impulse);
+            c.tangent_impulses = [at(&b.tangent_impulses[0]), at(&b.tangent_impulses[1])];
+            c.max_normal_impulse = at(&b.max_normal_impulse);
+            c.target_normal_velocity = at(&b.target);
+            c.softness = (at(&b.mass_scale), at(&b.impulse_scale));
+        };
+        if self.parallel
+            && rayon::current_num_threads() > 1
+            && constraints.len() >= PARALLEL_PACK_POINTS
+        {
+            use rayon::prelude::*;
+            constraints
+                .par_iter_mut()
+                .zip(self.slots.par_iter())
+                .with_min_len(PARALLEL_PACK_POINTS / 4)
+                .for_each(write);
+        } else {
+            constraints.iter_mut().zip(&self.slots).for_each(write);
         }
     }
 
@@ -494,6 +561,9 @@ impl BundleUpdate for WarmStart {
 
 /// Bundles of one colour per parallel task.
 const BUNDLES_PER_TASK: usize = 32;
+
+/// Islands of at least this many points are packed and unpacked on rayon's threads.
+const PARALLEL_PACK_POINTS: usize = 4096;
 
 /// Bundles per task of the (cheaper) target update.
 const TARGET_BUNDLES_PER_TASK: usize = 256;
