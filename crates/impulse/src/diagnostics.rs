@@ -105,15 +105,45 @@ fn squared_natural_map(
     sum
 }
 
-/// Total kinetic energy (J) and linear momentum (kg·m/s) of the moving bodies.
-pub fn energy_and_momentum(bodies: &Bodies) -> (f32, Vec3) {
-    let mut energy = 0.0f64;
-    let mut momentum = Vec3::ZERO;
+/// Energy, mass and momentum of the moving bodies, from one pass over them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EnergyTerms {
+    /// Kinetic energy ½mv² + ½ωᵀIω (J).
+    pub kinetic: f64,
+    /// Gravitational potential energy −m·g·x of each centre of mass, zero at the origin (J).
+    pub potential: f64,
+    /// Total mass (kg).
+    pub mass: f64,
+    /// Linear momentum (kg·m/s).
+    pub momentum: Vec3,
+}
+
+impl EnergyTerms {
+    /// Kinetic plus potential energy (J). Without repair and edits between steps a step cannot
+    /// raise it: contacts only dissipate (restitution ≤ 1), so a rise beyond the overlap
+    /// repair's share is a blow-up ([`crate::world::BLOW_UP_ENERGY_PER_KG`]).
+    pub fn mechanical(&self) -> f64 {
+        self.kinetic + self.potential
+    }
+}
+
+/// [`EnergyTerms`] of the moving bodies under `gravity` (m/s²).
+pub fn energy_terms(bodies: &Bodies, gravity: Vec3) -> EnergyTerms {
+    let mut terms = EnergyTerms::default();
     for i in 0..bodies.len() {
         if bodies.inverse_mass[i] > 0.0 {
-            energy += bodies.kinetic_energy(i) as f64;
-            momentum += bodies.linear_velocity[i] / bodies.inverse_mass[i];
+            let m = 1.0 / bodies.inverse_mass[i];
+            terms.kinetic += bodies.kinetic_energy(i) as f64;
+            terms.potential += (-m * gravity.dot(bodies.center_of_mass(i))) as f64;
+            terms.mass += m as f64;
+            terms.momentum += bodies.linear_velocity[i] * m;
         }
     }
-    (energy as f32, momentum)
+    terms
+}
+
+/// Total kinetic energy (J) and linear momentum (kg·m/s) of the moving bodies.
+pub fn energy_and_momentum(bodies: &Bodies) -> (f32, Vec3) {
+    let terms = energy_terms(bodies, Vec3::ZERO);
+    (terms.kinetic as f32, terms.momentum)
 }

@@ -48,6 +48,25 @@ pub enum StepError {
         /// The bound it crossed.
         bound: f32,
     },
+    /// The bodies' mechanical energy (kinetic + gravitational) rose more than
+    /// [`crate::world::BLOW_UP_ENERGY_PER_KG`] per kilogram of moving mass above its lowest
+    /// since the last edit: the solve created energy, which contacts cannot.
+    #[error(
+        "simulation blew up at step {step}: mechanical energy rose {gain_per_kg} J per kg of \
+         moving mass above its lowest (bound {bound}); fastest body {fastest_body} at {speed} m/s"
+    )]
+    EnergyBlowUp {
+        /// The step (counted from 1) during which the bound was crossed.
+        step: u64,
+        /// Energy gained per kilogram of moving mass (J/kg); may be NaN.
+        gain_per_kg: f32,
+        /// The bound it crossed (J/kg).
+        bound: f32,
+        /// Index of the fastest body, where to start looking.
+        fastest_body: usize,
+        /// Its speed (m/s).
+        speed: f32,
+    },
     /// A setting was changed to an invalid value between steps.
     #[error("invalid settings: {0}")]
     InvalidSettings(String),

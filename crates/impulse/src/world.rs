@@ -22,6 +22,27 @@ use rayon::prelude::*;
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
 /// A body faster than this (m/s) means the simulation has blown up.
 pub const BLOW_UP_SPEED: f32 = 1.0e4;
+/// Mechanical energy (kinetic + gravitational, [`diagnostics::EnergyTerms`]) more than
+/// this many joules per kilogram of moving mass above the lowest it has been since the last
+/// edit means the simulation has blown up. Contacts only take energy out; what the overlap
+/// repair puts in is lifting bodies out of each other (the `overlap_pyramid` scene, started
+/// 25 % overlapping, gains about 10 J/kg). 50 J/kg is every body lifted 5 m or moving at
+/// 10 m/s. A solve that fails to hold a pile can push it apart far faster than that while no
+/// body comes near [`BLOW_UP_SPEED`]: `impulse run pyramid100 --method pgs --substeps 4
+/// --iterations 1 --position-iterations 1` gained ~900 J/kg within 40 steps and sent the top
+/// cube 170 m up. Changing bodies between steps (velocities, poses, new bodies) restarts the
+/// reference.
+pub const BLOW_UP_ENERGY_PER_KG: f64 = 50.0;
+
+/// The energy check's state: the lowest mechanical energy since the last edit (J) and the
+/// energy at the end of the last step, to recognise edits made between steps.
+#[derive(Clone, Copy, Debug, Default)]
+struct EnergyCheck {
+    lowest: f64,
+    last: f64,
+    bodies: usize,
+    started: bool,
+}
 
 /// Bodies, settings and the persistent contact state of a simulation.
 pub struct World {
@@ -44,6 +65,7 @@ pub struct World {
     island_awake: Vec<bool>,
     workspaces: Vec<IslandWorkspace>,
     island_residuals: Vec<f32>,
+    energy: EnergyCheck,
     /// Run islands (and the narrow phase) on rayon's thread pool when it has more than one
     /// thread. `false` runs everything on the calling thread.
     pub parallel: bool,
@@ -71,6 +93,7 @@ impl World {
             island_awake: Vec::new(),
             workspaces: Vec::new(),
             island_residuals: Vec::new(),
+            energy: EnergyCheck::default(),
             parallel: true,
             diagnostics: StepDiagnostics::default(),
         };
@@ -171,6 +194,19 @@ impl World {
         let dt = self.dt;
         let settings = self.settings.clone();
         self.step_count += 1;
+        // The energy check's reference restarts whenever the bodies changed since the last step.
+        let start_energy = diagnostics::energy_terms(&self.bodies, self.gravity).mechanical();
+        if !self.energy.started
+            || self.energy.bodies != self.bodies.len()
+            || start_energy != self.energy.last
+        {
+            self.energy = EnergyCheck {
+                lowest: start_energy,
+                last: start_energy,
+                bodies: self.bodies.len(),
+                started: true,
+            };
+        }
 
         // Stages 2–4 once per step, on the poses and velocities at its start.
         narrow_phase::speculative_margins(
@@ -301,7 +337,7 @@ impl World {
         // Sleep last: it zeroes velocities, which must not leak into this step's LCP.
         self.update_sleep(dt);
 
-        let (kinetic_energy, momentum) = diagnostics::energy_and_momentum(&self.bodies);
+        let energy = diagnostics::energy_terms(&self.bodies, self.gravity);
         let friction_rows = self.constraints.iter().filter(|c| c.friction > 0.0).count();
         self.diagnostics = StepDiagnostics {
             step: self.step_count,
@@ -317,10 +353,10 @@ impl World {
             natural_map_residual: residual,
             islands: island_reports,
             max_depth: self.narrow_phase.max_depth(),
-            kinetic_energy,
-            linear_momentum: momentum.to_array(),
+            kinetic_energy: energy.kinetic as f32,
+            linear_momentum: energy.momentum.to_array(),
         };
-        self.check_blow_up()?;
+        self.check_blow_up(&energy)?;
         Ok(&self.diagnostics)
     }
 
@@ -508,7 +544,28 @@ impl World {
         }
     }
 
-    fn check_blow_up(&self) -> Result<(), StepError> {
+    fn check_blow_up(&mut self, terms: &diagnostics::EnergyTerms) -> Result<(), StepError> {
+        let energy = terms.mechanical();
+        let gain = (energy - self.energy.lowest) / terms.mass.max(f64::MIN_POSITIVE);
+        self.energy.lowest = self.energy.lowest.min(energy);
+        self.energy.last = energy;
+        if gain.is_nan() || gain > BLOW_UP_ENERGY_PER_KG {
+            let speed = |k: usize| self.bodies.linear_velocity[k].length();
+            let fastest = (0..self.bodies.len())
+                .max_by(|&i, &j| speed(i).total_cmp(&speed(j)))
+                .unwrap_or(0);
+            return Err(StepError::EnergyBlowUp {
+                step: self.step_count,
+                gain_per_kg: gain as f32,
+                bound: BLOW_UP_ENERGY_PER_KG as f32,
+                fastest_body: fastest,
+                speed: if self.bodies.is_empty() {
+                    0.0
+                } else {
+                    speed(fastest)
+                },
+            });
+        }
         let b = &self.bodies;
         for i in 0..b.len() {
             let position = b.pose[i].translation.length();
