@@ -89,10 +89,21 @@ impl Bodies {
         let mut energy = 0.5 * v.length_squared() / self.inverse_mass[i];
         let w = self.angular_velocity[i];
         if w != Vec3::ZERO {
-            // Solve I·x = ω through the inverse tensor: ωᵀIω = ωᵀ(I⁻¹)⁻¹ω.
-            let inv = self.world_inverse_inertia(i);
-            if inv.determinant().abs() > f32::MIN_POSITIVE {
-                energy += 0.5 * w.dot(inv.inverse() * w);
+            // ωᵀ·I_world·ω = ω_lᵀ·I_local·ω_l with ω_l = Rᵀω: no world tensor to build, and
+            // I_local = (I⁻¹_local)⁻¹ is a division per axis for the usual diagonal tensor.
+            let local = self.pose[i].rotation.inverse() * w;
+            let inv = &self.local_inverse_inertia[i];
+            let diagonal = Vec3::new(inv.x_axis.x, inv.y_axis.y, inv.z_axis.z);
+            let off_diagonal = inv.x_axis.y != 0.0
+                || inv.x_axis.z != 0.0
+                || inv.y_axis.x != 0.0
+                || inv.y_axis.z != 0.0
+                || inv.z_axis.x != 0.0
+                || inv.z_axis.y != 0.0;
+            if !off_diagonal && diagonal.cmpgt(Vec3::ZERO).all() {
+                energy += 0.5 * local.dot(local / diagonal);
+            } else if inv.determinant().abs() > f32::MIN_POSITIVE {
+                energy += 0.5 * local.dot(inv.inverse() * local);
             }
         }
         energy
