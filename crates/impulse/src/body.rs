@@ -115,3 +115,43 @@ pub(crate) fn rotate_tensor(rotation: Quat, tensor: &Mat3) -> Mat3 {
     let r = Mat3::from_quat(rotation);
     r * *tensor * r.transpose()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parry3d::shape::Ball;
+
+    /// ½ωᵀIω computed in the body frame equals the world-frame formula ½ωᵀ(R·I⁻¹·Rᵀ)⁻¹ω, for
+    /// a diagonal tensor and a full one, at a rotation that mixes all three axes.
+    #[test]
+    fn rotational_energy_in_the_body_frame_matches_the_world_tensor() {
+        let rotation = Quat::from_euler(glam::EulerRot::XYZ, 0.7, -1.1, 2.3);
+        let full = Mat3::from_cols_array(&[0.5, 0.1, -0.05, 0.1, 0.8, 0.2, -0.05, 0.2, 1.3]);
+        for inverse_inertia in [Mat3::from_diagonal(Vec3::new(0.5, 2.0, 4.0)), full] {
+            let mut bodies = Bodies::default();
+            bodies.kind.push(BodyKind::Dynamic);
+            bodies
+                .pose
+                .push(Pose::from_parts(Vec3::new(1.0, 2.0, 3.0), rotation));
+            bodies.local_center_of_mass.push(Vec3::ZERO);
+            bodies.linear_velocity.push(Vec3::new(1.0, -2.0, 0.5));
+            let omega = Vec3::new(3.0, -1.0, 2.0);
+            bodies.angular_velocity.push(omega);
+            bodies.inverse_mass.push(0.25);
+            bodies.local_inverse_inertia.push(inverse_inertia);
+            bodies.shape.push(SharedShape::new(Ball::new(0.5)));
+            bodies.friction.push(0.5);
+            bodies.restitution.push(0.0);
+            bodies.asleep.push(false);
+            bodies.sleep_time.push(0.0);
+            let world = rotate_tensor(rotation, &inverse_inertia);
+            let expected = 0.5 * 4.0 * Vec3::new(1.0, -2.0, 0.5).length_squared()
+                + 0.5 * omega.dot(world.inverse() * omega);
+            let energy = bodies.kinetic_energy(0);
+            assert!(
+                (energy - expected).abs() < 1e-4 * expected,
+                "{energy} J against {expected} J"
+            );
+        }
+    }
+}
