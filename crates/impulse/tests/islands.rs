@@ -138,14 +138,7 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
             parallel_island_contacts: 1000,
             ..settings
         };
-        let mut one = World::from_scene(&scene).unwrap();
-        one.parallel = false;
-        let mut two = World::from_scene(&scene).unwrap();
-        two.parallel = true;
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .unwrap();
+        let (mut one, mut two, pool) = one_and_two_threads(&scene);
         let top = (0..one.bodies.len())
             .max_by(|&i, &j| {
                 let (a, b) = (
@@ -186,14 +179,7 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
 fn many_bodies_on_two_threads_match_one_thread_bit_for_bit() {
     let mut scene = impulse::scene::builtin::builtin_scene("balls4096").unwrap();
     scene.solver.sleep = false;
-    let mut one = World::from_scene(&scene).unwrap();
-    one.parallel = false;
-    let mut two = World::from_scene(&scene).unwrap();
-    two.parallel = true;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
+    let (mut one, mut two, pool) = one_and_two_threads(&scene);
     let mut contacts = 0;
     for _ in 0..45 {
         let a = one.step().unwrap().clone();
@@ -213,4 +199,18 @@ fn many_bodies_on_two_threads_match_one_thread_bit_for_bit() {
             two.bodies.angular_velocity[i]
         );
     }
+}
+
+/// Two worlds of `scene`: one that never uses worker threads, one that does, and a pool of two
+/// threads to step the second in.
+fn one_and_two_threads(scene: &impulse::Scene) -> (World, World, rayon::ThreadPool) {
+    let mut one = World::from_scene(scene).unwrap();
+    one.parallel = false;
+    let mut two = World::from_scene(scene).unwrap();
+    two.parallel = true;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    (one, two, pool)
 }
