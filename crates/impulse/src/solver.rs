@@ -50,6 +50,12 @@ pub struct Sweep<'a> {
 }
 
 impl Sweep<'_> {
+    /// True when the island's `points` are sorted by colour ([`colour_constraints`]).
+    pub(crate) fn coloured(&self, points: usize) -> bool {
+        let colours = self.starts.len().saturating_sub(1);
+        colours > 0 && self.starts[colours] as usize == points
+    }
+
     /// Constraint order, one thread: the sweep of [`solve_pgs`]'s documentation.
     pub const SEQUENTIAL: Sweep<'static> = Sweep {
         starts: &[],
@@ -138,6 +144,30 @@ pub(crate) struct SharedVelocities {
     pub(crate) immovable: usize,
 }
 
+impl SharedVelocities {
+    /// [`apply_impulses`] through the shared pointers.
+    ///
+    /// # Safety
+    /// `c`'s slots are below the arrays' length, and no other thread touches them meanwhile
+    /// (the immovable slot is only read).
+    #[inline(always)]
+    unsafe fn apply(&self, c: &ContactConstraint, impulses: [f32; 3]) {
+        let (a, b) = (c.local_a as usize, c.local_b as usize);
+        let (linear, angular_a, angular_b) = impulse_velocity_changes(c, impulses);
+        // SAFETY: the caller's contract.
+        unsafe {
+            if a != self.immovable {
+                *self.linear.add(a) += linear * c.inverse_mass_a;
+                *self.angular.add(a) += angular_a;
+            }
+            if b != self.immovable {
+                *self.linear.add(b) -= linear * c.inverse_mass_b;
+                *self.angular.add(b) -= angular_b;
+            }
+        }
+    }
+}
+
 // SAFETY: see the type's documentation; each thread touches a disjoint set of slots.
 unsafe impl Send for SharedVelocities {}
 // SAFETY: as above.
@@ -223,7 +253,7 @@ where
     let slots = velocities.linear.len().min(velocities.angular.len());
     // A coloured sweep comes from the island step, right after `colour_constraints` checked
     // every slot against the island's `slots` arrays (see `Sweep`).
-    let coloured = colours > 0 && sweep.starts[colours] as usize == constraints.len();
+    let coloured = sweep.coloured(constraints.len());
     debug_assert!(
         !coloured
             || constraints
@@ -466,52 +496,185 @@ pub fn solve_nncg(
             break;
         }
         // −∇f = x_{k+1} − x_k.
-        let mut norm = 0.0f64;
-        for (c, previous) in constraints.iter().zip(&workspace.previous) {
-            let x = impulses(c);
-            for k in 0..3 {
-                let g = (x[k] - previous[k]) as f64;
-                norm += g * g;
-            }
-        }
+        let coloured = sweep.coloured(n);
+        let norm = gradient_norm(constraints, &workspace.previous, coloured, sweep.parallel);
         let beta = if iteration == 0 || previous_norm == 0.0 {
             0.0
         } else {
             norm / previous_norm
         };
         previous_norm = norm;
-        let restart = beta > 1.0 || beta == 0.0;
-        let beta = beta as f32;
-        for (c, (previous, direction)) in constraints.iter_mut().zip(
-            workspace
-                .previous
-                .iter_mut()
-                .zip(workspace.direction.iter_mut()),
-        ) {
-            let x = impulses(c);
-            let gradient_step = [x[0] - previous[0], x[1] - previous[1], x[2] - previous[2]];
-            if restart {
-                *direction = gradient_step;
-            } else {
-                let push = [
-                    beta * direction[0],
-                    beta * direction[1],
-                    beta * direction[2],
-                ];
-                if push != [0.0; 3] {
-                    c.normal_impulse += push[0];
-                    c.tangent_impulses[0] += push[1];
-                    c.tangent_impulses[1] += push[2];
-                    apply_impulses(c, push, velocities);
-                }
-                for k in 0..3 {
-                    direction[k] = push[k] + gradient_step[k];
-                }
-            }
-            *previous = impulses(c);
-        }
+        let step = Momentum {
+            beta: beta as f32,
+            restart: beta > 1.0 || beta == 0.0,
+        };
+        step.apply(
+            constraints,
+            &mut workspace.previous,
+            &mut workspace.direction,
+            sweep,
+            velocities,
+        );
     }
     report
+}
+
+/// Points per partial sum of NNCG's gradient norm on a coloured island.
+const NORM_POINTS_PER_TASK: usize = 4096;
+
+/// ‖x_{k+1} − x_k‖² over the points' three impulses. A coloured island sums fixed runs of
+/// [`NORM_POINTS_PER_TASK`] points and adds the partial sums in order, on rayon's threads
+/// with `parallel`, so its β does not depend on the thread count; an island in constraint
+/// order sums in one run, as before colouring existed.
+fn gradient_norm(
+    constraints: &[ContactConstraint],
+    previous: &[[f32; 3]],
+    coloured: bool,
+    parallel: bool,
+) -> f64 {
+    let run = |(constraints, previous): (&[ContactConstraint], &[[f32; 3]])| {
+        let mut norm = 0.0f64;
+        for (c, previous) in constraints.iter().zip(previous) {
+            let x = impulses(c);
+            for k in 0..3 {
+                let g = (x[k] - previous[k]) as f64;
+                norm += g * g;
+            }
+        }
+        norm
+    };
+    if !coloured {
+        return run((constraints, previous));
+    }
+    if parallel && rayon::current_num_threads() > 1 {
+        use rayon::prelude::*;
+        let parts: Vec<f64> = constraints
+            .par_chunks(NORM_POINTS_PER_TASK)
+            .zip(previous.par_chunks(NORM_POINTS_PER_TASK))
+            .map(run)
+            .collect();
+        parts.into_iter().sum()
+    } else {
+        constraints
+            .chunks(NORM_POINTS_PER_TASK)
+            .zip(previous.chunks(NORM_POINTS_PER_TASK))
+            .map(run)
+            .sum()
+    }
+}
+
+/// NNCG's momentum step x += β·p, p ← β·p − ∇f (or p ← −∇f on a restart).
+#[derive(Clone, Copy)]
+struct Momentum {
+    beta: f32,
+    restart: bool,
+}
+
+impl Momentum {
+    /// Updates one point's impulses, `previous` and `direction`; returns the impulse it added
+    /// (zero on a restart), which the caller applies to the velocities.
+    #[inline(always)]
+    fn point(
+        self,
+        c: &mut ContactConstraint,
+        previous: &mut [f32; 3],
+        direction: &mut [f32; 3],
+    ) -> [f32; 3] {
+        let x = impulses(c);
+        let gradient_step = [x[0] - previous[0], x[1] - previous[1], x[2] - previous[2]];
+        let mut push = [0.0; 3];
+        if self.restart {
+            *direction = gradient_step;
+        } else {
+            push = [
+                self.beta * direction[0],
+                self.beta * direction[1],
+                self.beta * direction[2],
+            ];
+            if push != [0.0; 3] {
+                c.normal_impulse += push[0];
+                c.tangent_impulses[0] += push[1];
+                c.tangent_impulses[1] += push[2];
+            }
+            for k in 0..3 {
+                direction[k] = push[k] + gradient_step[k];
+            }
+        }
+        *previous = impulses(c);
+        push
+    }
+
+    /// The step over all points. On a coloured island with `parallel`, colour by colour in
+    /// order, each colour's points on rayon's threads: a body is pushed by at most one point
+    /// of a colour, so every body receives its pushes in constraint order, as on one thread.
+    fn apply(
+        self,
+        constraints: &mut [ContactConstraint],
+        previous: &mut [[f32; 3]],
+        direction: &mut [[f32; 3]],
+        sweep: Sweep<'_>,
+        velocities: &mut Velocities<'_>,
+    ) {
+        let colours = sweep.starts.len().saturating_sub(1);
+        let serial = |constraints: &mut [ContactConstraint],
+                      previous: &mut [[f32; 3]],
+                      direction: &mut [[f32; 3]],
+                      velocities: &mut Velocities<'_>| {
+            for (c, (previous, direction)) in constraints
+                .iter_mut()
+                .zip(previous.iter_mut().zip(direction))
+            {
+                let push = self.point(c, previous, direction);
+                if push != [0.0; 3] {
+                    apply_impulses(c, push, velocities);
+                }
+            }
+        };
+        if !sweep.coloured(constraints.len()) || !sweep.parallel || rayon::current_num_threads() < 2
+        {
+            serial(constraints, previous, direction, velocities);
+            return;
+        }
+        let slots = velocities.linear.len().min(velocities.angular.len());
+        let shared = SharedVelocities {
+            linear: velocities.linear.as_mut_ptr(),
+            angular: velocities.angular.as_mut_ptr(),
+            immovable: slots - 1,
+        };
+        for k in 0..colours {
+            let range = sweep.starts[k] as usize..sweep.starts[k + 1] as usize;
+            let (part, part_previous, part_direction) = (
+                &mut constraints[range.clone()],
+                &mut previous[range.clone()],
+                &mut direction[range],
+            );
+            if k >= COLOURS || part.len() < 2 * POINTS_PER_TASK {
+                serial(part, part_previous, part_direction, velocities);
+                continue;
+            }
+            use rayon::prelude::*;
+            part.par_chunks_mut(POINTS_PER_TASK)
+                .zip(part_previous.par_chunks_mut(POINTS_PER_TASK))
+                .zip(part_direction.par_chunks_mut(POINTS_PER_TASK))
+                .for_each(|((chunk, chunk_previous), chunk_direction)| {
+                    // Capture the whole wrapper (Sync), not its raw-pointer fields (not Sync).
+                    #[allow(clippy::redundant_locals)]
+                    let shared = shared;
+                    for (c, (previous, direction)) in chunk
+                        .iter_mut()
+                        .zip(chunk_previous.iter_mut().zip(chunk_direction))
+                    {
+                        let push = self.point(c, previous, direction);
+                        if push != [0.0; 3] {
+                            // SAFETY: as in `sweep_points`: slots are below `slots`, and
+                            // within this colour only this point touches slots a and b
+                            // (the immovable slot is never written).
+                            unsafe { shared.apply(c, push) };
+                        }
+                    }
+                });
+        }
+    }
 }
 
 /// One Gauss-Seidel update of a contact point's rows: the friction pair as a 2×2 block
@@ -578,17 +741,26 @@ pub(crate) fn apply_impulses(
     velocities: &mut Velocities<'_>,
 ) {
     let (a, b) = (c.local_a as usize, c.local_b as usize);
+    let (linear, angular_a, angular_b) = impulse_velocity_changes(c, impulses);
+    velocities.linear[a] += linear * c.inverse_mass_a;
+    velocities.linear[b] -= linear * c.inverse_mass_b;
+    velocities.angular[a] += angular_a;
+    velocities.angular[b] -= angular_b;
+}
+
+/// Jᵀγ's linear part and I⁻¹(r × Jᵀγ) for A and B, for the point's (normal, t1, t2) impulses.
+#[inline(always)]
+fn impulse_velocity_changes(c: &ContactConstraint, impulses: [f32; 3]) -> (Vec3, Vec3, Vec3) {
     let [n, t1, t2] = [&c.normal, &c.tangents[0], &c.tangents[1]];
     let linear =
         n.direction * impulses[0] + t1.direction * impulses[1] + t2.direction * impulses[2];
-    velocities.linear[a] += linear * c.inverse_mass_a;
-    velocities.linear[b] -= linear * c.inverse_mass_b;
-    velocities.angular[a] += n.inverse_inertia_angular_a * impulses[0]
+    let angular_a = n.inverse_inertia_angular_a * impulses[0]
         + t1.inverse_inertia_angular_a * impulses[1]
         + t2.inverse_inertia_angular_a * impulses[2];
-    velocities.angular[b] -= n.inverse_inertia_angular_b * impulses[0]
+    let angular_b = n.inverse_inertia_angular_b * impulses[0]
         + t1.inverse_inertia_angular_b * impulses[1]
         + t2.inverse_inertia_angular_b * impulses[2];
+    (linear, angular_a, angular_b)
 }
 
 /// The position solve of split impulse: PGS over the normal rows alone, on pseudo-velocities
