@@ -7,6 +7,7 @@
 use glam::{Mat3, Vec3};
 
 use crate::body::Bodies;
+use crate::island::Islands;
 use crate::narrow_phase::{ContactPair, NarrowPhase, repeats_earlier_point, same_point};
 use crate::settings::SolverSettings;
 use rayon::prelude::*;
@@ -153,7 +154,8 @@ impl ContactConstraint {
     }
 }
 
-/// Builds one constraint per contact point, in narrow-phase order (pairs sorted by body index).
+/// Builds one constraint per contact point, island by island in `islands`' pair order
+/// (within an island, narrow-phase order), with each constraint's local body slots set.
 /// `velocity_before` is read from the current velocities: called before gravity is applied, it
 /// is the approach velocity v⁻ that restitution reflects. Targets are left at zero.
 ///
@@ -163,34 +165,39 @@ impl ContactConstraint {
 pub fn assemble(
     bodies: &Bodies,
     narrow_phase: &NarrowPhase,
+    islands: &Islands,
     settings: &SolverSettings,
     world_inverse_inertia: &[Mat3],
     parallel: bool,
     out: &mut Vec<ContactConstraint>,
 ) {
     let pairs = &narrow_phase.pairs;
-    let total: usize = pairs.iter().map(ContactPair::row_count).sum();
+    let order = islands.pair_order();
+    let rows =
+        |indices: &[u32]| -> usize { indices.iter().map(|&p| pairs[p as usize].row_count()).sum() };
+    let total = rows(order);
     // Every slot is overwritten below; resizing only fills slots the vector did not have.
     out.truncate(total);
     out.resize(total, ContactConstraint::default());
     let context = Assembly {
         bodies,
+        pairs,
+        islands,
         settings,
         world_inverse_inertia,
     };
-    if parallel && rayon::current_num_threads() > 1 && pairs.len() > PAIRS_PER_TASK {
-        let mut jobs = Vec::with_capacity(pairs.len().div_ceil(PAIRS_PER_TASK));
+    if parallel && rayon::current_num_threads() > 1 && order.len() > PAIRS_PER_TASK {
+        let mut jobs = Vec::with_capacity(order.len().div_ceil(PAIRS_PER_TASK));
         let mut rest: &mut [ContactConstraint] = out;
-        for (k, chunk) in pairs.chunks(PAIRS_PER_TASK).enumerate() {
-            let rows = chunk.iter().map(ContactPair::row_count).sum();
-            let (mine, others) = rest.split_at_mut(rows);
+        for chunk in order.chunks(PAIRS_PER_TASK) {
+            let (mine, others) = rest.split_at_mut(rows(chunk));
             rest = others;
-            jobs.push((k * PAIRS_PER_TASK, chunk, mine));
+            jobs.push((chunk, mine));
         }
         jobs.into_par_iter()
-            .for_each(|(first, chunk, slots)| context.pairs(first, chunk, slots));
+            .for_each(|(chunk, slots)| context.pairs(chunk, slots));
     } else {
-        context.pairs(0, pairs, out);
+        context.pairs(order, out);
     }
 }
 
@@ -199,20 +206,24 @@ pub const PAIRS_PER_TASK: usize = 1024;
 
 struct Assembly<'a> {
     bodies: &'a Bodies,
+    pairs: &'a [ContactPair],
+    islands: &'a Islands,
     settings: &'a SolverSettings,
     world_inverse_inertia: &'a [Mat3],
 }
 
 impl Assembly<'_> {
-    /// Assembles `pairs` (narrow-phase pairs `first..`) into `out`, which has exactly their
-    /// row count.
-    fn pairs(&self, first: usize, pairs: &[ContactPair], out: &mut [ContactConstraint]) {
+    /// Assembles the pairs with indices `order` into `out`, which has exactly their row count.
+    fn pairs(&self, order: &[u32], out: &mut [ContactConstraint]) {
         let (bodies, settings) = (self.bodies, self.settings);
         let mut slots = out.iter_mut();
-        for (pair_index, pair) in (first..).zip(pairs) {
+        for &pair_index in order {
+            let pair = &self.pairs[pair_index as usize];
             // Parry's shape 1 is body1 and its normal n1 points from shape 1 towards shape 2,
             // so in the seed's convention (n points from B towards A): B = body1, A = body2.
             let (b, a) = (pair.body1 as usize, pair.body2 as usize);
+            let island = self.islands.island_of_pair(b, a);
+            let (local_a, local_b) = (self.islands.slot(a, island), self.islands.slot(b, island));
             let pose_a = &bodies.pose[a];
             let pose_b = &bodies.pose[b];
             let com_a = bodies.center_of_mass(a);
@@ -276,8 +287,8 @@ impl Assembly<'_> {
                     *slot = ContactConstraint {
                         body_a: a as u32,
                         body_b: b as u32,
-                        local_a: 0,
-                        local_b: 0,
+                        local_a,
+                        local_b,
                         inverse_mass_a,
                         inverse_mass_b,
                         normal: normal_row,
@@ -296,7 +307,7 @@ impl Assembly<'_> {
                         tangent_impulses: [warm.friction.dot(t1), warm.friction.dot(t2)],
                         depth,
                         max_normal_impulse: 0.0,
-                        source: (pair_index as u32, manifold_index as u16, point_index as u16),
+                        source: (pair_index, manifold_index as u16, point_index as u16),
                     };
                 }
             }

@@ -221,9 +221,13 @@ impl World {
         self.narrow_phase
             .update(&self.bodies, &self.candidates, &self.margins, self.parallel)?;
         self.update_world_inverse_inertia();
+        // Islands from the pairs first, so that assembly writes each island's constraints
+        // contiguously and nothing has to be moved afterwards.
+        self.islands.build(&self.bodies, &self.narrow_phase.pairs);
         constraints::assemble(
             &self.bodies,
             &self.narrow_phase,
+            &self.islands,
             &settings,
             &self.world_inverse_inertia,
             self.parallel,
@@ -232,7 +236,6 @@ impl World {
         solver::scale_impulses(&mut self.constraints, settings.warm_start);
 
         // Stages 1, 5 and 6 per island: each island's substep loop touches only its bodies.
-        self.islands.build(&self.bodies, &mut self.constraints);
         let islands = self.islands.len();
         self.wake_or_skip_islands();
         if self.workspaces.len() < islands {
@@ -494,48 +497,45 @@ impl World {
     /// Writes the solved impulses back into the manifolds' points for next step's warm start.
     ///
     /// Runs over the pairs (in parallel runs of [`constraints::PAIRS_PER_TASK`]), each finding
-    /// its rows where assembly put them and the island sort moved them, so every manifold is
-    /// written by one task. Serial and in island order, this was 3 % of a balls16k step, spent
-    /// waiting on the manifolds' scattered heap blocks. An island swept colour by colour has
-    /// its rows re-sorted by colour; a row found under the wrong pair then sends the whole
-    /// write-back to the serial path, which follows each row's `source`.
+    /// its rows where assembly put them, so every manifold is written by one task. Serial and
+    /// in island order, this was 3 % of a balls16k step, spent waiting on the manifolds'
+    /// scattered heap blocks. An island swept colour by colour has its rows re-sorted by
+    /// colour; a row found under the wrong pair then sends the whole write-back to the serial
+    /// path, which follows each row's `source`.
     fn store_impulses(&mut self) {
         let constraints = &self.constraints;
         let islands = &self.islands;
-        let store =
-            |first_pair: usize, first_row: usize, pairs: &mut [narrow_phase::ContactPair]| {
-                let mut row = first_row;
-                for (pair_index, pair) in (first_pair..).zip(pairs) {
-                    for _ in 0..pair.row_count() {
-                        let Some(c) = constraints.get(islands.sorted_position(row)) else {
-                            return false;
-                        };
-                        row += 1;
-                        if c.source.0 as usize != pair_index {
-                            return false;
-                        }
-                        write_impulse(c, &mut pair.manifolds);
+        let store = |first_pair: usize, pairs: &mut [narrow_phase::ContactPair]| {
+            for (pair_index, pair) in (first_pair..).zip(pairs) {
+                let first = if pair.row_count() > 0 {
+                    islands.first_row(pair_index)
+                } else {
+                    0
+                };
+                for row in first..first + pair.row_count() {
+                    let Some(c) = constraints.get(row) else {
+                        return false;
+                    };
+                    if c.source.0 as usize != pair_index {
+                        return false;
                     }
+                    write_impulse(c, &mut pair.manifolds);
                 }
-                true
-            };
+            }
+            true
+        };
         let pairs = &mut self.narrow_phase.pairs;
         let in_place = if self.parallel
             && rayon::current_num_threads() > 1
             && pairs.len() > constraints::PAIRS_PER_TASK
         {
-            let mut jobs = Vec::with_capacity(pairs.len().div_ceil(constraints::PAIRS_PER_TASK));
-            let mut first_row = 0;
-            for (k, chunk) in pairs.chunks_mut(constraints::PAIRS_PER_TASK).enumerate() {
-                let rows: usize = chunk.iter().map(narrow_phase::ContactPair::row_count).sum();
-                jobs.push((k * constraints::PAIRS_PER_TASK, first_row, chunk));
-                first_row += rows;
-            }
-            jobs.into_par_iter()
-                .map(|(first_pair, first_row, chunk)| store(first_pair, first_row, chunk))
+            pairs
+                .par_chunks_mut(constraints::PAIRS_PER_TASK)
+                .enumerate()
+                .map(|(k, chunk)| store(k * constraints::PAIRS_PER_TASK, chunk))
                 .reduce(|| true, |x, y| x && y)
         } else {
-            store(0, 0, pairs)
+            store(0, pairs)
         };
         if !in_place {
             for c in constraints {
