@@ -8,7 +8,9 @@ use glam::{Mat3, Vec3};
 
 use crate::body::Bodies;
 use crate::island::Islands;
-use crate::narrow_phase::{ContactPair, NarrowPhase, repeats_earlier_point, same_point};
+use crate::narrow_phase::{
+    ContactPair, NarrowPhase, PREFETCH_AHEAD, prefetch, repeats_earlier_point, same_point,
+};
 use crate::settings::SolverSettings;
 use rayon::prelude::*;
 
@@ -217,8 +219,25 @@ impl Assembly<'_> {
     fn pairs(&self, order: &[u32], out: &mut [ContactConstraint]) {
         let (bodies, settings) = (self.bodies, self.settings);
         let mut slots = out.iter_mut();
-        for &pair_index in order {
-            let pair = &self.pairs[pair_index as usize];
+        let pairs = self.pairs;
+        for (i, &pair_index) in order.iter().enumerate() {
+            // Pairs come in island order, not memory order: ask for the pair three steps
+            // ahead, its manifolds' block two ahead and its points one ahead.
+            let ahead = |k: usize| {
+                order
+                    .get(i + k * PREFETCH_AHEAD)
+                    .map(|&p| &pairs[p as usize])
+            };
+            if let Some(pair) = ahead(3) {
+                prefetch(pair);
+            }
+            if let Some(pair) = ahead(2) {
+                prefetch(pair.manifolds.as_ptr());
+            }
+            if let Some(manifold) = ahead(1).and_then(|p| p.manifolds.first()) {
+                prefetch(manifold.points.as_ptr());
+            }
+            let pair = &pairs[pair_index as usize];
             // Parry's shape 1 is body1 and its normal n1 points from shape 1 towards shape 2,
             // so in the seed's convention (n points from B towards A): B = body1, A = body2.
             let (b, a) = (pair.body1 as usize, pair.body2 as usize);

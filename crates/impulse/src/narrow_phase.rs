@@ -140,6 +140,43 @@ pub fn speculative_margins(
     }
 }
 
+/// Pairs per parallel task of the manifold update.
+const PAIRS_PER_TASK: usize = 256;
+
+/// How many pairs ahead a pass over the pairs asks for the points' memory (twice as far for
+/// the manifolds' own block, whose address the points' lookup needs).
+pub(crate) const PREFETCH_AHEAD: usize = 8;
+
+/// Before visiting pair `i` of `pairs`: asks for the manifolds' block of pair
+/// i + 2·[`PREFETCH_AHEAD`] and the first manifold's points of pair i + [`PREFETCH_AHEAD`]
+/// (its address is in the manifolds' block, asked for earlier). Each pair's manifolds and
+/// points are two heap blocks away from the pair, and on large scenes both are cache misses:
+/// asking ahead halved the manifold update's time on balls16k (perf samples).
+#[inline(always)]
+pub(crate) fn prefetch_manifolds(pairs: &[ContactPair], i: usize) {
+    if let Some(ahead) = pairs.get(i + 2 * PREFETCH_AHEAD) {
+        prefetch(ahead.manifolds.as_ptr());
+    }
+    if let Some(manifold) = pairs
+        .get(i + PREFETCH_AHEAD)
+        .and_then(|p| p.manifolds.first())
+    {
+        prefetch(manifold.points.as_ptr());
+    }
+}
+
+/// Asks the CPU to bring the cache line at `pointer` in; a hint, which never faults.
+#[inline(always)]
+pub(crate) fn prefetch<T>(pointer: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: prefetching is a hint: it reads nothing and never faults, whatever the address.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(pointer.cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = pointer;
+}
+
 /// Cap on a body's speculative margin (m), so a body thrown at absurd speed does not pair
 /// with the whole scene.
 pub const MAX_SPECULATIVE_MARGIN: f32 = 2.0;
@@ -198,10 +235,19 @@ impl NarrowPhase {
             pair.summary = PairSummary::of(&pair.manifolds);
             Ok(())
         };
+        let run = |pairs: &mut [ContactPair]| -> Result<(), StepError> {
+            for i in 0..pairs.len() {
+                prefetch_manifolds(pairs, i);
+                update(&mut pairs[i])?;
+            }
+            Ok(())
+        };
         if parallel && rayon::current_num_threads() > 1 {
-            self.pairs.par_iter_mut().try_for_each(update)?;
+            self.pairs
+                .par_chunks_mut(PAIRS_PER_TASK)
+                .try_for_each(run)?;
         } else {
-            self.pairs.iter_mut().try_for_each(update)?;
+            run(&mut self.pairs)?;
         }
         // Pairs whose manifolds Parry emptied are kept for their workspace; pairs Parry never
         // gave a manifold are dropped.

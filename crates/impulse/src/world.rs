@@ -506,7 +506,9 @@ impl World {
         let constraints = &self.constraints;
         let islands = &self.islands;
         let store = |first_pair: usize, pairs: &mut [narrow_phase::ContactPair]| {
-            for (pair_index, pair) in (first_pair..).zip(pairs) {
+            for i in 0..pairs.len() {
+                narrow_phase::prefetch_manifolds(pairs, i);
+                let (pair_index, pair) = (first_pair + i, &mut pairs[i]);
                 let first = if pair.row_count() > 0 {
                     islands.first_row(pair_index)
                 } else {
