@@ -14,6 +14,14 @@
 use impulse_lcp::{Bounds, DenseMatrix, Lcp, Solution, SolverKind, SolverSettings, Status};
 use proptest::prelude::*;
 
+/// Values in `low..high` on a grid of 2³⁰ steps. proptest's own float range sampler trips an
+/// internal assertion on some seeds when debug assertions are on (as in our test profile):
+/// proptest-rs/proptest#343 and #479 describe the assertion.
+fn float(low: f64, high: f64) -> impl Strategy<Value = f64> {
+    const STEPS: u32 = 1 << 30;
+    (0..STEPS).prop_map(move |k| low + (high - low) * (k as f64 / STEPS as f64))
+}
+
 struct Contact {
     a: usize,
     b: usize,
@@ -53,13 +61,13 @@ fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
 
 prop_compose! {
     fn contact_problem()(particles in 2usize..6)(
-        masses in prop::collection::vec(0.1f64..10.0, particles),
+        masses in prop::collection::vec(float(0.1, 10.0), particles),
         raw in prop::collection::vec(
-            (0..particles, 1..particles, prop::array::uniform3(-1.0f64..1.0)),
+            (0..particles, 1..particles, prop::array::uniform3(float(-1.0, 1.0))),
             // Between half and all of the relative degrees of freedom (at most 10 contacts).
             ((3 * (particles - 1)).min(10) / 2).max(1)..=(3 * (particles - 1)).min(10),
         ),
-        b in prop::collection::vec(-1.0f64..1.0, 10),
+        b in prop::collection::vec(float(-1.0, 1.0), 10),
     ) -> (DenseMatrix, f64, Vec<f64>) {
         let contacts: Vec<Contact> = raw
             .into_iter()
@@ -202,7 +210,7 @@ proptest! {
     #[test]
     fn box_bounded_pgs_and_jacobi_agree(
         (a, eps, b) in contact_problem(),
-        limits in prop::collection::vec((0.0f64..0.5, 0.0f64..0.5), 10),
+        limits in prop::collection::vec((float(0.0, 0.5), float(0.0, 0.5)), 10),
     ) {
         let n = b.len();
         let lo: Vec<f64> = limits[..n].iter().map(|&(l, _)| -l).collect();
