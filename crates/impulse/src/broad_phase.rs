@@ -10,8 +10,6 @@ use crate::body::Bodies;
 pub struct BroadPhase {
     aabbs: Vec<Aabb>,
     workspace: BvhWorkspace,
-    /// Compute the bodies' boxes on rayon's threads (the same boxes either way).
-    pub parallel: bool,
     /// Kept between steps and refitted: bodies move little per step, so refitting plus
     /// Parry's incremental optimisation costs a fraction of a fresh binned build (10 % of a
     /// pyramid20 step under callgrind).
@@ -27,26 +25,15 @@ impl BroadPhase {
     /// contacts within the margins are found.
     pub fn candidate_pairs(&mut self, bodies: &Bodies, margins: &[f32], out: &mut Vec<(u32, u32)>) {
         out.clear();
-        let aabb = |i: usize| {
+        self.aabbs.clear();
+        for i in 0..bodies.len() {
             let margin = margins.get(i).copied().unwrap_or(0.0);
             let mut aabb = bodies.shape[i]
                 .compute_aabb(&bodies.pose[i])
                 .loosened(margin);
             aabb.mins = aabb.mins.max(glam::Vec3::splat(-WORLD_BOUND));
             aabb.maxs = aabb.maxs.min(glam::Vec3::splat(WORLD_BOUND));
-            aabb
-        };
-        let bodies_per_task = crate::narrow_phase::BODIES_PER_TASK;
-        if self.parallel && rayon::current_num_threads() > 1 && bodies.len() > bodies_per_task {
-            use rayon::prelude::*;
-            (0..bodies.len())
-                .into_par_iter()
-                .with_min_len(bodies_per_task)
-                .map(aabb)
-                .collect_into_vec(&mut self.aabbs);
-        } else {
-            self.aabbs.clear();
-            self.aabbs.extend((0..bodies.len()).map(aabb));
+            self.aabbs.push(aabb);
         }
         if self.aabbs.len() < 2 {
             return;

@@ -129,48 +129,17 @@ impl EnergyTerms {
 
 /// [`EnergyTerms`] of the moving bodies under `gravity` (m/s²).
 pub fn energy_terms(bodies: &Bodies, gravity: Vec3) -> EnergyTerms {
-    energy_terms_on(bodies, gravity, false)
-}
-
-/// Bodies per partial sum of [`energy_terms_on`].
-const ENERGY_BODIES_PER_TASK: usize = 4096;
-
-/// [`energy_terms`], with `parallel` spreading runs of [`ENERGY_BODIES_PER_TASK`] bodies over
-/// rayon's threads. The runs' partial sums are added in order on either path, so the result
-/// does not depend on the thread count.
-pub fn energy_terms_on(bodies: &Bodies, gravity: Vec3, parallel: bool) -> EnergyTerms {
-    let run = |range: std::ops::Range<usize>| {
-        let mut terms = EnergyTerms::default();
-        for i in range {
-            if bodies.inverse_mass[i] > 0.0 {
-                let m = 1.0 / bodies.inverse_mass[i];
-                terms.kinetic += bodies.kinetic_energy(i) as f64;
-                terms.potential += (-m * gravity.dot(bodies.center_of_mass(i))) as f64;
-                terms.mass += m as f64;
-                terms.momentum += bodies.linear_velocity[i] * m;
-            }
+    let mut terms = EnergyTerms::default();
+    for i in 0..bodies.len() {
+        if bodies.inverse_mass[i] > 0.0 {
+            let m = 1.0 / bodies.inverse_mass[i];
+            terms.kinetic += bodies.kinetic_energy(i) as f64;
+            terms.potential += (-m * gravity.dot(bodies.center_of_mass(i))) as f64;
+            terms.mass += m as f64;
+            terms.momentum += bodies.linear_velocity[i] * m;
         }
-        terms
-    };
-    let n = bodies.len();
-    let runs = n.div_ceil(ENERGY_BODIES_PER_TASK);
-    let range = |k: usize| k * ENERGY_BODIES_PER_TASK..((k + 1) * ENERGY_BODIES_PER_TASK).min(n);
-    let add = |mut total: EnergyTerms, part: EnergyTerms| {
-        total.kinetic += part.kinetic;
-        total.potential += part.potential;
-        total.mass += part.mass;
-        total.momentum += part.momentum;
-        total
-    };
-    if parallel && runs > 1 && rayon::current_num_threads() > 1 {
-        use rayon::prelude::*;
-        let parts: Vec<EnergyTerms> = (0..runs).into_par_iter().map(|k| run(range(k))).collect();
-        parts.into_iter().fold(EnergyTerms::default(), add)
-    } else {
-        (0..runs)
-            .map(|k| run(range(k)))
-            .fold(EnergyTerms::default(), add)
     }
+    terms
 }
 
 /// Total kinetic energy (J) and linear momentum (kg·m/s) of the moving bodies.

@@ -125,20 +125,9 @@ pub fn speculative_margins(
     dt: f32,
     out: &mut Vec<f32>,
 ) {
-    speculative_margins_on(bodies, prediction_distance, gravity, dt, false, out);
-}
-
-/// [`speculative_margins`], with `parallel` on rayon's threads (per body, so the same result).
-pub fn speculative_margins_on(
-    bodies: &Bodies,
-    prediction_distance: f32,
-    gravity: Vec3,
-    dt: f32,
-    parallel: bool,
-    out: &mut Vec<f32>,
-) {
-    let margin = |i: usize| {
-        if bodies.is_moving(i) {
+    out.clear();
+    for i in 0..bodies.len() {
+        let margin = if bodies.is_moving(i) {
             let radius = bodies.shape[i].compute_local_aabb().half_extents().length();
             let speed = bodies.linear_velocity[i].length()
                 + bodies.angular_velocity[i].length() * radius
@@ -146,22 +135,10 @@ pub fn speculative_margins_on(
             (0.5 * prediction_distance + speed * dt).min(MAX_SPECULATIVE_MARGIN)
         } else {
             0.5 * prediction_distance
-        }
-    };
-    if parallel && rayon::current_num_threads() > 1 && bodies.len() > BODIES_PER_TASK {
-        (0..bodies.len())
-            .into_par_iter()
-            .with_min_len(BODIES_PER_TASK)
-            .map(margin)
-            .collect_into_vec(out);
-    } else {
-        out.clear();
-        out.extend((0..bodies.len()).map(margin));
+        };
+        out.push(margin);
     }
 }
-
-/// Bodies per parallel task of the per-body passes of stages 2 and 3.
-pub(crate) const BODIES_PER_TASK: usize = 1024;
 
 /// Pairs per parallel task of the manifold update.
 const PAIRS_PER_TASK: usize = 256;

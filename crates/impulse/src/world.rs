@@ -195,8 +195,7 @@ impl World {
         let settings = self.settings.clone();
         self.step_count += 1;
         // The energy check's reference restarts whenever the bodies changed since the last step.
-        let start_energy =
-            diagnostics::energy_terms_on(&self.bodies, self.gravity, self.parallel).mechanical();
+        let start_energy = diagnostics::energy_terms(&self.bodies, self.gravity).mechanical();
         if !self.energy.started
             || self.energy.bodies != self.bodies.len()
             || start_energy != self.energy.last
@@ -210,15 +209,13 @@ impl World {
         }
 
         // Stages 2–4 once per step, on the poses and velocities at its start.
-        narrow_phase::speculative_margins_on(
+        narrow_phase::speculative_margins(
             &self.bodies,
             settings.prediction_distance,
             self.gravity,
             dt,
-            self.parallel,
             &mut self.margins,
         );
-        self.broad_phase.parallel = self.parallel;
         self.broad_phase
             .candidate_pairs(&self.bodies, &self.margins, &mut self.candidates);
         self.narrow_phase
@@ -343,7 +340,7 @@ impl World {
         // Sleep last: it zeroes velocities, which must not leak into this step's LCP.
         self.update_sleep(dt);
 
-        let energy = diagnostics::energy_terms_on(&self.bodies, self.gravity, self.parallel);
+        let energy = diagnostics::energy_terms(&self.bodies, self.gravity);
         let friction_rows = self.constraints.iter().filter(|c| c.friction > 0.0).count();
         self.diagnostics = StepDiagnostics {
             step: self.step_count,
