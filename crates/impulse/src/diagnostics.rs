@@ -50,7 +50,7 @@ pub fn natural_map_residual(
 /// Rows per partial sum of [`natural_map_residual_on`].
 const RESIDUAL_ROWS_PER_TASK: usize = 4096;
 
-/// [`natural_map_residual`], with `parallel` spreading runs of [`RESIDUAL_ROWS_PER_TASK`]
+/// [`natural_map_residual`], with `parallel` spreading runs of 4096
 /// rows over rayon's threads. The runs' partial sums are added in order on either path, so
 /// the result does not depend on the thread count.
 pub fn natural_map_residual_on(
