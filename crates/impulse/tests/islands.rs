@@ -1,6 +1,8 @@
 //! Islands and sleeping: independent islands give the same result in parallel as in sequence,
 //! quiet islands fall asleep, and an awake body touching a sleeping island wakes all of it.
 
+mod common;
+
 use glam::Vec3;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
 
@@ -139,15 +141,7 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
             ..settings
         };
         let (mut one, mut two, pool) = one_and_two_threads(&scene);
-        let top = (0..one.bodies.len())
-            .max_by(|&i, &j| {
-                let (a, b) = (
-                    one.bodies.pose[i].translation.y,
-                    one.bodies.pose[j].translation.y,
-                );
-                a.total_cmp(&b)
-            })
-            .unwrap();
+        let top = common::highest_body(&one.bodies);
         let top_y = one.bodies.pose[top].translation.y;
         for _ in 0..30 {
             one.step().unwrap();

@@ -108,15 +108,7 @@ fn fast_preset_keeps_pyramid20_standing_with_impulses_inside_their_bounds() {
         ..SolverSettings::fast()
     };
     let mut w = World::from_scene(&scene).unwrap();
-    let top = (0..w.bodies.len())
-        .max_by(|&i, &j| {
-            let (a, b) = (
-                w.bodies.pose[i].translation.y,
-                w.bodies.pose[j].translation.y,
-            );
-            a.total_cmp(&b)
-        })
-        .unwrap();
+    let top = common::highest_body(&w.bodies);
     let top_y = w.bodies.pose[top].translation.y;
     for _ in 0..300 {
         w.step().unwrap();

@@ -93,3 +93,13 @@ pub fn check_complementarity_at_exit(w: &impulse::World) -> bool {
     assert!(w.diagnostics().natural_map_residual < 1e-2);
     true
 }
+
+/// Index of the body whose origin is highest (largest y): the top of a pile.
+pub fn highest_body(bodies: &impulse::body::Bodies) -> usize {
+    (0..bodies.len())
+        .max_by(|&i, &j| {
+            let (a, b) = (bodies.pose[i].translation.y, bodies.pose[j].translation.y);
+            a.total_cmp(&b)
+        })
+        .unwrap()
+}
