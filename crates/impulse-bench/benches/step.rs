@@ -60,7 +60,7 @@ fn broad_phase(c: &mut Criterion) {
     let mut pairs = Vec::new();
     c.bench_function("broad_phase/pyramid20", |b| {
         b.iter(|| {
-            broad_phase.candidate_pairs(black_box(&world.bodies), &margins, &mut pairs);
+            broad_phase.candidate_pairs(black_box(&world.bodies), &margins, false, &mut pairs);
             black_box(pairs.len())
         })
     });
@@ -70,7 +70,7 @@ fn narrow_phase(c: &mut Criterion) {
     let world = settled_world();
     let margins = margins(&world);
     let mut pairs = Vec::new();
-    BroadPhase::default().candidate_pairs(&world.bodies, &margins, &mut pairs);
+    BroadPhase::default().candidate_pairs(&world.bodies, &margins, false, &mut pairs);
     let mut narrow_phase = NarrowPhase::default();
     narrow_phase
         .update(&world.bodies, &pairs, &margins, false)

@@ -14,7 +14,7 @@ use crate::broad_phase::BroadPhase;
 pub fn max_overlap(bodies: &Bodies) -> f32 {
     let mut broad_phase = BroadPhase::default();
     let mut pairs = Vec::new();
-    broad_phase.candidate_pairs(bodies, &[], &mut pairs);
+    broad_phase.candidate_pairs(bodies, &[], false, &mut pairs);
     max_overlap_of_pairs(&bodies.shape, &bodies.pose, &pairs)
 }
 

@@ -216,8 +216,12 @@ impl World {
             dt,
             &mut self.margins,
         );
-        self.broad_phase
-            .candidate_pairs(&self.bodies, &self.margins, &mut self.candidates);
+        self.broad_phase.candidate_pairs(
+            &self.bodies,
+            &self.margins,
+            self.parallel,
+            &mut self.candidates,
+        );
         self.narrow_phase
             .update(&self.bodies, &self.candidates, &self.margins, self.parallel)?;
         self.update_world_inverse_inertia();
