@@ -61,6 +61,7 @@ fn broad_phase(c: &mut Criterion) {
     c.bench_function("broad_phase/pyramid20", |b| {
         b.iter(|| {
             broad_phase.candidate_pairs(black_box(&world.bodies), &margins, false, &mut pairs);
+            broad_phase.optimize();
             black_box(pairs.len())
         })
     });

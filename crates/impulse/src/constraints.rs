@@ -157,7 +157,8 @@ impl ContactConstraint {
 /// Builds one constraint per contact point, island by island in `islands`' pair order
 /// (within an island, narrow-phase order), with each constraint's local body slots set.
 /// `velocity_before` is read from the current velocities: called before gravity is applied, it
-/// is the approach velocity v⁻ that restitution reflects. Targets are left at zero.
+/// is the approach velocity v⁻ that restitution reflects. Targets are left at zero. The
+/// carried-over impulses are scaled by `settings.warm_start` ([`crate::solver::scale_impulses`]).
 ///
 /// Pairs are read in memory order and written to their islands' rows. With `parallel`, runs of
 /// [`PAIRS_PER_TASK`] pairs are assembled on rayon's threads, each pair into its own rows of
@@ -369,6 +370,8 @@ impl Assembly<'_> {
             }
         }
         debug_assert!(slots.next().is_none(), "more slots than rows");
+        // While the rows are in cache, rather than in a pass of its own over every row.
+        crate::solver::scale_impulses(out, settings.warm_start);
     }
 }
 

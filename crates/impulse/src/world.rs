@@ -15,7 +15,6 @@ use crate::island::{self, IslandReport, IslandWorkspace, Islands, StepContext};
 use crate::narrow_phase::{self, ContactImpulse, NarrowPhase};
 use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
-use crate::solver;
 use rayon::prelude::*;
 
 /// A body further than this from the origin (m) means the simulation has blown up.
@@ -222,8 +221,16 @@ impl World {
             self.parallel,
             &mut self.candidates,
         );
-        self.narrow_phase
-            .update(&self.bodies, &self.candidates, &self.margins, self.parallel)?;
+        let (broad_phase, narrow_phase) = (&mut self.broad_phase, &mut self.narrow_phase);
+        let (bodies, candidates, margins) = (&self.bodies, &self.candidates, &self.margins);
+        let parallel = self.parallel;
+        let mut narrow = || narrow_phase.update(bodies, candidates, margins, parallel);
+        if parallel && rayon::current_num_threads() > 1 {
+            rayon::join(|| broad_phase.optimize(), narrow).1?;
+        } else {
+            broad_phase.optimize();
+            narrow()?;
+        }
         self.update_world_inverse_inertia();
         // Islands from the pairs first, so that assembly writes each island's constraints
         // contiguously and nothing has to be moved afterwards.
@@ -237,7 +244,6 @@ impl World {
             self.parallel,
             &mut self.constraints,
         );
-        solver::scale_impulses(&mut self.constraints, settings.warm_start);
 
         // Stages 1, 5 and 6 per island: each island's substep loop touches only its bodies.
         let islands = self.islands.len();
