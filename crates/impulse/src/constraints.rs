@@ -523,10 +523,49 @@ pub fn record_velocity_before(
     parallel: bool,
     scratch: &mut Vec<(Vec3, Vec3)>,
 ) {
+    record_with_slots(
+        constraints,
+        linear,
+        angular,
+        |c| (c.body_a as usize, c.body_b as usize),
+        parallel,
+        scratch,
+    );
+}
+
+/// [`record_velocity_before`] for one island's constraints, from the island's own velocity
+/// arrays indexed by local slot (`local_a`, `local_b`; the immovable slot last, at rest). The
+/// island's step calls it while its data is in cache and on whichever thread solved it; the
+/// result is the same as the world-wide pass once the velocities are scattered back.
+pub fn record_island_velocity_before(
+    constraints: &mut [ContactConstraint],
+    linear: &[Vec3],
+    angular: &[Vec3],
+    parallel: bool,
+    scratch: &mut Vec<(Vec3, Vec3)>,
+) {
+    record_with_slots(
+        constraints,
+        linear,
+        angular,
+        |c| (c.local_a as usize, c.local_b as usize),
+        parallel,
+        scratch,
+    );
+}
+
+fn record_with_slots(
+    constraints: &mut [ContactConstraint],
+    linear: &[Vec3],
+    angular: &[Vec3],
+    slots: impl Fn(&ContactConstraint) -> (usize, usize) + Sync,
+    parallel: bool,
+    scratch: &mut Vec<(Vec3, Vec3)>,
+) {
     scratch.clear();
     scratch.resize(linear.len(), (Vec3::ZERO, Vec3::ZERO));
     for c in constraints.iter() {
-        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let (a, b) = slots(c);
         let rows = [
             (&c.normal, c.normal_impulse),
             (&c.tangents[0], c.tangent_impulses[0]),
@@ -541,7 +580,7 @@ pub fn record_velocity_before(
     }
     let scratch = &scratch[..];
     let record = |c: &mut ContactConstraint| {
-        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let (a, b) = slots(c);
         let (la, aa) = (linear[a] - scratch[a].0, angular[a] - scratch[a].1);
         let (lb, ab) = (linear[b] - scratch[b].0, angular[b] - scratch[b].1);
         c.normal.velocity_before = c.normal.velocity(la, aa, lb, ab);
@@ -549,7 +588,7 @@ pub fn record_velocity_before(
             t.velocity_before = t.velocity(la, aa, lb, ab);
         }
     };
-    if parallel && rayon::current_num_threads() > 1 {
+    if parallel && rayon::current_num_threads() > 1 && constraints.len() > PAIRS_PER_TASK {
         constraints
             .par_iter_mut()
             .with_min_len(PAIRS_PER_TASK)

@@ -284,6 +284,8 @@ pub struct IslandWorkspace {
     used_colours: Vec<u64>,
     colours: Vec<u8>,
     colour_scratch: Vec<ContactConstraint>,
+    /// Per-slot M⁻¹Jᵀγ of [`constraints::record_island_velocity_before`].
+    record_scratch: Vec<(Vec3, Vec3)>,
     /// Whether one colour may be solved on several threads.
     parallel: bool,
     nncg: NncgWorkspace,
@@ -587,6 +589,13 @@ pub fn step_island(
             false,
         );
     }
+    constraints::record_island_velocity_before(
+        constraints,
+        &w.linear,
+        &w.angular,
+        w.parallel && coloured_threads,
+        &mut w.record_scratch,
+    );
 }
 
 /// Writes an island's velocities and poses back into the bodies.

@@ -293,13 +293,18 @@ impl World {
                 iterations = iterations.max(self.workspaces[k].report.iterations);
             }
         }
-        constraints::record_velocity_before(
-            &mut self.constraints,
-            &self.bodies.linear_velocity,
-            &self.bodies.angular_velocity,
-            self.parallel,
-            &mut self.scratch,
-        );
+        // Awake islands recorded their rows' v* as their step ended; a sleeping island's rows
+        // take it from the bodies' velocities. One pass over every row covers them (rows of
+        // awake islands come out the same as their own record).
+        if self.island_awake.iter().take(islands).any(|awake| !awake) {
+            constraints::record_velocity_before(
+                &mut self.constraints,
+                &self.bodies.linear_velocity,
+                &self.bodies.angular_velocity,
+                self.parallel,
+                &mut self.scratch,
+            );
+        }
         self.store_impulses();
         // Only awake islands were solved this step; sleeping ones keep last step's state.
         let mut squared = 0.0f64;
