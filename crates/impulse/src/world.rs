@@ -193,8 +193,33 @@ impl World {
         let dt = self.dt;
         let settings = self.settings.clone();
         self.step_count += 1;
+        // Stages 2–4 once per step, on the poses and velocities at its start. The energy at the
+        // start (read only to notice edits between steps) is summed beside the broad phase.
+        let parallel = self.parallel && rayon::current_num_threads() > 1;
+        let (bodies, gravity) = (&self.bodies, self.gravity);
+        let (margins, broad_phase, candidates) = (
+            &mut self.margins,
+            &mut self.broad_phase,
+            &mut self.candidates,
+        );
+        let start_energy = || diagnostics::energy_terms(bodies, gravity).mechanical();
+        let mut broad = || {
+            narrow_phase::speculative_margins(
+                bodies,
+                settings.prediction_distance,
+                gravity,
+                dt,
+                margins,
+            );
+            broad_phase.candidate_pairs(bodies, margins, parallel, candidates);
+        };
+        let start_energy = if parallel {
+            rayon::join(start_energy, broad).0
+        } else {
+            broad();
+            start_energy()
+        };
         // The energy check's reference restarts whenever the bodies changed since the last step.
-        let start_energy = diagnostics::energy_terms(&self.bodies, self.gravity).mechanical();
         if !self.energy.started
             || self.energy.bodies != self.bodies.len()
             || start_energy != self.energy.last
@@ -206,26 +231,10 @@ impl World {
                 started: true,
             };
         }
-
-        // Stages 2–4 once per step, on the poses and velocities at its start.
-        narrow_phase::speculative_margins(
-            &self.bodies,
-            settings.prediction_distance,
-            self.gravity,
-            dt,
-            &mut self.margins,
-        );
-        self.broad_phase.candidate_pairs(
-            &self.bodies,
-            &self.margins,
-            self.parallel,
-            &mut self.candidates,
-        );
         let (broad_phase, narrow_phase) = (&mut self.broad_phase, &mut self.narrow_phase);
         let (bodies, candidates, margins) = (&self.bodies, &self.candidates, &self.margins);
-        let parallel = self.parallel;
         let mut narrow = || narrow_phase.update(bodies, candidates, margins, parallel);
-        if parallel && rayon::current_num_threads() > 1 {
+        if parallel {
             rayon::join(|| broad_phase.optimize(), narrow).1?;
         } else {
             broad_phase.optimize();
@@ -352,25 +361,36 @@ impl World {
         }
         self.island_residuals = parts;
         let residual = squared.sqrt() as f32;
-        // Sleep last: it zeroes velocities, which must not leak into this step's LCP.
-        self.update_sleep(dt);
-
-        let energy = diagnostics::energy_terms(&self.bodies, self.gravity);
-        let friction_rows = self.constraints.iter().filter(|c| c.friction > 0.0).count();
+        // Sleep last: it zeroes velocities, which must not leak into this step's LCP. The
+        // counts over rows and pairs need no bodies, so they run beside it and the energy.
+        let (bodies, gravity) = (&mut self.bodies, self.gravity);
+        let (islands_of, awake) = (&self.islands, &self.island_awake);
+        let (constraints, pairs) = (&self.constraints, &self.narrow_phase);
+        let mut sleep_and_energy = || {
+            update_sleep(bodies, islands_of, awake, &settings, dt);
+            diagnostics::energy_terms(bodies, gravity)
+        };
+        let counts = || {
+            (
+                constraints.iter().filter(|c| c.friction > 0.0).count(),
+                pairs.pairs.iter().filter(|p| p.point_count() > 0).count(),
+                pairs.max_depth(),
+            )
+        };
+        let (energy, (friction_rows, contact_pairs, max_depth)) = if parallel {
+            rayon::join(sleep_and_energy, counts)
+        } else {
+            (sleep_and_energy(), counts())
+        };
         self.diagnostics = StepDiagnostics {
             step: self.step_count,
-            contact_pairs: self
-                .narrow_phase
-                .pairs
-                .iter()
-                .filter(|p| p.point_count() > 0)
-                .count(),
+            contact_pairs,
             contacts: self.constraints.len(),
             rows: self.constraints.len() + 2 * friction_rows,
             iterations,
             natural_map_residual: residual,
             islands: island_reports,
-            max_depth: self.narrow_phase.max_depth(),
+            max_depth,
             kinetic_energy: energy.kinetic as f32,
             linear_momentum: energy.momentum.to_array(),
         };
@@ -404,38 +424,6 @@ impl World {
                 }
             }
             self.island_awake.push(awake);
-        }
-    }
-
-    /// Puts an island to sleep once every body in it has been slower than the thresholds for
-    /// `sleep_time` seconds (Box2D's rule); its velocities are zeroed and it costs nothing
-    /// until something touches it.
-    fn update_sleep(&mut self, dt: f32) {
-        let s = &self.settings;
-        for k in 0..self.islands.len() {
-            if !self.island_awake[k] {
-                continue;
-            }
-            let mut quiet_for = f32::INFINITY;
-            for &i in self.islands.bodies(k) {
-                let i = i as usize;
-                let quiet = self.bodies.linear_velocity[i].length() < s.sleep_linear_speed
-                    && self.bodies.angular_velocity[i].length() < s.sleep_angular_speed;
-                self.bodies.sleep_time[i] = if quiet {
-                    self.bodies.sleep_time[i] + dt
-                } else {
-                    0.0
-                };
-                quiet_for = quiet_for.min(self.bodies.sleep_time[i]);
-            }
-            if s.sleep && quiet_for >= s.time_to_sleep {
-                for &i in self.islands.bodies(k) {
-                    let i = i as usize;
-                    self.bodies.asleep[i] = true;
-                    self.bodies.linear_velocity[i] = Vec3::ZERO;
-                    self.bodies.angular_velocity[i] = Vec3::ZERO;
-                }
-            }
         }
     }
 
@@ -919,4 +907,38 @@ fn build_body(index: usize, desc: &BodyDesc, material: &Material) -> Result<Buil
         local_inverse_inertia,
         shape,
     })
+}
+
+/// Puts an island to sleep once every body in it has been slower than the thresholds for
+/// `time_to_sleep` seconds (Box2D's rule); its velocities are zeroed and it costs nothing
+/// until something touches it. Sleep timers advance for the bodies of awake islands.
+fn update_sleep(
+    bodies: &mut Bodies,
+    islands: &Islands,
+    awake: &[bool],
+    s: &SolverSettings,
+    dt: f32,
+) {
+    for (k, _) in awake.iter().enumerate().filter(|(_, awake)| **awake) {
+        let mut quiet_for = f32::INFINITY;
+        for &i in islands.bodies(k) {
+            let i = i as usize;
+            let quiet = bodies.linear_velocity[i].length() < s.sleep_linear_speed
+                && bodies.angular_velocity[i].length() < s.sleep_angular_speed;
+            bodies.sleep_time[i] = if quiet {
+                bodies.sleep_time[i] + dt
+            } else {
+                0.0
+            };
+            quiet_for = quiet_for.min(bodies.sleep_time[i]);
+        }
+        if s.sleep && quiet_for >= s.time_to_sleep {
+            for &i in islands.bodies(k) {
+                let i = i as usize;
+                bodies.asleep[i] = true;
+                bodies.linear_velocity[i] = Vec3::ZERO;
+                bodies.angular_velocity[i] = Vec3::ZERO;
+            }
+        }
+    }
 }
