@@ -240,10 +240,20 @@ impl World {
             broad_phase.optimize();
             narrow()?;
         }
-        self.update_world_inverse_inertia();
         // Islands from the pairs first, so that assembly writes each island's constraints
-        // contiguously and nothing has to be moved afterwards.
-        self.islands.build(&self.bodies, &self.narrow_phase.pairs);
+        // contiguously and nothing has to be moved afterwards. The union-find is serial; the
+        // world inertia tensors (from the poses alone) are computed beside it.
+        let (islands, world_inverse_inertia) = (&mut self.islands, &mut self.world_inverse_inertia);
+        let (bodies, pairs) = (&self.bodies, &self.narrow_phase.pairs);
+        if parallel {
+            rayon::join(
+                || islands.build(bodies, pairs),
+                || world_inverse_inertia_of(bodies, parallel, world_inverse_inertia),
+            );
+        } else {
+            world_inverse_inertia_of(bodies, parallel, world_inverse_inertia);
+            islands.build(bodies, pairs);
+        }
         constraints::assemble(
             &self.bodies,
             &self.narrow_phase,
@@ -424,29 +434,6 @@ impl World {
                 }
             }
             self.island_awake.push(awake);
-        }
-    }
-
-    fn update_world_inverse_inertia(&mut self) {
-        let bodies = &self.bodies;
-        let world = |i: usize| {
-            let local = &bodies.local_inverse_inertia[i];
-            if *local == Mat3::ZERO {
-                Mat3::ZERO
-            } else {
-                rotate_tensor(bodies.pose[i].rotation, local)
-            }
-        };
-        if self.parallel && rayon::current_num_threads() > 1 {
-            (0..bodies.len())
-                .into_par_iter()
-                .with_min_len(BODIES_PER_TASK)
-                .map(world)
-                .collect_into_vec(&mut self.world_inverse_inertia);
-        } else {
-            self.world_inverse_inertia.clear();
-            self.world_inverse_inertia
-                .extend((0..bodies.len()).map(world));
         }
     }
 
@@ -940,5 +927,28 @@ fn update_sleep(
                 bodies.angular_velocity[i] = Vec3::ZERO;
             }
         }
+    }
+}
+
+/// World-frame inverse inertia tensors I⁻¹ = R I_local⁻¹ Rᵀ (1/(kg·m²)) of every body at its
+/// current pose, zero for bodies that do not rotate.
+fn world_inverse_inertia_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Mat3>) {
+    let world = |i: usize| {
+        let local = &bodies.local_inverse_inertia[i];
+        if *local == Mat3::ZERO {
+            Mat3::ZERO
+        } else {
+            rotate_tensor(bodies.pose[i].rotation, local)
+        }
+    };
+    if parallel && rayon::current_num_threads() > 1 {
+        (0..bodies.len())
+            .into_par_iter()
+            .with_min_len(BODIES_PER_TASK)
+            .map(world)
+            .collect_into_vec(out);
+    } else {
+        out.clear();
+        out.extend((0..bodies.len()).map(world));
     }
 }
