@@ -316,9 +316,9 @@ impl Assembly<'_> {
                 let contact_point = 0.5 * (p_a + p_b);
                 let r_a = contact_point - com_a;
                 let r_b = contact_point - com_b;
-                let (t1, t2) = tangent_basis(bodies, a, b, r_a, r_b, normal, manifold.data.tangent);
+                let (t1, t2) = tangent_basis(normal, manifold.data.tangent);
                 let row = |d| {
-                    let mut row = JacobianRow::new(
+                    JacobianRow::new(
                         d,
                         r_a,
                         r_b,
@@ -326,16 +326,17 @@ impl Assembly<'_> {
                         inverse_mass_b,
                         inertia_a,
                         inertia_b,
-                    );
-                    row.velocity_before = row.velocity(
-                        bodies.linear_velocity[a],
-                        bodies.angular_velocity[a],
-                        bodies.linear_velocity[b],
-                        bodies.angular_velocity[b],
-                    );
-                    row
+                    )
                 };
-                let normal_row = row(normal);
+                // Only the normal row's v⁻ is read before the step ends (restitution); every
+                // row's is rewritten as the step ends ([`record_velocity_before`]).
+                let mut normal_row = row(normal);
+                normal_row.velocity_before = normal_row.velocity(
+                    bodies.linear_velocity[a],
+                    bodies.angular_velocity[a],
+                    bodies.linear_velocity[b],
+                    bodies.angular_velocity[b],
+                );
                 let tangents = [row(t1), row(t2)];
                 let depth = -point.dist;
                 let Some(slot) = slots.next() else {
@@ -397,28 +398,11 @@ fn inverse_block(tangents: &[JacobianRow; 2]) -> [f32; 3] {
     }
 }
 
-/// Friction directions: t1 along the sliding velocity when the point slides, so that the two
-/// independently clamped rows (|γ_t| ≤ μ·γ_n each, a box) bound the sliding friction by exactly
-/// μ·γ_n as Coulomb's cone does; otherwise last step's t1 made orthogonal to the new normal,
-/// so a sticking contact keeps its basis; any orthonormal pair for a new manifold.
-fn tangent_basis(
-    bodies: &Bodies,
-    a: usize,
-    b: usize,
-    r_a: Vec3,
-    r_b: Vec3,
-    normal: Vec3,
-    previous: Vec3,
-) -> (Vec3, Vec3) {
-    let relative = bodies.linear_velocity[a] + bodies.angular_velocity[a].cross(r_a)
-        - bodies.linear_velocity[b]
-        - bodies.angular_velocity[b].cross(r_b);
-    let sliding = relative - normal * normal.dot(relative);
-    let speed = sliding.length();
-    if speed > SLIDING_SPEED {
-        let t1 = sliding / speed;
-        return (t1, normal.cross(t1));
-    }
+/// Friction directions: last step's t1 made orthogonal to the new normal, so that a sticking
+/// contact keeps its basis and its warm-started friction impulse; any orthonormal pair for a
+/// new manifold. The friction impulse is kept inside Coulomb's disc (|γ_t| ≤ μ·γ_n), which
+/// does not depend on the basis, so the basis need not follow the sliding direction.
+fn tangent_basis(normal: Vec3, previous: Vec3) -> (Vec3, Vec3) {
     let kept = previous - normal * normal.dot(previous);
     if kept.length_squared() > 0.25 {
         let t1 = kept.normalize();
@@ -427,9 +411,6 @@ fn tangent_basis(
         normal.any_orthonormal_pair()
     }
 }
-
-/// Below this tangential speed (m/s) a contact is treated as sticking for the tangent basis.
-const SLIDING_SPEED: f32 = 1.0e9;
 
 /// Sets every normal row's target for a solve of duration `h` (s), from the separation the
 /// contact has now: its separation at assembly plus the normal component of the two bodies'
