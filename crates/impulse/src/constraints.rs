@@ -497,42 +497,46 @@ pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32
 /// exported and checked ([`crate::contact_lcp`]). O(rows); `scratch` holds per-body deltas.
 /// With `parallel`, the second pass (one row at a time, no shared writes) runs on rayon's
 /// threads.
+///
+/// `slots` says how rows name their bodies, and so how `linear` and `angular` are indexed.
 pub fn record_velocity_before(
     constraints: &mut [ContactConstraint],
+    slots: BodySlots,
     linear: &[Vec3],
     angular: &[Vec3],
     parallel: bool,
     scratch: &mut Vec<(Vec3, Vec3)>,
 ) {
-    record_with_slots(
-        constraints,
-        linear,
-        angular,
-        |c| (c.body_a as usize, c.body_b as usize),
-        parallel,
-        scratch,
-    );
+    match slots {
+        BodySlots::World => record_with_slots(
+            constraints,
+            linear,
+            angular,
+            |c| (c.body_a as usize, c.body_b as usize),
+            parallel,
+            scratch,
+        ),
+        BodySlots::Island => record_with_slots(
+            constraints,
+            linear,
+            angular,
+            |c| (c.local_a as usize, c.local_b as usize),
+            parallel,
+            scratch,
+        ),
+    }
 }
 
-/// [`record_velocity_before`] for one island's constraints, from the island's own velocity
-/// arrays indexed by local slot (`local_a`, `local_b`; the immovable slot last, at rest). The
-/// island's step calls it while its data is in cache and on whichever thread solved it; the
-/// result is the same as the world-wide pass once the velocities are scattered back.
-pub fn record_island_velocity_before(
-    constraints: &mut [ContactConstraint],
-    linear: &[Vec3],
-    angular: &[Vec3],
-    parallel: bool,
-    scratch: &mut Vec<(Vec3, Vec3)>,
-) {
-    record_with_slots(
-        constraints,
-        linear,
-        angular,
-        |c| (c.local_a as usize, c.local_b as usize),
-        parallel,
-        scratch,
-    );
+/// Which indices of a [`ContactConstraint`] name its bodies in a pass over velocity arrays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodySlots {
+    /// `body_a` / `body_b`: the world's body arrays.
+    World,
+    /// `local_a` / `local_b`: one island's local arrays (the immovable slot last, at rest).
+    /// The island's step records its rows this way while its data is in cache, on whichever
+    /// thread solved it; the result is the world-wide pass's once the velocities are
+    /// scattered back.
+    Island,
 }
 
 fn record_with_slots(

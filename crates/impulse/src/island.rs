@@ -284,7 +284,7 @@ pub struct IslandWorkspace {
     used_colours: Vec<u64>,
     colours: Vec<u8>,
     colour_scratch: Vec<ContactConstraint>,
-    /// Per-slot M⁻¹Jᵀγ of [`constraints::record_island_velocity_before`].
+    /// Per-slot M⁻¹Jᵀγ of [`constraints::record_velocity_before`] on the island's rows.
     record_scratch: Vec<(Vec3, Vec3)>,
     /// Whether one colour may be solved on several threads.
     parallel: bool,
@@ -589,8 +589,9 @@ pub fn step_island(
             false,
         );
     }
-    constraints::record_island_velocity_before(
+    constraints::record_velocity_before(
         constraints,
+        constraints::BodySlots::Island,
         &w.linear,
         &w.angular,
         w.parallel && coloured_threads,

@@ -318,6 +318,7 @@ impl World {
         if self.island_awake.iter().take(islands).any(|awake| !awake) {
             constraints::record_velocity_before(
                 &mut self.constraints,
+                constraints::BodySlots::World,
                 &self.bodies.linear_velocity,
                 &self.bodies.angular_velocity,
                 self.parallel,
