@@ -507,24 +507,11 @@ pub fn record_velocity_before(
     parallel: bool,
     scratch: &mut Vec<(Vec3, Vec3)>,
 ) {
-    match slots {
-        BodySlots::World => record_with_slots(
-            constraints,
-            linear,
-            angular,
-            |c| (c.body_a as usize, c.body_b as usize),
-            parallel,
-            scratch,
-        ),
-        BodySlots::Island => record_with_slots(
-            constraints,
-            linear,
-            angular,
-            |c| (c.local_a as usize, c.local_b as usize),
-            parallel,
-            scratch,
-        ),
-    }
+    let bodies_of: fn(&ContactConstraint) -> (usize, usize) = match slots {
+        BodySlots::World => |c| (c.body_a as usize, c.body_b as usize),
+        BodySlots::Island => |c| (c.local_a as usize, c.local_b as usize),
+    };
+    record_with_slots(constraints, linear, angular, bodies_of, parallel, scratch);
 }
 
 /// Which indices of a [`ContactConstraint`] name its bodies in a pass over velocity arrays.
