@@ -84,8 +84,10 @@ impl BroadPhase {
         };
         if parallel {
             *out = bvh.traverse_bvtt_single_tree_parallel::<false>();
-            out.retain(keep);
-            out.par_iter_mut().for_each(|pair| *pair = ordered(*pair));
+            out.retain_mut(|pair| {
+                *pair = ordered(*pair);
+                keep(pair)
+            });
             out.par_sort_unstable();
         } else {
             bvh.traverse_bvtt_single_tree::<false>(&mut self.workspace, &mut |a, b| {

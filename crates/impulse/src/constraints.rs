@@ -154,8 +154,8 @@ impl ContactConstraint {
     }
 }
 
-/// Builds one constraint per contact point, island by island in `islands`' pair order
-/// (within an island, narrow-phase order), with each constraint's local body slots set.
+/// Builds one constraint per contact point, laid out island by island as `islands` placed
+/// them (within an island, narrow-phase order), with each constraint's local body slots set.
 /// `velocity_before` is read from the current velocities: called before gravity is applied, it
 /// is the approach velocity v⁻ that restitution reflects. Targets are left at zero. The
 /// carried-over impulses are scaled by `settings.warm_start` ([`crate::solver::scale_impulses`]).
@@ -174,11 +174,7 @@ pub fn assemble(
     out: &mut Vec<ContactConstraint>,
 ) {
     let pairs = &narrow_phase.pairs;
-    let total: usize = islands
-        .pair_order()
-        .iter()
-        .map(|&p| pairs[p as usize].row_count())
-        .sum();
+    let total = islands.constraint_count();
     // Every slot is overwritten below; resizing only fills slots the vector did not have.
     out.truncate(total);
     out.resize(total, ContactConstraint::default());
@@ -511,33 +507,10 @@ pub fn record_velocity_before(
         BodySlots::World => |c| (c.body_a as usize, c.body_b as usize),
         BodySlots::Island => |c| (c.local_a as usize, c.local_b as usize),
     };
-    record_with_slots(constraints, linear, angular, bodies_of, parallel, scratch);
-}
-
-/// Which indices of a [`ContactConstraint`] name its bodies in a pass over velocity arrays.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BodySlots {
-    /// `body_a` / `body_b`: the world's body arrays.
-    World,
-    /// `local_a` / `local_b`: one island's local arrays (the immovable slot last, at rest).
-    /// The island's step records its rows this way while its data is in cache, on whichever
-    /// thread solved it; the result is the world-wide pass's once the velocities are
-    /// scattered back.
-    Island,
-}
-
-fn record_with_slots(
-    constraints: &mut [ContactConstraint],
-    linear: &[Vec3],
-    angular: &[Vec3],
-    slots: impl Fn(&ContactConstraint) -> (usize, usize) + Sync,
-    parallel: bool,
-    scratch: &mut Vec<(Vec3, Vec3)>,
-) {
     scratch.clear();
     scratch.resize(linear.len(), (Vec3::ZERO, Vec3::ZERO));
     for c in constraints.iter() {
-        let (a, b) = slots(c);
+        let (a, b) = bodies_of(c);
         let rows = [
             (&c.normal, c.normal_impulse),
             (&c.tangents[0], c.tangent_impulses[0]),
@@ -552,7 +525,7 @@ fn record_with_slots(
     }
     let scratch = &scratch[..];
     let record = |c: &mut ContactConstraint| {
-        let (a, b) = slots(c);
+        let (a, b) = bodies_of(c);
         let (la, aa) = (linear[a] - scratch[a].0, angular[a] - scratch[a].1);
         let (lb, ab) = (linear[b] - scratch[b].0, angular[b] - scratch[b].1);
         c.normal.velocity_before = c.normal.velocity(la, aa, lb, ab);
@@ -568,4 +541,16 @@ fn record_with_slots(
     } else {
         constraints.iter_mut().for_each(record);
     }
+}
+
+/// Which indices of a [`ContactConstraint`] name its bodies in a pass over velocity arrays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodySlots {
+    /// `body_a` / `body_b`: the world's body arrays.
+    World,
+    /// `local_a` / `local_b`: one island's local arrays (the immovable slot last, at rest).
+    /// The island's step records its rows this way while its data is in cache, on whichever
+    /// thread solved it; the result is the world-wide pass's once the velocities are
+    /// scattered back.
+    Island,
 }

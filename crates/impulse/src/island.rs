@@ -80,9 +80,9 @@ impl Islands {
         }
     }
 
-    /// Pairs with constraints in assembly order: island by island.
-    pub fn pair_order(&self) -> &[u32] {
-        &self.pair_order
+    /// Constraints of all islands together: the length of the assembled array.
+    pub fn constraint_count(&self) -> usize {
+        self.constraint_start.last().map_or(0, |&end| end as usize)
     }
 
     /// Index of pair `pair`'s first constraint in the assembled array.
