@@ -359,23 +359,10 @@ pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f3
     if limit <= 0.0 {
         return [0.0, 0.0];
     }
-    let [a, b, d] = block;
-    // Eigen-decomposition of the symmetric 2×2 K.
-    let half_trace = 0.5 * (a + d);
-    let radius = (0.25 * (a - d) * (a - d) + b * b).sqrt();
-    let (k1, k2) = (half_trace + radius, half_trace - radius);
-    if k2.is_nan() || k2 <= 0.0 {
+    let Some(TangentEigen { k1, k2, u1 }) = TangentEigen::of(block) else {
         return cap_to_disc(q, limit);
-    }
-    let (u1, u2) = if b.abs() > 1e-12 * (a.abs() + d.abs()) {
-        let v = [b, k1 - a];
-        let n = (v[0] * v[0] + v[1] * v[1]).sqrt();
-        ([v[0] / n, v[1] / n], [-v[1] / n, v[0] / n])
-    } else if a >= d {
-        ([1.0, 0.0], [0.0, 1.0])
-    } else {
-        ([0.0, 1.0], [1.0, 0.0])
     };
+    let u2 = [-u1[1], u1[0]];
     // c = diag(k) Uᵀ q in the eigenbasis; λ(ν)_i = c_i / (k_i + ν).
     let c1 = k1 * (u1[0] * q[0] + u1[1] * q[1]);
     let c2 = k2 * (u2[0] * q[0] + u2[1] * q[1]);
@@ -394,6 +381,45 @@ pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f3
     let (e1, e2) = (c1 / (k1 + nu), c2 / (k2 + nu));
     // Back to tangent coordinates, then onto the disc exactly (Newton leaves ~1e-6 relative).
     cap_to_disc([e1 * u1[0] + e2 * u2[0], e1 * u1[1] + e2 * u2[1]], limit)
+}
+
+/// The eigen-decomposition K = k₁ u₁u₁ᵀ + k₂ u₂u₂ᵀ of a point's 2×2 tangent block
+/// (k₁₁, k₁₂, k₂₂) in 1/kg, with k₁ ≥ k₂ and u₂ = u₁ rotated by +90°: what
+/// [`project_to_friction_disc`] works in. K is fixed for the step, so the SIMD sweep
+/// ([`crate::simd`]) computes it once per point when it packs the rows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TangentEigen {
+    /// Larger and smaller eigenvalue (1/kg).
+    pub k1: f32,
+    pub k2: f32,
+    /// Unit eigenvector of `k1`, in tangent coordinates.
+    pub u1: [f32; 2],
+}
+
+impl TangentEigen {
+    /// The decomposition of `block`; `None` when K is not positive definite (k₂ ≤ 0 or NaN:
+    /// an immovable pair), where the projection falls back to the radial cap.
+    #[inline(always)]
+    pub fn of(block: [f32; 3]) -> Option<Self> {
+        let [a, b, d] = block;
+        let half_trace = 0.5 * (a + d);
+        let radius = (0.25 * (a - d) * (a - d) + b * b).sqrt();
+        let (k1, k2) = (half_trace + radius, half_trace - radius);
+        if k2.is_nan() || k2 <= 0.0 {
+            return None;
+        }
+        // For a diagonal K, the axes in the order of the eigenvalues.
+        let u1 = if b.abs() > 1e-12 * (a.abs() + d.abs()) {
+            let v = [b, k1 - a];
+            let n = (v[0] * v[0] + v[1] * v[1]).sqrt();
+            [v[0] / n, v[1] / n]
+        } else if a >= d {
+            [1.0, 0.0]
+        } else {
+            [0.0, 1.0]
+        };
+        Some(Self { k1, k2, u1 })
+    }
 }
 
 /// Projects a friction impulse onto Coulomb's disc of radius `limit` (N·s).
