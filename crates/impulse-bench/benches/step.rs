@@ -14,7 +14,7 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use impulse::World;
 use impulse::broad_phase::BroadPhase;
-use impulse::narrow_phase::{NarrowPhase, speculative_margins};
+use impulse::narrow_phase::{NarrowPhase, SpeculativeMargins};
 use impulse::scene::builtin::builtin_scene;
 
 const SCENE: &str = "pyramid20";
@@ -40,15 +40,14 @@ fn step(c: &mut Criterion) {
     });
 }
 
-/// The per-body speculative margins `World::step` would use next.
-fn margins(world: &World) -> Vec<f32> {
-    let mut margins = Vec::new();
-    speculative_margins(
+/// The speculative margins `World::step` would use next.
+fn margins(world: &World) -> SpeculativeMargins {
+    let mut margins = SpeculativeMargins::default();
+    margins.update(
         &world.bodies,
         world.settings.prediction_distance,
         world.gravity,
         world.dt(),
-        &mut margins,
     );
     margins
 }
@@ -60,7 +59,12 @@ fn broad_phase(c: &mut Criterion) {
     let mut pairs = Vec::new();
     c.bench_function("broad_phase/pyramid20", |b| {
         b.iter(|| {
-            broad_phase.candidate_pairs(black_box(&world.bodies), &margins, false, &mut pairs);
+            broad_phase.candidate_pairs(
+                black_box(&world.bodies),
+                margins.margins(),
+                false,
+                &mut pairs,
+            );
             broad_phase.optimize();
             black_box(pairs.len())
         })
@@ -71,7 +75,7 @@ fn narrow_phase(c: &mut Criterion) {
     let world = settled_world();
     let margins = margins(&world);
     let mut pairs = Vec::new();
-    BroadPhase::default().candidate_pairs(&world.bodies, &margins, false, &mut pairs);
+    BroadPhase::default().candidate_pairs(&world.bodies, margins.margins(), false, &mut pairs);
     let mut narrow_phase = NarrowPhase::default();
     narrow_phase
         .update(&world.bodies, &pairs, &margins, false)

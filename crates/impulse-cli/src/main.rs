@@ -82,7 +82,8 @@ enum Command {
         /// not converge (0 = never).
         #[arg(long)]
         exact_max_contacts: Option<u32>,
-        /// Write what the solver did on each island at each step (JSON Lines).
+        /// Write what the solver did on each island at each step, and the step's wall-clock
+        /// time in ms (JSON Lines).
         #[arg(long)]
         island_report: Option<PathBuf>,
         /// Soft contact frequency in Hz (0 = the seed's rigid rows with overlap repair c_d).

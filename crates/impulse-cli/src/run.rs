@@ -198,7 +198,11 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             use std::io::Write;
             serde_json::to_writer(
                 &mut *w,
-                &serde_json::json!({"step": diagnostics.step, "islands": &diagnostics.islands}),
+                &serde_json::json!({
+                    "step": diagnostics.step,
+                    "ms": step_ms.last(),
+                    "islands": &diagnostics.islands,
+                }),
             )?;
             writeln!(w)?;
         }

@@ -59,7 +59,7 @@ pub struct World {
     constraints: Vec<ContactConstraint>,
     world_inverse_inertia: Vec<Mat3>,
     scratch: Vec<(Vec3, Vec3)>,
-    margins: Vec<f32>,
+    margins: narrow_phase::SpeculativeMargins,
     islands: Islands,
     island_awake: Vec<bool>,
     workspaces: Vec<IslandWorkspace>,
@@ -87,7 +87,7 @@ impl World {
             constraints: Vec::new(),
             world_inverse_inertia: Vec::new(),
             scratch: Vec::new(),
-            margins: Vec::new(),
+            margins: narrow_phase::SpeculativeMargins::default(),
             islands: Islands::default(),
             island_awake: Vec::new(),
             workspaces: Vec::new(),
@@ -204,14 +204,8 @@ impl World {
         );
         let start_energy = || diagnostics::energy_terms(bodies, gravity).mechanical();
         let mut broad = || {
-            narrow_phase::speculative_margins(
-                bodies,
-                settings.prediction_distance,
-                gravity,
-                dt,
-                margins,
-            );
-            broad_phase.candidate_pairs(bodies, margins, parallel, candidates);
+            margins.update(bodies, settings.prediction_distance, gravity, dt);
+            broad_phase.candidate_pairs(bodies, margins.margins(), parallel, candidates);
         };
         let start_energy = if parallel {
             rayon::join(start_energy, broad).0
