@@ -716,52 +716,46 @@ fn cholesky_solve_columns(l: &[f64], s: usize, columns: &mut [f64]) {
         let (c0, rest) = group.split_at_mut(s);
         let (c1, rest) = rest.split_at_mut(s);
         let (c2, c3) = rest.split_at_mut(s);
+        let mut c = [c0, c1, c2, c3];
         for i in 0..s {
-            // −0.0 as `Iterator::sum` starts, so that signed zeros match too.
-            let mut dot = [-0.0f64; 4];
-            let row = &l[i * s..i * s + i];
-            for ((((factor, x0), x1), x2), x3) in row
-                .iter()
-                .zip(&c0[..i])
-                .zip(&c1[..i])
-                .zip(&c2[..i])
-                .zip(&c3[..i])
-            {
-                dot[0] += factor * x0;
-                dot[1] += factor * x1;
-                dot[2] += factor * x2;
-                dot[3] += factor * x3;
-            }
-            let pivot = l[i * s + i];
-            c0[i] = (c0[i] - dot[0]) / pivot;
-            c1[i] = (c1[i] - dot[1]) / pivot;
-            c2[i] = (c2[i] - dot[2]) / pivot;
-            c3[i] = (c3[i] - dot[3]) / pivot;
+            substitute_four(&mut c, i, l[i * s..i * s + i].iter(), 0, l[i * s + i]);
         }
         for i in (0..s).rev() {
-            let mut dot = [-0.0f64; 4];
             // Column i of L below the diagonal, read down the rows.
             let below = l.get((i + 1) * s + i..).unwrap_or(&[]).iter().step_by(s);
-            for ((((factor, x0), x1), x2), x3) in below
-                .zip(&c0[i + 1..])
-                .zip(&c1[i + 1..])
-                .zip(&c2[i + 1..])
-                .zip(&c3[i + 1..])
-            {
-                dot[0] += factor * x0;
-                dot[1] += factor * x1;
-                dot[2] += factor * x2;
-                dot[3] += factor * x3;
-            }
-            let pivot = l[i * s + i];
-            c0[i] = (c0[i] - dot[0]) / pivot;
-            c1[i] = (c1[i] - dot[1]) / pivot;
-            c2[i] = (c2[i] - dot[2]) / pivot;
-            c3[i] = (c3[i] - dot[3]) / pivot;
+            substitute_four(&mut c, i, below, i + 1, l[i * s + i]);
         }
     }
     for column in groups.into_remainder().chunks_exact_mut(s) {
         cholesky_solve(l, s, column);
+    }
+}
+
+/// One substitution step in four columns at once: x_i ← (x_i − Σ_k f_k·x_{from+k}) / pivot,
+/// the sum over `factors` in order from −0.0, as `Iterator::sum` adds.
+#[inline(always)]
+fn substitute_four<'a>(
+    columns: &mut [&mut [f64]; 4],
+    i: usize,
+    factors: impl Iterator<Item = &'a f64>,
+    from: usize,
+    pivot: f64,
+) {
+    let mut dot = [-0.0f64; 4];
+    let [c0, c1, c2, c3] = columns;
+    for ((((factor, x0), x1), x2), x3) in factors
+        .zip(&c0[from..])
+        .zip(&c1[from..])
+        .zip(&c2[from..])
+        .zip(&c3[from..])
+    {
+        dot[0] += factor * x0;
+        dot[1] += factor * x1;
+        dot[2] += factor * x2;
+        dot[3] += factor * x3;
+    }
+    for (column, dot) in columns.iter_mut().zip(dot) {
+        column[i] = (column[i] - dot) / pivot;
     }
 }
 
