@@ -295,6 +295,9 @@ pub struct IslandWorkspace {
     bundles: Bundles,
     /// What the solver did on this island in the step.
     pub report: IslandReport,
+    /// Whether a contact of the island was closing at the step's start faster than gravity
+    /// closes a resting one in a step (|g|·dt): an impact.
+    impact: bool,
 }
 
 impl IslandWorkspace {
@@ -402,7 +405,11 @@ impl IslandWorkspace {
                 let unconverged = outcome.last_change > settings.escalation_tolerance;
                 let heavy = report.mass_ratio > settings.mass_ratio_threshold;
                 let small = constraints.len() <= settings.exact_max_contacts as usize;
-                if escalate && small && (unconverged || heavy) {
+                // Unconverged in an impact, the island takes more iterations rather than the
+                // exact path: the next steps repair what an impact leaves, while pivoting every
+                // landing column of a pile is the cost of hundreds of exact solves a substep.
+                let persistent = unconverged && !self.impact;
+                if escalate && small && (persistent || heavy) {
                     report.escalations += 1;
                     match exact::solve_exact(
                         constraints,
@@ -488,6 +495,10 @@ pub fn step_island(
     w.displacement.resize(slots, Vec3::ZERO);
     w.rotation.clear();
     w.rotation.resize(slots, Vec3::ZERO);
+    let impact_speed = gravity.length() * dt;
+    w.impact = constraints
+        .iter()
+        .any(|c| c.normal.velocity_before < -impact_speed);
     w.report = IslandReport {
         first_body: island_bodies.iter().copied().min().unwrap_or(0),
         bodies: island_bodies.len() as u32,

@@ -17,7 +17,10 @@ pub enum SolverMethod {
     /// `escalation_tolerance`, or whose mass ratio exceeds `mass_ratio_threshold`, escalates:
     /// to the exact path when it has at most `exact_max_contacts` contact points (keeping the
     /// iterative result if pivoting fails), otherwise (only when unconverged) to
-    /// `escalation_iterations` more NNCG iterations. Each island's choice is reported in the
+    /// `escalation_iterations` more NNCG iterations. An unconverged island that is not heavy
+    /// but in an impact (a contact closing at the step's start faster than |g|·dt, the speed
+    /// gravity gives in one step) takes the iterations, not the exact path: later steps repair
+    /// what an impact leaves. Each island's choice is reported in the
     /// step diagnostics. It starts from NNCG rather than plain PGS because an NNCG iteration
     /// is a symmetric PGS sweep plus a momentum step, and on every standard scene it reached a
     /// given sink at less cost than PGS first (docs/solvers.md).

@@ -104,3 +104,71 @@ fn plate_stands_still_with_the_exact_path() {
     let energy = world.diagnostics().kinetic_energy;
     assert!(energy < 1e-3, "kinetic energy {energy} J at rest");
 }
+
+/// A column of four balls on the ground, and a fifth 5 cm above it, falling at `speed`; the
+/// fifth weighs `top_mass` kg (the others 1000·4/3·π·0.5³ ≈ 524 kg). The solver is set so that
+/// every main solve ends unconverged (one NNCG iteration, zero escalation tolerance) and the
+/// policy has to choose.
+fn landing_column(speed: f32, top_mass: Option<f32>) -> World {
+    use glam::Vec3;
+    use impulse::{BodyDesc, BodyKind, Material, ShapeDesc};
+    let settings = impulse::SolverSettings {
+        sleep: false,
+        iterations: 1,
+        escalation_tolerance: 0.0,
+        ..impulse::SolverSettings::default()
+    };
+    let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
+    let material = Material {
+        friction: 0.3,
+        restitution: 0.0,
+        density: 1000.0,
+    };
+    world
+        .add_body(
+            &BodyDesc::new(
+                BodyKind::Static,
+                ShapeDesc::Cuboid {
+                    half_extents: [5.0, 0.5, 5.0],
+                },
+                [0.0, -0.5, 0.0],
+            ),
+            &material,
+        )
+        .unwrap();
+    for i in 0..5 {
+        let mut ball = BodyDesc::new(
+            BodyKind::Dynamic,
+            ShapeDesc::Sphere { radius: 0.5 },
+            [0.0, 0.5 + i as f32 + if i == 4 { 0.05 } else { 0.0 }, 0.0],
+        );
+        if i == 4 {
+            ball.linear_velocity = [0.0, -speed, 0.0];
+            ball.mass = top_mass;
+        }
+        world.add_body(&ball, &material).unwrap();
+    }
+    world
+}
+
+/// The exact path is for what iterations cannot fix: an unconverged island at rest, or a
+/// heavy one. An unconverged island in an impact (a contact closing faster than gravity
+/// closes a resting one in a step) takes more NNCG iterations instead; a heavy one is still
+/// solved exactly.
+#[test]
+fn impacts_take_more_iterations_and_rest_or_heavy_islands_the_exact_path() {
+    let method = |mut world: World| {
+        let islands = world.step().unwrap().islands.clone();
+        assert_eq!(islands.len(), 1, "one column, one island: {islands:?}");
+        islands[0].method
+    };
+    assert_eq!(
+        method(landing_column(8.0, None)),
+        EscalationLevel::NncgExtended
+    );
+    assert_eq!(method(landing_column(0.0, None)), EscalationLevel::Exact);
+    assert_eq!(
+        method(landing_column(8.0, Some(524.0 * 50.0))),
+        EscalationLevel::Exact
+    );
+}
