@@ -295,9 +295,8 @@ pub struct IslandWorkspace {
     bundles: Bundles,
     /// What the solver did on this island in the step.
     pub report: IslandReport,
-    /// Whether a contact of the island was closing at the step's start faster than gravity
-    /// closes a resting one in a step (|g|·dt): an impact.
-    impact: bool,
+    /// |g|·dt (m/s): a contact closing faster at the step's start is an impact.
+    impact_speed: f32,
 }
 
 impl IslandWorkspace {
@@ -408,7 +407,14 @@ impl IslandWorkspace {
                 // Unconverged in an impact, the island takes more iterations rather than the
                 // exact path: the next steps repair what an impact leaves, while pivoting every
                 // landing column of a pile is the cost of hundreds of exact solves a substep.
-                let persistent = unconverged && !self.impact;
+                // Asked only when it decides something: a pass over the rows' v⁻ (set at
+                // assembly, rewritten only as the island's step ends).
+                let impact = || {
+                    constraints
+                        .iter()
+                        .any(|c| c.normal.velocity_before < -self.impact_speed)
+                };
+                let persistent = escalate && unconverged && !heavy && small && !impact();
                 if escalate && small && (persistent || heavy) {
                     report.escalations += 1;
                     match exact::solve_exact(
@@ -495,10 +501,7 @@ pub fn step_island(
     w.displacement.resize(slots, Vec3::ZERO);
     w.rotation.clear();
     w.rotation.resize(slots, Vec3::ZERO);
-    let impact_speed = gravity.length() * dt;
-    w.impact = constraints
-        .iter()
-        .any(|c| c.normal.velocity_before < -impact_speed);
+    w.impact_speed = gravity.length() * dt;
     w.report = IslandReport {
         first_body: island_bodies.iter().copied().min().unwrap_or(0),
         bodies: island_bodies.len() as u32,

@@ -658,11 +658,7 @@ fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &ContactConstra
         );
     }
     // Once per step rather than in every projection: K is fixed for the step.
-    let eigen = TangentEigen::of(c.tangent_block).unwrap_or(TangentEigen {
-        k1: 0.0,
-        k2: 0.0,
-        u1: [1.0, 0.0],
-    });
+    let eigen = TangentEigen::of(c.tangent_block).unwrap_or(TangentEigen::DEGENERATE);
     for (k, value) in [eigen.k1, eigen.k2, eigen.u1[0], eigen.u1[1]]
         .into_iter()
         .enumerate()
@@ -845,13 +841,7 @@ mod tests {
         ];
         let eigen: Vec<TangentEigen> = cases
             .iter()
-            .map(|(_, block, _)| {
-                TangentEigen::of(*block).unwrap_or(TangentEigen {
-                    k1: 0.0,
-                    k2: 0.0,
-                    u1: [1.0, 0.0],
-                })
-            })
+            .map(|(_, block, _)| TangentEigen::of(*block).unwrap_or(TangentEigen::DEGENERATE))
             .collect();
         let lane = |f: &dyn Fn(usize) -> f32| Lane::new(std::array::from_fn(f));
         let q = [lane(&|i| cases[i].0[0]), lane(&|i| cases[i].0[1])];

@@ -397,6 +397,14 @@ pub struct TangentEigen {
 }
 
 impl TangentEigen {
+    /// What the SIMD packing stores for a block without a decomposition: k₂ = 0 sends the
+    /// lane to the radial cap.
+    pub const DEGENERATE: Self = Self {
+        k1: 0.0,
+        k2: 0.0,
+        u1: [1.0, 0.0],
+    };
+
     /// The decomposition of `block`; `None` when K is not positive definite (k₂ ≤ 0 or NaN:
     /// an immovable pair), where the projection falls back to the radial cap.
     #[inline(always)]

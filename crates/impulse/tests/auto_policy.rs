@@ -1,6 +1,8 @@
 //! The automatic solver policy (`method: auto`, the default): what it chooses per island is
 //! reported, and the escalations it makes hold the seed's hard cases still.
 
+mod common;
+
 use impulse::World;
 use impulse::island::EscalationLevel;
 use impulse::scene::builtin::builtin_scene;
@@ -111,7 +113,7 @@ fn plate_stands_still_with_the_exact_path() {
 /// policy has to choose.
 fn landing_column(speed: f32, top_mass: Option<f32>) -> World {
     use glam::Vec3;
-    use impulse::{BodyDesc, BodyKind, Material, ShapeDesc};
+    use impulse::{BodyDesc, BodyKind, ShapeDesc};
     let settings = impulse::SolverSettings {
         sleep: false,
         iterations: 1,
@@ -119,20 +121,10 @@ fn landing_column(speed: f32, top_mass: Option<f32>) -> World {
         ..impulse::SolverSettings::default()
     };
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
-    let material = Material {
-        friction: 0.3,
-        restitution: 0.0,
-        density: 1000.0,
-    };
+    let material = common::material(0.3);
     world
         .add_body(
-            &BodyDesc::new(
-                BodyKind::Static,
-                ShapeDesc::Cuboid {
-                    half_extents: [5.0, 0.5, 5.0],
-                },
-                [0.0, -0.5, 0.0],
-            ),
+            &common::static_box(Vec3::new(5.0, 0.5, 5.0), Vec3::new(0.0, -0.5, 0.0)),
             &material,
         )
         .unwrap();
