@@ -4,7 +4,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 use crate::body::Bodies;
-use crate::constraints::ContactConstraint;
+use crate::constraints::{BodySlots, ContactConstraint};
 use crate::island::IslandReport;
 use crate::solver::cap_to_disc;
 
@@ -59,7 +59,27 @@ pub fn natural_map_residual_on(
     angular: &[Vec3],
     parallel: bool,
 ) -> f32 {
-    let run = |rows: &[ContactConstraint]| squared_natural_map(rows, linear, angular);
+    natural_map_residual_in(constraints, BodySlots::World, linear, angular, parallel)
+}
+
+/// [`natural_map_residual_on`] with the velocities indexed as `slots` says: an island's step
+/// takes its own residual on its local arrays ([`BodySlots::Island`]) while its rows are in
+/// cache, and gets the world-wide pass's value once its velocities are scattered back.
+pub fn natural_map_residual_in(
+    constraints: &[ContactConstraint],
+    slots: BodySlots,
+    linear: &[Vec3],
+    angular: &[Vec3],
+    parallel: bool,
+) -> f32 {
+    let run = |rows: &[ContactConstraint]| match slots {
+        BodySlots::World => squared_natural_map(rows, linear, angular, |c| {
+            (c.body_a as usize, c.body_b as usize)
+        }),
+        BodySlots::Island => squared_natural_map(rows, linear, angular, |c| {
+            (c.local_a as usize, c.local_b as usize)
+        }),
+    };
     let sum: f64 = if parallel
         && constraints.len() > RESIDUAL_ROWS_PER_TASK
         && rayon::current_num_threads() > 1
@@ -76,15 +96,17 @@ pub fn natural_map_residual_on(
     sum.sqrt() as f32
 }
 
-/// Σ φ² over `constraints` (see [`StepDiagnostics::natural_map_residual`]).
+/// Σ φ² over `constraints` (see [`StepDiagnostics::natural_map_residual`]); `bodies_of` gives
+/// a row's indices into `linear` and `angular`.
 fn squared_natural_map(
     constraints: &[ContactConstraint],
     linear: &[Vec3],
     angular: &[Vec3],
+    bodies_of: impl Fn(&ContactConstraint) -> (usize, usize),
 ) -> f64 {
     let mut sum = 0.0f64;
     for c in constraints {
-        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let (a, b) = bodies_of(c);
         let velocity = |row: &crate::constraints::JacobianRow| {
             row.velocity(linear[a], angular[a], linear[b], angular[b])
         };

@@ -230,7 +230,8 @@ pub struct IslandReport {
     /// Whether the substeps' solves ran in SIMD lanes ([`crate::simd`]).
     pub simd: bool,
     /// Natural-map residual of the island's rows at the end of the step (see
-    /// [`crate::diagnostics::StepDiagnostics::natural_map_residual`]); set by the world.
+    /// [`crate::diagnostics::StepDiagnostics::natural_map_residual`]); set by the world as the
+    /// island's step ends.
     pub natural_map_residual: f32,
 }
 
@@ -297,6 +298,8 @@ pub struct IslandWorkspace {
     pub report: IslandReport,
     /// |g|·dt (m/s): a contact closing faster at the step's start is an impact.
     impact_speed: f32,
+    /// Rows with friction (μ > 0), counted by the world as the island's step ends.
+    pub(crate) friction_rows: usize,
 }
 
 impl IslandWorkspace {

@@ -11,7 +11,7 @@ use crate::constraints::{self, ContactConstraint};
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{self, StepDiagnostics};
 use crate::error::{StepError, WorldError};
-use crate::island::{self, IslandReport, IslandWorkspace, Islands, StepContext};
+use crate::island::{self, IslandWorkspace, Islands, StepContext};
 use crate::narrow_phase::{self, ContactImpulse, NarrowPhase};
 use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
@@ -66,7 +66,6 @@ pub struct World {
     islands: Islands,
     island_awake: Vec<bool>,
     workspaces: Vec<IslandWorkspace>,
-    island_residuals: Vec<f32>,
     energy: EnergyCheck,
     /// Run islands (and the narrow phase) on rayon's thread pool when it has more than one
     /// thread. `false` runs everything on the calling thread.
@@ -94,7 +93,6 @@ impl World {
             islands: Islands::default(),
             island_awake: Vec::new(),
             workspaces: Vec::new(),
-            island_residuals: Vec::new(),
             energy: EnergyCheck::default(),
             parallel: true,
             diagnostics: StepDiagnostics::default(),
@@ -291,11 +289,25 @@ impl World {
                     jobs.push((self.islands.bodies(k), mine, workspace));
                 }
             }
+            // Each island ends its step with the passes that read its rows once more, while
+            // they are still in cache: its natural-map residual and its friction-row count. As
+            // world-wide passes over every row they were 3 % of a balls16k step at rest (perf),
+            // mostly waiting on memory; the results are the same to the bit.
             let run = |(bodies, constraints, workspace): &mut (
                 &[u32],
                 &mut [ContactConstraint],
                 &mut IslandWorkspace,
-            )| island::step_island(bodies, constraints, &context, workspace);
+            )| {
+                island::step_island(bodies, constraints, &context, workspace);
+                workspace.report.natural_map_residual = diagnostics::natural_map_residual_in(
+                    constraints,
+                    constraints::BodySlots::Island,
+                    &workspace.linear,
+                    &workspace.angular,
+                    context.parallel,
+                );
+                workspace.friction_rows = constraints.iter().filter(|c| c.friction > 0.0).count();
+            };
             if self.parallel && jobs.len() > 1 && rayon::current_num_threads() > 1 {
                 // Islands differ in cost by orders of magnitude (an exact solve against a
                 // resting column), so the jobs are split finely enough for work stealing to
@@ -331,67 +343,44 @@ impl World {
         self.store_impulses();
         // Only awake islands were solved this step; sleeping ones keep last step's state.
         let mut squared = 0.0f64;
+        let mut friction_rows = 0;
         // Reuse last step's list: no allocation per step once it has grown.
         let mut island_reports = std::mem::take(&mut self.diagnostics.islands);
         island_reports.clear();
-        let mut parts = std::mem::take(&mut self.island_residuals);
-        {
-            let (constraints, islands_of, awake) =
-                (&self.constraints, &self.islands, &self.island_awake);
-            let (linear, angular) = (&self.bodies.linear_velocity, &self.bodies.angular_velocity);
-            let parallel = self.parallel && rayon::current_num_threads() > 1;
-            let part = |k: usize| {
-                if awake[k] {
-                    diagnostics::natural_map_residual_on(
-                        &constraints[islands_of.constraint_range(k)],
-                        linear,
-                        angular,
-                        parallel,
-                    )
-                } else {
-                    0.0
-                }
-            };
-            if parallel {
-                (0..islands)
-                    .into_par_iter()
-                    .map(part)
-                    .collect_into_vec(&mut parts);
-            } else {
-                parts.clear();
-                parts.extend((0..islands).map(part));
-            }
-        }
-        for (k, &part) in parts.iter().enumerate() {
+        for k in 0..islands {
+            let range = self.islands.constraint_range(k);
             if self.island_awake[k] {
-                squared += (part as f64) * (part as f64);
-                if !self.islands.constraint_range(k).is_empty() {
-                    island_reports.push(IslandReport {
-                        natural_map_residual: part,
-                        ..self.workspaces[k].report
-                    });
+                let report = self.workspaces[k].report;
+                let part = report.natural_map_residual as f64;
+                squared += part * part;
+                friction_rows += self.workspaces[k].friction_rows;
+                if !range.is_empty() {
+                    island_reports.push(report);
                 }
+            } else {
+                friction_rows += self.constraints[range]
+                    .iter()
+                    .filter(|c| c.friction > 0.0)
+                    .count();
             }
         }
-        self.island_residuals = parts;
         let residual = squared.sqrt() as f32;
         // Sleep last: it zeroes velocities, which must not leak into this step's LCP. The
-        // counts over rows and pairs need no bodies, so they run beside it and the energy.
+        // counts over pairs need no bodies, so they run beside it and the energy.
         let (bodies, gravity) = (&mut self.bodies, self.gravity);
         let (islands_of, awake) = (&self.islands, &self.island_awake);
-        let (constraints, pairs) = (&self.constraints, &self.narrow_phase);
+        let pairs = &self.narrow_phase;
         let mut sleep_and_energy = || {
             update_sleep(bodies, islands_of, awake, &settings, dt);
             diagnostics::energy_terms(bodies, gravity)
         };
         let counts = || {
             (
-                constraints.iter().filter(|c| c.friction > 0.0).count(),
                 pairs.pairs.iter().filter(|p| p.point_count() > 0).count(),
                 pairs.max_depth(),
             )
         };
-        let (energy, (friction_rows, contact_pairs, max_depth)) = if parallel {
+        let (energy, (contact_pairs, max_depth)) = if parallel {
             rayon::join(sleep_and_energy, counts)
         } else {
             (sleep_and_energy(), counts())
