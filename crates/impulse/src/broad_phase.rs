@@ -33,9 +33,10 @@ pub struct BroadPhase {
 /// A leaf's box is stored this much larger (m) than the body's, and left alone while the
 /// body's box stays inside it and has not shrunk by more than this: at rest no leaf changes,
 /// and the refit, the incremental optimisation and the traversal are all skipped. Rapier's
-/// broad phase keeps boxes the same way with a 4 cm skin (`rapier3d` 0.36,
-/// `BroadPhaseBvh::CHANGE_DETECTION_FACTOR`, with Parry's containment test alone, so a box
-/// fattened by a fast body's speculative margin stays that large once it rests). 1 cm is far
+/// broad phase keeps boxes with a 4 cm skin (`rapier3d` 0.36,
+/// `BroadPhaseBvh::CHANGE_DETECTION_FACTOR`) and Parry's containment test alone; here a box
+/// fattened while its body fell (its speculative margin) would then stay that large once the
+/// body rests, hence the rule on shrinking. 1 cm is far
 /// above the jitter of a resting pile and below the gaps of the standard scenes (0.2 m
 /// between ball columns). The extra candidates it lets through are at most 4 skins apart and
 /// get no contact points from the narrow phase, which uses the exact per-pair speculative
@@ -55,7 +56,8 @@ impl BroadPhase {
     /// Candidate pairs `(i, j)` with `i < j`, sorted, at least one of them moving. Body i's box
     /// is loosened by `margins[i]` (m), or by 0 when `margins` is empty, so that speculative
     /// contacts within the margins are found; the tree keeps each box fattened by
-    /// [`CHANGE_DETECTION_SKIN`], so pairs up to that much further apart come too. With
+    /// [`CHANGE_DETECTION_SKIN`] (by at most twice that since its last rewrite), so pairs up
+    /// to four skins further apart come too. With
     /// `parallel`, the boxes, the leaf updates, the refit, the traversal and the sort run on
     /// rayon's threads (Parry's `parallel` feature); the pairs are the same on any thread
     /// count.

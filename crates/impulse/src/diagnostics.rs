@@ -62,9 +62,10 @@ pub fn natural_map_residual_on(
     natural_map_residual_in(constraints, BodySlots::World, linear, angular, parallel)
 }
 
-/// [`natural_map_residual_on`] with the velocities indexed as `slots` says: an island's step
+/// [`natural_map_residual_on`] with the velocities indexed as `slots` says. An island's step
 /// takes its own residual on its local arrays ([`BodySlots::Island`]) while its rows are in
-/// cache, and gets the world-wide pass's value once its velocities are scattered back.
+/// cache; the value is the world-wide pass's, as the local velocities are scattered back to
+/// the bodies unchanged.
 pub fn natural_map_residual_in(
     constraints: &[ContactConstraint],
     slots: BodySlots,
