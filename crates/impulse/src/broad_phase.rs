@@ -36,11 +36,10 @@ pub struct BroadPhase {
 /// broad phase keeps boxes with a 4 cm skin (`rapier3d` 0.36,
 /// `BroadPhaseBvh::CHANGE_DETECTION_FACTOR`) and Parry's containment test alone; here a box
 /// fattened while its body fell (its speculative margin) would then stay that large once the
-/// body rests, hence the rule on shrinking. 1 cm is far
-/// above the jitter of a resting pile and below the gaps of the standard scenes (0.2 m
-/// between ball columns). The extra candidates it lets through are at most 4 skins apart and
-/// get no contact points from the narrow phase, which uses the exact per-pair speculative
-/// distance.
+/// body rests, hence the rule on shrinking. 1 cm is far above the jitter of a resting pile
+/// and below the gaps of the standard scenes (0.2 m between ball columns). The extra
+/// candidates it lets through are at most 4 skins apart and get no contact points from the
+/// narrow phase, which uses the exact per-pair speculative distance.
 pub const CHANGE_DETECTION_SKIN: f32 = 0.01;
 
 /// Whether a leaf stored as `stored` must be rewritten for a body now bounded by `new`: the
@@ -57,10 +56,9 @@ impl BroadPhase {
     /// is loosened by `margins[i]` (m), or by 0 when `margins` is empty, so that speculative
     /// contacts within the margins are found; the tree keeps each box fattened by
     /// [`CHANGE_DETECTION_SKIN`] (by at most twice that since its last rewrite), so pairs up
-    /// to four skins further apart come too. With
-    /// `parallel`, the boxes, the leaf updates, the refit, the traversal and the sort run on
-    /// rayon's threads (Parry's `parallel` feature); the pairs are the same on any thread
-    /// count.
+    /// to four skins further apart come too. With `parallel`, the boxes, the leaf updates, the
+    /// refit, the traversal and the sort run on rayon's threads (Parry's `parallel` feature);
+    /// the pairs are the same on any thread count.
     pub fn candidate_pairs(
         &mut self,
         bodies: &Bodies,

@@ -306,7 +306,7 @@ impl World {
                     &workspace.angular,
                     context.parallel,
                 );
-                workspace.friction_rows = constraints.iter().filter(|c| c.friction > 0.0).count();
+                workspace.friction_rows = friction_rows(constraints);
             };
             if self.parallel && jobs.len() > 1 && rayon::current_num_threads() > 1 {
                 // Islands differ in cost by orders of magnitude (an exact solve against a
@@ -358,10 +358,7 @@ impl World {
                     island_reports.push(report);
                 }
             } else {
-                friction_rows += self.constraints[range]
-                    .iter()
-                    .filter(|c| c.friction > 0.0)
-                    .count();
+                friction_rows += self::friction_rows(&self.constraints[range]);
             }
         }
         let residual = squared.sqrt() as f32;
@@ -651,6 +648,11 @@ fn write_impulse(c: &ContactConstraint, manifolds: &mut [narrow_phase::Manifold]
             p.data = data;
         }
     }
+}
+
+/// Contact points with friction (μ > 0): each adds two tangent rows to the step's LCP.
+fn friction_rows(constraints: &[ContactConstraint]) -> usize {
+    constraints.iter().filter(|c| c.friction > 0.0).count()
 }
 
 /// Bodies per parallel task of the per-body passes.
