@@ -17,7 +17,7 @@ use crate::exact::{self, ExactWorkspace};
 use crate::integrate;
 use crate::narrow_phase::ContactPair;
 use crate::settings::{SolverMethod, SolverSettings};
-use crate::simd::Bundles;
+use crate::simd::{self, Bundles};
 use crate::solver::{self, NncgWorkspace, Sweep, Velocities};
 
 /// Islands of one step: body lists, and the order in which the narrow phase's pairs are
@@ -524,8 +524,11 @@ pub fn step_island(
     w.report.simd = bundled;
     let coloured_threads = threshold > 0 && constraints.len() >= threshold;
     if bundled {
-        w.bundles
-            .pack(constraints, slots, parallel && coloured_threads);
+        // Bundles are in colour order on any thread count, so spreading a colour over the
+        // threads costs no convergence (unlike the scalar sweep). Smaller islands stay on
+        // their thread: rayon's hand-offs then cost more than they spread.
+        let spread = coloured_threads || constraints.len() >= simd::PARALLEL_ISLAND_POINTS;
+        w.bundles.pack(constraints, slots, parallel && spread);
     } else if coloured_threads {
         solver::colour_constraints(
             constraints,
@@ -611,7 +614,7 @@ pub fn step_island(
         constraints::BodySlots::Island,
         &w.linear,
         &w.angular,
-        w.parallel && coloured_threads,
+        w.parallel && (coloured_threads || (bundled && w.bundles.parallel())),
         &mut w.record_scratch,
     );
 }

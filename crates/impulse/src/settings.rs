@@ -125,11 +125,15 @@ pub struct SolverSettings {
     /// narrow-phase order on piles (pyramid100: 18.5 mm sink after 30 steps against 8.3 mm) and
     /// costs ~20 % on one thread; on two threads pyramid100 steps 1.17× faster than in
     /// narrow-phase order (docs/benchmarks.md). Results do not depend on the thread count.
+    /// Islands solved in SIMD lanes (`simd_island_contacts`) are always in colour order and
+    /// spread each large colour over the threads whatever this says.
     pub parallel_island_contacts: u32,
     /// With `method: pgs` and without split impulse, islands with at least this many contact
     /// points are solved in SIMD lanes ([`crate::simd`]): coloured greedily, four points of a
     /// colour updated at once. 0 = never. Default 16; smaller islands do not repay the packing.
-    /// Colour order converges a little more slowly than narrow-phase order.
+    /// Colour order converges a little more slowly than narrow-phase order. In islands of at
+    /// least 1024 points, a colour of at least 64 bundles is spread over the worker threads
+    /// (the same result on any thread count).
     pub simd_island_contacts: u32,
 }
 

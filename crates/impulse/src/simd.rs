@@ -357,6 +357,11 @@ impl Bundles {
         });
     }
 
+    /// Whether [`Bundles::pack`] was asked to spread colours over rayon's threads.
+    pub fn parallel(&self) -> bool {
+        self.parallel
+    }
+
     /// Writes the bundles' impulses (and largest normal impulses) back to `constraints`, the
     /// slice [`Bundles::pack`] read. On rayon's threads when packing was.
     pub fn unpack(&self, constraints: &mut [ContactConstraint]) {
@@ -581,6 +586,11 @@ impl BundleUpdate for WarmStart {
 
 /// Bundles of one colour per parallel task.
 const BUNDLES_PER_TASK: usize = 32;
+
+/// Islands of at least this many points spread their colours over rayon's threads (whatever
+/// `parallel_island_contacts` says; see [`Bundles::pack`]). On balls4096 with `fast` (256
+/// columns of 16 points), spreading every island made a two-thread step about 1.4× slower.
+pub const PARALLEL_ISLAND_POINTS: usize = 1024;
 
 /// Islands of at least this many points are packed and unpacked on rayon's threads.
 const PARALLEL_PACK_POINTS: usize = 4096;
