@@ -385,8 +385,7 @@ pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f3
 
 /// The eigen-decomposition K = k₁ u₁u₁ᵀ + k₂ u₂u₂ᵀ of a point's 2×2 tangent block
 /// (k₁₁, k₁₂, k₂₂) in 1/kg, with k₁ ≥ k₂ and u₂ = u₁ rotated by +90°: what
-/// [`project_to_friction_disc`] works in. K is fixed for the step, so the SIMD sweep
-/// ([`crate::simd`]) computes it once per point when it packs the rows.
+/// [`project_to_friction_disc`] works in.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TangentEigen {
     /// Larger and smaller eigenvalue (1/kg).
