@@ -176,12 +176,21 @@ pub struct RapierVariant {
     /// `contact_softness.natural_frequency` (Hz; default 30); contacts with a fixed body get
     /// twice this (`static_contact_softness`), as in Rapier's defaults.
     pub contact_hz: f32,
+    /// `FrictionModel::Coulomb` (one friction disc per contact point, impulse's formulation)
+    /// instead of Rapier's default `Simplified` (one per manifold of up to four points, plus a
+    /// twist row).
+    pub coulomb_friction: bool,
 }
 
 impl RapierVariant {
-    /// Engine name of its rows, e.g. `rapier 8×120Hz`.
+    /// Engine name of its rows, e.g. `rapier 8×120Hz` or `rapier 4×30Hz coulomb`.
     pub fn engine_name(&self) -> String {
-        format!("rapier {}×{}Hz", self.substeps, self.contact_hz)
+        let friction = if self.coulomb_friction {
+            " coulomb"
+        } else {
+            ""
+        };
+        format!("rapier {}×{}Hz{friction}", self.substeps, self.contact_hz)
     }
 }
 
@@ -195,6 +204,9 @@ impl RapierVariant {
         };
         params.contact_softness.natural_frequency = self.contact_hz;
         params.static_contact_softness.natural_frequency = 2.0 * self.contact_hz;
+        if self.coulomb_friction {
+            params.friction_model = rapier3d::prelude::FrictionModel::Coulomb;
+        }
         params
     }
 }
@@ -202,11 +214,15 @@ impl RapierVariant {
 impl std::str::FromStr for RapierVariant {
     type Err = String;
 
-    /// `SUBSTEPS:HZ`, e.g. `8:120`.
+    /// `SUBSTEPS:HZ[:coulomb]`, e.g. `8:120` or `4:30:coulomb`.
     fn from_str(s: &str) -> Result<Self, String> {
-        let (substeps, hz) = s
-            .split_once(':')
-            .ok_or_else(|| format!("expected SUBSTEPS:HZ (e.g. 8:120), got \"{s}\""))?;
+        let (s, coulomb_friction) = match s.rsplit_once(':') {
+            Some((rest, "coulomb")) => (rest, true),
+            _ => (s, false),
+        };
+        let (substeps, hz) = s.split_once(':').ok_or_else(|| {
+            format!("expected SUBSTEPS:HZ[:coulomb] (e.g. 8:120 or 4:30:coulomb), got \"{s}\"")
+        })?;
         let substeps: usize = substeps
             .trim()
             .parse()
@@ -218,6 +234,7 @@ impl std::str::FromStr for RapierVariant {
         Ok(Self {
             substeps,
             contact_hz,
+            coulomb_friction,
         })
     }
 }
@@ -419,11 +436,17 @@ mod tests {
             v,
             RapierVariant {
                 substeps: 8,
-                contact_hz: 120.0
+                contact_hz: 120.0,
+                coulomb_friction: false,
             }
         );
         assert_eq!(v.engine_name(), "rapier 8×120Hz");
+        let v: RapierVariant = "4:30:coulomb".parse().unwrap();
+        assert!(v.coulomb_friction && v.substeps == 4 && v.contact_hz == 30.0);
+        assert_eq!(v.engine_name(), "rapier 4×30Hz coulomb");
         assert!("8".parse::<RapierVariant>().is_err());
+        assert!("4:30:cone".parse::<RapierVariant>().is_err());
+        assert!("coulomb".parse::<RapierVariant>().is_err());
         assert!("0:30".parse::<RapierVariant>().is_err());
         assert!("4:-1".parse::<RapierVariant>().is_err());
     }

@@ -32,7 +32,9 @@ struct Args {
     no_rapier: bool,
     /// Also measure Rapier with SUBSTEPS solver iterations and contact springs of HZ (fixed
     /// contacts 2·HZ), e.g. `--rapier-variant 8:120`; repeatable. Rapier's defaults are 4:30.
-    #[arg(long, value_name = "SUBSTEPS:HZ")]
+    /// A third field `coulomb` takes Rapier's per-point Coulomb friction, impulse's
+    /// formulation, instead of its default per-manifold friction: `4:30:coulomb`.
+    #[arg(long, value_name = "SUBSTEPS:HZ[:coulomb]")]
     rapier_variant: Vec<RapierVariant>,
     /// Also measure impulse with `SolverSettings::fast()` (rows "impulse fast", ratio against
     /// default Rapier too).
