@@ -593,10 +593,7 @@ fn for_each_prefetched(bundles: &mut [Bundle], forward: bool, mut update: impl F
             (n - 1 - step, (n - 1 - step).wrapping_sub(PREFETCH_BUNDLES))
         };
         if let Some(next) = bundles.get(ahead) {
-            let start = (next as *const Bundle).cast::<u8>();
-            for offset in (0..std::mem::size_of::<Bundle>()).step_by(64) {
-                crate::narrow_phase::prefetch(start.wrapping_add(offset));
-            }
+            crate::solver::prefetch_lines(next);
         }
         update(&mut bundles[k]);
     }

@@ -202,15 +202,30 @@ impl PointUpdate for PositionRows {
     }
 }
 
-/// Runs `update` on `points` in the iterator's order on this thread; returns the largest change.
+/// Runs `update` on `points` in order (`forward`) or in reverse on this thread, asking the CPU
+/// for the point [`PREFETCH_POINTS`] ahead first; returns the largest change.
 #[inline(always)]
-fn sweep_sequential<'c, I, F>(points: I, velocities: &mut Velocities<'_>, update: F) -> f32
+fn sweep_sequential<F>(
+    points: &mut [ContactConstraint],
+    forward: bool,
+    velocities: &mut Velocities<'_>,
+    update: F,
+) -> f32
 where
-    I: Iterator<Item = &'c mut ContactConstraint>,
     F: PointUpdate,
 {
     let mut largest = 0.0f32;
-    for c in points {
+    let n = points.len();
+    for step in 0..n {
+        let (k, ahead) = if forward {
+            (step, step + PREFETCH_POINTS)
+        } else {
+            (n - 1 - step, (n - 1 - step).wrapping_sub(PREFETCH_POINTS))
+        };
+        if let Some(next) = points.get(ahead) {
+            prefetch_lines(next);
+        }
+        let c = &mut points[k];
         let (a, b) = (c.local_a as usize, c.local_b as usize);
         let loaded = [
             velocities.linear[a],
@@ -228,6 +243,23 @@ where
     largest
 }
 
+/// How many points ahead a sweep asks for (see [`sweep_sequential`]).
+const PREFETCH_POINTS: usize = 4;
+
+/// Asks the CPU for every cache line of `value` (a hint: it never faults). Sweeps over rows or
+/// bundles that have outgrown L2 wait on L3 for them otherwise: the hardware prefetcher did not
+/// hide it (docs/benchmarks.md, session 9).
+#[inline(always)]
+pub(crate) fn prefetch_lines<T>(value: &T) {
+    let start = (value as *const T).cast::<u8>();
+    let size = std::mem::size_of::<T>();
+    for offset in (0..size).step_by(64) {
+        crate::narrow_phase::prefetch(start.wrapping_add(offset));
+    }
+    // The last line, when `value` straddles one more than its size fills.
+    crate::narrow_phase::prefetch(start.wrapping_add(size.saturating_sub(1)));
+}
+
 /// Runs `update` on the points of `constraints` in sweep order (`forward` or backward) and
 /// returns the largest change it reported. `update` gets the point and the two bodies'
 /// velocities (linear a, angular a, linear b, angular b) and returns them updated.
@@ -243,11 +275,7 @@ where
 {
     let sequential =
         |constraints: &mut [ContactConstraint], velocities: &mut Velocities<'_>, forward: bool| {
-            if forward {
-                sweep_sequential(constraints.iter_mut(), velocities, update)
-            } else {
-                sweep_sequential(constraints.iter_mut().rev(), velocities, update)
-            }
+            sweep_sequential(constraints, forward, velocities, update)
         };
     let colours = sweep.starts.len().saturating_sub(1);
     let slots = velocities.linear.len().min(velocities.angular.len());
