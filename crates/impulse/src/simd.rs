@@ -396,8 +396,9 @@ impl Bundles {
 
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), with the
     /// bundle's bodies gathered into lanes and scattered back; returns the lane-wise largest of
-    /// what `update` returned. With `parallel` (see [`Bundles::pack`]) a colour of at least
-    /// twice [`BUNDLES_PER_TASK`] bundles runs in chunks on rayon's threads.
+    /// what `update` returned. With `parallel` (see [`Bundles::pack`]) each colour is split
+    /// over rayon's threads, in parts of at least [`BUNDLES_PER_TASK`] bundles
+    /// ([`crate::solver::colour_after_colour`]).
     fn sweep<F>(&mut self, forward: bool, velocities: &mut Velocities<'_>, update: F) -> Lane
     where
         F: BundleUpdate,
@@ -448,22 +449,18 @@ impl Bundles {
             for_each_prefetched(part, forward, &mut one);
             largest
         };
-        let colours = self.colour_starts.len() - 1;
-        let mut largest = Lane::splat(0.0);
-        for step in 0..colours {
-            let k = if forward { step } else { colours - 1 - step };
-            let part = &mut self.bundles[self.colour_starts[k]..self.colour_starts[k + 1]];
-            let colour_largest = if k >= COLOURS || part.len() < 2 * BUNDLES_PER_TASK {
-                run(part, forward)
-            } else {
-                use rayon::prelude::*;
-                part.par_chunks_mut(BUNDLES_PER_TASK)
-                    .map(|chunk| run(chunk, forward))
-                    .reduce(|| Lane::splat(0.0), |x, y| x.max(y))
-            };
-            largest = largest.max(colour_largest);
-        }
-        largest
+        let starts = &self.colour_starts;
+        crate::solver::colour_after_colour(
+            &mut self.bundles,
+            starts.len() - 1,
+            |k| starts[k],
+            forward,
+            COLOURS,
+            BUNDLES_PER_TASK,
+            Lane::splat(0.0),
+            run,
+            |x, y| x.max(y),
+        )
     }
 
     /// Sets every point's target normal velocity and softness for a solve of `h` seconds, as
@@ -575,7 +572,7 @@ impl BundleUpdate for WarmStart {
     }
 }
 
-/// Bundles of one colour per parallel task.
+/// Fewest bundles of one colour in a part run on its own thread.
 const BUNDLES_PER_TASK: usize = 32;
 
 /// Runs `update` on each bundle in order (`forward`) or in reverse, asking the CPU for the

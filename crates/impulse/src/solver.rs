@@ -66,7 +66,8 @@ impl Sweep<'_> {
 /// Independent colours of a [`Sweep`]; points past them share one sequential colour.
 pub const COLOURS: usize = 64;
 
-/// Points of one colour per parallel task: below twice this a colour runs on one thread.
+/// Fewest points of one colour in a part run on its own thread: below twice this a colour
+/// runs on one thread.
 const POINTS_PER_TASK: usize = 256;
 
 /// Greedy graph colouring of an island's points: each point takes the lowest colour that
@@ -134,6 +135,125 @@ pub(crate) fn greedy_colours(
     }
     counts
 }
+
+/// Runs `run` over `items` colour after colour, colour `k` being `items[start(k)..start(k + 1)]`
+/// for `k < colours`, in order (`forward`) or in reverse, and returns `combine` over every
+/// chunk's result. A colour is cut into one chunk per rayon thread, none under `min_chunk`
+/// items; colours from `whole_from` on are one chunk (their items may share bodies). `run`
+/// gets a chunk and `forward`, and must touch nothing another chunk of its colour touches.
+///
+/// Why not a rayon call per colour: a coloured island has 24–34 colours and a `fast` step
+/// sweeps it 24 times, so a fork-join per colour was paid some 700 times a step. Here the
+/// threads are forked once per sweep and claim chunks from per-colour counters; a chunk waits
+/// (spinning) until every chunk of the colours before its own has finished. All those chunks
+/// were claimed before it, by threads that are running them or waiting in turn on earlier
+/// ones, and a chunk never calls into rayon, so every wait ends on any nesting of rayon jobs;
+/// a thread that joins late, or never, leaves more chunks to the others. One contiguous chunk
+/// per thread keeps each thread's reads a single stream: chunks of 32 bundles claimed in turn
+/// were no faster than the fork-joins, halves were (docs/benchmarks.md, session 10). The
+/// chunks of a colour touch disjoint bodies and colours run in order, so the result is the
+/// same on any number of threads (`combine` must not depend on order, as a maximum does not).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn colour_after_colour<T, R>(
+    items: &mut [T],
+    colours: usize,
+    start: impl Fn(usize) -> usize + Sync,
+    forward: bool,
+    whole_from: usize,
+    min_chunk: usize,
+    identity: R,
+    run: impl Fn(&mut [T], bool) -> R + Sync,
+    combine: impl Fn(R, R) -> R + Sync,
+) -> R
+where
+    T: Send,
+    R: Send + Sync + Copy,
+{
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    debug_assert!(colours <= COLOURS + 1);
+    let colours = colours.min(COLOURS + 1);
+    let threads = rayon::current_num_threads();
+    let colour_of = |visit: usize| if forward { visit } else { colours - 1 - visit };
+    // Per colour visited: its items and chunk size.
+    let len = items.len();
+    let range_of = |visit: usize| {
+        let k = colour_of(visit);
+        let range = start(k).min(len)..start(k + 1).min(len);
+        let size = if k >= whole_from {
+            range.len().max(1)
+        } else {
+            range.len().div_ceil(threads).max(min_chunk).max(1)
+        };
+        (range, size)
+    };
+    // Chunks of the colours visited before each one, and per colour the chunks claimed.
+    let mut before = [0usize; COLOURS + 2];
+    for visit in 0..colours {
+        let (range, size) = range_of(visit);
+        before[visit + 1] = before[visit] + range.len().div_ceil(size);
+    }
+    let next: [AtomicUsize; COLOURS + 1] = std::array::from_fn(|_| AtomicUsize::new(0));
+    // Chunks finished, all colours together. A chunk starts once every chunk of the colours
+    // before its own has: no chunk of a later colour can finish first, so the count reaches
+    // `before[visit]` exactly when they all have (empty colours need no special case).
+    let finished = AtomicUsize::new(0);
+    let base = SharedItems(items.as_mut_ptr());
+    let worker = |_| {
+        // Capture the whole wrapper (Sync), not its raw-pointer field.
+        #[allow(clippy::redundant_locals)]
+        let base = base;
+        let mut result = identity;
+        for visit in 0..colours {
+            let (range, size) = range_of(visit);
+            let chunks = before[visit + 1] - before[visit];
+            loop {
+                let claimed = next[visit].fetch_add(1, Ordering::Relaxed);
+                if claimed >= chunks {
+                    break;
+                }
+                let mut spins = 0u32;
+                while finished.load(Ordering::Acquire) < before[visit] {
+                    spins += 1;
+                    if spins < 1 << 12 {
+                        std::hint::spin_loop();
+                    } else {
+                        // The thread running that chunk may have lost its CPU.
+                        std::thread::yield_now();
+                    }
+                }
+                let from = range.start + claimed * size;
+                let to = (from + size).min(range.end);
+                // SAFETY: [from, to) lies inside `items`, and no other thread holds it: each
+                // chunk index is claimed once, and this colour's chunks are disjoint.
+                let part = unsafe { std::slice::from_raw_parts_mut(base.0.add(from), to - from) };
+                result = combine(result, run(part, forward));
+                finished.fetch_add(1, Ordering::Release);
+            }
+        }
+        result
+    };
+    (0..rayon::current_num_threads())
+        .into_par_iter()
+        .map(worker)
+        .reduce(|| identity, &combine)
+}
+
+/// The items of [`colour_after_colour`], shared by its threads.
+struct SharedItems<T>(*mut T);
+
+impl<T> Clone for SharedItems<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for SharedItems<T> {}
+
+// SAFETY: the threads of `colour_after_colour` only build disjoint chunks from the pointer.
+unsafe impl<T: Send> Send for SharedItems<T> {}
+// SAFETY: as for Send.
+unsafe impl<T: Send> Sync for SharedItems<T> {}
 
 /// Velocity slots shared by the threads of one colour. Safety rests on the colouring: within
 /// a colour no two points share a slot other than the immovable one, which is only read.
@@ -296,57 +416,52 @@ where
         angular: velocities.angular.as_mut_ptr(),
         immovable: slots - 1,
     };
-    let mut largest = 0.0f32;
-    for step in 0..colours {
-        let k = if forward { step } else { colours - 1 - step };
-        let range = sweep.starts[k] as usize..sweep.starts[k + 1] as usize;
-        let part = &mut constraints[range];
-        if k >= COLOURS || part.len() < 2 * POINTS_PER_TASK {
-            largest = largest.max(sequential(part, velocities, forward));
-            continue;
-        }
-        use rayon::prelude::*;
-        let change = part
-            .par_chunks_mut(POINTS_PER_TASK)
-            .map(|chunk| {
-                // Capture the whole wrapper (Sync), not its raw-pointer fields (not Sync).
-                #[allow(clippy::redundant_locals)]
-                let shared = shared;
-                let mut largest = 0.0f32;
-                let mut one = |c: &mut ContactConstraint| {
-                    let (a, b) = (c.local_a as usize, c.local_b as usize);
-                    // SAFETY: a, b < slots (see `Sweep`); within this colour only this
-                    // point touches slots a and b, except the immovable slot, never written.
-                    unsafe {
-                        let loaded = [
-                            *shared.linear.add(a),
-                            *shared.angular.add(a),
-                            *shared.linear.add(b),
-                            *shared.angular.add(b),
-                        ];
-                        let ([la, aa, lb, ab], change) = update.update(c, loaded);
-                        if a != shared.immovable {
-                            *shared.linear.add(a) = la;
-                            *shared.angular.add(a) = aa;
-                        }
-                        if b != shared.immovable {
-                            *shared.linear.add(b) = lb;
-                            *shared.angular.add(b) = ab;
-                        }
-                        largest = largest.max(change);
-                    }
-                };
-                if forward {
-                    chunk.iter_mut().for_each(&mut one);
-                } else {
-                    chunk.iter_mut().rev().for_each(&mut one);
+    let run = |chunk: &mut [ContactConstraint], forward: bool| {
+        // Capture the whole wrapper (Sync), not its raw-pointer fields (not Sync).
+        #[allow(clippy::redundant_locals)]
+        let shared = shared;
+        let mut largest = 0.0f32;
+        let mut one = |c: &mut ContactConstraint| {
+            let (a, b) = (c.local_a as usize, c.local_b as usize);
+            // SAFETY: a, b < slots (see `Sweep`); within this colour only this point touches
+            // slots a and b, except the immovable slot, never written.
+            unsafe {
+                let loaded = [
+                    *shared.linear.add(a),
+                    *shared.angular.add(a),
+                    *shared.linear.add(b),
+                    *shared.angular.add(b),
+                ];
+                let ([la, aa, lb, ab], change) = update.update(c, loaded);
+                if a != shared.immovable {
+                    *shared.linear.add(a) = la;
+                    *shared.angular.add(a) = aa;
                 }
-                largest
-            })
-            .reduce(|| 0.0f32, f32::max);
-        largest = largest.max(change);
-    }
-    largest
+                if b != shared.immovable {
+                    *shared.linear.add(b) = lb;
+                    *shared.angular.add(b) = ab;
+                }
+                largest = largest.max(change);
+            }
+        };
+        if forward {
+            chunk.iter_mut().for_each(&mut one);
+        } else {
+            chunk.iter_mut().rev().for_each(&mut one);
+        }
+        largest
+    };
+    colour_after_colour(
+        constraints,
+        colours,
+        |k| sweep.starts[k] as usize,
+        forward,
+        COLOURS,
+        POINTS_PER_TASK,
+        0.0f32,
+        run,
+        f32::max,
+    )
 }
 
 /// Scales the impulses carried over from the last step by `fraction` (0 = cold start) and
@@ -871,4 +986,111 @@ fn solve_position_point(
         ],
         delta.abs() * row.inverse_effective_mass,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{COLOURS, colour_after_colour};
+    use proptest::prelude::*;
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    /// Visits `sizes` colours (the last one as a whole, like the overflow colour) and returns
+    /// each item's (colour, visit stamp) and the number of items `run` reported.
+    fn visit(sizes: &[usize], forward: bool, min_chunk: usize) -> (Vec<(usize, u64)>, usize) {
+        let mut items: Vec<(usize, u64)> = sizes
+            .iter()
+            .enumerate()
+            .flat_map(|(k, &n)| std::iter::repeat_n((k, 0), n))
+            .collect();
+        let mut starts = vec![0];
+        for &n in sizes {
+            starts.push(starts.last().unwrap() + n);
+        }
+        let clock = AtomicU64::new(1);
+        let run = |chunk: &mut [(usize, u64)], forward: bool| {
+            // Long enough for the other threads to join in and overlap.
+            std::thread::sleep(std::time::Duration::from_micros(20));
+            let mut stamp = |item: &mut (usize, u64)| {
+                assert_eq!(item.1, 0, "an item visited twice");
+                item.1 = clock.fetch_add(1, Ordering::SeqCst);
+            };
+            if forward {
+                chunk.iter_mut().for_each(&mut stamp);
+            } else {
+                chunk.iter_mut().rev().for_each(&mut stamp);
+            }
+            chunk.len()
+        };
+        let count = colour_after_colour(
+            &mut items,
+            sizes.len(),
+            |k| starts[k],
+            forward,
+            sizes.len() - 1,
+            min_chunk,
+            0usize,
+            run,
+            |x, y| x + y,
+        );
+        (items, count)
+    }
+
+    /// Every item once; every item of a colour after every item of the colours visited before
+    /// it; the whole colour in sweep order.
+    fn check(sizes: &[usize], forward: bool, items: &[(usize, u64)], count: usize) {
+        assert_eq!(count, items.len());
+        let order = |k: usize| if forward { k } else { sizes.len() - 1 - k };
+        for (i, a) in items.iter().enumerate() {
+            assert!(a.1 > 0, "item {i} not visited");
+            for b in &items[i + 1..] {
+                if order(a.0) < order(b.0) {
+                    assert!(a.1 < b.1, "colour {} ran before colour {} had ended", b.0, a.0);
+                } else if order(a.0) > order(b.0) {
+                    assert!(a.1 > b.1, "colour {} ran before colour {} had ended", a.0, b.0);
+                }
+            }
+        }
+        let whole: Vec<u64> = items
+            .iter()
+            .filter(|a| a.0 == sizes.len() - 1)
+            .map(|a| a.1)
+            .collect();
+        assert!(whole.windows(2).all(|w| (w[0] < w[1]) == forward));
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Colours (empty ones included) run one after another on one to four threads, each
+        /// item exactly once, whatever the chunk size.
+        #[test]
+        fn colours_run_in_order_and_items_once(
+            sizes in proptest::collection::vec(0usize..40, 1..12),
+            forward in any::<bool>(),
+            min_chunk in 1usize..8,
+            threads in 1usize..5,
+        ) {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let (items, count) = pool.install(|| visit(&sizes, forward, min_chunk));
+            check(&sizes, forward, &items, count);
+        }
+    }
+
+    /// Sweeps started from inside other rayon jobs (as island jobs start theirs) all end, each
+    /// with its colours in order, although they share the two threads.
+    #[test]
+    fn nested_sweeps_on_shared_threads_all_end() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let sizes: Vec<usize> = (0..=COLOURS).map(|k| (k * 7) % 23).collect();
+        let results: Vec<_> = pool.install(|| {
+            (0..16)
+                .into_par_iter()
+                .map(|i| visit(&sizes, i % 2 == 0, 1 + i % 3))
+                .collect()
+        });
+        for (i, (items, count)) in results.iter().enumerate() {
+            check(&sizes, i % 2 == 0, items, *count);
+        }
+    }
 }
