@@ -285,7 +285,7 @@ pub struct IslandWorkspace {
     used_colours: Vec<u64>,
     colours: Vec<u8>,
     colour_scratch: Vec<ContactConstraint>,
-    /// Per-slot M⁻¹Jᵀγ of [`constraints::record_velocity_before`] on the island's rows.
+    /// Per part of rows, per slot: M⁻¹Jᵀγ of [`constraints::record_velocity_before`].
     record_scratch: Vec<(Vec3, Vec3)>,
     /// Whether one colour may be solved on several threads.
     parallel: bool,

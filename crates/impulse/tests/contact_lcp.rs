@@ -482,3 +482,106 @@ fn soft_rows_are_exported_with_their_regularisation() {
         );
     }
 }
+
+/// `record_velocity_before` on enough rows to sum its per-body deltas in parts (here a pile's
+/// rows repeated 800 times, every copy with its own impulses) gives the same bits on one and
+/// on two threads, and each row's J·v* matches v* = v − M⁻¹Jᵀγ summed directly in f64.
+#[test]
+fn velocity_before_in_parts_is_the_same_on_any_thread_count_and_matches_a_direct_sum() {
+    use impulse::constraints::{BodySlots, record_velocity_before};
+    let mut world = pile(true);
+    for _ in 0..30 {
+        world.step().unwrap();
+    }
+    let mut rows: Vec<ContactConstraint> = Vec::new();
+    for copy in 0..800 {
+        for c in world.contact_constraints() {
+            let mut c = *c;
+            let scale = 1.0 + 0.001 * copy as f32;
+            c.normal_impulse *= scale;
+            c.tangent_impulses = c.tangent_impulses.map(|t| -t * scale);
+            rows.push(c);
+        }
+    }
+    assert!(rows.len() > 20_000, "{} rows", rows.len());
+    let bodies = &world.bodies;
+    let (linear, angular) = (&bodies.linear_velocity, &bodies.angular_velocity);
+    let recorded = |threads: usize, parallel: bool| {
+        let mut rows = rows.clone();
+        let mut scratch = Vec::new();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            record_velocity_before(
+                &mut rows,
+                BodySlots::World,
+                linear,
+                angular,
+                parallel,
+                &mut scratch,
+            )
+        });
+        rows.iter()
+            .map(|c| {
+                [
+                    c.normal.velocity_before,
+                    c.tangents[0].velocity_before,
+                    c.tangents[1].velocity_before,
+                ]
+            })
+            .collect::<Vec<_>>()
+    };
+    let one = recorded(1, false);
+    assert_eq!(one, recorded(2, true));
+    assert_eq!(one, recorded(3, true));
+
+    let dvec = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+    let mut delta = vec![([0.0f64; 3], [0.0f64; 3]); bodies.len()];
+    for c in &rows {
+        let rows = [
+            (&c.normal, c.normal_impulse),
+            (&c.tangents[0], c.tangent_impulses[0]),
+            (&c.tangents[1], c.tangent_impulses[1]),
+        ];
+        for (row, impulse) in rows {
+            let (d, g) = (dvec(row.direction), impulse as f64);
+            let (ia, ib) = (
+                dvec(row.inverse_inertia_angular_a),
+                dvec(row.inverse_inertia_angular_b),
+            );
+            let (a, b) = (c.body_a as usize, c.body_b as usize);
+            for k in 0..3 {
+                delta[a].0[k] += d[k] * c.inverse_mass_a as f64 * g;
+                delta[a].1[k] += ia[k] * g;
+                delta[b].0[k] -= d[k] * c.inverse_mass_b as f64 * g;
+                delta[b].1[k] -= ib[k] * g;
+            }
+        }
+    }
+    let dot = |p: [f64; 3], q: [f64; 3]| p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+    let minus = |v: Vec3, d: [f64; 3]| {
+        let v = dvec(v);
+        [v[0] - d[0], v[1] - d[1], v[2] - d[2]]
+    };
+    let mut largest = 0.0f64;
+    for (c, got) in rows.iter().zip(&one) {
+        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let (la, aa) = (minus(linear[a], delta[a].0), minus(angular[a], delta[a].1));
+        let (lb, ab) = (minus(linear[b], delta[b].0), minus(angular[b], delta[b].1));
+        for (row, got) in [&c.normal, &c.tangents[0], &c.tangents[1]].iter().zip(got) {
+            let want = dot(
+                dvec(row.direction),
+                [la[0] - lb[0], la[1] - lb[1], la[2] - lb[2]],
+            ) + dot(dvec(row.angular_a), aa)
+                - dot(dvec(row.angular_b), ab);
+            largest = largest.max(want.abs());
+            assert!(
+                (*got as f64 - want).abs() <= 1e-4 * (1.0 + want.abs()),
+                "J·v* = {got}, direct f64 sum {want}"
+            );
+        }
+    }
+    assert!(largest > 1.0, "the check should see large v*: {largest}");
+}
