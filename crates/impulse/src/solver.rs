@@ -1045,9 +1045,19 @@ mod tests {
             assert!(a.1 > 0, "item {i} not visited");
             for b in &items[i + 1..] {
                 if order(a.0) < order(b.0) {
-                    assert!(a.1 < b.1, "colour {} ran before colour {} had ended", b.0, a.0);
+                    assert!(
+                        a.1 < b.1,
+                        "colour {} ran before colour {} had ended",
+                        b.0,
+                        a.0
+                    );
                 } else if order(a.0) > order(b.0) {
-                    assert!(a.1 > b.1, "colour {} ran before colour {} had ended", a.0, b.0);
+                    assert!(
+                        a.1 > b.1,
+                        "colour {} ran before colour {} had ended",
+                        a.0,
+                        b.0
+                    );
                 }
             }
         }
@@ -1081,7 +1091,10 @@ mod tests {
     /// with its colours in order, although they share the two threads.
     #[test]
     fn nested_sweeps_on_shared_threads_all_end() {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
         let sizes: Vec<usize> = (0..=COLOURS).map(|k| (k * 7) % 23).collect();
         let results: Vec<_> = pool.install(|| {
             (0..16)
