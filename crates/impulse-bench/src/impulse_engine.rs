@@ -15,6 +15,11 @@ pub const ENGINE: &str = "impulse";
 /// Engine name of the rows run with `SolverSettings::fast()`.
 pub const FAST_ENGINE: &str = "impulse fast";
 
+/// `engine` (e.g. [`FAST_ENGINE`]) run in a pool of its own with `threads` threads.
+pub fn threads_engine_name(engine: &str, threads: usize) -> String {
+    format!("{engine} on {threads} threads")
+}
+
 /// Steps `scene` `steps` times with impulse inside a rayon pool of `threads` threads, timing
 /// each `World::step`, and measures quality from the poses (metric time is not timed).
 /// The scene's solver settings are used as they are, except that sleeping is turned off.
@@ -30,13 +35,15 @@ pub fn bench_impulse(scene: &Scene, steps: u32, threads: usize) -> Result<BenchR
 /// take turns on the same scene (see `run_benchmarks`).
 pub(crate) struct ImpulseRun {
     scene: String,
-    engine: &'static str,
+    engine: String,
     world: World,
     quality: Quality,
     times_ms: Vec<f64>,
     step: u32,
     steps: u32,
     threads: usize,
+    /// A pool of its own that every step runs in; `None`: the caller's pool.
+    pool: Option<rayon::ThreadPool>,
 }
 
 impl ImpulseRun {
@@ -48,6 +55,29 @@ impl ImpulseRun {
         threads: usize,
         settings: Option<SolverSettings>,
     ) -> Result<Self> {
+        Self::build(scene, steps, threads, settings, None)
+    }
+
+    /// As [`Self::new`], but every step runs in a rayon pool of its own with `threads` threads,
+    /// whatever pool the caller is in; the engine is named e.g. `impulse fast on 2 threads`.
+    /// So one run can time impulse on one and on two threads by turns (`--also-threads`).
+    pub(crate) fn on_threads(
+        scene: &Scene,
+        steps: u32,
+        threads: usize,
+        settings: Option<SolverSettings>,
+    ) -> Result<Self> {
+        let pool = crate::thread_pool(threads)?;
+        Self::build(scene, steps, threads, settings, Some(pool))
+    }
+
+    fn build(
+        scene: &Scene,
+        steps: u32,
+        threads: usize,
+        settings: Option<SolverSettings>,
+        pool: Option<rayon::ThreadPool>,
+    ) -> Result<Self> {
         let mut scene = scene.clone();
         let engine = match settings {
             Some(settings) => {
@@ -55,6 +85,10 @@ impl ImpulseRun {
                 FAST_ENGINE
             }
             None => ENGINE,
+        };
+        let engine = match pool {
+            Some(_) => threads_engine_name(engine, threads),
+            None => engine.to_string(),
         };
         let mut world = World::from_scene(&scene)
             .with_context(|| format!("building scene {} in {engine}", scene.name))?;
@@ -68,11 +102,24 @@ impl ImpulseRun {
             step: 0,
             steps,
             threads,
+            pool,
         })
     }
 
     /// Takes up to `n` more steps (never past `steps`).
     pub(crate) fn advance(&mut self, n: u32) -> Result<()> {
+        match self.pool.take() {
+            Some(pool) => {
+                let result = pool.install(|| self.advance_here(n));
+                self.pool = Some(pool);
+                result
+            }
+            None => self.advance_here(n),
+        }
+    }
+
+    /// [`Self::advance`] in the current pool.
+    fn advance_here(&mut self, n: u32) -> Result<()> {
         let end = self.steps.min(self.step.saturating_add(n));
         while self.step < end {
             self.step += 1;
@@ -94,7 +141,7 @@ impl ImpulseRun {
         let report = self.quality.finish(&self.world.bodies);
         BenchRow::new(
             &self.scene,
-            self.engine,
+            &self.engine,
             self.world.bodies.len(),
             self.step,
             &mut self.times_ms,

@@ -109,16 +109,15 @@ pub fn format_table(rows: &[BenchRow]) -> String {
     );
     out.push_str("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
     for row in rows {
-        let ratio =
-            if row.engine == impulse_engine::ENGINE || row.engine == impulse_engine::FAST_ENGINE {
-                rows.iter()
-                    .find(|r| r.scene == row.scene && r.engine == "rapier")
-                    .filter(|r| r.ms_per_step_median > 0.0)
-                    .map(|r| format!("{:.2}", row.ms_per_step_median / r.ms_per_step_median))
-                    .unwrap_or_default()
-            } else {
-                String::new()
-            };
+        let ratio = if row.engine == impulse_engine::ENGINE || row.engine.starts_with("impulse ") {
+            rows.iter()
+                .find(|r| r.scene == row.scene && r.engine == "rapier")
+                .filter(|r| r.ms_per_step_median > 0.0)
+                .map(|r| format!("{:.2}", row.ms_per_step_median / r.ms_per_step_median))
+                .unwrap_or_default()
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             out,
             "| {} | {} | {} | {} | {} | {:.0} | {} | {:.1} | {:.1} | {:.1} | {} |",
@@ -133,6 +132,48 @@ pub fn format_table(rows: &[BenchRow]) -> String {
             row.max_overlap_m * 1e3,
             row.max_drift_m * 1e3,
             row.settings.replace('|', "\\|"),
+        );
+    }
+    out
+}
+
+/// The speed-up of every impulse row run in a pool of its own (`--also-threads`, engine
+/// "… on N threads") against the same configuration in the run's own pool, measured by turns
+/// in the same run, as a Markdown table; empty when there are no such rows.
+pub fn format_thread_table(rows: &[BenchRow], threads: usize) -> String {
+    let mut out = String::new();
+    for row in rows {
+        let Some((base, _)) = row.engine.rsplit_once(" on ") else {
+            continue;
+        };
+        let Some(reference) = rows
+            .iter()
+            .find(|r| r.scene == row.scene && r.engine == base)
+        else {
+            continue;
+        };
+        if out.is_empty() {
+            out.push_str(&format!(
+                "| scene | engine | ms/step on {threads} thread{} | ms/step in its own pool | \
+                 speed-up |\n|---|---|---:|---:|---:|\n",
+                if threads == 1 { "" } else { "s" }
+            ));
+        }
+        let speed_up = if row.ms_per_step_median > 0.0 {
+            format!(
+                "{:.2}",
+                reference.ms_per_step_median / row.ms_per_step_median
+            )
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {speed_up} |",
+            row.scene,
+            row.engine,
+            format_ms(reference.ms_per_step_median),
+            format_ms(row.ms_per_step_median),
         );
     }
     out
@@ -166,6 +207,10 @@ pub struct BenchConfig {
     pub rapier_variants: Vec<RapierVariant>,
     /// Also measure impulse with `SolverSettings::fast()` (row "impulse fast").
     pub impulse_fast: bool,
+    /// Also measure each impulse configuration in a rayon pool of this many threads of its
+    /// own, by turns with the others (rows "impulse on N threads"), for a thread speed-up
+    /// measured in one run ([`format_thread_table`]).
+    pub also_threads: Option<usize>,
 }
 
 /// Rapier with other settings than its defaults, to compare the engines at similar quality.
@@ -248,6 +293,7 @@ impl Default for BenchConfig {
             rapier: cfg!(feature = "rapier"),
             rapier_variants: Vec::new(),
             impulse_fast: false,
+            also_threads: None,
         }
     }
 }
@@ -317,6 +363,15 @@ pub fn bench_scene(scene: &Scene, config: &BenchConfig) -> Result<Vec<Result<Ben
                     .map(|run| EngineRun::Impulse(Box::new(run))),
             );
         }
+        if let Some(threads) = config.also_threads {
+            let fast = config.impulse_fast.then(impulse::SolverSettings::fast);
+            for settings in std::iter::once(None).chain(fast.map(Some)) {
+                runs.push(
+                    impulse_engine::ImpulseRun::on_threads(scene, steps, threads, settings)
+                        .map(|run| EngineRun::Impulse(Box::new(run))),
+                );
+            }
+        }
         #[cfg(feature = "rapier")]
         {
             if config.rapier {
@@ -371,7 +426,7 @@ pub fn run_benchmarks(
     if config.steps == 0 {
         bail!("steps must be at least 1");
     }
-    if config.threads == 0 {
+    if config.threads == 0 || config.also_threads == Some(0) {
         bail!("threads must be at least 1");
     }
     let scenes = config
@@ -429,6 +484,75 @@ mod tests {
         assert!(lines[4].contains("| 1000 |  |"));
     }
 
+    /// Rows in a pool of their own (`--also-threads`) follow the same trajectories as their
+    /// configurations in the run's pool (impulse gives the same bits on any thread count), say
+    /// so in their settings, and get a speed-up row each.
+    #[test]
+    fn own_pool_rows_follow_the_same_trajectories() {
+        let scene = scene_by_name("pyramid20").unwrap();
+        let config = BenchConfig {
+            scenes: vec!["pyramid20".into()],
+            steps: 25,
+            threads: 1,
+            rapier: false,
+            rapier_variants: Vec::new(),
+            impulse_fast: true,
+            also_threads: Some(2),
+        };
+        let rows: Vec<BenchRow> = bench_scene(&scene, &config)
+            .unwrap()
+            .into_iter()
+            .map(|r| r.unwrap())
+            .collect();
+        let engines: Vec<&str> = rows.iter().map(|r| r.engine.as_str()).collect();
+        assert_eq!(
+            engines,
+            [
+                "impulse",
+                "impulse fast",
+                "impulse on 2 threads",
+                "impulse fast on 2 threads"
+            ]
+        );
+        for (one, two) in [(&rows[0], &rows[2]), (&rows[1], &rows[3])] {
+            assert_eq!(one.top_sink_m, two.top_sink_m, "{}", two.engine);
+            assert_eq!(one.max_overlap_m, two.max_overlap_m, "{}", two.engine);
+            assert_eq!(one.max_drift_m, two.max_drift_m, "{}", two.engine);
+            assert_eq!(two.steps, 25);
+            assert!(one.settings.ends_with("1 thread"), "{}", one.settings);
+            assert!(two.settings.ends_with("2 threads"), "{}", two.settings);
+        }
+        let table = format_thread_table(&rows, 1);
+        assert_eq!(table.lines().count(), 4, "{table}");
+        assert!(table.contains("| pyramid20 | impulse fast on 2 threads |"));
+    }
+
+    #[test]
+    fn thread_table_divides_the_run_pool_time_by_the_own_pool_time() {
+        let rows = [
+            row("s", "impulse", 10.0),
+            row("s", "impulse fast", 3.0),
+            row("s", "impulse on 2 threads", 5.0),
+            row("s", "impulse fast on 2 threads", 2.0),
+            row("s", "rapier", 4.0),
+        ];
+        let table = format_thread_table(&rows, 1);
+        let lines: Vec<&str> = table.lines().collect();
+        assert_eq!(lines.len(), 4, "{table}");
+        assert!(lines[0].contains("ms/step on 1 thread |"));
+        assert_eq!(
+            lines[2],
+            "| s | impulse on 2 threads | 10.0 | 5.00 | 2.00 |"
+        );
+        assert_eq!(
+            lines[3],
+            "| s | impulse fast on 2 threads | 3.00 | 2.00 | 1.50 |"
+        );
+        assert!(format_thread_table(&rows[..2], 1).is_empty());
+        // The own-pool rows get their ratio against Rapier too.
+        assert!(format_table(&rows).contains("| 200 | 1.25 |"));
+    }
+
     #[test]
     fn rapier_variant_parses() {
         let v: RapierVariant = "8:120".parse().unwrap();
@@ -465,6 +589,7 @@ mod tests {
                 Vec::new()
             },
             impulse_fast: true,
+            also_threads: None,
         };
         let rows: Vec<BenchRow> = bench_scene(&scene, &config)
             .unwrap()

@@ -1,7 +1,7 @@
 //! `impulse-bench`: impulse and Rapier on the same built-in scenes, one Markdown table.
 //!
 //! ```text
-//! cargo run --release -p impulse-bench -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--impulse-fast] [--markdown FILE]
+//! cargo run --release -p impulse-bench -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--impulse-fast] [--also-threads N] [--markdown FILE]
 //! ```
 
 use std::path::PathBuf;
@@ -11,6 +11,7 @@ use anyhow::{Context, Result};
 use clap::Parser;
 use impulse_bench::{
     BenchConfig, DEFAULT_SCENES, DEFAULT_STEPS, MachineInfo, RapierVariant, format_table,
+    format_thread_table,
 };
 
 /// Times impulse and Rapier on the same built-in scenes (sleeping off, median ms/step) and
@@ -40,6 +41,11 @@ struct Args {
     /// default Rapier too).
     #[arg(long)]
     impulse_fast: bool,
+    /// Also measure impulse (and `--impulse-fast`) in a pool of N threads of its own, by turns
+    /// with the rows on `--threads`: a thread speed-up measured in one run, which a machine
+    /// whose speed drifts between runs cannot spoil. Prints a second table of speed-ups.
+    #[arg(long, value_name = "N")]
+    also_threads: Option<usize>,
     /// Also write the table, the command and the machine to this Markdown file.
     #[arg(long)]
     markdown: Option<PathBuf>,
@@ -69,6 +75,7 @@ fn run(args: Args) -> Result<bool> {
         rapier: !args.no_rapier,
         rapier_variants: args.rapier_variant,
         impulse_fast: args.impulse_fast,
+        also_threads: args.also_threads,
     };
     let machine = MachineInfo::current();
     let command = std::iter::once("impulse-bench".to_string())
@@ -96,7 +103,12 @@ fn run(args: Args) -> Result<bool> {
         },
     )?;
     let after = MachineInfo::current();
-    let table = format_table(&rows);
+    let mut table = format_table(&rows);
+    let threads = format_thread_table(&rows, config.threads);
+    if !threads.is_empty() {
+        table.push('\n');
+        table.push_str(&threads);
+    }
     println!("{table}");
     println!("command: {command}");
     println!("{machine}");
