@@ -21,9 +21,9 @@ pub struct BroadPhase {
     /// unused: 0).
     updates: Vec<(Aabb, u32, f32)>,
     statuses: Vec<BvhLeafUpdateStatus>,
-    /// The last traversal's pairs, and which bodies were moving then: while no leaf leaves its
-    /// fattened box and no body changes kind, the pairs are the same and the traversal is
-    /// skipped.
+    /// The last pairs, and which bodies were moving then: while no leaf leaves its fattened
+    /// box and no body changes kind, the pairs are the same and the traversal is skipped; while
+    /// few leaves changed ([`FEW_CHANGED_LEAVES`]), only those leaves' pairs are redone.
     pairs: Vec<(u32, u32)>,
     moving: Vec<bool>,
     /// Scratch of the update of the pairs by the changed leaves' queries: per leaf, whether
@@ -85,8 +85,8 @@ impl BroadPhase {
     /// contacts within the margins are found; the tree keeps each box fattened by
     /// [`CHANGE_DETECTION_SKIN`] (by at most twice that since its last rewrite), so pairs up
     /// to four skins further apart come too. With `parallel`, the boxes, the leaf updates, the
-    /// refit, the traversal and the sort run on rayon's threads (Parry's `parallel` feature);
-    /// the pairs are the same on any thread count.
+    /// refit, the traversal (or the changed leaves' queries) and the sort run on rayon's
+    /// threads (Parry's `parallel` feature); the pairs are the same on any thread count.
     pub fn candidate_pairs(
         &mut self,
         bodies: &Bodies,

@@ -1,6 +1,6 @@
 //! Stage 5 in SIMD lanes: the PGS sweep of [`crate::solver::solve_pgs`] run on [`LANES`] contact
 //! points at once, one point per lane. A sliding point's friction takes a cheaper update with
-//! the same fixed point as the scalar sweep's (see [`solve_bundle`]).
+//! the same fixed point as the scalar sweep's (see `solve_bundle` below).
 //!
 //! A point's update reads and writes its two bodies' velocities, so the points of one bundle
 //! must not share a moving body. The island's points are coloured greedily (no two points of a
