@@ -476,19 +476,7 @@ fn apgd_exit_velocities_are_consistent_with_the_impulses() {
                     .into_iter()
                     .zip(g)
                 {
-                    let impulse = impulse as f64;
-                    let (d, ia, ib) = (
-                        to64(row.direction),
-                        to64(row.inverse_inertia_angular_a),
-                        to64(row.inverse_inertia_angular_b),
-                    );
-                    let (a, b) = (c.body_a as usize, c.body_b as usize);
-                    for k in 0..3 {
-                        expected[a].0[k] += d[k] * c.inverse_mass_a as f64 * impulse;
-                        expected[a].1[k] += ia[k] * impulse;
-                        expected[b].0[k] -= d[k] * c.inverse_mass_b as f64 * impulse;
-                        expected[b].1[k] -= ib[k] * impulse;
-                    }
+                    common::add_row_impulse(&mut expected, c, row, impulse as f64);
                 }
             }
             assert!(moved, "the solve changed the impulses");

@@ -546,18 +546,7 @@ fn velocity_before_in_parts_is_the_same_on_any_thread_count_and_matches_a_direct
             (&c.tangents[1], c.tangent_impulses[1]),
         ];
         for (row, impulse) in rows {
-            let (d, g) = (dvec(row.direction), impulse as f64);
-            let (ia, ib) = (
-                dvec(row.inverse_inertia_angular_a),
-                dvec(row.inverse_inertia_angular_b),
-            );
-            let (a, b) = (c.body_a as usize, c.body_b as usize);
-            for k in 0..3 {
-                delta[a].0[k] += d[k] * c.inverse_mass_a as f64 * g;
-                delta[a].1[k] += ia[k] * g;
-                delta[b].0[k] -= d[k] * c.inverse_mass_b as f64 * g;
-                delta[b].1[k] -= ib[k] * g;
-            }
+            common::add_row_impulse(&mut delta, c, row, impulse as f64);
         }
     }
     let dot = |p: [f64; 3], q: [f64; 3]| p[0] * q[0] + p[1] * q[1] + p[2] * q[2];

@@ -103,3 +103,27 @@ pub fn highest_body(bodies: &impulse::body::Bodies) -> usize {
         })
         .unwrap()
 }
+
+/// Adds M⁻¹Jᵀγ of one of `c`'s rows, carrying `impulse` (N·s), to the (linear, angular)
+/// velocity changes of its two bodies (`body_a` +, `body_b` −), indexed by world body, in f64:
+/// a reference for the engine's f32 passes.
+pub fn add_row_impulse(
+    delta: &mut [([f64; 3], [f64; 3])],
+    c: &impulse::constraints::ContactConstraint,
+    row: &impulse::constraints::JacobianRow,
+    impulse: f64,
+) {
+    let to64 = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+    let (d, ia, ib) = (
+        to64(row.direction),
+        to64(row.inverse_inertia_angular_a),
+        to64(row.inverse_inertia_angular_b),
+    );
+    let (a, b) = (c.body_a as usize, c.body_b as usize);
+    for k in 0..3 {
+        delta[a].0[k] += d[k] * c.inverse_mass_a as f64 * impulse;
+        delta[a].1[k] += ia[k] * impulse;
+        delta[b].0[k] -= d[k] * c.inverse_mass_b as f64 * impulse;
+        delta[b].1[k] -= ib[k] * impulse;
+    }
+}
