@@ -17,7 +17,8 @@ pub const FAST_ENGINE: &str = "impulse fast";
 
 /// `engine` (e.g. [`FAST_ENGINE`]) run in a pool of its own with `threads` threads.
 pub fn threads_engine_name(engine: &str, threads: usize) -> String {
-    format!("{engine} on {threads} threads")
+    let plural = if threads == 1 { "" } else { "s" };
+    format!("{engine} on {threads} thread{plural}")
 }
 
 /// Steps `scene` `steps` times with impulse inside a rayon pool of `threads` threads, timing

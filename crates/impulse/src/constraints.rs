@@ -513,6 +513,9 @@ pub fn record_velocity_before(
     };
     let parallel = parallel && rayon::current_num_threads() > 1;
     let bodies = linear.len();
+    if bodies == 0 {
+        return;
+    }
     let parts = constraints
         .len()
         .div_ceil(RECORD_POINTS_PER_PART)
@@ -536,9 +539,6 @@ pub fn record_velocity_before(
             }
         }
     };
-    if bodies == 0 {
-        return;
-    }
     if parallel && parts > 1 {
         constraints
             .par_chunks(per_part)

@@ -572,7 +572,8 @@ impl BundleUpdate for WarmStart {
     }
 }
 
-/// Fewest bundles of one colour in a part run on its own thread.
+/// Fewest bundles of one colour in a part run on its own thread: a colour of at most this many
+/// runs as one part.
 const BUNDLES_PER_TASK: usize = 32;
 
 /// Runs `update` on each bundle in order (`forward`) or in reverse, asking the CPU for the

@@ -66,8 +66,8 @@ impl Sweep<'_> {
 /// Independent colours of a [`Sweep`]; points past them share one sequential colour.
 pub const COLOURS: usize = 64;
 
-/// Fewest points of one colour in a part run on its own thread: below twice this a colour
-/// runs on one thread.
+/// Fewest points of one colour in a part run on its own thread: a colour of at most this many
+/// runs as one part.
 const POINTS_PER_TASK: usize = 256;
 
 /// Greedy graph colouring of an island's points: each point takes the lowest colour that
@@ -150,7 +150,7 @@ pub(crate) fn greedy_colours(
 /// ones, and a chunk never calls into rayon, so every wait ends on any nesting of rayon jobs;
 /// a thread that joins late, or never, leaves more chunks to the others. One contiguous chunk
 /// per thread keeps each thread's reads a single stream: chunks of 32 bundles claimed in turn
-/// were no faster than the fork-joins, halves were (docs/benchmarks.md, session 10). The
+/// were slower than the fork-joins, halves faster (docs/benchmarks.md, session 10). The
 /// chunks of a colour touch disjoint bodies and colours run in order, so the result is the
 /// same on any number of threads (`combine` must not depend on order, as a maximum does not).
 #[allow(clippy::too_many_arguments)]
@@ -233,7 +233,7 @@ where
         }
         result
     };
-    (0..rayon::current_num_threads())
+    (0..threads)
         .into_par_iter()
         .map(worker)
         .reduce(|| identity, &combine)
