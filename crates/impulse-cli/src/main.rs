@@ -117,6 +117,10 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// After the summary, print the median wall time of each stage of the step (broad
+        /// phase, narrow phase, islands, assembly, solve, scatter, impulse write-back, finish).
+        #[arg(long)]
+        profile: bool,
     },
     /// List the built-in scenes.
     Scenes,
@@ -269,6 +273,7 @@ fn real_main() -> Result<ExitCode> {
             every,
             summary_json,
             quiet,
+            profile,
         } => {
             let mut scene = resolve_scene(&scene)?;
             if let Some(preset) = preset {
@@ -365,6 +370,9 @@ fn real_main() -> Result<ExitCode> {
             };
             let summary = run::run(scene, &options)?;
             println!("{}", summary.line());
+            if profile {
+                println!("{}", summary.stage_line());
+            }
         }
         Command::Scenes => {
             for (name, description) in builtin_names() {

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use impulse::diagnostics::StepProfile;
 use impulse::island::EscalationLevel;
 use impulse::{Scene, World, metrics};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -80,6 +81,10 @@ pub struct Summary {
     pub sleep: bool,
     /// `completed`, or the error that stopped the run.
     pub status: String,
+    /// Median wall time (ms) of each stage of the step over the run
+    /// ([`impulse::diagnostics::StepProfile`]), each stage's median on its own: they need not
+    /// add up to the median step.
+    pub stage_ms: StepProfile,
 }
 
 impl Summary {
@@ -104,6 +109,17 @@ impl Summary {
             self.max_natural_map_residual,
             self.final_natural_map_residual,
         )
+    }
+
+    /// The stage medians as one line: `stages (median ms): broad_phase 0.041, …`.
+    pub fn stage_line(&self) -> String {
+        let stages: Vec<String> = self
+            .stage_ms
+            .stages()
+            .iter()
+            .map(|(name, ms)| format!("{name} {ms:.3}"))
+            .collect();
+        format!("stages (median ms): {}", stages.join(", "))
     }
 }
 
@@ -157,6 +173,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
     bar.set_message(scene.name.clone());
 
     let mut step_ms = Vec::with_capacity(steps as usize);
+    let mut profiles: Vec<StepProfile> = Vec::with_capacity(steps as usize);
     let mut contacts_sum = 0u64;
     let mut iterations_sum = 0u64;
     let mut max_residual = 0.0f32;
@@ -182,6 +199,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             failure = Some(e);
             break;
         }
+        profiles.push(*world.profile());
         let diagnostics = world.diagnostics();
         for island in &diagnostics.islands {
             match island.method {
@@ -201,6 +219,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
                 &serde_json::json!({
                     "step": diagnostics.step,
                     "ms": step_ms.last(),
+                    "stages": world.profile(),
                     "islands": &diagnostics.islands,
                 }),
             )?;
@@ -263,6 +282,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         },
         sleep: scene.solver.sleep,
         status,
+        stage_ms: median_profile(&profiles),
     };
     if let Some(path) = &options.summary_json {
         let text = serde_json::to_string_pretty(&summary)?;
@@ -273,6 +293,25 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         return Err(anyhow::Error::new(e).context(summary.line()));
     }
     Ok(summary)
+}
+
+/// Each stage's median over `profiles`.
+fn median_profile(profiles: &[StepProfile]) -> StepProfile {
+    let of = |stage: fn(&StepProfile) -> f32| {
+        let mut times: Vec<f64> = profiles.iter().map(|p| stage(p) as f64).collect();
+        median(&mut times) as f32
+    };
+    StepProfile {
+        broad_phase: of(|p| p.broad_phase),
+        narrow_phase: of(|p| p.narrow_phase),
+        islands: of(|p| p.islands),
+        assembly: of(|p| p.assembly),
+        solve: of(|p| p.solve),
+        scatter: of(|p| p.scatter),
+        store_impulses: of(|p| p.store_impulses),
+        finish: of(|p| p.finish),
+        total: of(|p| p.total),
+    }
 }
 
 fn median(values: &mut [f64]) -> f64 {

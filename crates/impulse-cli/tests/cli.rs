@@ -67,12 +67,48 @@ fn run_writes_csv_trajectory_and_summary_json() {
         "top_sink_m",
         "kinetic_energy_j",
         "mean_contacts",
+        "stage_ms",
     ] {
         assert!(json.get(key).is_some(), "summary lacks {key}");
+    }
+    for stage in [
+        "broad_phase",
+        "narrow_phase",
+        "islands",
+        "assembly",
+        "solve",
+        "scatter",
+        "store_impulses",
+        "finish",
+        "total",
+    ] {
+        let ms = json["stage_ms"][stage].as_f64();
+        assert!(ms.is_some_and(|ms| ms >= 0.0), "stage_ms.{stage}: {ms:?}");
     }
     assert_eq!(json["bodies"], 31);
     assert_eq!(json["steps"], 20);
     assert!(String::from_utf8_lossy(&out.stdout).starts_with("stack30: 31 bodies, 20 steps"));
+}
+
+#[test]
+fn profile_prints_the_median_of_every_stage() {
+    let out = impulse()
+        .args(["run", "stack3", "--steps", "5", "--quiet", "--profile"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout.lines().nth(1).unwrap_or_default();
+    let stages: Vec<&str> = line
+        .strip_prefix("stages (median ms): ")
+        .unwrap_or_else(|| panic!("no stage line in {stdout}"))
+        .split(", ")
+        .collect();
+    assert_eq!(stages.len(), 8, "{line}");
+    for stage in stages {
+        let (_, ms) = stage.rsplit_once(' ').unwrap();
+        assert!(ms.parse::<f64>().unwrap() >= 0.0, "{stage}");
+    }
 }
 
 #[test]

@@ -418,6 +418,12 @@ fn tangent_basis(normal: Vec3, previous: Vec3) -> (Vec3, Vec3) {
 ///   capped at `max_repair_speed`. With `soft_contact_hertz` > 0, c_d and the row's softness
 ///   come from a damped spring instead ([`soft_contact`]);
 /// - s ≤ 0 without repair (the relax solve): v⁺ ≥ 0, rigid.
+///
+/// With split impulse, returns whether any row has a repair to make, a position target above
+/// `settings.tolerance`: when none has, the position solve would end after its first sweep
+/// having changed no row's velocity by more than the tolerance, and the caller skips it. At rest
+/// this is the usual case: the repair decays exponentially towards the slop and never quite
+/// reaches it. Without split impulse, returns false.
 pub fn update_targets(
     constraints: &mut [ContactConstraint],
     displacement: &[Vec3],
@@ -425,7 +431,8 @@ pub fn update_targets(
     settings: &SolverSettings,
     h: f32,
     with_repair: bool,
-) {
+) -> bool {
+    let mut any_repair = false;
     let (repair_rate, softness) = if settings.soft_contact_hertz > 0.0 {
         soft_contact(settings.soft_contact_hertz, settings.soft_damping_ratio, h)
     } else {
@@ -442,6 +449,7 @@ pub fn update_targets(
             // The repair goes to the position solve; the velocity rows stay rigid.
             c.position_target = repair;
             c.position_impulse = 0.0;
+            any_repair |= repair > settings.tolerance;
             c.target_normal_velocity = if separation > 0.0 {
                 -separation / h
             } else {
@@ -458,6 +466,7 @@ pub fn update_targets(
             (0.0, (1.0, 0.0))
         };
     }
+    any_repair
 }
 
 /// Soft contact as a damped spring of frequency `hertz` (capped at a quarter of the substep

@@ -38,6 +38,51 @@ pub struct StepDiagnostics {
     pub linear_momentum: [f32; 3],
 }
 
+/// Wall-clock time (ms) of each stage of one step, in the order [`crate::World::step`] runs
+/// them (as Box2D's `b2Profile` and Rapier's `Counters`); [`crate::World::profile`] gives the
+/// last step's. Kept apart from [`StepDiagnostics`], which is the same bit for bit on any thread
+/// count. Stages that run beside each other on
+/// two threads are timed together. Read from `std::time::Instant`, so it varies from run to run
+/// like any timing: it says where a step's time went, it is not a measure of quality.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct StepProfile {
+    /// Speculative margins and broad phase (with the energy at the step's start beside them).
+    pub broad_phase: f32,
+    /// Narrow phase: contact manifolds of the candidate pairs.
+    pub narrow_phase: f32,
+    /// Islands (union-find over the pairs) and the bodies' world inverse inertia tensors.
+    pub islands: f32,
+    /// Constraint assembly: Jacobian rows, effective masses, warm-start impulses.
+    pub assembly: f32,
+    /// The island jobs: substeps (solve, position integration), restitution, and each island's
+    /// residual.
+    pub solve: f32,
+    /// Island results written back to the bodies.
+    pub scatter: f32,
+    /// Impulses written back to the manifolds for the next warm start.
+    pub store_impulses: f32,
+    /// Sleep, energy, momentum and the counts of the diagnostics.
+    pub finish: f32,
+    /// The whole step.
+    pub total: f32,
+}
+
+impl StepProfile {
+    /// The stages as (name, ms) pairs, in step order (without `total`).
+    pub fn stages(&self) -> [(&'static str, f32); 8] {
+        [
+            ("broad_phase", self.broad_phase),
+            ("narrow_phase", self.narrow_phase),
+            ("islands", self.islands),
+            ("assembly", self.assembly),
+            ("solve", self.solve),
+            ("scatter", self.scatter),
+            ("store_impulses", self.store_impulses),
+            ("finish", self.finish),
+        ]
+    }
+}
+
 /// Natural-map residual of the solved rows (see [`StepDiagnostics::natural_map_residual`]).
 pub fn natural_map_residual(
     constraints: &[ContactConstraint],

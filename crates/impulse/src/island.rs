@@ -300,6 +300,8 @@ pub struct IslandWorkspace {
     impact_speed: f32,
     /// Rows with friction (μ > 0), counted by the world as the island's step ends.
     pub(crate) friction_rows: usize,
+    /// Split impulse: whether the last targets asked any row for overlap repair.
+    position_repair: bool,
 }
 
 impl IslandWorkspace {
@@ -321,7 +323,7 @@ impl IslandWorkspace {
             settings.relax_iterations
         };
         if !bundled {
-            constraints::update_targets(
+            self.position_repair = constraints::update_targets(
                 constraints,
                 &self.displacement,
                 &self.rotation,
@@ -557,8 +559,12 @@ pub fn step_island(
         } else {
             solver::warm_start(constraints, &mut velocities);
         }
+        w.position_repair = false;
         w.targets_and_solve(constraints, settings, h, bundled, true);
-        if settings.split_impulse {
+        // With no row to repair beyond the tolerance, positions move with the velocities alone
+        // (at rest, the usual case in a pile; see `constraints::update_targets`).
+        let split = settings.split_impulse && w.position_repair;
+        if split {
             // Positions move with v + the pseudo-velocity of the repair solve.
             w.pseudo_linear.clear();
             w.pseudo_linear.resize(slots, Vec3::ZERO);
@@ -583,7 +589,7 @@ pub fn step_island(
                 w.pseudo_angular[k] += w.angular[k];
             }
         }
-        let (linear, angular) = if settings.split_impulse {
+        let (linear, angular) = if split {
             (&w.pseudo_linear[..moving], &w.pseudo_angular[..moving])
         } else {
             (&w.linear[..moving], &w.angular[..moving])

@@ -9,7 +9,7 @@ use crate::body::{Bodies, rotate_tensor};
 use crate::broad_phase::BroadPhase;
 use crate::constraints::{self, ContactConstraint};
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
-use crate::diagnostics::{self, StepDiagnostics};
+use crate::diagnostics::{self, StepDiagnostics, StepProfile};
 use crate::error::{StepError, WorldError};
 use crate::island::{self, IslandWorkspace, Islands, StepContext};
 use crate::narrow_phase::{self, ContactImpulse, NarrowPhase};
@@ -43,6 +43,35 @@ struct EnergyCheck {
     started: bool,
 }
 
+/// Times the stages of one step for [`StepProfile`].
+struct StageClock {
+    start: std::time::Instant,
+    last: std::time::Instant,
+}
+
+impl StageClock {
+    fn start() -> Self {
+        let now = std::time::Instant::now();
+        Self {
+            start: now,
+            last: now,
+        }
+    }
+
+    /// Milliseconds since the last lap (or the start).
+    fn lap(&mut self) -> f32 {
+        let now = std::time::Instant::now();
+        let ms = (now - self.last).as_secs_f64() * 1e3;
+        self.last = now;
+        ms as f32
+    }
+
+    /// Milliseconds since the start.
+    fn total(&self) -> f32 {
+        (self.last - self.start).as_secs_f64() as f32 * 1e3
+    }
+}
+
 /// Most islands per parallel task of the island stage.
 const ISLANDS_PER_TASK: usize = 4;
 
@@ -71,6 +100,7 @@ pub struct World {
     /// thread. `false` runs everything on the calling thread.
     pub parallel: bool,
     diagnostics: StepDiagnostics,
+    profile: StepProfile,
 }
 
 impl World {
@@ -96,6 +126,7 @@ impl World {
             energy: EnergyCheck::default(),
             parallel: true,
             diagnostics: StepDiagnostics::default(),
+            profile: StepProfile::default(),
         };
         world.check_settings()?;
         Ok(world)
@@ -185,6 +216,11 @@ impl World {
         &self.narrow_phase
     }
 
+    /// Wall-clock time of each stage of the last step (all zero before the first step).
+    pub fn profile(&self) -> &StepProfile {
+        &self.profile
+    }
+
     /// Advances the world by dt through the pipeline of DESIGN.md. Settings are checked first;
     /// a blow-up is reported with the step number, after the state that caused it was written.
     pub fn step(&mut self) -> Result<&StepDiagnostics, StepError> {
@@ -194,6 +230,8 @@ impl World {
         let dt = self.dt;
         let settings = self.settings.clone();
         self.step_count += 1;
+        let mut clock = StageClock::start();
+        let mut profile = StepProfile::default();
         // Stages 2–4 once per step, on the poses and velocities at its start. The energy at the
         // start (read only to notice edits between steps) is summed beside the broad phase.
         let parallel = self.parallel && rayon::current_num_threads() > 1;
@@ -214,6 +252,7 @@ impl World {
             broad();
             start_energy()
         };
+        profile.broad_phase = clock.lap();
         // The energy check's reference restarts whenever the bodies changed since the last step.
         if !self.energy.started
             || self.energy.bodies != self.bodies.len()
@@ -235,6 +274,7 @@ impl World {
             broad_phase.optimize();
             narrow()?;
         }
+        profile.narrow_phase = clock.lap();
         // Islands from the pairs first, so that assembly writes each island's constraints
         // contiguously and nothing has to be moved afterwards. The union-find is serial; the
         // world inertia tensors (from the poses alone) are computed beside it.
@@ -249,6 +289,7 @@ impl World {
             world_inverse_inertia_of(bodies, parallel, world_inverse_inertia);
             islands.build(bodies, pairs);
         }
+        profile.islands = clock.lap();
         constraints::assemble(
             &self.bodies,
             &self.narrow_phase,
@@ -258,6 +299,7 @@ impl World {
             self.parallel,
             &mut self.constraints,
         );
+        profile.assembly = clock.lap();
 
         // Stages 1, 5 and 6 per island: each island's substep loop touches only its bodies.
         let islands = self.islands.len();
@@ -320,7 +362,9 @@ impl World {
                 jobs.iter_mut().for_each(run);
             }
         }
+        profile.solve = clock.lap();
         self.scatter_islands();
+        profile.scatter = clock.lap();
         let mut iterations = 0;
         for k in 0..islands {
             if self.island_awake[k] {
@@ -341,6 +385,7 @@ impl World {
             );
         }
         self.store_impulses();
+        profile.store_impulses = clock.lap();
         // Only awake islands were solved this step; sleeping ones keep last step's state.
         let mut squared = 0.0f64;
         let mut friction_rows = 0;
@@ -382,6 +427,8 @@ impl World {
         } else {
             (sleep_and_energy(), counts())
         };
+        profile.finish = clock.lap();
+        profile.total = clock.total();
         self.diagnostics = StepDiagnostics {
             step: self.step_count,
             contact_pairs,
@@ -394,6 +441,7 @@ impl World {
             kinetic_energy: energy.kinetic as f32,
             linear_momentum: energy.momentum.to_array(),
         };
+        self.profile = profile;
         self.check_blow_up(&energy)?;
         Ok(&self.diagnostics)
     }
