@@ -25,7 +25,7 @@ use wide::f32x4;
 
 use crate::constraints::{ContactConstraint, JacobianRow, soft_contact};
 use crate::settings::SolverSettings;
-use crate::solver::{COLOURS, SharedVelocities, SolveReport, Velocities, greedy_colours};
+use crate::solver::{COLOURS, SharedVelocities, SolveReport, Velocities};
 
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
 /// AArch64), so no target feature is needed.
@@ -82,21 +82,44 @@ struct BundleGeometry {
     depth: Lane,
 }
 
-/// An island's contact points packed in bundles, colour by colour.
+/// Bundles that share their lanes' bodies: lane i of every bundle in `start..start + len`
+/// holds a point of the same manifold group (the same two bodies), so a sweep gathers the
+/// lanes' velocities once, updates the `len` bundles in turn on them, and scatters once.
+#[derive(Clone, Copy, Default, Debug, PartialEq, Eq)]
+struct Group {
+    start: u32,
+    len: u32,
+}
+
+/// Most points of one manifold group: a pair's run of points is cut into groups of at most
+/// this many (a box face on a box gives four).
+const GROUP_POINTS: usize = 4;
+
+/// An island's contact points packed in bundles, manifold group by manifold group, colour by
+/// colour.
 #[derive(Default)]
 pub struct Bundles {
     bundles: Vec<Bundle>,
     geometry: Vec<BundleGeometry>,
     /// Bundles of colour k are `colour_starts[k]..colour_starts[k + 1]`; the last colour holds
-    /// the points the colouring could not place, one per bundle, and always runs on one thread.
+    /// the manifold groups the colouring could not place, one per lane group, and always runs
+    /// on one thread.
     colour_starts: Vec<usize>,
+    /// The lane groups (see [`Group`]) in bundle order; colour k's are
+    /// `group_colour_starts[k]..group_colour_starts[k + 1]`.
+    groups: Vec<Group>,
+    group_colour_starts: Vec<usize>,
+    /// Packing scratch: per manifold group (a run of at most [`GROUP_POINTS`] consecutive
+    /// points between the same two bodies), its first point, and its lane group and lane.
+    runs: Vec<u32>,
+    run_places: Vec<(u32, u32)>,
     /// Whether one colour's bundles may be updated on several threads.
     parallel: bool,
     /// Constraint index of each lane of each bundle; `u32::MAX` for padding.
     sources: Vec<[u32; LANES]>,
     /// Where each constraint went: bundle index × [`LANES`] + lane.
     slots: Vec<u32>,
-    /// Greedy colouring scratch: per slot, the colours its points use; per point, its colour.
+    /// Greedy colouring scratch: per slot, the colours its groups use; per group, its colour.
     used: Vec<u64>,
     colours: Vec<u8>,
 }
@@ -205,55 +228,111 @@ impl BodyLanes {
             angular_b: lane_vec(bundle_b.map(|k| angular[k as usize])),
         }
     }
-
-    /// Writes the lanes back; the immovable slot (`immovable`) is never written.
-    #[inline(always)]
-    fn scatter(
-        &self,
-        bundle_a: &[u32; LANES],
-        bundle_b: &[u32; LANES],
-        immovable: usize,
-        linear: &mut [Vec3],
-        angular: &mut [Vec3],
-    ) {
-        let (la, aa) = (unlane(&self.linear_a), unlane(&self.angular_a));
-        let (lb, ab) = (unlane(&self.linear_b), unlane(&self.angular_b));
-        for i in 0..LANES {
-            let (a, b) = (bundle_a[i] as usize, bundle_b[i] as usize);
-            if a != immovable {
-                linear[a] = la[i];
-                angular[a] = aa[i];
-            }
-            if b != immovable {
-                linear[b] = lb[i];
-                angular[b] = ab[i];
-            }
-        }
-    }
 }
 
 impl Bundles {
-    /// Colours the island's `constraints` greedily (slots below `slots`; `slots − 1` is the
-    /// immovable one) and packs them, with their current impulses, colour by colour into
-    /// bundles. Points the colouring cannot place (a body in more than [`COLOURS`] colours)
-    /// get a bundle each. O(points).
+    /// Packs the island's `constraints` (slots below `slots`; `slots − 1` is the immovable one),
+    /// with their current impulses, into bundles. The points are first cut into manifold groups:
+    /// runs of consecutive points between the same two bodies (assembly writes a pair's points
+    /// together), at most [`GROUP_POINTS`] each. The groups are coloured greedily (no two groups
+    /// of a colour share a moving body), and each colour's groups, in constraint order, go
+    /// [`LANES`] at a time into lane groups of as many bundles as their largest group has
+    /// points; a lane whose group is shorter is padded with rows of zero mass between the same
+    /// bodies, whose updates change nothing. Groups the colouring cannot place (a body in more
+    /// than [`COLOURS`] colours) get a lane group each. O(points).
     ///
-    /// With `parallel`, each colour's bundles are later spread over rayon's threads; the result
-    /// is the same bit for bit, as the bundles of one colour touch disjoint bodies.
+    /// Why manifold groups (Box2D v3's and Box3D's wide contact constraints are per manifold
+    /// too): a sweep gathers and scatters the bodies' velocities once per lane group instead of
+    /// once per bundle, and a body's groups need far fewer colours than its points (pyramid100
+    /// settled: 11 colours of groups against 32 of points, each a wait per sweep on two
+    /// threads).
+    ///
+    /// With `parallel`, each colour's lane groups are later spread over rayon's threads; the
+    /// result is the same bit for bit, as the lane groups of one colour touch disjoint bodies.
     pub fn pack(&mut self, constraints: &[ContactConstraint], slots: usize, parallel: bool) {
         self.parallel = parallel;
         let immovable = (slots - 1) as u32;
-        let counts = greedy_colours(constraints, slots, &mut self.used, &mut self.colours);
-        // Bundles per colour (the last colour: one point each) and where each colour starts.
-        let per_bundle = |colour: usize| if colour < COLOURS { LANES } else { 1 };
-        let mut bundle_start = [0usize; COLOURS + 2];
-        for colour in 0..=COLOURS {
-            let points = (counts[colour + 1] - counts[colour]) as usize;
-            bundle_start[colour + 1] = bundle_start[colour] + points.div_ceil(per_bundle(colour));
+        // Manifold groups: runs of points between the same two bodies.
+        self.runs.clear();
+        for (k, c) in constraints.iter().enumerate() {
+            let continues = self.runs.last().is_some_and(|&first| {
+                let first_point = &constraints[first as usize];
+                (first_point.local_a, first_point.local_b) == (c.local_a, c.local_b)
+                    && k - (first as usize) < GROUP_POINTS
+            });
+            if !continues {
+                self.runs.push(k as u32);
+            }
         }
-        let total = bundle_start[COLOURS + 1];
+        let run_count = self.runs.len();
+        self.runs.push(constraints.len() as u32);
+        let run_points = |runs: &[u32], r: usize| (runs[r + 1] - runs[r]) as usize;
+        // Greedy colours of the groups, and the groups per colour.
+        let immovable_slot = immovable as usize;
+        self.used.clear();
+        self.used.resize(slots, 0);
+        self.colours.clear();
+        let mut counts = [0usize; COLOURS + 2];
+        for r in 0..run_count {
+            let c = &constraints[self.runs[r] as usize];
+            let (a, b) = (c.local_a as usize, c.local_b as usize);
+            let used = &self.used;
+            let mask = (if a != immovable_slot { used[a] } else { 0 })
+                | (if b != immovable_slot { used[b] } else { 0 });
+            let colour = ((!mask).trailing_zeros() as usize).min(COLOURS);
+            if colour < COLOURS {
+                for slot in [a, b] {
+                    if slot != immovable_slot {
+                        self.used[slot] |= 1 << colour;
+                    }
+                }
+            }
+            self.colours.push(colour as u8);
+            counts[colour + 1] += 1;
+        }
+        for k in 0..=COLOURS {
+            counts[k + 1] += counts[k];
+        }
+        // Lane groups per colour (the last colour: one group each), and where each starts.
+        let per_group = |colour: usize| if colour < COLOURS { LANES } else { 1 };
+        self.group_colour_starts.clear();
+        self.group_colour_starts.push(0);
+        for colour in 0..=COLOURS {
+            let groups = (counts[colour + 1] - counts[colour]).div_ceil(per_group(colour));
+            let last = *self.group_colour_starts.last().unwrap_or(&0);
+            self.group_colour_starts.push(last + groups);
+        }
+        let total_groups = *self.group_colour_starts.last().unwrap_or(&0);
+        // Each group to the next free lane of its colour, in constraint order; a lane group
+        // is as long as its longest group.
+        self.groups.clear();
+        self.groups.resize(total_groups, Group::default());
+        self.run_places.clear();
+        let mut filled = [0usize; COLOURS + 1];
+        for r in 0..run_count {
+            let colour = self.colours[r] as usize;
+            let position = filled[colour];
+            filled[colour] += 1;
+            let per = per_group(colour);
+            let group = self.group_colour_starts[colour] + position / per;
+            let lane = position % per;
+            let g = &mut self.groups[group];
+            g.len = g.len.max(run_points(&self.runs, r) as u32);
+            self.run_places.push((group as u32, lane as u32));
+        }
+        let mut total = 0u32;
+        for g in self.groups.iter_mut() {
+            g.start = total;
+            total += g.len;
+        }
+        let total = total as usize;
         self.colour_starts.clear();
-        self.colour_starts.extend_from_slice(&bundle_start);
+        self.colour_starts
+            .extend(self.group_colour_starts.iter().map(|&g| {
+                self.groups
+                    .get(g)
+                    .map_or(total, |group| group.start as usize)
+            }));
         let empty = Bundle {
             local_a: [immovable; LANES],
             local_b: [immovable; LANES],
@@ -275,26 +354,40 @@ impl Bundles {
         self.geometry.resize(total, BundleGeometry::default());
         self.sources.clear();
         self.sources.resize(total, [u32::MAX; LANES]);
-        // Each point to the next free lane of its colour, in constraint order.
+        // Each point to its group's lane, in the bundle of its place in the group.
         self.slots.clear();
-        let mut filled = [0usize; COLOURS + 1];
-        for (k, &colour) in self.colours.iter().enumerate() {
-            let colour = colour as usize;
-            let position = filled[colour];
-            filled[colour] += 1;
-            let per = per_bundle(colour);
-            let index = bundle_start[colour] + position / per;
-            let lane = position % per;
-            self.sources[index][lane] = k as u32;
-            self.slots.push((index * LANES + lane) as u32);
+        for r in 0..run_count {
+            let (group, lane) = self.run_places[r];
+            let start = self.groups[group as usize].start as usize;
+            for (p, k) in (self.runs[r]..self.runs[r + 1]).enumerate() {
+                let index = start + p;
+                self.sources[index][lane as usize] = k;
+                self.slots.push((index * LANES + lane as usize) as u32);
+            }
         }
         if parallel_fill {
+            let bundle_start = self.colour_starts.clone();
             self.fill_parallel(constraints, &bundle_start, &empty);
         } else {
-            // The reads stream, and the writes go to one open bundle per colour (a few KiB).
+            // The reads stream, and the writes go to one open lane group per colour.
             for (c, &slot) in constraints.iter().zip(&self.slots) {
                 let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
                 set_lane(&mut self.bundles[index], &mut self.geometry[index], lane, c);
+            }
+        }
+        // Padding of a lane whose group is shorter than its lane group: the group's bodies,
+        // so that the lane group gathers and scatters one pair of bodies per lane.
+        for r in 0..run_count {
+            let (group, lane) = self.run_places[r];
+            let Group { start, len } = self.groups[group as usize];
+            let points = run_points(&self.runs, r) as u32;
+            if points < len {
+                let c = &constraints[self.runs[r] as usize];
+                for index in start + points..start + len {
+                    let b = &mut self.bundles[index as usize];
+                    b.local_a[lane as usize] = c.local_a;
+                    b.local_b[lane as usize] = c.local_b;
+                }
             }
         }
     }
@@ -330,17 +423,19 @@ impl Bundles {
                 first += size;
             }
         }
-        let (sources, slots, colours) = (&self.sources, &self.slots, &self.colours);
+        let (sources, slots) = (&self.sources, &self.slots);
         parts.into_par_iter().for_each(|mut task_parts| {
-            // Constraint range: lanes fill in constraint order within a colour, so a part's
-            // first lane holds its smallest index and its last real lane its largest.
+            // The task's constraint range, from the lanes it owns (a lane group's lanes hold
+            // groups in constraint order, but its later bundles may be padding).
             let mut low = usize::MAX;
             let mut high = 0;
-            for (start, part, _) in task_parts.iter().filter(|(_, part, _)| !part.is_empty()) {
-                low = low.min(sources[*start][0] as usize);
-                let last = sources[*start + part.len() - 1];
-                let largest = last.iter().filter(|&&k| k != u32::MAX).max();
-                high = high.max(largest.map_or(0, |&k| k as usize + 1));
+            for (start, part, _) in task_parts.iter() {
+                for lanes in &sources[*start..*start + part.len()] {
+                    for &k in lanes.iter().filter(|&&k| k != u32::MAX) {
+                        low = low.min(k as usize);
+                        high = high.max(k as usize + 1);
+                    }
+                }
             }
             for (_, part, geometry) in task_parts.iter_mut() {
                 part.fill(*empty);
@@ -348,7 +443,14 @@ impl Bundles {
             }
             for k in low..high.min(constraints.len()) {
                 let (index, lane) = (slots[k] as usize / LANES, slots[k] as usize % LANES);
-                let (start, part, geometry) = &mut task_parts[colours[k] as usize];
+                // The task's parts are in bundle order: the last one starting at or before
+                // `index` is the only one that can hold it.
+                let owner = task_parts.partition_point(|(start, _, _)| *start <= index);
+                let Some((start, part, geometry)) =
+                    owner.checked_sub(1).and_then(|p| task_parts.get_mut(p))
+                else {
+                    continue;
+                };
                 if let Some(i) = index.checked_sub(*start).filter(|&i| i < part.len()) {
                     set_lane(&mut part[i], &mut geometry[i], lane, &constraints[k]);
                 }
@@ -394,69 +496,47 @@ impl Bundles {
         self.sweep(true, velocities, WarmStart);
     }
 
-    /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), with the
-    /// bundle's bodies gathered into lanes and scattered back; returns the lane-wise largest of
-    /// what `update` returned. With `parallel` (see [`Bundles::pack`]) each colour is split
-    /// over rayon's threads, in parts of at least [`BUNDLES_PER_TASK`] bundles
-    /// ([`crate::solver::colour_after_colour`]).
+    /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
+    /// group's bodies gathered into lanes once and scattered back after its bundles; returns the
+    /// lane-wise largest of what `update` returned. With `parallel` (see [`Bundles::pack`])
+    /// each colour is split over rayon's threads, in parts of at least [`GROUPS_PER_TASK`]
+    /// lane groups ([`crate::solver::colour_after_colour`]).
     fn sweep<F>(&mut self, forward: bool, velocities: &mut Velocities<'_>, update: F) -> Lane
     where
         F: BundleUpdate,
     {
-        let immovable = velocities.linear.len() - 1;
-        if !self.parallel || rayon::current_num_threads() < 2 {
-            let mut largest = Lane::splat(0.0);
-            let one = |b: &mut Bundle| {
-                let mut v = BodyLanes::gather(
-                    &b.local_a,
-                    &b.local_b,
-                    velocities.linear,
-                    velocities.angular,
-                );
-                largest = largest.max(update.update(b, &mut v));
-                v.scatter(
-                    &b.local_a,
-                    &b.local_b,
-                    immovable,
-                    velocities.linear,
-                    velocities.angular,
-                );
-            };
-            for_each_prefetched(&mut self.bundles, forward, one);
-            return largest;
-        }
         let shared = SharedVelocities {
             linear: velocities.linear.as_mut_ptr(),
             angular: velocities.angular.as_mut_ptr(),
-            immovable,
+            immovable: velocities.linear.len() - 1,
         };
-        // Runs `update` on a run of bundles of one colour, in order or in reverse.
-        let run = |part: &mut [Bundle], forward: bool| {
-            // Capture the whole wrapper (Sync), not its raw-pointer fields.
+        let bundles = SharedBundles {
+            start: self.bundles.as_mut_ptr(),
+            len: self.bundles.len(),
+        };
+        if !self.parallel || rayon::current_num_threads() < 2 {
+            // SAFETY: `pack` gave every group a range inside the bundles and every lane slots
+            // below the island's slot count (the velocities' length); the bundles and the
+            // velocities are borrowed exclusively here.
+            return unsafe { sweep_groups(&self.groups, bundles, forward, &shared, update) };
+        }
+        // Runs `update` on a run of lane groups of one colour, in order or in reverse.
+        let run = |part: &mut [Group], forward: bool| {
+            // Capture the whole wrappers (Sync), not their raw-pointer fields.
             #[allow(clippy::redundant_locals)]
-            let shared = shared;
-            let mut largest = Lane::splat(0.0);
-            let mut one = |b: &mut Bundle| {
-                // SAFETY: slots are below the arrays' length (the island step sets them so);
-                // within one colour no other bundle touches b's moving slots, and the
-                // immovable slot is only read.
-                unsafe {
-                    let mut v = shared.gather(b);
-                    largest = largest.max(update.update(b, &mut v));
-                    shared.scatter(b, &v);
-                }
-            };
-            for_each_prefetched(part, forward, &mut one);
-            largest
+            let (shared, bundles) = (shared, bundles);
+            // SAFETY: as above, and within one colour no other lane group touches this run's
+            // bundles or its lanes' moving slots (the immovable slot is only read).
+            unsafe { sweep_groups(part, bundles, forward, &shared, update) }
         };
-        let starts = &self.colour_starts;
+        let starts = &self.group_colour_starts;
         crate::solver::colour_after_colour(
-            &mut self.bundles,
+            &mut self.groups,
             starts.len() - 1,
             |k| starts[k],
             forward,
             COLOURS,
-            BUNDLES_PER_TASK,
+            GROUPS_PER_TASK,
             Lane::splat(0.0),
             run,
             |x, y| x.max(y),
@@ -572,32 +652,80 @@ impl BundleUpdate for WarmStart {
     }
 }
 
-/// Fewest bundles of one colour in a part run on its own thread: a colour of at most this many
-/// runs as one part.
-const BUNDLES_PER_TASK: usize = 32;
+/// Fewest lane groups of one colour in a part run on its own thread: a colour of at most this
+/// many runs as one part.
+const GROUPS_PER_TASK: usize = 8;
 
-/// Runs `update` on each bundle in order (`forward`) or in reverse, asking the CPU for the
-/// bundle [`PREFETCH_BUNDLES`] ahead first. A bundle is 16 cache lines; once an island's
-/// bundles outgrow L2 (pyramid100: 17 MB) the sweep waited on L3 for them, which the hardware
-/// prefetcher did not hide: asking ahead made a one-thread `fast` pyramid100 step about a
-/// fifth faster (docs/benchmarks.md, session 9).
-#[inline(always)]
-fn for_each_prefetched(bundles: &mut [Bundle], forward: bool, mut update: impl FnMut(&mut Bundle)) {
-    let n = bundles.len();
-    for step in 0..n {
-        let (k, ahead) = if forward {
-            (step, step + PREFETCH_BUNDLES)
-        } else {
-            (n - 1 - step, (n - 1 - step).wrapping_sub(PREFETCH_BUNDLES))
-        };
-        if let Some(next) = bundles.get(ahead) {
-            crate::solver::prefetch_lines(next);
-        }
-        update(&mut bundles[k]);
-    }
+/// The bundles of a [`Bundles`], shared by the threads of one colour.
+#[derive(Clone, Copy)]
+struct SharedBundles {
+    start: *mut Bundle,
+    len: usize,
 }
 
-/// How many bundles ahead a sweep asks for (see [`for_each_prefetched`]).
+// SAFETY: the threads of one colour touch disjoint lane groups (see `sweep_groups`).
+unsafe impl Send for SharedBundles {}
+// SAFETY: as for Send.
+unsafe impl Sync for SharedBundles {}
+
+/// Runs `update` on the bundles of `groups` in order (`forward`) or in reverse, the bundles of
+/// each group in the same direction, with the group's bodies gathered once and scattered once.
+/// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first: a bundle is 16 cache lines, and
+/// once an island's bundles outgrow L2 (pyramid100: 17 MB) the sweep waited on L3 for them,
+/// which the hardware prefetcher did not hide (asking ahead made a one-thread `fast` pyramid100
+/// step about a fifth faster, docs/benchmarks.md, session 9). Groups lie in bundle order, so
+/// the bundle ahead in memory is the one the sweep visits next.
+///
+/// # Safety
+/// Every group's range lies inside `bundles`, every lane's slots are below the velocities'
+/// length, and no other thread touches these bundles or their lanes' moving slots meanwhile.
+#[inline(always)]
+unsafe fn sweep_groups<F: BundleUpdate>(
+    groups: &[Group],
+    bundles: SharedBundles,
+    forward: bool,
+    velocities: &SharedVelocities,
+    update: F,
+) -> Lane {
+    let mut largest = Lane::splat(0.0);
+    let n = groups.len();
+    for step in 0..n {
+        let group = groups[if forward { step } else { n - 1 - step }];
+        let (start, count) = (group.start as usize, group.len as usize);
+        debug_assert!(start + count <= bundles.len);
+        // SAFETY: the caller's contract; the slots are copied out before any bundle is
+        // borrowed mutably.
+        let (slots_a, slots_b) = unsafe {
+            let first = &*bundles.start.add(start);
+            (first.local_a, first.local_b)
+        };
+        let mut v = unsafe { velocities.gather(&slots_a, &slots_b) };
+        for p in 0..count {
+            let index = if forward {
+                start + p
+            } else {
+                start + count - 1 - p
+            };
+            let ahead = if forward {
+                index + PREFETCH_BUNDLES
+            } else {
+                index.wrapping_sub(PREFETCH_BUNDLES)
+            };
+            if ahead < bundles.len {
+                // SAFETY: in bounds; a prefetch reads nothing.
+                crate::solver::prefetch_lines(unsafe { &*bundles.start.add(ahead) });
+            }
+            // SAFETY: the caller's contract.
+            let b = unsafe { &mut *bundles.start.add(index) };
+            largest = largest.max(update.update(b, &mut v));
+        }
+        // SAFETY: the caller's contract.
+        unsafe { velocities.scatter(&slots_a, &slots_b, &v) };
+    }
+    largest
+}
+
+/// How many bundles ahead a sweep asks for (see [`sweep_groups`]).
 const PREFETCH_BUNDLES: usize = 2;
 
 /// Islands of at least this many points spread their colours over rayon's threads (whatever
@@ -613,39 +741,40 @@ const TARGET_BUNDLES_PER_TASK: usize = 256;
 
 /// [`BodyLanes`] through the velocity pointers that one colour's threads share.
 trait SharedLanes {
-    /// [`BodyLanes::gather`] through the shared pointers.
+    /// [`BodyLanes::gather`] through the shared pointers, for lanes between the bodies at
+    /// `slots_a` and `slots_b`.
     ///
     /// # Safety
-    /// Every slot of `b` is in bounds, and no other thread writes them meanwhile.
-    unsafe fn gather(&self, b: &Bundle) -> BodyLanes;
+    /// Every slot is in bounds, and no other thread writes them meanwhile.
+    unsafe fn gather(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes;
 
     /// [`BodyLanes::scatter`] through the shared pointers; the immovable slot is not written.
     ///
     /// # Safety
-    /// As [`SharedLanes::gather`], and no other thread reads b's moving slots meanwhile.
-    unsafe fn scatter(&self, b: &Bundle, v: &BodyLanes);
+    /// As [`SharedLanes::gather`], and no other thread reads these moving slots meanwhile.
+    unsafe fn scatter(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], v: &BodyLanes);
 }
 
 impl SharedLanes for SharedVelocities {
     #[inline(always)]
-    unsafe fn gather(&self, b: &Bundle) -> BodyLanes {
+    unsafe fn gather(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
         // SAFETY: the caller's contract.
         let load = |p: *mut Vec3, slots: &[u32; LANES]| {
             lane_vec(slots.map(|k| unsafe { *p.add(k as usize) }))
         };
         BodyLanes {
-            linear_a: load(self.linear, &b.local_a),
-            angular_a: load(self.angular, &b.local_a),
-            linear_b: load(self.linear, &b.local_b),
-            angular_b: load(self.angular, &b.local_b),
+            linear_a: load(self.linear, slots_a),
+            angular_a: load(self.angular, slots_a),
+            linear_b: load(self.linear, slots_b),
+            angular_b: load(self.angular, slots_b),
         }
     }
 
     #[inline(always)]
-    unsafe fn scatter(&self, b: &Bundle, v: &BodyLanes) {
+    unsafe fn scatter(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], v: &BodyLanes) {
         let [la, aa, lb, ab] = [&v.linear_a, &v.angular_a, &v.linear_b, &v.angular_b].map(unlane);
         for i in 0..LANES {
-            let (a, bb) = (b.local_a[i] as usize, b.local_b[i] as usize);
+            let (a, bb) = (slots_a[i] as usize, slots_b[i] as usize);
             // SAFETY: the caller's contract.
             unsafe {
                 if a != self.immovable {
@@ -837,6 +966,113 @@ mod tests {
     fn float(low: f32, high: f32) -> impl Strategy<Value = f32> {
         const STEPS: u32 = 1 << 20;
         (0..STEPS).prop_map(move |k| low + (high - low) * (k as f32 / STEPS as f32))
+    }
+
+    /// Packing cuts each pair's run of points into manifold groups of at most
+    /// [`GROUP_POINTS`], puts every point in exactly one lane, keeps a group's points in order
+    /// in one lane of one lane group, gives no two lane groups of a colour a common moving
+    /// body, and leaves every other lane empty: zero masses and impulses.
+    #[test]
+    fn packing_puts_each_manifold_group_in_one_lane_of_one_lane_group() {
+        // Slots 0–6 move, 7 is immovable. (pair, points): a box face (4), a ball (1), an edge
+        // (2), a face on the ground (4), a run of 5 that must be cut, and single points that
+        // share bodies with all of them.
+        let pairs: [((u32, u32), usize); 8] = [
+            ((0, 1), 4),
+            ((1, 2), 1),
+            ((2, 3), 2),
+            ((0, 7), 4),
+            ((3, 4), 5),
+            ((4, 5), 1),
+            ((5, 6), 1),
+            ((6, 0), 3),
+        ];
+        let mut constraints = Vec::new();
+        for ((a, b), points) in pairs {
+            for _ in 0..points {
+                let k = constraints.len();
+                constraints.push(ContactConstraint {
+                    local_a: a,
+                    local_b: b,
+                    inverse_mass_a: 1.0,
+                    inverse_mass_b: if b == 7 { 0.0 } else { 1.0 },
+                    normal_impulse: k as f32 + 1.0,
+                    ..ContactConstraint::default()
+                });
+            }
+        }
+        let mut packed = Bundles::default();
+        packed.pack(&constraints, 8, false);
+        // Every point in exactly one lane, found where `slots` says.
+        let mut seen = vec![0; constraints.len()];
+        for (index, lanes) in packed.sources.iter().enumerate() {
+            for (lane, &k) in lanes.iter().enumerate() {
+                let b = &packed.bundles[index];
+                if k == u32::MAX {
+                    assert_eq!(b.normal_impulse.as_array()[lane], 0.0);
+                    assert_eq!(b.inverse_mass_a.as_array()[lane], 0.0);
+                    assert_eq!(b.inverse_mass_b.as_array()[lane], 0.0);
+                    continue;
+                }
+                seen[k as usize] += 1;
+                assert_eq!(packed.slots[k as usize] as usize, index * LANES + lane);
+                assert_eq!(b.normal_impulse.as_array()[lane], k as f32 + 1.0);
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1), "{seen:?}");
+        // Lane groups: one pair of bodies per lane throughout, the group's points in order
+        // from the first bundle on, at most GROUP_POINTS of them.
+        for group in &packed.groups {
+            let (start, len) = (group.start as usize, group.len as usize);
+            assert!((1..=GROUP_POINTS).contains(&len));
+            for lane in 0..LANES {
+                let first = &packed.bundles[start];
+                let mut previous = None;
+                let mut ended = false;
+                for index in start..start + len {
+                    let b = &packed.bundles[index];
+                    assert_eq!(b.local_a[lane], first.local_a[lane]);
+                    assert_eq!(b.local_b[lane], first.local_b[lane]);
+                    match packed.sources[index][lane] {
+                        u32::MAX => ended = true,
+                        k => {
+                            assert!(!ended, "a hole inside lane {lane}'s group");
+                            let c = &constraints[k as usize];
+                            assert_eq!((c.local_a, c.local_b), (b.local_a[lane], b.local_b[lane]));
+                            if let Some(p) = previous {
+                                assert_eq!(k, p + 1, "points out of order");
+                            }
+                            previous = Some(k);
+                        }
+                    }
+                }
+            }
+        }
+        // Colours: no moving body twice among one colour's lane groups.
+        for colour in 0..COLOURS {
+            let mut bodies = std::collections::HashSet::new();
+            let groups = packed.group_colour_starts[colour]..packed.group_colour_starts[colour + 1];
+            for group in &packed.groups[groups] {
+                let b = &packed.bundles[group.start as usize];
+                for lane in 0..LANES {
+                    if packed.sources[group.start as usize][lane] == u32::MAX {
+                        continue;
+                    }
+                    for slot in [b.local_a[lane], b.local_b[lane]] {
+                        assert!(
+                            slot == 7 || bodies.insert(slot),
+                            "slot {slot} twice in colour {colour}"
+                        );
+                    }
+                }
+            }
+        }
+        // The run of five was cut into four and one.
+        let lengths: Vec<u32> = packed.groups.iter().map(|g| g.len).collect();
+        assert!(
+            lengths.iter().all(|&n| n as usize <= GROUP_POINTS),
+            "{lengths:?}"
+        );
     }
 
     #[test]

@@ -198,3 +198,56 @@ fn box_sliding_in_lanes_goes_straight_and_stops_where_coulomb_says() {
         .to_degrees();
     assert!(turn.abs() < 0.2, "turned by {turn}°");
 }
+
+/// Lane groups of different lengths in one island: cubes side by side (four-point manifolds
+/// between them) landing on the sphere pile (one-point manifolds), solved in lanes. The padded
+/// rows of the shorter groups must change nothing, so the engine's LCP at exit satisfies
+/// complementarity as in the scalar test.
+#[test]
+fn cubes_on_a_sphere_pile_in_lanes_satisfy_complementarity() {
+    let settings = SolverSettings {
+        tolerance: 0.0,
+        friction: false,
+        ..bundled(500)
+    };
+    let mut w = common::sphere_pile(settings);
+    let first_cube = w.bodies.len();
+    for i in 0..4 {
+        let cube = BodyDesc::new(
+            BodyKind::Dynamic,
+            ShapeDesc::Cuboid {
+                half_extents: [0.4; 3],
+            },
+            [-1.2 + 0.8 * i as f32, 5.0, 0.0],
+        );
+        w.add_body(&cube, &material(0.0, 0.0)).unwrap();
+    }
+    let cube = |body: u32| body as usize >= first_cube;
+    let mut checked_steps = 0;
+    let mut mixed_steps = 0;
+    for _ in 0..120 {
+        w.step().unwrap();
+        if !common::check_complementarity_at_exit(&w) {
+            continue;
+        }
+        assert!(w.diagnostics().islands.iter().all(|island| island.simd));
+        checked_steps += 1;
+        let constraints = w.contact_constraints();
+        let cube_pair_points = constraints
+            .iter()
+            .filter(|c| cube(c.body_a) && cube(c.body_b))
+            .count();
+        let cube_sphere_points = constraints
+            .iter()
+            .filter(|c| cube(c.body_a) != cube(c.body_b))
+            .count();
+        if cube_pair_points >= 4 && cube_sphere_points > 0 {
+            mixed_steps += 1;
+        }
+    }
+    assert!(checked_steps > 10, "{checked_steps} steps checked");
+    assert!(
+        mixed_steps > 10,
+        "{mixed_steps} steps mixed cube faces and spheres"
+    );
+}
