@@ -2,13 +2,17 @@
 //! points at once, one point per lane. A sliding point's friction takes a cheaper update with
 //! the same fixed point as the scalar sweep's (see `solve_bundle` below).
 //!
-//! A point's update reads and writes its two bodies' velocities, so the points of one bundle
-//! must not share a moving body. The island's points are coloured greedily (no two points of a
-//! colour share a moving body; static bodies never conflict) and each colour is cut into
-//! bundles of [`LANES`]; the sweep visits bundles colour by colour. This is the layout of
-//! Box2D v3's and Rapier's solvers ("graph colouring" + "wide" rows; Catto, "Solver2D", 2024).
-//! Lanes a colour cannot fill are padding: both slots are the island's immovable slot and every
-//! mass and impulse is zero, so their updates change nothing.
+//! A point's update reads and writes its two bodies' velocities, so the lanes of one bundle
+//! must not share a moving body. The island's points are cut into manifold groups (a pair's
+//! consecutive points, at most [`GROUP_POINTS`]); the groups are coloured greedily (no two
+//! groups of a colour share a moving body; static bodies never conflict) and each colour's
+//! groups go [`LANES`] at a time into a lane group: as many consecutive bundles as its longest
+//! group has points, lane i of each holding group i's next point. The sweep visits lane groups
+//! colour by colour, gathering their bodies' velocities once and updating their bundles in
+//! turn. This is the layout of Box2D v3's and Rapier's solvers ("graph colouring" + "wide"
+//! rows, per manifold; Catto, "Solver2D", 2024). Lanes a colour cannot fill, and the rows past
+//! a shorter group's points, are padding: every mass and impulse is zero, so their updates
+//! change nothing.
 //!
 //! Rows are packed once per step ([`Bundles::pack`]); the substep loop then warm-starts, sets
 //! targets and sweeps on the packed rows, and [`Bundles::unpack`] writes the impulses back to
