@@ -4,7 +4,7 @@
 //!
 //! A point's update reads and writes its two bodies' velocities, so the lanes of one bundle
 //! must not share a moving body. The island's points are cut into manifold groups (a pair's
-//! consecutive points, at most [`GROUP_POINTS`]); the groups are coloured greedily (no two
+//! consecutive points, at most four); the groups are coloured greedily (no two
 //! groups of a colour share a moving body; static bodies never conflict) and each colour's
 //! groups go [`LANES`] at a time into a lane group: as many consecutive bundles as its longest
 //! group has points, lane i of each holding group i's next point. The sweep visits lane groups
