@@ -176,10 +176,11 @@ pub fn settings_text(s: &SolverSettings, threads: usize) -> String {
         )
     };
     format!(
-        "{method}, {} substeps × ≤{} iterations, {repair}, tol {:e}, warm start {}, sleeping {}, \
-         {threads} thread{}",
+        "{method}, {} substeps × ≤{} iterations, {repair}, slop {} mm, tol {:e}, warm start {}, \
+         sleeping {}, {threads} thread{}",
         s.substeps,
         s.iterations,
+        s.overlap_slop * 1e3,
         s.tolerance,
         s.warm_start,
         if s.sleep { "on" } else { "off" },
