@@ -67,7 +67,8 @@ enum Command {
         #[arg(long)]
         simd_island_contacts: Option<u32>,
         /// Start from a preset instead of the scene's solver settings: `fast` (8 substeps of
-        /// one PGS and one relax sweep on 120 Hz soft contacts; see `SolverSettings::fast`).
+        /// one PGS and one relax sweep on 120 Hz soft contacts with a 1 mm slop; see
+        /// `SolverSettings::fast`).
         /// The other options apply on top of it; sleeping keeps the scene's setting.
         #[arg(long)]
         preset: Option<String>,
