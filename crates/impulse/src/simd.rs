@@ -572,8 +572,7 @@ impl Bundles {
         } else {
             (one, zero)
         };
-        let update = |(b, g): (&mut Bundle, &BundleGeometry)| {
-            let moved = BodyLanes::gather(&b.local_a, &b.local_b, displacement, rotation);
+        let update = |b: &mut Bundle, g: &BundleGeometry, moved: &BodyLanes| {
             let at_a = add_cross(moved.linear_a, moved.angular_a, g.lever_a);
             let at_b = add_cross(moved.linear_b, moved.angular_b, g.lever_b);
             let separation = dot(b.normal.direction, sub(at_a, at_b)) - g.depth;
@@ -584,18 +583,42 @@ impl Bundles {
             b.mass_scale = gap.select(one, soft_mass);
             b.impulse_scale = gap.select(zero, soft_impulse);
         };
+        // A lane group's bodies are gathered once for all its bundles. `bundles` and
+        // `geometry` start at bundle `base`.
+        let run =
+            |groups: &[Group], bundles: &mut [Bundle], geometry: &[BundleGeometry], base: usize| {
+                for group in groups {
+                    let start = group.start as usize - base;
+                    let end = start + group.len as usize;
+                    let first = &bundles[start];
+                    let moved =
+                        BodyLanes::gather(&first.local_a, &first.local_b, displacement, rotation);
+                    for (b, g) in bundles[start..end].iter_mut().zip(&geometry[start..end]) {
+                        update(b, g, &moved);
+                    }
+                }
+            };
         // Each bundle reads only the bodies' displacements: any split over threads gives the
         // same targets. Serial, this pass was 5 % of a two-thread pyramid100 step.
         if self.parallel && rayon::current_num_threads() > 1 {
             use rayon::prelude::*;
-            self.bundles
-                .par_chunks_mut(TARGET_BUNDLES_PER_TASK)
-                .zip(self.geometry.par_chunks(TARGET_BUNDLES_PER_TASK))
-                .for_each(|(bundles, geometry)| {
-                    bundles.iter_mut().zip(geometry).for_each(update);
-                });
+            // Runs of lane groups with their (contiguous) bundles.
+            type Part<'a> = (&'a [Group], &'a mut [Bundle], &'a [BundleGeometry], usize);
+            let mut parts: Vec<Part<'_>> = Vec::new();
+            let (mut bundles, mut geometry) = (&mut self.bundles[..], &self.geometry[..]);
+            let mut base = 0;
+            for groups in self.groups.chunks(TARGET_GROUPS_PER_TASK) {
+                let end = groups.last().map_or(base, |g| (g.start + g.len) as usize);
+                let (mine, rest) = std::mem::take(&mut bundles).split_at_mut(end - base);
+                let (mine_geometry, rest_geometry) = geometry.split_at(end - base);
+                parts.push((groups, mine, mine_geometry, base));
+                (bundles, geometry, base) = (rest, rest_geometry, end);
+            }
+            parts
+                .into_par_iter()
+                .for_each(|(groups, bundles, geometry, base)| run(groups, bundles, geometry, base));
         } else {
-            self.bundles.iter_mut().zip(&self.geometry).for_each(update);
+            run(&self.groups, &mut self.bundles, &self.geometry, 0);
         }
     }
 
@@ -740,8 +763,8 @@ pub const PARALLEL_ISLAND_POINTS: usize = 1024;
 /// Islands of at least this many points are packed and unpacked on rayon's threads.
 const PARALLEL_PACK_POINTS: usize = 4096;
 
-/// Bundles per task of the (cheaper) target update.
-const TARGET_BUNDLES_PER_TASK: usize = 256;
+/// Lane groups per task of the (cheaper) target update.
+const TARGET_GROUPS_PER_TASK: usize = 64;
 
 /// [`BodyLanes`] through the velocity pointers that one colour's threads share.
 trait SharedLanes {
