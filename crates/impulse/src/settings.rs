@@ -129,11 +129,12 @@ pub struct SolverSettings {
     /// spread each large colour over the threads whatever this says.
     pub parallel_island_contacts: u32,
     /// With `method: pgs` and without split impulse, islands with at least this many contact
-    /// points are solved in SIMD lanes ([`crate::simd`]): coloured greedily, four points of a
-    /// colour updated at once. 0 = never. Default 16; smaller islands do not repay the packing.
-    /// Colour order converges a little more slowly than narrow-phase order. In islands of at
-    /// least 1024 points, a colour of at least 64 bundles is spread over the worker threads
-    /// (the same result on any thread count).
+    /// points are solved in SIMD lanes ([`crate::simd`]): manifold groups (a pair's points)
+    /// coloured greedily, four groups of a colour updated at once, each lane taking its group's
+    /// points in turn. 0 = never. Default 16; smaller islands do not repay the packing. Colour
+    /// order converges a little more slowly than narrow-phase order. In islands of at least
+    /// 1024 points, a colour of more than 8 lane groups is spread over the worker threads (the
+    /// same result on any thread count).
     pub simd_island_contacts: u32,
 }
 

@@ -1,5 +1,5 @@
 //! Stage 5 in SIMD lanes: the PGS sweep of [`crate::solver::solve_pgs`] run on [`LANES`] contact
-//! points at once, one point per lane. A sliding point's friction takes a cheaper update with
+//! points at once, one point per lane, each lane taking a manifold's points in turn. A sliding point's friction takes a cheaper update with
 //! the same fixed point as the scalar sweep's (see `solve_bundle` below).
 //!
 //! A point's update reads and writes its two bodies' velocities, so the lanes of one bundle

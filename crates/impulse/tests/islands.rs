@@ -136,8 +136,8 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
         let simd = !settings.split_impulse;
         scene.solver = SolverSettings {
             sleep: false,
-            // pyramid3d10 is one island of ~8700 points: colours of over 512 points (or 64
-            // bundles) run in parallel. The scalar sweep needs the setting to go colour by
+            // pyramid3d10 is one island of ~8700 points: colours of over 512 points (or 8 lane
+            // groups) run in parallel. The scalar sweep needs the setting to go colour by
             // colour; SIMD bundles spread their colours in any island of 1024 points or more.
             parallel_island_contacts: if simd { 0 } else { 1000 },
             ..settings
