@@ -238,7 +238,7 @@ impl Bundles {
     /// Packs the island's `constraints` (slots below `slots`; `slots − 1` is the immovable one),
     /// with their current impulses, into bundles. The points are first cut into manifold groups:
     /// runs of consecutive points between the same two bodies (assembly writes a pair's points
-    /// together), at most [`GROUP_POINTS`] each. The groups are coloured greedily (no two groups
+    /// together), at most four each. The groups are coloured greedily (no two groups
     /// of a colour share a moving body), and each colour's groups, in constraint order, go
     /// [`LANES`] at a time into lane groups of as many bundles as their largest group has
     /// points; a lane whose group is shorter is padded with rows of zero mass between the same
