@@ -1,6 +1,7 @@
 //! Stage 5 in SIMD lanes: the PGS sweep of [`crate::solver::solve_pgs`] run on [`LANES`] contact
-//! points at once, one point per lane, each lane taking a manifold's points in turn. A sliding point's friction takes a cheaper update with
-//! the same fixed point as the scalar sweep's (see `solve_bundle` below).
+//! points at once, one point per lane, each lane taking a manifold's points in turn. A sliding
+//! point's friction takes a cheaper update with the same fixed point as the scalar sweep's (see
+//! `solve_bundle` below).
 //!
 //! A point's update reads and writes its two bodies' velocities, so the lanes of one bundle
 //! must not share a moving body. The island's points are cut into manifold groups (a pair's
@@ -29,7 +30,9 @@ use wide::f32x4;
 
 use crate::constraints::{ContactConstraint, JacobianRow, soft_contact};
 use crate::settings::SolverSettings;
-use crate::solver::{COLOURS, SharedVelocities, SolveReport, Velocities};
+use crate::solver::{
+    COLOURS, SharedItems, SharedVelocities, SolveReport, Velocities, greedy_colours,
+};
 
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
 /// AArch64), so no target feature is needed.
@@ -105,12 +108,9 @@ const GROUP_POINTS: usize = 4;
 pub struct Bundles {
     bundles: Vec<Bundle>,
     geometry: Vec<BundleGeometry>,
-    /// Bundles of colour k are `colour_starts[k]..colour_starts[k + 1]`; the last colour holds
-    /// the manifold groups the colouring could not place, one per lane group, and always runs
-    /// on one thread.
-    colour_starts: Vec<usize>,
     /// The lane groups (see [`Group`]) in bundle order; colour k's are
-    /// `group_colour_starts[k]..group_colour_starts[k + 1]`.
+    /// `group_colour_starts[k]..group_colour_starts[k + 1]`. The last colour holds the manifold
+    /// groups the colouring could not place, one per lane group, and always runs on one thread.
     groups: Vec<Group>,
     group_colour_starts: Vec<usize>,
     /// Packing scratch: per manifold group (a run of at most [`GROUP_POINTS`] consecutive
@@ -272,37 +272,19 @@ impl Bundles {
         self.runs.push(constraints.len() as u32);
         let run_points = |runs: &[u32], r: usize| (runs[r + 1] - runs[r]) as usize;
         // Greedy colours of the groups, and the groups per colour.
-        let immovable_slot = immovable as usize;
-        self.used.clear();
-        self.used.resize(slots, 0);
-        self.colours.clear();
-        let mut counts = [0usize; COLOURS + 2];
-        for r in 0..run_count {
-            let c = &constraints[self.runs[r] as usize];
-            let (a, b) = (c.local_a as usize, c.local_b as usize);
-            let used = &self.used;
-            let mask = (if a != immovable_slot { used[a] } else { 0 })
-                | (if b != immovable_slot { used[b] } else { 0 });
-            let colour = ((!mask).trailing_zeros() as usize).min(COLOURS);
-            if colour < COLOURS {
-                for slot in [a, b] {
-                    if slot != immovable_slot {
-                        self.used[slot] |= 1 << colour;
-                    }
-                }
-            }
-            self.colours.push(colour as u8);
-            counts[colour + 1] += 1;
-        }
-        for k in 0..=COLOURS {
-            counts[k + 1] += counts[k];
-        }
+        let runs = &self.runs;
+        let group_slots = (0..run_count).map(|r| {
+            let first = &constraints[runs[r] as usize];
+            (first.local_a, first.local_b)
+        });
+        let counts = greedy_colours(group_slots, slots, &mut self.used, &mut self.colours);
         // Lane groups per colour (the last colour: one group each), and where each starts.
         let per_group = |colour: usize| if colour < COLOURS { LANES } else { 1 };
         self.group_colour_starts.clear();
         self.group_colour_starts.push(0);
         for colour in 0..=COLOURS {
-            let groups = (counts[colour + 1] - counts[colour]).div_ceil(per_group(colour));
+            let groups =
+                ((counts[colour + 1] - counts[colour]) as usize).div_ceil(per_group(colour));
             let last = *self.group_colour_starts.last().unwrap_or(&0);
             self.group_colour_starts.push(last + groups);
         }
@@ -330,13 +312,6 @@ impl Bundles {
             total += g.len;
         }
         let total = total as usize;
-        self.colour_starts.clear();
-        self.colour_starts
-            .extend(self.group_colour_starts.iter().map(|&g| {
-                self.groups
-                    .get(g)
-                    .map_or(total, |group| group.start as usize)
-            }));
         let empty = Bundle {
             local_a: [immovable; LANES],
             local_b: [immovable; LANES],
@@ -370,8 +345,7 @@ impl Bundles {
             }
         }
         if parallel_fill {
-            let bundle_start = self.colour_starts.clone();
-            self.fill_parallel(constraints, &bundle_start, &empty);
+            self.fill_parallel(constraints, &empty);
         } else {
             // The reads stream, and the writes go to one open lane group per colour.
             for (c, &slot) in constraints.iter().zip(&self.slots) {
@@ -379,8 +353,9 @@ impl Bundles {
                 set_lane(&mut self.bundles[index], &mut self.geometry[index], lane, c);
             }
         }
-        // Padding of a lane whose group is shorter than its lane group: the group's bodies,
-        // so that the lane group gathers and scatters one pair of bodies per lane.
+        // Padding of a lane whose group is shorter than its lane group names the group's
+        // bodies, so that every bundle of a lane group names the same bodies per lane (as
+        // `Group` says); the sweeps and the target update read them from the first bundle.
         for r in 0..run_count {
             let (group, lane) = self.run_places[r];
             let Group { start, len } = self.groups[group as usize];
@@ -401,14 +376,17 @@ impl Bundles {
     /// from the first to the last one it owns: as each colour is spread evenly over the
     /// constraints, that range is about a 1/tasks share and the tasks' ranges barely overlap.
     /// Every lane gets the same value on any split.
-    fn fill_parallel(
-        &mut self,
-        constraints: &[ContactConstraint],
-        bundle_start: &[usize],
-        empty: &Bundle,
-    ) {
+    fn fill_parallel(&mut self, constraints: &[ContactConstraint], empty: &Bundle) {
         use rayon::prelude::*;
         let tasks = 2 * rayon::current_num_threads();
+        // Bundle where each colour starts (its first lane group's start).
+        let total = self.bundles.len();
+        let groups = &self.groups;
+        let bundle_start: Vec<usize> = self
+            .group_colour_starts
+            .iter()
+            .map(|&g| groups.get(g).map_or(total, |group| group.start as usize))
+            .collect();
         // Per task, per colour: (first bundle index, bundles, geometry).
         type Part<'a> = (usize, &'a mut [Bundle], &'a mut [BundleGeometry]);
         let mut parts: Vec<Vec<Part<'_>>> = (0..tasks).map(|_| Vec::new()).collect();
@@ -514,15 +492,12 @@ impl Bundles {
             angular: velocities.angular.as_mut_ptr(),
             immovable: velocities.linear.len() - 1,
         };
-        let bundles = SharedBundles {
-            start: self.bundles.as_mut_ptr(),
-            len: self.bundles.len(),
-        };
+        let (bundles, len) = (SharedItems(self.bundles.as_mut_ptr()), self.bundles.len());
         if !self.parallel || rayon::current_num_threads() < 2 {
             // SAFETY: `pack` gave every group a range inside the bundles and every lane slots
             // below the island's slot count (the velocities' length); the bundles and the
             // velocities are borrowed exclusively here.
-            return unsafe { sweep_groups(&self.groups, bundles, forward, &shared, update) };
+            return unsafe { sweep_groups(&self.groups, bundles, len, forward, &shared, update) };
         }
         // Runs `update` on a run of lane groups of one colour, in order or in reverse.
         let run = |part: &mut [Group], forward: bool| {
@@ -531,7 +506,7 @@ impl Bundles {
             let (shared, bundles) = (shared, bundles);
             // SAFETY: as above, and within one colour no other lane group touches this run's
             // bundles or its lanes' moving slots (the immovable slot is only read).
-            unsafe { sweep_groups(part, bundles, forward, &shared, update) }
+            unsafe { sweep_groups(part, bundles, len, forward, &shared, update) }
         };
         let starts = &self.group_colour_starts;
         crate::solver::colour_after_colour(
@@ -683,18 +658,6 @@ impl BundleUpdate for WarmStart {
 /// many runs as one part.
 const GROUPS_PER_TASK: usize = 8;
 
-/// The bundles of a [`Bundles`], shared by the threads of one colour.
-#[derive(Clone, Copy)]
-struct SharedBundles {
-    start: *mut Bundle,
-    len: usize,
-}
-
-// SAFETY: the threads of one colour touch disjoint lane groups (see `sweep_groups`).
-unsafe impl Send for SharedBundles {}
-// SAFETY: as for Send.
-unsafe impl Sync for SharedBundles {}
-
 /// Runs `update` on the bundles of `groups` in order (`forward`) or in reverse, the bundles of
 /// each group in the same direction, with the group's bodies gathered once and scattered once.
 /// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first: a bundle is 16 cache lines, and
@@ -704,12 +667,14 @@ unsafe impl Sync for SharedBundles {}
 /// the bundle ahead in memory is the one the sweep visits next.
 ///
 /// # Safety
-/// Every group's range lies inside `bundles`, every lane's slots are below the velocities'
-/// length, and no other thread touches these bundles or their lanes' moving slots meanwhile.
+/// `bundles` points to `len` bundles, every group's range lies inside them, every lane's slots
+/// are below the velocities' length, and no other thread touches these bundles or their lanes'
+/// moving slots meanwhile.
 #[inline(always)]
 unsafe fn sweep_groups<F: BundleUpdate>(
     groups: &[Group],
-    bundles: SharedBundles,
+    bundles: SharedItems<Bundle>,
+    len: usize,
     forward: bool,
     velocities: &SharedVelocities,
     update: F,
@@ -719,11 +684,11 @@ unsafe fn sweep_groups<F: BundleUpdate>(
     for step in 0..n {
         let group = groups[if forward { step } else { n - 1 - step }];
         let (start, count) = (group.start as usize, group.len as usize);
-        debug_assert!(start + count <= bundles.len);
+        debug_assert!(start + count <= len);
         // SAFETY: the caller's contract; the slots are copied out before any bundle is
         // borrowed mutably.
         let (slots_a, slots_b) = unsafe {
-            let first = &*bundles.start.add(start);
+            let first = &*bundles.0.add(start);
             (first.local_a, first.local_b)
         };
         let mut v = unsafe { velocities.gather(&slots_a, &slots_b) };
@@ -738,12 +703,12 @@ unsafe fn sweep_groups<F: BundleUpdate>(
             } else {
                 index.wrapping_sub(PREFETCH_BUNDLES)
             };
-            if ahead < bundles.len {
+            if ahead < len {
                 // SAFETY: in bounds; a prefetch reads nothing.
-                crate::solver::prefetch_lines(unsafe { &*bundles.start.add(ahead) });
+                crate::solver::prefetch_lines(unsafe { &*bundles.0.add(ahead) });
             }
             // SAFETY: the caller's contract.
-            let b = unsafe { &mut *bundles.start.add(index) };
+            let b = unsafe { &mut *bundles.0.add(index) };
             largest = largest.max(update.update(b, &mut v));
         }
         // SAFETY: the caller's contract.

@@ -83,7 +83,8 @@ pub(crate) fn colour_constraints(
     scratch: &mut Vec<ContactConstraint>,
     starts: &mut Vec<u32>,
 ) {
-    let counts = greedy_colours(constraints, slots, used, colours);
+    let slots_of = constraints.iter().map(|c| (c.local_a, c.local_b));
+    let counts = greedy_colours(slots_of, slots, used, colours);
     let used_colours = (0..=COLOURS)
         .rev()
         .find(|&k| counts[k + 1] > counts[k])
@@ -100,12 +101,13 @@ pub(crate) fn colour_constraints(
     }
 }
 
-/// The greedy colouring of [`colour_constraints`] without the sort: each point's colour (the
-/// lowest neither of its moving bodies has; [`COLOURS`] when none is left) in `colours`, and
-/// the colour offsets in point order, colour k at `counts[k]..counts[k + 1]`. `used` holds each
-/// slot's colours. Panics if a point's slot is not below `slots`.
+/// The greedy colouring of [`colour_constraints`] without the sort, for items (points, or the
+/// SIMD lanes' manifold groups) given by their two body slots: each item's colour (the lowest
+/// neither of its moving bodies has; [`COLOURS`] when none is left) in `colours`, and the
+/// colour offsets in item order, colour k at `counts[k]..counts[k + 1]`. `used` holds each
+/// slot's colours. Panics if a slot is not below `slots`.
 pub(crate) fn greedy_colours(
-    constraints: &[ContactConstraint],
+    items: impl Iterator<Item = (u32, u32)>,
     slots: usize,
     used: &mut Vec<u64>,
     colours: &mut Vec<u8>,
@@ -115,8 +117,8 @@ pub(crate) fn greedy_colours(
     used.resize(slots, 0);
     colours.clear();
     let mut counts = [0u32; COLOURS + 2];
-    for c in constraints {
-        let (a, b) = (c.local_a as usize, c.local_b as usize);
+    for (a, b) in items {
+        let (a, b) = (a as usize, b as usize);
         let mask =
             (if a != immovable { used[a] } else { 0 }) | (if b != immovable { used[b] } else { 0 });
         let colour = ((!mask).trailing_zeros() as usize).min(COLOURS);
@@ -239,8 +241,8 @@ where
         .reduce(|| identity, &combine)
 }
 
-/// The items of [`colour_after_colour`], shared by its threads.
-struct SharedItems<T>(*mut T);
+/// The items of [`colour_after_colour`] (or the SIMD lanes' bundles), shared by its threads.
+pub(crate) struct SharedItems<T>(pub(crate) *mut T);
 
 impl<T> Clone for SharedItems<T> {
     fn clone(&self) -> Self {
