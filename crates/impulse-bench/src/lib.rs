@@ -58,6 +58,10 @@ pub struct BenchRow {
     pub steps: u32,
     /// Median wall-clock time of one step (ms).
     pub ms_per_step_median: f64,
+    /// Wall-clock time of each turn of [`TURN_STEPS`] steps, in order (ms): the k-th turns of
+    /// two rows of one run were taken one right after the other, so their ratio is a paired
+    /// measurement ([`paired_speed_up`]).
+    pub turn_ms: Vec<f64>,
     /// 1000 / `ms_per_step_median`.
     pub steps_per_second: f64,
     /// Initial y − final y of the moving body that started highest (m).
@@ -82,6 +86,10 @@ impl BenchRow {
         quality: QualityReport,
         settings: String,
     ) -> Self {
+        let turn_ms = times_ms
+            .chunks(TURN_STEPS as usize)
+            .map(|turn| turn.iter().sum())
+            .collect();
         let median = quality::median(times_ms);
         Self {
             scene: scene.to_string(),
@@ -89,6 +97,7 @@ impl BenchRow {
             bodies,
             steps,
             ms_per_step_median: median,
+            turn_ms,
             steps_per_second: if median > 0.0 { 1e3 / median } else { 0.0 },
             top_sink_m: quality.top_sink.into(),
             max_overlap_m: quality.max_overlap.into(),
@@ -139,7 +148,9 @@ pub fn format_table(rows: &[BenchRow]) -> String {
 
 /// The speed-up of every impulse row run in a pool of its own (`--also-threads`, engine
 /// "… on N threads") against the same configuration in the run's own pool, measured by turns
-/// in the same run, as a Markdown table; empty when there are no such rows.
+/// in the same run, as a Markdown table; empty when there are no such rows. Two speed-ups: the
+/// ratio of the two median step times, and the median over turns of the ratio of the two
+/// rows' times in that turn ([`paired_speed_up`]).
 pub fn format_thread_table(rows: &[BenchRow], threads: usize) -> String {
     let mut out = String::new();
     for row in rows {
@@ -155,7 +166,7 @@ pub fn format_thread_table(rows: &[BenchRow], threads: usize) -> String {
         if out.is_empty() {
             out.push_str(&format!(
                 "| scene | engine | ms/step on {threads} thread{} | ms/step in its own pool | \
-                 speed-up |\n|---|---|---:|---:|---:|\n",
+                 speed-up | speed-up, median of turns |\n|---|---|---:|---:|---:|---:|\n",
                 if threads == 1 { "" } else { "s" }
             ));
         }
@@ -167,9 +178,10 @@ pub fn format_thread_table(rows: &[BenchRow], threads: usize) -> String {
         } else {
             String::new()
         };
+        let paired = paired_speed_up(reference, row).map_or(String::new(), |r| format!("{r:.2}"));
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {speed_up} |",
+            "| {} | {} | {} | {} | {speed_up} | {paired} |",
             row.scene,
             row.engine,
             format_ms(reference.ms_per_step_median),
@@ -177,6 +189,22 @@ pub fn format_thread_table(rows: &[BenchRow], threads: usize) -> String {
         );
     }
     out
+}
+
+/// The median over turns of `reference`'s time divided by `row`'s in the same turn; None
+/// without a turn both rows completed in positive time. A machine whose speed drifts during a
+/// run slows both rows of a turn alike, so each turn's ratio keeps little of the drift, while
+/// the ratio of two medians can take them from different stretches of the run (a median of a
+/// run that lands and then rests falls wherever the two regimes meet).
+pub fn paired_speed_up(reference: &BenchRow, row: &BenchRow) -> Option<f64> {
+    let mut ratios: Vec<f64> = reference
+        .turn_ms
+        .iter()
+        .zip(&row.turn_ms)
+        .filter(|&(&a, &b)| a > 0.0 && b > 0.0)
+        .map(|(a, b)| a / b)
+        .collect();
+    (!ratios.is_empty()).then(|| quality::median(&mut ratios))
 }
 
 /// Milliseconds with three significant digits at least (0.123, 1.23, 12.3, 123).
@@ -205,6 +233,8 @@ pub struct BenchConfig {
     pub rapier: bool,
     /// Extra Rapier rows with other settings than the defaults (needs `rapier`).
     pub rapier_variants: Vec<RapierVariant>,
+    /// Measure impulse at each scene's own solver settings (row "impulse").
+    pub impulse_defaults: bool,
     /// Also measure impulse with `SolverSettings::fast()` (row "impulse fast").
     pub impulse_fast: bool,
     /// Also measure each impulse configuration in a rayon pool of this many threads of its
@@ -292,6 +322,7 @@ impl Default for BenchConfig {
             threads: 1,
             rapier: cfg!(feature = "rapier"),
             rapier_variants: Vec::new(),
+            impulse_defaults: true,
             impulse_fast: false,
             also_threads: None,
         }
@@ -352,20 +383,22 @@ pub fn bench_scene(scene: &Scene, config: &BenchConfig) -> Result<Vec<Result<Ben
     }
     let steps = config.steps;
     thread_pool(config.threads)?.install(|| {
-        let mut runs: Vec<Result<EngineRun>> = vec![
-            impulse_engine::ImpulseRun::new(scene, steps, config.threads, None)
-                .map(|run| EngineRun::Impulse(Box::new(run))),
-        ];
-        if config.impulse_fast {
-            let fast = impulse::SolverSettings::fast();
+        // The impulse configurations: the scene's settings (None) and `fast`, as asked.
+        let defaults = config.impulse_defaults.then_some(None);
+        let fast = config
+            .impulse_fast
+            .then(|| Some(impulse::SolverSettings::fast()));
+        let impulse_settings: Vec<Option<impulse::SolverSettings>> =
+            defaults.into_iter().chain(fast).collect();
+        let mut runs: Vec<Result<EngineRun>> = Vec::new();
+        for settings in &impulse_settings {
             runs.push(
-                impulse_engine::ImpulseRun::new(scene, steps, config.threads, Some(fast))
+                impulse_engine::ImpulseRun::new(scene, steps, config.threads, settings.clone())
                     .map(|run| EngineRun::Impulse(Box::new(run))),
             );
         }
         if let Some(threads) = config.also_threads {
-            let fast = config.impulse_fast.then(impulse::SolverSettings::fast);
-            for settings in std::iter::once(None).chain(fast.map(Some)) {
+            for settings in impulse_settings {
                 runs.push(
                     impulse_engine::ImpulseRun::on_threads(scene, steps, threads, settings)
                         .map(|run| EngineRun::Impulse(Box::new(run))),
@@ -460,6 +493,7 @@ mod tests {
             bodies: 2,
             steps: 10,
             ms_per_step_median: ms,
+            turn_ms: vec![ms * TURN_STEPS as f64],
             steps_per_second: 1e3 / ms,
             top_sink_m: 0.0012,
             max_overlap_m: 0.0,
@@ -496,6 +530,7 @@ mod tests {
             threads: 1,
             rapier: false,
             rapier_variants: Vec::new(),
+            impulse_defaults: true,
             impulse_fast: true,
             also_threads: Some(2),
         };
@@ -542,15 +577,49 @@ mod tests {
         assert!(lines[0].contains("ms/step on 1 thread |"));
         assert_eq!(
             lines[2],
-            "| s | impulse on 2 threads | 10.0 | 5.00 | 2.00 |"
+            "| s | impulse on 2 threads | 10.0 | 5.00 | 2.00 | 2.00 |"
         );
         assert_eq!(
             lines[3],
-            "| s | impulse fast on 2 threads | 3.00 | 2.00 | 1.50 |"
+            "| s | impulse fast on 2 threads | 3.00 | 2.00 | 1.50 | 1.50 |"
         );
         assert!(format_thread_table(&rows[..2], 1).is_empty());
         // The own-pool rows get their ratio against Rapier too.
         assert!(format_table(&rows).contains("| 200 | 1.25 |"));
+    }
+
+    /// A run that slows down halfway: the two rows' medians come from different halves, the
+    /// ratios per turn do not.
+    #[test]
+    fn paired_speed_up_is_the_median_of_the_ratios_per_turn() {
+        let mut one = row("s", "impulse", 1.0);
+        let mut two = row("s", "impulse on 2 threads", 1.0);
+        one.turn_ms = vec![10.0, 10.0, 20.0, 20.0, 20.0];
+        two.turn_ms = vec![5.0, 5.0, 5.0, 10.0, 10.0];
+        assert_eq!(paired_speed_up(&one, &two), Some(2.0));
+        // Turns one row did not finish, or timed at zero, are left out.
+        two.turn_ms = vec![0.0, 4.0];
+        assert_eq!(paired_speed_up(&one, &two), Some(2.5));
+        two.turn_ms.clear();
+        assert_eq!(paired_speed_up(&one, &two), None);
+    }
+
+    #[test]
+    fn turn_times_sum_the_steps_of_each_turn() {
+        let mut times: Vec<f64> = (1..=25).map(f64::from).collect();
+        let turn = TURN_STEPS as usize;
+        let expected: Vec<f64> = times.chunks(turn).map(|t| t.iter().sum()).collect();
+        let row = BenchRow::new(
+            "s",
+            "impulse",
+            1,
+            25,
+            &mut times,
+            QualityReport::default(),
+            String::new(),
+        );
+        assert_eq!(row.turn_ms, expected);
+        assert_eq!(row.ms_per_step_median, 13.0);
     }
 
     #[test]
@@ -588,6 +657,7 @@ mod tests {
             } else {
                 Vec::new()
             },
+            impulse_defaults: true,
             impulse_fast: true,
             also_threads: None,
         };

@@ -41,6 +41,10 @@ struct Args {
     /// default Rapier too).
     #[arg(long)]
     impulse_fast: bool,
+    /// Measure impulse with `SolverSettings::fast()` only: `--impulse-fast` without the rows at
+    /// each scene's own settings.
+    #[arg(long)]
+    fast_only: bool,
     /// Also measure impulse (and `--impulse-fast`) in a pool of N threads of its own, by turns
     /// with the rows on `--threads`: a thread speed-up measured in one run, which a machine
     /// whose speed drifts between runs cannot spoil. Prints a second table of speed-ups.
@@ -74,7 +78,8 @@ fn run(args: Args) -> Result<bool> {
         threads: args.threads,
         rapier: !args.no_rapier,
         rapier_variants: args.rapier_variant,
-        impulse_fast: args.impulse_fast,
+        impulse_defaults: !args.fast_only,
+        impulse_fast: args.impulse_fast || args.fast_only,
         also_threads: args.also_threads,
     };
     let machine = MachineInfo::current();

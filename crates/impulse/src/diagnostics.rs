@@ -195,19 +195,59 @@ impl EnergyTerms {
     }
 }
 
-/// [`EnergyTerms`] of the moving bodies under `gravity` (m/s²).
-pub fn energy_terms(bodies: &Bodies, gravity: Vec3) -> EnergyTerms {
-    let mut terms = EnergyTerms::default();
-    for i in 0..bodies.len() {
-        if bodies.inverse_mass[i] > 0.0 {
-            let m = 1.0 / bodies.inverse_mass[i];
-            terms.kinetic += bodies.kinetic_energy(i) as f64;
-            terms.potential += (-m * gravity.dot(bodies.center_of_mass(i))) as f64;
-            terms.mass += m as f64;
-            terms.momentum += bodies.linear_velocity[i] * m;
+impl std::ops::Add for EnergyTerms {
+    type Output = Self;
+    fn add(self, other: Self) -> Self {
+        Self {
+            kinetic: self.kinetic + other.kinetic,
+            potential: self.potential + other.potential,
+            mass: self.mass + other.mass,
+            momentum: self.momentum + other.momentum,
         }
     }
-    terms
+}
+
+/// Bodies per partial sum of [`energy_terms_on`]. The sums run over fixed runs of bodies and
+/// are then added in order, so the result is the same to the bit on any number of threads.
+const ENERGY_BODIES_PER_PART: usize = 4096;
+
+/// [`EnergyTerms`] of the moving bodies under `gravity` (m/s²), on the calling thread.
+pub fn energy_terms(bodies: &Bodies, gravity: Vec3) -> EnergyTerms {
+    energy_terms_on(bodies, gravity, false)
+}
+
+/// [`EnergyTerms`] of the moving bodies under `gravity` (m/s²); with `parallel`, the partial
+/// sums run on rayon's threads (as one serial pass this was 1.3 % of the samples of a
+/// two-thread balls16k run, the other thread idle). The same result either way.
+pub fn energy_terms_on(bodies: &Bodies, gravity: Vec3, parallel: bool) -> EnergyTerms {
+    let n = bodies.len();
+    let part = |start: usize| {
+        let mut terms = EnergyTerms::default();
+        for i in start..(start + ENERGY_BODIES_PER_PART).min(n) {
+            if bodies.inverse_mass[i] > 0.0 {
+                let m = 1.0 / bodies.inverse_mass[i];
+                terms.kinetic += bodies.kinetic_energy(i) as f64;
+                terms.potential += (-m * gravity.dot(bodies.center_of_mass(i))) as f64;
+                terms.mass += m as f64;
+                terms.momentum += bodies.linear_velocity[i] * m;
+            }
+        }
+        terms
+    };
+    if parallel && rayon::current_num_threads() > 1 && n > ENERGY_BODIES_PER_PART {
+        use rayon::prelude::*;
+        let parts: Vec<EnergyTerms> = (0..n)
+            .into_par_iter()
+            .step_by(ENERGY_BODIES_PER_PART)
+            .map(part)
+            .collect();
+        parts.into_iter().fold(EnergyTerms::default(), |a, b| a + b)
+    } else {
+        (0..n)
+            .step_by(ENERGY_BODIES_PER_PART)
+            .map(part)
+            .fold(EnergyTerms::default(), |a, b| a + b)
+    }
 }
 
 /// Total kinetic energy (J) and linear momentum (kg·m/s) of the moving bodies.

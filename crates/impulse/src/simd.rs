@@ -126,6 +126,12 @@ pub struct Bundles {
     /// Greedy colouring scratch: per slot, the colours its groups use; per group, its colour.
     used: Vec<u64>,
     colours: Vec<u8>,
+    /// What the layout (`groups`, `runs`, `run_places`, `sources`, `slots`) was made for: each
+    /// point's body slots (local A, local B), and the island's slot count.
+    layout_keys: Vec<(u32, u32)>,
+    /// This pack's body slots per point, before they are compared with `layout_keys`.
+    keys: Vec<(u32, u32)>,
+    layout_slots: usize,
 }
 
 #[inline(always)]
@@ -253,30 +259,100 @@ impl Bundles {
     ///
     /// With `parallel`, each colour's lane groups are later spread over rayon's threads; the
     /// result is the same bit for bit, as the lane groups of one colour touch disjoint bodies.
+    ///
+    /// When every point has the same body slots as in the last pack (an island at rest), the
+    /// last layout is reused and only the lanes are filled again; the result is the same.
     pub fn pack(&mut self, constraints: &[ContactConstraint], slots: usize, parallel: bool) {
         self.parallel = parallel;
         let immovable = (slots - 1) as u32;
+        // The layout is a function of the points' body slots alone: when they repeat (an
+        // island at rest keeps its points), last pack's layout stands. The slots are first
+        // copied out of the 344-byte rows (on rayon's threads for a large island), so that the
+        // comparison, the grouping and the colouring, which are serial, read 8 bytes a point:
+        // reading them from the rows was 2 % of the samples of a two-thread pyramid100 run.
+        let parallel_fill = parallel
+            && rayon::current_num_threads() > 1
+            && constraints.len() >= PARALLEL_PACK_POINTS;
+        let key = |c: &ContactConstraint| (c.local_a, c.local_b);
+        if parallel_fill {
+            use rayon::prelude::*;
+            constraints
+                .par_iter()
+                .with_min_len(PARALLEL_PACK_POINTS / 4)
+                .map(key)
+                .collect_into_vec(&mut self.keys);
+        } else {
+            self.keys.clear();
+            self.keys.extend(constraints.iter().map(key));
+        }
+        if self.layout_slots != slots || self.keys != self.layout_keys {
+            std::mem::swap(&mut self.keys, &mut self.layout_keys);
+            self.layout_slots = slots;
+            self.lay_out(slots);
+        }
+        let total = self.groups.last().map_or(0, |g| (g.start + g.len) as usize);
+        let empty = Bundle {
+            local_a: [immovable; LANES],
+            local_b: [immovable; LANES],
+            ..Bundle::default()
+        };
+        if parallel_fill {
+            // Every bundle is reset by the task that fills it (pyramid100: 17 MB, which a
+            // serial reset here spent 1 % of a two-thread step on, the other thread idle).
+            self.bundles.truncate(total);
+            self.geometry.truncate(total);
+        } else {
+            self.bundles.clear();
+            self.geometry.clear();
+        }
+        self.bundles.resize(total, empty);
+        self.geometry.resize(total, BundleGeometry::default());
+        if parallel_fill {
+            self.fill_parallel(constraints, &empty);
+        } else {
+            // The reads stream, and the writes go to one open lane group per colour.
+            for (c, &slot) in constraints.iter().zip(&self.slots) {
+                let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
+                set_lane(&mut self.bundles[index], &mut self.geometry[index], lane, c);
+            }
+        }
+        // Padding of a lane whose group is shorter than its lane group names the group's
+        // bodies, so that every bundle of a lane group names the same bodies per lane (as
+        // `Group` says); the sweeps and the target update read them from the first bundle.
+        for (r, &(group, lane)) in self.run_places.iter().enumerate() {
+            let Group { start, len } = self.groups[group as usize];
+            let points = self.runs[r + 1] - self.runs[r];
+            if points < len {
+                let (a, b) = self.layout_keys[self.runs[r] as usize];
+                for index in start + points..start + len {
+                    let bundle = &mut self.bundles[index as usize];
+                    bundle.local_a[lane as usize] = a;
+                    bundle.local_b[lane as usize] = b;
+                }
+            }
+        }
+    }
+
+    /// The layout part of [`Bundles::pack`] for the points' body slots in `layout_keys`:
+    /// manifold groups, their colours, lane groups and each point's slot.
+    fn lay_out(&mut self, slots: usize) {
+        let keys = &self.layout_keys;
         // Manifold groups: runs of points between the same two bodies.
         self.runs.clear();
-        for (k, c) in constraints.iter().enumerate() {
+        for (k, key) in keys.iter().enumerate() {
             let continues = self.runs.last().is_some_and(|&first| {
-                let first_point = &constraints[first as usize];
-                (first_point.local_a, first_point.local_b) == (c.local_a, c.local_b)
-                    && k - (first as usize) < GROUP_POINTS
+                keys[first as usize] == *key && k - (first as usize) < GROUP_POINTS
             });
             if !continues {
                 self.runs.push(k as u32);
             }
         }
         let run_count = self.runs.len();
-        self.runs.push(constraints.len() as u32);
+        self.runs.push(keys.len() as u32);
         let run_points = |runs: &[u32], r: usize| (runs[r + 1] - runs[r]) as usize;
         // Greedy colours of the groups, and the groups per colour.
         let runs = &self.runs;
-        let group_slots = (0..run_count).map(|r| {
-            let first = &constraints[runs[r] as usize];
-            (first.local_a, first.local_b)
-        });
+        let group_slots = (0..run_count).map(|r| keys[runs[r] as usize]);
         let counts = greedy_colours(group_slots, slots, &mut self.used, &mut self.colours);
         // Lane groups per colour (the last colour: one group each), and where each starts.
         let per_group = |colour: usize| if colour < COLOURS { LANES } else { 1 };
@@ -311,29 +387,9 @@ impl Bundles {
             g.start = total;
             total += g.len;
         }
-        let total = total as usize;
-        let empty = Bundle {
-            local_a: [immovable; LANES],
-            local_b: [immovable; LANES],
-            ..Bundle::default()
-        };
-        let parallel_fill = self.parallel
-            && rayon::current_num_threads() > 1
-            && constraints.len() >= PARALLEL_PACK_POINTS;
-        if parallel_fill {
-            // Every bundle is reset by the task that fills it (pyramid100: 17 MB, which a
-            // serial reset here spent 1 % of a two-thread step on, the other thread idle).
-            self.bundles.truncate(total);
-            self.geometry.truncate(total);
-        } else {
-            self.bundles.clear();
-            self.geometry.clear();
-        }
-        self.bundles.resize(total, empty);
-        self.geometry.resize(total, BundleGeometry::default());
-        self.sources.clear();
-        self.sources.resize(total, [u32::MAX; LANES]);
         // Each point to its group's lane, in the bundle of its place in the group.
+        self.sources.clear();
+        self.sources.resize(total as usize, [u32::MAX; LANES]);
         self.slots.clear();
         for r in 0..run_count {
             let (group, lane) = self.run_places[r];
@@ -342,31 +398,6 @@ impl Bundles {
                 let index = start + p;
                 self.sources[index][lane as usize] = k;
                 self.slots.push((index * LANES + lane as usize) as u32);
-            }
-        }
-        if parallel_fill {
-            self.fill_parallel(constraints, &empty);
-        } else {
-            // The reads stream, and the writes go to one open lane group per colour.
-            for (c, &slot) in constraints.iter().zip(&self.slots) {
-                let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
-                set_lane(&mut self.bundles[index], &mut self.geometry[index], lane, c);
-            }
-        }
-        // Padding of a lane whose group is shorter than its lane group names the group's
-        // bodies, so that every bundle of a lane group names the same bodies per lane (as
-        // `Group` says); the sweeps and the target update read them from the first bundle.
-        for r in 0..run_count {
-            let (group, lane) = self.run_places[r];
-            let Group { start, len } = self.groups[group as usize];
-            let points = run_points(&self.runs, r) as u32;
-            if points < len {
-                let c = &constraints[self.runs[r] as usize];
-                for index in start + points..start + len {
-                    let b = &mut self.bundles[index as usize];
-                    b.local_a[lane as usize] = c.local_a;
-                    b.local_b[lane as usize] = c.local_b;
-                }
             }
         }
     }

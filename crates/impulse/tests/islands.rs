@@ -210,3 +210,33 @@ fn one_and_two_threads(scene: &impulse::Scene) -> (World, World, rayon::ThreadPo
         .unwrap();
     (one, two, pool)
 }
+
+/// Sleeping on two threads: the per-body sleep timers and the per-island test run on worker
+/// threads above a thousand bodies, and must put the same islands to sleep at the same step
+/// as one thread does; the energy sums (fixed runs of bodies, added in order) must agree too.
+#[test]
+fn many_bodies_fall_asleep_alike_on_one_and_two_threads() {
+    let scene = impulse::scene::builtin::builtin_scene("balls4096").unwrap();
+    assert!(scene.solver.sleep);
+    let (mut one, mut two, pool) = one_and_two_threads(&scene);
+    let mut first_sleep = None;
+    for _ in 0..240 {
+        let a = one.step().unwrap().clone();
+        let b = pool.install(|| two.step().unwrap().clone());
+        assert_eq!(a, b, "diagnostics of step {}", a.step);
+        assert_eq!(one.bodies.asleep, two.bodies.asleep, "step {}", a.step);
+        assert_eq!(
+            one.bodies.sleep_time, two.bodies.sleep_time,
+            "step {}",
+            a.step
+        );
+        if first_sleep.is_none() && one.bodies.asleep.iter().any(|&s| s) {
+            first_sleep = Some(a.step);
+        }
+    }
+    let asleep = one.bodies.asleep.iter().filter(|&&s| s).count();
+    assert!(
+        first_sleep.is_some() && asleep > 1024,
+        "only {asleep} bodies asleep after 4 s: the sleep paths were not taken"
+    );
+}
