@@ -361,14 +361,19 @@ impl IslandWorkspace {
             self.solve(constraints, settings, iterations, with_repair);
             return;
         }
-        self.bundles
-            .update_targets(&self.displacement, &self.rotation, settings, h, with_repair);
         let outcome = self.bundles.solve_pgs(
             iterations,
             settings.tolerance,
             &mut Velocities {
                 linear: &mut self.linear,
                 angular: &mut self.angular,
+            },
+            &simd::TargetInputs {
+                displacement: &self.displacement,
+                rotation: &self.rotation,
+                settings,
+                h,
+                with_repair,
             },
         );
         self.report.iterations += outcome.iterations;

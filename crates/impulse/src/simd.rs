@@ -80,7 +80,7 @@ struct Bundle {
     max_normal_impulse: Lane,
 }
 
-/// What [`Bundles::update_targets`] reads: where the points are.
+/// What the target update of [`Bundles::solve_pgs`] reads: where the points are.
 #[derive(Clone, Copy, Default)]
 struct BundleGeometry {
     lever_a: LaneVec,
@@ -506,7 +506,7 @@ impl Bundles {
 
     /// Applies the accumulated impulses to the velocities ([`crate::solver::warm_start`]).
     pub fn warm_start(&mut self, velocities: &mut Velocities<'_>) {
-        self.sweep(true, velocities, WarmStart);
+        self.sweep(true, velocities, WarmStart, NoTargets);
     }
 
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
@@ -514,9 +514,16 @@ impl Bundles {
     /// lane-wise largest of what `update` returned. With `parallel` (see [`Bundles::pack`])
     /// each colour is split over rayon's threads, in parts of at least [`GROUPS_PER_TASK`]
     /// lane groups ([`crate::solver::colour_after_colour`]).
-    fn sweep<F>(&mut self, forward: bool, velocities: &mut Velocities<'_>, update: F) -> Lane
+    fn sweep<F, T>(
+        &mut self,
+        forward: bool,
+        velocities: &mut Velocities<'_>,
+        update: F,
+        targets: T,
+    ) -> Lane
     where
         F: BundleUpdate,
+        T: SetTargets,
     {
         let shared = SharedVelocities {
             linear: velocities.linear.as_mut_ptr(),
@@ -528,7 +535,17 @@ impl Bundles {
             // SAFETY: `pack` gave every group a range inside the bundles and every lane slots
             // below the island's slot count (the velocities' length); the bundles and the
             // velocities are borrowed exclusively here.
-            return unsafe { sweep_groups(&self.groups, bundles, len, forward, &shared, update) };
+            return unsafe {
+                sweep_groups(
+                    &self.groups,
+                    bundles,
+                    len,
+                    forward,
+                    &shared,
+                    update,
+                    targets,
+                )
+            };
         }
         // Runs `update` on a run of lane groups of one colour, in order or in reverse.
         let run = |part: &mut [Group], forward: bool| {
@@ -537,7 +554,7 @@ impl Bundles {
             let (shared, bundles) = (shared, bundles);
             // SAFETY: as above, and within one colour no other lane group touches this run's
             // bundles or its lanes' moving slots (the immovable slot is only read).
-            unsafe { sweep_groups(part, bundles, len, forward, &shared, update) }
+            unsafe { sweep_groups(part, bundles, len, forward, &shared, update, targets) }
         };
         let starts = &self.group_colour_starts;
         crate::solver::colour_after_colour(
@@ -553,93 +570,33 @@ impl Bundles {
         )
     }
 
-    /// Sets every point's target normal velocity and softness for a solve of `h` seconds, as
-    /// [`crate::constraints::update_targets`] does for rigid or soft rows (not split impulse).
-    pub fn update_targets(
-        &mut self,
-        displacement: &[Vec3],
-        rotation: &[Vec3],
-        settings: &SolverSettings,
-        h: f32,
-        with_repair: bool,
-    ) {
-        let (repair_rate, (mass_scale, impulse_scale)) = if settings.soft_contact_hertz > 0.0 {
-            soft_contact(settings.soft_contact_hertz, settings.soft_damping_ratio, h)
-        } else {
-            (settings.overlap_repair_rate, (1.0, 0.0))
-        };
-        let zero = Lane::splat(0.0);
-        let one = Lane::splat(1.0);
-        let (repair_rate, slop) = (Lane::splat(repair_rate), Lane::splat(settings.overlap_slop));
-        let max_repair = Lane::splat(settings.max_repair_speed);
-        let inverse_h = Lane::splat(1.0 / h);
-        let (soft_mass, soft_impulse) = if with_repair {
-            (Lane::splat(mass_scale), Lane::splat(impulse_scale))
-        } else {
-            (one, zero)
-        };
-        let update = |b: &mut Bundle, g: &BundleGeometry, moved: &BodyLanes| {
-            let at_a = add_cross(moved.linear_a, moved.angular_a, g.lever_a);
-            let at_b = add_cross(moved.linear_b, moved.angular_b, g.lever_b);
-            let separation = dot(b.normal.direction, sub(at_a, at_b)) - g.depth;
-            let gap = separation.simd_gt(zero);
-            let repair = (repair_rate * (-separation - slop).max(zero)).min(max_repair);
-            let overlap_target = if with_repair { repair } else { zero };
-            b.target = gap.select(-separation * inverse_h, overlap_target);
-            b.mass_scale = gap.select(one, soft_mass);
-            b.impulse_scale = gap.select(zero, soft_impulse);
-        };
-        // A lane group's bodies are gathered once for all its bundles. `bundles` and
-        // `geometry` start at bundle `base`.
-        let run =
-            |groups: &[Group], bundles: &mut [Bundle], geometry: &[BundleGeometry], base: usize| {
-                for group in groups {
-                    let start = group.start as usize - base;
-                    let end = start + group.len as usize;
-                    let first = &bundles[start];
-                    let moved =
-                        BodyLanes::gather(&first.local_a, &first.local_b, displacement, rotation);
-                    for (b, g) in bundles[start..end].iter_mut().zip(&geometry[start..end]) {
-                        update(b, g, &moved);
-                    }
-                }
-            };
-        // Each bundle reads only the bodies' displacements: any split over threads gives the
-        // same targets. Serial, this pass was 5 % of a two-thread pyramid100 step.
-        if self.parallel && rayon::current_num_threads() > 1 {
-            use rayon::prelude::*;
-            // Runs of lane groups with their (contiguous) bundles.
-            type Part<'a> = (&'a [Group], &'a mut [Bundle], &'a [BundleGeometry], usize);
-            let mut parts: Vec<Part<'_>> = Vec::new();
-            let (mut bundles, mut geometry) = (&mut self.bundles[..], &self.geometry[..]);
-            let mut base = 0;
-            for groups in self.groups.chunks(TARGET_GROUPS_PER_TASK) {
-                let end = groups.last().map_or(base, |g| (g.start + g.len) as usize);
-                let (mine, rest) = std::mem::take(&mut bundles).split_at_mut(end - base);
-                let (mine_geometry, rest_geometry) = geometry.split_at(end - base);
-                parts.push((groups, mine, mine_geometry, base));
-                (bundles, geometry, base) = (rest, rest_geometry, end);
-            }
-            parts
-                .into_par_iter()
-                .for_each(|(groups, bundles, geometry, base)| run(groups, bundles, geometry, base));
-        } else {
-            run(&self.groups, &mut self.bundles, &self.geometry, 0);
-        }
-    }
-
-    /// Projected Gauss-Seidel on the bundles, as [`crate::solver::solve_pgs`]: at most
-    /// `iterations` sweeps in alternating direction, stopping when no row's velocity changed
-    /// by more than `tolerance` (m/s).
+    /// Sets every point's target normal velocity and softness from `targets` (as
+    /// [`crate::constraints::update_targets`] does for rigid or soft rows, not split impulse),
+    /// then runs at most `iterations` sweeps, alternating forward and backward, until no row's
+    /// velocity changes by more than `tolerance` (m/s).
+    ///
+    /// The targets are set inside the first sweep, each lane group's just before it is solved:
+    /// they depend on the bodies' displacements only, which a sweep does not change, so the
+    /// result is the same as a separate pass over the bundles first. That pass read and wrote
+    /// a third of the bytes of a sweep, twice a substep (pyramid100's bundles are 17 MB).
     pub fn solve_pgs(
         &mut self,
         iterations: u32,
         tolerance: f32,
         velocities: &mut Velocities<'_>,
+        targets: &TargetInputs<'_>,
     ) -> SolveReport {
         let mut report = SolveReport::default();
+        // Out of `self` while the sweeps borrow it mutably; only read.
+        let geometry = std::mem::take(&mut self.geometry);
+        let targets = Targets::new(targets, &geometry);
         for iteration in 0..iterations {
-            let largest = self.sweep(iteration % 2 == 0, velocities, VelocityRows);
+            let forward = iteration % 2 == 0;
+            let largest = if iteration == 0 {
+                self.sweep(forward, velocities, VelocityRows, &targets)
+            } else {
+                self.sweep(forward, velocities, VelocityRows, NoTargets)
+            };
             let largest_change = largest.to_array().into_iter().fold(0.0f32, f32::max);
             report.iterations += 1;
             report.last_change = largest_change;
@@ -647,6 +604,7 @@ impl Bundles {
                 break;
             }
         }
+        self.geometry = geometry;
         report
     }
 }
@@ -685,6 +643,126 @@ impl BundleUpdate for WarmStart {
     }
 }
 
+/// Whether a sweep sets the targets of each lane group before solving it: `&Targets` does,
+/// [`NoTargets`] compiles to nothing.
+trait SetTargets: Copy + Sync {
+    type Moved;
+    fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::Moved;
+    fn set(&self, b: &mut Bundle, index: usize, moved: &Self::Moved);
+}
+
+/// A sweep that leaves the targets as they are.
+#[derive(Clone, Copy)]
+struct NoTargets;
+
+impl SetTargets for NoTargets {
+    type Moved = ();
+    #[inline(always)]
+    fn moved(&self, _: &[u32; LANES], _: &[u32; LANES]) {}
+    #[inline(always)]
+    fn set(&self, _: &mut Bundle, _: usize, _: &()) {}
+}
+
+impl SetTargets for &Targets<'_> {
+    type Moved = BodyLanes;
+    #[inline(always)]
+    fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
+        Targets::moved(self, slots_a, slots_b)
+    }
+    #[inline(always)]
+    fn set(&self, b: &mut Bundle, index: usize, moved: &BodyLanes) {
+        Targets::set(self, b, index, moved)
+    }
+}
+
+/// What the target update of a solve reads (see [`Bundles::solve_pgs`]): the island's
+/// displacement and rotation vector per slot since the step began (m, rad; the immovable slot
+/// zero), the settings and the substep `h` (s), and whether this is the main solve, with
+/// overlap repair, or the relax solve.
+pub struct TargetInputs<'a> {
+    /// Per slot, displacement of the centre of mass (m).
+    pub displacement: &'a [Vec3],
+    /// Per slot, rotation vector (rad).
+    pub rotation: &'a [Vec3],
+    /// Soft contact, repair rate, slop and the repair's speed cap.
+    pub settings: &'a SolverSettings,
+    /// Substep (s).
+    pub h: f32,
+    /// Main solve (overlap repair on), or relax solve (off).
+    pub with_repair: bool,
+}
+
+/// The target update's constants as lanes, and what it reads.
+#[derive(Clone, Copy)]
+struct Targets<'a> {
+    displacement: &'a [Vec3],
+    rotation: &'a [Vec3],
+    geometry: &'a [BundleGeometry],
+    repair_rate: Lane,
+    slop: Lane,
+    max_repair: Lane,
+    inverse_h: Lane,
+    soft_mass: Lane,
+    soft_impulse: Lane,
+    with_repair: bool,
+}
+
+impl<'a> Targets<'a> {
+    fn new(inputs: &TargetInputs<'a>, geometry: &'a [BundleGeometry]) -> Self {
+        let settings = inputs.settings;
+        let (repair_rate, (mass_scale, impulse_scale)) = if settings.soft_contact_hertz > 0.0 {
+            soft_contact(
+                settings.soft_contact_hertz,
+                settings.soft_damping_ratio,
+                inputs.h,
+            )
+        } else {
+            (settings.overlap_repair_rate, (1.0, 0.0))
+        };
+        let (soft_mass, soft_impulse) = if inputs.with_repair {
+            (Lane::splat(mass_scale), Lane::splat(impulse_scale))
+        } else {
+            (Lane::splat(1.0), Lane::splat(0.0))
+        };
+        Self {
+            displacement: inputs.displacement,
+            rotation: inputs.rotation,
+            geometry,
+            repair_rate: Lane::splat(repair_rate),
+            slop: Lane::splat(settings.overlap_slop),
+            max_repair: Lane::splat(settings.max_repair_speed),
+            inverse_h: Lane::splat(1.0 / inputs.h),
+            soft_mass,
+            soft_impulse,
+            with_repair: inputs.with_repair,
+        }
+    }
+
+    /// A lane group's bodies' displacements and rotations.
+    #[inline(always)]
+    fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
+        BodyLanes::gather(slots_a, slots_b, self.displacement, self.rotation)
+    }
+
+    /// Sets bundle `index`'s targets from the separation its points have reached: a gap is
+    /// closed in one substep, an overlap deeper than the slop is repaired at the repair rate
+    /// (main solve only), with the soft contact's mass and impulse scales.
+    #[inline(always)]
+    fn set(&self, b: &mut Bundle, index: usize, moved: &BodyLanes) {
+        let zero = Lane::splat(0.0);
+        let g = &self.geometry[index];
+        let at_a = add_cross(moved.linear_a, moved.angular_a, g.lever_a);
+        let at_b = add_cross(moved.linear_b, moved.angular_b, g.lever_b);
+        let separation = dot(b.normal.direction, sub(at_a, at_b)) - g.depth;
+        let gap = separation.simd_gt(zero);
+        let repair = (self.repair_rate * (-separation - self.slop).max(zero)).min(self.max_repair);
+        let overlap_target = if self.with_repair { repair } else { zero };
+        b.target = gap.select(-separation * self.inverse_h, overlap_target);
+        b.mass_scale = gap.select(Lane::splat(1.0), self.soft_mass);
+        b.impulse_scale = gap.select(zero, self.soft_impulse);
+    }
+}
+
 /// Fewest lane groups of one colour in a part run on its own thread: a colour of at most this
 /// many runs as one part.
 const GROUPS_PER_TASK: usize = 8;
@@ -702,13 +780,14 @@ const GROUPS_PER_TASK: usize = 8;
 /// are below the velocities' length, and no other thread touches these bundles or their lanes'
 /// moving slots meanwhile.
 #[inline(always)]
-unsafe fn sweep_groups<F: BundleUpdate>(
+unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
     groups: &[Group],
     bundles: SharedItems<Bundle>,
     len: usize,
     forward: bool,
     velocities: &SharedVelocities,
     update: F,
+    targets: T,
 ) -> Lane {
     let mut largest = Lane::splat(0.0);
     let n = groups.len();
@@ -723,6 +802,7 @@ unsafe fn sweep_groups<F: BundleUpdate>(
             (first.local_a, first.local_b)
         };
         let mut v = unsafe { velocities.gather(&slots_a, &slots_b) };
+        let moved = targets.moved(&slots_a, &slots_b);
         for p in 0..count {
             let index = if forward {
                 start + p
@@ -740,6 +820,7 @@ unsafe fn sweep_groups<F: BundleUpdate>(
             }
             // SAFETY: the caller's contract.
             let b = unsafe { &mut *bundles.0.add(index) };
+            targets.set(b, index, &moved);
             largest = largest.max(update.update(b, &mut v));
         }
         // SAFETY: the caller's contract.
@@ -758,9 +839,6 @@ pub const PARALLEL_ISLAND_POINTS: usize = 1024;
 
 /// Islands of at least this many points are packed and unpacked on rayon's threads.
 const PARALLEL_PACK_POINTS: usize = 4096;
-
-/// Lane groups per task of the (cheaper) target update.
-const TARGET_GROUPS_PER_TASK: usize = 64;
 
 /// [`BodyLanes`] through the velocity pointers that one colour's threads share.
 trait SharedLanes {
