@@ -209,7 +209,7 @@ impl std::ops::Add for EnergyTerms {
 
 /// Bodies per partial sum of [`energy_terms_on`]. The sums run over fixed runs of bodies and
 /// are then added in order, so the result is the same to the bit on any number of threads.
-const ENERGY_BODIES_PER_PART: usize = 4096;
+const ENERGY_BODIES_PER_PART: usize = 1024;
 
 /// [`EnergyTerms`] of the moving bodies under `gravity` (m/s²), on the calling thread.
 pub fn energy_terms(bodies: &Bodies, gravity: Vec3) -> EnergyTerms {
