@@ -663,18 +663,6 @@ impl SetTargets for NoTargets {
     fn set(&self, _: &mut Bundle, _: usize, _: &()) {}
 }
 
-impl SetTargets for &Targets<'_> {
-    type Moved = BodyLanes;
-    #[inline(always)]
-    fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
-        Targets::moved(self, slots_a, slots_b)
-    }
-    #[inline(always)]
-    fn set(&self, b: &mut Bundle, index: usize, moved: &BodyLanes) {
-        Targets::set(self, b, index, moved)
-    }
-}
-
 /// What the target update of a solve reads (see [`Bundles::solve_pgs`]): the island's
 /// displacement and rotation vector per slot since the step began (m, rad; the immovable slot
 /// zero), the settings and the substep `h` (s), and whether this is the main solve, with
@@ -737,6 +725,10 @@ impl<'a> Targets<'a> {
             with_repair: inputs.with_repair,
         }
     }
+}
+
+impl SetTargets for &Targets<'_> {
+    type Moved = BodyLanes;
 
     /// A lane group's bodies' displacements and rotations.
     #[inline(always)]
