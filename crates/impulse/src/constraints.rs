@@ -506,6 +506,8 @@ pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32
 /// rows, so the sums are the same on any thread count. With `parallel`, the parts and the
 /// second pass (one row at a time, no shared writes) run on rayon's threads: serial, the first
 /// pass was 1.35 % of a two-thread `fast` pyramid100 step with the other thread idle.
+/// An island's step ends with the same two passes, the second one fused with its residual
+/// ([`crate::diagnostics::record_velocity_before_and_residual`]).
 ///
 /// `slots` says how rows name their bodies, and so how `linear` and `angular` are indexed.
 pub fn record_velocity_before(
@@ -516,15 +518,41 @@ pub fn record_velocity_before(
     parallel: bool,
     scratch: &mut Vec<(Vec3, Vec3)>,
 ) {
-    let bodies_of: fn(&ContactConstraint) -> (usize, usize) = match slots {
-        BodySlots::World => |c| (c.body_a as usize, c.body_b as usize),
-        BodySlots::Island => |c| (c.local_a as usize, c.local_b as usize),
-    };
     let parallel = parallel && rayon::current_num_threads() > 1;
-    let bodies = linear.len();
-    if bodies == 0 {
+    let Some(changes) =
+        impulse_velocity_changes(constraints, slots, linear.len(), parallel, scratch)
+    else {
         return;
+    };
+    let bodies_of = slots.bodies_of();
+    let record = |c: &mut ContactConstraint| {
+        let (a, b) = bodies_of(c);
+        record_row(c, a, b, linear, angular, changes);
+    };
+    if parallel && constraints.len() > PAIRS_PER_TASK {
+        constraints
+            .par_iter_mut()
+            .with_min_len(PAIRS_PER_TASK)
+            .for_each(record);
+    } else {
+        constraints.iter_mut().for_each(record);
     }
+}
+
+/// The first pass of [`record_velocity_before`]: per body slot (below `bodies`), the velocity
+/// change M⁻¹Jᵀγ of the rows' current impulses, as (linear, angular), summed in parts as
+/// described there. `None` when there are no bodies.
+pub(crate) fn impulse_velocity_changes<'s>(
+    constraints: &[ContactConstraint],
+    slots: BodySlots,
+    bodies: usize,
+    parallel: bool,
+    scratch: &'s mut Vec<(Vec3, Vec3)>,
+) -> Option<&'s [(Vec3, Vec3)]> {
+    if bodies == 0 {
+        return None;
+    }
+    let bodies_of = slots.bodies_of();
     let parts = constraints
         .len()
         .div_ceil(RECORD_POINTS_PER_PART)
@@ -575,23 +603,25 @@ pub fn record_velocity_before(
             first.iter_mut().enumerate().for_each(sum);
         }
     }
-    let scratch = &*first;
-    let record = |c: &mut ContactConstraint| {
-        let (a, b) = bodies_of(c);
-        let (la, aa) = (linear[a] - scratch[a].0, angular[a] - scratch[a].1);
-        let (lb, ab) = (linear[b] - scratch[b].0, angular[b] - scratch[b].1);
-        c.normal.velocity_before = c.normal.velocity(la, aa, lb, ab);
-        for t in &mut c.tangents {
-            t.velocity_before = t.velocity(la, aa, lb, ab);
-        }
-    };
-    if parallel && constraints.len() > PAIRS_PER_TASK {
-        constraints
-            .par_iter_mut()
-            .with_min_len(PAIRS_PER_TASK)
-            .for_each(record);
-    } else {
-        constraints.iter_mut().for_each(record);
+    Some(first)
+}
+
+/// The second pass of [`record_velocity_before`] on one row, whose bodies are at `a` and `b`:
+/// its rows' J·v* from the velocities and the `changes` of [`impulse_velocity_changes`].
+#[inline(always)]
+pub(crate) fn record_row(
+    c: &mut ContactConstraint,
+    a: usize,
+    b: usize,
+    linear: &[Vec3],
+    angular: &[Vec3],
+    changes: &[(Vec3, Vec3)],
+) {
+    let (la, aa) = (linear[a] - changes[a].0, angular[a] - changes[a].1);
+    let (lb, ab) = (linear[b] - changes[b].0, angular[b] - changes[b].1);
+    c.normal.velocity_before = c.normal.velocity(la, aa, lb, ab);
+    for t in &mut c.tangents {
+        t.velocity_before = t.velocity(la, aa, lb, ab);
     }
 }
 
@@ -612,4 +642,14 @@ pub enum BodySlots {
     /// thread solved it; the result is the world-wide pass's once the velocities are
     /// scattered back.
     Island,
+}
+
+impl BodySlots {
+    /// A row's two indices into the velocity arrays, (A, B).
+    pub(crate) fn bodies_of(self) -> fn(&ContactConstraint) -> (usize, usize) {
+        match self {
+            BodySlots::World => |c| (c.body_a as usize, c.body_b as usize),
+            BodySlots::Island => |c| (c.local_a as usize, c.local_b as usize),
+        }
+    }
 }

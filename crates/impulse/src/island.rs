@@ -313,7 +313,7 @@ pub struct IslandWorkspace {
     colours: Vec<u8>,
     colour_scratch: Vec<ContactConstraint>,
     /// Per part of rows, per slot: M⁻¹Jᵀγ of [`constraints::record_velocity_before`].
-    record_scratch: Vec<(Vec3, Vec3)>,
+    pub(crate) record_scratch: Vec<(Vec3, Vec3)>,
     /// Whether one colour may be solved on several threads.
     parallel: bool,
     nncg: NncgWorkspace,
@@ -504,11 +504,16 @@ pub struct StepContext<'a> {
     pub settings: &'a SolverSettings,
     /// Whether a large island may spread one colour's points over rayon's threads.
     pub parallel: bool,
+    /// Whether any body has a restitution coefficient above zero; without one the
+    /// restitution pass over the rows is skipped.
+    pub restitution: bool,
 }
 
 /// Runs stages 1, 5 and 6 of one step on one island: per substep of h = dt/substeps, gravity,
 /// warm start, the solve with overlap repair, position integration, and the relax solve; then
-/// the restitution solve. Results stay in `workspace` until [`scatter`].
+/// the restitution solve. Results stay in `workspace` until [`scatter`]. The rows' J·v*
+/// (`velocity_before`) is left to the caller, which takes it in one pass with the residual
+/// ([`crate::diagnostics::record_velocity_before_and_residual`], as [`crate::World`] does).
 pub fn step_island(
     island_bodies: &[u32],
     constraints: &mut [ContactConstraint],
@@ -521,6 +526,7 @@ pub fn step_island(
         dt,
         settings,
         parallel,
+        restitution,
     } = *context;
     let slots = island_bodies.len() + 1;
     let w = workspace;
@@ -658,7 +664,10 @@ pub fn step_island(
     // Restitution after the substeps (the seed's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
     // for the points that collided.
     let threshold = settings.restitution_threshold;
-    let bounces = if spread {
+    let bounces = if !restitution {
+        // No body bounces, so no pair does (a pair's coefficient is the larger of its bodies').
+        false
+    } else if spread {
         // Per point: any split gives the same targets.
         use rayon::prelude::*;
         constraints
@@ -676,14 +685,6 @@ pub fn step_island(
             false,
         );
     }
-    constraints::record_velocity_before(
-        constraints,
-        constraints::BodySlots::Island,
-        &w.linear,
-        &w.angular,
-        spread,
-        &mut w.record_scratch,
-    );
 }
 
 /// Bodies per task of a spread island's position integration.

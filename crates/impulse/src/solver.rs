@@ -146,10 +146,12 @@ pub(crate) fn greedy_colours(
 ///
 /// Why not a rayon call per colour: a coloured island has 24–34 colours and a `fast` step
 /// sweeps it 24 times, so a fork-join per colour was paid some 700 times a step. Here the
-/// threads are forked once per sweep and claim chunks from per-colour counters; a chunk waits
-/// (spinning) until every chunk of the colours before its own has finished. All those chunks
-/// were claimed before it, by threads that are running them or waiting in turn on earlier
-/// ones, and a chunk never calls into rayon, so every wait ends on any nesting of rayon jobs;
+/// threads are forked once per sweep and claim chunks, each its own (the chunk of its rayon
+/// thread index) first, then any left; a chunk waits (spinning) until every chunk of the
+/// colours before its own has finished. A thread moves on to a colour only once every chunk
+/// of the colour before has been claimed, so all those chunks are held by threads that are
+/// running them or waiting in turn on earlier ones, and a chunk never calls into rayon:
+/// every wait ends on any nesting of rayon jobs;
 /// a thread that joins late, or never, leaves more chunks to the others. One contiguous chunk
 /// per thread keeps each thread's reads a single stream: chunks of 32 bundles claimed in turn
 /// were slower than the fork-joins, halves faster (docs/benchmarks.md, session 10). The
@@ -172,7 +174,7 @@ where
     R: Send + Sync + Copy,
 {
     use rayon::prelude::*;
-    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     debug_assert!(colours <= COLOURS + 1);
     let colours = colours.min(COLOURS + 1);
     let threads = rayon::current_num_threads();
@@ -195,7 +197,10 @@ where
         let (range, size) = range_of(visit);
         before[visit + 1] = before[visit] + range.len().div_ceil(size);
     }
-    let next: [AtomicUsize; COLOURS + 1] = std::array::from_fn(|_| AtomicUsize::new(0));
+    // Per chunk, all colours together: whether a thread has claimed it.
+    let claimed: Vec<AtomicBool> = (0..before[colours])
+        .map(|_| AtomicBool::new(false))
+        .collect();
     // Chunks finished, all colours together. A chunk starts once every chunk of the colours
     // before its own has: no chunk of a later colour can finish first, so the count reaches
     // `before[visit]` exactly when they all have (empty colours need no special case).
@@ -206,13 +211,23 @@ where
         #[allow(clippy::redundant_locals)]
         let base = base;
         let mut result = identity;
+        // A thread tries its own chunk of each colour first: colour by colour, sweep after
+        // sweep, the same thread then takes the same part of the island, whose bodies'
+        // velocities stay in its core's cache instead of moving between cores every colour.
+        let own = rayon::current_thread_index().unwrap_or(0);
         for visit in 0..colours {
             let (range, size) = range_of(visit);
             let chunks = before[visit + 1] - before[visit];
-            loop {
-                let claimed = next[visit].fetch_add(1, Ordering::Relaxed);
-                if claimed >= chunks {
-                    break;
+            if chunks == 0 {
+                continue;
+            }
+            // Own chunk first, then the others in order; each runs on whichever thread
+            // claims it first.
+            let first = own % chunks;
+            let order = std::iter::once(first).chain((0..chunks).filter(|&c| c != first));
+            for claimed_chunk in order {
+                if claimed[before[visit] + claimed_chunk].swap(true, Ordering::Relaxed) {
+                    continue;
                 }
                 let mut spins = 0u32;
                 while finished.load(Ordering::Acquire) < before[visit] {
@@ -224,7 +239,7 @@ where
                         std::thread::yield_now();
                     }
                 }
-                let from = range.start + claimed * size;
+                let from = range.start + claimed_chunk * size;
                 let to = (from + size).min(range.end);
                 // SAFETY: [from, to) lies inside `items`, and no other thread holds it: each
                 // chunk index is claimed once, and this colour's chunks are disjoint.

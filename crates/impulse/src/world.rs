@@ -315,6 +315,7 @@ impl World {
                 dt,
                 settings: &settings,
                 parallel: self.parallel,
+                restitution: self.bodies.restitution.iter().any(|&r| r > 0.0),
             };
             let mut jobs = Vec::with_capacity(islands);
             let mut rest: &mut [ContactConstraint] = &mut self.constraints;
@@ -332,23 +333,26 @@ impl World {
                 }
             }
             // Each island ends its step with the passes that read its rows once more, while
-            // they are still in cache: its natural-map residual and its friction-row count. As
-            // world-wide passes over every row they were 3 % of a balls16k step at rest (perf),
-            // mostly waiting on memory; the results are the same to the bit.
+            // they are still in cache: its rows' v*, its natural-map residual and its
+            // friction-row count, in one pass. As world-wide passes over every row they were
+            // 3 % of a balls16k step at rest (perf), mostly waiting on memory; the results are
+            // the same to the bit.
             let run = |(bodies, constraints, workspace): &mut (
                 &[u32],
                 &mut [ContactConstraint],
                 &mut IslandWorkspace,
             )| {
                 island::step_island(bodies, constraints, &context, workspace);
-                workspace.report.natural_map_residual = diagnostics::natural_map_residual_in(
+                let rows = diagnostics::record_velocity_before_and_residual(
                     constraints,
                     constraints::BodySlots::Island,
                     &workspace.linear,
                     &workspace.angular,
                     context.parallel,
+                    &mut workspace.record_scratch,
                 );
-                workspace.friction_rows = friction_rows(constraints);
+                workspace.report.natural_map_residual = rows.natural_map_residual;
+                workspace.friction_rows = rows.friction_rows;
             };
             if self.parallel && jobs.len() > 1 && rayon::current_num_threads() > 1 {
                 // Islands differ in cost by orders of magnitude (an exact solve against a

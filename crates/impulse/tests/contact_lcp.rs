@@ -574,3 +574,92 @@ fn velocity_before_in_parts_is_the_same_on_any_thread_count_and_matches_a_direct
     }
     assert!(largest > 1.0, "the check should see large v*: {largest}");
 }
+
+/// The pass an island's step ends with (`record_velocity_before_and_residual`) gives, on one
+/// and on several threads, the bits of the three passes it replaced: `record_velocity_before`,
+/// `natural_map_residual_in` and the count of rows with friction. Rows: a pile's repeated 800
+/// times with scaled impulses, some copies frictionless, so both residual kinds and the parts
+/// of the velocity-change sums are exercised.
+#[test]
+fn fused_record_and_residual_equals_the_separate_passes_on_any_thread_count() {
+    use impulse::constraints::{BodySlots, record_velocity_before};
+    use impulse::diagnostics::{natural_map_residual_in, record_velocity_before_and_residual};
+    let mut world = pile(true);
+    for _ in 0..30 {
+        world.step().unwrap();
+    }
+    let mut rows: Vec<ContactConstraint> = Vec::new();
+    for copy in 0..800 {
+        for c in world.contact_constraints() {
+            let mut c = *c;
+            let scale = 1.0 + 0.001 * copy as f32;
+            c.normal_impulse *= scale;
+            c.tangent_impulses = c.tangent_impulses.map(|t| t * scale);
+            if copy % 3 == 0 {
+                c.friction = 0.0;
+                c.tangent_impulses = [0.0; 2];
+            }
+            rows.push(c);
+        }
+    }
+    let with_friction = rows.iter().filter(|c| c.friction > 0.0).count();
+    assert!(with_friction > 0 && with_friction < rows.len());
+    let bodies = &world.bodies;
+    let (linear, angular) = (&bodies.linear_velocity, &bodies.angular_velocity);
+    let recorded = |rows: &[ContactConstraint]| {
+        rows.iter()
+            .map(|c| {
+                [
+                    c.normal.velocity_before,
+                    c.tangents[0].velocity_before,
+                    c.tangents[1].velocity_before,
+                ]
+                .map(f32::to_bits)
+            })
+            .collect::<Vec<_>>()
+    };
+    let in_pool = |threads: usize, job: &mut (dyn FnMut() + Send)| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(job)
+    };
+
+    let mut separate = rows.clone();
+    let mut residual = 0.0f32;
+    in_pool(1, &mut || {
+        record_velocity_before(
+            &mut separate,
+            BodySlots::World,
+            linear,
+            angular,
+            false,
+            &mut Vec::new(),
+        );
+        residual = natural_map_residual_in(&rows, BodySlots::World, linear, angular, false);
+    });
+    assert!(residual > 0.0);
+    for threads in [1, 2, 3] {
+        let mut fused = rows.clone();
+        let mut report = Default::default();
+        in_pool(threads, &mut || {
+            report = record_velocity_before_and_residual(
+                &mut fused,
+                BodySlots::World,
+                linear,
+                angular,
+                threads > 1,
+                &mut Vec::new(),
+            );
+        });
+        assert_eq!(recorded(&fused), recorded(&separate), "{threads} threads");
+        assert_eq!(
+            report.natural_map_residual.to_bits(),
+            residual.to_bits(),
+            "{threads} threads: {} against {residual}",
+            report.natural_map_residual
+        );
+        assert_eq!(report.friction_rows, with_friction, "{threads} threads");
+    }
+}
