@@ -2,7 +2,10 @@
 //! - `step/pyramid20`: one whole `World::step`;
 //! - `broad_phase/pyramid20`: `BroadPhase::candidate_pairs` alone;
 //! - `narrow_phase/pyramid20`: `NarrowPhase::update` alone, serial (Parry `contact_manifolds`
-//!   on the broad phase's candidates, with the persistent manifolds of the previous call).
+//!   on the broad phase's candidates, with the persistent manifolds of the previous call);
+//! - `solver/pyramid20_pgs` and `solver/pyramid20_nncg`: the solver alone on the last step's
+//!   rows (2,000-odd contact points, three rows each), from a cold start at the velocities
+//!   before any contact impulse (v*), 8 sweeps or 8 NNCG iterations with no early exit.
 //!
 //! Sleeping is off, as in every timing of this crate.
 //!
@@ -11,11 +14,14 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use glam::Vec3;
 use impulse::World;
 use impulse::broad_phase::BroadPhase;
+use impulse::constraints::ContactConstraint;
 use impulse::narrow_phase::{NarrowPhase, SpeculativeMargins};
 use impulse::scene::builtin::builtin_scene;
+use impulse::solver::{NncgWorkspace, Sweep, Velocities, solve_nncg, solve_pgs, warm_start};
 
 const SCENE: &str = "pyramid20";
 const WARM_UP_STEPS: u32 = 60;
@@ -103,6 +109,76 @@ fn narrow_phase(c: &mut Criterion) {
     });
 }
 
+/// The last step's rows with their bodies named by world index and zero impulses, and the
+/// velocities v* = v − M⁻¹Jᵀγ the step's impulses γ started from: the step's LCP, unsolved.
+fn cold_problem(world: &World) -> (Vec<ContactConstraint>, Vec<Vec3>, Vec<Vec3>) {
+    let mut constraints = world.contact_constraints().to_vec();
+    let mut linear = world.bodies.linear_velocity.clone();
+    let mut angular = world.bodies.angular_velocity.clone();
+    for c in &mut constraints {
+        // The solver indexes velocities by `local_a`/`local_b`; here the world's arrays.
+        c.local_a = c.body_a;
+        c.local_b = c.body_b;
+        c.normal_impulse = -c.normal_impulse;
+        c.tangent_impulses = c.tangent_impulses.map(|t| -t);
+    }
+    // Applying −γ takes the impulses back out of the velocities.
+    warm_start(
+        &constraints,
+        &mut Velocities {
+            linear: &mut linear,
+            angular: &mut angular,
+        },
+    );
+    for c in &mut constraints {
+        c.normal_impulse = 0.0;
+        c.tangent_impulses = [0.0; 2];
+        c.max_normal_impulse = 0.0;
+    }
+    (constraints, linear, angular)
+}
+
+fn solver(c: &mut Criterion) {
+    let world = settled_world();
+    let problem = cold_problem(&world);
+    assert!(problem.0.len() > 1000, "{} points", problem.0.len());
+    const SWEEPS: u32 = 8;
+    c.bench_function("solver/pyramid20_pgs", |b| {
+        b.iter_batched_ref(
+            || problem.clone(),
+            |(constraints, linear, angular)| {
+                let mut velocities = Velocities { linear, angular };
+                black_box(solve_pgs(
+                    constraints,
+                    Sweep::SEQUENTIAL,
+                    SWEEPS,
+                    0.0,
+                    &mut velocities,
+                ))
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    let mut workspace = NncgWorkspace::default();
+    c.bench_function("solver/pyramid20_nncg", |b| {
+        b.iter_batched_ref(
+            || problem.clone(),
+            |(constraints, linear, angular)| {
+                let mut velocities = Velocities { linear, angular };
+                black_box(solve_nncg(
+                    constraints,
+                    Sweep::SEQUENTIAL,
+                    SWEEPS,
+                    0.0,
+                    &mut velocities,
+                    &mut workspace,
+                ))
+            },
+            BatchSize::LargeInput,
+        )
+    });
+}
+
 fn config() -> Criterion {
     Criterion::default()
         .sample_size(20)
@@ -113,6 +189,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = step, broad_phase, narrow_phase
+    targets = step, broad_phase, narrow_phase, solver
 }
 criterion_main!(benches);
