@@ -483,26 +483,42 @@ fn soft_rows_are_exported_with_their_regularisation() {
     }
 }
 
+/// The friction pile after 30 steps, and its rows repeated 800 times (enough for the per-body
+/// sums in parts and several residual runs of 4096), copy k with its impulses scaled by
+/// 1 + 0.001·k and its tangent impulses also by `tangent_sign`; with `frictionless_every`
+/// = Some(n), every n-th copy has no friction.
+fn repeated_pile_rows(
+    tangent_sign: f32,
+    frictionless_every: Option<usize>,
+) -> (World, Vec<ContactConstraint>) {
+    let mut world = pile(true);
+    for _ in 0..30 {
+        world.step().unwrap();
+    }
+    let mut rows = Vec::new();
+    for copy in 0..800 {
+        for c in world.contact_constraints() {
+            let mut c = *c;
+            let scale = 1.0 + 0.001 * copy as f32;
+            c.normal_impulse *= scale;
+            c.tangent_impulses = c.tangent_impulses.map(|t| tangent_sign * t * scale);
+            if frictionless_every.is_some_and(|n| copy % n == 0) {
+                c.friction = 0.0;
+                c.tangent_impulses = [0.0; 2];
+            }
+            rows.push(c);
+        }
+    }
+    (world, rows)
+}
+
 /// `record_velocity_before` on enough rows to sum its per-body deltas in parts (here a pile's
 /// rows repeated 800 times, every copy with its own impulses) gives the same bits on one and
 /// on two threads, and each row's J·v* matches v* = v − M⁻¹Jᵀγ summed directly in f64.
 #[test]
 fn velocity_before_in_parts_is_the_same_on_any_thread_count_and_matches_a_direct_sum() {
     use impulse::constraints::{BodySlots, record_velocity_before};
-    let mut world = pile(true);
-    for _ in 0..30 {
-        world.step().unwrap();
-    }
-    let mut rows: Vec<ContactConstraint> = Vec::new();
-    for copy in 0..800 {
-        for c in world.contact_constraints() {
-            let mut c = *c;
-            let scale = 1.0 + 0.001 * copy as f32;
-            c.normal_impulse *= scale;
-            c.tangent_impulses = c.tangent_impulses.map(|t| -t * scale);
-            rows.push(c);
-        }
-    }
+    let (world, rows) = repeated_pile_rows(-1.0, None);
     assert!(rows.len() > 20_000, "{} rows", rows.len());
     let bodies = &world.bodies;
     let (linear, angular) = (&bodies.linear_velocity, &bodies.angular_velocity);
@@ -584,24 +600,7 @@ fn velocity_before_in_parts_is_the_same_on_any_thread_count_and_matches_a_direct
 fn fused_record_and_residual_equals_the_separate_passes_on_any_thread_count() {
     use impulse::constraints::{BodySlots, record_velocity_before};
     use impulse::diagnostics::{natural_map_residual_in, record_velocity_before_and_residual};
-    let mut world = pile(true);
-    for _ in 0..30 {
-        world.step().unwrap();
-    }
-    let mut rows: Vec<ContactConstraint> = Vec::new();
-    for copy in 0..800 {
-        for c in world.contact_constraints() {
-            let mut c = *c;
-            let scale = 1.0 + 0.001 * copy as f32;
-            c.normal_impulse *= scale;
-            c.tangent_impulses = c.tangent_impulses.map(|t| t * scale);
-            if copy % 3 == 0 {
-                c.friction = 0.0;
-                c.tangent_impulses = [0.0; 2];
-            }
-            rows.push(c);
-        }
-    }
+    let (world, rows) = repeated_pile_rows(1.0, Some(3));
     let with_friction = rows.iter().filter(|c| c.friction > 0.0).count();
     assert!(with_friction > 0 && with_friction < rows.len());
     let bodies = &world.bodies;
