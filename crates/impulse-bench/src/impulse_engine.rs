@@ -56,7 +56,19 @@ impl ImpulseRun {
         threads: usize,
         settings: Option<SolverSettings>,
     ) -> Result<Self> {
-        Self::build(scene, steps, threads, settings, None)
+        Self::build(scene, steps, threads, settings, None, None)
+    }
+
+    /// As [`Self::new`], with the engine name `engine` in the row (e.g. a setting's name from
+    /// a grid of settings) whatever the settings are.
+    pub(crate) fn named(
+        scene: &Scene,
+        steps: u32,
+        threads: usize,
+        settings: Option<SolverSettings>,
+        engine: &str,
+    ) -> Result<Self> {
+        Self::build(scene, steps, threads, settings, None, Some(engine))
     }
 
     /// As [`Self::new`], but every step runs in a rayon pool of its own with `threads` threads,
@@ -69,15 +81,18 @@ impl ImpulseRun {
         settings: Option<SolverSettings>,
     ) -> Result<Self> {
         let pool = crate::thread_pool(threads)?;
-        Self::build(scene, steps, threads, settings, Some(pool))
+        Self::build(scene, steps, threads, settings, Some(pool), None)
     }
 
+    /// `name`: the engine name; None: [`ENGINE`] for the scene's settings, [`FAST_ENGINE`]
+    /// for others.
     fn build(
         scene: &Scene,
         steps: u32,
         threads: usize,
         settings: Option<SolverSettings>,
         pool: Option<rayon::ThreadPool>,
+        name: Option<&str>,
     ) -> Result<Self> {
         let mut scene = scene.clone();
         let engine = match settings {
@@ -87,6 +102,7 @@ impl ImpulseRun {
             }
             None => ENGINE,
         };
+        let engine = name.unwrap_or(engine);
         let engine = match pool {
             Some(_) => threads_engine_name(engine, threads),
             None => engine.to_string(),

@@ -263,12 +263,18 @@ pub struct RapierVariant {
 impl RapierVariant {
     /// Engine name of its rows, e.g. `rapier 8×120Hz` or `rapier 4×30Hz coulomb`.
     pub fn engine_name(&self) -> String {
+        format!("rapier {}", self.setting_name())
+    }
+
+    /// The settings alone, e.g. `8×120Hz` or `4×30Hz coulomb` (substeps × contact spring
+    /// frequency, and the friction model when it is Coulomb).
+    pub fn setting_name(&self) -> String {
         let friction = if self.coulomb_friction {
             " coulomb"
         } else {
             ""
         };
-        format!("rapier {}×{}Hz{friction}", self.substeps, self.contact_hz)
+        format!("{}×{}Hz{friction}", self.substeps, self.contact_hz)
     }
 }
 
