@@ -11,9 +11,12 @@
 //! - [`bench_rapier`] (feature `rapier`, on by default): Rapier 0.36 on the same scene.
 //! - [`format_table`]: the results as one Markdown table.
 //! - [`run_benchmarks`]: a list of built-in scenes through both engines.
+//! - [`front`]: the quality/speed Pareto front of each engine over a grid of its settings.
 
+pub mod front;
 mod impulse_engine;
 pub mod machine;
+mod plot;
 pub mod quality;
 #[cfg(feature = "rapier")]
 mod rapier_engine;
@@ -211,7 +214,7 @@ pub fn paired_speed_up(reference: &BenchRow, row: &BenchRow) -> Option<f64> {
 }
 
 /// Milliseconds with three significant digits at least (0.123, 1.23, 12.3, 123).
-fn format_ms(ms: f64) -> String {
+pub(crate) fn format_ms(ms: f64) -> String {
     if ms < 1.0 {
         format!("{ms:.3}")
     } else if ms < 10.0 {
