@@ -2,13 +2,15 @@
 //!
 //! ```text
 //! cargo run --release -p impulse-bench -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--impulse-fast] [--also-threads N] [--markdown FILE]
+//! cargo run --release -p impulse-bench -- front [SCENE...] [--steps N] [--large-steps M] [--out-dir DIR] [--markdown FILE] [--json FILE] [--quick]
 //! ```
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use clap::Parser;
+use clap::{Parser, Subcommand};
+use impulse_bench::front::{self, FrontConfig};
 use impulse_bench::{
     BenchConfig, DEFAULT_SCENES, DEFAULT_STEPS, MachineInfo, RapierVariant, format_table,
     format_thread_table,
@@ -17,8 +19,15 @@ use impulse_bench::{
 /// Times impulse and Rapier on the same built-in scenes (sleeping off, median ms/step) and
 /// measures both from poses: top-body sink, largest overlap, largest drift.
 #[derive(Parser)]
-#[command(name = "impulse-bench", version, about)]
+#[command(
+    name = "impulse-bench",
+    version,
+    about,
+    args_conflicts_with_subcommands = true
+)]
 struct Args {
+    #[command(subcommand)]
+    command: Option<Command>,
     /// Built-in scene names (default: pyramid20 pyramid100 pyramid3d10 stack30 massratio
     /// balls4096).
     scenes: Vec<String>,
@@ -59,8 +68,47 @@ struct Args {
     markdown: Option<PathBuf>,
 }
 
+#[derive(Subcommand)]
+enum Command {
+    /// The quality/speed Pareto front of impulse and of Rapier: each engine over a grid of its
+    /// settings, one run per setting (one thread, sleeping off, engines interleaved). Prints
+    /// Markdown tables of each engine's cheapest setting meeting E ≤ 50, 5 and 1 mm
+    /// (E = max(|top sink|, largest overlap, largest drift)) and of each engine's front, and
+    /// writes a plot per scene to DIR/front-<scene>.svg.
+    Front(FrontArgs),
+}
+
+#[derive(clap::Args)]
+struct FrontArgs {
+    /// Built-in scene names (default: pyramid20 pyramid3d10 stack30 massratio pyramid100).
+    scenes: Vec<String>,
+    /// Steps per scene.
+    #[arg(long, default_value_t = front::FRONT_STEPS)]
+    steps: u32,
+    /// Steps per scene of more than 2000 bodies (pyramid100).
+    #[arg(long, default_value_t = front::FRONT_LARGE_STEPS)]
+    large_steps: u32,
+    /// Directory of the plots (created if missing).
+    #[arg(long, default_value = "docs", value_name = "DIR")]
+    out_dir: PathBuf,
+    /// Also write the tables, the command and the machine to this Markdown file.
+    #[arg(long, value_name = "FILE")]
+    markdown: Option<PathBuf>,
+    /// Also write every point of every scene, the command and the machine to this JSON file.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+    /// A few settings per engine instead of the full grids (for checks).
+    #[arg(long)]
+    quick: bool,
+}
+
 fn main() -> ExitCode {
-    match run(Args::parse()) {
+    let mut args = Args::parse();
+    let result = match args.command.take() {
+        Some(Command::Front(front_args)) => run_front(front_args),
+        None => run(args),
+    };
+    match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {
@@ -87,10 +135,7 @@ fn run(args: Args) -> Result<bool> {
         also_threads: args.also_threads,
     };
     let machine = MachineInfo::current();
-    let command = std::iter::once("impulse-bench".to_string())
-        .chain(std::env::args().skip(1))
-        .collect::<Vec<_>>()
-        .join(" ");
+    let command = command_line();
     eprintln!("before: {machine}");
     let mut failures = 0;
     let rows = impulse_bench::run_benchmarks(
@@ -135,4 +180,130 @@ fn run(args: Args) -> Result<bool> {
         std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(failures == 0)
+}
+
+/// The command as run, for the record.
+fn command_line() -> String {
+    std::iter::once("impulse-bench".to_string())
+        .chain(std::env::args().skip(1))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// `impulse-bench front`. Ok(false) when some run failed (the others are still reported).
+fn run_front(args: FrontArgs) -> Result<bool> {
+    let config = FrontConfig {
+        scenes: if args.scenes.is_empty() {
+            front::FRONT_SCENES.iter().map(|s| s.to_string()).collect()
+        } else {
+            args.scenes
+        },
+        steps: args.steps,
+        large_steps: args.large_steps,
+        quick: args.quick,
+    };
+    let machine = MachineInfo::current();
+    let command = command_line();
+    eprintln!("before: {machine}");
+    let fronts = front::run_front(&config, &mut |p| {
+        let point = p.point;
+        match &point.failed {
+            None => eprintln!(
+                "[{}/{}] {} ({} steps) {:<7} {:<18} {:>9.3} ms/step  E {:.2} mm (sink {:.2}, \
+                 overlap {:.2}, drift {:.2})",
+                p.done,
+                p.total,
+                p.scene,
+                p.steps,
+                point.engine,
+                point.setting,
+                point.ms_per_step,
+                point.e_mm,
+                point.sink_mm,
+                point.overlap_mm,
+                point.drift_mm,
+            ),
+            Some(error) => eprintln!(
+                "[{}/{}] {} ({} steps) {:<7} {:<18} failed: {error}",
+                p.done, p.total, p.scene, p.steps, point.engine, point.setting,
+            ),
+        }
+    })?;
+    let after = MachineInfo::current();
+    let plots = front::write_plots(&fronts, &args.out_dir)?;
+    let tables = front::format_tables(&fronts, Some(&args.out_dir));
+    println!("{tables}");
+    println!("command: {command}");
+    println!("{machine}");
+    println!("load average after: {}", after.load_average);
+    for path in &plots {
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.markdown {
+        let text = front::format_markdown(&fronts, Some(&args.out_dir), &command, &machine, &after);
+        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.json {
+        let json = front::front_json(&fronts, &command, &machine, &after);
+        let text = serde_json::to_string_pretty(&json).context("writing the JSON")?;
+        std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))?;
+    }
+    let failed = fronts
+        .iter()
+        .flat_map(|f| &f.points)
+        .filter(|p| !p.counts())
+        .count();
+    Ok(failed == 0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scenes_without_a_subcommand_still_parse() {
+        let args = Args::try_parse_from(["impulse-bench", "stack30", "pyramid20", "--steps", "5"])
+            .unwrap();
+        assert!(args.command.is_none());
+        assert_eq!(args.scenes, ["stack30", "pyramid20"]);
+        assert_eq!(args.steps, 5);
+        let args = Args::try_parse_from(["impulse-bench"]).unwrap();
+        assert!(args.command.is_none() && args.scenes.is_empty());
+    }
+
+    #[test]
+    fn front_subcommand_parses() {
+        let args = Args::try_parse_from([
+            "impulse-bench",
+            "front",
+            "stack30",
+            "massratio",
+            "--steps",
+            "120",
+            "--quick",
+            "--out-dir",
+            "/tmp/x",
+            "--json",
+            "/tmp/x/f.json",
+        ])
+        .unwrap();
+        let Some(Command::Front(front)) = args.command else {
+            panic!("no front subcommand");
+        };
+        assert_eq!(front.scenes, ["stack30", "massratio"]);
+        assert_eq!(
+            (front.steps, front.large_steps),
+            (120, front::FRONT_LARGE_STEPS)
+        );
+        assert!(front.quick);
+        assert_eq!(front.out_dir, PathBuf::from("/tmp/x"));
+        assert!(front.markdown.is_none());
+        let args = Args::try_parse_from(["impulse-bench", "front"]).unwrap();
+        let Some(Command::Front(front)) = args.command else {
+            panic!("no front subcommand");
+        };
+        assert!(front.scenes.is_empty() && !front.quick);
+        assert_eq!(front.steps, front::FRONT_STEPS);
+        assert_eq!(front.out_dir, PathBuf::from("docs"));
+    }
 }
