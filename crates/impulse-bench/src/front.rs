@@ -16,7 +16,6 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use impulse::settings::SolverMethod;
 use impulse::{Scene, SolverSettings};
 use serde::Serialize;
 
@@ -55,30 +54,29 @@ pub const RAPIER: &str = "rapier";
 /// A named impulse setting: None is the scene's own solver settings (`scene.solver`).
 pub type ImpulseSetting = (String, Option<SolverSettings>);
 
-/// impulse's settings measured by `front`: the scene's own settings (`default`),
-/// `SolverSettings::fast()` (`fast`), a grid on the fast side and a few on the default side.
+/// impulse's settings measured by `front`: every preset (`default`, the scene's own settings,
+/// which for the built-in scenes is `SolverSettings::default()`; `fast`, `precise`,
+/// `reference`), the soft step at other substep counts, and the reference method at fewer
+/// substeps and iterations.
 ///
-/// - `pgs S×I softH`: `fast()` with S substeps of I PGS sweeps and soft contacts of H Hz.
-///   The spring is capped at a quarter of the substep rate, so at dt = 1/60 s and 2 substeps
-///   every H above 30 Hz runs as 30 Hz (and likewise 60 Hz at 4 substeps, 120 Hz at 8).
-/// - `default S×I`: `SolverSettings::default()` (method auto, split impulse) with S substeps
-///   of at most I iterations.
+/// - `soft S`: `SolverSettings::soft_step(S)`, S substeps of one PGS sweep and one relax sweep
+///   on contacts of a quarter of the substep rate (15·S Hz at dt = 1/60 s).
+/// - `soft S×I`: the same with I PGS sweeps in the main solve.
+/// - `reference S×I`: `SolverSettings::reference()` (auto NNCG, split impulse, the exact
+///   path) with S substeps of at most I iterations.
 pub fn impulse_grid() -> Vec<ImpulseSetting> {
-    let mut grid = vec![
-        ("default".to_string(), None),
-        ("fast".to_string(), Some(SolverSettings::fast())),
-    ];
-    for substeps in [2, 4, 8, 16] {
-        for hertz in [30.0, 60.0, 120.0, 240.0] {
-            for iterations in [1, 2] {
-                grid.push(soft_pgs(substeps, iterations, hertz));
-            }
-        }
+    let mut grid = vec![("default".to_string(), None)];
+    for name in ["fast", "precise", "reference"] {
+        grid.push((name.to_string(), SolverSettings::preset(name)));
     }
-    for substeps in [1, 2, 4] {
-        for iterations in [4, 8] {
-            grid.push(split_impulse(substeps, iterations));
-        }
+    for substeps in [2, 4, 6, 10, 12, 16, 24, 28, 32, 48, 64] {
+        grid.push(soft_step(substeps, 1));
+    }
+    for substeps in [4, 8, 16] {
+        grid.push(soft_step(substeps, 2));
+    }
+    for (substeps, iterations) in [(1, 4), (1, 8), (2, 4), (2, 8), (4, 4)] {
+        grid.push(reference(substeps, iterations));
     }
     grid
 }
@@ -88,33 +86,35 @@ pub fn impulse_quick_grid() -> Vec<ImpulseSetting> {
     vec![
         ("default".to_string(), None),
         ("fast".to_string(), Some(SolverSettings::fast())),
-        soft_pgs(4, 1, 60.0),
-        split_impulse(2, 4),
+        soft_step(4, 1),
+        reference(2, 4),
     ]
 }
 
-/// `fast()` with other substeps, sweeps and spring frequency (Hz).
-fn soft_pgs(substeps: u32, iterations: u32, hertz: f32) -> ImpulseSetting {
+/// The soft step at `substeps` substeps with `iterations` sweeps in the main solve.
+fn soft_step(substeps: u32, iterations: u32) -> ImpulseSetting {
+    let name = if iterations == 1 {
+        format!("soft {substeps}")
+    } else {
+        format!("soft {substeps}×{iterations}")
+    };
     (
-        format!("pgs {substeps}×{iterations} soft{hertz}"),
+        name,
         Some(SolverSettings {
-            substeps,
             iterations,
-            soft_contact_hertz: hertz,
-            ..SolverSettings::fast()
+            ..SolverSettings::soft_step(substeps)
         }),
     )
 }
 
-/// `default()` (auto, split impulse) with other substeps and iterations.
-fn split_impulse(substeps: u32, iterations: u32) -> ImpulseSetting {
+/// `SolverSettings::reference()` with other substeps and iterations.
+fn reference(substeps: u32, iterations: u32) -> ImpulseSetting {
     (
-        format!("default {substeps}×{iterations}"),
+        format!("reference {substeps}×{iterations}"),
         Some(SolverSettings {
-            method: SolverMethod::Auto,
             substeps,
             iterations,
-            ..SolverSettings::default()
+            ..SolverSettings::reference()
         }),
     )
 }
@@ -749,6 +749,7 @@ pub fn write_plots(fronts: &[SceneFront], dir: &Path) -> Result<Vec<PathBuf>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use impulse::settings::SolverMethod;
 
     fn point(engine: &str, setting: &str, ms: f64, e_mm: f64) -> FrontPoint {
         FrontPoint {
@@ -932,18 +933,25 @@ mod tests {
     #[test]
     fn grids_have_the_documented_sizes_and_names() {
         let grid = impulse_grid();
-        assert_eq!(grid.len(), 2 + 32 + 6);
+        assert_eq!(grid.len(), 4 + 11 + 3 + 5);
         assert_eq!(grid[0], ("default".to_string(), None));
         assert_eq!(grid[1].1, Some(SolverSettings::fast()));
-        let (name, settings) = grid
-            .iter()
-            .find(|(name, _)| name == "pgs 8×1 soft120")
-            .unwrap();
-        // The fast preset is one point of its own grid.
-        assert_eq!(settings.as_ref(), Some(&SolverSettings::fast()), "{name}");
+        // The presets are soft steps the grid does not repeat.
+        let (name, settings) = grid.iter().find(|(name, _)| name == "soft 16").unwrap();
+        assert_eq!(
+            settings.as_ref(),
+            Some(&SolverSettings::soft_step(16)),
+            "{name}"
+        );
+        let settings: Vec<&SolverSettings> = grid.iter().filter_map(|(_, s)| s.as_ref()).collect();
+        for preset in ["default", "fast", "precise", "reference"] {
+            let preset = SolverSettings::preset(preset).unwrap();
+            let copies = settings.iter().filter(|s| ***s == preset).count();
+            assert!(copies <= 1, "{preset:?} measured {copies} times");
+        }
         let names: std::collections::HashSet<&String> = grid.iter().map(|(n, _)| n).collect();
         assert_eq!(names.len(), grid.len(), "names are unique");
-        let (_, split) = grid.iter().find(|(n, _)| n == "default 2×4").unwrap();
+        let (_, split) = grid.iter().find(|(n, _)| n == "reference 2×4").unwrap();
         let split = split.as_ref().unwrap();
         assert!(split.split_impulse && split.method == SolverMethod::Auto);
         assert_eq!((split.substeps, split.iterations), (2, 4));
