@@ -66,11 +66,13 @@ enum Command {
         /// contact points four at a time in SIMD lanes (0 = never; default: the scene's).
         #[arg(long)]
         simd_island_contacts: Option<u32>,
-        /// Start from a preset instead of the scene's solver settings: `fast` (8 substeps of
-        /// one PGS and one relax sweep on 120 Hz soft contacts with a 1 mm slop; see
-        /// `SolverSettings::fast`).
+        /// Start from a preset instead of the scene's solver settings, named by speed or by the
+        /// quality bar it meets on the standard scenes (E = largest of sink, overlap and drift
+        /// after 10 s): `fast`/`q50` (the soft step at 8 substeps, E ≤ 50 mm), `default`/`q5`
+        /// (20 substeps, E ≤ 5 mm), `precise`/`q1` (40 substeps, E ≤ 1 mm on stacks) or
+        /// `reference` (NNCG with split impulse and the exact path: the LCP solved tightly).
         /// The other options apply on top of it; sleeping keeps the scene's setting.
-        #[arg(long)]
+        #[arg(long, alias = "quality")]
         preset: Option<String>,
         /// `auto`: escalate an island whose last iteration changed a row velocity by more
         /// than this (m/s).
@@ -278,16 +280,15 @@ fn real_main() -> Result<ExitCode> {
         } => {
             let mut scene = resolve_scene(&scene)?;
             if let Some(preset) = preset {
-                scene.solver = match preset.as_str() {
-                    "fast" => SolverSettings {
-                        sleep: scene.solver.sleep,
-                        ..SolverSettings::fast()
-                    },
-                    "default" => SolverSettings {
-                        sleep: scene.solver.sleep,
-                        ..SolverSettings::default()
-                    },
-                    other => bail!("unknown preset '{other}': expected fast or default"),
+                let Some(settings) = SolverSettings::preset(&preset) else {
+                    bail!(
+                        "unknown preset '{preset}': expected one of {} (or q50, q5, q1)",
+                        SolverSettings::PRESETS.join(", ")
+                    );
+                };
+                scene.solver = SolverSettings {
+                    sleep: scene.solver.sleep,
+                    ..settings
                 };
             }
             if let Some(substeps) = substeps {

@@ -343,12 +343,14 @@ impl IslandWorkspace {
         h: f32,
         bundled: bool,
         with_repair: bool,
+        half_turn: bool,
     ) {
         let iterations = if with_repair {
             settings.iterations
         } else {
             settings.relax_iterations
         };
+        let friction = !with_repair || settings.main_solve_friction();
         if !bundled {
             self.position_repair = constraints::update_targets(
                 constraints,
@@ -358,7 +360,14 @@ impl IslandWorkspace {
                 h,
                 with_repair,
             );
-            self.solve(constraints, settings, iterations, with_repair);
+            self.solve(
+                constraints,
+                settings,
+                iterations,
+                with_repair,
+                friction,
+                half_turn,
+            );
             return;
         }
         let outcome = self.bundles.solve_pgs(
@@ -374,6 +383,8 @@ impl IslandWorkspace {
                 settings,
                 h,
                 with_repair,
+                friction,
+                half_turn,
             },
         );
         self.report.iterations += outcome.iterations;
@@ -390,6 +401,8 @@ impl IslandWorkspace {
         settings: &SolverSettings,
         iterations: u32,
         escalate: bool,
+        friction: bool,
+        half_turn: bool,
     ) {
         let mut velocities = Velocities {
             linear: &mut self.linear,
@@ -414,12 +427,14 @@ impl IslandWorkspace {
             )
         };
         let outcome = match settings.method {
-            SolverMethod::Pgs => solver::solve_pgs(
+            SolverMethod::Pgs => solver::solve_pgs_rows(
                 constraints,
                 sweep,
                 iterations,
                 settings.tolerance,
                 &mut velocities,
+                friction,
+                half_turn,
             ),
             SolverMethod::Nncg => {
                 report.method = EscalationLevel::Nncg;
@@ -586,7 +601,12 @@ pub fn step_island(
         && (coloured_threads || (bundled && w.bundles.parallel()));
     let h = dt / settings.substeps as f32;
     let moving = slots - 1;
-    for _ in 0..settings.substeps {
+    for substep in 0..settings.substeps {
+        // Every other substep, PGS takes each manifold's points from halfway round (see
+        // `simd::sweep_groups`), so that no corner of a face always goes first. Split
+        // impulse keeps one order: its rigid rows are solved to the tolerance, where the order
+        // matters little, and its results are compared with exact solutions.
+        let half_turn = substep % 2 == 1 && !settings.split_impulse;
         integrate::prospective_velocities(&mut w.linear[..moving], gravity, h);
         let mut velocities = Velocities {
             linear: &mut w.linear,
@@ -598,7 +618,7 @@ pub fn step_island(
             solver::warm_start(constraints, &mut velocities);
         }
         w.position_repair = false;
-        w.targets_and_solve(constraints, settings, h, bundled, true);
+        w.targets_and_solve(constraints, settings, h, bundled, true, half_turn);
         // With no row to repair beyond the tolerance, positions move with the velocities alone
         // (at rest, the usual case in a pile; see `constraints::update_targets`).
         let split = settings.split_impulse && w.position_repair;
@@ -655,7 +675,7 @@ pub fn step_island(
             );
         }
         if settings.relax_iterations > 0 && !settings.split_impulse {
-            w.targets_and_solve(constraints, settings, h, bundled, false);
+            w.targets_and_solve(constraints, settings, h, bundled, false, half_turn);
         }
     }
     if bundled {
@@ -682,6 +702,8 @@ pub fn step_island(
             constraints,
             settings,
             settings.iterations.max(settings.relax_iterations),
+            false,
+            true,
             false,
         );
     }

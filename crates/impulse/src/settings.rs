@@ -6,13 +6,15 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum SolverMethod {
-    /// Projected Gauss-Seidel, the seed's method (sweeps in alternating direction).
+    /// Projected Gauss-Seidel, the seed's method (sweeps in alternating direction); the
+    /// default, in the soft step ([`SolverSettings::soft_step`]).
+    #[default]
     Pgs,
     /// Nonsmooth nonlinear conjugate gradient over PGS sweeps (Silcowitz et al. 2010).
     Nncg,
     /// Accelerated projected gradient descent with adaptive restart (Mazhar et al. 2015).
     Apgd,
-    /// The automatic policy, per island and solve (the default): NNCG within the iteration
+    /// The automatic policy, per island and solve ([`SolverSettings::reference`]): NNCG within the iteration
     /// budget; an island whose last iteration still changed a row's velocity by more than
     /// `escalation_tolerance`, or whose mass ratio exceeds `mass_ratio_threshold`, escalates:
     /// to the exact path when it has at most `exact_max_contacts` contact points (keeping the
@@ -24,7 +26,6 @@ pub enum SolverMethod {
     /// step diagnostics. It starts from NNCG rather than plain PGS because an NNCG iteration
     /// is a symmetric PGS sweep plus a momentum step, and on every standard scene it reached a
     /// given sink at less cost than PGS first (docs/solvers.md).
-    #[default]
     Auto,
 }
 
@@ -119,6 +120,16 @@ pub struct SolverSettings {
     pub time_to_sleep: f32,
     /// Apply Coulomb friction rows (two tangents per point, |γ_t| ≤ μ·γ_n).
     pub friction: bool,
+    /// Solve the friction rows in the main (repairing) solve as well as in the relax solve.
+    /// When false (the default), `pgs` with a relax solve (soft or bias repair, not split
+    /// impulse) sweeps only the normal rows while it repairs overlap, and the friction rows
+    /// with the normal rows in the relax solve, where the targets carry no repair: friction
+    /// then never works against the repair velocity, which in a pile otherwise pushes the
+    /// lower bodies sideways and spreads the pile (Rapier's `friction_in_bias_pass`, off by
+    /// default, makes the same choice). The friction impulses are applied throughout (warm
+    /// start). Other methods, split impulse, and solves without a relax solve always sweep
+    /// friction with the normal rows ([`Self::main_solve_friction`]).
+    pub friction_in_main_solve: bool,
     /// Islands with at least this many contact points are swept colour by colour (greedy graph
     /// colouring: no two points of a colour share a moving body), one colour's points spread
     /// over all worker threads; 0 = never (default). Colour order converges more slowly than
@@ -139,36 +150,103 @@ pub struct SolverSettings {
 }
 
 impl SolverSettings {
-    /// Speed before accuracy, in the manner of Box2D v3's soft step and Rapier's TGS-soft:
-    /// 8 substeps of one PGS sweep and one relax sweep, soft contacts of 120 Hz (ζ = 10; capped
-    /// at a quarter of the substep rate), no split impulse, so large islands run in SIMD lanes,
-    /// and an overlap slop of 1 mm (Rapier's allowed linear error): soft rows sink to the slop
-    /// under load before the spring pushes back, so a pile sinks by about the slop per layer
-    /// (pyramid20: 41.6 mm with the default 2 mm, 21.8 mm with 1 mm; docs/benchmarks.md,
-    /// session 11). On the standard scenes it stands with sinks of centimetres where the
-    /// default sinks fractions of a millimetre (docs/benchmarks.md, "impulse fast"); the LCP is
-    /// solved loosely, so the per-step residual is large. Everything else as [`Default`].
-    pub fn fast() -> Self {
+    /// Whether the main solve sweeps the friction rows: see [`Self::friction_in_main_solve`].
+    pub fn main_solve_friction(&self) -> bool {
+        self.friction_in_main_solve
+            || self.method != SolverMethod::Pgs
+            || self.split_impulse
+            || self.relax_iterations == 0
+    }
+
+    /// The soft step at `substeps` substeps: one PGS sweep of the normal rows with overlap
+    /// repair on soft contacts, position integration, and one relax sweep of all rows, per
+    /// substep (Box2D v3's soft step; Rapier's TGS-soft solves contacts the same way). The
+    /// contact spring is as stiff as the substep allows, a quarter of the substep rate
+    /// (15·`substeps` Hz at dt = 1/60 s), with ζ = 10, and there is no overlap slop: a soft
+    /// row's spring holds its load at a depth proportional to the load, so a slop below which
+    /// nothing is repaired would add one slop of sink per layer of a pile. Large islands run in
+    /// SIMD lanes. The quality error of the standard scenes falls about as 1/`substeps`²
+    /// (docs/benchmarks.md, "The front"). Overlap is repaired at most at 0.5 m/s per contact:
+    /// a repair velocity is partly kept by the bodies it separates and adds up along a chain of
+    /// overlapping bodies (the `overlap_pyramid` scene, 25 % overlapped, ejects bodies at up to
+    /// about eight times the cap; at 1 m/s a row of it flew apart and the pile fell).
+    /// Everything else as [`Self::default`].
+    pub fn soft_step(substeps: u32) -> Self {
+        let substeps = substeps.max(1);
         Self {
             method: SolverMethod::Pgs,
-            substeps: 8,
+            substeps,
             iterations: 1,
             relax_iterations: 1,
             split_impulse: false,
-            soft_contact_hertz: 120.0,
+            soft_contact_hertz: 15.0 * substeps as f32,
             soft_damping_ratio: 10.0,
-            overlap_slop: 0.001,
+            overlap_slop: 0.0,
+            max_repair_speed: 0.5,
+            ..Self::default()
+        }
+    }
+
+    /// The named presets, cheapest first, with the quality bar each meets on the standard
+    /// scenes at dt = 1/60 s (E, the largest of top sink, overlap and drift after 10 s):
+    /// `fast` (E ≤ 50 mm, [`Self::fast`]), `default` (E ≤ 5 mm, [`Self::default`]), `precise`
+    /// (E ≤ 1 mm on stacks and heavy-on-light, [`Self::precise`]) and `reference`
+    /// ([`Self::reference`]: the LCP solved tightly, for research).
+    pub const PRESETS: [&'static str; 4] = ["fast", "default", "precise", "reference"];
+
+    /// The preset called `name` (see [`Self::PRESETS`]; `q50`, `q5` and `q1` name `fast`,
+    /// `default` and `precise` by their bar); `None` for an unknown name.
+    pub fn preset(name: &str) -> Option<Self> {
+        match name {
+            "fast" | "q50" => Some(Self::fast()),
+            "default" | "q5" => Some(Self::default()),
+            "precise" | "q1" => Some(Self::precise()),
+            "reference" => Some(Self::reference()),
+            _ => None,
+        }
+    }
+
+    /// Speed before accuracy: the soft step at 8 substeps (120 Hz contacts). Meets E ≤ 50 mm
+    /// on the standard scenes (docs/benchmarks.md, "The front").
+    pub fn fast() -> Self {
+        Self::soft_step(8)
+    }
+
+    /// The soft step at 40 substeps (600 Hz contacts): E ≤ 1 mm on stacks and heavy-on-light,
+    /// about 1 mm on pyramids (docs/benchmarks.md, "The front").
+    pub fn precise() -> Self {
+        Self::soft_step(40)
+    }
+
+    /// The LCP solved tightly rather than cheaply, for reference and research: the automatic
+    /// policy (NNCG, escalating per island to more iterations or the exact path), 4 substeps of
+    /// at most 8 iterations, rigid velocity rows with split-impulse overlap repair (12/s above
+    /// a 2 mm slop). Its per-step residual is small and its LCP can be compared with an exact
+    /// solution; it costs several times the default for the same quality on stacks.
+    pub fn reference() -> Self {
+        Self {
+            method: SolverMethod::Auto,
+            substeps: 4,
+            iterations: 8,
+            relax_iterations: 1,
+            split_impulse: true,
+            soft_contact_hertz: 0.0,
+            overlap_slop: 0.002,
+            max_repair_speed: 1.0,
             ..Self::default()
         }
     }
 }
 
+/// The default: the soft step at 20 substeps (300 Hz contacts), the cheapest setting found
+/// to meet E ≤ 5 mm on every standard scene (docs/benchmarks.md, "The front"). Other presets:
+/// [`SolverSettings::PRESETS`].
 impl Default for SolverSettings {
     fn default() -> Self {
         Self {
-            method: SolverMethod::default(),
-            substeps: 4,
-            iterations: 8,
+            method: SolverMethod::Pgs,
+            substeps: 20,
+            iterations: 1,
             relax_iterations: 1,
             tolerance: 1e-5,
             escalation_tolerance: 3e-4,
@@ -177,12 +255,12 @@ impl Default for SolverSettings {
             exact_max_contacts: 32,
             restitution_threshold: 0.5,
             overlap_repair_rate: 12.0,
-            split_impulse: true,
+            split_impulse: false,
             position_iterations: 16,
-            soft_contact_hertz: 0.0,
+            soft_contact_hertz: 300.0,
             soft_damping_ratio: 10.0,
-            overlap_slop: 0.002,
-            max_repair_speed: 1.0,
+            overlap_slop: 0.0,
+            max_repair_speed: 0.5,
             warm_start: 1.0,
             prediction_distance: 0.02,
             sleep: true,
@@ -190,6 +268,7 @@ impl Default for SolverSettings {
             sleep_angular_speed: 2.0f32.to_radians(),
             time_to_sleep: 0.5,
             friction: true,
+            friction_in_main_solve: false,
             parallel_island_contacts: 0,
             simd_island_contacts: 16,
         }

@@ -506,7 +506,11 @@ impl Bundles {
 
     /// Applies the accumulated impulses to the velocities ([`crate::solver::warm_start`]).
     pub fn warm_start(&mut self, velocities: &mut Velocities<'_>) {
-        self.sweep(true, velocities, WarmStart, NoTargets);
+        let order = SweepOrder {
+            forward: true,
+            half_turn: false,
+        };
+        self.sweep(order, velocities, WarmStart, NoTargets);
     }
 
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
@@ -516,7 +520,7 @@ impl Bundles {
     /// lane groups ([`crate::solver::colour_after_colour`]).
     fn sweep<F, T>(
         &mut self,
-        forward: bool,
+        order: SweepOrder,
         velocities: &mut Velocities<'_>,
         update: F,
         targets: T,
@@ -536,15 +540,7 @@ impl Bundles {
             // below the island's slot count (the velocities' length); the bundles and the
             // velocities are borrowed exclusively here.
             return unsafe {
-                sweep_groups(
-                    &self.groups,
-                    bundles,
-                    len,
-                    forward,
-                    &shared,
-                    update,
-                    targets,
-                )
+                sweep_groups(&self.groups, bundles, len, order, &shared, update, targets)
             };
         }
         // Runs `update` on a run of lane groups of one colour, in order or in reverse.
@@ -554,14 +550,15 @@ impl Bundles {
             let (shared, bundles) = (shared, bundles);
             // SAFETY: as above, and within one colour no other lane group touches this run's
             // bundles or its lanes' moving slots (the immovable slot is only read).
-            unsafe { sweep_groups(part, bundles, len, forward, &shared, update, targets) }
+            let order = SweepOrder { forward, ..order };
+            unsafe { sweep_groups(part, bundles, len, order, &shared, update, targets) }
         };
         let starts = &self.group_colour_starts;
         crate::solver::colour_after_colour(
             &mut self.groups,
             starts.len() - 1,
             |k| starts[k],
-            forward,
+            order.forward,
             COLOURS,
             GROUPS_PER_TASK,
             Lane::splat(0.0),
@@ -587,15 +584,18 @@ impl Bundles {
         targets: &TargetInputs<'_>,
     ) -> SolveReport {
         let mut report = SolveReport::default();
+        let (friction, half_turn) = (targets.friction, targets.half_turn);
         // Out of `self` while the sweeps borrow it mutably; only read.
         let geometry = std::mem::take(&mut self.geometry);
         let targets = Targets::new(targets, &geometry);
         for iteration in 0..iterations {
             let forward = iteration % 2 == 0;
-            let largest = if iteration == 0 {
-                self.sweep(forward, velocities, VelocityRows, &targets)
-            } else {
-                self.sweep(forward, velocities, VelocityRows, NoTargets)
+            let order = SweepOrder { forward, half_turn };
+            let largest = match (iteration == 0, friction) {
+                (true, true) => self.sweep(order, velocities, VelocityRows::<true>, &targets),
+                (true, false) => self.sweep(order, velocities, VelocityRows::<false>, &targets),
+                (false, true) => self.sweep(order, velocities, VelocityRows::<true>, NoTargets),
+                (false, false) => self.sweep(order, velocities, VelocityRows::<false>, NoTargets),
             };
             let largest_change = largest.to_array().into_iter().fold(0.0f32, f32::max);
             report.iterations += 1;
@@ -618,13 +618,14 @@ trait BundleUpdate: Copy + Sync {
 }
 
 /// The velocity rows ([`solve_bundle`]).
+/// Without `FRICTION`, the normal rows alone (see [`solve_bundle`]).
 #[derive(Clone, Copy)]
-struct VelocityRows;
+struct VelocityRows<const FRICTION: bool = true>;
 
-impl BundleUpdate for VelocityRows {
+impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
     #[inline(always)]
     fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane {
-        solve_bundle(b, v)
+        solve_bundle::<FRICTION>(b, v)
     }
 }
 
@@ -678,6 +679,11 @@ pub struct TargetInputs<'a> {
     pub h: f32,
     /// Main solve (overlap repair on), or relax solve (off).
     pub with_repair: bool,
+    /// Whether the solve sweeps the friction rows too, or the normal rows alone.
+    pub friction: bool,
+    /// Whether each manifold group's points are taken starting halfway round the group
+    /// (points 2, 3, 0, 1 of four) instead of from its first point (see [`sweep_groups`]).
+    pub half_turn: bool,
 }
 
 /// The target update's constants as lanes, and what it reads.
@@ -755,12 +761,28 @@ impl SetTargets for &Targets<'_> {
     }
 }
 
+/// The order of a sweep: lane groups first to last (`forward`) or last to first, and each
+/// group's bundles from its first (or, backward, its last) or, with `half_turn`, from halfway
+/// round (two, three, zero, one of four).
+#[derive(Clone, Copy)]
+struct SweepOrder {
+    forward: bool,
+    half_turn: bool,
+}
+
 /// Fewest lane groups of one colour in a part run on its own thread: a colour of at most this
 /// many runs as one part.
 const GROUPS_PER_TASK: usize = 8;
 
 /// Runs `update` on the bundles of `groups` in order (`forward`) or in reverse, the bundles of
-/// each group in the same direction, with the group's bodies gathered once and scattered once.
+/// each group in the same direction, from the group's first bundle or, with `half_turn`, from
+/// halfway round it; the group's bodies are gathered once and scattered once.
+///
+/// The half turn is why a resting stack stays still. With one sweep a solve, the point of a
+/// face updated first takes more of the load than the others in every substep, a steady torque
+/// that set a 30-cube stack swaying by millimetres; a box face's points go round the face, so
+/// starting halfway round in every other substep puts the diagonally opposite corner first and
+/// the torques cancel. Reversing the group instead leaves the first point on the same side.
 /// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first: a bundle is 16 cache lines, and
 /// once an island's bundles outgrow L2 (pyramid100: 17 MB) the sweep waited on L3 for them,
 /// which the hardware prefetcher did not hide (asking ahead made a one-thread `fast` pyramid100
@@ -776,7 +798,7 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
     groups: &[Group],
     bundles: SharedItems<Bundle>,
     len: usize,
-    forward: bool,
+    SweepOrder { forward, half_turn }: SweepOrder,
     velocities: &SharedVelocities,
     update: F,
     targets: T,
@@ -795,7 +817,9 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
         };
         let mut v = unsafe { velocities.gather(&slots_a, &slots_b) };
         let moved = targets.moved(&slots_a, &slots_b);
+        let turn = if half_turn { count / 2 } else { 0 };
         for p in 0..count {
+            let p = (p + turn) % count;
             let index = if forward {
                 start + p
             } else {
@@ -960,8 +984,30 @@ fn set_vec(lanes: &mut LaneVec, i: usize, value: Vec3) {
 /// `fast` fell). The Newton iteration, a bundle waiting on its slowest lane, was about a third
 /// of a `fast` pyramid20 step; this step made it 1.4× faster (docs/benchmarks.md).
 #[inline(always)]
-fn solve_bundle(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
+fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
     let zero = Lane::splat(0.0);
+    let masses = (b.inverse_mass_a, b.inverse_mass_b);
+    let mut largest = zero;
+    if FRICTION {
+        largest = solve_friction(b, v);
+    }
+    let row = &b.normal;
+    let velocity = row.velocity(v);
+    let old = b.normal_impulse;
+    let new = (old + row.effective_mass * b.mass_scale * (b.target - velocity)
+        - b.impulse_scale * old)
+        .max(zero);
+    let delta = new - old;
+    b.normal_impulse = new;
+    b.max_normal_impulse = b.max_normal_impulse.max(new);
+    row.apply(delta, masses, v);
+    largest.max(delta.abs() * row.inverse_effective_mass)
+}
+
+/// The friction pair's part of [`solve_bundle`]: returns each lane's larger tangent row
+/// velocity change (m/s).
+#[inline(always)]
+fn solve_friction(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
     let masses = (b.inverse_mass_a, b.inverse_mass_b);
     let [t1, t2] = &b.tangents;
     let v1 = t1.velocity(v);
@@ -978,21 +1024,7 @@ fn solve_bundle(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
     b.tangent_impulses = new;
     t1.apply(d1, masses, v);
     t2.apply(d2, masses, v);
-    let mut largest =
-        (d1.abs() * t1.inverse_effective_mass).max(d2.abs() * t2.inverse_effective_mass);
-
-    let row = &b.normal;
-    let velocity = row.velocity(v);
-    let old = b.normal_impulse;
-    let new = (old + row.effective_mass * b.mass_scale * (b.target - velocity)
-        - b.impulse_scale * old)
-        .max(zero);
-    let delta = new - old;
-    b.normal_impulse = new;
-    b.max_normal_impulse = b.max_normal_impulse.max(new);
-    row.apply(delta, masses, v);
-    largest = largest.max(delta.abs() * row.inverse_effective_mass);
-    largest
+    (d1.abs() * t1.inverse_effective_mass).max(d2.abs() * t2.inverse_effective_mass)
 }
 
 /// The friction pair's update of [`solve_bundle`] per lane: from impulses `old` (N·s) and the

@@ -317,14 +317,15 @@ trait PointUpdate: Copy + Sync {
     fn update(self, c: &mut ContactConstraint, velocities: [Vec3; 4]) -> ([Vec3; 4], f32);
 }
 
-/// The velocity rows of a point ([`solve_point`]).
+/// The velocity rows of a point ([`solve_point`]); without `FRICTION`, the normal row alone
+/// (the friction impulses stay as they are, still applied to the bodies).
 #[derive(Clone, Copy)]
-struct VelocityRows;
+struct VelocityRows<const FRICTION: bool = true>;
 
-impl PointUpdate for VelocityRows {
+impl<const FRICTION: bool> PointUpdate for VelocityRows<FRICTION> {
     #[inline(always)]
     fn update(self, c: &mut ContactConstraint, velocities: [Vec3; 4]) -> ([Vec3; 4], f32) {
-        solve_point(c, velocities)
+        solve_point::<FRICTION>(c, velocities)
     }
 }
 
@@ -339,12 +340,54 @@ impl PointUpdate for PositionRows {
     }
 }
 
-/// Runs `update` on `points` in order (`forward`) or in reverse on this thread, asking the CPU
-/// for the point [`PREFETCH_POINTS`] ahead first; returns the largest change.
+/// The order of a sweep over points: first to last (`forward`) or last to first, and with
+/// `half_turn` each run of consecutive points between the same two bodies from halfway round.
+#[derive(Clone, Copy)]
+struct PointOrder {
+    forward: bool,
+    half_turn: bool,
+}
+
+/// First to last, each manifold from its first point.
+const FORWARD: PointOrder = PointOrder {
+    forward: true,
+    half_turn: false,
+};
+
+/// Last to first.
+const BACKWARD: PointOrder = PointOrder {
+    forward: false,
+    half_turn: false,
+};
+
+/// The point a sweep updates at `step` of `points`: in order or reversed, and with a half
+/// turn, within the run of points between the same two bodies, `len / 2` places further round.
+#[inline(always)]
+fn point_at(points: &[ContactConstraint], step: usize, order: PointOrder) -> usize {
+    let n = points.len();
+    let k = if order.forward { step } else { n - 1 - step };
+    if !order.half_turn {
+        return k;
+    }
+    let pair = |i: usize| (points[i].local_a, points[i].local_b);
+    let mut start = k;
+    while start > 0 && pair(start - 1) == pair(k) {
+        start -= 1;
+    }
+    let mut end = k + 1;
+    while end < n && pair(end) == pair(k) {
+        end += 1;
+    }
+    let len = end - start;
+    start + (k - start + len / 2) % len
+}
+
+/// Runs `update` on `points` in `order` on this thread, asking the CPU for the point
+/// [`PREFETCH_POINTS`] ahead first; returns the largest change.
 #[inline(always)]
 fn sweep_sequential<F>(
     points: &mut [ContactConstraint],
-    forward: bool,
+    order: PointOrder,
     velocities: &mut Velocities<'_>,
     update: F,
 ) -> f32
@@ -354,10 +397,15 @@ where
     let mut largest = 0.0f32;
     let n = points.len();
     for step in 0..n {
-        let (k, ahead) = if forward {
+        let (k, ahead) = if order.forward {
             (step, step + PREFETCH_POINTS)
         } else {
             (n - 1 - step, (n - 1 - step).wrapping_sub(PREFETCH_POINTS))
+        };
+        let k = if order.half_turn {
+            point_at(points, step, order)
+        } else {
+            k
         };
         if let Some(next) = points.get(ahead) {
             prefetch_lines(next);
@@ -403,16 +451,17 @@ pub(crate) fn prefetch_lines<T>(value: &T) {
 fn sweep_points<F>(
     constraints: &mut [ContactConstraint],
     sweep: Sweep<'_>,
-    forward: bool,
+    order: PointOrder,
     velocities: &mut Velocities<'_>,
     update: F,
 ) -> f32
 where
     F: PointUpdate,
 {
+    let forward = order.forward;
     let sequential =
-        |constraints: &mut [ContactConstraint], velocities: &mut Velocities<'_>, forward: bool| {
-            sweep_sequential(constraints, forward, velocities, update)
+        |constraints: &mut [ContactConstraint], velocities: &mut Velocities<'_>, order| {
+            sweep_sequential(constraints, order, velocities, update)
         };
     let colours = sweep.starts.len().saturating_sub(1);
     let slots = velocities.linear.len().min(velocities.angular.len());
@@ -426,7 +475,7 @@ where
                 .all(|c| (c.local_a as usize) < slots && (c.local_b as usize) < slots)
     );
     if !coloured || !sweep.parallel || rayon::current_num_threads() < 2 {
-        return sequential(constraints, velocities, forward);
+        return sequential(constraints, velocities, order);
     }
     let shared = SharedVelocities {
         linear: velocities.linear.as_mut_ptr(),
@@ -616,18 +665,45 @@ pub fn solve_pgs(
     tolerance: f32,
     velocities: &mut Velocities<'_>,
 ) -> SolveReport {
+    solve_pgs_rows(
+        constraints,
+        sweep,
+        iterations,
+        tolerance,
+        velocities,
+        true,
+        false,
+    )
+}
+
+/// [`solve_pgs`], with the friction rows left out when `friction` is false: the normal rows
+/// alone are swept and the friction impulses stay as they are (still applied to the bodies).
+/// The soft step's repairing solve runs this way when a relax solve follows that solves the
+/// friction ([`crate::SolverSettings::friction_in_main_solve`]). With `half_turn`, each run of
+/// consecutive points between the same two bodies (a manifold) is taken from halfway round (the
+/// soft step does so every other substep, so that no corner of a face is always updated first;
+/// see [`crate::simd`]'s sweep); sweeps colour by colour over threads ignore it.
+pub fn solve_pgs_rows(
+    constraints: &mut [ContactConstraint],
+    sweep: Sweep<'_>,
+    iterations: u32,
+    tolerance: f32,
+    velocities: &mut Velocities<'_>,
+    friction: bool,
+    half_turn: bool,
+) -> SolveReport {
     let mut report = SolveReport::default();
     for iteration in 0..iterations {
         // Alternating sweep direction (symmetric Gauss-Seidel): on a stack, a sweep from the
         // ground up carries support upwards and one from the top down carries weight downwards,
         // so alternating converges far faster than either direction alone.
-        let largest_change = sweep_points(
-            constraints,
-            sweep,
-            iteration % 2 == 0,
-            velocities,
-            VelocityRows,
-        );
+        let forward = iteration % 2 == 0;
+        let order = PointOrder { forward, half_turn };
+        let largest_change = if friction {
+            sweep_points(constraints, sweep, order, velocities, VelocityRows::<true>)
+        } else {
+            sweep_points(constraints, sweep, order, velocities, VelocityRows::<false>)
+        };
         report.iterations += 1;
         report.last_change = largest_change;
         if largest_change <= tolerance {
@@ -680,8 +756,20 @@ pub fn solve_nncg(
     for iteration in 0..iterations {
         // One fixed symmetric sweep (forward then backward) is the "PGS step": conjugate
         // directions need the same operator every iteration.
-        let forward = sweep_points(constraints, sweep, true, velocities, VelocityRows);
-        let backward = sweep_points(constraints, sweep, false, velocities, VelocityRows);
+        let forward = sweep_points(
+            constraints,
+            sweep,
+            FORWARD,
+            velocities,
+            VelocityRows::<true>,
+        );
+        let backward = sweep_points(
+            constraints,
+            sweep,
+            BACKWARD,
+            velocities,
+            VelocityRows::<true>,
+        );
         let largest_change = forward.max(backward);
         report.iterations += 1;
         report.last_change = largest_change;
@@ -871,17 +959,17 @@ impl Momentum {
 }
 
 /// One Gauss-Seidel update of a contact point's rows: the friction pair as a 2×2 block
-/// projected onto Coulomb's disc, then the normal row clamped to γ_n ≥ 0. Returns the largest
-/// row velocity change it caused (m/s). The two bodies' velocities (linear and angular of A,
-/// then of B) come in and go out by value, so they stay in registers.
+/// projected onto Coulomb's disc (when `FRICTION`), then the normal row clamped to γ_n ≥ 0.
+/// Returns the largest row velocity change it caused (m/s). The two bodies' velocities (linear
+/// and angular of A, then of B) come in and go out by value, so they stay in registers.
 #[inline(always)]
-fn solve_point(
+fn solve_point<const FRICTION: bool>(
     c: &mut ContactConstraint,
     [mut la, mut aa, mut lb, mut ab]: [Vec3; 4],
 ) -> ([Vec3; 4], f32) {
     let (ima, imb) = (c.inverse_mass_a, c.inverse_mass_b);
     let mut largest_change = 0.0f32;
-    if c.friction > 0.0 {
+    if FRICTION && c.friction > 0.0 {
         let [t1, t2] = &c.tangents;
         let v1 = t1.velocity(la, aa, lb, ab);
         let v2 = t2.velocity(la, aa, lb, ab);
@@ -969,7 +1057,7 @@ pub fn solve_positions(
     velocities: &mut Velocities<'_>,
 ) -> u32 {
     for iteration in 0..iterations {
-        let largest_change = sweep_points(constraints, sweep, true, velocities, PositionRows);
+        let largest_change = sweep_points(constraints, sweep, FORWARD, velocities, PositionRows);
         if largest_change <= tolerance {
             return iteration + 1;
         }

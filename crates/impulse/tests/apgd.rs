@@ -41,7 +41,7 @@ fn settings(friction: bool) -> SolverSettings {
         relax_iterations: 30,
         friction,
         sleep: false,
-        ..SolverSettings::default()
+        ..SolverSettings::reference()
     }
 }
 

@@ -1,5 +1,5 @@
-//! The automatic solver policy (`method: auto`, the default): what it chooses per island is
-//! reported, and the escalations it makes hold the seed's hard cases still.
+//! The automatic solver policy (`method: auto`, the `reference` preset): what it chooses per
+//! island is reported, and the escalations it makes hold the seed's hard cases still.
 
 mod common;
 
@@ -8,15 +8,18 @@ use impulse::island::EscalationLevel;
 use impulse::scene::builtin::builtin_scene;
 use impulse::settings::SolverMethod;
 
-/// Steps `name` (sleeping off) for `steps`; returns the world and, per step, the islands'
-/// reports.
+/// Steps `name` with the `reference` preset (sleeping off) for `steps`; returns the world and,
+/// per step, the islands' reports.
 fn run(
     name: &str,
     steps: u32,
     edit: impl Fn(&mut impulse::SolverSettings),
 ) -> (World, Vec<Vec<impulse::island::IslandReport>>) {
     let mut scene = builtin_scene(name).expect("built-in scene");
-    scene.solver.sleep = false;
+    scene.solver = impulse::SolverSettings {
+        sleep: false,
+        ..impulse::SolverSettings::reference()
+    };
     edit(&mut scene.solver);
     let mut world = World::from_scene(&scene).unwrap();
     let mut reports = Vec::new();
@@ -118,7 +121,7 @@ fn landing_column(speed: f32, top_mass: Option<f32>) -> World {
         sleep: false,
         iterations: 1,
         escalation_tolerance: 0.0,
-        ..impulse::SolverSettings::default()
+        ..impulse::SolverSettings::reference()
     };
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
     let material = common::material(0.3);

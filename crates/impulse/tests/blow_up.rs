@@ -21,7 +21,7 @@ fn a_solve_that_creates_energy_stops_with_the_step() {
         iterations: 1,
         position_iterations: 1,
         sleep: false,
-        ..SolverSettings::default()
+        ..SolverSettings::reference()
     };
     let mut world = World::from_scene(&scene).unwrap();
     world.parallel = false;

@@ -43,7 +43,7 @@ fn pile(friction: bool) -> World {
         tolerance: 0.0,
         friction,
         sleep: false,
-        ..SolverSettings::default()
+        ..SolverSettings::reference()
     };
     let mu = if friction { 0.5 } else { 0.0 };
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();

@@ -182,7 +182,7 @@ fn settings() -> SolverSettings {
     SolverSettings {
         method: SolverMethod::Pgs,
         sleep: false,
-        ..SolverSettings::default()
+        ..SolverSettings::reference()
     }
 }
 

@@ -368,7 +368,7 @@ fn invalid_settings_are_rejected_before_stepping() {
     );
 }
 
-/// Split impulse (the default repair) moves an overlapping ball out of the ground by positions
+/// Split impulse (the `reference` preset's repair) moves an overlapping ball out of the ground by positions
 /// alone, exponentially towards the slop at `overlap_repair_rate`, without turning the repair
 /// into velocity. Once the repair left is within the solve tolerance, the position solve is
 /// skipped, and the ball then rests where it is.
@@ -376,7 +376,10 @@ fn invalid_settings_are_rejected_before_stepping() {
 fn split_impulse_repairs_an_overlap_down_to_the_slop_and_then_rests() {
     let mut w = world(Vec3::new(0.0, -9.81, 0.0));
     // Awake throughout: a sleeping ball would stop wherever the repair had got to.
-    w.settings.sleep = false;
+    w.settings = SolverSettings {
+        sleep: false,
+        ..SolverSettings::reference()
+    };
     ground(&mut w, 0.5);
     let radius = 0.5;
     let ball = w
