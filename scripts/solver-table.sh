@@ -11,14 +11,16 @@ if [ ${#scenes[@]} -eq 0 ]; then
   scenes=(pyramid20 stack30 massratio vertical_stack15 mass_ratio_pyramid100 mass_ratio_pyramid300 plate card_house arch overlap_pyramid)
 fi
 configs=(
-  "seed: PGS, 1 solve/step, velocity bias|--substeps 1 --relax 0 --method pgs --iterations 20 --repair bias"
-  "PGS, 4 substeps, bias + relax|--method pgs --repair bias"
-  "NNCG, 4 substeps, bias + relax|--method nncg --repair bias"
-  "NNCG, 4 substeps, soft step (30 Hz, ζ = 10)|--method nncg --repair soft"
-  "PGS, 4 substeps, split impulse|--method pgs"
-  "NNCG, 4 substeps, split impulse|--method nncg"
-  "APGD, 4 substeps, split impulse|--method apgd"
-  "default: auto (NNCG → exact or more NNCG), split impulse|"
+  "seed: PGS, 1 solve/step, velocity bias|--preset reference --substeps 1 --relax 0 --method pgs --iterations 20 --repair bias"
+  "PGS, 4 substeps, bias + relax|--preset reference --method pgs --repair bias"
+  "NNCG, 4 substeps, bias + relax|--preset reference --method nncg --repair bias"
+  "PGS, 4 substeps, split impulse|--preset reference --method pgs"
+  "NNCG, 4 substeps, split impulse|--preset reference --method nncg"
+  "APGD, 4 substeps, split impulse|--preset reference --method apgd"
+  "reference: auto (NNCG → exact or more NNCG), split impulse|--preset reference"
+  "fast: soft step, 8 substeps|--preset fast"
+  "default: soft step, 20 substeps|"
+  "precise: soft step, 40 substeps|--preset precise"
 )
 tmp=$(mktemp -d)
 echo "| scene | solver | top sink (mm) | largest overlap (mm) | kinetic energy at 10 s (J) | largest speed (m/s) | largest LCP residual | island solves | ms/step |"

@@ -639,10 +639,11 @@ bars Q50: E ≤ 50 mm, Q5: E ≤ 5 mm, Q1: E ≤ 1 mm. ms/step: median wall-cloc
 one thread, sleeping off, each setting run on its own with the engines interleaved. Time \
 impulse/rapier: impulse's ms/step over Rapier's, each at its cheapest setting meeting the bar \
 (< 1: impulse is faster); \"impulse only\" / \"rapier only\": only that engine has a setting \
-meeting the bar; \"—\": neither. impulse settings: `default` the scene's own, `fast` \
-`SolverSettings::fast()`, `pgs S×I softH` fast with S substeps × I sweeps and soft contacts of \
-H Hz (capped at a quarter of the substep rate), `default S×I` the default (auto, split impulse) \
-with S substeps × I iterations. Rapier settings: `S×HHz` S substeps, contact springs of H Hz \
+meeting the bar; \"—\": neither. impulse settings: `default` the scene's own (for the \
+built-in scenes `SolverSettings::default()`, the soft step at 20 substeps), the presets `fast`, \
+`precise` and `reference`, `soft S` the soft step at S substeps (one PGS sweep and one relax \
+sweep each, contacts of 15·S Hz), `soft S×I` the same with I sweeps, `reference S×I` the \
+reference preset (auto, split impulse) with S substeps × I iterations. Rapier settings: `S×HHz` S substeps, contact springs of H Hz \
 (fixed contacts 2·H), `coulomb` Coulomb friction instead of Rapier's default simplified \
 friction; Rapier's defaults are `4×30Hz`.";
 

@@ -89,6 +89,14 @@ enum Command {
         /// time in ms (JSON Lines).
         #[arg(long)]
         island_report: Option<PathBuf>,
+        /// Overlap (m) left unrepaired, so resting rigid contacts do not jitter (default: the
+        /// scene's; the soft-step presets use 0).
+        #[arg(long)]
+        overlap_slop: Option<f32>,
+        /// Sweep the friction rows in the soft step's main (repairing) solve too, not only in
+        /// its relax solve (see `SolverSettings::friction_in_main_solve`).
+        #[arg(long)]
+        friction_in_main_solve: bool,
         /// Soft contact frequency in Hz (0 = the seed's rigid rows with overlap repair c_d).
         #[arg(long)]
         soft_hertz: Option<f32>,
@@ -267,6 +275,8 @@ fn real_main() -> Result<ExitCode> {
             exact_max_contacts,
             island_report,
             soft_hertz,
+            overlap_slop,
+            friction_in_main_solve,
             warm_start,
             repair_rate,
             repair,
@@ -322,6 +332,12 @@ fn real_main() -> Result<ExitCode> {
                     }
                     other => bail!("unknown repair '{other}': expected bias, split or soft"),
                 }
+            }
+            if let Some(slop) = overlap_slop {
+                scene.solver.overlap_slop = slop;
+            }
+            if friction_in_main_solve {
+                scene.solver.friction_in_main_solve = true;
             }
             if let Some(hertz) = soft_hertz {
                 scene.solver.soft_contact_hertz = hertz;

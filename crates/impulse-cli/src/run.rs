@@ -61,6 +61,11 @@ pub struct Summary {
     pub top_body: Option<usize>,
     /// Initial y − final y of the top body (m).
     pub top_sink_m: f32,
+    /// Largest distance of a moving body from its start, over the sampled frames (m).
+    pub max_drift_m: f32,
+    /// The quality error E: the largest of |top sink|, largest overlap and largest drift (m),
+    /// measured as `impulse-bench` measures it (docs/benchmarks.md).
+    pub quality_error_m: f32,
     pub kinetic_energy_j: f32,
     /// Largest speed of any body at any step (m/s): a blow-up or an over-eager repair shows here.
     pub max_speed_m_s: f32,
@@ -92,8 +97,9 @@ impl Summary {
     pub fn line(&self) -> String {
         format!(
             "{}: {} bodies, {} steps of {:.4} s, mean contacts {:.0}, {:.3} ms/step ({:.0} steps/s), \
-             max overlap {:.2} mm, top sink {:.2} mm, kinetic energy {:.4} J, max speed {:.2} m/s, \
-             mean iterations {:.1}, LCP residual max {:.2e} last {:.2e}",
+             max overlap {:.2} mm, top sink {:.2} mm, max drift {:.2} mm (E {:.2} mm), kinetic \
+             energy {:.4} J, max speed {:.2} m/s, mean iterations {:.1}, LCP residual max {:.2e} \
+             last {:.2e}",
             self.scene,
             self.bodies,
             self.steps,
@@ -103,6 +109,8 @@ impl Summary {
             self.steps_per_second,
             self.max_overlap_m * 1e3,
             self.top_sink_m * 1e3,
+            self.max_drift_m * 1e3,
+            self.quality_error_m * 1e3,
             self.kinetic_energy_j,
             self.max_speed_m_s,
             self.mean_iterations,
@@ -160,6 +168,8 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
     }
     let top = metrics::top_body(&world.bodies);
     let top_y0 = top.map(|i| world.bodies.pose[i].translation.y);
+    let initial: Vec<_> = world.bodies.pose.iter().map(|p| p.translation).collect();
+    let mut max_drift = 0.0f32;
 
     let bar = if options.quiet {
         ProgressBar::hidden()
@@ -234,6 +244,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         if step % OVERLAP_SAMPLE_EVERY == 0 || step == steps {
             final_overlap = metrics::max_overlap(&world.bodies);
             max_overlap = max_overlap.max(final_overlap);
+            max_drift = max_drift.max(metrics::max_drift(&world.bodies, &initial));
         }
         if let Some(w) = writer.as_mut()
             && (step % every == 0 || step == steps)
@@ -247,6 +258,10 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
     let taken = step_ms.len().max(1) as f64;
     let mean_ms = step_ms.iter().sum::<f64>() / taken;
     let median_ms = median(&mut step_ms);
+    let top_sink = match (top, top_y0) {
+        (Some(i), Some(y0)) => y0 - world.bodies.pose[i].translation.y,
+        _ => 0.0,
+    };
     let summary = Summary {
         scene: scene.name.clone(),
         bodies: world.bodies.len(),
@@ -262,10 +277,9 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         max_overlap_m: max_overlap,
         final_overlap_m: final_overlap,
         top_body: top,
-        top_sink_m: match (top, top_y0) {
-            (Some(i), Some(y0)) => y0 - world.bodies.pose[i].translation.y,
-            _ => 0.0,
-        },
+        top_sink_m: top_sink,
+        max_drift_m: max_drift,
+        quality_error_m: top_sink.abs().max(max_overlap).max(max_drift),
         kinetic_energy_j: world.diagnostics().kinetic_energy,
         max_speed_m_s: max_speed,
         mean_contacts: contacts_sum as f64 / taken,
