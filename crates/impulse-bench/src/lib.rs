@@ -199,9 +199,9 @@ pub fn format_thread_table(rows: &[BenchRow], threads: usize) -> String {
 /// run slows both rows of a turn alike, so each turn's ratio keeps little of the drift, while
 /// the ratio of two medians can take them from different stretches of the run (a median of a
 /// run that lands and then rests falls wherever the two regimes meet). It cannot remove a
-/// slow-down that the turns themselves cause to one row only: on pyramid100, in some hours, a
-/// one-thread world taking turns with another ran 11–40 % slower than alone and a two-thread
-/// world did not (docs/benchmarks.md, session 13), so there the speed-up came out too high.
+/// slow-down that the turns themselves cause to one row only: on pyramid100 a one-thread world
+/// taking turns with another can run slower than alone while a two-thread world does not, and
+/// then the speed-up comes out too high (docs/benchmarks.md, "Threads").
 pub fn paired_speed_up(reference: &BenchRow, row: &BenchRow) -> Option<f64> {
     let mut ratios: Vec<f64> = reference
         .turn_ms

@@ -57,10 +57,9 @@ struct Args {
     /// Also measure impulse (and `--impulse-fast`) in a pool of N threads of its own, by turns
     /// with the rows on `--threads`: a thread speed-up measured in one run, which a machine
     /// whose speed drifts between runs cannot spoil. Prints a second table of speed-ups.
-    /// Caveat: on large scenes (pyramid100), in some hours, a one-thread world taking turns
-    /// with another ran 11–40 % slower than alone while a two-thread one did not, which
-    /// inflates the speed-up; separate runs alternated are the check (docs/benchmarks.md,
-    /// session 13).
+    /// Caveat: on large scenes (pyramid100) a one-thread world taking turns with another can
+    /// run slower than alone while a two-thread one does not, which inflates the speed-up;
+    /// separate runs alternated are the check (docs/benchmarks.md, "Threads").
     #[arg(long, value_name = "N")]
     also_threads: Option<usize>,
     /// Also write the table, the command and the machine to this Markdown file.

@@ -783,10 +783,11 @@ const GROUPS_PER_TASK: usize = 8;
 /// that set a 30-cube stack swaying by millimetres; a box face's points go round the face, so
 /// starting halfway round in every other substep puts the diagonally opposite corner first and
 /// the torques cancel. Reversing the group instead leaves the first point on the same side.
+///
 /// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first: a bundle is 16 cache lines, and
 /// once an island's bundles outgrow L2 (pyramid100: 17 MB) the sweep waited on L3 for them,
-/// which the hardware prefetcher did not hide (asking ahead made a one-thread `fast` pyramid100
-/// step about a fifth faster, docs/benchmarks.md, session 9). Groups lie in bundle order, so
+/// which the hardware prefetcher did not hide (asking ahead made a one-thread pyramid100 step
+/// about a fifth faster when it was added). Groups lie in bundle order, so
 /// the bundle ahead in memory is the one the sweep visits next.
 ///
 /// # Safety

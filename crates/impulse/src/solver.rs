@@ -154,7 +154,7 @@ pub(crate) fn greedy_colours(
 /// every wait ends on any nesting of rayon jobs;
 /// a thread that joins late, or never, leaves more chunks to the others. One contiguous chunk
 /// per thread keeps each thread's reads a single stream: chunks of 32 bundles claimed in turn
-/// were slower than the fork-joins, halves faster (docs/benchmarks.md, session 10). The
+/// were slower than the fork-joins, halves faster. The
 /// chunks of a colour touch disjoint bodies and colours run in order, so the result is the
 /// same on any number of threads (`combine` must not depend on order, as a maximum does not).
 #[allow(clippy::too_many_arguments)]
@@ -433,7 +433,7 @@ const PREFETCH_POINTS: usize = 4;
 
 /// Asks the CPU for every cache line of `value` (a hint: it never faults). Sweeps over rows or
 /// bundles that have outgrown L2 wait on L3 for them otherwise: the hardware prefetcher did not
-/// hide it (docs/benchmarks.md, session 9).
+/// hide it.
 #[inline(always)]
 pub(crate) fn prefetch_lines<T>(value: &T) {
     let start = (value as *const T).cast::<u8>();
