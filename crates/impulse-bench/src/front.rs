@@ -60,7 +60,7 @@ pub type ImpulseSetting = (String, Option<SolverSettings>);
 /// substeps and iterations.
 ///
 /// - `soft S`: `SolverSettings::soft_step(S)`, S substeps of one PGS sweep and one relax sweep
-///   on contacts of a quarter of the substep rate (15·S Hz at dt = 1/60 s).
+///   on contacts of a fifth of the substep rate (12·S Hz at dt = 1/60 s).
 /// - `soft S×I`: the same with I PGS sweeps in the main solve.
 /// - `reference S×I`: `SolverSettings::reference()` (auto NNCG, split impulse, the exact
 ///   path) with S substeps of at most I iterations.
@@ -69,7 +69,7 @@ pub fn impulse_grid() -> Vec<ImpulseSetting> {
     for name in ["fast", "precise", "reference"] {
         grid.push((name.to_string(), SolverSettings::preset(name)));
     }
-    for substeps in [2, 4, 6, 10, 12, 16, 24, 28, 32, 48, 64] {
+    for substeps in [2, 4, 6, 10, 12, 16, 24, 28, 32, 40, 64] {
         grid.push(soft_step(substeps, 1));
     }
     for substeps in [4, 8, 16] {
@@ -642,7 +642,7 @@ impulse/rapier: impulse's ms/step over Rapier's, each at its cheapest setting me
 meeting the bar; \"—\": neither. impulse settings: `default` the scene's own (for the \
 built-in scenes `SolverSettings::default()`, the soft step at 20 substeps), the presets `fast`, \
 `precise` and `reference`, `soft S` the soft step at S substeps (one PGS sweep and one relax \
-sweep each, contacts of 15·S Hz), `soft S×I` the same with I sweeps, `reference S×I` the \
+sweep each, contacts of 12·S Hz), `soft S×I` the same with I sweeps, `reference S×I` the \
 reference preset (auto, split impulse) with S substeps × I iterations. Rapier settings: `S×HHz` S substeps, contact springs of H Hz \
 (fixed contacts 2·H), `coulomb` Coulomb friction instead of Rapier's default simplified \
 friction; Rapier's defaults are `4×30Hz`.";

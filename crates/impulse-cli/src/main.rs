@@ -69,7 +69,7 @@ enum Command {
         /// Start from a preset instead of the scene's solver settings, named by speed or by the
         /// quality bar it meets on the standard scenes (E = largest of sink, overlap and drift
         /// after 10 s): `fast`/`q50` (the soft step at 8 substeps, E ≤ 50 mm), `default`/`q5`
-        /// (20 substeps, E ≤ 5 mm), `precise`/`q1` (40 substeps, E ≤ 1 mm on stacks) or
+        /// (20 substeps, E ≤ 5 mm), `precise`/`q1` (48 substeps, E ≤ 1 mm) or
         /// `reference` (NNCG with split impulse and the exact path: the LCP solved tightly).
         /// The other options apply on top of it; sleeping keeps the scene's setting.
         #[arg(long, alias = "quality")]

@@ -469,11 +469,18 @@ pub fn update_targets(
     any_repair
 }
 
-/// Soft contact as a damped spring of frequency `hertz` (capped at a quarter of the substep
-/// rate) and damping ratio ζ, discretised implicitly over `h` (Catto, "Solver2D" and Box2D v3
-/// `b2MakeSoft`): returns the repair rate (1/s) and (mass scale, impulse scale).
+/// The stiffest contact spring the soft step takes, as a fraction of the substep rate 1/h.
+/// With one sweep a substep, a spring at a quarter of the rate (Box2D v3's cap) pumped energy
+/// into resting piles: pyramid20 gained tens of joules, the 400:1 `plate` kept rising; at a
+/// fifth they come to rest (docs/benchmarks.md, "Why the soft step is set this way").
+pub const MAX_SOFT_HERTZ_PER_SUBSTEP_RATE: f32 = 0.2;
+
+/// Soft contact as a damped spring of frequency `hertz` (capped at a fifth of the substep
+/// rate, [`MAX_SOFT_HERTZ_PER_SUBSTEP_RATE`]) and damping ratio ζ, discretised implicitly over
+/// `h` (Catto, "Solver2D" and Box2D v3 `b2MakeSoft`): returns the repair rate (1/s) and (mass
+/// scale, impulse scale).
 pub fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32)) {
-    let hertz = hertz.min(0.25 / h);
+    let hertz = hertz.min(MAX_SOFT_HERTZ_PER_SUBSTEP_RATE / h);
     let omega = 2.0 * std::f32::consts::PI * hertz;
     let a1 = 2.0 * damping_ratio + h * omega;
     let a2 = h * omega * a1;

@@ -95,7 +95,7 @@ pub struct SolverSettings {
     /// so this budget is separate from (and larger than) the velocity solve's. Must be ≥ 1.
     pub position_iterations: u32,
     /// Soft contact: when > 0, overlap repair is a damped spring of this frequency (Hz, capped
-    /// at a quarter of the substep rate) instead of the seed's rate c_d, and penetrating rows
+    /// at a fifth of the substep rate) instead of the seed's rate c_d, and penetrating rows
     /// are regularised by it (Box2D v3's soft step). 0 = the seed's rigid rows with c_d.
     pub soft_contact_hertz: f32,
     /// Damping ratio ζ of the soft contact spring (dimensionless; Box2D v3 uses 10).
@@ -161,8 +161,8 @@ impl SolverSettings {
     /// The soft step at `substeps` substeps: one PGS sweep of the normal rows with overlap
     /// repair on soft contacts, position integration, and one relax sweep of all rows, per
     /// substep (Box2D v3's soft step; Rapier's TGS-soft solves contacts the same way). The
-    /// contact spring is as stiff as the substep allows, a quarter of the substep rate
-    /// (15·`substeps` Hz at dt = 1/60 s), with ζ = 10, and there is no overlap slop: a soft
+    /// contact spring is as stiff as the substep allows, a fifth of the substep rate
+    /// (12·`substeps` Hz at dt = 1/60 s), with ζ = 10, and there is no overlap slop: a soft
     /// row's spring holds its load at a depth proportional to the load, so a slop below which
     /// nothing is repaired would add one slop of sink per layer of a pile. Large islands run in
     /// SIMD lanes. The quality error of the standard scenes falls about as 1/`substeps`²
@@ -179,7 +179,7 @@ impl SolverSettings {
             iterations: 1,
             relax_iterations: 1,
             split_impulse: false,
-            soft_contact_hertz: 15.0 * substeps as f32,
+            soft_contact_hertz: 12.0 * substeps as f32,
             soft_damping_ratio: 10.0,
             overlap_slop: 0.0,
             max_repair_speed: 0.5,
@@ -190,7 +190,7 @@ impl SolverSettings {
     /// The named presets, cheapest first, with the quality bar each meets on the standard
     /// scenes at dt = 1/60 s (E, the largest of top sink, overlap and drift after 10 s):
     /// `fast` (E ≤ 50 mm, [`Self::fast`]), `default` (E ≤ 5 mm, [`Self::default`]), `precise`
-    /// (E ≤ 1 mm on stacks and heavy-on-light, [`Self::precise`]) and `reference`
+    /// (E ≤ 1 mm, [`Self::precise`]) and `reference`
     /// ([`Self::reference`]: the LCP solved tightly, for research).
     pub const PRESETS: [&'static str; 4] = ["fast", "default", "precise", "reference"];
 
@@ -206,16 +206,16 @@ impl SolverSettings {
         }
     }
 
-    /// Speed before accuracy: the soft step at 8 substeps (120 Hz contacts). Meets E ≤ 50 mm
+    /// Speed before accuracy: the soft step at 8 substeps (96 Hz contacts). Meets E ≤ 50 mm
     /// on the standard scenes (docs/benchmarks.md, "The front").
     pub fn fast() -> Self {
         Self::soft_step(8)
     }
 
-    /// The soft step at 40 substeps (600 Hz contacts): E ≤ 1 mm on stacks and heavy-on-light,
-    /// about 1 mm on pyramids (docs/benchmarks.md, "The front").
+    /// The soft step at 48 substeps (576 Hz contacts): E ≤ 1 mm on the standard scenes
+    /// (docs/benchmarks.md, "The front").
     pub fn precise() -> Self {
-        Self::soft_step(40)
+        Self::soft_step(48)
     }
 
     /// The LCP solved tightly rather than cheaply, for reference and research: the automatic
@@ -238,7 +238,7 @@ impl SolverSettings {
     }
 }
 
-/// The default: the soft step at 20 substeps (300 Hz contacts), the cheapest setting found
+/// The default: the soft step at 20 substeps (240 Hz contacts), the cheapest setting found
 /// to meet E ≤ 5 mm on every standard scene (docs/benchmarks.md, "The front"). Other presets:
 /// [`SolverSettings::PRESETS`].
 impl Default for SolverSettings {
@@ -257,7 +257,7 @@ impl Default for SolverSettings {
             overlap_repair_rate: 12.0,
             split_impulse: false,
             position_iterations: 16,
-            soft_contact_hertz: 300.0,
+            soft_contact_hertz: 240.0,
             soft_damping_ratio: 10.0,
             overlap_slop: 0.0,
             max_repair_speed: 0.5,

@@ -26,7 +26,6 @@
 //! sweep of [`crate::solver`].
 
 use glam::Vec3;
-use wide::f32x4;
 
 use crate::constraints::{ContactConstraint, JacobianRow, soft_contact};
 use crate::settings::SolverSettings;
@@ -35,11 +34,24 @@ use crate::solver::{
 };
 
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
-/// AArch64), so no target feature is needed.
+/// AArch64), so no target feature is needed. The `lanes8` feature makes it 8 (a 256-bit AVX
+/// register when built with `-C target-cpu=native` on a CPU that has AVX2); measured slower on
+/// the standard scenes, since gathering and scattering eight lanes' bodies and the padding of
+/// small colours cost more than the wider arithmetic saves (docs/benchmarks.md, "Solver cost
+/// per row"). The sweep order is the same either way (colour by colour; the lanes of a bundle
+/// hold independent manifold groups of one colour), so results differ only where padding and
+/// the colouring's overflow groups fall differently.
+#[cfg(not(feature = "lanes8"))]
 pub const LANES: usize = 4;
+/// See the 4-lane constant.
+#[cfg(feature = "lanes8")]
+pub const LANES: usize = 8;
 
 /// One SIMD register of [`LANES`] `f32`s.
-type Lane = f32x4;
+#[cfg(not(feature = "lanes8"))]
+type Lane = wide::f32x4;
+#[cfg(feature = "lanes8")]
+type Lane = wide::f32x8;
 
 /// A vector per lane: x, y and z each in one register.
 type LaneVec = [Lane; 3];
