@@ -20,7 +20,7 @@ configs=(
   "reference: auto (NNCG → exact or more NNCG), split impulse|--preset reference"
   "fast: soft step, 8 substeps|--preset fast"
   "default: soft step, 20 substeps|"
-  "precise: soft step, 40 substeps|--preset precise"
+  "precise: soft step, 48 substeps|--preset precise"
 )
 tmp=$(mktemp -d)
 echo "| scene | solver | top sink (mm) | largest overlap (mm) | kinetic energy at 10 s (J) | largest speed (m/s) | largest LCP residual | island solves | ms/step |"

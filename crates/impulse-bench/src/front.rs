@@ -10,7 +10,8 @@
 //! Every setting runs on its own from the first step to the last, one world at a time, on one
 //! thread (a one-thread rayon pool; Rapier runs on the calling thread). The order interleaves
 //! the engines (an impulse setting, a Rapier setting, an impulse setting, …) so that a drift of
-//! the machine's speed during the run hits both engines alike.
+//! the machine's speed during the run hits both engines alike, after an untimed warm-up of each
+//! engine's first setting ([`WARM_UP_STEPS`]).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -35,6 +36,9 @@ pub const FRONT_STEPS: u32 = 600;
 
 /// Steps of a large scene (more than [`LARGE_SCENE_BODIES`] bodies) when not told otherwise.
 pub const FRONT_LARGE_STEPS: u32 = 120;
+
+/// Steps of each engine's first setting run, untimed, before a scene's measured runs.
+pub const WARM_UP_STEPS: u32 = 60;
 
 /// Scenes with more bodies than this run the large-scene step count.
 pub const LARGE_SCENE_BODIES: usize = 2000;
@@ -440,6 +444,15 @@ pub fn measure_scene(
     }
     let mut points = Vec::with_capacity(impulse.len() + rapier.len());
     let pool = thread_pool(1)?;
+    // Warm-up, not recorded, so that no measured run is the first on a scene: a scene's first
+    // run once read a third slower than its neighbours on the front (stack30's default).
+    let warm_up = steps.min(WARM_UP_STEPS);
+    if let Some((name, settings)) = impulse.first() {
+        pool.install(|| run_impulse(scene, warm_up, name, settings));
+    }
+    if let Some(variant) = rapier.first() {
+        pool.install(|| run_rapier(scene, warm_up, variant));
+    }
     for k in 0..impulse.len().max(rapier.len()) {
         if let Some((name, settings)) = impulse.get(k) {
             let point = pool.install(|| run_impulse(scene, steps, name, settings));

@@ -397,15 +397,11 @@ where
     let mut largest = 0.0f32;
     let n = points.len();
     for step in 0..n {
-        let (k, ahead) = if order.forward {
-            (step, step + PREFETCH_POINTS)
+        let k = point_at(points, step, order);
+        let ahead = if order.forward {
+            step + PREFETCH_POINTS
         } else {
-            (n - 1 - step, (n - 1 - step).wrapping_sub(PREFETCH_POINTS))
-        };
-        let k = if order.half_turn {
-            point_at(points, step, order)
-        } else {
-            k
+            (n - 1 - step).wrapping_sub(PREFETCH_POINTS)
         };
         if let Some(next) = points.get(ahead) {
             prefetch_lines(next);
