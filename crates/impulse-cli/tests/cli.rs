@@ -262,3 +262,57 @@ fn a_blow_up_stops_with_the_step_and_keeps_the_frames_written() {
     let last = text.lines().last().unwrap();
     assert!(last.starts_with("100,"), "last frame written: {last}");
 }
+
+/// `--preset` takes the presets by name and by bar, and the summary's E is the largest of
+/// |sink|, overlap and drift; a preset that does not exist is an error naming the presets.
+#[test]
+fn presets_by_name_and_bar_and_the_quality_error() {
+    let mut errors = Vec::new();
+    for preset in ["fast", "q50", "default", "q5", "precise", "q1", "reference"] {
+        let summary = temp(&format!("preset-{preset}.json"));
+        let out = impulse()
+            .args([
+                "run", "stack3", "--steps", "30", "--quiet", "--preset", preset,
+            ])
+            .arg("--summary-json")
+            .arg(&summary)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{preset}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+        let field = |key: &str| json[key].as_f64().unwrap_or_else(|| panic!("{key}"));
+        let e = field("quality_error_m");
+        let parts = field("top_sink_m")
+            .abs()
+            .max(field("max_overlap_m"))
+            .max(field("max_drift_m"));
+        assert_eq!(e, parts, "{preset}");
+        assert!(e < 0.05, "{preset}: a three-cube stack's E is {e} m");
+        errors.push((preset, e, json["method"].as_str().unwrap().to_string()));
+    }
+    // The aliases are the same settings, so the same trajectory.
+    for (a, b) in [(0, 1), (2, 3), (4, 5)] {
+        assert_eq!(
+            errors[a].1, errors[b].1,
+            "{} and {}",
+            errors[a].0, errors[b].0
+        );
+    }
+    assert_eq!(errors[2].2, "pgs");
+    assert_eq!(errors[6].2, "auto");
+    let out = impulse()
+        .args(["run", "stack3", "--steps", "1", "--quiet", "--preset", "q2"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("unknown preset 'q2'") && stderr.contains("precise"),
+        "{stderr}"
+    );
+}
