@@ -97,7 +97,9 @@ fn pile_of_spheres_solved_in_lanes_satisfies_complementarity() {
     assert!(checked_steps > 10);
 }
 
-/// `SolverSettings::fast()` keeps pyramid20 standing for 5 s, and whatever the loose solve
+/// `SolverSettings::fast()` keeps pyramid20 standing for 5 s with its top down by less than
+/// 1 cm (measured 3.2 mm at 10 s; a 1 mm overlap slop on its soft rows made it 22 mm), and
+/// whatever the loose solve
 /// leaves, every point's impulses stay inside their bounds: γ_n ≥ 0, and the friction impulse
 /// inside the disc of the largest normal impulse of the step, |γ_t| ≤ μ·max γ_n (friction is
 /// projected with the normal impulse of the moment, which the normal row may lower after).
@@ -126,7 +128,7 @@ fn fast_preset_keeps_pyramid20_standing_with_impulses_inside_their_bounds() {
         }
     }
     let sink = top_y - w.bodies.pose[top].translation.y;
-    assert!(sink < 0.1, "top sank {sink} m");
+    assert!(sink < 0.01, "top sank {sink} m");
     assert!(w.diagnostics().max_depth < 0.01);
 }
 
