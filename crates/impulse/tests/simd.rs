@@ -99,10 +99,10 @@ fn pile_of_spheres_solved_in_lanes_satisfies_complementarity() {
 
 /// `SolverSettings::fast()` keeps pyramid20 standing for 5 s with its top down by less than
 /// 1 cm (measured 3.2 mm at 10 s; a 1 mm overlap slop on its soft rows made it 22 mm), and
-/// whatever the loose solve
-/// leaves, every point's impulses stay inside their bounds: γ_n ≥ 0, and the friction impulse
-/// inside the disc of the largest normal impulse of the step, |γ_t| ≤ μ·max γ_n (friction is
-/// projected with the normal impulse of the moment, which the normal row may lower after).
+/// whatever the loose solve leaves, every point's impulses stay inside their bounds: γ_n ≥ 0,
+/// and the friction impulse inside the disc of the largest normal impulse of the step,
+/// |γ_t| ≤ μ·max γ_n (friction is projected with the normal impulse of the moment, which the
+/// normal row may lower after).
 #[test]
 fn fast_preset_keeps_pyramid20_standing_with_impulses_inside_their_bounds() {
     let mut scene = builtin_scene("pyramid20").unwrap();
