@@ -1,7 +1,7 @@
 //! The `impulse` binary end to end: trajectories, summaries, scene errors and LCP commands.
 
-use std::path::PathBuf;
-use std::process::Command;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 fn impulse() -> Command {
     Command::new(env!("CARGO_BIN_EXE_impulse"))
@@ -11,6 +11,20 @@ fn temp(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("impulse-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
+}
+
+/// Asserts that a run succeeded, showing its standard error (prefixed by `context`) if not.
+fn assert_success(out: &Output, context: &str) {
+    assert!(
+        out.status.success(),
+        "{context}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The JSON file at `path`.
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 fn repo(path: &str) -> PathBuf {
@@ -33,11 +47,7 @@ fn run_writes_csv_trajectory_and_summary_json() {
         .arg(&summary)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out, "");
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("frame,time,body,x,y,z,qx,qy,qz,qw"));
@@ -55,8 +65,7 @@ fn run_writes_csv_trajectory_and_summary_json() {
     }
     // Body 30 starts at y = 29.5.
     assert!((rows[30][4] - 29.5).abs() < 1e-6);
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let json = read_json(&summary);
     for key in [
         "scene",
         "bodies",
@@ -121,11 +130,7 @@ fn jsonl_has_one_object_per_frame() {
         .arg(&path)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out, "");
     let text = std::fs::read_to_string(&path).unwrap();
     let frames: Vec<serde_json::Value> = text
         .lines()
@@ -180,13 +185,8 @@ fn lcp_solve_reports_success_and_failure_through_the_exit_code() {
         .arg(&json)
         .output()
         .unwrap();
-    assert!(
-        ok.status.success(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
-    );
-    let result: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_success(&ok, "");
+    let result = read_json(&json);
     let z = result["z"].as_array().unwrap();
     assert!((z[0].as_f64().unwrap() - 4.0 / 3.0).abs() < 1e-9);
     assert!((z[1].as_f64().unwrap() - 7.0 / 3.0).abs() < 1e-9);
@@ -216,11 +216,7 @@ fn lcp_dump_writes_a_step_problem_that_solve_reads() {
         .arg(&path)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out, "");
     let solved = impulse()
         .args(["lcp", "solve"])
         .arg(&path)
@@ -278,13 +274,8 @@ fn presets_by_name_and_bar_and_the_quality_error() {
             .arg(&summary)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{preset}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let json: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+        assert_success(&out, &format!("{preset}: "));
+        let json = read_json(&summary);
         let field = |key: &str| json[key].as_f64().unwrap_or_else(|| panic!("{key}"));
         let e = field("quality_error_m");
         let parts = field("top_sink_m")
