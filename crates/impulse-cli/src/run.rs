@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use impulse::diagnostics::StepProfile;
-use impulse::island::EscalationLevel;
+use impulse::solver::EscalationLevel;
 use impulse::{Scene, World, metrics};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -28,7 +28,7 @@ pub struct RunOptions {
 }
 
 /// Island solves of a run by the strongest method each reached (one count per island and
-/// step), from [`impulse::island::IslandReport`].
+/// step), from [`impulse::solver::IslandReport`].
 #[derive(Debug, Default, Serialize)]
 pub struct IslandSolves {
     pub pgs: u64,

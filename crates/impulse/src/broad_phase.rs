@@ -95,7 +95,7 @@ impl BroadPhase {
         out: &mut Vec<(u32, u32)>,
     ) {
         out.clear();
-        let parallel = parallel && rayon::current_num_threads() > 1;
+        let parallel = crate::parallel::spread(parallel, 1, 0);
         let aabb_of = |i: usize| {
             let margin = margins.get(i).copied().unwrap_or(0.0);
             let mut aabb = bodies.shape[i]

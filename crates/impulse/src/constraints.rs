@@ -9,6 +9,7 @@ use glam::{Mat3, Vec3};
 use crate::body::Bodies;
 use crate::island::Islands;
 use crate::narrow_phase::{ContactPair, NarrowPhase, repeats_earlier_point, same_point};
+use crate::parallel::{PAIRS_PER_TASK, spread};
 use crate::settings::SolverSettings;
 use rayon::prelude::*;
 
@@ -185,7 +186,7 @@ pub fn assemble(
         settings,
         world_inverse_inertia,
     };
-    if parallel && rayon::current_num_threads() > 1 && pairs.len() > PAIRS_PER_TASK {
+    if spread(parallel, pairs.len(), PAIRS_PER_TASK) {
         let rows = IslandRows {
             start: out.as_mut_ptr(),
             len: out.len(),
@@ -238,9 +239,6 @@ impl IslandRows {
         unsafe { std::slice::from_raw_parts_mut(self.start.add(first), count) }
     }
 }
-
-/// Pairs per parallel assembly task: large enough that a task outweighs rayon's hand-off.
-pub const PAIRS_PER_TASK: usize = 1024;
 
 struct Assembly<'a> {
     bodies: &'a Bodies,
@@ -525,7 +523,7 @@ pub fn record_velocity_before(
     parallel: bool,
     scratch: &mut Vec<(Vec3, Vec3)>,
 ) {
-    let parallel = parallel && rayon::current_num_threads() > 1;
+    let parallel = spread(parallel, 1, 0);
     let Some(changes) =
         impulse_velocity_changes(constraints, slots, linear.len(), parallel, scratch)
     else {

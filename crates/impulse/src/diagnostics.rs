@@ -5,7 +5,8 @@ use serde::Serialize;
 
 use crate::body::Bodies;
 use crate::constraints::{BodySlots, ContactConstraint};
-use crate::island::IslandReport;
+use crate::parallel::{ENERGY_BODIES_PER_PART, RESIDUAL_ROWS_PER_TASK, spread};
+use crate::solver::IslandReport;
 use crate::solver::cap_to_disc;
 
 /// Per-step report. Every step's LCP can be checked: `natural_map_residual` is computed from
@@ -92,9 +93,6 @@ pub fn natural_map_residual(
     natural_map_residual_on(constraints, linear, angular, false)
 }
 
-/// Rows per partial sum of [`natural_map_residual_on`].
-const RESIDUAL_ROWS_PER_TASK: usize = 4096;
-
 /// [`natural_map_residual`], with `parallel` spreading runs of 4096
 /// rows over rayon's threads. The runs' partial sums are added in order on either path, so
 /// the result does not depend on the thread count.
@@ -126,10 +124,7 @@ pub fn natural_map_residual_in(
             (c.local_a as usize, c.local_b as usize)
         }),
     };
-    let sum: f64 = if parallel
-        && constraints.len() > RESIDUAL_ROWS_PER_TASK
-        && rayon::current_num_threads() > 1
-    {
+    let sum: f64 = if spread(parallel, constraints.len(), RESIDUAL_ROWS_PER_TASK) {
         use rayon::prelude::*;
         let parts: Vec<f64> = constraints
             .par_chunks(RESIDUAL_ROWS_PER_TASK)
@@ -211,7 +206,7 @@ pub fn record_velocity_before_and_residual(
     parallel: bool,
     scratch: &mut Vec<(Vec3, Vec3)>,
 ) -> RowsReport {
-    let parallel = parallel && rayon::current_num_threads() > 1;
+    let parallel = spread(parallel, 1, 0);
     let Some(changes) = crate::constraints::impulse_velocity_changes(
         constraints,
         slots,
@@ -295,10 +290,6 @@ impl std::ops::Add for EnergyTerms {
     }
 }
 
-/// Bodies per partial sum of [`energy_terms_on`]. The sums run over fixed runs of bodies and
-/// are then added in order, so the result is the same to the bit on any number of threads.
-const ENERGY_BODIES_PER_PART: usize = 1024;
-
 /// [`EnergyTerms`] of the moving bodies under `gravity` (m/s²), on the calling thread.
 pub fn energy_terms(bodies: &Bodies, gravity: Vec3) -> EnergyTerms {
     energy_terms_on(bodies, gravity, false)
@@ -322,7 +313,7 @@ pub fn energy_terms_on(bodies: &Bodies, gravity: Vec3, parallel: bool) -> Energy
         }
         terms
     };
-    if parallel && rayon::current_num_threads() > 1 && n > ENERGY_BODIES_PER_PART {
+    if spread(parallel, n, ENERGY_BODIES_PER_PART) {
         use rayon::prelude::*;
         let parts: Vec<EnergyTerms> = (0..n)
             .into_par_iter()

@@ -14,6 +14,7 @@ use rayon::prelude::*;
 
 use crate::body::Bodies;
 use crate::error::StepError;
+use crate::parallel::{MANIFOLD_PAIRS_PER_TASK, prefetch, spread};
 
 /// Impulses a contact point received in the last solve, kept with the point across steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -223,9 +224,6 @@ impl SpeculativeMargins {
     }
 }
 
-/// Pairs per parallel task of the manifold update.
-const PAIRS_PER_TASK: usize = 256;
-
 /// How many pairs ahead a pass over the pairs asks for the points' memory (twice as far for
 /// the manifolds' own block, whose address the points' lookup needs).
 pub(crate) const PREFETCH_AHEAD: usize = 8;
@@ -246,18 +244,6 @@ pub(crate) fn prefetch_manifolds(pairs: &[ContactPair], i: usize) {
     {
         prefetch(manifold.points.as_ptr());
     }
-}
-
-/// Asks the CPU to bring the cache line at `pointer` in; a hint, which never faults.
-#[inline(always)]
-pub(crate) fn prefetch<T>(pointer: *const T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: prefetching is a hint: it reads nothing and never faults, whatever the address.
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(pointer.cast());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = pointer;
 }
 
 /// Cap on a body's speculative margin (m), so a body thrown at absurd speed does not pair
@@ -348,9 +334,9 @@ impl NarrowPhase {
             }
             Ok(())
         };
-        if parallel && rayon::current_num_threads() > 1 {
+        if spread(parallel, 1, 0) {
             self.pairs
-                .par_chunks_mut(PAIRS_PER_TASK)
+                .par_chunks_mut(MANIFOLD_PAIRS_PER_TASK)
                 .try_for_each(run)?;
         } else {
             run(&mut self.pairs)?;

@@ -140,7 +140,7 @@ pub struct SolverSettings {
     /// spread each large colour over the threads whatever this says.
     pub parallel_island_contacts: u32,
     /// With `method: pgs` and without split impulse, islands with at least this many contact
-    /// points are solved in SIMD lanes ([`crate::simd`]): manifold groups (a pair's points)
+    /// points are solved in SIMD lanes ([`crate::solver::wide`]): manifold groups (a pair's points)
     /// coloured greedily, four groups of a colour updated at once, each lane taking its group's
     /// points in turn. 0 = never. Default 16; smaller islands do not repay the packing. Colour
     /// order converges a little more slowly than narrow-phase order. In islands of at least

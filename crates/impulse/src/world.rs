@@ -11,10 +11,12 @@ use crate::constraints::{self, ContactConstraint};
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{self, StepDiagnostics, StepProfile};
 use crate::error::{StepError, WorldError};
-use crate::island::{self, IslandWorkspace, Islands, StepContext};
+use crate::island::Islands;
 use crate::narrow_phase::{self, ContactImpulse, NarrowPhase};
+use crate::parallel::{BODIES_PER_TASK, ISLANDS_PER_TASK, PAIRS_PER_TASK, spread};
 use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
+use crate::solver::substep::{self, IslandWorkspace, StepContext};
 use rayon::prelude::*;
 
 /// A body further than this from the origin (m) means the simulation has blown up.
@@ -71,9 +73,6 @@ impl StageClock {
         (self.last - self.start).as_secs_f64() as f32 * 1e3
     }
 }
-
-/// Most islands per parallel task of the island stage.
-const ISLANDS_PER_TASK: usize = 4;
 
 /// Bodies, settings and the persistent contact state of a simulation.
 pub struct World {
@@ -234,7 +233,7 @@ impl World {
         let mut profile = StepProfile::default();
         // Stages 2–4 once per step, on the poses and velocities at its start. The energy at the
         // start (read only to notice edits between steps) is summed beside the broad phase.
-        let parallel = self.parallel && rayon::current_num_threads() > 1;
+        let parallel = spread(self.parallel, 1, 0);
         let (bodies, gravity) = (&self.bodies, self.gravity);
         let (margins, broad_phase, candidates) = (
             &mut self.margins,
@@ -342,7 +341,7 @@ impl World {
                 &mut [ContactConstraint],
                 &mut IslandWorkspace,
             )| {
-                island::step_island(bodies, constraints, &context, workspace);
+                substep::step_island(bodies, constraints, &context, workspace);
                 let rows = diagnostics::record_velocity_before_and_residual(
                     constraints,
                     constraints::BodySlots::Island,
@@ -354,7 +353,7 @@ impl World {
                 workspace.report.natural_map_residual = rows.natural_map_residual;
                 workspace.friction_rows = rows.friction_rows;
             };
-            if self.parallel && jobs.len() > 1 && rayon::current_num_threads() > 1 {
+            if spread(self.parallel, jobs.len(), 1) {
                 // Islands differ in cost by orders of magnitude (an exact solve against a
                 // resting column), so the jobs are split finely enough for work stealing to
                 // even them out: in balls16k's landing, 800 columns each solved exactly, rayon's
@@ -485,13 +484,10 @@ impl World {
     fn scatter_islands(&mut self) {
         let islands = &self.islands;
         let (workspaces, awake) = (&self.workspaces, &self.island_awake);
-        if !(self.parallel
-            && rayon::current_num_threads() > 1
-            && self.bodies.len() > BODIES_PER_TASK)
-        {
+        if !spread(self.parallel, self.bodies.len(), BODIES_PER_TASK) {
             for k in 0..islands.len() {
                 if awake[k] {
-                    island::scatter(islands.bodies(k), &workspaces[k], &mut self.bodies);
+                    substep::scatter(islands.bodies(k), &workspaces[k], &mut self.bodies);
                 }
             }
             return;
@@ -515,7 +511,7 @@ impl World {
                 if k == u32::MAX || !awake[k as usize] {
                     return;
                 }
-                island::scatter_body(
+                substep::scatter_body(
                     &workspaces[k as usize],
                     islands.local_index(i),
                     local_center_of_mass[i],
@@ -528,7 +524,7 @@ impl World {
 
     /// Writes the solved impulses back into the manifolds' points for next step's warm start.
     ///
-    /// Runs over the pairs (in parallel runs of [`constraints::PAIRS_PER_TASK`]), each finding
+    /// Runs over the pairs (in parallel runs of [`PAIRS_PER_TASK`]), each finding
     /// its rows where assembly put them, so every manifold is written by one task. Serial and
     /// in island order, this was 3 % of a balls16k step, spent waiting on the manifolds'
     /// scattered heap blocks. An island swept colour by colour has its rows re-sorted by
@@ -559,14 +555,11 @@ impl World {
             true
         };
         let pairs = &mut self.narrow_phase.pairs;
-        let in_place = if self.parallel
-            && rayon::current_num_threads() > 1
-            && pairs.len() > constraints::PAIRS_PER_TASK
-        {
+        let in_place = if spread(self.parallel, pairs.len(), PAIRS_PER_TASK) {
             pairs
-                .par_chunks_mut(constraints::PAIRS_PER_TASK)
+                .par_chunks_mut(PAIRS_PER_TASK)
                 .enumerate()
-                .map(|(k, chunk)| store(k * constraints::PAIRS_PER_TASK, chunk))
+                .map(|(k, chunk)| store(k * PAIRS_PER_TASK, chunk))
                 .reduce(|| true, |x, y| x && y)
         } else {
             store(0, pairs)
@@ -617,15 +610,14 @@ impl World {
                 || speed.is_nan()
                 || speed > BLOW_UP_SPEED
         };
-        let first_bad =
-            if self.parallel && rayon::current_num_threads() > 1 && b.len() > BODIES_PER_TASK {
-                (0..b.len())
-                    .into_par_iter()
-                    .with_min_len(BODIES_PER_TASK)
-                    .find_first(|&i| bad(i))
-            } else {
-                (0..b.len()).find(|&i| bad(i))
-            };
+        let first_bad = if spread(self.parallel, b.len(), BODIES_PER_TASK) {
+            (0..b.len())
+                .into_par_iter()
+                .with_min_len(BODIES_PER_TASK)
+                .find_first(|&i| bad(i))
+        } else {
+            (0..b.len()).find(|&i| bad(i))
+        };
         let Some(i) = first_bad else {
             return Ok(());
         };
@@ -726,9 +718,6 @@ fn write_impulse(c: &ContactConstraint, manifolds: &mut [narrow_phase::Manifold]
 fn friction_rows(constraints: &[ContactConstraint]) -> usize {
     constraints.iter().filter(|c| c.friction > 0.0).count()
 }
-
-/// Bodies per parallel task of the per-body passes.
-const BODIES_PER_TASK: usize = 1024;
 
 fn check_dt(dt: f32) -> Result<(), WorldError> {
     if dt.is_finite() && dt > 0.0 {
@@ -986,7 +975,7 @@ fn update_sleep(
     let quiet = |linear: Vec3, angular: Vec3| {
         linear.length() < s.sleep_linear_speed && angular.length() < s.sleep_angular_speed
     };
-    let parallel = parallel && rayon::current_num_threads() > 1 && bodies.len() > BODIES_PER_TASK;
+    let parallel = spread(parallel, bodies.len(), BODIES_PER_TASK);
     {
         let Bodies {
             linear_velocity,
@@ -1059,7 +1048,7 @@ fn world_inverse_inertia_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Mat3>
             rotate_tensor(bodies.pose[i].rotation, local)
         }
     };
-    if parallel && rayon::current_num_threads() > 1 {
+    if spread(parallel, 1, 0) {
         (0..bodies.len())
             .into_par_iter()
             .with_min_len(BODIES_PER_TASK)

@@ -1,4 +1,4 @@
-//! APGD (`impulse::apgd::solve_apgd`) on the contact problems of real steps, checked against
+//! APGD (`impulse::solver::apgd::solve_apgd`) on the contact problems of real steps, checked against
 //! what anyone can verify: Lemke's exact solution of the same exported LCP, complementarity,
 //! Coulomb's disc, the natural-map residual, and the velocities v* + M⁻¹Jᵀγ recomputed from
 //! scratch.
@@ -12,9 +12,9 @@
 mod common;
 use common::{material, static_box};
 use glam::Vec3;
-use impulse::apgd::{ApgdWorkspace, solve_apgd};
 use impulse::constraints::ContactConstraint;
 use impulse::contact_lcp::assemble_lcp;
+use impulse::solver::apgd::{ApgdWorkspace, solve_apgd};
 use impulse::solver::{NncgWorkspace, SolveReport, Sweep, Velocities, solve_nncg, solve_pgs};
 use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::lemke;

@@ -4,9 +4,9 @@
 mod common;
 
 use impulse::World;
-use impulse::island::EscalationLevel;
 use impulse::scene::builtin::builtin_scene;
 use impulse::settings::SolverMethod;
+use impulse::solver::EscalationLevel;
 
 /// Steps `name` with the `reference` preset (sleeping off) for `steps`; returns the world and,
 /// per step, the islands' reports.
@@ -14,7 +14,7 @@ fn run(
     name: &str,
     steps: u32,
     edit: impl Fn(&mut impulse::SolverSettings),
-) -> (World, Vec<Vec<impulse::island::IslandReport>>) {
+) -> (World, Vec<Vec<impulse::solver::IslandReport>>) {
     let mut scene = builtin_scene(name).expect("built-in scene");
     scene.solver = impulse::SolverSettings {
         sleep: false,

@@ -1,4 +1,4 @@
-//! The exact path (`impulse::exact::solve_exact`) on islands taken from real worlds: against
+//! The exact path (`impulse::solver::exact::solve_exact`) on islands taken from real worlds: against
 //! the statics of a sphere resting on two spheres and Lemke on the exported contact LCP,
 //! against the LCP's conditions on box stacks with friction, and its failure contract.
 //!
@@ -14,9 +14,9 @@ use std::time::Instant;
 
 use glam::{DVec3, Vec3};
 use impulse::constraints::ContactConstraint;
-use impulse::exact::{ExactFailure, ExactReport, ExactWorkspace, solve_exact};
 use impulse::settings::SolverMethod;
 use impulse::solver::Velocities;
+use impulse::solver::exact::{ExactFailure, ExactReport, ExactWorkspace, solve_exact};
 use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::lemke;
 use impulse_lcp::{Bounds, SolverSettings as LcpSettings, Status};

@@ -1,4 +1,4 @@
-//! The SIMD-lane solver (`impulse::simd`): the same LCP conditions as the scalar sweep, exact
+//! The SIMD-lane solver (`impulse::solver::wide`): the same LCP conditions as the scalar sweep, exact
 //! momentum with padding lanes, Coulomb's law for a sliding box, and the `fast` preset standing
 //! on a standard scene.
 

@@ -35,8 +35,62 @@ use glam::Vec3;
 use impulse_lcp::solvers::lemke;
 use impulse_lcp::{Bounds, DenseMatrix, Lcp, Matrix, SolveError, SolverSettings, Status};
 
+use super::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
+    apply_impulses, project_to_friction_disc, set_scalar_targets,
+};
 use crate::constraints::{ContactConstraint, JacobianRow};
-use crate::solver::{Velocities, apply_impulses, project_to_friction_disc};
+
+/// The exact path as a [`ContactSolver`]: [`solve_exact`] on islands of at most `max_contacts`
+/// points. A failed solve leaves the rows and velocities as they were and says so in
+/// [`SolveOutcome::exact_failed`]; its iterations are zero and its change is the residual.
+#[derive(Default)]
+pub struct Exact {
+    /// Work space, kept between solves.
+    pub workspace: ExactWorkspace,
+    /// Largest island solved; larger ones fail with [`ExactFailure::TooManyRows`].
+    pub max_contacts: usize,
+}
+
+impl ContactSolver for Exact {
+    fn warm_start(&mut self, constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
+        super::warm_start(constraints, velocities);
+    }
+
+    fn solve(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        pass: &SolvePass<'_>,
+    ) -> SolveOutcome {
+        let position_repair = set_scalar_targets(constraints, pass);
+        let outcome = match solve_exact(
+            constraints,
+            velocities,
+            self.max_contacts,
+            &mut self.workspace,
+        ) {
+            Ok(exact) => SolveOutcome {
+                exact_pivots: exact.pivots,
+                ..SolveOutcome::of(
+                    EscalationLevel::Exact,
+                    SolveReport {
+                        iterations: 0,
+                        last_change: exact.residual,
+                    },
+                )
+            },
+            Err(_) => SolveOutcome {
+                exact_failed: true,
+                ..SolveOutcome::of(EscalationLevel::Exact, SolveReport::default())
+            },
+        };
+        SolveOutcome {
+            position_repair,
+            ..outcome
+        }
+    }
+}
 
 /// Relative regularisation: Lemke runs on A + ε·diag(A) (plus the soft rows' terms), and the
 /// sticking tangent block is factored as A_tt + ε·diag(A_tt).

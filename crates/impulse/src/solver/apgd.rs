@@ -12,8 +12,44 @@
 
 use glam::Vec3;
 
+use super::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
+    apply_impulses, cap_to_disc, impulses, set_scalar_targets,
+};
 use crate::constraints::ContactConstraint;
-use crate::solver::{SolveReport, Velocities, apply_impulses, cap_to_disc, impulses};
+
+/// APGD as a [`ContactSolver`], with its work vectors.
+#[derive(Default)]
+pub struct Apgd {
+    /// Work vectors, kept between solves.
+    pub workspace: ApgdWorkspace,
+}
+
+impl ContactSolver for Apgd {
+    fn warm_start(&mut self, constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
+        super::warm_start(constraints, velocities);
+    }
+
+    fn solve(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        pass: &SolvePass<'_>,
+    ) -> SolveOutcome {
+        let position_repair = set_scalar_targets(constraints, pass);
+        let report = solve_apgd(
+            constraints,
+            pass.iterations,
+            pass.tolerance,
+            velocities,
+            &mut self.workspace,
+        );
+        SolveOutcome {
+            position_repair,
+            ..SolveOutcome::of(EscalationLevel::Apgd, report)
+        }
+    }
+}
 
 /// Work vectors of [`solve_apgd`], kept between calls so that a solve allocates nothing once
 /// they have grown to the largest island. Per contact point, impulses (N·s) and gradients (m/s)

@@ -27,10 +27,14 @@
 
 use glam::Vec3;
 
+use super::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, TargetInputs, Velocities,
+};
 use crate::constraints::{ContactConstraint, JacobianRow, soft_contact};
-use crate::settings::SolverSettings;
-use crate::solver::{
-    COLOURS, SharedItems, SharedVelocities, SolveReport, Velocities, greedy_colours,
+use crate::graph::{COLOURS, greedy_colours};
+use crate::parallel::{
+    GROUPS_PER_TASK, PARALLEL_PACK_POINTS, SharedItems, SharedVelocities, colour_after_colour,
+    prefetch_lines, spread, threads,
 };
 
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
@@ -282,9 +286,7 @@ impl Bundles {
         // copied out of the 344-byte rows (on rayon's threads for a large island), so that the
         // comparison, the grouping and the colouring, which are serial, read 8 bytes a point:
         // reading them from the rows was 2 % of the samples of a two-thread pyramid100 run.
-        let parallel_fill = parallel
-            && rayon::current_num_threads() > 1
-            && constraints.len() >= PARALLEL_PACK_POINTS;
+        let parallel_fill = spread(parallel, constraints.len(), PARALLEL_PACK_POINTS - 1);
         let key = |c: &ContactConstraint| (c.local_a, c.local_b);
         if parallel_fill {
             use rayon::prelude::*;
@@ -421,7 +423,7 @@ impl Bundles {
     /// Every lane gets the same value on any split.
     fn fill_parallel(&mut self, constraints: &[ContactConstraint], empty: &Bundle) {
         use rayon::prelude::*;
-        let tasks = 2 * rayon::current_num_threads();
+        let tasks = 2 * threads();
         // Bundle where each colour starts (its first lane group's start).
         let total = self.bundles.len();
         let groups = &self.groups;
@@ -501,10 +503,7 @@ impl Bundles {
             c.target_normal_velocity = at(&b.target);
             c.softness = (at(&b.mass_scale), at(&b.impulse_scale));
         };
-        if self.parallel
-            && rayon::current_num_threads() > 1
-            && constraints.len() >= PARALLEL_PACK_POINTS
-        {
+        if spread(self.parallel, constraints.len(), PARALLEL_PACK_POINTS - 1) {
             use rayon::prelude::*;
             constraints
                 .par_iter_mut()
@@ -529,7 +528,7 @@ impl Bundles {
     /// group's bodies gathered into lanes once and scattered back after its bundles; returns the
     /// lane-wise largest of what `update` returned. With `parallel` (see [`Bundles::pack`])
     /// each colour is split over rayon's threads, in parts of at least [`GROUPS_PER_TASK`]
-    /// lane groups ([`crate::solver::colour_after_colour`]).
+    /// lane groups ([`crate::parallel::colour_after_colour`]).
     fn sweep<F, T>(
         &mut self,
         order: SweepOrder,
@@ -547,7 +546,7 @@ impl Bundles {
             immovable: velocities.linear.len() - 1,
         };
         let (bundles, len) = (SharedItems(self.bundles.as_mut_ptr()), self.bundles.len());
-        if !self.parallel || rayon::current_num_threads() < 2 {
+        if !spread(self.parallel, 1, 0) {
             // SAFETY: `pack` gave every group a range inside the bundles and every lane slots
             // below the island's slot count (the velocities' length); the bundles and the
             // velocities are borrowed exclusively here.
@@ -566,7 +565,7 @@ impl Bundles {
             unsafe { sweep_groups(part, bundles, len, order, &shared, update, targets) }
         };
         let starts = &self.group_colour_starts;
-        crate::solver::colour_after_colour(
+        colour_after_colour(
             &mut self.groups,
             starts.len() - 1,
             |k| starts[k],
@@ -590,34 +589,64 @@ impl Bundles {
     /// a third of the bytes of a sweep, twice a substep (pyramid100's bundles are 17 MB).
     pub fn solve_pgs(
         &mut self,
-        iterations: u32,
-        tolerance: f32,
         velocities: &mut Velocities<'_>,
-        targets: &TargetInputs<'_>,
+        pass: &SolvePass<'_>,
     ) -> SolveReport {
         let mut report = SolveReport::default();
-        let (friction, half_turn) = (targets.friction, targets.half_turn);
+        let (friction, half_turn) = (pass.friction, pass.half_turn);
         // Out of `self` while the sweeps borrow it mutably; only read.
         let geometry = std::mem::take(&mut self.geometry);
-        let targets = Targets::new(targets, &geometry);
-        for iteration in 0..iterations {
+        let targets = pass.targets.map(|t| Targets::new(&t, &geometry));
+        for iteration in 0..pass.iterations {
             let forward = iteration % 2 == 0;
             let order = SweepOrder { forward, half_turn };
-            let largest = match (iteration == 0, friction) {
-                (true, true) => self.sweep(order, velocities, VelocityRows::<true>, &targets),
-                (true, false) => self.sweep(order, velocities, VelocityRows::<false>, &targets),
-                (false, true) => self.sweep(order, velocities, VelocityRows::<true>, NoTargets),
-                (false, false) => self.sweep(order, velocities, VelocityRows::<false>, NoTargets),
+            let first = if iteration == 0 {
+                targets.as_ref()
+            } else {
+                None
+            };
+            let largest = match (first, friction) {
+                (Some(t), true) => self.sweep(order, velocities, VelocityRows::<true>, t),
+                (Some(t), false) => self.sweep(order, velocities, VelocityRows::<false>, t),
+                (None, true) => self.sweep(order, velocities, VelocityRows::<true>, NoTargets),
+                (None, false) => self.sweep(order, velocities, VelocityRows::<false>, NoTargets),
             };
             let largest_change = largest.to_array().into_iter().fold(0.0f32, f32::max);
             report.iterations += 1;
             report.last_change = largest_change;
-            if largest_change <= tolerance {
+            if largest_change <= pass.tolerance {
                 break;
             }
         }
         self.geometry = geometry;
         report
+    }
+}
+
+/// PGS in lanes as a [`ContactSolver`]: `prepare` packs the island's points
+/// ([`Bundles::pack`]), the solves run on the bundles, `finish` unpacks the impulses. Its
+/// solves always set targets from the separations (`pass.targets`) when asked, and ignore
+/// `pass.sweep` (the bundles are in colour order already).
+impl ContactSolver for Bundles {
+    fn prepare(&mut self, constraints: &mut [ContactConstraint], slots: usize, parallel: bool) {
+        self.pack(constraints, slots, parallel);
+    }
+
+    fn warm_start(&mut self, _constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
+        Bundles::warm_start(self, velocities);
+    }
+
+    fn solve(
+        &mut self,
+        _constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        pass: &SolvePass<'_>,
+    ) -> SolveOutcome {
+        SolveOutcome::of(EscalationLevel::Pgs, self.solve_pgs(velocities, pass))
+    }
+
+    fn finish(&mut self, constraints: &mut [ContactConstraint]) {
+        self.unpack(constraints);
     }
 }
 
@@ -674,28 +703,6 @@ impl SetTargets for NoTargets {
     fn moved(&self, _: &[u32; LANES], _: &[u32; LANES]) {}
     #[inline(always)]
     fn set(&self, _: &mut Bundle, _: usize, _: &()) {}
-}
-
-/// What the target update of a solve reads (see [`Bundles::solve_pgs`]): the island's
-/// displacement and rotation vector per slot since the step began (m, rad; the immovable slot
-/// zero), the settings and the substep `h` (s), and whether this is the main solve, with
-/// overlap repair, or the relax solve.
-pub struct TargetInputs<'a> {
-    /// Per slot, displacement of the centre of mass (m).
-    pub displacement: &'a [Vec3],
-    /// Per slot, rotation vector (rad).
-    pub rotation: &'a [Vec3],
-    /// Soft contact, repair rate, slop and the repair's speed cap.
-    pub settings: &'a SolverSettings,
-    /// Substep (s).
-    pub h: f32,
-    /// Main solve (overlap repair on), or relax solve (off).
-    pub with_repair: bool,
-    /// Whether the solve sweeps the friction rows too, or the normal rows alone.
-    pub friction: bool,
-    /// Whether each manifold group's points are taken starting halfway round the group
-    /// (points 2, 3, 0, 1 of four) instead of from its first point (see [`sweep_groups`]).
-    pub half_turn: bool,
 }
 
 /// The target update's constants as lanes, and what it reads.
@@ -782,10 +789,6 @@ struct SweepOrder {
     half_turn: bool,
 }
 
-/// Fewest lane groups of one colour in a part run on its own thread: a colour of at most this
-/// many runs as one part.
-const GROUPS_PER_TASK: usize = 8;
-
 /// Runs `update` on the bundles of `groups` in order (`forward`) or in reverse, the bundles of
 /// each group in the same direction, from the group's first bundle or, with `half_turn`, from
 /// halfway round it; the group's bodies are gathered once and scattered once.
@@ -845,7 +848,7 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
             };
             if ahead < len {
                 // SAFETY: in bounds; a prefetch reads nothing.
-                crate::solver::prefetch_lines(unsafe { &*bundles.0.add(ahead) });
+                prefetch_lines(unsafe { &*bundles.0.add(ahead) });
             }
             // SAFETY: the caller's contract.
             let b = unsafe { &mut *bundles.0.add(index) };
@@ -860,14 +863,6 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
 
 /// How many bundles ahead a sweep asks for (see [`sweep_groups`]).
 const PREFETCH_BUNDLES: usize = 2;
-
-/// Islands of at least this many points spread their colours over rayon's threads (whatever
-/// `parallel_island_contacts` says; see [`Bundles::pack`]). On balls4096 with `fast` (256
-/// columns of 16 points), spreading every island made a two-thread step about 1.4× slower.
-pub const PARALLEL_ISLAND_POINTS: usize = 1024;
-
-/// Islands of at least this many points are packed and unpacked on rayon's threads.
-const PARALLEL_PACK_POINTS: usize = 4096;
 
 /// [`BodyLanes`] through the velocity pointers that one colour's threads share.
 trait SharedLanes {

@@ -1,0 +1,366 @@
+//! The one place that decides threading: whether a pass goes on rayon's threads
+//! ([`spread`]), how large each task is, the shared-slice wrappers through which the threads
+//! of one colour write disjoint items, and the colour-after-colour schedule of coloured sweeps.
+//! Memory hints for the sweeps (prefetching) live here too, beside the loops they serve.
+//!
+//! Every threaded pass gives the same result on any number of threads: work is split per item
+//! (per body, per point, per pair) or per fixed run of items, and reductions either do not
+//! depend on order (maxima) or add fixed runs' partial sums in order.
+
+use glam::Vec3;
+
+use crate::graph::COLOURS;
+
+// Task sizes. Each is large enough that a task outweighs rayon's hand-off; the sizes of fixed
+// runs whose partial sums are added in order (the residual, the energy, NNCG's norm) also fix
+// the rounding, so changing one changes results in the last bits, on every thread count alike.
+
+/// Pairs per task of contact assembly and of writing impulses back to the manifolds.
+pub(crate) const PAIRS_PER_TASK: usize = 1024;
+
+/// Pairs per task of the narrow phase's manifold update.
+pub(crate) const MANIFOLD_PAIRS_PER_TASK: usize = 256;
+
+/// Bodies per task of the per-body passes (inertia, sleep, scatter, checks, integration).
+pub(crate) const BODIES_PER_TASK: usize = 1024;
+
+/// Most islands per task of the island stage.
+pub(crate) const ISLANDS_PER_TASK: usize = 4;
+
+/// Points per task of a spread island's restitution pass.
+pub(crate) const RESTITUTION_POINTS_PER_TASK: usize = 4096;
+
+/// Rows per partial sum of the natural-map residual.
+pub(crate) const RESIDUAL_ROWS_PER_TASK: usize = 4096;
+
+/// Bodies per partial sum of the kinetic and potential energy.
+pub(crate) const ENERGY_BODIES_PER_PART: usize = 1024;
+
+/// Points per partial sum of NNCG's gradient norm on a coloured island.
+pub(crate) const NORM_POINTS_PER_TASK: usize = 4096;
+
+/// Fewest lane groups of one colour in a part run on its own thread by the SIMD sweep: a
+/// colour of at most this many runs as one part.
+pub(crate) const GROUPS_PER_TASK: usize = 8;
+
+/// Islands of at least this many points spread the SIMD sweep's colours over rayon's threads
+/// (whatever `parallel_island_contacts` says). On balls4096 with `fast` (256 columns of 16
+/// points), spreading every island made a two-thread step slower (docs/benchmarks.md).
+pub const PARALLEL_ISLAND_POINTS: usize = 1024;
+
+/// Islands of at least this many points are packed into and unpacked from SIMD lanes on
+/// rayon's threads.
+pub(crate) const PARALLEL_PACK_POINTS: usize = 4096;
+
+/// Fewest points of one colour in a part run on its own thread: a colour of at most this many
+/// runs as one part.
+pub(crate) const SWEEP_POINTS_PER_TASK: usize = 256;
+
+/// Whether a pass over `items` items goes on rayon's threads: threads are `allowed` (the
+/// world's `threads` setting, or the island's own decision), there is more than one, and the
+/// pass has more than `more_than` items (below that, handing work over costs more than it
+/// spreads). Every "threads or not?" in the engine asks this.
+#[inline]
+pub(crate) fn spread(allowed: bool, items: usize, more_than: usize) -> bool {
+    allowed && items > more_than && rayon::current_num_threads() > 1
+}
+
+/// Threads available to the current pass (rayon's pool, or 1 outside it).
+#[inline]
+pub(crate) fn threads() -> usize {
+    rayon::current_num_threads()
+}
+
+/// Asks the CPU to bring the cache line at `pointer` in; a hint, which never faults.
+#[inline(always)]
+pub(crate) fn prefetch<T>(pointer: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: prefetching is a hint: it reads nothing and never faults, whatever the address.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(pointer.cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = pointer;
+}
+
+/// Runs `run` over `items` colour after colour, colour `k` being `items[start(k)..start(k + 1)]`
+/// for `k < colours`, in order (`forward`) or in reverse, and returns `combine` over every
+/// chunk's result. A colour is cut into one chunk per rayon thread, none under `min_chunk`
+/// items; colours from `whole_from` on are one chunk (their items may share bodies). `run`
+/// gets a chunk and `forward`, and must touch nothing another chunk of its colour touches.
+///
+/// Why not a rayon call per colour: a coloured island has 24–34 colours and a `fast` step
+/// sweeps it 24 times, so a fork-join per colour was paid some 700 times a step. Here the
+/// threads are forked once per sweep and claim chunks, each its own (the chunk of its rayon
+/// thread index) first, then any left; a chunk waits (spinning) until every chunk of the
+/// colours before its own has finished. A thread moves on to a colour only once every chunk
+/// of the colour before has been claimed, so all those chunks are held by threads that are
+/// running them or waiting in turn on earlier ones, and a chunk never calls into rayon:
+/// every wait ends on any nesting of rayon jobs;
+/// a thread that joins late, or never, leaves more chunks to the others. One contiguous chunk
+/// per thread keeps each thread's reads a single stream: chunks of 32 bundles claimed in turn
+/// were slower than the fork-joins, halves faster. The
+/// chunks of a colour touch disjoint bodies and colours run in order, so the result is the
+/// same on any number of threads (`combine` must not depend on order, as a maximum does not).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn colour_after_colour<T, R>(
+    items: &mut [T],
+    colours: usize,
+    start: impl Fn(usize) -> usize + Sync,
+    forward: bool,
+    whole_from: usize,
+    min_chunk: usize,
+    identity: R,
+    run: impl Fn(&mut [T], bool) -> R + Sync,
+    combine: impl Fn(R, R) -> R + Sync,
+) -> R
+where
+    T: Send,
+    R: Send + Sync + Copy,
+{
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    debug_assert!(colours <= COLOURS + 1);
+    let colours = colours.min(COLOURS + 1);
+    let threads = rayon::current_num_threads();
+    let colour_of = |visit: usize| if forward { visit } else { colours - 1 - visit };
+    // Per colour visited: its items and chunk size.
+    let len = items.len();
+    let range_of = |visit: usize| {
+        let k = colour_of(visit);
+        let range = start(k).min(len)..start(k + 1).min(len);
+        let size = if k >= whole_from {
+            range.len().max(1)
+        } else {
+            range.len().div_ceil(threads).max(min_chunk).max(1)
+        };
+        (range, size)
+    };
+    // Chunks of the colours visited before each one, and per colour the chunks claimed.
+    let mut before = [0usize; COLOURS + 2];
+    for visit in 0..colours {
+        let (range, size) = range_of(visit);
+        before[visit + 1] = before[visit] + range.len().div_ceil(size);
+    }
+    // Per chunk, all colours together: whether a thread has claimed it.
+    let claimed: Vec<AtomicBool> = (0..before[colours])
+        .map(|_| AtomicBool::new(false))
+        .collect();
+    // Chunks finished, all colours together. A chunk starts once every chunk of the colours
+    // before its own has: no chunk of a later colour can finish first, so the count reaches
+    // `before[visit]` exactly when they all have (empty colours need no special case).
+    let finished = AtomicUsize::new(0);
+    let base = SharedItems(items.as_mut_ptr());
+    let worker = |_| {
+        // Capture the whole wrapper (Sync), not its raw-pointer field.
+        #[allow(clippy::redundant_locals)]
+        let base = base;
+        let mut result = identity;
+        // A thread tries its own chunk of each colour first: colour by colour, sweep after
+        // sweep, the same thread then takes the same part of the island, whose bodies'
+        // velocities stay in its core's cache instead of moving between cores every colour.
+        let own = rayon::current_thread_index().unwrap_or(0);
+        for visit in 0..colours {
+            let (range, size) = range_of(visit);
+            let chunks = before[visit + 1] - before[visit];
+            if chunks == 0 {
+                continue;
+            }
+            // Own chunk first, then the others in order; each runs on whichever thread
+            // claims it first.
+            let first = own % chunks;
+            let order = std::iter::once(first).chain((0..chunks).filter(|&c| c != first));
+            for claimed_chunk in order {
+                if claimed[before[visit] + claimed_chunk].swap(true, Ordering::Relaxed) {
+                    continue;
+                }
+                let mut spins = 0u32;
+                while finished.load(Ordering::Acquire) < before[visit] {
+                    spins += 1;
+                    if spins < 1 << 12 {
+                        std::hint::spin_loop();
+                    } else {
+                        // The thread running that chunk may have lost its CPU.
+                        std::thread::yield_now();
+                    }
+                }
+                let from = range.start + claimed_chunk * size;
+                let to = (from + size).min(range.end);
+                // SAFETY: [from, to) lies inside `items`, and no other thread holds it: each
+                // chunk index is claimed once, and this colour's chunks are disjoint.
+                let part = unsafe { std::slice::from_raw_parts_mut(base.0.add(from), to - from) };
+                result = combine(result, run(part, forward));
+                finished.fetch_add(1, Ordering::Release);
+            }
+        }
+        result
+    };
+    (0..threads)
+        .into_par_iter()
+        .map(worker)
+        .reduce(|| identity, &combine)
+}
+
+/// The items of [`colour_after_colour`] (or the SIMD lanes' bundles), shared by its threads.
+pub(crate) struct SharedItems<T>(pub(crate) *mut T);
+
+impl<T> Clone for SharedItems<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for SharedItems<T> {}
+
+// SAFETY: the threads of `colour_after_colour` only build disjoint chunks from the pointer.
+unsafe impl<T: Send> Send for SharedItems<T> {}
+// SAFETY: as for Send.
+unsafe impl<T: Send> Sync for SharedItems<T> {}
+
+/// Velocity slots shared by the threads of one colour. Safety rests on the colouring: within
+/// a colour no two points share a slot other than the immovable one, which is only read.
+#[derive(Clone, Copy)]
+pub(crate) struct SharedVelocities {
+    pub(crate) linear: *mut Vec3,
+    pub(crate) angular: *mut Vec3,
+    pub(crate) immovable: usize,
+}
+
+// SAFETY: see the type's documentation; each thread touches a disjoint set of slots.
+unsafe impl Send for SharedVelocities {}
+// SAFETY: as above.
+unsafe impl Sync for SharedVelocities {}
+
+/// Asks the CPU for every cache line of `value` (a hint: it never faults). Sweeps over rows or
+/// bundles that have outgrown L2 wait on L3 for them otherwise: the hardware prefetcher did not
+/// hide it.
+#[inline(always)]
+pub(crate) fn prefetch_lines<T>(value: &T) {
+    let start = (value as *const T).cast::<u8>();
+    let size = std::mem::size_of::<T>();
+    for offset in (0..size).step_by(64) {
+        prefetch(start.wrapping_add(offset));
+    }
+    // The last line, when `value` straddles one more than its size fills.
+    prefetch(start.wrapping_add(size.saturating_sub(1)));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{COLOURS, colour_after_colour};
+    use proptest::prelude::*;
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    /// Visits `sizes` colours (the last one as a whole, like the overflow colour) and returns
+    /// each item's (colour, visit stamp) and the number of items `run` reported.
+    fn visit(sizes: &[usize], forward: bool, min_chunk: usize) -> (Vec<(usize, u64)>, usize) {
+        let mut items: Vec<(usize, u64)> = sizes
+            .iter()
+            .enumerate()
+            .flat_map(|(k, &n)| std::iter::repeat_n((k, 0), n))
+            .collect();
+        let mut starts = vec![0];
+        for &n in sizes {
+            starts.push(starts.last().unwrap() + n);
+        }
+        let clock = AtomicU64::new(1);
+        let run = |chunk: &mut [(usize, u64)], forward: bool| {
+            // Long enough for the other threads to join in and overlap.
+            std::thread::sleep(std::time::Duration::from_micros(20));
+            let mut stamp = |item: &mut (usize, u64)| {
+                assert_eq!(item.1, 0, "an item visited twice");
+                item.1 = clock.fetch_add(1, Ordering::SeqCst);
+            };
+            if forward {
+                chunk.iter_mut().for_each(&mut stamp);
+            } else {
+                chunk.iter_mut().rev().for_each(&mut stamp);
+            }
+            chunk.len()
+        };
+        let count = colour_after_colour(
+            &mut items,
+            sizes.len(),
+            |k| starts[k],
+            forward,
+            sizes.len() - 1,
+            min_chunk,
+            0usize,
+            run,
+            |x, y| x + y,
+        );
+        (items, count)
+    }
+
+    /// Every item once; every item of a colour after every item of the colours visited before
+    /// it; the whole colour in sweep order.
+    fn check(sizes: &[usize], forward: bool, items: &[(usize, u64)], count: usize) {
+        assert_eq!(count, items.len());
+        let order = |k: usize| if forward { k } else { sizes.len() - 1 - k };
+        for (i, a) in items.iter().enumerate() {
+            assert!(a.1 > 0, "item {i} not visited");
+            for b in &items[i + 1..] {
+                if order(a.0) < order(b.0) {
+                    assert!(
+                        a.1 < b.1,
+                        "colour {} ran before colour {} had ended",
+                        b.0,
+                        a.0
+                    );
+                } else if order(a.0) > order(b.0) {
+                    assert!(
+                        a.1 > b.1,
+                        "colour {} ran before colour {} had ended",
+                        a.0,
+                        b.0
+                    );
+                }
+            }
+        }
+        let whole: Vec<u64> = items
+            .iter()
+            .filter(|a| a.0 == sizes.len() - 1)
+            .map(|a| a.1)
+            .collect();
+        assert!(whole.windows(2).all(|w| (w[0] < w[1]) == forward));
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Colours (empty ones included) run one after another on one to four threads, each
+        /// item exactly once, whatever the chunk size.
+        #[test]
+        fn colours_run_in_order_and_items_once(
+            sizes in proptest::collection::vec(0usize..40, 1..12),
+            forward in any::<bool>(),
+            min_chunk in 1usize..8,
+            threads in 1usize..5,
+        ) {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let (items, count) = pool.install(|| visit(&sizes, forward, min_chunk));
+            check(&sizes, forward, &items, count);
+        }
+    }
+
+    /// Sweeps started from inside other rayon jobs (as island jobs start theirs) all end, each
+    /// with its colours in order, although they share the two threads.
+    #[test]
+    fn nested_sweeps_on_shared_threads_all_end() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let sizes: Vec<usize> = (0..=COLOURS).map(|k| (k * 7) % 23).collect();
+        let results: Vec<_> = pool.install(|| {
+            (0..16)
+                .into_par_iter()
+                .map(|i| visit(&sizes, i % 2 == 0, 1 + i % 3))
+                .collect()
+        });
+        for (i, (items, count)) in results.iter().enumerate() {
+            check(&sizes, i % 2 == 0, items, *count);
+        }
+    }
+}

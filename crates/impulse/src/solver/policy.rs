@@ -1,0 +1,150 @@
+//! `method: auto`: NNCG within the iteration budget, escalating an island whose solve did not
+//! converge to more NNCG iterations or, for a small island, to the exact path ([`super::exact`]).
+
+use super::exact::Exact;
+use super::nncg::Nncg;
+use super::{ContactSolver, SolveOutcome, SolvePass, SolveReport, Velocities};
+use crate::constraints::ContactConstraint;
+use crate::settings::SolverSettings;
+
+/// The methods of the automatic policy, weakest first.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EscalationLevel {
+    /// Projected Gauss-Seidel alone (`method: pgs`).
+    #[default]
+    Pgs,
+    /// Nonsmooth nonlinear conjugate gradient within the iteration budget.
+    Nncg,
+    /// Accelerated projected gradient (`method: apgd`).
+    Apgd,
+    /// NNCG given `escalation_iterations` more after the budget left it unconverged.
+    NncgExtended,
+    /// Pivoting on the island's assembled LCP.
+    Exact,
+}
+
+impl EscalationLevel {
+    /// Lower-case name, as in the summary JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            EscalationLevel::Pgs => "pgs",
+            EscalationLevel::Nncg => "nncg",
+            EscalationLevel::Apgd => "apgd",
+            EscalationLevel::NncgExtended => "nncg_extended",
+            EscalationLevel::Exact => "exact",
+        }
+    }
+}
+
+/// What the escalation decides on, besides the solve's own outcome: the settings' thresholds
+/// and the island's heaviest-to-lightest mass ratio and impact speed.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EscalationLimits {
+    /// Escalate when the last iteration changed a row velocity by more than this (m/s).
+    pub tolerance: f32,
+    /// NNCG iterations given to an island that escalates.
+    pub iterations: u32,
+    /// Islands of at most this many points may take the exact path.
+    pub exact_max_contacts: u32,
+    /// Islands whose mass ratio exceeds this take the exact path whenever they are small.
+    pub mass_ratio_threshold: f32,
+    /// The island's heaviest to lightest moving body mass.
+    pub mass_ratio: f32,
+    /// |g|·dt (m/s): a contact closing faster at the step's start is an impact.
+    pub impact_speed: f32,
+}
+
+impl EscalationLimits {
+    /// The thresholds of `settings` for an island of `mass_ratio` in a step whose impact speed
+    /// is `impact_speed` (m/s).
+    pub fn new(settings: &SolverSettings, mass_ratio: f32, impact_speed: f32) -> Self {
+        Self {
+            tolerance: settings.escalation_tolerance,
+            iterations: settings.escalation_iterations,
+            exact_max_contacts: settings.exact_max_contacts,
+            mass_ratio_threshold: settings.mass_ratio_threshold,
+            mass_ratio,
+            impact_speed,
+        }
+    }
+}
+
+/// The automatic policy as a [`ContactSolver`] (see [`crate::settings::SolverMethod::Auto`]).
+#[derive(Default)]
+pub struct Auto {
+    /// The first method, and the one an unconverged island gets more of.
+    pub nncg: Nncg,
+    /// The exact path.
+    pub exact: Exact,
+    /// Set by the island's step before its first solve.
+    pub limits: EscalationLimits,
+}
+
+impl ContactSolver for Auto {
+    fn warm_start(&mut self, constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
+        super::warm_start(constraints, velocities);
+    }
+
+    /// NNCG for `pass.iterations`; then, with `pass.escalate`: the exact path for a small
+    /// island that is heavy (mass ratio above the threshold) or still unconverged outside an
+    /// impact, and otherwise, if unconverged, `limits.iterations` more NNCG iterations.
+    fn solve(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        pass: &SolvePass<'_>,
+    ) -> SolveOutcome {
+        let limits = self.limits;
+        let mut outcome = self.nncg.solve(constraints, velocities, pass);
+        let unconverged = outcome.report.last_change > limits.tolerance;
+        let heavy = limits.mass_ratio > limits.mass_ratio_threshold;
+        let small = constraints.len() <= limits.exact_max_contacts as usize;
+        // Unconverged in an impact, the island takes more iterations rather than the exact
+        // path: the next steps repair what an impact leaves, while pivoting every landing
+        // column of a pile is the cost of hundreds of exact solves a substep. Asked only when
+        // it decides something: a pass over the rows' v⁻ (set at assembly, rewritten only as
+        // the island's step ends).
+        let impact = || {
+            constraints
+                .iter()
+                .any(|c| c.normal.velocity_before < -limits.impact_speed)
+        };
+        let escalate = pass.escalate;
+        let persistent = escalate && unconverged && !heavy && small && !impact();
+        // The targets are set; the escalated solves keep them.
+        let again = SolvePass {
+            targets: None,
+            ..*pass
+        };
+        if escalate && small && (persistent || heavy) {
+            outcome.escalated = true;
+            self.exact.max_contacts = limits.exact_max_contacts as usize;
+            let exact = self.exact.solve(constraints, velocities, &again);
+            if exact.exact_failed {
+                // The iterative result stands; the failure is counted and reported.
+                outcome.exact_failed = true;
+            } else {
+                outcome.level = exact.level;
+                outcome.exact_pivots = exact.exact_pivots;
+                outcome.report.last_change = exact.report.last_change;
+            }
+        } else if escalate && unconverged {
+            outcome.escalated = true;
+            let more = self.nncg.solve(
+                constraints,
+                velocities,
+                &SolvePass {
+                    iterations: limits.iterations,
+                    ..again
+                },
+            );
+            outcome.report = SolveReport {
+                iterations: outcome.report.iterations + more.report.iterations,
+                last_change: more.report.last_change,
+            };
+            outcome.level = outcome.level.max(EscalationLevel::NncgExtended);
+        }
+        outcome
+    }
+}

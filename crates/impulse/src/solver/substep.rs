@@ -1,0 +1,453 @@
+//! One island's step (stages 1, 5 and 6 on one island): per substep, gravity, warm start, the
+//! solve with overlap repair, position integration and the relax solve; then the restitution
+//! solve. The method is picked here, per island, and called through [`ContactSolver`].
+//!
+//! Each island reads and writes only its own bodies, through local arrays gathered at the start
+//! and scattered at the end, so islands can run on separate threads without sharing anything
+//! mutable.
+
+use glam::{Quat, Vec3};
+use parry3d::math::Pose;
+
+use super::apgd::Apgd;
+use super::nncg::Nncg;
+use super::pgs::{Pgs, Sweep};
+use super::policy::{Auto, EscalationLevel, EscalationLimits};
+use super::wide::Bundles;
+use super::{ContactSolver, SolveOutcome, SolvePass, TargetInputs, Velocities, position};
+use crate::body::Bodies;
+use crate::constraints::{self, ContactConstraint};
+use crate::graph::colour_constraints;
+use crate::integrate;
+use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
+use crate::settings::{SolverMethod, SolverSettings};
+
+/// What the solver did on one island during a step (DESIGN.md step 7: every step can say how
+/// well its LCP was solved, here per island).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct IslandReport {
+    /// Smallest body index in the island: a stable name for it within the step.
+    pub first_body: u32,
+    /// Moving bodies in the island.
+    pub bodies: u32,
+    /// Contact points (normal rows) in the island.
+    pub contacts: u32,
+    /// Heaviest to lightest moving body mass (1 for one body).
+    pub mass_ratio: f32,
+    /// The strongest method any of its solves used: `pgs`, `nncg`, `apgd`, `nncg_extended` or
+    /// `exact`. For `auto`: `exact` if any solve was exact, as `last_change` is then the exact
+    /// solve's residual (m/s).
+    pub method: EscalationLevel,
+    /// Solves (one per substep) that escalated beyond their first method.
+    pub escalations: u32,
+    /// Exact solves attempted that failed (their iterative result was kept).
+    pub exact_failures: u32,
+    /// Lemke pivots of the exact solves.
+    pub exact_pivots: u32,
+    /// Iterations used in the step, all solves and methods together.
+    pub iterations: u32,
+    /// Largest row velocity change of the last iteration of the last main solve (m/s): how far
+    /// from converged the island's final solve stopped.
+    pub last_change: f32,
+    /// Whether the substeps' solves ran in SIMD lanes ([`crate::solver::wide`]).
+    pub simd: bool,
+    /// Natural-map residual of the island's rows at the end of the step (see
+    /// [`crate::diagnostics::StepDiagnostics::natural_map_residual`]); set by the world as the
+    /// island's step ends.
+    pub natural_map_residual: f32,
+}
+
+/// Local state of one island during a step.
+#[derive(Default)]
+pub struct IslandWorkspace {
+    /// Linear velocities (m/s) of the island's bodies, then the immovable slot.
+    pub linear: Vec<Vec3>,
+    /// Angular velocities (rad/s), same layout.
+    pub angular: Vec<Vec3>,
+    /// Centre-of-mass displacement since the start of the step (m).
+    pub displacement: Vec<Vec3>,
+    /// Rotation vector accumulated since the start of the step (rad), for separations.
+    pub rotation: Vec<Vec3>,
+    /// Orientations, integrated substep by substep.
+    pub orientation: Vec<Quat>,
+    pseudo_linear: Vec<Vec3>,
+    pseudo_angular: Vec<Vec3>,
+    /// Colour offsets of the island's constraints when it is coloured (see [`Sweep`]).
+    colour_starts: Vec<u32>,
+    used_colours: Vec<u64>,
+    colours: Vec<u8>,
+    colour_scratch: Vec<ContactConstraint>,
+    /// Per part of rows, per slot: M⁻¹Jᵀγ of [`constraints::record_velocity_before`].
+    pub(crate) record_scratch: Vec<(Vec3, Vec3)>,
+    /// Whether one colour may be solved on several threads.
+    parallel: bool,
+    /// The methods, each with its work space, kept between steps.
+    solvers: Solvers,
+    /// What the solver did on this island in the step.
+    pub report: IslandReport,
+    /// Rows with friction (μ > 0), counted by the world as the island's step ends.
+    pub(crate) friction_rows: usize,
+    /// Split impulse: whether the last targets asked any row for overlap repair.
+    position_repair: bool,
+}
+
+/// Every method's solver, so that an island keeps its work spaces from step to step.
+#[derive(Default)]
+struct Solvers {
+    pgs: Pgs,
+    nncg: Nncg,
+    apgd: Apgd,
+    auto: Auto,
+    /// The island's points in SIMD bundles, when it is solved in lanes.
+    wide: Bundles,
+}
+
+impl Solvers {
+    /// The solver of `method` on the constraints themselves.
+    fn scalar(&mut self, method: SolverMethod) -> &mut dyn ContactSolver {
+        match method {
+            SolverMethod::Pgs => &mut self.pgs,
+            SolverMethod::Nncg => &mut self.nncg,
+            SolverMethod::Apgd => &mut self.apgd,
+            SolverMethod::Auto => &mut self.auto,
+        }
+    }
+
+    /// The substeps' solver: the lanes when the island is `bundled`, else [`Solvers::scalar`].
+    fn substeps(&mut self, method: SolverMethod, bundled: bool) -> &mut dyn ContactSolver {
+        if bundled {
+            &mut self.wide
+        } else {
+            self.scalar(method)
+        }
+    }
+}
+
+impl IslandWorkspace {
+    /// One solve of a substep of `h` seconds: targets from the current separation, then the
+    /// main solve (`with_repair`: overlap repair, `iterations`, escalation allowed) or the relax
+    /// solve (`relax_iterations`), in lanes when the island is `bundled` and on the constraints
+    /// otherwise.
+    fn targets_and_solve(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        settings: &SolverSettings,
+        h: f32,
+        bundled: bool,
+        with_repair: bool,
+        half_turn: bool,
+    ) {
+        let pass = SolvePass {
+            iterations: if with_repair {
+                settings.iterations
+            } else {
+                settings.relax_iterations
+            },
+            tolerance: settings.tolerance,
+            friction: !with_repair || settings.main_solve_friction(),
+            half_turn,
+            escalate: with_repair,
+            targets: Some(TargetInputs {
+                displacement: &self.displacement,
+                rotation: &self.rotation,
+                settings,
+                h,
+                with_repair,
+            }),
+            sweep: Sweep {
+                starts: &self.colour_starts,
+                parallel: self.parallel,
+            },
+        };
+        let outcome = self.solvers.substeps(settings.method, bundled).solve(
+            constraints,
+            &mut Velocities {
+                linear: &mut self.linear,
+                angular: &mut self.angular,
+            },
+            &pass,
+        );
+        self.position_repair = outcome.position_repair;
+        self.record(&outcome, with_repair);
+    }
+
+    /// Adds one solve's outcome to the island's report; the main solve's last change is the
+    /// island's.
+    fn record(&mut self, outcome: &SolveOutcome, main: bool) {
+        let report = &mut self.report;
+        report.method = report.method.max(outcome.level);
+        report.escalations += u32::from(outcome.escalated);
+        report.exact_failures += u32::from(outcome.exact_failed);
+        report.exact_pivots += outcome.exact_pivots;
+        report.iterations += outcome.report.iterations;
+        if main {
+            report.last_change = outcome.report.last_change;
+        }
+    }
+}
+
+/// Everything an island's step reads besides its own bodies and constraints.
+pub struct StepContext<'a> {
+    /// All bodies (read only).
+    pub bodies: &'a Bodies,
+    /// Gravity (m/s²).
+    pub gravity: Vec3,
+    /// Step (s).
+    pub dt: f32,
+    /// Solver settings.
+    pub settings: &'a SolverSettings,
+    /// Whether a large island may spread one colour's points over rayon's threads.
+    pub parallel: bool,
+    /// Whether any body has a restitution coefficient above zero; without one the
+    /// restitution pass over the rows is skipped.
+    pub restitution: bool,
+}
+
+/// Runs stages 1, 5 and 6 of one step on one island: per substep of h = dt/substeps, gravity,
+/// warm start, the solve with overlap repair, position integration, and the relax solve; then
+/// the restitution solve. Results stay in `workspace` until [`scatter`]. The rows' J·v*
+/// (`velocity_before`) is left to the caller, which takes it in one pass with the residual
+/// ([`crate::diagnostics::record_velocity_before_and_residual`], as [`crate::World`] does).
+pub fn step_island(
+    island_bodies: &[u32],
+    constraints: &mut [ContactConstraint],
+    context: &StepContext<'_>,
+    workspace: &mut IslandWorkspace,
+) {
+    let StepContext {
+        bodies,
+        gravity,
+        dt,
+        settings,
+        parallel,
+        restitution,
+    } = *context;
+    let slots = island_bodies.len() + 1;
+    let w = workspace;
+    w.linear.clear();
+    w.angular.clear();
+    w.orientation.clear();
+    for &i in island_bodies {
+        w.linear.push(bodies.linear_velocity[i as usize]);
+        w.angular.push(bodies.angular_velocity[i as usize]);
+        w.orientation.push(bodies.pose[i as usize].rotation);
+    }
+    w.linear.push(Vec3::ZERO);
+    w.angular.push(Vec3::ZERO);
+    w.displacement.clear();
+    w.displacement.resize(slots, Vec3::ZERO);
+    w.rotation.clear();
+    w.rotation.resize(slots, Vec3::ZERO);
+    w.report = IslandReport {
+        first_body: island_bodies.iter().copied().min().unwrap_or(0),
+        bodies: island_bodies.len() as u32,
+        contacts: constraints.len() as u32,
+        mass_ratio: mass_ratio(island_bodies, bodies),
+        ..IslandReport::default()
+    };
+    w.solvers.auto.limits =
+        EscalationLimits::new(settings, w.report.mass_ratio, gravity.length() * dt);
+
+    // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
+    let bundled = settings.method == SolverMethod::Pgs
+        && !settings.split_impulse
+        && settings.simd_island_contacts > 0
+        && constraints.len() >= settings.simd_island_contacts as usize;
+    w.parallel = parallel;
+    w.colour_starts.clear();
+    let threshold = settings.parallel_island_contacts as usize;
+    w.report.simd = bundled;
+    let coloured_threads = threshold > 0 && constraints.len() >= threshold;
+    if bundled {
+        // Bundles are in colour order on any thread count, so spreading a colour over the
+        // threads costs no convergence (unlike the scalar sweep). Smaller islands stay on
+        // their thread: rayon's hand-offs then cost more than they spread.
+        let spread = coloured_threads || constraints.len() >= PARALLEL_ISLAND_POINTS;
+        w.solvers
+            .wide
+            .prepare(constraints, slots, parallel && spread);
+    } else if coloured_threads {
+        colour_constraints(
+            constraints,
+            slots,
+            &mut w.used_colours,
+            &mut w.colours,
+            &mut w.colour_scratch,
+            &mut w.colour_starts,
+        );
+    }
+
+    // Whether this island's passes over all its points or bodies go on rayon's threads too.
+    let spread = parallel::spread(w.parallel, 1, 0)
+        && (coloured_threads || (bundled && w.solvers.wide.parallel()));
+    let h = dt / settings.substeps as f32;
+    let moving = slots - 1;
+    for substep in 0..settings.substeps {
+        // Every other substep, PGS takes each manifold's points from halfway round (see
+        // `wide::sweep_groups`), so that no corner of a face always goes first. Split
+        // impulse keeps one order: its rigid rows are solved to the tolerance, where the order
+        // matters little, and its results are compared with exact solutions.
+        let half_turn = substep % 2 == 1 && !settings.split_impulse;
+        integrate::prospective_velocities(&mut w.linear[..moving], gravity, h);
+        let mut velocities = Velocities {
+            linear: &mut w.linear,
+            angular: &mut w.angular,
+        };
+        w.solvers
+            .substeps(settings.method, bundled)
+            .warm_start(constraints, &mut velocities);
+        w.position_repair = false;
+        w.targets_and_solve(constraints, settings, h, bundled, true, half_turn);
+        // With no row to repair beyond the tolerance, positions move with the velocities alone
+        // (at rest, the usual case in a pile; see `constraints::update_targets`).
+        let split = settings.split_impulse && w.position_repair;
+        if split {
+            // Positions move with v + the pseudo-velocity of the repair solve.
+            w.pseudo_linear.clear();
+            w.pseudo_linear.resize(slots, Vec3::ZERO);
+            w.pseudo_angular.clear();
+            w.pseudo_angular.resize(slots, Vec3::ZERO);
+            let mut pseudo = Velocities {
+                linear: &mut w.pseudo_linear,
+                angular: &mut w.pseudo_angular,
+            };
+            position::solve_positions(
+                constraints,
+                Sweep {
+                    starts: &w.colour_starts,
+                    parallel: w.parallel,
+                },
+                settings.position_iterations,
+                settings.tolerance,
+                &mut pseudo,
+            );
+            for k in 0..moving {
+                w.pseudo_linear[k] += w.linear[k];
+                w.pseudo_angular[k] += w.angular[k];
+            }
+        }
+        let (linear, angular) = if split {
+            (&w.pseudo_linear[..moving], &w.pseudo_angular[..moving])
+        } else {
+            (&w.linear[..moving], &w.angular[..moving])
+        };
+        let (displacement, rotation) = (&mut w.displacement[..moving], &mut w.rotation[..moving]);
+        if spread {
+            // Per body, so any split gives the same poses; serial, this was 0.4 % of a
+            // two-thread `fast` pyramid100 step with the other thread idle.
+            use rayon::prelude::*;
+            linear
+                .par_chunks(BODIES_PER_TASK)
+                .zip(angular.par_chunks(BODIES_PER_TASK))
+                .zip(displacement.par_chunks_mut(BODIES_PER_TASK))
+                .zip(rotation.par_chunks_mut(BODIES_PER_TASK))
+                .zip(w.orientation.par_chunks_mut(BODIES_PER_TASK))
+                .for_each(|((((l, a), d), r), o)| integrate::integrate_positions(l, a, d, r, o, h));
+        } else {
+            integrate::integrate_positions(
+                linear,
+                angular,
+                displacement,
+                rotation,
+                &mut w.orientation,
+                h,
+            );
+        }
+        if settings.relax_iterations > 0 && !settings.split_impulse {
+            w.targets_and_solve(constraints, settings, h, bundled, false, half_turn);
+        }
+    }
+    w.solvers
+        .substeps(settings.method, bundled)
+        .finish(constraints);
+    // Restitution after the substeps (the seed's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
+    // for the points that collided.
+    let threshold = settings.restitution_threshold;
+    let bounces = if !restitution {
+        // No body bounces, so no pair does (a pair's coefficient is the larger of its bodies').
+        false
+    } else if spread {
+        // Per point: any split gives the same targets.
+        use rayon::prelude::*;
+        constraints
+            .par_chunks_mut(RESTITUTION_POINTS_PER_TASK)
+            .map(|part| constraints::restitution_targets(part, threshold))
+            .reduce(|| false, |x, y| x || y)
+    } else {
+        constraints::restitution_targets(constraints, threshold)
+    };
+    if bounces {
+        let pass = SolvePass {
+            iterations: settings.iterations.max(settings.relax_iterations),
+            tolerance: settings.tolerance,
+            friction: true,
+            half_turn: false,
+            escalate: false,
+            targets: None,
+            sweep: Sweep {
+                starts: &w.colour_starts,
+                parallel: w.parallel,
+            },
+        };
+        let outcome = w.solvers.scalar(settings.method).solve(
+            constraints,
+            &mut Velocities {
+                linear: &mut w.linear,
+                angular: &mut w.angular,
+            },
+            &pass,
+        );
+        w.record(&outcome, false);
+    }
+}
+
+/// Writes an island's velocities and poses back into the bodies.
+pub fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut Bodies) {
+    for (k, &i) in island_bodies.iter().enumerate() {
+        let i = i as usize;
+        scatter_body(
+            workspace,
+            k,
+            bodies.local_center_of_mass[i],
+            &mut bodies.pose[i],
+            &mut bodies.linear_velocity[i],
+            &mut bodies.angular_velocity[i],
+        );
+    }
+}
+
+/// Writes the body at local index `k` of `workspace`'s island back: its velocities and its
+/// pose (the centre of mass moved by the island's displacement, at its new orientation).
+#[inline]
+pub fn scatter_body(
+    workspace: &IslandWorkspace,
+    k: usize,
+    local_center_of_mass: Vec3,
+    pose: &mut Pose,
+    linear: &mut Vec3,
+    angular: &mut Vec3,
+) {
+    let com = pose.transform_point(local_center_of_mass) + workspace.displacement[k];
+    let rotation = workspace.orientation[k];
+    *linear = workspace.linear[k];
+    *angular = workspace.angular[k];
+    pose.rotation = rotation;
+    pose.translation = com - rotation * local_center_of_mass;
+}
+
+/// Heaviest to lightest moving body of an island (1 when it has one body).
+fn mass_ratio(island_bodies: &[u32], bodies: &Bodies) -> f32 {
+    let (mut lightest, mut heaviest) = (f32::INFINITY, 0.0f32);
+    for &i in island_bodies {
+        let inverse_mass = bodies.inverse_mass[i as usize];
+        if inverse_mass > 0.0 {
+            lightest = lightest.min(1.0 / inverse_mass);
+            heaviest = heaviest.max(1.0 / inverse_mass);
+        }
+    }
+    if heaviest > 0.0 {
+        heaviest / lightest
+    } else {
+        1.0
+    }
+}
