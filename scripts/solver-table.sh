@@ -11,7 +11,7 @@ if [ ${#scenes[@]} -eq 0 ]; then
   scenes=(pyramid20 stack30 massratio vertical_stack15 mass_ratio_pyramid100 mass_ratio_pyramid300 plate card_house arch overlap_pyramid)
 fi
 configs=(
-  "seed: PGS, 1 solve/step, velocity bias|--preset reference --substeps 1 --relax 0 --method pgs --iterations 20 --repair bias"
+  "basic: PGS, 1 solve/step, velocity bias|--preset reference --substeps 1 --relax 0 --method pgs --iterations 20 --repair bias"
   "PGS, 4 substeps, bias + relax|--preset reference --method pgs --repair bias"
   "NNCG, 4 substeps, bias + relax|--preset reference --method nncg --repair bias"
   "PGS, 4 substeps, split impulse|--preset reference --method pgs"

@@ -1,5 +1,5 @@
-//! Benchmarks of impulse, and the side-by-side harness against Rapier (DESIGN.md, "Standard
-//! scenes" and "Metrics").
+//! Benchmarks of impulse, and the side-by-side harness against Rapier (the standard scenes of
+//! docs/scenes.md; the metrics of docs/benchmarks.md, "What is measured, and how").
 //!
 //! Both engines get the same scene, body for body and in scene order; time is the median
 //! wall-clock time of one step with sleeping off; quality is measured from poses alone with
@@ -35,7 +35,7 @@ pub use rapier_engine::{
     settings_text as rapier_settings_text,
 };
 
-/// Scenes measured when none are named: DESIGN.md's standard scenes plus `pyramid100`.
+/// Scenes measured when none are named: the standard scenes (docs/scenes.md) plus `pyramid100`.
 pub const DEFAULT_SCENES: &[&str] = &[
     "pyramid20",
     "pyramid100",

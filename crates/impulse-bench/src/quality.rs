@@ -1,6 +1,6 @@
-//! Quality metrics of DESIGN.md ("Metrics") taken from poses alone, the same way for every
-//! engine: each engine writes its poses into a [`Bodies`] in scene order and the functions of
-//! `impulse::metrics` measure them.
+//! Quality metrics (docs/benchmarks.md, "What is measured, and how") taken from poses alone, the
+//! same way for every engine: each engine writes its poses into a [`Bodies`] in scene order and
+//! the functions of `impulse::metrics` measure them.
 
 use glam::Vec3;
 use impulse::body::Bodies;

@@ -2,7 +2,7 @@
 //! writers, solvers and merit functions. No physics and no geometry, so that every solver can be
 //! checked on published test problems and on LCPs dumped from real engine steps.
 //!
-//! Convention (the project's seed notes): find `γ` with `w = Aγ − b ≥ 0`, `γ ≥ 0`, `wᵀγ = 0`
+//! Convention (the project's, docs/method.md): find `γ` with `w = Aγ − b ≥ 0`, `γ ≥ 0`, `wᵀγ = 0`
 //! ([`Bounds::NonNegative`]); also box bounds (mixed LCP) and ODE-style friction bounds
 //! `|γ_t| ≤ μ·γ_n` ([`Bounds`]). Siconos, Cottle–Pang–Stone and Murty write `w = Mz + q`:
 //! `A = M`, `b = −q`, same `w`.

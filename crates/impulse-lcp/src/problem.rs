@@ -1,6 +1,6 @@
 //! The problem: `A`, `b` and the bounds on `γ`, with validation.
 //!
-//! Convention (seed notes, DESIGN.md): find `γ` with `w = Aγ − b`, `γ ≥ 0`, `w ≥ 0`, `wᵀγ = 0`.
+//! Convention (docs/method.md): find `γ` with `w = Aγ − b`, `γ ≥ 0`, `w ≥ 0`, `wᵀγ = 0`.
 //! For contact, `γ` are impulses (N·s) and `w` relative velocities after the step (m/s), so `A` has
 //! units of inverse mass. Siconos and most of the literature (Cottle–Pang–Stone, Murty) write
 //! `w = Mz + q`; the two agree with `A = M`, `b = −q`, and `w` is the same vector in both.
@@ -44,9 +44,9 @@ pub enum ProblemError {
     InvalidFriction { index: usize, reason: String },
 }
 
-/// Bounds on `γ`. Why three kinds: the seed's contact LCP has only `γ ≥ 0`; joints and clamped
-/// impulses need a box (a mixed LCP); Coulomb friction in the ODE style needs bounds proportional
-/// to another unknown (the normal impulse), which is not a box known in advance.
+/// Bounds on `γ`. Why three kinds: the frictionless contact LCP has only `γ ≥ 0`; joints and
+/// clamped impulses need a box (a mixed LCP); Coulomb friction in the ODE style needs bounds
+/// proportional to another unknown (the normal impulse), which is not a box known in advance.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Bounds {
     /// Standard LCP: `γ ≥ 0`, `w ≥ 0`, `wᵀγ = 0`.

@@ -1,11 +1,11 @@
 //! Property tests on contact-like problems: `A = J M⁻¹ Jᵀ + εI` from random particles (random
-//! masses) touching in random pairs along random 3D unit normals, as in the seed's particle
-//! derivation. With fewer contacts than the 3(N − 1) relative degrees of freedom `J` has full row
-//! rank almost surely, but random pairs repeat, and two contacts with nearly the same normal
-//! between the same particles make `A` nearly singular, where PGS needs ~cond(A) sweeps. The
-//! regulariser `ε` (1% of the largest diagonal entry, a "compliance" as in ODE's CFM) bounds
-//! cond(A) by about 100·k, keeps the test fast, and gives the lower bound `λ_min ≥ ε` used by the
-//! error bound below.
+//! masses) touching in random pairs along random 3D unit normals: the frictionless LCP of
+//! particles (J rows (nᵀ, −nᵀ), M the particles' masses; docs/method.md). With fewer contacts
+//! than the 3(N − 1) relative degrees of freedom `J` has full row rank almost surely, but random
+//! pairs repeat, and two contacts with nearly the same normal between the same particles make
+//! `A` nearly singular, where PGS needs ~cond(A) sweeps. The regulariser `ε` (1% of the largest
+//! diagonal entry, a "compliance" as in ODE's CFM) bounds cond(A) by about 100·k, keeps the test
+//! fast, and gives the lower bound `λ_min ≥ ε` used by the error bound below.
 //!
 //! Comparing solutions: for symmetric positive definite `A` the natural-map error bound
 //! (Facchinei–Pang, strongly monotone case) is `‖z − z*‖₂ ≤ (1 + ‖A‖₂)/λ_min · ‖F(z)‖₂`, so two

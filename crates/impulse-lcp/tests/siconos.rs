@@ -1,6 +1,8 @@
-//! The Siconos numerics LCP test problems (shared/lcp-data/siconos, see its README): Lemke must
-//! solve each one to 1e-9 or, where it cannot, fail for a reason this file demonstrates; the
-//! known solutions of the README are checked; PGS is checked where its theory applies.
+//! The Siconos numerics LCP test problems (https://github.com/siconos/siconos,
+//! `numerics/src/LCP/test/data/`; where they are read from: `common::siconos_dir`): Lemke must
+//! solve each one to 1e-9 or, where it cannot, fail for a reason this file demonstrates; their
+//! known solutions and properties (the messages marked `README:`) are checked; PGS is checked
+//! where its theory applies.
 //!
 //! Per-file expectations for Lemke (the reasons are asserted in the tests below):
 //!

@@ -46,7 +46,8 @@ fn settings(friction: bool) -> SolverSettings {
 }
 
 /// A sphere resting on two spheres that stand on the ground between two walls (radius 0.5 m,
-/// gap 0.1 m between the lower pair): six coupled contacts, the seed's "second collision".
+/// gap 0.1 m between the lower pair): six coupled contacts, each one's impulse depending on the
+/// others'.
 fn sphere_on_two_spheres(mu: f32) -> World {
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings(mu > 0.0)).unwrap();
     let m = material(mu);

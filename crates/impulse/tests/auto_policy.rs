@@ -1,5 +1,6 @@
 //! The automatic solver policy (`method: auto`, the `reference` preset): what it chooses per
-//! island is reported, and the escalations it makes hold the seed's hard cases still.
+//! island is reported, and the escalations it makes hold PGS's hard cases (tall stacks, heavy on
+//! light) still.
 
 mod common;
 

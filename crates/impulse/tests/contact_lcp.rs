@@ -2,7 +2,7 @@
 //! checked against Lemke's exact solution, against the constraint rows it is assembled from,
 //! and, with friction, against Coulomb's disc that the engine actually enforces.
 //!
-//! Convention (seed notes): find γ with w = Aγ − b ≥ 0, γ ≥ 0, wᵀγ = 0, where A = J M⁻¹ Jᵀ and
+//! Convention (docs/method.md): find γ with w = Aγ − b ≥ 0, γ ≥ 0, wᵀγ = 0, where A = J M⁻¹ Jᵀ and
 //! b = target − J·v*. w is a velocity (m/s), γ an impulse (N·s).
 
 mod common;
@@ -103,7 +103,7 @@ fn max_abs(v: impl IntoIterator<Item = f64>) -> f64 {
     v.into_iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
-/// Frictionless pile (the seed's LCP, A symmetric positive semidefinite): at several steps of
+/// Frictionless pile (the plain LCP γ ≥ 0, A symmetric positive semidefinite): at several steps of
 /// its settling, (a) the engine's impulses solve the exported LCP, (b) Lemke solves it exactly,
 /// (c) both give the same w = Aγ − b. γ need not be unique (redundant contacts), but w, and
 /// hence Aγ = J·Δv, is for a symmetric positive semidefinite LCP, so (c) compares the engine

@@ -2,7 +2,7 @@
 //! the statics of a sphere resting on two spheres and Lemke on the exported contact LCP,
 //! against the LCP's conditions on box stacks with friction, and its failure contract.
 //!
-//! Convention (seed notes): per normal row γ ≥ 0, w = J·v − target ≥ 0, γ·w = 0, with v the
+//! Convention (docs/method.md): per normal row γ ≥ 0, w = J·v − target ≥ 0, γ·w = 0, with v the
 //! velocities after the impulses (m/s) and γ the impulses (N·s); friction |γ_t| ≤ μ·γ_n.
 //!
 //! Timings: `cargo test --release -p impulse --test exact -- --nocapture` prints, per island,

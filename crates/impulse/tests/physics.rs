@@ -1,5 +1,6 @@
-//! Behaviour against physics anyone can check: closed forms, conservation laws, the seed's
-//! simultaneous-contact cases and complementarity of the contact LCP at exit.
+//! Behaviour against physics anyone can check: closed forms, conservation laws, the classic
+//! simultaneous-contact cases (a body on two others, a body pulled away from its contact) and
+//! complementarity of the contact LCP at exit.
 
 mod common;
 
@@ -117,7 +118,7 @@ fn head_on_spheres_conserve_momentum_and_obey_restitution() {
     }
 }
 
-/// The seed's simultaneous case: a sphere resting on two others. Both contacts push (γ ≥ 0),
+/// Simultaneous contacts: a sphere resting on two others. Both contacts push (γ ≥ 0),
 /// each carries the analytic share of the weight, and overlap does not grow over 10 s.
 #[test]
 fn sphere_resting_on_two_spheres() {
@@ -192,7 +193,7 @@ fn sphere_resting_on_two_spheres() {
     );
 }
 
-/// The seed's "pulled apart" case: a body moving away from its contact is not held back (γ = 0).
+/// A body moving away from its contact is not held back (γ = 0): contacts push, never pull.
 #[test]
 fn body_moving_away_from_contact_is_not_held_back() {
     let g = Vec3::new(0.0, -9.81, 0.0);
@@ -312,7 +313,7 @@ fn box_on_incline_sticks_or_slides_by_coulomb() {
     }
 }
 
-/// A pile of spheres, solved to convergence without friction (the seed's LCP): at exit
+/// A pile of spheres, solved to convergence without friction (the LCP of docs/method.md): at exit
 /// γ ≥ 0, w = Aγ − b = J·v⁺ − target ≥ −tol, and wᵀγ ≈ 0, checked directly from velocities.
 #[test]
 fn pile_of_spheres_satisfies_complementarity_at_exit() {

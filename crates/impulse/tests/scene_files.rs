@@ -1,6 +1,6 @@
 //! Scene files: the JSON files in `scenes/` equal the built-in scenes, the writer round-trips,
-//! the standard scenes have the counts DESIGN.md gives, and malformed scenes are rejected with
-//! errors that name the file, line, body and field.
+//! the standard scenes have the counts docs/scenes.md gives, and malformed scenes are rejected
+//! with errors that name the file, line, body and field.
 //!
 //! `cargo test -p impulse --test scene_files -- --ignored regenerate` rewrites the files.
 

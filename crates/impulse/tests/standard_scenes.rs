@@ -88,7 +88,7 @@ fn run_awake(name: &str) -> (f32, f32, f32) {
     (sink, overlap, speed)
 }
 
-/// The seed's "heavy objects stacked on top of light ones": a 100 t cube on five 1 t cubes.
+/// Heavy on light, a known hard case for PGS: a 100 t cube on five 1 t cubes.
 #[test]
 fn massratio_holds_the_heavy_cube() {
     let (sink, overlap, speed) = run_awake("massratio");

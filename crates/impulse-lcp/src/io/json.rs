@@ -1,4 +1,4 @@
-//! The JSON problem format, in the seed's convention `w = Aγ − b`.
+//! The JSON problem format, in the project's convention `w = Aγ − b` (docs/method.md).
 //!
 //! ```json
 //! {

@@ -44,7 +44,7 @@ pub enum FileError {
 pub enum FileFormat {
     /// Siconos `.dat`: `w = Mz + q` (read as `A = M`, `b = −q`).
     Siconos,
-    /// This crate's JSON: the seed's `w = Aγ − b`.
+    /// This crate's JSON: the project's `w = Aγ − b`.
     Json,
 }
 

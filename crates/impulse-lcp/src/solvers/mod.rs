@@ -2,7 +2,8 @@
 //! `fn solve(lcp: &Lcp, initial: Option<&[f64]>, settings: &SolverSettings) -> Result<Solution, SolveError>`
 //! (the Solver2D layout: methods are easy to compare when they share one interface).
 //!
-//! - [`pgs`]: projected Gauss–Seidel / projected SOR, the seed's method; all bound kinds.
+//! - [`pgs`]: projected Gauss–Seidel / projected SOR, the engine's method (docs/method.md); all
+//!   bound kinds.
 //! - [`jacobi`]: projected Jacobi with damping; all bound kinds; order-independent (parallel-friendly).
 //! - [`lemke`]: Lemke's complementary pivoting, the exact reference for standard LCPs.
 //!

@@ -1,4 +1,5 @@
-//! Projected Gauss–Seidel / projected SOR (Cottle–Pang–Stone ch. 5; the seed's iteration).
+//! Projected Gauss–Seidel / projected SOR (Cottle–Pang–Stone ch. 5; the engine's iteration,
+//! docs/method.md).
 //!
 //! Row by row, with the newest values of the other unknowns:
 //! `γ_i ← mid(lo_i, γ_i − ω·(Aγ − b)_i / A_ii, hi_i)`. Friction rows take their bounds

@@ -6,7 +6,9 @@
 use impulse_lcp::DenseMatrix;
 use std::path::PathBuf;
 
-/// The Siconos test problems: `shared/` sits beside the repository, here and in CI.
+/// The Siconos numerics LCP test problems (https://github.com/siconos/siconos,
+/// `numerics/src/LCP/test/data/`), not stored in this repository: read from the directory
+/// below, here and in CI.
 pub fn siconos_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/lcp-data/siconos")
 }
