@@ -50,7 +50,7 @@ pub fn solve_file(
 
     let convention = match format {
         FileFormat::Siconos => "Siconos, w = Mz + q",
-        FileFormat::Json => "seed, w = Aγ − b",
+        FileFormat::Json => "impulse JSON, w = Aγ − b",
     };
     println!("file        {} ({convention})", path.display());
     println!("n           {}", lcp.n());
@@ -111,7 +111,7 @@ fn abbreviate(history: &[f64]) -> String {
 // ---------------------------------------------------------------------------------------------
 
 /// Steps `scene` `step` times and writes the contact LCP of the last step to `out` in impulse's
-/// JSON format (seed convention `w = Aγ − b`, `A` as CSR, friction rows with `friction_index` /
+/// JSON format (convention `w = Aγ − b`, `A` as CSR, friction rows with `friction_index` /
 /// `mu`). Prints rows, non-zeros, `‖b‖₂` and the engine's own natural-map residual on the
 /// exported problem (absolute, and normalised by `‖b‖₂` as the solvers report it).
 ///

@@ -97,16 +97,16 @@ enum Command {
         /// its relax solve (see `SolverSettings::friction_in_main_solve`).
         #[arg(long)]
         friction_in_main_solve: bool,
-        /// Soft contact frequency in Hz (0 = the seed's rigid rows with overlap repair c_d).
+        /// Soft contact frequency in Hz (0 = rigid rows with overlap repair c_d).
         #[arg(long)]
         soft_hertz: Option<f32>,
         /// Fraction of last step's impulses to start from (0 = cold start, 1 = full warm start).
         #[arg(long)]
         warm_start: Option<f32>,
-        /// Overlap repair rate c_d in 1/s (the seed's "nudge" coefficient).
+        /// Overlap repair rate c_d in 1/s (Baumgarte stabilisation).
         #[arg(long)]
         repair_rate: Option<f32>,
-        /// Overlap repair: `bias` (the seed's velocity bias c_d·d, with relax), `split` (split
+        /// Overlap repair: `bias` (a velocity bias c_d·d, with relax), `split` (split
         /// impulse: a separate position solve) or `soft` (soft contact springs, with relax).
         #[arg(long)]
         repair: Option<String>,
@@ -184,7 +184,7 @@ enum LcpCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
-    /// Write the contact LCP of a real step (seed convention, JSON).
+    /// Write the contact LCP of a real step (w = Aγ − b, JSON).
     Dump {
         /// Built-in name or JSON scene file.
         scene: String,

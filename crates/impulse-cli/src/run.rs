@@ -42,7 +42,7 @@ pub struct IslandSolves {
     pub exact_failures: u64,
 }
 
-/// What a run measured. Overlap and sink are measured from poses (DESIGN.md "Metrics").
+/// What a run measured. Overlap and sink are measured from poses (docs/benchmarks.md, "Method").
 #[derive(Debug, Serialize)]
 pub struct Summary {
     pub scene: String,

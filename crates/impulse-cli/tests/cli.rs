@@ -176,7 +176,7 @@ fn unknown_scene_lists_the_builtins() {
 
 #[test]
 fn lcp_solve_reports_success_and_failure_through_the_exit_code() {
-    let data = repo("../shared/lcp-data/siconos");
+    let data = repo("crates/impulse-lcp/tests/data/siconos");
     let json = temp("deudeu.json");
     let ok = impulse()
         .args(["lcp", "solve"])

@@ -79,7 +79,7 @@ fn assert_close(z: &[f64], expected: &[f64], tol: f64, what: &str) {
 #[test]
 fn every_file_parses_and_the_table_covers_it() {
     let mut names: Vec<String> = std::fs::read_dir(siconos_dir())
-        .expect("shared/lcp-data/siconos beside the repository")
+        .expect("tests/data/siconos")
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();

@@ -2,7 +2,7 @@
 //! per point), each a flat record of the numbers the solver needs and nothing else.
 //!
 //! Row i of the Jacobian J acting on (v_a, ω_a, v_b, ω_b) is (dᵀ, (r_a×d)ᵀ, −dᵀ, −(r_b×d)ᵀ)
-//! for direction d (seed, "Rigid bodies"); body A is the one the normal points towards.
+//! for direction d (docs/method.md, "Contacts"); body A is the one the normal points towards.
 
 use glam::{Mat3, Vec3};
 
@@ -111,7 +111,7 @@ pub struct ContactConstraint {
     /// contacts by [`restitution_targets`].
     pub target_normal_velocity: f32,
     /// Softness of the normal row in the current solve, (mass scale, impulse scale): the update
-    /// is Δγ = m_eff·mass_scale·(target − v) − impulse_scale·γ. (1, 0) is the seed's rigid row.
+    /// is Δγ = m_eff·mass_scale·(target − v) − impulse_scale·γ. (1, 0) is a rigid row.
     pub softness: (f32, f32),
     /// Split impulse: the repair speed the position solve aims for (m/s, ≥ 0; 0 = no push),
     /// and the pseudo-impulse it has accumulated this substep (N·s).
@@ -273,7 +273,7 @@ impl Assembly<'_> {
         let pairs = self.pairs;
         let pair = &pairs[pair_index as usize];
         // Parry's shape 1 is body1 and its normal n1 points from shape 1 towards shape 2,
-        // so in the seed's convention (n points from B towards A): B = body1, A = body2.
+        // so in our convention (n points from B towards A): B = body1, A = body2.
         let (b, a) = (pair.body1 as usize, pair.body2 as usize);
         let island = self.islands.island_of_pair(b, a);
         let (local_a, local_b) = (self.islands.slot(a, island), self.islands.slot(b, island));
@@ -412,7 +412,7 @@ fn tangent_basis(normal: Vec3, previous: Vec3) -> (Vec3, Vec3) {
 /// per body, m and rad). With separation s (= −depth):
 ///
 /// - s > 0, a speculative gap: v⁺ ≥ −s/h, the bodies may close the gap but not overlap;
-/// - s ≤ 0, overlap d = −s, `with_repair`: the seed's overlap repair v⁺ ≥ c_d·max(d − slop, 0),
+/// - s ≤ 0, overlap d = −s, `with_repair`: the overlap repair (Baumgarte) v⁺ ≥ c_d·max(d − slop, 0),
 ///   capped at `max_repair_speed`. With `soft_contact_hertz` > 0, c_d and the row's softness
 ///   come from a damped spring instead ([`soft_contact`]);
 /// - s ≤ 0 without repair (the relax solve): v⁺ ≥ 0, rigid.
@@ -486,7 +486,7 @@ pub fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32))
     (omega / a1, (a2 * a3, a3))
 }
 
-/// The restitution hypothesis of the seed, v⁺ = −c_r·v⁻, for the points that collided this
+/// Newton's restitution hypothesis, v⁺ = −c_r·v⁻, for the points that collided this
 /// step: approach speed −v⁻ above the threshold and a normal impulse received. Sets their
 /// targets and returns whether any point bounces; other targets are left as they are.
 pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32) -> bool {

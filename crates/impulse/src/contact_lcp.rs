@@ -4,7 +4,7 @@
 //! Rows are ordered per contact point as the solver orders them: normal, then (with friction)
 //! the two tangents. A = J M⁻¹ Jᵀ is assembled from the same Jacobian rows and inverse masses
 //! the solver used, and b = target − J·v* from the same targets and prospective velocities v*,
-//! so that w = Aγ − b ≥ 0, γ ≥ 0, wᵀγ = 0 is exactly the problem PGS iterated on (seed eq. (2)
+//! so that w = Aγ − b ≥ 0, γ ≥ 0, wᵀγ = 0 is exactly the problem PGS iterated on (docs/method.md, eq. (2)
 //! with the complementarity of "Resolving a collision in the context of a second collision").
 //! Normal rows that were soft in the last solve (soft contact without a relax solve) add their
 //! regularisation to A's diagonal, so the problem stays the one the engine solved.
@@ -19,7 +19,7 @@ use crate::constraints::{ContactConstraint, JacobianRow};
 /// A step's contact LCP together with what the engine found for it.
 #[derive(Clone, Debug)]
 pub struct ContactLcp {
-    /// The problem in the seed's convention, with friction rows bounded by μ·γ_n (`findex`).
+    /// The problem in our convention (w = Aγ − b), with friction rows bounded by μ·γ_n (`findex`).
     pub problem: Lcp,
     /// The engine's impulses at exit, in row order (N·s).
     pub engine_solution: Vec<f64>,

@@ -24,7 +24,7 @@ pub struct StepDiagnostics {
     /// PGS sweeps used.
     pub iterations: u32,
     /// ‖φ‖₂ of the natural map at exit, with w = Aγ − b the post-solve row velocity minus its
-    /// target (seed convention): φ_i = min(γ_i, w_i) for a normal row, and
+    /// target (w = Aγ − b): φ_i = min(γ_i, w_i) for a normal row, and
     /// φ_t = γ_t − Proj(γ_t − w_t) onto the friction disc |γ_t| ≤ μ·γ_n for a tangent pair.
     /// Mixed units (N·s and m/s), as in the LCP itself.
     pub natural_map_residual: f32,

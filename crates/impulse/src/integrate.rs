@@ -3,7 +3,7 @@
 
 use glam::{Quat, Vec3};
 
-/// Stage 1: v* = v + h·M⁻¹·f_ext with gravity the only external force (seed: "compute
+/// Stage 1: v* = v + h·M⁻¹·f_ext with gravity the only external force (docs/method.md: "compute
 /// prospective velocities of all objects for this time step"). `linear` holds moving bodies
 /// only.
 pub fn prospective_velocities(linear: &mut [Vec3], gravity: Vec3, h: f32) {
@@ -34,7 +34,7 @@ pub fn integrate_positions(
     }
 }
 
-/// q ← normalize(q + h/2·ω⊗q): first-order orientation update (DESIGN.md step 6).
+/// q ← normalize(q + h/2·ω⊗q): first-order orientation update (step 6 of docs/architecture.md).
 pub fn integrate_orientation(q: Quat, omega: Vec3, h: f32) -> Quat {
     let spin = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0) * q;
     Quat::from_xyzw(

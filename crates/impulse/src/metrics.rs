@@ -1,4 +1,4 @@
-//! Quality metrics of DESIGN.md measured from poses alone, never from the engine's own contact
+//! Quality metrics (docs/benchmarks.md) measured from poses alone, never from the engine's own contact
 //! report, so the same functions can measure any engine's output.
 
 use glam::Vec3;
@@ -65,7 +65,7 @@ pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u3
 }
 
 /// Index of the moving body whose position is highest (largest y), the "top body" whose sink
-/// DESIGN.md measures. `None` when no body moves.
+/// the benchmarks measure. `None` when no body moves.
 pub fn top_body(bodies: &Bodies) -> Option<usize> {
     (0..bodies.len())
         .filter(|&i| bodies.is_moving(i))

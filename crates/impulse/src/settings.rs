@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum SolverMethod {
-    /// Projected Gauss-Seidel, the seed's method (sweeps in alternating direction); the
+    /// Projected Gauss-Seidel, the basic method of docs/method.md (sweeps in alternating direction); the
     /// default, in the soft step ([`SolverSettings::soft_step`]).
     #[default]
     Pgs,
@@ -41,10 +41,10 @@ impl SolverMethod {
     }
 }
 
-/// Settings of the contact solve (DESIGN.md step 4 and 5).
+/// Settings of the contact solve (steps 4 and 5 of docs/architecture.md).
 ///
 /// Defaults are chosen for the standard scenes at dt = 1/60 s. Units are SI.
-/// Source of each term: the seed notes (`contact-resolution-notes.md`) unless stated.
+/// Each term is explained in docs/method.md with its source.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSettings {
@@ -54,14 +54,14 @@ pub struct SolverSettings {
     /// applies gravity, solves, and integrates positions, with each contact's separation
     /// updated from the bodies' motion (as Box2D v3's soft step and Rapier's TGS do). Shorter
     /// solves propagate load through a tall stack far better than more sweeps of one long
-    /// solve. Must be ≥ 1; 1 is the seed's one solve per step.
+    /// solve. Must be ≥ 1; 1 is the basic method's one solve per step.
     pub substeps: u32,
     /// Projected Gauss-Seidel sweeps per substep, at most (with overlap repair). Must be ≥ 1.
     pub iterations: u32,
     /// Relax sweeps per substep after position integration, with the overlap repair removed
     /// from the targets: positions move with the repair velocity, but the velocities carried
     /// on do not keep it, so repair adds no kinetic energy (Box2D v3's "relax" stage).
-    /// 0 keeps the seed's plain velocity bias.
+    /// 0 keeps the plain velocity bias.
     pub relax_iterations: u32,
     /// Early exit: stop sweeping once no row's velocity changed by more than this in a sweep
     /// (m/s), i.e. max |Δγ_i|/m_eff,i ≤ tolerance. 0 disables early exit.
@@ -74,16 +74,16 @@ pub struct SolverSettings {
     pub escalation_iterations: u32,
     /// `auto`: islands whose heaviest to lightest moving body mass ratio exceeds this escalate
     /// to the exact path even when the iterations look converged (iterative methods stall on
-    /// heavy-on-light, seed "Convergence").
+    /// heavy-on-light).
     pub mass_ratio_threshold: f32,
     /// `auto`: islands with at most this many contact points may escalate to the exact path
     /// (0 = never).
     pub exact_max_contacts: u32,
     /// Restitution hypothesis v⁺ = −c_r·v⁻ is applied only when the contact approaches faster
-    /// than this (m/s), so resting contacts do not bounce (seed "Spherical particles").
+    /// than this (m/s), so resting contacts do not bounce (docs/method.md, "Targets: restitution, gaps and repair").
     pub restitution_threshold: f32,
     /// Overlap repair coefficient c_d (1/s): target separation speed c_d·max(d − slop, 0)
-    /// (seed, "nudge … proportional to the overlap"; Baumgarte stabilisation).
+    /// (a velocity proportional to the overlap: Baumgarte stabilisation).
     pub overlap_repair_rate: f32,
     /// Split impulse: overlap repair runs as a separate solve on pseudo-velocities that move
     /// positions and are then discarded, so repair never becomes kinetic energy (Catto 2006,
@@ -95,8 +95,8 @@ pub struct SolverSettings {
     /// so this budget is separate from (and larger than) the velocity solve's. Must be ≥ 1.
     pub position_iterations: u32,
     /// Soft contact: when > 0, overlap repair is a damped spring of this frequency (Hz, capped
-    /// at a fifth of the substep rate) instead of the seed's rate c_d, and penetrating rows
-    /// are regularised by it (Box2D v3's soft step). 0 = the seed's rigid rows with c_d.
+    /// at a fifth of the substep rate) instead of the rate c_d, and penetrating rows
+    /// are regularised by it (Box2D v3's soft step). 0 = rigid rows with c_d.
     pub soft_contact_hertz: f32,
     /// Damping ratio ζ of the soft contact spring (dimensionless; Box2D v3 uses 10).
     pub soft_damping_ratio: f32,
@@ -110,7 +110,7 @@ pub struct SolverSettings {
     /// Contacts are generated up to this separation (m) ahead of touching ("speculative"
     /// contacts): a row with gap g > 0 only forbids closing faster than g/dt.
     pub prediction_distance: f32,
-    /// Let quiet islands sleep (DESIGN.md step 6). Off for benchmarks.
+    /// Let quiet islands sleep (step 6 of docs/architecture.md). Off for benchmarks.
     pub sleep: bool,
     /// A body slower than this (m/s) …
     pub sleep_linear_speed: f32,

@@ -1,4 +1,4 @@
-//! The world and its step. `World::step` reads as DESIGN.md's pipeline: each call is one stage,
+//! The world and its step. `World::step` reads as the pipeline of docs/architecture.md: each call is one stage,
 //! each stage lives in its own module, and data flows one way through them.
 
 use glam::{Mat3, Quat, Vec3};
@@ -220,7 +220,7 @@ impl World {
         &self.profile
     }
 
-    /// Advances the world by dt through the pipeline of DESIGN.md. Settings are checked first;
+    /// Advances the world by dt through the pipeline of docs/architecture.md. Settings are checked first;
     /// a blow-up is reported with the step number, after the state that caused it was written.
     pub fn step(&mut self) -> Result<&StepDiagnostics, StepError> {
         if let Err(e) = self.check_settings() {

@@ -7,10 +7,10 @@ use impulse_lcp::DenseMatrix;
 use std::path::PathBuf;
 
 /// The Siconos numerics LCP test problems (https://github.com/siconos/siconos,
-/// `numerics/src/LCP/test/data/`), not stored in this repository: read from the directory
-/// below, here and in CI.
+/// `numerics/src/LCP/test/data/`, Apache License 2.0), stored unchanged in `tests/data/siconos`
+/// (`tests/data/README.md` gives their format and known solutions).
 pub fn siconos_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/lcp-data/siconos")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/siconos")
 }
 
 /// `w = M z + q` in plain loops.

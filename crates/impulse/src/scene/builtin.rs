@@ -1,4 +1,4 @@
-//! The standard scenes of DESIGN.md, built by code. `docs/scenes.md` gives every number, so
+//! The standard scenes, built by code. `docs/scenes.md` gives every number, so
 //! other engines can build the same scenes; `scenes/*.json` holds the same scenes as files.
 //!
 //! Common to all: body 0 is the ground, a static cuboid of half extents (150, 0.5, 150) at

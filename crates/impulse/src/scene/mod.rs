@@ -65,7 +65,7 @@ pub enum BodyKind {
     Dynamic,
     /// Never moves; infinite mass.
     Static,
-    /// A sphere whose rotation is locked: the seed's particle (translation only).
+    /// A sphere whose rotation is locked: a particle (translation only).
     Particle,
 }
 

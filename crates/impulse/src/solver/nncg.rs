@@ -51,7 +51,7 @@ pub struct NncgWorkspace {
 }
 
 /// Nonsmooth nonlinear conjugate gradient (Silcowitz, Niebe, Erleben 2010): each iteration is
-/// one PGS sweep (the seed's, in alternating direction) x_{k+1} = PGS(x_k), read as a step
+/// one PGS sweep (in alternating direction) x_{k+1} = PGS(x_k), read as a step
 /// along −∇f = x_{k+1} − x_k, and then pushed further along the previous direction,
 /// x_{k+1} += β_k p_k with Fletcher–Reeves β_k = ‖∇f_{k+1}‖² / ‖∇f_k‖² and
 /// p_{k+1} = β_k p_k − ∇f_{k+1}; β_k > 1 restarts (p = −∇f). On a chain of L contacts, such as a

@@ -22,7 +22,7 @@ use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
 use crate::settings::{SolverMethod, SolverSettings};
 
-/// What the solver did on one island during a step (DESIGN.md step 7: every step can say how
+/// What the solver did on one island during a step (step 7 of docs/architecture.md: every step can say how
 /// well its LCP was solved, here per island).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct IslandReport {
@@ -360,7 +360,7 @@ pub fn step_island(
     w.solvers
         .substeps(settings.method, bundled)
         .finish(constraints);
-    // Restitution after the substeps (the seed's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
+    // Restitution after the substeps (Newton's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
     // for the points that collided.
     let threshold = settings.restitution_threshold;
     let bounces = if !restitution {
