@@ -5,7 +5,9 @@ use serde::Serialize;
 
 use crate::body::Bodies;
 use crate::constraints::{BodySlots, ContactConstraint};
-use crate::parallel::{ENERGY_BODIES_PER_PART, RESIDUAL_ROWS_PER_TASK, spread};
+use crate::parallel::{
+    ENERGY_BODIES_PER_PART, RESIDUAL_ROWS_PER_TASK, SharedItems, parts_in_order, spread,
+};
 use crate::solver::IslandReport;
 use crate::solver::cap_to_disc;
 
@@ -125,12 +127,15 @@ pub fn natural_map_residual_in(
         }),
     };
     let sum: f64 = if spread(parallel, constraints.len(), RESIDUAL_ROWS_PER_TASK) {
-        use rayon::prelude::*;
-        let parts: Vec<f64> = constraints
-            .par_chunks(RESIDUAL_ROWS_PER_TASK)
-            .map(run)
-            .collect();
-        parts.iter().sum()
+        let n = constraints.len();
+        parts_in_order(
+            n.div_ceil(RESIDUAL_ROWS_PER_TASK),
+            |i| {
+                let start = i * RESIDUAL_ROWS_PER_TASK;
+                run(&constraints[start..(start + RESIDUAL_ROWS_PER_TASK).min(n)])
+            },
+            |parts| parts.iter().sum(),
+        )
     } else {
         constraints.chunks(RESIDUAL_ROWS_PER_TASK).map(run).sum()
     };
@@ -229,14 +234,26 @@ pub fn record_velocity_before_and_residual(
     };
     let (sum, friction_rows): (f64, usize) =
         if parallel && constraints.len() > RESIDUAL_ROWS_PER_TASK {
-            use rayon::prelude::*;
-            let parts: Vec<(f64, usize)> = constraints
-                .par_chunks_mut(RESIDUAL_ROWS_PER_TASK)
-                .map(run)
-                .collect();
-            (
-                parts.iter().map(|p| p.0).sum(),
-                parts.iter().map(|p| p.1).sum(),
+            let n = constraints.len();
+            let rows = SharedItems(constraints.as_mut_ptr());
+            parts_in_order(
+                n.div_ceil(RESIDUAL_ROWS_PER_TASK),
+                |i| {
+                    // Capture the whole wrapper (Sync), not its raw-pointer field.
+                    #[allow(clippy::redundant_locals)]
+                    let rows = rows;
+                    let start = i * RESIDUAL_ROWS_PER_TASK;
+                    let len = RESIDUAL_ROWS_PER_TASK.min(n - start);
+                    // SAFETY: part i is rows [start, start + len) of the constraints, disjoint
+                    // from every other part's.
+                    run(unsafe { std::slice::from_raw_parts_mut(rows.0.add(start), len) })
+                },
+                |parts| {
+                    (
+                        parts.iter().map(|p| p.0).sum(),
+                        parts.iter().map(|p| p.1).sum(),
+                    )
+                },
             )
         } else {
             let mut friction_rows = 0;
@@ -314,13 +331,11 @@ pub fn energy_terms_on(bodies: &Bodies, gravity: Vec3, parallel: bool) -> Energy
         terms
     };
     if spread(parallel, n, ENERGY_BODIES_PER_PART) {
-        use rayon::prelude::*;
-        let parts: Vec<EnergyTerms> = (0..n)
-            .into_par_iter()
-            .step_by(ENERGY_BODIES_PER_PART)
-            .map(part)
-            .collect();
-        parts.into_iter().fold(EnergyTerms::default(), |a, b| a + b)
+        parts_in_order(
+            n.div_ceil(ENERGY_BODIES_PER_PART),
+            |i| part(i * ENERGY_BODIES_PER_PART),
+            |parts| parts.iter().fold(EnergyTerms::default(), |a, &b| a + b),
+        )
     } else {
         (0..n)
             .step_by(ENERGY_BODIES_PER_PART)

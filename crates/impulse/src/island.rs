@@ -32,6 +32,8 @@ pub struct Islands {
     pair_keys: Vec<PairKey>,
     last_pair_keys: Vec<PairKey>,
     kinds: Vec<BodyKind>,
+    /// Counting-sort scratch of the build, kept so that a rebuild allocates nothing.
+    fill: Vec<u32>,
 }
 
 /// A pair as the island build reads it: its two bodies and its number of constraints.
@@ -157,7 +159,9 @@ impl Islands {
         for k in 0..islands {
             self.body_start[k + 1] += self.body_start[k];
         }
-        let mut fill: Vec<u32> = self.body_start[..islands].to_vec();
+        let mut fill = std::mem::take(&mut self.fill);
+        fill.clear();
+        fill.extend_from_slice(&self.body_start[..islands]);
         self.bodies.clear();
         self.bodies.resize(self.body_start[islands] as usize, 0);
         // `parent` is free again: reuse it for local indices.
@@ -177,7 +181,10 @@ impl Islands {
         // Constraints and pairs per island, then pairs in island order (counting sort).
         self.constraint_start.clear();
         self.constraint_start.resize(islands + 1, 0);
-        let mut pairs_per_island = vec![0u32; islands + 1];
+        // `fill` is free again: reuse it for the pair counts.
+        let mut pairs_per_island = fill;
+        pairs_per_island.clear();
+        pairs_per_island.resize(islands + 1, 0);
         for &(a, b, rows) in keys.iter().filter(|k| k.2 > 0) {
             let k = self.island_of_pair(a as usize, b as usize);
             self.constraint_start[k + 1] += rows;
@@ -202,6 +209,7 @@ impl Islands {
             self.pair_first_row[index as usize] = row;
             row += keys[index as usize].2;
         }
+        self.fill = pairs_per_island;
     }
 }
 

@@ -119,10 +119,11 @@ where
     R: Send + Sync + Copy,
 {
     use rayon::prelude::*;
-    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
     debug_assert!(colours <= COLOURS + 1);
     let colours = colours.min(COLOURS + 1);
-    let threads = rayon::current_num_threads();
+    // At most 64 chunks a colour, so that one 64-bit mask a colour says which are claimed.
+    let threads = rayon::current_num_threads().min(64);
     let colour_of = |visit: usize| if forward { visit } else { colours - 1 - visit };
     // Per colour visited: its items and chunk size.
     let len = items.len();
@@ -142,10 +143,9 @@ where
         let (range, size) = range_of(visit);
         before[visit + 1] = before[visit] + range.len().div_ceil(size);
     }
-    // Per chunk, all colours together: whether a thread has claimed it.
-    let claimed: Vec<AtomicBool> = (0..before[colours])
-        .map(|_| AtomicBool::new(false))
-        .collect();
+    // Per colour visited, one bit per chunk: whether a thread has claimed it. On the stack, so
+    // a sweep allocates nothing.
+    let claimed: [AtomicU64; COLOURS + 1] = std::array::from_fn(|_| AtomicU64::new(0));
     // Chunks finished, all colours together. A chunk starts once every chunk of the colours
     // before its own has: no chunk of a later colour can finish first, so the count reaches
     // `before[visit]` exactly when they all have (empty colours need no special case).
@@ -171,7 +171,8 @@ where
             let first = own % chunks;
             let order = std::iter::once(first).chain((0..chunks).filter(|&c| c != first));
             for claimed_chunk in order {
-                if claimed[before[visit] + claimed_chunk].swap(true, Ordering::Relaxed) {
+                let bit = 1u64 << claimed_chunk;
+                if claimed[visit].fetch_or(bit, Ordering::Relaxed) & bit != 0 {
                     continue;
                 }
                 let mut spins = 0u32;
@@ -200,6 +201,32 @@ where
         .map(worker)
         .reduce(|| identity, &combine)
 }
+
+/// Runs `part(i)` for i in 0..`parts` on rayon's threads and hands the results, in order of i,
+/// to `finish`: partial sums over fixed runs of items, added in order by `finish`, give the
+/// same result to the bit on any number of threads. Up to [`STACK_PARTS`] results live on the
+/// stack, so such a pass allocates nothing; more go in a vector.
+pub(crate) fn parts_in_order<R, F>(parts: usize, part: F, finish: impl FnOnce(&[R]) -> R) -> R
+where
+    R: Copy + Default + Send,
+    F: Fn(usize) -> R + Sync + Send,
+{
+    use rayon::prelude::*;
+    if parts <= STACK_PARTS {
+        let mut results = [R::default(); STACK_PARTS];
+        results[..parts]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(i, result)| *result = part(i));
+        finish(&results[..parts])
+    } else {
+        let results: Vec<R> = (0..parts).into_par_iter().map(part).collect();
+        finish(&results)
+    }
+}
+
+/// Results [`parts_in_order`] keeps on the stack.
+pub(crate) const STACK_PARTS: usize = 64;
 
 /// The items of [`colour_after_colour`] (or the SIMD lanes' bundles), shared by its threads.
 pub(crate) struct SharedItems<T>(pub(crate) *mut T);

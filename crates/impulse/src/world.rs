@@ -13,7 +13,7 @@ use crate::diagnostics::{self, StepDiagnostics, StepProfile};
 use crate::error::{StepError, WorldError};
 use crate::island::Islands;
 use crate::narrow_phase::{self, ContactImpulse, NarrowPhase};
-use crate::parallel::{BODIES_PER_TASK, ISLANDS_PER_TASK, PAIRS_PER_TASK, spread};
+use crate::parallel::{BODIES_PER_TASK, ISLANDS_PER_TASK, PAIRS_PER_TASK, SharedItems, spread};
 use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
 use crate::solver::substep::{self, IslandWorkspace, StepContext};
@@ -316,31 +316,14 @@ impl World {
                 parallel: self.parallel,
                 restitution: self.bodies.restitution.iter().any(|&r| r > 0.0),
             };
-            let mut jobs = Vec::with_capacity(islands);
-            let mut rest: &mut [ContactConstraint] = &mut self.constraints;
-            for ((k, workspace), awake) in self
-                .workspaces
-                .iter_mut()
-                .enumerate()
-                .take(islands)
-                .zip(&self.island_awake)
-            {
-                let (mine, others) = rest.split_at_mut(self.islands.constraint_range(k).len());
-                rest = others;
-                if *awake {
-                    jobs.push((self.islands.bodies(k), mine, workspace));
-                }
-            }
             // Each island ends its step with the passes that read its rows once more, while
             // they are still in cache: its rows' v*, its natural-map residual and its
             // friction-row count, in one pass. As world-wide passes over every row they were
             // 3 % of a balls16k step at rest (perf), mostly waiting on memory; the results are
             // the same to the bit.
-            let run = |(bodies, constraints, workspace): &mut (
-                &[u32],
-                &mut [ContactConstraint],
-                &mut IslandWorkspace,
-            )| {
+            let run = |bodies: &[u32],
+                       constraints: &mut [ContactConstraint],
+                       workspace: &mut IslandWorkspace| {
                 substep::step_island(bodies, constraints, &context, workspace);
                 let rows = diagnostics::record_velocity_before_and_residual(
                     constraints,
@@ -353,16 +336,46 @@ impl World {
                 workspace.report.natural_map_residual = rows.natural_map_residual;
                 workspace.friction_rows = rows.friction_rows;
             };
-            if spread(self.parallel, jobs.len(), 1) {
+            let islands_of = &self.islands;
+            let awake = &self.island_awake;
+            let workspaces = &mut self.workspaces[..islands];
+            let awake_count = awake.iter().take(islands).filter(|&&a| a).count();
+            if spread(self.parallel, awake_count, 1) {
                 // Islands differ in cost by orders of magnitude (an exact solve against a
                 // resting column), so the jobs are split finely enough for work stealing to
                 // even them out: in balls16k's landing, 800 columns each solved exactly, rayon's
                 // default split left one thread with three quarters of the work.
-                jobs.par_iter_mut()
+                let rows = SharedItems(self.constraints.as_mut_ptr());
+                let total = self.constraints.len();
+                workspaces
+                    .par_iter_mut()
+                    .enumerate()
                     .with_max_len(ISLANDS_PER_TASK)
-                    .for_each(run);
+                    .for_each(|(k, workspace)| {
+                        // Capture the whole wrapper (Sync), not its raw-pointer field.
+                        #[allow(clippy::redundant_locals)]
+                        let rows = rows;
+                        if !awake[k] {
+                            return;
+                        }
+                        let range = islands_of.constraint_range(k);
+                        assert!(range.end <= total);
+                        // SAFETY: the islands' constraint ranges are disjoint and inside the
+                        // constraints (checked above), and each island is visited once.
+                        let mine = unsafe {
+                            std::slice::from_raw_parts_mut(rows.0.add(range.start), range.len())
+                        };
+                        run(islands_of.bodies(k), mine, workspace);
+                    });
             } else {
-                jobs.iter_mut().for_each(run);
+                let mut rest: &mut [ContactConstraint] = &mut self.constraints;
+                for (k, workspace) in workspaces.iter_mut().enumerate() {
+                    let (mine, others) = rest.split_at_mut(islands_of.constraint_range(k).len());
+                    rest = others;
+                    if awake[k] {
+                        run(islands_of.bodies(k), mine, workspace);
+                    }
+                }
             }
         }
         profile.solve = clock.lap();

@@ -7,7 +7,9 @@ use super::{
 };
 use crate::constraints::ContactConstraint;
 use crate::graph::COLOURS;
-use crate::parallel::{NORM_POINTS_PER_TASK, SWEEP_POINTS_PER_TASK, SharedVelocities, spread};
+use crate::parallel::{
+    NORM_POINTS_PER_TASK, SWEEP_POINTS_PER_TASK, SharedVelocities, parts_in_order, spread,
+};
 
 /// NNCG as a [`ContactSolver`], with its work vectors.
 #[derive(Default)]
@@ -145,13 +147,15 @@ fn gradient_norm(
         return run((constraints, previous));
     }
     if spread(parallel, 1, 0) {
-        use rayon::prelude::*;
-        let parts: Vec<f64> = constraints
-            .par_chunks(NORM_POINTS_PER_TASK)
-            .zip(previous.par_chunks(NORM_POINTS_PER_TASK))
-            .map(run)
-            .collect();
-        parts.into_iter().sum()
+        let n = constraints.len();
+        parts_in_order(
+            n.div_ceil(NORM_POINTS_PER_TASK),
+            |i| {
+                let range = i * NORM_POINTS_PER_TASK..((i + 1) * NORM_POINTS_PER_TASK).min(n);
+                run((&constraints[range.clone()], &previous[range]))
+            },
+            |parts| parts.iter().sum(),
+        )
     } else {
         constraints
             .chunks(NORM_POINTS_PER_TASK)

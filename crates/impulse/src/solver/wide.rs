@@ -424,62 +424,66 @@ impl Bundles {
     fn fill_parallel(&mut self, constraints: &[ContactConstraint], empty: &Bundle) {
         use rayon::prelude::*;
         let tasks = 2 * threads();
-        // Bundle where each colour starts (its first lane group's start).
+        // Bundle where each colour starts (its first lane group's start); on the stack, so a
+        // pack allocates nothing.
         let total = self.bundles.len();
-        let groups = &self.groups;
-        let bundle_start: Vec<usize> = self
-            .group_colour_starts
-            .iter()
-            .map(|&g| groups.get(g).map_or(total, |group| group.start as usize))
-            .collect();
-        // Per task, per colour: (first bundle index, bundles, geometry).
-        type Part<'a> = (usize, &'a mut [Bundle], &'a mut [BundleGeometry]);
-        let mut parts: Vec<Vec<Part<'_>>> = (0..tasks).map(|_| Vec::new()).collect();
-        let (mut bundles, mut geometry) = (&mut self.bundles[..], &mut self.geometry[..]);
-        let mut first = 0;
-        for colour in 0..=COLOURS {
-            let count = bundle_start[colour + 1] - bundle_start[colour];
-            for (t, task_parts) in parts.iter_mut().enumerate() {
-                let size = count * (t + 1) / tasks - count * t / tasks;
-                let (mine, rest) = std::mem::take(&mut bundles).split_at_mut(size);
-                let (mine_geometry, rest_geometry) =
-                    std::mem::take(&mut geometry).split_at_mut(size);
-                bundles = rest;
-                geometry = rest_geometry;
-                task_parts.push((first, mine, mine_geometry));
-                first += size;
-            }
+        let mut bundle_start = [total; COLOURS + 2];
+        for (start, &g) in bundle_start.iter_mut().zip(&self.group_colour_starts) {
+            *start = self
+                .groups
+                .get(g)
+                .map_or(total, |group| group.start as usize);
         }
+        // Task t's bundles of colour c: the t-th of `tasks` equal parts of the colour.
+        let part = move |t: usize, c: usize| {
+            let count = bundle_start[c + 1] - bundle_start[c];
+            bundle_start[c] + count * t / tasks..bundle_start[c] + count * (t + 1) / tasks
+        };
+        let colour_of = move |index: usize| {
+            bundle_start[..=COLOURS + 1].partition_point(|&start| start <= index) - 1
+        };
         let (sources, slots) = (&self.sources, &self.slots);
-        parts.into_par_iter().for_each(|mut task_parts| {
+        let bundles = SharedItems(self.bundles.as_mut_ptr());
+        let geometry = SharedItems(self.geometry.as_mut_ptr());
+        (0..tasks).into_par_iter().for_each(|t| {
+            // Capture the whole wrappers (Sync), not their raw-pointer fields.
+            #[allow(clippy::redundant_locals)]
+            let (bundles, geometry) = (bundles, geometry);
             // The task's constraint range, from the lanes it owns (a lane group's lanes hold
             // groups in constraint order, but its later bundles may be padding).
             let mut low = usize::MAX;
             let mut high = 0;
-            for (start, part, _) in task_parts.iter() {
-                for lanes in &sources[*start..*start + part.len()] {
+            for c in 0..=COLOURS {
+                let range = part(t, c);
+                for lanes in &sources[range.clone()] {
                     for &k in lanes.iter().filter(|&&k| k != u32::MAX) {
                         low = low.min(k as usize);
                         high = high.max(k as usize + 1);
                     }
                 }
-            }
-            for (_, part, geometry) in task_parts.iter_mut() {
-                part.fill(*empty);
-                geometry.fill(BundleGeometry::default());
+                // SAFETY: the parts of all tasks and colours are disjoint ranges inside the
+                // bundles and the geometry (`bundle_start` is non-decreasing, ending at the
+                // bundles' length), and only task t touches its own.
+                unsafe {
+                    std::slice::from_raw_parts_mut(bundles.0.add(range.start), range.len())
+                        .fill(*empty);
+                    std::slice::from_raw_parts_mut(geometry.0.add(range.start), range.len())
+                        .fill(BundleGeometry::default());
+                }
             }
             for k in low..high.min(constraints.len()) {
                 let (index, lane) = (slots[k] as usize / LANES, slots[k] as usize % LANES);
-                // The task's parts are in bundle order: the last one starting at or before
-                // `index` is the only one that can hold it.
-                let owner = task_parts.partition_point(|(start, _, _)| *start <= index);
-                let Some((start, part, geometry)) =
-                    owner.checked_sub(1).and_then(|p| task_parts.get_mut(p))
-                else {
+                if index >= total || !part(t, colour_of(index)).contains(&index) {
                     continue;
-                };
-                if let Some(i) = index.checked_sub(*start).filter(|&i| i < part.len()) {
-                    set_lane(&mut part[i], &mut geometry[i], lane, &constraints[k]);
+                }
+                // SAFETY: as above: `index` lies in one of this task's parts.
+                unsafe {
+                    set_lane(
+                        &mut *bundles.0.add(index),
+                        &mut *geometry.0.add(index),
+                        lane,
+                        &constraints[k],
+                    );
                 }
             }
         });
