@@ -4,8 +4,228 @@
 use glam::{Mat3, Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
+use serde::{Deserialize, Serialize};
 
-use crate::scene::BodyKind;
+/// How a body moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BodyKind {
+    /// A rigid body with mass and inertia tensor.
+    Dynamic,
+    /// Never moves; infinite mass.
+    Static,
+    /// A sphere whose rotation is locked: a particle (translation only).
+    Particle,
+}
+
+/// A body's name in a [`crate::World`] that stays valid while the body lives and never names
+/// another body afterwards: the index of a slot and the slot's generation, which grows each
+/// time the slot is reused (Rapier's and Box2D's handles work the same way). A handle of a
+/// removed body is refused by every call that takes one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct BodyHandle {
+    index: u32,
+    generation: u32,
+}
+
+impl BodyHandle {
+    /// The slot index: for a world built from a scene and never edited, the body's index in
+    /// scene order.
+    pub fn index(self) -> u32 {
+        self.index
+    }
+
+    /// How many bodies used this slot before.
+    pub fn generation(self) -> u32 {
+        self.generation
+    }
+}
+
+/// Handle slots of a world: which dense body index each handle names, and the free slots.
+#[derive(Clone, Default)]
+pub(crate) struct Handles {
+    /// Per slot: its generation, and the body's dense index (`u32::MAX` when free).
+    slots: Vec<(u32, u32)>,
+    /// Free slots, reused last in, first out.
+    free: Vec<u32>,
+    /// Per dense body index, its handle.
+    pub(crate) of_body: Vec<BodyHandle>,
+}
+
+impl Handles {
+    /// A handle for a new body at dense index `body` (the end of the storage).
+    pub(crate) fn insert(&mut self, body: usize) -> BodyHandle {
+        let handle = match self.free.pop() {
+            Some(index) => {
+                let slot = &mut self.slots[index as usize];
+                slot.1 = body as u32;
+                BodyHandle {
+                    index,
+                    generation: slot.0,
+                }
+            }
+            None => {
+                self.slots.push((0, body as u32));
+                BodyHandle {
+                    index: self.slots.len() as u32 - 1,
+                    generation: 0,
+                }
+            }
+        };
+        debug_assert_eq!(self.of_body.len(), body);
+        self.of_body.push(handle);
+        handle
+    }
+
+    /// The dense index of `handle`'s body, or `None` for a removed body or a foreign handle.
+    pub(crate) fn body(&self, handle: BodyHandle) -> Option<usize> {
+        let &(generation, body) = self.slots.get(handle.index as usize)?;
+        (generation == handle.generation && body != u32::MAX).then_some(body as usize)
+    }
+
+    /// Frees `handle`'s slot after its body (dense index `body`) was swap-removed: the body
+    /// that was last now sits at `body`.
+    pub(crate) fn remove(&mut self, handle: BodyHandle, body: usize) {
+        let slot = &mut self.slots[handle.index as usize];
+        slot.0 = slot.0.wrapping_add(1);
+        slot.1 = u32::MAX;
+        self.free.push(handle.index);
+        self.of_body.swap_remove(body);
+        if let Some(&moved) = self.of_body.get(body) {
+            self.slots[moved.index as usize].1 = body as u32;
+        }
+    }
+}
+
+/// A body to insert into a [`crate::World`]: shape, kind, pose, velocities, material and mass,
+/// with glam types. Units SI; velocities are those of the body origin, angular velocity in
+/// the world frame. Mass and inertia come from Parry's mass properties of the shape at
+/// `density` (kg/m³), scaled to `mass` when given. Checked when inserted
+/// ([`crate::World::insert`]): every number finite, friction ≥ 0, restitution in [0, 1],
+/// density and mass > 0, a particle a ball, a half-space static.
+///
+/// ```
+/// use impulse::glam::Vec3;
+/// use impulse::{BodyBuilder, SharedShape};
+///
+/// let crate_body = BodyBuilder::dynamic(SharedShape::cuboid(0.5, 0.5, 0.5))
+///     .translation(Vec3::new(0.0, 3.0, 0.0))
+///     .linear_velocity(Vec3::new(1.0, 0.0, 0.0))
+///     .friction(0.4)
+///     .name("crate");
+/// # let _ = crate_body;
+/// ```
+#[derive(Clone)]
+pub struct BodyBuilder {
+    pub(crate) kind: BodyKind,
+    pub(crate) shape: SharedShape,
+    pub(crate) translation: Vec3,
+    pub(crate) rotation: Quat,
+    pub(crate) linear_velocity: Vec3,
+    pub(crate) angular_velocity: Vec3,
+    pub(crate) friction: f32,
+    pub(crate) restitution: f32,
+    pub(crate) density: f32,
+    pub(crate) mass: Option<f32>,
+    pub(crate) name: Option<String>,
+    pub(crate) user_data: u128,
+}
+
+impl BodyBuilder {
+    /// A body of `kind` and `shape` at the origin, at rest, with the default material
+    /// (friction 0.6, restitution 0, density 1000 kg/m³).
+    pub fn new(kind: BodyKind, shape: SharedShape) -> Self {
+        Self {
+            kind,
+            shape,
+            translation: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            linear_velocity: Vec3::ZERO,
+            angular_velocity: Vec3::ZERO,
+            friction: 0.6,
+            restitution: 0.0,
+            density: 1000.0,
+            mass: None,
+            name: None,
+            user_data: 0,
+        }
+    }
+
+    /// A rigid body with mass and inertia.
+    pub fn dynamic(shape: SharedShape) -> Self {
+        Self::new(BodyKind::Dynamic, shape)
+    }
+
+    /// A body that never moves (ground, walls).
+    pub fn fixed(shape: SharedShape) -> Self {
+        Self::new(BodyKind::Static, shape)
+    }
+
+    /// A ball of `radius` (m) whose rotation is locked.
+    pub fn particle(radius: f32) -> Self {
+        Self::new(BodyKind::Particle, SharedShape::ball(radius))
+    }
+
+    /// Position of the body origin (m).
+    pub fn translation(mut self, translation: Vec3) -> Self {
+        self.translation = translation;
+        self
+    }
+
+    /// Orientation (normalised when inserted; must not be zero).
+    pub fn rotation(mut self, rotation: Quat) -> Self {
+        self.rotation = rotation;
+        self
+    }
+
+    /// Linear velocity of the body origin (m/s).
+    pub fn linear_velocity(mut self, velocity: Vec3) -> Self {
+        self.linear_velocity = velocity;
+        self
+    }
+
+    /// Angular velocity, world frame (rad/s); ignored for particles and static bodies.
+    pub fn angular_velocity(mut self, velocity: Vec3) -> Self {
+        self.angular_velocity = velocity;
+        self
+    }
+
+    /// Coulomb friction coefficient μ ≥ 0; a pair uses the geometric mean of its bodies'.
+    pub fn friction(mut self, friction: f32) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// Restitution coefficient in [0, 1]; a pair uses the larger of its bodies'.
+    pub fn restitution(mut self, restitution: f32) -> Self {
+        self.restitution = restitution;
+        self
+    }
+
+    /// Density (kg/m³) > 0.
+    pub fn density(mut self, density: f32) -> Self {
+        self.density = density;
+        self
+    }
+
+    /// Mass (kg) > 0, overriding the density; the inertia tensor is scaled to match.
+    pub fn mass(mut self, mass: f32) -> Self {
+        self.mass = Some(mass);
+        self
+    }
+
+    /// A name, shown in error messages and exports.
+    pub fn name(mut self, name: impl Into<String>) -> Self {
+        self.name = Some(name.into());
+        self
+    }
+
+    /// Any number the caller wants to find the body by; the engine never reads it.
+    pub fn user_data(mut self, user_data: u128) -> Self {
+        self.user_data = user_data;
+        self
+    }
+}
 
 /// All bodies of a world. Index `i` of every array is body `i` in scene order.
 ///
@@ -38,9 +258,37 @@ pub struct Bodies {
     pub asleep: Vec<bool>,
     /// How long (s) the body has been below the sleep thresholds.
     pub sleep_time: Vec<f32>,
+    /// Force (N) applied at the centre of mass during the next step, then cleared.
+    pub force: Vec<Vec3>,
+    /// Torque (N·m, world frame) applied during the next step, then cleared.
+    pub torque: Vec<Vec3>,
+    /// Name given when the body was made.
+    pub name: Vec<Option<String>>,
+    /// The caller's number for the body ([`BodyBuilder::user_data`]).
+    pub user_data: Vec<u128>,
 }
 
 impl Bodies {
+    /// Removes body `i`, moving the last body into its place; returns its name.
+    pub(crate) fn swap_remove(&mut self, i: usize) -> Option<String> {
+        self.kind.swap_remove(i);
+        self.pose.swap_remove(i);
+        self.local_center_of_mass.swap_remove(i);
+        self.linear_velocity.swap_remove(i);
+        self.angular_velocity.swap_remove(i);
+        self.inverse_mass.swap_remove(i);
+        self.local_inverse_inertia.swap_remove(i);
+        self.shape.swap_remove(i);
+        self.friction.swap_remove(i);
+        self.restitution.swap_remove(i);
+        self.asleep.swap_remove(i);
+        self.sleep_time.swap_remove(i);
+        self.force.swap_remove(i);
+        self.torque.swap_remove(i);
+        self.user_data.swap_remove(i);
+        self.name.swap_remove(i)
+    }
+
     /// Number of bodies.
     pub fn len(&self) -> usize {
         self.kind.len()

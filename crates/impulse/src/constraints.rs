@@ -135,6 +135,10 @@ pub struct ContactConstraint {
     /// Largest normal impulse this point received during the step (N·s): a contact that
     /// never pushed did not collide, so it does not bounce.
     pub max_normal_impulse: f32,
+    /// Impulses (normal, tangent 1, tangent 2) the point applied over the whole step (N·s):
+    /// the sum of each substep's final impulses, plus what the restitution solve added. What
+    /// the world reports per contact; the solver never reads it.
+    pub step_impulses: [f32; 3],
     /// Where the point lives: (pair, manifold, point) in the narrow phase, for write-back.
     pub source: (u32, u16, u16),
 }
@@ -360,6 +364,13 @@ impl Assembly<'_> {
                     tangent_impulses: [warm.friction.dot(t1), warm.friction.dot(t2)],
                     depth,
                     max_normal_impulse: 0.0,
+                    // Last step's totals, which a sleeping island keeps reporting; an awake
+                    // island's step starts them from zero.
+                    step_impulses: [
+                        warm.step_normal,
+                        warm.step_friction.dot(t1),
+                        warm.step_friction.dot(t2),
+                    ],
                     source: (pair_index, manifold_index as u16, point_index as u16),
                 };
             }

@@ -17,6 +17,10 @@ pub enum WorldError {
         /// What is wrong.
         message: String,
     },
+    /// A handle names no body of this world (the body was removed, or the handle is another
+    /// world's).
+    #[error("no body {0:?} in this world (removed, or another world's handle)")]
+    UnknownBody(crate::body::BodyHandle),
     /// A world-wide setting is invalid (time step, gravity, solver settings).
     #[error("{field}: {message}")]
     InvalidSetting {

@@ -4,9 +4,8 @@
 //! Two moving bodies are in one island when a chain of contacts joins them; static bodies join
 //! nothing (they take no impulse). Quiet islands fall asleep.
 
-use crate::body::Bodies;
+use crate::body::{Bodies, BodyKind};
 use crate::narrow_phase::ContactPair;
-use crate::scene::BodyKind;
 
 /// Islands of one step: body lists, and the order in which the narrow phase's pairs are
 /// assembled so that each island's constraints come out contiguous.

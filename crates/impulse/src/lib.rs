@@ -24,7 +24,17 @@ pub mod settings;
 pub mod solver;
 pub mod world;
 
+/// The vector types of the API (the version Parry uses), so a user needs no glam of their own.
+pub use glam;
+/// The geometry library behind shapes and queries, so a user needs no parry3d of their own.
+pub use parry3d;
+/// Shapes to build bodies from: `SharedShape::ball(r)`, `::cuboid(hx, hy, hz)`,
+/// `::capsule_y(half_height, r)`, `::convex_hull(&points)`, `::halfspace(normal)`.
+pub use parry3d::shape::SharedShape;
+
+pub use body::{BodyBuilder, BodyHandle, BodyKind};
+pub use diagnostics::StepDiagnostics;
 pub use error::{StepError, WorldError};
-pub use scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
+pub use scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
 pub use settings::SolverSettings;
-pub use world::World;
+pub use world::{BodyRef, ContactEvent, ContactPairView, ContactPoint, RayHit, ShapeHit, World};

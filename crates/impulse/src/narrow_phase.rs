@@ -23,6 +23,11 @@ pub struct ContactImpulse {
     pub normal: f32,
     /// Friction impulse as a world vector (N·s), so it survives a change of tangent basis.
     pub friction: Vec3,
+    /// Normal impulse over the whole last step (N·s): every substep's together. `normal` is
+    /// the last substep's alone, which is what warm starting reads.
+    pub step_normal: f32,
+    /// Friction impulse over the whole last step, world vector (N·s).
+    pub step_friction: Vec3,
 }
 
 /// Per-manifold state kept across steps.
@@ -259,6 +264,14 @@ pub struct NarrowPhase {
 }
 
 impl NarrowPhase {
+    /// Drops every pair with body `a` or body `b` (a body removal: the body at `a` goes and the
+    /// last one, `b`, takes its index, so neither's pairs name the right bodies any more).
+    pub(crate) fn remove_pairs_of(&mut self, a: u32, b: u32) {
+        let keep = |p: &ContactPair| ![p.body1, p.body2].iter().any(|&i| i == a || i == b);
+        self.pairs.retain(keep);
+        self.previous.retain(keep);
+    }
+
     /// Updates manifolds for `candidates`; pairs no longer candidates are dropped with their
     /// history. Points of pair (i, j) are generated up to
     /// [`SpeculativeMargins::pair_prediction`] of separation.

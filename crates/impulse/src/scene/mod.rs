@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::body::BodyKind;
 use crate::settings::SolverSettings;
 
 /// A whole scene: world settings and bodies, in SI units with y up.
@@ -55,18 +56,6 @@ impl Default for Material {
             density: 1000.0,
         }
     }
-}
-
-/// How a body moves.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BodyKind {
-    /// A rigid body with mass and inertia tensor.
-    Dynamic,
-    /// Never moves; infinite mass.
-    Static,
-    /// A sphere whose rotation is locked: a particle (translation only).
-    Particle,
 }
 
 /// Collision shape of a body, in the body's local frame (centred on its origin).

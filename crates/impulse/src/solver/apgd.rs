@@ -26,8 +26,13 @@ pub struct Apgd {
 }
 
 impl ContactSolver for Apgd {
-    fn warm_start(&mut self, constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
-        super::warm_start(constraints, velocities);
+    fn warm_start(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        substep: u32,
+    ) {
+        super::warm_start_substep(constraints, velocities, substep);
     }
 
     fn solve(

@@ -53,8 +53,13 @@ pub struct Exact {
 }
 
 impl ContactSolver for Exact {
-    fn warm_start(&mut self, constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
-        super::warm_start(constraints, velocities);
+    fn warm_start(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        substep: u32,
+    ) {
+        super::warm_start_substep(constraints, velocities, substep);
     }
 
     fn solve(

@@ -53,8 +53,15 @@ pub trait ContactSolver {
     /// rayon's threads. Default: nothing to do.
     fn prepare(&mut self, _constraints: &mut [ContactConstraint], _slots: usize, _parallel: bool) {}
 
-    /// Applies the accumulated impulses to `velocities` (warm starting).
-    fn warm_start(&mut self, constraints: &[ContactConstraint], velocities: &mut Velocities<'_>);
+    /// Applies the accumulated impulses to `velocities` (warm starting) at the start of
+    /// substep `substep` (from 0). From the second substep on these are the last substep's
+    /// final impulses, which it also adds to each row's `step_impulses`.
+    fn warm_start(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        substep: u32,
+    );
 
     /// One solve: with `pass.targets`, first sets every row's target velocity and softness from
     /// the separation its point has reached (scalar rows: [`constraints::update_targets`]);
@@ -67,8 +74,13 @@ pub trait ContactSolver {
         pass: &SolvePass<'_>,
     ) -> SolveOutcome;
 
-    /// Writes the step's impulses back to `constraints`. Default: nothing to do.
-    fn finish(&mut self, _constraints: &mut [ContactConstraint]) {}
+    /// Writes the step's impulses back to `constraints` and adds the last substep's to their
+    /// `step_impulses`. Default: the adding, for solvers that work on the constraints.
+    fn finish(&mut self, constraints: &mut [ContactConstraint]) {
+        for c in constraints {
+            add_step_impulses(c);
+        }
+    }
 }
 
 /// What one [`ContactSolver::solve`] is asked to do.
@@ -135,6 +147,32 @@ impl SolveOutcome {
             ..Self::default()
         }
     }
+}
+
+/// Adds the point's current impulses to its step totals.
+#[inline(always)]
+pub(crate) fn add_step_impulses(c: &mut ContactConstraint) {
+    let now = impulses(c);
+    for (total, now) in c.step_impulses.iter_mut().zip(now) {
+        *total += now;
+    }
+}
+
+/// The scalar methods' [`ContactSolver::warm_start`]: [`warm_start`], and from the second
+/// substep on the impulses added to the step totals.
+pub(crate) fn warm_start_substep(
+    constraints: &mut [ContactConstraint],
+    velocities: &mut Velocities<'_>,
+    substep: u32,
+) {
+    for c in constraints.iter_mut() {
+        if substep > 0 {
+            add_step_impulses(c);
+        } else {
+            c.step_impulses = [0.0; 3];
+        }
+    }
+    warm_start(constraints, velocities);
 }
 
 /// For the scalar methods: sets the rows' targets when the pass asks (see

@@ -19,8 +19,13 @@ pub struct Nncg {
 }
 
 impl ContactSolver for Nncg {
-    fn warm_start(&mut self, constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
-        super::warm_start(constraints, velocities);
+    fn warm_start(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        substep: u32,
+    ) {
+        super::warm_start_substep(constraints, velocities, substep);
     }
 
     fn solve(

@@ -82,8 +82,13 @@ pub struct Auto {
 }
 
 impl ContactSolver for Auto {
-    fn warm_start(&mut self, constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
-        super::warm_start(constraints, velocities);
+    fn warm_start(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        substep: u32,
+    ) {
+        super::warm_start_substep(constraints, velocities, substep);
     }
 
     /// NNCG for `pass.iterations`; then, with `pass.escalate`: the exact path for a small

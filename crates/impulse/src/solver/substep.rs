@@ -70,6 +70,9 @@ pub struct IslandWorkspace {
     pub rotation: Vec<Vec3>,
     /// Orientations, integrated substep by substep.
     pub orientation: Vec<Quat>,
+    /// Per body, the linear and angular acceleration of its applied force and torque (m/s²,
+    /// rad/s²); empty in a step without forces.
+    acceleration: Vec<(Vec3, Vec3)>,
     pseudo_linear: Vec<Vec3>,
     pseudo_angular: Vec<Vec3>,
     /// Colour offsets of the island's constraints when it is coloured (see [`Sweep`]).
@@ -201,6 +204,9 @@ pub struct StepContext<'a> {
     /// Whether any body has a restitution coefficient above zero; without one the
     /// restitution pass over the rows is skipped.
     pub restitution: bool,
+    /// Whether any body has a force or torque this step ([`Bodies::force`]); without one the
+    /// substeps add gravity alone.
+    pub forces: bool,
 }
 
 /// Runs stages 1, 5 and 6 of one step on one island: per substep of h = dt/substeps, gravity,
@@ -221,6 +227,7 @@ pub fn step_island(
         settings,
         parallel,
         restitution,
+        forces,
     } = *context;
     let slots = island_bodies.len() + 1;
     let w = workspace;
@@ -234,6 +241,17 @@ pub fn step_island(
     }
     w.linear.push(Vec3::ZERO);
     w.angular.push(Vec3::ZERO);
+    // The bodies' accelerations from applied forces and torques, constant over the step.
+    w.acceleration.clear();
+    if forces {
+        w.acceleration.extend(island_bodies.iter().map(|&i| {
+            let i = i as usize;
+            (
+                bodies.force[i] * bodies.inverse_mass[i],
+                bodies.world_inverse_inertia(i) * bodies.torque[i],
+            )
+        }));
+    }
     w.displacement.clear();
     w.displacement.resize(slots, Vec3::ZERO);
     w.rotation.clear();
@@ -289,13 +307,19 @@ pub fn step_island(
         // matters little, and its results are compared with exact solutions.
         let half_turn = substep % 2 == 1 && !settings.split_impulse;
         integrate::prospective_velocities(&mut w.linear[..moving], gravity, h);
+        for (k, &(linear, angular)) in w.acceleration.iter().enumerate() {
+            w.linear[k] += linear * h;
+            w.angular[k] += angular * h;
+        }
         let mut velocities = Velocities {
             linear: &mut w.linear,
             angular: &mut w.angular,
         };
-        w.solvers
-            .substeps(settings.method, bundled)
-            .warm_start(constraints, &mut velocities);
+        w.solvers.substeps(settings.method, bundled).warm_start(
+            constraints,
+            &mut velocities,
+            substep,
+        );
         w.position_repair = false;
         w.targets_and_solve(constraints, settings, h, bundled, true, half_turn);
         // With no row to repair beyond the tolerance, positions move with the velocities alone
@@ -389,6 +413,13 @@ pub fn step_island(
                 parallel: w.parallel,
             },
         };
+        // The step totals gain what the restitution solve adds to each impulse.
+        for c in constraints.iter_mut() {
+            let before = super::impulses(c);
+            for (total, before) in c.step_impulses.iter_mut().zip(before) {
+                *total -= before;
+            }
+        }
         let outcome = w.solvers.scalar(settings.method).solve(
             constraints,
             &mut Velocities {
@@ -397,6 +428,9 @@ pub fn step_island(
             },
             &pass,
         );
+        for c in constraints.iter_mut() {
+            super::add_step_impulses(c);
+        }
         w.record(&outcome, false);
     }
 }

@@ -94,6 +94,8 @@ struct Bundle {
     normal_impulse: Lane,
     tangent_impulses: [Lane; 2],
     max_normal_impulse: Lane,
+    /// Impulses over the substeps so far (see [`ContactConstraint::step_impulses`]).
+    step_impulses: [Lane; 3],
 }
 
 /// What the target update of [`Bundles::solve_pgs`] reads: where the points are.
@@ -504,6 +506,11 @@ impl Bundles {
             c.normal_impulse = at(&b.normal_impulse);
             c.tangent_impulses = [at(&b.tangent_impulses[0]), at(&b.tangent_impulses[1])];
             c.max_normal_impulse = at(&b.max_normal_impulse);
+            c.step_impulses = [
+                at(&b.step_impulses[0]) + c.normal_impulse,
+                at(&b.step_impulses[1]) + c.tangent_impulses[0],
+                at(&b.step_impulses[2]) + c.tangent_impulses[1],
+            ];
             c.target_normal_velocity = at(&b.target);
             c.softness = (at(&b.mass_scale), at(&b.impulse_scale));
         };
@@ -525,7 +532,7 @@ impl Bundles {
             forward: true,
             half_turn: false,
         };
-        self.sweep(order, velocities, WarmStart, NoTargets);
+        self.sweep(order, velocities, WarmStart::<false>, NoTargets);
     }
 
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
@@ -636,8 +643,21 @@ impl ContactSolver for Bundles {
         self.pack(constraints, slots, parallel);
     }
 
-    fn warm_start(&mut self, _constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
-        Bundles::warm_start(self, velocities);
+    fn warm_start(
+        &mut self,
+        _constraints: &mut [ContactConstraint],
+        velocities: &mut Velocities<'_>,
+        substep: u32,
+    ) {
+        let order = SweepOrder {
+            forward: true,
+            half_turn: false,
+        };
+        if substep > 0 {
+            self.sweep(order, velocities, WarmStart::<true>, NoTargets);
+        } else {
+            self.sweep(order, velocities, WarmStart::<false>, NoTargets);
+        }
     }
 
     fn solve(
@@ -674,13 +694,19 @@ impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
     }
 }
 
-/// The accumulated impulses applied to the bodies (warm start); changes no impulse.
+/// The accumulated impulses applied to the bodies (warm start); changes no impulse. With
+/// `ADD`, also adds them to the step totals (every substep's but the first).
 #[derive(Clone, Copy)]
-struct WarmStart;
+struct WarmStart<const ADD: bool>;
 
-impl BundleUpdate for WarmStart {
+impl<const ADD: bool> BundleUpdate for WarmStart<ADD> {
     #[inline(always)]
     fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane {
+        if ADD {
+            b.step_impulses[0] += b.normal_impulse;
+            b.step_impulses[1] += b.tangent_impulses[0];
+            b.step_impulses[2] += b.tangent_impulses[1];
+        }
         let masses = (b.inverse_mass_a, b.inverse_mass_b);
         b.normal.apply(b.normal_impulse, masses, v);
         b.tangents[0].apply(b.tangent_impulses[0], masses, v);
@@ -963,6 +989,10 @@ fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &ContactConstra
     set(&mut b.tangent_impulses[0], i, c.tangent_impulses[0]);
     set(&mut b.tangent_impulses[1], i, c.tangent_impulses[1]);
     set(&mut b.max_normal_impulse, i, c.max_normal_impulse);
+    // The step totals start from zero (the packed bundles are this step's alone).
+    for k in 0..3 {
+        set(&mut b.step_impulses[k], i, 0.0);
+    }
     set_vec(&mut g.lever_a, i, c.lever_a);
     set_vec(&mut g.lever_b, i, c.lever_b);
     set(&mut g.depth, i, c.depth);

@@ -5,7 +5,7 @@ use glam::{Mat3, Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
-use crate::body::{Bodies, rotate_tensor};
+use crate::body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Handles, rotate_tensor};
 use crate::broad_phase::BroadPhase;
 use crate::constraints::{self, ContactConstraint};
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
@@ -14,10 +14,18 @@ use crate::error::{StepError, WorldError};
 use crate::island::Islands;
 use crate::narrow_phase::{self, ContactImpulse, NarrowPhase};
 use crate::parallel::{BODIES_PER_TASK, ISLANDS_PER_TASK, PAIRS_PER_TASK, SharedItems, spread};
-use crate::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
+use crate::scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
 use crate::solver::substep::{self, IslandWorkspace, StepContext};
 use rayon::prelude::*;
+
+mod bodies;
+mod contacts;
+mod query;
+
+pub use bodies::BodyRef;
+pub use contacts::{ContactEvent, ContactPairView, ContactPoint};
+pub use query::{RayHit, ShapeHit};
 
 /// A body further than this from the origin (m) means the simulation has blown up.
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
@@ -76,8 +84,10 @@ impl StageClock {
 
 /// Bodies, settings and the persistent contact state of a simulation.
 pub struct World {
-    /// The bodies, in scene order.
+    /// The bodies, in scene order while none has been removed (a removal moves the last body
+    /// into the freed index; [`BodyHandle`]s stay valid).
     pub bodies: Bodies,
+    handles: Handles,
     /// Gravity (m/s²).
     pub gravity: Vec3,
     /// Solver settings.
@@ -100,6 +110,12 @@ pub struct World {
     pub parallel: bool,
     diagnostics: StepDiagnostics,
     profile: StepProfile,
+    /// Whether any body has a force or torque for the next step.
+    forces_pending: bool,
+    /// Body indices, for edits that visit a body's neighbours.
+    scratch_bodies: Vec<u32>,
+    /// Contact pairs touching at the end of the last step, and this step's events.
+    contact_events: contacts::ContactEvents,
 }
 
 impl World {
@@ -108,6 +124,7 @@ impl World {
     pub fn new(gravity: Vec3, dt: f32, settings: SolverSettings) -> Result<Self, WorldError> {
         let world = Self {
             bodies: Bodies::default(),
+            handles: Handles::default(),
             gravity,
             settings,
             dt,
@@ -126,6 +143,9 @@ impl World {
             parallel: true,
             diagnostics: StepDiagnostics::default(),
             profile: StepProfile::default(),
+            forces_pending: false,
+            scratch_bodies: Vec::new(),
+            contact_events: contacts::ContactEvents::default(),
         };
         world.check_settings()?;
         Ok(world)
@@ -156,13 +176,24 @@ impl World {
         Ok(world)
     }
 
-    /// Adds a body and returns its index. Mass and inertia come from Parry's mass properties
-    /// of the shape at the material's density, scaled to `desc.mass` when given.
+    /// Adds a body described as in a scene file and returns its dense index (its index in
+    /// scene order while no body has been removed). Mass and inertia come from Parry's mass
+    /// properties of the shape at the material's density, scaled to `desc.mass` when given.
+    /// Errors name the body and the field ([`WorldError::InvalidBody`]).
     pub fn add_body(&mut self, desc: &BodyDesc, material: &Material) -> Result<usize, WorldError> {
         let index = self.bodies.len();
-        let built = build_body(index, desc, material)?;
+        let builder = builder_of(index, desc, material)?;
+        self.insert(builder)?;
+        Ok(index)
+    }
+
+    /// Inserts a body and returns its handle. Errors, naming the field, when a number is not
+    /// finite or out of range (see [`BodyBuilder`]); the world is then unchanged.
+    pub fn insert(&mut self, builder: BodyBuilder) -> Result<BodyHandle, WorldError> {
+        let index = self.bodies.len();
+        let built = build(index, &builder)?;
         let b = &mut self.bodies;
-        b.kind.push(desc.kind);
+        b.kind.push(builder.kind);
         b.pose.push(built.pose);
         b.local_center_of_mass.push(built.local_center_of_mass);
         b.linear_velocity.push(built.linear_velocity);
@@ -170,11 +201,15 @@ impl World {
         b.inverse_mass.push(built.inverse_mass);
         b.local_inverse_inertia.push(built.local_inverse_inertia);
         b.shape.push(built.shape);
-        b.friction.push(material.friction);
-        b.restitution.push(material.restitution);
+        b.friction.push(builder.friction);
+        b.restitution.push(builder.restitution);
         b.asleep.push(false);
         b.sleep_time.push(0.0);
-        Ok(index)
+        b.force.push(Vec3::ZERO);
+        b.torque.push(Vec3::ZERO);
+        b.name.push(builder.name);
+        b.user_data.push(builder.user_data);
+        Ok(self.handles.insert(index))
     }
 
     /// The time step (s).
@@ -315,6 +350,7 @@ impl World {
                 settings: &settings,
                 parallel: self.parallel,
                 restitution: self.bodies.restitution.iter().any(|&r| r > 0.0),
+                forces: self.forces_pending,
             };
             // Each island ends its step with the passes that read its rows once more, while
             // they are still in cache: its rows' v*, its natural-map residual and its
@@ -458,6 +494,14 @@ impl World {
             linear_momentum: energy.momentum.to_array(),
         };
         self.profile = profile;
+        self.record_contact_events();
+        if std::mem::take(&mut self.forces_pending) {
+            // Forces are for one step. Their work is energy the contacts did not make, so the
+            // energy check starts again from here.
+            self.bodies.force.fill(Vec3::ZERO);
+            self.bodies.torque.fill(Vec3::ZERO);
+            self.energy.lowest = energy.mechanical();
+        }
         self.check_blow_up(&energy)?;
         Ok(&self.diagnostics)
     }
@@ -715,6 +759,9 @@ fn write_impulse(c: &ContactConstraint, manifolds: &mut [narrow_phase::Manifold]
         normal: c.normal_impulse,
         friction: c.tangents[0].direction * c.tangent_impulses[0]
             + c.tangents[1].direction * c.tangent_impulses[1],
+        step_normal: c.step_impulses[0],
+        step_friction: c.tangents[0].direction * c.step_impulses[1]
+            + c.tangents[1].direction * c.step_impulses[2],
     };
     let manifold = &mut manifolds[manifold as usize];
     manifold.data.tangent = c.tangents[0].direction;
@@ -779,51 +826,13 @@ fn positive(index: usize, desc: &BodyDesc, field: &str, value: f32) -> Result<()
     }
 }
 
-fn finite(index: usize, desc: &BodyDesc, field: &str, values: &[f32]) -> Result<(), WorldError> {
-    if values.iter().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(invalid(
-            index,
-            desc,
-            field,
-            format!("must be finite, got {values:?}"),
-        ))
-    }
-}
-
-/// Turns a body description into state, rejecting every value that would make the
-/// simulation meaningless (the library never panics on user input).
-fn build_body(index: usize, desc: &BodyDesc, material: &Material) -> Result<BuiltBody, WorldError> {
-    finite(index, desc, "position", &desc.position)?;
-    finite(index, desc, "orientation", &desc.orientation)?;
-    finite(index, desc, "linear_velocity", &desc.linear_velocity)?;
-    finite(index, desc, "angular_velocity", &desc.angular_velocity)?;
-    let q = Quat::from_array(desc.orientation);
-    if q.length() < 1e-6 {
-        return Err(invalid(
-            index,
-            desc,
-            "orientation",
-            "quaternion must not be zero".into(),
-        ));
-    }
-    if !(material.friction.is_finite() && material.friction >= 0.0) {
-        return Err(invalid(
-            index,
-            desc,
-            "material.friction",
-            format!("must be finite and ≥ 0, got {}", material.friction),
-        ));
-    }
-    if !(0.0..=1.0).contains(&material.restitution) {
-        return Err(invalid(
-            index,
-            desc,
-            "material.restitution",
-            format!("must be in [0, 1], got {}", material.restitution),
-        ));
-    }
+/// Turns a scene's body description into a builder: the shape from its description (each
+/// size checked, with the scene's field names), the rest copied for [`build`] to check.
+fn builder_of(
+    index: usize,
+    desc: &BodyDesc,
+    material: &Material,
+) -> Result<BodyBuilder, WorldError> {
     let shape = match &desc.shape {
         ShapeDesc::Sphere { radius } => {
             positive(index, desc, "shape.radius", *radius)?;
@@ -902,57 +911,133 @@ fn build_body(index: usize, desc: &BodyDesc, material: &Material) -> Result<Buil
             SharedShape::halfspace(n.normalize())
         }
     };
-    if desc.kind == BodyKind::Particle && !matches!(desc.shape, ShapeDesc::Sphere { .. }) {
-        return Err(invalid(
-            index,
-            desc,
-            "shape",
-            "a particle must be a sphere".into(),
-        ));
+    let q = Quat::from_array(desc.orientation);
+    Ok(BodyBuilder {
+        kind: desc.kind,
+        shape,
+        translation: Vec3::from(desc.position),
+        rotation: q,
+        linear_velocity: Vec3::from(desc.linear_velocity),
+        angular_velocity: Vec3::from(desc.angular_velocity),
+        friction: material.friction,
+        restitution: material.restitution,
+        density: material.density,
+        mass: desc.mass,
+        name: desc.name.clone(),
+        user_data: 0,
+    })
+}
+
+/// An invalid field of body `index` built from `builder`.
+fn invalid_built(index: usize, builder: &BodyBuilder, field: &str, message: String) -> WorldError {
+    WorldError::InvalidBody {
+        body: index,
+        name: builder.name.clone(),
+        field: field.to_string(),
+        message,
     }
-    let rotation = q.normalize();
-    let pose = Pose::from_parts(Vec3::from(desc.position), rotation);
-    let (inverse_mass, local_center_of_mass, local_inverse_inertia) = match desc.kind {
+}
+
+/// Turns a builder into state, rejecting every value that would make the simulation
+/// meaningless (the library never panics on user input). Fields are named as in the scene
+/// format (`position` for the translation, `material.friction`, …).
+fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
+    let bad = |field: &str, message: String| Err(invalid_built(index, b, field, message));
+    let vectors = [
+        ("position", b.translation),
+        ("linear_velocity", b.linear_velocity),
+        ("angular_velocity", b.angular_velocity),
+    ];
+    for (field, v) in vectors {
+        if !v.is_finite() {
+            return bad(field, format!("must be finite, got {:?}", v.to_array()));
+        }
+    }
+    if !b.rotation.is_finite() {
+        return bad(
+            "orientation",
+            format!("must be finite, got {:?}", b.rotation.to_array()),
+        );
+    }
+    if b.rotation.length() < 1e-6 {
+        return bad("orientation", "quaternion must not be zero".into());
+    }
+    if !(b.friction.is_finite() && b.friction >= 0.0) {
+        return bad(
+            "material.friction",
+            format!("must be finite and ≥ 0, got {}", b.friction),
+        );
+    }
+    if !(0.0..=1.0).contains(&b.restitution) {
+        return bad(
+            "material.restitution",
+            format!("must be in [0, 1], got {}", b.restitution),
+        );
+    }
+    let shape = b.shape.clone();
+    if b.kind != BodyKind::Static && shape.as_halfspace().is_some() {
+        return bad("shape", "a half-space must be a static body".into());
+    }
+    if b.kind == BodyKind::Particle && shape.as_ball().is_none() {
+        return bad("shape", "a particle must be a sphere".into());
+    }
+    let rotation = b.rotation.normalize();
+    let pose = Pose::from_parts(b.translation, rotation);
+    let positive = |field: &str, value: f32| {
+        if value.is_finite() && value > 0.0 {
+            Ok(())
+        } else {
+            Err(invalid_built(
+                index,
+                b,
+                field,
+                format!("must be finite and > 0, got {value}"),
+            ))
+        }
+    };
+    let (inverse_mass, local_center_of_mass, local_inverse_inertia) = match b.kind {
         BodyKind::Static => (0.0, Vec3::ZERO, Mat3::ZERO),
         BodyKind::Dynamic | BodyKind::Particle => {
-            positive(index, desc, "material.density", material.density)?;
-            let props = shape.mass_properties(material.density);
+            positive("material.density", b.density)?;
+            let props = shape.mass_properties(b.density);
             let computed_mass = props.mass();
             // Scaling mass and inertia together keeps the shape's mass distribution.
-            let scale = match desc.mass {
+            let scale = match b.mass {
                 Some(m) => {
-                    positive(index, desc, "mass", m)?;
+                    positive("mass", m)?;
                     m / computed_mass
                 }
                 None => 1.0,
             };
             let inverse_mass = props.inv_mass / scale;
             if !(inverse_mass.is_finite() && inverse_mass > 0.0) {
-                return Err(invalid(
-                    index,
-                    desc,
+                return bad(
                     "mass",
                     format!("mass must be finite and > 0, got {}", 1.0 / inverse_mass),
-                ));
+                );
             }
-            let inertia = if desc.kind == BodyKind::Particle {
+            let inertia = if b.kind == BodyKind::Particle {
                 Mat3::ZERO
             } else {
                 props.reconstruct_inverse_inertia_matrix() / scale
             };
+            if !inertia.is_finite() || !props.local_com.is_finite() {
+                return bad("shape", "mass properties are not finite".into());
+            }
             (inverse_mass, props.local_com, inertia)
         }
     };
-    let angular_velocity = if desc.kind == BodyKind::Dynamic {
-        Vec3::from(desc.angular_velocity)
+    let angular_velocity = if b.kind == BodyKind::Dynamic {
+        b.angular_velocity
     } else {
         Vec3::ZERO
     };
-    // The scene gives the velocity of the body origin; the solver works at the centre of mass.
-    let linear_velocity = if desc.kind == BodyKind::Static {
+    // The builder gives the velocity of the body origin; the solver works at the centre of
+    // mass.
+    let linear_velocity = if b.kind == BodyKind::Static {
         Vec3::ZERO
     } else {
-        Vec3::from(desc.linear_velocity) + angular_velocity.cross(rotation * local_center_of_mass)
+        b.linear_velocity + angular_velocity.cross(rotation * local_center_of_mass)
     };
     Ok(BuiltBody {
         pose,

@@ -1,0 +1,227 @@
+//! The world's contacts as a user reads them: the pairs in contact with their points and
+//! impulses, and the events of the last step (pairs that started or stopped touching).
+
+use glam::Vec3;
+
+use super::World;
+use crate::body::BodyHandle;
+use crate::narrow_phase::{ContactPair, repeats_earlier_point};
+
+/// One contact point of a pair after the last step, in world coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactPoint {
+    /// Midpoint of the two bodies' surface points (m).
+    pub position: Vec3,
+    /// Unit normal pointing from [`ContactPairView::body1`] towards
+    /// [`ContactPairView::body2`].
+    pub normal: Vec3,
+    /// Signed distance between the surfaces along the normal (m): negative when they overlap,
+    /// positive for a speculative point that has not touched yet.
+    pub separation: f32,
+    /// Normal impulse over the last step, all its substeps together (N·s, ≥ 0), pushing body 2
+    /// along the normal and body 1 against it. Divided by the step, the mean contact force.
+    pub normal_impulse: f32,
+    /// Friction impulse over the last step on body 2 (N·s, world vector in the contact plane;
+    /// body 1 receives its opposite).
+    pub friction_impulse: Vec3,
+}
+
+/// A pair of bodies with contact points after the last step ([`World::contact_pairs`]).
+#[derive(Clone, Copy)]
+pub struct ContactPairView<'a> {
+    world: &'a World,
+    pair: &'a ContactPair,
+}
+
+impl<'a> ContactPairView<'a> {
+    /// The first body (shape 1 of the manifolds).
+    pub fn body1(&self) -> BodyHandle {
+        self.world.handles.of_body[self.pair.body1 as usize]
+    }
+
+    /// The second body.
+    pub fn body2(&self) -> BodyHandle {
+        self.world.handles.of_body[self.pair.body2 as usize]
+    }
+
+    /// The pair's contact points (each point once, although Parry may list a point twice).
+    pub fn points(&self) -> impl Iterator<Item = ContactPoint> + 'a {
+        let bodies = &self.world.bodies;
+        let (pose1, pose2) = (
+            bodies.pose[self.pair.body1 as usize],
+            bodies.pose[self.pair.body2 as usize],
+        );
+        self.pair.manifolds.iter().flat_map(move |manifold| {
+            let normal = pose1.rotation * manifold.local_n1;
+            manifold
+                .points
+                .iter()
+                .enumerate()
+                .filter(|&(index, _)| !repeats_earlier_point(&manifold.points, index))
+                .map(move |(_, point)| ContactPoint {
+                    position: 0.5
+                        * (pose1.transform_point(point.local_p1)
+                            + pose2.transform_point(point.local_p2)),
+                    normal,
+                    separation: point.dist,
+                    // The solver's normal pushes body 2 (its A) away from body 1 (its B), and
+                    // its friction vector is the impulse on A.
+                    normal_impulse: point.data.step_normal,
+                    friction_impulse: point.data.step_friction,
+                })
+        })
+    }
+
+    /// Sum of the points' normal impulses in the last step (N·s).
+    pub fn total_normal_impulse(&self) -> f32 {
+        total_normal_impulse(self.pair)
+    }
+
+    /// Whether the bodies touch: a point overlaps or pushed in the last step.
+    pub fn touching(&self) -> bool {
+        touching(self.pair)
+    }
+}
+
+/// A change in which pairs of bodies touch, from one step to the next ([`World::contact_events`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ContactEvent {
+    /// The bodies touch now and did not at the end of the step before.
+    Started {
+        /// The body with the smaller handle.
+        body1: BodyHandle,
+        /// The other body.
+        body2: BodyHandle,
+        /// Their total normal impulse in the step (N·s): how hard they met.
+        normal_impulse: f32,
+    },
+    /// The bodies touched at the end of the step before and do not now (one may have been
+    /// removed).
+    Stopped {
+        /// The body with the smaller handle.
+        body1: BodyHandle,
+        /// The other body.
+        body2: BodyHandle,
+    },
+}
+
+/// Which pairs touched at the end of the last step, and the events that step produced. Both
+/// lists are kept and reused, so tracking events allocates nothing once they have grown.
+#[derive(Default)]
+pub(crate) struct ContactEvents {
+    /// Touching pairs (smaller handle first) with their total normal impulse, sorted.
+    touching: Vec<(BodyHandle, BodyHandle, f32)>,
+    /// The same for the step just taken, before it replaces `touching`.
+    now: Vec<(BodyHandle, BodyHandle, f32)>,
+    events: Vec<ContactEvent>,
+}
+
+/// Sum of a pair's normal impulses in the last step (N·s), each point once.
+fn total_normal_impulse(pair: &ContactPair) -> f32 {
+    pair.manifolds
+        .iter()
+        .flat_map(|m| {
+            m.points
+                .iter()
+                .enumerate()
+                .filter(|&(index, _)| !repeats_earlier_point(&m.points, index))
+                .map(|(_, p)| p.data.step_normal)
+        })
+        .sum()
+}
+
+/// Whether a pair touches: any point overlaps (separation ≤ 0) or pushed (normal impulse > 0).
+fn touching(pair: &ContactPair) -> bool {
+    pair.manifolds
+        .iter()
+        .flat_map(|m| m.points.iter())
+        .any(|p| p.dist <= 0.0 || p.data.step_normal > 0.0)
+}
+
+impl World {
+    /// Pairs of bodies with contact points after the last step (speculative points included:
+    /// see [`ContactPairView::touching`]).
+    pub fn contact_pairs(&self) -> impl Iterator<Item = ContactPairView<'_>> + '_ {
+        self.narrow_phase
+            .pairs
+            .iter()
+            .filter(|pair| pair.manifolds.iter().any(|m| !m.points.is_empty()))
+            .map(move |pair| ContactPairView { world: self, pair })
+    }
+
+    /// The contact pair of bodies `a` and `b` after the last step, if they have contact points.
+    pub fn contact_pair(&self, a: BodyHandle, b: BodyHandle) -> Option<ContactPairView<'_>> {
+        let (i, j) = (self.handles.body(a)?, self.handles.body(b)?);
+        let key = (i.min(j) as u32, i.max(j) as u32);
+        let pairs = &self.narrow_phase.pairs;
+        let at = pairs
+            .binary_search_by(|p| (p.body1, p.body2).cmp(&key))
+            .ok()?;
+        Some(ContactPairView {
+            world: self,
+            pair: &pairs[at],
+        })
+        .filter(|view| view.pair.manifolds.iter().any(|m| !m.points.is_empty()))
+    }
+
+    /// The pairs that started or stopped touching in the last step, in handle order.
+    pub fn contact_events(&self) -> &[ContactEvent] {
+        &self.contact_events.events
+    }
+
+    /// Compares the pairs touching now with those at the end of the step before, and writes
+    /// the events; called once at the end of every step.
+    pub(crate) fn record_contact_events(&mut self) {
+        let state = &mut self.contact_events;
+        let of_body = &self.handles.of_body;
+        state.now.clear();
+        for pair in &self.narrow_phase.pairs {
+            if !touching(pair) {
+                continue;
+            }
+            let (h1, h2) = (of_body[pair.body1 as usize], of_body[pair.body2 as usize]);
+            let impulse = total_normal_impulse(pair);
+            state.now.push((h1.min(h2), h1.max(h2), impulse));
+        }
+        state.now.sort_unstable_by_key(|p| (p.0, p.1));
+        state.events.clear();
+        let (mut old, mut new) = (
+            state.touching.iter().peekable(),
+            state.now.iter().peekable(),
+        );
+        loop {
+            let key = |p: &&(BodyHandle, BodyHandle, f32)| (p.0, p.1);
+            match (old.peek().map(key), new.peek().map(key)) {
+                (None, None) => break,
+                (Some(a), Some(b)) if a == b => {
+                    old.next();
+                    new.next();
+                }
+                (Some(a), Some(b)) if a > b => {
+                    let impulse = new.next().map_or(0.0, |p| p.2);
+                    state.events.push(ContactEvent::Started {
+                        body1: b.0,
+                        body2: b.1,
+                        normal_impulse: impulse,
+                    });
+                }
+                (None, Some(b)) => {
+                    let impulse = new.next().map_or(0.0, |p| p.2);
+                    state.events.push(ContactEvent::Started {
+                        body1: b.0,
+                        body2: b.1,
+                        normal_impulse: impulse,
+                    });
+                }
+                (Some(a), _) => {
+                    state.events.push(ContactEvent::Stopped {
+                        body1: a.0,
+                        body2: a.1,
+                    });
+                    old.next();
+                }
+            }
+        }
+        std::mem::swap(&mut state.touching, &mut state.now);
+    }
+}
