@@ -166,7 +166,7 @@ impl ContactConstraint {
 /// carried-over impulses are scaled by `settings.warm_start` ([`crate::solver::scale_impulses`]).
 ///
 /// Pairs are read in memory order and written to their islands' rows. With `parallel`, runs of
-/// [`PAIRS_PER_TASK`] pairs are assembled on rayon's threads, each pair into its own rows of
+/// `PAIRS_PER_TASK` (1024) pairs are assembled on rayon's threads, each pair into its own rows of
 /// `out` (the narrow phase knows every pair's row count); the result is the same as on one
 /// thread.
 pub fn assemble(

@@ -2,7 +2,30 @@
 //!
 //! Spheres, particles and rigid bodies in piles and stacks, whose contact impulses are found
 //! together as one linear complementarity problem per step and solved by Projected
-//! Gauss-Seidel and its relatives (docs/method.md). Each stage of the step is one module:
+//! Gauss-Seidel and its relatives (docs/method.md in the repository).
+//!
+//! ```
+//! use impulse::glam::Vec3;
+//! use impulse::{BodyBuilder, SharedShape, SolverSettings, World};
+//!
+//! let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, SolverSettings::default())?;
+//! world.insert(BodyBuilder::fixed(SharedShape::cuboid(10.0, 0.5, 10.0))
+//!     .translation(Vec3::new(0.0, -0.5, 0.0)))?;
+//! let cube = world.insert(BodyBuilder::dynamic(SharedShape::cuboid(0.5, 0.5, 0.5))
+//!     .translation(Vec3::new(0.0, 3.0, 0.0)))?;
+//! for _ in 0..120 {
+//!     let diagnostics = world.step()?;
+//!     // How well this step's LCP was solved (m/s).
+//!     assert!(diagnostics.natural_map_residual.is_finite());
+//! }
+//! let y = world.body(cube).unwrap().translation().y;
+//! assert!((y - 0.5).abs() < 0.01, "the cube rests on the ground: y = {y}");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! Where to start: [`World`] (insert, edit, step, read contacts and events, query),
+//! [`BodyBuilder`] and [`BodyHandle`], [`SolverSettings`] (presets along the quality/speed
+//! front), [`Scene`] (the JSON scene format). Each stage of the step is one module:
 //! [`integrate`] (1, 6) → [`broad_phase`] (2) → [`narrow_phase`] (3) → [`constraints`] (4) →
 //! [`island`] and [`solver`] (5: one island at a time, [`solver::substep`], each method behind
 //! [`solver::ContactSolver`]) → [`diagnostics`] (7), driven by [`World::step`].
@@ -38,3 +61,8 @@ pub use error::{StepError, WorldError};
 pub use scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
 pub use settings::SolverSettings;
 pub use world::{BodyRef, ContactEvent, ContactPairView, ContactPoint, RayHit, ShapeHit, World};
+
+/// The README's code, compiled and run as a doc-test.
+#[doc = include_str!("../../../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

@@ -57,9 +57,9 @@ impl ContactSolver for Pgs {
 /// How a sweep visits an island's points: in constraint order, or colour by colour.
 ///
 /// A coloured island has its constraints sorted by colour (`colour_constraints`);
-/// colour k is `starts[k]..starts[k + 1]`. Points of one colour below [`COLOURS`] share no
+/// colour k is `starts[k]..starts[k + 1]`. Points of one colour below `COLOURS` (64) share no
 /// moving body, so with `parallel` their updates run on rayon's threads at once; the
-/// forward sweep visits colours in order, the backward sweep in reverse. Colour [`COLOURS`]
+/// forward sweep visits colours in order, the backward sweep in reverse. Colour `COLOURS`
 /// (when present) holds the points the greedy colouring could not place and always runs
 /// sequentially.
 ///

@@ -267,7 +267,7 @@ impl Bundles {
     /// [`LANES`] at a time into lane groups of as many bundles as their largest group has
     /// points; a lane whose group is shorter is padded with rows of zero mass between the same
     /// bodies, whose updates change nothing. Groups the colouring cannot place (a body in more
-    /// than [`COLOURS`] colours) get a lane group each. O(points).
+    /// than `COLOURS` (64) colours) get a lane group each. O(points).
     ///
     /// Why manifold groups (Box2D v3's and Box3D's wide contact constraints are per manifold
     /// too): a sweep gathers and scatters the bodies' velocities once per lane group instead of
