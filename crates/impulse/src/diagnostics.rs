@@ -70,19 +70,91 @@ pub struct StepProfile {
     pub total: f32,
 }
 
+/// The stages of a step, in order: what [`StepProfile`] times and docs/architecture.md
+/// describes. `World::step` calls one method per stage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stage {
+    /// Speculative margins and candidate pairs (with the energy at the step's start).
+    BroadPhase,
+    /// Contact manifolds of the candidate pairs.
+    NarrowPhase,
+    /// Islands from the pairs, and the bodies' world inverse inertia tensors.
+    Islands,
+    /// Constraint assembly: Jacobian rows, effective masses, warm-start impulses.
+    Assembly,
+    /// Each island's substeps (warm start, solve, integrate positions, relax), restitution and
+    /// residual.
+    Solve,
+    /// Island results written back to the bodies.
+    Scatter,
+    /// Impulses written back to the manifolds for the next warm start.
+    StoreImpulses,
+    /// Sleep, energy, momentum and the counts of the diagnostics.
+    Finish,
+}
+
+impl Stage {
+    /// Every stage, in step order.
+    pub const ALL: [Stage; 8] = [
+        Stage::BroadPhase,
+        Stage::NarrowPhase,
+        Stage::Islands,
+        Stage::Assembly,
+        Stage::Solve,
+        Stage::Scatter,
+        Stage::StoreImpulses,
+        Stage::Finish,
+    ];
+
+    /// Snake-case name, as in JSON and the CLI's profile.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::BroadPhase => "broad_phase",
+            Stage::NarrowPhase => "narrow_phase",
+            Stage::Islands => "islands",
+            Stage::Assembly => "assembly",
+            Stage::Solve => "solve",
+            Stage::Scatter => "scatter",
+            Stage::StoreImpulses => "store_impulses",
+            Stage::Finish => "finish",
+        }
+    }
+}
+
 impl StepProfile {
+    /// The time of `stage` (ms).
+    pub fn get(&self, stage: Stage) -> f32 {
+        match stage {
+            Stage::BroadPhase => self.broad_phase,
+            Stage::NarrowPhase => self.narrow_phase,
+            Stage::Islands => self.islands,
+            Stage::Assembly => self.assembly,
+            Stage::Solve => self.solve,
+            Stage::Scatter => self.scatter,
+            Stage::StoreImpulses => self.store_impulses,
+            Stage::Finish => self.finish,
+        }
+    }
+
+    /// Sets the time of `stage` (ms).
+    pub fn set(&mut self, stage: Stage, ms: f32) {
+        let field = match stage {
+            Stage::BroadPhase => &mut self.broad_phase,
+            Stage::NarrowPhase => &mut self.narrow_phase,
+            Stage::Islands => &mut self.islands,
+            Stage::Assembly => &mut self.assembly,
+            Stage::Solve => &mut self.solve,
+            Stage::Scatter => &mut self.scatter,
+            Stage::StoreImpulses => &mut self.store_impulses,
+            Stage::Finish => &mut self.finish,
+        };
+        *field = ms;
+    }
+
     /// The stages as (name, ms) pairs, in step order (without `total`).
     pub fn stages(&self) -> [(&'static str, f32); 8] {
-        [
-            ("broad_phase", self.broad_phase),
-            ("narrow_phase", self.narrow_phase),
-            ("islands", self.islands),
-            ("assembly", self.assembly),
-            ("solve", self.solve),
-            ("scatter", self.scatter),
-            ("store_impulses", self.store_impulses),
-            ("finish", self.finish),
-        ]
+        Stage::ALL.map(|stage| (stage.name(), self.get(stage)))
     }
 }
 

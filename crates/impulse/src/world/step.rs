@@ -1,0 +1,671 @@
+//! `World::step`: the step as its stages, in the order of docs/architecture.md. Each stage is
+//! one method here, and [`Stage`] names them for the profile ([`StepProfile`]) and the docs.
+
+use glam::{Mat3, Vec3};
+use rayon::prelude::*;
+
+use super::{BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, World};
+use crate::body::{Bodies, rotate_tensor};
+use crate::constraints::{self, ContactConstraint};
+use crate::diagnostics::{self, EnergyTerms, Stage, StepDiagnostics, StepProfile};
+use crate::error::StepError;
+use crate::island::Islands;
+use crate::narrow_phase::{self, ContactImpulse};
+use crate::parallel::{BODIES_PER_TASK, ISLANDS_PER_TASK, PAIRS_PER_TASK, SharedItems, spread};
+use crate::settings::SolverSettings;
+use crate::solver::substep::{self, IslandWorkspace, StepContext};
+
+/// The energy check's state: the lowest mechanical energy since the last edit (J) and the
+/// energy at the end of the last step, to recognise edits made between steps.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct EnergyCheck {
+    lowest: f64,
+    last: f64,
+    bodies: usize,
+    started: bool,
+}
+
+/// Times the stages of one step for [`StepProfile`].
+struct StageClock {
+    start: std::time::Instant,
+    last: std::time::Instant,
+    profile: StepProfile,
+}
+
+impl StageClock {
+    fn start() -> Self {
+        let now = std::time::Instant::now();
+        Self {
+            start: now,
+            last: now,
+            profile: StepProfile::default(),
+        }
+    }
+
+    /// Ends `stage`: its time is the time since the last stage ended (or the start).
+    fn end(&mut self, stage: Stage) {
+        let now = std::time::Instant::now();
+        self.profile
+            .set(stage, ((now - self.last).as_secs_f64() * 1e3) as f32);
+        self.last = now;
+    }
+
+    /// The stages' times and the total (ms).
+    fn profile(&self) -> StepProfile {
+        StepProfile {
+            total: ((self.last - self.start).as_secs_f64() * 1e3) as f32,
+            ..self.profile
+        }
+    }
+}
+
+impl World {
+    /// Advances the world by dt through the stages of docs/architecture.md. Settings are
+    /// checked first; a blow-up is reported with the step number, after the state that caused
+    /// it was written.
+    pub fn step(&mut self) -> Result<&StepDiagnostics, StepError> {
+        if let Err(e) = self.check_settings() {
+            return Err(StepError::InvalidSettings(e.to_string()));
+        }
+        let settings = self.settings.clone();
+        self.step_count += 1;
+        let parallel = spread(self.parallel, 1, 0);
+        let mut clock = StageClock::start();
+        self.broad_phase_stage(&settings, parallel);
+        clock.end(Stage::BroadPhase);
+        self.narrow_phase_stage(parallel)?;
+        clock.end(Stage::NarrowPhase);
+        self.islands_stage(parallel);
+        clock.end(Stage::Islands);
+        self.assembly_stage(&settings);
+        clock.end(Stage::Assembly);
+        self.solve_stage(&settings);
+        clock.end(Stage::Solve);
+        self.scatter_islands();
+        clock.end(Stage::Scatter);
+        self.store_impulses();
+        clock.end(Stage::StoreImpulses);
+        let energy = self.finish_stage(&settings, parallel);
+        clock.end(Stage::Finish);
+        self.profile = clock.profile();
+        self.end_step(&energy)?;
+        Ok(&self.diagnostics)
+    }
+
+    /// Speculative margins and candidate pairs on the poses and velocities at the step's start,
+    /// with the energy at the start summed beside them (read only to notice edits between
+    /// steps: the energy check's reference restarts whenever the bodies changed).
+    fn broad_phase_stage(&mut self, settings: &SolverSettings, parallel: bool) {
+        let dt = self.dt;
+        let (bodies, gravity) = (&self.bodies, self.gravity);
+        let (margins, broad_phase, candidates) = (
+            &mut self.margins,
+            &mut self.broad_phase,
+            &mut self.candidates,
+        );
+        let start_energy = || diagnostics::energy_terms(bodies, gravity).mechanical();
+        let mut broad = || {
+            margins.update(bodies, settings.prediction_distance, gravity, dt);
+            broad_phase.candidate_pairs(bodies, margins.margins(), parallel, candidates);
+        };
+        let start_energy = if parallel {
+            rayon::join(start_energy, broad).0
+        } else {
+            broad();
+            start_energy()
+        };
+        // The energy check's reference restarts whenever the bodies changed since the last step.
+        if !self.energy.started
+            || self.energy.bodies != self.bodies.len()
+            || start_energy != self.energy.last
+        {
+            self.energy = EnergyCheck {
+                lowest: start_energy,
+                last: start_energy,
+                bodies: self.bodies.len(),
+                started: true,
+            };
+        }
+    }
+
+    /// Contact manifolds of the candidate pairs (Parry), beside the broad phase tree's upkeep.
+    fn narrow_phase_stage(&mut self, parallel: bool) -> Result<(), StepError> {
+        let (broad_phase, narrow_phase) = (&mut self.broad_phase, &mut self.narrow_phase);
+        let (bodies, candidates, margins) = (&self.bodies, &self.candidates, &self.margins);
+        let mut narrow = || narrow_phase.update(bodies, candidates, margins, parallel);
+        if parallel {
+            rayon::join(|| broad_phase.optimize(), narrow).1?;
+        } else {
+            broad_phase.optimize();
+            narrow()?;
+        }
+        Ok(())
+    }
+
+    /// Islands from the pairs, so that assembly writes each island's constraints contiguously
+    /// and nothing has to be moved afterwards.
+    fn islands_stage(&mut self, parallel: bool) {
+        // Islands from the pairs first, so that assembly writes each island's constraints
+        // contiguously and nothing has to be moved afterwards. The union-find is serial; the
+        // world inertia tensors (from the poses alone) are computed beside it.
+        let (islands, world_inverse_inertia) = (&mut self.islands, &mut self.world_inverse_inertia);
+        let (bodies, pairs) = (&self.bodies, &self.narrow_phase.pairs);
+        if parallel {
+            rayon::join(
+                || islands.build(bodies, pairs),
+                || world_inverse_inertia_of(bodies, parallel, world_inverse_inertia),
+            );
+        } else {
+            world_inverse_inertia_of(bodies, parallel, world_inverse_inertia);
+            islands.build(bodies, pairs);
+        }
+    }
+
+    /// One constraint per contact point: Jacobian rows, effective masses, warm-start impulses.
+    fn assembly_stage(&mut self, settings: &SolverSettings) {
+        constraints::assemble(
+            &self.bodies,
+            &self.narrow_phase,
+            &self.islands,
+            settings,
+            &self.world_inverse_inertia,
+            self.parallel,
+            &mut self.constraints,
+        );
+    }
+
+    /// Stages 1, 5 and 6 per island: each island's substeps touch only its own bodies.
+    fn solve_stage(&mut self, settings: &SolverSettings) {
+        let dt = self.dt;
+        let islands = self.islands.len();
+        self.wake_or_skip_islands();
+        if self.workspaces.len() < islands {
+            self.workspaces
+                .resize_with(islands, IslandWorkspace::default);
+        }
+        {
+            let context = StepContext {
+                bodies: &self.bodies,
+                gravity: self.gravity,
+                dt,
+                settings: settings,
+                parallel: self.parallel,
+                restitution: self.bodies.restitution.iter().any(|&r| r > 0.0),
+                forces: self.forces_pending,
+            };
+            // Each island ends its step with the passes that read its rows once more, while
+            // they are still in cache: its rows' v*, its natural-map residual and its
+            // friction-row count, in one pass. As world-wide passes over every row they were
+            // 3 % of a balls16k step at rest (perf), mostly waiting on memory; the results are
+            // the same to the bit.
+            let run = |bodies: &[u32],
+                       constraints: &mut [ContactConstraint],
+                       workspace: &mut IslandWorkspace| {
+                substep::step_island(bodies, constraints, &context, workspace);
+                let rows = diagnostics::record_velocity_before_and_residual(
+                    constraints,
+                    constraints::BodySlots::Island,
+                    &workspace.linear,
+                    &workspace.angular,
+                    context.parallel,
+                    &mut workspace.record_scratch,
+                );
+                workspace.report.natural_map_residual = rows.natural_map_residual;
+                workspace.friction_rows = rows.friction_rows;
+            };
+            let islands_of = &self.islands;
+            let awake = &self.island_awake;
+            let workspaces = &mut self.workspaces[..islands];
+            let awake_count = awake.iter().take(islands).filter(|&&a| a).count();
+            if spread(self.parallel, awake_count, 1) {
+                // Islands differ in cost by orders of magnitude (an exact solve against a
+                // resting column), so the jobs are split finely enough for work stealing to
+                // even them out: in balls16k's landing, 800 columns each solved exactly, rayon's
+                // default split left one thread with three quarters of the work.
+                let rows = SharedItems(self.constraints.as_mut_ptr());
+                let total = self.constraints.len();
+                workspaces
+                    .par_iter_mut()
+                    .enumerate()
+                    .with_max_len(ISLANDS_PER_TASK)
+                    .for_each(|(k, workspace)| {
+                        // Capture the whole wrapper (Sync), not its raw-pointer field.
+                        #[allow(clippy::redundant_locals)]
+                        let rows = rows;
+                        if !awake[k] {
+                            return;
+                        }
+                        let range = islands_of.constraint_range(k);
+                        assert!(range.end <= total);
+                        // SAFETY: the islands' constraint ranges are disjoint and inside the
+                        // constraints (checked above), and each island is visited once.
+                        let mine = unsafe {
+                            std::slice::from_raw_parts_mut(rows.0.add(range.start), range.len())
+                        };
+                        run(islands_of.bodies(k), mine, workspace);
+                    });
+            } else {
+                let mut rest: &mut [ContactConstraint] = &mut self.constraints;
+                for (k, workspace) in workspaces.iter_mut().enumerate() {
+                    let (mine, others) = rest.split_at_mut(islands_of.constraint_range(k).len());
+                    rest = others;
+                    if awake[k] {
+                        run(islands_of.bodies(k), mine, workspace);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Sleep, energy, momentum and the step's diagnostics; returns the energy terms for the
+    /// blow-up check.
+    fn finish_stage(&mut self, settings: &SolverSettings, parallel: bool) -> EnergyTerms {
+        let dt = self.dt;
+        let islands = self.islands.len();
+        let mut iterations = 0;
+        for k in 0..islands {
+            if self.island_awake[k] {
+                iterations = iterations.max(self.workspaces[k].report.iterations);
+            }
+        }
+        // Awake islands recorded their rows' v* as their step ended; a sleeping island's rows
+        // take it from the bodies' velocities. One pass over every row covers them (rows of
+        // awake islands come out the same as their own record).
+        if self.island_awake.iter().take(islands).any(|awake| !awake) {
+            constraints::record_velocity_before(
+                &mut self.constraints,
+                constraints::BodySlots::World,
+                &self.bodies.linear_velocity,
+                &self.bodies.angular_velocity,
+                self.parallel,
+                &mut self.scratch,
+            );
+        }
+        // Only awake islands were solved this step; sleeping ones keep last step's state.
+        let mut squared = 0.0f64;
+        let mut friction_rows = 0;
+        // Reuse last step's list: no allocation per step once it has grown.
+        let mut island_reports = std::mem::take(&mut self.diagnostics.islands);
+        island_reports.clear();
+        for k in 0..islands {
+            let range = self.islands.constraint_range(k);
+            if self.island_awake[k] {
+                let report = self.workspaces[k].report;
+                let part = report.natural_map_residual as f64;
+                squared += part * part;
+                friction_rows += self.workspaces[k].friction_rows;
+                if !range.is_empty() {
+                    island_reports.push(report);
+                }
+            } else {
+                friction_rows += self::friction_rows(&self.constraints[range]);
+            }
+        }
+        let residual = squared.sqrt() as f32;
+        // Sleep last: it zeroes velocities, which must not leak into this step's LCP. The
+        // counts over pairs need no bodies, so they run beside it and the energy.
+        let (bodies, gravity) = (&mut self.bodies, self.gravity);
+        let (islands_of, awake) = (&self.islands, &self.island_awake);
+        let pairs = &self.narrow_phase;
+        let mut sleep_and_energy = || {
+            update_sleep(bodies, islands_of, awake, settings, dt, parallel);
+            diagnostics::energy_terms_on(bodies, gravity, parallel)
+        };
+        let counts = || {
+            (
+                pairs.pairs.iter().filter(|p| p.point_count() > 0).count(),
+                pairs.max_depth(),
+            )
+        };
+        let (energy, (contact_pairs, max_depth)) = if parallel {
+            rayon::join(sleep_and_energy, counts)
+        } else {
+            (sleep_and_energy(), counts())
+        };
+        self.diagnostics = StepDiagnostics {
+            step: self.step_count,
+            contact_pairs,
+            contacts: self.constraints.len(),
+            rows: self.constraints.len() + 2 * friction_rows,
+            iterations,
+            natural_map_residual: residual,
+            islands: island_reports,
+            max_depth,
+            kinetic_energy: energy.kinetic as f32,
+            linear_momentum: energy.momentum.to_array(),
+        };
+        energy
+    }
+
+    /// Contact events, the end of this step's forces, and the blow-up check.
+    fn end_step(&mut self, energy: &EnergyTerms) -> Result<(), StepError> {
+        self.record_contact_events();
+        if std::mem::take(&mut self.forces_pending) {
+            // Forces are for one step. Their work is energy the contacts did not make, so the
+            // energy check starts again from here.
+            self.bodies.force.fill(Vec3::ZERO);
+            self.bodies.torque.fill(Vec3::ZERO);
+            self.energy.lowest = energy.mechanical();
+        }
+        self.check_blow_up(&energy)?;
+        Ok(())
+    }
+
+    /// Marks which islands run this step: an island with any awake body runs and wakes all its
+    /// bodies (a sleeping pile hit by an awake body wakes whole); an island whose bodies are all
+    /// asleep is skipped.
+    fn wake_or_skip_islands(&mut self) {
+        self.island_awake.clear();
+        for k in 0..self.islands.len() {
+            let bodies = self.islands.bodies(k);
+            let awake = bodies.iter().any(|&i| !self.bodies.asleep[i as usize]);
+            if awake {
+                for &i in bodies {
+                    if self.bodies.asleep[i as usize] {
+                        self.bodies.asleep[i as usize] = false;
+                        self.bodies.sleep_time[i as usize] = 0.0;
+                    }
+                }
+            }
+            self.island_awake.push(awake);
+        }
+    }
+
+    /// Writes every awake island's velocities and poses back into the bodies. In parallel,
+    /// runs of bodies each look up their island and local index (islands can be many and
+    /// small, or one and large; body runs split either evenly).
+    fn scatter_islands(&mut self) {
+        let islands = &self.islands;
+        let (workspaces, awake) = (&self.workspaces, &self.island_awake);
+        if !spread(self.parallel, self.bodies.len(), BODIES_PER_TASK) {
+            for k in 0..islands.len() {
+                if awake[k] {
+                    substep::scatter(islands.bodies(k), &workspaces[k], &mut self.bodies);
+                }
+            }
+            return;
+        }
+        let Bodies {
+            pose,
+            linear_velocity,
+            angular_velocity,
+            local_center_of_mass,
+            ..
+        } = &mut self.bodies;
+        pose.par_iter_mut()
+            .zip(linear_velocity.par_iter_mut())
+            .zip(angular_velocity.par_iter_mut())
+            .enumerate()
+            .with_min_len(BODIES_PER_TASK)
+            .for_each(|(i, ((pose, linear), angular))| {
+                let Some(&k) = islands.island_of_body.get(i) else {
+                    return;
+                };
+                if k == u32::MAX || !awake[k as usize] {
+                    return;
+                }
+                substep::scatter_body(
+                    &workspaces[k as usize],
+                    islands.local_index(i),
+                    local_center_of_mass[i],
+                    pose,
+                    linear,
+                    angular,
+                );
+            });
+    }
+
+    /// Writes the solved impulses back into the manifolds' points for next step's warm start.
+    ///
+    /// Runs over the pairs (in parallel runs of [`PAIRS_PER_TASK`]), each finding
+    /// its rows where assembly put them, so every manifold is written by one task. Serial and
+    /// in island order, this was 3 % of a balls16k step, spent waiting on the manifolds'
+    /// scattered heap blocks. An island swept colour by colour has its rows re-sorted by
+    /// colour; a row found under the wrong pair then sends the whole write-back to the serial
+    /// path, which follows each row's `source`.
+    fn store_impulses(&mut self) {
+        let constraints = &self.constraints;
+        let islands = &self.islands;
+        let store = |first_pair: usize, pairs: &mut [narrow_phase::ContactPair]| {
+            for i in 0..pairs.len() {
+                narrow_phase::prefetch_manifolds(pairs, i);
+                let (pair_index, pair) = (first_pair + i, &mut pairs[i]);
+                let first = if pair.row_count() > 0 {
+                    islands.first_row(pair_index)
+                } else {
+                    0
+                };
+                for row in first..first + pair.row_count() {
+                    let Some(c) = constraints.get(row) else {
+                        return false;
+                    };
+                    if c.source.0 as usize != pair_index {
+                        return false;
+                    }
+                    write_impulse(c, &mut pair.manifolds);
+                }
+            }
+            true
+        };
+        let pairs = &mut self.narrow_phase.pairs;
+        let in_place = if spread(self.parallel, pairs.len(), PAIRS_PER_TASK) {
+            pairs
+                .par_chunks_mut(PAIRS_PER_TASK)
+                .enumerate()
+                .map(|(k, chunk)| store(k * PAIRS_PER_TASK, chunk))
+                .reduce(|| true, |x, y| x && y)
+        } else {
+            store(0, pairs)
+        };
+        if !in_place {
+            for c in constraints {
+                write_impulse(c, &mut pairs[c.source.0 as usize].manifolds);
+            }
+        }
+    }
+
+    fn check_blow_up(&mut self, terms: &diagnostics::EnergyTerms) -> Result<(), StepError> {
+        let energy = terms.mechanical();
+        let gain = (energy - self.energy.lowest) / terms.mass.max(f64::MIN_POSITIVE);
+        self.energy.lowest = self.energy.lowest.min(energy);
+        self.energy.last = energy;
+        if gain.is_nan() || gain > BLOW_UP_ENERGY_PER_KG {
+            let speed = |k: usize| self.bodies.linear_velocity[k].length();
+            let fastest = (0..self.bodies.len())
+                .max_by(|&i, &j| speed(i).total_cmp(&speed(j)))
+                .unwrap_or(0);
+            return Err(StepError::EnergyBlowUp {
+                step: self.step_count,
+                gain_per_kg: gain as f32,
+                bound: BLOW_UP_ENERGY_PER_KG as f32,
+                fastest_body: fastest,
+                speed: if self.bodies.is_empty() {
+                    0.0
+                } else {
+                    speed(fastest)
+                },
+            });
+        }
+        // One pass over the bodies finds the first bad one, and only then is the error built.
+        // On rayon's threads for a large world: serial, it was a quarter of `World::step`'s
+        // own samples in a two-thread balls16k run.
+        let b = &self.bodies;
+        let position = |i: usize| b.pose[i].translation.length();
+        let speed = |i: usize| {
+            b.linear_velocity[i]
+                .length()
+                .max(b.angular_velocity[i].length())
+        };
+        let bad = |i: usize| {
+            let (position, speed) = (position(i), speed(i));
+            position.is_nan()
+                || position > BLOW_UP_DISTANCE
+                || speed.is_nan()
+                || speed > BLOW_UP_SPEED
+        };
+        let first_bad = if spread(self.parallel, b.len(), BODIES_PER_TASK) {
+            (0..b.len())
+                .into_par_iter()
+                .with_min_len(BODIES_PER_TASK)
+                .find_first(|&i| bad(i))
+        } else {
+            (0..b.len()).find(|&i| bad(i))
+        };
+        let Some(i) = first_bad else {
+            return Ok(());
+        };
+        let position = position(i);
+        if position.is_nan() || position > BLOW_UP_DISTANCE {
+            return Err(StepError::BlowUp {
+                step: self.step_count,
+                body: i,
+                quantity: "position",
+                value: position,
+                bound: BLOW_UP_DISTANCE,
+            });
+        }
+        Err(StepError::BlowUp {
+            step: self.step_count,
+            body: i,
+            quantity: "velocity",
+            value: speed(i),
+            bound: BLOW_UP_SPEED,
+        })
+    }
+}
+
+/// Writes constraint `c`'s impulses into its point (named by `c.source`) of `manifolds`, its
+/// pair's manifolds, and into every duplicate copy of that point (see `constraints::assemble`).
+fn write_impulse(c: &ContactConstraint, manifolds: &mut [narrow_phase::Manifold]) {
+    let (_, manifold, point) = c.source;
+    let data = ContactImpulse {
+        normal: c.normal_impulse,
+        friction: c.tangents[0].direction * c.tangent_impulses[0]
+            + c.tangents[1].direction * c.tangent_impulses[1],
+        step_normal: c.step_impulses[0],
+        step_friction: c.tangents[0].direction * c.step_impulses[1]
+            + c.tangents[1].direction * c.step_impulses[2],
+    };
+    let manifold = &mut manifolds[manifold as usize];
+    manifold.data.tangent = c.tangents[0].direction;
+    let points = &mut manifold.points;
+    let location = points[point as usize].local_p1;
+    for p in points[point as usize..].iter_mut() {
+        if narrow_phase::same_point(p.local_p1, location) {
+            p.data = data;
+        }
+    }
+}
+
+/// Contact points with friction (μ > 0): each adds two tangent rows to the step's LCP.
+fn friction_rows(constraints: &[ContactConstraint]) -> usize {
+    constraints.iter().filter(|c| c.friction > 0.0).count()
+}
+
+/// Puts an island to sleep once every body in it has been slower than the thresholds for
+/// `time_to_sleep` seconds (Box2D's rule); its velocities are zeroed and it costs nothing
+/// until something touches it. Sleep timers advance for the bodies of awake islands.
+fn update_sleep(
+    bodies: &mut Bodies,
+    islands: &Islands,
+    awake: &[bool],
+    s: &SolverSettings,
+    dt: f32,
+    parallel: bool,
+) {
+    // Per body first (the bodies of awake islands), then per island; both passes are
+    // independent per item, so they run on rayon's threads when the world is large (serial
+    // they were 0.5 % of the samples of a two-thread balls16k run, the other thread idle).
+    let in_awake_island = |i: usize| {
+        islands
+            .island_of_body
+            .get(i)
+            .is_some_and(|&k| k != u32::MAX && awake.get(k as usize).copied().unwrap_or(false))
+    };
+    let quiet = |linear: Vec3, angular: Vec3| {
+        linear.length() < s.sleep_linear_speed && angular.length() < s.sleep_angular_speed
+    };
+    let parallel = spread(parallel, bodies.len(), BODIES_PER_TASK);
+    {
+        let Bodies {
+            linear_velocity,
+            angular_velocity,
+            sleep_time,
+            ..
+        } = &mut *bodies;
+        let update = |(i, ((time, linear), angular)): (usize, ((&mut f32, &Vec3), &Vec3))| {
+            if in_awake_island(i) {
+                *time = if quiet(*linear, *angular) {
+                    *time + dt
+                } else {
+                    0.0
+                };
+            }
+        };
+        if parallel {
+            sleep_time
+                .par_iter_mut()
+                .zip(linear_velocity.par_iter())
+                .zip(angular_velocity.par_iter())
+                .enumerate()
+                .with_min_len(BODIES_PER_TASK)
+                .for_each(update);
+        } else {
+            sleep_time
+                .iter_mut()
+                .zip(linear_velocity.iter())
+                .zip(angular_velocity.iter())
+                .enumerate()
+                .for_each(update);
+        }
+    }
+    if !s.sleep {
+        return;
+    }
+    let falls_asleep = |k: usize| {
+        awake[k]
+            && islands
+                .bodies(k)
+                .iter()
+                .all(|&i| bodies.sleep_time[i as usize] >= s.time_to_sleep)
+    };
+    let sleepers: Vec<usize> = if parallel {
+        (0..awake.len())
+            .into_par_iter()
+            .filter(|&k| falls_asleep(k))
+            .collect()
+    } else {
+        (0..awake.len()).filter(|&k| falls_asleep(k)).collect()
+    };
+    for k in sleepers {
+        for &i in islands.bodies(k) {
+            let i = i as usize;
+            bodies.asleep[i] = true;
+            bodies.linear_velocity[i] = Vec3::ZERO;
+            bodies.angular_velocity[i] = Vec3::ZERO;
+        }
+    }
+}
+
+/// World-frame inverse inertia tensors I⁻¹ = R I_local⁻¹ Rᵀ (1/(kg·m²)) of every body at its
+/// current pose, zero for bodies that do not rotate.
+fn world_inverse_inertia_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Mat3>) {
+    let world = |i: usize| {
+        let local = &bodies.local_inverse_inertia[i];
+        if *local == Mat3::ZERO {
+            Mat3::ZERO
+        } else {
+            rotate_tensor(bodies.pose[i].rotation, local)
+        }
+    };
+    if spread(parallel, 1, 0) {
+        (0..bodies.len())
+            .into_par_iter()
+            .with_min_len(BODIES_PER_TASK)
+            .map(world)
+            .collect_into_vec(out);
+    } else {
+        out.clear();
+        out.extend((0..bodies.len()).map(world));
+    }
+}
