@@ -188,7 +188,7 @@ impl World {
                 bodies: &self.bodies,
                 gravity: self.gravity,
                 dt,
-                settings: settings,
+                settings,
                 parallel: self.parallel,
                 restitution: self.bodies.restitution.iter().any(|&r| r > 0.0),
                 forces: self.forces_pending,
@@ -347,7 +347,7 @@ impl World {
             self.bodies.torque.fill(Vec3::ZERO);
             self.energy.lowest = energy.mechanical();
         }
-        self.check_blow_up(&energy)?;
+        self.check_blow_up(energy)?;
         Ok(())
     }
 
