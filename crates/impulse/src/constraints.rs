@@ -377,7 +377,7 @@ impl Assembly<'_> {
         }
         debug_assert!(slots.next().is_none(), "more slots than rows");
         // While the rows are in cache, rather than in a pass of its own over every row.
-        crate::solver::scale_impulses(out, settings.warm_start);
+        scale_impulses(out, settings.warm_start);
     }
 }
 
@@ -667,5 +667,31 @@ impl BodySlots {
             BodySlots::World => |c| (c.body_a as usize, c.body_b as usize),
             BodySlots::Island => |c| (c.local_a as usize, c.local_b as usize),
         }
+    }
+}
+
+/// Scales the impulses carried over from the last step by `fraction` (0 = cold start) and
+/// keeps the friction impulse inside its disc.
+pub fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
+    for c in constraints.iter_mut() {
+        c.normal_impulse *= fraction;
+        c.tangent_impulses[0] *= fraction;
+        c.tangent_impulses[1] *= fraction;
+        c.tangent_impulses = cap_to_disc(c.tangent_impulses, c.friction * c.normal_impulse);
+        c.max_normal_impulse = c.normal_impulse;
+    }
+}
+
+/// Projects a friction impulse onto Coulomb's disc of radius `limit` (N·s).
+#[inline(always)]
+pub fn cap_to_disc(impulse: [f32; 2], limit: f32) -> [f32; 2] {
+    let squared = impulse[0] * impulse[0] + impulse[1] * impulse[1];
+    if squared <= limit * limit {
+        impulse
+    } else if squared > 0.0 {
+        let scale = limit / squared.sqrt();
+        [impulse[0] * scale, impulse[1] * scale]
+    } else {
+        [0.0, 0.0]
     }
 }

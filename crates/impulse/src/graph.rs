@@ -1,43 +1,10 @@
 //! Greedy graph colouring of contact points (or of the SIMD lanes' manifold groups): items of
 //! one colour share no moving body, so their updates can run at once, on threads or in lanes.
 
-use crate::constraints::ContactConstraint;
-
-/// Independent colours of a [`Sweep`]; points past them share one sequential colour.
+/// Independent colours of a sweep; items past them share one sequential colour.
 pub const COLOURS: usize = 64;
 
-/// Greedy graph colouring of an island's points: each point takes the lowest colour that
-/// neither of its moving bodies has yet (the immovable slot, `slots − 1`, never conflicts);
-/// the constraints are then sorted by colour (stably, so each colour keeps narrow-phase
-/// order) and the colour offsets written to `starts`. `scratch` holds the sorted copy.
-/// Panics if a point's slot is not below `slots` (the island step sets them so).
-pub(crate) fn colour_constraints(
-    constraints: &mut [ContactConstraint],
-    slots: usize,
-    used: &mut Vec<u64>,
-    colours: &mut Vec<u8>,
-    scratch: &mut Vec<ContactConstraint>,
-    starts: &mut Vec<u32>,
-) {
-    let slots_of = constraints.iter().map(|c| (c.local_a, c.local_b));
-    let counts = greedy_colours(slots_of, slots, used, colours);
-    let used_colours = (0..=COLOURS)
-        .rev()
-        .find(|&k| counts[k + 1] > counts[k])
-        .map_or(0, |k| k + 1);
-    starts.clear();
-    starts.extend_from_slice(&counts[..=used_colours]);
-    scratch.clear();
-    scratch.extend_from_slice(constraints);
-    let mut fill = counts;
-    for (c, &colour) in scratch.iter().zip(colours.iter()) {
-        let slot = &mut fill[colour as usize];
-        constraints[*slot as usize] = *c;
-        *slot += 1;
-    }
-}
-
-/// The greedy colouring of [`colour_constraints`] without the sort, for items (points, or the
+/// Greedy colouring (the scalar sweep's `colour_constraints` then sorts by it), for items (points, or the
 /// SIMD lanes' manifold groups) given by their two body slots: each item's colour (the lowest
 /// neither of its moving bodies has; [`COLOURS`] when none is left) in `colours`, and the
 /// colour offsets in item order, colour k at `counts[k]..counts[k + 1]`. `used` holds each

@@ -20,6 +20,7 @@
 use glam::Vec3;
 
 use crate::constraints::{self, ContactConstraint};
+pub use crate::constraints::{cap_to_disc, scale_impulses};
 use crate::parallel::SharedVelocities;
 use crate::settings::SolverSettings;
 
@@ -213,18 +214,6 @@ pub struct SolveReport {
     pub last_change: f32,
 }
 
-/// Scales the impulses carried over from the last step by `fraction` (0 = cold start) and
-/// keeps the friction impulse inside its disc.
-pub fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
-    for c in constraints.iter_mut() {
-        c.normal_impulse *= fraction;
-        c.tangent_impulses[0] *= fraction;
-        c.tangent_impulses[1] *= fraction;
-        c.tangent_impulses = cap_to_disc(c.tangent_impulses, c.friction * c.normal_impulse);
-        c.max_normal_impulse = c.normal_impulse;
-    }
-}
-
 /// Applies the accumulated impulses to the velocities, so the sweeps start from the last
 /// solution (warm starting).
 pub fn warm_start(constraints: &[ContactConstraint], velocities: &mut Velocities<'_>) {
@@ -318,20 +307,6 @@ impl TangentEigen {
             [0.0, 1.0]
         };
         Some(Self { k1, k2, u1 })
-    }
-}
-
-/// Projects a friction impulse onto Coulomb's disc of radius `limit` (N·s).
-#[inline(always)]
-pub fn cap_to_disc(impulse: [f32; 2], limit: f32) -> [f32; 2] {
-    let squared = impulse[0] * impulse[0] + impulse[1] * impulse[1];
-    if squared <= limit * limit {
-        impulse
-    } else if squared > 0.0 {
-        let scale = limit / squared.sqrt();
-        [impulse[0] * scale, impulse[1] * scale]
-    } else {
-        [0.0, 0.0]
     }
 }
 

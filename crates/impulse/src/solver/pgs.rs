@@ -12,7 +12,7 @@ use super::{
     project_to_friction_disc, set_scalar_targets,
 };
 use crate::constraints::ContactConstraint;
-use crate::graph::COLOURS;
+use crate::graph::{COLOURS, greedy_colours};
 use crate::parallel::{
     SWEEP_POINTS_PER_TASK, SharedVelocities, colour_after_colour, prefetch_lines, spread,
 };
@@ -394,4 +394,35 @@ fn solve_point<const FRICTION: bool>(
         largest_change = largest_change.max(delta.abs() * row.inverse_effective_mass);
     }
     ([la, aa, lb, ab], largest_change)
+}
+
+/// Greedy graph colouring of an island's points: each point takes the lowest colour that
+/// neither of its moving bodies has yet (the immovable slot, `slots − 1`, never conflicts);
+/// the constraints are then sorted by colour (stably, so each colour keeps narrow-phase
+/// order) and the colour offsets written to `starts`. `scratch` holds the sorted copy.
+/// Panics if a point's slot is not below `slots` (the island step sets them so).
+pub(crate) fn colour_constraints(
+    constraints: &mut [ContactConstraint],
+    slots: usize,
+    used: &mut Vec<u64>,
+    colours: &mut Vec<u8>,
+    scratch: &mut Vec<ContactConstraint>,
+    starts: &mut Vec<u32>,
+) {
+    let slots_of = constraints.iter().map(|c| (c.local_a, c.local_b));
+    let counts = greedy_colours(slots_of, slots, used, colours);
+    let used_colours = (0..=COLOURS)
+        .rev()
+        .find(|&k| counts[k + 1] > counts[k])
+        .map_or(0, |k| k + 1);
+    starts.clear();
+    starts.extend_from_slice(&counts[..=used_colours]);
+    scratch.clear();
+    scratch.extend_from_slice(constraints);
+    let mut fill = counts;
+    for (c, &colour) in scratch.iter().zip(colours.iter()) {
+        let slot = &mut fill[colour as usize];
+        constraints[*slot as usize] = *c;
+        *slot += 1;
+    }
 }

@@ -11,13 +11,12 @@ use parry3d::math::Pose;
 
 use super::apgd::Apgd;
 use super::nncg::Nncg;
-use super::pgs::{Pgs, Sweep};
+use super::pgs::{Pgs, Sweep, colour_constraints};
 use super::policy::{Auto, EscalationLevel, EscalationLimits};
 use super::wide::Bundles;
 use super::{ContactSolver, SolveOutcome, SolvePass, TargetInputs, Velocities, position};
 use crate::body::Bodies;
 use crate::constraints::{self, ContactConstraint};
-use crate::graph::colour_constraints;
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
 use crate::settings::{SolverMethod, SolverSettings};

@@ -1,0 +1,42 @@
+#!/usr/bin/env python3
+"""Checks that the modules of the engine crate depend on each other one way: no cycles.
+
+A module's dependencies are the top-level modules its code names as `crate::m` (in paths and
+`use crate::{...}` lists); comments and doc links do not count. Prints the graph and exits 1
+on a cycle. Usage: scripts/module-cycles.py [crates/impulse/src]
+"""
+import glob
+import os
+import re
+import sys
+
+root = sys.argv[1] if len(sys.argv) > 1 else "crates/impulse/src"
+graph = {}
+for path in glob.glob(os.path.join(root, "**", "*.rs"), recursive=True):
+    module = os.path.relpath(path, root).split(os.sep)[0].removesuffix(".rs")
+    if module == "lib":
+        continue
+    with open(path, encoding="utf-8") as f:
+        code = "\n".join(l for l in f if not l.strip().startswith("//"))
+    names = set(re.findall(r"crate::([a-z_]+)", code))
+    for group in re.findall(r"use crate::\{([^}]*)\}", code, re.S):
+        names.update(p.strip().split("::")[0] for p in group.split(",") if p.strip())
+    names.discard(module)
+    graph.setdefault(module, set()).update(names)
+
+def reachable(start):
+    seen, stack = set(), [start]
+    while stack:
+        for n in graph.get(stack.pop(), ()):
+            if n not in seen:
+                seen.add(n)
+                stack.append(n)
+    return seen
+
+for module in sorted(graph):
+    print(f"{module} -> {', '.join(sorted(graph[module])) or '(nothing)'}")
+cycles = sorted((a, b) for a in graph for b in graph[a] if a in reachable(b))
+if cycles:
+    print("cycles through:", ", ".join(f"{a} -> {b}" for a, b in cycles))
+    sys.exit(1)
+print("no cycles")
