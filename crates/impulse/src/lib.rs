@@ -30,6 +30,8 @@
 //! [`island`] and [`solver`] (5: one island at a time, [`solver::substep`], each method behind
 //! [`solver::ContactSolver`]) → [`diagnostics`] (7), driven by [`World::step`].
 
+#![warn(missing_docs)]
+
 pub mod body;
 pub mod broad_phase;
 pub mod constraints;

@@ -62,17 +62,33 @@ impl Default for Material {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ShapeDesc {
-    /// Sphere of `radius` (m) > 0.
-    Sphere { radius: f32 },
-    /// Box with `half_extents` (m), each > 0.
-    Cuboid { half_extents: [f32; 3] },
-    /// Capsule along the local y axis: segment of length 2·`half_height` ≥ 0, `radius` > 0.
-    Capsule { half_height: f32, radius: f32 },
-    /// Convex hull of at least 4 non-coplanar `points` (m, local frame).
-    ConvexHull { points: Vec<[f32; 3]> },
-    /// Half-space below the plane through the body origin with outward unit `normal`;
-    /// static bodies only.
-    HalfSpace { normal: [f32; 3] },
+    /// A sphere.
+    Sphere {
+        /// Radius (m) > 0.
+        radius: f32,
+    },
+    /// A box.
+    Cuboid {
+        /// Half extents along the local x, y and z axes (m), each > 0.
+        half_extents: [f32; 3],
+    },
+    /// A capsule along the local y axis.
+    Capsule {
+        /// Half the length of the axis segment (m) ≥ 0.
+        half_height: f32,
+        /// Radius (m) > 0.
+        radius: f32,
+    },
+    /// The convex hull of points.
+    ConvexHull {
+        /// At least 4 non-coplanar points (m, local frame).
+        points: Vec<[f32; 3]>,
+    },
+    /// The half-space below the plane through the body origin; static bodies only.
+    HalfSpace {
+        /// Outward normal (normalised when built; must not be zero).
+        normal: [f32; 3],
+    },
 }
 
 /// A material given inline or by name from [`Scene::materials`].

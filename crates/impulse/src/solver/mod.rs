@@ -269,8 +269,9 @@ pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f3
 /// [`project_to_friction_disc`] works in.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TangentEigen {
-    /// Larger and smaller eigenvalue (1/kg).
+    /// Larger eigenvalue (1/kg).
     pub k1: f32,
+    /// Smaller eigenvalue (1/kg).
     pub k2: f32,
     /// Unit eigenvector of `k1`, in tangent coordinates.
     pub u1: [f32; 2],
