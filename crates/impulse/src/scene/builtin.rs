@@ -113,6 +113,29 @@ pub fn builtin_names() -> &'static [(&'static str, &'static str)] {
     NAMES
 }
 
+/// The parametrised families [`builtin_scene`] also builds, as (pattern, description): any N
+/// in the stated range is a scene.
+pub fn builtin_families() -> Vec<(&'static str, String)> {
+    vec![
+        (
+            "pyramid<N>",
+            format!("2D pyramid of cubes, base N: N(N+1)/2 cubes, 1 ≤ N ≤ {MAX_PYRAMID_BASE}"),
+        ),
+        (
+            "pyramid3d<N>",
+            format!("square pyramid of cubes, base N×N, 1 ≤ N ≤ {MAX_PYRAMID3D_BASE}"),
+        ),
+        ("stack<N>", format!("tower of N cubes, 1 ≤ N ≤ {MAX_STACK}")),
+        (
+            "balls<N>",
+            format!(
+                "N balls dropped into a walled box, 1 ≤ N ≤ {MAX_BALLS}; N in digits, `k` for \
+                 thousands (balls16k)"
+            ),
+        ),
+    ]
+}
+
 /// The built-in scene called `name`, or `None` if there is none. The scene's `name` field is
 /// `name` as given.
 ///

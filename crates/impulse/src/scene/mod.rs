@@ -187,7 +187,7 @@ pub mod error;
 pub mod json;
 pub mod validate;
 
-pub use builtin::{builtin_names, builtin_scene};
+pub use builtin::{builtin_families, builtin_names, builtin_scene};
 pub use error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
 pub use json::{load_scene_file, parse_scene_str, to_json_string};
 pub use validate::validate;
