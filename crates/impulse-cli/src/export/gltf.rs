@@ -21,7 +21,7 @@ use gltf::json;
 use json::validation::{Checked::Valid, USize64};
 
 use super::mesh::shape_mesh;
-use super::{Animation, BodyInfo, PALETTE, STATIC_GREY, palette_indices};
+use super::{Animation, PALETTE, STATIC_GREY, palette_indices};
 
 /// Writes `animation` as binary glTF (`.glb`).
 pub fn write_glb(animation: &Animation, path: &Path) -> Result<()> {
@@ -153,7 +153,7 @@ fn trajectory(
     buffer: &mut BufferBuilder,
 ) {
     let moving: Vec<usize> = (0..animation.bodies.len())
-        .filter(|&i| !BodyInfo::is_static(&animation.bodies[i]))
+        .filter(|&i| !animation.bodies[i].is_static())
         .collect();
     if moving.is_empty() || animation.frames.is_empty() {
         return;
@@ -380,7 +380,7 @@ impl BufferBuilder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::export::{Frame, PoseSample};
+    use crate::export::{BodyInfo, Frame, PoseSample};
     use impulse::{BodyKind, ShapeDesc};
 
     #[test]

@@ -22,7 +22,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use impulse::ShapeDesc;
 
-use super::mesh::{Hull, bounds, convex_hull, ground_corners};
+use super::mesh::{Hull, bounds, convex_hull, cross, ground_corners, normalize, sub};
 use super::{Animation, PoseSample, body_colours};
 
 /// Writes `animation` as a USD ASCII stage.
@@ -72,6 +72,11 @@ pub fn stage_text(animation: &Animation) -> Result<String> {
     let colours = body_colours(&animation.bodies);
     let ground_half_size = animation.ground_half_size();
     for (i, body) in animation.bodies.iter().enumerate() {
+        let poses: Vec<(u64, PoseSample)> = animation
+            .frames
+            .iter()
+            .map(|f| (f.step, f.poses[i]))
+            .collect();
         out.open_prim_metadata("Xform", &names[i]);
         out.line("customData = {");
         out.line(&format!("    int bodyIndex = {i}"));
@@ -79,37 +84,7 @@ pub fn stage_text(animation: &Animation) -> Result<String> {
         out.line("}");
         out.close_metadata();
         out.open_block();
-        let poses: Vec<(u64, PoseSample)> = animation
-            .frames
-            .iter()
-            .map(|f| (f.step, f.poses[i]))
-            .collect();
-        if body.is_static() || poses.len() <= 1 {
-            if let Some((_, pose)) = poses.first() {
-                out.line(&format!(
-                    "float3 xformOp:translate = {}",
-                    vector(&pose.translation)
-                ));
-                out.line(&format!(
-                    "quatf xformOp:orient = {}",
-                    quaternion(pose.rotation)
-                ));
-            }
-        } else {
-            out.line("float3 xformOp:translate.timeSamples = {");
-            for (step, pose) in &poses {
-                out.line(&format!("    {step}: {},", vector(&pose.translation)));
-            }
-            out.line("}");
-            out.line("quatf xformOp:orient.timeSamples = {");
-            for (step, pose) in &poses {
-                out.line(&format!("    {step}: {},", quaternion(pose.rotation)));
-            }
-            out.line("}");
-        }
-        if !poses.is_empty() {
-            out.line("uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\"]");
-        }
+        transform(&mut out, &poses, body.is_static());
         out.blank();
         geometry(&mut out, &body.shape, colours[i], ground_half_size)
             .with_context(|| format!("body {i} ({})", body.name))?;
@@ -117,6 +92,36 @@ pub fn stage_text(animation: &Animation) -> Result<String> {
     }
     out.close_block();
     Ok(out.text)
+}
+
+/// The translate and orient ops of a body prim: time-sampled at each `(step, pose)`, or single
+/// values for a static body (or a single frame).
+fn transform(out: &mut Usda, poses: &[(u64, PoseSample)], is_static: bool) {
+    let Some((_, first)) = poses.first() else {
+        return;
+    };
+    if is_static || poses.len() == 1 {
+        out.line(&format!(
+            "float3 xformOp:translate = {}",
+            vector(&first.translation)
+        ));
+        out.line(&format!(
+            "quatf xformOp:orient = {}",
+            quaternion(first.rotation)
+        ));
+    } else {
+        out.line("float3 xformOp:translate.timeSamples = {");
+        for (step, pose) in poses {
+            out.line(&format!("    {step}: {},", vector(&pose.translation)));
+        }
+        out.line("}");
+        out.line("quatf xformOp:orient.timeSamples = {");
+        for (step, pose) in poses {
+            out.line(&format!("    {step}: {},", quaternion(pose.rotation)));
+        }
+        out.line("}");
+    }
+    out.line("uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\"]");
 }
 
 /// Time codes per second for time step `dt`: 1/dt, rounded to a whole number when it is one
@@ -174,7 +179,7 @@ fn geometry(out: &mut Usda, shape: &ShapeDesc, colour: [f32; 3], ground: f32) ->
                 .iter()
                 .map(|t| {
                     let [a, b, c] = t.map(|k| vertices[k as usize]);
-                    super::mesh::normalize(cross(sub(b, a), sub(c, a)))
+                    normalize(cross(sub(b, a), sub(c, a)))
                 })
                 .collect();
             out.def("Mesh", "geometry");
@@ -362,18 +367,6 @@ fn quaternion(q: [f32; 4]) -> String {
 
 fn extent(min: [f32; 3], max: [f32; 3]) -> String {
     format!("float3[] extent = [{}, {}]", vector(&min), vector(&max))
-}
-
-fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 #[cfg(test)]
