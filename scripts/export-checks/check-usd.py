@@ -10,7 +10,7 @@ import sys
 
 from pxr import Usd, UsdGeom, UsdValidation
 
-from trajectory import Trajectory, body_kinds, body_names, close
+from trajectory import Trajectory, body_kinds, body_names, close, same_rotation
 
 TOLERANCE = 1e-6
 SHAPES = {"Sphere", "Cube", "Capsule", "Mesh"}
@@ -70,7 +70,7 @@ def main(usda, csv_path, scene_path):
             t = translate.Get(step)
             q = orient.Get(step)
             quaternion = (*q.GetImaginary(), q.GetReal())
-            if not close(t, position, TOLERANCE) or not close(quaternion, rotation, TOLERANCE):
+            if not close(t, position, TOLERANCE) or not same_rotation(quaternion, rotation, TOLERANCE):
                 problems.append(
                     f"{prim.GetPath()} at {step}: {tuple(t)} {quaternion}, "
                     f"CSV {position} {rotation}"

@@ -57,3 +57,9 @@ def body_kinds(scene_path):
 
 def close(a, b, tolerance):
     return all(abs(x - y) <= tolerance for x, y in zip(a, b, strict=True))
+
+
+def same_rotation(q, r, tolerance):
+    """Quaternions equal up to sign (q and -q are the same rotation; the exports keep
+    consecutive keyframes in one hemisphere)."""
+    return close(q, r, tolerance) or close([-c for c in q], r, tolerance)

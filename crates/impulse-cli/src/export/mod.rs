@@ -195,13 +195,26 @@ impl Recording {
     }
 
     /// Keeps the poses of `bodies` (scene order) at `step`.
+    ///
+    /// A rotation quaternion whose dot product with the body's previous keyframe is negative is
+    /// negated (q and −q are the same rotation), so consecutive keyframes lie in one hemisphere
+    /// and tools that interpolate quaternions component by component (Blender's f-curves) turn
+    /// the short way.
     pub fn record(&mut self, step: u64, bodies: &Bodies) {
+        let previous = self.animation.frames.last();
         let poses = bodies
             .pose
             .iter()
-            .map(|p| PoseSample {
-                translation: p.translation.to_array(),
-                rotation: p.rotation.to_array(),
+            .enumerate()
+            .map(|(i, p)| {
+                let rotation = p.rotation.to_array();
+                PoseSample {
+                    translation: p.translation.to_array(),
+                    rotation: match previous {
+                        Some(frame) => same_hemisphere(rotation, frame.poses[i].rotation),
+                        None => rotation,
+                    },
+                }
             })
             .collect();
         self.animation.frames.push(Frame { step, poses });
@@ -215,5 +228,39 @@ impl Recording {
             Format::Usda => usd::write_usda(&self.animation, &self.path),
         };
         result.map_err(|e| e.context(format!("cannot write {}", self.path.display())))
+    }
+}
+
+/// `q`, or −q (the same rotation) when that is nearer to `previous` (their dot product is
+/// negative).
+fn same_hemisphere(q: [f32; 4], previous: [f32; 4]) -> [f32; 4] {
+    let dot: f32 = q.iter().zip(previous).map(|(a, b)| a * b).sum();
+    if dot < 0.0 { q.map(|c| -c) } else { q }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keyframe_quaternions_stay_in_one_hemisphere() {
+        let previous = [0.0, 0.6, 0.0, 0.8];
+        assert_eq!(
+            same_hemisphere([0.0, -0.7, 0.0, -0.71], previous),
+            [0.0, 0.7, 0.0, 0.71]
+        );
+        assert_eq!(
+            same_hemisphere([0.0, 0.7, 0.0, 0.71], previous),
+            [0.0, 0.7, 0.0, 0.71]
+        );
+    }
+
+    #[test]
+    fn formats_by_extension() {
+        assert_eq!(Format::from_path(Path::new("a.glb")), Some(Format::Glb));
+        assert_eq!(Format::from_path(Path::new("a.gltf")), Some(Format::Gltf));
+        assert_eq!(Format::from_path(Path::new("a.usda")), Some(Format::Usda));
+        assert_eq!(Format::from_path(Path::new("a.usd")), None);
+        assert_eq!(Format::from_path(Path::new("a.csv")), None);
     }
 }
