@@ -5,14 +5,14 @@
 //!   own translation and rotation are the body's pose at the first frame;
 //! - one mesh per body (named like it), one triangle primitive with `POSITION`, `NORMAL`,
 //!   `u32` indices and a material: a base colour from a small palette per dynamic body, grey
-//!   for static bodies;
+//!   for static bodies; bodies of the same shape share those accessors;
 //! - one animation (`"trajectory"`) with a `translation` and a `rotation` channel per non-static
 //!   body, linear interpolation, all sharing one input accessor of frame times in seconds;
 //! - one buffer holding all of it, in the GLB BIN chunk or as a base64 data URI.
 //!
 //! Units are metres and seconds, y up, as glTF specifies and the engine uses.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -69,26 +69,39 @@ fn document(animation: &Animation) -> Result<(json::Root, Vec<u8>)> {
     // Materials are made on first use: a glTF validator flags unused ones.
     let mut materials: BTreeMap<Option<usize>, json::Index<json::Material>> = BTreeMap::new();
     let palette = palette_indices(&animation.bodies);
+    type Accessor = json::Index<json::Accessor>;
+    let mut geometry: HashMap<String, (Accessor, Accessor, Accessor)> = HashMap::new();
     let ground_half_size = animation.ground_half_size();
     let first = animation.frames.first();
     let mut nodes = Vec::with_capacity(animation.bodies.len());
     for (i, body) in animation.bodies.iter().enumerate() {
-        let mesh = shape_mesh(&body.shape, ground_half_size)
-            .with_context(|| format!("body {i} ({})", body.name))?;
-        let (min, max) = mesh.bounds();
-        let positions = buffer.accessor(
-            &mut root,
-            &mesh.positions,
-            Some(json::buffer::Target::ArrayBuffer),
-            Some((min.to_vec(), max.to_vec())),
-        );
-        let normals = buffer.accessor(
-            &mut root,
-            &mesh.normals,
-            Some(json::buffer::Target::ArrayBuffer),
-            None,
-        );
-        let indices = buffer.indices(&mut root, &mesh.indices);
+        // Bodies of the same shape share the vertex data (each still has its own mesh).
+        let key = format!("{:?}", body.shape);
+        let (positions, normals, indices) = match geometry.get(&key) {
+            Some(&accessors) => accessors,
+            None => {
+                let mesh = shape_mesh(&body.shape, ground_half_size)
+                    .with_context(|| format!("body {i} ({})", body.name))?;
+                let (min, max) = mesh.bounds();
+                let accessors = (
+                    buffer.accessor(
+                        &mut root,
+                        &mesh.positions,
+                        Some(json::buffer::Target::ArrayBuffer),
+                        Some((min.to_vec(), max.to_vec())),
+                    ),
+                    buffer.accessor(
+                        &mut root,
+                        &mesh.normals,
+                        Some(json::buffer::Target::ArrayBuffer),
+                        None,
+                    ),
+                    buffer.indices(&mut root, &mesh.indices),
+                );
+                geometry.insert(key, accessors);
+                accessors
+            }
+        };
         let material = *materials
             .entry(palette[i])
             .or_insert_with(|| match palette[i] {
