@@ -3,7 +3,7 @@
 # - the Khronos glTF-Validator (npm `gltf-validator`) on every .glb and .gltf: no errors;
 # - OpenUSD (PyPI `usd-core`) on every .usda: its validators, units, axes, time codes, one
 #   Xform per body and every translate/orient sample against the CSV of the same run;
-# - Blender (PyPI `bpy`) importing every .glb headless: one mesh object per body and its
+# - Blender (PyPI `bpy`) importing every .glb and .gltf headless: one mesh object per body and its
 #   world transform at every written step against the CSV. IMPULSE_CHECK_BLENDER=0 skips it.
 #
 # Installs what it needs into a scratch directory kept between runs
@@ -37,9 +37,10 @@ fi
 "$python" -m pip install --quiet --disable-pip-version-check "${packages[@]}"
 echo "gltf-validator $(node -p "require('$scratch/node/node_modules/gltf-validator/package.json').version"), $("$python" -m pip list --disable-pip-version-check 2>/dev/null | grep -E '^(usd-core|bpy) ' | tr -s ' ' | paste -sd, -)"
 
-# scene (built-in name or file), steps, every
+# scene (built-in name or file), steps, every (60 is no multiple of 7: the last frame is
+# written on its own)
 runs=(
-  "pyramid20 60 5"
+  "pyramid20 60 7"
   "scenes/shapes.json 120 10"
   "scenes/example-three-spheres.json 60 1"
 )
@@ -59,8 +60,10 @@ for run in "${runs[@]}"; do
   "$python" "$checks/check-usd.py" "$out.usda" "$out.csv" "$out.json" || failed=1
   if [[ "$blender" != 0 ]]; then
     # Blender logs every imported node; keep its verdict and any problem.
-    "$python" "$checks/check-blender.py" "$out.glb" "$out.csv" "$out.json" 2>&1 \
-      | grep -v '| INFO:' || failed=1
+    for ext in glb gltf; do
+      "$python" "$checks/check-blender.py" "$out.$ext" "$out.csv" "$out.json" 2>&1 \
+        | grep -v '| INFO:' || failed=1
+    done
   fi
 done
 echo "-- glTF-Validator"

@@ -1,8 +1,8 @@
-"""Imports a `.glb` written by `impulse run --out` into Blender headless (the `bpy` wheel) and
+"""Imports a `.glb` or `.gltf` written by `impulse run --out` into Blender headless (the `bpy` wheel) and
 checks it: one mesh object per body, named after it, whose world transform at each written
 step equals the CSV trajectory of the same run (converted to Blender's z-up axes).
 
-Usage: python check-blender.py ANIMATION.glb TRAJECTORY.csv SCENE.json
+Usage: python check-blender.py ANIMATION.glb|ANIMATION.gltf TRAJECTORY.csv SCENE.json
 """
 
 import math
