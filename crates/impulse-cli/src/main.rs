@@ -1,6 +1,7 @@
 //! The `impulse` command: run scenes, list and export them, and work with contact LCPs.
 
 mod engine_convergence;
+mod export;
 mod lcp_command;
 mod run;
 mod trajectory;
@@ -116,7 +117,9 @@ enum Command {
         /// Keep every body awake (no sleeping of quiet islands), as benchmarks do.
         #[arg(long)]
         no_sleep: bool,
-        /// Trajectory file: `.csv` (frame,time,body,x,y,z,qx,qy,qz,qw) or `.jsonl`.
+        /// Output file, by extension: a trajectory, `.csv` (frame,time,body,x,y,z,qx,qy,qz,qw) or
+        /// `.jsonl`; or an animation of the bodies' shapes, `.glb`/`.gltf` (glTF 2.0) or `.usda`
+        /// (OpenUSD), written at the end of the run (docs/export.md).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Write every K-th frame (frame 0 and the last are always written).

@@ -10,6 +10,7 @@ use impulse::{Scene, World, metrics};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
+use crate::export::{self, Recording};
 use crate::trajectory::TrajectoryWriter;
 
 /// Options of `impulse run` beyond the scene itself.
@@ -131,11 +132,53 @@ impl Summary {
     }
 }
 
+/// Where `--out` sends the written frames, by the file's extension.
+enum FrameOutput {
+    /// `.csv` or `.jsonl`: each frame appended to the file as it is written.
+    Trajectory(TrajectoryWriter),
+    /// `.glb`, `.gltf` or `.usda`: frames kept and the file written at the end of the run.
+    Animation(Recording),
+}
+
+impl FrameOutput {
+    fn create(path: &std::path::Path, scene: &Scene) -> Result<Self> {
+        if let Some(format) = export::Format::from_path(path) {
+            return Ok(Self::Animation(Recording::create(path, format, scene)?));
+        }
+        match path.extension().and_then(|e| e.to_str()) {
+            Some("csv" | "jsonl") => Ok(Self::Trajectory(TrajectoryWriter::create(path)?)),
+            _ => anyhow::bail!(
+                "{}: the output file must end in .csv or .jsonl (trajectory), .glb or .gltf \
+                 (glTF 2.0) or .usda (OpenUSD)",
+                path.display()
+            ),
+        }
+    }
+
+    fn write_frame(&mut self, step: u64, time: f64, bodies: &impulse::body::Bodies) -> Result<()> {
+        match self {
+            Self::Trajectory(writer) => writer.write_frame(step, time, bodies),
+            Self::Animation(recording) => {
+                recording.record(step, bodies);
+                Ok(())
+            }
+        }
+    }
+
+    /// Writes the animation file, if any, with every frame recorded so far.
+    fn finish(&self) -> Result<()> {
+        match self {
+            Self::Trajectory(_) => Ok(()),
+            Self::Animation(recording) => recording.write(),
+        }
+    }
+}
+
 /// Overlap from poses is measured every this many steps (and at the last).
 const OVERLAP_SAMPLE_EVERY: u64 = 10;
 
 /// Runs `scene` under `options`. A blow-up stops the run: the frames written so far stay on
-/// disk, the summary (with `status` naming the step) is still written, and the error returns.
+/// disk (an animation file is written with them), the summary (with `status` naming the step) is still written, and the error returns.
 pub fn run(scene: Scene, options: &RunOptions) -> Result<Summary> {
     match options.threads {
         Some(1) => run_on_this_thread(scene, options, false),
@@ -160,7 +203,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
     let mut world = World::from_scene(&scene).context("cannot build the world")?;
     world.parallel = parallel;
     let mut writer = match &options.out {
-        Some(path) => Some(TrajectoryWriter::create(path)?),
+        Some(path) => Some(FrameOutput::create(path, &scene)?),
         None => None,
     };
     if let Some(w) = writer.as_mut() {
@@ -254,6 +297,8 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         bar.inc(1);
     }
     bar.finish_and_clear();
+    // The animation file holds every frame written so far, also when a step failed.
+    let exported = writer.as_ref().map_or(Ok(()), FrameOutput::finish);
 
     let taken = step_ms.len().max(1) as f64;
     let mean_ms = step_ms.iter().sum::<f64>() / taken;
@@ -304,8 +349,13 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(e) = failure {
-        return Err(anyhow::Error::new(e).context(summary.line()));
+        let mut error = anyhow::Error::new(e).context(summary.line());
+        if let Err(export_error) = exported {
+            error = error.context(format!("{export_error:#}"));
+        }
+        return Err(error);
     }
+    exported?;
     Ok(summary)
 }
 
