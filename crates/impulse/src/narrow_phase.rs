@@ -58,6 +58,9 @@ pub struct ContactPair {
     summary: PairSummary,
     /// What the last manifold update was asked: see [`ManifoldQuery`].
     last_query: Option<ManifoldQuery>,
+    /// The pair's normal impulse over the last step (N·s), summed as the impulses are written
+    /// back: what contact events read without visiting every point.
+    pub(crate) step_normal_impulse: f32,
 }
 
 /// The inputs of a pair's manifold update: the relative pose (body 2 in body 1's frame), the
@@ -134,11 +137,17 @@ impl ContactPair {
             manifolds: Vec::new(),
             workspace: None,
             summary: PairSummary::default(),
+            step_normal_impulse: 0.0,
             last_query: None,
         }
     }
 
-    /// Number of contact points over all manifolds.
+    /// Whether a point overlaps (negative separation) as of the last manifold update.
+    pub(crate) fn overlaps(&self) -> bool {
+        self.summary.max_depth > 0.0
+    }
+
+    /// Number of contact points over all manifolds (duplicates included).
     pub fn point_count(&self) -> usize {
         self.summary.points as usize
     }

@@ -94,8 +94,6 @@ struct Bundle {
     normal_impulse: Lane,
     tangent_impulses: [Lane; 2],
     max_normal_impulse: Lane,
-    /// Impulses over the substeps so far (see [`ContactConstraint::step_impulses`]).
-    step_impulses: [Lane; 3],
 }
 
 /// What the target update of [`Bundles::solve_pgs`] reads: where the points are.
@@ -126,6 +124,9 @@ const GROUP_POINTS: usize = 4;
 pub struct Bundles {
     bundles: Vec<Bundle>,
     geometry: Vec<BundleGeometry>,
+    /// Per bundle, the impulses (normal, tangent 1, tangent 2) of the substeps so far, lane by
+    /// lane (see [`ContactConstraint::step_impulses`]).
+    step_totals: Vec<[Lane; 3]>,
     /// The lane groups (see [`Group`]) in bundle order; colour k's are
     /// `group_colour_starts[k]..group_colour_starts[k + 1]`. The last colour holds the manifold
     /// groups the colouring could not place, one per lane group, and always runs on one thread.
@@ -323,6 +324,9 @@ impl Bundles {
         }
         self.bundles.resize(total, empty);
         self.geometry.resize(total, BundleGeometry::default());
+        // The step totals start from zero: the packed bundles are this step's alone.
+        self.step_totals.clear();
+        self.step_totals.resize(total, [Lane::splat(0.0); 3]);
         if parallel_fill {
             self.fill_parallel(constraints, &empty);
         } else {
@@ -506,10 +510,11 @@ impl Bundles {
             c.normal_impulse = at(&b.normal_impulse);
             c.tangent_impulses = [at(&b.tangent_impulses[0]), at(&b.tangent_impulses[1])];
             c.max_normal_impulse = at(&b.max_normal_impulse);
+            let totals = &self.step_totals[index];
             c.step_impulses = [
-                at(&b.step_impulses[0]) + c.normal_impulse,
-                at(&b.step_impulses[1]) + c.tangent_impulses[0],
-                at(&b.step_impulses[2]) + c.tangent_impulses[1],
+                at(&totals[0]) + c.normal_impulse,
+                at(&totals[1]) + c.tangent_impulses[0],
+                at(&totals[2]) + c.tangent_impulses[1],
             ];
             c.target_normal_velocity = at(&b.target);
             c.softness = (at(&b.mass_scale), at(&b.impulse_scale));
@@ -532,7 +537,7 @@ impl Bundles {
             forward: true,
             half_turn: false,
         };
-        self.sweep(order, velocities, WarmStart::<false>, NoTargets);
+        self.sweep(order, velocities, WarmStart { totals: None }, NoTargets);
     }
 
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
@@ -653,11 +658,8 @@ impl ContactSolver for Bundles {
             forward: true,
             half_turn: false,
         };
-        if substep > 0 {
-            self.sweep(order, velocities, WarmStart::<true>, NoTargets);
-        } else {
-            self.sweep(order, velocities, WarmStart::<false>, NoTargets);
-        }
+        let totals = (substep > 0).then(|| SharedItems(self.step_totals.as_mut_ptr()));
+        self.sweep(order, velocities, WarmStart { totals }, NoTargets);
     }
 
     fn solve(
@@ -680,6 +682,13 @@ impl ContactSolver for Bundles {
 /// closure it was not, and pyramid20's `fast` step took 30 % longer).
 trait BundleUpdate: Copy + Sync {
     fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane;
+
+    /// [`BundleUpdate::update`] of bundle `index`, for updates that keep per-bundle data
+    /// outside the bundles.
+    #[inline(always)]
+    fn update_at(self, b: &mut Bundle, _index: usize, v: &mut BodyLanes) -> Lane {
+        self.update(b, v)
+    }
 }
 
 /// The velocity rows ([`solve_bundle`]).
@@ -695,17 +704,28 @@ impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
 }
 
 /// The accumulated impulses applied to the bodies (warm start); changes no impulse. With
-/// `ADD`, also adds them to the step totals (every substep's but the first).
+/// `totals`, also adds them to each bundle's step totals (every substep's warm start but the
+/// first's), which live apart from the bundles: the sweeps never read them.
 #[derive(Clone, Copy)]
-struct WarmStart<const ADD: bool>;
+struct WarmStart {
+    totals: Option<SharedItems<[Lane; 3]>>,
+}
 
-impl<const ADD: bool> BundleUpdate for WarmStart<ADD> {
+impl BundleUpdate for WarmStart {
     #[inline(always)]
     fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane {
-        if ADD {
-            b.step_impulses[0] += b.normal_impulse;
-            b.step_impulses[1] += b.tangent_impulses[0];
-            b.step_impulses[2] += b.tangent_impulses[1];
+        self.update_at(b, usize::MAX, v)
+    }
+
+    #[inline(always)]
+    fn update_at(self, b: &mut Bundle, index: usize, v: &mut BodyLanes) -> Lane {
+        if let Some(totals) = self.totals {
+            // SAFETY: `totals` has one entry per bundle (`pack` sizes it so) and `index` is
+            // the bundle's; no other thread touches this bundle's entry meanwhile.
+            let total = unsafe { &mut *totals.0.add(index) };
+            total[0] += b.normal_impulse;
+            total[1] += b.tangent_impulses[0];
+            total[2] += b.tangent_impulses[1];
         }
         let masses = (b.inverse_mass_a, b.inverse_mass_b);
         b.normal.apply(b.normal_impulse, masses, v);
@@ -883,7 +903,7 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
             // SAFETY: the caller's contract.
             let b = unsafe { &mut *bundles.0.add(index) };
             targets.set(b, index, &moved);
-            largest = largest.max(update.update(b, &mut v));
+            largest = largest.max(update.update_at(b, index, &mut v));
         }
         // SAFETY: the caller's contract.
         unsafe { velocities.scatter(&slots_a, &slots_b, &v) };
@@ -989,10 +1009,6 @@ fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &ContactConstra
     set(&mut b.tangent_impulses[0], i, c.tangent_impulses[0]);
     set(&mut b.tangent_impulses[1], i, c.tangent_impulses[1]);
     set(&mut b.max_normal_impulse, i, c.max_normal_impulse);
-    // The step totals start from zero (the packed bundles are this step's alone).
-    for k in 0..3 {
-        set(&mut b.step_impulses[k], i, 0.0);
-    }
     set_vec(&mut g.lever_a, i, c.lever_a);
     set_vec(&mut g.lever_b, i, c.lever_b);
     set(&mut g.depth, i, c.depth);

@@ -116,26 +116,15 @@ pub(crate) struct ContactEvents {
     events: Vec<ContactEvent>,
 }
 
-/// Sum of a pair's normal impulses in the last step (N·s), each point once.
+/// Sum of a pair's normal impulses in the last step (N·s), each point once (summed as the
+/// step wrote them back).
 fn total_normal_impulse(pair: &ContactPair) -> f32 {
-    pair.manifolds
-        .iter()
-        .flat_map(|m| {
-            m.points
-                .iter()
-                .enumerate()
-                .filter(|&(index, _)| !repeats_earlier_point(&m.points, index))
-                .map(|(_, p)| p.data.step_normal)
-        })
-        .sum()
+    pair.step_normal_impulse
 }
 
-/// Whether a pair touches: any point overlaps (separation ≤ 0) or pushed (normal impulse > 0).
+/// Whether a pair touches: a point overlaps or pushed in the last step.
 fn touching(pair: &ContactPair) -> bool {
-    pair.manifolds
-        .iter()
-        .flat_map(|m| m.points.iter())
-        .any(|p| p.dist <= 0.0 || p.data.step_normal > 0.0)
+    pair.overlaps() || pair.step_normal_impulse > 0.0
 }
 
 impl World {

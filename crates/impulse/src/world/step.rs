@@ -435,6 +435,7 @@ impl World {
                 } else {
                     0
                 };
+                let mut step_normal_impulse = 0.0;
                 for row in first..first + pair.row_count() {
                     let Some(c) = constraints.get(row) else {
                         return false;
@@ -443,7 +444,9 @@ impl World {
                         return false;
                     }
                     write_impulse(c, &mut pair.manifolds);
+                    step_normal_impulse += c.step_impulses[0];
                 }
+                pair.step_normal_impulse = step_normal_impulse;
             }
             true
         };
@@ -458,8 +461,13 @@ impl World {
             store(0, pairs)
         };
         if !in_place {
+            for pair in pairs.iter_mut() {
+                pair.step_normal_impulse = 0.0;
+            }
             for c in constraints {
-                write_impulse(c, &mut pairs[c.source.0 as usize].manifolds);
+                let pair = &mut pairs[c.source.0 as usize];
+                write_impulse(c, &mut pair.manifolds);
+                pair.step_normal_impulse += c.step_impulses[0];
             }
         }
     }
