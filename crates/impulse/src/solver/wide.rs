@@ -658,7 +658,7 @@ impl ContactSolver for Bundles {
             forward: true,
             half_turn: false,
         };
-        let totals = (substep > 0).then(|| SharedItems(self.step_totals.as_mut_ptr()));
+        let totals = (substep > 0).then_some(SharedItems(self.step_totals.as_mut_ptr()));
         self.sweep(order, velocities, WarmStart { totals }, NoTargets);
     }
 
