@@ -303,7 +303,7 @@ fn presets_by_name_and_bar_and_the_quality_error() {
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("unknown preset 'q2'") && stderr.contains("precise"),
+        stderr.contains("invalid value 'q2'") && stderr.contains("precise"),
         "{stderr}"
     );
 }

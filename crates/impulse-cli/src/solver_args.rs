@@ -1,0 +1,248 @@
+//! The solver options of `impulse run`: one clap `Args` group applied on top of a scene's (or a
+//! preset's) `SolverSettings`.
+
+use clap::{Args, ValueEnum};
+use impulse::settings::{SolverMethod, SolverSettings};
+
+/// A preset, named by speed or by the quality bar it meets on the standard scenes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PresetArg {
+    /// The soft step at 8 substeps: E ≤ 50 mm.
+    #[value(alias = "q50")]
+    Fast,
+    /// The soft step at 20 substeps: E ≤ 5 mm.
+    #[value(alias = "q5")]
+    Default,
+    /// The soft step at 48 substeps: E ≤ 1 mm.
+    #[value(alias = "q1")]
+    Precise,
+    /// NNCG with split impulse and the exact path: the LCP solved tightly.
+    Reference,
+}
+
+impl PresetArg {
+    fn name(self) -> &'static str {
+        match self {
+            PresetArg::Fast => "fast",
+            PresetArg::Default => "default",
+            PresetArg::Precise => "precise",
+            PresetArg::Reference => "reference",
+        }
+    }
+}
+
+/// The solve method of every island.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Projected Gauss-Seidel.
+    Pgs,
+    /// Nonsmooth nonlinear conjugate gradient.
+    Nncg,
+    /// Accelerated projected gradient descent.
+    Apgd,
+    /// NNCG escalating per island to more iterations or the exact path.
+    Auto,
+}
+
+impl From<MethodArg> for SolverMethod {
+    fn from(method: MethodArg) -> Self {
+        match method {
+            MethodArg::Pgs => SolverMethod::Pgs,
+            MethodArg::Nncg => SolverMethod::Nncg,
+            MethodArg::Apgd => SolverMethod::Apgd,
+            MethodArg::Auto => SolverMethod::Auto,
+        }
+    }
+}
+
+/// How overlap is repaired.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum RepairArg {
+    /// A velocity bias c_d·d, with relax.
+    Bias,
+    /// Split impulse: a separate position solve.
+    Split,
+    /// Soft contact springs, with relax.
+    Soft,
+}
+
+/// Solver options; each one given overrides the scene's settings (or the preset's).
+#[derive(Args, Debug, Default)]
+pub struct SolverArgs {
+    /// Start from a preset instead of the scene's solver settings, named by speed or by the
+    /// quality bar it meets on the standard scenes (E = largest of sink, overlap and drift
+    /// after 10 s): `fast`/`q50` (the soft step at 8 substeps, E ≤ 50 mm), `default`/`q5`
+    /// (20 substeps, E ≤ 5 mm), `precise`/`q1` (48 substeps, E ≤ 1 mm) or `reference` (NNCG
+    /// with split impulse and the exact path: the LCP solved tightly). The other options
+    /// apply on top of it; sleeping keeps the scene's setting.
+    #[arg(long, alias = "quality", value_enum)]
+    pub preset: Option<PresetArg>,
+    /// Solver iterations per substep at most.
+    #[arg(long)]
+    pub iterations: Option<u32>,
+    /// Substeps per step.
+    #[arg(long)]
+    pub substeps: Option<u32>,
+    /// Relax iterations per substep.
+    #[arg(long)]
+    pub relax: Option<u32>,
+    /// Method of every island's solve.
+    #[arg(long, value_enum)]
+    pub method: Option<MethodArg>,
+    /// Early exit: a solve stops when no row's velocity changed by more than this in a sweep
+    /// (m/s).
+    #[arg(long)]
+    pub tolerance: Option<f32>,
+    /// Split impulse: position-solve sweeps per substep at most.
+    #[arg(long)]
+    pub position_iterations: Option<u32>,
+    /// Sweep islands of at least this many contact points colour by colour, one colour over
+    /// all threads (0 = never).
+    #[arg(long)]
+    pub parallel_island_contacts: Option<u32>,
+    /// With `--method pgs` and bias or soft repair, solve islands of at least this many
+    /// contact points four at a time in SIMD lanes (0 = never).
+    #[arg(long)]
+    pub simd_island_contacts: Option<u32>,
+    /// `auto`: escalate an island whose last iteration changed a row velocity by more than
+    /// this (m/s).
+    #[arg(long)]
+    pub escalation_tolerance: Option<f32>,
+    /// `auto`: NNCG iterations per substep after an island escalates.
+    #[arg(long)]
+    pub escalation_iterations: Option<u32>,
+    /// `auto`: solve islands of at most this many contact points exactly when NNCG does not
+    /// converge (0 = never).
+    #[arg(long)]
+    pub exact_max_contacts: Option<u32>,
+    /// Overlap (m) left unrepaired, so resting rigid contacts do not jitter (the soft-step
+    /// presets use 0).
+    #[arg(long)]
+    pub overlap_slop: Option<f32>,
+    /// Sweep the friction rows in the soft step's main (repairing) solve too, not only in its
+    /// relax solve (see `SolverSettings::friction_in_main_solve`).
+    #[arg(long)]
+    pub friction_in_main_solve: bool,
+    /// Soft contact frequency in Hz (0 = rigid rows with overlap repair c_d).
+    #[arg(long)]
+    pub soft_hertz: Option<f32>,
+    /// Fraction of last step's impulses to start from (0 = cold start, 1 = full warm start).
+    #[arg(long)]
+    pub warm_start: Option<f32>,
+    /// Overlap repair rate c_d in 1/s (Baumgarte stabilisation).
+    #[arg(long)]
+    pub repair_rate: Option<f32>,
+    /// Overlap repair (`soft` starts the springs at 30 Hz unless `--soft-hertz` or the
+    /// settings give a frequency).
+    #[arg(long, value_enum)]
+    pub repair: Option<RepairArg>,
+    /// Keep every body awake (no sleeping of quiet islands), as benchmarks do.
+    #[arg(long)]
+    pub no_sleep: bool,
+}
+
+impl SolverArgs {
+    /// The settings these options make of `settings`: the preset first (keeping `sleep`),
+    /// then every option given. The world checks the result before its first step.
+    pub fn apply(&self, settings: &SolverSettings) -> SolverSettings {
+        let mut s = match self.preset {
+            Some(preset) => SolverSettings {
+                sleep: settings.sleep,
+                ..SolverSettings::preset(preset.name()).unwrap_or_default()
+            },
+            None => settings.clone(),
+        };
+        let set = |field: &mut u32, value: Option<u32>| {
+            if let Some(v) = value {
+                *field = v;
+            }
+        };
+        set(&mut s.iterations, self.iterations);
+        set(&mut s.substeps, self.substeps);
+        set(&mut s.relax_iterations, self.relax);
+        if let Some(fraction) = self.warm_start {
+            s.warm_start = fraction;
+        }
+        if let Some(rate) = self.repair_rate {
+            s.overlap_repair_rate = rate;
+        }
+        match self.repair {
+            Some(RepairArg::Bias) => {
+                s.split_impulse = false;
+                s.soft_contact_hertz = 0.0;
+            }
+            Some(RepairArg::Split) => {
+                s.split_impulse = true;
+                s.soft_contact_hertz = 0.0;
+            }
+            Some(RepairArg::Soft) => {
+                s.split_impulse = false;
+                if s.soft_contact_hertz == 0.0 {
+                    s.soft_contact_hertz = 30.0;
+                }
+            }
+            None => {}
+        }
+        if let Some(slop) = self.overlap_slop {
+            s.overlap_slop = slop;
+        }
+        if self.friction_in_main_solve {
+            s.friction_in_main_solve = true;
+        }
+        if let Some(hertz) = self.soft_hertz {
+            s.soft_contact_hertz = hertz;
+        }
+        if self.no_sleep {
+            s.sleep = false;
+        }
+        if let Some(tolerance) = self.tolerance {
+            s.tolerance = tolerance;
+        }
+        set(&mut s.position_iterations, self.position_iterations);
+        set(
+            &mut s.parallel_island_contacts,
+            self.parallel_island_contacts,
+        );
+        set(&mut s.simd_island_contacts, self.simd_island_contacts);
+        if let Some(tolerance) = self.escalation_tolerance {
+            s.escalation_tolerance = tolerance;
+        }
+        set(&mut s.escalation_iterations, self.escalation_iterations);
+        set(&mut s.exact_max_contacts, self.exact_max_contacts);
+        if let Some(method) = self.method {
+            s.method = method.into();
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_preset_then_the_options_on_top() {
+        let args = SolverArgs {
+            preset: Some(PresetArg::Fast),
+            substeps: Some(3),
+            repair: Some(RepairArg::Split),
+            method: Some(MethodArg::Nncg),
+            no_sleep: true,
+            ..SolverArgs::default()
+        };
+        let mut scene = SolverSettings::reference();
+        scene.sleep = true;
+        let s = args.apply(&scene);
+        assert_eq!(s.substeps, 3);
+        assert!(s.split_impulse);
+        assert_eq!(s.soft_contact_hertz, 0.0);
+        assert_eq!(s.method, SolverMethod::Nncg);
+        assert!(!s.sleep);
+        assert_eq!(
+            s.relax_iterations,
+            SolverSettings::preset("fast").unwrap().relax_iterations
+        );
+        // Without options the settings stay as they are.
+        assert_eq!(SolverArgs::default().apply(&scene), scene);
+    }
+}
