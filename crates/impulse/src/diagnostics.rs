@@ -356,6 +356,10 @@ pub struct EnergyTerms {
     pub mass: f64,
     /// Linear momentum (kg·m/s).
     pub momentum: Vec3,
+    /// Largest distance of a moving body's centre of mass from the origin (m).
+    pub largest_distance: f32,
+    /// Largest linear speed of a moving body (m/s).
+    pub largest_speed: f32,
 }
 
 impl EnergyTerms {
@@ -375,6 +379,8 @@ impl std::ops::Add for EnergyTerms {
             potential: self.potential + other.potential,
             mass: self.mass + other.mass,
             momentum: self.momentum + other.momentum,
+            largest_distance: self.largest_distance.max(other.largest_distance),
+            largest_speed: self.largest_speed.max(other.largest_speed),
         }
     }
 }
@@ -398,6 +404,10 @@ pub fn energy_terms_on(bodies: &Bodies, gravity: Vec3, parallel: bool) -> Energy
                 terms.potential += (-m * gravity.dot(bodies.center_of_mass(i))) as f64;
                 terms.mass += m as f64;
                 terms.momentum += bodies.linear_velocity[i] * m;
+                terms.largest_distance = terms
+                    .largest_distance
+                    .max(bodies.center_of_mass(i).length());
+                terms.largest_speed = terms.largest_speed.max(bodies.linear_velocity[i].length());
             }
         }
         terms
