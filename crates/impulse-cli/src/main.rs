@@ -36,8 +36,8 @@ enum Command {
         /// Steps to take (default: the scene's, 600 for built-ins).
         #[arg(long)]
         steps: Option<u32>,
-        /// Time step in seconds (default: the scene's).
-        #[arg(long)]
+        /// Time step in seconds (default: the scene's); must be finite and > 0.
+        #[arg(long, allow_negative_numbers = true)]
         dt: Option<f32>,
         #[command(flatten)]
         solver: solver_args::SolverArgs,
@@ -53,8 +53,8 @@ enum Command {
         /// (OpenUSD), written at the end of the run (docs/export.md).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Write every K-th frame (frame 0 and the last are always written).
-        #[arg(long, default_value_t = 1)]
+        /// Write every K-th frame, K ≥ 1 (frame 0 and the last are always written).
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
         every: u32,
         /// Write the summary as JSON to this file.
         #[arg(long)]

@@ -201,6 +201,17 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
     let steps = options.steps.unwrap_or(scene.steps) as u64;
     let every = options.every.max(1) as u64;
     let mut world = World::from_scene(&scene).context("cannot build the world")?;
+    if !world
+        .bodies
+        .kind
+        .iter()
+        .any(|&k| k != impulse::BodyKind::Static)
+    {
+        eprintln!(
+            "warning: scene {:?} has no moving body: nothing will move",
+            scene.name
+        );
+    }
     world.parallel = parallel;
     let mut writer = match &options.out {
         Some(path) => Some(FrameOutput::create(path, &scene)?),
@@ -225,8 +236,11 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
     );
     bar.set_message(scene.name.clone());
 
-    let mut step_ms = Vec::with_capacity(steps as usize);
-    let mut profiles: Vec<StepProfile> = Vec::with_capacity(steps as usize);
+    // Grown as the steps are taken: reserving for the whole run up front failed outright for a
+    // run of 4 billion steps.
+    let reserve = steps.min(1 << 16) as usize;
+    let mut step_ms = Vec::with_capacity(reserve);
+    let mut profiles: Vec<StepProfile> = Vec::with_capacity(reserve);
     let mut contacts_sum = 0u64;
     let mut iterations_sum = 0u64;
     let mut max_residual = 0.0f32;
@@ -253,6 +267,9 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             break;
         }
         profiles.push(*world.profile());
+        if step == 1 {
+            warn_of_overlaps_at_start(&world);
+        }
         let diagnostics = world.diagnostics();
         for island in &diagnostics.islands {
             match island.method {
@@ -388,5 +405,45 @@ fn median(values: &mut [f64]) -> f64 {
         values[n / 2]
     } else {
         0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+/// Overlap (m) beyond which bodies the scene creates inside each other are worth a warning:
+/// the solver pushes them apart in the first steps, which is rarely what a scene meant.
+const START_OVERLAP_WARNING: f32 = 0.01;
+
+/// Warns of every pair of bodies that started overlapping by more than
+/// [`START_OVERLAP_WARNING`], naming both and the depth: the first step's contact points are
+/// found on the poses the scene gave.
+fn warn_of_overlaps_at_start(world: &World) {
+    let name = |h: impulse::BodyHandle| match world.body(h) {
+        Some(b) => match b.name() {
+            Some(name) => format!("{} (\"{name}\")", b.index()),
+            None => b.index().to_string(),
+        },
+        None => "?".to_string(),
+    };
+    const NAMED: usize = 5;
+    let mut count = 0;
+    for pair in world.contact_pairs() {
+        let depth = pair.points().map(|p| -p.separation).fold(0.0f32, f32::max);
+        if depth > START_OVERLAP_WARNING {
+            count += 1;
+            if count <= NAMED {
+                eprintln!(
+                    "warning: bodies {} and {} start overlapping by {:.1} mm; the solver pushes them apart",
+                    name(pair.body1()),
+                    name(pair.body2()),
+                    depth * 1e3
+                );
+            }
+        }
+    }
+    if count > NAMED {
+        eprintln!(
+            "warning: {} more pairs start overlapping by more than {} mm",
+            count - NAMED,
+            START_OVERLAP_WARNING * 1e3
+        );
     }
 }
