@@ -218,10 +218,15 @@ fn real_main() -> Result<ExitCode> {
                 threads,
                 island_report,
             };
+            run::stop_on_ctrl_c()?;
             let summary = run::run(scene, &options)?;
             println!("{}", summary.line());
             if profile {
                 println!("{}", summary.stage_line());
+            }
+            if run::INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
+                eprintln!("{}: {}", summary.scene, summary.status);
+                return Ok(ExitCode::from(130));
             }
         }
         Command::Scenes => {

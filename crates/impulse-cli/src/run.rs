@@ -1,6 +1,7 @@
 //! `impulse run`: step a scene, write its trajectory, print and save a summary.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
@@ -174,6 +175,20 @@ impl FrameOutput {
     }
 }
 
+/// Set by Ctrl-C (SIGINT): the run stops after the step under way, writes that step's frame
+/// and every file as a finished run would, and `impulse` exits with status 130.
+pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Makes Ctrl-C set [`INTERRUPTED`]; a second Ctrl-C ends the process at once.
+pub fn stop_on_ctrl_c() -> Result<()> {
+    ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    })
+    .context("cannot install the Ctrl-C handler")
+}
+
 /// Overlap from poses is measured every this many steps (and at the last).
 const OVERLAP_SAMPLE_EVERY: u64 = 10;
 
@@ -306,12 +321,17 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             max_overlap = max_overlap.max(final_overlap);
             max_drift = max_drift.max(metrics::max_drift(&world.bodies, &initial));
         }
+        let interrupted = INTERRUPTED.load(Ordering::SeqCst);
         if let Some(w) = writer.as_mut()
-            && (step % every == 0 || step == steps)
+            && (step % every == 0 || step == steps || interrupted)
         {
             w.write_frame(step, step as f64 * scene.dt as f64, &world.bodies)?;
         }
         bar.inc(1);
+        if interrupted {
+            status = format!("interrupted after step {step}");
+            break;
+        }
     }
     bar.finish_and_clear();
     // The animation file holds every frame written so far, also when a step failed.
