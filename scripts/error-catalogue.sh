@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Prints docs/errors.md's catalogue: each bad input below, run through `impulse run`, with the
+# exit status and the first line the command prints on standard error.
+# Usage: scripts/error-catalogue.sh [path/to/impulse]  (default: target/release/impulse)
+set -uo pipefail
+bin=${1:-target/release/impulse}
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+body='{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "position": [0, 2, 0]}'
+ground='{"kind": "static", "shape": {"type": "half_space", "normal": [0, 1, 0]}}'
+scene() { printf '{"name": "case", "bodies": [%s, %s]}' "$ground" "$1"; }
+case_file() { printf '%s' "$2" > "$dir/$1.json"; echo "$dir/$1.json"; }
+row() {
+  local what=$1; shift
+  local err status
+  err=$("$bin" "$@" 2>&1 >/dev/null | grep -v '^$' | head -1)
+  "$bin" "$@" >/dev/null 2>&1; status=$?
+  err=${err//"$dir/"/}
+  printf '| %s | %s | `%s` |\n' "$what" "$status" "${err//|/\\|}"
+}
+echo "| input | exit | message (first line) |"
+echo "|---|---:|---|"
+row "malformed JSON" run "$(case_file malformed '{"name": "x", "bodies": [')" --steps 1 --quiet
+row "unknown field" run "$(case_file unknown "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "colour": "red"}')")" --steps 1 --quiet
+row "wrong type" run "$(case_file wrongtype "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": "big"}}')")" --steps 1 --quiet
+row "unknown shape type" run "$(case_file shape "$(scene '{"kind": "dynamic", "shape": {"type": "torus", "radius": 1}}')")" --steps 1 --quiet
+row "NaN is not JSON" run "$(case_file nan "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": NaN}}')")" --steps 1 --quiet
+row "negative radius" run "$(case_file radius "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": -1}}')")" --steps 1 --quiet
+row "zero half extent" run "$(case_file extent "$(scene '{"kind": "dynamic", "shape": {"type": "cuboid", "half_extents": [0.5, 0, 0.5]}}')")" --steps 1 --quiet
+row "negative mass" run "$(case_file mass "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "mass": -2}')")" --steps 1 --quiet
+row "friction below zero" run "$(case_file friction "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "material": {"friction": -0.1}}')")" --steps 1 --quiet
+row "restitution above one" run "$(case_file restitution "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "material": {"restitution": 1.5}}')")" --steps 1 --quiet
+row "degenerate hull" run "$(case_file hull "$(scene '{"kind": "dynamic", "shape": {"type": "convex_hull", "points": [[0,0,0],[1,0,0],[0,1,0],[1,1,0]]}}')")" --steps 1 --quiet
+row "half-space on a moving body" run "$(case_file halfspace "$(scene '{"kind": "dynamic", "shape": {"type": "half_space", "normal": [0, 1, 0]}}')")" --steps 1 --quiet
+row "dt = 0 in the scene" run "$(case_file dt '{"name": "x", "dt": 0, "bodies": []}')" --steps 1 --quiet
+row "--dt -0.01" run stack3 --dt -0.01 --steps 1 --quiet
+row "--every 0" run stack3 --every 0 --steps 1 --quiet
+row "unknown preset" run stack3 --preset q2 --steps 1 --quiet
+row "unknown scene" run no_such_scene --steps 1 --quiet
+row "missing file" run "$dir/missing.json" --steps 1 --quiet
+row "binary file" run /bin/true --steps 1 --quiet
+row "truncated file" run "$(case_file truncated '{"name": "x", "bodies": [{"kind": "dynamic", "sha')" --steps 1 --quiet
+row "unknown --out extension" run stack3 --steps 1 --quiet --out "$dir/x.txt"
+row "empty scene (a warning)" run "$(case_file empty '{"name": "empty", "bodies": []}')" --steps 1 --quiet
+row "bodies created overlapping (a warning)" run "$(case_file overlap "$(scene "$body, {\"kind\": \"dynamic\", \"shape\": {\"type\": \"sphere\", \"radius\": 0.5}, \"position\": [0, 2.2, 0]}")")" --steps 1 --quiet
