@@ -16,7 +16,7 @@ row() {
   err=$("$bin" "$@" 2>&1 >/dev/null | grep -v '^$' | head -1)
   "$bin" "$@" >/dev/null 2>&1; status=$?
   err=${err//"$dir/"/}
-  printf '| %s | %s | `%s` |\n' "$what" "$status" "${err//|/\\|}"
+  printf '| %s | %s | `` %s `` |\n' "$what" "$status" "${err//|/\\|}"
 }
 echo "| input | exit | message (first line) |"
 echo "|---|---:|---|"
