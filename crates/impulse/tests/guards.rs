@@ -232,7 +232,7 @@ fn an_island_sleeps_when_all_its_bodies_were_quiet_long_enough() {
     }
     let asleep_at = asleep_at.expect("a resting cube falls asleep") as f32 * DT;
     assert!(
-        asleep_at >= 0.5 && asleep_at <= 0.5 + 2.0 * DT + 0.2,
+        (0.5..=0.5 + 2.0 * DT + 0.2).contains(&asleep_at),
         "fell asleep at {asleep_at} s with time_to_sleep 0.5 s"
     );
 
