@@ -7,7 +7,7 @@ use impulse::scene::builtin::builtin_scene;
 use impulse::{BodyKind, World};
 
 #[test]
-#[ignore = "a soak of about ten minutes; run on demand"]
+#[ignore = "a soak of a few minutes; run on demand"]
 fn balls4096_for_20000_steps_stays_finite_boxed_and_dissipative() {
     let mut scene = builtin_scene("balls4096").unwrap();
     scene.solver.sleep = false;
