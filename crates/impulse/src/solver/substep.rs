@@ -1,4 +1,5 @@
-//! One island's step (stages 1, 5 and 6 on one island): per substep, gravity, warm start, the
+//! One island's step (stages 1, 5 and 6 on one island): per substep, gravity and the
+//! gyroscopic term, warm start, the
 //! solve with overlap repair, position integration and the relax solve; then the restitution
 //! solve. The method is picked here, per island, and called through [`ContactSolver`].
 //!
@@ -6,7 +7,7 @@
 //! and scattered at the end, so islands can run on separate threads without sharing anything
 //! mutable.
 
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3};
 use parry3d::math::Pose;
 
 use super::apgd::Apgd;
@@ -15,7 +16,7 @@ use super::pgs::{Pgs, Sweep, colour_constraints};
 use super::policy::{Auto, EscalationLevel, EscalationLimits};
 use super::wide::Bundles;
 use super::{ContactSolver, SolveOutcome, SolvePass, TargetInputs, Velocities, position};
-use crate::body::Bodies;
+use crate::body::{Bodies, BodyKind};
 use crate::constraints::{self, ContactConstraint};
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
@@ -72,6 +73,9 @@ pub struct IslandWorkspace {
     /// Per body, the linear and angular acceleration of its applied force and torque (m/s²,
     /// rad/s²); empty in a step without forces.
     acceleration: Vec<(Vec3, Vec3)>,
+    /// Per body, the body-frame inertia tensor of its gyroscopic term
+    /// ([`integrate::gyroscopic_inertia`]); empty when no body of the island has one.
+    inertia: Vec<Mat3>,
     pseudo_linear: Vec<Vec3>,
     pseudo_angular: Vec<Vec3>,
     /// Colour offsets of the island's constraints when it is coloured (see [`Sweep`]).
@@ -251,6 +255,22 @@ pub fn step_island(
             )
         }));
     }
+    // The gyroscopic term's tensors; kept only when some body of the island has one, so
+    // islands of balls, cubes and particles skip the pass.
+    w.inertia.clear();
+    if settings.gyroscopic {
+        w.inertia.extend(island_bodies.iter().map(|&i| {
+            let i = i as usize;
+            if bodies.kind[i] == BodyKind::Dynamic {
+                integrate::gyroscopic_inertia(&bodies.local_inverse_inertia[i])
+            } else {
+                Mat3::ZERO
+            }
+        }));
+        if w.inertia.iter().all(|t| *t == Mat3::ZERO) {
+            w.inertia.clear();
+        }
+    }
     w.displacement.clear();
     w.displacement.resize(slots, Vec3::ZERO);
     w.rotation.clear();
@@ -309,6 +329,21 @@ pub fn step_island(
         for (k, &(linear, angular)) in w.acceleration.iter().enumerate() {
             w.linear[k] += linear * h;
             w.angular[k] += angular * h;
+        }
+        // The gyroscopic term, per body at its current orientation, with the other velocity
+        // updates before the contacts are solved (as Bullet applies it with the external forces).
+        if !w.inertia.is_empty() {
+            let angular = &mut w.angular[..moving];
+            if spread {
+                use rayon::prelude::*;
+                angular
+                    .par_chunks_mut(BODIES_PER_TASK)
+                    .zip(w.orientation.par_chunks(BODIES_PER_TASK))
+                    .zip(w.inertia.par_chunks(BODIES_PER_TASK))
+                    .for_each(|((a, o), t)| integrate::gyroscopic(a, o, t, h));
+            } else {
+                integrate::gyroscopic(angular, &w.orientation, &w.inertia, h);
+            }
         }
         let mut velocities = Velocities {
             linear: &mut w.linear,
