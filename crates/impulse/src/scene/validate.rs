@@ -11,7 +11,7 @@
 //!   `sleep_linear_speed`, `sleep_angular_speed`, `time_to_sleep` are ≥ 0;
 //!   `solver.warm_start` is in [0, 1];
 //! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`;
-//! - a body's `mass`, when given, is > 0;
+//! - a body's `mass`, when given, is > 0; its `linear_damping` and `angular_damping` are ≥ 0;
 //! - shapes: sphere and capsule `radius > 0`, capsule `half_height ≥ 0`, every cuboid half
 //!   extent > 0, a convex hull has ≥ 4 points that span a volume (not all coincident,
 //!   collinear or coplanar), a half-space normal is not zero and belongs to a static body;
@@ -185,6 +185,8 @@ impl Checker {
         if let Some(mass) = b.mass {
             self.positive(&path.key("mass"), mass);
         }
+        self.non_negative(&path.key("linear_damping"), b.linear_damping);
+        self.non_negative(&path.key("angular_damping"), b.angular_damping);
         match &b.material {
             MaterialRef::Named(name) => {
                 if name != "default" && !materials.contains_key(name) {

@@ -76,6 +76,9 @@ pub struct IslandWorkspace {
     /// Per body, the body-frame inertia tensor of its gyroscopic term
     /// ([`integrate::gyroscopic_inertia`]); empty when no body of the island has one.
     inertia: Vec<Mat3>,
+    /// Per body, the factors 1/(1 + h·c) of its linear and angular damping for one substep;
+    /// empty when no body of the island is damped.
+    damping: Vec<(f32, f32)>,
     pseudo_linear: Vec<Vec3>,
     pseudo_angular: Vec<Vec3>,
     /// Colour offsets of the island's constraints when it is coloured (see [`Sweep`]).
@@ -271,6 +274,19 @@ pub fn step_island(
             w.inertia.clear();
         }
     }
+    let h = dt / settings.substeps as f32;
+    w.damping.clear();
+    if island_bodies.iter().any(|&i| {
+        bodies.linear_damping[i as usize] > 0.0 || bodies.angular_damping[i as usize] > 0.0
+    }) {
+        w.damping.extend(island_bodies.iter().map(|&i| {
+            let i = i as usize;
+            (
+                1.0 / (1.0 + h * bodies.linear_damping[i]),
+                1.0 / (1.0 + h * bodies.angular_damping[i]),
+            )
+        }));
+    }
     w.displacement.clear();
     w.displacement.resize(slots, Vec3::ZERO);
     w.rotation.clear();
@@ -317,7 +333,6 @@ pub fn step_island(
     // Whether this island's passes over all its points or bodies go on rayon's threads too.
     let spread = parallel::spread(w.parallel, 1, 0)
         && (coloured_threads || (bundled && w.solvers.wide.parallel()));
-    let h = dt / settings.substeps as f32;
     let moving = slots - 1;
     for substep in 0..settings.substeps {
         // Every other substep, PGS takes each manifold's points from halfway round (see
@@ -329,6 +344,11 @@ pub fn step_island(
         for (k, &(linear, angular)) in w.acceleration.iter().enumerate() {
             w.linear[k] += linear * h;
             w.angular[k] += angular * h;
+        }
+        // Damping after gravity and forces, implicit: v ← v/(1 + h·c) (Box2D's damping).
+        for (k, &(linear, angular)) in w.damping.iter().enumerate() {
+            w.linear[k] *= linear;
+            w.angular[k] *= angular;
         }
         // The gyroscopic term, per body at its current orientation, with the other velocity
         // updates before the contacts are solved (as Bullet applies it with the external forces).
