@@ -79,6 +79,21 @@ pub enum ShapeDesc {
         /// Radius (m) > 0.
         radius: f32,
     },
+    /// A solid circular cylinder along the local y axis, centred on the body origin.
+    Cylinder {
+        /// Half the height (m) > 0: the flat ends are at y = ±half_height.
+        half_height: f32,
+        /// Radius (m) > 0.
+        radius: f32,
+    },
+    /// A solid circular cone along the local y axis: base at y = −half_height, apex at
+    /// y = +half_height (Parry's convention; the centre of mass is at y = −half_height/2).
+    Cone {
+        /// Half the height (m) > 0.
+        half_height: f32,
+        /// Radius of the base (m) > 0.
+        radius: f32,
+    },
     /// The convex hull of points.
     ConvexHull {
         /// At least 4 non-coplanar points (m, local frame).

@@ -12,7 +12,8 @@
 //!   `solver.warm_start` is in [0, 1];
 //! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`;
 //! - a body's `mass`, when given, is > 0; its `linear_damping` and `angular_damping` are ≥ 0;
-//! - shapes: sphere and capsule `radius > 0`, capsule `half_height ≥ 0`, every cuboid half
+//! - shapes: sphere, capsule, cylinder and cone `radius > 0`, capsule `half_height ≥ 0`,
+//!   cylinder and cone `half_height > 0`, every cuboid half
 //!   extent > 0, a convex hull has ≥ 4 points that span a volume (not all coincident,
 //!   collinear or coplanar), a half-space normal is not zero and belongs to a static body;
 //! - a particle's shape is a sphere;
@@ -232,6 +233,17 @@ impl Checker {
                 self.non_negative(&path.key("half_height"), *half_height);
                 self.positive(&path.key("radius"), *radius);
             }
+            ShapeDesc::Cylinder {
+                half_height,
+                radius,
+            }
+            | ShapeDesc::Cone {
+                half_height,
+                radius,
+            } => {
+                self.positive(&path.key("half_height"), *half_height);
+                self.positive(&path.key("radius"), *radius);
+            }
             ShapeDesc::ConvexHull { points } => {
                 let points_path = path.key("points");
                 let mut finite = true;
@@ -284,6 +296,8 @@ fn shape_type_name(shape: &ShapeDesc) -> &'static str {
         ShapeDesc::Sphere { .. } => "sphere",
         ShapeDesc::Cuboid { .. } => "cuboid",
         ShapeDesc::Capsule { .. } => "capsule",
+        ShapeDesc::Cylinder { .. } => "cylinder",
+        ShapeDesc::Cone { .. } => "cone",
         ShapeDesc::ConvexHull { .. } => "convex_hull",
         ShapeDesc::HalfSpace { .. } => "half_space",
     }

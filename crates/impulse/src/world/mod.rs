@@ -364,6 +364,22 @@ fn builder_of(
             }
             SharedShape::capsule_y(*half_height, *radius)
         }
+        ShapeDesc::Cylinder {
+            half_height,
+            radius,
+        } => {
+            positive(index, desc, "shape.half_height", *half_height)?;
+            positive(index, desc, "shape.radius", *radius)?;
+            SharedShape::cylinder(*half_height, *radius)
+        }
+        ShapeDesc::Cone {
+            half_height,
+            radius,
+        } => {
+            positive(index, desc, "shape.half_height", *half_height)?;
+            positive(index, desc, "shape.radius", *radius)?;
+            SharedShape::cone(*half_height, *radius)
+        }
         ShapeDesc::ConvexHull { points } => {
             let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
             if !points.iter().all(|p| p.is_finite()) {
