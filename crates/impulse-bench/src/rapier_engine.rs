@@ -241,6 +241,14 @@ fn collider_builder(shape: &ShapeDesc) -> Result<ColliderBuilder> {
             half_height,
             radius,
         } => ColliderBuilder::capsule_y(*half_height, *radius),
+        ShapeDesc::Cylinder {
+            half_height,
+            radius,
+        } => ColliderBuilder::cylinder(*half_height, *radius),
+        ShapeDesc::Cone {
+            half_height,
+            radius,
+        } => ColliderBuilder::cone(*half_height, *radius),
         ShapeDesc::ConvexHull { points } => {
             let points: Vec<Vector> = points.iter().map(|p| Vector::from(*p)).collect();
             match ColliderBuilder::convex_hull(&points) {

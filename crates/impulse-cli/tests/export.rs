@@ -78,13 +78,15 @@ fn assert_same_rotation(got: &[f32], expected: &[f32], what: &str) {
     assert_close(&got, expected, what);
 }
 
-const SHAPES_NAMES: [&str; 6] = [
+const SHAPES_NAMES: [&str; 8] = [
     "ground",
     "ball",
     "crate",
     "tilted capsule",
     "rock",
     "body_5",
+    "cylinder",
+    "cone",
 ];
 
 /// Frames written by `--steps 30 --every 7`: 0, 7, 14, 21, 28 and the last, 30.
@@ -131,8 +133,8 @@ fn glb_has_a_named_node_and_mesh_per_body_and_the_trajectory_as_animation() {
     let animations: Vec<_> = document.animations().collect();
     assert_eq!(animations.len(), 1);
     let channels: Vec<_> = animations[0].channels().collect();
-    // Translation and rotation for the four moving bodies; the static ground and bar have none.
-    assert_eq!(channels.len(), 8);
+    // Translation and rotation for the six moving bodies; the static ground and bar have none.
+    assert_eq!(channels.len(), 12);
     let dt = 0.016666668f32;
     for channel in &channels {
         let body = channel.target().node().index();
@@ -251,6 +253,8 @@ fn usda_has_an_xform_per_body_with_the_trajectory_as_time_samples() {
         ("tilted_capsule", "Capsule"),
         ("rock", "Mesh"),
         ("body_5", "Cube"),
+        ("cylinder", "Cylinder"),
+        ("cone", "Cone"),
     ] {
         let at = text.find(&format!("def Xform \"{prim}\"")).unwrap() + 1;
         let child = &text[at..][text[at..].find("def ").unwrap()..];

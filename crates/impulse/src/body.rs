@@ -102,7 +102,7 @@ impl Handles {
 /// the world frame. Mass and inertia come from Parry's mass properties of the shape at
 /// `density` (kg/m³), scaled to `mass` when given. Checked when inserted
 /// ([`crate::World::insert`]): every number finite, friction ≥ 0, restitution in [0, 1],
-/// density and mass > 0, a particle a ball, a half-space static.
+/// density and mass > 0, damping ≥ 0, a particle a ball, a half-space static.
 ///
 /// ```
 /// use impulse::glam::Vec3;
@@ -129,6 +129,11 @@ pub struct BodyBuilder {
     pub(crate) mass: Option<f32>,
     pub(crate) name: Option<String>,
     pub(crate) user_data: u128,
+    pub(crate) linear_damping: f32,
+    pub(crate) angular_damping: f32,
+    pub(crate) lock_rotation: bool,
+    pub(crate) groups: u32,
+    pub(crate) mask: u32,
 }
 
 impl BodyBuilder {
@@ -148,6 +153,11 @@ impl BodyBuilder {
             mass: None,
             name: None,
             user_data: 0,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            lock_rotation: false,
+            groups: u32::MAX,
+            mask: u32::MAX,
         }
     }
 
@@ -225,6 +235,39 @@ impl BodyBuilder {
         self.user_data = user_data;
         self
     }
+
+    /// Linear damping c (1/s, finite, ≥ 0): each substep of h seconds scales the linear
+    /// velocity by 1/(1 + h·c), after gravity and applied forces (Box2D's damping, implicit
+    /// so that it is stable for any c). Default 0.
+    pub fn linear_damping(mut self, damping: f32) -> Self {
+        self.linear_damping = damping;
+        self
+    }
+
+    /// Angular damping c (1/s, finite, ≥ 0): each substep scales the angular velocity by
+    /// 1/(1 + h·c), as [`Self::linear_damping`]. Default 0.
+    pub fn angular_damping(mut self, damping: f32) -> Self {
+        self.angular_damping = damping;
+        self
+    }
+
+    /// Locks all three rotation axes of a dynamic body (default unlocked): its inverse
+    /// inertia is zero, so contacts, torques and impulses cannot turn it, and its angular
+    /// velocity stays zero. It still translates.
+    pub fn lock_rotation(mut self, locked: bool) -> Self {
+        self.lock_rotation = locked;
+        self
+    }
+
+    /// Collision groups: `groups` are the groups the body belongs to and `mask` the groups it
+    /// collides with, one bit each; bodies a and b collide when
+    /// `(groups_a & mask_b) != 0 && (groups_b & mask_a) != 0` (Rapier's `InteractionGroups`).
+    /// Default all bits of both: every body collides with every other.
+    pub fn collision_groups(mut self, groups: u32, mask: u32) -> Self {
+        self.groups = groups;
+        self.mask = mask;
+        self
+    }
 }
 
 /// All bodies of a world. Index `i` of every array is body `i` in scene order.
@@ -266,6 +309,14 @@ pub struct Bodies {
     pub name: Vec<Option<String>>,
     /// The caller's number for the body ([`BodyBuilder::user_data`]).
     pub user_data: Vec<u128>,
+    /// Linear damping c (1/s): v ← v/(1 + h·c) per substep ([`BodyBuilder::linear_damping`]).
+    pub linear_damping: Vec<f32>,
+    /// Angular damping c (1/s): ω ← ω/(1 + h·c) per substep.
+    pub angular_damping: Vec<f32>,
+    /// Collision groups the body belongs to, one bit each ([`BodyBuilder::collision_groups`]).
+    pub groups: Vec<u32>,
+    /// Collision groups the body collides with.
+    pub mask: Vec<u32>,
 }
 
 impl Bodies {
@@ -286,6 +337,10 @@ impl Bodies {
         self.force.swap_remove(i);
         self.torque.swap_remove(i);
         self.user_data.swap_remove(i);
+        self.linear_damping.swap_remove(i);
+        self.angular_damping.swap_remove(i);
+        self.groups.swap_remove(i);
+        self.mask.swap_remove(i);
         self.name.swap_remove(i)
     }
 
@@ -307,6 +362,13 @@ impl Bodies {
     /// True for bodies that move (dynamic rigid bodies and particles).
     pub fn is_moving(&self, i: usize) -> bool {
         self.kind[i] != BodyKind::Static
+    }
+
+    /// Whether bodies `a` and `b` may collide by their collision groups:
+    /// `(groups_a & mask_b) != 0 && (groups_b & mask_a) != 0`.
+    #[inline]
+    pub fn groups_interact(&self, a: usize, b: usize) -> bool {
+        (self.groups[a] & self.mask[b]) != 0 && (self.groups[b] & self.mask[a]) != 0
     }
 
     /// World position of body `i`'s centre of mass (m).

@@ -110,7 +110,9 @@ impl BroadPhase {
             return;
         }
         let keep = |&(a, b): &(u32, u32)| {
-            a != b && (bodies.is_moving(a as usize) || bodies.is_moving(b as usize))
+            a != b
+                && (bodies.is_moving(a as usize) || bodies.is_moving(b as usize))
+                && bodies.groups_interact(a as usize, b as usize)
         };
         let ordered = |(a, b): (u32, u32)| if a < b { (a, b) } else { (b, a) };
         let same_kinds = self.moving.len() == bodies.len()

@@ -1,7 +1,7 @@
 //! Stages 1 and 6 of the step, on an island's local arrays: prospective velocities and
-//! position integration (symplectic Euler, per substep).
+//! position integration (symplectic Euler, per substep), and the implicit gyroscopic term.
 
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3};
 
 /// Stage 1: v* = v + h·M⁻¹·f_ext with gravity the only external force (docs/method.md: "compute
 /// prospective velocities of all objects for this time step"). `linear` holds moving bodies
@@ -44,4 +44,110 @@ pub fn integrate_orientation(q: Quat, omega: Vec3, h: f32) -> Quat {
         q.w + 0.5 * h * spin.w,
     )
     .normalize()
+}
+
+/// The implicit gyroscopic step of every body, per substep of `h` seconds: between contacts a
+/// free body keeps its world angular momentum L = R·I·Rᵀ·ω, so in the body frame ω obeys
+/// Euler's equations I·ω̇ + ω × I·ω = 0. Backward Euler gives
+/// f(ω') = I·(ω' − ω) + h·ω' × I·ω' = 0 in body coordinates, solved by one Newton step from
+/// ω' = ω: ω' = ω − J⁻¹·h·ω × I·ω with J = I + h·([ω]×·I − [I·ω]×) (Catto, "Numerical Methods",
+/// GDC 2015; Bullet's `btRigidBody::computeGyroscopicImpulseImplicit_Body`). Unlike the explicit
+/// term it is stable at any spin: the exact backward-Euler solution has |I·ω'| ≤ |I·ω| and
+/// ω'·I·ω' ≤ ω·I·ω (take f(ω') = 0 dotted with I·ω' and with ω'), so it never adds angular
+/// momentum or energy, and one Newton step is within O(h²) of it.
+///
+/// `inertia` holds each body's inertia tensor about its centre of mass in the body frame
+/// (kg·m²), or zero for a body with no gyroscopic term (a particle, a body that does not
+/// rotate, an isotropic tensor for which ω × I·ω = 0); `orientation` its current orientation.
+/// A body whose Newton matrix is singular or whose result is not finite keeps its ω.
+pub fn gyroscopic(angular: &mut [Vec3], orientation: &[Quat], inertia: &[Mat3], h: f32) {
+    for ((omega, &q), tensor) in angular.iter_mut().zip(orientation).zip(inertia) {
+        if *omega == Vec3::ZERO || *tensor == Mat3::ZERO {
+            continue;
+        }
+        let local = q.inverse() * *omega;
+        let momentum = *tensor * local;
+        let residual = h * local.cross(momentum);
+        let jacobian = *tensor + (skew(local) * *tensor - skew(momentum)) * h;
+        let determinant = jacobian.determinant();
+        if !determinant.is_finite() || determinant.abs() <= f32::MIN_POSITIVE {
+            continue;
+        }
+        // Only the change goes back through the rotation: a round trip of ω itself through
+        // a quaternion of norm 1 ± ulp scales it each substep, and in f32 that bias adds up
+        // (0.2 % of kinetic energy in 10 s at 1200 substeps/s when it was done that way).
+        let change = q * (jacobian.inverse() * residual);
+        if change.is_finite() {
+            *omega -= change;
+        }
+    }
+}
+
+/// [a]×: the matrix of b ↦ a × b.
+fn skew(a: Vec3) -> Mat3 {
+    Mat3::from_cols(
+        Vec3::new(0.0, a.z, -a.y),
+        Vec3::new(-a.z, 0.0, a.x),
+        Vec3::new(a.y, -a.x, 0.0),
+    )
+}
+
+/// The tensor [`gyroscopic`] needs for a body of local inverse inertia `inverse` (body frame):
+/// its inverse, or zero when the gyroscopic term vanishes or cannot be formed (a particle or
+/// static body, a singular tensor, or an isotropic one such as a ball's or a cube's, for which
+/// ω × I·ω = 0 for every ω).
+pub fn gyroscopic_inertia(inverse: &Mat3) -> Mat3 {
+    let diagonal = Vec3::new(inverse.x_axis.x, inverse.y_axis.y, inverse.z_axis.z);
+    let off_diagonal = inverse.x_axis.y != 0.0
+        || inverse.x_axis.z != 0.0
+        || inverse.y_axis.x != 0.0
+        || inverse.y_axis.z != 0.0
+        || inverse.z_axis.x != 0.0
+        || inverse.z_axis.y != 0.0;
+    if !off_diagonal {
+        if diagonal.x == diagonal.y && diagonal.y == diagonal.z {
+            return Mat3::ZERO;
+        }
+        if diagonal.cmpgt(Vec3::ZERO).all() {
+            return Mat3::from_diagonal(diagonal.recip());
+        }
+        return Mat3::ZERO;
+    }
+    if inverse.determinant().abs() > f32::MIN_POSITIVE {
+        let tensor = inverse.inverse();
+        if tensor.is_finite() {
+            return tensor;
+        }
+    }
+    Mat3::ZERO
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Substeps of the gyroscopic term and the orientation update, as the substep loop runs
+    /// them, keep a box's kinetic energy to f32 rounding for 10 s at 1200 substeps/s: the
+    /// orientation update turns the body about ω, which leaves the body-frame ω unchanged, so
+    /// only the gyroscopic step may change the energy, and backward Euler only takes it out.
+    #[test]
+    fn gyroscopic_substeps_do_not_gain_energy() {
+        let tensor = Mat3::from_diagonal(Vec3::new(0.34, 0.10, 0.26) * 20.0);
+        for start in [Vec3::new(5.0, 0.05, 0.05), Vec3::new(1.0, 2.0, 3.0)] {
+            let mut omega = [start];
+            let mut q = [Quat::from_rotation_y(0.3)];
+            let energy = |omega: Vec3, q: Quat| {
+                let local = q.inverse() * omega;
+                0.5 * local.dot(tensor * local)
+            };
+            let e0 = energy(omega[0], q[0]);
+            let h = 1.0 / 1200.0;
+            for _ in 0..12_000 {
+                gyroscopic(&mut omega, &q, &[tensor], h);
+                q[0] = integrate_orientation(q[0], omega[0], h);
+                let e = energy(omega[0], q[0]);
+                assert!(e < e0 * (1.0 + 1e-4), "{e} J from {e0} J");
+            }
+        }
+    }
 }

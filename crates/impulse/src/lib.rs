@@ -54,7 +54,8 @@ pub use glam;
 /// The geometry library behind shapes and queries, so a user needs no parry3d of their own.
 pub use parry3d;
 /// Shapes to build bodies from: `SharedShape::ball(r)`, `::cuboid(hx, hy, hz)`,
-/// `::capsule_y(half_height, r)`, `::convex_hull(&points)`, `::halfspace(normal)`.
+/// `::capsule_y(half_height, r)`, `::cylinder(half_height, r)` and `::cone(half_height, r)`
+/// (along y), `::convex_hull(&points)`, `::halfspace(normal)`.
 pub use parry3d::shape::SharedShape;
 
 pub use body::{BodyBuilder, BodyHandle, BodyKind};

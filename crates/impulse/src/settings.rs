@@ -147,6 +147,11 @@ pub struct SolverSettings {
     /// 1024 points, a colour of more than 8 lane groups is spread over the worker threads (the
     /// same result on any thread count).
     pub simd_island_contacts: u32,
+    /// Integrate the gyroscopic term ω × I·ω of rigid bodies, implicitly, once per substep
+    /// ([`crate::integrate::gyroscopic`]), so that a free body keeps its world angular momentum
+    /// and a body spun near its intermediate axis tumbles (docs/method.md, "Gyroscopic
+    /// motion"). Off keeps ω constant in the world frame between contacts.
+    pub gyroscopic: bool,
 }
 
 impl SolverSettings {
@@ -271,6 +276,7 @@ impl Default for SolverSettings {
             friction_in_main_solve: false,
             parallel_island_contacts: 0,
             simd_island_contacts: 16,
+            gyroscopic: true,
         }
     }
 }

@@ -76,6 +76,26 @@ pub fn shape_mesh(shape: &ShapeDesc, ground_half_size: f32) -> Result<TriMesh> {
             radius,
         } => round(*radius, *half_height),
         ShapeDesc::Cuboid { half_extents } => cuboid(*half_extents),
+        ShapeDesc::Cylinder {
+            half_height,
+            radius,
+        } => {
+            // The hull of two rings: flat ends, flat-shaded sides.
+            let ring = |y: f32| (0..SIDES).map(move |k| ring_point(k, *radius, y));
+            let points = ring(-*half_height).chain(ring(*half_height)).collect();
+            shape_mesh(&ShapeDesc::ConvexHull { points }, ground_half_size)?
+        }
+        ShapeDesc::Cone {
+            half_height,
+            radius,
+        } => {
+            // The hull of the base ring and the apex (Parry's cone: apex at +half_height).
+            let points = (0..SIDES)
+                .map(|k| ring_point(k, *radius, -*half_height))
+                .chain(std::iter::once([0.0, *half_height, 0.0]))
+                .collect();
+            shape_mesh(&ShapeDesc::ConvexHull { points }, ground_half_size)?
+        }
         ShapeDesc::ConvexHull { points } => {
             let Hull {
                 vertices,
@@ -95,6 +115,15 @@ pub fn shape_mesh(shape: &ShapeDesc, ground_half_size: f32) -> Result<TriMesh> {
             mesh
         }
     })
+}
+
+/// Sides of the polygon a cylinder's or cone's circle is drawn with.
+const SIDES: u32 = 32;
+
+/// Point `k` of `SIDES` on the circle of `radius` about the y axis at height `y`.
+fn ring_point(k: u32, radius: f32, y: f32) -> [f32; 3] {
+    let angle = std::f32::consts::TAU * k as f32 / SIDES as f32;
+    [radius * angle.cos(), y, radius * angle.sin()]
 }
 
 /// A convex hull with shared vertices.

@@ -169,6 +169,31 @@ fn geometry(out: &mut Usda, shape: &ShapeDesc, colour: [f32; 3], ground: f32) ->
                 [*radius, reach, *radius],
             ));
         }
+        ShapeDesc::Cylinder {
+            half_height,
+            radius,
+        }
+        | ShapeDesc::Cone {
+            half_height,
+            radius,
+        } => {
+            // UsdGeomCylinder and UsdGeomCone, both centred, along Y; a cone's apex is at
+            // +height/2, as Parry's.
+            let prim = if matches!(shape, ShapeDesc::Cone { .. }) {
+                "Cone"
+            } else {
+                "Cylinder"
+            };
+            out.def(prim, "geometry");
+            out.open_block();
+            out.line("uniform token axis = \"Y\"");
+            out.line(&format!("double height = {}", number(2.0 * half_height)));
+            out.line(&format!("double radius = {}", number(*radius)));
+            out.line(&extent(
+                [-*radius, -*half_height, -*radius],
+                [*radius, *half_height, *radius],
+            ));
+        }
         ShapeDesc::ConvexHull { points } => {
             let Hull {
                 vertices,

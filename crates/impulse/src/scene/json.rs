@@ -448,6 +448,16 @@ struct BodyOut<'a> {
     material: &'a MaterialRef,
     #[serde(skip_serializing_if = "Option::is_none")]
     mass: Option<f32>,
+    #[serde(skip_serializing_if = "is_zero_scalar")]
+    linear_damping: f32,
+    #[serde(skip_serializing_if = "is_zero_scalar")]
+    angular_damping: f32,
+    #[serde(skip_serializing_if = "is_false")]
+    lock_rotation: bool,
+    #[serde(skip_serializing_if = "is_all")]
+    groups: u32,
+    #[serde(skip_serializing_if = "is_all")]
+    mask: u32,
 }
 
 impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
@@ -463,6 +473,11 @@ impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
             angular_velocity,
             material,
             mass,
+            linear_damping,
+            angular_damping,
+            lock_rotation,
+            groups,
+            mask,
         } = b;
         Self {
             name,
@@ -474,6 +489,11 @@ impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
             angular_velocity: *angular_velocity,
             material,
             mass: *mass,
+            linear_damping: *linear_damping,
+            angular_damping: *angular_damping,
+            lock_rotation: *lock_rotation,
+            groups: *groups,
+            mask: *mask,
         }
     }
 }
@@ -487,6 +507,16 @@ fn is_identity(q: &[f32; 4]) -> bool {
 #[allow(clippy::float_cmp)]
 fn is_zero(v: &[f32; 3]) -> bool {
     *v == [0.0; 3]
+}
+#[allow(clippy::float_cmp)]
+fn is_zero_scalar(v: &f32) -> bool {
+    *v == 0.0
+}
+fn is_false(b: &bool) -> bool {
+    !*b
+}
+fn is_all(bits: &u32) -> bool {
+    *bits == u32::MAX
 }
 fn is_default_material(m: &&MaterialRef) -> bool {
     **m == MaterialRef::default()

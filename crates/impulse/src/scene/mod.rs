@@ -79,6 +79,21 @@ pub enum ShapeDesc {
         /// Radius (m) > 0.
         radius: f32,
     },
+    /// A solid circular cylinder along the local y axis, centred on the body origin.
+    Cylinder {
+        /// Half the height (m) > 0: the flat ends are at y = ±half_height.
+        half_height: f32,
+        /// Radius (m) > 0.
+        radius: f32,
+    },
+    /// A solid circular cone along the local y axis: base at y = −half_height, apex at
+    /// y = +half_height (Parry's convention; the centre of mass is at y = −half_height/2).
+    Cone {
+        /// Half the height (m) > 0.
+        half_height: f32,
+        /// Radius of the base (m) > 0.
+        radius: f32,
+    },
     /// The convex hull of points.
     ConvexHull {
         /// At least 4 non-coplanar points (m, local frame).
@@ -136,6 +151,26 @@ pub struct BodyDesc {
     /// Mass (kg) > 0 overriding the density; the inertia tensor is scaled to match.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mass: Option<f32>,
+    /// Linear damping (1/s), finite, ≥ 0: v ← v/(1 + h·c) per substep.
+    #[serde(default)]
+    pub linear_damping: f32,
+    /// Angular damping (1/s), finite, ≥ 0: ω ← ω/(1 + h·c) per substep.
+    #[serde(default)]
+    pub angular_damping: f32,
+    /// Lock all three rotation axes (dynamic bodies): the body translates but never turns.
+    #[serde(default)]
+    pub lock_rotation: bool,
+    /// Collision groups the body belongs to (bits); default all.
+    #[serde(default = "all_groups")]
+    pub groups: u32,
+    /// Collision groups the body collides with (bits); default all. Bodies a and b collide
+    /// when `(groups_a & mask_b) != 0 && (groups_b & mask_a) != 0`.
+    #[serde(default = "all_groups")]
+    pub mask: u32,
+}
+
+fn all_groups() -> u32 {
+    u32::MAX
 }
 
 fn default_gravity() -> [f32; 3] {
@@ -178,6 +213,11 @@ impl BodyDesc {
             angular_velocity: [0.0; 3],
             material: MaterialRef::default(),
             mass: None,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            lock_rotation: false,
+            groups: all_groups(),
+            mask: all_groups(),
         }
     }
 }

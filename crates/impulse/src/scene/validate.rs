@@ -11,8 +11,9 @@
 //!   `sleep_linear_speed`, `sleep_angular_speed`, `time_to_sleep` are ≥ 0;
 //!   `solver.warm_start` is in [0, 1];
 //! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`;
-//! - a body's `mass`, when given, is > 0;
-//! - shapes: sphere and capsule `radius > 0`, capsule `half_height ≥ 0`, every cuboid half
+//! - a body's `mass`, when given, is > 0; its `linear_damping` and `angular_damping` are ≥ 0;
+//! - shapes: sphere, capsule, cylinder and cone `radius > 0`, capsule `half_height ≥ 0`,
+//!   cylinder and cone `half_height > 0`, every cuboid half
 //!   extent > 0, a convex hull has ≥ 4 points that span a volume (not all coincident,
 //!   collinear or coplanar), a half-space normal is not zero and belongs to a static body;
 //! - a particle's shape is a sphere;
@@ -185,6 +186,8 @@ impl Checker {
         if let Some(mass) = b.mass {
             self.positive(&path.key("mass"), mass);
         }
+        self.non_negative(&path.key("linear_damping"), b.linear_damping);
+        self.non_negative(&path.key("angular_damping"), b.angular_damping);
         match &b.material {
             MaterialRef::Named(name) => {
                 if name != "default" && !materials.contains_key(name) {
@@ -228,6 +231,17 @@ impl Checker {
                 radius,
             } => {
                 self.non_negative(&path.key("half_height"), *half_height);
+                self.positive(&path.key("radius"), *radius);
+            }
+            ShapeDesc::Cylinder {
+                half_height,
+                radius,
+            }
+            | ShapeDesc::Cone {
+                half_height,
+                radius,
+            } => {
+                self.positive(&path.key("half_height"), *half_height);
                 self.positive(&path.key("radius"), *radius);
             }
             ShapeDesc::ConvexHull { points } => {
@@ -282,6 +296,8 @@ fn shape_type_name(shape: &ShapeDesc) -> &'static str {
         ShapeDesc::Sphere { .. } => "sphere",
         ShapeDesc::Cuboid { .. } => "cuboid",
         ShapeDesc::Capsule { .. } => "capsule",
+        ShapeDesc::Cylinder { .. } => "cylinder",
+        ShapeDesc::Cone { .. } => "cone",
         ShapeDesc::ConvexHull { .. } => "convex_hull",
         ShapeDesc::HalfSpace { .. } => "half_space",
     }

@@ -1,4 +1,5 @@
-//! One island's step (stages 1, 5 and 6 on one island): per substep, gravity, warm start, the
+//! One island's step (stages 1, 5 and 6 on one island): per substep, gravity and the
+//! gyroscopic term, warm start, the
 //! solve with overlap repair, position integration and the relax solve; then the restitution
 //! solve. The method is picked here, per island, and called through [`ContactSolver`].
 //!
@@ -6,7 +7,7 @@
 //! and scattered at the end, so islands can run on separate threads without sharing anything
 //! mutable.
 
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3};
 use parry3d::math::Pose;
 
 use super::apgd::Apgd;
@@ -15,7 +16,7 @@ use super::pgs::{Pgs, Sweep, colour_constraints};
 use super::policy::{Auto, EscalationLevel, EscalationLimits};
 use super::wide::Bundles;
 use super::{ContactSolver, SolveOutcome, SolvePass, TargetInputs, Velocities, position};
-use crate::body::Bodies;
+use crate::body::{Bodies, BodyKind};
 use crate::constraints::{self, ContactConstraint};
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
@@ -72,6 +73,12 @@ pub struct IslandWorkspace {
     /// Per body, the linear and angular acceleration of its applied force and torque (m/s²,
     /// rad/s²); empty in a step without forces.
     acceleration: Vec<(Vec3, Vec3)>,
+    /// Per body, the body-frame inertia tensor of its gyroscopic term
+    /// ([`integrate::gyroscopic_inertia`]); empty when no body of the island has one.
+    inertia: Vec<Mat3>,
+    /// Per body, the factors 1/(1 + h·c) of its linear and angular damping for one substep;
+    /// empty when no body of the island is damped.
+    damping: Vec<(f32, f32)>,
     pseudo_linear: Vec<Vec3>,
     pseudo_angular: Vec<Vec3>,
     /// Colour offsets of the island's constraints when it is coloured (see [`Sweep`]).
@@ -251,6 +258,35 @@ pub fn step_island(
             )
         }));
     }
+    // The gyroscopic term's tensors; kept only when some body of the island has one, so
+    // islands of balls, cubes and particles skip the pass.
+    w.inertia.clear();
+    if settings.gyroscopic {
+        w.inertia.extend(island_bodies.iter().map(|&i| {
+            let i = i as usize;
+            if bodies.kind[i] == BodyKind::Dynamic {
+                integrate::gyroscopic_inertia(&bodies.local_inverse_inertia[i])
+            } else {
+                Mat3::ZERO
+            }
+        }));
+        if w.inertia.iter().all(|t| *t == Mat3::ZERO) {
+            w.inertia.clear();
+        }
+    }
+    let h = dt / settings.substeps as f32;
+    w.damping.clear();
+    if island_bodies.iter().any(|&i| {
+        bodies.linear_damping[i as usize] > 0.0 || bodies.angular_damping[i as usize] > 0.0
+    }) {
+        w.damping.extend(island_bodies.iter().map(|&i| {
+            let i = i as usize;
+            (
+                1.0 / (1.0 + h * bodies.linear_damping[i]),
+                1.0 / (1.0 + h * bodies.angular_damping[i]),
+            )
+        }));
+    }
     w.displacement.clear();
     w.displacement.resize(slots, Vec3::ZERO);
     w.rotation.clear();
@@ -297,7 +333,6 @@ pub fn step_island(
     // Whether this island's passes over all its points or bodies go on rayon's threads too.
     let spread = parallel::spread(w.parallel, 1, 0)
         && (coloured_threads || (bundled && w.solvers.wide.parallel()));
-    let h = dt / settings.substeps as f32;
     let moving = slots - 1;
     for substep in 0..settings.substeps {
         // Every other substep, PGS takes each manifold's points from halfway round (see
@@ -309,6 +344,26 @@ pub fn step_island(
         for (k, &(linear, angular)) in w.acceleration.iter().enumerate() {
             w.linear[k] += linear * h;
             w.angular[k] += angular * h;
+        }
+        // Damping after gravity and forces, implicit: v ← v/(1 + h·c) (Box2D's damping).
+        for (k, &(linear, angular)) in w.damping.iter().enumerate() {
+            w.linear[k] *= linear;
+            w.angular[k] *= angular;
+        }
+        // The gyroscopic term, per body at its current orientation, with the other velocity
+        // updates before the contacts are solved (as Bullet applies it with the external forces).
+        if !w.inertia.is_empty() {
+            let angular = &mut w.angular[..moving];
+            if spread {
+                use rayon::prelude::*;
+                angular
+                    .par_chunks_mut(BODIES_PER_TASK)
+                    .zip(w.orientation.par_chunks(BODIES_PER_TASK))
+                    .zip(w.inertia.par_chunks(BODIES_PER_TASK))
+                    .for_each(|((a, o), t)| integrate::gyroscopic(a, o, t, h));
+            } else {
+                integrate::gyroscopic(angular, &w.orientation, &w.inertia, h);
+            }
         }
         let mut velocities = Velocities {
             linear: &mut w.linear,

@@ -189,7 +189,10 @@ impl World {
         velocity: Vec3,
     ) -> Result<(), WorldError> {
         let i = self.moving(handle, "angular_velocity", velocity)?;
-        if self.bodies.kind[i] == BodyKind::Dynamic {
+        // A particle or a body with its rotation locked keeps ω = 0.
+        if self.bodies.kind[i] == BodyKind::Dynamic
+            && self.bodies.local_inverse_inertia[i] != glam::Mat3::ZERO
+        {
             self.bodies.angular_velocity[i] = velocity;
         }
         self.wake_up(i);

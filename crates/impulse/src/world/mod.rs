@@ -169,8 +169,12 @@ impl World {
         b.sleep_time.push(0.0);
         b.force.push(Vec3::ZERO);
         b.torque.push(Vec3::ZERO);
-        b.name.push(builder.name);
         b.user_data.push(builder.user_data);
+        b.linear_damping.push(builder.linear_damping);
+        b.angular_damping.push(builder.angular_damping);
+        b.groups.push(builder.groups);
+        b.mask.push(builder.mask);
+        b.name.push(builder.name);
         Ok(self.handles.insert(index))
     }
 
@@ -360,6 +364,22 @@ fn builder_of(
             }
             SharedShape::capsule_y(*half_height, *radius)
         }
+        ShapeDesc::Cylinder {
+            half_height,
+            radius,
+        } => {
+            positive(index, desc, "shape.half_height", *half_height)?;
+            positive(index, desc, "shape.radius", *radius)?;
+            SharedShape::cylinder(*half_height, *radius)
+        }
+        ShapeDesc::Cone {
+            half_height,
+            radius,
+        } => {
+            positive(index, desc, "shape.half_height", *half_height)?;
+            positive(index, desc, "shape.radius", *radius)?;
+            SharedShape::cone(*half_height, *radius)
+        }
         ShapeDesc::ConvexHull { points } => {
             let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
             if !points.iter().all(|p| p.is_finite()) {
@@ -426,6 +446,11 @@ fn builder_of(
         mass: desc.mass,
         name: desc.name.clone(),
         user_data: 0,
+        linear_damping: desc.linear_damping,
+        angular_damping: desc.angular_damping,
+        lock_rotation: desc.lock_rotation,
+        groups: desc.groups,
+        mask: desc.mask,
     })
 }
 
@@ -475,6 +500,14 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
             format!("must be in [0, 1], got {}", b.restitution),
         );
     }
+    for (field, value) in [
+        ("linear_damping", b.linear_damping),
+        ("angular_damping", b.angular_damping),
+    ] {
+        if !(value.is_finite() && value >= 0.0) {
+            return bad(field, format!("must be finite and ≥ 0, got {value}"));
+        }
+    }
     let shape = b.shape.clone();
     if b.kind != BodyKind::Static && shape.as_halfspace().is_some() {
         return bad("shape", "a half-space must be a static body".into());
@@ -517,7 +550,7 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
                     format!("mass must be finite and > 0, got {}", 1.0 / inverse_mass),
                 );
             }
-            let inertia = if b.kind == BodyKind::Particle {
+            let inertia = if b.kind == BodyKind::Particle || b.lock_rotation {
                 Mat3::ZERO
             } else {
                 props.reconstruct_inverse_inertia_matrix() / scale
@@ -528,7 +561,7 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
             (inverse_mass, props.local_com, inertia)
         }
     };
-    let angular_velocity = if b.kind == BodyKind::Dynamic {
+    let angular_velocity = if b.kind == BodyKind::Dynamic && !b.lock_rotation {
         b.angular_velocity
     } else {
         Vec3::ZERO

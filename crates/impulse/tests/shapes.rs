@@ -1,0 +1,212 @@
+//! Cylinders and cones (`ShapeDesc::Cylinder`, `ShapeDesc::Cone`, along local y): mass
+//! properties against the closed forms, resting contact on the ground, and the shape pairs
+//! Parry generates contacts for.
+
+use impulse::glam::Vec3;
+use impulse::scene::{BodyDesc, BodyKind, Scene, ShapeDesc};
+use impulse::{SolverSettings, World};
+
+const DENSITY: f32 = 1000.0;
+
+fn world_of(bodies: Vec<BodyDesc>) -> World {
+    let scene = Scene {
+        solver: SolverSettings {
+            sleep: false,
+            ..SolverSettings::default()
+        },
+        bodies,
+        ..Scene::default()
+    };
+    World::from_scene(&scene).unwrap()
+}
+
+fn ground() -> BodyDesc {
+    BodyDesc::new(
+        BodyKind::Static,
+        ShapeDesc::HalfSpace {
+            normal: [0.0, 1.0, 0.0],
+        },
+        [0.0; 3],
+    )
+}
+
+fn dynamic(shape: ShapeDesc, position: [f32; 3]) -> BodyDesc {
+    BodyDesc::new(BodyKind::Dynamic, shape, position)
+}
+
+/// Mass, centre of mass and principal moments (about the centre of mass) of body 0.
+fn mass_properties(shape: ShapeDesc) -> (f64, Vec3, [f64; 3]) {
+    let world = world_of(vec![dynamic(shape, [0.0; 3])]);
+    let b = &world.bodies;
+    let inverse = b.local_inverse_inertia[0];
+    let moments =
+        [inverse.x_axis.x, inverse.y_axis.y, inverse.z_axis.z].map(|x| 1.0 / f64::from(x));
+    (
+        1.0 / f64::from(b.inverse_mass[0]),
+        b.local_center_of_mass[0],
+        moments,
+    )
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() < 1e-4 * b.abs()
+}
+
+#[test]
+fn cylinder_inertia_matches_the_closed_form() {
+    let (hh, r) = (0.6f64, 0.25f64);
+    let (m, com, [ix, iy, iz]) = mass_properties(ShapeDesc::Cylinder {
+        half_height: hh as f32,
+        radius: r as f32,
+    });
+    let h = 2.0 * hh;
+    let expected_m = f64::from(DENSITY) * std::f64::consts::PI * r * r * h;
+    assert!(close(m, expected_m), "mass {m} against {expected_m}");
+    assert!(com.length() < 1e-6, "centre of mass {com}");
+    let diameter = m * (3.0 * r * r + h * h) / 12.0;
+    let axis = m * r * r / 2.0;
+    assert!(
+        close(ix, diameter) && close(iz, diameter),
+        "{ix}, {iz} against {diameter}"
+    );
+    assert!(close(iy, axis), "{iy} against {axis}");
+}
+
+#[test]
+fn cone_inertia_matches_the_closed_form() {
+    let (hh, r) = (0.5f64, 0.4f64);
+    let (m, com, [ix, iy, iz]) = mass_properties(ShapeDesc::Cone {
+        half_height: hh as f32,
+        radius: r as f32,
+    });
+    let h = 2.0 * hh;
+    let expected_m = f64::from(DENSITY) * std::f64::consts::PI * r * r * h / 3.0;
+    assert!(close(m, expected_m), "mass {m} against {expected_m}");
+    // A quarter of the height above the base, at y = −half_height.
+    let expected_com = -hh + h / 4.0;
+    assert!(
+        (f64::from(com.y) - expected_com).abs() < 1e-6 && com.x == 0.0 && com.z == 0.0,
+        "centre of mass {com} against y = {expected_com}"
+    );
+    let diameter = 3.0 * m * (r * r / 20.0 + h * h / 80.0);
+    let axis = 3.0 * m * r * r / 10.0;
+    assert!(
+        close(ix, diameter) && close(iz, diameter),
+        "{ix}, {iz} against {diameter}"
+    );
+    assert!(close(iy, axis), "{iy} against {axis}");
+}
+
+/// Steps `world` for 10 s and returns the largest distance (m) body `i` moved from where it
+/// was after the first second (the contact settling).
+fn drift_after_settling(world: &mut World, i: usize) -> f32 {
+    for _ in 0..60 {
+        world.step().unwrap();
+    }
+    let start = world.bodies.pose[i].translation;
+    let mut worst = 0.0f32;
+    for _ in 0..540 {
+        world.step().unwrap();
+        worst = worst.max((world.bodies.pose[i].translation - start).length());
+    }
+    worst
+}
+
+#[test]
+fn a_cylinder_and_a_cone_rest_on_the_ground() {
+    let cylinder = ShapeDesc::Cylinder {
+        half_height: 0.5,
+        radius: 0.3,
+    };
+    let cone = ShapeDesc::Cone {
+        half_height: 0.4,
+        radius: 0.5,
+    };
+    for (shape, half_height) in [(cylinder, 0.5), (cone, 0.4)] {
+        // On a half-space and on a static box.
+        let floors = [
+            ground(),
+            BodyDesc::new(
+                BodyKind::Static,
+                ShapeDesc::Cuboid {
+                    half_extents: [5.0, 0.5, 5.0],
+                },
+                [0.0, -0.5, 0.0],
+            ),
+        ];
+        for floor in floors {
+            let mut world = world_of(vec![floor, dynamic(shape.clone(), [0.0, half_height, 0.0])]);
+            let drift = drift_after_settling(&mut world, 1);
+            let y = world.bodies.pose[1].translation.y;
+            assert!(drift < 0.001, "{shape:?} drifts {drift} m");
+            assert!(
+                (y - half_height).abs() < 0.005,
+                "{shape:?} rests at y = {y}, not {half_height}"
+            );
+        }
+    }
+}
+
+#[test]
+fn parry_makes_contacts_for_cylinders_and_cones_against_the_other_shapes() {
+    let cylinder = ShapeDesc::Cylinder {
+        half_height: 0.5,
+        radius: 0.5,
+    };
+    let cone = ShapeDesc::Cone {
+        half_height: 0.5,
+        radius: 0.5,
+    };
+    let ball = ShapeDesc::Sphere { radius: 0.3 };
+    let cuboid = ShapeDesc::Cuboid {
+        half_extents: [0.3, 0.3, 0.3],
+    };
+    let capsule = ShapeDesc::Capsule {
+        half_height: 0.3,
+        radius: 0.2,
+    };
+    let hull = ShapeDesc::ConvexHull {
+        points: vec![
+            [-0.3, -0.3, -0.3],
+            [0.3, -0.3, -0.3],
+            [-0.3, -0.3, 0.3],
+            [0.3, -0.3, 0.3],
+            [0.0, 0.3, 0.0],
+        ],
+    };
+    // Each top shape dropped flat-side down onto an upright cylinder (top face at y = 1),
+    // and each shape under a cuboid landing on it; the top body must come to rest above.
+    for (top, bottom_of_top) in [
+        (ball.clone(), 0.3),
+        (cuboid.clone(), 0.3),
+        (capsule, 0.5),
+        (hull, 0.3),
+        (cylinder.clone(), 0.5),
+        (cone.clone(), 0.5),
+    ] {
+        for base in [cylinder.clone(), cone.clone()] {
+            if matches!(base, ShapeDesc::Cone { .. }) && !matches!(top, ShapeDesc::Cuboid { .. }) {
+                continue;
+            }
+            let mut world = world_of(vec![
+                ground(),
+                dynamic(base.clone(), [0.0, 0.5, 0.0]),
+                dynamic(top.clone(), [0.0, 1.1 + bottom_of_top, 0.0]),
+            ]);
+            for _ in 0..60 {
+                world
+                    .step()
+                    .unwrap_or_else(|e| panic!("{top:?} on {base:?}: {e}"));
+            }
+            let y = world.bodies.center_of_mass(2).y;
+            assert!(
+                y > 0.9,
+                "{top:?} on {base:?} fell through: centre of mass at y = {y}"
+            );
+            assert!(
+                !world.contact_constraints().is_empty(),
+                "{top:?} on {base:?}: no contact"
+            );
+        }
+    }
+}
