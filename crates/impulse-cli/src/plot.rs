@@ -131,7 +131,7 @@ pub fn plot(input: &Path, out: &Path, columns: &[String]) -> Result<()> {
             .configure_mesh()
             .x_desc(x_name.as_str())
             .label_style((FONT, 12))
-            .y_label_formatter(&|v| format!("{v:.3e}"))
+            .y_label_formatter(&|v| tick(*v))
             .draw()
             .map_err(|e| draw_error(&e))?;
         chart
@@ -140,6 +140,20 @@ pub fn plot(input: &Path, out: &Path, columns: &[String]) -> Result<()> {
     }
     root.present().map_err(|e| draw_error(&e))?;
     Ok(())
+}
+
+/// A tick label: plain with up to four decimals between 0.01 and 10⁶, else in scientific
+/// notation.
+fn tick(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    if (1e-2..1e6).contains(&v.abs()) {
+        let text = format!("{v:.4}");
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{v:.2e}")
+    }
 }
 
 /// The smallest and largest of `values`, widened to a non-empty range.

@@ -157,8 +157,9 @@ impl Canvas {
                     (1.0 - d / (0.75 * footprint.max(1e-6))).clamp(0.0, 1.0)
                 };
                 let coverage = line(hit.x).max(line(hit.z));
-                // Lines closer than a few pixels blur into a tone: fade them out there.
-                let fade = (1.0 - footprint / (0.3 * spacing)).clamp(0.0, 1.0);
+                // Lines closer than a few pixels blur into a tone: fade them out from four
+                // pixels apart to one and a half.
+                let fade = ((spacing / footprint.max(1e-6) - 1.5) / 2.5).clamp(0.0, 1.0);
                 let ground_colour = GROUND.lerp(GRID_LINE, coverage * fade);
                 // Haze towards the horizon.
                 let haze = (-(t / (400.0 * spacing))).exp();
