@@ -5,6 +5,7 @@ mod export;
 mod lcp_command;
 mod plot;
 mod render;
+mod residual_plot;
 mod run;
 mod solver_args;
 mod stats;
