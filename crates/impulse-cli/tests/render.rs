@@ -201,6 +201,18 @@ fn render_rejects_bad_sizes_and_unwritable_outputs_by_name() {
         .output()
         .unwrap();
     assert!(!out.status.success(), "nothing to write must be an error");
+    let out = impulse()
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .args(["--camera-eye", "1,2,3", "--camera-target", "1,2,3"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success(), "eye at the target must be an error");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("same point"));
 }
 
 #[test]

@@ -125,6 +125,17 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
     if options.out_dir.is_none() && options.gif.is_none() {
         bail!("nothing to write: give --out DIR (PNG frames) and/or --gif FILE");
     }
+    if !(options.speed_max.is_finite() && options.speed_max > 0.0) {
+        bail!(
+            "--speed-max {} is not a speed above 0 (m/s)",
+            options.speed_max
+        );
+    }
+    if let (Some(eye), Some(target)) = (options.eye, options.target)
+        && eye.distance(target) < 1e-4
+    {
+        bail!("the camera eye and target are the same point ({eye}): the view has no direction");
+    }
     if let Some(dir) = &options.out_dir {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create the frame directory {}", dir.display()))?;
@@ -145,6 +156,12 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
     let centre = 0.5 * (min + max);
     let radius = (0.5 * (max - min).length()).max(0.5);
     let camera = default_camera(centre, radius, options);
+    if camera.eye.distance(camera.target) < 1e-4 {
+        bail!(
+            "the camera eye {} is at its target: give --camera-target or another --camera-eye",
+            camera.eye
+        );
+    }
     let (bodies, ground) = drawn_bodies(scene, &world, min, max, radius)?;
     // No ground body: the grid still shows which way is down, under everything.
     let ground = ground.unwrap_or(Ground {
