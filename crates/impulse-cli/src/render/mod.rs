@@ -10,13 +10,13 @@
 
 pub mod raster;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, RgbImage, RgbaImage};
-use impulse::glam::Vec3;
+use impulse::glam::{Quat, Vec3};
 use impulse::{BodyKind, Scene, ShapeDesc, World};
 
 use crate::export::mesh::{TriMesh, shape_mesh};
@@ -122,6 +122,53 @@ struct Ground {
 
 /// Simulates `scene` and writes the frames `options` asks for.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
+    check_options(options)?;
+    let every = options.every.max(1) as u64;
+    let delay_ms = (every as f64 * scene.dt as f64 * 1e3).round().max(10.0) as u32;
+    // Fail before simulating if the outputs cannot be written.
+    let mut sink = FrameSink::create(options, delay_ms)?;
+    let mut world = World::from_scene(scene).context("cannot build the world")?;
+    let steps = options.steps.unwrap_or(scene.steps) as u64;
+
+    let (min, max) = moving_bounds(scene, &world);
+    let centre = 0.5 * (min + max);
+    let radius = (0.5 * (max - min).length()).max(0.5);
+    let camera = checked_camera(centre, radius, options)?;
+    let (bodies, ground) = drawn_bodies(scene, &world, min, max, radius)?;
+    // No ground body: the grid still shows which way is down, under everything.
+    let ground = ground.unwrap_or(Ground {
+        height: min.y,
+        spacing: grid_spacing(radius),
+    });
+
+    let mut frames = 0;
+    for step in 0..=steps {
+        if step > 0 {
+            world
+                .step()
+                .with_context(|| format!("the simulation stopped at step {step}"))?;
+        }
+        if !(step % every == 0 || step == steps) {
+            continue;
+        }
+        let poses: Vec<(Quat, Vec3)> = world
+            .bodies
+            .pose
+            .iter()
+            .map(|p| (p.rotation, p.translation))
+            .collect();
+        let colours = body_colours(&world, &bodies, options);
+        sink.write(
+            step,
+            &draw(&bodies, &poses, &colours, &ground, &camera, options),
+        )?;
+        frames += 1;
+    }
+    Ok(RenderSummary { frames, camera })
+}
+
+/// Checks the options that do not depend on the scene.
+fn check_options(options: &RenderOptions) -> Result<()> {
     if options.out_dir.is_none() && options.gif.is_none() {
         bail!("nothing to write: give --out DIR (PNG frames) and/or --gif FILE");
     }
@@ -136,25 +183,12 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
     {
         bail!("the camera eye and target are the same point ({eye}): the view has no direction");
     }
-    if let Some(dir) = &options.out_dir {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create the frame directory {}", dir.display()))?;
-    }
-    // Fail before simulating if the GIF cannot be written.
-    let gif_file = match &options.gif {
-        Some(path) => Some(
-            std::fs::File::create(path)
-                .with_context(|| format!("cannot create {}", path.display()))?,
-        ),
-        None => None,
-    };
-    let mut world = World::from_scene(scene).context("cannot build the world")?;
-    let steps = options.steps.unwrap_or(scene.steps) as u64;
-    let every = options.every.max(1) as u64;
+    Ok(())
+}
 
-    let (min, max) = moving_bounds(scene, &world);
-    let centre = 0.5 * (min + max);
-    let radius = (0.5 * (max - min).length()).max(0.5);
+/// The camera of `options` around a sphere of `radius` about `centre`, unless it has no
+/// direction.
+fn checked_camera(centre: Vec3, radius: f32, options: &RenderOptions) -> Result<Camera> {
     let camera = default_camera(centre, radius, options);
     if camera.eye.distance(camera.target) < 1e-4 {
         bail!(
@@ -162,61 +196,70 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
             camera.eye
         );
     }
-    let (bodies, ground) = drawn_bodies(scene, &world, min, max, radius)?;
-    // No ground body: the grid still shows which way is down, under everything.
-    let ground = ground.unwrap_or(Ground {
-        height: min.y,
-        spacing: grid_spacing(radius),
-    });
+    Ok(camera)
+}
 
-    let mut gif = gif_file.map(|file| {
-        let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
-        // The delay is set per frame; a preview loops.
-        let _ = encoder.set_repeat(Repeat::Infinite);
-        encoder
-    });
-    let delay_ms = (every as f64 * scene.dt as f64 * 1e3).round().max(10.0) as u32;
-    let mut frames = 0;
-    for step in 0..=steps {
-        if step > 0 {
-            world
-                .step()
-                .with_context(|| format!("the simulation stopped at step {step}"))?;
+/// Where drawn frames go: PNG files in a directory and/or one animated GIF.
+struct FrameSink {
+    out_dir: Option<PathBuf>,
+    gif: Option<(PathBuf, GifEncoder<std::io::BufWriter<std::fs::File>>)>,
+    /// GIF frame delay (ms).
+    delay_ms: u32,
+}
+
+impl FrameSink {
+    /// Creates the directory and the GIF file of `options`.
+    fn create(options: &RenderOptions, delay_ms: u32) -> Result<Self> {
+        if let Some(dir) = &options.out_dir {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create the frame directory {}", dir.display()))?;
         }
-        if !(step % every == 0 || step == steps) {
-            continue;
-        }
-        let canvas = draw(&world, &bodies, &ground, &camera, options);
+        let gif = match &options.gif {
+            Some(path) => {
+                let file = std::fs::File::create(path)
+                    .with_context(|| format!("cannot create {}", path.display()))?;
+                let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
+                // A preview loops.
+                encoder
+                    .set_repeat(Repeat::Infinite)
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+                Some((path.clone(), encoder))
+            }
+            None => None,
+        };
+        Ok(Self {
+            out_dir: options.out_dir.clone(),
+            gif,
+            delay_ms,
+        })
+    }
+
+    /// Writes `canvas` as `frame_<number>.png` and/or the GIF's next frame.
+    fn write(&mut self, number: u64, canvas: &Canvas) -> Result<()> {
         let (w, h) = canvas.size();
         let rgb = canvas.to_rgb8();
-        if let Some(dir) = &options.out_dir {
-            let path = dir.join(format!("frame_{step:05}.png"));
+        if let Some(dir) = &self.out_dir {
+            let path = dir.join(format!("frame_{number:05}.png"));
             let image =
                 RgbImage::from_raw(w, h, rgb.clone()).context("image buffer of the wrong size")?;
             image
                 .save(&path)
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
-        if let Some(encoder) = gif.as_mut() {
+        if let Some((path, encoder)) = self.gif.as_mut() {
             let rgba: Vec<u8> = rgb
                 .chunks_exact(3)
                 .flat_map(|p| [p[0], p[1], p[2], 255])
                 .collect();
             let image =
                 RgbaImage::from_raw(w, h, rgba).context("image buffer of the wrong size")?;
-            let frame =
-                image::Frame::from_parts(image, 0, 0, Delay::from_numer_denom_ms(delay_ms, 1));
+            let delay = Delay::from_numer_denom_ms(self.delay_ms, 1);
             encoder
-                .encode_frame(frame)
-                .with_context(|| format!("cannot write {}", gif_path(options).display()))?;
+                .encode_frame(image::Frame::from_parts(image, 0, 0, delay))
+                .with_context(|| format!("cannot write {}", path.display()))?;
         }
-        frames += 1;
+        Ok(())
     }
-    Ok(RenderSummary { frames, camera })
-}
-
-fn gif_path(options: &RenderOptions) -> &Path {
-    options.gif.as_deref().unwrap_or(Path::new("the GIF"))
 }
 
 /// The box of the moving bodies' meshes at their current poses (a unit box at the origin when
@@ -331,10 +374,12 @@ fn drawn_bodies(
     })
 }
 
-/// One frame of the world as it is now.
+/// One frame: each body drawn at its pose (rotation, translation) in its colour (linear RGB),
+/// all but the ground, over the ground grid.
 fn draw(
-    world: &World,
     bodies: &[DrawnBody],
+    poses: &[(Quat, Vec3)],
+    colours: &[Vec3],
     ground: &Ground,
     camera: &Camera,
     options: &RenderOptions,
@@ -342,21 +387,18 @@ fn draw(
     let (w, h) = options.size;
     let mut canvas = Canvas::new(w, h, camera);
     canvas.draw_background(Some((ground.height, ground.spacing)));
-    let colours = body_colours(world, bodies, options);
-    for (i, body) in bodies.iter().enumerate() {
+    for ((body, &(rotation, translation)), &colour) in bodies.iter().zip(poses).zip(colours) {
         if body.is_ground {
             continue;
         }
-        let pose = world.bodies.pose[i];
-        let colour = colours[i];
         let vertices: Vec<Vertex> = body
             .mesh
             .positions
             .iter()
             .zip(&body.mesh.normals)
             .map(|(p, n)| Vertex {
-                position: pose.rotation * Vec3::from(*p) + pose.translation,
-                normal: pose.rotation * Vec3::from(*n),
+                position: rotation * Vec3::from(*p) + translation,
+                normal: rotation * Vec3::from(*n),
                 colour,
             })
             .collect();
