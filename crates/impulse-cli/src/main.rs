@@ -79,7 +79,9 @@ enum Command {
     /// Simulate a scene and draw shaded previews: PNG frames into a directory and/or an
     /// animated GIF (CPU rasteriser; docs/export.md).
     Render {
-        /// JSON scene file, or the name of a built-in scene (see `impulse scenes`).
+        /// JSON scene file, the name of a built-in scene (see `impulse scenes`), or a `.glb`
+        /// written by `impulse run --out` (its keyframes are drawn; --steps and --every do not
+        /// apply, --color island falls back to the file's colours).
         scene: String,
         /// Directory for one PNG per drawn frame, `frame_<step>.png` (created if missing).
         #[arg(long)]
@@ -298,7 +300,6 @@ fn real_main() -> Result<ExitCode> {
             color,
             speed_max,
         } => {
-            let scene = resolve_scene(&scene)?;
             let options = render::RenderOptions {
                 steps,
                 every,
@@ -311,11 +312,18 @@ fn real_main() -> Result<ExitCode> {
                 colour: color,
                 speed_max,
             };
-            let summary = render::render(&scene, &options)?;
+            let (name, summary) = if scene.ends_with(".glb") {
+                let summary = render::glb::render_glb(Path::new(&scene), &options)?;
+                (scene, summary)
+            } else {
+                let scene = resolve_scene(&scene)?;
+                let summary = render::render(&scene, &options)?;
+                (scene.name, summary)
+            };
             let c = summary.camera;
             println!(
                 "{}: {} frames, camera eye {:.2},{:.2},{:.2} target {:.2},{:.2},{:.2} fov {}",
-                scene.name,
+                name,
                 summary.frames,
                 c.eye.x,
                 c.eye.y,

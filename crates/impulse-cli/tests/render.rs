@@ -298,3 +298,37 @@ fn stats_have_one_finite_row_per_step_and_plot_as_svg() {
         .unwrap();
     assert!(!out.status.success(), "PNG plots are not offered");
 }
+
+#[test]
+fn a_glb_written_by_run_renders_one_frame_per_keyframe() {
+    let dir = temp_dir("glb");
+    let scene = scene(&dir, true);
+    let glb = dir.join("drop.glb");
+    let out = impulse()
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--steps",
+            "20",
+            "--every",
+            "10",
+        ])
+        .args(["--quiet", "--out", glb.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_success(&out, "run: ");
+    let frames = dir.join("frames");
+    let out = impulse()
+        .args(["render", glb.to_str().unwrap(), "--size", "160x100"])
+        .args(["--out", frames.to_str().unwrap()])
+        .args(["--camera-eye", "0,2,10", "--camera-target", "0,2,0"])
+        .output()
+        .unwrap();
+    assert_success(&out, "render: ");
+    // Keyframes of steps 0, 10 and 20, numbered by keyframe.
+    let first = read_png(&frames.join("frame_00000.png"));
+    let last = read_png(&frames.join("frame_00002.png"));
+    assert!(!frames.join("frame_00003.png").exists());
+    assert!(variance(&first) > 100.0);
+    assert_ne!(first, last, "the ball did not move");
+}

@@ -8,6 +8,7 @@
 //! grid: the plane of an upward static half-space, or the top of a static box wider than the
 //! moving bodies' box and below it, or else the bottom of the moving bodies' box.
 
+pub mod glb;
 pub mod raster;
 
 use std::path::PathBuf;
