@@ -27,6 +27,7 @@ const LINE: RGBColor = RGBColor(31, 100, 200);
 /// A CSV table of numbers with a header row.
 #[derive(Debug)]
 pub struct Table {
+    /// Column names, from the first line.
     pub header: Vec<String>,
     /// Row-major values; a cell that is not a number is NaN.
     pub rows: Vec<Vec<f64>>,

@@ -54,6 +54,7 @@ pub struct RenderOptions {
     pub target: Option<Vec3>,
     /// Vertical field of view (degrees).
     pub fov_deg: f32,
+    /// How moving bodies are coloured.
     pub colour: ColourBy,
     /// Speed drawn in the hottest colour with `ColourBy::Speed` (m/s).
     pub speed_max: f32,

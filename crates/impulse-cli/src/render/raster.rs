@@ -63,8 +63,11 @@ impl Camera {
 /// A triangle's corner ready to draw: world position, unit world normal and base colour.
 #[derive(Clone, Copy, Debug)]
 pub struct Vertex {
+    /// Position (m, world frame).
     pub position: Vec3,
+    /// Unit normal (world frame).
     pub normal: Vec3,
+    /// Base colour before lighting (linear RGB, 0..1).
     pub colour: Vec3,
 }
 
