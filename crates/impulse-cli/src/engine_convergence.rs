@@ -13,7 +13,7 @@ use anyhow::{Context, Result, bail};
 use impulse::settings::SolverMethod;
 use impulse::{Scene, World};
 
-use crate::lcp_command::{Series, svg_plot};
+use crate::lcp_command::Series;
 
 /// Residual after `k` iterations of `method` on step `step` of `scene`, for k = 1..=iterations.
 fn history(scene: &Scene, step: u64, method: SolverMethod, iterations: u32) -> Result<Vec<f64>> {
@@ -91,8 +91,15 @@ pub fn engine_convergence(scene: &Scene, step: u64, iterations: u32, out_svg: &P
         scene.name
     );
     let subtitle = "engine solvers on the contact rows; one substep, warm-started, no early exit";
-    std::fs::write(out_svg, svg_plot(&title, subtitle, &series))
-        .with_context(|| format!("cannot write {}", out_svg.display()))?;
+    let svg = crate::residual_plot::svg_plot(
+        &title,
+        subtitle,
+        "iteration",
+        "natural-map residual (log scale)",
+        &series,
+        1e-17,
+    )?;
+    std::fs::write(out_svg, svg).with_context(|| format!("cannot write {}", out_svg.display()))?;
     println!("plot  {}", out_svg.display());
     Ok(())
 }

@@ -3,8 +3,12 @@
 mod engine_convergence;
 mod export;
 mod lcp_command;
+mod plot;
+mod render;
+mod residual_plot;
 mod run;
 mod solver_args;
+mod stats;
 mod trajectory;
 
 use std::path::{Path, PathBuf};
@@ -45,6 +49,11 @@ enum Command {
         /// time in ms (JSON Lines).
         #[arg(long)]
         island_report: Option<PathBuf>,
+        /// Write per-step diagnostics as CSV, one row per step: step, time, contacts, rows,
+        /// iterations, natural_map_residual, kinetic_energy, max_depth and each stage's time
+        /// in ms (plot them with `impulse plot`).
+        #[arg(long)]
+        stats: Option<PathBuf>,
         /// Worker threads (default: all cores); 1 runs everything on the calling thread.
         #[arg(long)]
         threads: Option<usize>,
@@ -66,6 +75,58 @@ enum Command {
         /// phase, narrow phase, islands, assembly, solve, scatter, impulse write-back, finish).
         #[arg(long)]
         profile: bool,
+    },
+    /// Simulate a scene and draw shaded previews: PNG frames into a directory and/or an
+    /// animated GIF (CPU rasteriser; docs/export.md).
+    Render {
+        /// JSON scene file, the name of a built-in scene (see `impulse scenes`), or a `.glb`
+        /// written by `impulse run --out` (its keyframes are drawn; --steps and --every do not
+        /// apply, --color island falls back to the file's colours).
+        scene: String,
+        /// Directory for one PNG per drawn frame, `frame_<step>.png` (created if missing).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Animated GIF of the drawn frames (frame delay: K steps of the scene's dt).
+        #[arg(long)]
+        gif: Option<PathBuf>,
+        /// Steps to simulate (default: the scene's).
+        #[arg(long)]
+        steps: Option<u32>,
+        /// Draw every K-th step (step 0 and the last are always drawn).
+        #[arg(long, default_value_t = 1)]
+        every: u32,
+        /// Image size in pixels, WIDTHxHEIGHT.
+        #[arg(long, default_value = "640x400", value_parser = render::parse_size)]
+        size: (u32, u32),
+        /// Camera position x,y,z (m); default: an elevated 3/4 view from +z that fits the
+        /// moving bodies at step 0.
+        #[arg(long, value_parser = render::parse_vec3, allow_hyphen_values = true)]
+        camera_eye: Option<impulse::glam::Vec3>,
+        /// Point the camera looks at, x,y,z (m); default: the centre of the moving bodies' box.
+        #[arg(long, value_parser = render::parse_vec3, allow_hyphen_values = true)]
+        camera_target: Option<impulse::glam::Vec3>,
+        /// Vertical field of view (degrees).
+        #[arg(long, default_value = "40", value_parser = render::parse_fov)]
+        fov: f32,
+        /// Colour of moving bodies: by speed, by island, or one colour per body.
+        #[arg(long, value_enum, default_value_t = render::ColourBy::Speed)]
+        color: render::ColourBy,
+        /// Speed drawn in the hottest colour with `--color speed` (m/s).
+        #[arg(long, default_value_t = 5.0)]
+        speed_max: f32,
+    },
+    /// Plot the columns of an `impulse run --stats` CSV over the run (SVG, one panel per
+    /// column).
+    Plot {
+        /// CSV file written by `impulse run --stats`.
+        stats: PathBuf,
+        /// Output SVG file.
+        #[arg(long)]
+        out: PathBuf,
+        /// Columns to plot, comma-separated (default: contacts, iterations,
+        /// natural_map_residual, kinetic_energy, max_depth).
+        #[arg(long, value_delimiter = ',')]
+        columns: Vec<String>,
     },
     /// List the built-in scenes and the parametrised families (pyramidN, pyramid3dN, stackN,
     /// ballsN).
@@ -198,6 +259,7 @@ fn real_main() -> Result<ExitCode> {
             dt,
             solver,
             island_report,
+            stats,
             threads,
             out,
             every,
@@ -217,6 +279,7 @@ fn real_main() -> Result<ExitCode> {
                 quiet,
                 threads,
                 island_report,
+                stats,
             };
             run::stop_on_ctrl_c()?;
             let summary = run::run(scene, &options)?;
@@ -229,6 +292,58 @@ fn real_main() -> Result<ExitCode> {
                 return Ok(ExitCode::from(130));
             }
         }
+        Command::Render {
+            scene,
+            out,
+            gif,
+            steps,
+            every,
+            size,
+            camera_eye,
+            camera_target,
+            fov,
+            color,
+            speed_max,
+        } => {
+            let options = render::RenderOptions {
+                steps,
+                every,
+                size,
+                out_dir: out,
+                gif,
+                eye: camera_eye,
+                target: camera_target,
+                fov_deg: fov,
+                colour: color,
+                speed_max,
+            };
+            let (name, summary) = if scene.ends_with(".glb") {
+                let summary = render::glb::render_glb(Path::new(&scene), &options)?;
+                (scene, summary)
+            } else {
+                let scene = resolve_scene(&scene)?;
+                let summary = render::render(&scene, &options)?;
+                (scene.name, summary)
+            };
+            let c = summary.camera;
+            println!(
+                "{}: {} frames, camera eye {:.2},{:.2},{:.2} target {:.2},{:.2},{:.2} fov {}",
+                name,
+                summary.frames,
+                c.eye.x,
+                c.eye.y,
+                c.eye.z,
+                c.target.x,
+                c.target.y,
+                c.target.z,
+                c.fov_y_deg
+            );
+        }
+        Command::Plot {
+            stats,
+            out,
+            columns,
+        } => plot::plot(&stats, &out, &columns)?,
         Command::Scenes => {
             for (name, description) in builtin_names() {
                 println!("{name:<22} {description}");

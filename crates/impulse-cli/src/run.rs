@@ -27,6 +27,8 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     /// Per-step island reports (JSON Lines), if wanted.
     pub island_report: Option<PathBuf>,
+    /// Per-step diagnostics and stage times (CSV, [`crate::stats`]), if wanted.
+    pub stats: Option<PathBuf>,
 }
 
 /// Island solves of a run by the strongest method each reached (one count per island and
@@ -272,6 +274,10 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         )),
         None => None,
     };
+    let mut stats = match &options.stats {
+        Some(path) => Some(crate::stats::StatsWriter::create(path)?),
+        None => None,
+    };
     for step in 1..=steps {
         let start = Instant::now();
         let result = world.step().map(|_| ());
@@ -310,6 +316,9 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             )?;
             writeln!(w)?;
         }
+        if let Some(stats) = stats.as_mut() {
+            stats.write_step(step as f64 * scene.dt as f64, diagnostics, world.profile())?;
+        }
         contacts_sum += diagnostics.contacts as u64;
         iterations_sum += diagnostics.iterations as u64;
         max_residual = max_residual.max(diagnostics.natural_map_residual);
@@ -334,6 +343,9 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         }
     }
     bar.finish_and_clear();
+    if let Some(stats) = stats.as_mut() {
+        stats.finish()?;
+    }
     // The animation file holds every frame written so far, also when a step failed.
     let exported = writer.as_ref().map_or(Ok(()), FrameOutput::finish);
 

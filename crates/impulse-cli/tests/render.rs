@@ -1,0 +1,334 @@
+//! `impulse render`, `impulse run --stats` and `impulse plot` end to end, on small scenes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use image::AnimationDecoder;
+use image::codecs::gif::GifDecoder;
+
+fn impulse() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_impulse"))
+}
+
+/// A fresh directory for one test's files.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir()
+        .join(format!("impulse-render-{}", std::process::id()))
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn assert_success(out: &Output, context: &str) {
+    assert!(
+        out.status.success(),
+        "{context}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// A scene of a ground half-space and, if `ball`, a ball of radius 0.5 m dropped from 3 m.
+fn scene(dir: &Path, ball: bool) -> PathBuf {
+    let mut bodies = vec![
+        r#"{"name": "ground", "kind": "static", "shape": {"type": "half_space", "normal": [0.0, 1.0, 0.0]}}"#,
+    ];
+    if ball {
+        bodies.push(
+            r#"{"name": "ball", "kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "position": [0.0, 3.0, 0.0]}"#,
+        );
+    }
+    let text = format!(
+        r#"{{"name": "drop", "gravity": [0.0, -9.81, 0.0], "dt": 0.016666668, "steps": 60, "bodies": [{}]}}"#,
+        bodies.join(", ")
+    );
+    let path = dir.join("scene.json");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn read_png(path: &Path) -> image::RgbImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb8()
+}
+
+/// The variance of the pixels' brightness (sum of the channels).
+fn variance(image: &image::RgbImage) -> f64 {
+    let values: Vec<f64> = image
+        .pixels()
+        .map(|p| p.0.iter().map(|&c| c as f64).sum())
+        .collect();
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64
+}
+
+/// Pixels of row `y` darker than the row's median by more than 25 (of 765, the sum of the
+/// channels): grid lines on the ground; none on the sky, whose rows are uniform.
+fn dark_in_row(image: &image::RgbImage, y: u32) -> usize {
+    let brightness: Vec<i32> = (0..image.width())
+        .map(|x| image.get_pixel(x, y).0.iter().map(|&c| c as i32).sum())
+        .collect();
+    let mut sorted = brightness.clone();
+    sorted.sort();
+    let median = sorted[sorted.len() / 2];
+    brightness.iter().filter(|&&b| b < median - 25).count()
+}
+
+#[test]
+fn a_falling_ball_is_drawn_and_moves_between_frames() {
+    let dir = temp_dir("falling");
+    let scene = scene(&dir, true);
+    let frames = dir.join("frames");
+    let out = impulse()
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "--steps",
+            "20",
+            "--every",
+            "10",
+        ])
+        .args(["--size", "160x100", "--out", frames.to_str().unwrap()])
+        .args(["--camera-eye", "0,2,10", "--camera-target", "0,2,0"])
+        .output()
+        .unwrap();
+    assert_success(&out, "render: ");
+    let names: Vec<String> = ["frame_00000.png", "frame_00010.png", "frame_00020.png"]
+        .iter()
+        .map(|n| n.to_string())
+        .collect();
+    for name in &names {
+        assert!(frames.join(name).exists(), "{name} missing");
+    }
+    let first = read_png(&frames.join(&names[0]));
+    let last = read_png(&frames.join(&names[2]));
+    assert_eq!(first.dimensions(), (160, 100));
+    assert!(variance(&first) > 100.0, "blank: {}", variance(&first));
+    // The ball (at x = 0, in the middle column) fell: pixels changed there, and only there.
+    let (mut changed, mut min_x, mut max_x) = (0, u32::MAX, 0);
+    for (x, y, p) in first.enumerate_pixels() {
+        let q = last.get_pixel(x, y);
+        let difference: i32 = (0..3).map(|c| (p.0[c] as i32 - q.0[c] as i32).abs()).sum();
+        if difference > 30 {
+            changed += 1;
+            min_x = min_x.min(x);
+            max_x = max_x.max(x);
+        }
+    }
+    assert!(changed > 20, "only {changed} pixels changed");
+    assert!(
+        min_x > 50 && max_x < 110,
+        "changes from x = {min_x} to {max_x}"
+    );
+}
+
+#[test]
+fn the_ground_grid_lies_below_the_horizon() {
+    let dir = temp_dir("ground");
+    let scene = scene(&dir, false);
+    let frames = dir.join("frames");
+    // Eye 1 m above the ground looking level: the horizon is the middle row.
+    let out = impulse()
+        .args(["render", scene.to_str().unwrap(), "--steps", "0"])
+        .args(["--size", "320x200", "--out", frames.to_str().unwrap()])
+        .args(["--camera-eye", "0,1,0", "--camera-target", "0,1,-10"])
+        .output()
+        .unwrap();
+    assert_success(&out, "render: ");
+    let image = read_png(&frames.join("frame_00000.png"));
+    let lines_in = |rows: std::ops::Range<u32>| rows.map(|y| dark_in_row(&image, y)).sum::<usize>();
+    assert_eq!(lines_in(0..97), 0, "grid-line pixels above the horizon");
+    assert!(
+        lines_in(140..200) > 300,
+        "too few grid-line pixels below it"
+    );
+}
+
+#[test]
+fn the_gif_has_one_frame_per_drawn_step() {
+    let dir = temp_dir("gif");
+    let scene = scene(&dir, true);
+    let gif = dir.join("drop.gif");
+    let out = impulse()
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "--steps",
+            "6",
+            "--every",
+            "2",
+        ])
+        .args(["--size", "80x50", "--gif", gif.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_success(&out, "render: ");
+    let file = std::io::BufReader::new(std::fs::File::open(&gif).unwrap());
+    let frames = GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap();
+    // Steps 0, 2, 4 and 6.
+    assert_eq!(frames.len(), 4);
+    assert_eq!(frames[0].buffer().dimensions(), (80, 50));
+}
+
+#[test]
+fn render_rejects_bad_sizes_and_unwritable_outputs_by_name() {
+    let dir = temp_dir("errors");
+    let scene = scene(&dir, true);
+    let out = impulse()
+        .args(["render", scene.to_str().unwrap(), "--size", "big"])
+        .args(["--out", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("'big'"));
+    let blocker = dir.join("file");
+    std::fs::write(&blocker, "").unwrap();
+    let inside = blocker.join("frames");
+    let out = impulse()
+        .args(["render", scene.to_str().unwrap(), "--steps", "1"])
+        .args(["--out", inside.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains(inside.to_str().unwrap()), "{stderr}");
+    let out = impulse()
+        .args(["render", scene.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success(), "nothing to write must be an error");
+    let out = impulse()
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .args(["--camera-eye", "1,2,3", "--camera-target", "1,2,3"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success(), "eye at the target must be an error");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("same point"));
+}
+
+#[test]
+fn stats_have_one_finite_row_per_step_and_plot_as_svg() {
+    let dir = temp_dir("stats");
+    let scene = scene(&dir, true);
+    let stats = dir.join("stats.csv");
+    let out = impulse()
+        .args(["run", scene.to_str().unwrap(), "--steps", "60", "--quiet"])
+        .args(["--stats", stats.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_success(&out, "run: ");
+    let text = std::fs::read_to_string(&stats).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        header[..8],
+        [
+            "step",
+            "time",
+            "contacts",
+            "rows",
+            "iterations",
+            "natural_map_residual",
+            "kinetic_energy",
+            "max_depth"
+        ]
+    );
+    for stage in ["broad_phase_ms", "narrow_phase_ms", "solve_ms", "total_ms"] {
+        assert!(header.contains(&stage), "no {stage} in {header:?}");
+    }
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 60);
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row.len(), header.len());
+        assert_eq!(row[0], (k + 1) as f64);
+        assert!(row.iter().all(|v| v.is_finite()), "row {k}: {row:?}");
+    }
+    // The ball lands after 0.71 s (43 steps): some step has a contact.
+    assert!(rows.iter().any(|r| r[2] > 0.0));
+
+    let svg = dir.join("plot.svg");
+    let out = impulse()
+        .args([
+            "plot",
+            stats.to_str().unwrap(),
+            "--out",
+            svg.to_str().unwrap(),
+        ])
+        .args(["--columns", "contacts,kinetic_energy,solve_ms"])
+        .output()
+        .unwrap();
+    assert_success(&out, "plot: ");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.contains("polyline"));
+    for column in ["contacts", "kinetic_energy", "solve_ms"] {
+        assert!(text.contains(column), "{column} not in the plot");
+    }
+    let out = impulse()
+        .args([
+            "plot",
+            stats.to_str().unwrap(),
+            "--out",
+            svg.to_str().unwrap(),
+        ])
+        .args(["--columns", "nope"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no column 'nope'"));
+    let png = dir.join("plot.png");
+    let out = impulse()
+        .args([
+            "plot",
+            stats.to_str().unwrap(),
+            "--out",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success(), "PNG plots are not offered");
+}
+
+#[test]
+fn a_glb_written_by_run_renders_one_frame_per_keyframe() {
+    let dir = temp_dir("glb");
+    let scene = scene(&dir, true);
+    let glb = dir.join("drop.glb");
+    let out = impulse()
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--steps",
+            "20",
+            "--every",
+            "10",
+        ])
+        .args(["--quiet", "--out", glb.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_success(&out, "run: ");
+    let frames = dir.join("frames");
+    let out = impulse()
+        .args(["render", glb.to_str().unwrap(), "--size", "160x100"])
+        .args(["--out", frames.to_str().unwrap()])
+        .args(["--camera-eye", "0,2,10", "--camera-target", "0,2,0"])
+        .output()
+        .unwrap();
+    assert_success(&out, "render: ");
+    // Keyframes of steps 0, 10 and 20, numbered by keyframe.
+    let first = read_png(&frames.join("frame_00000.png"));
+    let last = read_png(&frames.join("frame_00002.png"));
+    assert!(!frames.join("frame_00003.png").exists());
+    assert!(variance(&first) > 100.0);
+    assert_ne!(first, last, "the ball did not move");
+}
