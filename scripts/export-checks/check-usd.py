@@ -13,7 +13,7 @@ from pxr import Usd, UsdGeom, UsdValidation
 from trajectory import Trajectory, body_kinds, body_names, close, same_rotation
 
 TOLERANCE = 1e-6
-SHAPES = {"Sphere", "Cube", "Capsule", "Mesh"}
+SHAPES = {"Sphere", "Cube", "Capsule", "Mesh", "Cylinder", "Cone"}
 
 
 def main(usda, csv_path, scene_path):
