@@ -216,7 +216,7 @@ fn render_rejects_bad_sizes_and_unwritable_outputs_by_name() {
 }
 
 #[test]
-fn stats_have_one_finite_row_per_step_and_plot_as_svg() {
+fn stats_have_one_finite_row_per_step_and_plot_as_svg_and_png() {
     let dir = temp_dir("stats");
     let scene = scene(&dir, true);
     let stats = dir.join("stats.csv");
@@ -296,7 +296,50 @@ fn stats_have_one_finite_row_per_step_and_plot_as_svg() {
         ])
         .output()
         .unwrap();
-    assert!(!out.status.success(), "PNG plots are not offered");
+    assert_success(&out, "plot --out plot.png: ");
+    let image = read_png(&png);
+    // Five default columns (contacts, iterations, natural_map_residual, kinetic_energy,
+    // max_depth), 900 × 180 pixels each.
+    assert_eq!(image.dimensions(), (900, 5 * 180));
+    assert!(variance(&image) > 100.0, "the PNG plot is blank");
+    let dark = |y0: u32, y1: u32| {
+        (y0..y1)
+            .flat_map(|y| (0..image.width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                image
+                    .get_pixel(x, y)
+                    .0
+                    .iter()
+                    .map(|&c| c as u32)
+                    .sum::<u32>()
+                    < 150
+            })
+            .count()
+    };
+    // Text and axes are black: the first panel's caption ("contacts", in its top 30 rows) and
+    // its axis, tick labels and x label.
+    assert!(
+        dark(0, 30) > 50,
+        "no caption text: {} dark pixels",
+        dark(0, 30)
+    );
+    assert!(dark(0, 180) > 1000, "no axes: {} dark pixels", dark(0, 180));
+    let blue = image.pixels().filter(|p| p.0 == [31, 100, 200]).count();
+    assert!(blue > 100, "no data line: {blue} blue pixels");
+
+    let jpg = dir.join("plot.jpg");
+    let out = impulse()
+        .args([
+            "plot",
+            stats.to_str().unwrap(),
+            "--out",
+            jpg.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
+    assert!(!jpg.exists());
 }
 
 #[test]
