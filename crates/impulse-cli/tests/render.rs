@@ -375,3 +375,48 @@ fn a_glb_written_by_run_renders_one_frame_per_keyframe() {
     assert!(variance(&first) > 100.0);
     assert_ne!(first, last, "the ball did not move");
 }
+
+#[test]
+fn lcp_convergence_writes_a_png_plot_and_refuses_other_formats() {
+    let dir = temp_dir("convergence");
+    let data = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../crates/impulse-lcp/tests/data/siconos/lcp_deudeu.dat");
+    let png = dir.join("deudeu.png");
+    let out = impulse()
+        .args(["lcp", "convergence"])
+        .arg(&data)
+        .args(["--iterations", "50", "--out"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_success(&out, "lcp convergence --out deudeu.png: ");
+    let image = read_png(&png);
+    assert_eq!(image.dimensions(), (820, 600));
+    assert!(variance(&image) > 100.0, "the PNG plot is blank");
+    // The title, in black, in the top 30 rows.
+    let dark = (0..30)
+        .flat_map(|y| (0..image.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            image
+                .get_pixel(x, y)
+                .0
+                .iter()
+                .map(|&c| c as u32)
+                .sum::<u32>()
+                < 150
+        })
+        .count();
+    assert!(dark > 50, "no title text: {dark} dark pixels");
+
+    let pdf = dir.join("deudeu.pdf");
+    let out = impulse()
+        .args(["lcp", "convergence"])
+        .arg(&data)
+        .arg("--out")
+        .arg(&pdf)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
+    assert!(!pdf.exists());
+}
