@@ -3,29 +3,18 @@
 //! neither format needs system fonts.
 
 use std::path::Path;
-use std::sync::OnceLock;
 
 use anyhow::{Context, Result, anyhow, bail};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::FontStyle;
 
 /// The family name the plots ask for; it is the compiled-in font.
 pub const FONT: &str = "sans-serif";
 
-static DEJAVU_SANS: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
-
-/// Registers the compiled-in font under [`FONT`] (once per process).
+/// Registers the compiled-in font under [`FONT`] (once per process; impulse-bench compiles it
+/// in, since its front plots need it too and impulse-cli depends on it).
 pub fn register_font() -> Result<()> {
-    static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok = *REGISTERED.get_or_init(|| {
-        plotters::style::register_font(FONT, FontStyle::Normal, DEJAVU_SANS).is_ok()
-    });
-    if ok {
-        Ok(())
-    } else {
-        bail!("the compiled-in plot font could not be read")
-    }
+    impulse_bench::register_plot_font()
 }
 
 /// The image format of a plot file.
