@@ -28,6 +28,7 @@ use impulse::Scene;
 
 pub use impulse_engine::{bench_impulse, settings_text as impulse_settings_text};
 pub use machine::MachineInfo;
+pub use plot::register_plot_font;
 pub use quality::QualityReport;
 #[cfg(feature = "rapier")]
 pub use rapier_engine::{

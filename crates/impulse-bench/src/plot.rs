@@ -1,8 +1,9 @@
 //! SVG plots of the quality/speed fronts (`impulse-bench front`).
 //!
 //! plotters' SVG backend writes text as SVG `<text>` elements and leaves the glyphs to the
-//! viewer; without plotters' `ttf` feature the layout uses an estimate of the text's width, so
-//! no font files, font-kit or fontconfig are needed to write a plot.
+//! viewer. The workspace builds plotters with `ab_glyph` (for impulse-cli's PNG plots), which
+//! measures text with a registered font: [`register_plot_font`] registers DejaVu Sans, compiled
+//! in, so no font files, font-kit or fontconfig are needed to write a plot.
 
 use std::path::Path;
 
@@ -11,6 +12,23 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::front::{BARS, FrontPoint, IMPULSE, PLOT_E_FLOOR_MM, RAPIER, SceneFront, pareto_front};
+
+/// DejaVu Sans 2.37 (Bitstream Vera licence, `crates/impulse-cli/assets/fonts/`).
+static DEJAVU_SANS: &[u8] = include_bytes!("../../impulse-cli/assets/fonts/DejaVuSans.ttf");
+
+/// Registers the compiled-in DejaVu Sans as plotters' `sans-serif` (once per process); every
+/// plot of the workspace draws its text with it.
+pub fn register_plot_font() -> Result<()> {
+    static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| {
+        plotters::style::register_font(FONT, FontStyle::Normal, DEJAVU_SANS).is_ok()
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(anyhow!("the compiled-in plot font could not be read"))
+    }
+}
 
 /// Plot size in SVG pixels.
 const SIZE: (u32, u32) = (960, 640);
@@ -120,6 +138,7 @@ fn draw(front: &SceneFront, path: &Path) -> Result<(), Box<dyn std::error::Error
         .fold(BARS[0].1, f64::max)
         * 3.0;
 
+    register_plot_font()?;
     let root = SVGBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)

@@ -40,12 +40,13 @@ fn history(scene: &Scene, step: u64, method: SolverMethod, iterations: u32) -> R
     Ok(out)
 }
 
-/// Writes `out_svg`: log10 of the natural-map residual of step `step` of `scene` against
+/// Writes `out_svg` (SVG or PNG after its extension): log10 of the natural-map residual of step `step` of `scene` against
 /// iterations (1..=`iterations`) for PGS, NNCG and APGD. Prints each method's final residual.
 pub fn engine_convergence(scene: &Scene, step: u64, iterations: u32, out_svg: &Path) -> Result<()> {
     if step == 0 || iterations == 0 {
         bail!("--step and --iterations must be at least 1");
     }
+    crate::plot_output::Format::of(out_svg)?;
     let methods = [
         (
             SolverMethod::Pgs,
@@ -91,7 +92,8 @@ pub fn engine_convergence(scene: &Scene, step: u64, iterations: u32, out_svg: &P
         scene.name
     );
     let subtitle = "engine solvers on the contact rows; one substep, warm-started, no early exit";
-    let svg = crate::residual_plot::svg_plot(
+    crate::residual_plot::write_plot(
+        out_svg,
         &title,
         subtitle,
         "iteration",
@@ -99,7 +101,6 @@ pub fn engine_convergence(scene: &Scene, step: u64, iterations: u32, out_svg: &P
         &series,
         1e-17,
     )?;
-    std::fs::write(out_svg, svg).with_context(|| format!("cannot write {}", out_svg.display()))?;
     println!("plot  {}", out_svg.display());
     Ok(())
 }

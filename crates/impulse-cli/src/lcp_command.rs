@@ -254,7 +254,7 @@ pub(crate) struct Series {
 
 /// Reads an LCP (`.json` or Siconos `.dat`), runs projected Gauss–Seidel, damped projected
 /// Jacobi and, when the bounds are plain `γ ≥ 0` and `n ≤` [`LEMKE_MAX_ROWS`], Lemke's method,
-/// each from `γ = 0`, and writes `out_svg`: log10 of the normalised natural-map residual
+/// each from `γ = 0`, and writes `out_svg` (SVG or PNG after its extension): log10 of the normalised natural-map residual
 /// `‖min-map(γ)‖₂ / ‖b‖₂` against sweeps (PGS, Jacobi, at most `iterations` each) or pivots
 /// (Lemke), with its final polished residual as a marker. Prints each solver's status, count,
 /// final residual and time. When Lemke does not converge (redundant contacts: `A` singular) and
@@ -266,8 +266,10 @@ pub(crate) struct Series {
 /// and Jacobi rerun (at most 4 times). Non-symmetric `A` (Siconos files) uses the Gershgorin
 /// bound instead of power iteration.
 ///
-/// Errors: unreadable or invalid file, an empty problem, no solver able to run, unwritable SVG.
+/// Errors: unreadable or invalid file, an empty problem, no solver able to run, an output
+/// file not ending in `.svg` or `.png`, unwritable output.
 pub fn convergence(path: &Path, iterations: usize, out_svg: &Path) -> Result<()> {
+    crate::plot_output::Format::of(out_svg)?;
     let (lcp, format) = read_lcp(path)?;
     let n = lcp.n();
     if n == 0 {
@@ -431,7 +433,8 @@ pub fn convergence(path: &Path, iterations: usize, out_svg: &Path) -> Result<()>
         "n = {n}, {} nonzeros, {bounds}; every solver starts from γ = 0",
         nonzeros(&lcp.a)
     );
-    let svg = crate::residual_plot::svg_plot(
+    crate::residual_plot::write_plot(
+        out_svg,
         &title,
         &subtitle,
         "iteration (sweeps; Lemke: pivots)",
@@ -439,7 +442,6 @@ pub fn convergence(path: &Path, iterations: usize, out_svg: &Path) -> Result<()>
         &series,
         PLOT_FLOOR,
     )?;
-    std::fs::write(out_svg, svg).with_context(|| format!("cannot write {}", out_svg.display()))?;
     println!("plot        {}", out_svg.display());
     Ok(())
 }

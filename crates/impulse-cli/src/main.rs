@@ -4,6 +4,7 @@ mod engine_convergence;
 mod export;
 mod lcp_command;
 mod plot;
+mod plot_output;
 mod render;
 mod residual_plot;
 mod run;
@@ -115,12 +116,12 @@ enum Command {
         #[arg(long, default_value_t = 5.0)]
         speed_max: f32,
     },
-    /// Plot the columns of an `impulse run --stats` CSV over the run (SVG, one panel per
-    /// column).
+    /// Plot the columns of an `impulse run --stats` CSV over the run (SVG or PNG, one
+    /// panel per column).
     Plot {
         /// CSV file written by `impulse run --stats`.
         stats: PathBuf,
-        /// Output SVG file.
+        /// Output file: `.svg` or `.png`.
         #[arg(long)]
         out: PathBuf,
         /// Columns to plot, comma-separated (default: contacts, iterations,
@@ -195,7 +196,7 @@ enum LcpCommand {
         no_friction: bool,
     },
     /// Plot residual against iterations for the engine's own solvers (PGS, NNCG, APGD on the
-    /// contact rows) on one step of a scene (SVG).
+    /// contact rows) on one step of a scene (SVG or PNG).
     EngineConvergence {
         /// JSON scene file, or the name of a built-in scene.
         scene: String,
@@ -205,18 +206,19 @@ enum LcpCommand {
         /// Largest iteration count plotted.
         #[arg(long, default_value_t = 40)]
         iterations: u32,
-        /// Output SVG file.
+        /// Output file: `.svg` or `.png`.
         #[arg(long)]
         out: PathBuf,
     },
-    /// Plot residual against iteration for PGS, projected Jacobi and Lemke (SVG).
+    /// Plot residual against iteration for PGS, projected Jacobi and Lemke (SVG or
+    /// PNG).
     Convergence {
         /// LCP file: Siconos `.dat` or impulse `.json`.
         file: PathBuf,
         /// Iterations of the iterative solvers.
         #[arg(long, default_value_t = 200)]
         iterations: usize,
-        /// Output SVG file.
+        /// Output file: `.svg` or `.png`.
         #[arg(long)]
         out: PathBuf,
     },

@@ -1,13 +1,16 @@
-//! `impulse plot`: the columns of a `--stats` CSV over the run, one panel per column, as SVG.
+//! `impulse plot`: the columns of a `--stats` CSV over the run, one panel per column, as SVG
+//! or PNG (after the output file's extension).
 //!
-//! Drawn with plotters' SVG backend, which writes text as SVG `<text>` elements and needs no
-//! font files. PNG is not offered: plotters' bitmap backend can only draw text with a font
-//! feature (system fonts or a bundled font file), and panics without one.
+//! Drawn with plotters' SVG and bitmap backends; text uses the font compiled into the binary
+//! (see [`crate::plot_output`]), so no system fonts are needed.
 
 use std::path::Path;
 
 use anyhow::{Context, Result, anyhow, bail};
+use plotters::coord::Shift;
 use plotters::prelude::*;
+
+use crate::plot_output::{self, FONT};
 
 /// The columns plotted when none are asked for.
 pub const DEFAULT_COLUMNS: [&str; 5] = [
@@ -18,10 +21,9 @@ pub const DEFAULT_COLUMNS: [&str; 5] = [
     "max_depth",
 ];
 
-/// Width of the plot and height of one panel (SVG pixels).
+/// Width of the plot and height of one panel (pixels).
 const WIDTH: u32 = 900;
 const PANEL_HEIGHT: u32 = 180;
-const FONT: &str = "sans-serif";
 const LINE: RGBColor = RGBColor(31, 100, 200);
 
 /// A CSV table of numbers with a header row.
@@ -76,14 +78,9 @@ impl Table {
 }
 
 /// Plots `columns` of the CSV at `input` against its `time` column (else its first) into the
-/// SVG file `out`.
+/// file `out`, SVG or PNG after its extension.
 pub fn plot(input: &Path, out: &Path, columns: &[String]) -> Result<()> {
-    if out.extension().and_then(|e| e.to_str()) != Some("svg") {
-        bail!(
-            "{}: the plot is written as SVG; give a file ending in .svg",
-            out.display()
-        );
-    }
+    plot_output::Format::of(out)?;
     let table = Table::read(input)?;
     let x_column = table.column("time").unwrap_or(0);
     let columns: Vec<String> = if columns.is_empty() {
@@ -107,40 +104,64 @@ pub fn plot(input: &Path, out: &Path, columns: &[String]) -> Result<()> {
         .map(|c| table.column(c))
         .collect::<Result<Vec<_>>>()?;
     let height = PANEL_HEIGHT * columns.len() as u32;
-    let root = SVGBackend::new(out, (WIDTH, height)).into_drawing_area();
-    let draw_error = |e: &dyn std::fmt::Display| anyhow!("cannot draw {}: {e}", out.display());
-    root.fill(&WHITE).map_err(|e| draw_error(&e))?;
-    let panels = root.split_evenly((columns.len(), 1));
-    let x_name = &table.header[x_column];
-    for ((panel, name), &k) in panels.iter().zip(&columns).zip(&indices) {
-        let points: Vec<(f64, f64)> = table
-            .rows
-            .iter()
-            .map(|r| (r[x_column], r[k]))
-            .filter(|(x, y)| x.is_finite() && y.is_finite())
-            .collect();
-        let (x0, x1) = range(points.iter().map(|p| p.0));
-        let (y0, y1) = range(points.iter().map(|p| p.1));
-        let mut chart = ChartBuilder::on(panel)
-            .caption(name, (FONT, 16))
-            .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(80)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| draw_error(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc(x_name.as_str())
-            .label_style((FONT, 12))
-            .y_label_formatter(&|v| tick(*v))
-            .draw()
-            .map_err(|e| draw_error(&e))?;
-        chart
-            .draw_series(LineSeries::new(points, LINE.stroke_width(2)))
-            .map_err(|e| draw_error(&e))?;
+    let panels = Panels {
+        table: &table,
+        x_column,
+        columns: &columns,
+        indices: &indices,
+    };
+    plot_output::write(
+        out,
+        (WIDTH, height),
+        |root| panels.draw(root),
+        |root| panels.draw(root),
+    )
+}
+
+/// What [`plot`] draws: one panel per column.
+struct Panels<'a> {
+    table: &'a Table,
+    x_column: usize,
+    columns: &'a [String],
+    indices: &'a [usize],
+}
+
+impl Panels<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()> {
+        let draw_error = |e: &dyn std::fmt::Display| anyhow!("{e}");
+        let table = self.table;
+        root.fill(&WHITE).map_err(|e| draw_error(&e))?;
+        let panels = root.split_evenly((self.columns.len(), 1));
+        let x_name = &table.header[self.x_column];
+        for ((panel, name), &k) in panels.iter().zip(self.columns).zip(self.indices) {
+            let points: Vec<(f64, f64)> = table
+                .rows
+                .iter()
+                .map(|r| (r[self.x_column], r[k]))
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect();
+            let (x0, x1) = range(points.iter().map(|p| p.0));
+            let (y0, y1) = range(points.iter().map(|p| p.1));
+            let mut chart = ChartBuilder::on(panel)
+                .caption(name, (FONT, 16))
+                .margin(8)
+                .x_label_area_size(30)
+                .y_label_area_size(80)
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(|e| draw_error(&e))?;
+            chart
+                .configure_mesh()
+                .x_desc(x_name.as_str())
+                .label_style((FONT, 12))
+                .y_label_formatter(&|v| tick(*v))
+                .draw()
+                .map_err(|e| draw_error(&e))?;
+            chart
+                .draw_series(LineSeries::new(points, LINE.stroke_width(2)))
+                .map_err(|e| draw_error(&e))?;
+        }
+        Ok(())
     }
-    root.present().map_err(|e| draw_error(&e))?;
-    Ok(())
 }
 
 /// A tick label: plain with up to four decimals between 0.01 and 10⁶, else in scientific

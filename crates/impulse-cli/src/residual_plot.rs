@@ -1,30 +1,52 @@
 //! The residual-against-iteration plots of `impulse lcp convergence` and `impulse lcp
-//! engine-convergence`, drawn with plotters' SVG backend (text as SVG `<text>`, no fonts
-//! needed): log10 of each series' residual against sweeps or pivots, one line per solver
-//! (dashed where asked), an optional marker per series, and a legend.
+//! engine-convergence`, as SVG or PNG (after the output file's extension, text in the font
+//! compiled into the binary): log10 of each series' residual against sweeps or pivots, one
+//! line per solver (dashed where asked), an optional marker per series, and a legend.
+
+use std::path::Path;
 
 use anyhow::{Result, anyhow};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::lcp_command::Series;
+use crate::plot_output::{self, FONT};
 
-/// Plot size (SVG pixels).
+/// Plot size (pixels).
 const SIZE: (u32, u32) = (820, 600);
-const FONT: &str = "sans-serif";
 
-/// The SVG text of the plot. Residuals are drawn as log10(max(r, `floor`)), so an exact 0
-/// stays on the plot. The x axis spans the series without markers (the iterative solvers'
-/// sweeps); a marker beyond it (a longer Lemke path) is drawn on its right edge with its
-/// pivot count. NaN points are left out.
-pub fn svg_plot(
+/// Writes the plot to `out`, SVG or PNG after its extension (see [`draw`]).
+pub fn write_plot(
+    out: &Path,
     title: &str,
     subtitle: &str,
     x_label: &str,
     y_label: &str,
     series: &[Series],
     floor: f64,
-) -> Result<String> {
+) -> Result<()> {
+    plot_output::write(
+        out,
+        SIZE,
+        |root| draw(root, title, subtitle, x_label, y_label, series, floor),
+        |root| draw(root, title, subtitle, x_label, y_label, series, floor),
+    )
+}
+
+/// Draws the plot on `root`. Residuals are drawn as log10(max(r, `floor`)), so an exact 0
+/// stays on the plot. The x axis spans the series without markers (the iterative solvers'
+/// sweeps); a marker beyond it (a longer Lemke path) is drawn on its right edge with its
+/// pivot count. NaN points are left out.
+pub fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    subtitle: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    floor: f64,
+) -> Result<()> {
     let log = |r: f64| r.max(floor).log10();
     let sweeps = series
         .iter()
@@ -56,10 +78,8 @@ pub fn svg_plot(
         y_max = y_min + 1.0;
     }
 
-    let mut text = String::new();
     {
-        let error = |e: &dyn std::fmt::Display| anyhow!("cannot draw the plot: {e}");
-        let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
+        let error = |e: &dyn std::fmt::Display| anyhow!("{e}");
         root.fill(&WHITE).map_err(|e| error(&e))?;
         let centre =
             |size| TextStyle::from((FONT, size).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
@@ -136,9 +156,8 @@ pub fn svg_plot(
             .label_font((FONT, 12))
             .draw()
             .map_err(|e| error(&e))?;
-        root.present().map_err(|e| error(&e))?;
     }
-    Ok(text)
+    Ok(())
 }
 
 /// `#rrggbb` as a colour (black if malformed).
@@ -173,7 +192,13 @@ mod tests {
                 marker: Some((40.0, 1e-12)),
             },
         ];
-        let svg = svg_plot("t", "s", "iteration", "residual", &series, 1e-17).unwrap();
+        plot_output::register_font().unwrap();
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+            draw(&root, "t", "s", "iteration", "residual", &series, 1e-17).unwrap();
+            root.present().unwrap();
+        }
         assert!(svg.starts_with("<svg"));
         for text in ["PGS", "Lemke", "after 40 pivots", "1e-12", "iteration"] {
             assert!(svg.contains(text), "{text} missing");

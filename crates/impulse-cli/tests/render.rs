@@ -216,7 +216,7 @@ fn render_rejects_bad_sizes_and_unwritable_outputs_by_name() {
 }
 
 #[test]
-fn stats_have_one_finite_row_per_step_and_plot_as_svg() {
+fn stats_have_one_finite_row_per_step_and_plot_as_svg_and_png() {
     let dir = temp_dir("stats");
     let scene = scene(&dir, true);
     let stats = dir.join("stats.csv");
@@ -296,7 +296,50 @@ fn stats_have_one_finite_row_per_step_and_plot_as_svg() {
         ])
         .output()
         .unwrap();
-    assert!(!out.status.success(), "PNG plots are not offered");
+    assert_success(&out, "plot --out plot.png: ");
+    let image = read_png(&png);
+    // Five default columns (contacts, iterations, natural_map_residual, kinetic_energy,
+    // max_depth), 900 × 180 pixels each.
+    assert_eq!(image.dimensions(), (900, 5 * 180));
+    assert!(variance(&image) > 100.0, "the PNG plot is blank");
+    let dark = |y0: u32, y1: u32| {
+        (y0..y1)
+            .flat_map(|y| (0..image.width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                image
+                    .get_pixel(x, y)
+                    .0
+                    .iter()
+                    .map(|&c| c as u32)
+                    .sum::<u32>()
+                    < 150
+            })
+            .count()
+    };
+    // Text and axes are black: the first panel's caption ("contacts", in its top 30 rows) and
+    // its axis, tick labels and x label.
+    assert!(
+        dark(0, 30) > 50,
+        "no caption text: {} dark pixels",
+        dark(0, 30)
+    );
+    assert!(dark(0, 180) > 400, "no axes: {} dark pixels", dark(0, 180));
+    let blue = image.pixels().filter(|p| p.0 == [31, 100, 200]).count();
+    assert!(blue > 100, "no data line: {blue} blue pixels");
+
+    let jpg = dir.join("plot.jpg");
+    let out = impulse()
+        .args([
+            "plot",
+            stats.to_str().unwrap(),
+            "--out",
+            jpg.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
+    assert!(!jpg.exists());
 }
 
 #[test]
@@ -331,4 +374,49 @@ fn a_glb_written_by_run_renders_one_frame_per_keyframe() {
     assert!(!frames.join("frame_00003.png").exists());
     assert!(variance(&first) > 100.0);
     assert_ne!(first, last, "the ball did not move");
+}
+
+#[test]
+fn lcp_convergence_writes_a_png_plot_and_refuses_other_formats() {
+    let dir = temp_dir("convergence");
+    let data = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../crates/impulse-lcp/tests/data/siconos/lcp_deudeu.dat");
+    let png = dir.join("deudeu.png");
+    let out = impulse()
+        .args(["lcp", "convergence"])
+        .arg(&data)
+        .args(["--iterations", "50", "--out"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_success(&out, "lcp convergence --out deudeu.png: ");
+    let image = read_png(&png);
+    assert_eq!(image.dimensions(), (820, 600));
+    assert!(variance(&image) > 100.0, "the PNG plot is blank");
+    // The title, in black, in the top 30 rows.
+    let dark = (0..30)
+        .flat_map(|y| (0..image.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            image
+                .get_pixel(x, y)
+                .0
+                .iter()
+                .map(|&c| c as u32)
+                .sum::<u32>()
+                < 150
+        })
+        .count();
+    assert!(dark > 50, "no title text: {dark} dark pixels");
+
+    let pdf = dir.join("deudeu.pdf");
+    let out = impulse()
+        .args(["lcp", "convergence"])
+        .arg(&data)
+        .arg("--out")
+        .arg(&pdf)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains(".svg or .png"));
+    assert!(!pdf.exists());
 }
