@@ -38,9 +38,13 @@ fi
 echo "gltf-validator $(node -p "require('$scratch/node/node_modules/gltf-validator/package.json').version"), $("$python" -m pip list --disable-pip-version-check 2>/dev/null | grep -E '^(usd-core|bpy) ' | tr -s ' ' | paste -sd, -)"
 
 # scene (built-in name or file), steps, every (60 is no multiple of 7: the last frame is
-# written on its own)
+# written on its own); every standard scene family and a scene of every shape
 runs=(
   "pyramid20 60 7"
+  "pyramid3d10 20 10"
+  "stack30 30 10"
+  "massratio 30 10"
+  "balls1k 20 10"
   "scenes/shapes.json 120 10"
   "scenes/example-three-spheres.json 60 1"
 )
