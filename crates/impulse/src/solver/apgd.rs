@@ -14,7 +14,7 @@ use glam::Vec3;
 
 use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
-    apply_impulses, cap_to_disc, impulses, set_scalar_targets,
+    apply_impulses, cap_to_disc, impulses, solve_scalar,
 };
 use crate::constraints::ContactConstraint;
 
@@ -26,33 +26,21 @@ pub struct Apgd {
 }
 
 impl ContactSolver for Apgd {
-    fn warm_start(
-        &mut self,
-        constraints: &mut [ContactConstraint],
-        velocities: &mut Velocities<'_>,
-        substep: u32,
-    ) {
-        super::warm_start_substep(constraints, velocities, substep);
-    }
-
     fn solve(
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
-        let position_repair = set_scalar_targets(constraints, pass);
-        let report = solve_apgd(
-            constraints,
-            pass.iterations,
-            pass.tolerance,
-            velocities,
-            &mut self.workspace,
-        );
-        SolveOutcome {
-            position_repair,
-            ..SolveOutcome::of(EscalationLevel::Apgd, report)
-        }
+        solve_scalar(constraints, pass, EscalationLevel::Apgd, |rows| {
+            solve_apgd(
+                rows,
+                pass.iterations,
+                pass.tolerance,
+                velocities,
+                &mut self.workspace,
+            )
+        })
     }
 }
 

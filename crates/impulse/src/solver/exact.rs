@@ -53,15 +53,6 @@ pub struct Exact {
 }
 
 impl ContactSolver for Exact {
-    fn warm_start(
-        &mut self,
-        constraints: &mut [ContactConstraint],
-        velocities: &mut Velocities<'_>,
-        substep: u32,
-    ) {
-        super::warm_start_substep(constraints, velocities, substep);
-    }
-
     fn solve(
         &mut self,
         constraints: &mut [ContactConstraint],

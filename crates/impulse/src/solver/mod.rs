@@ -56,13 +56,16 @@ pub trait ContactSolver {
 
     /// Applies the accumulated impulses to `velocities` (warm starting) at the start of
     /// substep `substep` (from 0). From the second substep on these are the last substep's
-    /// final impulses, which it also adds to each row's `step_impulses`.
+    /// final impulses, which it also adds to each row's `step_impulses`. Default: on the
+    /// constraints themselves ([`warm_start_substep`]).
     fn warm_start(
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
         substep: u32,
-    );
+    ) {
+        warm_start_substep(constraints, velocities, substep);
+    }
 
     /// One solve: with `pass.targets`, first sets every row's target velocity and softness from
     /// the separation its point has reached (scalar rows: [`constraints::update_targets`]);
@@ -174,6 +177,21 @@ pub(crate) fn warm_start_substep(
         }
     }
     warm_start(constraints, velocities);
+}
+
+/// For the methods that work on the constraints: sets the targets the pass asks for, runs
+/// `method` on the rows, and reports its sweeps under `level`.
+pub(crate) fn solve_scalar(
+    constraints: &mut [ContactConstraint],
+    pass: &SolvePass<'_>,
+    level: EscalationLevel,
+    method: impl FnOnce(&mut [ContactConstraint]) -> SolveReport,
+) -> SolveOutcome {
+    let position_repair = set_scalar_targets(constraints, pass);
+    SolveOutcome {
+        position_repair,
+        ..SolveOutcome::of(level, method(constraints))
+    }
 }
 
 /// For the scalar methods: sets the rows' targets when the pass asks (see

@@ -3,7 +3,7 @@
 use super::pgs::{BACKWARD, FORWARD, Sweep, VelocityRows, sweep_points};
 use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
-    apply_impulses, impulses, set_scalar_targets,
+    apply_impulses, impulses, solve_scalar,
 };
 use crate::constraints::ContactConstraint;
 use crate::graph::COLOURS;
@@ -19,34 +19,22 @@ pub struct Nncg {
 }
 
 impl ContactSolver for Nncg {
-    fn warm_start(
-        &mut self,
-        constraints: &mut [ContactConstraint],
-        velocities: &mut Velocities<'_>,
-        substep: u32,
-    ) {
-        super::warm_start_substep(constraints, velocities, substep);
-    }
-
     fn solve(
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
-        let position_repair = set_scalar_targets(constraints, pass);
-        let report = solve_nncg(
-            constraints,
-            pass.sweep,
-            pass.iterations,
-            pass.tolerance,
-            velocities,
-            &mut self.workspace,
-        );
-        SolveOutcome {
-            position_repair,
-            ..SolveOutcome::of(EscalationLevel::Nncg, report)
-        }
+        solve_scalar(constraints, pass, EscalationLevel::Nncg, |rows| {
+            solve_nncg(
+                rows,
+                pass.sweep,
+                pass.iterations,
+                pass.tolerance,
+                velocities,
+                &mut self.workspace,
+            )
+        })
     }
 }
 

@@ -9,7 +9,7 @@ use glam::Vec3;
 
 use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
-    project_to_friction_disc, set_scalar_targets,
+    project_to_friction_disc, solve_scalar,
 };
 use crate::constraints::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours};
@@ -22,35 +22,23 @@ use crate::parallel::{
 pub struct Pgs;
 
 impl ContactSolver for Pgs {
-    fn warm_start(
-        &mut self,
-        constraints: &mut [ContactConstraint],
-        velocities: &mut Velocities<'_>,
-        substep: u32,
-    ) {
-        super::warm_start_substep(constraints, velocities, substep);
-    }
-
     fn solve(
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
-        let position_repair = set_scalar_targets(constraints, pass);
-        let report = solve_pgs_rows(
-            constraints,
-            pass.sweep,
-            pass.iterations,
-            pass.tolerance,
-            velocities,
-            pass.friction,
-            pass.half_turn,
-        );
-        SolveOutcome {
-            position_repair,
-            ..SolveOutcome::of(EscalationLevel::Pgs, report)
-        }
+        solve_scalar(constraints, pass, EscalationLevel::Pgs, |rows| {
+            solve_pgs_rows(
+                rows,
+                pass.sweep,
+                pass.iterations,
+                pass.tolerance,
+                velocities,
+                pass.friction,
+                pass.half_turn,
+            )
+        })
     }
 }
 

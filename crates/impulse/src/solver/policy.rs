@@ -82,15 +82,6 @@ pub struct Auto {
 }
 
 impl ContactSolver for Auto {
-    fn warm_start(
-        &mut self,
-        constraints: &mut [ContactConstraint],
-        velocities: &mut Velocities<'_>,
-        substep: u32,
-    ) {
-        super::warm_start_substep(constraints, velocities, substep);
-    }
-
     /// NNCG for `pass.iterations`; then, with `pass.escalate`: the exact path for a small
     /// island that is heavy (mass ratio above the threshold) or still unconverged outside an
     /// impact, and otherwise, if unconverged, `limits.iterations` more NNCG iterations.
