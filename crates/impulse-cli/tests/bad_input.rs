@@ -1,11 +1,9 @@
 //! Bad command lines and scenes get a clear message instead of an abort or silence.
 
-use std::process::Command;
 use std::time::Duration;
 
-fn impulse() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_impulse"))
-}
+mod common;
+use common::impulse;
 
 fn stderr_of(args: &[&str]) -> (bool, String) {
     let out = impulse().args(args).output().unwrap();

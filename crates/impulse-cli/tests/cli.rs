@@ -1,36 +1,17 @@
 //! The `impulse` binary end to end: trajectories, summaries, scene errors and LCP commands.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn impulse() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_impulse"))
-}
+mod common;
+use common::{assert_success, impulse, repo};
 
 fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("impulse-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-/// Asserts that a run succeeded, showing its standard error (prefixed by `context`) if not.
-fn assert_success(out: &Output, context: &str) {
-    assert!(
-        out.status.success(),
-        "{context}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::temp("cli", name)
 }
 
 /// The JSON file at `path`.
 fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
-fn repo(path: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(path)
 }
 
 #[test]

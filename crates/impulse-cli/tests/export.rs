@@ -3,34 +3,16 @@
 //! same run writes.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use base64::Engine as _;
 use gltf::animation::util::ReadOutputs;
 
-fn impulse() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_impulse"))
-}
+mod common;
+use common::{assert_success, impulse, repo};
 
 fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("impulse-export-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-/// Asserts that a run succeeded, showing its standard error (prefixed by `context`) if not.
-fn assert_success(out: &Output, context: &str) {
-    assert!(
-        out.status.success(),
-        "{context}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
-fn repo(path: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(path)
+    common::temp("export", name)
 }
 
 /// `impulse run SCENE ARGS --out OUT` on one thread (so every format sees the same trajectory).

@@ -1,31 +1,16 @@
 //! `impulse render`, `impulse run --stats` and `impulse plot` end to end, on small scenes.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use image::AnimationDecoder;
 use image::codecs::gif::GifDecoder;
 
-fn impulse() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_impulse"))
-}
+mod common;
+use common::{assert_success, impulse};
 
 /// A fresh directory for one test's files.
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir()
-        .join(format!("impulse-render-{}", std::process::id()))
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn assert_success(out: &Output, context: &str) {
-    assert!(
-        out.status.success(),
-        "{context}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::fresh_dir("render", name)
 }
 
 /// A scene of a ground half-space and, if `ball`, a ball of radius 0.5 m dropped from 3 m.
