@@ -1,9 +1,9 @@
 //! Projected Gauss-Seidel over an island's points, and the scalar sweep that NNCG and the
 //! position solve build on.
 //!
-//! Per point, the two friction rows (one 2×2 block, projected onto Coulomb's disc
-//! |γ_t| ≤ μ·γ_n) go before the normal row (clamped to γ_n ≥ 0), so the normal row, the one
-//! that prevents overlap, has the last word. Sweeps alternate direction.
+//! Per point, the normal row (clamped to γ_n ≥ 0) goes first, then the two friction rows (one
+//! 2×2 block, projected onto Coulomb's disc |γ_t| ≤ μ·γ_n of the γ_n just found). Sweeps
+//! alternate direction.
 
 use glam::Vec3;
 
@@ -270,9 +270,9 @@ where
 /// Projected Gauss-Seidel: at most `iterations` sweeps; stops early when no row's velocity
 /// changed by more than `tolerance` (m/s) in a sweep, i.e. max |Δγ_i| / m_eff,i ≤ tolerance.
 /// A velocity measure, unlike a relative impulse change, does not let a light body on a
-/// heavily loaded contact keep a large velocity error. Per point, the two
-/// friction rows (one 2×2 block, projected onto the disc |γ_t| ≤ μ·γ_n) go before the normal row
-/// (clamped to γ_n ≥ 0), so the normal row, the one that prevents overlap, has the last word.
+/// heavily loaded contact keep a large velocity error. Per point, the normal row (clamped to
+/// γ_n ≥ 0) goes first and the two friction rows (one 2×2 block, projected onto the disc
+/// |γ_t| ≤ μ·γ_n of that γ_n) after it (see `solve_point`).
 pub fn solve_pgs(
     constraints: &mut [ContactConstraint],
     sweep: Sweep<'_>,
@@ -328,8 +328,13 @@ pub fn solve_pgs_rows(
     report
 }
 
-/// One Gauss-Seidel update of a contact point's rows: the friction pair as a 2×2 block
-/// projected onto Coulomb's disc (when `FRICTION`), then the normal row clamped to γ_n ≥ 0.
+/// One Gauss-Seidel update of a contact point's rows: the normal row clamped to γ_n ≥ 0,
+/// then (when `FRICTION`) the friction pair as a 2×2 block projected onto Coulomb's disc of the
+/// normal impulse just found, as Box2D v3 orders them (`contact_solver.c`: non-penetration,
+/// then friction). The other order caps friction with the normal impulse of the previous
+/// update: in the sweep where an impact's normal impulse first appears (the relax sweep of the
+/// substep in which a speculative gap closes) the friction then gets nothing, and an oblique
+/// impact loses all its friction; it also leaves γ_t outside the disc of the final γ_n.
 /// Returns the largest row velocity change it caused (m/s). The two bodies' velocities (linear
 /// and angular of A, then of B) come in and go out by value, so they stay in registers.
 #[inline(always)]
@@ -339,6 +344,24 @@ fn solve_point<const FRICTION: bool>(
 ) -> ([Vec3; 4], f32) {
     let (ima, imb) = (c.inverse_mass_a, c.inverse_mass_b);
     let mut largest_change = 0.0f32;
+    let row = &c.normal;
+    let v = row.velocity(la, aa, lb, ab);
+    let old = c.normal_impulse;
+    let (mass_scale, impulse_scale) = c.softness;
+    let new = (old + row.effective_mass * mass_scale * (c.target_normal_velocity - v)
+        - impulse_scale * old)
+        .max(0.0);
+    let delta = new - old;
+    if delta != 0.0 {
+        c.normal_impulse = new;
+        c.max_normal_impulse = c.max_normal_impulse.max(new);
+        let linear = row.direction * delta;
+        la += linear * ima;
+        lb -= linear * imb;
+        aa += row.inverse_inertia_angular_a * delta;
+        ab -= row.inverse_inertia_angular_b * delta;
+        largest_change = largest_change.max(delta.abs() * row.inverse_effective_mass);
+    }
     if FRICTION && c.friction > 0.0 {
         let [t1, t2] = &c.tangents;
         let v1 = t1.velocity(la, aa, lb, ab);
@@ -359,27 +382,10 @@ fn solve_point<const FRICTION: bool>(
             lb -= linear * imb;
             aa += t1.inverse_inertia_angular_a * d1 + t2.inverse_inertia_angular_a * d2;
             ab -= t1.inverse_inertia_angular_b * d1 + t2.inverse_inertia_angular_b * d2;
-            largest_change =
-                (d1.abs() * t1.inverse_effective_mass).max(d2.abs() * t2.inverse_effective_mass);
+            largest_change = largest_change
+                .max(d1.abs() * t1.inverse_effective_mass)
+                .max(d2.abs() * t2.inverse_effective_mass);
         }
-    }
-    let row = &c.normal;
-    let v = row.velocity(la, aa, lb, ab);
-    let old = c.normal_impulse;
-    let (mass_scale, impulse_scale) = c.softness;
-    let new = (old + row.effective_mass * mass_scale * (c.target_normal_velocity - v)
-        - impulse_scale * old)
-        .max(0.0);
-    let delta = new - old;
-    if delta != 0.0 {
-        c.normal_impulse = new;
-        c.max_normal_impulse = c.max_normal_impulse.max(new);
-        let linear = row.direction * delta;
-        la += linear * ima;
-        lb -= linear * imb;
-        aa += row.inverse_inertia_angular_a * delta;
-        ab -= row.inverse_inertia_angular_b * delta;
-        largest_change = largest_change.max(delta.abs() * row.inverse_effective_mass);
     }
     ([la, aa, lb, ab], largest_change)
 }

@@ -1026,8 +1026,9 @@ fn set_vec(lanes: &mut LaneVec, i: usize, value: Vec3) {
     set(&mut lanes[2], i, value.z);
 }
 
-/// One Gauss-Seidel update of every lane's point: the friction pair, then the normal row
-/// clamped to γ_n ≥ 0. Returns each lane's largest row velocity change (m/s).
+/// One Gauss-Seidel update of every lane's point: the normal row clamped to γ_n ≥ 0, then the
+/// friction pair inside the disc of that γ_n (the order of the scalar update, see
+/// [`crate::solver::pgs`]). Returns each lane's largest row velocity change (m/s).
 ///
 /// The friction pair is solved as a 2×2 block, as in [`crate::solver`]'s scalar update, while
 /// the block's solution q = γ_t − K⁻¹v_t sticks (lies in Coulomb's disc |γ_t| ≤ μγ_n). A lane
@@ -1045,10 +1046,6 @@ fn set_vec(lanes: &mut LaneVec, i: usize, value: Vec3) {
 fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
     let zero = Lane::splat(0.0);
     let masses = (b.inverse_mass_a, b.inverse_mass_b);
-    let mut largest = zero;
-    if FRICTION {
-        largest = solve_friction(b, v);
-    }
     let row = &b.normal;
     let velocity = row.velocity(v);
     let old = b.normal_impulse;
@@ -1059,7 +1056,12 @@ fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, v: &mut BodyLanes) -> Lane
     b.normal_impulse = new;
     b.max_normal_impulse = b.max_normal_impulse.max(new);
     row.apply(delta, masses, v);
-    largest.max(delta.abs() * row.inverse_effective_mass)
+    let largest = delta.abs() * row.inverse_effective_mass;
+    if FRICTION {
+        largest.max(solve_friction(b, v))
+    } else {
+        largest
+    }
 }
 
 /// The friction pair's part of [`solve_bundle`]: returns each lane's larger tangent row
