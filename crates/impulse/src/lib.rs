@@ -62,7 +62,7 @@ pub use body::{BodyBuilder, BodyHandle, BodyKind};
 pub use diagnostics::StepDiagnostics;
 pub use error::{StepError, WorldError};
 pub use scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
-pub use settings::SolverSettings;
+pub use settings::{SettingError, SolverSettings};
 pub use world::{BodyRef, ContactEvent, ContactPairView, ContactPoint, RayHit, ShapeHit, World};
 
 /// The README's code, compiled and run as a doc-test.

@@ -154,6 +154,89 @@ pub struct SolverSettings {
     pub gyroscopic: bool,
 }
 
+/// A solver setting outside its allowed range: which field, and what is allowed.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("solver.{field}: {message}")]
+pub struct SettingError {
+    /// The field's name in [`SolverSettings`], which is also its key in a scene file's
+    /// `solver` object.
+    pub field: &'static str,
+    /// What is wrong and what is allowed, with the value found (e.g. `must be ≥ 0, got -1`).
+    pub message: String,
+}
+
+impl SolverSettings {
+    /// Every setting outside its allowed range, in field order; empty when all are valid.
+    /// The one check of solver settings: the scene loader reports each problem at its place in
+    /// the file, [`crate::World::new`] and [`crate::World::step`] the first one. Counts
+    /// (`iterations`, `substeps`, `position_iterations`, `escalation_iterations`) must be ≥ 1;
+    /// tolerances, thresholds, rates, speeds, distances, frequencies and times finite and ≥ 0;
+    /// `warm_start` in [0, 1].
+    pub fn problems(&self) -> Vec<SettingError> {
+        let mut problems = Vec::new();
+        let counts = [
+            ("iterations", self.iterations),
+            ("substeps", self.substeps),
+            ("position_iterations", self.position_iterations),
+            ("escalation_iterations", self.escalation_iterations),
+        ];
+        for (field, value) in counts {
+            if value == 0 {
+                problems.push(SettingError {
+                    field,
+                    message: "must be ≥ 1, got 0".to_string(),
+                });
+            }
+        }
+        let non_negative = [
+            ("tolerance", self.tolerance),
+            ("escalation_tolerance", self.escalation_tolerance),
+            ("mass_ratio_threshold", self.mass_ratio_threshold),
+            ("soft_contact_hertz", self.soft_contact_hertz),
+            ("soft_damping_ratio", self.soft_damping_ratio),
+            ("sleep_linear_speed", self.sleep_linear_speed),
+            ("sleep_angular_speed", self.sleep_angular_speed),
+            ("time_to_sleep", self.time_to_sleep),
+            ("restitution_threshold", self.restitution_threshold),
+            ("overlap_repair_rate", self.overlap_repair_rate),
+            ("overlap_slop", self.overlap_slop),
+            ("max_repair_speed", self.max_repair_speed),
+            ("prediction_distance", self.prediction_distance),
+        ];
+        for (field, value) in non_negative {
+            let message = if !value.is_finite() {
+                format!("must be finite, got {value}")
+            } else if value < 0.0 {
+                format!("must be ≥ 0, got {value}")
+            } else {
+                continue;
+            };
+            problems.push(SettingError { field, message });
+        }
+        let warm_start = self.warm_start;
+        if !warm_start.is_finite() {
+            problems.push(SettingError {
+                field: "warm_start",
+                message: format!("must be finite, got {warm_start}"),
+            });
+        } else if !(0.0..=1.0).contains(&warm_start) {
+            problems.push(SettingError {
+                field: "warm_start",
+                message: format!("must be in [0, 1], got {warm_start}"),
+            });
+        }
+        problems
+    }
+
+    /// The first of [`Self::problems`], if any.
+    pub fn validate(&self) -> Result<(), SettingError> {
+        match self.problems().into_iter().next() {
+            Some(problem) => Err(problem),
+            None => Ok(()),
+        }
+    }
+}
+
 impl SolverSettings {
     /// Whether the main solve sweeps the friction rows: see [`Self::friction_in_main_solve`].
     pub fn main_solve_friction(&self) -> bool {

@@ -287,3 +287,42 @@ fn rays_and_shapes_find_the_bodies_they_meet() {
     assert!((hit.time - 1.35).abs() < 1e-3, "{}", hit.time);
     assert!((hit.normal - Vec3::NEG_Y).length() < 1e-3);
 }
+
+/// Solver settings are checked once ([`SolverSettings::problems`]): a world built in code and
+/// a scene file with the same bad setting get the same field and message.
+#[test]
+fn the_api_and_the_scene_loader_reject_a_bad_setting_alike() {
+    let cases: [(&str, &str, fn(&mut SolverSettings)); 4] = [
+        ("substeps", "0", |s| s.substeps = 0),
+        ("warm_start", "1.5", |s| s.warm_start = 1.5),
+        ("overlap_slop", "-0.001", |s| s.overlap_slop = -0.001),
+        ("escalation_iterations", "0", |s| {
+            s.escalation_iterations = 0
+        }),
+    ];
+    for (field, value, edit) in cases {
+        let mut settings = SolverSettings::default();
+        edit(&mut settings);
+        let problem = settings.validate().expect_err("invalid");
+        assert_eq!(problem.field, field);
+        let Err(WorldError::InvalidSetting {
+            field: world_field,
+            message,
+        }) = World::new(Vec3::ZERO, DT, settings)
+        else {
+            panic!("{field} = {value} accepted by World::new");
+        };
+        assert_eq!(world_field, format!("solver.{field}"));
+        assert_eq!(message, problem.message);
+        let text = format!(
+            r#"{{"gravity": [0, 0, 0], "dt": 0.0166, "solver": {{"{field}": {value}}}, "bodies": []}}"#
+        );
+        let error = impulse::scene::json::parse_scene_str(&text, "bad.json")
+            .expect_err("the scene loader rejects it")
+            .to_string();
+        assert!(
+            error.contains(&format!("solver.{field}: {}", problem.message)),
+            "{error}"
+        );
+    }
+}

@@ -5,11 +5,8 @@
 //!
 //! - every number is finite (gravity, dt, solver settings, materials, positions, orientations,
 //!   velocities, shape sizes, hull points, mass);
-//! - `dt > 0`; `solver.iterations ≥ 1`, `solver.substeps ≥ 1`; `solver.tolerance`,
-//!   `restitution_threshold`, `overlap_repair_rate`, `soft_contact_hertz`,
-//!   `soft_damping_ratio`, `overlap_slop`, `max_repair_speed`, `prediction_distance`,
-//!   `sleep_linear_speed`, `sleep_angular_speed`, `time_to_sleep` are ≥ 0;
-//!   `solver.warm_start` is in [0, 1];
+//! - `dt > 0`; the solver settings as [`crate::SolverSettings::problems`] checks them (the
+//!   same check the library's `World` makes);
 //! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`;
 //! - a body's `mass`, when given, is > 0; its `linear_damping` and `angular_damping` are ≥ 0;
 //! - shapes: sphere, capsule, cylinder and cone `radius > 0`, capsule `half_height ≥ 0`,
@@ -62,43 +59,10 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
     c.finite_array(&root.key("gravity"), &scene.gravity);
     c.positive(&root.key("dt"), scene.dt);
 
-    let s = &scene.solver;
     let solver = root.key("solver");
-    if s.iterations == 0 {
-        c.fail(&solver.key("iterations"), "must be ≥ 1, got 0".to_string());
+    for problem in scene.solver.problems() {
+        c.fail(&solver.key(problem.field), problem.message);
     }
-    if s.substeps == 0 {
-        c.fail(&solver.key("substeps"), "must be ≥ 1, got 0".to_string());
-    }
-    c.non_negative(&solver.key("tolerance"), s.tolerance);
-    if s.position_iterations == 0 {
-        c.fail(
-            &solver.key("position_iterations"),
-            "must be ≥ 1, got 0".to_string(),
-        );
-    }
-    if s.escalation_iterations == 0 {
-        c.fail(
-            &solver.key("escalation_iterations"),
-            "must be ≥ 1, got 0".to_string(),
-        );
-    }
-    c.non_negative(&solver.key("escalation_tolerance"), s.escalation_tolerance);
-    c.non_negative(&solver.key("mass_ratio_threshold"), s.mass_ratio_threshold);
-    c.non_negative(&solver.key("soft_contact_hertz"), s.soft_contact_hertz);
-    c.non_negative(&solver.key("soft_damping_ratio"), s.soft_damping_ratio);
-    c.non_negative(&solver.key("sleep_linear_speed"), s.sleep_linear_speed);
-    c.non_negative(&solver.key("sleep_angular_speed"), s.sleep_angular_speed);
-    c.non_negative(&solver.key("time_to_sleep"), s.time_to_sleep);
-    c.non_negative(
-        &solver.key("restitution_threshold"),
-        s.restitution_threshold,
-    );
-    c.non_negative(&solver.key("overlap_repair_rate"), s.overlap_repair_rate);
-    c.non_negative(&solver.key("overlap_slop"), s.overlap_slop);
-    c.non_negative(&solver.key("max_repair_speed"), s.max_repair_speed);
-    c.unit_interval(&solver.key("warm_start"), s.warm_start);
-    c.non_negative(&solver.key("prediction_distance"), s.prediction_distance);
 
     for (name, material) in &scene.materials {
         c.material(&root.key("materials").key(name), material);

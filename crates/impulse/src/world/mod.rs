@@ -235,52 +235,9 @@ impl World {
         if !self.gravity.is_finite() {
             return Err(setting("gravity", "must be finite"));
         }
-        let s = &self.settings;
-        if s.iterations == 0 {
-            return Err(setting("solver.iterations", "must be at least 1"));
-        }
-        if s.substeps == 0 {
-            return Err(setting("solver.substeps", "must be at least 1"));
-        }
-        if s.position_iterations == 0 {
-            return Err(setting("solver.position_iterations", "must be at least 1"));
-        }
-        if s.escalation_iterations == 0 {
-            return Err(setting(
-                "solver.escalation_iterations",
-                "must be at least 1",
-            ));
-        }
-        let non_negative = [
-            ("solver.tolerance", s.tolerance),
-            ("solver.escalation_tolerance", s.escalation_tolerance),
-            ("solver.mass_ratio_threshold", s.mass_ratio_threshold),
-            ("solver.restitution_threshold", s.restitution_threshold),
-            ("solver.overlap_repair_rate", s.overlap_repair_rate),
-            ("solver.overlap_slop", s.overlap_slop),
-            ("solver.max_repair_speed", s.max_repair_speed),
-            ("solver.prediction_distance", s.prediction_distance),
-            ("solver.soft_contact_hertz", s.soft_contact_hertz),
-            ("solver.soft_damping_ratio", s.soft_damping_ratio),
-            ("solver.sleep_linear_speed", s.sleep_linear_speed),
-            ("solver.sleep_angular_speed", s.sleep_angular_speed),
-            ("solver.time_to_sleep", s.time_to_sleep),
-        ];
-        for (field, value) in non_negative {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(setting(
-                    field,
-                    &format!("must be finite and ≥ 0, got {value}"),
-                ));
-            }
-        }
-        if !(0.0..=1.0).contains(&s.warm_start) {
-            return Err(setting(
-                "solver.warm_start",
-                &format!("must be in [0, 1], got {}", s.warm_start),
-            ));
-        }
-        Ok(())
+        self.settings
+            .validate()
+            .map_err(|problem| setting(&format!("solver.{}", problem.field), &problem.message))
     }
 }
 
