@@ -292,7 +292,8 @@ fn rays_and_shapes_find_the_bodies_they_meet() {
 /// a scene file with the same bad setting get the same field and message.
 #[test]
 fn the_api_and_the_scene_loader_reject_a_bad_setting_alike() {
-    let cases: [(&str, &str, fn(&mut SolverSettings)); 4] = [
+    type Edit = fn(&mut SolverSettings);
+    let cases: [(&str, &str, Edit); 4] = [
         ("substeps", "0", |s| s.substeps = 0),
         ("warm_start", "1.5", |s| s.warm_start = 1.5),
         ("overlap_slop", "-0.001", |s| s.overlap_slop = -0.001),
