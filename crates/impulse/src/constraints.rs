@@ -85,7 +85,7 @@ pub struct ContactConstraint {
     pub body_a: u32,
     /// The other body.
     pub body_b: u32,
-    /// A's index in its island's local arrays (set by [`crate::island`]); static bodies map to
+    /// A's index in its island's local arrays (set by the island stage); static bodies map to
     /// the island's immovable slot.
     pub local_a: u32,
     /// B's index in its island's local arrays.

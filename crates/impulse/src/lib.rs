@@ -26,8 +26,8 @@
 //! Where to start: [`World`] (insert, edit, step, read contacts and events, query),
 //! [`BodyBuilder`] and [`BodyHandle`], [`SolverSettings`] (presets along the quality/speed
 //! front), [`Scene`] (the JSON scene format). Each stage of the step is one module:
-//! [`integrate`] (1, 6) → [`broad_phase`] (2) → [`narrow_phase`] (3) → [`constraints`] (4) →
-//! [`island`] and [`solver`] (5: one island at a time, [`solver::substep`], each method behind
+//! `integrate` (1, 6) → [`broad_phase`] (2) → [`narrow_phase`] (3) → [`constraints`] (4) →
+//! `island` and [`solver`] (5: one island at a time, [`solver::substep`], each method behind
 //! [`solver::ContactSolver`]) → [`diagnostics`] (7), driven by [`World::step`].
 
 #![warn(missing_docs)]
@@ -39,8 +39,8 @@ pub mod contact_lcp;
 pub mod diagnostics;
 pub mod error;
 pub(crate) mod graph;
-pub mod integrate;
-pub mod island;
+pub(crate) mod integrate;
+pub(crate) mod island;
 pub mod metrics;
 pub mod narrow_phase;
 pub(crate) mod parallel;

@@ -148,7 +148,7 @@ pub struct SolverSettings {
     /// same result on any thread count).
     pub simd_island_contacts: u32,
     /// Integrate the gyroscopic term ω × I·ω of rigid bodies, implicitly, once per substep
-    /// ([`crate::integrate::gyroscopic`]), so that a free body keeps its world angular momentum
+    /// (`integrate::gyroscopic`), so that a free body keeps its world angular momentum
     /// and a body spun near its intermediate axis tumbles (docs/method.md, "Gyroscopic
     /// motion"). Off keeps ω constant in the world frame between contacts.
     pub gyroscopic: bool,

@@ -57,7 +57,7 @@ pub trait ContactSolver {
     /// Applies the accumulated impulses to `velocities` (warm starting) at the start of
     /// substep `substep` (from 0). From the second substep on these are the last substep's
     /// final impulses, which it also adds to each row's `step_impulses`. Default: on the
-    /// constraints themselves ([`warm_start_substep`]).
+    /// constraints themselves (`warm_start_substep`).
     fn warm_start(
         &mut self,
         constraints: &mut [ContactConstraint],

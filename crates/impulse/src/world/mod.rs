@@ -32,7 +32,7 @@ pub use query::{RayHit, ShapeHit};
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
 /// A body faster than this (m/s) means the simulation has blown up.
 pub const BLOW_UP_SPEED: f32 = 1.0e4;
-/// Mechanical energy (kinetic + gravitational, [`diagnostics::EnergyTerms`]) more than
+/// Mechanical energy (kinetic + gravitational, [`crate::diagnostics::EnergyTerms`]) more than
 /// this many joules per kilogram of moving mass above the lowest it has been since the last
 /// edit means the simulation has blown up. Contacts only take energy out; what the overlap
 /// repair puts in is lifting bodies out of each other (the `overlap_pyramid` scene, started
