@@ -967,7 +967,7 @@ mod tests {
         assert_eq!(names.len(), grid.len(), "names are unique");
         let (_, split) = grid.iter().find(|(n, _)| n == "reference 2×4").unwrap();
         let split = split.as_ref().unwrap();
-        assert!(split.split_impulse && split.method == SolverMethod::Auto);
+        assert!(split.split_impulse() && split.method == SolverMethod::Auto);
         assert_eq!((split.substeps, split.iterations), (2, 4));
         assert!(impulse_quick_grid().len() < 5);
         #[cfg(feature = "rapier")]

@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use impulse::settings::SolverMethod;
+use impulse::settings::{ContactRepair, SolverMethod};
 use impulse::{Scene, SolverSettings, World};
 
 use crate::BenchRow;
@@ -177,19 +177,15 @@ pub fn settings_text(s: &SolverSettings, threads: usize) -> String {
         SolverMethod::Apgd => "APGD",
         SolverMethod::Auto => "auto (NNCG, escalating per island)",
     };
-    // As the step runs them: split impulse leaves no work to soft rows or the relax pass.
-    let repair = if s.split_impulse {
-        format!("split-impulse repair {}/s", s.overlap_repair_rate)
-    } else if s.soft_contact_hertz > 0.0 {
-        format!(
-            "soft contact {} Hz + {} relax",
-            s.soft_contact_hertz, s.relax_iterations
-        )
-    } else {
-        format!(
-            "bias repair {}/s + {} relax",
-            s.overlap_repair_rate, s.relax_iterations
-        )
+    // As the step runs them: split impulse leaves no work to the relax pass.
+    let repair = match s.repair {
+        ContactRepair::SplitImpulse { rate, .. } => format!("split-impulse repair {rate}/s"),
+        ContactRepair::Soft { hertz, .. } => {
+            format!("soft contact {hertz} Hz + {} relax", s.relax_iterations)
+        }
+        ContactRepair::Bias { rate } => {
+            format!("bias repair {rate}/s + {} relax", s.relax_iterations)
+        }
     };
     format!(
         "{method}, {} substeps × ≤{} iterations, {repair}, slop {} mm, tol {:e}, warm start {}, \

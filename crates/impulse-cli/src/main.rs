@@ -270,7 +270,7 @@ fn real_main() -> Result<ExitCode> {
             profile,
         } => {
             let mut scene = resolve_scene(&scene)?;
-            scene.solver = solver.apply(&scene.solver);
+            scene.solver = solver.apply(&scene.solver).map_err(anyhow::Error::msg)?;
             let options = run::RunOptions {
                 steps,
                 dt,

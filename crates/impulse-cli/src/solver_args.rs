@@ -2,7 +2,7 @@
 //! preset's) `SolverSettings`.
 
 use clap::{Args, ValueEnum};
-use impulse::settings::{SolverMethod, SolverSettings};
+use impulse::settings::{ContactRepair, SolverMethod, SolverSettings};
 
 /// A preset, named by speed or by the quality bar it meets on the standard scenes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -93,7 +93,8 @@ pub struct SolverArgs {
     /// (m/s).
     #[arg(long)]
     pub tolerance: Option<f32>,
-    /// Split impulse: position-solve sweeps per substep at most.
+    /// Split impulse: position-solve sweeps per substep at most (with `--repair split` or
+    /// settings that repair by split impulse).
     #[arg(long)]
     pub position_iterations: Option<u32>,
     /// Sweep islands of at least this many contact points colour by colour, one colour over
@@ -123,17 +124,21 @@ pub struct SolverArgs {
     /// relax solve (see `SolverSettings::friction_in_main_solve`).
     #[arg(long)]
     pub friction_in_main_solve: bool,
-    /// Soft contact frequency in Hz (0 = rigid rows with overlap repair c_d).
+    /// Soft contact frequency in Hz, > 0 (with `--repair soft` or settings that repair with
+    /// soft springs).
     #[arg(long)]
     pub soft_hertz: Option<f32>,
     /// Fraction of last step's impulses to start from (0 = cold start, 1 = full warm start).
     #[arg(long)]
     pub warm_start: Option<f32>,
-    /// Overlap repair rate c_d in 1/s (Baumgarte stabilisation).
+    /// Overlap repair rate c_d in 1/s (with `--repair bias|split` or settings that repair by
+    /// a bias or split impulse).
     #[arg(long)]
     pub repair_rate: Option<f32>,
-    /// Overlap repair (`soft` starts the springs at 30 Hz unless `--soft-hertz` or the
-    /// settings give a frequency).
+    /// Overlap repair: `soft` springs (30 Hz, ζ = 10 unless the settings already repair with
+    /// springs or `--soft-hertz` says), a velocity `bias` or `split` impulse (the settings'
+    /// rate, or 12/s, unless `--repair-rate` says; split impulse with 16 position sweeps unless
+    /// `--position-iterations` says).
     #[arg(long, value_enum)]
     pub repair: Option<RepairArg>,
     /// Keep every body awake (no sleeping of quiet islands), as benchmarks do.
@@ -142,12 +147,15 @@ pub struct SolverArgs {
 }
 
 impl SolverArgs {
-    /// The settings these options make of `settings`: the preset first (keeping `sleep`),
-    /// then every option given. The world checks the result before its first step.
-    pub fn apply(&self, settings: &SolverSettings) -> SolverSettings {
+    /// The settings these options make of `settings`: the preset first (keeping `sleep` and
+    /// `gyroscopic`, which are about the scene rather than the solve), then every option given.
+    /// The world checks the values before its first step. Errors: a repair parameter given for
+    /// a repair method that has none (`--soft-hertz` with a bias, say).
+    pub fn apply(&self, settings: &SolverSettings) -> Result<SolverSettings, String> {
         let mut s = match self.preset {
             Some(preset) => SolverSettings {
                 sleep: settings.sleep,
+                gyroscopic: settings.gyroscopic,
                 ..SolverSettings::preset(preset.name()).unwrap_or_default()
             },
             None => settings.clone(),
@@ -163,34 +171,12 @@ impl SolverArgs {
         if let Some(fraction) = self.warm_start {
             s.warm_start = fraction;
         }
-        if let Some(rate) = self.repair_rate {
-            s.overlap_repair_rate = rate;
-        }
-        match self.repair {
-            Some(RepairArg::Bias) => {
-                s.split_impulse = false;
-                s.soft_contact_hertz = 0.0;
-            }
-            Some(RepairArg::Split) => {
-                s.split_impulse = true;
-                s.soft_contact_hertz = 0.0;
-            }
-            Some(RepairArg::Soft) => {
-                s.split_impulse = false;
-                if s.soft_contact_hertz == 0.0 {
-                    s.soft_contact_hertz = 30.0;
-                }
-            }
-            None => {}
-        }
+        s.repair = self.repair(s.repair)?;
         if let Some(slop) = self.overlap_slop {
             s.overlap_slop = slop;
         }
         if self.friction_in_main_solve {
             s.friction_in_main_solve = true;
-        }
-        if let Some(hertz) = self.soft_hertz {
-            s.soft_contact_hertz = hertz;
         }
         if self.no_sleep {
             s.sleep = false;
@@ -198,7 +184,6 @@ impl SolverArgs {
         if let Some(tolerance) = self.tolerance {
             s.tolerance = tolerance;
         }
-        set(&mut s.position_iterations, self.position_iterations);
         set(
             &mut s.parallel_island_contacts,
             self.parallel_island_contacts,
@@ -212,7 +197,76 @@ impl SolverArgs {
         if let Some(method) = self.method {
             s.method = method.into();
         }
-        s
+        Ok(s)
+    }
+
+    /// `repair` with `--repair`, then the repair parameters, applied.
+    fn repair(&self, repair: ContactRepair) -> Result<ContactRepair, String> {
+        const RATE: f32 = 12.0;
+        const POSITION_ITERATIONS: u32 = 16;
+        const HERTZ: f32 = 30.0;
+        const DAMPING_RATIO: f32 = 10.0;
+        let rate = match repair {
+            ContactRepair::Bias { rate } | ContactRepair::SplitImpulse { rate, .. } => rate,
+            ContactRepair::Soft { .. } => RATE,
+        };
+        let mut repair = match self.repair {
+            None => repair,
+            Some(RepairArg::Bias) => ContactRepair::Bias { rate },
+            Some(RepairArg::Split) => ContactRepair::SplitImpulse {
+                rate,
+                iterations: match repair {
+                    ContactRepair::SplitImpulse { iterations, .. } => iterations,
+                    _ => POSITION_ITERATIONS,
+                },
+            },
+            Some(RepairArg::Soft) => match repair {
+                ContactRepair::Soft { .. } => repair,
+                _ => ContactRepair::Soft {
+                    hertz: HERTZ,
+                    damping_ratio: DAMPING_RATIO,
+                },
+            },
+        };
+        let method = repair.name();
+        if let Some(new_rate) = self.repair_rate {
+            match &mut repair {
+                ContactRepair::Bias { rate } | ContactRepair::SplitImpulse { rate, .. } => {
+                    *rate = new_rate;
+                }
+                ContactRepair::Soft { .. } => {
+                    return Err(
+                        "--repair-rate is the rate of bias or split-impulse repair; these \
+                         settings repair with soft springs (add --repair bias or --repair split, \
+                         or set --soft-hertz)"
+                            .to_string(),
+                    );
+                }
+            }
+        }
+        if let Some(new_hertz) = self.soft_hertz {
+            match &mut repair {
+                ContactRepair::Soft { hertz, .. } => *hertz = new_hertz,
+                _ => {
+                    return Err(format!(
+                        "--soft-hertz is the frequency of soft repair; these settings repair \
+                         by {method} (add --repair soft)"
+                    ));
+                }
+            }
+        }
+        if let Some(sweeps) = self.position_iterations {
+            match &mut repair {
+                ContactRepair::SplitImpulse { iterations, .. } => *iterations = sweeps,
+                _ => {
+                    return Err(format!(
+                        "--position-iterations is the budget of split-impulse repair; these \
+                         settings repair by {method} (add --repair split)"
+                    ));
+                }
+            }
+        }
+        Ok(repair)
     }
 }
 
@@ -232,10 +286,15 @@ mod tests {
         };
         let mut scene = SolverSettings::reference();
         scene.sleep = true;
-        let s = args.apply(&scene);
+        let s = args.apply(&scene).unwrap();
         assert_eq!(s.substeps, 3);
-        assert!(s.split_impulse);
-        assert_eq!(s.soft_contact_hertz, 0.0);
+        assert_eq!(
+            s.repair,
+            ContactRepair::SplitImpulse {
+                rate: 12.0,
+                iterations: 16
+            }
+        );
         assert_eq!(s.method, SolverMethod::Nncg);
         assert!(!s.sleep);
         assert_eq!(
@@ -243,6 +302,41 @@ mod tests {
             SolverSettings::preset("fast").unwrap().relax_iterations
         );
         // Without options the settings stay as they are.
-        assert_eq!(SolverArgs::default().apply(&scene), scene);
+        assert_eq!(SolverArgs::default().apply(&scene), Ok(scene));
+    }
+
+    #[test]
+    fn repair_parameters_apply_to_their_method_only() {
+        let soft = SolverSettings::default();
+        let args = SolverArgs {
+            soft_hertz: Some(60.0),
+            ..SolverArgs::default()
+        };
+        assert_eq!(
+            args.apply(&soft).unwrap().repair,
+            ContactRepair::Soft {
+                hertz: 60.0,
+                damping_ratio: 10.0
+            }
+        );
+        let rate = SolverArgs {
+            repair_rate: Some(5.0),
+            ..SolverArgs::default()
+        };
+        assert!(rate.apply(&soft).unwrap_err().contains("--repair-rate"));
+        let bias = SolverArgs {
+            repair: Some(RepairArg::Bias),
+            repair_rate: Some(5.0),
+            ..SolverArgs::default()
+        };
+        assert_eq!(
+            bias.apply(&soft).unwrap().repair,
+            ContactRepair::Bias { rate: 5.0 }
+        );
+        let sweeps = SolverArgs {
+            position_iterations: Some(4),
+            ..SolverArgs::default()
+        };
+        assert!(sweeps.apply(&soft).unwrap_err().contains("--repair split"));
     }
 }

@@ -10,7 +10,7 @@ use crate::body::Bodies;
 use crate::island::Islands;
 use crate::narrow_phase::{ContactPair, NarrowPhase, repeats_earlier_point, same_point};
 use crate::parallel::{PAIRS_PER_TASK, spread};
-use crate::settings::SolverSettings;
+use crate::settings::{ContactRepair, SolverSettings};
 use rayon::prelude::*;
 
 /// One row of J for a direction d, with the products the solver reuses every sweep.
@@ -439,7 +439,7 @@ fn tangent_basis(normal: Vec3, previous: Vec3) -> (Vec3, Vec3) {
 ///
 /// - s > 0, a speculative gap: v⁺ ≥ −s/h, the bodies may close the gap but not overlap;
 /// - s ≤ 0, overlap d = −s, `with_repair`: the overlap repair (Baumgarte) v⁺ ≥ c_d·max(d − slop, 0),
-///   capped at `max_repair_speed`. With `soft_contact_hertz` > 0, c_d and the row's softness
+///   capped at `max_repair_speed`. With soft repair ([`ContactRepair::Soft`]), c_d and the row's softness
 ///   come from a damped spring instead ([`soft_contact`]);
 /// - s ≤ 0 without repair (the relax solve): v⁺ ≥ 0, rigid.
 ///
@@ -457,11 +457,7 @@ pub fn update_targets(
     with_repair: bool,
 ) -> bool {
     let mut any_repair = false;
-    let (repair_rate, softness) = if settings.soft_contact_hertz > 0.0 {
-        soft_contact(settings.soft_contact_hertz, settings.soft_damping_ratio, h)
-    } else {
-        (settings.overlap_repair_rate, (1.0, 0.0))
-    };
+    let (repair_rate, softness) = repair_terms(&settings.repair, h);
     for c in constraints.iter_mut() {
         let (a, b) = (c.local_a as usize, c.local_b as usize);
         let moved = (displacement[a] + rotation[a].cross(c.lever_a))
@@ -469,7 +465,7 @@ pub fn update_targets(
         let separation = -c.depth + c.normal.direction.dot(moved);
         let repair = (repair_rate * (-separation - settings.overlap_slop).max(0.0))
             .min(settings.max_repair_speed);
-        if settings.split_impulse {
+        if settings.split_impulse() {
             // The repair goes to the position solve; the velocity rows stay rigid.
             c.position_target = repair;
             c.position_impulse = 0.0;
@@ -510,6 +506,21 @@ pub fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32))
     let a2 = h * omega * a1;
     let a3 = 1.0 / (1.0 + a2);
     (omega / a1, (a2 * a3, a3))
+}
+
+/// The repair rate (1/s) and the soft rows' (mass scale, impulse scale) of `repair` for a
+/// substep of `h` seconds: the spring's for soft repair ([`soft_contact`]), the rate with
+/// rigid rows (1, 0) otherwise.
+pub fn repair_terms(repair: &ContactRepair, h: f32) -> (f32, (f32, f32)) {
+    match *repair {
+        ContactRepair::Soft {
+            hertz,
+            damping_ratio,
+        } => soft_contact(hertz, damping_ratio, h),
+        ContactRepair::Bias { rate } | ContactRepair::SplitImpulse { rate, .. } => {
+            (rate, (1.0, 0.0))
+        }
+    }
 }
 
 /// Newton's restitution hypothesis, v⁺ = −c_r·v⁻, for the points that collided this

@@ -41,6 +41,53 @@ impl SolverMethod {
     }
 }
 
+/// How overlap is repaired: one of three methods, each with its own parameters (docs/method.md,
+/// "Targets: restitution, gaps and repair"). In scene files, an object tagged by `type`:
+/// `{"type": "soft", "hertz": 240, "damping_ratio": 10}`, `{"type": "bias", "rate": 12}` or
+/// `{"type": "split_impulse", "rate": 12, "iterations": 16}`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ContactRepair {
+    /// Baumgarte stabilisation on rigid rows: an overlap d asks for a separating speed
+    /// `rate`·max(d − slop, 0) (1/s), with a relax solve after position integration that
+    /// removes it from the velocities (Box2D v3's relax; Baumgarte 1972).
+    Bias {
+        /// Repair rate c_d (1/s), ≥ 0.
+        rate: f32,
+    },
+    /// Split impulse: the repair runs as a separate solve on pseudo-velocities that move
+    /// positions and are then discarded, so repair never becomes kinetic energy (Catto 2006,
+    /// Bullet's split impulse). The velocity rows stay rigid (target 0 when touching).
+    SplitImpulse {
+        /// Repair rate c_d (1/s) of the position solve, ≥ 0.
+        rate: f32,
+        /// PGS sweeps of the position solve per substep, at most (early exit at the
+        /// tolerance), ≥ 1. A deep overlap in a tall pile is a chain the repair has to carry
+        /// through, so this budget is separate from (and larger than) the velocity solve's.
+        iterations: u32,
+    },
+    /// Soft contacts: each penetrating row is a damped spring of frequency `hertz` (capped at
+    /// a fifth of the substep rate) and damping ratio `damping_ratio`, discretised implicitly
+    /// over a substep (Box2D v3's soft step; Catto 2024).
+    Soft {
+        /// Spring frequency (Hz), > 0.
+        hertz: f32,
+        /// Damping ratio ζ (dimensionless), ≥ 0; Box2D v3 uses 10.
+        damping_ratio: f32,
+    },
+}
+
+impl ContactRepair {
+    /// The name used on the command line and in scene files' `type`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactRepair::Bias { .. } => "bias",
+            ContactRepair::SplitImpulse { .. } => "split_impulse",
+            ContactRepair::Soft { .. } => "soft",
+        }
+    }
+}
+
 /// Settings of the contact solve (steps 4 and 5 of docs/architecture.md).
 ///
 /// Defaults are chosen for the standard scenes at dt = 1/60 s. Units are SI.
@@ -82,24 +129,9 @@ pub struct SolverSettings {
     /// Restitution hypothesis v⁺ = −c_r·v⁻ is applied only when the contact approaches faster
     /// than this (m/s), so resting contacts do not bounce (docs/method.md, "Targets: restitution, gaps and repair").
     pub restitution_threshold: f32,
-    /// Overlap repair coefficient c_d (1/s): target separation speed c_d·max(d − slop, 0)
-    /// (a velocity proportional to the overlap: Baumgarte stabilisation).
-    pub overlap_repair_rate: f32,
-    /// Split impulse: overlap repair runs as a separate solve on pseudo-velocities that move
-    /// positions and are then discarded, so repair never becomes kinetic energy (Catto 2006,
-    /// Bullet's split impulse). The velocity rows are then rigid (target 0 when touching), and
-    /// `soft_contact_hertz` and the relax pass have nothing left to do.
-    pub split_impulse: bool,
-    /// Split impulse: PGS sweeps of the position solve per substep, at most (early exit at
-    /// `tolerance`). A deep overlap in a tall pile is a chain the repair has to carry through,
-    /// so this budget is separate from (and larger than) the velocity solve's. Must be ≥ 1.
-    pub position_iterations: u32,
-    /// Soft contact: when > 0, overlap repair is a damped spring of this frequency (Hz, capped
-    /// at a fifth of the substep rate) instead of the rate c_d, and penetrating rows
-    /// are regularised by it (Box2D v3's soft step). 0 = rigid rows with c_d.
-    pub soft_contact_hertz: f32,
-    /// Damping ratio ζ of the soft contact spring (dimensionless; Box2D v3 uses 10).
-    pub soft_damping_ratio: f32,
+    /// How overlap is repaired: soft contact springs (the default), a velocity bias, or
+    /// split impulse ([`ContactRepair`]).
+    pub repair: ContactRepair,
     /// Overlap (m) tolerated without repair, so resting contacts do not jitter.
     pub overlap_slop: f32,
     /// Cap (m/s) on the repair speed, so deep overlaps separate without an explosion.
@@ -169,15 +201,20 @@ impl SolverSettings {
     /// Every setting outside its allowed range, in field order; empty when all are valid.
     /// The one check of solver settings: the scene loader reports each problem at its place in
     /// the file, [`crate::World::new`] and [`crate::World::step`] the first one. Counts
-    /// (`iterations`, `substeps`, `position_iterations`, `escalation_iterations`) must be ≥ 1;
+    /// (`iterations`, `substeps`, split impulse's `repair.iterations`, `escalation_iterations`)
+    /// must be ≥ 1; a soft repair's `hertz` > 0;
     /// tolerances, thresholds, rates, speeds, distances, frequencies and times finite and ≥ 0;
     /// `warm_start` in [0, 1].
     pub fn problems(&self) -> Vec<SettingError> {
         let mut problems = Vec::new();
+        let position_iterations = match self.repair {
+            ContactRepair::SplitImpulse { iterations, .. } => iterations,
+            _ => 1,
+        };
         let counts = [
             ("iterations", self.iterations),
             ("substeps", self.substeps),
-            ("position_iterations", self.position_iterations),
+            ("repair.iterations", position_iterations),
             ("escalation_iterations", self.escalation_iterations),
         ];
         for (field, value) in counts {
@@ -188,17 +225,35 @@ impl SolverSettings {
                 });
             }
         }
+        let (rate, damping_ratio) = match self.repair {
+            ContactRepair::Bias { rate } | ContactRepair::SplitImpulse { rate, .. } => (rate, 0.0),
+            ContactRepair::Soft {
+                hertz,
+                damping_ratio,
+            } => {
+                if hertz.is_finite() && hertz <= 0.0 {
+                    problems.push(SettingError {
+                        field: "repair.hertz",
+                        message: format!("must be > 0, got {hertz}"),
+                    });
+                }
+                (hertz, damping_ratio)
+            }
+        };
+        let rate_field = match self.repair {
+            ContactRepair::Soft { .. } => "repair.hertz",
+            _ => "repair.rate",
+        };
         let non_negative = [
             ("tolerance", self.tolerance),
             ("escalation_tolerance", self.escalation_tolerance),
             ("mass_ratio_threshold", self.mass_ratio_threshold),
-            ("soft_contact_hertz", self.soft_contact_hertz),
-            ("soft_damping_ratio", self.soft_damping_ratio),
+            (rate_field, rate),
+            ("repair.damping_ratio", damping_ratio),
             ("sleep_linear_speed", self.sleep_linear_speed),
             ("sleep_angular_speed", self.sleep_angular_speed),
             ("time_to_sleep", self.time_to_sleep),
             ("restitution_threshold", self.restitution_threshold),
-            ("overlap_repair_rate", self.overlap_repair_rate),
             ("overlap_slop", self.overlap_slop),
             ("max_repair_speed", self.max_repair_speed),
             ("prediction_distance", self.prediction_distance),
@@ -228,6 +283,11 @@ impl SolverSettings {
         problems
     }
 
+    /// Whether overlap is repaired by split impulse.
+    pub fn split_impulse(&self) -> bool {
+        matches!(self.repair, ContactRepair::SplitImpulse { .. })
+    }
+
     /// The first of [`Self::problems`], if any.
     pub fn validate(&self) -> Result<(), SettingError> {
         match self.problems().into_iter().next() {
@@ -242,7 +302,7 @@ impl SolverSettings {
     pub fn main_solve_friction(&self) -> bool {
         self.friction_in_main_solve
             || self.method != SolverMethod::Pgs
-            || self.split_impulse
+            || self.split_impulse()
             || self.relax_iterations == 0
     }
 
@@ -266,9 +326,10 @@ impl SolverSettings {
             substeps,
             iterations: 1,
             relax_iterations: 1,
-            split_impulse: false,
-            soft_contact_hertz: 12.0 * substeps as f32,
-            soft_damping_ratio: 10.0,
+            repair: ContactRepair::Soft {
+                hertz: 12.0 * substeps as f32,
+                damping_ratio: 10.0,
+            },
             overlap_slop: 0.0,
             max_repair_speed: 0.5,
             ..Self::default()
@@ -317,8 +378,10 @@ impl SolverSettings {
             substeps: 4,
             iterations: 8,
             relax_iterations: 1,
-            split_impulse: true,
-            soft_contact_hertz: 0.0,
+            repair: ContactRepair::SplitImpulse {
+                rate: 12.0,
+                iterations: 16,
+            },
             overlap_slop: 0.002,
             max_repair_speed: 1.0,
             ..Self::default()
@@ -342,11 +405,10 @@ impl Default for SolverSettings {
             mass_ratio_threshold: 10.0,
             exact_max_contacts: 32,
             restitution_threshold: 0.5,
-            overlap_repair_rate: 12.0,
-            split_impulse: false,
-            position_iterations: 16,
-            soft_contact_hertz: 240.0,
-            soft_damping_ratio: 10.0,
+            repair: ContactRepair::Soft {
+                hertz: 240.0,
+                damping_ratio: 10.0,
+            },
             overlap_slop: 0.0,
             max_repair_speed: 0.5,
             warm_start: 1.0,

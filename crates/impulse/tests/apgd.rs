@@ -14,6 +14,7 @@ use common::{material, static_box};
 use glam::Vec3;
 use impulse::constraints::ContactConstraint;
 use impulse::contact_lcp::assemble_lcp;
+use impulse::settings::ContactRepair;
 use impulse::solver::apgd::{ApgdWorkspace, solve_apgd};
 use impulse::solver::{NncgWorkspace, SolveReport, Sweep, Velocities, solve_nncg, solve_pgs};
 use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
@@ -346,8 +347,10 @@ fn apgd_frictionless_matches_lemke() {
 #[test]
 fn apgd_soft_rows_match_lemke() {
     let mut world = pile(0.0);
-    world.settings.split_impulse = false;
-    world.settings.soft_contact_hertz = 30.0;
+    world.settings.repair = ContactRepair::Soft {
+        hertz: 30.0,
+        damping_ratio: 10.0,
+    };
     world.settings.relax_iterations = 0;
     let p = settled(world, 60);
     assert!(p.constraints.iter().any(|c| c.softness != (1.0, 0.0)));

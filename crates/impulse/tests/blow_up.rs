@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 use impulse::scene::builtin::builtin_scene;
+use impulse::settings::ContactRepair;
 use impulse::settings::SolverMethod;
 use impulse::world::BLOW_UP_ENERGY_PER_KG;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, StepError, World};
@@ -19,7 +20,10 @@ fn a_solve_that_creates_energy_stops_with_the_step() {
         method: SolverMethod::Pgs,
         substeps: 4,
         iterations: 1,
-        position_iterations: 1,
+        repair: ContactRepair::SplitImpulse {
+            rate: 12.0,
+            iterations: 1,
+        },
         sleep: false,
         ..SolverSettings::reference()
     };

@@ -9,6 +9,7 @@ mod common;
 use common::{material, static_box};
 use glam::Vec3;
 use impulse::constraints::ContactConstraint;
+use impulse::settings::ContactRepair;
 use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::{lemke, pgs};
 use impulse_lcp::{
@@ -449,14 +450,16 @@ fn friction_pile_engine_is_in_the_disc_and_pyramid_pgs_converges() {
     assert_eq!(checked, 4);
 }
 
-/// Soft contact (`soft_contact_hertz` > 0, no split impulse) without a relax solve leaves the last solve's normal
+/// Soft contact (`repair: soft`) without a relax solve leaves the last solve's normal
 /// rows soft, Δγ = m_eff·s·(target − v) − i·γ; the export must add their regularisation to A's
 /// diagonal, or the engine's impulses do not solve it (measured residual ~1e-2 without).
 #[test]
 fn soft_rows_are_exported_with_their_regularisation() {
     let mut world = pile(false);
-    world.settings.split_impulse = false;
-    world.settings.soft_contact_hertz = 30.0;
+    world.settings.repair = ContactRepair::Soft {
+        hertz: 30.0,
+        damping_ratio: 10.0,
+    };
     world.settings.relax_iterations = 0;
     for step in 1..=120 {
         world.step().unwrap();

@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use glam::{DVec3, Vec3};
 use impulse::constraints::ContactConstraint;
+use impulse::settings::ContactRepair;
 use impulse::settings::SolverMethod;
 use impulse::solver::Velocities;
 use impulse::solver::exact::{ExactFailure, ExactReport, ExactWorkspace, solve_exact};
@@ -494,8 +495,10 @@ fn box_stacks_with_friction_satisfy_the_contact_conditions() {
 fn soft_rows_solve_the_exported_lcp() {
     let soft = SolverSettings {
         friction: false,
-        split_impulse: false,
-        soft_contact_hertz: 30.0,
+        repair: ContactRepair::Soft {
+            hertz: 30.0,
+            damping_ratio: 10.0,
+        },
         relax_iterations: 0,
         ..settings()
     };

@@ -5,6 +5,7 @@
 //! sleep rule against its definition (all bodies quiet for `time_to_sleep`).
 
 use impulse::glam::Vec3;
+use impulse::settings::ContactRepair;
 use impulse::{BodyBuilder, BodyHandle, SharedShape, SolverSettings, World};
 
 const DT: f32 = 1.0 / 60.0;
@@ -122,7 +123,10 @@ fn a_soft_contact_deflects_as_a_spring_of_its_frequency() {
     // In SIMD lanes (islands of at least one point) and in the scalar sweep.
     for (hertz, radius, lanes) in [(5.0f32, 0.25f32, 1), (8.0, 0.5, 1), (5.0, 0.25, 0)] {
         let settings = SolverSettings {
-            soft_contact_hertz: hertz,
+            repair: ContactRepair::Soft {
+                hertz,
+                damping_ratio: 10.0,
+            },
             simd_island_contacts: lanes,
             sleep: false,
             ..SolverSettings::default()

@@ -133,7 +133,7 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
     let default = SolverSettings::default();
     for (settings, largest_sink) in [(default, 0.005), (SolverSettings::fast(), 0.05)] {
         let mut scene = impulse::scene::builtin::builtin_scene("pyramid3d10").unwrap();
-        let simd = !settings.split_impulse;
+        let simd = !settings.split_impulse();
         scene.solver = SolverSettings {
             sleep: false,
             // pyramid3d10 is one island of ~8700 points: colours of over 512 points (or 8 lane

@@ -5,6 +5,7 @@
 mod common;
 
 use glam::{Quat, Vec3};
+use impulse::settings::ContactRepair;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
 
 const DT: f32 = 1.0 / 60.0;
@@ -351,7 +352,10 @@ fn invalid_settings_are_rejected_before_stepping() {
             ..SolverSettings::default()
         },
         SolverSettings {
-            soft_contact_hertz: -1.0,
+            repair: ContactRepair::Soft {
+                hertz: -1.0,
+                damping_ratio: 10.0,
+            },
             ..SolverSettings::default()
         },
     ];
@@ -400,7 +404,10 @@ fn split_impulse_repairs_an_overlap_down_to_the_slop_and_then_rests() {
         w.step().unwrap();
     }
     let depth = radius - w.bodies.pose[ball].translation.y;
-    let tolerance_depth = w.settings.tolerance / w.settings.overlap_repair_rate;
+    let ContactRepair::SplitImpulse { rate, .. } = w.settings.repair else {
+        panic!("split impulse");
+    };
+    let tolerance_depth = w.settings.tolerance / rate;
     assert!(
         depth > slop - 1e-6 && depth < slop + tolerance_depth + 1e-6,
         "depth {depth} m after 1.5 s, slop {slop} m"

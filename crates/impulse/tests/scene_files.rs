@@ -1209,7 +1209,6 @@ fn solver_settings_are_checked() {
         (r#""overlap_slop": -0.1"#, "must be ≥ 0, got -0.1"),
         (r#""warm_start": 1.5"#, "must be in [0, 1], got 1.5"),
         (r#""substeps": 0"#, "must be ≥ 1, got 0"),
-        (r#""soft_damping_ratio": -1"#, "must be ≥ 0, got -1"),
     ] {
         let text = format!("{{\n  \"solver\": {{{setting}}},\n  \"bodies\": []\n}}");
         let e = parse_scene_str(&text, "s.json").unwrap_err();
@@ -1219,6 +1218,39 @@ fn solver_settings_are_checked() {
             format!("s.json:2:{}: solver.{key}: {message}", 15 + key.len() + 3)
         );
     }
+    // The repair's parameters, at their place inside the `repair` object.
+    for (repair, path, message) in [
+        (
+            r#"{"type": "soft", "hertz": 240, "damping_ratio": -1}"#,
+            "solver.repair.damping_ratio",
+            "must be ≥ 0, got -1",
+        ),
+        (
+            r#"{"type": "soft", "hertz": 0, "damping_ratio": 10}"#,
+            "solver.repair.hertz",
+            "must be > 0, got 0",
+        ),
+        (
+            r#"{"type": "split_impulse", "rate": 12, "iterations": 0}"#,
+            "solver.repair.iterations",
+            "must be ≥ 1, got 0",
+        ),
+        (
+            r#"{"type": "bias", "rate": -2}"#,
+            "solver.repair.rate",
+            "must be ≥ 0, got -2",
+        ),
+    ] {
+        let text = format!("{{\n  \"solver\": {{\"repair\": {repair}}},\n  \"bodies\": []\n}}");
+        let e = parse_scene_str(&text, "s.json").unwrap_err().to_string();
+        assert!(
+            e.starts_with("s.json:2:") && e.ends_with(&format!("{path}: {message}")),
+            "{e}"
+        );
+    }
+    let unknown = "{\n  \"solver\": {\"repair\": {\"type\": \"springs\"}},\n  \"bodies\": []\n}";
+    let e = parse_scene_str(unknown, "s.json").unwrap_err().to_string();
+    assert!(e.contains("springs") && e.contains("soft"), "{e}");
 }
 
 // ---------------------------------------------------------------------------------------------

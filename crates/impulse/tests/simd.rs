@@ -6,6 +6,7 @@ mod common;
 
 use glam::Vec3;
 use impulse::scene::builtin::builtin_scene;
+use impulse::settings::ContactRepair;
 use impulse::settings::SolverMethod;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
 
@@ -31,8 +32,7 @@ fn sphere(radius: f32, position: Vec3) -> BodyDesc {
 fn bundled(iterations: u32) -> SolverSettings {
     SolverSettings {
         method: SolverMethod::Pgs,
-        split_impulse: false,
-        soft_contact_hertz: 0.0,
+        repair: ContactRepair::Bias { rate: 12.0 },
         iterations,
         relax_iterations: iterations,
         simd_island_contacts: 1,

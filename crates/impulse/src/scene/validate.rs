@@ -61,7 +61,11 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
 
     let solver = root.key("solver");
     for problem in scene.solver.problems() {
-        c.fail(&solver.key(problem.field), problem.message);
+        let path = problem
+            .field
+            .split('.')
+            .fold(solver.clone(), |path, key| path.key(key));
+        c.fail(&path, problem.message);
     }
 
     for (name, material) in &scene.materials {

@@ -20,7 +20,7 @@ use crate::body::{Bodies, BodyKind};
 use crate::constraints::{self, ContactConstraint};
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
-use crate::settings::{SolverMethod, SolverSettings};
+use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 
 /// What the solver did on one island during a step (step 7 of docs/architecture.md: every step can say how
 /// well its LCP was solved, here per island).
@@ -303,7 +303,7 @@ pub fn step_island(
 
     // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
     let bundled = settings.method == SolverMethod::Pgs
-        && !settings.split_impulse
+        && !settings.split_impulse()
         && settings.simd_island_contacts > 0
         && constraints.len() >= settings.simd_island_contacts as usize;
     w.parallel = parallel;
@@ -339,7 +339,7 @@ pub fn step_island(
         // `wide::sweep_groups`), so that no corner of a face always goes first. Split
         // impulse keeps one order: its rigid rows are solved to the tolerance, where the order
         // matters little, and its results are compared with exact solutions.
-        let half_turn = substep % 2 == 1 && !settings.split_impulse;
+        let half_turn = substep % 2 == 1 && !settings.split_impulse();
         integrate::prospective_velocities(&mut w.linear[..moving], gravity, h);
         for (k, &(linear, angular)) in w.acceleration.iter().enumerate() {
             w.linear[k] += linear * h;
@@ -378,7 +378,7 @@ pub fn step_island(
         w.targets_and_solve(constraints, settings, h, bundled, true, half_turn);
         // With no row to repair beyond the tolerance, positions move with the velocities alone
         // (at rest, the usual case in a pile; see `constraints::update_targets`).
-        let split = settings.split_impulse && w.position_repair;
+        let split = settings.split_impulse() && w.position_repair;
         if split {
             // Positions move with v + the pseudo-velocity of the repair solve.
             w.pseudo_linear.clear();
@@ -395,7 +395,10 @@ pub fn step_island(
                     starts: &w.colour_starts,
                     parallel: w.parallel,
                 },
-                settings.position_iterations,
+                match settings.repair {
+                    ContactRepair::SplitImpulse { iterations, .. } => iterations,
+                    _ => 1,
+                },
                 settings.tolerance,
                 &mut pseudo,
             );
@@ -431,7 +434,7 @@ pub fn step_island(
                 h,
             );
         }
-        if settings.relax_iterations > 0 && !settings.split_impulse {
+        if settings.relax_iterations > 0 && !settings.split_impulse() {
             w.targets_and_solve(constraints, settings, h, bundled, false, half_turn);
         }
     }

@@ -30,7 +30,7 @@ use glam::Vec3;
 use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, TargetInputs, Velocities,
 };
-use crate::constraints::{ContactConstraint, JacobianRow, soft_contact};
+use crate::constraints::{ContactConstraint, JacobianRow, repair_terms};
 use crate::graph::{COLOURS, greedy_colours};
 use crate::parallel::{
     GROUPS_PER_TASK, PARALLEL_PACK_POINTS, SharedItems, SharedVelocities, colour_after_colour,
@@ -773,15 +773,7 @@ struct Targets<'a> {
 impl<'a> Targets<'a> {
     fn new(inputs: &TargetInputs<'a>, geometry: &'a [BundleGeometry]) -> Self {
         let settings = inputs.settings;
-        let (repair_rate, (mass_scale, impulse_scale)) = if settings.soft_contact_hertz > 0.0 {
-            soft_contact(
-                settings.soft_contact_hertz,
-                settings.soft_damping_ratio,
-                inputs.h,
-            )
-        } else {
-            (settings.overlap_repair_rate, (1.0, 0.0))
-        };
+        let (repair_rate, (mass_scale, impulse_scale)) = repair_terms(&settings.repair, inputs.h);
         let (soft_mass, soft_impulse) = if inputs.with_repair {
             (Lane::splat(mass_scale), Lane::splat(impulse_scale))
         } else {
