@@ -88,16 +88,28 @@ pub struct FastBody<'a> {
 
 /// The fraction of the step, in [0, 1), to which `body`'s motion is clamped so that it does not
 /// pass `target` (a static or kinematic body's shape moving along `target_sweep`), or `None`
-/// when the motion needs no clamp. With the two apart by more than the gap at the start: the
-/// first time of impact of Parry's nonlinear cast, moved back by the gap along the motion.
-/// With the two touching or overlapping at the start (the contacts were already holding them
-/// apart): the time of impact of the body's core sphere, so that only a body driven through
-/// the target is stopped. Shape pairs Parry cannot cast are not clamped.
-pub fn clamp_fraction(body: &FastBody<'_>, target: &dyn Shape, target_sweep: &Sweep) -> Option<f32> {
+/// when the motion needs no clamp. With the two apart by more than the gap at the start and no
+/// contact between them this step (`in_contact` false): the first time of impact of Parry's
+/// nonlinear cast, moved back by the gap along the motion. With the two touching at the start,
+/// or in contact this step (the solver already held them apart at the points the narrow phase
+/// found, speculative ones included): the time of impact of the body's core sphere, so that
+/// only a body driven through the target is stopped, and a body sliding or spinning along it
+/// is not held at its start pose step after step. Shape pairs Parry cannot cast are not
+/// clamped.
+pub fn clamp_fraction(
+    body: &FastBody<'_>,
+    target: &dyn Shape,
+    target_sweep: &Sweep,
+    in_contact: bool,
+) -> Option<f32> {
     let gap = CLAMP_GAP.min(0.1 * body.min_half_extent);
-    let start_distance = distance(&body.sweep.start, body.shape, &target_sweep.start, target)
-        .ok()?
-        .distance;
+    let start_distance = if in_contact {
+        0.0
+    } else {
+        distance(&body.sweep.start, body.shape, &target_sweep.start, target)
+            .ok()?
+            .distance
+    };
     let motion = body.sweep.motion();
     let target_motion = target_sweep.motion();
     if start_distance > gap {

@@ -376,6 +376,14 @@ impl NarrowPhase {
         Ok(())
     }
 
+    /// Whether bodies `a` and `b` have contact points this step (speculative ones included).
+    pub fn has_points(&self, a: u32, b: u32) -> bool {
+        let key = (a.min(b), a.max(b));
+        self.pairs
+            .binary_search_by(|p| (p.body1, p.body2).cmp(&key))
+            .is_ok_and(|i| self.pairs[i].point_count() > 0)
+    }
+
     /// Largest penetration depth (m) among current contact points, 0 if none overlap.
     pub fn max_depth(&self) -> f32 {
         self.pairs

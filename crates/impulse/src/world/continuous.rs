@@ -66,7 +66,10 @@ impl World {
                     end: b.pose[j],
                     local_center_of_mass: b.local_center_of_mass[j],
                 };
-                if let Some(t) = continuous::clamp_fraction(&body, &*b.shape[j], &target) {
+                let in_contact = self.narrow_phase.has_points(i as u32, j as u32);
+                if let Some(t) =
+                    continuous::clamp_fraction(&body, &*b.shape[j], &target, in_contact)
+                {
                     earliest = earliest.min(t);
                 }
             };
