@@ -353,3 +353,44 @@ fn the_kinematic_example_scene_runs() {
         "crate at {crate_velocity} m/s along the push"
     );
 }
+
+/// Bad keyframes in a scene file are refused with the body and the field, at the line of the
+/// offending value.
+#[test]
+fn bad_keyframes_in_a_scene_name_the_field() {
+    let body = |extra: &str| {
+        format!(
+            "{{\n  \"bodies\": [\n    {{\"name\": \"lift\", \"kind\": \"kinematic\",\n     \"shape\": {{\"type\": \"sphere\", \"radius\": 1}},\n     {extra}}}\n  ]\n}}\n"
+        )
+    };
+    let cases = [
+        (body("\"keyframes\": []"), "bodies[0].keyframes"),
+        (
+            body("\"keyframes\": [{\"t\": 0, \"position\": [0, 1, 0]}]"),
+            "bodies[0].keyframes[0].t",
+        ),
+        (
+            body("\"keyframes\": [{\"t\": 1, \"position\": [0, 1, 0], \"orientation\": [0, 0, 0, 0]}]"),
+            "bodies[0].keyframes[0].orientation",
+        ),
+        (
+            body("\"linear_velocity\": [1, 0, 0], \"keyframes\": [{\"t\": 1, \"position\": [0, 1, 0]}]"),
+            "bodies[0].linear_velocity",
+        ),
+        (
+            body("\"keyframes\": [{\"t\": 1, \"position\": [0, 1, 0]}]")
+                .replace("\"kinematic\"", "\"dynamic\""),
+            "bodies[0].keyframes",
+        ),
+    ];
+    for (text, field) in cases {
+        let error = impulse::scene::parse_scene_str(&text, "case.json").unwrap_err();
+        assert_eq!(
+            error.field.as_ref().map(|f| f.to_string()).as_deref(),
+            Some(field),
+            "{error}"
+        );
+        assert_eq!(error.body.as_ref().and_then(|b| b.name.as_deref()), Some("lift"));
+        assert_eq!(error.position.map(|p| p.line), Some(5), "{error}");
+    }
+}
