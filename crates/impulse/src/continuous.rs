@@ -113,8 +113,9 @@ pub fn clamp_fraction(
     let motion = body.sweep.motion();
     let target_motion = target_sweep.motion();
     if start_distance > gap {
-        let hit = cast_shapes_nonlinear(&motion, body.shape, &target_motion, target, 0.0, 1.0, true)
-            .ok()??;
+        let hit =
+            cast_shapes_nonlinear(&motion, body.shape, &target_motion, target, 0.0, 1.0, true)
+                .ok()??;
         let t = hit.time_of_impact;
         return (t < 1.0).then(|| (t - gap / body.travel).max(0.0));
     }
@@ -122,7 +123,10 @@ pub fn clamp_fraction(
     let com = body.sweep.local_center_of_mass;
     // The core sphere is centred on the centre of mass: the same motion about the same point.
     let core_motion = NonlinearRigidMotion::new(
-        Pose::from_parts(body.sweep.start.transform_point(com), body.sweep.start.rotation),
+        Pose::from_parts(
+            body.sweep.start.transform_point(com),
+            body.sweep.start.rotation,
+        ),
         Vec3::ZERO,
         motion.linvel,
         motion.angvel,

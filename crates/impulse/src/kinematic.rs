@@ -58,7 +58,12 @@ pub fn keyframed_pose(initial: &Pose, keyframes: &[Keyframe], time: f64) -> Pose
 /// world frame) that carry a body from pose `from` to pose `to` in `dt` seconds, its centre of
 /// mass at `local_center_of_mass` in the body frame: Δc/dt and the rotation vector of
 /// `to.rotation · from.rotation⁻¹` (the shorter way round) over dt.
-pub fn velocity_between(from: &Pose, to: &Pose, local_center_of_mass: Vec3, dt: f32) -> (Vec3, Vec3) {
+pub fn velocity_between(
+    from: &Pose,
+    to: &Pose,
+    local_center_of_mass: Vec3,
+    dt: f32,
+) -> (Vec3, Vec3) {
     let linear = (to.transform_point(local_center_of_mass)
         - from.transform_point(local_center_of_mass))
         / dt;
@@ -72,14 +77,24 @@ pub fn rotation_vector(from: Quat, to: Quat) -> Vec3 {
         delta = -delta;
     }
     let scaled = delta.normalize().to_scaled_axis();
-    if scaled.is_finite() { scaled } else { Vec3::ZERO }
+    if scaled.is_finite() {
+        scaled
+    } else {
+        Vec3::ZERO
+    }
 }
 
 /// The pose a body reaches from `pose` in `dt` seconds at constant velocities: its centre of
 /// mass (at `local_center_of_mass` in the body frame) moves by `linear`·dt and the body turns
 /// by the rotation vector `angular`·dt about it (exact for a constant ω, unlike the island's
 /// first-order orientation update).
-pub fn advance(pose: &Pose, local_center_of_mass: Vec3, linear: Vec3, angular: Vec3, dt: f32) -> Pose {
+pub fn advance(
+    pose: &Pose,
+    local_center_of_mass: Vec3,
+    linear: Vec3,
+    angular: Vec3,
+    dt: f32,
+) -> Pose {
     let center = pose.transform_point(local_center_of_mass) + linear * dt;
     let rotation = (Quat::from_scaled_axis(angular * dt) * pose.rotation).normalize();
     Pose::from_parts(center - rotation * local_center_of_mass, rotation)

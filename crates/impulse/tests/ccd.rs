@@ -23,10 +23,8 @@ fn settings(continuous: bool) -> SolverSettings {
 /// A 1 cm wall across x = 0 (its faces at x = ±0.005), 200 m square so that nothing goes round
 /// it within the test.
 fn wall(w: &mut World) {
-    w.insert(
-        BodyBuilder::fixed(SharedShape::cuboid(HALF_THICKNESS, 100.0, 100.0)).name("wall"),
-    )
-    .expect("wall");
+    w.insert(BodyBuilder::fixed(SharedShape::cuboid(HALF_THICKNESS, 100.0, 100.0)).name("wall"))
+        .expect("wall");
 }
 
 /// The plane x = 0 as a triangle mesh of two triangles, no thickness at all: a square of
@@ -80,9 +78,16 @@ fn a_fast_ball_never_crosses_a_thin_wall() {
         for angle in [0.0, 30.0, 60.0, 80.0] {
             let mut w = World::new(gravity, DT, settings(true)).unwrap();
             wall(&mut w);
-            let ball = shoot(&mut w, BodyBuilder::dynamic(SharedShape::ball(RADIUS)), angle);
+            let ball = shoot(
+                &mut w,
+                BodyBuilder::dynamic(SharedShape::ball(RADIUS)),
+                angle,
+            );
             let (largest, met) = fly(&mut w, ball, 20, RADIUS);
-            assert!(met, "{angle}°, g = {gravity}: the ball never reached the wall");
+            assert!(
+                met,
+                "{angle}°, g = {gravity}: the ball never reached the wall"
+            );
             assert!(
                 largest < -HALF_THICKNESS,
                 "{angle}°, g = {gravity}: the ball's centre reached x = {largest}"
@@ -98,10 +103,17 @@ fn a_fast_ball_never_crosses_a_triangle_mesh() {
     for angle in [0.0, 30.0, 60.0, 80.0] {
         let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings(true)).unwrap();
         mesh_wall(&mut w);
-        let ball = shoot(&mut w, BodyBuilder::dynamic(SharedShape::ball(RADIUS)), angle);
+        let ball = shoot(
+            &mut w,
+            BodyBuilder::dynamic(SharedShape::ball(RADIUS)),
+            angle,
+        );
         let (largest, met) = fly(&mut w, ball, 20, RADIUS);
         assert!(met, "{angle}°: the ball never reached the mesh");
-        assert!(largest < 0.0, "{angle}°: the ball's centre reached x = {largest}");
+        assert!(
+            largest < 0.0,
+            "{angle}°: the ball's centre reached x = {largest}"
+        );
     }
 }
 
@@ -134,7 +146,11 @@ fn without_continuous_collision_the_ball_tunnels() {
     for angle in [0.0, 30.0] {
         let mut w = World::new(Vec3::ZERO, DT, settings(false)).unwrap();
         wall(&mut w);
-        let ball = shoot(&mut w, BodyBuilder::dynamic(SharedShape::ball(RADIUS)), angle);
+        let ball = shoot(
+            &mut w,
+            BodyBuilder::dynamic(SharedShape::ball(RADIUS)),
+            angle,
+        );
         let (largest, _) = fly(&mut w, ball, 20, RADIUS);
         assert!(
             largest > 1.0,

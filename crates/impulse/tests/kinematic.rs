@@ -62,7 +62,11 @@ fn a_kinematic_paddle_pushes_a_box_and_is_not_slowed() {
         let p = w.body(paddle).unwrap();
         let c = w.body(cube).unwrap();
         let t = step as f32 * DT;
-        assert_eq!(p.linear_velocity(), Vec3::new(speed, 0.0, 0.0), "step {step}");
+        assert_eq!(
+            p.linear_velocity(),
+            Vec3::new(speed, 0.0, 0.0),
+            "step {step}"
+        );
         assert_eq!(p.angular_velocity(), Vec3::ZERO);
         let expected = start + Vec3::new(speed * t, 0.0, 0.0);
         assert!(
@@ -73,12 +77,19 @@ fn a_kinematic_paddle_pushes_a_box_and_is_not_slowed() {
         // The paddle's front face at x_p + 0.1 never passes the cube's back face at x_c − 0.5
         // by more than a few millimetres (soft contact).
         let gap = (c.translation().x - 0.5) - (p.translation().x + 0.1);
-        assert!(gap > -0.005, "step {step}: paddle 0.5 m into the cube by {}", -gap);
+        assert!(
+            gap > -0.005,
+            "step {step}: paddle 0.5 m into the cube by {}",
+            -gap
+        );
         if gap < 0.01 {
             pushed_steps += 1;
         }
     }
-    assert!(pushed_steps > 60, "the paddle pushed the cube for {pushed_steps} steps");
+    assert!(
+        pushed_steps > 60,
+        "the paddle pushed the cube for {pushed_steps} steps"
+    );
     let c = w.body(cube).unwrap();
     assert!(
         c.linear_velocity().x >= speed - 1e-3,
@@ -133,7 +144,10 @@ fn a_box_rides_a_moving_platform() {
         }
         let p = w.body(platform).unwrap().translation();
         let c = w.body(cube).unwrap().translation();
-        assert!((c.y - p.y - 0.35).abs() < 0.005, "cube at {c}, platform at {p}");
+        assert!(
+            (c.y - p.y - 0.35).abs() < 0.005,
+            "cube at {c}, platform at {p}"
+        );
         assert!(!w.body(cube).unwrap().is_asleep());
     }
 }
@@ -159,15 +173,26 @@ fn a_moving_kinematic_body_wakes_what_it_touches() {
     for _ in 0..120 {
         w.step().unwrap();
     }
-    assert!(w.body(cube).unwrap().is_asleep(), "the cube rests and sleeps");
-    assert!(w.body(platform).unwrap().is_asleep(), "a still kinematic body counts as asleep");
-    w.set_linear_velocity(platform, Vec3::new(0.5, 0.0, 0.0)).unwrap();
+    assert!(
+        w.body(cube).unwrap().is_asleep(),
+        "the cube rests and sleeps"
+    );
+    assert!(
+        w.body(platform).unwrap().is_asleep(),
+        "a still kinematic body counts as asleep"
+    );
+    w.set_linear_velocity(platform, Vec3::new(0.5, 0.0, 0.0))
+        .unwrap();
     for _ in 0..60 {
         w.step().unwrap();
     }
     let c = w.body(cube).unwrap();
     assert!(!c.is_asleep());
-    assert!((c.linear_velocity().x - 0.5).abs() < 0.005, "{}", c.linear_velocity());
+    assert!(
+        (c.linear_velocity().x - 0.5).abs() < 0.005,
+        "{}",
+        c.linear_velocity()
+    );
 }
 
 /// Two cubes on one platform are two islands: a kinematic body joins nothing.
@@ -208,10 +233,7 @@ fn keyframes_reach_the_keyed_poses_at_the_keyed_times() {
         rotation: Quat::from_rotation_z(1.0),
     };
     let body = w
-        .insert(
-            BodyBuilder::kinematic(SharedShape::cuboid(0.5, 0.2, 0.3))
-                .keyframes([a, b]),
-        )
+        .insert(BodyBuilder::kinematic(SharedShape::cuboid(0.5, 0.2, 0.3)).keyframes([a, b]))
         .unwrap();
     let at_step = |w: &mut World, step: u64| {
         while w.step_count() < step {
@@ -250,7 +272,12 @@ fn keyframes_reach_the_keyed_poses_at_the_keyed_times() {
         "t = 0.75",
     );
     close(at_step(&mut w, 60), b.translation, b.rotation, "t = 1");
-    close(at_step(&mut w, 120), b.translation, b.rotation, "t = 2 (held)");
+    close(
+        at_step(&mut w, 120),
+        b.translation,
+        b.rotation,
+        "t = 2 (held)",
+    );
     assert_eq!(w.body(body).unwrap().linear_velocity(), Vec3::ZERO);
     assert!(w.body(body).unwrap().is_asleep());
 }
@@ -286,11 +313,16 @@ fn kinematic_edits_are_checked() {
     let k = w
         .insert(BodyBuilder::kinematic(SharedShape::ball(0.5)))
         .unwrap();
-    let d = w.insert(BodyBuilder::dynamic(SharedShape::ball(0.5))).unwrap();
+    let d = w
+        .insert(BodyBuilder::dynamic(SharedShape::ball(0.5)))
+        .unwrap();
     assert!(w.apply_force(k, Vec3::X).is_err());
     assert!(w.apply_impulse(k, Vec3::X).is_err());
     assert!(w.set_kinematic_target(d, Vec3::X, Quat::IDENTITY).is_err());
-    assert!(w.set_kinematic_target(k, Vec3::NAN, Quat::IDENTITY).is_err());
+    assert!(
+        w.set_kinematic_target(k, Vec3::NAN, Quat::IDENTITY)
+            .is_err()
+    );
     let key = |time| Keyframe {
         time,
         translation: Vec3::ZERO,
@@ -318,13 +350,18 @@ fn kinematic_edits_are_checked() {
     // The kinematic body keeps a velocity it is given and moves by it.
     w.set_angular_velocity(k, Vec3::new(0.0, 1.0, 0.0)).unwrap();
     w.step().unwrap();
-    assert_eq!(w.body(k).unwrap().angular_velocity(), Vec3::new(0.0, 1.0, 0.0));
+    assert_eq!(
+        w.body(k).unwrap().angular_velocity(),
+        Vec3::new(0.0, 1.0, 0.0)
+    );
     let angle = w.body(k).unwrap().rotation().to_axis_angle().1;
     assert!((angle - DT).abs() < 1e-5, "{angle}");
 }
 
 fn example(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
 }
 
 /// The example scene with a kinematic paddle and a keyframed platform loads and runs: the
@@ -370,11 +407,15 @@ fn bad_keyframes_in_a_scene_name_the_field() {
             "bodies[0].keyframes[0].t",
         ),
         (
-            body("\"keyframes\": [{\"t\": 1, \"position\": [0, 1, 0], \"orientation\": [0, 0, 0, 0]}]"),
+            body(
+                "\"keyframes\": [{\"t\": 1, \"position\": [0, 1, 0], \"orientation\": [0, 0, 0, 0]}]",
+            ),
             "bodies[0].keyframes[0].orientation",
         ),
         (
-            body("\"linear_velocity\": [1, 0, 0], \"keyframes\": [{\"t\": 1, \"position\": [0, 1, 0]}]"),
+            body(
+                "\"linear_velocity\": [1, 0, 0], \"keyframes\": [{\"t\": 1, \"position\": [0, 1, 0]}]",
+            ),
             "bodies[0].linear_velocity",
         ),
         (
@@ -390,7 +431,10 @@ fn bad_keyframes_in_a_scene_name_the_field() {
             Some(field),
             "{error}"
         );
-        assert_eq!(error.body.as_ref().and_then(|b| b.name.as_deref()), Some("lift"));
+        assert_eq!(
+            error.body.as_ref().and_then(|b| b.name.as_deref()),
+            Some("lift")
+        );
         assert_eq!(error.position.map(|p| p.line), Some(5), "{error}");
     }
 }

@@ -46,7 +46,7 @@ impl World {
             let min_half_extent = half.min_element();
             let radius = (local.center() - sweep.local_center_of_mass).length() + half.length();
             let travel = sweep.travel(radius);
-            if !(travel > FAST_FRACTION * min_half_extent) || !travel.is_finite() {
+            if !travel.is_finite() || travel <= FAST_FRACTION * min_half_extent {
                 continue;
             }
             let body = FastBody {

@@ -21,7 +21,10 @@ impl World {
         translation: Vec3,
         rotation: Quat,
     ) -> Result<(), WorldError> {
-        let i = self.handles.body(handle).ok_or(WorldError::UnknownBody(handle))?;
+        let i = self
+            .handles
+            .body(handle)
+            .ok_or(WorldError::UnknownBody(handle))?;
         let refuse = |field: &str, message: String| {
             Err(WorldError::InvalidBody {
                 body: i,
@@ -85,12 +88,9 @@ impl World {
             });
             let b = &mut self.bodies;
             (b.linear_velocity[i], b.angular_velocity[i]) = match &script.step_target {
-                Some(target) => kinematic::velocity_between(
-                    &b.pose[i],
-                    target,
-                    b.local_center_of_mass[i],
-                    dt,
-                ),
+                Some(target) => {
+                    kinematic::velocity_between(&b.pose[i], target, b.local_center_of_mass[i], dt)
+                }
                 None => (Vec3::ZERO, Vec3::ZERO),
             };
         }
@@ -101,7 +101,8 @@ impl World {
         let b = &mut self.bodies;
         for i in 0..b.len() {
             if b.kind[i] == BodyKind::Kinematic {
-                let still = b.linear_velocity[i] == Vec3::ZERO && b.angular_velocity[i] == Vec3::ZERO;
+                let still =
+                    b.linear_velocity[i] == Vec3::ZERO && b.angular_velocity[i] == Vec3::ZERO;
                 b.asleep[i] = still;
                 b.sleep_time[i] = 0.0;
                 if !still {
@@ -127,7 +128,8 @@ impl World {
             );
         }
         for script in &mut self.scripts {
-            if let (Some(target), Some(i)) = (script.step_target, self.handles.body(script.handle)) {
+            if let (Some(target), Some(i)) = (script.step_target, self.handles.body(script.handle))
+            {
                 self.bodies.pose[i] = target;
             }
         }

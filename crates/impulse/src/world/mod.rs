@@ -618,13 +618,12 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
             (inverse_mass, props.local_com, inertia)
         }
     };
-    let angular_velocity = if b.kind == BodyKind::Kinematic
-        || (b.kind == BodyKind::Dynamic && !b.lock_rotation)
-    {
-        b.angular_velocity
-    } else {
-        Vec3::ZERO
-    };
+    let angular_velocity =
+        if b.kind == BodyKind::Kinematic || (b.kind == BodyKind::Dynamic && !b.lock_rotation) {
+            b.angular_velocity
+        } else {
+            Vec3::ZERO
+        };
     // The builder gives the velocity of the body origin; the solver works at the centre of
     // mass.
     let linear_velocity = if b.kind == BodyKind::Static {
@@ -647,7 +646,10 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
 /// A builder's keyframes, checked (kinematic bodies only; times finite, > 0 and increasing;
 /// translations finite; rotations finite and non-zero) and with normalised rotations. Fields
 /// are named as in the scene format (`keyframes[i].t`, `.position`, `.orientation`).
-fn check_keyframes(index: usize, b: &BodyBuilder) -> Result<Vec<crate::body::Keyframe>, WorldError> {
+fn check_keyframes(
+    index: usize,
+    b: &BodyBuilder,
+) -> Result<Vec<crate::body::Keyframe>, WorldError> {
     let bad = |field: String, message: String| Err(invalid_built(index, b, &field, message));
     if b.keyframes.is_empty() {
         return Ok(Vec::new());
