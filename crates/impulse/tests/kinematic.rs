@@ -152,6 +152,56 @@ fn a_box_rides_a_moving_platform() {
     }
 }
 
+/// A turntable turning at 1 rad/s about y carries a cube resting 1 m from its axis round with
+/// it: after the start, the cube moves at ω × r (1 m/s) within 1 %, r its position as each
+/// step begins, and stays at its radius (up to the step's own drift)
+/// (friction, μ = 0.6, supplies the centripetal ω²r = 1 m/s² < μg).
+#[test]
+fn a_box_turns_with_a_turntable() {
+    let mut w = world();
+    let omega = Vec3::new(0.0, 1.0, 0.0);
+    w.insert(
+        BodyBuilder::kinematic(SharedShape::cuboid(3.0, 0.1, 3.0))
+            .translation(Vec3::new(0.0, -0.1, 0.0))
+            .angular_velocity(omega)
+            .friction(0.6),
+    )
+    .unwrap();
+    let cube = w
+        .insert(
+            BodyBuilder::dynamic(SharedShape::cuboid(0.1, 0.1, 0.1))
+                .translation(Vec3::new(1.0, 0.1, 0.0))
+                .friction(0.6),
+        )
+        .unwrap();
+    let mut settled = None;
+    for step in 1..=240 {
+        // Contacts are found once per step, so the step holds the cube to the turntable's
+        // velocity where the cube was as the step began.
+        let r = w.body(cube).unwrap().center_of_mass() * Vec3::new(1.0, 0.0, 1.0);
+        w.step().unwrap();
+        if step < 60 {
+            continue;
+        }
+        let c = w.body(cube).unwrap();
+        let expected = omega.cross(r);
+        assert!(
+            (c.linear_velocity() - expected).length() <= 0.01 * expected.length(),
+            "step {step}: cube at {} m/s, the turntable there at {expected} m/s",
+            c.linear_velocity()
+        );
+        // Each step moves the cube by dt·ω × r along the tangent, outside the circle: the
+        // radius grows by the factor √(1 + (ω·dt)²) a step, the step's first-order error.
+        let radius = (c.center_of_mass() * Vec3::new(1.0, 0.0, 1.0)).length();
+        let first = *settled.get_or_insert(radius);
+        let expected = first * (1.0 + (omega.y * DT).powi(2)).powf((step - 60) as f32 / 2.0);
+        assert!(
+            (radius - expected).abs() < 0.005,
+            "step {step}: cube {radius} m from the axis, {expected} m expected"
+        );
+    }
+}
+
 /// A sleeping cube on a resting platform wakes when the platform starts to move, and rides.
 #[test]
 fn a_moving_kinematic_body_wakes_what_it_touches() {
