@@ -146,10 +146,17 @@ impl RapierScene {
         let built = &world.bodies;
         for (i, desc) in scene.bodies.iter().enumerate() {
             let material = resolve_material(scene, &desc.material)?;
+            if desc.keyframes.is_some() {
+                bail!(
+                    "body {i}: keyframed kinematic bodies are not supported by the Rapier comparison"
+                );
+            }
             let body = match desc.kind {
                 BodyKind::Static => RigidBodyBuilder::fixed(),
                 BodyKind::Dynamic => RigidBodyBuilder::dynamic(),
                 BodyKind::Particle => RigidBodyBuilder::dynamic().lock_rotations(),
+                // Rapier has no keyframes: a keyframed body is refused below.
+                BodyKind::Kinematic => RigidBodyBuilder::kinematic_velocity_based(),
             }
             // The pose as impulse built it (quaternion normalised), velocities of the centre
             // of mass (Rapier's convention too), no sleeping.

@@ -421,6 +421,7 @@ fn median_profile(profiles: &[StepProfile]) -> StepProfile {
         assembly: of(|p| p.assembly),
         solve: of(|p| p.solve),
         scatter: of(|p| p.scatter),
+        continuous: of(|p| p.continuous),
         store_impulses: of(|p| p.store_impulses),
         finish: of(|p| p.finish),
         total: of(|p| p.total),

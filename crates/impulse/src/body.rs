@@ -16,6 +16,35 @@ pub enum BodyKind {
     Static,
     /// A sphere whose rotation is locked: a particle (translation only).
     Particle,
+    /// Moved by a prescribed motion, not by forces or contacts: infinite mass, but its
+    /// velocity enters every contact it makes, so it pushes and carries dynamic bodies and is
+    /// never pushed back. Velocity-based (it keeps the linear and angular velocity it is
+    /// given), or position-based (keyframes, or a target pose for the next step, from which
+    /// the step's velocity is taken as Rapier's position-based kinematic bodies do).
+    Kinematic,
+}
+
+/// A timed pose of a keyframed kinematic body ([`BodyBuilder::keyframes`]): at `time`
+/// seconds after the world's start the body frame is at `translation` with `rotation`.
+/// Between keyframes the pose is interpolated linearly in translation and by slerp in
+/// rotation; after the last one it is held.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Keyframe {
+    /// Time (s) since the world's start; > 0 and increasing along the list (the body's
+    /// initial pose is its pose at time 0).
+    pub time: f32,
+    /// Position of the body origin (m).
+    pub translation: Vec3,
+    /// Orientation (normalised when inserted; must not be zero).
+    pub rotation: Quat,
+}
+
+impl BodyKind {
+    /// Whether bodies of this kind are moved by forces and contacts (dynamic rigid bodies
+    /// and particles).
+    pub fn is_dynamic(self) -> bool {
+        matches!(self, BodyKind::Dynamic | BodyKind::Particle)
+    }
 }
 
 /// A body's name in a [`crate::World`] that stays valid while the body lives and never names
@@ -134,6 +163,7 @@ pub struct BodyBuilder {
     pub(crate) lock_rotation: bool,
     pub(crate) groups: u32,
     pub(crate) mask: u32,
+    pub(crate) keyframes: Vec<Keyframe>,
 }
 
 impl BodyBuilder {
@@ -158,6 +188,7 @@ impl BodyBuilder {
             lock_rotation: false,
             groups: u32::MAX,
             mask: u32::MAX,
+            keyframes: Vec::new(),
         }
     }
 
@@ -169,6 +200,13 @@ impl BodyBuilder {
     /// A body that never moves (ground, walls).
     pub fn fixed(shape: SharedShape) -> Self {
         Self::new(BodyKind::Static, shape)
+    }
+
+    /// A kinematic body ([`BodyKind::Kinematic`]): moved at its
+    /// [`Self::linear_velocity`] and [`Self::angular_velocity`] (or along its
+    /// [`Self::keyframes`]), pushing dynamic bodies without being pushed.
+    pub fn kinematic(shape: SharedShape) -> Self {
+        Self::new(BodyKind::Kinematic, shape)
     }
 
     /// A ball of `radius` (m) whose rotation is locked.
@@ -194,7 +232,8 @@ impl BodyBuilder {
         self
     }
 
-    /// Angular velocity, world frame (rad/s); ignored for particles and static bodies.
+    /// Angular velocity, world frame (rad/s); ignored for particles, static bodies and
+    /// dynamic bodies with locked rotation.
     pub fn angular_velocity(mut self, velocity: Vec3) -> Self {
         self.angular_velocity = velocity;
         self
@@ -268,6 +307,18 @@ impl BodyBuilder {
         self.mask = mask;
         self
     }
+
+    /// Keyframes of a kinematic body (kinematic bodies only; default none): the body moves
+    /// from its initial pose (its pose at time 0) through each keyframe's pose at its time,
+    /// linearly in translation and by slerp in rotation, and stays at the last one. Each step
+    /// takes the velocity that carries the body from its pose to the keyframed pose at the
+    /// step's end (Rapier's position-based kinematic bodies), so contacts see the motion. The
+    /// velocities given to the builder are then unused. Checked when inserted: times finite,
+    /// > 0 and increasing; translations finite; rotations finite and non-zero.
+    pub fn keyframes(mut self, keyframes: impl IntoIterator<Item = Keyframe>) -> Self {
+        self.keyframes = keyframes.into_iter().collect();
+        self
+    }
 }
 
 /// All bodies of a world. Index `i` of every array is body `i` in scene order.
@@ -276,7 +327,7 @@ impl BodyBuilder {
 /// (trajectories report it), and `local_center_of_mass` locates the centre of mass in it.
 #[derive(Clone, Default)]
 pub struct Bodies {
-    /// Dynamic, static or particle.
+    /// Dynamic, static, particle or kinematic.
     pub kind: Vec<BodyKind>,
     /// Body frame in world coordinates.
     pub pose: Vec<Pose>,
@@ -284,12 +335,13 @@ pub struct Bodies {
     pub local_center_of_mass: Vec<Vec3>,
     /// Linear velocity of the centre of mass (m/s).
     pub linear_velocity: Vec<Vec3>,
-    /// Angular velocity, world frame (rad/s). Always zero for particles and static bodies.
+    /// Angular velocity, world frame (rad/s). Always zero for particles and static bodies;
+    /// a kinematic body's is its prescribed one.
     pub angular_velocity: Vec<Vec3>,
-    /// 1/m (1/kg); 0 for static bodies.
+    /// 1/m (1/kg); 0 for static and kinematic bodies.
     pub inverse_mass: Vec<f32>,
     /// Inverse inertia tensor about the centre of mass, body frame (1/(kg·m²)); zero for
-    /// static bodies and particles (rotation locked).
+    /// static and kinematic bodies and particles (rotation locked).
     pub local_inverse_inertia: Vec<Mat3>,
     /// Collision shape in the body frame.
     pub shape: Vec<SharedShape>,
@@ -297,7 +349,8 @@ pub struct Bodies {
     pub friction: Vec<f32>,
     /// Restitution coefficient c_r.
     pub restitution: Vec<f32>,
-    /// Asleep: skipped by the step until something awake touches its island.
+    /// Asleep: skipped by the step until something awake touches its island. A kinematic
+    /// body counts as asleep exactly while it does not move (zero velocities).
     pub asleep: Vec<bool>,
     /// How long (s) the body has been below the sleep thresholds.
     pub sleep_time: Vec<f32>,
@@ -354,14 +407,21 @@ impl Bodies {
         self.kind.is_empty()
     }
 
-    /// True for moving bodies that are awake: the ones the step simulates.
+    /// True for moving bodies that are awake: the dynamic bodies the step simulates, and
+    /// kinematic bodies in motion.
     pub fn is_awake(&self, i: usize) -> bool {
         self.kind[i] != BodyKind::Static && !self.asleep[i]
     }
 
-    /// True for bodies that move (dynamic rigid bodies and particles).
+    /// True for bodies that may move: dynamic rigid bodies, particles and kinematic bodies.
     pub fn is_moving(&self, i: usize) -> bool {
         self.kind[i] != BodyKind::Static
+    }
+
+    /// True for bodies moved by forces and contacts (dynamic rigid bodies and particles): the
+    /// bodies of islands. Static and kinematic bodies take no impulse.
+    pub fn is_dynamic(&self, i: usize) -> bool {
+        self.kind[i].is_dynamic()
     }
 
     /// Whether bodies `a` and `b` may collide by their collision groups:
@@ -381,7 +441,7 @@ impl Bodies {
         rotate_tensor(self.pose[i].rotation, &self.local_inverse_inertia[i])
     }
 
-    /// Mass (kg) of body `i`; infinity for static bodies.
+    /// Mass (kg) of body `i`; infinity for static and kinematic bodies.
     pub fn mass(&self, i: usize) -> f32 {
         if self.inverse_mass[i] > 0.0 {
             1.0 / self.inverse_mass[i]
@@ -390,7 +450,8 @@ impl Bodies {
         }
     }
 
-    /// Kinetic energy ½mv² + ½ωᵀIω of body `i` (J); 0 for static bodies.
+    /// Kinetic energy ½mv² + ½ωᵀIω of body `i` (J); 0 for static and kinematic bodies
+    /// (infinite mass: their motion is prescribed, not part of the system's energy).
     pub fn kinetic_energy(&self, i: usize) -> f32 {
         if self.inverse_mass[i] == 0.0 {
             return 0.0;

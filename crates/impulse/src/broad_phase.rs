@@ -21,7 +21,7 @@ pub struct BroadPhase {
     /// unused: 0).
     updates: Vec<(Aabb, u32, f32)>,
     statuses: Vec<BvhLeafUpdateStatus>,
-    /// The last pairs, and which bodies were moving then: while no leaf leaves its fattened
+    /// The last pairs, and which bodies were dynamic then: while no leaf leaves its fattened
     /// box and no body changes kind, the pairs are the same and the traversal is skipped; while
     /// few leaves changed ([`FEW_CHANGED_LEAVES`]), only those leaves' pairs are redone.
     pairs: Vec<(u32, u32)>,
@@ -80,7 +80,7 @@ fn merge_sorted(a: &[(u32, u32)], b: &[(u32, u32)], out: &mut Vec<(u32, u32)>) {
 const WORLD_BOUND: f32 = 1.0e6;
 
 impl BroadPhase {
-    /// Candidate pairs `(i, j)` with `i < j`, sorted, at least one of them moving. Body i's box
+    /// Candidate pairs `(i, j)` with `i < j`, sorted, at least one of them dynamic. Body i's box
     /// is loosened by `margins[i]` (m), or by 0 when `margins` is empty, so that speculative
     /// contacts within the margins are found; the tree keeps each box fattened by
     /// [`CHANGE_DETECTION_SKIN`] (by at most twice that since its last rewrite), so pairs up
@@ -109,14 +109,16 @@ impl BroadPhase {
             self.tree = None;
             return;
         }
+        // Contacts need a body that takes impulses: pairs of static and kinematic bodies
+        // only are left out.
         let keep = |&(a, b): &(u32, u32)| {
             a != b
-                && (bodies.is_moving(a as usize) || bodies.is_moving(b as usize))
+                && (bodies.is_dynamic(a as usize) || bodies.is_dynamic(b as usize))
                 && bodies.groups_interact(a as usize, b as usize)
         };
         let ordered = |(a, b): (u32, u32)| if a < b { (a, b) } else { (b, a) };
         let same_kinds = self.moving.len() == bodies.len()
-            && (0..bodies.len()).all(|i| self.moving[i] == bodies.is_moving(i));
+            && (0..bodies.len()).all(|i| self.moving[i] == bodies.is_dynamic(i));
         let mut kept = false;
         let changed = match &mut self.tree {
             Some(tree)
@@ -219,9 +221,18 @@ impl BroadPhase {
             pairs.dedup();
             self.moving.clear();
             self.moving
-                .extend((0..bodies.len()).map(|i| bodies.is_moving(i)));
+                .extend((0..bodies.len()).map(|i| bodies.is_dynamic(i)));
         }
         out.extend_from_slice(&self.pairs);
+    }
+
+    /// The bodies whose boxes in the tree meet `aabb`: as of the last
+    /// [`Self::candidate_pairs`], each body's box at the step's start loosened by its margin
+    /// and the skin. Nothing before the first call.
+    pub fn bodies_in<'a>(&'a self, aabb: &'a Aabb) -> impl Iterator<Item = u32> + 'a {
+        self.tree
+            .iter()
+            .flat_map(move |tree| tree.intersect_aabb(aabb))
     }
 
     /// Rebuilds the next part of the tree (Parry's `optimize_incremental`, which cycles

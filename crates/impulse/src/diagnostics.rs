@@ -60,8 +60,10 @@ pub struct StepProfile {
     /// The island jobs: substeps (solve, position integration), restitution, and each island's
     /// residual.
     pub solve: f32,
-    /// Island results written back to the bodies.
+    /// Island results written back to the bodies, and kinematic bodies moved.
     pub scatter: f32,
+    /// Continuous collision: fast bodies swept against static and kinematic bodies.
+    pub continuous: f32,
     /// Impulses written back to the manifolds for the next warm start.
     pub store_impulses: f32,
     /// Sleep, energy, momentum and the counts of the diagnostics.
@@ -86,8 +88,11 @@ pub enum Stage {
     /// Each island's substeps (warm start, solve, integrate positions, relax), restitution and
     /// residual.
     Solve,
-    /// Island results written back to the bodies.
+    /// Island results written back to the bodies, and kinematic bodies moved.
     Scatter,
+    /// Continuous collision: fast bodies swept against static and kinematic bodies, their
+    /// motion clamped to the first impact.
+    Continuous,
     /// Impulses written back to the manifolds for the next warm start.
     StoreImpulses,
     /// Sleep, energy, momentum and the counts of the diagnostics.
@@ -96,13 +101,14 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage, in step order.
-    pub const ALL: [Stage; 8] = [
+    pub const ALL: [Stage; 9] = [
         Stage::BroadPhase,
         Stage::NarrowPhase,
         Stage::Islands,
         Stage::Assembly,
         Stage::Solve,
         Stage::Scatter,
+        Stage::Continuous,
         Stage::StoreImpulses,
         Stage::Finish,
     ];
@@ -116,6 +122,7 @@ impl Stage {
             Stage::Assembly => "assembly",
             Stage::Solve => "solve",
             Stage::Scatter => "scatter",
+            Stage::Continuous => "continuous",
             Stage::StoreImpulses => "store_impulses",
             Stage::Finish => "finish",
         }
@@ -132,6 +139,7 @@ impl StepProfile {
             Stage::Assembly => self.assembly,
             Stage::Solve => self.solve,
             Stage::Scatter => self.scatter,
+            Stage::Continuous => self.continuous,
             Stage::StoreImpulses => self.store_impulses,
             Stage::Finish => self.finish,
         }
@@ -146,6 +154,7 @@ impl StepProfile {
             Stage::Assembly => &mut self.assembly,
             Stage::Solve => &mut self.solve,
             Stage::Scatter => &mut self.scatter,
+            Stage::Continuous => &mut self.continuous,
             Stage::StoreImpulses => &mut self.store_impulses,
             Stage::Finish => &mut self.finish,
         };
@@ -153,7 +162,7 @@ impl StepProfile {
     }
 
     /// The stages as (name, ms) pairs, in step order (without `total`).
-    pub fn stages(&self) -> [(&'static str, f32); 8] {
+    pub fn stages(&self) -> [(&'static str, f32); 9] {
         Stage::ALL.map(|stage| (stage.name(), self.get(stage)))
     }
 }

@@ -1,8 +1,12 @@
 //! Islands: the connected components of the contact graph, which are solved independently
 //! ([`crate::solver::substep`] runs one island's step).
 //!
-//! Two moving bodies are in one island when a chain of contacts joins them; static bodies join
-//! nothing (they take no impulse). Quiet islands fall asleep.
+//! Two dynamic bodies are in one island when a chain of contacts joins them; static and
+//! kinematic bodies join nothing (they take no impulse). A kinematic body touching an island
+//! is one of its guests: it has a slot of its own in the island's local arrays, holding its
+//! prescribed velocity, so that contacts see its motion (it may be a guest of several
+//! islands). Static bodies share the island's immovable slot, at rest. Quiet islands fall
+//! asleep.
 
 use crate::body::{Bodies, BodyKind};
 use crate::narrow_phase::ContactPair;
@@ -16,7 +20,14 @@ pub struct Islands {
     bodies: Vec<u32>,
     /// Island k's constraints are `constraint_start[k]..constraint_start[k + 1]`.
     constraint_start: Vec<u32>,
-    /// Island of each body; `u32::MAX` for static bodies.
+    /// Island k's guests (kinematic bodies touching it, in increasing index order) are
+    /// `guests[guest_start[k]..guest_start[k + 1]]`; their slots follow the island's bodies.
+    guest_start: Vec<u32>,
+    guests: Vec<u32>,
+    /// (island, kinematic body) of every pair between a kinematic and a dynamic body: build
+    /// scratch, sorted into `guests`.
+    guest_pairs: Vec<(u32, u32)>,
+    /// Island of each body; `u32::MAX` for static and kinematic bodies.
     pub island_of_body: Vec<u32>,
     /// During the build the union-find forest; then each moving body's local index.
     parent: Vec<u32>,
@@ -59,13 +70,28 @@ impl Islands {
         self.parent[body] as usize
     }
 
+    /// Kinematic bodies touching island `k` (its guests), in increasing index order. Their
+    /// slots in the island's local arrays follow the island's bodies, in this order; the
+    /// immovable slot comes last.
+    pub fn guests(&self, k: usize) -> &[u32] {
+        match self.guest_start.get(k..k + 2) {
+            Some(range) => &self.guests[range[0] as usize..range[1] as usize],
+            None => &[],
+        }
+    }
+
     /// `body`'s slot in its island's local arrays, where the island is `island`: its local
-    /// index if it moves, the immovable slot after the island's bodies if it is static.
+    /// index if it is dynamic; after the island's bodies, its guest slot if it is kinematic;
+    /// the immovable slot after those if it is static.
     pub fn slot(&self, body: usize, island: usize) -> u32 {
-        if self.island_of_body[body] == u32::MAX {
-            self.body_start[island + 1] - self.body_start[island]
-        } else {
-            self.parent[body]
+        if self.island_of_body[body] != u32::MAX {
+            return self.parent[body];
+        }
+        let bodies = self.body_start[island + 1] - self.body_start[island];
+        let guests = self.guests(island);
+        match guests.binary_search(&(body as u32)) {
+            Ok(guest) if self.kinds[body] == BodyKind::Kinematic => bodies + guest as u32,
+            _ => bodies + guests.len() as u32,
         }
     }
 
@@ -95,7 +121,7 @@ impl Islands {
     }
 
     /// Finds the islands of the narrow phase's `pairs` (union-find over pairs with constraints
-    /// between moving bodies) and the order in which to assemble the pairs so that each
+    /// between dynamic bodies), each island's guests (the kinematic bodies it touches) and the order in which to assemble the pairs so that each
     /// island's constraints are contiguous (a stable counting sort of pair indices: within an
     /// island, narrow-phase order). Sorting 4-byte pair indices here replaces moving the
     /// assembled 340-byte constraints (4 % of a balls16k step as a comparison sort, 2 % as a
@@ -122,7 +148,7 @@ impl Islands {
         self.parent.extend(0..n as u32);
         for &(a, b, _) in keys.iter().filter(|k| k.2 > 0) {
             let (a, b) = (a as usize, b as usize);
-            if bodies.is_moving(a) && bodies.is_moving(b) {
+            if bodies.is_dynamic(a) && bodies.is_dynamic(b) {
                 let (ra, rb) = (find(&mut self.parent, a), find(&mut self.parent, b));
                 if ra != rb {
                     // Union by index keeps the result independent of pair order.
@@ -136,7 +162,7 @@ impl Islands {
         self.island_of_body.resize(n, u32::MAX);
         let mut count = 0u32;
         for i in 0..n {
-            if bodies.is_moving(i) {
+            if bodies.is_dynamic(i) {
                 let root = find(&mut self.parent, i) as usize;
                 if self.island_of_body[root] == u32::MAX {
                     self.island_of_body[root] = count;
@@ -177,6 +203,33 @@ impl Islands {
                 fill[k as usize] += 1;
             }
         }
+        // Guests: the kinematic bodies of pairs with constraints, per island of their partner.
+        self.guest_pairs.clear();
+        for &(a, b, _) in keys.iter().filter(|k| k.2 > 0) {
+            let (a, b) = (a as usize, b as usize);
+            let (kinematic, other) = match (self.kinds[a], self.kinds[b]) {
+                (BodyKind::Kinematic, _) => (a, b),
+                (_, BodyKind::Kinematic) => (b, a),
+                _ => continue,
+            };
+            let k = self.island_of_body[other];
+            if k != u32::MAX {
+                self.guest_pairs.push((k, kinematic as u32));
+            }
+        }
+        self.guest_pairs.sort_unstable();
+        self.guest_pairs.dedup();
+        self.guest_start.clear();
+        self.guest_start.resize(islands + 1, 0);
+        for &(k, _) in &self.guest_pairs {
+            self.guest_start[k as usize + 1] += 1;
+        }
+        for k in 0..islands {
+            self.guest_start[k + 1] += self.guest_start[k];
+        }
+        self.guests.clear();
+        self.guests
+            .extend(self.guest_pairs.iter().map(|&(_, body)| body));
         // Constraints and pairs per island, then pairs in island order (counting sort).
         self.constraint_start.clear();
         self.constraint_start.resize(islands + 1, 0);

@@ -28,7 +28,8 @@
 //! front), [`Scene`] (the JSON scene format). Each stage of the step is one module:
 //! `integrate` (1, 6) → [`broad_phase`] (2) → [`narrow_phase`] (3) → [`constraints`] (4) →
 //! `island` and [`solver`] (5: one island at a time, [`solver::substep`], each method behind
-//! [`solver::ContactSolver`]) → [`diagnostics`] (7), driven by [`World::step`].
+//! [`solver::ContactSolver`]) → `kinematic` and [`continuous`] (kinematic bodies' motion,
+//! continuous collision) → [`diagnostics`] (7), driven by [`World::step`].
 
 #![warn(missing_docs)]
 
@@ -36,11 +37,13 @@ pub mod body;
 pub mod broad_phase;
 pub mod constraints;
 pub mod contact_lcp;
+pub mod continuous;
 pub mod diagnostics;
 pub mod error;
 pub(crate) mod graph;
 pub(crate) mod integrate;
 pub(crate) mod island;
+pub(crate) mod kinematic;
 pub mod metrics;
 pub mod narrow_phase;
 pub(crate) mod parallel;
@@ -58,7 +61,7 @@ pub use parry3d;
 /// (along y), `::convex_hull(&points)`, `::halfspace(normal)`.
 pub use parry3d::shape::SharedShape;
 
-pub use body::{BodyBuilder, BodyHandle, BodyKind};
+pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe};
 pub use diagnostics::StepDiagnostics;
 pub use error::{StepError, WorldError};
 pub use scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};

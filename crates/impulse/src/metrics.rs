@@ -64,11 +64,11 @@ pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u3
     deepest
 }
 
-/// Index of the moving body whose position is highest (largest y), the "top body" whose sink
+/// Index of the dynamic body whose position is highest (largest y), the "top body" whose sink
 /// the benchmarks measure. `None` when no body moves.
 pub fn top_body(bodies: &Bodies) -> Option<usize> {
     (0..bodies.len())
-        .filter(|&i| bodies.is_moving(i))
+        .filter(|&i| bodies.is_dynamic(i))
         .max_by(|&a, &b| {
             bodies.pose[a]
                 .translation
@@ -77,10 +77,10 @@ pub fn top_body(bodies: &Bodies) -> Option<usize> {
         })
 }
 
-/// Largest distance (m) any moving body has moved from `initial` positions.
+/// Largest distance (m) any dynamic body has moved from `initial` positions.
 pub fn max_drift(bodies: &Bodies, initial: &[Vec3]) -> f32 {
     (0..bodies.len())
-        .filter(|&i| bodies.is_moving(i))
+        .filter(|&i| bodies.is_dynamic(i))
         .map(|i| (bodies.pose[i].translation - initial[i]).length())
         .fold(0.0, f32::max)
 }

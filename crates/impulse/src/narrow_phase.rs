@@ -169,7 +169,8 @@ impl ContactPair {
 /// - Per pair ([`SpeculativeMargins::pair_prediction`], for the narrow phase): contact points
 ///   are generated up to the base prediction distance plus how far the two bodies can close
 ///   in one step, dt·(|v_a − v_b| + |ω_a|·R_a + |ω_b|·R_b), plus |g|·dt² when only one of them
-///   moves (gravity moves both alike otherwise); never more than the two bodies' margins.
+///   is dynamic (gravity moves both alike otherwise); never more than the two bodies' margins.
+///   A kinematic body counts with its prescribed velocities and no gravity.
 ///   Balls falling side by side close at 0 m/s, so they get no speculative contact and do not
 ///   join one island; with the sum of the per-body margins every column of `balls16k` joined
 ///   one island of 16,000 balls while falling.
@@ -197,7 +198,12 @@ impl SpeculativeMargins {
             let (margin, spin_speed) = if bodies.is_moving(i) {
                 let radius = bodies.shape[i].compute_local_aabb().half_extents().length();
                 let spin_speed = bodies.angular_velocity[i].length() * radius;
-                let speed = bodies.linear_velocity[i].length() + spin_speed + self.gravity_speed;
+                let gravity_speed = if bodies.is_dynamic(i) {
+                    self.gravity_speed
+                } else {
+                    0.0
+                };
+                let speed = bodies.linear_velocity[i].length() + spin_speed + gravity_speed;
                 (
                     (0.5 * prediction_distance + speed * dt).min(MAX_SPECULATIVE_MARGIN),
                     spin_speed,
@@ -225,7 +231,8 @@ impl SpeculativeMargins {
                 Vec3::ZERO
             }
         };
-        let gravity = if bodies.is_moving(a) != bodies.is_moving(b) {
+        // Gravity moves dynamic bodies alike, and kinematic and static ones not at all.
+        let gravity = if bodies.is_dynamic(a) != bodies.is_dynamic(b) {
             self.gravity_speed
         } else {
             0.0
@@ -367,6 +374,14 @@ impl NarrowPhase {
         // gave a manifold are dropped.
         self.pairs.retain(|p| !p.manifolds.is_empty());
         Ok(())
+    }
+
+    /// Whether bodies `a` and `b` have contact points this step (speculative ones included).
+    pub fn has_points(&self, a: u32, b: u32) -> bool {
+        let key = (a.min(b), a.max(b));
+        self.pairs
+            .binary_search_by(|p| (p.body1, p.body2).cmp(&key))
+            .is_ok_and(|i| self.pairs[i].point_count() > 0)
     }
 
     /// Largest penetration depth (m) among current contact points, 0 if none overlap.

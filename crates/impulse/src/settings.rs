@@ -184,6 +184,14 @@ pub struct SolverSettings {
     /// and a body spun near its intermediate axis tumbles (docs/method.md, "Gyroscopic
     /// motion"). Off keeps ω constant in the world frame between contacts.
     pub gyroscopic: bool,
+    /// Continuous collision (motion clamping, [`crate::continuous`]): a dynamic body that
+    /// moved more than half its smallest half extent in a step is swept from its pose at the
+    /// step's start to its pose at the end against the static and kinematic bodies (Parry's
+    /// nonlinear shape cast), and put back to the first impact, its velocity kept for the
+    /// next step's contacts (Rapier's CCD against fixed colliders, Box2D v3's continuous
+    /// collision). Fast bodies then never pass through a thin wall, whatever their speed. On
+    /// by default; the cost without fast bodies is a pass over the bodies' poses.
+    pub continuous: bool,
 }
 
 /// A solver setting outside its allowed range: which field, and what is allowed.
@@ -422,6 +430,7 @@ impl Default for SolverSettings {
             parallel_island_contacts: 0,
             simd_island_contacts: 16,
             gyroscopic: true,
+            continuous: true,
         }
     }
 }

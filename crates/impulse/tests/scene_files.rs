@@ -755,7 +755,7 @@ fn missing_field() {
 #[test]
 fn bad_enum_value() {
     let text = Bad {
-        kind: "kinematic",
+        kind: "ghost",
         ..Bad::default()
     }
     .text();
@@ -764,10 +764,10 @@ fn bad_enum_value() {
         &text,
         SceneErrorKind::Structure,
         10,
-        25,
+        21,
         LID,
         "bodies[2].kind",
-        "unknown variant `kinematic`",
+        "unknown variant `ghost`",
     );
 }
 

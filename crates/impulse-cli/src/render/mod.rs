@@ -480,7 +480,8 @@ fn islands(world: &World, bodies: &[DrawnBody]) -> Vec<usize> {
             continue;
         };
         let (a, b) = (a.index(), b.index());
-        if bodies[a].kind == BodyKind::Static || bodies[b].kind == BodyKind::Static {
+        // Static and kinematic bodies join no island (as in the engine).
+        if !bodies[a].kind.is_dynamic() || !bodies[b].kind.is_dynamic() {
             continue;
         }
         let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));

@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use super::error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
 use super::validate::validate;
-use super::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
+use super::{BodyDesc, BodyKind, KeyframeDesc, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
 
 /// Reads, parses and validates the scene file at `path`.
@@ -458,6 +458,8 @@ struct BodyOut<'a> {
     groups: u32,
     #[serde(skip_serializing_if = "is_all")]
     mask: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    keyframes: &'a Option<Vec<KeyframeDesc>>,
 }
 
 impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
@@ -478,6 +480,7 @@ impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
             lock_rotation,
             groups,
             mask,
+            keyframes,
         } = b;
         Self {
             name,
@@ -494,6 +497,7 @@ impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
             lock_rotation: *lock_rotation,
             groups: *groups,
             mask: *mask,
+            keyframes,
         }
     }
 }

@@ -129,7 +129,7 @@ pub struct BodyDesc {
     /// Optional name, shown in error messages.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// Dynamic, static or particle.
+    /// Dynamic, static, particle or kinematic.
     pub kind: BodyKind,
     /// Collision shape.
     pub shape: ShapeDesc,
@@ -139,10 +139,11 @@ pub struct BodyDesc {
     /// Orientation as a unit quaternion `[x, y, z, w]` (scalar last).
     #[serde(default = "identity_quaternion")]
     pub orientation: [f32; 4],
-    /// Linear velocity (m/s) of the body origin.
+    /// Linear velocity (m/s) of the body origin; a kinematic body without keyframes keeps it.
     #[serde(default)]
     pub linear_velocity: [f32; 3],
-    /// Angular velocity (rad/s), world frame. Ignored for particles.
+    /// Angular velocity (rad/s), world frame. Ignored for particles; a kinematic body without
+    /// keyframes keeps it, turning about its shape's centroid.
     #[serde(default)]
     pub angular_velocity: [f32; 3],
     /// Material (inline or by name).
@@ -167,6 +168,24 @@ pub struct BodyDesc {
     /// when `(groups_a & mask_b) != 0 && (groups_b & mask_a) != 0`.
     #[serde(default = "all_groups")]
     pub mask: u32,
+    /// Kinematic bodies only: timed poses the body moves through, from its own `position` and
+    /// `orientation` at t = 0, linearly in position and by slerp in orientation, holding the
+    /// last pose after the last time. At least one; times finite, > 0 and increasing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub keyframes: Option<Vec<KeyframeDesc>>,
+}
+
+/// One keyframe of a kinematic body ([`BodyDesc::keyframes`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyframeDesc {
+    /// Time (s) since the start, > 0.
+    pub t: f32,
+    /// Position of the body origin at that time (m).
+    pub position: [f32; 3],
+    /// Orientation at that time, a quaternion `[x, y, z, w]` (normalised; not zero).
+    #[serde(default = "identity_quaternion")]
+    pub orientation: [f32; 4],
 }
 
 fn all_groups() -> u32 {
@@ -218,6 +237,7 @@ impl BodyDesc {
             lock_rotation: false,
             groups: all_groups(),
             mask: all_groups(),
+            keyframes: None,
         }
     }
 }

@@ -14,6 +14,8 @@
 //!   extent > 0, a convex hull has ≥ 4 points that span a volume (not all coincident,
 //!   collinear or coplanar), a half-space normal is not zero and belongs to a static body;
 //! - a particle's shape is a sphere;
+//! - `keyframes` belong to a kinematic body, are at least one, with times finite, > 0 and
+//!   increasing, finite positions and non-zero orientations;
 //! - the orientation quaternion is not zero (norm ≥ [`MIN_NORM`]); a nonzero non-unit
 //!   quaternion is accepted and normalised when the world is built; the same holds for a
 //!   half-space normal;
@@ -23,7 +25,7 @@
 use std::collections::BTreeMap;
 
 use super::error::{BodyRef, FieldPath, SceneError, SceneErrorKind};
-use super::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
+use super::{BodyDesc, BodyKind, KeyframeDesc, Material, MaterialRef, Scene, ShapeDesc};
 
 /// Smallest norm of an orientation quaternion or a half-space normal that is accepted;
 /// below it the vector counts as zero (its direction is not defined in f32).
@@ -175,6 +177,85 @@ impl Checker {
             MaterialRef::Inline(m) => self.material(&path.key("material"), m),
         }
         self.shape(&path.key("shape"), b.kind, &b.shape);
+        if let Some(keyframes) = &b.keyframes {
+            self.keyframes(path, b, keyframes);
+        }
+    }
+
+    /// Keyframes of body `b` at `body` (its path).
+    fn keyframes(&mut self, body: &FieldPath, b: &BodyDesc, keyframes: &[KeyframeDesc]) {
+        let kind = b.kind;
+        let path = &body.key("keyframes");
+        if kind != BodyKind::Kinematic {
+            self.fail(
+                path,
+                format!(
+                    "only a kinematic body may have keyframes, this body is {}",
+                    kind_name(kind)
+                ),
+            );
+            return;
+        }
+        if keyframes.is_empty() {
+            self.fail(
+                path,
+                "needs at least one keyframe {\"t\": s, \"position\": [x, y, z]}".to_string(),
+            );
+        }
+        for field in ["linear_velocity", "angular_velocity"] {
+            let velocity = if field == "linear_velocity" {
+                b.linear_velocity
+            } else {
+                b.angular_velocity
+            };
+            if velocity != [0.0; 3] {
+                self.fail(
+                    &body.key(field),
+                    format!(
+                        "a body with keyframes takes its velocity from them: leave {field} out, \
+                         got {velocity:?}"
+                    ),
+                );
+            }
+        }
+        let mut previous = 0.0f32;
+        for (i, key) in keyframes.iter().enumerate() {
+            let key_path = path.index(i);
+            let t_path = key_path.key("t");
+            if self.finite(&t_path, key.t) {
+                if key.t <= previous {
+                    self.fail(
+                        &t_path,
+                        if i == 0 {
+                            format!(
+                                "must be > 0 (the body's position and orientation are its pose \
+                                 at t = 0), got {}",
+                                key.t
+                            )
+                        } else {
+                            format!(
+                                "must be after the previous keyframe's t = {previous}, got {}",
+                                key.t
+                            )
+                        },
+                    );
+                }
+                previous = key.t;
+            }
+            self.finite_array(&key_path.key("position"), &key.position);
+            let orientation = key_path.key("orientation");
+            if self.finite_array(&orientation, &key.orientation)
+                && norm(&key.orientation) < f64::from(MIN_NORM)
+            {
+                self.fail(
+                    &orientation,
+                    format!(
+                        "quaternion must not be zero (it is normalised), got {:?}",
+                        key.orientation
+                    ),
+                );
+            }
+        }
     }
 
     fn shape(&mut self, path: &FieldPath, kind: BodyKind, shape: &ShapeDesc) {
@@ -276,6 +357,7 @@ fn kind_name(kind: BodyKind) -> &'static str {
         BodyKind::Dynamic => "dynamic",
         BodyKind::Static => "static",
         BodyKind::Particle => "particle",
+        BodyKind::Kinematic => "kinematic",
     }
 }
 

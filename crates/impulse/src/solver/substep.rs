@@ -60,7 +60,8 @@ pub struct IslandReport {
 /// Local state of one island during a step.
 #[derive(Default)]
 pub struct IslandWorkspace {
-    /// Linear velocities (m/s) of the island's bodies, then the immovable slot.
+    /// Linear velocities (m/s) of the island's bodies, then its guests (kinematic bodies),
+    /// then the immovable slot.
     pub linear: Vec<Vec3>,
     /// Angular velocities (rad/s), same layout.
     pub angular: Vec<Vec3>,
@@ -220,8 +221,15 @@ pub struct StepContext<'a> {
 /// the restitution solve. Results stay in `workspace` until [`scatter`]. The rows' J·v*
 /// (`velocity_before`) is left to the caller, which takes it in one pass with the residual
 /// ([`crate::diagnostics::record_velocity_before_and_residual`], as [`crate::World`] does).
+///
+/// `guests` are the kinematic bodies touching the island (`Islands::guests` of the island stage):
+/// their slots follow the island's bodies and hold their prescribed velocities, which no
+/// impulse changes (their inverse mass and inertia are zero) and no gravity or force
+/// touches; their displacement is integrated with the island's so that the contacts'
+/// separations follow their motion. They are not written back.
 pub fn step_island(
     island_bodies: &[u32],
+    guests: &[u32],
     constraints: &mut [ContactConstraint],
     context: &StepContext<'_>,
     workspace: &mut IslandWorkspace,
@@ -235,12 +243,12 @@ pub fn step_island(
         restitution,
         forces,
     } = *context;
-    let slots = island_bodies.len() + 1;
+    let slots = island_bodies.len() + guests.len() + 1;
     let w = workspace;
     w.linear.clear();
     w.angular.clear();
     w.orientation.clear();
-    for &i in island_bodies {
+    for &i in island_bodies.iter().chain(guests) {
         w.linear.push(bodies.linear_velocity[i as usize]);
         w.angular.push(bodies.angular_velocity[i as usize]);
         w.orientation.push(bodies.pose[i as usize].rotation);
@@ -333,7 +341,10 @@ pub fn step_island(
     // Whether this island's passes over all its points or bodies go on rayon's threads too.
     let spread = parallel::spread(w.parallel, 1, 0)
         && (coloured_threads || (bundled && w.solvers.wide.parallel()));
-    let moving = slots - 1;
+    // Gravity, forces and damping act on the island's bodies; positions are integrated for
+    // its guests too.
+    let moving = island_bodies.len();
+    let integrated = slots - 1;
     for substep in 0..settings.substeps {
         // Every other substep, PGS takes each manifold's points from halfway round (see
         // `wide::sweep_groups`), so that no corner of a face always goes first. Split
@@ -402,17 +413,23 @@ pub fn step_island(
                 settings.tolerance,
                 &mut pseudo,
             );
-            for k in 0..moving {
+            for k in 0..integrated {
                 w.pseudo_linear[k] += w.linear[k];
                 w.pseudo_angular[k] += w.angular[k];
             }
         }
         let (linear, angular) = if split {
-            (&w.pseudo_linear[..moving], &w.pseudo_angular[..moving])
+            (
+                &w.pseudo_linear[..integrated],
+                &w.pseudo_angular[..integrated],
+            )
         } else {
-            (&w.linear[..moving], &w.angular[..moving])
+            (&w.linear[..integrated], &w.angular[..integrated])
         };
-        let (displacement, rotation) = (&mut w.displacement[..moving], &mut w.rotation[..moving]);
+        let (displacement, rotation) = (
+            &mut w.displacement[..integrated],
+            &mut w.rotation[..integrated],
+        );
         if spread {
             // Per body, so any split gives the same poses; serial, this was 0.4 % of a
             // two-thread `fast` pyramid100 step with the other thread idle.

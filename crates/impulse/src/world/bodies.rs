@@ -29,7 +29,7 @@ impl<'a> BodyRef<'a> {
         self.index
     }
 
-    /// Dynamic, static or particle.
+    /// Dynamic, static, particle or kinematic.
     pub fn kind(&self) -> BodyKind {
         self.world.bodies.kind[self.index]
     }
@@ -69,7 +69,7 @@ impl<'a> BodyRef<'a> {
         self.linear_velocity() + self.angular_velocity().cross(point - self.center_of_mass())
     }
 
-    /// Mass (kg); infinity for a static body.
+    /// Mass (kg); infinity for a static or kinematic body.
     pub fn mass(&self) -> f32 {
         self.world.bodies.mass(self.index)
     }
@@ -148,8 +148,8 @@ impl World {
             .ok_or(WorldError::UnknownBody(handle))
     }
 
-    /// The index of a moving body, for edits of its motion; errors for a removed or a static
-    /// body, or a non-finite `value` (named `field`).
+    /// The index of a moving body, for edits of its velocities; errors for a removed or a
+    /// static body, or a non-finite `value` (named `field`).
     fn moving(&self, handle: BodyHandle, field: &str, value: Vec3) -> Result<usize, WorldError> {
         let index = self.index_of(handle)?;
         let refuse = |message: String| {
@@ -169,7 +169,25 @@ impl World {
         Ok(index)
     }
 
-    /// Sets the linear velocity of the body's centre of mass (m/s) and wakes it.
+    /// The index of a dynamic body, for forces and impulses; errors as [`Self::moving`], and
+    /// for a kinematic body, which forces and impulses do not move.
+    fn dynamic(&self, handle: BodyHandle, field: &str, value: Vec3) -> Result<usize, WorldError> {
+        let index = self.moving(handle, field, value)?;
+        if self.bodies.kind[index] == BodyKind::Kinematic {
+            return Err(WorldError::InvalidBody {
+                body: index,
+                name: self.bodies.name[index].clone(),
+                field: field.to_string(),
+                message: "a kinematic body follows its prescribed motion: set its velocity \
+                          or target pose instead"
+                    .into(),
+            });
+        }
+        Ok(index)
+    }
+
+    /// Sets the linear velocity of the body's centre of mass (m/s) and wakes it. A kinematic
+    /// body moves at it from the next step on (unless keyframes drive it).
     pub fn set_linear_velocity(
         &mut self,
         handle: BodyHandle,
@@ -182,7 +200,8 @@ impl World {
     }
 
     /// Sets the angular velocity (rad/s, world frame) and wakes the body; ignored for a
-    /// particle, whose rotation is locked.
+    /// particle or a body with locked rotation. A kinematic body turns at it about its centre
+    /// of mass from the next step on (unless keyframes drive it).
     pub fn set_angular_velocity(
         &mut self,
         handle: BodyHandle,
@@ -190,8 +209,9 @@ impl World {
     ) -> Result<(), WorldError> {
         let i = self.moving(handle, "angular_velocity", velocity)?;
         // A particle or a body with its rotation locked keeps ω = 0.
-        if self.bodies.kind[i] == BodyKind::Dynamic
-            && self.bodies.local_inverse_inertia[i] != glam::Mat3::ZERO
+        if self.bodies.kind[i] == BodyKind::Kinematic
+            || (self.bodies.kind[i] == BodyKind::Dynamic
+                && self.bodies.local_inverse_inertia[i] != glam::Mat3::ZERO)
         {
             self.bodies.angular_velocity[i] = velocity;
         }
@@ -200,8 +220,10 @@ impl World {
     }
 
     /// Moves the body frame to `translation` (m) and `rotation` (normalised; must not be
-    /// zero) and wakes the body: a teleport, which keeps its velocities. Static bodies may be
-    /// moved too; the bodies touching them then wake.
+    /// zero) and wakes the body: a teleport, which keeps its velocities. Static and kinematic
+    /// bodies may be moved too; the bodies touching them then wake. A kinematic body pushes
+    /// what it touches only when moved by its velocity or [`World::set_kinematic_target`]; a
+    /// teleport does not.
     pub fn set_pose(
         &mut self,
         handle: BodyHandle,
@@ -233,7 +255,7 @@ impl World {
             );
         }
         self.bodies.pose[i] = Pose::from_parts(translation, rotation.normalize());
-        if self.bodies.kind[i] == BodyKind::Static {
+        if !self.bodies.is_dynamic(i) {
             self.wake_touching(i);
         } else {
             self.wake_up(i);
@@ -245,7 +267,7 @@ impl World {
     /// gravity; forces are cleared after each step (call again every step for a steady push).
     /// Wakes the body.
     pub fn apply_force(&mut self, handle: BodyHandle, force: Vec3) -> Result<(), WorldError> {
-        let i = self.moving(handle, "force", force)?;
+        let i = self.dynamic(handle, "force", force)?;
         self.bodies.force[i] += force;
         self.forces_pending = true;
         self.wake_up(i);
@@ -260,7 +282,7 @@ impl World {
         force: Vec3,
         point: Vec3,
     ) -> Result<(), WorldError> {
-        let i = self.moving(handle, "point", point)?;
+        let i = self.dynamic(handle, "point", point)?;
         let torque = (point - self.bodies.center_of_mass(i)).cross(force);
         self.apply_force(handle, force)?;
         self.apply_torque(handle, torque)
@@ -269,7 +291,7 @@ impl World {
     /// Adds `torque` (N·m, world frame) for the next step; no effect on a particle. Wakes the
     /// body.
     pub fn apply_torque(&mut self, handle: BodyHandle, torque: Vec3) -> Result<(), WorldError> {
-        let i = self.moving(handle, "torque", torque)?;
+        let i = self.dynamic(handle, "torque", torque)?;
         self.bodies.torque[i] += torque;
         self.forces_pending = true;
         self.wake_up(i);
@@ -279,7 +301,7 @@ impl World {
     /// Changes the body's momentum by `impulse` (N·s) at the centre of mass, now: Δv = J/m.
     /// Wakes the body.
     pub fn apply_impulse(&mut self, handle: BodyHandle, impulse: Vec3) -> Result<(), WorldError> {
-        let i = self.moving(handle, "impulse", impulse)?;
+        let i = self.dynamic(handle, "impulse", impulse)?;
         self.bodies.linear_velocity[i] += impulse * self.bodies.inverse_mass[i];
         self.wake_up(i);
         Ok(())
@@ -293,7 +315,7 @@ impl World {
         impulse: Vec3,
         point: Vec3,
     ) -> Result<(), WorldError> {
-        let i = self.moving(handle, "point", point)?;
+        let i = self.dynamic(handle, "point", point)?;
         let torque = (point - self.bodies.center_of_mass(i)).cross(impulse);
         self.apply_impulse(handle, impulse)?;
         self.apply_torque_impulse(handle, torque)
@@ -306,7 +328,7 @@ impl World {
         handle: BodyHandle,
         impulse: Vec3,
     ) -> Result<(), WorldError> {
-        let i = self.moving(handle, "torque_impulse", impulse)?;
+        let i = self.dynamic(handle, "torque_impulse", impulse)?;
         let change = self.bodies.world_inverse_inertia(i) * impulse;
         self.bodies.angular_velocity[i] += change;
         self.wake_up(i);

@@ -12,6 +12,7 @@ use crate::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{StepDiagnostics, StepProfile};
 use crate::error::WorldError;
 use crate::island::Islands;
+use crate::kinematic::Script;
 use crate::narrow_phase::{self, NarrowPhase};
 use crate::scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
@@ -19,6 +20,8 @@ use crate::solver::substep::IslandWorkspace;
 
 mod bodies;
 mod contacts;
+mod continuous;
+mod kinematic;
 mod query;
 mod step;
 
@@ -78,6 +81,17 @@ pub struct World {
     scratch_bodies: Vec<u32>,
     /// Contact pairs touching at the end of the last step, and this step's events.
     contact_events: contacts::ContactEvents,
+    /// Simulated time (s): the sum of the steps' dt.
+    time: f64,
+    /// The position-based kinematic bodies' keyframes and targets.
+    scripts: Vec<Script>,
+    /// Every body's pose at the start of the step, for continuous collision (empty when it is
+    /// off).
+    start_poses: Vec<Pose>,
+    /// Kinematic bodies moving this step, in index order.
+    moving_kinematic: Vec<u32>,
+    /// The continuous stage's clamped poses (scratch).
+    clamps: Vec<(usize, Pose)>,
 }
 
 impl World {
@@ -108,6 +122,11 @@ impl World {
             forces_pending: false,
             scratch_bodies: Vec::new(),
             contact_events: contacts::ContactEvents::default(),
+            time: 0.0,
+            scripts: Vec::new(),
+            start_poses: Vec::new(),
+            moving_kinematic: Vec::new(),
+            clamps: Vec::new(),
         };
         world.check_settings()?;
         Ok(world)
@@ -175,7 +194,17 @@ impl World {
         b.groups.push(builder.groups);
         b.mask.push(builder.mask);
         b.name.push(builder.name);
-        Ok(self.handles.insert(index))
+        let handle = self.handles.insert(index);
+        if !builder.keyframes.is_empty() {
+            self.scripts.push(Script {
+                handle,
+                initial: built.pose,
+                keyframes: built.keyframes,
+                target: None,
+                step_target: None,
+            });
+        }
+        Ok(handle)
     }
 
     /// The time step (s).
@@ -193,6 +222,11 @@ impl World {
     /// Steps taken so far.
     pub fn step_count(&self) -> u64 {
         self.step_count
+    }
+
+    /// Simulated time (s): the sum of the steps' dt, the clock of kinematic keyframes.
+    pub fn time(&self) -> f64 {
+        self.time
     }
 
     /// The last step's diagnostics.
@@ -266,6 +300,7 @@ fn invalid(index: usize, desc: &BodyDesc, field: &str, message: String) -> World
 }
 
 struct BuiltBody {
+    keyframes: Vec<crate::body::Keyframe>,
     pose: Pose,
     local_center_of_mass: Vec3,
     linear_velocity: Vec3,
@@ -408,6 +443,16 @@ fn builder_of(
         lock_rotation: desc.lock_rotation,
         groups: desc.groups,
         mask: desc.mask,
+        keyframes: desc
+            .keyframes
+            .iter()
+            .flatten()
+            .map(|k| crate::body::Keyframe {
+                time: k.t,
+                translation: Vec3::from(k.position),
+                rotation: Quat::from_array(k.orientation),
+            })
+            .collect(),
     })
 }
 
@@ -465,6 +510,7 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
             return bad(field, format!("must be finite and ≥ 0, got {value}"));
         }
     }
+    let keyframes = check_keyframes(index, b)?;
     let shape = b.shape.clone();
     if b.kind != BodyKind::Static && shape.as_halfspace().is_some() {
         return bad("shape", "a half-space must be a static body".into());
@@ -488,6 +534,17 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
     };
     let (inverse_mass, local_center_of_mass, local_inverse_inertia) = match b.kind {
         BodyKind::Static => (0.0, Vec3::ZERO, Mat3::ZERO),
+        BodyKind::Kinematic => {
+            // No mass; the velocities are those of the shape's centroid, as for a dynamic
+            // body of uniform density.
+            let centroid = shape.mass_properties(1.0).local_com;
+            let centroid = if centroid.is_finite() {
+                centroid
+            } else {
+                Vec3::ZERO
+            };
+            (0.0, centroid, Mat3::ZERO)
+        }
         BodyKind::Dynamic | BodyKind::Particle => {
             positive("material.density", b.density)?;
             let props = shape.mass_properties(b.density);
@@ -518,11 +575,12 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
             (inverse_mass, props.local_com, inertia)
         }
     };
-    let angular_velocity = if b.kind == BodyKind::Dynamic && !b.lock_rotation {
-        b.angular_velocity
-    } else {
-        Vec3::ZERO
-    };
+    let angular_velocity =
+        if b.kind == BodyKind::Kinematic || (b.kind == BodyKind::Dynamic && !b.lock_rotation) {
+            b.angular_velocity
+        } else {
+            Vec3::ZERO
+        };
     // The builder gives the velocity of the body origin; the solver works at the centre of
     // mass.
     let linear_velocity = if b.kind == BodyKind::Static {
@@ -531,6 +589,7 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
         b.linear_velocity + angular_velocity.cross(rotation * local_center_of_mass)
     };
     Ok(BuiltBody {
+        keyframes,
         pose,
         local_center_of_mass,
         linear_velocity,
@@ -539,4 +598,64 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
         local_inverse_inertia,
         shape,
     })
+}
+
+/// A builder's keyframes, checked (kinematic bodies only; times finite, > 0 and increasing;
+/// translations finite; rotations finite and non-zero) and with normalised rotations. Fields
+/// are named as in the scene format (`keyframes[i].t`, `.position`, `.orientation`).
+fn check_keyframes(
+    index: usize,
+    b: &BodyBuilder,
+) -> Result<Vec<crate::body::Keyframe>, WorldError> {
+    let bad = |field: String, message: String| Err(invalid_built(index, b, &field, message));
+    if b.keyframes.is_empty() {
+        return Ok(Vec::new());
+    }
+    if b.kind != BodyKind::Kinematic {
+        return bad(
+            "keyframes".into(),
+            "only a kinematic body may have keyframes".into(),
+        );
+    }
+    let mut previous = 0.0f32;
+    let mut out = Vec::with_capacity(b.keyframes.len());
+    for (k, key) in b.keyframes.iter().enumerate() {
+        if !(key.time.is_finite() && key.time > previous) {
+            return bad(
+                format!("keyframes[{k}].t"),
+                if k == 0 {
+                    format!(
+                        "must be finite and > 0 (the body's own pose is its pose at t = 0), got {}",
+                        key.time
+                    )
+                } else {
+                    format!(
+                        "must be finite and after the previous keyframe's {previous} s, got {}",
+                        key.time
+                    )
+                },
+            );
+        }
+        previous = key.time;
+        if !key.translation.is_finite() {
+            return bad(
+                format!("keyframes[{k}].position"),
+                format!("must be finite, got {:?}", key.translation.to_array()),
+            );
+        }
+        if !key.rotation.is_finite() || key.rotation.length() < 1e-6 {
+            return bad(
+                format!("keyframes[{k}].orientation"),
+                format!(
+                    "must be a finite non-zero quaternion, got {:?}",
+                    key.rotation.to_array()
+                ),
+            );
+        }
+        out.push(crate::body::Keyframe {
+            rotation: key.rotation.normalize(),
+            ..*key
+        });
+    }
+    Ok(out)
 }

@@ -73,6 +73,8 @@ impl World {
         self.step_count += 1;
         let parallel = spread(self.parallel, 1, 0);
         let mut clock = StageClock::start();
+        self.kinematic_velocities();
+        self.record_start_poses(&settings);
         self.broad_phase_stage(&settings, parallel);
         clock.end(Stage::BroadPhase);
         self.narrow_phase_stage(parallel)?;
@@ -84,12 +86,16 @@ impl World {
         self.solve_stage(&settings);
         clock.end(Stage::Solve);
         self.scatter_islands();
+        self.move_kinematic_bodies();
         clock.end(Stage::Scatter);
+        self.continuous_stage(&settings);
+        clock.end(Stage::Continuous);
         self.store_impulses();
         clock.end(Stage::StoreImpulses);
         let energy = self.finish_stage(&settings, parallel);
         clock.end(Stage::Finish);
         self.profile = clock.profile();
+        self.time += f64::from(self.dt);
         self.end_step(&energy)?;
         Ok(&self.diagnostics)
     }
@@ -202,9 +208,10 @@ impl World {
             // 3 % of a balls16k step at rest (perf), mostly waiting on memory; the results are
             // the same to the bit.
             let run = |bodies: &[u32],
+                       guests: &[u32],
                        constraints: &mut [ContactConstraint],
                        workspace: &mut IslandWorkspace| {
-                substep::step_island(bodies, constraints, &context, workspace);
+                substep::step_island(bodies, guests, constraints, &context, workspace);
                 let rows = diagnostics::record_velocity_before_and_residual(
                     constraints,
                     constraints::BodySlots::Island,
@@ -245,7 +252,7 @@ impl World {
                         let mine = unsafe {
                             std::slice::from_raw_parts_mut(rows.0.add(range.start), range.len())
                         };
-                        run(islands_of.bodies(k), mine, workspace);
+                        run(islands_of.bodies(k), islands_of.guests(k), mine, workspace);
                     });
             } else {
                 let mut rest: &mut [ContactConstraint] = &mut self.constraints;
@@ -253,7 +260,7 @@ impl World {
                     let (mine, others) = rest.split_at_mut(islands_of.constraint_range(k).len());
                     rest = others;
                     if awake[k] {
-                        run(islands_of.bodies(k), mine, workspace);
+                        run(islands_of.bodies(k), islands_of.guests(k), mine, workspace);
                     }
                 }
             }
@@ -350,18 +357,26 @@ impl World {
             self.bodies.torque.fill(Vec3::ZERO);
             self.energy.lowest = energy.mechanical();
         }
+        if !self.moving_kinematic.is_empty() {
+            // A moving kinematic body does work on what it pushes or lifts, as a force does.
+            self.energy.lowest = energy.mechanical();
+        }
         self.check_blow_up(energy)?;
         Ok(())
     }
 
-    /// Marks which islands run this step: an island with any awake body runs and wakes all its
-    /// bodies (a sleeping pile hit by an awake body wakes whole); an island whose bodies are all
-    /// asleep is skipped.
+    /// Marks which islands run this step: an island with any awake body or moving kinematic
+    /// guest runs and wakes all its bodies (a sleeping pile hit by an awake body, or carried
+    /// off by a kinematic one, wakes whole); an island whose bodies are all asleep and whose
+    /// guests are still is skipped.
     fn wake_or_skip_islands(&mut self) {
         self.island_awake.clear();
         for k in 0..self.islands.len() {
             let bodies = self.islands.bodies(k);
-            let awake = bodies.iter().any(|&i| !self.bodies.asleep[i as usize]);
+            let awake = bodies
+                .iter()
+                .chain(self.islands.guests(k))
+                .any(|&i| !self.bodies.asleep[i as usize]);
             if awake {
                 for &i in bodies {
                     if self.bodies.asleep[i as usize] {
@@ -643,12 +658,15 @@ fn update_sleep(
     if !s.sleep {
         return;
     }
+    // An island touching a moving kinematic body stays awake: the body may carry it at any
+    // speed, below the thresholds too.
     let falls_asleep = |k: usize| {
         awake[k]
             && islands
                 .bodies(k)
                 .iter()
                 .all(|&i| bodies.sleep_time[i as usize] >= s.time_to_sleep)
+            && islands.guests(k).iter().all(|&i| bodies.asleep[i as usize])
     };
     let sleepers: Vec<usize> = if parallel {
         (0..awake.len())

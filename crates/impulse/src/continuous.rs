@@ -1,0 +1,138 @@
+//! Continuous collision (motion clamping): a dynamic body that moved more than a fraction of
+//! its own size in a step is swept from its pose at the step's start to its pose at the end
+//! against the static and kinematic bodies in its swept box, with Parry's nonlinear shape
+//! cast (translation and rotation); if it would pass one, its pose is put back to the first
+//! time of impact, less a small gap, and its velocity is left as it is, so that the next
+//! step's speculative contact stops it (docs/method.md, "Continuous collision").
+//!
+//! This is the method of Rapier's CCD, which sweeps every fast dynamic body against the fixed
+//! colliders and clamps its motion to the first impact, leaving the velocities to the solver
+//! (rapier.rs user guide, "Rigid-body CCD"), and of Box2D v3's continuous collision against
+//! static shapes, including its fallback for a body that starts the step touching a shape:
+//! the sweep of a small core sphere around the centre of mass, so that a body sliding along
+//! a surface is not stopped by it but one pushed through it is (Box2D v3.1,
+//! `b2ContinuousQueryCallback`).
+
+use glam::Vec3;
+use parry3d::math::Pose;
+use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, distance};
+use parry3d::shape::{Ball, Shape};
+
+use crate::kinematic::rotation_vector;
+
+/// A body is swept when it moved more than this fraction of its smallest half extent in a
+/// step (Box2D v3's safety factor: a slower body cannot pass through anything the contacts
+/// see, and needs no sweep).
+pub const FAST_FRACTION: f32 = 0.5;
+
+/// The gap (m) a clamped body is left short of the surface it would hit, at most (Box2D's
+/// linear slop), and at most this fraction of its smallest half extent for small bodies.
+pub const CLAMP_GAP: f32 = 0.005;
+
+/// Radius of the core sphere of a body that starts the step touching a surface, as a fraction
+/// of its smallest half extent (Box2D v3.1 uses a quarter of the shape's minimum extent).
+pub const CORE_FRACTION: f32 = 0.25;
+
+/// One body's motion over a step: from `start` to `end` (body frames), about its centre of
+/// mass at `local_center_of_mass`.
+#[derive(Clone, Copy, Debug)]
+pub struct Sweep {
+    /// Pose at the step's start.
+    pub start: Pose,
+    /// Pose at the step's end.
+    pub end: Pose,
+    /// Centre of mass in the body frame (m).
+    pub local_center_of_mass: Vec3,
+}
+
+impl Sweep {
+    /// The motion as Parry's [`NonlinearRigidMotion`] over the time interval [0, 1]: the centre
+    /// of mass moving at constant velocity and the body turning at constant angular velocity
+    /// about it.
+    pub fn motion(&self) -> NonlinearRigidMotion {
+        let com = self.local_center_of_mass;
+        NonlinearRigidMotion::new(
+            self.start,
+            com,
+            self.end.transform_point(com) - self.start.transform_point(com),
+            rotation_vector(self.start.rotation, self.end.rotation),
+        )
+    }
+
+    /// The pose at fraction `t` ∈ [0, 1] of the step along [`Sweep::motion`].
+    pub fn pose_at(&self, t: f32) -> Pose {
+        self.motion().position_at_time(t)
+    }
+
+    /// A bound on how far (m) any point within `radius` of the centre of mass moves along the
+    /// sweep: the centre's travel plus the turned angle times `radius`.
+    pub fn travel(&self, radius: f32) -> f32 {
+        let com = self.local_center_of_mass;
+        (self.end.transform_point(com) - self.start.transform_point(com)).length()
+            + rotation_vector(self.start.rotation, self.end.rotation).length() * radius
+    }
+}
+
+/// What the sweep needs to know of the fast body's shape.
+#[derive(Clone, Copy)]
+pub struct FastBody<'a> {
+    /// Its shape (body frame).
+    pub shape: &'a dyn Shape,
+    /// Its motion over the step.
+    pub sweep: Sweep,
+    /// Its smallest half extent (m): the core sphere's and the gap's scale.
+    pub min_half_extent: f32,
+    /// A bound on how far any of its points moves in the step (m), > 0.
+    pub travel: f32,
+}
+
+/// The fraction of the step, in [0, 1), to which `body`'s motion is clamped so that it does not
+/// pass `target` (a static or kinematic body's shape moving along `target_sweep`), or `None`
+/// when the motion needs no clamp. With the two apart by more than the gap at the start and no
+/// contact between them this step (`in_contact` false): the first time of impact of Parry's
+/// nonlinear cast, moved back by the gap along the motion. With the two touching at the start,
+/// or in contact this step (the solver already held them apart at the points the narrow phase
+/// found, speculative ones included): the time of impact of the body's core sphere, so that
+/// only a body driven through the target is stopped, and a body sliding or spinning along it
+/// is not held at its start pose step after step. Shape pairs Parry cannot cast are not
+/// clamped.
+pub fn clamp_fraction(
+    body: &FastBody<'_>,
+    target: &dyn Shape,
+    target_sweep: &Sweep,
+    in_contact: bool,
+) -> Option<f32> {
+    let gap = CLAMP_GAP.min(0.1 * body.min_half_extent);
+    let start_distance = if in_contact {
+        0.0
+    } else {
+        distance(&body.sweep.start, body.shape, &target_sweep.start, target)
+            .ok()?
+            .distance
+    };
+    let motion = body.sweep.motion();
+    let target_motion = target_sweep.motion();
+    if start_distance > gap {
+        let hit =
+            cast_shapes_nonlinear(&motion, body.shape, &target_motion, target, 0.0, 1.0, true)
+                .ok()??;
+        let t = hit.time_of_impact;
+        return (t < 1.0).then(|| (t - gap / body.travel).max(0.0));
+    }
+    let core = Ball::new(CORE_FRACTION * body.min_half_extent);
+    let com = body.sweep.local_center_of_mass;
+    // The core sphere is centred on the centre of mass: the same motion about the same point.
+    let core_motion = NonlinearRigidMotion::new(
+        Pose::from_parts(
+            body.sweep.start.transform_point(com),
+            body.sweep.start.rotation,
+        ),
+        Vec3::ZERO,
+        motion.linvel,
+        motion.angvel,
+    );
+    let hit = cast_shapes_nonlinear(&core_motion, &core, &target_motion, target, 0.0, 1.0, true)
+        .ok()??;
+    let t = hit.time_of_impact;
+    (t > 0.0 && t < 1.0).then_some(t)
+}
