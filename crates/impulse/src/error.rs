@@ -88,7 +88,7 @@ pub enum StepError {
 #[derive(Debug, Error)]
 pub enum SnapshotError {
     /// The snapshot file could not be read or written.
-    #[error("{path}: {source}")]
+    #[error("snapshot file {path}")]
     Io {
         /// The file.
         path: std::path::PathBuf,
@@ -110,11 +110,11 @@ pub enum SnapshotError {
         supported: u32,
     },
     /// Fewer bytes than the header promised: the file was cut short.
-    #[error("snapshot truncated: {found} bytes of payload where the header promised {expected}")]
+    #[error("snapshot truncated: {found} bytes where the header promises {expected}")]
     Truncated {
-        /// Payload bytes the header announced.
+        /// Bytes the file should have: the header's 32, and then the payload length it gives.
         expected: u64,
-        /// Payload bytes present.
+        /// Bytes present.
         found: u64,
     },
     /// The payload's CRC-32 differs from the header's: the file was damaged.
