@@ -464,19 +464,19 @@ fn simulate(
         for v in &world.bodies.linear_velocity {
             max_speed = max_speed.max(v.length());
         }
-        if step % OVERLAP_SAMPLE_EVERY == 0 || step == last {
+        if step.is_multiple_of(OVERLAP_SAMPLE_EVERY) || step == last {
             final_overlap = metrics::max_overlap(&world.bodies);
             max_overlap = max_overlap.max(final_overlap);
             max_drift = max_drift.max(metrics::max_drift(&world.bodies, &initial));
         }
         let interrupted = INTERRUPTED.load(Ordering::SeqCst);
         if let Some(w) = session.writer.as_mut()
-            && (step % every == 0 || step == last || interrupted)
+            && (step.is_multiple_of(every) || step == last || interrupted)
         {
             w.write_frame(step, step as f64 * dt, &world.bodies)?;
         }
         if let (Some(k), Some(dir)) = (options.checkpoint_every, &options.checkpoint_dir)
-            && step % k == 0
+            && step.is_multiple_of(k)
         {
             write_checkpoint(&world, dir, &session, last)?;
             checkpointed = Some(step);

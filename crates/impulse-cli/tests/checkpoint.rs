@@ -60,7 +60,7 @@ fn resumed_rows_match(scene: &str, steps: u32, k: u32, every: u32) {
     let mut expected: Vec<String> = (1..=steps / k)
         .map(|i| format!("step-{:06}.snapshot", i * k))
         .collect();
-    if steps % k != 0 {
+    if !steps.is_multiple_of(k) {
         expected.push(format!("step-{steps:06}.snapshot"));
     }
     assert_eq!(

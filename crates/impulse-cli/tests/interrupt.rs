@@ -102,7 +102,11 @@ fn sigint_writes_a_final_checkpoint_that_resumes() {
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
     let last = format!("step-{stopped:06}.snapshot");
-    assert_eq!(names, [last.clone()], "only the final checkpoint");
+    assert_eq!(
+        names,
+        std::slice::from_ref(&last),
+        "only the final checkpoint"
+    );
     let resumed = Command::new(env!("CARGO_BIN_EXE_impulse"))
         .arg("resume")
         .arg(dir.join(&last))
