@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Prints docs/errors.md's catalogue: each bad input below, run through `impulse run`, with the
-# exit status and the first line the command prints on standard error.
+# Prints docs/errors.md's catalogue: each bad input below, run through `impulse run` (or
+# `impulse resume`), with the exit status and the first line the command prints on standard
+# error.
 # Usage: scripts/error-catalogue.sh [path/to/impulse]  (default: target/release/impulse)
 set -uo pipefail
 bin=${1:-target/release/impulse}
@@ -43,5 +44,18 @@ row "missing file" run "$dir/missing.json" --steps 1 --quiet
 row "binary file" run /bin/true --steps 1 --quiet
 row "truncated file" run "$(case_file truncated '{"name": "x", "bodies": [{"kind": "dynamic", "sha')" --steps 1 --quiet
 row "unknown --out extension" run stack3 --steps 1 --quiet --out "$dir/x.txt"
+"$bin" run stack3 --steps 5 --quiet --checkpoint-dir "$dir/checkpoints" >/dev/null 2>&1
+good="$dir/checkpoints/step-000005.snapshot"
+head -c 100 "$good" > "$dir/cut.snapshot"
+cp "$good" "$dir/damaged.snapshot"
+python3 -c 'import sys; b = bytearray(open(sys.argv[1], "rb").read()); b[-1] ^= 1; open(sys.argv[1], "wb").write(b)' "$dir/damaged.snapshot"
+cp "$good" "$dir/newer.snapshot"; printf '\x09' | dd of="$dir/newer.snapshot" bs=1 seek=16 conv=notrunc status=none
+row "resume: truncated snapshot" resume "$dir/cut.snapshot" --quiet
+row "resume: damaged snapshot" resume "$dir/damaged.snapshot" --quiet
+row "resume: not a snapshot" resume "$(case_file scene_not_snapshot '{"name": "x", "bodies": []}')" --quiet
+row "resume: another format version" resume "$dir/newer.snapshot" --quiet
+row "resume: missing snapshot" resume "$dir/missing.snapshot" --quiet
+row "resume: animation output" resume "$good" --quiet --out "$dir/x.glb"
+row "--checkpoint-every without --checkpoint-dir" run stack3 --steps 1 --quiet --checkpoint-every 10
 row "empty scene (a warning)" run "$(case_file empty '{"name": "empty", "bodies": []}')" --steps 1 --quiet
 row "bodies created overlapping (a warning)" run "$(case_file overlap "$(scene "$body, {\"kind\": \"dynamic\", \"shape\": {\"type\": \"sphere\", \"radius\": 0.5}, \"position\": [0, 2.2, 0]}")")" --steps 1 --quiet

@@ -76,6 +76,46 @@ enum Command {
         /// phase, narrow phase, islands, assembly, solve, scatter, impulse write-back, finish).
         #[arg(long)]
         profile: bool,
+        #[command(flatten)]
+        checkpoints: CheckpointArgs,
+    },
+    /// Continue a run from a world snapshot (a checkpoint of `impulse run --checkpoint-dir`):
+    /// the same steps, to the bit, as the run would have taken (docs/snapshots.md).
+    Resume {
+        /// Snapshot file, e.g. `checkpoints/step-000600.snapshot`.
+        snapshot: PathBuf,
+        /// Steps to take after the snapshot's step (default: up to the last step of the run
+        /// that wrote it).
+        #[arg(long)]
+        steps: Option<u32>,
+        /// Trajectory file continuing the run's, `.csv` or `.jsonl`: the frames after the
+        /// snapshot's step, numbered by step as the run numbers them.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Write every K-th frame, K ≥ 1 (default: the run's; the last frame is always
+        /// written).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        every: Option<u32>,
+        /// Worker threads (default: all cores); the results do not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Per-step diagnostics as CSV (as `impulse run --stats`).
+        #[arg(long)]
+        stats: Option<PathBuf>,
+        /// Per-step island reports as JSON Lines (as `impulse run --island-report`).
+        #[arg(long)]
+        island_report: Option<PathBuf>,
+        /// Write the summary as JSON to this file.
+        #[arg(long)]
+        summary_json: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+        /// After the summary, print the median wall time of each stage of the step.
+        #[arg(long)]
+        profile: bool,
+        #[command(flatten)]
+        checkpoints: CheckpointArgs,
     },
     /// Simulate a scene and draw shaded previews: PNG frames into a directory and/or an
     /// animated GIF (CPU rasteriser; docs/export.md).
@@ -158,6 +198,19 @@ enum Command {
         #[command(subcommand)]
         command: LcpCommand,
     },
+}
+
+/// World snapshots written while stepping (docs/snapshots.md).
+#[derive(clap::Args)]
+struct CheckpointArgs {
+    /// Write a world snapshot every K steps (K ≥ 1) into --checkpoint-dir.
+    #[arg(long, requires = "checkpoint_dir", value_parser = clap::value_parser!(u64).range(1..))]
+    checkpoint_every: Option<u64>,
+    /// Directory (created if missing) for the snapshots, `step-000120.snapshot`: every
+    /// --checkpoint-every steps, and the last step's when the run ends or is stopped by
+    /// Ctrl-C. Continue one with `impulse resume`.
+    #[arg(long)]
+    checkpoint_dir: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -252,6 +305,20 @@ fn main() -> ExitCode {
     }
 }
 
+/// Prints a finished run's summary (and stage times with `profile`); a run stopped by Ctrl-C
+/// exits with status 130.
+fn report(summary: run::Summary, profile: bool) -> Result<ExitCode> {
+    println!("{}", summary.line());
+    if profile {
+        println!("{}", summary.stage_line());
+    }
+    if run::INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
+        eprintln!("{}: {}", summary.scene, summary.status);
+        return Ok(ExitCode::from(130));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 fn real_main() -> Result<ExitCode> {
     let cli = Cli::parse();
     match cli.command {
@@ -268,6 +335,7 @@ fn real_main() -> Result<ExitCode> {
             summary_json,
             quiet,
             profile,
+            checkpoints,
         } => {
             let mut scene = resolve_scene(&scene)?;
             scene.solver = solver.apply(&scene.solver).map_err(anyhow::Error::msg)?;
@@ -276,23 +344,47 @@ fn real_main() -> Result<ExitCode> {
                 dt,
                 iterations: None,
                 out,
+                every: Some(every),
+                summary_json,
+                quiet,
+                threads,
+                island_report,
+                stats,
+                checkpoint_every: checkpoints.checkpoint_every,
+                checkpoint_dir: checkpoints.checkpoint_dir,
+            };
+            run::stop_on_ctrl_c()?;
+            return report(run::run(scene, &options)?, profile);
+        }
+        Command::Resume {
+            snapshot,
+            steps,
+            out,
+            every,
+            threads,
+            stats,
+            island_report,
+            summary_json,
+            quiet,
+            profile,
+            checkpoints,
+        } => {
+            let options = run::RunOptions {
+                steps,
+                dt: None,
+                iterations: None,
+                out,
                 every,
                 summary_json,
                 quiet,
                 threads,
                 island_report,
                 stats,
+                checkpoint_every: checkpoints.checkpoint_every,
+                checkpoint_dir: checkpoints.checkpoint_dir,
             };
             run::stop_on_ctrl_c()?;
-            let summary = run::run(scene, &options)?;
-            println!("{}", summary.line());
-            if profile {
-                println!("{}", summary.stage_line());
-            }
-            if run::INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
-                eprintln!("{}: {}", summary.scene, summary.status);
-                return Ok(ExitCode::from(130));
-            }
+            return report(run::resume(&snapshot, &options)?, profile);
         }
         Command::Render {
             scene,

@@ -1,26 +1,28 @@
 //! `impulse run`: step a scene, write its trajectory, print and save a summary.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use impulse::diagnostics::StepProfile;
 use impulse::solver::EscalationLevel;
-use impulse::{Scene, World, metrics};
+use impulse::{Scene, World, WorldSnapshot, metrics};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
 use crate::export::{self, Recording};
 use crate::trajectory::TrajectoryWriter;
 
-/// Options of `impulse run` beyond the scene itself.
+/// Options of `impulse run` and `impulse resume` beyond the scene or snapshot itself.
 pub struct RunOptions {
+    /// Steps to take (run: default the scene's; resume: default up to the run's last step).
     pub steps: Option<u32>,
     pub dt: Option<f32>,
     pub iterations: Option<u32>,
     pub out: Option<PathBuf>,
-    pub every: u32,
+    /// Write every K-th frame; `None`: 1 for a run, the run's own for a resume.
+    pub every: Option<u32>,
     pub summary_json: Option<PathBuf>,
     pub quiet: bool,
     /// Worker threads; `None` = all cores, 1 = none (everything on the calling thread).
@@ -29,6 +31,11 @@ pub struct RunOptions {
     pub island_report: Option<PathBuf>,
     /// Per-step diagnostics and stage times (CSV, [`crate::stats`]), if wanted.
     pub stats: Option<PathBuf>,
+    /// Write a world snapshot every K steps into `checkpoint_dir`.
+    pub checkpoint_every: Option<u64>,
+    /// Directory of the checkpoints: every `checkpoint_every` steps, and at the end of the
+    /// run (completed or stopped by Ctrl-C).
+    pub checkpoint_dir: Option<PathBuf>,
 }
 
 /// Island solves of a run by the strongest method each reached (one count per island and
@@ -194,21 +201,52 @@ pub fn stop_on_ctrl_c() -> Result<()> {
 /// Overlap from poses is measured every this many steps (and at the last).
 const OVERLAP_SAMPLE_EVERY: u64 = 10;
 
+/// Checkpoint metadata: the scene's name, the run's last step and its frame interval, so that
+/// `impulse resume` can name the run and carry on to its end with the same frames.
+const SCENE_KEY: &str = "scene";
+const FINAL_STEP_KEY: &str = "final_step";
+const EVERY_KEY: &str = "every";
+
+/// Extension of checkpoint files, `step-000120.snapshot`.
+pub const CHECKPOINT_EXTENSION: &str = "snapshot";
+
 /// Runs `scene` under `options`. A blow-up stops the run: the frames written so far stay on
 /// disk (an animation file is written with them), the summary (with `status` naming the step) is still written, and the error returns.
 pub fn run(scene: Scene, options: &RunOptions) -> Result<Summary> {
-    match options.threads {
-        Some(1) => run_on_this_thread(scene, options, false),
+    on_threads(options.threads, |parallel| {
+        run_scene(scene, options, parallel)
+    })
+}
+
+/// Continues the run a snapshot file holds (written by `--checkpoint-dir`, or by
+/// [`impulse::World::write_snapshot`]) for `options.steps` steps, or up to the last step of
+/// the run that wrote it. The trajectory continues the run's: frames after the snapshot's step,
+/// numbered by the world's step count, the same columns.
+pub fn resume(snapshot: &Path, options: &RunOptions) -> Result<Summary> {
+    let snapshot = WorldSnapshot::read_file(snapshot)?;
+    on_threads(options.threads, |parallel| {
+        resume_snapshot(snapshot, options, parallel)
+    })
+}
+
+/// Runs `job` on a pool of `threads` worker threads (`None`: all cores; 1: the calling thread
+/// alone), telling it whether it may spread work.
+fn on_threads<T: Send>(
+    threads: Option<usize>,
+    job: impl FnOnce(bool) -> Result<T> + Send,
+) -> Result<T> {
+    match threads {
+        Some(1) => job(false),
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
             .context("cannot start the worker threads")?
-            .install(|| run_on_this_thread(scene, options, true)),
-        None => run_on_this_thread(scene, options, true),
+            .install(|| job(true)),
+        None => job(true),
     }
 }
 
-fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<Summary> {
+fn run_scene(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<Summary> {
     if let Some(dt) = options.dt {
         scene.dt = dt;
     }
@@ -216,8 +254,8 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         scene.solver.iterations = iterations;
     }
     let steps = options.steps.unwrap_or(scene.steps) as u64;
-    let every = options.every.max(1) as u64;
-    let mut world = World::from_scene(&scene).context("cannot build the world")?;
+    let every = options.every.unwrap_or(1).max(1) as u64;
+    let world = World::from_scene(&scene).context("cannot build the world")?;
     if !world
         .bodies
         .kind
@@ -229,13 +267,111 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             scene.name
         );
     }
-    world.parallel = parallel;
     let mut writer = match &options.out {
         Some(path) => Some(FrameOutput::create(path, &scene)?),
         None => None,
     };
     if let Some(w) = writer.as_mut() {
         w.write_frame(0, 0.0, &world.bodies)?;
+    }
+    let session = Session {
+        name: scene.name.clone(),
+        steps,
+        every,
+        writer,
+    };
+    simulate(world, session, options, parallel)
+}
+
+fn resume_snapshot(
+    snapshot: WorldSnapshot,
+    options: &RunOptions,
+    parallel: bool,
+) -> Result<Summary> {
+    let metadata = snapshot.metadata();
+    let name = metadata
+        .get(SCENE_KEY)
+        .cloned()
+        .unwrap_or_else(|| "snapshot".to_string());
+    let start = snapshot.step_count();
+    let steps = match (options.steps, metadata.get(FINAL_STEP_KEY)) {
+        (Some(steps), _) => steps as u64,
+        (None, Some(last)) => last
+            .parse::<u64>()
+            .with_context(|| format!("the snapshot's {FINAL_STEP_KEY} is not a step: {last}"))?
+            .saturating_sub(start),
+        (None, None) => anyhow::bail!(
+            "the snapshot does not say where its run ends (it was not written by `impulse \
+             run`): give --steps"
+        ),
+    };
+    let every = match (options.every, metadata.get(EVERY_KEY)) {
+        (Some(every), _) => every as u64,
+        (None, Some(every)) => every.parse().unwrap_or(1),
+        (None, None) => 1,
+    }
+    .max(1);
+    let world = World::from_snapshot(snapshot)?;
+    let writer = match &options.out {
+        Some(path) => match path.extension().and_then(|e| e.to_str()) {
+            Some("csv" | "jsonl") => Some(FrameOutput::Trajectory(TrajectoryWriter::create(path)?)),
+            _ => anyhow::bail!(
+                "{}: a resumed run writes a trajectory that continues the run's: the output file \
+                 must end in .csv or .jsonl",
+                path.display()
+            ),
+        },
+        None => None,
+    };
+    let session = Session {
+        name,
+        steps,
+        every,
+        writer,
+    };
+    simulate(world, session, options, parallel)
+}
+
+/// What the stepping loop needs besides the world: the run's name, how many steps to take,
+/// the frame interval and the frame output.
+struct Session {
+    name: String,
+    steps: u64,
+    every: u64,
+    writer: Option<FrameOutput>,
+}
+
+/// Writes the world's snapshot as `dir/step-<step, 6 digits or more>.snapshot`, atomically,
+/// with the run's name, last step and frame interval as metadata.
+fn write_checkpoint(world: &World, dir: &Path, session: &Session, last: u64) -> Result<()> {
+    let mut snapshot = world.snapshot()?;
+    let metadata = snapshot.metadata_mut();
+    metadata.insert(SCENE_KEY.into(), session.name.clone());
+    metadata.insert(FINAL_STEP_KEY.into(), last.to_string());
+    metadata.insert(EVERY_KEY.into(), session.every.to_string());
+    let path = dir.join(format!(
+        "step-{:06}.{CHECKPOINT_EXTENSION}",
+        world.step_count()
+    ));
+    snapshot.write_file(&path)?;
+    Ok(())
+}
+
+/// Steps `world` `session.steps` times, writing frames, statistics and checkpoints, and
+/// measures the summary. A blow-up stops the loop and returns the error after every file is
+/// written; Ctrl-C stops it after the step under way, with a checkpoint of that step.
+fn simulate(
+    mut world: World,
+    mut session: Session,
+    options: &RunOptions,
+    parallel: bool,
+) -> Result<Summary> {
+    world.parallel = parallel;
+    let last = world.step_count() + session.steps;
+    let every = session.every;
+    if let Some(dir) = &options.checkpoint_dir {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create the checkpoint directory {}", dir.display()))?;
     }
     let top = metrics::top_body(&world.bodies);
     let top_y0 = top.map(|i| world.bodies.pose[i].translation.y);
@@ -245,17 +381,17 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
     let bar = if options.quiet {
         ProgressBar::hidden()
     } else {
-        ProgressBar::new(steps)
+        ProgressBar::new(session.steps)
     };
     bar.set_style(
         ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} steps ({per_sec}, eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    bar.set_message(scene.name.clone());
+    bar.set_message(session.name.clone());
 
     // Grown as the steps are taken: reserving for the whole run up front failed outright for a
     // run of 4 billion steps.
-    let reserve = steps.min(1 << 16) as usize;
+    let reserve = session.steps.min(1 << 16) as usize;
     let mut step_ms = Vec::with_capacity(reserve);
     let mut profiles: Vec<StepProfile> = Vec::with_capacity(reserve);
     let mut contacts_sum = 0u64;
@@ -278,7 +414,9 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         Some(path) => Some(crate::stats::StatsWriter::create(path)?),
         None => None,
     };
-    for step in 1..=steps {
+    let dt = world.dt() as f64;
+    let mut checkpointed = None;
+    while world.step_count() < last {
         let start = Instant::now();
         let result = world.step().map(|_| ());
         step_ms.push(start.elapsed().as_secs_f64() * 1e3);
@@ -287,6 +425,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             failure = Some(e);
             break;
         }
+        let step = world.step_count();
         profiles.push(*world.profile());
         if step == 1 {
             warn_of_overlaps_at_start(&world);
@@ -317,7 +456,7 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
             writeln!(w)?;
         }
         if let Some(stats) = stats.as_mut() {
-            stats.write_step(step as f64 * scene.dt as f64, diagnostics, world.profile())?;
+            stats.write_step(step as f64 * dt, diagnostics, world.profile())?;
         }
         contacts_sum += diagnostics.contacts as u64;
         iterations_sum += diagnostics.iterations as u64;
@@ -325,16 +464,22 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         for v in &world.bodies.linear_velocity {
             max_speed = max_speed.max(v.length());
         }
-        if step % OVERLAP_SAMPLE_EVERY == 0 || step == steps {
+        if step.is_multiple_of(OVERLAP_SAMPLE_EVERY) || step == last {
             final_overlap = metrics::max_overlap(&world.bodies);
             max_overlap = max_overlap.max(final_overlap);
             max_drift = max_drift.max(metrics::max_drift(&world.bodies, &initial));
         }
         let interrupted = INTERRUPTED.load(Ordering::SeqCst);
-        if let Some(w) = writer.as_mut()
-            && (step % every == 0 || step == steps || interrupted)
+        if let Some(w) = session.writer.as_mut()
+            && (step.is_multiple_of(every) || step == last || interrupted)
         {
-            w.write_frame(step, step as f64 * scene.dt as f64, &world.bodies)?;
+            w.write_frame(step, step as f64 * dt, &world.bodies)?;
+        }
+        if let (Some(k), Some(dir)) = (options.checkpoint_every, &options.checkpoint_dir)
+            && step.is_multiple_of(k)
+        {
+            write_checkpoint(&world, dir, &session, last)?;
+            checkpointed = Some(step);
         }
         bar.inc(1);
         if interrupted {
@@ -343,11 +488,18 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         }
     }
     bar.finish_and_clear();
+    // The last state, completed or interrupted, is checkpointed too; a blown-up one is not.
+    if let Some(dir) = &options.checkpoint_dir
+        && failure.is_none()
+        && checkpointed != Some(world.step_count())
+    {
+        write_checkpoint(&world, dir, &session, last)?;
+    }
     if let Some(stats) = stats.as_mut() {
         stats.finish()?;
     }
     // The animation file holds every frame written so far, also when a step failed.
-    let exported = writer.as_ref().map_or(Ok(()), FrameOutput::finish);
+    let exported = session.writer.as_ref().map_or(Ok(()), FrameOutput::finish);
 
     let taken = step_ms.len().max(1) as f64;
     let mean_ms = step_ms.iter().sum::<f64>() / taken;
@@ -356,11 +508,12 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         (Some(i), Some(y0)) => y0 - world.bodies.pose[i].translation.y,
         _ => 0.0,
     };
+    let settings = &world.settings;
     let summary = Summary {
-        scene: scene.name.clone(),
+        scene: session.name.clone(),
         bodies: world.bodies.len(),
         steps: world.step_count(),
-        dt: scene.dt,
+        dt: world.dt(),
         ms_per_step: median_ms,
         mean_ms_per_step: mean_ms,
         steps_per_second: if median_ms > 0.0 {
@@ -380,15 +533,15 @@ fn run_on_this_thread(mut scene: Scene, options: &RunOptions, parallel: bool) ->
         mean_iterations: iterations_sum as f64 / taken,
         max_natural_map_residual: max_residual,
         final_natural_map_residual: world.diagnostics().natural_map_residual,
-        iterations_limit: scene.solver.iterations,
-        method: scene.solver.method.name().to_string(),
+        iterations_limit: settings.iterations,
+        method: settings.method.name().to_string(),
         island_solves,
         threads: if parallel {
             rayon::current_num_threads()
         } else {
             1
         },
-        sleep: scene.solver.sleep,
+        sleep: settings.sleep,
         status,
         stage_ms: median_profile(&profiles),
     };

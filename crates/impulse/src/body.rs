@@ -28,7 +28,7 @@ pub enum BodyKind {
 /// seconds after the world's start the body frame is at `translation` with `rotation`.
 /// Between keyframes the pose is interpolated linearly in translation and by slerp in
 /// rotation; after the last one it is held.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Keyframe {
     /// Time (s) since the world's start; > 0 and increasing along the list (the body's
     /// initial pose is its pose at time 0).
@@ -71,7 +71,7 @@ impl BodyHandle {
 }
 
 /// Handle slots of a world: which dense body index each handle names, and the free slots.
-#[derive(Clone, Default)]
+#[derive(Clone, Default, Serialize, Deserialize)]
 pub(crate) struct Handles {
     /// Per slot: its generation, and the body's dense index (`u32::MAX` when free).
     slots: Vec<(u32, u32)>,
@@ -104,6 +104,38 @@ impl Handles {
         debug_assert_eq!(self.of_body.len(), body);
         self.of_body.push(handle);
         handle
+    }
+
+    /// Checks that the slots, the free list and the per-body handles agree, for a world of
+    /// `bodies` bodies (a snapshot's handles before they are trusted): every body's handle
+    /// names a slot that names the body back, and every other slot is free exactly once.
+    pub(crate) fn check(&self, bodies: usize) -> Result<(), String> {
+        if self.of_body.len() != bodies {
+            return Err(format!(
+                "{} body handles for {bodies} bodies",
+                self.of_body.len()
+            ));
+        }
+        for (body, handle) in self.of_body.iter().enumerate() {
+            if self.slots.get(handle.index as usize) != Some(&(handle.generation, body as u32)) {
+                return Err(format!("the handle of body {body} names another slot"));
+            }
+        }
+        let mut free = vec![false; self.slots.len()];
+        for &index in &self.free {
+            match self.slots.get(index as usize) {
+                Some(&(_, u32::MAX)) if !free[index as usize] => free[index as usize] = true,
+                _ => return Err(format!("free handle slot {index} is not a free slot")),
+            }
+        }
+        if self.free.len() + bodies != self.slots.len() {
+            return Err(format!(
+                "{} handle slots, {} free, for {bodies} bodies",
+                self.slots.len(),
+                self.free.len()
+            ));
+        }
+        Ok(())
     }
 
     /// The dense index of `handle`'s body, or `None` for a removed body or a foreign handle.
@@ -325,7 +357,7 @@ impl BodyBuilder {
 ///
 /// Velocities are those of the centre of mass; `pose` is the body frame the scene gave
 /// (trajectories report it), and `local_center_of_mass` locates the centre of mass in it.
-#[derive(Clone, Default)]
+#[derive(Clone, Default, Serialize, Deserialize)]
 pub struct Bodies {
     /// Dynamic, static, particle or kinematic.
     pub kind: Vec<BodyKind>,
@@ -395,6 +427,37 @@ impl Bodies {
         self.groups.swap_remove(i);
         self.mask.swap_remove(i);
         self.name.swap_remove(i)
+    }
+
+    /// Checks that every array has one entry per body (a snapshot's bodies before they are
+    /// trusted). Lists the same fields as [`Self::swap_remove`].
+    pub(crate) fn check_lengths(&self) -> Result<(), String> {
+        let n = self.kind.len();
+        let lengths = [
+            ("pose", self.pose.len()),
+            ("local_center_of_mass", self.local_center_of_mass.len()),
+            ("linear_velocity", self.linear_velocity.len()),
+            ("angular_velocity", self.angular_velocity.len()),
+            ("inverse_mass", self.inverse_mass.len()),
+            ("local_inverse_inertia", self.local_inverse_inertia.len()),
+            ("shape", self.shape.len()),
+            ("friction", self.friction.len()),
+            ("restitution", self.restitution.len()),
+            ("asleep", self.asleep.len()),
+            ("sleep_time", self.sleep_time.len()),
+            ("force", self.force.len()),
+            ("torque", self.torque.len()),
+            ("user_data", self.user_data.len()),
+            ("linear_damping", self.linear_damping.len()),
+            ("angular_damping", self.angular_damping.len()),
+            ("groups", self.groups.len()),
+            ("mask", self.mask.len()),
+            ("name", self.name.len()),
+        ];
+        match lengths.iter().find(|(_, len)| *len != n) {
+            Some((field, len)) => Err(format!("bodies.{field} has {len} entries for {n} bodies")),
+            None => Ok(()),
+        }
     }
 
     /// Number of bodies.

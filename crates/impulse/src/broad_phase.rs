@@ -3,6 +3,7 @@
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhLeafUpdateStatus, BvhWorkspace};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use crate::body::Bodies;
 
@@ -247,5 +248,64 @@ impl BroadPhase {
             tree.optimize_incremental(&mut self.workspace);
             self.changed_since_optimize = false;
         }
+    }
+}
+
+/// The broad phase's state between steps as a [`crate::world::WorldSnapshot`] keeps it: the
+/// leaf boxes, the last pairs and which bodies were moving. The tree is not kept: it is
+/// rebuilt from the leaf boxes, and the pairs are a function of the leaf boxes alone (every
+/// query and traversal finds all leaves whose boxes overlap, and the pairs are sorted), so a
+/// tree of another shape gives the same pairs.
+#[derive(Clone, Serialize, Deserialize)]
+pub(crate) struct BroadPhaseState {
+    has_tree: bool,
+    leaf_boxes: Vec<Aabb>,
+    pairs: Vec<(u32, u32)>,
+    moving: Vec<bool>,
+    changed_since_optimize: bool,
+}
+
+impl BroadPhase {
+    /// The state a snapshot keeps.
+    pub(crate) fn state(&self) -> BroadPhaseState {
+        BroadPhaseState {
+            has_tree: self.tree.is_some(),
+            leaf_boxes: self.leaf_boxes.clone(),
+            pairs: self.pairs.clone(),
+            moving: self.moving.clone(),
+            changed_since_optimize: self.changed_since_optimize,
+        }
+    }
+
+    /// The broad phase of `state` for a world of `bodies` bodies. Errors (saying what is
+    /// wrong) unless the boxes are ordered and not NaN and the pairs sorted, without repeats,
+    /// and name bodies `a < b < bodies`.
+    pub(crate) fn from_state(state: BroadPhaseState, bodies: usize) -> Result<Self, String> {
+        let ordered = |b: &Aabb| (0..3).all(|k| b.mins[k] <= b.maxs[k]);
+        if let Some(k) = state.leaf_boxes.iter().position(|b| !ordered(b)) {
+            return Err(format!("broad-phase leaf box {k} is empty or NaN"));
+        }
+        if state.leaf_boxes.len() > bodies || state.moving.len() > bodies {
+            return Err(format!(
+                "the broad phase has {} leaf boxes and {} moving flags; there are {bodies} bodies",
+                state.leaf_boxes.len(),
+                state.moving.len()
+            ));
+        }
+        let named = |&(a, b): &(u32, u32)| a < b && (b as usize) < bodies;
+        if !state.pairs.iter().all(named) || !state.pairs.windows(2).all(|w| w[0] < w[1]) {
+            return Err("the broad phase's pairs are not sorted pairs of bodies".into());
+        }
+        let tree = state
+            .has_tree
+            .then(|| Bvh::from_leaves(BvhBuildStrategy::Binned, &state.leaf_boxes));
+        Ok(Self {
+            tree,
+            leaf_boxes: state.leaf_boxes,
+            pairs: state.pairs,
+            moving: state.moving,
+            changed_since_optimize: state.changed_since_optimize,
+            ..Self::default()
+        })
     }
 }

@@ -1,7 +1,7 @@
 //! Stage 7 of the step: what the step did and how well its contact LCP was solved.
 
 use glam::Vec3;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::body::Bodies;
 use crate::constraints::{BodySlots, ContactConstraint};
@@ -13,7 +13,7 @@ use crate::solver::cap_to_disc;
 
 /// Per-step report. Every step's LCP can be checked: `natural_map_residual` is computed from
 /// the solver's own impulses and the velocities they produce, in the LCP's own units.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct StepDiagnostics {
     /// Steps taken so far, including this one.
     pub step: u64,

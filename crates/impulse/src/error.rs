@@ -83,3 +83,59 @@ pub enum StepError {
         body2: usize,
     },
 }
+
+/// A world snapshot that cannot be written or restored ([`crate::world::WorldSnapshot`]).
+#[derive(Debug, Error)]
+pub enum SnapshotError {
+    /// The snapshot file could not be read or written.
+    #[error("snapshot file {path}")]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What the operating system said.
+        source: std::io::Error,
+    },
+    /// The bytes do not start with the snapshot header: not a snapshot file.
+    #[error("not an impulse world snapshot (the file does not start with \"IMPULSE-WORLD\")")]
+    NotASnapshot,
+    /// The snapshot was written in another format version than this build reads.
+    #[error(
+        "snapshot format version {found}, but this build of impulse reads version {supported} \
+         (snapshots are not portable across impulse versions)"
+    )]
+    VersionMismatch {
+        /// The file's format version.
+        found: u32,
+        /// The version this build reads and writes ([`crate::world::SNAPSHOT_FORMAT_VERSION`]).
+        supported: u32,
+    },
+    /// Fewer bytes than the header promised: the file was cut short.
+    #[error("snapshot truncated: {found} bytes where the header promises {expected}")]
+    Truncated {
+        /// Bytes the file should have: the header's 32, and then the payload length it gives.
+        expected: u64,
+        /// Bytes present.
+        found: u64,
+    },
+    /// The payload's CRC-32 differs from the header's: the file was damaged.
+    #[error("snapshot corrupt: payload checksum {found:08x}, header says {expected:08x}")]
+    ChecksumMismatch {
+        /// CRC-32 in the header.
+        expected: u32,
+        /// CRC-32 of the payload as read.
+        found: u32,
+    },
+    /// The payload is not a valid encoding of a snapshot.
+    #[error("snapshot corrupt: cannot decode the payload: {0}")]
+    Decode(String),
+    /// The snapshot decodes but describes a world that cannot be stepped (a body index out
+    /// of range, a non-finite pose, an invalid setting, …); the message says what.
+    #[error("snapshot invalid: {0}")]
+    Invalid(String),
+    /// A body's shape cannot be stored (a user-defined Parry shape has no serialised form).
+    #[error("body {body}: its shape has no serialised form (a user-defined Parry shape)")]
+    UnsupportedShape {
+        /// Dense index of the body.
+        body: usize,
+    },
+}

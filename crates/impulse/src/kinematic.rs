@@ -15,7 +15,7 @@ use parry3d::math::Pose;
 use crate::body::{BodyHandle, Keyframe};
 
 /// The prescribed motion of one position-based kinematic body.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Script {
     /// The body it moves.
     pub handle: BodyHandle,

@@ -63,10 +63,12 @@ pub use parry3d::shape::SharedShape;
 
 pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe};
 pub use diagnostics::StepDiagnostics;
-pub use error::{StepError, WorldError};
+pub use error::{SnapshotError, StepError, WorldError};
 pub use scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
 pub use settings::{SettingError, SolverSettings};
-pub use world::{BodyRef, ContactEvent, ContactPairView, ContactPoint, RayHit, ShapeHit, World};
+pub use world::{
+    BodyRef, ContactEvent, ContactPairView, ContactPoint, RayHit, ShapeHit, World, WorldSnapshot,
+};
 
 /// The README's code, compiled and run as a doc-test.
 #[doc = include_str!("../../../README.md")]

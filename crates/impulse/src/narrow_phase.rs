@@ -11,13 +11,14 @@ use parry3d::query::{
     TrackedContact,
 };
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use crate::body::Bodies;
 use crate::error::StepError;
 use crate::parallel::{MANIFOLD_PAIRS_PER_TASK, prefetch, spread};
 
 /// Impulses a contact point received in the last solve, kept with the point across steps.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ContactImpulse {
     /// Normal impulse γ_n ≥ 0 (N·s).
     pub normal: f32,
@@ -31,7 +32,7 @@ pub struct ContactImpulse {
 }
 
 /// Per-manifold state kept across steps.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ManifoldState {
     /// First friction direction of the last step (zero before the first solve). Reusing it
     /// keeps the friction basis continuous: a basis rebuilt from the normal alone can flip
@@ -390,5 +391,124 @@ impl NarrowPhase {
             .iter()
             .map(|p| p.summary.max_depth)
             .fold(0.0, f32::max)
+    }
+}
+
+/// One pair's state between steps as a [`crate::world::WorldSnapshot`] keeps it: everything
+/// the next manifold update and warm start read. The point and row counts are not kept: they
+/// are a function of the manifolds ([`PairSummary::of`]).
+#[derive(Clone, Serialize, Deserialize)]
+pub(crate) struct PairState {
+    body1: u32,
+    body2: u32,
+    manifolds: Vec<Manifold>,
+    /// Parry's per-pair work space (composite shapes only), which it serialises itself.
+    workspace: Option<ContactManifoldsWorkspace>,
+    last_query: Option<QueryState>,
+    step_normal_impulse: f32,
+}
+
+/// A pair's last [`ManifoldQuery`] with the shapes' addresses replaced by whether they were
+/// the bodies' shapes when the snapshot was taken: addresses do not survive a restore, and
+/// the update is skipped only when the shapes are unchanged.
+#[derive(Clone, Copy, Serialize, Deserialize)]
+struct QueryState {
+    pose: Pose,
+    distance: f32,
+    shapes_current: bool,
+}
+
+/// The address of body `i`'s shape, which a [`ManifoldQuery`] compares.
+fn shape_address(bodies: &Bodies, i: usize) -> usize {
+    std::sync::Arc::as_ptr(&bodies.shape[i].0) as *const () as usize
+}
+
+impl NarrowPhase {
+    /// Every pair's state between steps (`previous` is always empty then).
+    pub(crate) fn state(&self, bodies: &Bodies) -> Vec<PairState> {
+        self.pairs
+            .iter()
+            .map(|pair| {
+                let (a, b) = (pair.body1 as usize, pair.body2 as usize);
+                PairState {
+                    body1: pair.body1,
+                    body2: pair.body2,
+                    manifolds: pair.manifolds.clone(),
+                    workspace: pair.workspace.clone(),
+                    last_query: pair.last_query.map(|q| QueryState {
+                        pose: q.pose,
+                        distance: q.distance,
+                        shapes_current: q.shapes
+                            == [shape_address(bodies, a), shape_address(bodies, b)],
+                    }),
+                    step_normal_impulse: pair.step_normal_impulse,
+                }
+            })
+            .collect()
+    }
+
+    /// The narrow phase of `pairs`, taken by [`Self::state`], for `bodies`. Errors (saying
+    /// what is wrong) unless the pairs are sorted without repeats, name bodies
+    /// `body1 < body2 < bodies.len()`, and their points and impulses are finite.
+    pub(crate) fn from_state(pairs: Vec<PairState>, bodies: &Bodies) -> Result<Self, String> {
+        let n = bodies.len();
+        let mut last = None;
+        let mut restored = Vec::with_capacity(pairs.len());
+        for (index, state) in pairs.into_iter().enumerate() {
+            let key = (state.body1, state.body2);
+            if state.body1 >= state.body2 || state.body2 as usize >= n {
+                return Err(format!(
+                    "contact pair {index} names bodies {key:?}; there are {n} bodies"
+                ));
+            }
+            if last.is_some_and(|last| last >= key) {
+                return Err(format!("contact pair {index} {key:?} is out of order"));
+            }
+            last = Some(key);
+            let finite = state.step_normal_impulse.is_finite()
+                && state.manifolds.iter().all(|m| {
+                    m.local_n1.is_finite()
+                        && m.local_n2.is_finite()
+                        && m.data.tangent.is_finite()
+                        && m.points.iter().all(|p| {
+                            p.local_p1.is_finite()
+                                && p.local_p2.is_finite()
+                                && p.dist.is_finite()
+                                && p.data.friction.is_finite()
+                                && p.data.normal.is_finite()
+                                && p.data.step_normal.is_finite()
+                                && p.data.step_friction.is_finite()
+                        })
+                });
+            if !finite {
+                return Err(format!(
+                    "contact pair {index} {key:?} has a non-finite value"
+                ));
+            }
+            let (a, b) = (state.body1 as usize, state.body2 as usize);
+            let last_query = state.last_query.map(|q| ManifoldQuery {
+                pose: q.pose,
+                distance: q.distance,
+                // No shape lives at address 0, so a query of replaced shapes never matches.
+                shapes: if q.shapes_current {
+                    [shape_address(bodies, a), shape_address(bodies, b)]
+                } else {
+                    [0, 0]
+                },
+            });
+            restored.push(ContactPair {
+                body1: state.body1,
+                body2: state.body2,
+                summary: PairSummary::of(&state.manifolds),
+                manifolds: state.manifolds,
+                workspace: state.workspace,
+                last_query,
+                step_normal_impulse: state.step_normal_impulse,
+            });
+        }
+        Ok(Self {
+            pairs: restored,
+            previous: Vec::new(),
+        })
     }
 }

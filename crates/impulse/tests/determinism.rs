@@ -1,6 +1,8 @@
 //! Determinism: the same scene stepped the same number of times ends in the same state, to the
 //! bit, on 1, 2 and 4 threads and from one run to the next (same binary, same CPU features).
-//! The state is hashed (FNV-1a over every body's pose and velocities as f32 bits).
+//! The state is hashed (FNV-1a over every body's pose and velocities and every contact point's
+//! impulses and separation, as f32 bits). `tests/snapshot.rs` checks that a world restored
+//! from a snapshot continues to the same state.
 
 use impulse::scene::builtin::builtin_scene;
 use impulse::scene::json::load_scene_file;
@@ -24,6 +26,15 @@ fn hash_state(world: &World) -> u64 {
             for x in v.to_array() {
                 add(x);
             }
+        }
+    }
+    for pair in world.contact_pairs() {
+        for point in pair.points() {
+            add(point.normal_impulse);
+            for x in point.friction_impulse.to_array() {
+                add(x);
+            }
+            add(point.separation);
         }
     }
     hash

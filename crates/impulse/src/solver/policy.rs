@@ -8,7 +8,18 @@ use crate::constraints::ContactConstraint;
 use crate::settings::SolverSettings;
 
 /// The methods of the automatic policy, weakest first.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    PartialOrd,
+    Ord,
+    serde::Serialize,
+    serde::Deserialize,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum EscalationLevel {
     /// Projected Gauss-Seidel alone (`method: pgs`).

@@ -24,7 +24,7 @@ use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 
 /// What the solver did on one island during a step (step 7 of docs/architecture.md: every step can say how
 /// well its LCP was solved, here per island).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct IslandReport {
     /// Smallest body index in the island: a stable name for it within the step.
     pub first_body: u32,

@@ -2,6 +2,7 @@
 //! impulses, and the events of the last step (pairs that started or stopped touching).
 
 use glam::Vec3;
+use serde::{Deserialize, Serialize};
 
 use super::World;
 use crate::body::BodyHandle;
@@ -84,7 +85,7 @@ impl<'a> ContactPairView<'a> {
 }
 
 /// A change in which pairs of bodies touch, from one step to the next ([`World::contact_events`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum ContactEvent {
     /// The bodies touch now and did not at the end of the step before.
     Started {
@@ -107,7 +108,7 @@ pub enum ContactEvent {
 
 /// Which pairs touched at the end of the last step, and the events that step produced. Both
 /// lists are kept and reused, so tracking events allocates nothing once they have grown.
-#[derive(Default)]
+#[derive(Clone, Default, Serialize, Deserialize)]
 pub(crate) struct ContactEvents {
     /// Touching pairs (smaller handle first) with their total normal impulse, sorted.
     touching: Vec<(BodyHandle, BodyHandle, f32)>,

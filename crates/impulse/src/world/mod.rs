@@ -23,6 +23,7 @@ mod contacts;
 mod continuous;
 mod kinematic;
 mod query;
+mod snapshot;
 mod step;
 
 use step::EnergyCheck;
@@ -30,6 +31,7 @@ use step::EnergyCheck;
 pub use bodies::BodyRef;
 pub use contacts::{ContactEvent, ContactPairView, ContactPoint};
 pub use query::{RayHit, ShapeHit};
+pub use snapshot::{SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
 
 /// A body further than this from the origin (m) means the simulation has blown up.
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;

@@ -17,7 +17,7 @@ use crate::solver::substep::{self, IslandWorkspace, StepContext};
 
 /// The energy check's state: the lowest mechanical energy since the last edit (J) and the
 /// energy at the end of the last step, to recognise edits made between steps.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub(super) struct EnergyCheck {
     lowest: f64,
     last: f64,
