@@ -277,6 +277,27 @@ pub(crate) fn prefetch_manifolds(pairs: &[ContactPair], i: usize) {
     }
 }
 
+/// Whether `shape` has a curved surface, on which the contact point is not a fixed point of
+/// the body. Parry reuses a manifold's points while the shapes have moved less than 1 mm
+/// and 1° (`ContactManifold::try_update_contacts`, in its cuboid–capsule, cuboid–triangle
+/// and general convex generators): the reused points are points of the bodies, which is right
+/// for a box's corners but not for a capsule or cylinder lying on a box: as it rolls, the
+/// reused point turns with it, behind the true contact, and the normal force's torque rolls
+/// it further (a capsule at rest on a box rolled off at 0.1 m/s within 5 s). Such pairs
+/// recompute their points every step (`ContactManifold::mark_shapes_deformed`).
+fn has_curved_surface(shape: &parry3d::shape::SharedShape) -> bool {
+    use parry3d::shape::ShapeType;
+    !matches!(
+        shape.shape_type(),
+        ShapeType::Cuboid
+            | ShapeType::ConvexPolyhedron
+            | ShapeType::Triangle
+            | ShapeType::TriMesh
+            | ShapeType::HeightField
+            | ShapeType::HalfSpace
+    )
+}
+
 /// Cap on a body's speculative margin (m), so a body thrown at absurd speed does not pair
 /// with the whole scene.
 pub const MAX_SPECULATIVE_MARGIN: f32 = 2.0;
@@ -352,6 +373,11 @@ impl NarrowPhase {
                 .is_some_and(|last| last.same(&query))
             {
                 return Ok(());
+            }
+            if has_curved_surface(&bodies.shape[a]) || has_curved_surface(&bodies.shape[b]) {
+                for manifold in &mut pair.manifolds {
+                    manifold.mark_shapes_deformed();
+                }
             }
             DefaultQueryDispatcher
                 .contact_manifolds(
