@@ -308,6 +308,7 @@ pub struct NarrowPhase {
     /// This step's pairs, in the broad phase's sorted order.
     pub pairs: Vec<ContactPair>,
     previous: Vec<ContactPair>,
+    seam_buffers: seams::SeamBuffers,
 }
 
 impl NarrowPhase {
@@ -408,7 +409,7 @@ impl NarrowPhase {
         } else {
             run(&mut self.pairs)?;
         }
-        seams::drop_internal_points(&mut self.pairs, bodies);
+        seams::drop_internal_points(&mut self.pairs, bodies, &mut self.seam_buffers);
         // Pairs whose manifolds Parry emptied are kept for their workspace; pairs Parry never
         // gave a manifold are dropped.
         self.pairs.retain(|p| !p.manifolds.is_empty());
@@ -488,18 +489,17 @@ pub mod seams {
         }
     }
 
-    /// Every point of `pair` with its manifold and point index, seen from static body `s`.
+    /// Appends every point of `pair` to `out` as (`member`, manifold, point, side), seen from
+    /// static body `s`.
     fn points_on_static(
         pair: &ContactPair,
         bodies: &Bodies,
         s: usize,
-    ) -> Vec<(usize, usize, StaticSide)> {
-        let (pose1, pose2) = (
-            &bodies.pose[pair.body1 as usize],
-            &bodies.pose[pair.body2 as usize],
-        );
+        member: usize,
+        out: &mut Vec<(usize, usize, usize, StaticSide)>,
+    ) {
+        let (pose1, pose2) = (&bodies.pose[pair.body1 as usize], &bodies.pose[pair.body2 as usize]);
         let static_is_1 = pair.body1 as usize == s;
-        let mut out = Vec::new();
         for (m, manifold) in pair.manifolds.iter().enumerate() {
             let (part1, part2): (Pose, Pose) = manifold_poses(manifold, pose1, pose2);
             for (i, point) in manifold.points.iter().enumerate() {
@@ -514,10 +514,9 @@ pub mod seams {
                         normal: part2.rotation * manifold.local_n2,
                     }
                 };
-                out.push((m, i, side));
+                out.push((member, m, i, side));
             }
         }
-        out
     }
 
     /// Signed-free distance (m) from `point` to static body `body` (0 inside).
@@ -525,45 +524,65 @@ pub mod seams {
         bodies.shape[body].distance_to_point(&bodies.pose[body], point, true)
     }
 
+    /// Buffers kept between steps, so that a step at rest allocates nothing.
+    #[derive(Default)]
+    pub(super) struct SeamBuffers {
+        /// (moving body, static body, pair index) of every pair with one static body.
+        entries: Vec<(usize, usize, usize)>,
+        /// One group's points: (group member, manifold, point, static side).
+        points: Vec<(usize, usize, usize, StaticSide)>,
+        /// (pair, manifold, point) of the points to drop.
+        drops: Vec<(usize, usize, usize)>,
+    }
+
     /// Drops the points of `pairs` that the rule above finds inside a seam, for every moving
     /// body with manifolds on two or more static bodies, one of them recomputed this step.
-    pub(super) fn drop_internal_points(pairs: &mut [ContactPair], bodies: &Bodies) {
-        // (moving body, static body, pair index) of every pair with one static body.
-        let mut entries: Vec<(usize, usize, usize)> = pairs
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| p.manifolds.iter().any(|m| !m.points.is_empty()))
-            .filter_map(|(k, p)| static_body(p, bodies).map(|(s, x)| (x, s, k)))
-            .collect();
+    pub(super) fn drop_internal_points(
+        pairs: &mut [ContactPair],
+        bodies: &Bodies,
+        buffers: &mut SeamBuffers,
+    ) {
+        let SeamBuffers {
+            entries,
+            points,
+            drops,
+        } = buffers;
+        entries.clear();
+        drops.clear();
+        entries.extend(
+            pairs
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| p.manifolds.iter().any(|m| !m.points.is_empty()))
+                .filter_map(|(k, p)| static_body(p, bodies).map(|(s, x)| (x, s, k))),
+        );
         if entries.len() < 2 {
             return;
         }
         entries.sort_unstable();
-        let mut drops: Vec<(usize, usize, usize)> = Vec::new();
         for group in entries.chunk_by(|a, b| a.0 == b.0) {
             if group.len() < 2 || !group.iter().any(|&(_, _, k)| pairs[k].recomputed) {
                 continue;
             }
-            let sides: Vec<Vec<(usize, usize, StaticSide)>> = group
-                .iter()
-                .map(|&(_, s, k)| points_on_static(&pairs[k], bodies, s))
-                .collect();
+            points.clear();
             for (g, &(_, s, k)) in group.iter().enumerate() {
-                for (m, i, side) in &sides[g] {
-                    let internal = group.iter().enumerate().any(|(h, &(_, t, _))| {
-                        h != g
-                            && distance(bodies, t, side.point) <= SEAM_TOLERANCE
-                            && sides[h].iter().any(|(_, _, other)| {
-                                side.normal.dot(other.normal) < SEAM_COS && {
-                                    let probe = side.point + SEAM_PROBE * other.normal;
-                                    distance(bodies, s, probe) > 0.5 * SEAM_PROBE
-                                        && distance(bodies, t, probe) > 0.5 * SEAM_PROBE
-                                }
-                            })
-                    });
-                    if internal {
-                        drops.push((k, *m, *i));
-                    }
+                points_on_static(&pairs[k], bodies, s, g, points);
+            }
+            for (g, m, i, side) in points.iter() {
+                let (_, s, k) = group[*g];
+                let internal = points.iter().any(|(h, _, _, other)| {
+                    let t = group[*h].1;
+                    h != g
+                        && side.normal.dot(other.normal) < SEAM_COS
+                        && distance(bodies, t, side.point) <= SEAM_TOLERANCE
+                        && {
+                            let probe = side.point + SEAM_PROBE * other.normal;
+                            distance(bodies, s, probe) > 0.5 * SEAM_PROBE
+                                && distance(bodies, t, probe) > 0.5 * SEAM_PROBE
+                        }
+                });
+                if internal {
+                    drops.push((k, *m, *i));
                 }
             }
         }
@@ -575,10 +594,12 @@ pub mod seams {
         for &(k, m, i) in drops.iter().rev() {
             pairs[k].manifolds[m].points.remove(i);
         }
-        let mut touched: Vec<usize> = drops.iter().map(|d| d.0).collect();
-        touched.dedup();
-        for k in touched {
-            pairs[k].summary = PairSummary::of(&pairs[k].manifolds);
+        let mut last = usize::MAX;
+        for &(k, _, _) in drops.iter() {
+            if k != last {
+                pairs[k].summary = PairSummary::of(&pairs[k].manifolds);
+                last = k;
+            }
         }
     }
 }
