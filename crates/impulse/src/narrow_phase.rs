@@ -498,7 +498,10 @@ pub mod seams {
         member: usize,
         out: &mut Vec<(usize, usize, usize, StaticSide)>,
     ) {
-        let (pose1, pose2) = (&bodies.pose[pair.body1 as usize], &bodies.pose[pair.body2 as usize]);
+        let (pose1, pose2) = (
+            &bodies.pose[pair.body1 as usize],
+            &bodies.pose[pair.body2 as usize],
+        );
         let static_is_1 = pair.body1 as usize == s;
         for (m, manifold) in pair.manifolds.iter().enumerate() {
             let (part1, part2): (Pose, Pose) = manifold_poses(manifold, pose1, pose2);

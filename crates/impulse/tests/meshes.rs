@@ -136,11 +136,11 @@ fn obj_gltf_and_glb_give_the_same_triangles() {
     std::fs::write(dir.join("terrain.gltf"), document(Some(uri)).to_string()).unwrap();
     // GLB: 12-byte header, a JSON chunk and a BIN chunk, each padded to 4 bytes.
     let mut json = document(None).to_string().into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let mut blob = bin.clone();
-    while blob.len() % 4 != 0 {
+    while !blob.len().is_multiple_of(4) {
         blob.push(0);
     }
     let mut glb = Vec::new();

@@ -133,7 +133,8 @@ fn sphere_box_and_capsule_inertia_match_the_closed_forms() {
     assert!(close(m, cylinder_m + sphere_m), "capsule mass {m}");
     assert!(com.length() < 1e-6);
     let axis = cylinder_m * r * r / 2.0 + 0.4 * sphere_m * r * r;
-    let hemisphere_own = 0.4 * (sphere_m / 2.0) * r * r - (sphere_m / 2.0) * (3.0 * r / 8.0).powi(2);
+    let hemisphere_own =
+        0.4 * (sphere_m / 2.0) * r * r - (sphere_m / 2.0) * (3.0 * r / 8.0).powi(2);
     let hemisphere_offset = hh + 3.0 * r / 8.0;
     let across = cylinder_m * (3.0 * r * r + 4.0 * hh * hh) / 12.0
         + 2.0 * (hemisphere_own + sphere_m / 2.0 * hemisphere_offset * hemisphere_offset);
@@ -194,23 +195,34 @@ fn compound_inertia_matches_the_parallel_axis_theorem() {
         ));
         let rotation = DMat3::from_quat(*q);
         let d = DVec3::from(*p) - centre;
-        let shift = m * (DMat3::from_diagonal(DVec3::splat(d.length_squared()))
-            - DMat3::from_cols(d * d.x, d * d.y, d * d.z));
+        let shift = m
+            * (DMat3::from_diagonal(DVec3::splat(d.length_squared()))
+                - DMat3::from_cols(d * d.x, d * d.y, d * d.z));
         tensor += rotation * own * rotation.transpose() + shift;
     }
     // The engine's.
     let world = world_of(vec![dynamic(shape, [0.0; 3])]);
     let b = &world.bodies;
     let engine_mass = 1.0 / f64::from(b.inverse_mass[0]);
-    assert!(close(engine_mass, mass), "mass {engine_mass} against {mass}");
+    assert!(
+        close(engine_mass, mass),
+        "mass {engine_mass} against {mass}"
+    );
     let engine_centre = b.local_center_of_mass[0].as_dvec3();
     assert!(
         (engine_centre - centre).length() < 1e-5,
         "centre of mass {engine_centre} against {centre}"
     );
     let engine_tensor = b.local_inverse_inertia[0].as_dmat3().inverse();
-    let scale = tensor.to_cols_array().iter().fold(0.0f64, |s, x| s.max(x.abs()));
-    for (e, t) in engine_tensor.to_cols_array().iter().zip(tensor.to_cols_array()) {
+    let scale = tensor
+        .to_cols_array()
+        .iter()
+        .fold(0.0f64, |s, x| s.max(x.abs()));
+    for (e, t) in engine_tensor
+        .to_cols_array()
+        .iter()
+        .zip(tensor.to_cols_array())
+    {
         assert!(
             (e - t).abs() < 1e-4 * scale,
             "inertia tensor\n{engine_tensor}\nagainst\n{tensor}"

@@ -126,11 +126,8 @@ fn load_obj(path: &Path, name: &str) -> Result<MeshData, MeshFileError> {
         let base = u32::try_from(mesh.vertices.len())
             .map_err(|_| format_error(name, "more than 2³² vertices"))?;
         let count = m.positions.len() / 3;
-        mesh.vertices.extend(
-            m.positions
-                .chunks_exact(3)
-                .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32]),
-        );
+        mesh.vertices
+            .extend(m.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
         for t in m.indices.chunks_exact(3) {
             if t.iter().any(|&i| i as usize >= count) {
                 return Err(format_error(
