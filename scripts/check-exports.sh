@@ -38,7 +38,8 @@ fi
 echo "gltf-validator $(node -p "require('$scratch/node/node_modules/gltf-validator/package.json').version"), $("$python" -m pip list --disable-pip-version-check 2>/dev/null | grep -E '^(usd-core|bpy) ' | tr -s ' ' | paste -sd, -)"
 
 # scene (built-in name or file), steps, every (60 is no multiple of 7: the last frame is
-# written on its own); every standard scene family and a scene of every shape
+# written on its own); every standard scene family, a scene of every shape, and the mesh,
+# height-field, compound and rounded shapes
 runs=(
   "pyramid20 60 7"
   "pyramid3d10 20 10"
@@ -47,6 +48,8 @@ runs=(
   "balls1k 20 10"
   "scenes/shapes.json 120 10"
   "scenes/example-three-spheres.json 60 1"
+  "scenes/mesh_terrain.json 120 10"
+  "scenes/compound.json 60 10"
 )
 glbs=()
 failed=0

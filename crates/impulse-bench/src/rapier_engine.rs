@@ -166,8 +166,8 @@ impl RapierScene {
             .can_sleep(false)
             .build();
             let handle = bodies.insert(body);
-            let collider =
-                collider_builder(&desc.shape).with_context(|| format!("body {i}: shape"))?;
+            let collider = collider_builder(desc.kind, &desc.shape)
+                .with_context(|| format!("body {i}: shape"))?;
             let collider = match desc.mass {
                 Some(mass) => collider.mass(mass),
                 None => collider.density(material.density),
@@ -239,8 +239,10 @@ fn resolve_material(scene: &Scene, material: &MaterialRef) -> Result<Material> {
     })
 }
 
-/// The Rapier collider of a scene shape (the same Parry shape impulse builds).
-fn collider_builder(shape: &ShapeDesc) -> Result<ColliderBuilder> {
+/// The Rapier collider of a scene shape (the same Parry shape impulse builds: triangle meshes,
+/// height fields, compounds and rounded shapes through `impulse::scene::build_shape`, as
+/// Rapier 0.36 uses the same Parry).
+fn collider_builder(kind: BodyKind, shape: &ShapeDesc) -> Result<ColliderBuilder> {
     Ok(match shape {
         ShapeDesc::Sphere { radius } => ColliderBuilder::ball(*radius),
         ShapeDesc::Cuboid { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
@@ -265,6 +267,12 @@ fn collider_builder(shape: &ShapeDesc) -> Result<ColliderBuilder> {
         }
         ShapeDesc::HalfSpace { normal } => {
             ColliderBuilder::new(SharedShape::halfspace(Vector::from(*normal).normalize()))
+        }
+        ShapeDesc::Trimesh { .. }
+        | ShapeDesc::HeightField { .. }
+        | ShapeDesc::Compound { .. }
+        | ShapeDesc::Round { .. } => {
+            ColliderBuilder::new(impulse::scene::build_shape(kind, shape)?)
         }
     })
 }

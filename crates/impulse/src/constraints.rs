@@ -298,7 +298,9 @@ impl Assembly<'_> {
             if manifold.points.is_empty() {
                 continue;
             }
-            let normal = pose_b.rotation * manifold.local_n1;
+            // Body B is shape 1: its points and normal are in its part's frame.
+            let (part_b, part_a) = crate::narrow_phase::manifold_poses(manifold, pose_b, pose_a);
+            let normal = part_b.rotation * manifold.local_n1;
             for (point_index, point) in manifold.points.iter().enumerate() {
                 // Which copy of a duplicated point comes first can change between steps, so
                 // the warm start takes the copy that carries an impulse and the write-back
@@ -319,8 +321,8 @@ impl Assembly<'_> {
                 // quarter of the spin at dt = 1/60 s; tests/impacts.rs). Touching and
                 // overlapping points take the middle of the two witness points, which
                 // coincide at zero separation, so the lever arms are continuous there.
-                let p_b = pose_b.transform_point(point.local_p1);
-                let p_a = pose_a.transform_point(point.local_p2);
+                let p_b = part_b.transform_point(point.local_p1);
+                let p_a = part_a.transform_point(point.local_p2);
                 let (at_a, at_b) = if point.dist > 0.0 {
                     (p_a, p_b)
                 } else {

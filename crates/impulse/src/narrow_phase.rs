@@ -10,6 +10,7 @@ use parry3d::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
     TrackedContact,
 };
+use parry3d::utils::PoseOpt;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -43,6 +44,19 @@ pub struct ManifoldState {
 /// Parry's manifold type with our per-manifold and per-point data.
 pub type Manifold = ContactManifold<ManifoldState, ContactImpulse>;
 
+/// The world poses of a manifold's two shapes: the bodies' poses `pose1`, `pose2` with the
+/// manifold's sub-shape poses (a compound's part) appended. Parry gives a composite shape's
+/// points and normal in the frame of the part that touches (`subshape_pos1`/`subshape_pos2`,
+/// absent for convex shapes, triangle meshes and height fields, whose parts are in the
+/// shape's own frame).
+#[inline]
+pub fn manifold_poses(manifold: &Manifold, pose1: &Pose, pose2: &Pose) -> (Pose, Pose) {
+    (
+        manifold.subshape_pos1().prepend_to(pose1),
+        manifold.subshape_pos2().prepend_to(pose2),
+    )
+}
+
 /// The contact state of one pair of bodies. Shape 1 belongs to `body1`, shape 2 to `body2`,
 /// and `body1 < body2`.
 pub struct ContactPair {
@@ -62,6 +76,8 @@ pub struct ContactPair {
     /// The pair's normal impulse over the last step (N·s), summed as the impulses are written
     /// back: what contact events read without visiting every point.
     pub(crate) step_normal_impulse: f32,
+    /// Whether this step's update recomputed the manifolds (see [`seams`]).
+    recomputed: bool,
 }
 
 /// The inputs of a pair's manifold update: the relative pose (body 2 in body 1's frame), the
@@ -140,6 +156,7 @@ impl ContactPair {
             summary: PairSummary::default(),
             step_normal_impulse: 0.0,
             last_query: None,
+            recomputed: false,
         }
     }
 
@@ -268,6 +285,27 @@ pub(crate) fn prefetch_manifolds(pairs: &[ContactPair], i: usize) {
     }
 }
 
+/// Whether `shape` has a curved surface, on which the contact point is not a fixed point of
+/// the body. Parry reuses a manifold's points while the shapes have moved less than 1 mm
+/// and 1° (`ContactManifold::try_update_contacts`, in its cuboid–capsule, cuboid–triangle
+/// and general convex generators): the reused points are points of the bodies, which is right
+/// for a box's corners but not for a capsule or cylinder lying on a box: as it rolls, the
+/// reused point turns with it, behind the true contact, and the normal force's torque rolls
+/// it further (a capsule at rest on a box rolled off at 0.1 m/s within 5 s). Such pairs
+/// recompute their points every step (`ContactManifold::mark_shapes_deformed`).
+fn has_curved_surface(shape: &parry3d::shape::SharedShape) -> bool {
+    use parry3d::shape::ShapeType;
+    !matches!(
+        shape.shape_type(),
+        ShapeType::Cuboid
+            | ShapeType::ConvexPolyhedron
+            | ShapeType::Triangle
+            | ShapeType::TriMesh
+            | ShapeType::HeightField
+            | ShapeType::HalfSpace
+    )
+}
+
 /// Cap on a body's speculative margin (m), so a body thrown at absurd speed does not pair
 /// with the whole scene.
 pub const MAX_SPECULATIVE_MARGIN: f32 = 2.0;
@@ -278,6 +316,7 @@ pub struct NarrowPhase {
     /// This step's pairs, in the broad phase's sorted order.
     pub pairs: Vec<ContactPair>,
     previous: Vec<ContactPair>,
+    seam_buffers: seams::SeamBuffers,
 }
 
 impl NarrowPhase {
@@ -323,6 +362,7 @@ impl NarrowPhase {
             }
         }
         let update = |pair: &mut ContactPair| -> Result<(), StepError> {
+            pair.recomputed = false;
             let (a, b) = (pair.body1 as usize, pair.body2 as usize);
             // A pair with no awake body keeps its manifolds as they were: nothing moved.
             if !bodies.is_awake(a) && !bodies.is_awake(b) {
@@ -343,6 +383,11 @@ impl NarrowPhase {
             {
                 return Ok(());
             }
+            if has_curved_surface(&bodies.shape[a]) || has_curved_surface(&bodies.shape[b]) {
+                for manifold in &mut pair.manifolds {
+                    manifold.mark_shapes_deformed();
+                }
+            }
             DefaultQueryDispatcher
                 .contact_manifolds(
                     &pos12,
@@ -355,6 +400,7 @@ impl NarrowPhase {
                 .map_err(|_| StepError::UnsupportedShapePair { body1: a, body2: b })?;
             pair.summary = PairSummary::of(&pair.manifolds);
             pair.last_query = Some(query);
+            pair.recomputed = true;
             Ok(())
         };
         let run = |pairs: &mut [ContactPair]| -> Result<(), StepError> {
@@ -371,6 +417,7 @@ impl NarrowPhase {
         } else {
             run(&mut self.pairs)?;
         }
+        seams::drop_internal_points(&mut self.pairs, bodies, &mut self.seam_buffers);
         // Pairs whose manifolds Parry emptied are kept for their workspace; pairs Parry never
         // gave a manifold are dropped.
         self.pairs.retain(|p| !p.manifolds.is_empty());
@@ -504,11 +551,196 @@ impl NarrowPhase {
                 workspace: state.workspace,
                 last_query,
                 step_normal_impulse: state.step_normal_impulse,
+                // Set by every update before the seam rule reads it.
+                recomputed: false,
             });
         }
         Ok(Self {
             pairs: restored,
             previous: Vec::new(),
+            seam_buffers: Default::default(),
         })
+    }
+}
+
+/// Seams between static bodies: contact points of a moving body on one static body that lie
+/// inside the surface the static bodies form together.
+///
+/// A body sliding across the level joint of two static boxes S and T gets, from Parry's
+/// convex–convex manifold with S alone, points whose normal is not the floor's: S's side face
+/// at the joint (a speculative point with normal along the floor, which stops a sliding box),
+/// or S's top edge there (a normal tilted up, which makes a rolling ball hop). Neither normal
+/// is a normal of S ∪ T at that point, whose surface there is the flat floor; the floor's
+/// normal comes from the body's manifold with T. This is the "ghost collision" of separate
+/// colliders (Box2D v3 avoids it only for chain shapes, with ghost vertices; Parry and Rapier
+/// fix it only inside one triangle mesh or height field, `TriMeshFlags::FIX_INTERNAL_EDGES`
+/// with pseudo-normals after Bullet's `btAdjustInternalEdgeContacts`; Jolt's
+/// `InternalEdgeRemovingCollector`, after Terdiman's "Contact generation for meshes", drops
+/// an edge contact whose edge belongs to a face another contact already touches). The rule
+/// here extends that last one to separate static bodies, by geometry instead of shared
+/// features:
+///
+/// A point of moving body X on static body S, at S's witness point p with normal n (out of
+/// S), is dropped when X also has a manifold with another static body T, with normal n_T
+/// (out of T), such that
+///
+/// 1. p lies on T: |distance(p, T)| ≤ [`seams::SEAM_TOLERANCE`] (S and T meet at p);
+/// 2. n differs from n_T (n·n_T < [`seams::SEAM_COS`]);
+/// 3. n_T leaves both bodies at p: the probe p + δ·n_T, δ = [`seams::SEAM_PROBE`], is farther than
+///    δ/2 from S and from T. Then S ∪ T is locally on one side of the plane through p normal
+///    to n_T, a flat (or convex) joint whose outward normal is n_T, and the contact with T
+///    already carries X there.
+///
+/// At a concave corner (a wall standing on a floor) the probe along the wall's normal runs
+/// along the floor, so (3) fails and both contacts stay. Decisions are taken from the
+/// manifolds as Parry left them, before any point is dropped, so the result does not depend
+/// on the order of the pairs.
+pub mod seams {
+    use glam::Vec3;
+    use parry3d::math::Pose;
+
+    use super::{ContactPair, PairSummary, manifold_poses};
+    use crate::body::Bodies;
+
+    /// How close (m) a contact point must be to the other static body to be on it.
+    pub const SEAM_TOLERANCE: f32 = 1.0e-4;
+    /// Normals whose dot product is at least this are the same (about 0.8°).
+    pub const SEAM_COS: f32 = 0.9999;
+    /// Length (m) of the probe along the other body's normal; the rule holds for
+    /// penetrations up to half of it.
+    pub const SEAM_PROBE: f32 = 0.01;
+
+    /// One contact point seen from the static body: witness point and outward normal (world).
+    struct StaticSide {
+        point: Vec3,
+        normal: Vec3,
+    }
+
+    /// The static body of `pair` and the world poses of its shape and the moving one's, if
+    /// exactly one of the two bodies is static.
+    fn static_body(pair: &ContactPair, bodies: &Bodies) -> Option<(usize, usize)> {
+        let (a, b) = (pair.body1 as usize, pair.body2 as usize);
+        match (bodies.is_moving(a), bodies.is_moving(b)) {
+            (true, false) => Some((b, a)),
+            (false, true) => Some((a, b)),
+            _ => None,
+        }
+    }
+
+    /// Appends every point of `pair` to `out` as (`member`, manifold, point, side), seen from
+    /// static body `s`.
+    fn points_on_static(
+        pair: &ContactPair,
+        bodies: &Bodies,
+        s: usize,
+        member: usize,
+        out: &mut Vec<(usize, usize, usize, StaticSide)>,
+    ) {
+        let (pose1, pose2) = (
+            &bodies.pose[pair.body1 as usize],
+            &bodies.pose[pair.body2 as usize],
+        );
+        let static_is_1 = pair.body1 as usize == s;
+        for (m, manifold) in pair.manifolds.iter().enumerate() {
+            let (part1, part2): (Pose, Pose) = manifold_poses(manifold, pose1, pose2);
+            for (i, point) in manifold.points.iter().enumerate() {
+                let side = if static_is_1 {
+                    StaticSide {
+                        point: part1.transform_point(point.local_p1),
+                        normal: part1.rotation * manifold.local_n1,
+                    }
+                } else {
+                    StaticSide {
+                        point: part2.transform_point(point.local_p2),
+                        normal: part2.rotation * manifold.local_n2,
+                    }
+                };
+                out.push((member, m, i, side));
+            }
+        }
+    }
+
+    /// Signed-free distance (m) from `point` to static body `body` (0 inside).
+    fn distance(bodies: &Bodies, body: usize, point: Vec3) -> f32 {
+        bodies.shape[body].distance_to_point(&bodies.pose[body], point, true)
+    }
+
+    /// Buffers kept between steps, so that a step at rest allocates nothing.
+    #[derive(Default)]
+    pub(super) struct SeamBuffers {
+        /// (moving body, static body, pair index) of every pair with one static body.
+        entries: Vec<(usize, usize, usize)>,
+        /// One group's points: (group member, manifold, point, static side).
+        points: Vec<(usize, usize, usize, StaticSide)>,
+        /// (pair, manifold, point) of the points to drop.
+        drops: Vec<(usize, usize, usize)>,
+    }
+
+    /// Drops the points of `pairs` that the rule above finds inside a seam, for every moving
+    /// body with manifolds on two or more static bodies, one of them recomputed this step.
+    pub(super) fn drop_internal_points(
+        pairs: &mut [ContactPair],
+        bodies: &Bodies,
+        buffers: &mut SeamBuffers,
+    ) {
+        let SeamBuffers {
+            entries,
+            points,
+            drops,
+        } = buffers;
+        entries.clear();
+        drops.clear();
+        entries.extend(
+            pairs
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| p.manifolds.iter().any(|m| !m.points.is_empty()))
+                .filter_map(|(k, p)| static_body(p, bodies).map(|(s, x)| (x, s, k))),
+        );
+        if entries.len() < 2 {
+            return;
+        }
+        entries.sort_unstable();
+        for group in entries.chunk_by(|a, b| a.0 == b.0) {
+            if group.len() < 2 || !group.iter().any(|&(_, _, k)| pairs[k].recomputed) {
+                continue;
+            }
+            points.clear();
+            for (g, &(_, s, k)) in group.iter().enumerate() {
+                points_on_static(&pairs[k], bodies, s, g, points);
+            }
+            for (g, m, i, side) in points.iter() {
+                let (_, s, k) = group[*g];
+                let internal = points.iter().any(|(h, _, _, other)| {
+                    let t = group[*h].1;
+                    h != g
+                        && side.normal.dot(other.normal) < SEAM_COS
+                        && distance(bodies, t, side.point) <= SEAM_TOLERANCE
+                        && {
+                            let probe = side.point + SEAM_PROBE * other.normal;
+                            distance(bodies, s, probe) > 0.5 * SEAM_PROBE
+                                && distance(bodies, t, probe) > 0.5 * SEAM_PROBE
+                        }
+                });
+                if internal {
+                    drops.push((k, *m, *i));
+                }
+            }
+        }
+        if drops.is_empty() {
+            return;
+        }
+        // Remove from the back so that the indices still to remove stay valid.
+        drops.sort_unstable();
+        for &(k, m, i) in drops.iter().rev() {
+            pairs[k].manifolds[m].points.remove(i);
+        }
+        let mut last = usize::MAX;
+        for &(k, _, _) in drops.iter() {
+            if k != last {
+                pairs[k].summary = PairSummary::of(&pairs[k].manifolds);
+                last = k;
+            }
+        }
     }
 }

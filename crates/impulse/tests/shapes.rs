@@ -97,6 +97,139 @@ fn cone_inertia_matches_the_closed_form() {
     assert!(close(iy, axis), "{iy} against {axis}");
 }
 
+#[test]
+fn sphere_box_and_capsule_inertia_match_the_closed_forms() {
+    let pi = std::f64::consts::PI;
+    let rho = f64::from(DENSITY);
+    // Solid sphere: I = 2/5 m r².
+    let r = 0.35f64;
+    let (m, com, moments) = mass_properties(ShapeDesc::Sphere { radius: r as f32 });
+    let expected_m = rho * 4.0 / 3.0 * pi * r.powi(3);
+    assert!(close(m, expected_m), "sphere mass {m} against {expected_m}");
+    assert!(com.length() < 1e-6);
+    for i in moments {
+        assert!(close(i, 0.4 * m * r * r), "sphere {i}");
+    }
+    // Box of sides a, b, c: I_x = m (b² + c²)/12 and so on.
+    let h = [0.3f64, 0.5, 0.7];
+    let (m, com, [ix, iy, iz]) = mass_properties(ShapeDesc::Cuboid {
+        half_extents: h.map(|x| x as f32),
+    });
+    let [a, b, c] = h.map(|x| 2.0 * x);
+    assert!(close(m, rho * a * b * c), "box mass {m}");
+    assert!(com.length() < 1e-6);
+    assert!(close(ix, m * (b * b + c * c) / 12.0), "box x {ix}");
+    assert!(close(iy, m * (a * a + c * c) / 12.0), "box y {iy}");
+    assert!(close(iz, m * (a * a + b * b) / 12.0), "box z {iz}");
+    // Capsule along y: a cylinder (radius r, height 2h) and two hemispheres, each hemisphere
+    // with its own centre of mass 3r/8 from its flat face (parallel-axis theorem).
+    let (r, hh) = (0.25f64, 0.4f64);
+    let (m, com, [ix, iy, iz]) = mass_properties(ShapeDesc::Capsule {
+        half_height: hh as f32,
+        radius: r as f32,
+    });
+    let cylinder_m = rho * pi * r * r * 2.0 * hh;
+    let sphere_m = rho * 4.0 / 3.0 * pi * r.powi(3);
+    assert!(close(m, cylinder_m + sphere_m), "capsule mass {m}");
+    assert!(com.length() < 1e-6);
+    let axis = cylinder_m * r * r / 2.0 + 0.4 * sphere_m * r * r;
+    let hemisphere_own =
+        0.4 * (sphere_m / 2.0) * r * r - (sphere_m / 2.0) * (3.0 * r / 8.0).powi(2);
+    let hemisphere_offset = hh + 3.0 * r / 8.0;
+    let across = cylinder_m * (3.0 * r * r + 4.0 * hh * hh) / 12.0
+        + 2.0 * (hemisphere_own + sphere_m / 2.0 * hemisphere_offset * hemisphere_offset);
+    assert!(close(iy, axis), "capsule axis {iy} against {axis}");
+    assert!(
+        close(ix, across) && close(iz, across),
+        "capsule {ix}, {iz} against {across}"
+    );
+}
+
+/// A compound of two boxes side by side (and a small one turned on top): its mass is the sum,
+/// its centre of mass the mass-weighted mean, and its inertia tensor about that centre the
+/// sum of each part's own tensor (turned into the body's frame) plus m·(|d|²I − d dᵀ) for each
+/// part's offset d from it (the parallel-axis theorem), computed here by hand.
+#[test]
+fn compound_inertia_matches_the_parallel_axis_theorem() {
+    use impulse::glam::{DMat3, DQuat, DVec3};
+    use impulse::scene::CompoundPart;
+    let rho = f64::from(DENSITY);
+    let parts = [
+        ([0.5f64, 0.2, 0.3], [-0.5f64, 0.0, 0.1], DQuat::IDENTITY),
+        ([0.25, 0.4, 0.3], [0.75, 0.2, 0.0], DQuat::IDENTITY),
+        (
+            [0.1, 0.1, 0.3],
+            [0.0, 0.5, -0.2],
+            DQuat::from_rotation_y(0.7) * DQuat::from_rotation_x(0.3),
+        ),
+    ];
+    let shape = ShapeDesc::Compound {
+        parts: parts
+            .iter()
+            .map(|(h, p, q)| CompoundPart {
+                shape: ShapeDesc::Cuboid {
+                    half_extents: h.map(|x| x as f32),
+                },
+                position: p.map(|x| x as f32),
+                orientation: q.as_quat().to_array(),
+            })
+            .collect(),
+    };
+    // By hand.
+    let mut mass = 0.0;
+    let mut moment = DVec3::ZERO;
+    for (h, p, _) in &parts {
+        let m = rho * 8.0 * h[0] * h[1] * h[2];
+        mass += m;
+        moment += m * DVec3::from(*p);
+    }
+    let centre = moment / mass;
+    let mut tensor = DMat3::ZERO;
+    for (h, p, q) in &parts {
+        let m = rho * 8.0 * h[0] * h[1] * h[2];
+        let [a, b, c] = h.map(|x| 2.0 * x);
+        let own = DMat3::from_diagonal(DVec3::new(
+            m * (b * b + c * c) / 12.0,
+            m * (a * a + c * c) / 12.0,
+            m * (a * a + b * b) / 12.0,
+        ));
+        let rotation = DMat3::from_quat(*q);
+        let d = DVec3::from(*p) - centre;
+        let shift = m
+            * (DMat3::from_diagonal(DVec3::splat(d.length_squared()))
+                - DMat3::from_cols(d * d.x, d * d.y, d * d.z));
+        tensor += rotation * own * rotation.transpose() + shift;
+    }
+    // The engine's.
+    let world = world_of(vec![dynamic(shape, [0.0; 3])]);
+    let b = &world.bodies;
+    let engine_mass = 1.0 / f64::from(b.inverse_mass[0]);
+    assert!(
+        close(engine_mass, mass),
+        "mass {engine_mass} against {mass}"
+    );
+    let engine_centre = b.local_center_of_mass[0].as_dvec3();
+    assert!(
+        (engine_centre - centre).length() < 1e-5,
+        "centre of mass {engine_centre} against {centre}"
+    );
+    let engine_tensor = b.local_inverse_inertia[0].as_dmat3().inverse();
+    let scale = tensor
+        .to_cols_array()
+        .iter()
+        .fold(0.0f64, |s, x| s.max(x.abs()));
+    for (e, t) in engine_tensor
+        .to_cols_array()
+        .iter()
+        .zip(tensor.to_cols_array())
+    {
+        assert!(
+            (e - t).abs() < 1e-4 * scale,
+            "inertia tensor\n{engine_tensor}\nagainst\n{tensor}"
+        );
+    }
+}
+
 /// Steps `world` for 10 s and returns the largest distance (m) body `i` moved from where it
 /// was after the first second (the contact settling).
 fn drift_after_settling(world: &mut World, i: usize) -> f32 {

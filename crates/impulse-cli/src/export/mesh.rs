@@ -8,6 +8,7 @@
 
 use anyhow::{Result, bail};
 use impulse::ShapeDesc;
+use impulse::glam::{Quat, Vec3};
 use parry3d::math::Vector3;
 
 /// Longitude segments of sphere and capsule meshes.
@@ -114,7 +115,86 @@ pub fn shape_mesh(shape: &ShapeDesc, ground_half_size: f32) -> Result<TriMesh> {
             mesh.push_flat_polygon(&ground_corners(*normal, ground_half_size), *normal);
             mesh
         }
+        ShapeDesc::Trimesh { file, .. } => {
+            let Some(data) = shape.mesh_data() else {
+                bail!(
+                    "the triangle mesh file {:?} was not read with its scene",
+                    file.as_deref().unwrap_or("")
+                );
+            };
+            flat_triangles(&data.vertices, &data.indices, false)
+        }
+        ShapeDesc::HeightField { .. } => {
+            let built = impulse::scene::build_shape(impulse::BodyKind::Static, shape)?;
+            let Some(field) = built.as_heightfield() else {
+                bail!("not a height field");
+            };
+            let (vertices, triangles) = field.to_trimesh();
+            let vertices: Vec<[f32; 3]> = vertices.iter().map(|v| v.to_array()).collect();
+            flat_triangles(&vertices, &triangles, true)
+        }
+        ShapeDesc::Compound { parts } => {
+            let mut mesh = TriMesh::default();
+            for part in parts {
+                let part_mesh = shape_mesh(&part.shape, ground_half_size)?;
+                let rotation = Quat::from_array(part.orientation).normalize();
+                let translation = Vec3::from(part.position);
+                let first = mesh.positions.len() as u32;
+                for (p, n) in part_mesh.positions.iter().zip(&part_mesh.normals) {
+                    mesh.positions
+                        .push((rotation * Vec3::from(*p) + translation).to_array());
+                    mesh.normals.push((rotation * Vec3::from(*n)).to_array());
+                }
+                mesh.indices
+                    .extend(part_mesh.indices.iter().map(|i| first + i));
+            }
+            mesh
+        }
+        ShapeDesc::Round {
+            shape: inner,
+            border_radius,
+        } => {
+            // Approximately: the hull of the inner shape's mesh corners each moved out by the
+            // border radius along 26 directions (faces, edges and corners of a cube).
+            let inner_mesh = shape_mesh(inner, ground_half_size)?;
+            let mut directions = Vec::new();
+            for x in [-1.0f32, 0.0, 1.0] {
+                for y in [-1.0f32, 0.0, 1.0] {
+                    for z in [-1.0f32, 0.0, 1.0] {
+                        if (x, y, z) != (0.0, 0.0, 0.0) {
+                            directions.push(scale(normalize([x, y, z]), *border_radius));
+                        }
+                    }
+                }
+            }
+            let mut corners = inner_mesh.positions.clone();
+            corners.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
+            corners.dedup();
+            let points: Vec<[f32; 3]> = corners
+                .iter()
+                .flat_map(|&c| directions.iter().map(move |&d| add(c, d)))
+                .collect();
+            shape_mesh(&ShapeDesc::ConvexHull { points }, ground_half_size)?
+        }
     })
+}
+
+/// Flat-shaded triangles (each corner repeated per triangle, with the triangle's normal).
+/// With `upward`, triangles facing down are turned over (a height field's surface faces +y).
+fn flat_triangles(vertices: &[[f32; 3]], triangles: &[[u32; 3]], upward: bool) -> TriMesh {
+    let mut mesh = TriMesh::default();
+    for triangle in triangles {
+        let mut corners = triangle.map(|i| vertices[i as usize]);
+        let mut normal = cross(sub(corners[1], corners[0]), sub(corners[2], corners[0]));
+        if upward && normal[1] < 0.0 {
+            corners.swap(1, 2);
+            normal = scale(normal, -1.0);
+        }
+        if dot(normal, normal) > 0.0 {
+            mesh.push_flat_polygon(&corners, normal);
+        }
+    }
+    mesh
 }
 
 /// Sides of the polygon a cylinder's or cone's circle is drawn with.

@@ -211,6 +211,25 @@ fn geometry(out: &mut Usda, shape: &ShapeDesc, colour: [f32; 3], ground: f32) ->
             out.open_block();
             mesh_attributes(out, &vertices, 3, &indices, Some(&normals));
         }
+        ShapeDesc::Trimesh { .. }
+        | ShapeDesc::HeightField { .. }
+        | ShapeDesc::Compound { .. }
+        | ShapeDesc::Round { .. } => {
+            // Triangle meshes as their triangles, height fields as their grid's triangles,
+            // compounds as their parts, rounded shapes approximately (export::mesh).
+            let mesh = super::mesh::shape_mesh(shape, ground)?;
+            let normals: Vec<[f32; 3]> = mesh
+                .indices
+                .chunks_exact(3)
+                .map(|t| {
+                    let [a, b, c] = [t[0], t[1], t[2]].map(|k| mesh.positions[k as usize]);
+                    normalize(cross(sub(b, a), sub(c, a)))
+                })
+                .collect();
+            out.def("Mesh", "geometry");
+            out.open_block();
+            mesh_attributes(out, &mesh.positions, 3, &mesh.indices, Some(&normals));
+        }
         ShapeDesc::HalfSpace { normal } => {
             let corners = ground_corners(*normal, ground);
             out.def("Mesh", "geometry");

@@ -137,10 +137,25 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
     let radius = (0.5 * (max - min).length()).max(0.5);
     let camera = checked_camera(centre, radius, options)?;
     let (bodies, ground) = drawn_bodies(scene, &world, min, max, radius)?;
-    // No ground body: the grid still shows which way is down, under everything.
-    let ground = ground.unwrap_or(Ground {
-        height: min.y,
-        spacing: grid_spacing(radius),
+    // No ground body: the grid still shows which way is down, under everything (static
+    // meshes, height fields and compounds included, so that the grid hides none of them).
+    let ground = ground.unwrap_or_else(|| {
+        let lowest_static = bodies
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.kind == BodyKind::Static)
+            .flat_map(|(i, b)| {
+                let pose = world.bodies.pose[i];
+                b.mesh
+                    .positions
+                    .iter()
+                    .map(move |p| (pose.rotation * Vec3::from(*p) + pose.translation).y)
+            })
+            .fold(f32::INFINITY, f32::min);
+        Ground {
+            height: min.y.min(lowest_static),
+            spacing: grid_spacing(radius),
+        }
     });
 
     let mut frames = 0;

@@ -27,7 +27,8 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
         error.origin = Some(origin.clone());
         error
     })?;
-    parse_scene_str(&text, &origin)
+    let directory = path.parent().unwrap_or(Path::new(""));
+    parse_scene_str_in(&text, &origin, directory)
 }
 
 /// Parses the JSON scene `text` and validates it. `origin` names the text in error messages
@@ -47,19 +48,63 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
 /// Inside a `shape` the path of a type error stops at `shape`, because serde reads a tagged
 /// shape whole before choosing its type; errors inside an inline `material` are traced to the
 /// material's field.
+///
+/// Mesh files of `trimesh` shapes are read relative to the current directory
+/// ([`parse_scene_str_in`] names another).
 pub fn parse_scene_str(text: &str, origin: &str) -> Result<Scene, SceneError> {
-    let scene = parse_only(text).map_err(|mut e| {
-        e.origin = Some(origin.to_string());
-        e
-    })?;
-    validate(&scene).map_err(|mut e| {
+    parse_scene_str_in(text, origin, Path::new(""))
+}
+
+/// [`parse_scene_str`], reading the mesh files of `trimesh` shapes relative to `directory`
+/// (the scene file's own directory when called by [`load_scene_file`]).
+///
+/// # Errors
+/// As [`parse_scene_str`]; also [`SceneErrorKind::Invalid`] at `bodies[i].shape.file` for a
+/// mesh file that cannot be read or is not a valid OBJ, glTF or GLB file.
+pub fn parse_scene_str_in(text: &str, origin: &str, directory: &Path) -> Result<Scene, SceneError> {
+    let locate_error = |mut e: SceneError| {
         e.origin = Some(origin.to_string());
         if let Some(field) = &e.field {
             e.position = locate_closest(text, field);
         }
         e
+    };
+    let mut scene = parse_only(text).map_err(|mut e| {
+        e.origin = Some(origin.to_string());
+        e
     })?;
+    load_meshes(&mut scene, directory).map_err(locate_error)?;
+    validate(&scene).map_err(locate_error)?;
     Ok(scene)
+}
+
+/// Reads the file of every `trimesh` shape of `scene` (relative to `directory`) into its
+/// `loaded` mesh. Errors name the body and `shape.file` but have no origin yet.
+fn load_meshes(scene: &mut Scene, directory: &Path) -> Result<(), SceneError> {
+    for (index, body) in scene.bodies.iter_mut().enumerate() {
+        if let ShapeDesc::Trimesh {
+            file: Some(file),
+            loaded,
+            ..
+        } = &mut body.shape
+        {
+            let path = directory.join(file.as_str());
+            let mesh = super::mesh_file::load_mesh_file(&path).map_err(|e| {
+                let mut error = SceneError::new(
+                    SceneErrorKind::Invalid,
+                    Some(FieldPath::body(index).key("shape").key("file")),
+                    e.to_string(),
+                );
+                error.body = Some(BodyRef {
+                    index,
+                    name: body.name.clone(),
+                });
+                error
+            })?;
+            *loaded = Some(super::mesh_file::LoadedMesh(std::sync::Arc::new(mesh)));
+        }
+    }
+    Ok(())
 }
 
 /// Parses without validating; errors have no origin yet.

@@ -59,8 +59,11 @@ impl Default for Material {
 }
 
 /// Collision shape of a body, in the body's local frame (centred on its origin).
+///
+/// In JSON each shape is an object with a `"type"` (`docs/scene-format.md`); a rounded
+/// shape is its inner shape's object with a `"border_radius"`, read into [`ShapeDesc::Round`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(from = "json_shape::ShapeJson", into = "json_shape::ShapeJson")]
 pub enum ShapeDesc {
     /// A sphere.
     Sphere {
@@ -104,6 +107,126 @@ pub enum ShapeDesc {
         /// Outward normal (normalised when built; must not be zero).
         normal: [f32; 3],
     },
+    /// A triangle mesh (Parry's `TriMesh` with `FIX_INTERNAL_EDGES`: no bumps at the edges
+    /// between its triangles); static bodies only. The triangles come from `file` or from
+    /// `vertices` and `indices`, never both.
+    Trimesh {
+        /// An OBJ, glTF or GLB file, relative to the scene file's directory (to the current
+        /// directory for scenes not read from a file). Read when the scene file is loaded.
+        file: Option<String>,
+        /// Vertex positions (m, local frame), when the mesh is given inline.
+        vertices: Option<Vec<[f32; 3]>>,
+        /// Triangles as indices into `vertices`, counter-clockwise seen from the side that
+        /// bodies touch (unless `two_sided`).
+        indices: Option<Vec<[u32; 3]>>,
+        /// Whether bodies may touch the triangles from both sides (for meshes whose winding
+        /// is not consistent); by default a contact from behind a triangle is ignored.
+        two_sided: bool,
+        /// The triangles read from `file` (not part of the JSON form).
+        loaded: Option<mesh_file::LoadedMesh>,
+    },
+    /// A height field (Parry's `HeightField` with `FIX_INTERNAL_EDGES`); static bodies only.
+    /// Centred on the body origin: it spans x ∈ [−scale.x/2, scale.x/2] and z ∈
+    /// [−scale.z/2, scale.z/2], and the surface height at a grid point is scale.y times its
+    /// entry of `heights`.
+    HeightField {
+        /// Heights, one row per z from −scale.z/2 to scale.z/2, each row one entry per x from
+        /// −scale.x/2 to scale.x/2: at least 2 rows of at least 2 entries, all rows alike.
+        heights: Vec<Vec<f32>>,
+        /// Size of the field along x and z and the factor of the heights (m), each > 0.
+        scale: [f32; 3],
+    },
+    /// Several convex shapes moving as one body (Parry's `Compound`); mass, centre of mass
+    /// and inertia combine the parts' (Parry's mass properties, summed with the parallel-axis
+    /// theorem).
+    Compound {
+        /// The parts, at least one; each a convex shape (no half-space, mesh, height field
+        /// or compound).
+        parts: Vec<CompoundPart>,
+    },
+    /// A shape with rounded edges: every point within `border_radius` of `shape` (Parry's
+    /// `RoundShape`). `shape` is a cuboid, cylinder, cone or convex hull.
+    Round {
+        /// The inner shape.
+        shape: Box<ShapeDesc>,
+        /// Radius of the rounding (m) > 0: the shape grows by it in every direction.
+        border_radius: f32,
+    },
+}
+
+/// One part of a [`ShapeDesc::Compound`]: a shape placed in the body's frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompoundPart {
+    /// The part's shape.
+    pub shape: ShapeDesc,
+    /// Position of the part's origin in the body's frame (m).
+    #[serde(default)]
+    pub position: [f32; 3],
+    /// Orientation of the part in the body's frame, unit quaternion `[x, y, z, w]`.
+    #[serde(default = "identity_quaternion")]
+    pub orientation: [f32; 4],
+}
+
+impl ShapeDesc {
+    /// A triangle mesh given inline (see [`ShapeDesc::Trimesh`]).
+    pub fn trimesh(vertices: Vec<[f32; 3]>, indices: Vec<[u32; 3]>) -> Self {
+        ShapeDesc::Trimesh {
+            file: None,
+            vertices: Some(vertices),
+            indices: Some(indices),
+            two_sided: false,
+            loaded: None,
+        }
+    }
+
+    /// A triangle mesh read from `file` when the scene is loaded (see [`ShapeDesc::Trimesh`]).
+    pub fn trimesh_file(file: impl Into<String>) -> Self {
+        ShapeDesc::Trimesh {
+            file: Some(file.into()),
+            vertices: None,
+            indices: None,
+            two_sided: false,
+            loaded: None,
+        }
+    }
+
+    /// The triangles of a [`ShapeDesc::Trimesh`]: inline, or as read from its file; `None`
+    /// for other shapes and for a file not read yet.
+    pub fn mesh_data(&self) -> Option<std::borrow::Cow<'_, mesh_file::MeshData>> {
+        use std::borrow::Cow;
+        match self {
+            ShapeDesc::Trimesh {
+                loaded: Some(mesh), ..
+            } => Some(Cow::Borrowed(&*mesh.0)),
+            ShapeDesc::Trimesh {
+                vertices: Some(vertices),
+                indices: Some(indices),
+                ..
+            } => Some(Cow::Owned(mesh_file::MeshData {
+                vertices: vertices.clone(),
+                indices: indices.clone(),
+            })),
+            _ => None,
+        }
+    }
+
+    /// The name of the shape's `"type"` in JSON (a rounded shape's is its inner shape's).
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            ShapeDesc::Sphere { .. } => "sphere",
+            ShapeDesc::Cuboid { .. } => "cuboid",
+            ShapeDesc::Capsule { .. } => "capsule",
+            ShapeDesc::Cylinder { .. } => "cylinder",
+            ShapeDesc::Cone { .. } => "cone",
+            ShapeDesc::ConvexHull { .. } => "convex_hull",
+            ShapeDesc::HalfSpace { .. } => "half_space",
+            ShapeDesc::Trimesh { .. } => "trimesh",
+            ShapeDesc::HeightField { .. } => "heightfield",
+            ShapeDesc::Compound { .. } => "compound",
+            ShapeDesc::Round { shape, .. } => shape.type_name(),
+        }
+    }
 }
 
 /// A material given inline or by name from [`Scene::materials`].
@@ -245,9 +368,14 @@ impl BodyDesc {
 pub mod builtin;
 pub mod error;
 pub mod json;
+mod json_shape;
+pub mod mesh_file;
+mod shape;
 pub mod validate;
 
 pub use builtin::{builtin_families, builtin_names, builtin_scene};
 pub use error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
-pub use json::{load_scene_file, parse_scene_str, to_json_string};
+pub use json::{load_scene_file, parse_scene_str, parse_scene_str_in, to_json_string};
+pub use mesh_file::{LoadedMesh, MeshData, MeshFileError, load_mesh_file};
+pub use shape::build_shape;
 pub use validate::validate;

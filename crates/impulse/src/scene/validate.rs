@@ -13,6 +13,12 @@
 //!   cylinder and cone `half_height > 0`, every cuboid half
 //!   extent > 0, a convex hull has ≥ 4 points that span a volume (not all coincident,
 //!   collinear or coplanar), a half-space normal is not zero and belongs to a static body;
+//! - a trimesh belongs to a static body and has `file`, or `vertices` and `indices`, with at
+//!   least one triangle, finite vertices, indices below the vertex count and no triangle
+//!   without area; a heightfield belongs to a static body and has at least 2 × 2 finite
+//!   heights in rows of one length and a scale > 0; a compound has at least one part, each a
+//!   convex shape with a finite position and a non-zero orientation; a `border_radius` is
+//!   > 0 and only on a cuboid, cylinder, cone or convex hull;
 //! - a particle's shape is a sphere;
 //! - `keyframes` belong to a kinematic body, are at least one, with times finite, > 0 and
 //!   increasing, finite positions and non-zero orientations;
@@ -25,6 +31,7 @@
 use std::collections::BTreeMap;
 
 use super::error::{BodyRef, FieldPath, SceneError, SceneErrorKind};
+use super::mesh_file::MeshData;
 use super::{BodyDesc, BodyKind, KeyframeDesc, Material, MaterialRef, Scene, ShapeDesc};
 
 /// Smallest norm of an orientation quaternion or a half-space normal that is accepted;
@@ -82,6 +89,21 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
         c.body(&FieldPath::body(index), body, &scene.materials);
     }
     c.errors
+}
+
+/// The first problem of `shape` on a body of `kind`, as (field path from the body, message),
+/// e.g. `("shape.border_radius", "must be > 0, got -1")`; `None` if it is valid. Used when a
+/// world is built from a scene that was not validated.
+pub(crate) fn shape_problem(kind: BodyKind, shape: &ShapeDesc) -> Option<(String, String)> {
+    let mut c = Checker {
+        errors: Vec::new(),
+        body: None,
+    };
+    c.shape(&FieldPath::root().key("shape"), kind, shape);
+    c.errors.into_iter().next().map(|e| {
+        let field = e.field.map(|f| f.to_string()).unwrap_or_default();
+        (field, e.message)
+    })
 }
 
 /// Collects errors; `body` is attached to each error raised while it is set.
@@ -264,10 +286,15 @@ impl Checker {
                 &path.key("type"),
                 format!(
                     "a particle must have a sphere shape, got {}",
-                    shape_type_name(shape)
+                    shape.type_name()
                 ),
             );
         }
+        self.shape_fields(path, kind, shape);
+    }
+
+    /// Checks the fields of `shape` at `path` (its own, not whether it suits the body).
+    fn shape_fields(&mut self, path: &FieldPath, kind: BodyKind, shape: &ShapeDesc) {
         match shape {
             ShapeDesc::Sphere { radius } => self.positive(&path.key("radius"), *radius),
             ShapeDesc::Cuboid { half_extents } => {
@@ -329,8 +356,239 @@ impl Checker {
                     );
                 }
             }
+            ShapeDesc::Trimesh {
+                file,
+                vertices,
+                indices,
+                ..
+            } => {
+                self.static_only(path, kind, "a trimesh");
+                match (file, vertices, indices) {
+                    (Some(_), None, None) => {
+                        if let Some(mesh) = shape.mesh_data() {
+                            self.mesh(&path.key("file"), &path.key("file"), &mesh);
+                        }
+                    }
+                    (None, Some(_), Some(_)) => {
+                        if let Some(mesh) = shape.mesh_data() {
+                            self.mesh(&path.key("vertices"), &path.key("indices"), &mesh);
+                        }
+                    }
+                    (Some(_), _, _) => self.fail(
+                        &path.key("file"),
+                        "give either `file` or `vertices` and `indices`, not both".to_string(),
+                    ),
+                    (None, None, _) => self.fail(
+                        &path.key("vertices"),
+                        "a trimesh needs `file`, or `vertices` and `indices`".to_string(),
+                    ),
+                    (None, Some(_), None) => self.fail(
+                        &path.key("indices"),
+                        "a trimesh with `vertices` needs `indices` (triangles as three vertex \
+                         indices each)"
+                            .to_string(),
+                    ),
+                }
+            }
+            ShapeDesc::HeightField { heights, scale } => {
+                self.static_only(path, kind, "a heightfield");
+                let heights_path = path.key("heights");
+                let columns = heights.first().map_or(0, Vec::len);
+                if heights.len() < 2 || columns < 2 {
+                    self.fail(
+                        &heights_path,
+                        format!(
+                            "a height field needs at least 2 rows of at least 2 heights, got {} \
+                             rows of {columns}",
+                            heights.len()
+                        ),
+                    );
+                }
+                for (i, row) in heights.iter().enumerate() {
+                    if row.len() != columns {
+                        self.fail(
+                            &heights_path.index(i),
+                            format!(
+                                "every row needs the same number of heights as the first \
+                                 ({columns}), got {}",
+                                row.len()
+                            ),
+                        );
+                    }
+                    self.finite_array(&heights_path.index(i), row);
+                }
+                for (i, &v) in scale.iter().enumerate() {
+                    self.positive(&path.key("scale").index(i), v);
+                }
+            }
+            ShapeDesc::Compound { parts } => {
+                let parts_path = path.key("parts");
+                if parts.is_empty() {
+                    self.fail(
+                        &parts_path,
+                        "a compound needs at least one part".to_string(),
+                    );
+                }
+                for (i, part) in parts.iter().enumerate() {
+                    let part_path = parts_path.index(i);
+                    self.finite_array(&part_path.key("position"), &part.position);
+                    if self.finite_array(&part_path.key("orientation"), &part.orientation)
+                        && norm(&part.orientation) < f64::from(MIN_NORM)
+                    {
+                        self.fail(
+                            &part_path.key("orientation"),
+                            format!(
+                                "quaternion must not be zero (it is normalised), got {:?}",
+                                part.orientation
+                            ),
+                        );
+                    }
+                    let shape_path = part_path.key("shape");
+                    let inner = match &part.shape {
+                        ShapeDesc::Round { shape, .. } => shape.as_ref(),
+                        other => other,
+                    };
+                    if matches!(
+                        inner,
+                        ShapeDesc::HalfSpace { .. }
+                            | ShapeDesc::Trimesh { .. }
+                            | ShapeDesc::HeightField { .. }
+                            | ShapeDesc::Compound { .. }
+                    ) {
+                        self.fail(
+                            &shape_path.key("type"),
+                            format!(
+                                "a compound part must be a sphere, cuboid, capsule, cylinder, \
+                                 cone or convex_hull, got {}",
+                                inner.type_name()
+                            ),
+                        );
+                    } else {
+                        self.shape_fields(&shape_path, kind, &part.shape);
+                    }
+                }
+            }
+            ShapeDesc::Round {
+                shape,
+                border_radius,
+            } => {
+                self.positive(&path.key("border_radius"), *border_radius);
+                if matches!(
+                    shape.as_ref(),
+                    ShapeDesc::Cuboid { .. }
+                        | ShapeDesc::Cylinder { .. }
+                        | ShapeDesc::Cone { .. }
+                        | ShapeDesc::ConvexHull { .. }
+                ) {
+                    self.shape_fields(path, kind, shape);
+                } else {
+                    self.fail(
+                        &path.key("border_radius"),
+                        format!(
+                            "border_radius is allowed on a cuboid, cylinder, cone or \
+                             convex_hull, not on a {}",
+                            shape.type_name()
+                        ),
+                    );
+                }
+            }
         }
     }
+
+    /// Fails unless `kind` is static: `what` (a triangle mesh, a height field) has no volume
+    /// to give a moving body mass.
+    fn static_only(&mut self, path: &FieldPath, kind: BodyKind, what: &str) {
+        if kind != BodyKind::Static {
+            self.fail(
+                &path.key("type"),
+                format!(
+                    "{what} shape is only allowed on a static body, this body is {}",
+                    kind_name(kind)
+                ),
+            );
+        }
+    }
+
+    /// Checks a triangle mesh: at least one triangle, finite vertices, indices within the
+    /// vertices, and no triangle without area. Vertex problems are reported at
+    /// `vertices_path`, triangle problems at `indices_path` (both the `file` field for a
+    /// mesh read from a file).
+    fn mesh(&mut self, vertices_path: &FieldPath, indices_path: &FieldPath, mesh: &MeshData) {
+        let from_file = vertices_path == indices_path;
+        let vertex_path = |i: usize| {
+            if from_file {
+                vertices_path.clone()
+            } else {
+                vertices_path.index(i)
+            }
+        };
+        let triangle_path = |t: usize| {
+            if from_file {
+                indices_path.clone()
+            } else {
+                indices_path.index(t)
+            }
+        };
+        if mesh.indices.is_empty() {
+            self.fail(
+                indices_path,
+                "a trimesh needs at least one triangle".to_string(),
+            );
+            return;
+        }
+        for (i, v) in mesh.vertices.iter().enumerate() {
+            if !v.iter().all(|x| x.is_finite()) {
+                self.fail(
+                    &vertex_path(i),
+                    format!("vertex {i} must be finite, got {v:?}"),
+                );
+                return;
+            }
+        }
+        let count = mesh.vertices.len();
+        let extent = mesh_extent(&mesh.vertices);
+        for (t, triangle) in mesh.indices.iter().enumerate() {
+            if let Some(&bad) = triangle.iter().find(|&&i| i as usize >= count) {
+                self.fail(
+                    &triangle_path(t),
+                    format!(
+                        "triangle {t} refers to vertex {bad}, but there are {count} vertices \
+                         (indices 0 to {})",
+                        count.saturating_sub(1)
+                    ),
+                );
+                return;
+            }
+            let [a, b, c] = triangle.map(|i| {
+                let p = mesh.vertices[i as usize];
+                [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])]
+            });
+            let twice_area = len(cross(sub(b, a), sub(c, a)));
+            if twice_area <= HULL_FLATNESS_TOLERANCE * HULL_FLATNESS_TOLERANCE * extent * extent {
+                self.fail(
+                    &triangle_path(t),
+                    format!(
+                        "triangle {t} (vertices {}, {}, {}) has no area: its corners coincide \
+                         or are collinear",
+                        triangle[0], triangle[1], triangle[2]
+                    ),
+                );
+                return;
+            }
+        }
+    }
+}
+
+/// The largest coordinate range of `vertices` (m), or 1 for an empty or single-point set.
+fn mesh_extent(vertices: &[[f32; 3]]) -> f64 {
+    let mut extent: f64 = 0.0;
+    for axis in 0..3 {
+        let values = vertices.iter().map(|v| f64::from(v[axis]));
+        let low = values.clone().fold(f64::INFINITY, f64::min);
+        let high = values.fold(f64::NEG_INFINITY, f64::max);
+        extent = extent.max(high - low);
+    }
+    if extent > 0.0 { extent } else { 1.0 }
 }
 
 fn norm(v: &[f32]) -> f64 {
@@ -338,18 +596,6 @@ fn norm(v: &[f32]) -> f64 {
         .map(|&x| f64::from(x) * f64::from(x))
         .sum::<f64>()
         .sqrt()
-}
-
-fn shape_type_name(shape: &ShapeDesc) -> &'static str {
-    match shape {
-        ShapeDesc::Sphere { .. } => "sphere",
-        ShapeDesc::Cuboid { .. } => "cuboid",
-        ShapeDesc::Capsule { .. } => "capsule",
-        ShapeDesc::Cylinder { .. } => "cylinder",
-        ShapeDesc::Cone { .. } => "cone",
-        ShapeDesc::ConvexHull { .. } => "convex_hull",
-        ShapeDesc::HalfSpace { .. } => "half_space",
-    }
 }
 
 fn kind_name(kind: BodyKind) -> &'static str {

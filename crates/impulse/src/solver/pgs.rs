@@ -340,6 +340,22 @@ pub fn solve_pgs_rows(
 #[inline(always)]
 fn solve_point<const FRICTION: bool>(
     c: &mut ContactConstraint,
+    velocities: [Vec3; 4],
+) -> ([Vec3; 4], f32) {
+    let (velocities, normal) = solve_normal(c, velocities);
+    if FRICTION && c.friction > 0.0 {
+        let (velocities, friction) = solve_friction(c, velocities);
+        (velocities, normal.max(friction))
+    } else {
+        (velocities, normal)
+    }
+}
+
+/// The normal row's update of [`solve_point`], clamped to γ_n ≥ 0; returns the velocities and
+/// the row's velocity change (m/s).
+#[inline(always)]
+fn solve_normal(
+    c: &mut ContactConstraint,
     [mut la, mut aa, mut lb, mut ab]: [Vec3; 4],
 ) -> ([Vec3; 4], f32) {
     let (ima, imb) = (c.inverse_mass_a, c.inverse_mass_b);
@@ -362,7 +378,19 @@ fn solve_point<const FRICTION: bool>(
         ab -= row.inverse_inertia_angular_b * delta;
         largest_change = largest_change.max(delta.abs() * row.inverse_effective_mass);
     }
-    if FRICTION && c.friction > 0.0 {
+    ([la, aa, lb, ab], largest_change)
+}
+
+/// The friction pair's update of [`solve_point`] (μ > 0): the 2×2 block projected onto the
+/// disc of the current γ_n; returns the velocities and the larger row velocity change (m/s).
+#[inline(always)]
+fn solve_friction(
+    c: &mut ContactConstraint,
+    [mut la, mut aa, mut lb, mut ab]: [Vec3; 4],
+) -> ([Vec3; 4], f32) {
+    let (ima, imb) = (c.inverse_mass_a, c.inverse_mass_b);
+    let mut largest_change = 0.0f32;
+    {
         let [t1, t2] = &c.tangents;
         let v1 = t1.velocity(la, aa, lb, ab);
         let v2 = t2.velocity(la, aa, lb, ab);

@@ -1036,6 +1036,17 @@ fn set_vec(lanes: &mut LaneVec, i: usize, value: Vec3) {
 /// of a `fast` pyramid20 step; this step made it 1.4× faster (docs/benchmarks.md).
 #[inline(always)]
 fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
+    let normal = solve_normal(b, v);
+    if FRICTION {
+        normal.max(solve_friction(b, v))
+    } else {
+        normal
+    }
+}
+
+/// The normal row's part of [`solve_bundle`]: returns each lane's row velocity change (m/s).
+#[inline(always)]
+fn solve_normal(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
     let zero = Lane::splat(0.0);
     let masses = (b.inverse_mass_a, b.inverse_mass_b);
     let row = &b.normal;
@@ -1048,12 +1059,7 @@ fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, v: &mut BodyLanes) -> Lane
     b.normal_impulse = new;
     b.max_normal_impulse = b.max_normal_impulse.max(new);
     row.apply(delta, masses, v);
-    let largest = delta.abs() * row.inverse_effective_mass;
-    if FRICTION {
-        largest.max(solve_friction(b, v))
-    } else {
-        largest
-    }
+    delta.abs() * row.inverse_effective_mass
 }
 
 /// The friction pair's part of [`solve_bundle`]: returns each lane's larger tangent row

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::World;
 use crate::body::BodyHandle;
-use crate::narrow_phase::{ContactPair, repeats_earlier_point};
+use crate::narrow_phase::{self, ContactPair, repeats_earlier_point};
 
 /// One contact point of a pair after the last step, in world coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,6 +53,7 @@ impl<'a> ContactPairView<'a> {
             bodies.pose[self.pair.body2 as usize],
         );
         self.pair.manifolds.iter().flat_map(move |manifold| {
+            let (pose1, pose2) = narrow_phase::manifold_poses(manifold, &pose1, &pose2);
             let normal = pose1.rotation * manifold.local_n1;
             manifold
                 .points

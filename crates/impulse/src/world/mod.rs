@@ -405,6 +405,15 @@ fn builder_of(
                 }
             }
         }
+        ShapeDesc::Trimesh { .. }
+        | ShapeDesc::HeightField { .. }
+        | ShapeDesc::Compound { .. }
+        | ShapeDesc::Round { .. } => {
+            crate::scene::build_shape(desc.kind, &desc.shape).map_err(|e| {
+                let field = e.field.map(|f| f.to_string()).unwrap_or_default();
+                invalid(index, desc, &field, e.message)
+            })?
+        }
         ShapeDesc::HalfSpace { normal } => {
             let n = Vec3::from(*normal);
             if desc.kind != BodyKind::Static {
@@ -516,6 +525,14 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
     let shape = b.shape.clone();
     if b.kind != BodyKind::Static && shape.as_halfspace().is_some() {
         return bad("shape", "a half-space must be a static body".into());
+    }
+    if b.kind != BodyKind::Static
+        && (shape.as_trimesh().is_some() || shape.as_heightfield().is_some())
+    {
+        return bad(
+            "shape",
+            "a triangle mesh or height field must be a static body (it has no volume)".into(),
+        );
     }
     if b.kind == BodyKind::Particle && shape.as_ball().is_none() {
         return bad("shape", "a particle must be a sphere".into());

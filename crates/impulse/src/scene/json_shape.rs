@@ -1,0 +1,232 @@
+//! The JSON form of [`ShapeDesc`]: one object per shape with a `"type"`, where a rounded
+//! shape is its inner shape's object with a `"border_radius"` (`docs/scene-format.md`).
+//! [`ShapeDesc`] is read and written through [`ShapeJson`].
+
+use serde::{Deserialize, Serialize};
+
+use super::{CompoundPart, ShapeDesc};
+
+fn is_zero(value: &f32) -> bool {
+    *value == 0.0
+}
+
+fn is_false(value: &bool) -> bool {
+    !*value
+}
+
+/// [`ShapeDesc`] as written in JSON.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ShapeJson {
+    Sphere {
+        radius: f32,
+    },
+    Cuboid {
+        half_extents: [f32; 3],
+        #[serde(default, skip_serializing_if = "is_zero")]
+        border_radius: f32,
+    },
+    Capsule {
+        half_height: f32,
+        radius: f32,
+    },
+    Cylinder {
+        half_height: f32,
+        radius: f32,
+        #[serde(default, skip_serializing_if = "is_zero")]
+        border_radius: f32,
+    },
+    Cone {
+        half_height: f32,
+        radius: f32,
+        #[serde(default, skip_serializing_if = "is_zero")]
+        border_radius: f32,
+    },
+    ConvexHull {
+        points: Vec<[f32; 3]>,
+        #[serde(default, skip_serializing_if = "is_zero")]
+        border_radius: f32,
+    },
+    HalfSpace {
+        normal: [f32; 3],
+    },
+    Trimesh {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        file: Option<String>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        vertices: Option<Vec<[f32; 3]>>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        indices: Option<Vec<[u32; 3]>>,
+        #[serde(default, skip_serializing_if = "is_false")]
+        two_sided: bool,
+    },
+    #[serde(rename = "heightfield")]
+    HeightField {
+        heights: Vec<Vec<f32>>,
+        scale: [f32; 3],
+    },
+    Compound {
+        parts: Vec<CompoundPart>,
+    },
+}
+
+/// `shape` rounded by `border_radius`, or `shape` itself when the radius is zero.
+fn rounded(shape: ShapeDesc, border_radius: f32) -> ShapeDesc {
+    if border_radius == 0.0 {
+        shape
+    } else {
+        ShapeDesc::Round {
+            shape: Box::new(shape),
+            border_radius,
+        }
+    }
+}
+
+impl From<ShapeJson> for ShapeDesc {
+    fn from(json: ShapeJson) -> Self {
+        match json {
+            ShapeJson::Sphere { radius } => ShapeDesc::Sphere { radius },
+            ShapeJson::Cuboid {
+                half_extents,
+                border_radius,
+            } => rounded(ShapeDesc::Cuboid { half_extents }, border_radius),
+            ShapeJson::Capsule {
+                half_height,
+                radius,
+            } => ShapeDesc::Capsule {
+                half_height,
+                radius,
+            },
+            ShapeJson::Cylinder {
+                half_height,
+                radius,
+                border_radius,
+            } => rounded(
+                ShapeDesc::Cylinder {
+                    half_height,
+                    radius,
+                },
+                border_radius,
+            ),
+            ShapeJson::Cone {
+                half_height,
+                radius,
+                border_radius,
+            } => rounded(
+                ShapeDesc::Cone {
+                    half_height,
+                    radius,
+                },
+                border_radius,
+            ),
+            ShapeJson::ConvexHull {
+                points,
+                border_radius,
+            } => rounded(ShapeDesc::ConvexHull { points }, border_radius),
+            ShapeJson::HalfSpace { normal } => ShapeDesc::HalfSpace { normal },
+            ShapeJson::Trimesh {
+                file,
+                vertices,
+                indices,
+                two_sided,
+            } => ShapeDesc::Trimesh {
+                file,
+                vertices,
+                indices,
+                two_sided,
+                loaded: None,
+            },
+            ShapeJson::HeightField { heights, scale } => ShapeDesc::HeightField { heights, scale },
+            ShapeJson::Compound { parts } => ShapeDesc::Compound { parts },
+        }
+    }
+}
+
+impl From<ShapeDesc> for ShapeJson {
+    /// Every shape the scene format can hold is written as it was read. A [`ShapeDesc::Round`]
+    /// of a shape that cannot carry a `border_radius` (validation rejects it) is written as
+    /// its inner shape.
+    fn from(shape: ShapeDesc) -> Self {
+        match shape {
+            ShapeDesc::Sphere { radius } => ShapeJson::Sphere { radius },
+            ShapeDesc::Cuboid { half_extents } => ShapeJson::Cuboid {
+                half_extents,
+                border_radius: 0.0,
+            },
+            ShapeDesc::Capsule {
+                half_height,
+                radius,
+            } => ShapeJson::Capsule {
+                half_height,
+                radius,
+            },
+            ShapeDesc::Cylinder {
+                half_height,
+                radius,
+            } => ShapeJson::Cylinder {
+                half_height,
+                radius,
+                border_radius: 0.0,
+            },
+            ShapeDesc::Cone {
+                half_height,
+                radius,
+            } => ShapeJson::Cone {
+                half_height,
+                radius,
+                border_radius: 0.0,
+            },
+            ShapeDesc::ConvexHull { points } => ShapeJson::ConvexHull {
+                points,
+                border_radius: 0.0,
+            },
+            ShapeDesc::HalfSpace { normal } => ShapeJson::HalfSpace { normal },
+            ShapeDesc::Trimesh {
+                file,
+                vertices,
+                indices,
+                two_sided,
+                loaded: _,
+            } => ShapeJson::Trimesh {
+                file,
+                vertices,
+                indices,
+                two_sided,
+            },
+            ShapeDesc::HeightField { heights, scale } => ShapeJson::HeightField { heights, scale },
+            ShapeDesc::Compound { parts } => ShapeJson::Compound { parts },
+            ShapeDesc::Round {
+                shape,
+                border_radius: radius,
+            } => match ShapeJson::from(*shape) {
+                ShapeJson::Cuboid { half_extents, .. } => ShapeJson::Cuboid {
+                    half_extents,
+                    border_radius: radius,
+                },
+                ShapeJson::Cylinder {
+                    half_height,
+                    radius: r,
+                    ..
+                } => ShapeJson::Cylinder {
+                    half_height,
+                    radius: r,
+                    border_radius: radius,
+                },
+                ShapeJson::Cone {
+                    half_height,
+                    radius: r,
+                    ..
+                } => ShapeJson::Cone {
+                    half_height,
+                    radius: r,
+                    border_radius: radius,
+                },
+                ShapeJson::ConvexHull { points, .. } => ShapeJson::ConvexHull {
+                    points,
+                    border_radius: radius,
+                },
+                other => other,
+            },
+        }
+    }
+}

@@ -1,0 +1,283 @@
+//! Triangle meshes read from files for `trimesh` shapes: Wavefront OBJ (with `tobj`) and
+//! glTF 2.0, `.gltf` or `.glb` (with `gltf`).
+//!
+//! Every triangle of the file is kept, in the file's own units and axes (impulse works in
+//! metres with y up, as glTF does): for OBJ every object and group, polygons split into
+//! triangles; for glTF every triangle primitive (`TRIANGLES`, `TRIANGLE_STRIP`,
+//! `TRIANGLE_FAN`) of every mesh reached from the default scene's nodes (or from every scene
+//! when there is no default), with the nodes' transforms applied.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+use thiserror::Error;
+
+/// A triangle mesh as plain data: vertex positions (m, the body's frame) and triangles as
+/// three indices into `vertices`, counter-clockwise seen from the side bodies touch.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshData {
+    /// Vertex positions (m).
+    pub vertices: Vec<[f32; 3]>,
+    /// Triangles: indices into `vertices`.
+    pub indices: Vec<[u32; 3]>,
+}
+
+/// A mesh read from a `trimesh` shape's `file`, kept with the scene description so that
+/// the world is built from what was read (not serialised: the scene keeps the file's name).
+#[derive(Clone, PartialEq)]
+pub struct LoadedMesh(pub Arc<MeshData>);
+
+impl std::fmt::Debug for LoadedMesh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "LoadedMesh({} vertices, {} triangles)",
+            self.0.vertices.len(),
+            self.0.indices.len()
+        )
+    }
+}
+
+/// Why a mesh file could not be used.
+#[derive(Debug, Error)]
+pub enum MeshFileError {
+    /// The file (or a glTF buffer it refers to) cannot be read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The system's reason.
+        source: std::io::Error,
+    },
+    /// The extension is none of `.obj`, `.gltf`, `.glb`.
+    #[error(
+        "{path}: unknown mesh file type; allowed: .obj (Wavefront OBJ), .gltf or .glb (glTF 2.0)"
+    )]
+    UnknownType {
+        /// The file.
+        path: String,
+    },
+    /// The file is not a valid OBJ or glTF file, or uses what is not supported.
+    #[error("{path}: {message}")]
+    Format {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file has no triangle.
+    #[error("{path}: the file has no triangles")]
+    Empty {
+        /// The file.
+        path: String,
+    },
+}
+
+/// Reads the triangles of the OBJ, glTF or GLB file at `path` (by extension, any case).
+///
+/// # Errors
+/// [`MeshFileError`]: unreadable file, unknown extension, a malformed file, or no triangle.
+pub fn load_mesh_file(path: &Path) -> Result<MeshData, MeshFileError> {
+    let name = path.display().to_string();
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let mesh = match extension.as_deref() {
+        Some("obj") => load_obj(path, &name)?,
+        Some("gltf") | Some("glb") => load_gltf(path, &name)?,
+        _ => return Err(MeshFileError::UnknownType { path: name }),
+    };
+    if mesh.indices.is_empty() {
+        return Err(MeshFileError::Empty { path: name });
+    }
+    Ok(mesh)
+}
+
+fn read(path: &Path, name: &str) -> Result<Vec<u8>, MeshFileError> {
+    std::fs::read(path).map_err(|source| MeshFileError::Io {
+        path: name.to_string(),
+        source,
+    })
+}
+
+fn format_error(name: &str, message: impl Into<String>) -> MeshFileError {
+    MeshFileError::Format {
+        path: name.to_string(),
+        message: message.into(),
+    }
+}
+
+fn load_obj(path: &Path, name: &str) -> Result<MeshData, MeshFileError> {
+    let bytes = read(path, name)?;
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    // Materials are not needed: a missing .mtl file must not fail the load.
+    let (models, _) =
+        tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| Ok(Default::default()))
+            .map_err(|e| format_error(name, format!("not a valid OBJ file: {e}")))?;
+    let mut mesh = MeshData::default();
+    for model in models {
+        let m = &model.mesh;
+        let base = u32::try_from(mesh.vertices.len())
+            .map_err(|_| format_error(name, "more than 2³² vertices"))?;
+        let count = m.positions.len() / 3;
+        mesh.vertices
+            .extend(m.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
+        for t in m.indices.chunks_exact(3) {
+            if t.iter().any(|&i| i as usize >= count) {
+                return Err(format_error(
+                    name,
+                    format!(
+                        "object {:?}: a face refers to a vertex beyond the {count} it has",
+                        model.name
+                    ),
+                ));
+            }
+            mesh.indices.push([base + t[0], base + t[1], base + t[2]]);
+        }
+    }
+    Ok(mesh)
+}
+
+fn load_gltf(path: &Path, name: &str) -> Result<MeshData, MeshFileError> {
+    let bytes = read(path, name)?;
+    let document = gltf::Gltf::from_slice(&bytes)
+        .map_err(|e| format_error(name, format!("not a valid glTF file: {e}")))?;
+    let directory = path.parent().unwrap_or(Path::new("."));
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for buffer in document.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => document
+                .blob
+                .clone()
+                .ok_or_else(|| format_error(name, "buffer refers to a missing GLB binary chunk"))?,
+            gltf::buffer::Source::Uri(uri) => {
+                if let Some(rest) = uri.strip_prefix("data:") {
+                    let (_, encoded) = rest.split_once(";base64,").ok_or_else(|| {
+                        format_error(name, "a data URI buffer must be base64-encoded")
+                    })?;
+                    use base64::Engine as _;
+                    base64::engine::general_purpose::STANDARD
+                        .decode(encoded)
+                        .map_err(|e| format_error(name, format!("bad base64 buffer: {e}")))?
+                } else if uri.contains("://") {
+                    return Err(format_error(
+                        name,
+                        format!(
+                            "buffer {uri:?}: only files beside the glTF file and data URIs are read"
+                        ),
+                    ));
+                } else {
+                    let buffer_path = directory.join(uri);
+                    read(&buffer_path, &buffer_path.display().to_string())?
+                }
+            }
+        };
+        if data.len() < buffer.length() {
+            return Err(format_error(
+                name,
+                format!(
+                    "buffer {} holds {} bytes, the file says {}",
+                    buffer.index(),
+                    data.len(),
+                    buffer.length()
+                ),
+            ));
+        }
+        buffers.push(data);
+    }
+    let mut mesh = MeshData::default();
+    let scenes: Vec<gltf::Scene> = match document.default_scene() {
+        Some(scene) => vec![scene],
+        None => document.scenes().collect(),
+    };
+    for scene in scenes {
+        for node in scene.nodes() {
+            add_node(&node, Mat4::IDENTITY, &buffers, &mut mesh, name, 0)?;
+        }
+    }
+    Ok(mesh)
+}
+
+/// Adds the triangles of `node` and its children, with `parent` the transform above it.
+fn add_node(
+    node: &gltf::Node,
+    parent: Mat4,
+    buffers: &[Vec<u8>],
+    mesh: &mut MeshData,
+    name: &str,
+    depth: usize,
+) -> Result<(), MeshFileError> {
+    // A valid glTF node tree is acyclic; the depth bound only guards against a malformed one.
+    if depth > 1000 {
+        return Err(format_error(
+            name,
+            "the node tree is deeper than 1000 levels",
+        ));
+    }
+    let transform = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+    if let Some(node_mesh) = node.mesh() {
+        for primitive in node_mesh.primitives() {
+            let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+            let Some(positions) = reader.read_positions() else {
+                continue;
+            };
+            let positions: Vec<Vec3> = positions
+                .map(|p| transform.transform_point3(Vec3::from(p)))
+                .collect();
+            let count = positions.len();
+            let order: Vec<u32> = match reader.read_indices() {
+                Some(indices) => indices.into_u32().collect(),
+                None => (0..count as u32).collect(),
+            };
+            let triangles: Vec<[u32; 3]> = match primitive.mode() {
+                gltf::mesh::Mode::Triangles => {
+                    order.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect()
+                }
+                gltf::mesh::Mode::TriangleStrip => order
+                    .windows(3)
+                    .enumerate()
+                    .map(|(k, t)| {
+                        if k % 2 == 0 {
+                            [t[0], t[1], t[2]]
+                        } else {
+                            [t[1], t[0], t[2]]
+                        }
+                    })
+                    .collect(),
+                gltf::mesh::Mode::TriangleFan => order
+                    .windows(2)
+                    .skip(1)
+                    .map(|t| [order[0], t[0], t[1]])
+                    .collect(),
+                // Points and lines have no area to touch.
+                _ => continue,
+            };
+            let base = u32::try_from(mesh.vertices.len())
+                .map_err(|_| format_error(name, "more than 2³² vertices"))?;
+            for t in &triangles {
+                if t.iter().any(|&i| i as usize >= count) {
+                    return Err(format_error(
+                        name,
+                        format!(
+                            "mesh {:?}: an index is beyond its {count} vertices",
+                            node_mesh.name().unwrap_or("")
+                        ),
+                    ));
+                }
+            }
+            mesh.vertices.extend(positions.iter().map(|p| p.to_array()));
+            mesh.indices
+                .extend(triangles.iter().map(|t| t.map(|i| base + i)));
+        }
+    }
+    for child in node.children() {
+        add_node(&child, transform, buffers, mesh, name, depth + 1)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,163 @@
+//! Parry shapes from scene shape descriptions.
+
+use glam::{Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::shape::SharedShape;
+
+use super::error::{FieldPath, SceneError, SceneErrorKind};
+use super::{BodyKind, ShapeDesc};
+
+/// The Parry shape of `shape` for a body of `kind`, after the checks of
+/// [`validate`](super::validate::validate) for that shape. A triangle mesh whose file was
+/// not read with its scene ([`super::load_scene_file`]) is read here, relative to the
+/// current directory. The same shapes `World::from_scene` builds (the Rapier comparison
+/// uses it too).
+///
+/// # Errors
+/// A [`SceneError`] of kind [`SceneErrorKind::Invalid`] whose field is the path from the
+/// body (`shape.parts[1].shape.radius`): an invalid value, an unreadable or degenerate mesh
+/// file, a hull Parry cannot build.
+pub fn build_shape(kind: BodyKind, shape: &ShapeDesc) -> Result<SharedShape, SceneError> {
+    let error = |(field, message): (String, String)| {
+        SceneError::new(SceneErrorKind::Invalid, FieldPath::parse(&field), message)
+    };
+    if let Some(problem) = super::validate::shape_problem(kind, shape) {
+        return Err(error(problem));
+    }
+    shape_of(shape).map_err(error)
+}
+
+/// The Parry shape of `shape`, which [`super::validate::shape_problem`] found valid.
+/// A triangle mesh whose file was not read with the scene is read here, relative to the
+/// current directory.
+///
+/// # Errors
+/// (field, message) for what validation cannot see: an unreadable mesh file, a mesh whose
+/// file turns out degenerate, a hull Parry cannot build.
+fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String)> {
+    use parry3d::shape::{HeightField, HeightFieldFlags, TriMeshFlags};
+    let hull = |points: &[[f32; 3]], border_radius: f32| {
+        let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
+        let hull = if border_radius > 0.0 {
+            SharedShape::round_convex_hull(&points, border_radius)
+        } else {
+            SharedShape::convex_hull(&points)
+        };
+        hull.filter(|h| h.mass_properties(1.0).mass() > 1e-9)
+            .ok_or_else(|| {
+                (
+                    "shape.points".to_string(),
+                    "need at least 4 points spanning a volume".to_string(),
+                )
+            })
+    };
+    Ok(match shape {
+        ShapeDesc::Sphere { radius } => SharedShape::ball(*radius),
+        ShapeDesc::Cuboid { half_extents: h } => SharedShape::cuboid(h[0], h[1], h[2]),
+        ShapeDesc::Capsule {
+            half_height,
+            radius,
+        } => SharedShape::capsule_y(*half_height, *radius),
+        ShapeDesc::Cylinder {
+            half_height,
+            radius,
+        } => SharedShape::cylinder(*half_height, *radius),
+        ShapeDesc::Cone {
+            half_height,
+            radius,
+        } => SharedShape::cone(*half_height, *radius),
+        ShapeDesc::ConvexHull { points } => hull(points, 0.0)?,
+        ShapeDesc::HalfSpace { normal } => SharedShape::halfspace(Vec3::from(*normal).normalize()),
+        ShapeDesc::Round {
+            shape,
+            border_radius: r,
+        } => match shape.as_ref() {
+            ShapeDesc::Cuboid { half_extents: h } => {
+                SharedShape::round_cuboid(h[0], h[1], h[2], *r)
+            }
+            ShapeDesc::Cylinder {
+                half_height,
+                radius,
+            } => SharedShape::round_cylinder(*half_height, *radius, *r),
+            ShapeDesc::Cone {
+                half_height,
+                radius,
+            } => SharedShape::round_cone(*half_height, *radius, *r),
+            ShapeDesc::ConvexHull { points } => hull(points, *r)?,
+            other => {
+                return Err((
+                    "shape.border_radius".to_string(),
+                    format!("not allowed on a {}", other.type_name()),
+                ));
+            }
+        },
+        ShapeDesc::Trimesh {
+            file, two_sided, ..
+        } => {
+            let mesh = match (shape.mesh_data(), file) {
+                (Some(mesh), _) => mesh.into_owned(),
+                (None, Some(file)) => {
+                    let mesh = super::load_mesh_file(std::path::Path::new(file))
+                        .map_err(|e| ("shape.file".to_string(), e.to_string()))?;
+                    let loaded = ShapeDesc::Trimesh {
+                        file: Some(file.clone()),
+                        vertices: None,
+                        indices: None,
+                        two_sided: *two_sided,
+                        loaded: Some(super::LoadedMesh(std::sync::Arc::new(mesh.clone()))),
+                    };
+                    if let Some(problem) = super::validate::shape_problem(BodyKind::Static, &loaded)
+                    {
+                        return Err(problem);
+                    }
+                    mesh
+                }
+                (None, None) => {
+                    return Err((
+                        "shape.vertices".to_string(),
+                        "a trimesh needs `file`, or `vertices` and `indices`".to_string(),
+                    ));
+                }
+            };
+            let flags = if *two_sided {
+                TriMeshFlags::FIX_INTERNAL_EDGES_TWO_SIDED
+            } else {
+                TriMeshFlags::FIX_INTERNAL_EDGES
+            };
+            let vertices = mesh.vertices.iter().map(|v| Vec3::from(*v)).collect();
+            SharedShape::trimesh_with_flags(vertices, mesh.indices, flags)
+                .map_err(|e| ("shape".to_string(), format!("invalid triangle mesh: {e}")))?
+        }
+        ShapeDesc::HeightField { heights, scale } => {
+            let (rows, columns) = (heights.len(), heights[0].len());
+            // Parry's grid is column-major: entry (row i, column j) at i + j·rows.
+            let mut data = vec![0.0; rows * columns];
+            for (i, row) in heights.iter().enumerate() {
+                for (j, &h) in row.iter().enumerate() {
+                    data[i + j * rows] = h;
+                }
+            }
+            let grid = parry3d::utils::Array2::new(rows, columns, data);
+            SharedShape::new(HeightField::with_flags(
+                grid,
+                Vec3::from(*scale),
+                HeightFieldFlags::FIX_INTERNAL_EDGES,
+            ))
+        }
+        ShapeDesc::Compound { parts } => {
+            let mut built = Vec::with_capacity(parts.len());
+            for (i, part) in parts.iter().enumerate() {
+                let pose = Pose::from_parts(
+                    Vec3::from(part.position),
+                    Quat::from_array(part.orientation).normalize(),
+                );
+                let shape = shape_of(&part.shape).map_err(|(field, message)| {
+                    let field = field.replacen("shape", &format!("shape.parts[{i}].shape"), 1);
+                    (field, message)
+                })?;
+                built.push((pose, shape));
+            }
+            SharedShape::compound(built)
+        }
+    })
+}
