@@ -1,6 +1,6 @@
 //! Nonsmooth nonlinear conjugate gradient: PGS sweeps with Fletcher–Reeves momentum.
 
-use super::pgs::{BACKWARD, FORWARD, Sweep, VelocityRows, sweep_points};
+use super::pgs::{BACKWARD, FORWARD, FrictionFirstRows, Sweep, sweep_points};
 use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
     apply_impulses, impulses, solve_scalar,
@@ -71,20 +71,8 @@ pub fn solve_nncg(
     for iteration in 0..iterations {
         // One fixed symmetric sweep (forward then backward) is the "PGS step": conjugate
         // directions need the same operator every iteration.
-        let forward = sweep_points(
-            constraints,
-            sweep,
-            FORWARD,
-            velocities,
-            VelocityRows::<true>,
-        );
-        let backward = sweep_points(
-            constraints,
-            sweep,
-            BACKWARD,
-            velocities,
-            VelocityRows::<true>,
-        );
+        let forward = sweep_points(constraints, sweep, FORWARD, velocities, FrictionFirstRows);
+        let backward = sweep_points(constraints, sweep, BACKWARD, velocities, FrictionFirstRows);
         let largest_change = forward.max(backward);
         report.iterations += 1;
         report.last_change = largest_change;

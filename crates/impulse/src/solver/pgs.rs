@@ -95,6 +95,22 @@ impl<const FRICTION: bool> PointUpdate for VelocityRows<FRICTION> {
     }
 }
 
+/// The velocity rows of a point with the friction pair first, capped by the normal impulse of
+/// the previous update, and the normal row last ([`solve_point_friction_first`]): NNCG's
+/// sweeps. NNCG iterates towards convergence, so the cap catches up within a solve, and in
+/// this order it converged in fewer iterations: the `reference` preset on pyramid20 took 18.2
+/// iterations a step against 24.8 with the normal row first, at about half the time (`impulse
+/// run pyramid20 --steps 300 --no-sleep --preset reference --threads 1 --quiet`).
+#[derive(Clone, Copy)]
+pub(super) struct FrictionFirstRows;
+
+impl PointUpdate for FrictionFirstRows {
+    #[inline(always)]
+    fn update(self, c: &mut ContactConstraint, velocities: [Vec3; 4]) -> ([Vec3; 4], f32) {
+        solve_point_friction_first(c, velocities)
+    }
+}
+
 /// The order of a sweep over points: first to last (`forward`) or last to first, and with
 /// `half_turn` each run of consecutive points between the same two bodies from halfway round.
 #[derive(Clone, Copy)]
@@ -348,6 +364,22 @@ fn solve_point<const FRICTION: bool>(
         (velocities, normal.max(friction))
     } else {
         (velocities, normal)
+    }
+}
+
+/// [`solve_point`] with the friction pair first, capped by the normal impulse of the previous
+/// update, and the normal row last (see [`FrictionFirstRows`]).
+#[inline(always)]
+fn solve_point_friction_first(
+    c: &mut ContactConstraint,
+    velocities: [Vec3; 4],
+) -> ([Vec3; 4], f32) {
+    if c.friction > 0.0 {
+        let (velocities, friction) = solve_friction(c, velocities);
+        let (velocities, normal) = solve_normal(c, velocities);
+        (velocities, friction.max(normal))
+    } else {
+        solve_normal(c, velocities)
     }
 }
 
