@@ -117,10 +117,10 @@ fn scene_parser_inputs_give_errors_not_panics() {
 fn short_simulation_inputs_give_errors_not_panics() {
     let mut stepped = 0;
     for path in inputs("short_simulation") {
-        if let Some(text) = text_of(&path).filter(|text| !names_a_file(text)) {
-            if simulate(&text) > 0 {
-                stepped += 1;
-            }
+        if let Some(text) = text_of(&path).filter(|text| !names_a_file(text))
+            && simulate(&text) > 0
+        {
+            stepped += 1;
         }
     }
     // The corpus starts from the repository's scenes, so some inputs are scenes that step.
