@@ -1,0 +1,37 @@
+//! Bytes → a scene → `World::from_scene` → at most `MAX_STEPS` steps on the calling thread,
+//! stopping at the first step error. Scenes with more than `MAX_BODIES` bodies are skipped and
+//! the solver effort is capped (common.rs) so that one input runs in milliseconds. A panic,
+//! abort, timeout or out-of-memory is a bug.
+
+#![no_main]
+
+use impulse::scene::json::parse_scene_str;
+use impulse::world::World;
+use libfuzzer_sys::fuzz_target;
+
+#[path = "common.rs"]
+mod common;
+
+fuzz_target!(|data: &[u8]| {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    if common::names_a_file(text) {
+        return;
+    }
+    let Ok(scene) = parse_scene_str(text, "fuzz.json") else {
+        return;
+    };
+    let Some(scene) = common::capped(scene) else {
+        return;
+    };
+    let Ok(mut world) = World::from_scene(&scene) else {
+        return;
+    };
+    world.parallel = false;
+    for _ in 0..common::MAX_STEPS {
+        if world.step().is_err() {
+            break;
+        }
+    }
+});
