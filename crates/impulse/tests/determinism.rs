@@ -4,41 +4,12 @@
 //! impulses and separation, as f32 bits). `tests/snapshot.rs` checks that a world restored
 //! from a snapshot continues to the same state.
 
+mod common;
+
+use common::hash_state;
 use impulse::scene::builtin::builtin_scene;
 use impulse::scene::json::load_scene_file;
 use impulse::{Scene, World};
-
-fn hash_state(world: &World) -> u64 {
-    let mut hash = 0xcbf2_9ce4_8422_2325u64;
-    let mut add = |x: f32| {
-        for byte in x.to_bits().to_le_bytes() {
-            hash ^= u64::from(byte);
-            hash = hash.wrapping_mul(0x0100_0000_01b3);
-        }
-    };
-    let b = &world.bodies;
-    for i in 0..b.len() {
-        let (t, q) = (b.pose[i].translation, b.pose[i].rotation);
-        for x in [t.x, t.y, t.z, q.x, q.y, q.z, q.w] {
-            add(x);
-        }
-        for v in [b.linear_velocity[i], b.angular_velocity[i]] {
-            for x in v.to_array() {
-                add(x);
-            }
-        }
-    }
-    for pair in world.contact_pairs() {
-        for point in pair.points() {
-            add(point.normal_impulse);
-            for x in point.friction_impulse.to_array() {
-                add(x);
-            }
-            add(point.separation);
-        }
-    }
-    hash
-}
 
 /// `steps` steps of `scene` (sleeping off) on a pool of `threads` threads; the final state's
 /// hash.

@@ -9,46 +9,15 @@
 //! boxes, energy reference), and a hash of every body's pose and velocities and every contact
 //! point's impulses read through the public API agrees.
 
+mod common;
+
+use common::hash_state;
 use impulse::glam::Vec3;
 use impulse::scene::builtin::builtin_scene;
 use impulse::scene::json::load_scene_file;
 use impulse::{
     BodyBuilder, Scene, SharedShape, SnapshotError, SolverSettings, World, WorldSnapshot,
 };
-
-/// FNV-1a over every body's pose and velocities and every contact point's impulses, as f32
-/// bits.
-fn hash_state(world: &World) -> u64 {
-    let mut hash = 0xcbf2_9ce4_8422_2325u64;
-    let mut add = |x: f32| {
-        for byte in x.to_bits().to_le_bytes() {
-            hash ^= u64::from(byte);
-            hash = hash.wrapping_mul(0x0100_0000_01b3);
-        }
-    };
-    let b = &world.bodies;
-    for i in 0..b.len() {
-        let (t, q) = (b.pose[i].translation, b.pose[i].rotation);
-        for x in [t.x, t.y, t.z, q.x, q.y, q.z, q.w] {
-            add(x);
-        }
-        for v in [b.linear_velocity[i], b.angular_velocity[i]] {
-            v.to_array().into_iter().for_each(&mut add);
-        }
-    }
-    for pair in world.contact_pairs() {
-        for point in pair.points() {
-            add(point.normal_impulse);
-            point
-                .friction_impulse
-                .to_array()
-                .into_iter()
-                .for_each(&mut add);
-            add(point.separation);
-        }
-    }
-    hash
-}
 
 /// Runs `f` on a pool of `threads` threads (1: everything on the calling thread).
 fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {

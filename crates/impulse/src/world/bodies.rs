@@ -239,22 +239,11 @@ impl World {
                 message,
             })
         };
-        if !translation.is_finite() {
-            return refuse(
-                "position",
-                format!("must be finite, got {:?}", translation.to_array()),
-            );
-        }
-        if !rotation.is_finite() || rotation.length() < 1e-6 {
-            return refuse(
-                "orientation",
-                format!(
-                    "must be a finite non-zero quaternion, got {:?}",
-                    rotation.to_array()
-                ),
-            );
-        }
-        self.bodies.pose[i] = Pose::from_parts(translation, rotation.normalize());
+        let pose = match checked_pose(translation, rotation) {
+            Ok(pose) => pose,
+            Err((field, message)) => return refuse(field, message),
+        };
+        self.bodies.pose[i] = pose;
         if !self.bodies.is_dynamic(i) {
             self.wake_touching(i);
         } else {
@@ -374,4 +363,28 @@ impl World {
         self.wake_up(i);
         self.scratch_bodies = touching;
     }
+}
+
+/// The pose of a body frame at `translation` with `rotation` (normalised), or the field that
+/// is wrong (`position`: not finite; `orientation`: not finite or zero) and what is allowed.
+pub(super) fn checked_pose(
+    translation: Vec3,
+    rotation: Quat,
+) -> Result<Pose, (&'static str, String)> {
+    if !translation.is_finite() {
+        return Err((
+            "position",
+            format!("must be finite, got {:?}", translation.to_array()),
+        ));
+    }
+    if !rotation.is_finite() || rotation.length() < 1e-6 {
+        return Err((
+            "orientation",
+            format!(
+                "must be a finite non-zero quaternion, got {:?}",
+                rotation.to_array()
+            ),
+        ));
+    }
+    Ok(Pose::from_parts(translation, rotation.normalize()))
 }

@@ -2,7 +2,6 @@
 //! target pose), their poses as it ends, and the target-pose edit.
 
 use glam::{Quat, Vec3};
-use parry3d::math::Pose;
 
 use super::World;
 use crate::body::{BodyHandle, BodyKind};
@@ -39,22 +38,10 @@ impl World {
                 "only a kinematic body has a target pose".to_string(),
             );
         }
-        if !translation.is_finite() {
-            return refuse(
-                "position",
-                format!("must be finite, got {:?}", translation.to_array()),
-            );
-        }
-        if !rotation.is_finite() || rotation.length() < 1e-6 {
-            return refuse(
-                "orientation",
-                format!(
-                    "must be a finite non-zero quaternion, got {:?}",
-                    rotation.to_array()
-                ),
-            );
-        }
-        let target = Pose::from_parts(translation, rotation.normalize());
+        let target = match super::bodies::checked_pose(translation, rotation) {
+            Ok(pose) => pose,
+            Err((field, message)) => return refuse(field, message),
+        };
         match self.scripts.iter_mut().find(|s| s.handle == handle) {
             Some(script) => script.target = Some(target),
             None => self.scripts.push(Script {

@@ -127,3 +127,37 @@ pub fn add_row_impulse(
         delta[b].1[k] -= ib[k] * impulse;
     }
 }
+
+/// FNV-1a hash of a world's state: every body's pose and velocities and every contact point's
+/// impulses and separation, as f32 bits. Equal hashes mean the same state to the bit.
+pub fn hash_state(world: &impulse::World) -> u64 {
+    let mut hash = 0xcbf2_9ce4_8422_2325u64;
+    let mut add = |x: f32| {
+        for byte in x.to_bits().to_le_bytes() {
+            hash ^= u64::from(byte);
+            hash = hash.wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    let b = &world.bodies;
+    for i in 0..b.len() {
+        let (t, q) = (b.pose[i].translation, b.pose[i].rotation);
+        for x in [t.x, t.y, t.z, q.x, q.y, q.z, q.w] {
+            add(x);
+        }
+        for v in [b.linear_velocity[i], b.angular_velocity[i]] {
+            v.to_array().into_iter().for_each(&mut add);
+        }
+    }
+    for pair in world.contact_pairs() {
+        for point in pair.points() {
+            add(point.normal_impulse);
+            point
+                .friction_impulse
+                .to_array()
+                .into_iter()
+                .for_each(&mut add);
+            add(point.separation);
+        }
+    }
+    hash
+}
