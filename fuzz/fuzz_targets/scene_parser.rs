@@ -1,10 +1,10 @@
-//! Bytes → `impulse::scene::json::parse_scene_str` (parse and validate) → `World::from_scene`.
+//! Bytes → `impulse::scene::parse_scene_str` (parse and validate) → `World::from_scene`.
 //! Any result is fine; a panic, abort, timeout or out-of-memory is a bug.
 
 #![no_main]
 
-use impulse::scene::json::parse_scene_str;
-use impulse::world::World;
+use impulse::scene::parse_scene_str;
+use impulse::World;
 use libfuzzer_sys::fuzz_target;
 
 #[path = "common.rs"]
@@ -18,7 +18,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     }
     if let Ok(scene) = parse_scene_str(text, "fuzz.json") {
-        let _ = impulse::scene::validate::validate_all(&scene);
+        let _ = impulse::scene::validate_all(&scene);
         let _ = World::from_scene(&scene);
     }
 });

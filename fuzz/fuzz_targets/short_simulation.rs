@@ -5,8 +5,8 @@
 
 #![no_main]
 
-use impulse::scene::json::parse_scene_str;
-use impulse::world::World;
+use impulse::scene::parse_scene_str;
+use impulse::World;
 use libfuzzer_sys::fuzz_target;
 
 #[path = "common.rs"]
@@ -28,7 +28,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(mut world) = World::from_scene(&scene) else {
         return;
     };
-    world.parallel = false;
+    world.set_parallel(false);
     for _ in 0..common::MAX_STEPS {
         if world.step().is_err() {
             break;

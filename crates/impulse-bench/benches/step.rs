@@ -17,11 +17,11 @@ use std::time::Duration;
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use impulse::World;
-use impulse::broad_phase::BroadPhase;
-use impulse::constraints::ContactConstraint;
-use impulse::narrow_phase::{NarrowPhase, SpeculativeMargins};
-use impulse::scene::builtin::builtin_scene;
-use impulse::solver::{NncgWorkspace, Sweep, Velocities, solve_nncg, solve_pgs, warm_start};
+use impulse::internals::{
+    BroadPhase, ContactConstraint, NarrowPhase, NncgWorkspace, SpeculativeMargins, Sweep,
+    Velocities, contact_constraints, solve_nncg, solve_pgs, warm_start,
+};
+use impulse::scene::builtin_scene;
 
 const SCENE: &str = "pyramid20";
 const WARM_UP_STEPS: u32 = 60;
@@ -30,7 +30,12 @@ fn settled_world() -> World {
     let scene = builtin_scene(SCENE).expect("pyramid20 is a built-in scene");
     let mut world = World::from_scene(&scene).expect("pyramid20 builds");
     // A pyramid at rest would fall asleep and cost nothing.
-    world.settings.sleep = false;
+    world
+        .set_settings(impulse::SolverSettings {
+            sleep: false,
+            ..world.settings().clone()
+        })
+        .expect("valid settings");
     for _ in 0..WARM_UP_STEPS {
         world.step().expect("pyramid20 steps");
     }
@@ -50,9 +55,9 @@ fn step(c: &mut Criterion) {
 fn margins(world: &World) -> SpeculativeMargins {
     let mut margins = SpeculativeMargins::default();
     margins.update(
-        &world.bodies,
-        world.settings.prediction_distance,
-        world.gravity,
+        world.bodies(),
+        world.settings().prediction_distance,
+        world.gravity(),
         world.dt(),
     );
     margins
@@ -66,7 +71,7 @@ fn broad_phase(c: &mut Criterion) {
     c.bench_function("broad_phase/pyramid20", |b| {
         b.iter(|| {
             broad_phase.candidate_pairs(
-                black_box(&world.bodies),
+                black_box(world.bodies()),
                 margins.margins(),
                 false,
                 &mut pairs,
@@ -80,7 +85,7 @@ fn broad_phase(c: &mut Criterion) {
     c.bench_function("broad_phase/pyramid20_fresh", |b| {
         b.iter(|| {
             BroadPhase::default().candidate_pairs(
-                black_box(&world.bodies),
+                black_box(world.bodies()),
                 margins.margins(),
                 false,
                 &mut pairs,
@@ -94,15 +99,15 @@ fn narrow_phase(c: &mut Criterion) {
     let world = settled_world();
     let margins = margins(&world);
     let mut pairs = Vec::new();
-    BroadPhase::default().candidate_pairs(&world.bodies, margins.margins(), false, &mut pairs);
+    BroadPhase::default().candidate_pairs(world.bodies(), margins.margins(), false, &mut pairs);
     let mut narrow_phase = NarrowPhase::default();
     narrow_phase
-        .update(&world.bodies, &pairs, &margins, false)
+        .update(world.bodies(), &pairs, &margins, false)
         .expect("pyramid20 shapes are supported");
     c.bench_function("narrow_phase/pyramid20", |b| {
         b.iter(|| {
             narrow_phase
-                .update(black_box(&world.bodies), &pairs, &margins, false)
+                .update(black_box(world.bodies()), &pairs, &margins, false)
                 .expect("pyramid20 shapes are supported");
             black_box(narrow_phase.pairs.len())
         })
@@ -112,9 +117,9 @@ fn narrow_phase(c: &mut Criterion) {
 /// The last step's rows with their bodies named by world index and zero impulses, and the
 /// velocities v* = v − M⁻¹Jᵀγ the step's impulses γ started from: the step's LCP, unsolved.
 fn cold_problem(world: &World) -> (Vec<ContactConstraint>, Vec<Vec3>, Vec<Vec3>) {
-    let mut constraints = world.contact_constraints().to_vec();
-    let mut linear = world.bodies.linear_velocity.clone();
-    let mut angular = world.bodies.angular_velocity.clone();
+    let mut constraints = contact_constraints(world).to_vec();
+    let mut linear = world.bodies().linear_velocity.clone();
+    let mut angular = world.bodies().angular_velocity.clone();
     for c in &mut constraints {
         // The solver indexes velocities by `local_a`/`local_b`; here the world's arrays.
         c.local_a = c.body_a;

@@ -763,7 +763,7 @@ pub fn write_plots(fronts: &[SceneFront], dir: &Path) -> Result<Vec<PathBuf>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use impulse::settings::SolverMethod;
+    use impulse::SolverMethod;
 
     fn point(engine: &str, setting: &str, ms: f64, e_mm: f64) -> FrontPoint {
         FrontPoint {

@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use impulse::settings::{ContactRepair, SolverMethod};
+use impulse::{ContactRepair, SolverMethod};
 use impulse::{Scene, SolverSettings, World};
 
 use crate::BenchRow;
@@ -109,11 +109,14 @@ impl ImpulseRun {
         };
         let mut world = World::from_scene(&scene)
             .with_context(|| format!("building scene {} in {engine}", scene.name))?;
-        world.settings.sleep = false;
+        world.set_settings(SolverSettings {
+            sleep: false,
+            ..world.settings().clone()
+        })?;
         Ok(Self {
             scene: scene.name.clone(),
             engine,
-            quality: Quality::new(&world.bodies),
+            quality: Quality::new(world.bodies()),
             world,
             times_ms: Vec::with_capacity(steps as usize),
             step: 0,
@@ -147,7 +150,7 @@ impl ImpulseRun {
                 format!("{}, scene {}, step {}", self.engine, self.scene, self.step)
             })?;
             if quality::is_sample_step(self.step, self.steps) {
-                self.quality.sample(&self.world.bodies);
+                self.quality.sample(self.world.bodies());
             }
         }
         Ok(())
@@ -155,15 +158,15 @@ impl ImpulseRun {
 
     /// The row of the steps taken so far.
     pub(crate) fn finish(mut self) -> BenchRow {
-        let report = self.quality.finish(&self.world.bodies);
+        let report = self.quality.finish(self.world.bodies());
         BenchRow::new(
             &self.scene,
             &self.engine,
-            self.world.bodies.len(),
+            self.world.bodies().len(),
             self.step,
             &mut self.times_ms,
             report,
-            settings_text(&self.world.settings, self.threads),
+            settings_text(self.world.settings(), self.threads),
         )
     }
 }

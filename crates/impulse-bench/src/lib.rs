@@ -230,7 +230,7 @@ pub(crate) fn format_ms(ms: f64) -> String {
 /// What [`run_benchmarks`] measures.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BenchConfig {
-    /// Built-in scene names (`impulse::scene::builtin::builtin_scene`).
+    /// Built-in scene names (`impulse::scene::builtin_scene`).
     pub scenes: Vec<String>,
     /// Steps per scene.
     pub steps: u32,
@@ -344,7 +344,7 @@ impl Default for BenchConfig {
 
 /// The built-in scene `name`, or an error naming it.
 pub fn scene_by_name(name: &str) -> Result<Scene> {
-    impulse::scene::builtin::builtin_scene(name)
+    impulse::scene::builtin_scene(name)
         .with_context(|| format!("no built-in scene named \"{name}\""))
 }
 

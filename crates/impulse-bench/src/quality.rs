@@ -3,7 +3,7 @@
 //! the functions of `impulse::metrics` measure them.
 
 use glam::Vec3;
-use impulse::body::Bodies;
+use impulse::Bodies;
 use impulse::metrics;
 
 /// Poses are measured after every `SAMPLE_EVERY`-th step, and after the last one.

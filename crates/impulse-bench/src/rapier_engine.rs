@@ -8,7 +8,7 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use impulse::body::Bodies;
+use impulse::Bodies;
 use impulse::scene::{BodyKind, Material, MaterialRef, ShapeDesc};
 use impulse::{Scene, World};
 use parry3d::shape::SharedShape;
@@ -75,7 +75,7 @@ impl RapierRun {
         let world = World::from_scene(scene)
             .with_context(|| format!("building scene {} in impulse", scene.name))?;
         let sim = RapierScene::build(scene, &world, params)?;
-        let bodies = world.bodies;
+        let bodies = world.bodies().clone();
         Ok(Self {
             scene: scene.name.clone(),
             engine: engine.to_string(),
@@ -143,7 +143,7 @@ impl RapierScene {
         let mut bodies = RigidBodySet::new();
         let mut colliders = ColliderSet::new();
         let mut handles = Vec::with_capacity(scene.bodies.len());
-        let built = &world.bodies;
+        let built = world.bodies();
         for (i, desc) in scene.bodies.iter().enumerate() {
             let material = resolve_material(scene, &desc.material)?;
             if desc.keyframes.is_some() {
@@ -378,9 +378,9 @@ mod tests {
         assert_eq!(sim.handles.len(), scene.bodies.len());
         for (i, &handle) in sim.handles.iter().enumerate() {
             let body = &sim.bodies[handle];
-            assert_eq!(*body.position(), world.bodies.pose[i], "body {i} pose");
-            let expected_mass = if world.bodies.inverse_mass[i] > 0.0 {
-                1.0 / world.bodies.inverse_mass[i]
+            assert_eq!(*body.position(), world.bodies().pose[i], "body {i} pose");
+            let expected_mass = if world.bodies().inverse_mass[i] > 0.0 {
+                1.0 / world.bodies().inverse_mass[i]
             } else {
                 0.0
             };
@@ -389,10 +389,10 @@ mod tests {
                 (mass - expected_mass).abs() <= 1e-4 * expected_mass.max(1.0),
                 "body {i}: rapier mass {mass}, impulse mass {expected_mass}"
             );
-            assert!((body.linvel() - world.bodies.linear_velocity[i]).length() < 1e-6);
+            assert!((body.linvel() - world.bodies().linear_velocity[i]).length() < 1e-6);
             let collider = &sim.colliders[body.colliders()[0]];
-            assert_eq!(collider.friction(), world.bodies.friction[i]);
-            assert_eq!(collider.restitution(), world.bodies.restitution[i]);
+            assert_eq!(collider.friction(), world.bodies().friction[i]);
+            assert_eq!(collider.restitution(), world.bodies().restitution[i]);
             assert_eq!(collider.friction_combine_rule(), FRICTION_COMBINE);
             assert_eq!(collider.restitution_combine_rule(), RESTITUTION_COMBINE);
         }

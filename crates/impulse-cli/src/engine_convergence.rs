@@ -10,8 +10,8 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use impulse::settings::SolverMethod;
 use impulse::{Scene, World};
+use impulse::{SolverMethod, SolverSettings};
 
 use crate::lcp_command::Series;
 
@@ -27,10 +27,13 @@ fn history(scene: &Scene, step: u64, method: SolverMethod, iterations: u32) -> R
                 .step()
                 .context("the run stopped before the plotted step")?;
         }
-        world.settings.substeps = 1;
-        world.settings.method = method;
-        world.settings.iterations = k;
-        world.settings.tolerance = 0.0;
+        world.set_settings(SolverSettings {
+            substeps: 1,
+            method,
+            iterations: k,
+            tolerance: 0.0,
+            ..world.settings().clone()
+        })?;
         let residual = world
             .step()
             .context("the plotted step failed")?

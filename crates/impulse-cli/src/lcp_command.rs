@@ -154,7 +154,7 @@ pub fn dump(mut scene: Scene, step: u64, out: &Path, no_friction: bool) -> Resul
     let z = &contact_lcp.engine_solution;
     let report = merit_report(lcp, z);
     let friction = !lcp.bounds.is_nonnegative();
-    let contacts = world.contact_constraints().len();
+    let contacts = contact_lcp.contact_points();
     println!("scene       {name}, step {step}");
     println!(
         "file        {} (impulse JSON, w = Aγ − b, A as CSR)",
@@ -571,7 +571,7 @@ fn is_symmetric(a: &Matrix) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use impulse::scene::builtin::builtin_scene;
+    use impulse::scene::builtin_scene;
     use std::path::PathBuf;
 
     fn docs() -> PathBuf {

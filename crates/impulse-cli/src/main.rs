@@ -18,8 +18,8 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use impulse::Scene;
-use impulse::scene::builtin::{builtin_families, builtin_names, builtin_scene};
-use impulse::scene::json::{load_scene_file, to_json_string};
+use impulse::scene::{builtin_families, builtin_names, builtin_scene};
+use impulse::scene::{load_scene_file, to_json_string};
 
 /// Simultaneous contact resolution for animation: piles, stacks and pyramids solved as one
 /// linear complementarity problem per step.

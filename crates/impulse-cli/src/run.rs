@@ -5,8 +5,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use impulse::diagnostics::StepProfile;
-use impulse::solver::EscalationLevel;
+use impulse::EscalationLevel;
+use impulse::StepProfile;
 use impulse::{Scene, World, WorldSnapshot, metrics};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -39,7 +39,7 @@ pub struct RunOptions {
 }
 
 /// Island solves of a run by the strongest method each reached (one count per island and
-/// step), from [`impulse::solver::IslandReport`].
+/// step), from [`impulse::IslandReport`].
 #[derive(Debug, Default, Serialize)]
 pub struct IslandSolves {
     pub pgs: u64,
@@ -98,7 +98,7 @@ pub struct Summary {
     /// `completed`, or the error that stopped the run.
     pub status: String,
     /// Median wall time (ms) of each stage of the step over the run
-    /// ([`impulse::diagnostics::StepProfile`]), each stage's median on its own: they need not
+    /// ([`impulse::StepProfile`]), each stage's median on its own: they need not
     /// add up to the median step.
     pub stage_ms: StepProfile,
 }
@@ -165,7 +165,7 @@ impl FrameOutput {
         }
     }
 
-    fn write_frame(&mut self, step: u64, time: f64, bodies: &impulse::body::Bodies) -> Result<()> {
+    fn write_frame(&mut self, step: u64, time: f64, bodies: &impulse::Bodies) -> Result<()> {
         match self {
             Self::Trajectory(writer) => writer.write_frame(step, time, bodies),
             Self::Animation(recording) => {
@@ -257,7 +257,7 @@ fn run_scene(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<S
     let every = options.every.unwrap_or(1).max(1) as u64;
     let world = World::from_scene(&scene).context("cannot build the world")?;
     if !world
-        .bodies
+        .bodies()
         .kind
         .iter()
         .any(|&k| k != impulse::BodyKind::Static)
@@ -272,7 +272,7 @@ fn run_scene(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<S
         None => None,
     };
     if let Some(w) = writer.as_mut() {
-        w.write_frame(0, 0.0, &world.bodies)?;
+        w.write_frame(0, 0.0, world.bodies())?;
     }
     let session = Session {
         name: scene.name.clone(),
@@ -366,16 +366,16 @@ fn simulate(
     options: &RunOptions,
     parallel: bool,
 ) -> Result<Summary> {
-    world.parallel = parallel;
+    world.set_parallel(parallel);
     let last = world.step_count() + session.steps;
     let every = session.every;
     if let Some(dir) = &options.checkpoint_dir {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create the checkpoint directory {}", dir.display()))?;
     }
-    let top = metrics::top_body(&world.bodies);
-    let top_y0 = top.map(|i| world.bodies.pose[i].translation.y);
-    let initial: Vec<_> = world.bodies.pose.iter().map(|p| p.translation).collect();
+    let top = metrics::top_body(world.bodies());
+    let top_y0 = top.map(|i| world.bodies().pose[i].translation.y);
+    let initial: Vec<_> = world.bodies().pose.iter().map(|p| p.translation).collect();
     let mut max_drift = 0.0f32;
 
     let bar = if options.quiet {
@@ -398,7 +398,7 @@ fn simulate(
     let mut iterations_sum = 0u64;
     let mut max_residual = 0.0f32;
     let mut max_speed = 0.0f32;
-    let mut max_overlap = metrics::max_overlap(&world.bodies);
+    let mut max_overlap = metrics::max_overlap(world.bodies());
     let mut final_overlap = max_overlap;
     let mut status = "completed".to_string();
     let mut failure = None;
@@ -461,19 +461,19 @@ fn simulate(
         contacts_sum += diagnostics.contacts as u64;
         iterations_sum += diagnostics.iterations as u64;
         max_residual = max_residual.max(diagnostics.natural_map_residual);
-        for v in &world.bodies.linear_velocity {
+        for v in &world.bodies().linear_velocity {
             max_speed = max_speed.max(v.length());
         }
         if step.is_multiple_of(OVERLAP_SAMPLE_EVERY) || step == last {
-            final_overlap = metrics::max_overlap(&world.bodies);
+            final_overlap = metrics::max_overlap(world.bodies());
             max_overlap = max_overlap.max(final_overlap);
-            max_drift = max_drift.max(metrics::max_drift(&world.bodies, &initial));
+            max_drift = max_drift.max(metrics::max_drift(world.bodies(), &initial));
         }
         let interrupted = INTERRUPTED.load(Ordering::SeqCst);
         if let Some(w) = session.writer.as_mut()
             && (step.is_multiple_of(every) || step == last || interrupted)
         {
-            w.write_frame(step, step as f64 * dt, &world.bodies)?;
+            w.write_frame(step, step as f64 * dt, world.bodies())?;
         }
         if let (Some(k), Some(dir)) = (options.checkpoint_every, &options.checkpoint_dir)
             && step.is_multiple_of(k)
@@ -505,13 +505,13 @@ fn simulate(
     let mean_ms = step_ms.iter().sum::<f64>() / taken;
     let median_ms = median(&mut step_ms);
     let top_sink = match (top, top_y0) {
-        (Some(i), Some(y0)) => y0 - world.bodies.pose[i].translation.y,
+        (Some(i), Some(y0)) => y0 - world.bodies().pose[i].translation.y,
         _ => 0.0,
     };
-    let settings = &world.settings;
+    let settings = world.settings();
     let summary = Summary {
         scene: session.name.clone(),
-        bodies: world.bodies.len(),
+        bodies: world.bodies().len(),
         steps: world.step_count(),
         dt: world.dt(),
         ms_per_step: median_ms,

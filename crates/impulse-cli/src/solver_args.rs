@@ -2,7 +2,7 @@
 //! preset's) `SolverSettings`.
 
 use clap::{Args, ValueEnum};
-use impulse::settings::{ContactRepair, SolverMethod, SolverSettings};
+use impulse::{ContactRepair, SolverMethod, SolverSettings};
 
 /// A preset, named by speed or by the quality bar it meets on the standard scenes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

@@ -6,7 +6,7 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use impulse::body::Bodies;
+use impulse::Bodies;
 
 /// Output format, chosen from the file extension.
 enum Format {

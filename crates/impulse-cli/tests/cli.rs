@@ -94,11 +94,7 @@ fn profile_prints_the_median_of_every_stage() {
         .unwrap_or_else(|| panic!("no stage line in {stdout}"))
         .split(", ")
         .collect();
-    assert_eq!(
-        stages.len(),
-        impulse::diagnostics::Stage::ALL.len(),
-        "{line}"
-    );
+    assert_eq!(stages.len(), impulse::Stage::ALL.len(), "{line}");
     for stage in stages {
         let (_, ms) = stage.rsplit_once(' ').unwrap();
         assert!(ms.parse::<f64>().unwrap() >= 0.0, "{stage}");

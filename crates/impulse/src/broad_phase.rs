@@ -309,3 +309,7 @@ impl BroadPhase {
         })
     }
 }
+
+#[cfg(test)]
+#[path = "broad_phase_tests.rs"]
+mod tests;

@@ -23,8 +23,16 @@ pub struct ContactLcp {
     pub problem: Lcp,
     /// The engine's impulses at exit, in row order (N·s).
     pub engine_solution: Vec<f64>,
-    /// For each row, the index of its contact point in [`crate::World::contact_constraints`].
+    /// For each row, the index of its contact point (0, 1, …, in the order the step solved
+    /// them): a point's normal row and, with friction, its two tangent rows share one index.
     pub contact_of_row: Vec<usize>,
+}
+
+impl ContactLcp {
+    /// Number of contact points the problem's rows belong to.
+    pub fn contact_points(&self) -> usize {
+        self.contact_of_row.last().map_or(0, |&k| k + 1)
+    }
 }
 
 /// Builds the LCP of `constraints` (as left by the solver). Errors only if the assembled data
@@ -145,3 +153,7 @@ pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, Pro
         contact_of_row,
     })
 }
+
+#[cfg(test)]
+#[path = "contact_lcp_tests.rs"]
+mod tests;

@@ -167,32 +167,13 @@ impl StepProfile {
     }
 }
 
-/// Natural-map residual of the solved rows (see [`StepDiagnostics::natural_map_residual`]).
-pub fn natural_map_residual(
-    constraints: &[ContactConstraint],
-    linear: &[Vec3],
-    angular: &[Vec3],
-) -> f32 {
-    natural_map_residual_on(constraints, linear, angular, false)
-}
-
-/// [`natural_map_residual`], with `parallel` spreading runs of 4096
-/// rows over rayon's threads. The runs' partial sums are added in order on either path, so
-/// the result does not depend on the thread count.
-pub fn natural_map_residual_on(
-    constraints: &[ContactConstraint],
-    linear: &[Vec3],
-    angular: &[Vec3],
-    parallel: bool,
-) -> f32 {
-    natural_map_residual_in(constraints, BodySlots::World, linear, angular, parallel)
-}
-
-/// [`natural_map_residual_on`] with the velocities indexed as `slots` says. An island's step
-/// takes its own residual on its local arrays ([`BodySlots::Island`]) while its rows are in
-/// cache; the value is the world-wide pass's, as the local velocities are scattered back to
-/// the bodies unchanged.
-pub fn natural_map_residual_in(
+/// The natural-map residual of `constraints` ([`StepDiagnostics::natural_map_residual`]) by
+/// a pass of its own over the rows, with the velocities indexed as `slots` says and
+/// `parallel` spreading runs of rows over rayon's threads (partial sums added in order, so the
+/// result does not depend on the thread count): the reference the step's fused pass
+/// ([`record_velocity_before_and_residual`]) is tested against.
+#[cfg(test)]
+pub(crate) fn natural_map_residual_in(
     constraints: &[ContactConstraint],
     slots: BodySlots,
     linear: &[Vec3],
@@ -225,6 +206,7 @@ pub fn natural_map_residual_in(
 
 /// Σ φ² over `constraints` (see [`StepDiagnostics::natural_map_residual`]); `bodies_of` gives
 /// a row's indices into `linear` and `angular`.
+#[cfg(test)]
 fn squared_natural_map(
     constraints: &[ContactConstraint],
     linear: &[Vec3],
@@ -433,10 +415,4 @@ pub fn energy_terms_on(bodies: &Bodies, gravity: Vec3, parallel: bool) -> Energy
             .map(part)
             .fold(EnergyTerms::default(), |a, b| a + b)
     }
-}
-
-/// Total kinetic energy (J) and linear momentum (kg·m/s) of the moving bodies.
-pub fn energy_and_momentum(bodies: &Bodies) -> (f32, Vec3) {
-    let terms = energy_terms(bodies, Vec3::ZERO);
-    (terms.kinetic as f32, terms.momentum)
 }

@@ -55,11 +55,6 @@ impl Islands {
         self.constraint_start.len().saturating_sub(1)
     }
 
-    /// True when there is no island.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// Bodies of island `k`, in increasing index order.
     pub fn bodies(&self, k: usize) -> &[u32] {
         &self.bodies[self.body_start[k] as usize..self.body_start[k + 1] as usize]

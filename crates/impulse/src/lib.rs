@@ -25,35 +25,50 @@
 //!
 //! Where to start: [`World`] (insert, edit, step, read contacts and events, query),
 //! [`BodyBuilder`] and [`BodyHandle`], [`SolverSettings`] (presets along the quality/speed
-//! front), [`Scene`] (the JSON scene format). Each stage of the step is one module:
-//! `integrate` (1, 6) → [`broad_phase`] (2) → [`narrow_phase`] (3) → [`constraints`] (4) →
-//! `island` and [`solver`] (5: one island at a time, [`solver::substep`], each method behind
-//! [`solver::ContactSolver`]) → `kinematic` and [`continuous`] (kinematic bodies' motion,
-//! continuous collision) → [`diagnostics`] (7), driven by [`World::step`].
+//! front), [`Scene`] and the [`scene`] module (the JSON scene format and built-in scenes),
+//! [`StepDiagnostics`] (how well each step's LCP was solved) and [`metrics`] (sink, overlap
+//! and drift of a simulation's state). Inside, each stage of [`World::step`] is one private
+//! module: integrate (1, 6) → broad phase (2) → narrow phase (3) → constraints (4) → islands
+//! and the solver (5: one island at a time, each method behind one interface) → kinematic
+//! bodies and continuous collision → diagnostics (7); docs/architecture.md in the repository
+//! maps them.
 
 #![warn(missing_docs)]
 
-pub mod body;
-pub mod broad_phase;
-pub mod constraints;
-pub mod contact_lcp;
-pub mod continuous;
-pub mod diagnostics;
-pub mod error;
-pub(crate) mod graph;
-pub(crate) mod integrate;
-pub(crate) mod island;
-pub(crate) mod kinematic;
+// Every stage is private: the public API is the re-exports below, plus two namespaces,
+// [`scene`] (the JSON scene format and the built-in scenes) and [`metrics`] (quality measures
+// of a simulation's state).
+mod body;
+mod broad_phase;
+mod constraints;
+mod contact_lcp;
+mod continuous;
+mod diagnostics;
+mod error;
+mod graph;
+mod integrate;
+mod island;
+mod kinematic;
+mod narrow_phase;
+mod parallel;
+mod settings;
+mod solver;
+mod world;
+
 pub mod metrics;
-pub mod narrow_phase;
-pub(crate) mod parallel;
 pub mod scene;
-pub mod settings;
-pub mod solver;
-pub mod world;
+
+// The unit tests share `tests/common` with the integration tests, whose paths start with
+// `impulse::`.
+#[cfg(test)]
+extern crate self as impulse;
+#[cfg(test)]
+mod test_support;
 
 /// The vector types of the API (the version Parry uses), so a user needs no glam of their own.
 pub use glam;
+/// The LCP types of [`World::contact_lcp`]'s export and the solvers to run on it.
+pub use impulse_lcp;
 /// The geometry library behind shapes and queries, so a user needs no parry3d of their own.
 pub use parry3d;
 /// Shapes to build bodies from: `SharedShape::ball(r)`, `::cuboid(hx, hy, hz)`,
@@ -61,14 +76,36 @@ pub use parry3d;
 /// (along y), `::convex_hull(&points)`, `::halfspace(normal)`.
 pub use parry3d::shape::SharedShape;
 
-pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe};
-pub use diagnostics::StepDiagnostics;
+pub use body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Keyframe};
+pub use contact_lcp::ContactLcp;
+pub use diagnostics::{EnergyTerms, RowsReport, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
-pub use scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
-pub use settings::{SettingError, SolverSettings};
+pub use scene::{BodyDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc};
+pub use settings::{ContactRepair, SettingError, SolverMethod, SolverSettings};
+pub use solver::{EscalationLevel, IslandReport};
 pub use world::{
-    BodyRef, ContactEvent, ContactPairView, ContactPoint, RayHit, ShapeHit, World, WorldSnapshot,
+    BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, BodyRef, ContactEvent, ContactPairView,
+    ContactPoint, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World, WorldSnapshot,
 };
+
+/// The engine's stages for benchmarks that time them one by one (`impulse-bench`'s
+/// criterion benches). Not part of the supported API: names and signatures change without
+/// notice. Enabled by the `internals` feature.
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::broad_phase::BroadPhase;
+    pub use crate::constraints::ContactConstraint;
+    pub use crate::narrow_phase::{NarrowPhase, SpeculativeMargins};
+    pub use crate::solver::nncg::{NncgWorkspace, solve_nncg};
+    pub use crate::solver::pgs::solve_pgs;
+    pub use crate::solver::{Sweep, Velocities, warm_start};
+
+    /// The last step's solved contact constraints (impulses as the solver left them).
+    pub fn contact_constraints(world: &crate::World) -> &[ContactConstraint] {
+        &world.constraints
+    }
+}
 
 /// The README's code, compiled and run as a doc-test.
 #[doc = include_str!("../../../README.md")]

@@ -744,3 +744,7 @@ pub mod seams {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "narrow_phase_tests.rs"]
+mod tests;

@@ -12,7 +12,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use impulse::scene::builtin::builtin_scene;
+use impulse::scene::builtin_scene;
 use impulse::{SolverSettings, World};
 
 struct Counting;

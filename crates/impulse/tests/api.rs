@@ -212,9 +212,9 @@ fn removal_keeps_every_other_handle_and_never_reuses_one() {
 #[test]
 fn edits_are_checked_and_wake_the_body() {
     let (mut w, ground, cube) = cube_on_ground();
-    let mut settings = w.settings.clone();
+    let mut settings = w.settings().clone();
     settings.sleep = true;
-    w.settings = settings;
+    w.set_settings(settings).unwrap();
     for _ in 0..240 {
         w.step().unwrap();
     }
@@ -318,7 +318,7 @@ fn the_api_and_the_scene_loader_reject_a_bad_setting_alike() {
         let text = format!(
             r#"{{"gravity": [0, 0, 0], "dt": 0.0166, "solver": {{"{field}": {value}}}, "bodies": []}}"#
         );
-        let error = impulse::scene::json::parse_scene_str(&text, "bad.json")
+        let error = impulse::scene::parse_scene_str(&text, "bad.json")
             .expect_err("the scene loader rejects it")
             .to_string();
         assert!(

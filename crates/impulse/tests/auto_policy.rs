@@ -4,10 +4,10 @@
 
 mod common;
 
+use impulse::EscalationLevel;
+use impulse::SolverMethod;
 use impulse::World;
-use impulse::scene::builtin::builtin_scene;
-use impulse::settings::SolverMethod;
-use impulse::solver::EscalationLevel;
+use impulse::scene::builtin_scene;
 
 /// Steps `name` with the `reference` preset (sleeping off) for `steps`; returns the world and,
 /// per step, the islands' reports.
@@ -15,7 +15,7 @@ fn run(
     name: &str,
     steps: u32,
     edit: impl Fn(&mut impulse::SolverSettings),
-) -> (World, Vec<Vec<impulse::solver::IslandReport>>) {
+) -> (World, Vec<Vec<impulse::IslandReport>>) {
     let mut scene = builtin_scene(name).expect("built-in scene");
     scene.solver = impulse::SolverSettings {
         sleep: false,
@@ -38,7 +38,7 @@ fn run(
 #[test]
 fn heavy_small_island_is_solved_exactly_and_stays_at_rest() {
     let (world, reports) = run("massratio", 300, |_| {});
-    assert_eq!(world.settings.method, SolverMethod::Auto);
+    assert_eq!(world.settings().method, SolverMethod::Auto);
     for (step, islands) in reports.iter().enumerate() {
         assert_eq!(islands.len(), 1, "step {step}: one island");
         let island = islands[0];
@@ -53,7 +53,7 @@ fn heavy_small_island_is_solved_exactly_and_stays_at_rest() {
         assert!(island.exact_failures < 4, "step {step}: {island:?}");
         assert!(island.exact_pivots > 0);
         assert!(
-            island.last_change <= world.settings.escalation_tolerance,
+            island.last_change <= world.settings().escalation_tolerance,
             "{island:?}"
         );
     }
@@ -107,7 +107,7 @@ fn fixed_methods_do_not_escalate() {
 #[test]
 fn plate_stands_still_with_the_exact_path() {
     let (world, reports) = run("plate", 300, |_| {});
-    let tolerance = world.settings.escalation_tolerance;
+    let tolerance = world.settings().escalation_tolerance;
     let mut exact = 0;
     for (step, island) in reports.iter().flatten().enumerate() {
         if island.method == EscalationLevel::Exact {

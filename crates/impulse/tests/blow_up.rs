@@ -2,10 +2,10 @@
 //! user puts in between steps is not mistaken for one.
 
 use glam::Vec3;
-use impulse::scene::builtin::builtin_scene;
-use impulse::settings::ContactRepair;
-use impulse::settings::SolverMethod;
-use impulse::world::BLOW_UP_ENERGY_PER_KG;
+use impulse::BLOW_UP_ENERGY_PER_KG;
+use impulse::ContactRepair;
+use impulse::SolverMethod;
+use impulse::scene::builtin_scene;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, StepError, World};
 
 /// One PGS sweep per substep with split impulse cannot hold the 5050-cube pyramid: its rows
@@ -28,7 +28,7 @@ fn a_solve_that_creates_energy_stops_with_the_step() {
         ..SolverSettings::reference()
     };
     let mut world = World::from_scene(&scene).unwrap();
-    world.parallel = false;
+    world.set_parallel(false);
     let mut stopped = None;
     for _ in 0..40 {
         if let Err(e) = world.step() {
@@ -90,12 +90,14 @@ fn a_throw_between_steps_is_not_a_blow_up() {
     for _ in 0..30 {
         world.step().unwrap();
     }
-    world.bodies.linear_velocity[b] = Vec3::new(0.0, 40.0, 0.0);
-    world.wake_up(b);
+    let handle = world.handle_of(b).unwrap();
+    world
+        .set_linear_velocity(handle, Vec3::new(0.0, 40.0, 0.0))
+        .unwrap();
     let mut highest = 0.0f32;
     for _ in 0..300 {
         world.step().unwrap();
-        highest = highest.max(world.bodies.pose[b].translation.y);
+        highest = highest.max(world.bodies().pose[b].translation.y);
     }
     // v²/2g above the start: 81.5 m (the first step's half-step of gravity aside).
     assert!(

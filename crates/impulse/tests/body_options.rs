@@ -253,10 +253,10 @@ fn the_scene_format_reads_and_writes_the_options() {
     );
     assert!(!written.lines().nth(7).unwrap_or("").contains("groups"));
     let world = World::from_scene(&scene).unwrap();
-    assert_eq!(world.bodies.groups[1], 2);
-    assert_eq!(world.bodies.mask[1], 5);
+    assert_eq!(world.bodies().groups[1], 2);
+    assert_eq!(world.bodies().mask[1], 5);
     assert_eq!(
-        world.bodies.local_inverse_inertia[1],
+        world.bodies().local_inverse_inertia[1],
         impulse::glam::Mat3::ZERO
     );
 }

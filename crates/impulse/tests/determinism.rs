@@ -7,8 +7,8 @@
 mod common;
 
 use common::hash_state;
-use impulse::scene::builtin::builtin_scene;
-use impulse::scene::json::load_scene_file;
+use impulse::scene::builtin_scene;
+use impulse::scene::load_scene_file;
 use impulse::{Scene, World};
 
 /// `steps` steps of `scene` (sleeping off) on a pool of `threads` threads; the final state's

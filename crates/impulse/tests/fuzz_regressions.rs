@@ -7,10 +7,10 @@
 
 use std::path::{Path, PathBuf};
 
+use impulse::World;
 use impulse::scene::Scene;
-use impulse::scene::json::parse_scene_str;
-use impulse::scene::validate::validate_all;
-use impulse::world::World;
+use impulse::scene::parse_scene_str;
+use impulse::scene::validate_all;
 
 /// The caps of `fuzz/fuzz_targets/common.rs`.
 const MAX_BODIES: usize = 32;
@@ -93,7 +93,7 @@ fn simulate(text: &str) -> usize {
     let Ok(mut world) = World::from_scene(&scene) else {
         return 0;
     };
-    world.parallel = false;
+    world.set_parallel(false);
     let mut steps = 0;
     for _ in 0..MAX_STEPS {
         if world.step().is_err() {

@@ -4,8 +4,8 @@
 //! the static deflection of a spring, the reported residual against the exported LCP, and the
 //! sleep rule against its definition (all bodies quiet for `time_to_sleep`).
 
+use impulse::ContactRepair;
 use impulse::glam::Vec3;
-use impulse::settings::ContactRepair;
 use impulse::{BodyBuilder, BodyHandle, SharedShape, SolverSettings, World};
 
 const DT: f32 = 1.0 / 60.0;
@@ -178,14 +178,21 @@ fn the_reported_residual_is_that_of_the_exported_lcp_friction_included() {
         let exported = w.contact_lcp().unwrap();
         let (lcp, gamma) = (&exported.problem, &exported.engine_solution);
         let wv = lcp.w(gamma);
-        let constraints = w.contact_constraints();
+        // The export lays out each contact point as its normal row, then, with friction, its
+        // two tangent rows bounded by μ·γ_n of that normal row (ODE's `findex`).
+        let (friction_index, mu) = match &lcp.bounds {
+            impulse::impulse_lcp::Bounds::Friction {
+                friction_index, mu, ..
+            } => (friction_index.clone(), mu.clone()),
+            _ => (vec![None; gamma.len()], vec![0.0; gamma.len()]),
+        };
         let (mut normal, mut tangent) = (0.0f64, 0.0f64);
         let mut row = 0;
-        for c in constraints {
+        while row < gamma.len() {
             let phi = gamma[row].min(wv[row]);
             normal += phi * phi;
-            if c.friction > 0.0 {
-                let limit = f64::from(c.friction) * gamma[row].max(0.0);
+            if friction_index.get(row + 1) == Some(&Some(row)) {
+                let limit = mu[row + 1] * gamma[row].max(0.0);
                 let q = [gamma[row + 1] - wv[row + 1], gamma[row + 2] - wv[row + 2]];
                 let norm = q[0].hypot(q[1]);
                 let p = if norm > limit {

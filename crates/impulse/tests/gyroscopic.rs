@@ -56,7 +56,7 @@ fn body_omega(world: &World, body: BodyHandle) -> DVec3 {
 #[test]
 fn the_moments_are_the_engines() {
     let (world, _) = free_box(Quat::IDENTITY, Vec3::ZERO, true);
-    let inverse = world.bodies.local_inverse_inertia[0];
+    let inverse = world.bodies().local_inverse_inertia[0];
     let engine = DVec3::new(
         f64::from(inverse.x_axis.x).recip(),
         f64::from(inverse.y_axis.y).recip(),

@@ -60,9 +60,9 @@ fn parallel_islands_match_sequential_bit_for_bit() {
         ..SolverSettings::default()
     };
     let mut sequential = stacks(6, 5, settings.clone());
-    sequential.parallel = false;
+    sequential.set_parallel(false);
     let mut parallel = stacks(6, 5, settings);
-    parallel.parallel = true;
+    parallel.set_parallel(true);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
@@ -71,14 +71,15 @@ fn parallel_islands_match_sequential_bit_for_bit() {
         sequential.step().unwrap();
         pool.install(|| parallel.step().unwrap());
     }
-    for i in 0..sequential.bodies.len() {
+    for i in 0..sequential.bodies().len() {
         assert_eq!(
-            sequential.bodies.pose[i], parallel.bodies.pose[i],
+            sequential.bodies().pose[i],
+            parallel.bodies().pose[i],
             "body {i}"
         );
         assert_eq!(
-            sequential.bodies.linear_velocity[i],
-            parallel.bodies.linear_velocity[i]
+            sequential.bodies().linear_velocity[i],
+            parallel.bodies().linear_velocity[i]
         );
     }
 }
@@ -91,12 +92,12 @@ fn a_quiet_island_sleeps_and_a_falling_box_wakes_it() {
     }
     for i in 1..=3 {
         assert!(
-            w.bodies.asleep[i],
+            w.bodies().asleep[i],
             "body {i} should sleep after 2 s at rest"
         );
-        assert_eq!(w.bodies.linear_velocity[i], Vec3::ZERO);
+        assert_eq!(w.bodies().linear_velocity[i], Vec3::ZERO);
     }
-    let resting_y = w.bodies.pose[3].translation.y;
+    let resting_y = w.bodies().pose[3].translation.y;
     // A box dropped onto the sleeping stack.
     let dropped = w
         .add_body(
@@ -111,11 +112,11 @@ fn a_quiet_island_sleeps_and_a_falling_box_wakes_it() {
     let mut woke = false;
     for _ in 0..60 {
         w.step().unwrap();
-        woke |= (1..=3).all(|i| !w.bodies.asleep[i]);
+        woke |= (1..=3).all(|i| !w.bodies().asleep[i]);
     }
     assert!(woke, "the stack must wake when the box lands on it");
     // The dropped box ends resting on the stack, which still stands.
-    let top = w.bodies.pose[dropped].translation.y;
+    let top = w.bodies().pose[dropped].translation.y;
     assert!(
         (top - (resting_y + 1.0)).abs() < 0.01,
         "dropped box at y = {top}"
@@ -132,7 +133,7 @@ fn a_quiet_island_sleeps_and_a_falling_box_wakes_it() {
 fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
     let default = SolverSettings::default();
     for (settings, largest_sink) in [(default, 0.005), (SolverSettings::fast(), 0.05)] {
-        let mut scene = impulse::scene::builtin::builtin_scene("pyramid3d10").unwrap();
+        let mut scene = impulse::scene::builtin_scene("pyramid3d10").unwrap();
         let simd = !settings.split_impulse();
         scene.solver = SolverSettings {
             sleep: false,
@@ -143,8 +144,8 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
             ..settings
         };
         let (mut one, mut two, pool) = one_and_two_threads(&scene);
-        let top = common::highest_body(&one.bodies);
-        let top_y = one.bodies.pose[top].translation.y;
+        let top = common::highest_body(one.bodies());
+        let top_y = one.bodies().pose[top].translation.y;
         for _ in 0..30 {
             one.step().unwrap();
             pool.install(|| two.step().unwrap());
@@ -155,14 +156,14 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
                     .all(|island| island.simd == simd)
             );
         }
-        for i in 0..one.bodies.len() {
-            assert_eq!(one.bodies.pose[i], two.bodies.pose[i], "body {i}");
+        for i in 0..one.bodies().len() {
+            assert_eq!(one.bodies().pose[i], two.bodies().pose[i], "body {i}");
             assert_eq!(
-                one.bodies.angular_velocity[i],
-                two.bodies.angular_velocity[i]
+                one.bodies().angular_velocity[i],
+                two.bodies().angular_velocity[i]
             );
         }
-        let sink = top_y - one.bodies.pose[top].translation.y;
+        let sink = top_y - one.bodies().pose[top].translation.y;
         assert!(sink < largest_sink, "top cube sank {sink} m in 0.5 s");
     }
 }
@@ -173,7 +174,7 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
 /// threads must reproduce one thread exactly, diagnostics included.
 #[test]
 fn many_bodies_on_two_threads_match_one_thread_bit_for_bit() {
-    let mut scene = impulse::scene::builtin::builtin_scene("balls4096").unwrap();
+    let mut scene = impulse::scene::builtin_scene("balls4096").unwrap();
     scene.solver.sleep = false;
     let (mut one, mut two, pool) = one_and_two_threads(&scene);
     let mut contacts = 0;
@@ -187,12 +188,15 @@ fn many_bodies_on_two_threads_match_one_thread_bit_for_bit() {
         contacts > 1024,
         "only {contacts} contacts: the parallel paths were not taken"
     );
-    for i in 0..one.bodies.len() {
-        assert_eq!(one.bodies.pose[i], two.bodies.pose[i], "body {i}");
-        assert_eq!(one.bodies.linear_velocity[i], two.bodies.linear_velocity[i]);
+    for i in 0..one.bodies().len() {
+        assert_eq!(one.bodies().pose[i], two.bodies().pose[i], "body {i}");
         assert_eq!(
-            one.bodies.angular_velocity[i],
-            two.bodies.angular_velocity[i]
+            one.bodies().linear_velocity[i],
+            two.bodies().linear_velocity[i]
+        );
+        assert_eq!(
+            one.bodies().angular_velocity[i],
+            two.bodies().angular_velocity[i]
         );
     }
 }
@@ -201,9 +205,9 @@ fn many_bodies_on_two_threads_match_one_thread_bit_for_bit() {
 /// threads to step the second in.
 fn one_and_two_threads(scene: &impulse::Scene) -> (World, World, rayon::ThreadPool) {
     let mut one = World::from_scene(scene).unwrap();
-    one.parallel = false;
+    one.set_parallel(false);
     let mut two = World::from_scene(scene).unwrap();
-    two.parallel = true;
+    two.set_parallel(true);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
@@ -216,7 +220,7 @@ fn one_and_two_threads(scene: &impulse::Scene) -> (World, World, rayon::ThreadPo
 /// as one thread does; the energy sums (fixed runs of bodies, added in order) must agree too.
 #[test]
 fn many_bodies_fall_asleep_alike_on_one_and_two_threads() {
-    let scene = impulse::scene::builtin::builtin_scene("balls4096").unwrap();
+    let scene = impulse::scene::builtin_scene("balls4096").unwrap();
     assert!(scene.solver.sleep);
     let (mut one, mut two, pool) = one_and_two_threads(&scene);
     let mut first_sleep = None;
@@ -224,17 +228,18 @@ fn many_bodies_fall_asleep_alike_on_one_and_two_threads() {
         let a = one.step().unwrap().clone();
         let b = pool.install(|| two.step().unwrap().clone());
         assert_eq!(a, b, "diagnostics of step {}", a.step);
-        assert_eq!(one.bodies.asleep, two.bodies.asleep, "step {}", a.step);
+        assert_eq!(one.bodies().asleep, two.bodies().asleep, "step {}", a.step);
         assert_eq!(
-            one.bodies.sleep_time, two.bodies.sleep_time,
+            one.bodies().sleep_time,
+            two.bodies().sleep_time,
             "step {}",
             a.step
         );
-        if first_sleep.is_none() && one.bodies.asleep.iter().any(|&s| s) {
+        if first_sleep.is_none() && one.bodies().asleep.iter().any(|&s| s) {
             first_sleep = Some(a.step);
         }
     }
-    let asleep = one.bodies.asleep.iter().filter(|&&s| s).count();
+    let asleep = one.bodies().asleep.iter().filter(|&&s| s).count();
     assert!(
         first_sleep.is_some() && asleep > 1024,
         "only {asleep} bodies asleep after 4 s: the sleep paths were not taken"

@@ -28,7 +28,7 @@ fn scratch(name: &str) -> PathBuf {
 
 /// Largest depth (m) by which any moving body of `world` overlaps static body `ground`.
 fn deepest_into(world: &World, ground: usize) -> f32 {
-    let b = &world.bodies;
+    let b = world.bodies();
     let mut deepest = 0.0f32;
     for i in 0..b.len() {
         if i == ground || !b.is_moving(i) {
@@ -69,10 +69,10 @@ fn pile_on_the_mesh_terrain_comes_to_rest_without_falling_through() {
     let mut deepest = 0.0f32;
     let mut steps = 0;
     let settled = |w: &World| {
-        (1..w.bodies.len()).all(|i| {
-            !w.bodies.is_moving(i)
-                || w.bodies.asleep[i]
-                || (cone(i) && w.bodies.linear_velocity[i].length() < 0.2)
+        (1..w.bodies().len()).all(|i| {
+            !w.bodies().is_moving(i)
+                || w.bodies().asleep[i]
+                || (cone(i) && w.bodies().linear_velocity[i].length() < 0.2)
         })
     };
     while !settled(&world) {
@@ -81,9 +81,9 @@ fn pile_on_the_mesh_terrain_comes_to_rest_without_falling_through() {
         steps += 1;
         deepest = deepest.max(deepest_into(&world, 0));
     }
-    for i in 1..world.bodies.len() {
+    for i in 1..world.bodies().len() {
         // The terrain's lowest point is at y = −0.4 m.
-        let p = world.bodies.pose[i].translation;
+        let p = world.bodies().pose[i].translation;
         assert!(p.y > -0.4, "body {i} fell through: {p}");
     }
     assert!(deepest < 0.01, "a body sank {deepest} m into the terrain");
@@ -382,13 +382,13 @@ fn drift(bodies: Vec<BodyDesc>) -> f32 {
         ..Scene::default()
     };
     let mut world = World::from_scene(&scene).unwrap();
-    let start: Vec<Vec3> = world.bodies.pose.iter().map(|p| p.translation).collect();
+    let start: Vec<Vec3> = world.bodies().pose.iter().map(|p| p.translation).collect();
     for _ in 0..600 {
         world.step().unwrap();
     }
-    (0..world.bodies.len())
-        .filter(|&i| world.bodies.is_moving(i))
-        .map(|i| world.bodies.pose[i].translation.distance(start[i]))
+    (0..world.bodies().len())
+        .filter(|&i| world.bodies().is_moving(i))
+        .map(|i| world.bodies().pose[i].translation.distance(start[i]))
         .fold(0.0, f32::max)
 }
 

@@ -2,7 +2,7 @@
 //! up to the whole step.
 
 use impulse::World;
-use impulse::scene::builtin::builtin_scene;
+use impulse::scene::builtin_scene;
 
 #[test]
 fn stage_times_add_up_to_the_step() {

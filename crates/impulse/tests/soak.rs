@@ -3,7 +3,7 @@
 //! (contacts only dissipate). On demand, not in the default suite:
 //! `cargo test --release -p impulse --test soak -- --ignored --nocapture`.
 
-use impulse::scene::builtin::builtin_scene;
+use impulse::scene::builtin_scene;
 use impulse::{BodyKind, World};
 
 #[test]
@@ -28,7 +28,7 @@ fn balls4096_for_20000_steps_stays_finite_boxed_and_dissipative() {
     let inner_min_z = wall("wall_-z").position[2] + half_x(wall("wall_-z"))[2];
     let inner_max_z = wall("wall_+z").position[2] - half_x(wall("wall_+z"))[2];
     let mut world = World::from_scene(&scene).unwrap();
-    let energy = |w: &World| impulse::diagnostics::energy_terms(&w.bodies, w.gravity).mechanical();
+    let energy = |w: &World| w.energy().mechanical();
     let start = energy(&world);
     let mut highest = start;
     let slack = 0.05f32;
@@ -38,7 +38,7 @@ fn balls4096_for_20000_steps_stays_finite_boxed_and_dissipative() {
             let e = energy(&world);
             highest = highest.max(e);
             assert!(e.is_finite(), "step {step}: energy {e}");
-            let b = &world.bodies;
+            let b = world.bodies();
             for i in (0..b.len()).filter(|&i| b.kind[i] != BodyKind::Static) {
                 let p = b.pose[i].translation;
                 assert!(p.is_finite(), "step {step}: body {i} at {p}");

@@ -16,7 +16,7 @@ pub mod usd;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use impulse::body::Bodies;
+use impulse::Bodies;
 use impulse::{BodyKind, Scene, ShapeDesc};
 
 /// An animation file format, chosen from the file extension.

@@ -186,7 +186,7 @@ pub enum SceneErrorKind {
     /// missing field, unknown enum value.
     Structure,
     /// A value has the right type but cannot be simulated: found by
-    /// [`validate`](crate::scene::validate::validate).
+    /// [`validate`](crate::scene::validate).
     Invalid,
 }
 

@@ -365,17 +365,19 @@ impl BodyDesc {
     }
 }
 
-pub mod builtin;
-pub mod error;
-pub mod json;
+mod builtin;
+mod error;
+pub(crate) mod json;
 mod json_shape;
-pub mod mesh_file;
+mod mesh_file;
 mod shape;
-pub mod validate;
+pub(crate) mod validate;
 
 pub use builtin::{builtin_families, builtin_names, builtin_scene};
 pub use error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
-pub use json::{load_scene_file, parse_scene_str, parse_scene_str_in, to_json_string};
+pub use json::{
+    load_scene_file, locate, locate_closest, parse_scene_str, parse_scene_str_in, to_json_string,
+};
 pub use mesh_file::{LoadedMesh, MeshData, MeshFileError, load_mesh_file};
 pub use shape::build_shape;
-pub use validate::validate;
+pub use validate::{validate, validate_all};

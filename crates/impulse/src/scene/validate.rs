@@ -49,7 +49,7 @@ pub const HULL_FLATNESS_TOLERANCE: f64 = 1e-5;
 /// # Errors
 /// A [`SceneError`] of kind [`SceneErrorKind::Invalid`] with `field` set to the path of the
 /// offending value (e.g. `bodies[3].shape.radius`) and `body` set for body errors. It has no
-/// origin or text position; [`parse_scene_str`](crate::scene::json::parse_scene_str) adds them.
+/// origin or text position; [`parse_scene_str`](crate::scene::parse_scene_str) adds them.
 pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     match validate_all(scene).into_iter().next() {
         Some(error) => Err(error),

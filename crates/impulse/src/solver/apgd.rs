@@ -416,3 +416,7 @@ fn residual_squared(c: &ContactConstraint, gamma: [f32; 3], gradient: [f32; 3], 
 fn sub(p: [f32; 3], q: [f32; 3]) -> [f32; 3] {
     [p[0] - q[0], p[1] - q[1], p[2] - q[2]]
 }
+
+#[cfg(test)]
+#[path = "apgd_tests.rs"]
+mod tests;

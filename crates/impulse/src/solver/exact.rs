@@ -937,3 +937,7 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "exact_tests.rs"]
+mod world_tests;

@@ -19,8 +19,8 @@
 
 use glam::Vec3;
 
+pub use crate::constraints::cap_to_disc;
 use crate::constraints::{self, ContactConstraint};
-pub use crate::constraints::{cap_to_disc, scale_impulses};
 use crate::parallel::SharedVelocities;
 use crate::settings::SolverSettings;
 
@@ -33,10 +33,8 @@ pub mod position;
 pub mod substep;
 pub mod wide;
 
-pub use nncg::{NncgWorkspace, solve_nncg};
-pub use pgs::{Sweep, solve_pgs, solve_pgs_rows};
+pub use pgs::Sweep;
 pub use policy::EscalationLevel;
-pub use position::solve_positions;
 pub use substep::IslandReport;
 
 /// An island's contact solver, whatever its method: what the substep loop
@@ -296,14 +294,6 @@ pub struct TangentEigen {
 }
 
 impl TangentEigen {
-    /// What the SIMD packing stores for a block without a decomposition: k₂ = 0 sends the
-    /// lane to the radial cap.
-    pub const DEGENERATE: Self = Self {
-        k1: 0.0,
-        k2: 0.0,
-        u1: [1.0, 0.0],
-    };
-
     /// The decomposition of `block`; `None` when K is not positive definite (k₂ ≤ 0 or NaN:
     /// an immovable pair), where the projection falls back to the radial cap.
     #[inline(always)]

@@ -70,6 +70,7 @@ impl Sweep<'_> {
     }
 
     /// Constraint order, one thread: the sweep of [`solve_pgs`]'s documentation.
+    #[cfg(any(test, feature = "internals"))]
     pub const SEQUENTIAL: Sweep<'static> = Sweep {
         starts: &[],
         parallel: false,
@@ -289,6 +290,7 @@ where
 /// heavily loaded contact keep a large velocity error. Per point, the normal row (clamped to
 /// γ_n ≥ 0) goes first and the two friction rows (one 2×2 block, projected onto the disc
 /// |γ_t| ≤ μ·γ_n of that γ_n) after it (see `solve_point`).
+#[cfg(any(test, feature = "internals"))]
 pub fn solve_pgs(
     constraints: &mut [ContactConstraint],
     sweep: Sweep<'_>,

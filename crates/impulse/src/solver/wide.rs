@@ -531,15 +531,6 @@ impl Bundles {
         }
     }
 
-    /// Applies the accumulated impulses to the velocities ([`crate::solver::warm_start`]).
-    pub fn warm_start(&mut self, velocities: &mut Velocities<'_>) {
-        let order = SweepOrder {
-            forward: true,
-            half_turn: false,
-        };
-        self.sweep(order, velocities, WarmStart { totals: None }, NoTargets);
-    }
-
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
     /// group's bodies gathered into lanes once and scattered back after its bundles; returns the
     /// lane-wise largest of what `update` returned. With `parallel` (see [`Bundles::pack`])
@@ -1337,3 +1328,7 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "wide_tests.rs"]
+mod world_tests;

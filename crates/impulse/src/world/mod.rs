@@ -9,7 +9,7 @@ use crate::body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Handles};
 use crate::broad_phase::BroadPhase;
 use crate::constraints::ContactConstraint;
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
-use crate::diagnostics::{StepDiagnostics, StepProfile};
+use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms};
 use crate::error::WorldError;
 use crate::island::Islands;
 use crate::kinematic::Script;
@@ -53,18 +53,18 @@ pub const BLOW_UP_ENERGY_PER_KG: f64 = 50.0;
 pub struct World {
     /// The bodies, in scene order while none has been removed (a removal moves the last body
     /// into the freed index; [`BodyHandle`]s stay valid).
-    pub bodies: Bodies,
+    pub(crate) bodies: Bodies,
     handles: Handles,
     /// Gravity (m/s²).
-    pub gravity: Vec3,
+    pub(crate) gravity: Vec3,
     /// Solver settings.
-    pub settings: SolverSettings,
+    pub(crate) settings: SolverSettings,
     dt: f32,
     step_count: u64,
     broad_phase: BroadPhase,
     narrow_phase: NarrowPhase,
     candidates: Vec<(u32, u32)>,
-    constraints: Vec<ContactConstraint>,
+    pub(crate) constraints: Vec<ContactConstraint>,
     world_inverse_inertia: Vec<Mat3>,
     scratch: Vec<(Vec3, Vec3)>,
     margins: narrow_phase::SpeculativeMargins,
@@ -74,7 +74,7 @@ pub struct World {
     energy: EnergyCheck,
     /// Run islands (and the narrow phase) on rayon's thread pool when it has more than one
     /// thread. `false` runs everything on the calling thread.
-    pub parallel: bool,
+    pub(crate) parallel: bool,
     diagnostics: StepDiagnostics,
     profile: StepProfile,
     /// Whether any body has a force or torque for the next step.
@@ -237,7 +237,8 @@ impl World {
     }
 
     /// The last step's solved contact constraints (impulses as the solver left them).
-    pub fn contact_constraints(&self) -> &[ContactConstraint] {
+    #[cfg(test)]
+    pub(crate) fn contact_constraints(&self) -> &[ContactConstraint] {
         &self.constraints
     }
 
@@ -247,14 +248,64 @@ impl World {
         assemble_lcp(&self.constraints)
     }
 
-    /// The last step's contact manifolds.
-    pub fn narrow_phase(&self) -> &NarrowPhase {
-        &self.narrow_phase
-    }
-
     /// Wall-clock time of each stage of the last step (all zero before the first step).
     pub fn profile(&self) -> &StepProfile {
         &self.profile
+    }
+
+    /// Every body's state, one array per quantity indexed by body index ([`BodyRef::index`],
+    /// [`Self::handle_of`]): read-only; edit bodies through [`Self::set_pose`],
+    /// [`Self::set_linear_velocity`] and the other setters, which wake them.
+    pub fn bodies(&self) -> &Bodies {
+        &self.bodies
+    }
+
+    /// Kinetic and gravitational energy, mass and momentum of the moving bodies now (the
+    /// quantities the blow-up check watches).
+    pub fn energy(&self) -> EnergyTerms {
+        energy_terms(&self.bodies, self.gravity)
+    }
+
+    /// Gravity (m/s²).
+    pub fn gravity(&self) -> Vec3 {
+        self.gravity
+    }
+
+    /// Sets gravity (m/s²) and wakes every body. Errors unless finite.
+    pub fn set_gravity(&mut self, gravity: Vec3) -> Result<(), WorldError> {
+        if !gravity.is_finite() {
+            return Err(setting("gravity", "must be finite"));
+        }
+        self.gravity = gravity;
+        self.wake_all();
+        Ok(())
+    }
+
+    /// The solver settings.
+    pub fn settings(&self) -> &SolverSettings {
+        &self.settings
+    }
+
+    /// Replaces the solver settings from the next step on. Errors, leaving the settings as they
+    /// were, when one is out of range ([`SolverSettings::validate`]).
+    pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), WorldError> {
+        let previous = std::mem::replace(&mut self.settings, settings);
+        if let Err(error) = self.check_settings() {
+            self.settings = previous;
+            return Err(error);
+        }
+        Ok(())
+    }
+
+    /// Whether islands (and the narrow phase) run on rayon's thread pool when it has more than
+    /// one thread (the default). Results are the same to the bit either way.
+    pub fn parallel(&self) -> bool {
+        self.parallel
+    }
+
+    /// Runs every stage on the calling thread (`false`) or on rayon's pool (`true`).
+    pub fn set_parallel(&mut self, parallel: bool) {
+        self.parallel = parallel;
     }
 
     /// Wakes the whole body `i` belongs to (its island wakes with it at the next step). Call
@@ -263,6 +314,16 @@ impl World {
         if i < self.bodies.len() {
             self.bodies.asleep[i] = false;
             self.bodies.sleep_time[i] = 0.0;
+        }
+    }
+
+    /// Wakes every body that can move.
+    fn wake_all(&mut self) {
+        for i in 0..self.bodies.len() {
+            if self.bodies.is_dynamic(i) {
+                self.bodies.asleep[i] = false;
+                self.bodies.sleep_time[i] = 0.0;
+            }
         }
     }
 

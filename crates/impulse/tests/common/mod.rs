@@ -1,4 +1,5 @@
-//! Scene pieces shared by the solver tests (`mod common;` in each test file that uses them).
+//! Scene pieces shared by the tests (`mod common;` in each integration test that uses them;
+//! the unit tests reach them through `test_support`). Public API only.
 #![allow(dead_code)] // each test binary uses its own subset
 
 use glam::Vec3;
@@ -65,67 +66,14 @@ pub fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
     w
 }
 
-/// Checks the engine's own LCP at exit of the last step: for every point γ ≥ 0, w = J·v −
-/// target ≥ −1e-3 m/s and |w·γ| ≤ 1e-3 of the largest γ, and the natural-map residual is
-/// below 1e-2. Returns false (checks nothing) while the pile has fewer than 50 contacts.
-pub fn check_complementarity_at_exit(w: &impulse::World) -> bool {
-    let constraints = w.contact_constraints();
-    if constraints.len() < 50 {
-        return false;
-    }
-    let lin = &w.bodies.linear_velocity;
-    let ang = &w.bodies.angular_velocity;
-    let largest = constraints
-        .iter()
-        .map(|c| c.normal_impulse)
-        .fold(0.0f32, f32::max);
-    for c in constraints {
-        let (a, b) = (c.body_a as usize, c.body_b as usize);
-        let wv = c.normal.velocity(lin[a], ang[a], lin[b], ang[b]) - c.target_normal_velocity;
-        assert!(c.normal_impulse >= 0.0);
-        assert!(wv >= -1e-3, "w = {wv} < 0");
-        assert!(
-            (wv * c.normal_impulse).abs() <= 1e-3 * largest.max(1e-6),
-            "complementarity: w = {wv}, γ = {}",
-            c.normal_impulse
-        );
-    }
-    assert!(w.diagnostics().natural_map_residual < 1e-2);
-    true
-}
-
 /// Index of the body whose origin is highest (largest y): the top of a pile.
-pub fn highest_body(bodies: &impulse::body::Bodies) -> usize {
+pub fn highest_body(bodies: &impulse::Bodies) -> usize {
     (0..bodies.len())
         .max_by(|&i, &j| {
             let (a, b) = (bodies.pose[i].translation.y, bodies.pose[j].translation.y);
             a.total_cmp(&b)
         })
         .unwrap()
-}
-
-/// Adds M⁻¹Jᵀγ of one of `c`'s rows, carrying `impulse` (N·s), to the (linear, angular)
-/// velocity changes of its two bodies (`body_a` +, `body_b` −), indexed by world body, in f64:
-/// a reference for the engine's f32 passes.
-pub fn add_row_impulse(
-    delta: &mut [([f64; 3], [f64; 3])],
-    c: &impulse::constraints::ContactConstraint,
-    row: &impulse::constraints::JacobianRow,
-    impulse: f64,
-) {
-    let to64 = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
-    let (d, ia, ib) = (
-        to64(row.direction),
-        to64(row.inverse_inertia_angular_a),
-        to64(row.inverse_inertia_angular_b),
-    );
-    let (a, b) = (c.body_a as usize, c.body_b as usize);
-    for k in 0..3 {
-        delta[a].0[k] += d[k] * c.inverse_mass_a as f64 * impulse;
-        delta[a].1[k] += ia[k] * impulse;
-        delta[b].0[k] -= d[k] * c.inverse_mass_b as f64 * impulse;
-        delta[b].1[k] -= ib[k] * impulse;
-    }
 }
 
 /// FNV-1a hash of a world's state: every body's pose and velocities and every contact point's
@@ -138,7 +86,7 @@ pub fn hash_state(world: &impulse::World) -> u64 {
             hash = hash.wrapping_mul(0x0100_0000_01b3);
         }
     };
-    let b = &world.bodies;
+    let b = world.bodies();
     for i in 0..b.len() {
         let (t, q) = (b.pose[i].translation, b.pose[i].rotation);
         for x in [t.x, t.y, t.z, q.x, q.y, q.z, q.w] {

@@ -2,10 +2,10 @@
 //! speculative distance and its shapes are all unchanged. Whatever changes between steps (a
 //! pose moved by hand, a shape replaced), the next step must see the contact as it now is.
 
-mod common;
+use crate::test_support as common;
 
+use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use glam::Vec3;
-use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use parry3d::shape::SharedShape;
 
 /// A ball of radius 0.5 m resting exactly on a static box (top face at y = 0), without

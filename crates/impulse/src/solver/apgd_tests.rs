@@ -1,4 +1,4 @@
-//! APGD (`impulse::solver::apgd::solve_apgd`) on the contact problems of real steps, checked against
+//! APGD (`crate::solver::apgd::solve_apgd`) on the contact problems of real steps, checked against
 //! what anyone can verify: Lemke's exact solution of the same exported LCP, complementarity,
 //! Coulomb's disc, the natural-map residual, and the velocities v* + M⁻¹Jᵀγ recomputed from
 //! scratch.
@@ -9,15 +9,17 @@
 //! folded into the rows, like the island's immovable slot), so a solver can be run on them
 //! from any starting impulses.
 
-mod common;
+use crate::constraints::ContactConstraint;
+use crate::contact_lcp::assemble_lcp;
+use crate::settings::ContactRepair;
+use crate::solver::apgd::{ApgdWorkspace, solve_apgd};
+use crate::solver::nncg::{NncgWorkspace, solve_nncg};
+use crate::solver::pgs::solve_pgs;
+use crate::solver::{SolveReport, Sweep, Velocities};
+use crate::test_support as common;
+use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use common::{material, static_box};
 use glam::Vec3;
-use impulse::constraints::ContactConstraint;
-use impulse::contact_lcp::assemble_lcp;
-use impulse::settings::ContactRepair;
-use impulse::solver::apgd::{ApgdWorkspace, solve_apgd};
-use impulse::solver::{NncgWorkspace, SolveReport, Sweep, Velocities, solve_nncg, solve_pgs};
-use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::lemke;
 use impulse_lcp::{
     Bounds, Lcp, SolverSettings as LcpSettings, Status, normalised_natural_map_residual,

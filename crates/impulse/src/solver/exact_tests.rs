@@ -1,4 +1,4 @@
-//! The exact path (`impulse::solver::exact::solve_exact`) on islands taken from real worlds: against
+//! The exact path (`crate::solver::exact::solve_exact`) on islands taken from real worlds: against
 //! the statics of a sphere resting on two spheres and Lemke on the exported contact LCP,
 //! against the LCP's conditions on box stacks with friction, and its failure contract.
 //!
@@ -8,17 +8,17 @@
 //! Timings: `cargo test --release -p impulse --test exact -- --nocapture` prints, per island,
 //! rows, pivots and the median time of `solve_exact` over repeated runs from the same entry.
 
-mod common;
+use crate::test_support as common;
 use common::material;
 use std::time::Instant;
 
+use crate::constraints::ContactConstraint;
+use crate::settings::ContactRepair;
+use crate::settings::SolverMethod;
+use crate::solver::Velocities;
+use crate::solver::exact::{ExactFailure, ExactReport, ExactWorkspace, solve_exact};
+use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use glam::{DVec3, Vec3};
-use impulse::constraints::ContactConstraint;
-use impulse::settings::ContactRepair;
-use impulse::settings::SolverMethod;
-use impulse::solver::Velocities;
-use impulse::solver::exact::{ExactFailure, ExactReport, ExactWorkspace, solve_exact};
-use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::lemke;
 use impulse_lcp::{Bounds, SolverSettings as LcpSettings, Status};
 

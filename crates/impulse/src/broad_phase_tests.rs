@@ -3,11 +3,11 @@
 //! large. Whatever the history of moves, it must find every pair whose boxes overlap, and only
 //! pairs whose boxes are within a few skins of each other.
 
-mod common;
+use crate::test_support as common;
 
+use crate::broad_phase::{BroadPhase, CHANGE_DETECTION_SKIN};
+use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use glam::Vec3;
-use impulse::broad_phase::{BroadPhase, CHANGE_DETECTION_SKIN};
-use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 
 const RADIUS: f32 = 0.5;

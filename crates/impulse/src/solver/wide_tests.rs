@@ -1,14 +1,14 @@
-//! The SIMD-lane solver (`impulse::solver::wide`): the same LCP conditions as the scalar sweep, exact
+//! The SIMD-lane solver (`crate::solver::wide`): the same LCP conditions as the scalar sweep, exact
 //! momentum with padding lanes, Coulomb's law for a sliding box, and the `fast` preset standing
 //! on a standard scene.
 
-mod common;
+use crate::test_support as common;
 
+use crate::scene::builtin_scene;
+use crate::settings::ContactRepair;
+use crate::settings::SolverMethod;
+use crate::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
 use glam::Vec3;
-use impulse::scene::builtin::builtin_scene;
-use impulse::settings::ContactRepair;
-use impulse::settings::SolverMethod;
-use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
 
 const DT: f32 = 1.0 / 60.0;
 

@@ -5,12 +5,12 @@
 //! Convention (docs/method.md): find γ with w = Aγ − b ≥ 0, γ ≥ 0, wᵀγ = 0, where A = J M⁻¹ Jᵀ and
 //! b = target − J·v*. w is a velocity (m/s), γ an impulse (N·s).
 
-mod common;
+use crate::constraints::ContactConstraint;
+use crate::settings::ContactRepair;
+use crate::test_support as common;
+use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use common::{material, static_box};
 use glam::Vec3;
-use impulse::constraints::ContactConstraint;
-use impulse::settings::ContactRepair;
-use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use impulse_lcp::solvers::{lemke, pgs};
 use impulse_lcp::{
     Bounds, Lcp, Matrix, SolverSettings as LcpSettings, Status, bound_violation,
@@ -227,7 +227,7 @@ fn exported_rows_match_the_constraints() {
             panic!("the contact LCP is sparse")
         };
         let diagonal = lcp.a.diagonal();
-        let row_data = |r: usize| -> (&impulse::constraints::JacobianRow, f32, f32) {
+        let row_data = |r: usize| -> (&crate::constraints::JacobianRow, f32, f32) {
             let c = &constraints[exported.contact_of_row[r]];
             match r % rows_per_contact {
                 0 => (&c.normal, c.target_normal_velocity, c.normal_impulse),
@@ -520,7 +520,7 @@ fn repeated_pile_rows(
 /// on two threads, and each row's J·v* matches v* = v − M⁻¹Jᵀγ summed directly in f64.
 #[test]
 fn velocity_before_in_parts_is_the_same_on_any_thread_count_and_matches_a_direct_sum() {
-    use impulse::constraints::{BodySlots, record_velocity_before};
+    use crate::constraints::{BodySlots, record_velocity_before};
     let (world, rows) = repeated_pile_rows(-1.0, None);
     assert!(rows.len() > 20_000, "{} rows", rows.len());
     let bodies = &world.bodies;
@@ -601,8 +601,8 @@ fn velocity_before_in_parts_is_the_same_on_any_thread_count_and_matches_a_direct
 /// of the velocity-change sums are exercised.
 #[test]
 fn fused_record_and_residual_equals_the_separate_passes_on_any_thread_count() {
-    use impulse::constraints::{BodySlots, record_velocity_before};
-    use impulse::diagnostics::{natural_map_residual_in, record_velocity_before_and_residual};
+    use crate::constraints::{BodySlots, record_velocity_before};
+    use crate::diagnostics::{natural_map_residual_in, record_velocity_before_and_residual};
     let (world, rows) = repeated_pile_rows(1.0, Some(3));
     let with_friction = rows.iter().filter(|c| c.friction > 0.0).count();
     assert!(with_friction > 0 && with_friction < rows.len());
@@ -664,4 +664,29 @@ fn fused_record_and_residual_equals_the_separate_passes_on_any_thread_count() {
         );
         assert_eq!(report.friction_rows, with_friction, "{threads} threads");
     }
+}
+
+/// A pile of spheres, solved to convergence without friction (the LCP of docs/method.md): at exit
+/// γ ≥ 0, w = Aγ − b = J·v⁺ − target ≥ −tol, and wᵀγ ≈ 0, checked directly from velocities.
+#[test]
+fn pile_of_spheres_satisfies_complementarity_at_exit() {
+    // The LCP at exit is that of the last solve of the step (the relax solve), so both are
+    // run to convergence.
+    let settings = SolverSettings {
+        iterations: 500,
+        relax_iterations: 500,
+        tolerance: 0.0,
+        friction: false,
+        ..SolverSettings::default()
+    };
+    let mut w = common::sphere_pile(settings);
+    assert_eq!(w.bodies().len(), 5 + 64);
+    let mut checked_steps = 0;
+    for _ in 0..90 {
+        w.step().unwrap();
+        if common::check_complementarity_at_exit(&w) {
+            checked_steps += 1;
+        }
+    }
+    assert!(checked_steps > 10);
 }

@@ -1,0 +1,65 @@
+//! Helpers of the unit tests: the integration tests' scene pieces (`tests/common`, compiled
+//! here as well through the `impulse` alias of lib.rs) and checks that need the engine's rows.
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+pub(crate) use common::*;
+
+use glam::Vec3;
+
+use crate::World;
+use crate::constraints::{ContactConstraint, JacobianRow};
+
+/// Checks the engine's own LCP at exit of the last step: for every point γ ≥ 0, w = J·v −
+/// target ≥ −1e-3 m/s and |w·γ| ≤ 1e-3 of the largest γ, and the natural-map residual is
+/// below 1e-2. Returns false (checks nothing) while the pile has fewer than 50 contacts.
+pub(crate) fn check_complementarity_at_exit(w: &World) -> bool {
+    let constraints = w.contact_constraints();
+    if constraints.len() < 50 {
+        return false;
+    }
+    let lin = &w.bodies.linear_velocity;
+    let ang = &w.bodies.angular_velocity;
+    let largest = constraints
+        .iter()
+        .map(|c| c.normal_impulse)
+        .fold(0.0f32, f32::max);
+    for c in constraints {
+        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let wv = c.normal.velocity(lin[a], ang[a], lin[b], ang[b]) - c.target_normal_velocity;
+        assert!(c.normal_impulse >= 0.0);
+        assert!(wv >= -1e-3, "w = {wv} < 0");
+        assert!(
+            (wv * c.normal_impulse).abs() <= 1e-3 * largest.max(1e-6),
+            "complementarity: w = {wv}, γ = {}",
+            c.normal_impulse
+        );
+    }
+    assert!(w.diagnostics().natural_map_residual < 1e-2);
+    true
+}
+
+/// Adds M⁻¹Jᵀγ of one of `c`'s rows, carrying `impulse` (N·s), to the (linear, angular)
+/// velocity changes of its two bodies (`body_a` +, `body_b` −), indexed by world body, in f64:
+/// a reference for the engine's f32 passes.
+pub(crate) fn add_row_impulse(
+    delta: &mut [([f64; 3], [f64; 3])],
+    c: &ContactConstraint,
+    row: &JacobianRow,
+    impulse: f64,
+) {
+    let to64 = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+    let (d, ia, ib) = (
+        to64(row.direction),
+        to64(row.inverse_inertia_angular_a),
+        to64(row.inverse_inertia_angular_b),
+    );
+    let (a, b) = (c.body_a as usize, c.body_b as usize);
+    for k in 0..3 {
+        delta[a].0[k] += d[k] * c.inverse_mass_a as f64 * impulse;
+        delta[a].1[k] += ia[k] * impulse;
+        delta[b].0[k] -= d[k] * c.inverse_mass_b as f64 * impulse;
+        delta[b].1[k] -= ib[k] * impulse;
+    }
+}
