@@ -61,10 +61,10 @@ pub use parry3d;
 /// (along y), `::convex_hull(&points)`, `::halfspace(normal)`.
 pub use parry3d::shape::SharedShape;
 
-pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe};
+pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use diagnostics::StepDiagnostics;
 pub use error::{SnapshotError, StepError, WorldError};
-pub use scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
+pub use scene::{BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, ShapeDesc, WorldAxis};
 pub use settings::{SettingError, SolverSettings};
 pub use world::{
     BodyRef, ContactEvent, ContactPairView, ContactPoint, RayHit, ShapeHit, World, WorldSnapshot,
