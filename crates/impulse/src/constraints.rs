@@ -458,16 +458,31 @@ fn tangent_block(
     [t1.inverse_effective_mass, k12, t2.inverse_effective_mass]
 }
 
-/// (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) of the tangent block; zeros when the block is singular (both bodies
-/// immovable).
-fn inverse_block(tangents: &[JacobianRow; 2], inverse_mass_a: Vec3, inverse_mass_b: Vec3) -> [f32; 3] {
+/// (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) of the tangent block; its pseudo-inverse when the block has rank one,
+/// zeros when it is zero (both bodies immovable along the tangents).
+fn inverse_block(
+    tangents: &[JacobianRow; 2],
+    inverse_mass_a: Vec3,
+    inverse_mass_b: Vec3,
+) -> [f32; 3] {
     let [k11, k12, k22] = tangent_block(tangents, inverse_mass_a, inverse_mass_b);
     let determinant = k11 * k22 - k12 * k12;
     if determinant > f32::EPSILON * (k11 * k22).max(f32::MIN_POSITIVE) {
         let inverse = 1.0 / determinant;
         [k22 * inverse, -k12 * inverse, k11 * inverse]
     } else {
-        [0.0; 3]
+        // Rank one: the bodies slide along one tangent direction u only (locked axes, e.g. a
+        // body confined to a plane touching it along a line). K = tr(K)·u·uᵀ, whose
+        // pseudo-inverse K/tr(K)² stops the motion along u and asks for no impulse across it.
+        // Unlocked bodies never get here with K ≠ 0: each contributes at least 1/m on every
+        // direction.
+        let trace = k11 + k22;
+        if trace > 0.0 && trace.is_finite() {
+            let scale = 1.0 / (trace * trace);
+            [k11 * scale, k12 * scale, k22 * scale]
+        } else {
+            [0.0; 3]
+        }
     }
 }
 

@@ -663,9 +663,10 @@ fn assemble(constraints: &[ContactConstraint], w: &mut ExactWorkspace) {
                             side_p.inverse_mass.x as f64
                                 * side_p.direction.as_dvec3().dot(side_q.direction.as_dvec3())
                         } else {
-                            side_p.direction.as_dvec3().dot(
-                                side_p.inverse_mass.as_dvec3() * side_q.direction.as_dvec3(),
-                            )
+                            side_p
+                                .direction
+                                .as_dvec3()
+                                .dot(side_p.inverse_mass.as_dvec3() * side_q.direction.as_dvec3())
                         };
                         value += side_p.sign * side_q.sign * (linear + angular);
                     }
