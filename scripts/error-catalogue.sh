@@ -41,6 +41,8 @@ row "degenerate mesh triangle" run "$(case_file flatmesh "$(scene '{"kind": "sta
 row "half-space on a moving body" run "$(case_file halfspace "$(scene '{"kind": "dynamic", "shape": {"type": "half_space", "normal": [0, 1, 0]}}')")" --steps 1 --quiet
 row "keyframes out of order" run "$(case_file keyframes "$(scene '{"kind": "kinematic", "shape": {"type": "cuboid", "half_extents": [1, 0.1, 1]}, "keyframes": [{"t": 2, "position": [0, 1, 0]}, {"t": 1, "position": [0, 2, 0]}]}')")" --steps 1 --quiet
 row "keyframes on a dynamic body" run "$(case_file keyed "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "keyframes": [{"t": 1, "position": [0, 1, 0]}]}')")" --steps 1 --quiet
+row "unknown locked axis" run "$(case_file axis "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "locked_axes": {"rotation": ["w"]}}')")" --steps 1 --quiet
+row "locked axes on a static body" run "$(case_file lockedstatic "$(scene '{"kind": "static", "shape": {"type": "sphere", "radius": 0.5}, "locked_axes": {"translation": ["x"]}}')")" --steps 1 --quiet
 row "dt = 0 in the scene" run "$(case_file dt '{"name": "x", "dt": 0, "bodies": []}')" --steps 1 --quiet
 row "--dt -0.01" run stack3 --dt -0.01 --steps 1 --quiet
 row "--every 0" run stack3 --every 0 --steps 1 --quiet

@@ -47,6 +47,199 @@ impl BodyKind {
     }
 }
 
+/// The world axes along which a dynamic body may not translate or about which it may not
+/// rotate (Rapier's `LockedAxes`, Bullet's linear and angular factors, Box2D's fixed
+/// rotation): a set of six flags, combined with `|`.
+///
+/// A locked translation axis sets that component of the body's inverse mass to 0 (the inverse
+/// mass becomes a per-axis vector in every solver); a locked rotation axis zeroes that row and
+/// column of the world inverse inertia, recomputed whenever the body turns. Contacts, gravity, forces and impulses then leave the
+/// locked components of the centre of mass's linear velocity and of the angular velocity (world
+/// frame) at exactly zero. A body frame whose origin is not its centre of mass may still move
+/// along a locked translation axis while it turns: the lock holds the centre of mass.
+///
+/// ```
+/// use impulse::LockedAxes;
+///
+/// // A body that moves in the x–y plane and turns only about z (a 2D body).
+/// let planar = LockedAxes::TRANSLATION_Z | LockedAxes::ROTATION_X | LockedAxes::ROTATION_Y;
+/// assert!(planar.contains(LockedAxes::ROTATION_X));
+/// assert!(!planar.contains(LockedAxes::ROTATION_Z));
+/// ```
+#[derive(Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(try_from = "u8", into = "u8")]
+pub struct LockedAxes(u8);
+
+impl LockedAxes {
+    /// Nothing locked (the default).
+    pub const NONE: Self = Self(0);
+    /// No translation along the world x axis.
+    pub const TRANSLATION_X: Self = Self(1 << 0);
+    /// No translation along the world y axis.
+    pub const TRANSLATION_Y: Self = Self(1 << 1);
+    /// No translation along the world z axis.
+    pub const TRANSLATION_Z: Self = Self(1 << 2);
+    /// No rotation about the world x axis.
+    pub const ROTATION_X: Self = Self(1 << 3);
+    /// No rotation about the world y axis.
+    pub const ROTATION_Y: Self = Self(1 << 4);
+    /// No rotation about the world z axis.
+    pub const ROTATION_Z: Self = Self(1 << 5);
+    /// The three translations.
+    pub const ALL_TRANSLATIONS: Self = Self(0b000_111);
+    /// The three rotations ([`BodyBuilder::lock_rotation`]).
+    pub const ALL_ROTATIONS: Self = Self(0b111_000);
+    /// Every axis: the body does not move.
+    pub const ALL: Self = Self(0b111_111);
+
+    /// The flags as bits: translation x, y, z in bits 0–2, rotation x, y, z in bits 3–5.
+    pub const fn bits(self) -> u8 {
+        self.0
+    }
+
+    /// The flags of `bits` (as [`Self::bits`]); `None` when a bit above bit 5 is set.
+    pub const fn from_bits(bits: u8) -> Option<Self> {
+        if bits & !Self::ALL.0 == 0 {
+            Some(Self(bits))
+        } else {
+            None
+        }
+    }
+
+    /// Whether every flag of `other` is set in `self`.
+    pub const fn contains(self, other: Self) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Whether no flag is set.
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The flags of `self` and of `other`.
+    pub const fn union(self, other: Self) -> Self {
+        Self(self.0 | other.0)
+    }
+
+    /// The flags of `self` that `other` does not have.
+    pub const fn difference(self, other: Self) -> Self {
+        Self(self.0 & !other.0)
+    }
+
+    /// Whether some translation is locked.
+    pub const fn locks_translation(self) -> bool {
+        self.0 & Self::ALL_TRANSLATIONS.0 != 0
+    }
+
+    /// Whether some rotation is locked.
+    pub const fn locks_rotation(self) -> bool {
+        self.0 & Self::ALL_ROTATIONS.0 != 0
+    }
+
+    /// Per world axis, 1 where translation is free and 0 where it is locked: the factor of
+    /// the linear velocity and of the inverse mass.
+    pub fn translation_factor(self) -> Vec3 {
+        let free = |flag: Self| if self.contains(flag) { 0.0 } else { 1.0 };
+        Vec3::new(
+            free(Self::TRANSLATION_X),
+            free(Self::TRANSLATION_Y),
+            free(Self::TRANSLATION_Z),
+        )
+    }
+
+    /// Per world axis, 1 where rotation is free and 0 where it is locked: the factor of the
+    /// angular velocity.
+    pub fn rotation_factor(self) -> Vec3 {
+        let free = |flag: Self| if self.contains(flag) { 0.0 } else { 1.0 };
+        Vec3::new(
+            free(Self::ROTATION_X),
+            free(Self::ROTATION_Y),
+            free(Self::ROTATION_Z),
+        )
+    }
+
+    /// `velocity` (a linear velocity, world frame) with its locked components zero.
+    pub fn lock_linear_velocity(self, velocity: Vec3) -> Vec3 {
+        if self.locks_translation() {
+            velocity * self.translation_factor()
+        } else {
+            velocity
+        }
+    }
+
+    /// `velocity` (an angular velocity, world frame) with its locked components zero.
+    pub fn lock_angular_velocity(self, velocity: Vec3) -> Vec3 {
+        if self.locks_rotation() {
+            velocity * self.rotation_factor()
+        } else {
+            velocity
+        }
+    }
+
+    /// `tensor` (a world-frame inverse inertia) with the row and column of each locked rotation
+    /// axis set to zero (Rapier's `effective_world_inv_inertia`).
+    pub fn lock_inverse_inertia(self, tensor: Mat3) -> Mat3 {
+        if !self.locks_rotation() {
+            return tensor;
+        }
+        let f = self.rotation_factor();
+        // Column j scaled by f_j, then each row i by f_i.
+        Mat3::from_cols(
+            tensor.x_axis * (f * f.x),
+            tensor.y_axis * (f * f.y),
+            tensor.z_axis * (f * f.z),
+        )
+    }
+}
+
+impl std::ops::BitOr for LockedAxes {
+    type Output = Self;
+    fn bitor(self, other: Self) -> Self {
+        self.union(other)
+    }
+}
+
+impl std::ops::BitOrAssign for LockedAxes {
+    fn bitor_assign(&mut self, other: Self) {
+        *self = self.union(other);
+    }
+}
+
+impl std::fmt::Debug for LockedAxes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        const NAMES: [&str; 6] = [
+            "TRANSLATION_X",
+            "TRANSLATION_Y",
+            "TRANSLATION_Z",
+            "ROTATION_X",
+            "ROTATION_Y",
+            "ROTATION_Z",
+        ];
+        let set: Vec<&str> = (0..6)
+            .filter(|bit| self.0 & (1 << bit) != 0)
+            .map(|bit| NAMES[bit])
+            .collect();
+        if set.is_empty() {
+            write!(f, "LockedAxes(NONE)")
+        } else {
+            write!(f, "LockedAxes({})", set.join(" | "))
+        }
+    }
+}
+
+impl TryFrom<u8> for LockedAxes {
+    type Error = String;
+    fn try_from(bits: u8) -> Result<Self, String> {
+        Self::from_bits(bits).ok_or_else(|| format!("locked axes {bits:#b} has bits above bit 5"))
+    }
+}
+
+impl From<LockedAxes> for u8 {
+    fn from(axes: LockedAxes) -> u8 {
+        axes.0
+    }
+}
+
 /// A body's name in a [`crate::World`] that stays valid while the body lives and never names
 /// another body afterwards: the index of a slot and the slot's generation, which grows each
 /// time the slot is reused (Rapier's and Box2D's handles work the same way). A handle of a
@@ -192,7 +385,7 @@ pub struct BodyBuilder {
     pub(crate) user_data: u128,
     pub(crate) linear_damping: f32,
     pub(crate) angular_damping: f32,
-    pub(crate) lock_rotation: bool,
+    pub(crate) locked_axes: LockedAxes,
     pub(crate) groups: u32,
     pub(crate) mask: u32,
     pub(crate) keyframes: Vec<Keyframe>,
@@ -217,7 +410,7 @@ impl BodyBuilder {
             user_data: 0,
             linear_damping: 0.0,
             angular_damping: 0.0,
-            lock_rotation: false,
+            locked_axes: LockedAxes::NONE,
             groups: u32::MAX,
             mask: u32::MAX,
             keyframes: Vec::new(),
@@ -322,11 +515,34 @@ impl BodyBuilder {
         self
     }
 
-    /// Locks all three rotation axes of a dynamic body (default unlocked): its inverse
-    /// inertia is zero, so contacts, torques and impulses cannot turn it, and its angular
-    /// velocity stays zero. It still translates.
+    /// Locks all three rotation axes of a dynamic body (default unlocked), or unlocks them:
+    /// [`Self::locked_axes`] with [`LockedAxes::ALL_ROTATIONS`] added or removed. Its world
+    /// inverse inertia is then zero, so contacts, torques and impulses cannot turn it, and its
+    /// angular velocity stays zero. It still translates.
     pub fn lock_rotation(mut self, locked: bool) -> Self {
-        self.lock_rotation = locked;
+        self.locked_axes = if locked {
+            self.locked_axes | LockedAxes::ALL_ROTATIONS
+        } else {
+            self.locked_axes.difference(LockedAxes::ALL_ROTATIONS)
+        };
+        self
+    }
+
+    /// The world axes along which a dynamic body may not translate or about which it may not
+    /// rotate (default none; [`LockedAxes`]). The locked components of the builder's
+    /// velocities are dropped. Ignored for static and kinematic bodies (which contacts never
+    /// move) and, for rotations, for particles (which never rotate).
+    ///
+    /// ```
+    /// use impulse::{BodyBuilder, LockedAxes, SharedShape};
+    ///
+    /// // A door: turns only about the vertical axis and does not translate.
+    /// let door = BodyBuilder::dynamic(SharedShape::cuboid(0.5, 1.0, 0.05))
+    ///     .locked_axes(LockedAxes::ALL_TRANSLATIONS | LockedAxes::ROTATION_X | LockedAxes::ROTATION_Z);
+    /// # let _ = door;
+    /// ```
+    pub fn locked_axes(mut self, locked_axes: LockedAxes) -> Self {
+        self.locked_axes = locked_axes;
         self
     }
 
@@ -402,6 +618,10 @@ pub struct Bodies {
     pub groups: Vec<u32>,
     /// Collision groups the body collides with.
     pub mask: Vec<u32>,
+    /// The world axes the body may not translate along or rotate about
+    /// ([`BodyBuilder::locked_axes`]); always [`LockedAxes::NONE`] for static and kinematic
+    /// bodies.
+    pub locked_axes: Vec<LockedAxes>,
 }
 
 impl Bodies {
@@ -426,6 +646,7 @@ impl Bodies {
         self.angular_damping.swap_remove(i);
         self.groups.swap_remove(i);
         self.mask.swap_remove(i);
+        self.locked_axes.swap_remove(i);
         self.name.swap_remove(i)
     }
 
@@ -452,6 +673,7 @@ impl Bodies {
             ("angular_damping", self.angular_damping.len()),
             ("groups", self.groups.len()),
             ("mask", self.mask.len()),
+            ("locked_axes", self.locked_axes.len()),
             ("name", self.name.len()),
         ];
         match lengths.iter().find(|(_, len)| *len != n) {
@@ -499,9 +721,30 @@ impl Bodies {
         self.pose[i].transform_point(self.local_center_of_mass[i])
     }
 
-    /// World-frame inverse inertia R·I⁻¹·Rᵀ of body `i`.
+    /// World-frame inverse inertia R·I⁻¹·Rᵀ of body `i` (1/(kg·m²)), with the row and column
+    /// of each locked rotation axis zero ([`LockedAxes::lock_inverse_inertia`]); zero for a
+    /// body that does not rotate.
     pub fn world_inverse_inertia(&self, i: usize) -> Mat3 {
-        rotate_tensor(self.pose[i].rotation, &self.local_inverse_inertia[i])
+        let local = &self.local_inverse_inertia[i];
+        if *local == Mat3::ZERO {
+            return Mat3::ZERO;
+        }
+        self.locked_axes[i].lock_inverse_inertia(rotate_tensor(self.pose[i].rotation, local))
+    }
+
+    /// Per-axis inverse mass of body `i` (1/kg per world axis): 1/m on each free translation
+    /// axis, 0 on each locked one (Rapier's `effective_inv_mass`); zero for static and
+    /// kinematic bodies. A linear impulse p changes the velocity of the centre of mass by
+    /// `effective_inverse_mass * p`, component by component.
+    #[inline]
+    pub fn effective_inverse_mass(&self, i: usize) -> Vec3 {
+        let inverse_mass = Vec3::splat(self.inverse_mass[i]);
+        let locked = self.locked_axes[i];
+        if locked.locks_translation() {
+            inverse_mass * locked.translation_factor()
+        } else {
+            inverse_mass
+        }
     }
 
     /// Mass (kg) of body `i`; infinity for static and kinematic bodies.

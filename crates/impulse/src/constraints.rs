@@ -34,13 +34,44 @@ pub struct JacobianRow {
     pub velocity_before: f32,
 }
 
+/// dᵀ·M⁻¹·e (1/kg) for a body of per-axis inverse mass `inverse_mass` (1/kg per world axis,
+/// zero on locked translation axes) and directions d, e: the linear part of an entry of
+/// J M⁻¹ Jᵀ. For an isotropic inverse mass m (no translation locked) it is m·(d·e),
+/// computed so as that product (not through m·e), which keeps unlocked bodies' results to the
+/// bit those of a scalar inverse mass.
+#[inline]
+pub(crate) fn linear_inverse_mass(inverse_mass: Vec3, d: Vec3, e: Vec3) -> f32 {
+    if is_isotropic(inverse_mass) {
+        inverse_mass.x * d.dot(e)
+    } else {
+        d.dot(inverse_mass * e)
+    }
+}
+
+/// Whether a per-axis inverse mass is the same on every axis (no translation locked).
+#[inline]
+pub(crate) fn is_isotropic(inverse_mass: Vec3) -> bool {
+    inverse_mass.x == inverse_mass.y && inverse_mass.y == inverse_mass.z
+}
+
+/// dᵀ·M⁻¹·d (1/kg) for a unit direction d: 1/m when no translation is locked (not
+/// m·|d|², which rounds), the sum over the free axes of d_i²/m otherwise.
+#[inline]
+fn inverse_mass_along(inverse_mass: Vec3, d: Vec3) -> f32 {
+    if is_isotropic(inverse_mass) {
+        inverse_mass.x
+    } else {
+        d.dot(inverse_mass * d)
+    }
+}
+
 impl JacobianRow {
     fn new(
         direction: Vec3,
         r_a: Vec3,
         r_b: Vec3,
-        inverse_mass_a: f32,
-        inverse_mass_b: f32,
+        inverse_mass_a: Vec3,
+        inverse_mass_b: Vec3,
         inverse_inertia_a: &Mat3,
         inverse_inertia_b: &Mat3,
     ) -> Self {
@@ -48,8 +79,8 @@ impl JacobianRow {
         let angular_b = r_b.cross(direction);
         let inverse_inertia_angular_a = *inverse_inertia_a * angular_a;
         let inverse_inertia_angular_b = *inverse_inertia_b * angular_b;
-        let k = inverse_mass_a
-            + inverse_mass_b
+        let k = inverse_mass_along(inverse_mass_a, direction)
+            + inverse_mass_along(inverse_mass_b, direction)
             + angular_a.dot(inverse_inertia_angular_a)
             + angular_b.dot(inverse_inertia_angular_b);
         Self {
@@ -90,10 +121,12 @@ pub struct ContactConstraint {
     pub local_a: u32,
     /// B's index in its island's local arrays.
     pub local_b: u32,
-    /// 1/m_a and 1/m_b (1/kg).
-    pub inverse_mass_a: f32,
-    /// See `inverse_mass_a`.
-    pub inverse_mass_b: f32,
+    /// Per-axis inverse mass of A (1/kg per world axis): 1/m_a on free translation axes, 0 on
+    /// locked ones; a linear impulse p changes v_a by `inverse_mass_a * p` component by
+    /// component. `Vec3::splat(1/m_a)` for a body with no translation locked.
+    pub inverse_mass_a: Vec3,
+    /// Per-axis inverse mass of B, as `inverse_mass_a`.
+    pub inverse_mass_b: Vec3,
     /// Normal row; its impulse γ_n ≥ 0.
     pub normal: JacobianRow,
     /// Two friction rows along orthonormal tangents. Solved together, with the friction
@@ -297,8 +330,8 @@ impl Assembly<'_> {
         let com_b = bodies.center_of_mass(b);
         let friction = (bodies.friction[a] * bodies.friction[b]).sqrt();
         let restitution = bodies.restitution[a].max(bodies.restitution[b]);
-        let inverse_mass_a = bodies.inverse_mass[a];
-        let inverse_mass_b = bodies.inverse_mass[b];
+        let inverse_mass_a = bodies.effective_inverse_mass(a);
+        let inverse_mass_b = bodies.effective_inverse_mass(b);
         let inertia_a = &self.world_inverse_inertia[a];
         let inertia_b = &self.world_inverse_inertia[b];
         for (manifold_index, manifold) in pair.manifolds.iter().enumerate() {
@@ -374,8 +407,8 @@ impl Assembly<'_> {
                     inverse_mass_b,
                     normal: normal_row,
                     tangents,
-                    tangent_inverse_block: inverse_block(&tangents),
-                    tangent_block: tangent_block(&tangents),
+                    tangent_inverse_block: inverse_block(&tangents, inverse_mass_a, inverse_mass_b),
+                    tangent_block: tangent_block(&tangents, inverse_mass_a, inverse_mass_b),
                     target_normal_velocity: 0.0,
                     softness: (1.0, 0.0),
                     position_target: 0.0,
@@ -405,25 +438,51 @@ impl Assembly<'_> {
     }
 }
 
-/// (K₁₁, K₁₂, K₂₂) of the tangent block K = J_t M⁻¹ J_tᵀ (1/kg).
-fn tangent_block(tangents: &[JacobianRow; 2]) -> [f32; 3] {
+/// (K₁₁, K₁₂, K₂₂) of the tangent block K = J_t M⁻¹ J_tᵀ (1/kg), for bodies of per-axis
+/// inverse masses `inverse_mass_a` and `inverse_mass_b`.
+fn tangent_block(
+    tangents: &[JacobianRow; 2],
+    inverse_mass_a: Vec3,
+    inverse_mass_b: Vec3,
+) -> [f32; 3] {
     let [t1, t2] = tangents;
-    // Linear parts are orthogonal, so only the angular terms couple the two rows.
-    let k12 = t1.angular_a.dot(t2.inverse_inertia_angular_a)
+    let mut k12 = t1.angular_a.dot(t2.inverse_inertia_angular_a)
         + t1.angular_b.dot(t2.inverse_inertia_angular_b);
+    // The linear parts couple the rows only through a locked translation axis (t1 ⊥ t2, so
+    // t1ᵀ·(m·I)·t2 = 0).
+    for inverse_mass in [inverse_mass_a, inverse_mass_b] {
+        if !is_isotropic(inverse_mass) {
+            k12 += t1.direction.dot(inverse_mass * t2.direction);
+        }
+    }
     [t1.inverse_effective_mass, k12, t2.inverse_effective_mass]
 }
 
-/// (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) of the tangent block; zeros when the block is singular (both bodies
-/// immovable).
-fn inverse_block(tangents: &[JacobianRow; 2]) -> [f32; 3] {
-    let [k11, k12, k22] = tangent_block(tangents);
+/// (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) of the tangent block; its pseudo-inverse when the block has rank one,
+/// zeros when it is zero (both bodies immovable along the tangents).
+fn inverse_block(
+    tangents: &[JacobianRow; 2],
+    inverse_mass_a: Vec3,
+    inverse_mass_b: Vec3,
+) -> [f32; 3] {
+    let [k11, k12, k22] = tangent_block(tangents, inverse_mass_a, inverse_mass_b);
     let determinant = k11 * k22 - k12 * k12;
     if determinant > f32::EPSILON * (k11 * k22).max(f32::MIN_POSITIVE) {
         let inverse = 1.0 / determinant;
         [k22 * inverse, -k12 * inverse, k11 * inverse]
     } else {
-        [0.0; 3]
+        // Rank one: the bodies slide along one tangent direction u only (locked axes, e.g. a
+        // body confined to a plane touching it along a line). K = tr(K)·u·uᵀ, whose
+        // pseudo-inverse K/tr(K)² stops the motion along u and asks for no impulse across it.
+        // Unlocked bodies never get here with K ≠ 0: each contributes at least 1/m on every
+        // direction.
+        let trace = k11 + k22;
+        if trace > 0.0 && trace.is_finite() {
+            let scale = 1.0 / (trace * trace);
+            [k11 * scale, k12 * scale, k22 * scale]
+        } else {
+            [0.0; 3]
+        }
     }
 }
 

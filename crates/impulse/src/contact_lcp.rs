@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 use impulse_lcp::{Bounds, CsrMatrix, Lcp, ProblemError};
 
-use crate::constraints::{ContactConstraint, JacobianRow};
+use crate::constraints::{ContactConstraint, JacobianRow, linear_inverse_mass};
 
 /// A step's contact LCP together with what the engine found for it.
 #[derive(Clone, Debug)]
@@ -46,7 +46,7 @@ pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, Pro
         direction: Vec3,
         angular: Vec3,
         inverse_inertia_angular: Vec3,
-        inverse_mass: f32,
+        inverse_mass: Vec3,
     }
     let mut by_body: BTreeMap<u32, Vec<Incidence>> = BTreeMap::new();
     let mut b = Vec::new();
@@ -97,7 +97,7 @@ pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, Pro
                 ),
             ];
             for (body, sign, angular, inverse_inertia_angular, inverse_mass) in sides {
-                if inverse_mass == 0.0 && inverse_inertia_angular == Vec3::ZERO {
+                if inverse_mass == Vec3::ZERO && inverse_inertia_angular == Vec3::ZERO {
                     continue; // an immovable body couples nothing
                 }
                 by_body.entry(body).or_default().push(Incidence {
@@ -112,13 +112,14 @@ pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, Pro
         }
     }
     let n = b.len();
-    // A_ij = Σ_bodies s_i s_j (m⁻¹ d_i·d_j + (r×d)_i · I⁻¹(r×d)_j), plus the soft rows' terms.
+    // A_ij = Σ_bodies s_i s_j (d_iᵀ M⁻¹ d_j + (r×d)_i · I⁻¹(r×d)_j), plus the soft rows' terms;
+    // M⁻¹ is the body's per-axis inverse mass (zero on locked translation axes).
     for incidences in by_body.values() {
         for p in incidences {
             for q in incidences {
                 let value = p.sign
                     * q.sign
-                    * (p.inverse_mass * p.direction.dot(q.direction)
+                    * (linear_inverse_mass(p.inverse_mass, p.direction, q.direction)
                         + p.angular.dot(q.inverse_inertia_angular));
                 *entries.entry((p.row, q.row)).or_insert(0.0) += value as f64;
             }

@@ -76,11 +76,13 @@ pub use parry3d;
 /// (along y), `::convex_hull(&points)`, `::halfspace(normal)`.
 pub use parry3d::shape::SharedShape;
 
-pub use body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Keyframe};
+pub use body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, RowsReport, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
-pub use scene::{BodyDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc};
+pub use scene::{
+    BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
+};
 pub use settings::{ContactRepair, SettingError, SolverMethod, SolverSettings};
 pub use solver::{EscalationLevel, IslandReport};
 pub use world::{

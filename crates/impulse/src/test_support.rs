@@ -50,16 +50,18 @@ pub(crate) fn add_row_impulse(
     impulse: f64,
 ) {
     let to64 = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
-    let (d, ia, ib) = (
+    let (d, ma, mb, ia, ib) = (
         to64(row.direction),
+        to64(c.inverse_mass_a),
+        to64(c.inverse_mass_b),
         to64(row.inverse_inertia_angular_a),
         to64(row.inverse_inertia_angular_b),
     );
     let (a, b) = (c.body_a as usize, c.body_b as usize);
     for k in 0..3 {
-        delta[a].0[k] += d[k] * c.inverse_mass_a as f64 * impulse;
+        delta[a].0[k] += d[k] * ma[k] * impulse;
         delta[a].1[k] += ia[k] * impulse;
-        delta[b].0[k] -= d[k] * c.inverse_mass_b as f64 * impulse;
+        delta[b].0[k] -= d[k] * mb[k] * impulse;
         delta[b].1[k] -= ib[k] * impulse;
     }
 }

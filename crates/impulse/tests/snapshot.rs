@@ -280,7 +280,7 @@ fn damaged_files_give_typed_errors() {
     newer[16] += 1;
     let message = read(&newer).to_string();
     assert!(
-        message.contains("format version 2") && message.contains("reads version 1"),
+        message.contains("format version 3") && message.contains("reads version 2"),
         "{message}"
     );
     let mut longer = bytes.clone();
@@ -369,7 +369,7 @@ fn an_inconsistent_snapshot_is_invalid() {
         World::from_snapshot(snapshot),
         Err(SnapshotError::VersionMismatch {
             found: 99,
-            supported: 1
+            supported: 2
         })
     ));
 }

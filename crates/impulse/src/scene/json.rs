@@ -12,7 +12,9 @@ use serde::Serialize;
 
 use super::error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
 use super::validate::validate;
-use super::{BodyDesc, BodyKind, KeyframeDesc, Material, MaterialRef, Scene, ShapeDesc};
+use super::{
+    BodyDesc, BodyKind, KeyframeDesc, LockedAxesDesc, Material, MaterialRef, Scene, ShapeDesc,
+};
 use crate::settings::SolverSettings;
 
 /// Reads, parses and validates the scene file at `path`.
@@ -499,6 +501,8 @@ struct BodyOut<'a> {
     angular_damping: f32,
     #[serde(skip_serializing_if = "is_false")]
     lock_rotation: bool,
+    #[serde(skip_serializing_if = "LockedAxesDesc::is_empty")]
+    locked_axes: &'a LockedAxesDesc,
     #[serde(skip_serializing_if = "is_all")]
     groups: u32,
     #[serde(skip_serializing_if = "is_all")]
@@ -523,6 +527,7 @@ impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
             linear_damping,
             angular_damping,
             lock_rotation,
+            locked_axes,
             groups,
             mask,
             keyframes,
@@ -540,6 +545,7 @@ impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
             linear_damping: *linear_damping,
             angular_damping: *angular_damping,
             lock_rotation: *lock_rotation,
+            locked_axes,
             groups: *groups,
             mask: *mask,
             keyframes,

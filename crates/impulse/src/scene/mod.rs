@@ -8,6 +8,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 pub use crate::body::BodyKind;
+use crate::body::LockedAxes;
 use crate::settings::SolverSettings;
 
 /// A whole scene: world settings and bodies, in SI units with y up.
@@ -282,8 +283,14 @@ pub struct BodyDesc {
     #[serde(default)]
     pub angular_damping: f32,
     /// Lock all three rotation axes (dynamic bodies): the body translates but never turns.
+    /// The same as `locked_axes` with rotation `["x", "y", "z"]`; both may be given.
     #[serde(default)]
     pub lock_rotation: bool,
+    /// World axes the body may not translate along or rotate about (dynamic bodies and
+    /// particles; [`crate::LockedAxes`]), e.g. `{"translation": ["z"], "rotation": ["x", "y"]}`
+    /// for a body that moves in the x–y plane. Default none.
+    #[serde(default, skip_serializing_if = "LockedAxesDesc::is_empty")]
+    pub locked_axes: LockedAxesDesc,
     /// Collision groups the body belongs to (bits); default all.
     #[serde(default = "all_groups")]
     pub groups: u32,
@@ -296,6 +303,58 @@ pub struct BodyDesc {
     /// last pose after the last time. At least one; times finite, > 0 and increasing.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub keyframes: Option<Vec<KeyframeDesc>>,
+}
+
+/// A body's locked axes as a scene gives them ([`BodyDesc::locked_axes`]): the world axes
+/// along which it may not translate and those about which it may not rotate.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LockedAxesDesc {
+    /// Axes along which the centre of mass does not move.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub translation: Vec<WorldAxis>,
+    /// Axes about which the body does not turn.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rotation: Vec<WorldAxis>,
+}
+
+/// A world coordinate axis, written `"x"`, `"y"` or `"z"` in a scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WorldAxis {
+    /// The x axis.
+    X,
+    /// The y axis.
+    Y,
+    /// The z axis.
+    Z,
+}
+
+impl LockedAxesDesc {
+    /// Whether no axis is listed.
+    pub fn is_empty(&self) -> bool {
+        self.translation.is_empty() && self.rotation.is_empty()
+    }
+
+    /// The flags of the listed axes (an axis listed twice counts once).
+    pub fn to_locked_axes(&self) -> LockedAxes {
+        let mut locked = LockedAxes::NONE;
+        for &axis in &self.translation {
+            locked |= match axis {
+                WorldAxis::X => LockedAxes::TRANSLATION_X,
+                WorldAxis::Y => LockedAxes::TRANSLATION_Y,
+                WorldAxis::Z => LockedAxes::TRANSLATION_Z,
+            };
+        }
+        for &axis in &self.rotation {
+            locked |= match axis {
+                WorldAxis::X => LockedAxes::ROTATION_X,
+                WorldAxis::Y => LockedAxes::ROTATION_Y,
+                WorldAxis::Z => LockedAxes::ROTATION_Z,
+            };
+        }
+        locked
+    }
 }
 
 /// One keyframe of a kinematic body ([`BodyDesc::keyframes`]).
@@ -358,6 +417,7 @@ impl BodyDesc {
             linear_damping: 0.0,
             angular_damping: 0.0,
             lock_rotation: false,
+            locked_axes: LockedAxesDesc::default(),
             groups: all_groups(),
             mask: all_groups(),
             keyframes: None,

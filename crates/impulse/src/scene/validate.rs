@@ -20,6 +20,7 @@
 //!   convex shape with a finite position and a non-zero orientation; a `border_radius` is
 //!   > 0 and only on a cuboid, cylinder, cone or convex hull;
 //! - a particle's shape is a sphere;
+//! - `locked_axes` belong to a dynamic body or a particle;
 //! - `keyframes` belong to a kinematic body, are at least one, with times finite, > 0 and
 //!   increasing, finite positions and non-zero orientations;
 //! - the orientation quaternion is not zero (norm ≥ [`MIN_NORM`]); a nonzero non-unit
@@ -199,6 +200,16 @@ impl Checker {
             MaterialRef::Inline(m) => self.material(&path.key("material"), m),
         }
         self.shape(&path.key("shape"), b.kind, &b.shape);
+        if !b.locked_axes.is_empty() && !b.kind.is_dynamic() {
+            self.fail(
+                &path.key("locked_axes"),
+                format!(
+                    "only a dynamic body or a particle may have locked axes (contacts never \
+                     move the others), this body is {}",
+                    kind_name(b.kind)
+                ),
+            );
+        }
         if let Some(keyframes) = &b.keyframes {
             self.keyframes(path, b, keyframes);
         }

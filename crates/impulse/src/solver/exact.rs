@@ -39,7 +39,7 @@ use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
     apply_impulses, project_to_friction_disc, set_scalar_targets,
 };
-use crate::constraints::{ContactConstraint, JacobianRow};
+use crate::constraints::{ContactConstraint, JacobianRow, is_isotropic};
 
 /// The exact path as a [`ContactSolver`]: [`solve_exact`] on islands of at most `max_contacts`
 /// points. A failed solve leaves the rows and velocities as they were and says so in
@@ -654,14 +654,21 @@ fn assemble(constraints: &[ContactConstraint], w: &mut ExactWorkspace) {
             for side_p in p.iter().flatten() {
                 for side_q in q.iter().flatten() {
                     if side_p.slot == side_q.slot {
-                        let linear = side_p.direction.as_dvec3().dot(side_q.direction.as_dvec3());
                         let angular = side_p
                             .angular
                             .as_dvec3()
                             .dot(side_q.inverse_inertia_angular.as_dvec3());
-                        value += side_p.sign
-                            * side_q.sign
-                            * (side_p.inverse_mass as f64 * linear + angular);
+                        // d_pᵀ M⁻¹ d_q with the per-axis inverse mass (zero on locked axes).
+                        let linear = if is_isotropic(side_p.inverse_mass) {
+                            side_p.inverse_mass.x as f64
+                                * side_p.direction.as_dvec3().dot(side_q.direction.as_dvec3())
+                        } else {
+                            side_p
+                                .direction
+                                .as_dvec3()
+                                .dot(side_p.inverse_mass.as_dvec3() * side_q.direction.as_dvec3())
+                        };
+                        value += side_p.sign * side_q.sign * (linear + angular);
                     }
                 }
             }
@@ -682,7 +689,8 @@ struct Side {
     slot: u32,
     /// +1 for body A, −1 for body B.
     sign: f64,
-    inverse_mass: f32,
+    /// Per-axis inverse mass (1/kg; zero on locked translation axes).
+    inverse_mass: Vec3,
     direction: Vec3,
     /// r × d.
     angular: Vec3,
@@ -692,8 +700,8 @@ struct Side {
 
 /// The movable sides of `row` of contact `c`; `None` for an immovable side.
 fn sides(c: &ContactConstraint, row: &JacobianRow) -> [Option<Side>; 2] {
-    let side = |slot, sign, inverse_mass: f32, angular, inverse_inertia_angular: Vec3| {
-        (inverse_mass != 0.0 || inverse_inertia_angular != Vec3::ZERO).then_some(Side {
+    let side = |slot, sign, inverse_mass: Vec3, angular, inverse_inertia_angular: Vec3| {
+        (inverse_mass != Vec3::ZERO || inverse_inertia_angular != Vec3::ZERO).then_some(Side {
             slot,
             sign,
             inverse_mass,
@@ -874,8 +882,6 @@ fn is_finite(c: &ContactConstraint) -> bool {
             && r.inverse_effective_mass.is_finite()
     };
     let scalars = [
-        c.inverse_mass_a,
-        c.inverse_mass_b,
         c.target_normal_velocity,
         c.softness.0,
         c.softness.1,
@@ -885,6 +891,8 @@ fn is_finite(c: &ContactConstraint) -> bool {
         c.tangent_impulses[1],
     ];
     scalars.iter().all(|v| v.is_finite())
+        && c.inverse_mass_a.is_finite()
+        && c.inverse_mass_b.is_finite()
         && row_is_finite(&c.normal)
         && (c.friction <= 0.0
             || (row_is_finite(&c.tangents[0])

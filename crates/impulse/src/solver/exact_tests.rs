@@ -108,9 +108,9 @@ impl Island {
                 let g = g as f64;
                 let (a, b) = (c.local_a as usize, c.local_b as usize);
                 let d = row.direction.as_dvec3();
-                delta[a].0 += d * (c.inverse_mass_a as f64 * g);
+                delta[a].0 += d * (c.inverse_mass_a.as_dvec3() * g);
                 delta[a].1 += row.inverse_inertia_angular_a.as_dvec3() * g;
-                delta[b].0 -= d * (c.inverse_mass_b as f64 * g);
+                delta[b].0 -= d * (c.inverse_mass_b.as_dvec3() * g);
                 delta[b].1 -= row.inverse_inertia_angular_b.as_dvec3() * g;
             }
         }
@@ -592,8 +592,8 @@ fn failures_leave_the_island_unchanged() {
     let k = rows / 2;
     {
         let c = &mut infeasible.constraints[k];
-        c.inverse_mass_a = 0.0;
-        c.inverse_mass_b = 0.0;
+        c.inverse_mass_a = Vec3::ZERO;
+        c.inverse_mass_b = Vec3::ZERO;
         c.normal.inverse_inertia_angular_a = Vec3::ZERO;
         c.normal.inverse_inertia_angular_b = Vec3::ZERO;
         c.friction = 0.0;

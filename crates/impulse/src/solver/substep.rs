@@ -80,6 +80,10 @@ pub struct IslandWorkspace {
     /// Per body, the factors 1/(1 + h·c) of its linear and angular damping for one substep;
     /// empty when no body of the island is damped.
     damping: Vec<(f32, f32)>,
+    /// The island's bodies with a locked translation axis: their slot and
+    /// [`crate::body::LockedAxes::translation_factor`], which takes gravity's share off the
+    /// locked axes (forces and impulses go through the per-axis inverse mass, zero there).
+    translation_locks: Vec<(u32, Vec3)>,
     pseudo_linear: Vec<Vec3>,
     pseudo_angular: Vec<Vec3>,
     /// Colour offsets of the island's constraints when it is coloured (see [`Sweep`]).
@@ -261,7 +265,7 @@ pub fn step_island(
         w.acceleration.extend(island_bodies.iter().map(|&i| {
             let i = i as usize;
             (
-                bodies.force[i] * bodies.inverse_mass[i],
+                bodies.force[i] * bodies.effective_inverse_mass(i),
                 bodies.world_inverse_inertia(i) * bodies.torque[i],
             )
         }));
@@ -272,7 +276,10 @@ pub fn step_island(
     if settings.gyroscopic {
         w.inertia.extend(island_bodies.iter().map(|&i| {
             let i = i as usize;
-            if bodies.kind[i] == BodyKind::Dynamic {
+            // A body with a locked rotation axis has none: with two or three axes locked the
+            // free component of ω × I·ω is zero (ω lies along the free axis, so the torque is
+            // normal to it), and with one locked the term is left out.
+            if bodies.kind[i] == BodyKind::Dynamic && !bodies.locked_axes[i].locks_rotation() {
                 integrate::gyroscopic_inertia(&bodies.local_inverse_inertia[i])
             } else {
                 Mat3::ZERO
@@ -295,6 +302,14 @@ pub fn step_island(
             )
         }));
     }
+    w.translation_locks.clear();
+    w.translation_locks
+        .extend(island_bodies.iter().enumerate().filter_map(|(k, &i)| {
+            let locked = bodies.locked_axes[i as usize];
+            locked
+                .locks_translation()
+                .then(|| (k as u32, locked.translation_factor()))
+        }));
     w.displacement.clear();
     w.displacement.resize(slots, Vec3::ZERO);
     w.rotation.clear();
@@ -360,6 +375,11 @@ pub fn step_island(
         for (k, &(linear, angular)) in w.damping.iter().enumerate() {
             w.linear[k] *= linear;
             w.angular[k] *= angular;
+        }
+        // Locked components stay zero: gravity is the one velocity change above that does
+        // not go through the inverse mass.
+        for &(k, free) in &w.translation_locks {
+            w.linear[k as usize] *= free;
         }
         // The gyroscopic term, per body at its current orientation, with the other velocity
         // updates before the contacts are solved (as Bullet applies it with the external forces).

@@ -78,8 +78,9 @@ struct Bundle {
     /// Local slots of bodies A and B per lane (the immovable slot for padding).
     local_a: [u32; LANES],
     local_b: [u32; LANES],
-    inverse_mass_a: Lane,
-    inverse_mass_b: Lane,
+    /// Per-axis inverse masses of A and B (see [`ContactConstraint::inverse_mass_a`]).
+    inverse_mass_a: LaneVec,
+    inverse_mass_b: LaneVec,
     normal: RowLanes,
     tangents: [RowLanes; 2],
     tangent_inverse_block: [Lane; 3],
@@ -172,6 +173,12 @@ fn add_scaled(a: LaneVec, b: LaneVec, s: Lane) -> LaneVec {
     [a[0] + b[0] * s, a[1] + b[1] * s, a[2] + b[2] * s]
 }
 
+/// a + b·s component by component: a scale per axis (a per-axis inverse mass).
+#[inline(always)]
+fn add_scaled_per_axis(a: LaneVec, b: LaneVec, s: LaneVec) -> LaneVec {
+    [a[0] + b[0] * s[0], a[1] + b[1] * s[1], a[2] + b[2] * s[2]]
+}
+
 #[inline(always)]
 fn cross(a: LaneVec, b: LaneVec) -> LaneVec {
     [
@@ -215,14 +222,15 @@ impl RowLanes {
 
     /// Adds M⁻¹J_iᵀ·impulse to the two bodies of each lane.
     #[inline(always)]
-    fn apply(&self, impulse: Lane, inverse_mass: (Lane, Lane), v: &mut BodyLanes) {
+    fn apply(&self, impulse: Lane, inverse_mass: (LaneVec, LaneVec), v: &mut BodyLanes) {
         let linear = [
             self.direction[0] * impulse,
             self.direction[1] * impulse,
             self.direction[2] * impulse,
         ];
-        v.linear_a = add_scaled(v.linear_a, linear, inverse_mass.0);
-        v.linear_b = add_scaled(v.linear_b, linear, -inverse_mass.1);
+        let [bx, by, bz] = inverse_mass.1;
+        v.linear_a = add_scaled_per_axis(v.linear_a, linear, inverse_mass.0);
+        v.linear_b = add_scaled_per_axis(v.linear_b, linear, [-bx, -by, -bz]);
         v.angular_a = add_scaled(v.angular_a, self.inverse_inertia_angular_a, impulse);
         v.angular_b = add_scaled(v.angular_b, self.inverse_inertia_angular_b, -impulse);
     }
@@ -971,8 +979,8 @@ fn add_cross(linear: LaneVec, angular: LaneVec, lever: LaneVec) -> LaneVec {
 fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &ContactConstraint) {
     b.local_a[i] = c.local_a;
     b.local_b[i] = c.local_b;
-    set(&mut b.inverse_mass_a, i, c.inverse_mass_a);
-    set(&mut b.inverse_mass_b, i, c.inverse_mass_b);
+    set_vec(&mut b.inverse_mass_a, i, c.inverse_mass_a);
+    set_vec(&mut b.inverse_mass_b, i, c.inverse_mass_b);
     b.normal.set(i, &c.normal);
     b.tangents[0].set(i, &c.tangents[0]);
     b.tangents[1].set(i, &c.tangents[1]);
@@ -1168,8 +1176,8 @@ mod tests {
                 constraints.push(ContactConstraint {
                     local_a: a,
                     local_b: b,
-                    inverse_mass_a: 1.0,
-                    inverse_mass_b: if b == 7 { 0.0 } else { 1.0 },
+                    inverse_mass_a: Vec3::ONE,
+                    inverse_mass_b: if b == 7 { Vec3::ZERO } else { Vec3::ONE },
                     normal_impulse: k as f32 + 1.0,
                     ..ContactConstraint::default()
                 });
@@ -1184,8 +1192,10 @@ mod tests {
                 let b = &packed.bundles[index];
                 if k == u32::MAX {
                     assert_eq!(b.normal_impulse.as_array()[lane], 0.0);
-                    assert_eq!(b.inverse_mass_a.as_array()[lane], 0.0);
-                    assert_eq!(b.inverse_mass_b.as_array()[lane], 0.0);
+                    for axis in 0..3 {
+                        assert_eq!(b.inverse_mass_a[axis].as_array()[lane], 0.0);
+                        assert_eq!(b.inverse_mass_b[axis].as_array()[lane], 0.0);
+                    }
                     continue;
                 }
                 seen[k as usize] += 1;

@@ -6,7 +6,7 @@ use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
 use super::World;
-use crate::body::{BodyHandle, BodyKind};
+use crate::body::{BodyHandle, BodyKind, LockedAxes};
 use crate::error::WorldError;
 
 /// A read-only view of one body ([`World::body`]). Velocities are those of the centre of mass;
@@ -77,6 +77,11 @@ impl<'a> BodyRef<'a> {
     /// Kinetic energy ½mv² + ½ωᵀIω (J).
     pub fn kinetic_energy(&self) -> f32 {
         self.world.bodies.kinetic_energy(self.index)
+    }
+
+    /// The world axes it may not translate along or rotate about ([`LockedAxes`]).
+    pub fn locked_axes(&self) -> LockedAxes {
+        self.world.bodies.locked_axes[self.index]
     }
 
     /// Collision shape, body frame.
@@ -186,21 +191,22 @@ impl World {
         Ok(index)
     }
 
-    /// Sets the linear velocity of the body's centre of mass (m/s) and wakes it. A kinematic
-    /// body moves at it from the next step on (unless keyframes drive it).
+    /// Sets the linear velocity of the body's centre of mass (m/s) and wakes it; the components
+    /// along locked axes ([`World::set_locked_axes`]) are dropped. A kinematic body moves at it
+    /// from the next step on (unless keyframes drive it).
     pub fn set_linear_velocity(
         &mut self,
         handle: BodyHandle,
         velocity: Vec3,
     ) -> Result<(), WorldError> {
         let i = self.moving(handle, "linear_velocity", velocity)?;
-        self.bodies.linear_velocity[i] = velocity;
+        self.bodies.linear_velocity[i] = self.bodies.locked_axes[i].lock_linear_velocity(velocity);
         self.wake_up(i);
         Ok(())
     }
 
     /// Sets the angular velocity (rad/s, world frame) and wakes the body; ignored for a
-    /// particle or a body with locked rotation. A kinematic body turns at it about its centre
+    /// particle, and its components about locked axes are dropped. A kinematic body turns at it about its centre
     /// of mass from the next step on (unless keyframes drive it).
     pub fn set_angular_velocity(
         &mut self,
@@ -208,12 +214,14 @@ impl World {
         velocity: Vec3,
     ) -> Result<(), WorldError> {
         let i = self.moving(handle, "angular_velocity", velocity)?;
-        // A particle or a body with its rotation locked keeps ω = 0.
-        if self.bodies.kind[i] == BodyKind::Kinematic
-            || (self.bodies.kind[i] == BodyKind::Dynamic
-                && self.bodies.local_inverse_inertia[i] != glam::Mat3::ZERO)
-        {
-            self.bodies.angular_velocity[i] = velocity;
+        // A particle keeps ω = 0, a body with locked rotation axes ω = 0 about them.
+        match self.bodies.kind[i] {
+            BodyKind::Kinematic => self.bodies.angular_velocity[i] = velocity,
+            BodyKind::Dynamic => {
+                self.bodies.angular_velocity[i] =
+                    self.bodies.locked_axes[i].lock_angular_velocity(velocity);
+            }
+            BodyKind::Particle | BodyKind::Static => {}
         }
         self.wake_up(i);
         Ok(())
@@ -287,11 +295,12 @@ impl World {
         Ok(())
     }
 
-    /// Changes the body's momentum by `impulse` (N·s) at the centre of mass, now: Δv = J/m.
-    /// Wakes the body.
+    /// Changes the body's momentum by `impulse` (N·s) at the centre of mass, now: Δv = J/m per
+    /// free axis, 0 along locked ones ([`World::set_locked_axes`]). Wakes the body.
     pub fn apply_impulse(&mut self, handle: BodyHandle, impulse: Vec3) -> Result<(), WorldError> {
         let i = self.dynamic(handle, "impulse", impulse)?;
-        self.bodies.linear_velocity[i] += impulse * self.bodies.inverse_mass[i];
+        let change = impulse * self.bodies.effective_inverse_mass(i);
+        self.bodies.linear_velocity[i] += change;
         self.wake_up(i);
         Ok(())
     }
@@ -311,7 +320,8 @@ impl World {
     }
 
     /// Changes the angular momentum by `impulse` (N·m·s, world frame), now: Δω = I⁻¹·impulse
-    /// with the world-frame inverse inertia; no effect on a particle. Wakes the body.
+    /// with the world-frame inverse inertia (its locked rows and columns zero); no effect on a
+    /// particle. Wakes the body.
     pub fn apply_torque_impulse(
         &mut self,
         handle: BodyHandle,
@@ -320,6 +330,38 @@ impl World {
         let i = self.dynamic(handle, "torque_impulse", impulse)?;
         let change = self.bodies.world_inverse_inertia(i) * impulse;
         self.bodies.angular_velocity[i] += change;
+        self.wake_up(i);
+        Ok(())
+    }
+
+    /// Sets the world axes along which a dynamic body may not translate or about which it may
+    /// not rotate ([`LockedAxes`], as [`crate::BodyBuilder::locked_axes`]) and wakes it: the
+    /// velocity components along newly locked axes are set to zero, and the mass properties
+    /// take the locks from the next step on. Errors for a removed body, or a static or
+    /// kinematic body (which contacts never move).
+    pub fn set_locked_axes(
+        &mut self,
+        handle: BodyHandle,
+        locked_axes: LockedAxes,
+    ) -> Result<(), WorldError> {
+        let i = self.index_of(handle)?;
+        if !self.bodies.is_dynamic(i) {
+            return Err(WorldError::InvalidBody {
+                body: i,
+                name: self.bodies.name[i].clone(),
+                field: "locked_axes".into(),
+                message: "only a dynamic body or a particle can have locked axes".into(),
+            });
+        }
+        let locked_axes = if self.bodies.kind[i] == BodyKind::Particle {
+            locked_axes.difference(LockedAxes::ALL_ROTATIONS)
+        } else {
+            locked_axes
+        };
+        let b = &mut self.bodies;
+        b.locked_axes[i] = locked_axes;
+        b.linear_velocity[i] = locked_axes.lock_linear_velocity(b.linear_velocity[i]);
+        b.angular_velocity[i] = locked_axes.lock_angular_velocity(b.angular_velocity[i]);
         self.wake_up(i);
         Ok(())
     }

@@ -5,7 +5,7 @@ use glam::{Mat3, Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
-use crate::body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Handles};
+use crate::body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Handles, LockedAxes};
 use crate::broad_phase::BroadPhase;
 use crate::constraints::ContactConstraint;
 use crate::contact_lcp::{ContactLcp, assemble_lcp};
@@ -195,6 +195,7 @@ impl World {
         b.angular_damping.push(builder.angular_damping);
         b.groups.push(builder.groups);
         b.mask.push(builder.mask);
+        b.locked_axes.push(built.locked_axes);
         b.name.push(builder.name);
         let handle = self.handles.insert(index);
         if !builder.keyframes.is_empty() {
@@ -371,6 +372,7 @@ struct BuiltBody {
     inverse_mass: f32,
     local_inverse_inertia: Mat3,
     shape: SharedShape,
+    locked_axes: LockedAxes,
 }
 
 fn positive(index: usize, desc: &BodyDesc, field: &str, value: f32) -> Result<(), WorldError> {
@@ -512,7 +514,11 @@ fn builder_of(
         user_data: 0,
         linear_damping: desc.linear_damping,
         angular_damping: desc.angular_damping,
-        lock_rotation: desc.lock_rotation,
+        locked_axes: if desc.lock_rotation {
+            desc.locked_axes.to_locked_axes() | LockedAxes::ALL_ROTATIONS
+        } else {
+            desc.locked_axes.to_locked_axes()
+        },
         groups: desc.groups,
         mask: desc.mask,
         keyframes: desc
@@ -644,7 +650,9 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
                     format!("mass must be finite and > 0, got {}", 1.0 / inverse_mass),
                 );
             }
-            let inertia = if b.kind == BodyKind::Particle || b.lock_rotation {
+            // A body with locked rotations keeps its inertia: the locks act on the world
+            // tensor ([`Bodies::world_inverse_inertia`]), so they may be lifted later.
+            let inertia = if b.kind == BodyKind::Particle {
                 Mat3::ZERO
             } else {
                 props.reconstruct_inverse_inertia_matrix() / scale
@@ -655,18 +663,25 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
             (inverse_mass, props.local_com, inertia)
         }
     };
-    let angular_velocity =
-        if b.kind == BodyKind::Kinematic || (b.kind == BodyKind::Dynamic && !b.lock_rotation) {
-            b.angular_velocity
-        } else {
-            Vec3::ZERO
-        };
+    // Locks act on dynamic bodies only; a particle never rotates.
+    let locked_axes = match b.kind {
+        BodyKind::Dynamic => b.locked_axes,
+        BodyKind::Particle => b.locked_axes.difference(LockedAxes::ALL_ROTATIONS),
+        BodyKind::Static | BodyKind::Kinematic => LockedAxes::NONE,
+    };
+    let angular_velocity = match b.kind {
+        BodyKind::Kinematic => b.angular_velocity,
+        BodyKind::Dynamic => locked_axes.lock_angular_velocity(b.angular_velocity),
+        BodyKind::Static | BodyKind::Particle => Vec3::ZERO,
+    };
     // The builder gives the velocity of the body origin; the solver works at the centre of
     // mass.
     let linear_velocity = if b.kind == BodyKind::Static {
         Vec3::ZERO
     } else {
-        b.linear_velocity + angular_velocity.cross(rotation * local_center_of_mass)
+        locked_axes.lock_linear_velocity(
+            b.linear_velocity + angular_velocity.cross(rotation * local_center_of_mass),
+        )
     };
     Ok(BuiltBody {
         keyframes,
@@ -677,6 +692,7 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
         inverse_mass,
         local_inverse_inertia,
         shape,
+        locked_axes,
     })
 }
 

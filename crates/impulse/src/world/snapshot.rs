@@ -35,7 +35,7 @@ use crate::settings::SolverSettings;
 
 /// The snapshot format this build writes and reads. Raised whenever the stored state changes
 /// shape; a snapshot of another version is refused ([`SnapshotError::VersionMismatch`]).
-pub const SNAPSHOT_FORMAT_VERSION: u32 = 1;
+pub const SNAPSHOT_FORMAT_VERSION: u32 = 2;
 
 /// The first bytes of a snapshot file.
 const MAGIC: &[u8; 16] = b"IMPULSE-WORLD\0\0\0";
@@ -397,6 +397,16 @@ fn check_bodies(b: &Bodies) -> Result<(), String> {
             return bad("a particle must be a sphere");
         }
         check_shape(shape).map_err(|e| format!("body {i}: shape: {e}"))?;
+        // The step keeps locked velocity components at zero only if they start there.
+        let locked = b.locked_axes[i];
+        if !locked.is_empty() && !b.kind[i].is_dynamic() {
+            return bad("only a dynamic body or a particle may have locked axes");
+        }
+        if locked.lock_linear_velocity(b.linear_velocity[i]) != b.linear_velocity[i]
+            || locked.lock_angular_velocity(b.angular_velocity[i]) != b.angular_velocity[i]
+        {
+            return bad("a velocity has a non-zero component along a locked axis");
+        }
     }
     Ok(())
 }

@@ -5,7 +5,7 @@ use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
 use super::{BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, World};
-use crate::body::{Bodies, rotate_tensor};
+use crate::body::Bodies;
 use crate::constraints::{self, ContactConstraint};
 use crate::diagnostics::{self, EnergyTerms, Stage, StepDiagnostics, StepProfile};
 use crate::error::StepError;
@@ -687,16 +687,10 @@ fn update_sleep(
 }
 
 /// World-frame inverse inertia tensors I⁻¹ = R I_local⁻¹ Rᵀ (1/(kg·m²)) of every body at its
-/// current pose, zero for bodies that do not rotate.
+/// current pose, with the rows and columns of locked rotation axes zero
+/// (`Bodies::world_inverse_inertia`); zero for bodies that do not rotate.
 fn world_inverse_inertia_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Mat3>) {
-    let world = |i: usize| {
-        let local = &bodies.local_inverse_inertia[i];
-        if *local == Mat3::ZERO {
-            Mat3::ZERO
-        } else {
-            rotate_tensor(bodies.pose[i].rotation, local)
-        }
-    };
+    let world = |i: usize| bodies.world_inverse_inertia(i);
     if spread(parallel, 1, 0) {
         (0..bodies.len())
             .into_par_iter()
