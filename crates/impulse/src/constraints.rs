@@ -65,13 +65,42 @@ fn inverse_mass_along(inverse_mass: Vec3, d: Vec3) -> f32 {
     }
 }
 
+/// The linear part of a pair's diagonal entries dᵀ(M_a⁻¹ + M_b⁻¹)d, decided once per pair:
+/// with no translation locked it is the same 1/m_a + 1/m_b for every direction.
+#[derive(Clone, Copy)]
+enum PairInverseMass {
+    /// 1/m_a + 1/m_b (1/kg).
+    Isotropic(f32),
+    /// The per-axis inverse masses of A and B.
+    Locked(Vec3, Vec3),
+}
+
+impl PairInverseMass {
+    fn new(inverse_mass_a: Vec3, inverse_mass_b: Vec3) -> Self {
+        if is_isotropic(inverse_mass_a) && is_isotropic(inverse_mass_b) {
+            Self::Isotropic(inverse_mass_a.x + inverse_mass_b.x)
+        } else {
+            Self::Locked(inverse_mass_a, inverse_mass_b)
+        }
+    }
+
+    /// dᵀ(M_a⁻¹ + M_b⁻¹)d (1/kg) for a unit direction d.
+    #[inline(always)]
+    fn along(self, d: Vec3) -> f32 {
+        match self {
+            Self::Isotropic(sum) => sum,
+            Self::Locked(a, b) => inverse_mass_along(a, d) + inverse_mass_along(b, d),
+        }
+    }
+}
+
 impl JacobianRow {
+    #[inline(always)]
     fn new(
         direction: Vec3,
         r_a: Vec3,
         r_b: Vec3,
-        inverse_mass_a: Vec3,
-        inverse_mass_b: Vec3,
+        inverse_mass: PairInverseMass,
         inverse_inertia_a: &Mat3,
         inverse_inertia_b: &Mat3,
     ) -> Self {
@@ -79,8 +108,7 @@ impl JacobianRow {
         let angular_b = r_b.cross(direction);
         let inverse_inertia_angular_a = *inverse_inertia_a * angular_a;
         let inverse_inertia_angular_b = *inverse_inertia_b * angular_b;
-        let k = inverse_mass_along(inverse_mass_a, direction)
-            + inverse_mass_along(inverse_mass_b, direction)
+        let k = inverse_mass.along(direction)
             + angular_a.dot(inverse_inertia_angular_a)
             + angular_b.dot(inverse_inertia_angular_b);
         Self {
@@ -332,6 +360,7 @@ impl Assembly<'_> {
         let restitution = bodies.restitution[a].max(bodies.restitution[b]);
         let inverse_mass_a = bodies.effective_inverse_mass(a);
         let inverse_mass_b = bodies.effective_inverse_mass(b);
+        let pair_inverse_mass = PairInverseMass::new(inverse_mass_a, inverse_mass_b);
         let inertia_a = &self.world_inverse_inertia[a];
         let inertia_b = &self.world_inverse_inertia[b];
         for (manifold_index, manifold) in pair.manifolds.iter().enumerate() {
@@ -372,17 +401,8 @@ impl Assembly<'_> {
                 let r_a = at_a - com_a;
                 let r_b = at_b - com_b;
                 let (t1, t2) = tangent_basis(normal, manifold.data.tangent);
-                let row = |d| {
-                    JacobianRow::new(
-                        d,
-                        r_a,
-                        r_b,
-                        inverse_mass_a,
-                        inverse_mass_b,
-                        inertia_a,
-                        inertia_b,
-                    )
-                };
+                let row =
+                    |d| JacobianRow::new(d, r_a, r_b, pair_inverse_mass, inertia_a, inertia_b);
                 // Only the normal row's v⁻ is read before the step ends (restitution); every
                 // row's is rewritten as the step ends ([`record_velocity_before`]).
                 let mut normal_row = row(normal);
@@ -393,6 +413,7 @@ impl Assembly<'_> {
                     bodies.angular_velocity[b],
                 );
                 let tangents = [row(t1), row(t2)];
+                let block = tangent_block(&tangents, pair_inverse_mass);
                 let depth = -point.dist;
                 let Some(slot) = slots.next() else {
                     debug_assert!(false, "fewer slots than the narrow phase's row count");
@@ -407,8 +428,8 @@ impl Assembly<'_> {
                     inverse_mass_b,
                     normal: normal_row,
                     tangents,
-                    tangent_inverse_block: inverse_block(&tangents, inverse_mass_a, inverse_mass_b),
-                    tangent_block: tangent_block(&tangents, inverse_mass_a, inverse_mass_b),
+                    tangent_inverse_block: inverse_block(block),
+                    tangent_block: block,
                     target_normal_velocity: 0.0,
                     softness: (1.0, 0.0),
                     position_target: 0.0,
@@ -440,19 +461,17 @@ impl Assembly<'_> {
 
 /// (K₁₁, K₁₂, K₂₂) of the tangent block K = J_t M⁻¹ J_tᵀ (1/kg), for bodies of per-axis
 /// inverse masses `inverse_mass_a` and `inverse_mass_b`.
-fn tangent_block(
-    tangents: &[JacobianRow; 2],
-    inverse_mass_a: Vec3,
-    inverse_mass_b: Vec3,
-) -> [f32; 3] {
+fn tangent_block(tangents: &[JacobianRow; 2], inverse_mass: PairInverseMass) -> [f32; 3] {
     let [t1, t2] = tangents;
     let mut k12 = t1.angular_a.dot(t2.inverse_inertia_angular_a)
         + t1.angular_b.dot(t2.inverse_inertia_angular_b);
     // The linear parts couple the rows only through a locked translation axis (t1 ⊥ t2, so
     // t1ᵀ·(m·I)·t2 = 0).
-    for inverse_mass in [inverse_mass_a, inverse_mass_b] {
-        if !is_isotropic(inverse_mass) {
-            k12 += t1.direction.dot(inverse_mass * t2.direction);
+    if let PairInverseMass::Locked(inverse_mass_a, inverse_mass_b) = inverse_mass {
+        for inverse_mass in [inverse_mass_a, inverse_mass_b] {
+            if !is_isotropic(inverse_mass) {
+                k12 += t1.direction.dot(inverse_mass * t2.direction);
+            }
         }
     }
     [t1.inverse_effective_mass, k12, t2.inverse_effective_mass]
@@ -460,12 +479,7 @@ fn tangent_block(
 
 /// (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) of the tangent block; its pseudo-inverse when the block has rank one,
 /// zeros when it is zero (both bodies immovable along the tangents).
-fn inverse_block(
-    tangents: &[JacobianRow; 2],
-    inverse_mass_a: Vec3,
-    inverse_mass_b: Vec3,
-) -> [f32; 3] {
-    let [k11, k12, k22] = tangent_block(tangents, inverse_mass_a, inverse_mass_b);
+fn inverse_block([k11, k12, k22]: [f32; 3]) -> [f32; 3] {
     let determinant = k11 * k22 - k12 * k12;
     if determinant > f32::EPSILON * (k11 * k22).max(f32::MIN_POSITIVE) {
         let inverse = 1.0 / determinant;
