@@ -1,5 +1,8 @@
 //! Semantic checks of a [`Scene`]: everything that would make a simulation meaningless or
-//! crash, rejected before any world is built.
+//! crash, rejected before any world is built. The rules of a body's own values (numbers, kind
+//! and shape, locks, keyframes) are `body::rules`, the same functions `World::insert` checks a
+//! builder with; this module adds what only a file has (materials by name, shape fields,
+//! mesh data) and reports every problem with its path.
 //!
 //! The rules (also listed in `docs/scene-format.md`):
 //!
@@ -34,10 +37,11 @@ use std::collections::BTreeMap;
 use super::error::{BodyRef, FieldPath, SceneError, SceneErrorKind};
 use super::mesh_file::MeshData;
 use super::{BodyDesc, BodyKind, KeyframeDesc, Material, MaterialRef, Scene, ShapeDesc};
+use crate::body::rules::{self, ShapeClass};
 
 /// Smallest norm of an orientation quaternion or a half-space normal that is accepted;
 /// below it the vector counts as zero (its direction is not defined in f32).
-pub const MIN_NORM: f32 = 1e-6;
+pub const MIN_NORM: f32 = rules::MIN_NORM;
 
 /// Relative tolerance of the convex-hull volume test: the points count as coincident,
 /// collinear or coplanar when they deviate from a point, line or plane by at most
@@ -120,13 +124,19 @@ impl Checker {
         self.errors.push(error);
     }
 
-    fn finite(&mut self, path: &FieldPath, v: f32) -> bool {
-        if v.is_finite() {
-            true
-        } else {
-            self.fail(path, format!("must be finite, got {v}"));
-            false
+    /// Records `rule`'s message at `path` if it failed; returns whether it held.
+    fn rule(&mut self, path: &FieldPath, rule: Result<(), String>) -> bool {
+        match rule {
+            Ok(()) => true,
+            Err(message) => {
+                self.fail(path, message);
+                false
+            }
         }
+    }
+
+    fn finite(&mut self, path: &FieldPath, v: f32) -> bool {
+        self.rule(path, rules::finite(&[v]))
     }
 
     fn finite_array(&mut self, path: &FieldPath, values: &[f32]) -> bool {
@@ -138,20 +148,21 @@ impl Checker {
     }
 
     fn positive(&mut self, path: &FieldPath, v: f32) {
-        if self.finite(path, v) && v <= 0.0 {
-            self.fail(path, format!("must be > 0, got {v}"));
-        }
+        self.rule(path, rules::positive(v));
     }
 
     fn non_negative(&mut self, path: &FieldPath, v: f32) {
-        if self.finite(path, v) && v < 0.0 {
-            self.fail(path, format!("must be ≥ 0, got {v}"));
-        }
+        self.rule(path, rules::non_negative(v));
     }
 
     fn unit_interval(&mut self, path: &FieldPath, v: f32) {
-        if self.finite(path, v) && !(0.0..=1.0).contains(&v) {
-            self.fail(path, format!("must be in [0, 1], got {v}"));
+        self.rule(path, rules::unit_interval(v));
+    }
+
+    /// An orientation quaternion at `path`: finite component by component, then not zero.
+    fn orientation(&mut self, path: &FieldPath, q: [f32; 4]) {
+        if self.finite_array(path, &q) {
+            self.rule(path, rules::orientation(q));
         }
     }
 
@@ -163,17 +174,7 @@ impl Checker {
 
     fn body(&mut self, path: &FieldPath, b: &BodyDesc, materials: &BTreeMap<String, Material>) {
         self.finite_array(&path.key("position"), &b.position);
-        if self.finite_array(&path.key("orientation"), &b.orientation)
-            && norm(&b.orientation) < f64::from(MIN_NORM)
-        {
-            self.fail(
-                &path.key("orientation"),
-                format!(
-                    "quaternion must not be zero (it is normalised), got {:?}",
-                    b.orientation
-                ),
-            );
-        }
+        self.orientation(&path.key("orientation"), b.orientation);
         self.finite_array(&path.key("linear_velocity"), &b.linear_velocity);
         self.finite_array(&path.key("angular_velocity"), &b.angular_velocity);
         if let Some(mass) = b.mass {
@@ -200,14 +201,10 @@ impl Checker {
             MaterialRef::Inline(m) => self.material(&path.key("material"), m),
         }
         self.shape(&path.key("shape"), b.kind, &b.shape);
-        if !b.locked_axes.is_empty() && !b.kind.is_dynamic() {
-            self.fail(
+        if !b.locked_axes.is_empty() {
+            self.rule(
                 &path.key("locked_axes"),
-                format!(
-                    "only a dynamic body or a particle may have locked axes (contacts never \
-                     move the others), this body is {}",
-                    kind_name(b.kind)
-                ),
+                rules::locked_axes_for_kind(b.kind),
             );
         }
         if let Some(keyframes) = &b.keyframes {
@@ -219,14 +216,7 @@ impl Checker {
     fn keyframes(&mut self, body: &FieldPath, b: &BodyDesc, keyframes: &[KeyframeDesc]) {
         let kind = b.kind;
         let path = &body.key("keyframes");
-        if kind != BodyKind::Kinematic {
-            self.fail(
-                path,
-                format!(
-                    "only a kinematic body may have keyframes, this body is {}",
-                    kind_name(kind)
-                ),
-            );
+        if !self.rule(path, rules::keyframes_for_kind(kind)) {
             return;
         }
         if keyframes.is_empty() {
@@ -235,77 +225,42 @@ impl Checker {
                 "needs at least one keyframe {\"t\": s, \"position\": [x, y, z]}".to_string(),
             );
         }
-        for field in ["linear_velocity", "angular_velocity"] {
-            let velocity = if field == "linear_velocity" {
-                b.linear_velocity
-            } else {
-                b.angular_velocity
-            };
-            if velocity != [0.0; 3] {
-                self.fail(
-                    &body.key(field),
-                    format!(
-                        "a body with keyframes takes its velocity from them: leave {field} out, \
-                         got {velocity:?}"
-                    ),
-                );
-            }
+        for (field, velocity) in [
+            ("linear_velocity", b.linear_velocity),
+            ("angular_velocity", b.angular_velocity),
+        ] {
+            self.rule(&body.key(field), rules::keyframed_velocity(field, velocity));
         }
         let mut previous = 0.0f32;
         for (i, key) in keyframes.iter().enumerate() {
             let key_path = path.index(i);
             let t_path = key_path.key("t");
             if self.finite(&t_path, key.t) {
-                if key.t <= previous {
-                    self.fail(
-                        &t_path,
-                        if i == 0 {
-                            format!(
-                                "must be > 0 (the body's position and orientation are its pose \
-                                 at t = 0), got {}",
-                                key.t
-                            )
-                        } else {
-                            format!(
-                                "must be after the previous keyframe's t = {previous}, got {}",
-                                key.t
-                            )
-                        },
-                    );
-                }
+                self.rule(&t_path, rules::keyframe_time(i, key.t, previous));
                 previous = key.t;
             }
             self.finite_array(&key_path.key("position"), &key.position);
-            let orientation = key_path.key("orientation");
-            if self.finite_array(&orientation, &key.orientation)
-                && norm(&key.orientation) < f64::from(MIN_NORM)
-            {
-                self.fail(
-                    &orientation,
-                    format!(
-                        "quaternion must not be zero (it is normalised), got {:?}",
-                        key.orientation
-                    ),
-                );
-            }
+            self.orientation(&key_path.key("orientation"), key.orientation);
         }
     }
 
     fn shape(&mut self, path: &FieldPath, kind: BodyKind, shape: &ShapeDesc) {
-        if kind == BodyKind::Particle && !matches!(shape, ShapeDesc::Sphere { .. }) {
-            self.fail(
-                &path.key("type"),
-                format!(
-                    "a particle must have a sphere shape, got {}",
-                    shape.type_name()
-                ),
-            );
-        }
-        self.shape_fields(path, kind, shape);
+        let class = match shape {
+            ShapeDesc::Sphere { .. } => ShapeClass::Sphere,
+            ShapeDesc::HalfSpace { .. } => ShapeClass::StaticOnly("a half_space"),
+            ShapeDesc::Trimesh { .. } => ShapeClass::StaticOnly("a trimesh"),
+            ShapeDesc::HeightField { .. } => ShapeClass::StaticOnly("a heightfield"),
+            _ => ShapeClass::Solid,
+        };
+        self.rule(
+            &path.key("type"),
+            rules::shape_for_kind(kind, class, shape.type_name()),
+        );
+        self.shape_fields(path, shape);
     }
 
     /// Checks the fields of `shape` at `path` (its own, not whether it suits the body).
-    fn shape_fields(&mut self, path: &FieldPath, kind: BodyKind, shape: &ShapeDesc) {
+    fn shape_fields(&mut self, path: &FieldPath, shape: &ShapeDesc) {
         match shape {
             ShapeDesc::Sphere { radius } => self.positive(&path.key("radius"), *radius),
             ShapeDesc::Cuboid { half_extents } => {
@@ -350,15 +305,6 @@ impl Checker {
                 }
             }
             ShapeDesc::HalfSpace { normal } => {
-                if kind != BodyKind::Static {
-                    self.fail(
-                        &path.key("type"),
-                        format!(
-                            "a half_space shape is only allowed on a static body, this body is {}",
-                            kind_name(kind)
-                        ),
-                    );
-                }
                 let normal_path = path.key("normal");
                 if self.finite_array(&normal_path, normal) && norm(normal) < f64::from(MIN_NORM) {
                     self.fail(
@@ -372,37 +318,33 @@ impl Checker {
                 vertices,
                 indices,
                 ..
-            } => {
-                self.static_only(path, kind, "a trimesh");
-                match (file, vertices, indices) {
-                    (Some(_), None, None) => {
-                        if let Some(mesh) = shape.mesh_data() {
-                            self.mesh(&path.key("file"), &path.key("file"), &mesh);
-                        }
+            } => match (file, vertices, indices) {
+                (Some(_), None, None) => {
+                    if let Some(mesh) = shape.mesh_data() {
+                        self.mesh(&path.key("file"), &path.key("file"), &mesh);
                     }
-                    (None, Some(_), Some(_)) => {
-                        if let Some(mesh) = shape.mesh_data() {
-                            self.mesh(&path.key("vertices"), &path.key("indices"), &mesh);
-                        }
-                    }
-                    (Some(_), _, _) => self.fail(
-                        &path.key("file"),
-                        "give either `file` or `vertices` and `indices`, not both".to_string(),
-                    ),
-                    (None, None, _) => self.fail(
-                        &path.key("vertices"),
-                        "a trimesh needs `file`, or `vertices` and `indices`".to_string(),
-                    ),
-                    (None, Some(_), None) => self.fail(
-                        &path.key("indices"),
-                        "a trimesh with `vertices` needs `indices` (triangles as three vertex \
-                         indices each)"
-                            .to_string(),
-                    ),
                 }
-            }
+                (None, Some(_), Some(_)) => {
+                    if let Some(mesh) = shape.mesh_data() {
+                        self.mesh(&path.key("vertices"), &path.key("indices"), &mesh);
+                    }
+                }
+                (Some(_), _, _) => self.fail(
+                    &path.key("file"),
+                    "give either `file` or `vertices` and `indices`, not both".to_string(),
+                ),
+                (None, None, _) => self.fail(
+                    &path.key("vertices"),
+                    "a trimesh needs `file`, or `vertices` and `indices`".to_string(),
+                ),
+                (None, Some(_), None) => self.fail(
+                    &path.key("indices"),
+                    "a trimesh with `vertices` needs `indices` (triangles as three vertex \
+                         indices each)"
+                        .to_string(),
+                ),
+            },
             ShapeDesc::HeightField { heights, scale } => {
-                self.static_only(path, kind, "a heightfield");
                 let heights_path = path.key("heights");
                 let columns = heights.first().map_or(0, Vec::len);
                 if heights.len() < 2 || columns < 2 {
@@ -475,7 +417,7 @@ impl Checker {
                             ),
                         );
                     } else {
-                        self.shape_fields(&shape_path, kind, &part.shape);
+                        self.shape_fields(&shape_path, &part.shape);
                     }
                 }
             }
@@ -491,7 +433,7 @@ impl Checker {
                         | ShapeDesc::Cone { .. }
                         | ShapeDesc::ConvexHull { .. }
                 ) {
-                    self.shape_fields(path, kind, shape);
+                    self.shape_fields(path, shape);
                 } else {
                     self.fail(
                         &path.key("border_radius"),
@@ -503,20 +445,6 @@ impl Checker {
                     );
                 }
             }
-        }
-    }
-
-    /// Fails unless `kind` is static: `what` (a triangle mesh, a height field) has no volume
-    /// to give a moving body mass.
-    fn static_only(&mut self, path: &FieldPath, kind: BodyKind, what: &str) {
-        if kind != BodyKind::Static {
-            self.fail(
-                &path.key("type"),
-                format!(
-                    "{what} shape is only allowed on a static body, this body is {}",
-                    kind_name(kind)
-                ),
-            );
         }
     }
 
@@ -607,15 +535,6 @@ fn norm(v: &[f32]) -> f64 {
         .map(|&x| f64::from(x) * f64::from(x))
         .sum::<f64>()
         .sqrt()
-}
-
-fn kind_name(kind: BodyKind) -> &'static str {
-    match kind {
-        BodyKind::Dynamic => "dynamic",
-        BodyKind::Static => "static",
-        BodyKind::Particle => "particle",
-        BodyKind::Kinematic => "kinematic",
-    }
 }
 
 type V = [f64; 3];

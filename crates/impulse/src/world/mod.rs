@@ -5,6 +5,7 @@ use glam::{Mat3, Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
+use crate::body::rules::{self, ShapeClass};
 use crate::body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Handles, LockedAxes};
 use crate::broad_phase::BroadPhase;
 use crate::constraints::ContactConstraint;
@@ -548,76 +549,36 @@ fn invalid_built(index: usize, builder: &BodyBuilder, field: &str, message: Stri
 /// meaningless (the library never panics on user input). Fields are named as in the scene
 /// format (`position` for the translation, `material.friction`, …).
 fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
+    let check = |field: &str, rule: Result<(), String>| {
+        rule.map_err(|message| invalid_built(index, b, field, message))
+    };
     let bad = |field: &str, message: String| Err(invalid_built(index, b, field, message));
-    let vectors = [
-        ("position", b.translation),
-        ("linear_velocity", b.linear_velocity),
-        ("angular_velocity", b.angular_velocity),
-    ];
-    for (field, v) in vectors {
-        if !v.is_finite() {
-            return bad(field, format!("must be finite, got {:?}", v.to_array()));
-        }
-    }
-    if !b.rotation.is_finite() {
-        return bad(
-            "orientation",
-            format!("must be finite, got {:?}", b.rotation.to_array()),
-        );
-    }
-    if b.rotation.length() < 1e-6 {
-        return bad("orientation", "quaternion must not be zero".into());
-    }
-    if !(b.friction.is_finite() && b.friction >= 0.0) {
-        return bad(
-            "material.friction",
-            format!("must be finite and ≥ 0, got {}", b.friction),
-        );
-    }
-    if !(0.0..=1.0).contains(&b.restitution) {
-        return bad(
-            "material.restitution",
-            format!("must be in [0, 1], got {}", b.restitution),
-        );
-    }
-    for (field, value) in [
-        ("linear_damping", b.linear_damping),
-        ("angular_damping", b.angular_damping),
-    ] {
-        if !(value.is_finite() && value >= 0.0) {
-            return bad(field, format!("must be finite and ≥ 0, got {value}"));
-        }
+    check("position", rules::finite(&b.translation.to_array()))?;
+    check("orientation", rules::orientation(b.rotation.to_array()))?;
+    check(
+        "linear_velocity",
+        rules::finite(&b.linear_velocity.to_array()),
+    )?;
+    check(
+        "angular_velocity",
+        rules::finite(&b.angular_velocity.to_array()),
+    )?;
+    check("material.friction", rules::non_negative(b.friction))?;
+    check("material.restitution", rules::unit_interval(b.restitution))?;
+    check("linear_damping", rules::non_negative(b.linear_damping))?;
+    check("angular_damping", rules::non_negative(b.angular_damping))?;
+    let shape = b.shape.clone();
+    let type_name = format!("{:?}", shape.shape_type()).to_lowercase();
+    check(
+        "shape.type",
+        rules::shape_for_kind(b.kind, ShapeClass::of(&shape), &type_name),
+    )?;
+    if !b.locked_axes.is_empty() {
+        check("locked_axes", rules::locked_axes_for_kind(b.kind))?;
     }
     let keyframes = check_keyframes(index, b)?;
-    let shape = b.shape.clone();
-    if b.kind != BodyKind::Static && shape.as_halfspace().is_some() {
-        return bad("shape", "a half-space must be a static body".into());
-    }
-    if b.kind != BodyKind::Static
-        && (shape.as_trimesh().is_some() || shape.as_heightfield().is_some())
-    {
-        return bad(
-            "shape",
-            "a triangle mesh or height field must be a static body (it has no volume)".into(),
-        );
-    }
-    if b.kind == BodyKind::Particle && shape.as_ball().is_none() {
-        return bad("shape", "a particle must be a sphere".into());
-    }
     let rotation = b.rotation.normalize();
     let pose = Pose::from_parts(b.translation, rotation);
-    let positive = |field: &str, value: f32| {
-        if value.is_finite() && value > 0.0 {
-            Ok(())
-        } else {
-            Err(invalid_built(
-                index,
-                b,
-                field,
-                format!("must be finite and > 0, got {value}"),
-            ))
-        }
-    };
     let (inverse_mass, local_center_of_mass, local_inverse_inertia) = match b.kind {
         BodyKind::Static => (0.0, Vec3::ZERO, Mat3::ZERO),
         BodyKind::Kinematic => {
@@ -632,13 +593,13 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
             (0.0, centroid, Mat3::ZERO)
         }
         BodyKind::Dynamic | BodyKind::Particle => {
-            positive("material.density", b.density)?;
+            check("material.density", rules::positive(b.density))?;
             let props = shape.mass_properties(b.density);
             let computed_mass = props.mass();
             // Scaling mass and inertia together keeps the shape's mass distribution.
             let scale = match b.mass {
                 Some(m) => {
-                    positive("mass", m)?;
+                    check("mass", rules::positive(m))?;
                     m / computed_mass
                 }
                 None => 1.0,
@@ -696,58 +657,46 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
     })
 }
 
-/// A builder's keyframes, checked (kinematic bodies only; times finite, > 0 and increasing;
-/// translations finite; rotations finite and non-zero) and with normalised rotations. Fields
-/// are named as in the scene format (`keyframes[i].t`, `.position`, `.orientation`).
+/// A builder's keyframes, checked by the rules of [`rules`] (kinematic bodies only, with no
+/// velocities of their own; times finite, > 0 and increasing; translations finite; rotations
+/// finite and non-zero) and with normalised rotations. Fields are named as in the scene format
+/// (`keyframes[i].t`, `.position`, `.orientation`).
 fn check_keyframes(
     index: usize,
     b: &BodyBuilder,
 ) -> Result<Vec<crate::body::Keyframe>, WorldError> {
-    let bad = |field: String, message: String| Err(invalid_built(index, b, &field, message));
     if b.keyframes.is_empty() {
         return Ok(Vec::new());
     }
-    if b.kind != BodyKind::Kinematic {
-        return bad(
-            "keyframes".into(),
-            "only a kinematic body may have keyframes".into(),
-        );
+    let check = |field: String, rule: Result<(), String>| {
+        rule.map_err(|message| invalid_built(index, b, &field, message))
+    };
+    check("keyframes".into(), rules::keyframes_for_kind(b.kind))?;
+    for (field, velocity) in [
+        ("linear_velocity", b.linear_velocity),
+        ("angular_velocity", b.angular_velocity),
+    ] {
+        check(
+            field.into(),
+            rules::keyframed_velocity(field, velocity.to_array()),
+        )?;
     }
     let mut previous = 0.0f32;
     let mut out = Vec::with_capacity(b.keyframes.len());
     for (k, key) in b.keyframes.iter().enumerate() {
-        if !(key.time.is_finite() && key.time > previous) {
-            return bad(
-                format!("keyframes[{k}].t"),
-                if k == 0 {
-                    format!(
-                        "must be finite and > 0 (the body's own pose is its pose at t = 0), got {}",
-                        key.time
-                    )
-                } else {
-                    format!(
-                        "must be finite and after the previous keyframe's {previous} s, got {}",
-                        key.time
-                    )
-                },
-            );
-        }
+        check(
+            format!("keyframes[{k}].t"),
+            rules::keyframe_time(k, key.time, previous),
+        )?;
         previous = key.time;
-        if !key.translation.is_finite() {
-            return bad(
-                format!("keyframes[{k}].position"),
-                format!("must be finite, got {:?}", key.translation.to_array()),
-            );
-        }
-        if !key.rotation.is_finite() || key.rotation.length() < 1e-6 {
-            return bad(
-                format!("keyframes[{k}].orientation"),
-                format!(
-                    "must be a finite non-zero quaternion, got {:?}",
-                    key.rotation.to_array()
-                ),
-            );
-        }
+        check(
+            format!("keyframes[{k}].position"),
+            rules::finite(&key.translation.to_array()),
+        )?;
+        check(
+            format!("keyframes[{k}].orientation"),
+            rules::orientation(key.rotation.to_array()),
+        )?;
         out.push(crate::body::Keyframe {
             rotation: key.rotation.normalize(),
             ..*key

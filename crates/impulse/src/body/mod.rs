@@ -6,6 +6,8 @@ use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 use serde::{Deserialize, Serialize};
 
+pub(crate) mod rules;
+
 /// How a body moves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -1,0 +1,175 @@
+//! The rules every body obeys, however it is made: the scene validator checks them on a scene
+//! file's fields (and reports file, line, body and field), [`crate::World::insert`] on a
+//! [`super::BodyBuilder`] (and reports the body and field). Each rule gives the message for
+//! the one field it checks, so both paths say the same thing in the same words.
+
+use parry3d::shape::{SharedShape, TypedShape};
+
+use super::BodyKind;
+
+/// Smallest length of an orientation quaternion (or a direction) that can be normalised.
+pub(crate) const MIN_NORM: f32 = 1e-6;
+
+/// The scene format's name of a body kind.
+pub(crate) fn kind_name(kind: BodyKind) -> &'static str {
+    match kind {
+        BodyKind::Dynamic => "dynamic",
+        BodyKind::Static => "static",
+        BodyKind::Particle => "particle",
+        BodyKind::Kinematic => "kinematic",
+    }
+}
+
+/// Every component finite.
+pub(crate) fn finite(values: &[f32]) -> Result<(), String> {
+    match values {
+        [v] if !v.is_finite() => Err(format!("must be finite, got {v}")),
+        _ if values.iter().any(|v| !v.is_finite()) => {
+            Err(format!("must be finite, got {values:?}"))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Finite and > 0 (sizes, density, mass).
+pub(crate) fn positive(v: f32) -> Result<(), String> {
+    finite(&[v])?;
+    if v > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("must be > 0, got {v}"))
+    }
+}
+
+/// Finite and ≥ 0 (friction, damping, capsule half heights).
+pub(crate) fn non_negative(v: f32) -> Result<(), String> {
+    finite(&[v])?;
+    if v >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!("must be ≥ 0, got {v}"))
+    }
+}
+
+/// Finite and in [0, 1] (restitution).
+pub(crate) fn unit_interval(v: f32) -> Result<(), String> {
+    finite(&[v])?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(())
+    } else {
+        Err(format!("must be in [0, 1], got {v}"))
+    }
+}
+
+/// A body's or keyframe's orientation `[x, y, z, w]`: finite and not zero (it is normalised).
+pub(crate) fn orientation(q: [f32; 4]) -> Result<(), String> {
+    finite(&q)?;
+    let norm = q
+        .iter()
+        .map(|&c| f64::from(c) * f64::from(c))
+        .sum::<f64>()
+        .sqrt();
+    if norm < f64::from(MIN_NORM) {
+        Err(format!(
+            "quaternion must not be zero (it is normalised), got {q:?}"
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+/// What a shape allows of the body that carries it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ShapeClass {
+    /// A sphere: any kind of body, the only shape of a particle.
+    Sphere,
+    /// A solid of finite volume other than a sphere.
+    Solid,
+    /// No volume to give a moving body mass (`what` names it): static bodies only.
+    StaticOnly(&'static str),
+}
+
+impl ShapeClass {
+    /// The class of a built shape.
+    pub(crate) fn of(shape: &SharedShape) -> Self {
+        match shape.as_typed_shape() {
+            TypedShape::Ball(_) => Self::Sphere,
+            TypedShape::HalfSpace(_) => Self::StaticOnly("a half_space"),
+            TypedShape::TriMesh(_) => Self::StaticOnly("a trimesh"),
+            TypedShape::HeightField(_) => Self::StaticOnly("a heightfield"),
+            _ => Self::Solid,
+        }
+    }
+}
+
+/// Whether a body of `kind` may carry a shape of `class` (named `type_name` in messages).
+pub(crate) fn shape_for_kind(
+    kind: BodyKind,
+    class: ShapeClass,
+    type_name: &str,
+) -> Result<(), String> {
+    match class {
+        ShapeClass::StaticOnly(what) if kind != BodyKind::Static => Err(format!(
+            "{what} shape is only allowed on a static body, this body is {}",
+            kind_name(kind)
+        )),
+        ShapeClass::Solid | ShapeClass::StaticOnly(_) if kind == BodyKind::Particle => Err(
+            format!("a particle must have a sphere shape, got {type_name}"),
+        ),
+        _ => Ok(()),
+    }
+}
+
+/// Whether a body of `kind` may have locked axes: contacts never move the others.
+pub(crate) fn locked_axes_for_kind(kind: BodyKind) -> Result<(), String> {
+    if kind.is_dynamic() {
+        Ok(())
+    } else {
+        Err(format!(
+            "only a dynamic body or a particle may have locked axes (contacts never move the \
+             others), this body is {}",
+            kind_name(kind)
+        ))
+    }
+}
+
+/// Whether a body of `kind` may have keyframes.
+pub(crate) fn keyframes_for_kind(kind: BodyKind) -> Result<(), String> {
+    if kind == BodyKind::Kinematic {
+        Ok(())
+    } else {
+        Err(format!(
+            "only a kinematic body may have keyframes, this body is {}",
+            kind_name(kind)
+        ))
+    }
+}
+
+/// A body with keyframes takes its velocities from them: its own `field` velocity must be zero.
+pub(crate) fn keyframed_velocity(field: &str, velocity: [f32; 3]) -> Result<(), String> {
+    if velocity == [0.0; 3] {
+        Ok(())
+    } else {
+        Err(format!(
+            "a body with keyframes takes its velocity from them: leave {field} out, got \
+             {velocity:?}"
+        ))
+    }
+}
+
+/// Keyframe `index`'s time `t` (s), after `previous` (the last keyframe's time, 0 for the
+/// first: the body's own pose is its pose at t = 0).
+pub(crate) fn keyframe_time(index: usize, t: f32, previous: f32) -> Result<(), String> {
+    finite(&[t])?;
+    if t > previous {
+        Ok(())
+    } else if index == 0 {
+        Err(format!(
+            "must be > 0 (the body's position and orientation are its pose at t = 0), got {t}"
+        ))
+    } else {
+        Err(format!(
+            "must be after the previous keyframe's t = {previous}, got {t}"
+        ))
+    }
+}
