@@ -252,8 +252,8 @@ fn row_squared_natural_map(
 
 /// What [`record_velocity_before_and_residual`] found.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RowsReport {
-    /// [`natural_map_residual_in`] of the rows.
+pub(crate) struct RowsReport {
+    /// Natural-map residual of the rows ([`StepDiagnostics::natural_map_residual`]).
     pub natural_map_residual: f32,
     /// Points with friction (μ > 0): each has two tangent rows.
     pub friction_rows: usize,

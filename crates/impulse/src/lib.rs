@@ -78,7 +78,7 @@ pub use parry3d::shape::SharedShape;
 
 pub use body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use contact_lcp::ContactLcp;
-pub use diagnostics::{EnergyTerms, RowsReport, Stage, StepDiagnostics, StepProfile};
+pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
 pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,

@@ -172,7 +172,7 @@ pub struct SolverSettings {
     /// spread each large colour over the threads whatever this says.
     pub parallel_island_contacts: u32,
     /// With `method: pgs` and without split impulse, islands with at least this many contact
-    /// points are solved in SIMD lanes ([`crate::solver::wide`]): manifold groups (a pair's points)
+    /// points are solved in SIMD lanes (docs/solvers.md): manifold groups (a pair's points)
     /// coloured greedily, four groups of a colour updated at once, each lane taking its group's
     /// points in turn. 0 = never. Default 16; smaller islands do not repay the packing. Colour
     /// order converges a little more slowly than narrow-phase order. In islands of at least
@@ -184,7 +184,7 @@ pub struct SolverSettings {
     /// and a body spun near its intermediate axis tumbles (docs/method.md, "Gyroscopic
     /// motion"). Off keeps ω constant in the world frame between contacts.
     pub gyroscopic: bool,
-    /// Continuous collision (motion clamping, [`crate::continuous`]): a dynamic body that
+    /// Continuous collision (motion clamping): a dynamic body that
     /// moved more than half its smallest half extent in a step is swept from its pose at the
     /// step's start to its pose at the end against the static and kinematic bodies (Parry's
     /// nonlinear shape cast), and put back to the first impact, its velocity kept for the

@@ -143,7 +143,7 @@ pub fn builtin_families() -> Vec<(&'static str, String)> {
 /// - `pyramid<N>`: 2D pyramid of base N (1 ≤ N ≤ [`MAX_PYRAMID_BASE`]), N(N+1)/2 cubes;
 /// - `pyramid3d<N>`: square pyramid of base N×N (1 ≤ N ≤ [`MAX_PYRAMID3D_BASE`]);
 /// - `stack<N>`: N cubes (1 ≤ N ≤ [`MAX_STACK`]);
-/// - `balls<N>`: N balls (1 ≤ N ≤ [`MAX_BALLS`]) on the grid chosen by [`balls_grid`];
+/// - `balls<N>`: N balls (1 ≤ N ≤ [`MAX_BALLS`]) on a grid of columns as square as N allows;
 ///   N is written in digits, optionally with the suffix `k` for thousands (`balls1k` = 1000,
 ///   `balls16k` = 16000, `balls2500`).
 ///

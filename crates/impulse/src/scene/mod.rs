@@ -433,7 +433,10 @@ mod mesh_file;
 mod shape;
 pub(crate) mod validate;
 
-pub use builtin::{builtin_families, builtin_names, builtin_scene};
+pub use builtin::{
+    MAX_BALLS, MAX_PYRAMID_BASE, MAX_PYRAMID3D_BASE, MAX_STACK, builtin_families, builtin_names,
+    builtin_scene,
+};
 pub use error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
 pub use json::{
     load_scene_file, locate, locate_closest, parse_scene_str, parse_scene_str_in, to_json_string,

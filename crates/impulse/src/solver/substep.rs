@@ -49,7 +49,7 @@ pub struct IslandReport {
     /// Largest row velocity change of the last iteration of the last main solve (m/s): how far
     /// from converged the island's final solve stopped.
     pub last_change: f32,
-    /// Whether the substeps' solves ran in SIMD lanes ([`crate::solver::wide`]).
+    /// Whether the substeps' solves ran in SIMD lanes.
     pub simd: bool,
     /// Natural-map residual of the island's rows at the end of the step (see
     /// [`crate::diagnostics::StepDiagnostics::natural_map_residual`]); set by the world as the
