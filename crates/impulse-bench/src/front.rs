@@ -444,8 +444,8 @@ pub fn measure_scene(
     }
     let mut points = Vec::with_capacity(impulse.len() + rapier.len());
     let pool = thread_pool(1)?;
-    // Warm-up, not recorded, so that no measured run is the first on a scene: a scene's first
-    // run once read a third slower than its neighbours on the front (stack30's default).
+    // Warm-up, not recorded, so that no measured run is the first on a scene: the first run on
+    // a scene pays for cold caches and page faults that its neighbours do not.
     let warm_up = steps.min(WARM_UP_STEPS);
     if let Some((name, settings)) = impulse.first() {
         pool.install(|| run_impulse(scene, warm_up, name, settings));

@@ -217,17 +217,16 @@ fn nonzeros(a: &Matrix) -> usize {
 // ---------------------------------------------------------------------------------------------
 
 /// Largest `n` on which [`convergence`] runs Lemke's method. Its dense tableau has `n × (2n + 2)`
-/// doubles and every pivot touches all of it: pyramid20's frictionless LCP (n = 2435, 95 MB)
-/// took 59–76 s for 2443 pivots on a 2-core machine, pyramid10's (n = 602) 5 s for 6020.
-/// Beyond this size the plot shows PGS and Jacobi only (`impulse lcp solve --solver lemke`
+/// doubles and every pivot touches all of it, about one pivot per active row: the cost grows
+/// as n³ (pyramid20's frictionless LCP, n = 2435, needs a 95 MB tableau). Beyond this size the plot shows PGS and Jacobi only (`impulse lcp solve --solver lemke`
 /// still runs Lemke on any size).
 pub const LEMKE_MAX_ROWS: usize = 2000;
 /// When Lemke fails on a problem of at most this many rows, it is rerun on `A + εD` (see
-/// [`LEMKE_REGULARISATION`]); beyond it the second run costs too much (pyramid20: > 1 min).
+/// [`LEMKE_REGULARISATION`]); beyond it the second run costs too much.
 pub const LEMKE_REGULARISED_MAX_ROWS: usize = 1500;
 /// ε of the regularised rerun `A + ε·diag(A)`: a P-matrix, so Lemke's path is well posed even
 /// when redundant contacts make `A` singular; its solution misses the original problem by about
-/// ε·‖Aγ‖ (measured 3e-7, normalised, on pyramid10). ODE calls this constraint force mixing.
+/// ε·‖Aγ‖. ODE calls this constraint force mixing.
 pub const LEMKE_REGULARISATION: f64 = 1e-6;
 /// Lemke's pivot budget per row (contact LCPs need about one pivot per active row).
 const LEMKE_PIVOTS_PER_ROW: usize = 10;

@@ -328,8 +328,8 @@ impl Assembly<'_> {
     /// (pair index, first row, row count), asking ahead for their manifolds. Assembly reads
     /// the pairs in this order, the narrow phase's, so that pairs, manifolds and bodies come in
     /// sequence, and writes each pair into its island's rows (at [`Islands::first_row`]).
-    /// Reading in island order instead chased pairs all over memory: on balls16k, where a
-    /// column's bodies are 800 indices apart, memory order made a one-thread step 8 % faster.
+    /// Reading in island order instead would chase pairs all over memory (on balls16k a
+    /// column's bodies are 800 indices apart).
     fn rows_in_memory_order(
         &self,
         pairs: std::ops::Range<usize>,
@@ -628,8 +628,8 @@ pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32
 /// The deltas are summed in up to [`RECORD_PARTS`] parts of consecutive rows, each into its
 /// own per-body array, then added part after part; the parts depend only on the number of
 /// rows, so the sums are the same on any thread count. With `parallel`, the parts and the
-/// second pass (one row at a time, no shared writes) run on rayon's threads: serial, the first
-/// pass was 1.35 % of a two-thread `fast` pyramid100 step with the other thread idle.
+/// second pass (one row at a time, no shared writes) run on rayon's threads, so that a large
+/// island does not leave the other threads idle.
 /// An island's step ends with the same two passes, the second one fused with its residual
 /// ([`crate::diagnostics::record_velocity_before_and_residual`]).
 ///

@@ -37,8 +37,7 @@ pub struct Islands {
     pair_first_row: Vec<u32>,
     /// What the last build read: per pair (body 1, body 2, constraints), and each body's kind.
     /// The islands are a function of these alone, so when they repeat (a pile at rest keeps
-    /// its pairs and their point counts) the build is skipped; as a serial pass it was 1.8 %
-    /// of the samples of a two-thread balls16k run, the other thread idle (perf).
+    /// its pairs and their point counts) the build, a serial pass, is skipped.
     pair_keys: Vec<PairKey>,
     last_pair_keys: Vec<PairKey>,
     kinds: Vec<BodyKind>,
@@ -119,8 +118,7 @@ impl Islands {
     /// between dynamic bodies), each island's guests (the kinematic bodies it touches) and the order in which to assemble the pairs so that each
     /// island's constraints are contiguous (a stable counting sort of pair indices: within an
     /// island, narrow-phase order). Sorting 4-byte pair indices here replaces moving the
-    /// assembled 340-byte constraints (4 % of a balls16k step as a comparison sort, 2 % as a
-    /// counting sort). When every pair's bodies and constraint count and every body's kind are
+    /// assembled constraints of several hundred bytes each. When every pair's bodies and constraint count and every body's kind are
     /// as in the last build, the islands are too, and nothing is rebuilt.
     pub fn build(&mut self, bodies: &Bodies, pairs: &[ContactPair]) {
         let n = bodies.len();

@@ -165,9 +165,8 @@ pub struct SolverSettings {
     /// Islands with at least this many contact points are swept colour by colour (greedy graph
     /// colouring: no two points of a colour share a moving body), one colour's points spread
     /// over all worker threads; 0 = never (default). Colour order converges more slowly than
-    /// narrow-phase order on piles (pyramid100: 18.5 mm sink after 30 steps against 8.3 mm) and
-    /// costs ~20 % on one thread; on two threads pyramid100 steps 1.17× faster than in
-    /// narrow-phase order (docs/benchmarks.md). Results do not depend on the thread count.
+    /// narrow-phase order on piles and costs more on one thread; it pays on several threads
+    /// (docs/benchmarks.md, "Threads"). Results do not depend on the thread count.
     /// Islands solved in SIMD lanes (`simd_island_contacts`) are always in colour order and
     /// spread each large colour over the threads whatever this says.
     pub parallel_island_contacts: u32,

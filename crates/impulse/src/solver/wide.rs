@@ -677,8 +677,8 @@ impl ContactSolver for Bundles {
 
 /// One bundle's update in a sweep: takes the bundle and its bodies' velocities in lanes,
 /// updates both, and returns each lane's largest row velocity change (m/s). A trait rather
-/// than a closure or function pointer so that the update is inlined into the sweep loop (as a
-/// closure it was not, and pyramid20's `fast` step took 30 % longer).
+/// than a closure or function pointer so that the update is inlined into the sweep loop (a
+/// closure was not inlined).
 trait BundleUpdate: Copy + Sync {
     fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane;
 
@@ -1031,8 +1031,8 @@ fn set_vec(lanes: &mut LaneVec, i: usize, value: Vec3) {
 /// itself, as Rapier does, would not: its fixed point has v_t opposite Kγ_t, friction off the
 /// slip wherever K is anisotropic (a box's corner points). A step of 1/k₁ is a descent step for
 /// the block's quadratic; the larger 2/(k₁ + k₂) was tried and not kept (`card_house` with
-/// `fast` fell). The Newton iteration, a bundle waiting on its slowest lane, was about a third
-/// of a `fast` pyramid20 step; this step made it 1.4× faster (docs/benchmarks.md).
+/// `fast` fell). A Newton iteration on the disc would keep a bundle waiting on its slowest
+/// lane; this step costs the same on every lane.
 #[inline(always)]
 fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
     let normal = solve_normal(b, v);

@@ -204,9 +204,8 @@ impl World {
             };
             // Each island ends its step with the passes that read its rows once more, while
             // they are still in cache: its rows' v*, its natural-map residual and its
-            // friction-row count, in one pass. As world-wide passes over every row they were
-            // 3 % of a balls16k step at rest (perf), mostly waiting on memory; the results are
-            // the same to the bit.
+            // friction-row count, in one pass, instead of world-wide passes over every row
+            // that wait on memory; the results are the same to the bit.
             let run = |bodies: &[u32],
                        guests: &[u32],
                        constraints: &mut [ContactConstraint],
@@ -436,9 +435,8 @@ impl World {
     /// Writes the solved impulses back into the manifolds' points for next step's warm start.
     ///
     /// Runs over the pairs (in parallel runs of [`PAIRS_PER_TASK`]), each finding
-    /// its rows where assembly put them, so every manifold is written by one task. Serial and
-    /// in island order, this was 3 % of a balls16k step, spent waiting on the manifolds'
-    /// scattered heap blocks. An island swept colour by colour has its rows re-sorted by
+    /// its rows where assembly put them, so every manifold is written by one task and the
+    /// manifolds' scattered heap blocks are visited in memory order. An island swept colour by colour has its rows re-sorted by
     /// colour; a row found under the wrong pair then sends the whole write-back to the serial
     /// path, which follows each row's `source`.
     fn store_impulses(&mut self) {
