@@ -9,7 +9,7 @@
 //! asleep.
 
 use crate::body::{Bodies, BodyKind};
-use crate::narrow_phase::ContactPair;
+use crate::collision::narrow_phase::ContactPair;
 
 /// Islands of one step: body lists, and the order in which the narrow phase's pairs are
 /// assembled so that each island's constraints come out contiguous.

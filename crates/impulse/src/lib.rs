@@ -39,9 +39,8 @@
 // [`scene`] (the JSON scene format and the built-in scenes) and [`metrics`] (quality measures
 // of a simulation's state).
 mod body;
-mod broad_phase;
-mod constraints;
-mod contact_lcp;
+mod collision;
+mod contact;
 mod continuous;
 mod diagnostics;
 mod error;
@@ -49,7 +48,6 @@ mod graph;
 mod integrate;
 mod island;
 mod kinematic;
-mod narrow_phase;
 mod parallel;
 mod settings;
 mod solver;
@@ -77,7 +75,7 @@ pub use parry3d;
 pub use parry3d::shape::SharedShape;
 
 pub use body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
-pub use contact_lcp::ContactLcp;
+pub use diagnostics::contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
 pub use scene::{
@@ -96,9 +94,9 @@ pub use world::{
 #[cfg(feature = "internals")]
 #[doc(hidden)]
 pub mod internals {
-    pub use crate::broad_phase::BroadPhase;
-    pub use crate::constraints::ContactConstraint;
-    pub use crate::narrow_phase::{NarrowPhase, SpeculativeMargins};
+    pub use crate::collision::broad_phase::BroadPhase;
+    pub use crate::collision::narrow_phase::{NarrowPhase, SpeculativeMargins};
+    pub use crate::contact::constraints::ContactConstraint;
     pub use crate::solver::nncg::{NncgWorkspace, solve_nncg};
     pub use crate::solver::pgs::solve_pgs;
     pub use crate::solver::{Sweep, Velocities, warm_start};

@@ -7,7 +7,7 @@ use parry3d::query::{self, ContactManifold, DefaultQueryDispatcher, PersistentQu
 use parry3d::shape::SharedShape;
 
 use crate::body::Bodies;
-use crate::broad_phase::BroadPhase;
+use crate::collision::broad_phase::BroadPhase;
 
 /// Largest penetration depth (m) between any two bodies at the given poses, found with Parry's
 /// exact contact query on the pairs whose bounding boxes overlap. 0 when nothing overlaps.

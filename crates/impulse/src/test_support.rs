@@ -9,7 +9,7 @@ pub(crate) use common::*;
 use glam::Vec3;
 
 use crate::World;
-use crate::constraints::{ContactConstraint, JacobianRow};
+use crate::contact::constraints::{ContactConstraint, JacobianRow};
 
 /// Checks the engine's own LCP at exit of the last step: for every point γ ≥ 0, w = J·v −
 /// target ≥ −1e-3 m/s and |w·γ| ≤ 1e-3 of the largest γ, and the natural-map residual is

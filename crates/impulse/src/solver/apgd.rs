@@ -16,7 +16,7 @@ use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
     apply_impulses, cap_to_disc, impulses, solve_scalar,
 };
-use crate::constraints::ContactConstraint;
+use crate::contact::constraints::ContactConstraint;
 
 /// APGD as a [`ContactSolver`], with its work vectors.
 #[derive(Default)]

@@ -9,8 +9,8 @@
 //! folded into the rows, like the island's immovable slot), so a solver can be run on them
 //! from any starting impulses.
 
-use crate::constraints::ContactConstraint;
-use crate::contact_lcp::assemble_lcp;
+use crate::contact::constraints::ContactConstraint;
+use crate::diagnostics::contact_lcp::assemble_lcp;
 use crate::settings::ContactRepair;
 use crate::solver::apgd::{ApgdWorkspace, solve_apgd};
 use crate::solver::nncg::{NncgWorkspace, solve_nncg};
@@ -81,7 +81,7 @@ fn sphere_on_two_spheres(mu: f32) -> World {
 }
 
 /// 18 spheres of radii 0.35–0.5 m on a 3 × 3 grid, 2 layers, in a 3 m × 3 m box of static walls
-/// on a static ground (the pile of tests/contact_lcp.rs, smaller).
+/// on a static ground (the pile of the contact LCP tests, smaller).
 fn pile(mu: f32) -> World {
     const HALF_WIDTH: f32 = 1.5;
     const SPACING: f32 = 1.0;

@@ -39,7 +39,7 @@ use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
     apply_impulses, project_to_friction_disc, set_scalar_targets,
 };
-use crate::constraints::{ContactConstraint, JacobianRow, is_isotropic};
+use crate::contact::constraints::{ContactConstraint, JacobianRow, is_isotropic};
 
 /// The exact path as a [`ContactSolver`]: [`solve_exact`] on islands of at most `max_contacts`
 /// points. A failed solve leaves the rows and velocities as they were and says so in
@@ -254,7 +254,7 @@ pub enum ExactFailure {
 /// stored in `constraints` (any γ, e.g. an iterative solver's result), indexed by `local_a`
 /// and `local_b`, the last slot being the immovable one. Per point the normal row asks
 /// γ_n ≥ 0, w_n = J_n·v − `target_normal_velocity` ≥ 0 and γ_n·w_n = 0 (a soft row adds
-/// (impulse_scale / mass_scale)·k·γ_n to w_n, as [`crate::contact_lcp`] derives), and with
+/// (impulse_scale / mass_scale)·k·γ_n to w_n, as [`crate::diagnostics::contact_lcp`] derives), and with
 /// friction the pair (γ_t1, γ_t2) lies in the disc |γ_t| ≤ μ·γ_n. Sign convention: positive
 /// w_n separates; the normal points from B towards A.
 ///

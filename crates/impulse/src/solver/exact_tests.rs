@@ -12,7 +12,7 @@ use crate::test_support as common;
 use common::material;
 use std::time::Instant;
 
-use crate::constraints::ContactConstraint;
+use crate::contact::constraints::ContactConstraint;
 use crate::settings::ContactRepair;
 use crate::settings::SolverMethod;
 use crate::solver::Velocities;

@@ -19,8 +19,8 @@
 
 use glam::Vec3;
 
-pub use crate::constraints::cap_to_disc;
-use crate::constraints::{self, ContactConstraint};
+pub use crate::contact::constraints::cap_to_disc;
+use crate::contact::constraints::{self, ContactConstraint};
 use crate::parallel::SharedVelocities;
 use crate::settings::SolverSettings;
 

@@ -17,7 +17,7 @@ use super::policy::{Auto, EscalationLevel, EscalationLimits};
 use super::wide::Bundles;
 use super::{ContactSolver, SolveOutcome, SolvePass, TargetInputs, Velocities, position};
 use crate::body::{Bodies, BodyKind};
-use crate::constraints::{self, ContactConstraint};
+use crate::contact::constraints::{self, ContactConstraint};
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
 use crate::settings::{ContactRepair, SolverMethod, SolverSettings};

@@ -30,7 +30,7 @@ use glam::Vec3;
 use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, TargetInputs, Velocities,
 };
-use crate::constraints::{ContactConstraint, JacobianRow, repair_terms};
+use crate::contact::constraints::{ContactConstraint, JacobianRow, repair_terms};
 use crate::graph::{COLOURS, greedy_colours};
 use crate::parallel::{
     GROUPS_PER_TASK, PARALLEL_PACK_POINTS, SharedItems, SharedVelocities, colour_after_colour,
@@ -594,7 +594,7 @@ impl Bundles {
     }
 
     /// Sets every point's target normal velocity and softness from `targets` (as
-    /// [`crate::constraints::update_targets`] does for rigid or soft rows, not split impulse),
+    /// [`crate::contact::constraints::update_targets`] does for rigid or soft rows, not split impulse),
     /// then runs at most `iterations` sweeps, alternating forward and backward, until no row's
     /// velocity changes by more than `tolerance` (m/s).
     ///

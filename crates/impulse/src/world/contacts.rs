@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::World;
 use crate::body::BodyHandle;
-use crate::narrow_phase::{self, ContactPair, repeats_earlier_point};
+use crate::collision::narrow_phase::{self, ContactPair, repeats_earlier_point};
 
 /// One contact point of a pair after the last step, in world coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]

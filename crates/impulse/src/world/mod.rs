@@ -7,14 +7,14 @@ use parry3d::shape::SharedShape;
 
 use crate::body::rules::{self, ShapeClass};
 use crate::body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Handles, LockedAxes};
-use crate::broad_phase::BroadPhase;
-use crate::constraints::ContactConstraint;
-use crate::contact_lcp::{ContactLcp, assemble_lcp};
+use crate::collision::broad_phase::BroadPhase;
+use crate::collision::narrow_phase::{self, NarrowPhase};
+use crate::contact::constraints::ContactConstraint;
+use crate::diagnostics::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms};
 use crate::error::WorldError;
 use crate::island::Islands;
 use crate::kinematic::Script;
-use crate::narrow_phase::{self, NarrowPhase};
 use crate::scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
 use crate::solver::substep::IslandWorkspace;

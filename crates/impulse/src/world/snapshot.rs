@@ -26,11 +26,11 @@ use super::World;
 use super::contacts::ContactEvents;
 use super::step::EnergyCheck;
 use crate::body::{Bodies, BodyKind, Handles};
-use crate::broad_phase::{BroadPhase, BroadPhaseState};
+use crate::collision::broad_phase::{BroadPhase, BroadPhaseState};
+use crate::collision::narrow_phase::{NarrowPhase, PairState};
 use crate::diagnostics::StepDiagnostics;
 use crate::error::SnapshotError;
 use crate::kinematic::Script;
-use crate::narrow_phase::{NarrowPhase, PairState};
 use crate::settings::SolverSettings;
 
 /// The snapshot format this build writes and reads. Raised whenever the stored state changes

@@ -6,11 +6,11 @@ use rayon::prelude::*;
 
 use super::{BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, World};
 use crate::body::Bodies;
-use crate::constraints::{self, ContactConstraint};
+use crate::collision::narrow_phase::{self, ContactImpulse};
+use crate::contact::constraints::{self, ContactConstraint};
 use crate::diagnostics::{self, EnergyTerms, Stage, StepDiagnostics, StepProfile};
 use crate::error::StepError;
 use crate::island::Islands;
-use crate::narrow_phase::{self, ContactImpulse};
 use crate::parallel::{BODIES_PER_TASK, ISLANDS_PER_TASK, PAIRS_PER_TASK, SharedItems, spread};
 use crate::settings::SolverSettings;
 use crate::solver::substep::{self, IslandWorkspace, StepContext};

@@ -5,7 +5,7 @@
 
 use crate::test_support as common;
 
-use crate::broad_phase::{BroadPhase, CHANGE_DETECTION_SKIN};
+use crate::collision::broad_phase::{BroadPhase, CHANGE_DETECTION_SKIN};
 use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use glam::Vec3;
 use parry3d::bounding_volume::{Aabb, BoundingVolume};

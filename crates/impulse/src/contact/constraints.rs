@@ -7,8 +7,8 @@
 use glam::{Mat3, Vec3};
 
 use crate::body::Bodies;
+use crate::collision::narrow_phase::{ContactPair, NarrowPhase, repeats_earlier_point, same_point};
 use crate::island::Islands;
-use crate::narrow_phase::{ContactPair, NarrowPhase, repeats_earlier_point, same_point};
 use crate::parallel::{PAIRS_PER_TASK, spread};
 use crate::settings::{ContactRepair, SolverSettings};
 use rayon::prelude::*;
@@ -335,7 +335,7 @@ impl Assembly<'_> {
         pairs: std::ops::Range<usize>,
     ) -> impl Iterator<Item = (u32, usize, usize)> + '_ {
         pairs.filter_map(|index| {
-            crate::narrow_phase::prefetch_manifolds(self.pairs, index);
+            crate::collision::narrow_phase::prefetch_manifolds(self.pairs, index);
             let count = self.pairs[index].row_count();
             (count > 0).then(|| (index as u32, self.islands.first_row(index), count))
         })
@@ -368,7 +368,8 @@ impl Assembly<'_> {
                 continue;
             }
             // Body B is shape 1: its points and normal are in its part's frame.
-            let (part_b, part_a) = crate::narrow_phase::manifold_poses(manifold, pose_b, pose_a);
+            let (part_b, part_a) =
+                crate::collision::narrow_phase::manifold_poses(manifold, pose_b, pose_a);
             let normal = part_b.rotation * manifold.local_n1;
             for (point_index, point) in manifold.points.iter().enumerate() {
                 // Which copy of a duplicated point comes first can change between steps, so
@@ -623,7 +624,7 @@ pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32
 /// Rewrites each row's `velocity_before` as J·v* for the solve that produced the current
 /// impulses: v* = v − M⁻¹Jᵀγ, the velocities without this solve's impulses. With it,
 /// (A, b = target − J·v*) is exactly the LCP whose solution the rows now hold, so it can be
-/// exported and checked ([`crate::contact_lcp`]). O(rows); `scratch` holds per-body deltas.
+/// exported and checked ([`crate::diagnostics::contact_lcp`]). O(rows); `scratch` holds per-body deltas.
 ///
 /// The deltas are summed in up to [`RECORD_PARTS`] parts of consecutive rows, each into its
 /// own per-body array, then added part after part; the parts depend only on the number of

@@ -1,10 +1,12 @@
 //! Stage 7 of the step: what the step did and how well its contact LCP was solved.
 
+pub(crate) mod contact_lcp;
+
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use crate::body::Bodies;
-use crate::constraints::{BodySlots, ContactConstraint};
+use crate::contact::constraints::{BodySlots, ContactConstraint};
 use crate::parallel::{
     ENERGY_BODIES_PER_PART, RESIDUAL_ROWS_PER_TASK, SharedItems, parts_in_order, spread,
 };
@@ -231,7 +233,7 @@ fn row_squared_natural_map(
     linear_b: Vec3,
     angular_b: Vec3,
 ) -> f64 {
-    let velocity = |row: &crate::constraints::JacobianRow| {
+    let velocity = |row: &crate::contact::constraints::JacobianRow| {
         row.velocity(linear_a, angular_a, linear_b, angular_b)
     };
     let w = velocity(&c.normal) - c.target_normal_velocity;
@@ -259,7 +261,7 @@ pub(crate) struct RowsReport {
     pub friction_rows: usize,
 }
 
-/// [`crate::constraints::record_velocity_before`], [`natural_map_residual_in`] and the count of
+/// [`crate::contact::constraints::record_velocity_before`], [`natural_map_residual_in`] and the count of
 /// points with friction in one pass over the rows instead of three: how an island's step ends.
 /// The results are those of the three passes to the bit (the residual's partial sums are
 /// taken over the same runs of rows and added in the same order) on any thread count.
@@ -275,7 +277,7 @@ pub fn record_velocity_before_and_residual(
     scratch: &mut Vec<(Vec3, Vec3)>,
 ) -> RowsReport {
     let parallel = spread(parallel, 1, 0);
-    let Some(changes) = crate::constraints::impulse_velocity_changes(
+    let Some(changes) = crate::contact::constraints::impulse_velocity_changes(
         constraints,
         slots,
         linear.len(),
@@ -291,7 +293,7 @@ pub fn record_velocity_before_and_residual(
             let (a, b) = bodies_of(c);
             sum += row_squared_natural_map(c, linear[a], angular[a], linear[b], angular[b]);
             friction_rows += usize::from(c.friction > 0.0);
-            crate::constraints::record_row(c, a, b, linear, angular, changes);
+            crate::contact::constraints::record_row(c, a, b, linear, angular, changes);
         }
         (sum, friction_rows)
     };
