@@ -433,3 +433,174 @@ impl Default for SolverSettings {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The one problem of `settings`, as "field: message".
+    fn problem(settings: SolverSettings) -> String {
+        let problems = settings.problems();
+        assert_eq!(problems.len(), 1, "{problems:?}");
+        assert_eq!(settings.validate(), Err(problems[0].clone()));
+        format!("{}: {}", problems[0].field, problems[0].message)
+    }
+
+    #[test]
+    fn presets_are_valid() {
+        for settings in [
+            SolverSettings::default(),
+            SolverSettings::fast(),
+            SolverSettings::precise(),
+            SolverSettings::reference(),
+            SolverSettings::soft_step(1),
+        ] {
+            assert_eq!(settings.problems(), Vec::new());
+            assert_eq!(settings.validate(), Ok(()));
+        }
+    }
+
+    #[test]
+    fn each_rule_names_its_field_and_what_is_allowed() {
+        let base = SolverSettings::default;
+        let cases = [
+            (
+                SolverSettings {
+                    iterations: 0,
+                    ..base()
+                },
+                "iterations: must be ≥ 1, got 0",
+            ),
+            (
+                SolverSettings {
+                    substeps: 0,
+                    ..base()
+                },
+                "substeps: must be ≥ 1, got 0",
+            ),
+            (
+                SolverSettings {
+                    escalation_iterations: 0,
+                    ..base()
+                },
+                "escalation_iterations: must be ≥ 1, got 0",
+            ),
+            (
+                SolverSettings {
+                    repair: ContactRepair::SplitImpulse {
+                        rate: 10.0,
+                        iterations: 0,
+                    },
+                    ..base()
+                },
+                "repair.iterations: must be ≥ 1, got 0",
+            ),
+            (
+                SolverSettings {
+                    repair: ContactRepair::Soft {
+                        hertz: 0.0,
+                        damping_ratio: 1.0,
+                    },
+                    ..base()
+                },
+                "repair.hertz: must be > 0, got 0",
+            ),
+            (
+                SolverSettings {
+                    repair: ContactRepair::Soft {
+                        hertz: 30.0,
+                        damping_ratio: -1.0,
+                    },
+                    ..base()
+                },
+                "repair.damping_ratio: must be ≥ 0, got -1",
+            ),
+            (
+                SolverSettings {
+                    repair: ContactRepair::Bias { rate: f32::NAN },
+                    ..base()
+                },
+                "repair.rate: must be finite, got NaN",
+            ),
+            (
+                SolverSettings {
+                    tolerance: -1.0,
+                    ..base()
+                },
+                "tolerance: must be ≥ 0, got -1",
+            ),
+            (
+                SolverSettings {
+                    time_to_sleep: f32::INFINITY,
+                    ..base()
+                },
+                "time_to_sleep: must be finite, got inf",
+            ),
+            (
+                SolverSettings {
+                    max_repair_speed: -0.5,
+                    ..base()
+                },
+                "max_repair_speed: must be ≥ 0, got -0.5",
+            ),
+            (
+                SolverSettings {
+                    warm_start: 1.5,
+                    ..base()
+                },
+                "warm_start: must be in [0, 1], got 1.5",
+            ),
+            (
+                SolverSettings {
+                    warm_start: f32::NAN,
+                    ..base()
+                },
+                "warm_start: must be finite, got NaN",
+            ),
+        ];
+        for (settings, expected) in cases {
+            assert_eq!(problem(settings), expected);
+        }
+    }
+
+    #[test]
+    fn every_problem_is_listed_in_field_order() {
+        let settings = SolverSettings {
+            iterations: 0,
+            tolerance: -1.0,
+            warm_start: 2.0,
+            ..SolverSettings::default()
+        };
+        let fields: Vec<_> = settings.problems().iter().map(|p| p.field).collect();
+        assert_eq!(fields, ["iterations", "tolerance", "warm_start"]);
+        assert_eq!(settings.validate().unwrap_err().field, "iterations");
+    }
+
+    /// The names the CLI and reports print are the scene format's.
+    #[test]
+    fn names_are_the_scene_format_names() {
+        for method in [
+            SolverMethod::Pgs,
+            SolverMethod::Nncg,
+            SolverMethod::Apgd,
+            SolverMethod::Auto,
+        ] {
+            let json = serde_json::to_string(&method).unwrap();
+            assert_eq!(json, format!("\"{}\"", method.name()));
+        }
+        for repair in [
+            ContactRepair::Bias { rate: 1.0 },
+            ContactRepair::SplitImpulse {
+                rate: 1.0,
+                iterations: 1,
+            },
+            ContactRepair::Soft {
+                hertz: 1.0,
+                damping_ratio: 1.0,
+            },
+        ] {
+            let json = serde_json::to_value(repair).unwrap();
+            assert_eq!(json["type"], repair.name());
+        }
+    }
+}
