@@ -576,6 +576,42 @@ mod tests {
         assert_eq!(settings.validate().unwrap_err().field, "iterations");
     }
 
+    /// The documented rule of `friction_in_main_solve`: only `pgs` with a relax solve and no
+    /// split impulse keeps friction out of the repairing solve, and only when asked to.
+    #[test]
+    fn friction_leaves_the_main_solve_only_for_pgs_with_a_relax_solve() {
+        let base = SolverSettings::default;
+        assert_eq!(base().method, SolverMethod::Pgs);
+        assert!(!base().main_solve_friction());
+        assert!(
+            SolverSettings {
+                friction_in_main_solve: true,
+                ..base()
+            }
+            .main_solve_friction()
+        );
+        for method in [SolverMethod::Nncg, SolverMethod::Apgd, SolverMethod::Auto] {
+            assert!(SolverSettings { method, ..base() }.main_solve_friction());
+        }
+        assert!(
+            SolverSettings {
+                repair: ContactRepair::SplitImpulse {
+                    rate: 10.0,
+                    iterations: 1
+                },
+                ..base()
+            }
+            .main_solve_friction()
+        );
+        assert!(
+            SolverSettings {
+                relax_iterations: 0,
+                ..base()
+            }
+            .main_solve_friction()
+        );
+    }
+
     /// The names the CLI and reports print are the scene format's.
     #[test]
     fn names_are_the_scene_format_names() {
