@@ -325,20 +325,16 @@ impl SolverSettings {
     /// a repair velocity is partly kept by the bodies it separates and adds up along a chain of
     /// overlapping bodies (the `overlap_pyramid` scene, 25 % overlapped, ejects bodies at up to
     /// about eight times the cap; at 1 m/s a row of it flew apart and the pile fell).
-    /// Everything else as [`Self::default`].
+    /// Everything else, the method, the sweeps, the slop and the repair cap included, as
+    /// [`Self::default`], which is this step at 20 substeps.
     pub fn soft_step(substeps: u32) -> Self {
         let substeps = substeps.max(1);
         Self {
-            method: SolverMethod::Pgs,
             substeps,
-            iterations: 1,
-            relax_iterations: 1,
             repair: ContactRepair::Soft {
                 hertz: 12.0 * substeps as f32,
                 damping_ratio: 10.0,
             },
-            overlap_slop: 0.0,
-            max_repair_speed: 0.5,
             ..Self::default()
         }
     }
@@ -610,6 +606,44 @@ mod tests {
             }
             .main_solve_friction()
         );
+    }
+
+    /// The soft step is one PGS sweep and one relax sweep a substep, springs at a fifth of
+    /// the substep rate (12·S Hz at dt = 1/60 s), no slop, repair capped at 0.5 m/s; the
+    /// default is that step at 20 substeps, `fast` at 8 and `precise` at 48.
+    #[test]
+    fn the_presets_are_the_soft_step() {
+        for substeps in [1, 8, 20, 48] {
+            let s = SolverSettings::soft_step(substeps);
+            assert_eq!(
+                (s.method, s.substeps, s.iterations, s.relax_iterations),
+                (SolverMethod::Pgs, substeps, 1, 1)
+            );
+            assert_eq!(
+                s.repair,
+                ContactRepair::Soft {
+                    hertz: 12.0 * substeps as f32,
+                    damping_ratio: 10.0
+                }
+            );
+            assert_eq!((s.overlap_slop, s.max_repair_speed), (0.0, 0.5));
+        }
+        assert_eq!(SolverSettings::soft_step(0).substeps, 1);
+        assert_eq!(SolverSettings::default(), SolverSettings::soft_step(20));
+        assert_eq!(SolverSettings::fast(), SolverSettings::soft_step(8));
+        assert_eq!(SolverSettings::precise(), SolverSettings::soft_step(48));
+        for (name, preset) in [
+            ("fast", SolverSettings::fast()),
+            ("q50", SolverSettings::fast()),
+            ("default", SolverSettings::default()),
+            ("q5", SolverSettings::default()),
+            ("precise", SolverSettings::precise()),
+            ("q1", SolverSettings::precise()),
+            ("reference", SolverSettings::reference()),
+        ] {
+            assert_eq!(SolverSettings::preset(name), Some(preset), "{name}");
+        }
+        assert_eq!(SolverSettings::preset("fastest"), None);
     }
 
     /// The names the CLI and reports print are the scene format's.
