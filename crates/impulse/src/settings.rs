@@ -380,7 +380,6 @@ impl SolverSettings {
             method: SolverMethod::Auto,
             substeps: 4,
             iterations: 8,
-            relax_iterations: 1,
             repair: ContactRepair::SplitImpulse {
                 rate: 12.0,
                 iterations: 16,
@@ -644,6 +643,26 @@ mod tests {
             assert_eq!(SolverSettings::preset(name), Some(preset), "{name}");
         }
         assert_eq!(SolverSettings::preset("fastest"), None);
+    }
+
+    /// `reference` as documented: the automatic policy, 4 substeps of at most 8 iterations,
+    /// split impulse at 12/s above a 2 mm slop, repair capped at 1 m/s.
+    #[test]
+    fn the_reference_preset_is_as_documented() {
+        let r = SolverSettings::reference();
+        assert_eq!(
+            (r.method, r.substeps, r.iterations),
+            (SolverMethod::Auto, 4, 8)
+        );
+        assert_eq!(
+            r.repair,
+            ContactRepair::SplitImpulse {
+                rate: 12.0,
+                iterations: 16
+            }
+        );
+        assert!(r.split_impulse() && !SolverSettings::default().split_impulse());
+        assert_eq!((r.overlap_slop, r.max_repair_speed), (0.002, 1.0));
     }
 
     /// The names the CLI and reports print are the scene format's.
