@@ -503,6 +503,16 @@ mod tests {
             (
                 SolverSettings {
                     repair: ContactRepair::Soft {
+                        hertz: f32::NAN,
+                        damping_ratio: 1.0,
+                    },
+                    ..base()
+                },
+                "repair.hertz: must be finite, got NaN",
+            ),
+            (
+                SolverSettings {
+                    repair: ContactRepair::Soft {
                         hertz: 30.0,
                         damping_ratio: -1.0,
                     },
