@@ -103,7 +103,7 @@ pub mod internals {
 
     /// The last step's solved contact constraints (impulses as the solver left them).
     pub fn contact_constraints(world: &crate::World) -> &[ContactConstraint] {
-        &world.constraints
+        world.contact_constraints()
     }
 }
 

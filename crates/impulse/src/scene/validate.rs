@@ -385,17 +385,7 @@ impl Checker {
                 for (i, part) in parts.iter().enumerate() {
                     let part_path = parts_path.index(i);
                     self.finite_array(&part_path.key("position"), &part.position);
-                    if self.finite_array(&part_path.key("orientation"), &part.orientation)
-                        && norm(&part.orientation) < f64::from(MIN_NORM)
-                    {
-                        self.fail(
-                            &part_path.key("orientation"),
-                            format!(
-                                "quaternion must not be zero (it is normalised), got {:?}",
-                                part.orientation
-                            ),
-                        );
-                    }
+                    self.orientation(&part_path.key("orientation"), part.orientation);
                     let shape_path = part_path.key("shape");
                     let inner = match &part.shape {
                         ShapeDesc::Round { shape, .. } => shape.as_ref(),

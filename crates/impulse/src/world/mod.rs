@@ -64,7 +64,7 @@ pub struct World {
     broad_phase: BroadPhase,
     narrow_phase: NarrowPhase,
     candidates: Vec<(u32, u32)>,
-    pub(crate) constraints: Vec<ContactConstraint>,
+    constraints: Vec<ContactConstraint>,
     world_inverse_inertia: Vec<Mat3>,
     scratch: Vec<(Vec3, Vec3)>,
     margins: narrow_phase::SpeculativeMargins,
@@ -238,7 +238,7 @@ impl World {
     }
 
     /// The last step's solved contact constraints (impulses as the solver left them).
-    #[cfg(test)]
+    #[cfg(any(test, feature = "internals"))]
     pub(crate) fn contact_constraints(&self) -> &[ContactConstraint] {
         &self.constraints
     }
@@ -322,8 +322,7 @@ impl World {
     fn wake_all(&mut self) {
         for i in 0..self.bodies.len() {
             if self.bodies.is_dynamic(i) {
-                self.bodies.asleep[i] = false;
-                self.bodies.sleep_time[i] = 0.0;
+                self.wake_up(i);
             }
         }
     }
