@@ -130,16 +130,21 @@ fn plate_stands_still_with_the_exact_path() {
 /// A column of four balls on the ground, and a fifth 5 cm above it, falling at `speed`; the
 /// fifth weighs `top_mass` kg (the others 1000·4/3·π·0.5³ ≈ 524 kg). The solver is set so that
 /// every main solve ends unconverged (one NNCG iteration, zero escalation tolerance) and the
-/// policy has to choose.
-fn landing_column(speed: f32, top_mass: Option<f32>) -> World {
+/// policy has to choose; `edit` changes these settings further.
+fn landing_column(
+    speed: f32,
+    top_mass: Option<f32>,
+    edit: impl Fn(&mut impulse::SolverSettings),
+) -> World {
     use glam::Vec3;
     use impulse::{BodyDesc, BodyKind, ShapeDesc};
-    let settings = impulse::SolverSettings {
+    let mut settings = impulse::SolverSettings {
         sleep: false,
         iterations: 1,
         escalation_tolerance: 0.0,
         ..impulse::SolverSettings::reference()
     };
+    edit(&mut settings);
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
     let material = common::material(0.3);
     world
@@ -175,12 +180,71 @@ fn impacts_take_more_iterations_and_rest_or_heavy_islands_the_exact_path() {
         islands[0].method
     };
     assert_eq!(
-        method(landing_column(8.0, None)),
+        method(landing_column(8.0, None, |_| {})),
         EscalationLevel::NncgExtended
     );
-    assert_eq!(method(landing_column(0.0, None)), EscalationLevel::Exact);
     assert_eq!(
-        method(landing_column(8.0, Some(524.0 * 50.0))),
+        method(landing_column(0.0, None, |_| {})),
         EscalationLevel::Exact
+    );
+    assert_eq!(
+        method(landing_column(8.0, Some(524.0 * 50.0), |_| {})),
+        EscalationLevel::Exact
+    );
+}
+
+/// The island's report after one step of `world`.
+fn first_step_report(mut world: World) -> impulse::IslandReport {
+    let islands = world.step().unwrap().islands.clone();
+    assert_eq!(islands.len(), 1, "one column, one island: {islands:?}");
+    islands[0]
+}
+
+/// "Heavy" means a mass ratio above `mass_ratio_threshold`: a column of equal balls (ratio
+/// exactly 1) with the threshold at 1 is not heavy, so in an impact it takes more NNCG
+/// iterations, not the exact path.
+#[test]
+fn an_island_at_the_mass_ratio_threshold_is_not_heavy() {
+    let island = first_step_report(landing_column(8.0, None, |s| s.mass_ratio_threshold = 1.0));
+    assert_eq!(island.mass_ratio, 1.0, "{island:?}");
+    assert_eq!(island.method, EscalationLevel::NncgExtended, "{island:?}");
+}
+
+/// The exact path is only for islands of at most `exact_max_contacts` points: with the limit
+/// below the column's point count, neither rest nor a heavy top sends it there; unconverged,
+/// it takes more NNCG iterations.
+#[test]
+fn islands_above_the_exact_limit_take_more_iterations_instead() {
+    for (speed, top_mass) in [(0.0, None), (8.0, Some(524.0 * 50.0))] {
+        let island = first_step_report(landing_column(speed, top_mass, |s| {
+            s.exact_max_contacts = 3
+        }));
+        assert!(island.contacts > 3, "{island:?}");
+        assert_eq!(island.method, EscalationLevel::NncgExtended, "{island:?}");
+        assert_eq!(island.exact_pivots, 0, "{island:?}");
+        assert!(island.escalations > 0, "{island:?}");
+    }
+}
+
+/// An escalated solve runs `escalation_iterations` more NNCG iterations after its budget, and
+/// the report counts both: with the tolerances at zero (no early exit), raising
+/// `escalation_iterations` by 4 raises the step's iterations by 4 per escalated solve.
+#[test]
+fn the_report_counts_the_budget_and_the_extension() {
+    let report = |extra: u32| {
+        first_step_report(landing_column(8.0, None, |s| {
+            s.iterations = 2;
+            s.tolerance = 0.0;
+            s.escalation_iterations = extra;
+        }))
+    };
+    let (short, long) = (report(4), report(8));
+    assert_eq!(short.method, EscalationLevel::NncgExtended, "{short:?}");
+    assert!(short.escalations > 0, "{short:?}");
+    assert_eq!(short.escalations, long.escalations, "{short:?} {long:?}");
+    assert_eq!(
+        long.iterations - short.iterations,
+        4 * short.escalations,
+        "{short:?} {long:?}"
     );
 }
