@@ -6,7 +6,7 @@
 
 use impulse::glam::{Quat, Vec3};
 use impulse::parry3d::math::Vector;
-use impulse::{BodyBuilder, BodyHandle, SharedShape, SolverSettings, World};
+use impulse::{BodyBuilder, BodyHandle, SharedShape, SolverSettings, StepError, World};
 
 const DT: f32 = 1.0 / 60.0;
 const SPEED: f32 = 200.0;
@@ -135,6 +135,79 @@ fn thin_box_bullets_never_cross_a_thin_wall() {
                 largest < -HALF_THICKNESS,
                 "{name}, {angle}°: its centre reached x = {largest}"
             );
+        }
+    }
+}
+
+/// The thin boxes of the test above, spinning at `rate` (rad/s) about `axis`.
+fn tumbling_bullets(rate: f32, axis: Vec3) -> [(&'static str, BodyBuilder); 2] {
+    let dart = BodyBuilder::dynamic(SharedShape::cuboid(0.1, 0.01, 0.01));
+    let plate = BodyBuilder::dynamic(SharedShape::cuboid(0.01, 0.1, 0.1));
+    [
+        ("dart", dart.angular_velocity(rate * axis)),
+        ("plate", plate.angular_velocity(rate * axis)),
+    ]
+}
+
+/// Tumbling thin boxes: the dart and the plate spinning at 30 and 100 rad/s about the axis
+/// across their path, the vertical or their path, at every angle. An end or edge that meets
+/// the wall first sets a box spinning at up to 1,300 rad/s, over 20 rad a step: the sweep
+/// turns it the way it spins (not the short way to its end orientation, which once let the
+/// dart at 30° spinning about its path through), so a box that would swing its far end
+/// through the wall is stopped at that turn.
+///
+/// Some of these impacts gain energy (see the ignored test below), which the world reports as
+/// a blow-up; the flight goes on regardless, since this test is about where the boxes go.
+#[test]
+fn tumbling_thin_box_bullets_never_cross_a_thin_wall() {
+    for angle in [0.0f32, 30.0, 60.0, 80.0] {
+        let path = Vec3::new(angle.to_radians().cos(), angle.to_radians().sin(), 0.0);
+        for (axis_name, axis) in [("across", Vec3::Z), ("vertical", Vec3::Y), ("path", path)] {
+            for rate in [30.0, 100.0] {
+                for (name, bullet) in tumbling_bullets(rate, axis) {
+                    let case = format!("{name} at {rate} rad/s about {axis_name}, {angle}°");
+                    let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings(true)).unwrap();
+                    wall(&mut w);
+                    let body = shoot(&mut w, bullet, angle);
+                    let mut largest = f32::NEG_INFINITY;
+                    for _ in 0..20 {
+                        match w.step() {
+                            Ok(_) | Err(StepError::EnergyBlowUp { .. }) => {}
+                            Err(other) => panic!("{case}: {other}"),
+                        }
+                        largest = largest.max(w.body(body).unwrap().center_of_mass().x);
+                    }
+                    // Only the wall slows it along x: it met the wall.
+                    let v = w.body(body).unwrap().linear_velocity();
+                    let approach = SPEED * angle.to_radians().cos();
+                    assert!(v.x < 0.5 * approach, "{case}: never met the wall ({v} m/s)");
+                    assert!(
+                        largest < -HALF_THICKNESS,
+                        "{case}: its centre reached x = {largest}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Known defect: two of the tumbling impacts above gain energy after the first hit (the
+/// dart at 30 rad/s about the axis across its path at 60°: 527 J after the hit, 595 J a step
+/// later; at 100 rad/s about the vertical at 0°: 8 J, then 27 J), which the blow-up guard
+/// stops. The dart then spins at 400–900 rad/s, several radians a substep, and each substep
+/// moves its contact points by Δθ × r, a linearisation that is far off at such angles.
+#[test]
+#[ignore = "known defect: extreme-spin impacts gain energy"]
+fn tumbling_dart_impacts_gain_no_energy() {
+    for (angle, axis, rate) in [(60.0f32, Vec3::Z, 30.0), (0.0, Vec3::Y, 100.0)] {
+        let [(_, dart), _] = tumbling_bullets(rate, axis);
+        let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings(true)).unwrap();
+        wall(&mut w);
+        shoot(&mut w, dart, angle);
+        for step in 0..20 {
+            if let Err(error) = w.step() {
+                panic!("{angle}°, {rate} rad/s, step {step}: {error}");
+            }
         }
     }
 }

@@ -35,11 +35,12 @@ impl World {
             if !b.is_dynamic(i) || b.asleep[i] || b.pose[i] == self.start_poses[i] {
                 continue;
             }
-            let sweep = Sweep {
-                start: self.start_poses[i],
-                end: b.pose[i],
-                local_center_of_mass: b.local_center_of_mass[i],
-            };
+            let sweep = Sweep::new(
+                self.start_poses[i],
+                b.pose[i],
+                b.local_center_of_mass[i],
+                b.angular_velocity[i] * self.dt,
+            );
             let shape = &*b.shape[i];
             let local = shape.compute_local_aabb();
             let half = local.half_extents();
@@ -61,11 +62,12 @@ impl World {
                 if j == i || !b.groups_interact(i, j) {
                     return;
                 }
-                let target = Sweep {
-                    start: self.start_poses[j],
-                    end: b.pose[j],
-                    local_center_of_mass: b.local_center_of_mass[j],
-                };
+                let target = Sweep::new(
+                    self.start_poses[j],
+                    b.pose[j],
+                    b.local_center_of_mass[j],
+                    b.angular_velocity[j] * self.dt,
+                );
                 let in_contact = self.narrow_phase.has_points(i as u32, j as u32);
                 if let Some(t) =
                     continuous::clamp_fraction(&body, &*b.shape[j], &target, in_contact)
