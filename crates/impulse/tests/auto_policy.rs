@@ -174,11 +174,7 @@ fn landing_column(
 /// solved exactly.
 #[test]
 fn impacts_take_more_iterations_and_rest_or_heavy_islands_the_exact_path() {
-    let method = |mut world: World| {
-        let islands = world.step().unwrap().islands.clone();
-        assert_eq!(islands.len(), 1, "one column, one island: {islands:?}");
-        islands[0].method
-    };
+    let method = |world: World| first_step_report(world).method;
     assert_eq!(
         method(landing_column(8.0, None, |_| {})),
         EscalationLevel::NncgExtended

@@ -117,15 +117,23 @@ fn a_fast_ball_never_crosses_a_triangle_mesh() {
     }
 }
 
+/// A dart: a box 20 cm long along x, 2 cm square across.
+fn dart() -> BodyBuilder {
+    BodyBuilder::dynamic(SharedShape::cuboid(0.1, 0.01, 0.01))
+}
+
+/// A plate: a box 2 cm thick along x, 20 cm square across.
+fn plate() -> BodyBuilder {
+    BodyBuilder::dynamic(SharedShape::cuboid(0.01, 0.1, 0.1))
+}
+
 /// Thin boxes: a dart (20 cm × 2 cm × 2 cm) flying along its long axis, and a plate (2 cm ×
 /// 20 cm × 20 cm) flying face first.
 #[test]
 fn thin_box_bullets_never_cross_a_thin_wall() {
     for angle in [0.0f32, 30.0, 60.0, 80.0] {
-        let dart = BodyBuilder::dynamic(SharedShape::cuboid(0.1, 0.01, 0.01))
-            .rotation(Quat::from_rotation_z(angle.to_radians()));
-        let plate = BodyBuilder::dynamic(SharedShape::cuboid(0.01, 0.1, 0.1));
-        for (name, bullet, reach) in [("dart", dart, 0.101), ("plate", plate, 0.142)] {
+        let dart = dart().rotation(Quat::from_rotation_z(angle.to_radians()));
+        for (name, bullet, reach) in [("dart", dart, 0.101), ("plate", plate(), 0.142)] {
             let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings(true)).unwrap();
             wall(&mut w);
             let body = shoot(&mut w, bullet, angle);
@@ -141,11 +149,9 @@ fn thin_box_bullets_never_cross_a_thin_wall() {
 
 /// The thin boxes of the test above, spinning at `rate` (rad/s) about `axis`.
 fn tumbling_bullets(rate: f32, axis: Vec3) -> [(&'static str, BodyBuilder); 2] {
-    let dart = BodyBuilder::dynamic(SharedShape::cuboid(0.1, 0.01, 0.01));
-    let plate = BodyBuilder::dynamic(SharedShape::cuboid(0.01, 0.1, 0.1));
     [
-        ("dart", dart.angular_velocity(rate * axis)),
-        ("plate", plate.angular_velocity(rate * axis)),
+        ("dart", dart().angular_velocity(rate * axis)),
+        ("plate", plate().angular_velocity(rate * axis)),
     ]
 }
 
