@@ -73,7 +73,7 @@ pub fn impulse_grid() -> Vec<ImpulseSetting> {
     for name in ["fast", "precise", "reference"] {
         grid.push((name.to_string(), SolverSettings::preset(name)));
     }
-    for substeps in [2, 4, 6, 10, 12, 16, 24, 28, 32, 40, 64] {
+    for substeps in [1, 2, 3, 4, 5, 6, 10, 12, 16, 24, 28, 32, 40, 64] {
         grid.push(soft_step(substeps, 1));
     }
     for substeps in [4, 8, 16] {
@@ -947,7 +947,7 @@ mod tests {
     #[test]
     fn grids_have_the_documented_sizes_and_names() {
         let grid = impulse_grid();
-        assert_eq!(grid.len(), 4 + 11 + 3 + 5);
+        assert_eq!(grid.len(), 4 + 14 + 3 + 5);
         assert_eq!(grid[0], ("default".to_string(), None));
         assert_eq!(grid[1].1, Some(SolverSettings::fast()));
         // The presets are soft steps the grid does not repeat.

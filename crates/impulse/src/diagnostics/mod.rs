@@ -10,8 +10,8 @@ use crate::contact::constraints::{BodySlots, ContactConstraint};
 use crate::parallel::{
     ENERGY_BODIES_PER_PART, RESIDUAL_ROWS_PER_TASK, SharedItems, parts_in_order, spread,
 };
-use crate::solver::IslandReport;
 use crate::solver::cap_to_disc;
+use crate::solver::{IslandReport, RowsReport};
 
 /// Per-step report. Every step's LCP can be checked: `natural_map_residual` is computed from
 /// the solver's own impulses and the velocities they produce, in the LCP's own units.
@@ -250,15 +250,6 @@ fn row_squared_natural_map(
         }
     }
     sum
-}
-
-/// What [`record_velocity_before_and_residual`] found.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct RowsReport {
-    /// Natural-map residual of the rows ([`StepDiagnostics::natural_map_residual`]).
-    pub natural_map_residual: f32,
-    /// Points with friction (μ > 0): each has two tangent rows.
-    pub friction_rows: usize,
 }
 
 /// [`crate::contact::constraints::record_velocity_before`], [`natural_map_residual_in`] and the count of

@@ -221,6 +221,17 @@ pub struct Velocities<'a> {
     pub angular: &'a mut [Vec3],
 }
 
+/// What the record of an island's rows found as its step ended
+/// ([`crate::diagnostics::record_velocity_before_and_residual`], or the SIMD lanes'
+/// [`wide::Bundles::record`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct RowsReport {
+    /// Natural-map residual of the rows ([`crate::StepDiagnostics::natural_map_residual`]).
+    pub natural_map_residual: f32,
+    /// Points with friction (μ > 0): each has two tangent rows.
+    pub friction_rows: usize,
+}
+
 /// What one solve did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SolveReport {

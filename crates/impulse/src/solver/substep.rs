@@ -15,7 +15,9 @@ use super::nncg::Nncg;
 use super::pgs::{Pgs, Sweep, colour_constraints};
 use super::policy::{Auto, EscalationLevel, EscalationLimits};
 use super::wide::Bundles;
-use super::{ContactSolver, SolveOutcome, SolvePass, TargetInputs, Velocities, position};
+use super::{
+    ContactSolver, RowsReport, SolveOutcome, SolvePass, TargetInputs, Velocities, position,
+};
 use crate::body::{Bodies, BodyKind};
 use crate::contact::constraints::{self, ContactConstraint};
 use crate::integrate;
@@ -93,6 +95,10 @@ pub struct IslandWorkspace {
     colour_scratch: Vec<ContactConstraint>,
     /// Per part of rows, per slot: M⁻¹Jᵀγ of [`constraints::record_velocity_before`].
     pub(crate) record_scratch: Vec<(Vec3, Vec3)>,
+    /// The rows' record as the step ended when the SIMD lanes took it (the rows' J·v* are
+    /// then in the constraints); `None` leaves it to
+    /// [`crate::diagnostics::record_velocity_before_and_residual`].
+    pub(crate) rows: Option<RowsReport>,
     /// Whether one colour may be solved on several threads.
     parallel: bool,
     /// The methods, each with its work space, kept between steps.
@@ -223,7 +229,9 @@ pub struct StepContext<'a> {
 /// Runs stages 1, 5 and 6 of one step on one island: per substep of h = dt/substeps, gravity,
 /// warm start, the solve with overlap repair, position integration, and the relax solve; then
 /// the restitution solve. Results stay in `workspace` until [`scatter`]. The rows' J·v*
-/// (`velocity_before`) is left to the caller, which takes it in one pass with the residual
+/// (`velocity_before`) and the residual are recorded here when the SIMD lanes solved the
+/// island and no restitution solve followed (`IslandWorkspace::rows`); otherwise they are
+/// left to the caller, which takes them in one pass
 /// ([`crate::diagnostics::record_velocity_before_and_residual`], as [`crate::World`] does).
 ///
 /// `guests` are the kinematic bodies touching the island (`Islands::guests` of the island stage):
@@ -475,9 +483,20 @@ pub fn step_island(
             w.targets_and_solve(constraints, settings, h, bundled, false, half_turn);
         }
     }
+    // With no restitution solve to follow, the lanes record the rows' J·v* and residual
+    // while the bundles are in cache (`wide::Bundles::record`); `rows` then holds them.
+    let record_in_lanes = bundled && !restitution;
+    if record_in_lanes {
+        w.solvers.wide.record(&w.linear, &w.angular);
+    }
     w.solvers
         .substeps(settings.method, bundled)
         .finish(constraints);
+    w.rows = if record_in_lanes {
+        w.solvers.wide.take_rows()
+    } else {
+        None
+    };
     // Restitution after the substeps (Newton's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
     // for the points that collided.
     let threshold = settings.restitution_threshold;

@@ -28,13 +28,14 @@
 use glam::Vec3;
 
 use super::{
-    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, TargetInputs, Velocities,
+    ContactSolver, EscalationLevel, RowsReport, SolveOutcome, SolvePass, SolveReport, TargetInputs,
+    Velocities,
 };
 use crate::contact::constraints::{ContactConstraint, JacobianRow, repair_terms};
 use crate::graph::{COLOURS, greedy_colours};
 use crate::parallel::{
-    GROUPS_PER_TASK, PARALLEL_PACK_POINTS, SharedItems, SharedVelocities, colour_after_colour,
-    prefetch_lines, spread, threads,
+    GROUPS_PER_TASK, PARALLEL_PACK_POINTS, RESIDUAL_ROWS_PER_TASK, SharedItems, SharedVelocities,
+    colour_after_colour, parts_in_order, prefetch_lines, spread, threads,
 };
 
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
@@ -152,6 +153,24 @@ pub struct Bundles {
     /// This pack's body slots per point, before they are compared with `layout_keys`.
     keys: Vec<(u32, u32)>,
     layout_slots: usize,
+    /// What [`Bundles::record`] found per bundle, and the velocities v* it took them from;
+    /// `recorded` until the next pack. `rows` is what [`Bundles::unpack`] summed from them.
+    records: Vec<BundleRecord>,
+    before_linear: Vec<Vec3>,
+    before_angular: Vec<Vec3>,
+    recorded: bool,
+    rows: Option<RowsReport>,
+}
+
+/// A bundle's rows as its island's step ends, per lane (see [`Bundles::record`]).
+#[derive(Clone, Copy, Default)]
+struct BundleRecord {
+    /// J·v* of the normal row and the two tangent rows (m/s).
+    velocity_before: [Lane; 3],
+    /// The natural map φ of the rows: min(γ_n, J_n·v − target) for the normal row and
+    /// γ_t − Proj_disc(γ_t − J_t·v) for the friction pair (N·s and m/s mixed, as
+    /// [`crate::StepDiagnostics::natural_map_residual`] sums them).
+    phi: [Lane; 3],
 }
 
 #[inline(always)]
@@ -291,6 +310,8 @@ impl Bundles {
     /// last layout is reused and only the lanes are filled again; the result is the same.
     pub fn pack(&mut self, constraints: &[ContactConstraint], slots: usize, parallel: bool) {
         self.parallel = parallel;
+        self.recorded = false;
+        self.rows = None;
         let immovable = (slots - 1) as u32;
         // The layout is a function of the points' body slots alone: when they repeat (an
         // island at rest keeps its points), last pack's layout stands. The slots are first
@@ -509,34 +530,191 @@ impl Bundles {
     }
 
     /// Writes the bundles' impulses (and largest normal impulses) back to `constraints`, the
-    /// slice [`Bundles::pack`] read. On rayon's threads when packing was.
-    pub fn unpack(&self, constraints: &mut [ContactConstraint]) {
-        let write = |(c, &slot): (&mut ContactConstraint, &u32)| {
+    /// slice [`Bundles::pack`] read. On rayon's threads when packing was. After
+    /// [`Bundles::record`], also each row's J·v* (`velocity_before`), and sums the island's
+    /// natural-map residual and friction rows ([`Bundles::take_rows`]): over the points in
+    /// constraint order, in runs of the same length and added in the same order as
+    /// `diagnostics::record_velocity_before_and_residual`, so the residual is its to the bit.
+    pub fn unpack(&mut self, constraints: &mut [ContactConstraint]) {
+        let (bundles, totals, records) = (&self.bundles, &self.step_totals, &self.records);
+        let recorded = self.recorded;
+        // Writes one point back; returns its rows' φ² (0 unless recorded).
+        let write = |c: &mut ContactConstraint, slot: u32| -> f64 {
             let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
-            let b = &self.bundles[index];
+            let b = &bundles[index];
             let at = |x: &Lane| x.as_array()[lane];
             c.normal_impulse = at(&b.normal_impulse);
             c.tangent_impulses = [at(&b.tangent_impulses[0]), at(&b.tangent_impulses[1])];
             c.max_normal_impulse = at(&b.max_normal_impulse);
-            let totals = &self.step_totals[index];
+            let total = &totals[index];
             c.step_impulses = [
-                at(&totals[0]) + c.normal_impulse,
-                at(&totals[1]) + c.tangent_impulses[0],
-                at(&totals[2]) + c.tangent_impulses[1],
+                at(&total[0]) + c.normal_impulse,
+                at(&total[1]) + c.tangent_impulses[0],
+                at(&total[2]) + c.tangent_impulses[1],
             ];
             c.target_normal_velocity = at(&b.target);
             c.softness = (at(&b.mass_scale), at(&b.impulse_scale));
+            if !recorded {
+                return 0.0;
+            }
+            let r = &records[index];
+            c.normal.velocity_before = at(&r.velocity_before[0]);
+            c.tangents[0].velocity_before = at(&r.velocity_before[1]);
+            c.tangents[1].velocity_before = at(&r.velocity_before[2]);
+            let phi = at(&r.phi[0]) as f64;
+            let mut squared = phi * phi;
+            if c.friction > 0.0 {
+                for k in 1..3 {
+                    let phi = at(&r.phi[k]) as f64;
+                    squared += phi * phi;
+                }
+            }
+            squared
         };
-        if spread(self.parallel, constraints.len(), PARALLEL_PACK_POINTS - 1) {
-            use rayon::prelude::*;
-            constraints
-                .par_iter_mut()
-                .zip(self.slots.par_iter())
-                .with_min_len(PARALLEL_PACK_POINTS / 4)
-                .for_each(write);
-        } else {
-            constraints.iter_mut().zip(&self.slots).for_each(write);
+        let slots = &self.slots;
+        let parallel = spread(self.parallel, constraints.len(), PARALLEL_PACK_POINTS - 1);
+        if !recorded {
+            if parallel {
+                use rayon::prelude::*;
+                constraints
+                    .par_iter_mut()
+                    .zip(slots.par_iter())
+                    .with_min_len(PARALLEL_PACK_POINTS / 4)
+                    .for_each(|(c, &slot)| {
+                        write(c, slot);
+                    });
+            } else {
+                for (c, &slot) in constraints.iter_mut().zip(slots) {
+                    write(c, slot);
+                }
+            }
+            return;
         }
+        // One run of points: its φ² sum and its points with friction.
+        let run = |rows: &mut [ContactConstraint], slots: &[u32]| {
+            let (mut sum, mut friction_rows) = (0.0f64, 0usize);
+            for (c, &slot) in rows.iter_mut().zip(slots) {
+                sum += write(c, slot);
+                friction_rows += usize::from(c.friction > 0.0);
+            }
+            (sum, friction_rows)
+        };
+        let n = constraints.len();
+        let (sum, friction_rows): (f64, usize) = if parallel && n > RESIDUAL_ROWS_PER_TASK {
+            let rows = SharedItems(constraints.as_mut_ptr());
+            parts_in_order(
+                n.div_ceil(RESIDUAL_ROWS_PER_TASK),
+                |i| {
+                    // Capture the whole wrapper (Sync), not its raw-pointer field.
+                    #[allow(clippy::redundant_locals)]
+                    let rows = rows;
+                    let start = i * RESIDUAL_ROWS_PER_TASK;
+                    let len = RESIDUAL_ROWS_PER_TASK.min(n - start);
+                    // SAFETY: part i is rows [start, start + len) of the constraints, disjoint
+                    // from every other part's.
+                    let mine = unsafe { std::slice::from_raw_parts_mut(rows.0.add(start), len) };
+                    run(mine, &slots[start..start + len])
+                },
+                |parts| {
+                    (
+                        parts.iter().map(|p| p.0).sum(),
+                        parts.iter().map(|p| p.1).sum(),
+                    )
+                },
+            )
+        } else {
+            let mut friction_rows = 0;
+            let sum = constraints
+                .chunks_mut(RESIDUAL_ROWS_PER_TASK)
+                .zip(slots.chunks(RESIDUAL_ROWS_PER_TASK))
+                .map(|(rows, slots)| {
+                    let (sum, rows) = run(rows, slots);
+                    friction_rows += rows;
+                    sum
+                })
+                .sum();
+            (sum, friction_rows)
+        };
+        self.rows = Some(RowsReport {
+            natural_map_residual: sum.sqrt() as f32,
+            friction_rows,
+        });
+    }
+
+    /// The island's natural-map residual and friction rows that the last [`Bundles::unpack`]
+    /// summed after a [`Bundles::record`]; `None` when the step's rows were not recorded in
+    /// the lanes. Taking it leaves `None`.
+    pub(crate) fn take_rows(&mut self) -> Option<RowsReport> {
+        self.rows.take()
+    }
+
+    /// Records, as the island's step ends, what its diagnostics need from each point at the
+    /// final velocities `linear`, `angular` (per island slot, as the sweeps had them): the
+    /// rows' J·v*, with v* = v − M⁻¹Jᵀγ the velocities before the final impulses γ, and the
+    /// natural map of its rows. [`Bundles::unpack`] then writes J·v* into the constraints and
+    /// sums the residual. Call it after the last solve, before `unpack`, and only when no
+    /// solve on the constraints follows (restitution): it reads the bundles' impulses.
+    ///
+    /// The same quantities as `diagnostics::record_velocity_before_and_residual` computes from
+    /// the unpacked constraints, which reads every 344-byte row twice (once to sum M⁻¹Jᵀγ per
+    /// body, once for the rows); here a sweep takes the impulses off a copy of the velocities
+    /// and one pass reads the bundles, a third of the bytes. The residual is the same to the
+    /// bit; v* sums each body's M⁻¹Jᵀγ in colour order rather than constraint order, so J·v*
+    /// may differ in its last bits.
+    pub fn record(&mut self, linear: &[Vec3], angular: &[Vec3]) {
+        let mut before_linear = std::mem::take(&mut self.before_linear);
+        let mut before_angular = std::mem::take(&mut self.before_angular);
+        before_linear.clear();
+        before_linear.extend_from_slice(linear);
+        before_angular.clear();
+        before_angular.extend_from_slice(angular);
+        let order = SweepOrder {
+            forward: true,
+            half_turn: false,
+        };
+        let mut before = Velocities {
+            linear: &mut before_linear,
+            angular: &mut before_angular,
+        };
+        self.sweep(order, &mut before, RemoveImpulses, NoTargets);
+        // Per lane group, its bodies gathered once (as a sweep does) for all its bundles.
+        let len = self.bundles.len();
+        self.records.resize(len, BundleRecord::default());
+        let (bundles, records) = (&self.bundles, SharedItems(self.records.as_mut_ptr()));
+        let (before_linear_ref, before_angular_ref) = (&before_linear, &before_angular);
+        let fill = |groups: &[Group]| {
+            // Capture the whole wrapper (Sync), not its raw-pointer field.
+            #[allow(clippy::redundant_locals)]
+            let records = records;
+            for group in groups {
+                let range = group.start as usize..(group.start + group.len) as usize;
+                let Some(first) = bundles.get(range.start) else {
+                    continue;
+                };
+                let (a, b) = (&first.local_a, &first.local_b);
+                let before = BodyLanes::gather(a, b, before_linear_ref, before_angular_ref);
+                let after = BodyLanes::gather(a, b, linear, angular);
+                let end = range.end.min(len);
+                for (index, bundle) in (range.start..end).zip(&bundles[range.start..end]) {
+                    // SAFETY: `index` < the records' length (`len`); the groups' ranges are
+                    // disjoint, so no other task writes this record.
+                    unsafe {
+                        *records.0.add(index) = record_bundle(bundle, &before, &after);
+                    }
+                }
+            }
+        };
+        if spread(self.parallel, len * LANES, PARALLEL_PACK_POINTS - 1) {
+            use rayon::prelude::*;
+            self.groups
+                .par_chunks(PARALLEL_PACK_POINTS / (4 * LANES))
+                .for_each(fill);
+        } else {
+            fill(&self.groups);
+        }
+        self.before_linear = before_linear;
+        self.before_angular = before_angular;
+        self.recorded = true;
     }
 
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
@@ -731,6 +909,54 @@ impl BundleUpdate for WarmStart {
         b.tangents[0].apply(b.tangent_impulses[0], masses, v);
         b.tangents[1].apply(b.tangent_impulses[1], masses, v);
         Lane::splat(0.0)
+    }
+}
+
+/// The accumulated impulses taken off the bodies (v − M⁻¹Jᵀγ, the warm start's reverse);
+/// changes no impulse. [`Bundles::record`]'s way to the velocities before the impulses.
+#[derive(Clone, Copy)]
+struct RemoveImpulses;
+
+impl BundleUpdate for RemoveImpulses {
+    #[inline(always)]
+    fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane {
+        let masses = (b.inverse_mass_a, b.inverse_mass_b);
+        b.normal.apply(-b.normal_impulse, masses, v);
+        b.tangents[0].apply(-b.tangent_impulses[0], masses, v);
+        b.tangents[1].apply(-b.tangent_impulses[1], masses, v);
+        Lane::splat(0.0)
+    }
+}
+
+/// One bundle's [`BundleRecord`] from its bodies' velocities v* (`before`) and v (`after`),
+/// with the operations of the scalar record in the same order (`JacobianRow::velocity`,
+/// `diagnostics::row_squared_natural_map`).
+#[inline(always)]
+fn record_bundle(b: &Bundle, before: &BodyLanes, after: &BodyLanes) -> BundleRecord {
+    let [t1, t2] = &b.tangents;
+    let normal_velocity = b.normal.velocity(after) - b.target;
+    let g = b.tangent_impulses;
+    let slip = [t1.velocity(after), t2.velocity(after)];
+    // `solver::cap_to_disc`'s steps per lane (the sweeps' lane version clamps its scale,
+    // which may round differently).
+    let (zero, trial) = (Lane::splat(0.0), [g[0] - slip[0], g[1] - slip[1]]);
+    let limit = b.friction * b.normal_impulse;
+    let squared = trial[0] * trial[0] + trial[1] * trial[1];
+    let inside = squared.simd_le(limit * limit);
+    let positive = squared.simd_gt(zero);
+    let scale = limit / squared.sqrt();
+    let projected = trial.map(|x| inside.select(x, positive.select(x * scale, zero)));
+    BundleRecord {
+        velocity_before: [
+            b.normal.velocity(before),
+            t1.velocity(before),
+            t2.velocity(before),
+        ],
+        phi: [
+            b.normal_impulse.min(normal_velocity),
+            g[0] - projected[0],
+            g[1] - projected[1],
+        ],
     }
 }
 

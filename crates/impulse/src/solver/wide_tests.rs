@@ -253,3 +253,116 @@ fn cubes_on_a_sphere_pile_in_lanes_satisfy_complementarity() {
         "{mixed_steps} steps mixed cube faces and spheres"
     );
 }
+
+/// The record the lanes take as an island's step ends (`Bundles::record`, summed by
+/// `Bundles::unpack`) against the scalar one over the unpacked constraints
+/// (`record_velocity_before_and_residual`): the same natural-map residual to the bit, the same
+/// friction-row count, each row's J·v* equal up to the order of the per-body sums, and the
+/// same bits on one and two threads. Rows: a settled pyramid's, repeated with scaled
+/// impulses (every third copy frictionless) to pass the parallel and per-part thresholds.
+#[test]
+fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
+    use super::Bundles;
+    use crate::contact::constraints::{BodySlots, ContactConstraint};
+    use crate::diagnostics::record_velocity_before_and_residual;
+    let mut scene = builtin_scene("pyramid20").unwrap();
+    scene.solver.sleep = false;
+    let mut w = World::from_scene(&scene).unwrap();
+    for _ in 0..30 {
+        w.step().unwrap();
+    }
+    // World indices as slots; every immovable body in the last slot.
+    let n = w.bodies.len();
+    let slot = |i: u32| {
+        if w.bodies.kind[i as usize] == BodyKind::Dynamic {
+            i
+        } else {
+            n as u32
+        }
+    };
+    let mut rows: Vec<ContactConstraint> = Vec::new();
+    for copy in 0..12 {
+        for c in w.contact_constraints() {
+            let mut c = *c;
+            (c.local_a, c.local_b) = (slot(c.body_a), slot(c.body_b));
+            let scale = 1.0 + 0.01 * copy as f32;
+            c.normal_impulse *= scale;
+            c.tangent_impulses = c.tangent_impulses.map(|t| t * scale);
+            if copy % 3 == 0 {
+                c.friction = 0.0;
+                c.tangent_impulses = [0.0; 2];
+            }
+            rows.push(c);
+        }
+    }
+    assert!(rows.len() > 2 * 4096, "{} rows", rows.len());
+    let with_friction = rows.iter().filter(|c| c.friction > 0.0).count();
+    let mut linear = w.bodies.linear_velocity.clone();
+    let mut angular = w.bodies.angular_velocity.clone();
+    linear.push(Vec3::ZERO);
+    angular.push(Vec3::ZERO);
+    let before = |rows: &[ContactConstraint]| -> Vec<[f32; 3]> {
+        rows.iter()
+            .map(|c| {
+                [
+                    c.normal.velocity_before,
+                    c.tangents[0].velocity_before,
+                    c.tangents[1].velocity_before,
+                ]
+            })
+            .collect()
+    };
+    let mut results = Vec::new();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let (lanes, report, scalar, scalar_report) = pool.install(|| {
+            let parallel = threads > 1;
+            let mut bundles = Bundles::default();
+            bundles.pack(&rows, n + 1, parallel);
+            bundles.record(&linear, &angular);
+            let mut lanes = rows.clone();
+            bundles.unpack(&mut lanes);
+            let report = bundles.take_rows().expect("recorded rows give a report");
+            let mut scalar = lanes.clone();
+            let scalar_report = record_velocity_before_and_residual(
+                &mut scalar,
+                BodySlots::Island,
+                &linear,
+                &angular,
+                parallel,
+                &mut Vec::new(),
+            );
+            (lanes, report, scalar, scalar_report)
+        });
+        assert!(report.natural_map_residual > 0.0);
+        assert_eq!(
+            report.natural_map_residual.to_bits(),
+            scalar_report.natural_map_residual.to_bits(),
+            "{threads} threads: {} against {}",
+            report.natural_map_residual,
+            scalar_report.natural_map_residual
+        );
+        assert_eq!(report.friction_rows, with_friction);
+        assert_eq!(scalar_report.friction_rows, with_friction);
+        let (got, want) = (before(&lanes), before(&scalar));
+        let largest = want.iter().flatten().fold(0.0f32, |m, v| m.max(v.abs()));
+        assert!(largest > 0.1, "the rows should have some v*: {largest}");
+        for (k, (g, e)) in got.iter().zip(&want).enumerate() {
+            for r in 0..3 {
+                assert!(
+                    (g[r] - e[r]).abs() <= 1e-5 * largest,
+                    "{threads} threads, point {k} row {r}: J·v* {} in lanes, {} scalar",
+                    g[r],
+                    e[r]
+                );
+            }
+        }
+        results.push((got, report));
+    }
+    let bits = |v: &Vec<[f32; 3]>| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&results[0].0), bits(&results[1].0), "1 and 2 threads");
+    assert_eq!(results[0].1, results[1].1);
+}

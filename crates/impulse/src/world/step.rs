@@ -222,20 +222,24 @@ impl World {
             // Each island ends its step with the passes that read its rows once more, while
             // they are still in cache: its rows' v*, its natural-map residual and its
             // friction-row count, in one pass, instead of world-wide passes over every row
-            // that wait on memory; the results are the same to the bit.
+            // that wait on memory; the results are the same to the bit. Islands solved in SIMD
+            // lanes have taken them from their bundles already (`IslandWorkspace::rows`).
             let run = |bodies: &[u32],
                        guests: &[u32],
                        constraints: &mut [ContactConstraint],
                        workspace: &mut IslandWorkspace| {
                 substep::step_island(bodies, guests, constraints, &context, workspace);
-                let rows = diagnostics::record_velocity_before_and_residual(
-                    constraints,
-                    constraints::BodySlots::Island,
-                    &workspace.linear,
-                    &workspace.angular,
-                    context.parallel,
-                    &mut workspace.record_scratch,
-                );
+                let rows = match workspace.rows.take() {
+                    Some(rows) => rows,
+                    None => diagnostics::record_velocity_before_and_residual(
+                        constraints,
+                        constraints::BodySlots::Island,
+                        &workspace.linear,
+                        &workspace.angular,
+                        context.parallel,
+                        &mut workspace.record_scratch,
+                    ),
+                };
                 workspace.report.natural_map_residual = rows.natural_map_residual;
                 workspace.friction_rows = rows.friction_rows;
             };
@@ -296,7 +300,8 @@ impl World {
         }
         // Awake islands recorded their rows' v* as their step ended; a sleeping island's rows
         // take it from the bodies' velocities. One pass over every row covers them (rows of
-        // awake islands come out the same as their own record).
+        // awake islands come out as their own record, to the last bits where the SIMD lanes
+        // took it: see `wide::Bundles::record`).
         if self.island_awake.iter().take(islands).any(|awake| !awake) {
             constraints::record_velocity_before(
                 &mut self.constraints,
