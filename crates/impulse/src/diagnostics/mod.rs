@@ -7,9 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::body::Bodies;
 use crate::contact::constraints::{BodySlots, ContactConstraint};
-use crate::parallel::{
-    ENERGY_BODIES_PER_PART, RESIDUAL_ROWS_PER_TASK, SharedItems, parts_in_order, spread,
-};
+use crate::parallel::{ENERGY_BODIES_PER_PART, parts_in_order, spread};
 use crate::solver::cap_to_disc;
 use crate::solver::{IslandReport, RowsReport};
 
@@ -182,6 +180,7 @@ pub(crate) fn natural_map_residual_in(
     angular: &[Vec3],
     parallel: bool,
 ) -> f32 {
+    use crate::parallel::RESIDUAL_ROWS_PER_TASK;
     let run = |rows: &[ContactConstraint]| match slots {
         BodySlots::World => squared_natural_map(rows, linear, angular, |c| {
             (c.body_a as usize, c.body_b as usize)
@@ -278,7 +277,7 @@ pub fn record_velocity_before_and_residual(
         return RowsReport::default();
     };
     let bodies_of = slots.bodies_of();
-    let run = |rows: &mut [ContactConstraint]| {
+    let run = |_: usize, rows: &mut [ContactConstraint]| {
         let (mut sum, mut friction_rows) = (0.0f64, 0usize);
         for c in rows {
             let (a, b) = bodies_of(c);
@@ -288,45 +287,7 @@ pub fn record_velocity_before_and_residual(
         }
         (sum, friction_rows)
     };
-    let (sum, friction_rows): (f64, usize) =
-        if parallel && constraints.len() > RESIDUAL_ROWS_PER_TASK {
-            let n = constraints.len();
-            let rows = SharedItems(constraints.as_mut_ptr());
-            parts_in_order(
-                n.div_ceil(RESIDUAL_ROWS_PER_TASK),
-                |i| {
-                    // Capture the whole wrapper (Sync), not its raw-pointer field.
-                    #[allow(clippy::redundant_locals)]
-                    let rows = rows;
-                    let start = i * RESIDUAL_ROWS_PER_TASK;
-                    let len = RESIDUAL_ROWS_PER_TASK.min(n - start);
-                    // SAFETY: part i is rows [start, start + len) of the constraints, disjoint
-                    // from every other part's.
-                    run(unsafe { std::slice::from_raw_parts_mut(rows.0.add(start), len) })
-                },
-                |parts| {
-                    (
-                        parts.iter().map(|p| p.0).sum(),
-                        parts.iter().map(|p| p.1).sum(),
-                    )
-                },
-            )
-        } else {
-            let mut friction_rows = 0;
-            let sum = constraints
-                .chunks_mut(RESIDUAL_ROWS_PER_TASK)
-                .map(|rows| {
-                    let (sum, rows) = run(rows);
-                    friction_rows += rows;
-                    sum
-                })
-                .sum();
-            (sum, friction_rows)
-        };
-    RowsReport {
-        natural_map_residual: sum.sqrt() as f32,
-        friction_rows,
-    }
+    RowsReport::sum_in_runs(constraints, parallel, run)
 }
 
 /// Energy, mass and momentum of the moving bodies, from one pass over them.

@@ -21,7 +21,7 @@ use glam::Vec3;
 
 pub use crate::contact::constraints::cap_to_disc;
 use crate::contact::constraints::{self, ContactConstraint};
-use crate::parallel::SharedVelocities;
+use crate::parallel::{RESIDUAL_ROWS_PER_TASK, SharedItems, SharedVelocities, parts_in_order};
 use crate::settings::SolverSettings;
 
 pub mod apgd;
@@ -230,6 +230,64 @@ pub(crate) struct RowsReport {
     pub natural_map_residual: f32,
     /// Points with friction (μ > 0): each has two tangent rows.
     pub friction_rows: usize,
+}
+
+impl RowsReport {
+    /// The report of `run` over `constraints` cut into runs of [`RESIDUAL_ROWS_PER_TASK`]
+    /// rows: `run(start, rows)` gets a run's first index and its rows and returns the run's
+    /// sum of φ² and its rows with friction. The runs' sums are added in run order, so the
+    /// residual is the same to the bit whether the runs go on rayon's threads (`parallel`,
+    /// with more than one run) or not.
+    pub(crate) fn sum_in_runs<F>(
+        constraints: &mut [ContactConstraint],
+        parallel: bool,
+        run: F,
+    ) -> Self
+    where
+        F: Fn(usize, &mut [ContactConstraint]) -> (f64, usize) + Sync,
+    {
+        let n = constraints.len();
+        let (sum, friction_rows): (f64, usize) = if parallel && n > RESIDUAL_ROWS_PER_TASK {
+            let rows = SharedItems(constraints.as_mut_ptr());
+            parts_in_order(
+                n.div_ceil(RESIDUAL_ROWS_PER_TASK),
+                |i| {
+                    // Capture the whole wrapper (Sync), not its raw-pointer field.
+                    #[allow(clippy::redundant_locals)]
+                    let rows = rows;
+                    let start = i * RESIDUAL_ROWS_PER_TASK;
+                    let len = RESIDUAL_ROWS_PER_TASK.min(n - start);
+                    // SAFETY: part i is rows [start, start + len) of the constraints, disjoint
+                    // from every other part's.
+                    run(start, unsafe {
+                        std::slice::from_raw_parts_mut(rows.0.add(start), len)
+                    })
+                },
+                |parts| {
+                    (
+                        parts.iter().map(|p| p.0).sum(),
+                        parts.iter().map(|p| p.1).sum(),
+                    )
+                },
+            )
+        } else {
+            let mut friction_rows = 0;
+            let sum = constraints
+                .chunks_mut(RESIDUAL_ROWS_PER_TASK)
+                .enumerate()
+                .map(|(i, rows)| {
+                    let (sum, rows) = run(i * RESIDUAL_ROWS_PER_TASK, rows);
+                    friction_rows += rows;
+                    sum
+                })
+                .sum();
+            (sum, friction_rows)
+        };
+        Self {
+            natural_map_residual: sum.sqrt() as f32,
+            friction_rows,
+        }
+    }
 }
 
 /// What one solve did.

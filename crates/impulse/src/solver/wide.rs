@@ -34,8 +34,8 @@ use super::{
 use crate::contact::constraints::{ContactConstraint, JacobianRow, repair_terms};
 use crate::graph::{COLOURS, greedy_colours};
 use crate::parallel::{
-    GROUPS_PER_TASK, PARALLEL_PACK_POINTS, RESIDUAL_ROWS_PER_TASK, SharedItems, SharedVelocities,
-    colour_after_colour, parts_in_order, prefetch_lines, spread, threads,
+    GROUPS_PER_TASK, PARALLEL_PACK_POINTS, SharedItems, SharedVelocities, colour_after_colour,
+    prefetch_lines, spread, threads,
 };
 
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
@@ -590,55 +590,16 @@ impl Bundles {
             }
             return;
         }
-        // One run of points: its φ² sum and its points with friction.
-        let run = |rows: &mut [ContactConstraint], slots: &[u32]| {
+        // One run of points from `start`: its φ² sum and its points with friction.
+        let run = |start: usize, rows: &mut [ContactConstraint]| {
             let (mut sum, mut friction_rows) = (0.0f64, 0usize);
-            for (c, &slot) in rows.iter_mut().zip(slots) {
+            for (c, &slot) in rows.iter_mut().zip(&slots[start..]) {
                 sum += write(c, slot);
                 friction_rows += usize::from(c.friction > 0.0);
             }
             (sum, friction_rows)
         };
-        let n = constraints.len();
-        let (sum, friction_rows): (f64, usize) = if parallel && n > RESIDUAL_ROWS_PER_TASK {
-            let rows = SharedItems(constraints.as_mut_ptr());
-            parts_in_order(
-                n.div_ceil(RESIDUAL_ROWS_PER_TASK),
-                |i| {
-                    // Capture the whole wrapper (Sync), not its raw-pointer field.
-                    #[allow(clippy::redundant_locals)]
-                    let rows = rows;
-                    let start = i * RESIDUAL_ROWS_PER_TASK;
-                    let len = RESIDUAL_ROWS_PER_TASK.min(n - start);
-                    // SAFETY: part i is rows [start, start + len) of the constraints, disjoint
-                    // from every other part's.
-                    let mine = unsafe { std::slice::from_raw_parts_mut(rows.0.add(start), len) };
-                    run(mine, &slots[start..start + len])
-                },
-                |parts| {
-                    (
-                        parts.iter().map(|p| p.0).sum(),
-                        parts.iter().map(|p| p.1).sum(),
-                    )
-                },
-            )
-        } else {
-            let mut friction_rows = 0;
-            let sum = constraints
-                .chunks_mut(RESIDUAL_ROWS_PER_TASK)
-                .zip(slots.chunks(RESIDUAL_ROWS_PER_TASK))
-                .map(|(rows, slots)| {
-                    let (sum, rows) = run(rows, slots);
-                    friction_rows += rows;
-                    sum
-                })
-                .sum();
-            (sum, friction_rows)
-        };
-        self.rows = Some(RowsReport {
-            natural_map_residual: sum.sqrt() as f32,
-            friction_rows,
-        });
+        self.rows = Some(RowsReport::sum_in_runs(constraints, parallel, run));
     }
 
     /// The island's natural-map residual and friction rows that the last [`Bundles::unpack`]
