@@ -111,6 +111,8 @@ struct PairSummary {
     points: u32,
     rows: u32,
     max_depth: f32,
+    /// Whether some manifold lists a point twice ([`repeats_earlier_point`]).
+    duplicates: bool,
 }
 
 impl PairSummary {
@@ -123,6 +125,7 @@ impl PairSummary {
                 summary.rows += u32::from(!repeats_earlier_point(&manifold.points, index));
             }
         }
+        summary.duplicates = summary.rows != summary.points;
         summary
     }
 }
@@ -173,6 +176,12 @@ impl ContactPair {
     /// Number of contact constraints the pair yields: its points less repeated ones.
     pub fn row_count(&self) -> usize {
         self.summary.rows as usize
+    }
+
+    /// Whether some manifold of the pair lists a point twice, as of the last manifold update
+    /// ([`repeats_earlier_point`]): without, each point is its own row and its own warm start.
+    pub(crate) fn has_duplicate_points(&self) -> bool {
+        self.summary.duplicates
     }
 }
 

@@ -367,6 +367,7 @@ impl Assembly<'_> {
         let pair_inverse_mass = PairInverseMass::new(inverse_mass_a, inverse_mass_b);
         let inertia_a = &Mat3A::from(self.world_inverse_inertia[a]);
         let inertia_b = &Mat3A::from(self.world_inverse_inertia[b]);
+        let duplicates = pair.has_duplicate_points();
         for (manifold_index, manifold) in pair.manifolds.iter().enumerate() {
             if manifold.points.is_empty() {
                 continue;
@@ -375,19 +376,24 @@ impl Assembly<'_> {
             let (part_b, part_a) =
                 crate::collision::narrow_phase::manifold_poses(manifold, pose_b, pose_a);
             let normal = part_b.rotation * manifold.local_n1;
+            let (t1, t2) = tangent_basis(normal, manifold.data.tangent);
             for (point_index, point) in manifold.points.iter().enumerate() {
                 // Which copy of a duplicated point comes first can change between steps, so
                 // the warm start takes the copy that carries an impulse and the write-back
                 // goes to every copy.
-                if repeats_earlier_point(&manifold.points, point_index) {
-                    continue;
-                }
-                let warm = manifold.points[point_index..]
-                    .iter()
-                    .filter(|q| same_point(q.local_p1, point.local_p1))
-                    .map(|q| q.data)
-                    .max_by(|x, y| x.normal.total_cmp(&y.normal))
-                    .unwrap_or(point.data);
+                let warm = if duplicates {
+                    if repeats_earlier_point(&manifold.points, point_index) {
+                        continue;
+                    }
+                    manifold.points[point_index..]
+                        .iter()
+                        .filter(|q| same_point(q.local_p1, point.local_p1))
+                        .map(|q| q.data)
+                        .max_by(|x, y| x.normal.total_cmp(&y.normal))
+                        .unwrap_or(point.data)
+                } else {
+                    point.data
+                };
                 // A speculative contact's impulse acts once its gap has closed, where the two
                 // witness points meet: each body's lever arm then reaches its own surface
                 // point, so a sphere's is its radius and an oblique impact spins it at the
@@ -405,7 +411,6 @@ impl Assembly<'_> {
                 };
                 let r_a = at_a - com_a;
                 let r_b = at_b - com_b;
-                let (t1, t2) = tangent_basis(normal, manifold.data.tangent);
                 let (r_a_wide, r_b_wide) = (Vec3A::from(r_a), Vec3A::from(r_b));
                 let row = |d| {
                     JacobianRow::new(
