@@ -474,6 +474,7 @@ impl World {
                     0
                 };
                 let mut step_normal_impulse = 0.0;
+                let duplicates = pair.has_duplicate_points();
                 for row in first..first + pair.row_count() {
                     let Some(c) = constraints.get(row) else {
                         return false;
@@ -481,7 +482,7 @@ impl World {
                     if c.source.0 as usize != pair_index {
                         return false;
                     }
-                    write_impulse(c, &mut pair.manifolds);
+                    write_impulse(c, &mut pair.manifolds, duplicates);
                     step_normal_impulse += c.step_impulses[0];
                 }
                 pair.step_normal_impulse = step_normal_impulse;
@@ -504,7 +505,8 @@ impl World {
             }
             for c in constraints {
                 let pair = &mut pairs[c.source.0 as usize];
-                write_impulse(c, &mut pair.manifolds);
+                let duplicates = pair.has_duplicate_points();
+                write_impulse(c, &mut pair.manifolds, duplicates);
                 pair.step_normal_impulse += c.step_impulses[0];
             }
         }
@@ -591,8 +593,14 @@ impl World {
 }
 
 /// Writes constraint `c`'s impulses into its point (named by `c.source`) of `manifolds`, its
-/// pair's manifolds, and into every duplicate copy of that point (see `constraints::assemble`).
-fn write_impulse(c: &ContactConstraint, manifolds: &mut [narrow_phase::Manifold]) {
+/// pair's manifolds, and, when the pair has `duplicates`
+/// ([`narrow_phase::ContactPair::has_duplicate_points`]), into every duplicate copy of that
+/// point (see `constraints::assemble`).
+fn write_impulse(
+    c: &ContactConstraint,
+    manifolds: &mut [narrow_phase::Manifold],
+    duplicates: bool,
+) {
     let (_, manifold, point) = c.source;
     let data = ContactImpulse {
         normal: c.normal_impulse,
@@ -605,6 +613,10 @@ fn write_impulse(c: &ContactConstraint, manifolds: &mut [narrow_phase::Manifold]
     let manifold = &mut manifolds[manifold as usize];
     manifold.data.tangent = c.tangents[0].direction;
     let points = &mut manifold.points;
+    if !duplicates {
+        points[point as usize].data = data;
+        return;
+    }
     let location = points[point as usize].local_p1;
     for p in points[point as usize..].iter_mut() {
         if narrow_phase::same_point(p.local_p1, location) {
