@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# Fuzz the scene parser, the LCP file readers and a short simulation with cargo fuzz
+# Fuzz the scene parser, the LCP file readers, a short simulation, the mesh file readers and
+# the world snapshot reader with cargo fuzz
 # (libFuzzer). Usage: scripts/fuzz.sh [SECONDS] [TARGET...]
 #   SECONDS  time per target (default 600); targets run one after the other.
-#   TARGET   scene_parser, lcp_readers, short_simulation (default: all three).
+#   TARGET   scene_parser, lcp_readers, short_simulation, mesh_readers, snapshot_reader
+#            (default: all five).
 # cargo fuzz needs nightly compiler flags (-Z sanitizer, -C passes=sancov-module). The script
 # sets RUSTC_BOOTSTRAP=1 so that a stable toolchain accepts them; no nightly is installed.
-# The corpus grows under fuzz/corpus/<target> (seeded from scenes/*.json and the LCP test data
-# when empty); crashes are written to fuzz/artifacts/<target>. Environment: FUZZ_JOBS (libFuzzer
+# The corpus grows under fuzz/corpus/<target> (seeded from scenes/*.json, the LCP test data and
+# fuzz/seeds/<target> when empty); crashes are written to fuzz/artifacts/<target>. Environment: FUZZ_JOBS (libFuzzer
 # -jobs/-workers, default 1: one process; more write fuzz/fuzz-<n>.log), CARGO_TARGET_DIR as usual. docs/fuzzing.md has the details.
 set -euo pipefail
 
@@ -14,7 +16,7 @@ seconds="${1:-600}"
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(scene_parser lcp_readers short_simulation)
+    targets=(scene_parser lcp_readers short_simulation mesh_readers snapshot_reader)
 fi
 jobs="${FUZZ_JOBS:-1}"
 # With -jobs libFuzzer runs workers that log to fuzz-<n>.log; one process logs here.
@@ -48,6 +50,9 @@ seed() {
             cp "$root"/crates/impulse-lcp/tests/data/siconos/*.dat "$dir"
             cp seeds/lcp_readers/* "$dir"
             ;;
+        mesh_readers | snapshot_reader)
+            cp "seeds/$target"/* "$dir"
+            ;;
     esac
 }
 
@@ -56,6 +61,7 @@ seed() {
 options() {
     case "$1" in
         short_simulation) echo "-max_len=8192 -timeout=10" ;;
+        snapshot_reader) echo "-max_len=16384 -timeout=10" ;;
         *) echo "-max_len=65536 -timeout=10" ;;
     esac
 }

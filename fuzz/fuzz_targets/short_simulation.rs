@@ -6,7 +6,6 @@
 #![no_main]
 
 use impulse::scene::parse_scene_str;
-use impulse::World;
 use libfuzzer_sys::fuzz_target;
 
 #[path = "common.rs"]
@@ -19,19 +18,7 @@ fuzz_target!(|data: &[u8]| {
     if common::names_a_file(text) {
         return;
     }
-    let Ok(scene) = parse_scene_str(text, "fuzz.json") else {
-        return;
-    };
-    let Some(scene) = common::capped(scene) else {
-        return;
-    };
-    let Ok(mut world) = World::from_scene(&scene) else {
-        return;
-    };
-    world.set_parallel(false);
-    for _ in 0..common::MAX_STEPS {
-        if world.step().is_err() {
-            break;
-        }
+    if let Ok(scene) = parse_scene_str(text, "fuzz.json") {
+        let _ = common::run_capped(&scene);
     }
 });

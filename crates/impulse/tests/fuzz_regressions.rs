@@ -1,32 +1,32 @@
-//! The committed corpora of the scene fuzz targets (`fuzz/corpus/<target>`, docs/fuzzing.md)
-//! and any input that once crashed them (`tests/data/fuzz/<target>/`), run through the same
-//! code paths: parsing, validation and `World::from_scene` (`scene_parser`), and up to 30
-//! steps with the same caps on bodies and solver effort (`short_simulation`). Each input must
-//! give an error or a clean run; a panic fails the test. Unlike the fuzz build, the test
-//! profile has debug assertions and overflow checks on.
+//! The committed corpora and seeds of impulse's fuzz targets (`fuzz/corpus/<target>`,
+//! `fuzz/seeds/<target>`, docs/fuzzing.md) and any input that once crashed them
+//! (`tests/data/fuzz/<target>/`), run through the same code paths (the targets' own
+//! `fuzz/fuzz_targets/common.rs`): parsing, validation and `World::from_scene`
+//! (`scene_parser`); up to 30 steps with the same caps on bodies and solver effort
+//! (`short_simulation`); the mesh file readers and a ball dropped on what they read
+//! (`mesh_readers`); the snapshot reader and steps of the restored world (`snapshot_reader`).
+//! Each input must give an error or a clean run; a panic fails the test. Unlike the fuzz
+//! build, the test profile has debug assertions and overflow checks on.
 
 use std::path::{Path, PathBuf};
 
 use impulse::World;
-use impulse::scene::Scene;
 use impulse::scene::parse_scene_str;
 use impulse::scene::validate_all;
 
-/// The caps of `fuzz/fuzz_targets/common.rs`.
-const MAX_BODIES: usize = 32;
-const MAX_STEPS: usize = 30;
-const MAX_SUBSTEPS: u32 = 4;
-const MAX_ITERATIONS: u32 = 100;
-const MAX_RELAX_ITERATIONS: u32 = 20;
-const MAX_EXACT_CONTACTS: u32 = 32;
+/// The fuzz targets' own caps and input handling, so that the corpora are replayed exactly as
+/// the fuzzer ran them.
+#[path = "../../../fuzz/fuzz_targets/common.rs"]
+mod common;
 
-/// The files of `fuzz/corpus/<target>` and of `tests/data/fuzz/<target>` (which exists only
-/// once a crash has been found), sorted.
+/// The files of `fuzz/corpus/<target>`, `fuzz/seeds/<target>` and `tests/data/fuzz/<target>`
+/// (each read if it exists), sorted.
 fn inputs(target: &str) -> Vec<PathBuf> {
     let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
     for directory in [
         manifest.join("../../fuzz/corpus").join(target),
+        manifest.join("../../fuzz/seeds").join(target),
         manifest.join("tests/data/fuzz").join(target),
     ] {
         let Ok(entries) = std::fs::read_dir(&directory) else {
@@ -48,32 +48,6 @@ fn text_of(path: &Path) -> Option<String> {
     String::from_utf8(bytes).ok()
 }
 
-/// Whether the JSON names a mesh `file` anywhere: the fuzz targets skip such inputs, which
-/// would read arbitrary paths.
-fn names_a_file(text: &str) -> bool {
-    fn walk(value: &serde_json::Value) -> bool {
-        match value {
-            serde_json::Value::Object(map) => map.iter().any(|(k, v)| k == "file" || walk(v)),
-            serde_json::Value::Array(items) => items.iter().any(walk),
-            _ => false,
-        }
-    }
-    serde_json::from_str::<serde_json::Value>(text).is_ok_and(|value| walk(&value))
-}
-
-fn capped(mut scene: Scene) -> Option<Scene> {
-    if scene.bodies.len() > MAX_BODIES {
-        return None;
-    }
-    let solver = &mut scene.solver;
-    solver.substeps = solver.substeps.min(MAX_SUBSTEPS);
-    solver.iterations = solver.iterations.min(MAX_ITERATIONS);
-    solver.relax_iterations = solver.relax_iterations.min(MAX_RELAX_ITERATIONS);
-    solver.escalation_iterations = solver.escalation_iterations.min(MAX_ITERATIONS);
-    solver.exact_max_contacts = solver.exact_max_contacts.min(MAX_EXACT_CONTACTS);
-    Some(scene)
-}
-
 /// What `scene_parser` does with one input.
 fn parse_and_build(text: &str) {
     if let Ok(scene) = parse_scene_str(text, "fuzz.json") {
@@ -82,32 +56,10 @@ fn parse_and_build(text: &str) {
     }
 }
 
-/// What `short_simulation` does with one input; returns the steps taken without error.
-fn simulate(text: &str) -> usize {
-    let Ok(scene) = parse_scene_str(text, "fuzz.json") else {
-        return 0;
-    };
-    let Some(scene) = capped(scene) else {
-        return 0;
-    };
-    let Ok(mut world) = World::from_scene(&scene) else {
-        return 0;
-    };
-    world.set_parallel(false);
-    let mut steps = 0;
-    for _ in 0..MAX_STEPS {
-        if world.step().is_err() {
-            break;
-        }
-        steps += 1;
-    }
-    steps
-}
-
 #[test]
 fn scene_parser_inputs_give_errors_not_panics() {
     for path in inputs("scene_parser") {
-        if let Some(text) = text_of(&path).filter(|text| !names_a_file(text)) {
+        if let Some(text) = text_of(&path).filter(|text| !common::names_a_file(text)) {
             parse_and_build(&text);
         }
     }
@@ -117,12 +69,40 @@ fn scene_parser_inputs_give_errors_not_panics() {
 fn short_simulation_inputs_give_errors_not_panics() {
     let mut stepped = 0;
     for path in inputs("short_simulation") {
-        if let Some(text) = text_of(&path).filter(|text| !names_a_file(text))
-            && simulate(&text) > 0
+        if let Some(text) = text_of(&path).filter(|text| !common::names_a_file(text))
+            && parse_scene_str(&text, "fuzz.json").is_ok_and(|scene| common::run_capped(&scene) > 0)
         {
             stepped += 1;
         }
     }
     // The corpus starts from the repository's scenes, so some inputs are scenes that step.
     assert!(stepped > 0, "no short_simulation input stepped");
+}
+
+/// How many inputs of `target` stepped at least once when run by `run` (the target's own
+/// handling of an input, returning the steps taken).
+fn inputs_that_stepped(target: &str, run: fn(&[u8]) -> Option<usize>) -> usize {
+    inputs(target)
+        .iter()
+        .map(|path| std::fs::read(path).expect("readable input"))
+        .filter(|bytes| run(bytes).is_some_and(|steps| steps > 0))
+        .count()
+}
+
+#[test]
+fn mesh_reader_inputs_give_errors_not_panics() {
+    // The corpus starts from an OBJ terrain and glTF files the exporter wrote.
+    assert!(
+        inputs_that_stepped("mesh_readers", common::mesh_input) > 0,
+        "no mesh_readers input read and stepped"
+    );
+}
+
+#[test]
+fn snapshot_reader_inputs_give_errors_not_panics() {
+    // The corpus starts from checkpoints of small scenes.
+    assert!(
+        inputs_that_stepped("snapshot_reader", common::snapshot_input) > 0,
+        "no snapshot_reader input restored and stepped"
+    );
 }

@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use impulse::glam::Vec3;
 use impulse::parry3d::query;
 use impulse::scene::{
-    BodyDesc, BodyKind, CompoundPart, Scene, SceneErrorKind, ShapeDesc, load_mesh_file,
-    load_scene_file, parse_scene_str,
+    BodyDesc, BodyKind, CompoundPart, MeshFormat, Scene, SceneErrorKind, ShapeDesc, load_mesh_file,
+    load_scene_file, parse_scene_str, read_mesh_bytes,
 };
 use impulse::{SolverSettings, World};
 
@@ -165,8 +165,12 @@ fn obj_gltf_and_glb_give_the_same_triangles() {
     glb.extend((blob.len() as u32).to_le_bytes());
     glb.extend(b"BIN\0");
     glb.extend(&blob);
-    std::fs::write(dir.join("terrain.glb"), glb).unwrap();
-    for name in ["terrain.gltf", "terrain.glb"] {
+    std::fs::write(dir.join("terrain.glb"), &glb).unwrap();
+    // The buffer in a file beside the glTF file.
+    std::fs::write(dir.join("terrain.bin"), &bin).unwrap();
+    let external = document(Some("terrain.bin".into())).to_string();
+    std::fs::write(dir.join("external.gltf"), &external).unwrap();
+    for name in ["terrain.gltf", "terrain.glb", "external.gltf"] {
         let mesh = load_mesh_file(&dir.join(name)).unwrap();
         assert_eq!(mesh.indices, obj.indices, "{name}");
         for (a, b) in mesh.vertices.iter().zip(&obj.vertices) {
@@ -174,6 +178,18 @@ fn obj_gltf_and_glb_give_the_same_triangles() {
             assert_eq!(*a, moved, "{name}");
         }
     }
+    // From bytes: the same triangles; a buffer in another file is read only from a directory.
+    let from_glb = read_mesh_bytes(&glb, MeshFormat::Gltf, "terrain.glb", None).unwrap();
+    assert_eq!(from_glb, load_mesh_file(&dir.join("terrain.glb")).unwrap());
+    let beside = read_mesh_bytes(external.as_bytes(), MeshFormat::Gltf, "x.gltf", Some(&dir));
+    assert_eq!(beside.unwrap(), from_glb);
+    let refused = read_mesh_bytes(external.as_bytes(), MeshFormat::Gltf, "x.gltf", None)
+        .expect_err("a buffer in another file without a directory must be refused")
+        .to_string();
+    assert!(
+        refused.contains("x.gltf") && refused.contains("terrain.bin"),
+        "{refused}"
+    );
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -74,23 +74,63 @@ pub enum MeshFileError {
     },
 }
 
-/// Reads the triangles of the OBJ, glTF or GLB file at `path` (by extension, any case).
+/// The format of a mesh file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ (text).
+    Obj,
+    /// glTF 2.0: JSON (`.gltf`) or binary (`.glb`), told apart by the GLB magic.
+    Gltf,
+}
+
+impl MeshFormat {
+    /// The format of a file by its extension, any case: `.obj`, `.gltf` or `.glb`; `None`
+    /// for any other.
+    pub fn of_path(path: &Path) -> Option<Self> {
+        let extension = path.extension()?.to_str()?.to_ascii_lowercase();
+        match extension.as_str() {
+            "obj" => Some(Self::Obj),
+            "gltf" | "glb" => Some(Self::Gltf),
+            _ => None,
+        }
+    }
+}
+
+/// Reads the triangles of the OBJ, glTF or GLB file at `path` (by extension, any case). A glTF
+/// file's buffers may be in its GLB chunk, in data URIs or in files beside it.
 ///
 /// # Errors
 /// [`MeshFileError`]: unreadable file, unknown extension, a malformed file, or no triangle.
 pub fn load_mesh_file(path: &Path) -> Result<MeshData, MeshFileError> {
     let name = path.display().to_string();
-    let extension = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let mesh = match extension.as_deref() {
-        Some("obj") => load_obj(path, &name)?,
-        Some("gltf") | Some("glb") => load_gltf(path, &name)?,
-        _ => return Err(MeshFileError::UnknownType { path: name }),
+    let format =
+        MeshFormat::of_path(path).ok_or(MeshFileError::UnknownType { path: name.clone() })?;
+    let bytes = read(path, &name)?;
+    let directory = path.parent().unwrap_or(Path::new("."));
+    read_mesh_bytes(&bytes, format, &name, Some(directory))
+}
+
+/// Reads the triangles of a mesh file's contents `bytes` in `format`; `name` names the file in
+/// errors. A glTF file's buffers in other files (relative URIs) are read from `directory`;
+/// with `None` they are refused, so that only self-contained files (a GLB chunk, data URIs)
+/// are read and no other file is touched.
+///
+/// # Errors
+/// [`MeshFileError`]: a malformed file, a buffer that cannot be read, or no triangle.
+pub fn read_mesh_bytes(
+    bytes: &[u8],
+    format: MeshFormat,
+    name: &str,
+    directory: Option<&Path>,
+) -> Result<MeshData, MeshFileError> {
+    let mesh = match format {
+        MeshFormat::Obj => read_obj(bytes, name)?,
+        MeshFormat::Gltf => read_gltf(bytes, name, directory)?,
     };
     if mesh.indices.is_empty() {
-        return Err(MeshFileError::Empty { path: name });
+        return Err(MeshFileError::Empty {
+            path: name.to_string(),
+        });
     }
     Ok(mesh)
 }
@@ -109,17 +149,15 @@ fn format_error(name: &str, message: impl Into<String>) -> MeshFileError {
     }
 }
 
-fn load_obj(path: &Path, name: &str) -> Result<MeshData, MeshFileError> {
-    let bytes = read(path, name)?;
+fn read_obj(bytes: &[u8], name: &str) -> Result<MeshData, MeshFileError> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
     };
     // Materials are not needed: a missing .mtl file must not fail the load.
-    let (models, _) =
-        tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| Ok(Default::default()))
-            .map_err(|e| format_error(name, format!("not a valid OBJ file: {e}")))?;
+    let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &options, |_| Ok(Default::default()))
+        .map_err(|e| format_error(name, format!("not a valid OBJ file: {e}")))?;
     let mut mesh = MeshData::default();
     for model in models {
         let m = &model.mesh;
@@ -144,11 +182,13 @@ fn load_obj(path: &Path, name: &str) -> Result<MeshData, MeshFileError> {
     Ok(mesh)
 }
 
-fn load_gltf(path: &Path, name: &str) -> Result<MeshData, MeshFileError> {
-    let bytes = read(path, name)?;
-    let document = gltf::Gltf::from_slice(&bytes)
+fn read_gltf(
+    bytes: &[u8],
+    name: &str,
+    directory: Option<&Path>,
+) -> Result<MeshData, MeshFileError> {
+    let document = gltf::Gltf::from_slice(bytes)
         .map_err(|e| format_error(name, format!("not a valid glTF file: {e}")))?;
-    let directory = path.parent().unwrap_or(Path::new("."));
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for buffer in document.buffers() {
         let data = match buffer.source() {
@@ -172,9 +212,14 @@ fn load_gltf(path: &Path, name: &str) -> Result<MeshData, MeshFileError> {
                             "buffer {uri:?}: only files beside the glTF file and data URIs are read"
                         ),
                     ));
-                } else {
+                } else if let Some(directory) = directory {
                     let buffer_path = directory.join(uri);
                     read(&buffer_path, &buffer_path.display().to_string())?
+                } else {
+                    return Err(format_error(
+                        name,
+                        format!("buffer {uri:?}: buffers in other files are not read here"),
+                    ));
                 }
             }
         };

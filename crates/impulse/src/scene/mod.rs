@@ -441,6 +441,8 @@ pub use error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, Tex
 pub use json::{
     load_scene_file, locate, locate_closest, parse_scene_str, parse_scene_str_in, to_json_string,
 };
-pub use mesh_file::{LoadedMesh, MeshData, MeshFileError, load_mesh_file};
+pub use mesh_file::{
+    LoadedMesh, MeshData, MeshFileError, MeshFormat, load_mesh_file, read_mesh_bytes,
+};
 pub use shape::build_shape;
 pub use validate::{validate, validate_all};
