@@ -187,8 +187,9 @@ fn read_gltf(
     name: &str,
     directory: Option<&Path>,
 ) -> Result<MeshData, MeshFileError> {
-    let document = gltf::Gltf::from_slice(bytes)
-        .map_err(|e| format_error(name, format!("not a valid glTF file: {e}")))?;
+    let not_valid = |e: gltf::Error| format_error(name, format!("not a valid glTF file: {e}"));
+    let document = gltf::Gltf::from_slice_without_validation(bytes).map_err(not_valid)?;
+    validate_gltf(document.as_json()).map_err(not_valid)?;
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for buffer in document.buffers() {
         let data = match buffer.source() {
@@ -247,6 +248,43 @@ fn read_gltf(
         }
     }
     Ok(mesh)
+}
+
+/// The glTF crate's own validation of a parsed document (what `Gltf::from_slice` runs), after
+/// the one check it leaves too late: gltf-json 1.4's validation reads each primitive's
+/// `POSITION` accessor before it checks that the accessor exists, and panics on an index out
+/// of range (found by fuzzing), so that index is checked first.
+fn validate_gltf(root: &gltf::json::Root) -> Result<(), gltf::Error> {
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::{Checked, Error, Validate};
+    let mut errors = Vec::new();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(Semantic::Positions));
+            if position.is_some_and(|index| index.value() >= root.accessors.len()) {
+                let path = gltf::json::Path::new()
+                    .field("meshes")
+                    .index(m)
+                    .field("primitives")
+                    .index(p)
+                    .field("attributes")
+                    .key("POSITION");
+                errors.push((path, Error::IndexOutOfBounds));
+            }
+        }
+    }
+    if errors.is_empty() {
+        root.validate(root, gltf::json::Path::new, &mut |path, error| {
+            errors.push((path(), error))
+        });
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(gltf::Error::Validation(errors))
+    }
 }
 
 /// Adds the triangles of `node` and its children, with `parent` the transform above it.

@@ -458,54 +458,80 @@ impl Checker {
                 indices_path.index(t)
             }
         };
-        if mesh.indices.is_empty() {
-            self.fail(
-                indices_path,
-                "a trimesh needs at least one triangle".to_string(),
-            );
-            return;
-        }
-        for (i, v) in mesh.vertices.iter().enumerate() {
-            if !v.iter().all(|x| x.is_finite()) {
-                self.fail(
-                    &vertex_path(i),
-                    format!("vertex {i} must be finite, got {v:?}"),
-                );
-                return;
-            }
-        }
-        let count = mesh.vertices.len();
-        let extent = mesh_extent(&mesh.vertices);
-        for (t, triangle) in mesh.indices.iter().enumerate() {
-            if let Some(&bad) = triangle.iter().find(|&&i| i as usize >= count) {
-                self.fail(
-                    &triangle_path(t),
-                    format!(
-                        "triangle {t} refers to vertex {bad}, but there are {count} vertices \
-                         (indices 0 to {})",
-                        count.saturating_sub(1)
-                    ),
-                );
-                return;
-            }
-            let [a, b, c] = triangle.map(|i| {
-                let p = mesh.vertices[i as usize];
-                [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])]
-            });
-            let twice_area = len(cross(sub(b, a), sub(c, a)));
-            if twice_area <= HULL_FLATNESS_TOLERANCE * HULL_FLATNESS_TOLERANCE * extent * extent {
-                self.fail(
-                    &triangle_path(t),
-                    format!(
-                        "triangle {t} (vertices {}, {}, {}) has no area: its corners coincide \
-                         or are collinear",
-                        triangle[0], triangle[1], triangle[2]
-                    ),
-                );
-                return;
-            }
+        match mesh_problem(mesh) {
+            None => {}
+            Some(MeshProblem::NoTriangles(message)) => self.fail(indices_path, message),
+            Some(MeshProblem::Vertex(i, message)) => self.fail(&vertex_path(i), message),
+            Some(MeshProblem::Triangle(t, message)) => self.fail(&triangle_path(t), message),
         }
     }
+}
+
+/// The first thing wrong with a triangle mesh, with where it is and what is allowed.
+pub(crate) enum MeshProblem {
+    /// No triangle at all.
+    NoTriangles(String),
+    /// Vertex i is not finite.
+    Vertex(usize, String),
+    /// Triangle t refers to a missing vertex, or has no area.
+    Triangle(usize, String),
+}
+
+impl MeshProblem {
+    /// What is wrong, in words.
+    pub(crate) fn message(&self) -> &str {
+        match self {
+            Self::NoTriangles(m) | Self::Vertex(_, m) | Self::Triangle(_, m) => m,
+        }
+    }
+}
+
+/// Checks a triangle mesh as the scene format requires it (at least one triangle, finite
+/// vertices, indices in range, every triangle with an area); the first problem found.
+pub(crate) fn mesh_problem(mesh: &MeshData) -> Option<MeshProblem> {
+    if mesh.indices.is_empty() {
+        return Some(MeshProblem::NoTriangles(
+            "a trimesh needs at least one triangle".to_string(),
+        ));
+    }
+    for (i, v) in mesh.vertices.iter().enumerate() {
+        if !v.iter().all(|x| x.is_finite()) {
+            return Some(MeshProblem::Vertex(
+                i,
+                format!("vertex {i} must be finite, got {v:?}"),
+            ));
+        }
+    }
+    let count = mesh.vertices.len();
+    let extent = mesh_extent(&mesh.vertices);
+    for (t, triangle) in mesh.indices.iter().enumerate() {
+        if let Some(&bad) = triangle.iter().find(|&&i| i as usize >= count) {
+            return Some(MeshProblem::Triangle(
+                t,
+                format!(
+                    "triangle {t} refers to vertex {bad}, but there are {count} vertices \
+                     (indices 0 to {})",
+                    count.saturating_sub(1)
+                ),
+            ));
+        }
+        let [a, b, c] = triangle.map(|i| {
+            let p = mesh.vertices[i as usize];
+            [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])]
+        });
+        let twice_area = len(cross(sub(b, a), sub(c, a)));
+        if twice_area <= HULL_FLATNESS_TOLERANCE * HULL_FLATNESS_TOLERANCE * extent * extent {
+            return Some(MeshProblem::Triangle(
+                t,
+                format!(
+                    "triangle {t} (vertices {}, {}, {}) has no area: its corners coincide \
+                     or are collinear",
+                    triangle[0], triangle[1], triangle[2]
+                ),
+            ));
+        }
+    }
+    None
 }
 
 /// The largest coordinate range of `vertices` (m), or 1 for an empty or single-point set.

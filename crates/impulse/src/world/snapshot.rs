@@ -19,7 +19,7 @@ use std::path::Path;
 
 use glam::Vec3;
 use parry3d::math::Pose;
-use parry3d::shape::{SharedShape, TypedShape};
+use parry3d::shape::{Shape, SharedShape, TypedShape};
 use serde::{Deserialize, Serialize};
 
 use super::World;
@@ -31,6 +31,8 @@ use crate::collision::narrow_phase::{NarrowPhase, PairState};
 use crate::diagnostics::StepDiagnostics;
 use crate::error::SnapshotError;
 use crate::kinematic::Script;
+use crate::scene::MeshData;
+use crate::scene::validate::mesh_problem;
 use crate::settings::SolverSettings;
 
 /// The snapshot format this build writes and reads. Raised whenever the stored state changes
@@ -280,8 +282,15 @@ impl World {
         let invalid = SnapshotError::Invalid;
         let mut world = World::new(snapshot.gravity, snapshot.dt, snapshot.settings)
             .map_err(|e| invalid(e.to_string()))?;
-        let bodies = snapshot.bodies;
+        let mut bodies = snapshot.bodies;
         bodies.check_lengths().map_err(invalid)?;
+        for i in 0..bodies.len() {
+            if let Some(shape) = rebuilt_composite(&bodies.shape[i])
+                .map_err(|e| invalid(format!("body {i}: shape: {e}")))?
+            {
+                bodies.shape[i] = shape;
+            }
+        }
         check_bodies(&bodies).map_err(invalid)?;
         snapshot.handles.check(bodies.len()).map_err(invalid)?;
         world.broad_phase =
@@ -411,10 +420,95 @@ fn check_bodies(b: &Bodies) -> Result<(), String> {
     Ok(())
 }
 
-/// Checks the sizes of the shapes impulse builds (positive and finite) and a convex
-/// polyhedron's index arrays (every index in range), so that contact generation cannot index
-/// out of bounds. Other Parry shapes are taken as Parry decoded them.
+/// A composite shape (triangle mesh, height field, compound) built again from its defining
+/// data once that data is checked; `None` for any other shape. Parry decodes a composite
+/// shape's derived data too (its BVH, topology, pseudo-normals), which a damaged snapshot could
+/// leave inconsistent with the triangles or parts it indexes; built again, it cannot be.
+/// Parry's builders are deterministic, so an intact snapshot gives back the same shape.
+fn rebuilt_composite(shape: &SharedShape) -> Result<Option<SharedShape>, String> {
+    use parry3d::shape::{Compound, HeightField, TriMesh};
+    let rebuilt = match shape.as_typed_shape() {
+        TypedShape::TriMesh(mesh) => {
+            let data = MeshData {
+                vertices: mesh.vertices().iter().map(|v| v.to_array()).collect(),
+                indices: mesh.indices().to_vec(),
+            };
+            if let Some(problem) = mesh_problem(&data) {
+                return Err(format!("triangle mesh: {}", problem.message()));
+            }
+            let rebuilt = TriMesh::with_flags(mesh.vertices().to_vec(), data.indices, mesh.flags())
+                .map_err(|e| format!("triangle mesh: {e}"))?;
+            SharedShape::new(rebuilt)
+        }
+        TypedShape::HeightField(field) => {
+            let heights = field.heights();
+            let scale = field.scale();
+            if heights.nrows() < 2
+                || heights.ncols() < 2
+                || !heights.data().iter().all(|h| h.is_finite())
+                || !(scale.is_finite() && scale.cmpgt(Vec3::ZERO).all())
+            {
+                return Err(
+                    "height field: fewer than 2 × 2 heights, a height not finite, \
+                            or a scale not finite and positive"
+                        .into(),
+                );
+            }
+            SharedShape::new(HeightField::with_flags(
+                heights.clone(),
+                scale,
+                field.flags(),
+            ))
+        }
+        TypedShape::Compound(compound) => {
+            let parts = compound.shapes();
+            if parts.is_empty() {
+                return Err("a compound without parts".into());
+            }
+            for (k, (pose, part)) in parts.iter().enumerate() {
+                let pose_ok = pose.translation.is_finite()
+                    && pose.rotation.is_finite()
+                    && (pose.rotation.length() - 1.0).abs() <= 1e-3;
+                if !pose_ok || part.as_composite_shape().is_some() {
+                    return Err(format!(
+                        "compound part {k}: a pose not finite, or a composite part"
+                    ));
+                }
+                check_shape(part).map_err(|e| format!("compound part {k}: {e}"))?;
+            }
+            SharedShape::new(Compound::with_flags(parts.to_vec(), compound.flags(), None))
+        }
+        _ => return Ok(None),
+    };
+    Ok(Some(rebuilt))
+}
+
+/// Checks the sizes of the shapes impulse builds (positive and finite), rounded shapes'
+/// border radii and inner shapes, and a convex polyhedron's index arrays (every index in
+/// range), so that contact generation cannot index out of bounds. Composite shapes are checked
+/// and built again by [`rebuilt_composite`]; other Parry shapes are taken as Parry decoded
+/// them.
 fn check_shape(shape: &SharedShape) -> Result<(), String> {
+    let positive = |x: f32| x.is_finite() && x > 0.0;
+    let round = |border_radius: f32, inner: &dyn Shape| {
+        if positive(border_radius) {
+            check_shape_of(inner)
+        } else {
+            Err("a border radius is not finite and positive".to_string())
+        }
+    };
+    match shape.as_typed_shape() {
+        TypedShape::RoundCuboid(s) => return round(s.border_radius, &s.inner_shape),
+        TypedShape::RoundCylinder(s) => return round(s.border_radius, &s.inner_shape),
+        TypedShape::RoundCone(s) => return round(s.border_radius, &s.inner_shape),
+        TypedShape::RoundConvexPolyhedron(s) => return round(s.border_radius, &s.inner_shape),
+        _ => {}
+    }
+    check_shape_of(shape.as_ref())
+}
+
+/// [`check_shape`] of a shape that is not rounded.
+fn check_shape_of(shape: &dyn Shape) -> Result<(), String> {
     let positive = |x: f32| x.is_finite() && x > 0.0;
     let ok = match shape.as_typed_shape() {
         TypedShape::Ball(ball) => positive(ball.radius),
