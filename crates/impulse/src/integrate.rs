@@ -83,6 +83,61 @@ pub fn gyroscopic(angular: &mut [Vec3], orientation: &[Quat], inertia: &[Mat3], 
     }
 }
 
+/// The implicit gyroscopic step of [`gyroscopic`] for a body that may not turn about world
+/// axis `locked` (0, 1, 2 for x, y, z) and turns freely about the other two, per substep of `h`
+/// seconds. The lock's reaction is a torque λ·e along the locked axis e, so in world
+/// coordinates, with the free world axes the columns of P and I_w = R·I·Rᵀ at the current
+/// orientation, backward Euler asks for ω' = ω − P·Δ with
+///
+///   Pᵀ·f(ω') = 0,  f(ω') = I_w·(ω' − ω) + h·ω' × I_w·ω'
+///
+/// (f is the body-frame residual of [`gyroscopic`] rotated to the world frame; its component
+/// along e is the lock's reaction). One Newton step from ω' = ω solves the 2×2 system
+/// (Pᵀ·J·P)·Δ = Pᵀ·h·ω × I_w·ω with J = I_w + h·([ω]×·I_w − [I_w·ω]×). The exact solution
+/// never adds kinetic energy: ω' lies in the free plane, so f(ω')·ω' = 0 gives
+/// ω'·I_w·ω' = ω'·I_w·ω ≤ √(ω'·I_w·ω')·√(ω·I_w·ω); and it keeps the free components Pᵀ·L of the world
+/// angular momentum L = I_w·ω up to O(h²) a step, as the exact motion keeps them (the lock
+/// only torques about e). The component of ω along e is left as it is (zero for a locked body)
+/// to the bit.
+///
+/// `inertia` is the body-frame tensor of [`gyroscopic_inertia`] (kg·m², zero for no term),
+/// `orientation` the body's current orientation, `omega` its world angular velocity (rad/s).
+/// A singular 2×2 system or a result that is not finite leaves ω as it is.
+pub fn gyroscopic_in_plane(
+    omega: &mut Vec3,
+    orientation: Quat,
+    inertia: &Mat3,
+    locked: usize,
+    h: f32,
+) {
+    if *omega == Vec3::ZERO || *inertia == Mat3::ZERO {
+        return;
+    }
+    let (a, b) = match locked {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    let r = Mat3::from_quat(orientation);
+    let tensor = r * *inertia * r.transpose();
+    let momentum = tensor * *omega;
+    let residual = h * omega.cross(momentum);
+    let jacobian = tensor + (skew(*omega) * tensor - skew(momentum)) * h;
+    // The free block of J (J_ij = column j, row i) and its determinant.
+    let (jaa, jab) = (jacobian.col(a)[a], jacobian.col(b)[a]);
+    let (jba, jbb) = (jacobian.col(a)[b], jacobian.col(b)[b]);
+    let determinant = jaa * jbb - jab * jba;
+    if !determinant.is_finite() || determinant.abs() <= f32::MIN_POSITIVE {
+        return;
+    }
+    let mut change = Vec3::ZERO;
+    change[a] = (jbb * residual[a] - jab * residual[b]) / determinant;
+    change[b] = (jaa * residual[b] - jba * residual[a]) / determinant;
+    if change.is_finite() {
+        *omega -= change;
+    }
+}
+
 /// [a]×: the matrix of b ↦ a × b.
 fn skew(a: Vec3) -> Mat3 {
     Mat3::from_cols(
@@ -148,6 +203,42 @@ mod tests {
                 let e = energy(omega[0], q[0]);
                 assert!(e < e0 * (1.0 + 1e-4), "{e} J from {e0} J");
             }
+        }
+    }
+
+    /// The constrained step with one locked world axis, substep after substep with the
+    /// orientation update, at a rotation that puts no principal axis on a world axis: the
+    /// locked component of ω stays zero to the bit, the kinetic energy ½ωᵀ·I_w·ω never grows
+    /// beyond f32 rounding, and ω does change (the free part of ω × I_w·ω is not zero here).
+    #[test]
+    fn the_step_in_the_free_plane_keeps_the_lock_and_gains_no_energy() {
+        let tensor = Mat3::from_diagonal(Vec3::new(0.34, 0.10, 0.26) * 40.0);
+        let start = Quat::from_euler(glam::EulerRot::XYZ, 0.4, -0.9, 1.3);
+        for (locked, omega) in [
+            (0, Vec3::new(0.0, 2.0, -3.0)),
+            (1, Vec3::new(2.0, 0.0, -3.0)),
+            (2, Vec3::new(2.0, -3.0, 0.0)),
+        ] {
+            let (mut omega, mut q) = (omega, start);
+            let energy = |omega: Vec3, q: Quat| {
+                let local = q.inverse() * omega;
+                0.5 * local.dot(tensor * local)
+            };
+            let (omega0, e0) = (omega, energy(omega, q));
+            let h = 1.0 / 1200.0;
+            let mut turned = 0.0f32;
+            for _ in 0..12_000 {
+                gyroscopic_in_plane(&mut omega, q, &tensor, locked, h);
+                assert_eq!(omega[locked], 0.0);
+                q = integrate_orientation(q, omega, h);
+                let e = energy(omega, q);
+                assert!(e < e0 * (1.0 + 1e-4), "{e} J from {e0} J");
+                turned = turned.max((omega - omega0).length());
+            }
+            assert!(
+                turned > 0.1 * omega0.length(),
+                "ω moves by {turned} rad/s at most"
+            );
         }
     }
 }

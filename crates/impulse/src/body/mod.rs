@@ -54,11 +54,13 @@ impl BodyKind {
 /// rotation): a set of six flags, combined with `|`.
 ///
 /// A locked translation axis sets that component of the body's inverse mass to 0 (the inverse
-/// mass becomes a per-axis vector in every solver); a locked rotation axis zeroes that row and
-/// column of the world inverse inertia, recomputed whenever the body turns. Contacts, gravity, forces and impulses then leave the
-/// locked components of the centre of mass's linear velocity and of the angular velocity (world
-/// frame) at exactly zero. A body frame whose origin is not its centre of mass may still move
-/// along a locked translation axis while it turns: the lock holds the centre of mass.
+/// mass becomes a per-axis vector in every solver); locked rotation axes restrict the world
+/// inverse inertia to the free rotations ([`LockedAxes::world_inverse_inertia`], recomputed each
+/// step at the body's orientation), whose locked rows and columns are zero. Contacts, gravity,
+/// forces and impulses then leave the locked components of the centre of mass's linear velocity
+/// and of the angular velocity (world frame) at exactly zero. A body frame whose origin is not
+/// its centre of mass may still move along a locked translation axis while it turns: the lock
+/// holds the centre of mass.
 ///
 /// ```
 /// use impulse::LockedAxes;
@@ -178,18 +180,62 @@ impl LockedAxes {
         }
     }
 
-    /// `tensor` (a world-frame inverse inertia) with the row and column of each locked rotation
-    /// axis set to zero (Rapier's `effective_world_inv_inertia`).
-    pub fn lock_inverse_inertia(self, tensor: Mat3) -> Mat3 {
+    /// The world-frame inverse inertia (1/(kg·m²)) of a body of body-frame inverse inertia
+    /// `local` at `rotation` whose rotations about the locked world axes are held at zero:
+    /// the map from a torque impulse τ (N·m·s, world) to the change Δω (rad/s, world) when each
+    /// lock applies the reaction about its own axis that keeps its component of ω zero.
+    ///
+    /// With nothing locked this is R·I⁻¹·Rᵀ, computed as it always was (bit for bit); with all
+    /// three rotations locked it is zero. With one or two locked, and the free world axes the
+    /// columns of P, it is P·(Pᵀ·I_w·P)⁻¹·Pᵀ, I_w = R·I·Rᵀ: the inverse of Euler's equations
+    /// restricted to the free directions, Pᵀ·I_w·P·ω̇_free = Pᵀ·(τ − ω × I_w·ω), whose locks
+    /// react along the locked axes (the Lagrange multipliers of the constraints e·ω = 0;
+    /// docs/method.md, "Locked rotations"). It is formed without inverting I_w, one lock at a
+    /// time on A = I_w⁻¹: for locked axis e, the reaction λ·e with eᵀ·A·(τ + λ·e) = 0 gives
+    ///
+    ///   A ← A − (A·e)(A·e)ᵀ / (eᵀ·A·e),
+    ///
+    /// the Schur complement of A's locked block, which is the inverse of I_w's free block. It
+    /// is the tensor with the locked rows and columns of I_w⁻¹ zeroed (Rapier's
+    /// `effective_world_inv_inertia`) only when each locked axis is a principal axis of I_w;
+    /// otherwise that tensor makes the locks do work. The update runs in f64 from `local` and
+    /// `rotation` because the subtraction cancels: the digits lost grow with the body's ratio
+    /// of moments. It takes no division when eᵀ·A·e is zero, as for a body that cannot turn
+    /// about e anyway (then A·e = 0, A being positive semidefinite), so a singular or zero
+    /// `local` gives a finite result (zero if it cannot be formed). The locked rows and columns
+    /// of the result are zero to the bit, so no impulse changes the locked components of ω.
+    pub fn world_inverse_inertia(self, rotation: Quat, local: &Mat3) -> Mat3 {
         if !self.locks_rotation() {
-            return tensor;
+            return rotate_tensor(rotation, local);
         }
+        if self.contains(Self::ALL_ROTATIONS) {
+            return Mat3::ZERO;
+        }
+        let r = glam::DMat3::from_quat(rotation.as_dquat().normalize());
+        let mut a = r * local.as_dmat3() * r.transpose();
         let f = self.rotation_factor();
-        // Column j scaled by f_j, then each row i by f_i.
+        for axis in 0..3 {
+            if f[axis] != 0.0 {
+                continue;
+            }
+            let column = a.col(axis);
+            let diagonal = column[axis];
+            if diagonal > f64::MIN_POSITIVE {
+                let scaled = column / diagonal;
+                a -=
+                    glam::DMat3::from_cols(column * scaled.x, column * scaled.y, column * scaled.z);
+            }
+        }
+        let a = a.as_mat3();
+        if !a.is_finite() {
+            return Mat3::ZERO;
+        }
+        // Column j scaled by f_j, then each row i by f_i: the locked rows and columns are
+        // zero to the bit, not to rounding.
         Mat3::from_cols(
-            tensor.x_axis * (f * f.x),
-            tensor.y_axis * (f * f.y),
-            tensor.z_axis * (f * f.z),
+            a.x_axis * (f * f.x),
+            a.y_axis * (f * f.y),
+            a.z_axis * (f * f.z),
         )
     }
 }
@@ -723,15 +769,15 @@ impl Bodies {
         self.pose[i].transform_point(self.local_center_of_mass[i])
     }
 
-    /// World-frame inverse inertia R·I⁻¹·Rᵀ of body `i` (1/(kg·m²)), with the row and column
-    /// of each locked rotation axis zero ([`LockedAxes::lock_inverse_inertia`]); zero for a
+    /// World-frame inverse inertia R·I⁻¹·Rᵀ of body `i` (1/(kg·m²)), restricted to the
+    /// rotations its locked axes leave free ([`LockedAxes::world_inverse_inertia`]); zero for a
     /// body that does not rotate.
     pub fn world_inverse_inertia(&self, i: usize) -> Mat3 {
         let local = &self.local_inverse_inertia[i];
         if *local == Mat3::ZERO {
             return Mat3::ZERO;
         }
-        self.locked_axes[i].lock_inverse_inertia(rotate_tensor(self.pose[i].rotation, local))
+        self.locked_axes[i].world_inverse_inertia(self.pose[i].rotation, local)
     }
 
     /// Per-axis inverse mass of body `i` (1/kg per world axis): 1/m on each free translation
@@ -831,6 +877,140 @@ mod tests {
                 (energy - expected).abs() < 1e-4 * expected,
                 "{energy} J against {expected} J"
             );
+        }
+    }
+
+    /// P·(Pᵀ·I_w·P)⁻¹·Pᵀ by inverting I_w and its free block in f64, for the locks of `locked`
+    /// (one or two rotations).
+    fn free_block_inverse(rotation: Quat, local: &Mat3, locked: LockedAxes) -> glam::DMat3 {
+        let r = glam::DMat3::from_quat(rotation.as_dquat().normalize());
+        let tensor = r * local.as_dmat3().inverse() * r.transpose();
+        let free: Vec<usize> = (0..3)
+            .filter(|&k| locked.rotation_factor()[k] != 0.0)
+            .collect();
+        let mut out = glam::DMat3::ZERO;
+        match free[..] {
+            [a] => {
+                out.col_mut(a)[a] = 1.0 / tensor.col(a)[a];
+            }
+            [a, b] => {
+                let (paa, pab, pbb) = (tensor.col(a)[a], tensor.col(b)[a], tensor.col(b)[b]);
+                let det = paa * pbb - pab * pab;
+                out.col_mut(a)[a] = pbb / det;
+                out.col_mut(b)[b] = paa / det;
+                out.col_mut(b)[a] = -pab / det;
+                out.col_mut(a)[b] = -pab / det;
+            }
+            _ => unreachable!(),
+        }
+        out
+    }
+
+    const ONE_OR_TWO: [LockedAxes; 6] = [
+        LockedAxes::ROTATION_X,
+        LockedAxes::ROTATION_Y,
+        LockedAxes::ROTATION_Z,
+        LockedAxes::ROTATION_X.union(LockedAxes::ROTATION_Y),
+        LockedAxes::ROTATION_X.union(LockedAxes::ROTATION_Z),
+        LockedAxes::ROTATION_Y.union(LockedAxes::ROTATION_Z),
+    ];
+
+    /// The locked world inverse inertia is the inverse of I_w's free block, P·(Pᵀ·I_w·P)⁻¹·Pᵀ,
+    /// for one and two locked rotations, at a rotation mixing all three axes, for a box's
+    /// diagonal tensor, a needle's (moments 1 : 2000 : 2000) and a full one; its locked rows
+    /// and columns are zero to the bit. Zeroing the rows and columns of I_w⁻¹ instead is off by
+    /// far more for the same bodies.
+    #[test]
+    fn locked_inverse_inertia_inverts_the_free_block_of_the_world_tensor() {
+        let rotation = Quat::from_euler(glam::EulerRot::XYZ, 0.7, -1.1, 2.3);
+        let full = Mat3::from_cols_array(&[0.5, 0.1, -0.05, 0.1, 0.8, 0.2, -0.05, 0.2, 1.3]);
+        let tensors = [
+            Mat3::from_diagonal(Vec3::new(1.0 / 13.6, 1.0 / 4.0, 1.0 / 10.4)),
+            Mat3::from_diagonal(Vec3::new(1.0, 5e-4, 5e-4)),
+            full,
+        ];
+        for local in tensors {
+            for locked in ONE_OR_TWO {
+                let got = locked.world_inverse_inertia(rotation, &local);
+                let expected = free_block_inverse(rotation, &local, locked);
+                let scale = expected
+                    .to_cols_array()
+                    .iter()
+                    .fold(0.0f64, |m, x| m.max(x.abs()));
+                let error = (got.as_dmat3() - expected)
+                    .to_cols_array()
+                    .iter()
+                    .fold(0.0f64, |m, x| m.max(x.abs()));
+                assert!(error < 1e-6 * scale, "{locked:?}: {got} against {expected}");
+                let f = locked.rotation_factor();
+                for k in (0..3).filter(|&k| f[k] == 0.0) {
+                    assert_eq!(got.col(k), Vec3::ZERO, "{locked:?}");
+                    assert_eq!(got.row(k), Vec3::ZERO, "{locked:?}");
+                }
+                let zeroed = rotate_tensor(rotation, &local).as_dmat3()
+                    * glam::DMat3::from_diagonal(f.as_dvec3());
+                let zeroed = glam::DMat3::from_diagonal(f.as_dvec3()) * zeroed;
+                let old = (zeroed - expected)
+                    .to_cols_array()
+                    .iter()
+                    .fold(0.0f64, |m, x| m.max(x.abs()));
+                assert!(old > 1e-3 * scale, "{locked:?}: zeroing would do");
+            }
+        }
+    }
+
+    /// When every locked axis is a principal axis of I_w (the box turned about the locked axis
+    /// only, or not at all), the free block's inverse is the zeroed I⁻¹ of old; with nothing
+    /// locked the tensor is R·I⁻¹·Rᵀ to the bit; with all three rotations locked it is zero; a
+    /// singular or zero tensor gives a finite result.
+    #[test]
+    fn locked_inverse_inertia_in_the_cases_with_a_known_answer() {
+        let local = Mat3::from_diagonal(Vec3::new(1.0 / 13.6, 1.0 / 4.0, 1.0 / 10.4));
+        let zeroed = |rotation: Quat, locked: LockedAxes| {
+            let f = locked.rotation_factor();
+            let t = rotate_tensor(rotation, &local);
+            Mat3::from_cols(
+                t.x_axis * (f * f.x),
+                t.y_axis * (f * f.y),
+                t.z_axis * (f * f.z),
+            )
+        };
+        for locked in ONE_OR_TWO {
+            assert_eq!(
+                locked.world_inverse_inertia(Quat::IDENTITY, &local),
+                zeroed(Quat::IDENTITY, locked),
+                "{locked:?}"
+            );
+        }
+        for (axis, locked) in [
+            (Vec3::X, LockedAxes::ROTATION_X),
+            (Vec3::Y, LockedAxes::ROTATION_Y),
+            (Vec3::Z, LockedAxes::ROTATION_Z),
+        ] {
+            let rotation = Quat::from_axis_angle(axis, 0.8);
+            let got = locked.world_inverse_inertia(rotation, &local);
+            let old = zeroed(rotation, locked);
+            assert!(
+                got.abs_diff_eq(old, 1e-7),
+                "{locked:?}: {got} against {old}"
+            );
+        }
+        let rotation = Quat::from_euler(glam::EulerRot::XYZ, 0.7, -1.1, 2.3);
+        assert_eq!(
+            LockedAxes::NONE.world_inverse_inertia(rotation, &local),
+            rotate_tensor(rotation, &local)
+        );
+        assert_eq!(
+            LockedAxes::ALL_ROTATIONS.world_inverse_inertia(rotation, &local),
+            Mat3::ZERO
+        );
+        for singular in [Mat3::ZERO, Mat3::from_diagonal(Vec3::new(0.0, 2.0, 3.0))] {
+            for locked in ONE_OR_TWO {
+                for rotation in [Quat::IDENTITY, rotation] {
+                    let got = locked.world_inverse_inertia(rotation, &singular);
+                    assert!(got.is_finite(), "{locked:?}: {got}");
+                }
+            }
         }
     }
 }

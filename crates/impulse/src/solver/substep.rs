@@ -18,7 +18,7 @@ use super::wide::Bundles;
 use super::{
     ContactSolver, RowsReport, SolveOutcome, SolvePass, TargetInputs, Velocities, position,
 };
-use crate::body::{Bodies, BodyKind};
+use crate::body::{Bodies, BodyKind, LockedAxes};
 use crate::contact::constraints::{self, ContactConstraint};
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
@@ -77,8 +77,13 @@ pub struct IslandWorkspace {
     /// rad/s²); empty in a step without forces.
     acceleration: Vec<(Vec3, Vec3)>,
     /// Per body, the body-frame inertia tensor of its gyroscopic term
-    /// ([`integrate::gyroscopic_inertia`]); empty when no body of the island has one.
+    /// ([`integrate::gyroscopic_inertia`]); empty when no body of the island has one. Zero for
+    /// bodies with a locked rotation axis.
     inertia: Vec<Mat3>,
+    /// The island's bodies with exactly one locked rotation axis and a gyroscopic term: their
+    /// slot, the locked world axis (0, 1, 2 for x, y, z) and their body-frame tensor, for
+    /// [`integrate::gyroscopic_in_plane`].
+    rotation_locks: Vec<(u32, u8, Mat3)>,
     /// Per body, the factors 1/(1 + h·c) of its linear and angular damping for one substep;
     /// empty when no body of the island is damped.
     damping: Vec<(f32, f32)>,
@@ -281,12 +286,13 @@ pub fn step_island(
     // The gyroscopic term's tensors; kept only when some body of the island has one, so
     // islands of balls, cubes and particles skip the pass.
     w.inertia.clear();
+    w.rotation_locks.clear();
     if settings.gyroscopic {
         w.inertia.extend(island_bodies.iter().map(|&i| {
             let i = i as usize;
-            // A body with a locked rotation axis has none: with two or three axes locked the
-            // free component of ω × I·ω is zero (ω lies along the free axis, so the torque is
-            // normal to it), and with one locked the term is left out.
+            // A body with a locked rotation axis takes the constrained step below, or none: with
+            // two or three axes locked, ω lies along the free axis (or is zero), so ω × I_w·ω is
+            // normal to it and has no free component.
             if bodies.kind[i] == BodyKind::Dynamic && !bodies.locked_axes[i].locks_rotation() {
                 integrate::gyroscopic_inertia(&bodies.local_inverse_inertia[i])
             } else {
@@ -296,6 +302,18 @@ pub fn step_island(
         if w.inertia.iter().all(|t| *t == Mat3::ZERO) {
             w.inertia.clear();
         }
+        w.rotation_locks
+            .extend(island_bodies.iter().enumerate().filter_map(|(k, &i)| {
+                let i = i as usize;
+                let rotations = bodies.locked_axes[i].bits() & LockedAxes::ALL_ROTATIONS.bits();
+                if bodies.kind[i] != BodyKind::Dynamic || rotations.count_ones() != 1 {
+                    return None;
+                }
+                // Rotation bits are 3–5 (x, y, z).
+                let locked = rotations.trailing_zeros() as u8 - 3;
+                let tensor = integrate::gyroscopic_inertia(&bodies.local_inverse_inertia[i]);
+                (tensor != Mat3::ZERO).then_some((k as u32, locked, tensor))
+            }));
     }
     let h = dt / settings.substeps as f32;
     w.damping.clear();
@@ -403,6 +421,16 @@ pub fn step_island(
             } else {
                 integrate::gyroscopic(angular, &w.orientation, &w.inertia, h);
             }
+        }
+        for (k, locked, tensor) in &w.rotation_locks {
+            let k = *k as usize;
+            integrate::gyroscopic_in_plane(
+                &mut w.angular[k],
+                w.orientation[k],
+                tensor,
+                usize::from(*locked),
+                h,
+            );
         }
         let mut velocities = Velocities {
             linear: &mut w.linear,

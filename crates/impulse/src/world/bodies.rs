@@ -320,8 +320,9 @@ impl World {
     }
 
     /// Changes the angular momentum by `impulse` (N·m·s, world frame), now: Δω = I⁻¹·impulse
-    /// with the world-frame inverse inertia (its locked rows and columns zero); no effect on a
-    /// particle. Wakes the body.
+    /// with the world-frame inverse inertia, restricted to the free rotations when some are
+    /// locked ([`LockedAxes::world_inverse_inertia`]: the locks react about their own axes);
+    /// no effect on a particle. Wakes the body.
     pub fn apply_torque_impulse(
         &mut self,
         handle: BodyHandle,

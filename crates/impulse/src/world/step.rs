@@ -719,7 +719,7 @@ fn update_sleep(
 }
 
 /// World-frame inverse inertia tensors I⁻¹ = R I_local⁻¹ Rᵀ (1/(kg·m²)) of every body at its
-/// current pose, with the rows and columns of locked rotation axes zero
+/// current pose, restricted to the free rotations of bodies with locked rotation axes
 /// (`Bodies::world_inverse_inertia`); zero for bodies that do not rotate.
 fn world_inverse_inertia_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Mat3>) {
     let world = |i: usize| bodies.world_inverse_inertia(i);
