@@ -1063,7 +1063,12 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
         let moved = targets.moved(&slots_a, &slots_b);
         let turn = if half_turn { count / 2 } else { 0 };
         for p in 0..count {
-            let p = (p + turn) % count;
+            // (p + turn) mod count, without a division per bundle.
+            let p = if p + turn < count {
+                p + turn
+            } else {
+                p + turn - count
+            };
             let index = if forward {
                 start + p
             } else {
