@@ -248,6 +248,16 @@ fn edits_are_checked_and_wake_the_body() {
     );
     let bad = w.insert(BodyBuilder::dynamic(SharedShape::halfspace(Vec3::Y)));
     assert!(bad.is_err());
+    // A shape reaching farther than 1,000 km from its origin is refused (f32 cannot resolve
+    // its contacts; a 7e37 m box panicked inside Parry); one just inside is taken.
+    for (half, refused) in [(2.0e6, true), (9.0e5, false), (7.0e37, true)] {
+        let result = w.insert(BodyBuilder::fixed(SharedShape::cuboid(half, 0.1, 0.1)));
+        assert_eq!(
+            matches!(result, Err(WorldError::InvalidBody { ref field, .. }) if field == "shape"),
+            refused,
+            "{half}: {result:?}"
+        );
+    }
 }
 
 #[test]

@@ -10,6 +10,39 @@ use super::BodyKind;
 /// Smallest length of an orientation quaternion (or a direction) that can be normalised.
 pub(crate) const MIN_NORM: f32 = 1e-6;
 
+/// How far a shape may reach from its body's origin (m). An f32 keeps about seven digits, so a
+/// shape of 1,000 km resolves to about 10 cm at its rim; larger shapes only overflow the
+/// contact queries (a box 7e37 m long made Parry's EPA index out of bounds).
+pub(crate) const MAX_SHAPE_EXTENT: f32 = 1.0e6;
+
+/// A shape's reach from its body's origin: its local bounding box finite and within
+/// [`MAX_SHAPE_EXTENT`] on every axis (a half-space, unbounded, is exempt), and a rounded
+/// shape's border radius finite and ≥ 0 (Parry asserts it when it grows the box).
+pub(crate) fn shape_extent(shape: &SharedShape) -> Result<(), String> {
+    let border_radius = match shape.as_typed_shape() {
+        TypedShape::RoundCuboid(s) => Some(s.border_radius),
+        TypedShape::RoundCylinder(s) => Some(s.border_radius),
+        TypedShape::RoundCone(s) => Some(s.border_radius),
+        TypedShape::RoundConvexPolyhedron(s) => Some(s.border_radius),
+        TypedShape::HalfSpace(_) => return Ok(()),
+        _ => None,
+    };
+    if let Some(radius) = border_radius.filter(|r| !(r.is_finite() && *r >= 0.0)) {
+        return Err(format!(
+            "border radius must be finite and ≥ 0, got {radius}"
+        ));
+    }
+    let aabb = shape.compute_local_aabb();
+    let reach = aabb.mins.abs().max(aabb.maxs.abs()).max_element();
+    if reach.is_finite() && reach <= MAX_SHAPE_EXTENT {
+        Ok(())
+    } else {
+        Err(format!(
+            "the shape reaches {reach} m from the body's origin; at most {MAX_SHAPE_EXTENT} m"
+        ))
+    }
+}
+
 /// The scene format's name of a body kind.
 pub(crate) fn kind_name(kind: BodyKind) -> &'static str {
     match kind {

@@ -287,6 +287,45 @@ fn validate_gltf(root: &gltf::json::Root) -> Result<(), gltf::Error> {
     }
 }
 
+/// The accessor types the glTF specification requires of what is read: positions three
+/// floats, indices unsigned integers. The glTF crate's readers assume them (an index accessor
+/// of floats reaches an `unreachable!`, found by fuzzing) and its validation does not check
+/// them.
+fn check_accessor_types(primitive: &gltf::Primitive, name: &str) -> Result<(), MeshFileError> {
+    use gltf::accessor::{DataType, Dimensions};
+    if let Some(positions) = primitive.get(&gltf::Semantic::Positions)
+        && (positions.data_type() != DataType::F32 || positions.dimensions() != Dimensions::Vec3)
+    {
+        return Err(format_error(
+            name,
+            format!(
+                "accessor {}: POSITION must be VEC3 of FLOAT, got {:?} of {:?}",
+                positions.index(),
+                positions.dimensions(),
+                positions.data_type()
+            ),
+        ));
+    }
+    if let Some(indices) = primitive.indices()
+        && (!matches!(
+            indices.data_type(),
+            DataType::U8 | DataType::U16 | DataType::U32
+        ) || indices.dimensions() != Dimensions::Scalar)
+    {
+        return Err(format_error(
+            name,
+            format!(
+                "accessor {}: indices must be SCALAR of UNSIGNED_BYTE, UNSIGNED_SHORT or \
+                 UNSIGNED_INT, got {:?} of {:?}",
+                indices.index(),
+                indices.dimensions(),
+                indices.data_type()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Adds the triangles of `node` and its children, with `parent` the transform above it.
 fn add_node(
     node: &gltf::Node,
@@ -306,6 +345,7 @@ fn add_node(
     let transform = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
     if let Some(node_mesh) = node.mesh() {
         for primitive in node_mesh.primitives() {
+            check_accessor_types(&primitive, name)?;
             let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
             let Some(positions) = reader.read_positions() else {
                 continue;

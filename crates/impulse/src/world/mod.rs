@@ -571,6 +571,7 @@ fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
         "shape.type",
         rules::shape_for_kind(b.kind, ShapeClass::of(&shape), &type_name),
     )?;
+    check("shape", rules::shape_extent(&shape))?;
     if !b.locked_axes.is_empty() {
         check("locked_axes", rules::locked_axes_for_kind(b.kind))?;
     }

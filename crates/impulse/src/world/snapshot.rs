@@ -405,7 +405,9 @@ fn check_bodies(b: &Bodies) -> Result<(), String> {
         if b.kind[i] == BodyKind::Particle && shape.as_ball().is_none() {
             return bad("a particle must be a sphere");
         }
-        check_shape(shape).map_err(|e| format!("body {i}: shape: {e}"))?;
+        check_shape(shape)
+            .and_then(|()| crate::body::rules::shape_extent(shape))
+            .map_err(|e| format!("body {i}: shape: {e}"))?;
         // The step keeps locked velocity components at zero only if they start there.
         let locked = b.locked_axes[i];
         if !locked.is_empty() && !b.kind[i].is_dynamic() {
