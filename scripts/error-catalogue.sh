@@ -28,6 +28,7 @@ row "unknown shape type" run "$(case_file shape "$(scene '{"kind": "dynamic", "s
 row "NaN is not JSON" run "$(case_file nan "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": NaN}}')")" --steps 1 --quiet
 row "negative radius" run "$(case_file radius "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": -1}}')")" --steps 1 --quiet
 row "zero half extent" run "$(case_file extent "$(scene '{"kind": "dynamic", "shape": {"type": "cuboid", "half_extents": [0.5, 0, 0.5]}}')")" --steps 1 --quiet
+row "a shape larger than 1,000 km" run "$(case_file huge "$(scene '{"kind": "dynamic", "shape": {"type": "cuboid", "half_extents": [2e6, 0.5, 0.5]}}')")" --steps 1 --quiet
 row "negative mass" run "$(case_file mass "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "mass": -2}')")" --steps 1 --quiet
 row "friction below zero" run "$(case_file friction "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "material": {"friction": -0.1}}')")" --steps 1 --quiet
 row "restitution above one" run "$(case_file restitution "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "material": {"restitution": 1.5}}')")" --steps 1 --quiet

@@ -712,6 +712,29 @@ fn a_negative_border_radius_is_refused() {
     );
 }
 
+/// Each size within bounds, but a compound part 900 km out and 200 km long reaches beyond
+/// 1,000 km of the body's origin: refused at the shape, with the reach; a mesh vertex beyond
+/// it likewise.
+#[test]
+fn a_shape_reaching_beyond_1000_km_is_refused() {
+    let error = load_error(
+        "reach",
+        r#""kind": "dynamic", "shape": {"type": "compound", "parts": [{"shape": {"type": "cuboid", "half_extents": [2e5, 1, 1]}, "position": [9e5, 0, 0]}]}"#,
+        &[],
+    );
+    check(
+        &error,
+        "bodies[1].shape",
+        "the shape reaches 1100000 m from the body's origin; at most 1000000 m",
+    );
+    let error = load_error(
+        "far_vertex",
+        r#""kind": "static", "shape": {"type": "trimesh", "vertices": [[0, 0, 0], [2e6, 0, 0], [0, 0, 1]], "indices": [[0, 2, 1]]}"#,
+        &[],
+    );
+    check(&error, "bodies[1].shape", "the shape reaches 2000000 m");
+}
+
 /// The library refuses the same shapes when a world is built from a scene made in code (not
 /// validated): a typed error, no panic.
 #[test]

@@ -34,7 +34,7 @@ pub fn build_shape(kind: BodyKind, shape: &ShapeDesc) -> Result<SharedShape, Sce
 /// # Errors
 /// (field, message) for what validation cannot see: an unreadable mesh file, a mesh whose
 /// file turns out degenerate, a hull Parry cannot build.
-fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String)> {
+pub(crate) fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String)> {
     use parry3d::shape::{HeightField, HeightFieldFlags, TriMeshFlags};
     let hull = |points: &[[f32; 3]], border_radius: f32| {
         let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();

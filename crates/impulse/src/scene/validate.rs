@@ -252,11 +252,20 @@ impl Checker {
             ShapeDesc::HeightField { .. } => ShapeClass::StaticOnly("a heightfield"),
             _ => ShapeClass::Solid,
         };
+        let before = self.errors.len();
         self.rule(
             &path.key("type"),
             rules::shape_for_kind(kind, class, shape.type_name()),
         );
         self.shape_fields(path, shape);
+        // Its fields valid, the shape built must lie within reach of the body's origin
+        // (`rules::MAX_SHAPE_EXTENT`): each size may be, and their sum (a compound's offsets
+        // plus its parts, a border around a shape) not.
+        if self.errors.len() == before
+            && let Ok(built) = super::shape::shape_of(shape)
+        {
+            self.rule(path, rules::shape_extent(&built));
+        }
     }
 
     /// Checks the fields of `shape` at `path` (its own, not whether it suits the body).
