@@ -1,5 +1,6 @@
 //! The query dispatcher of the narrow phase: Parry's [`DefaultQueryDispatcher`], except for a
-//! ball against a rounded convex shape.
+//! ball against a rounded convex shape (below) and a cylinder's or cone's flat cap on a flat
+//! face ([`super::caps`]).
 //!
 //! Parry projects a point on a `RoundShape` with GJK on the rounded shape's support map (the
 //! inner shape's support point moved out by the border radius along the direction asked),
@@ -22,17 +23,18 @@
 //! rounded edge or corner) the normal is still exact: it is the direction from the inner
 //! shape's closest point to the ball's centre.
 //!
-//! Pairs whose parts can be a ball and a rounded shape (compounds against convex shapes or
-//! other compounds) are handed to Parry's composite generators with this dispatcher, so their
-//! parts come back to [`ContactDispatcher::contact_manifold_convex_convex`]. Triangle meshes,
-//! height fields and voxels go to Parry's dispatcher whole: their parts are triangles or
-//! voxels, never a ball against a rounded shape. Every other pair gets exactly what
-//! [`DefaultQueryDispatcher`] gives it.
+//! Composite shapes (compounds, triangle meshes, height fields) are handed to Parry's composite
+//! generators with this dispatcher, so their parts' pairs (a compound's rounded part against a
+//! ball, a mesh triangle under a cylinder) come back to
+//! [`ContactDispatcher::contact_manifold_convex_convex`]. Voxels go to Parry's dispatcher whole.
+//! Every other pair gets exactly what [`DefaultQueryDispatcher`] gives it.
 
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::query::details::{
     NormalConstraints, contact_manifold_convex_ball,
     contact_manifolds_composite_shape_composite_shape, contact_manifolds_composite_shape_shape,
+    contact_manifolds_heightfield_composite_shape, contact_manifolds_heightfield_shape_shapes,
+    contact_manifolds_trimesh_shape_shapes,
 };
 use parry3d::query::{
     ClosestPoints, Contact, ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher,
@@ -41,8 +43,11 @@ use parry3d::query::{
 };
 use parry3d::shape::{Ball, Shape, ShapeType, TypedShape};
 
+use super::caps;
+
 /// Parry's default dispatcher, with exact contacts between a ball and a rounded convex shape
-/// (see the module's documentation).
+/// and a fine polygon for a cylinder's or cone's flat cap on a flat face (see the module's
+/// documentation).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ContactDispatcher;
 
@@ -124,10 +129,9 @@ where
     ManifoldData: Default + Clone + Send + Sync,
     ContactData: Default + Copy + Send + Sync,
 {
-    /// The same routing as [`DefaultQueryDispatcher`]'s (which tests two composite shapes
-    /// first, then meshes, height fields and voxels, then one composite shape, then two convex
-    /// shapes), with this dispatcher passed down wherever a part may be a ball or a rounded
-    /// shape.
+    /// The same routing as [`DefaultQueryDispatcher`]'s (two composite shapes first, then
+    /// meshes, height fields and voxels, then one composite shape, then two convex shapes),
+    /// with this dispatcher passed down to the composite generators (all but voxels').
     fn contact_manifolds(
         &self,
         pos12: &Pose,
@@ -145,44 +149,83 @@ where
             );
             return Ok(());
         }
-        let triangles_or_voxels = |shape: &dyn Shape| {
-            matches!(
-                shape.shape_type(),
-                ShapeType::TriMesh | ShapeType::HeightField | ShapeType::Voxels
-            )
-        };
-        if triangles_or_voxels(g1) || triangles_or_voxels(g2) {
-            return DefaultQueryDispatcher
-                .contact_manifolds(pos12, g1, g2, prediction, manifolds, workspace);
-        }
-        if let Some(composite1) = composite1 {
-            contact_manifolds_composite_shape_shape(
-                self, pos12, composite1, g2, prediction, manifolds, workspace, false,
-            );
-        } else if let Some(composite2) = composite2 {
-            contact_manifolds_composite_shape_shape(
-                self,
-                &pos12.inverse(),
-                composite2,
-                g1,
-                prediction,
-                manifolds,
-                workspace,
-                true,
-            );
-        } else {
-            if manifolds.is_empty() {
-                manifolds.push(ContactManifold::new());
+        match (g1.shape_type(), g2.shape_type()) {
+            (ShapeType::TriMesh, _) | (_, ShapeType::TriMesh) => {
+                contact_manifolds_trimesh_shape_shapes(
+                    self, pos12, g1, g2, prediction, manifolds, workspace,
+                );
             }
-            return self.contact_manifold_convex_convex(
-                pos12,
-                g1,
-                g2,
-                None,
-                None,
-                prediction,
-                &mut manifolds[0],
-            );
+            (ShapeType::HeightField, _) => match (g1.as_heightfield(), composite2) {
+                (Some(heightfield1), Some(composite2)) => {
+                    contact_manifolds_heightfield_composite_shape(
+                        self,
+                        pos12,
+                        &pos12.inverse(),
+                        heightfield1,
+                        composite2,
+                        prediction,
+                        manifolds,
+                        workspace,
+                        false,
+                    )
+                }
+                _ => contact_manifolds_heightfield_shape_shapes(
+                    self, pos12, g1, g2, prediction, manifolds, workspace,
+                ),
+            },
+            (_, ShapeType::HeightField) => match (g2.as_heightfield(), composite1) {
+                (Some(heightfield2), Some(composite1)) => {
+                    contact_manifolds_heightfield_composite_shape(
+                        self,
+                        &pos12.inverse(),
+                        pos12,
+                        heightfield2,
+                        composite1,
+                        prediction,
+                        manifolds,
+                        workspace,
+                        true,
+                    )
+                }
+                _ => contact_manifolds_heightfield_shape_shapes(
+                    self, pos12, g1, g2, prediction, manifolds, workspace,
+                ),
+            },
+            (ShapeType::Voxels, _) | (_, ShapeType::Voxels) => {
+                return DefaultQueryDispatcher
+                    .contact_manifolds(pos12, g1, g2, prediction, manifolds, workspace);
+            }
+            _ => {
+                if let Some(composite1) = composite1 {
+                    contact_manifolds_composite_shape_shape(
+                        self, pos12, composite1, g2, prediction, manifolds, workspace, false,
+                    );
+                } else if let Some(composite2) = composite2 {
+                    contact_manifolds_composite_shape_shape(
+                        self,
+                        &pos12.inverse(),
+                        composite2,
+                        g1,
+                        prediction,
+                        manifolds,
+                        workspace,
+                        true,
+                    );
+                } else {
+                    if manifolds.is_empty() {
+                        manifolds.push(ContactManifold::new());
+                    }
+                    return self.contact_manifold_convex_convex(
+                        pos12,
+                        g1,
+                        g2,
+                        None,
+                        None,
+                        prediction,
+                        &mut manifolds[0],
+                    );
+                }
+            }
         }
         Ok(())
     }
@@ -225,6 +268,14 @@ where
         {
             return Ok(());
         }
+        // Parry's manifold gives the normal (with a mesh's normal constraints applied); the cap
+        // points replace its points, keeping the impulses of last step's points.
+        let cap_pair = caps::has_cap(g1) || caps::has_cap(g2);
+        let old = if cap_pair {
+            manifold.points.clone()
+        } else {
+            Vec::new()
+        };
         DefaultQueryDispatcher.contact_manifold_convex_convex(
             pos12,
             g1,
@@ -233,7 +284,11 @@ where
             normal_constraints2,
             prediction,
             manifold,
-        )
+        )?;
+        if cap_pair {
+            caps::refine_cap_contact(pos12, g1, g2, prediction, manifold, &old);
+        }
+        Ok(())
     }
 }
 

@@ -3,7 +3,8 @@
 //! Each pair keeps its manifolds from step to step, so Parry can match new contact points to
 //! old ones by feature id and carry the solver's impulses over ([`ContactImpulse`]): that is
 //! what warm starting reads. Manifolds come from Parry's dispatcher, but for a ball against a
-//! rounded shape, whose contact is built on the inner shape ([`super::dispatch`]).
+//! rounded shape, whose contact is built on the inner shape, and a cylinder's or cone's flat cap
+//! on a flat face, whose points come from a fine polygon ([`super::dispatch`]).
 
 use glam::Vec3;
 use parry3d::math::Pose;
