@@ -3,4 +3,6 @@
 //! manifolds (Parry) with the speculative margins that decide how far ahead points are made.
 
 pub(crate) mod broad_phase;
+pub(crate) mod caps;
+pub(crate) mod dispatch;
 pub(crate) mod narrow_phase;

@@ -2,18 +2,20 @@
 //!
 //! Each pair keeps its manifolds from step to step, so Parry can match new contact points to
 //! old ones by feature id and carry the solver's impulses over ([`ContactImpulse`]): that is
-//! what warm starting reads.
+//! what warm starting reads. Manifolds come from Parry's dispatcher, but for a ball against a
+//! rounded shape, whose contact is built on the inner shape, and a cylinder's or cone's flat cap
+//! on a flat face, whose points come from a fine polygon ([`super::dispatch`]).
 
 use glam::Vec3;
 use parry3d::math::Pose;
 use parry3d::query::{
-    ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
-    TrackedContact,
+    ContactManifold, ContactManifoldsWorkspace, PersistentQueryDispatcher, TrackedContact,
 };
 use parry3d::utils::PoseOpt;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::dispatch::ContactDispatcher;
 use crate::body::Bodies;
 use crate::error::StepError;
 use crate::parallel::{MANIFOLD_PAIRS_PER_TASK, prefetch, spread};
@@ -397,7 +399,7 @@ impl NarrowPhase {
                     manifold.mark_shapes_deformed();
                 }
             }
-            DefaultQueryDispatcher
+            ContactDispatcher
                 .contact_manifolds(
                     &pos12,
                     bodies.shape[a].as_ref(),

@@ -1,0 +1,230 @@
+//! A ball against a rounded shape touches it exactly where a ball grown by the border touches
+//! the inner shape: the same normal and separation, with the witness points on the true
+//! surfaces, on flat faces as on rounded edges and corners, in either order of the pair and
+//! as a compound's part.
+
+use glam::{Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::query::{ContactManifold, PersistentQueryDispatcher};
+use parry3d::shape::{Ball, Shape, SharedShape};
+use parry3d::utils::PoseOpt;
+
+use super::ContactDispatcher;
+
+const RADIUS: f32 = 0.3;
+/// The ball's separation from the rounded surface (m).
+const GAP: f32 = 1.0e-3;
+
+/// (name, rounded shape, its inner shape, border radius (m)).
+fn rounded_shapes() -> Vec<(&'static str, SharedShape, SharedShape, f32)> {
+    let hull = [
+        Vec3::new(-0.45, -0.15, -0.45),
+        Vec3::new(0.45, -0.15, -0.45),
+        Vec3::new(0.45, -0.15, 0.45),
+        Vec3::new(-0.45, -0.15, 0.45),
+        Vec3::new(-0.4, 0.15, -0.4),
+        Vec3::new(0.4, 0.15, -0.4),
+        Vec3::new(0.4, 0.15, 0.4),
+        Vec3::new(-0.4, 0.15, 0.4),
+    ];
+    vec![
+        (
+            "round cuboid",
+            SharedShape::round_cuboid(0.45, 0.15, 0.3, 0.05),
+            SharedShape::cuboid(0.45, 0.15, 0.3),
+            0.05,
+        ),
+        (
+            "round cylinder",
+            SharedShape::round_cylinder(0.15, 0.5, 0.05),
+            SharedShape::cylinder(0.15, 0.5),
+            0.05,
+        ),
+        (
+            "round cone",
+            SharedShape::round_cone(0.2, 0.25, 0.04),
+            SharedShape::cone(0.2, 0.25),
+            0.04,
+        ),
+        (
+            "round convex hull",
+            SharedShape::round_convex_hull(&hull, 0.05).unwrap(),
+            SharedShape::convex_hull(&hull).unwrap(),
+            0.05,
+        ),
+    ]
+}
+
+/// 26 directions: the faces, edges and corners of a cube, and 8 more between them.
+fn directions() -> Vec<Vec3> {
+    let mut out = Vec::new();
+    for x in -1..=1 {
+        for y in -1..=1 {
+            for z in -1..=1 {
+                if (x, y, z) != (0, 0, 0) {
+                    out.push(Vec3::new(x as f32, y as f32, z as f32).normalize());
+                }
+            }
+        }
+    }
+    for s in [-1.0, 1.0] {
+        for t in [-1.0, 1.0] {
+            out.push(Vec3::new(0.3 * s, 1.0, 0.7 * t).normalize());
+            out.push(Vec3::new(0.9 * s, -0.4, 0.2 * t).normalize());
+        }
+    }
+    out
+}
+
+fn manifold(pos1: &Pose, g1: &dyn Shape, pos2: &Pose, g2: &dyn Shape) -> ContactManifold<(), ()> {
+    let mut manifolds = Vec::new();
+    let mut workspace = None;
+    PersistentQueryDispatcher::<(), ()>::contact_manifolds(
+        &ContactDispatcher,
+        &pos1.inv_mul(pos2),
+        g1,
+        g2,
+        0.01,
+        &mut manifolds,
+        &mut workspace,
+    )
+    .unwrap();
+    assert_eq!(manifolds.len(), 1);
+    manifolds.pop().unwrap()
+}
+
+/// The contact as world quantities: (normal out of shape 1, point on shape 1, point on shape 2,
+/// separation), with each side's part pose (a compound's part) applied.
+fn world_contact(m: &ContactManifold<(), ()>, pos1: &Pose, pos2: &Pose) -> (Vec3, Vec3, Vec3, f32) {
+    assert_eq!(m.points.len(), 1, "one point");
+    let part1 = m.subshape_pos1().prepend_to(pos1);
+    let part2 = m.subshape_pos2().prepend_to(pos2);
+    let p = &m.points[0];
+    let n1 = part1.rotation * m.local_n1;
+    let n2 = part2.rotation * m.local_n2;
+    assert!((n1 + n2).length() < 1e-6, "opposite normals {n1} {n2}");
+    (
+        n1,
+        part1.transform_point(p.local_p1),
+        part2.transform_point(p.local_p2),
+        p.dist,
+    )
+}
+
+/// The expected contact of a ball (radius [`RADIUS`]) placed [`GAP`] outside rounded shape
+/// `inner` ⊕ ball(`border`) at pose `pose`, out along `direction` (local): the ball's centre,
+/// the outward normal, the point on the rounded surface and the point on the ball (world).
+fn ball_outside(inner: &dyn Shape, border: f32, pose: &Pose, direction: Vec3) -> [Vec3; 4] {
+    // The inner point closest to a far point along `direction`; every point out from it along
+    // the inner shape's outward normal there projects back on it.
+    let far = 10.0 * direction;
+    let closest = inner.project_local_point(far, true).point;
+    let normal = (far - closest).normalize();
+    let centre = closest + normal * (border + RADIUS + GAP);
+    [
+        pose.transform_point(centre),
+        pose.rotation * normal,
+        pose.transform_point(closest + normal * border),
+        pose.transform_point(centre - normal * RADIUS),
+    ]
+}
+
+fn close(a: Vec3, b: Vec3, tolerance: f32) -> bool {
+    a.distance(b) <= tolerance
+}
+
+#[test]
+fn a_ball_touches_a_rounded_shape_where_the_grown_ball_touches_the_inner_shape() {
+    let pose = Pose::from_parts(
+        Vec3::new(0.3, -0.2, 0.5),
+        Quat::from_euler(glam::EulerRot::XYZ, 0.3, -0.7, 0.2),
+    );
+    let ball = Ball::new(RADIUS);
+    let ball_rotation = Quat::from_rotation_z(1.1);
+    let mut failures = Vec::new();
+    for (name, rounded, inner, border) in rounded_shapes() {
+        for direction in directions() {
+            let [centre, normal, on_rounded, on_ball] =
+                ball_outside(inner.as_ref(), border, &pose, direction);
+            let ball_pose = Pose::from_parts(centre, ball_rotation);
+            // Either order of the pair.
+            let rounded_first = manifold(&pose, rounded.as_ref(), &ball_pose, &ball);
+            let (n, p1, p2, dist) = world_contact(&rounded_first, &pose, &ball_pose);
+            let ok_first = close(n, normal, 5e-6)
+                && close(p1, on_rounded, 1e-6)
+                && close(p2, on_ball, 1e-6)
+                && (dist - GAP).abs() < 1e-6;
+            let ball_first = manifold(&ball_pose, &ball, &pose, rounded.as_ref());
+            let (n, p1, p2, dist) = world_contact(&ball_first, &ball_pose, &pose);
+            let ok_second = close(n, -normal, 5e-6)
+                && close(p1, on_ball, 1e-6)
+                && close(p2, on_rounded, 1e-6)
+                && (dist - GAP).abs() < 1e-6;
+            if !(ok_first && ok_second) {
+                failures.push(format!(
+                    "{name}, direction {direction}: normal {n} (expected {}), dist {dist}",
+                    -normal
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// On a flat face the normal is the face's to within rounding: a lean of 1e-5 rad (Parry's GJK
+/// on the rounded shape) rolls a resting ball centimetres in 10 s.
+#[test]
+fn a_ball_on_a_rounded_flat_top_gets_the_face_normal() {
+    let ball = Ball::new(RADIUS);
+    for (name, rounded, _, border) in rounded_shapes() {
+        if name == "round cone" {
+            continue;
+        }
+        let top = rounded.compute_local_aabb().maxs.y;
+        assert!((top - 0.15 - border).abs() < 1e-6, "{name}: top {top}");
+        let centre = Vec3::new(0.07, top + RADIUS + GAP, -0.04);
+        let ball_pose = Pose::from_parts(centre, Quat::from_rotation_x(0.4));
+        let m = manifold(&Pose::IDENTITY, rounded.as_ref(), &ball_pose, &ball);
+        let (n, p1, _, dist) = world_contact(&m, &Pose::IDENTITY, &ball_pose);
+        assert!(
+            n.cross(Vec3::Y).length() < 1e-7 && n.y > 0.0,
+            "{name}: normal {n}"
+        );
+        assert!(close(p1, Vec3::new(0.07, top, -0.04), 1e-6), "{name}: {p1}");
+        assert!((dist - GAP).abs() < 1e-6, "{name}: dist {dist}");
+    }
+}
+
+/// A compound's rounded part, turned and moved in the compound, against a ball over its top:
+/// the part's face normal, so the compound's parts reach the exact ball contact too.
+#[test]
+fn a_ball_on_a_compounds_rounded_part_gets_the_face_normal() {
+    let part_pose = Pose::from_parts(Vec3::new(0.6, 0.1, 0.0), Quat::from_rotation_y(0.5));
+    let compound = SharedShape::compound(vec![
+        (part_pose, SharedShape::round_cuboid(0.3, 0.1, 0.3, 0.05)),
+        (
+            Pose::from_parts(Vec3::new(-0.6, 0.0, 0.0), Quat::IDENTITY),
+            SharedShape::cuboid(0.3, 0.1, 0.3),
+        ),
+    ]);
+    let body = Pose::from_parts(Vec3::new(1.0, 2.0, 3.0), Quat::from_rotation_x(0.2));
+    let part = body * part_pose;
+    let up = part.rotation * Vec3::Y;
+    let on_top = part.transform_point(Vec3::new(0.05, 0.15, 0.02));
+    let ball_pose = Pose::from_parts(on_top + up * (RADIUS + GAP), Quat::IDENTITY);
+    let ball = Ball::new(RADIUS);
+    for (m, flip) in [
+        (manifold(&body, compound.as_ref(), &ball_pose, &ball), 1.0),
+        (manifold(&ball_pose, &ball, &body, compound.as_ref()), -1.0),
+    ] {
+        let (n, p1, p2, dist) = if flip > 0.0 {
+            world_contact(&m, &body, &ball_pose)
+        } else {
+            world_contact(&m, &ball_pose, &body)
+        };
+        let on_part = if flip > 0.0 { p1 } else { p2 };
+        assert!(close(flip * n, up, 1e-6), "normal {n}, face {up}");
+        assert!(close(on_part, on_top, 1e-6), "{on_part} vs {on_top}");
+        assert!((dist - GAP).abs() < 1e-6, "dist {dist}");
+    }
+}
