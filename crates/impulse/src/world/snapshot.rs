@@ -447,12 +447,14 @@ fn rebuilt_composite(shape: &SharedShape) -> Result<Option<SharedShape>, String>
             let scale = field.scale();
             if heights.nrows() < 2
                 || heights.ncols() < 2
+                || heights.nrows().checked_mul(heights.ncols()) != Some(heights.data().len())
                 || !heights.data().iter().all(|h| h.is_finite())
                 || !(scale.is_finite() && scale.cmpgt(Vec3::ZERO).all())
             {
                 return Err(
-                    "height field: fewer than 2 × 2 heights, a height not finite, \
-                            or a scale not finite and positive"
+                    "height field: fewer than 2 × 2 heights, a grid whose size is not its \
+                     rows times its columns, a height not finite, or a scale not finite and \
+                     positive"
                         .into(),
                 );
             }
