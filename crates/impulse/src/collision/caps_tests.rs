@@ -4,30 +4,16 @@
 
 use glam::{Quat, Vec3};
 use parry3d::math::Pose;
-use parry3d::query::{ContactManifold, PersistentQueryDispatcher};
+use parry3d::query::ContactManifold;
 use parry3d::shape::{Shape, SharedShape, Triangle};
 
 use super::{COARSE_STEP, RIM_VERTICES};
-use crate::collision::dispatch::ContactDispatcher;
 
 const PREDICTION: f32 = 0.02;
 
 /// The one manifold of `g1` at `pos1` against `g2` at `pos2`.
 fn manifold(pos1: &Pose, g1: &dyn Shape, pos2: &Pose, g2: &dyn Shape) -> ContactManifold<(), ()> {
-    let mut manifolds = Vec::new();
-    let mut workspace = None;
-    PersistentQueryDispatcher::<(), ()>::contact_manifolds(
-        &ContactDispatcher,
-        &pos1.inv_mul(pos2),
-        g1,
-        g2,
-        PREDICTION,
-        &mut manifolds,
-        &mut workspace,
-    )
-    .unwrap();
-    assert_eq!(manifolds.len(), 1);
-    manifolds.pop().unwrap()
+    crate::collision::dispatch::tests::manifold_within(pos1, g1, pos2, g2, PREDICTION)
 }
 
 /// World points (on shape 1, on shape 2), the world normal out of shape 1, and separations.

@@ -359,4 +359,4 @@ fn move_witnesses_out<ManifoldData, ContactData>(
 
 #[cfg(test)]
 #[path = "dispatch_tests.rs"]
-mod tests;
+pub(crate) mod tests;

@@ -77,6 +77,18 @@ fn directions() -> Vec<Vec3> {
 }
 
 fn manifold(pos1: &Pose, g1: &dyn Shape, pos2: &Pose, g2: &dyn Shape) -> ContactManifold<(), ()> {
+    manifold_within(pos1, g1, pos2, g2, 0.01)
+}
+
+/// The one manifold [`ContactDispatcher`] gives `g1` at `pos1` against `g2` at `pos2`, with
+/// points up to `prediction` (m) apart.
+pub(crate) fn manifold_within(
+    pos1: &Pose,
+    g1: &dyn Shape,
+    pos2: &Pose,
+    g2: &dyn Shape,
+    prediction: f32,
+) -> ContactManifold<(), ()> {
     let mut manifolds = Vec::new();
     let mut workspace = None;
     PersistentQueryDispatcher::<(), ()>::contact_manifolds(
@@ -84,7 +96,7 @@ fn manifold(pos1: &Pose, g1: &dyn Shape, pos2: &Pose, g2: &dyn Shape) -> Contact
         &pos1.inv_mul(pos2),
         g1,
         g2,
-        0.01,
+        prediction,
         &mut manifolds,
         &mut workspace,
     )
