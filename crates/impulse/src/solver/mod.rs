@@ -115,6 +115,9 @@ pub struct TargetInputs<'a> {
     pub displacement: &'a [Vec3],
     /// Per slot, rotation vector (rad).
     pub rotation: &'a [Vec3],
+    /// Per slot, the square of the angle (rad²) turned since the step began, as the substep
+    /// started: stale speculative rows ([`constraints::speculative_row_is_stale`]).
+    pub turn: &'a [f32],
     /// Soft contact, repair rate, slop and the repair's speed cap.
     pub settings: &'a SolverSettings,
     /// Substep (s).
@@ -203,6 +206,7 @@ pub(crate) fn set_scalar_targets(
             constraints,
             t.displacement,
             t.rotation,
+            t.turn,
             t.settings,
             t.h,
             t.with_repair,

@@ -71,6 +71,10 @@ pub struct IslandWorkspace {
     pub displacement: Vec<Vec3>,
     /// Rotation vector accumulated since the start of the step (rad), for separations.
     pub rotation: Vec<Vec3>,
+    /// Per slot, the square of the angle (rad²) turned since the start of the step, as the
+    /// current substep started: which speculative rows are stale
+    /// ([`constraints::speculative_row_is_stale`]).
+    turn: Vec<f32>,
     /// Orientations, integrated substep by substep.
     pub orientation: Vec<Quat>,
     /// Per body, the linear and angular acceleration of its applied force and torque (m/s²,
@@ -175,6 +179,7 @@ impl IslandWorkspace {
             targets: Some(TargetInputs {
                 displacement: &self.displacement,
                 rotation: &self.rotation,
+                turn: &self.turn,
                 settings,
                 h,
                 with_repair,
@@ -441,6 +446,11 @@ pub fn step_island(
             &mut velocities,
             substep,
         );
+        // Both solves of the substep take the turn as it started, so that the relax solve
+        // does not release what the main solve gave a row before the body turned.
+        w.turn.clear();
+        w.turn
+            .extend(w.rotation.iter().map(|rotation| rotation.length_squared()));
         w.position_repair = false;
         w.targets_and_solve(constraints, settings, h, bundled, true, half_turn);
         // With no row to repair beyond the tolerance, positions move with the velocities alone

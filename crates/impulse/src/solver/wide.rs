@@ -31,7 +31,9 @@ use super::{
     ContactSolver, EscalationLevel, RowsReport, SolveOutcome, SolvePass, SolveReport, TargetInputs,
     Velocities,
 };
-use crate::contact::constraints::{ContactConstraint, JacobianRow, repair_terms};
+use crate::contact::constraints::{
+    ContactConstraint, JacobianRow, SPECULATIVE_TURN, STALE_TARGET, repair_terms,
+};
 use crate::graph::{COLOURS, greedy_colours};
 use crate::parallel::{
     GROUPS_PER_TASK, PARALLEL_PACK_POINTS, SharedItems, SharedVelocities, colour_after_colour,
@@ -946,6 +948,7 @@ impl SetTargets for NoTargets {
 struct Targets<'a> {
     displacement: &'a [Vec3],
     rotation: &'a [Vec3],
+    turn: &'a [f32],
     geometry: &'a [BundleGeometry],
     repair_rate: Lane,
     slop: Lane,
@@ -968,6 +971,7 @@ impl<'a> Targets<'a> {
         Self {
             displacement: inputs.displacement,
             rotation: inputs.rotation,
+            turn: inputs.turn,
             geometry,
             repair_rate: Lane::splat(repair_rate),
             slop: Lane::splat(settings.overlap_slop),
@@ -981,19 +985,29 @@ impl<'a> Targets<'a> {
 }
 
 impl SetTargets for &Targets<'_> {
-    type Moved = BodyLanes;
+    /// The lane group's bodies' displacements and rotations, and the squares of their angles
+    /// turned as the substep started (A's, B's).
+    type Moved = (BodyLanes, [Lane; 2]);
 
-    /// A lane group's bodies' displacements and rotations.
+    /// A lane group's bodies' displacements, rotations and turns.
     #[inline(always)]
-    fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
-        BodyLanes::gather(slots_a, slots_b, self.displacement, self.rotation)
+    fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::Moved {
+        (
+            BodyLanes::gather(slots_a, slots_b, self.displacement, self.rotation),
+            [
+                Lane::new(slots_a.map(|k| self.turn[k as usize])),
+                Lane::new(slots_b.map(|k| self.turn[k as usize])),
+            ],
+        )
     }
 
     /// Sets bundle `index`'s targets from the separation its points have reached: a gap is
     /// closed in one substep, an overlap deeper than the slop is repaired at the repair rate
-    /// (main solve only), with the soft contact's mass and impulse scales.
+    /// (main solve only), with the soft contact's mass and impulse scales. A stale gap
+    /// ([`crate::contact::constraints::speculative_row_is_stale`]) gets
+    /// [`STALE_TARGET`], as in [`crate::contact::constraints::update_targets`].
     #[inline(always)]
-    fn set(&self, b: &mut Bundle, index: usize, moved: &BodyLanes) {
+    fn set(&self, b: &mut Bundle, index: usize, (moved, [turn_a, turn_b]): &Self::Moved) {
         let zero = Lane::splat(0.0);
         let g = &self.geometry[index];
         let at_a = add_cross(moved.linear_a, moved.angular_a, g.lever_a);
@@ -1002,7 +1016,16 @@ impl SetTargets for &Targets<'_> {
         let gap = separation.simd_gt(zero);
         let repair = (self.repair_rate * (-separation - self.slop).max(zero)).min(self.max_repair);
         let overlap_target = if self.with_repair { repair } else { zero };
-        b.target = gap.select(-separation * self.inverse_h, overlap_target);
+        let limit = Lane::splat(SPECULATIVE_TURN * SPECULATIVE_TURN);
+        let negligible = Lane::splat(1e-6);
+        let (arm_a, arm_b) = (b.normal.angular_a, b.normal.angular_b);
+        let stale_a = turn_a.simd_gt(limit)
+            & dot(arm_a, arm_a).simd_gt(negligible * dot(g.lever_a, g.lever_a));
+        let stale_b = turn_b.simd_gt(limit)
+            & dot(arm_b, arm_b).simd_gt(negligible * dot(g.lever_b, g.lever_b));
+        let gap_target =
+            (stale_a | stale_b).select(Lane::splat(STALE_TARGET), -separation * self.inverse_h);
+        b.target = gap.select(gap_target, overlap_target);
         b.mass_scale = gap.select(Lane::splat(1.0), self.soft_mass);
         b.impulse_scale = gap.select(zero, self.soft_impulse);
     }
