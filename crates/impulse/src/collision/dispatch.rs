@@ -240,6 +240,24 @@ where
         prediction: Real,
         manifold: &mut ContactManifold<ManifoldData, ContactData>,
     ) -> Result<(), Unsupported> {
+        // Pairs this dispatcher treats as Parry does (boxes, capsules, hulls, triangles, balls
+        // on anything not rounded: most pairs of most scenes) go straight to Parry's, decided
+        // from the two shape types alone.
+        let (type1, type2) = (g1.shape_type(), g2.shape_type());
+        let own = |this: ShapeType, other: ShapeType| {
+            has_cap_type(this) || (other == ShapeType::Ball && is_rounded_type(this))
+        };
+        if !own(type1, type2) && !own(type2, type1) {
+            return DefaultQueryDispatcher.contact_manifold_convex_convex(
+                pos12,
+                g1,
+                g2,
+                normal_constraints1,
+                normal_constraints2,
+                prediction,
+                manifold,
+            );
+        }
         if let Some(ball2) = g2.as_ball()
             && rounded_against_ball(
                 pos12,
@@ -290,6 +308,26 @@ where
         }
         Ok(())
     }
+}
+
+/// Whether shapes of this type have a flat cap ([`caps::has_cap`]).
+fn has_cap_type(shape_type: ShapeType) -> bool {
+    matches!(
+        shape_type,
+        ShapeType::Cylinder | ShapeType::RoundCylinder | ShapeType::Cone | ShapeType::RoundCone
+    )
+}
+
+/// Whether shapes of this type are the rounded convex shapes [`rounded_against_ball`] takes.
+fn is_rounded_type(shape_type: ShapeType) -> bool {
+    matches!(
+        shape_type,
+        ShapeType::RoundCuboid
+            | ShapeType::RoundTriangle
+            | ShapeType::RoundCylinder
+            | ShapeType::RoundCone
+            | ShapeType::RoundConvexPolyhedron
+    )
 }
 
 /// The manifold of `rounded` against `ball` (the ball's pose in the rounded shape's frame is

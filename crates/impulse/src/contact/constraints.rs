@@ -572,6 +572,7 @@ pub fn update_targets(
             - (displacement[b] + rotation[b].cross(c.lever_b));
         let separation = -c.depth + c.normal.direction.dot(moved);
         let stale = separation > 0.0
+            && !turn.is_empty()
             && (speculative_row_is_stale(turn[a], c.normal.angular_a, c.lever_a)
                 || speculative_row_is_stale(turn[b], c.normal.angular_b, c.lever_b));
         let gap_target = if stale { STALE_TARGET } else { -separation / h };

@@ -116,7 +116,8 @@ pub struct TargetInputs<'a> {
     /// Per slot, rotation vector (rad).
     pub rotation: &'a [Vec3],
     /// Per slot, the square of the angle (rad²) turned since the step began, as the substep
-    /// started: stale speculative rows ([`constraints::speculative_row_is_stale`]).
+    /// started: stale speculative rows ([`constraints::speculative_row_is_stale`]). Empty when
+    /// no body has turned past [`constraints::SPECULATIVE_TURN`]: no row is stale.
     pub turn: &'a [f32],
     /// Soft contact, repair rate, slop and the repair's speed cap.
     pub settings: &'a SolverSettings,

@@ -447,10 +447,15 @@ pub fn step_island(
             substep,
         );
         // Both solves of the substep take the turn as it started, so that the relax solve
-        // does not release what the main solve gave a row before the body turned.
+        // does not release what the main solve gave a row before the body turned. Left empty
+        // while no body of the island has turned past the limit (every ordinary step), so
+        // that the target updates skip the test.
         w.turn.clear();
-        w.turn
-            .extend(w.rotation.iter().map(|rotation| rotation.length_squared()));
+        let limit = constraints::SPECULATIVE_TURN * constraints::SPECULATIVE_TURN;
+        if w.rotation.iter().any(|r| r.length_squared() > limit) {
+            w.turn
+                .extend(w.rotation.iter().map(|rotation| rotation.length_squared()));
+        }
         w.position_repair = false;
         w.targets_and_solve(constraints, settings, h, bundled, true, half_turn);
         // With no row to repair beyond the tolerance, positions move with the velocities alone

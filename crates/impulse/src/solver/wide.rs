@@ -761,11 +761,24 @@ impl Bundles {
             } else {
                 None
             };
-            let largest = match (first, friction) {
-                (Some(t), true) => self.sweep(order, velocities, VelocityRows::<true>, t),
-                (Some(t), false) => self.sweep(order, velocities, VelocityRows::<false>, t),
-                (None, true) => self.sweep(order, velocities, VelocityRows::<true>, NoTargets),
-                (None, false) => self.sweep(order, velocities, VelocityRows::<false>, NoTargets),
+            // A sweep that may meet stale rows is compiled apart, so that the usual one (no
+            // body of the island turned past the limit) carries no test for them.
+            let stale = first.is_some_and(|t| !t.turn.is_empty());
+            let largest = match (first, friction, stale) {
+                (Some(t), true, false) => {
+                    self.sweep(order, velocities, VelocityRows::<true>, Turned::<false>(t))
+                }
+                (Some(t), false, false) => {
+                    self.sweep(order, velocities, VelocityRows::<false>, Turned::<false>(t))
+                }
+                (Some(t), true, true) => {
+                    self.sweep(order, velocities, VelocityRows::<true>, Turned::<true>(t))
+                }
+                (Some(t), false, true) => {
+                    self.sweep(order, velocities, VelocityRows::<false>, Turned::<true>(t))
+                }
+                (None, true, _) => self.sweep(order, velocities, VelocityRows::<true>, NoTargets),
+                (None, false, _) => self.sweep(order, velocities, VelocityRows::<false>, NoTargets),
             };
             let largest_change = largest.to_array().into_iter().fold(0.0f32, f32::max);
             report.iterations += 1;
@@ -984,20 +997,31 @@ impl<'a> Targets<'a> {
     }
 }
 
-impl SetTargets for &Targets<'_> {
+/// [`Targets`] for a sweep that tests for stale speculative rows (`STALE`: some body of the
+/// island turned past [`SPECULATIVE_TURN`], so `turn` is filled) or not.
+#[derive(Clone, Copy)]
+struct Turned<'a, const STALE: bool>(&'a Targets<'a>);
+
+impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
     /// The lane group's bodies' displacements and rotations, and the squares of their angles
-    /// turned as the substep started (A's, B's).
+    /// turned as the substep started (A's, B's; zero without `STALE`).
     type Moved = (BodyLanes, [Lane; 2]);
 
     /// A lane group's bodies' displacements, rotations and turns.
     #[inline(always)]
     fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::Moved {
-        (
-            BodyLanes::gather(slots_a, slots_b, self.displacement, self.rotation),
+        let t = self.0;
+        let turns = if STALE {
             [
-                Lane::new(slots_a.map(|k| self.turn[k as usize])),
-                Lane::new(slots_b.map(|k| self.turn[k as usize])),
-            ],
+                Lane::new(slots_a.map(|k| t.turn[k as usize])),
+                Lane::new(slots_b.map(|k| t.turn[k as usize])),
+            ]
+        } else {
+            [Lane::splat(0.0); 2]
+        };
+        (
+            BodyLanes::gather(slots_a, slots_b, t.displacement, t.rotation),
+            turns,
         )
     }
 
@@ -1008,26 +1032,31 @@ impl SetTargets for &Targets<'_> {
     /// [`STALE_TARGET`], as in [`crate::contact::constraints::update_targets`].
     #[inline(always)]
     fn set(&self, b: &mut Bundle, index: usize, (moved, [turn_a, turn_b]): &Self::Moved) {
+        let t = self.0;
         let zero = Lane::splat(0.0);
-        let g = &self.geometry[index];
+        let g = &t.geometry[index];
         let at_a = add_cross(moved.linear_a, moved.angular_a, g.lever_a);
         let at_b = add_cross(moved.linear_b, moved.angular_b, g.lever_b);
         let separation = dot(b.normal.direction, sub(at_a, at_b)) - g.depth;
         let gap = separation.simd_gt(zero);
-        let repair = (self.repair_rate * (-separation - self.slop).max(zero)).min(self.max_repair);
-        let overlap_target = if self.with_repair { repair } else { zero };
-        let limit = Lane::splat(SPECULATIVE_TURN * SPECULATIVE_TURN);
-        let negligible = Lane::splat(1e-6);
-        let (arm_a, arm_b) = (b.normal.angular_a, b.normal.angular_b);
-        let stale_a = turn_a.simd_gt(limit)
-            & dot(arm_a, arm_a).simd_gt(negligible * dot(g.lever_a, g.lever_a));
-        let stale_b = turn_b.simd_gt(limit)
-            & dot(arm_b, arm_b).simd_gt(negligible * dot(g.lever_b, g.lever_b));
-        let gap_target =
-            (stale_a | stale_b).select(Lane::splat(STALE_TARGET), -separation * self.inverse_h);
+        let repair = (t.repair_rate * (-separation - t.slop).max(zero)).min(t.max_repair);
+        let overlap_target = if t.with_repair { repair } else { zero };
+        let closing = -separation * t.inverse_h;
+        let gap_target = if !STALE {
+            closing
+        } else {
+            let limit = Lane::splat(SPECULATIVE_TURN * SPECULATIVE_TURN);
+            let negligible = Lane::splat(1e-6);
+            let (arm_a, arm_b) = (b.normal.angular_a, b.normal.angular_b);
+            let stale_a = turn_a.simd_gt(limit)
+                & dot(arm_a, arm_a).simd_gt(negligible * dot(g.lever_a, g.lever_a));
+            let stale_b = turn_b.simd_gt(limit)
+                & dot(arm_b, arm_b).simd_gt(negligible * dot(g.lever_b, g.lever_b));
+            (stale_a | stale_b).select(Lane::splat(STALE_TARGET), closing)
+        };
         b.target = gap.select(gap_target, overlap_target);
-        b.mass_scale = gap.select(Lane::splat(1.0), self.soft_mass);
-        b.impulse_scale = gap.select(zero, self.soft_impulse);
+        b.mass_scale = gap.select(Lane::splat(1.0), t.soft_mass);
+        b.impulse_scale = gap.select(zero, t.soft_impulse);
     }
 }
 
