@@ -3,7 +3,7 @@
 //! [`super::BodyBuilder`] (and reports the body and field). Each rule gives the message for
 //! the one field it checks, so both paths say the same thing in the same words.
 
-use parry3d::shape::{SharedShape, TypedShape};
+use parry3d::shape::{Shape, SharedShape, TypedShape};
 
 use super::BodyKind;
 
@@ -19,14 +19,10 @@ pub(crate) const MAX_SHAPE_EXTENT: f32 = 1.0e6;
 /// [`MAX_SHAPE_EXTENT`] on every axis (a half-space, unbounded, is exempt), and a rounded
 /// shape's border radius finite and ≥ 0 (Parry asserts it when it grows the box).
 pub(crate) fn shape_extent(shape: &SharedShape) -> Result<(), String> {
-    let border_radius = match shape.as_typed_shape() {
-        TypedShape::RoundCuboid(s) => Some(s.border_radius),
-        TypedShape::RoundCylinder(s) => Some(s.border_radius),
-        TypedShape::RoundCone(s) => Some(s.border_radius),
-        TypedShape::RoundConvexPolyhedron(s) => Some(s.border_radius),
-        TypedShape::HalfSpace(_) => return Ok(()),
-        _ => None,
-    };
+    if shape.as_halfspace().is_some() {
+        return Ok(());
+    }
+    let border_radius = rounded_parts(shape.as_ref()).map(|(_, radius)| radius);
     if let Some(radius) = border_radius.filter(|r| !(r.is_finite() && *r >= 0.0)) {
         return Err(format!(
             "border radius must be finite and ≥ 0, got {radius}"
@@ -40,6 +36,19 @@ pub(crate) fn shape_extent(shape: &SharedShape) -> Result<(), String> {
         Err(format!(
             "the shape reaches {reach} m from the body's origin; at most {MAX_SHAPE_EXTENT} m"
         ))
+    }
+}
+
+/// A rounded shape (Parry's `RoundShape`: every point within the border radius of its inner
+/// shape) as its inner shape and border radius (m); `None` for any other shape.
+pub(crate) fn rounded_parts(shape: &dyn Shape) -> Option<(&dyn Shape, f32)> {
+    match shape.as_typed_shape() {
+        TypedShape::RoundCuboid(s) => Some((&s.inner_shape, s.border_radius)),
+        TypedShape::RoundTriangle(s) => Some((&s.inner_shape, s.border_radius)),
+        TypedShape::RoundCylinder(s) => Some((&s.inner_shape, s.border_radius)),
+        TypedShape::RoundCone(s) => Some((&s.inner_shape, s.border_radius)),
+        TypedShape::RoundConvexPolyhedron(s) => Some((&s.inner_shape, s.border_radius)),
+        _ => None,
     }
 }
 

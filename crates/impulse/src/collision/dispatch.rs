@@ -41,9 +41,10 @@ use parry3d::query::{
     NonlinearRigidMotion, PersistentQueryDispatcher, QueryDispatcher, ShapeCastHit,
     ShapeCastOptions, ShapeDistance, ShapeIntersection, Unsupported,
 };
-use parry3d::shape::{Ball, Shape, ShapeType, TypedShape};
+use parry3d::shape::{Ball, Shape, ShapeType};
 
 use super::caps;
+use crate::body::rules::rounded_parts;
 
 /// Parry's default dispatcher, with exact contacts between a ball and a rounded convex shape
 /// and a fine polygon for a cylinder's or cone's flat cap on a flat face (see the module's
@@ -318,7 +319,8 @@ fn has_cap_type(shape_type: ShapeType) -> bool {
     )
 }
 
-/// Whether shapes of this type are the rounded convex shapes [`rounded_against_ball`] takes.
+/// Whether shapes of this type are the rounded shapes [`rounded_against_ball`] takes (those of
+/// [`rounded_parts`]), decided from the type alone.
 fn is_rounded_type(shape_type: ShapeType) -> bool {
     matches!(
         shape_type,
@@ -345,27 +347,20 @@ fn rounded_against_ball<ManifoldData, ContactData: Default + Copy>(
     manifold: &mut ContactManifold<ManifoldData, ContactData>,
     flipped: bool,
 ) -> bool {
-    let mut inner_against_ball = |inner: &dyn Shape, border: Real| {
-        contact_manifold_convex_ball(
-            pos12,
-            inner,
-            &Ball::new(ball.radius + border),
-            normal_constraints_rounded,
-            normal_constraints_ball,
-            prediction,
-            manifold,
-            flipped,
-        );
-        move_witnesses_out(manifold, border, flipped);
+    let Some((inner, border)) = rounded_parts(rounded) else {
+        return false;
     };
-    match rounded.as_typed_shape() {
-        TypedShape::RoundCuboid(s) => inner_against_ball(&s.inner_shape, s.border_radius),
-        TypedShape::RoundTriangle(s) => inner_against_ball(&s.inner_shape, s.border_radius),
-        TypedShape::RoundCylinder(s) => inner_against_ball(&s.inner_shape, s.border_radius),
-        TypedShape::RoundCone(s) => inner_against_ball(&s.inner_shape, s.border_radius),
-        TypedShape::RoundConvexPolyhedron(s) => inner_against_ball(&s.inner_shape, s.border_radius),
-        _ => return false,
-    }
+    contact_manifold_convex_ball(
+        pos12,
+        inner,
+        &Ball::new(ball.radius + border),
+        normal_constraints_rounded,
+        normal_constraints_ball,
+        prediction,
+        manifold,
+        flipped,
+    );
+    move_witnesses_out(manifold, border, flipped);
     true
 }
 

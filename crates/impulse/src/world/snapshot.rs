@@ -493,22 +493,13 @@ fn rebuilt_composite(shape: &SharedShape) -> Result<Option<SharedShape>, String>
 /// and built again by [`rebuilt_composite`]; other Parry shapes are taken as Parry decoded
 /// them.
 fn check_shape(shape: &SharedShape) -> Result<(), String> {
-    let positive = |x: f32| x.is_finite() && x > 0.0;
-    let round = |border_radius: f32, inner: &dyn Shape| {
-        if positive(border_radius) {
+    match crate::body::rules::rounded_parts(shape.as_ref()) {
+        Some((inner, border_radius)) if border_radius.is_finite() && border_radius > 0.0 => {
             check_shape_of(inner)
-        } else {
-            Err("a border radius is not finite and positive".to_string())
         }
-    };
-    match shape.as_typed_shape() {
-        TypedShape::RoundCuboid(s) => return round(s.border_radius, &s.inner_shape),
-        TypedShape::RoundCylinder(s) => return round(s.border_radius, &s.inner_shape),
-        TypedShape::RoundCone(s) => return round(s.border_radius, &s.inner_shape),
-        TypedShape::RoundConvexPolyhedron(s) => return round(s.border_radius, &s.inner_shape),
-        _ => {}
+        Some(_) => Err("a border radius is not finite and positive".to_string()),
+        None => check_shape_of(shape.as_ref()),
     }
-    check_shape_of(shape.as_ref())
 }
 
 /// [`check_shape`] of a shape that is not rounded.
