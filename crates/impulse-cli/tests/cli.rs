@@ -72,8 +72,8 @@ fn run_writes_csv_trajectory_and_summary_json() {
         "finish",
         "total",
     ] {
-        let ms = json["stage_ms"][stage].as_f64();
-        assert!(ms.is_some_and(|ms| ms >= 0.0), "stage_ms.{stage}: {ms:?}");
+        let ms = &json["stage_ms"][stage];
+        assert!(ms.is_number(), "stage_ms.{stage}: {ms:?}");
     }
     assert_eq!(json["bodies"], 31);
     assert_eq!(json["steps"], 20);

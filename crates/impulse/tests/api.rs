@@ -113,6 +113,54 @@ fn a_resting_cube_presses_its_weight_into_the_ground() {
     assert!(cube_ref.translation().y > 0.49);
 }
 
+/// A resting column of five cubes, solved in SIMD lanes (20 points): each contact pair
+/// reports, summed over the step's substeps, the weight of the cubes above it times the step,
+/// (5 − k)·m·g·dt under cube k.
+#[test]
+fn each_joint_of_a_resting_column_carries_the_weight_above_it() {
+    let mut w = World::new(
+        Vec3::new(0.0, -9.81, 0.0),
+        DT,
+        SolverSettings {
+            sleep: false,
+            ..SolverSettings::default()
+        },
+    )
+    .unwrap();
+    let mut below = w
+        .insert(
+            BodyBuilder::fixed(SharedShape::cuboid(10.0, 0.5, 10.0))
+                .translation(Vec3::new(0.0, -0.5, 0.0)),
+        )
+        .unwrap();
+    let mut joints = Vec::new();
+    for k in 0..5 {
+        let cube = w
+            .insert(
+                BodyBuilder::dynamic(SharedShape::cuboid(0.5, 0.5, 0.5)).translation(Vec3::new(
+                    0.0,
+                    0.5 + k as f32,
+                    0.0,
+                )),
+            )
+            .unwrap();
+        joints.push((below, cube));
+        below = cube;
+    }
+    for _ in 0..120 {
+        w.step().unwrap();
+    }
+    assert!(w.diagnostics().islands.iter().all(|island| island.simd));
+    for (k, &(lower, upper)) in joints.iter().enumerate() {
+        let expected = (5 - k) as f32 * 1000.0 * 9.81 * DT;
+        let total = w.contact_pair(lower, upper).unwrap().total_normal_impulse();
+        assert!(
+            (total - expected).abs() < 0.01 * expected,
+            "joint {k}: {total} N·s against {expected}"
+        );
+    }
+}
+
 #[test]
 fn contact_events_start_once_on_landing_and_stop_on_removal() {
     let mut w = world(Vec3::new(0.0, -9.81, 0.0));
@@ -207,6 +255,53 @@ fn removal_keeps_every_other_handle_and_never_reuses_one() {
     assert!(!w.contains(cubes[2]));
     assert_eq!(w.body_count(), 6);
     w.step().unwrap();
+}
+
+/// A dynamic cube replaced, at the same index and pose, by a kinematic one: the contact pairs
+/// come back with the same bodies and point counts, yet the new body must not be solved as a
+/// member of the island (it is a guest the island pushes against, moved only by its own
+/// velocity).
+#[test]
+fn a_body_replaced_by_one_of_another_kind_is_not_solved_as_the_old_one() {
+    let (mut w, _ground, lower) = cube_on_ground();
+    let upper = w
+        .insert(
+            BodyBuilder::dynamic(SharedShape::cuboid(0.5, 0.5, 0.5))
+                .translation(Vec3::new(0.0, 1.5, 0.0)),
+        )
+        .unwrap();
+    for _ in 0..30 {
+        w.step().unwrap();
+    }
+    let (translation, rotation) = {
+        let b = w.body(upper).unwrap();
+        (b.translation(), b.rotation())
+    };
+    let pairs_before = w.contact_pairs().count();
+    w.remove(upper).unwrap();
+    let kinematic = w
+        .insert(
+            BodyBuilder::kinematic(SharedShape::cuboid(0.5, 0.5, 0.5))
+                .translation(translation)
+                .rotation(rotation),
+        )
+        .unwrap();
+    assert_eq!(kinematic.index(), upper.index());
+    let lower_y = w.body(lower).unwrap().translation().y;
+    for step in 0..30 {
+        w.step().unwrap();
+        let b = w.body(kinematic).unwrap();
+        assert_eq!(b.linear_velocity(), Vec3::ZERO, "step {step}");
+        assert_eq!(b.translation(), translation, "step {step}");
+    }
+    assert_eq!(w.contact_pairs().count(), pairs_before);
+    // The lower cube still rests on the ground under the kinematic one, which does not weigh
+    // on it.
+    let y = w.body(lower).unwrap().translation().y;
+    assert!(
+        (y - lower_y).abs() < 1e-3,
+        "lower cube moved from {lower_y} to {y}"
+    );
 }
 
 #[test]

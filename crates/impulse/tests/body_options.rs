@@ -332,6 +332,49 @@ fn a_body_locked_along_z_moves_as_a_free_body_in_x_and_y_and_never_in_z() {
     assert!((got - x).abs() < 0.01, "x = {got} m, analytic {x} m");
 }
 
+/// A ball resting on the ground with one horizontal translation locked (x, z, or both) is held
+/// up as a free ball is: the ground's normal row sees the ball's mass along y whatever is
+/// locked across it. The balls roll along their free axis and stay on the ground's surface.
+#[test]
+fn a_ball_locked_along_a_horizontal_axis_rests_on_the_ground_as_a_free_one() {
+    let radius = 0.25;
+    for (name, locked, velocity) in [
+        ("x", LockedAxes::TRANSLATION_X, Vec3::new(0.0, 0.0, 1.0)),
+        ("z", LockedAxes::TRANSLATION_Z, Vec3::new(1.0, 0.0, 0.0)),
+        (
+            "x and z",
+            LockedAxes::TRANSLATION_X | LockedAxes::TRANSLATION_Z,
+            Vec3::ZERO,
+        ),
+    ] {
+        let mut world = World::new(Vec3::new(0.0, -G, 0.0), DT, settings()).unwrap();
+        ground(&mut world, 0.5, 0.0);
+        let ball = |x: f32| {
+            BodyBuilder::dynamic(SharedShape::ball(radius))
+                .translation(Vec3::new(x, radius, 0.0))
+                .linear_velocity(velocity)
+        };
+        let free = world.insert(ball(-5.0)).unwrap();
+        let held = world.insert(ball(5.0).locked_axes(locked)).unwrap();
+        for step in 0..120 {
+            world.step().unwrap();
+            let (f, l) = (world.body(free).unwrap(), world.body(held).unwrap());
+            assert!(
+                (l.translation().y - f.translation().y).abs() < 1e-4
+                    && (l.translation().y - radius).abs() < 1e-3,
+                "{name}, step {step}: locked ball at y = {}, free ball at {}",
+                l.translation().y,
+                f.translation().y
+            );
+        }
+        let moved = world.body(held).unwrap().translation() - Vec3::new(5.0, radius, 0.0);
+        assert!(
+            (moved.length() - velocity.length() * 2.0).abs() < 0.6,
+            "{name}: moved {moved}"
+        );
+    }
+}
+
 /// Two frictionless spheres meet obliquely, with no gravity: A (at rest, locked along z) is
 /// hit by B moving along x, the line of centres n having a z component. The inelastic impulse
 /// along n is γ = −u₀/K with K = nᵀ M_A⁻¹ n + 1/m_B, where M_A⁻¹ = diag(1, 1, 0)/m_A: A then

@@ -71,6 +71,16 @@ fn parallel_islands_match_sequential_bit_for_bit() {
         sequential.step().unwrap();
         pool.install(|| parallel.step().unwrap());
     }
+    // Six islands, one per stack, each named by its lowest body (the ground is body 0), with
+    // its five cubes and the contacts of a cube on a cube or the ground (four corners each).
+    let islands = &sequential.diagnostics().islands;
+    assert_eq!(islands, &parallel.diagnostics().islands);
+    let mut firsts: Vec<u32> = islands.iter().map(|island| island.first_body).collect();
+    firsts.sort_unstable();
+    assert_eq!(firsts, [1, 6, 11, 16, 21, 26]);
+    for island in islands {
+        assert_eq!((island.bodies, island.contacts), (5, 20), "{island:?}");
+    }
     for i in 0..sequential.bodies().len() {
         assert_eq!(
             sequential.bodies().pose[i],
@@ -126,13 +136,19 @@ fn a_quiet_island_sleeps_and_a_falling_box_wakes_it() {
 /// One large island swept colour by colour: the colouring keeps every colour free of shared
 /// moving bodies (checked through the result: spreading each colour over two threads gives
 /// exactly the one-thread trajectory), and the pyramid still stands. Its ~3000 pairs also take
-/// the parallel assembly path (`constraints::PAIRS_PER_TASK`). Once with the default
-/// scalar sweeps, once with `SolverSettings::fast()`, whose island is solved in SIMD bundles
-/// (spread over the threads without `parallel_island_contacts`).
+/// the parallel assembly path (`constraints::PAIRS_PER_TASK`). With the default and
+/// `SolverSettings::fast()`, whose island is solved in SIMD bundles (spread over the threads
+/// without `parallel_island_contacts`), and with `SolverSettings::reference()`, whose NNCG
+/// sweeps the island colour by colour in scalar rows and sums its momentum's β over fixed runs
+/// of points on the threads.
 #[test]
 fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
     let default = SolverSettings::default();
-    for (settings, largest_sink) in [(default, 0.005), (SolverSettings::fast(), 0.05)] {
+    for (settings, largest_sink) in [
+        (default, 0.005),
+        (SolverSettings::fast(), 0.05),
+        (SolverSettings::reference(), 0.005),
+    ] {
         let mut scene = impulse::scene::builtin_scene("pyramid3d10").unwrap();
         let simd = !settings.split_impulse();
         scene.solver = SolverSettings {

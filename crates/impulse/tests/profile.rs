@@ -13,7 +13,6 @@ fn stage_times_add_up_to_the_step() {
         world.step().unwrap();
         let profile = *world.profile();
         let stages = profile.stages();
-        assert!(stages.iter().all(|(_, ms)| *ms >= 0.0), "{stages:?}");
         let sum: f32 = stages.iter().map(|(_, ms)| ms).sum();
         assert!(profile.total > 0.0);
         assert!(

@@ -863,3 +863,53 @@ pub fn cap_to_disc(impulse: [f32; 2], limit: f32) -> [f32; 2] {
         [0.0, 0.0]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The warm start's fraction scales all three impulses alike, then Coulomb's disc of the
+    /// scaled normal impulse caps the friction impulse (a 3-4-5 triangle: |γ_t| = 2.5 after
+    /// halving, inside the disc of radius 1.0·5 and outside 0.4·5 = 2).
+    #[test]
+    fn a_warm_start_fraction_scales_every_impulse_then_caps_friction() {
+        let row = |friction| ContactConstraint {
+            friction,
+            normal_impulse: 10.0,
+            tangent_impulses: [3.0, 4.0],
+            ..ContactConstraint::default()
+        };
+        let mut rows = [row(1.0), row(0.4)];
+        scale_impulses(&mut rows, 0.5);
+        assert_eq!(rows[0].normal_impulse, 5.0);
+        assert_eq!(rows[0].tangent_impulses, [1.5, 2.0]);
+        assert_eq!(rows[0].max_normal_impulse, 5.0);
+        assert_eq!(rows[1].normal_impulse, 5.0);
+        let [t1, t2] = rows[1].tangent_impulses;
+        assert!(
+            (t1 - 1.2).abs() < 1e-6 && (t2 - 1.6).abs() < 1e-6,
+            "{t1}, {t2}"
+        );
+    }
+
+    /// A speculative row is stale once its body has turned by more than
+    /// [`SPECULATIVE_TURN`], not at it, and never when its lever arm lies along its normal (a
+    /// ball's row, r × n = 0) or is zero.
+    #[test]
+    fn a_row_goes_stale_past_the_turn_limit_unless_its_lever_lies_along_the_normal() {
+        let limit = SPECULATIVE_TURN * SPECULATIVE_TURN;
+        let lever = Vec3::new(0.3, -0.5, 0.0);
+        let angular = lever.cross(Vec3::Y);
+        assert!(!speculative_row_is_stale(limit, angular, lever));
+        assert!(speculative_row_is_stale(limit * 1.001, angular, lever));
+        assert!(!speculative_row_is_stale(0.0, angular, lever));
+        let along = Vec3::new(0.0, -0.5, 0.0);
+        assert!(!speculative_row_is_stale(
+            100.0,
+            along.cross(Vec3::Y),
+            along
+        ));
+        // A contact at the centre of mass has no lever arm at all.
+        assert!(!speculative_row_is_stale(100.0, Vec3::ZERO, Vec3::ZERO));
+    }
+}

@@ -366,3 +366,138 @@ fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
     assert_eq!(bits(&results[0].0), bits(&results[1].0), "1 and 2 threads");
     assert_eq!(results[0].1, results[1].1);
 }
+
+/// The lanes set each row's target and softness from the separation the bodies have reached,
+/// as the scalar [`crate::contact::constraints::update_targets`] does: pyramid20's rows, with
+/// every moving body displaced by up to 2 mm and turned by up to 0.05 rad about all three axes
+/// (each point's move is Δx + Δθ × r), through the soft main solve and the relax solve, with
+/// the problem turned out of the pyramid's plane.
+#[test]
+fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
+    use super::Bundles;
+    use crate::contact::constraints::{ContactConstraint, update_targets};
+    use crate::solver::{SolvePass, Sweep, TargetInputs, Velocities};
+    let mut scene = builtin_scene("pyramid20").unwrap();
+    scene.solver.sleep = false;
+    let mut w = World::from_scene(&scene).unwrap();
+    for _ in 0..30 {
+        w.step().unwrap();
+    }
+    let n = w.bodies.len();
+    let slot = |i: u32| {
+        if w.bodies.kind[i as usize] == BodyKind::Dynamic {
+            i
+        } else {
+            n as u32
+        }
+    };
+    // The planar pyramid's normals lie in its plane; the whole problem turned by one rotation
+    // R (directions, r × d, I⁻¹(r × d) and lever arms alike: the same contacts seen from
+    // another frame) gives every point a normal with all three components.
+    let turn = glam::Quat::from_euler(glam::EulerRot::XYZ, 0.3, 0.5, 0.7);
+    let rows: Vec<ContactConstraint> = w
+        .contact_constraints()
+        .iter()
+        .map(|c| {
+            let mut c = *c;
+            (c.local_a, c.local_b) = (slot(c.body_a), slot(c.body_b));
+            let [t1, t2] = &mut c.tangents;
+            for row in [&mut c.normal, t1, t2] {
+                row.direction = turn * row.direction;
+                row.angular_a = turn * row.angular_a;
+                row.angular_b = turn * row.angular_b;
+                row.inverse_inertia_angular_a = turn * row.inverse_inertia_angular_a;
+                row.inverse_inertia_angular_b = turn * row.inverse_inertia_angular_b;
+            }
+            (c.lever_a, c.lever_b) = (turn * c.lever_a, turn * c.lever_b);
+            c
+        })
+        .collect();
+    assert!(
+        rows.iter()
+            .all(|c| c.normal.direction.abs().min_element() > 0.01)
+    );
+    // A fixed LCG in [-1, 1).
+    let mut state = 7u32;
+    let mut unit = || {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (state >> 8) as f32 / (1u32 << 23) as f32 - 1.0
+    };
+    let mut displacement: Vec<Vec3> = (0..n)
+        .map(|_| 0.002 * Vec3::new(unit(), unit(), unit()))
+        .collect();
+    let mut rotation: Vec<Vec3> = (0..n)
+        .map(|_| 0.05 * Vec3::new(unit(), unit(), unit()))
+        .collect();
+    displacement.push(Vec3::ZERO);
+    rotation.push(Vec3::ZERO);
+    // A slop (the default has none), so that the repair's subtraction of it counts too.
+    let settings = SolverSettings {
+        overlap_slop: 5e-4,
+        ..SolverSettings::default()
+    };
+    let h = DT / settings.substeps as f32;
+    for with_repair in [true, false] {
+        let inputs = TargetInputs {
+            displacement: &displacement,
+            rotation: &rotation,
+            turn: &[],
+            settings: &settings,
+            h,
+            with_repair,
+        };
+        let mut scalar = rows.clone();
+        update_targets(
+            &mut scalar,
+            &displacement,
+            &rotation,
+            &[],
+            &settings,
+            h,
+            with_repair,
+        );
+        let mut bundles = Bundles::default();
+        bundles.pack(&rows, n + 1, false);
+        let (mut linear, mut angular) = (vec![Vec3::ZERO; n + 1], vec![Vec3::ZERO; n + 1]);
+        let pass = SolvePass {
+            iterations: 1,
+            tolerance: 0.0,
+            friction: true,
+            half_turn: false,
+            escalate: false,
+            targets: Some(inputs),
+            sweep: Sweep::default(),
+        };
+        bundles.solve_pgs(
+            &mut Velocities {
+                linear: &mut linear,
+                angular: &mut angular,
+            },
+            &pass,
+        );
+        let mut lanes = rows.clone();
+        bundles.unpack(&mut lanes);
+        let largest = scalar
+            .iter()
+            .fold(0.0f32, |m, c| m.max(c.target_normal_velocity.abs()));
+        assert!(largest > 1.0, "the moves should set targets: {largest} m/s");
+        let (mut gaps, mut overlaps) = (0, 0);
+        for (k, (l, s)) in lanes.iter().zip(&scalar).enumerate() {
+            // The two compute the separation in different orders: a few f32 roundings of a
+            // centimetre-sized move, divided by the substep.
+            assert!(
+                (l.target_normal_velocity - s.target_normal_velocity).abs() <= 1e-5 * largest,
+                "repair {with_repair}, point {k}: target {} in lanes, {} scalar",
+                l.target_normal_velocity,
+                s.target_normal_velocity
+            );
+            assert_eq!(l.softness, s.softness, "repair {with_repair}, point {k}");
+            if s.softness == (1.0, 0.0) && s.target_normal_velocity != 0.0 {
+                gaps += 1;
+            } else {
+                overlaps += 1;
+            }
+        }
+        assert!(gaps > 0 && overlaps > 0, "{gaps} gaps, {overlaps} overlaps");
+    }
+}
