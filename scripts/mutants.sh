@@ -25,9 +25,10 @@ for f in crates/impulse/src/solver/*.rs crates/impulse/src/contact/*.rs \
     case "$f" in *_tests.rs) continue ;; esac
     files+=(-f "$f")
 done
-sharding=()
+# Shuffled, so that a run stopped early is still a spread sample of its mutants.
+sharding=(--shuffle)
 if [ -n "$shard" ]; then
-    sharding=(--shard "$shard" --sharding round-robin)
+    sharding+=(--shard "$shard" --sharding round-robin)
 fi
 mkdir -p "$out"
 # A target directory of the copy's own: sharing the workspace's would rebuild it each time.
