@@ -537,7 +537,7 @@ fn apgd_workspace_reuse_gives_the_same_result() {
 
 /// Iterations each method needs to bring the disc natural-map residual (normalised by ‖b‖₂)
 /// below thresholds, on the same problems from the same starts, and the time per iteration. A
-/// measurement, not a check: `cargo test -p impulse --test apgd -- --ignored --nocapture`.
+/// measurement, not a check: `cargo test -p impulse --lib apgd_convergence_comparison -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn apgd_convergence_comparison() {

@@ -5,8 +5,8 @@
 //! Convention (docs/method.md): per normal row γ ≥ 0, w = J·v − target ≥ 0, γ·w = 0, with v the
 //! velocities after the impulses (m/s) and γ the impulses (N·s); friction |γ_t| ≤ μ·γ_n.
 //!
-//! Timings: `cargo test --release -p impulse --test exact -- --nocapture` prints, per island,
-//! rows, pivots and the median time of `solve_exact` over repeated runs from the same entry.
+//! Timings are not measured here: the ignored `survey` prints, per scene, the outcomes, pivots,
+//! rounds, residuals and single-call times of the exact path on every step's island.
 
 use crate::test_support as common;
 use common::material;
@@ -187,23 +187,6 @@ fn settings() -> SolverSettings {
     }
 }
 
-/// Median time (µs) of `solve_exact` from `island`'s entry state, over `runs` runs.
-fn median_micros(island: &Island, runs: usize) -> f64 {
-    let mut workspace = ExactWorkspace::default();
-    let mut times: Vec<f64> = (0..runs)
-        .map(|_| {
-            let mut copy = island.clone();
-            let start = Instant::now();
-            let result = copy.solve(usize::MAX, &mut workspace);
-            let elapsed = start.elapsed().as_secs_f64() * 1e6;
-            assert!(result.is_ok());
-            elapsed
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[runs / 2]
-}
-
 /// A frictionless dynamic sphere of radius r on two static ones touching it, centres 2r apart
 /// with the two contact normals 30° from vertical. The statics: each contact carries
 /// m·g/(2 cos 30°); over a solve of h from rest, v* = −g·h·ŷ, the exact impulses are
@@ -308,12 +291,6 @@ fn sphere_on_two_spheres_matches_statics_and_lemke() {
     }
     // Momentum balance: the top sphere stops (v = v* + M⁻¹Jᵀγ = 0).
     assert!(statics.linear[0].length() <= 1e-6, "{}", statics.linear[0]);
-
-    eprintln!(
-        "sphere on two spheres: rows 2, pivots {}, {:.1} µs",
-        report.pivots,
-        median_micros(&island, 200)
-    );
 }
 
 /// `count` unit cubes stacked on a static ground, μ = 0.5, under `gravity`, each moving at
@@ -411,7 +388,6 @@ fn box_stacks_with_friction_satisfy_the_contact_conditions() {
         let rows = island.constraints.len();
         assert!(rows >= 4 * count, "{name}: {rows} contact points");
         island.rescale_impulses(0.5);
-        let entry = island.clone();
         let prospective = island.prospective();
         let report = island.solve(rows, &mut workspace).unwrap();
         assert!(
@@ -478,13 +454,6 @@ fn box_stacks_with_friction_satisfy_the_contact_conditions() {
             );
         }
         assert_eq!(island.linear.last(), Some(&Vec3::ZERO));
-        eprintln!(
-            "{name}: rows {rows}, pivots {}, rounds {}, residual {:.2e} m/s, {:.1} µs",
-            report.pivots,
-            report.rounds,
-            report.residual,
-            median_micros(&entry, 50)
-        );
     }
 }
 
@@ -658,7 +627,7 @@ fn box_pyramid() -> World {
 /// Survey, not run by default: the exact path on every step's island of a few scenes,
 /// entered from the engine's own (iterative) result. Prints per scene the outcomes, rows,
 /// pivots, rounds, entry and exit residuals and single-call times. Run with
-/// `cargo test --release -p impulse --test exact survey -- --ignored --nocapture`.
+/// `cargo test --release -p impulse --lib survey -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn survey() {
