@@ -254,6 +254,35 @@ fn cubes_on_a_sphere_pile_in_lanes_satisfy_complementarity() {
     );
 }
 
+/// pyramid20 after 30 steps, and its contact rows with world indices as slots: every
+/// immovable body in the last slot, `bodies.len()`.
+fn settled_pyramid20_rows() -> (World, Vec<crate::contact::constraints::ContactConstraint>) {
+    let mut scene = builtin_scene("pyramid20").unwrap();
+    scene.solver.sleep = false;
+    let mut w = World::from_scene(&scene).unwrap();
+    for _ in 0..30 {
+        w.step().unwrap();
+    }
+    let n = w.bodies.len();
+    let slot = |i: u32| {
+        if w.bodies.kind[i as usize] == BodyKind::Dynamic {
+            i
+        } else {
+            n as u32
+        }
+    };
+    let rows = w
+        .contact_constraints()
+        .iter()
+        .map(|c| {
+            let mut c = *c;
+            (c.local_a, c.local_b) = (slot(c.body_a), slot(c.body_b));
+            c
+        })
+        .collect();
+    (w, rows)
+}
+
 /// The record the lanes take as an island's step ends (`Bundles::record`, summed by
 /// `Bundles::unpack`) against the scalar one over the unpacked constraints
 /// (`record_velocity_before_and_residual`): the same natural-map residual to the bit, the same
@@ -265,26 +294,12 @@ fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
     use super::Bundles;
     use crate::contact::constraints::{BodySlots, ContactConstraint};
     use crate::diagnostics::record_velocity_before_and_residual;
-    let mut scene = builtin_scene("pyramid20").unwrap();
-    scene.solver.sleep = false;
-    let mut w = World::from_scene(&scene).unwrap();
-    for _ in 0..30 {
-        w.step().unwrap();
-    }
-    // World indices as slots; every immovable body in the last slot.
+    let (w, settled) = settled_pyramid20_rows();
     let n = w.bodies.len();
-    let slot = |i: u32| {
-        if w.bodies.kind[i as usize] == BodyKind::Dynamic {
-            i
-        } else {
-            n as u32
-        }
-    };
     let mut rows: Vec<ContactConstraint> = Vec::new();
     for copy in 0..12 {
-        for c in w.contact_constraints() {
+        for c in &settled {
             let mut c = *c;
-            (c.local_a, c.local_b) = (slot(c.body_a), slot(c.body_b));
             let scale = 1.0 + 0.01 * copy as f32;
             c.normal_impulse *= scale;
             c.tangent_impulses = c.tangent_impulses.map(|t| t * scale);
@@ -377,30 +392,16 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
     use super::Bundles;
     use crate::contact::constraints::{ContactConstraint, update_targets};
     use crate::solver::{SolvePass, Sweep, TargetInputs, Velocities};
-    let mut scene = builtin_scene("pyramid20").unwrap();
-    scene.solver.sleep = false;
-    let mut w = World::from_scene(&scene).unwrap();
-    for _ in 0..30 {
-        w.step().unwrap();
-    }
+    let (w, settled) = settled_pyramid20_rows();
     let n = w.bodies.len();
-    let slot = |i: u32| {
-        if w.bodies.kind[i as usize] == BodyKind::Dynamic {
-            i
-        } else {
-            n as u32
-        }
-    };
     // The planar pyramid's normals lie in its plane; the whole problem turned by one rotation
     // R (directions, r × d, I⁻¹(r × d) and lever arms alike: the same contacts seen from
     // another frame) gives every point a normal with all three components.
     let turn = glam::Quat::from_euler(glam::EulerRot::XYZ, 0.3, 0.5, 0.7);
-    let rows: Vec<ContactConstraint> = w
-        .contact_constraints()
+    let rows: Vec<ContactConstraint> = settled
         .iter()
         .map(|c| {
             let mut c = *c;
-            (c.local_a, c.local_b) = (slot(c.body_a), slot(c.body_b));
             let [t1, t2] = &mut c.tangents;
             for row in [&mut c.normal, t1, t2] {
                 row.direction = turn * row.direction;
