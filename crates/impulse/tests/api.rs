@@ -113,13 +113,16 @@ fn a_resting_cube_presses_its_weight_into_the_ground() {
     assert!(cube_ref.translation().y > 0.49);
 }
 
-/// A resting column of five cubes, solved in SIMD lanes (20 points): each contact pair
-/// reports, summed over the step's substeps, the weight of the cubes above it times the step,
-/// (5 − k)·m·g·dt under cube k.
+/// A resting column of five cubes, solved in SIMD lanes (20 points), under gravity tilted by a
+/// tenth of g along the diagonal s = (x + z)/√2 (the column would tip only past a fifth): each
+/// contact pair reports, summed over the step's substeps, the weight of the cubes above it times
+/// the step, its normal impulse (5 − k)·m·g·dt under cube k, and friction (5 − k)·m·(g/10)·dt
+/// along −s (across both friction directions).
 #[test]
 fn each_joint_of_a_resting_column_carries_the_weight_above_it() {
+    use std::f32::consts::FRAC_1_SQRT_2;
     let mut w = World::new(
-        Vec3::new(0.0, -9.81, 0.0),
+        Vec3::new(0.981 * FRAC_1_SQRT_2, -9.81, 0.981 * FRAC_1_SQRT_2),
         DT,
         SolverSettings {
             sleep: false,
@@ -153,10 +156,19 @@ fn each_joint_of_a_resting_column_carries_the_weight_above_it() {
     assert!(w.diagnostics().islands.iter().all(|island| island.simd));
     for (k, &(lower, upper)) in joints.iter().enumerate() {
         let expected = (5 - k) as f32 * 1000.0 * 9.81 * DT;
-        let total = w.contact_pair(lower, upper).unwrap().total_normal_impulse();
+        let pair = w.contact_pair(lower, upper).unwrap();
+        let total = pair.total_normal_impulse();
         assert!(
             (total - expected).abs() < 0.01 * expected,
             "joint {k}: {total} N·s against {expected}"
+        );
+        // Friction on the upper body, whichever of the two the pair names first.
+        let sign = if pair.body2() == upper { 1.0 } else { -1.0 };
+        let friction: Vec3 = pair.points().map(|p| sign * p.friction_impulse).sum();
+        let sideways = -0.1 * expected * Vec3::new(FRAC_1_SQRT_2, 0.0, FRAC_1_SQRT_2);
+        assert!(
+            (friction - sideways).length() < 0.02 * sideways.length(),
+            "joint {k}: friction {friction} N·s against {sideways}"
         );
     }
 }

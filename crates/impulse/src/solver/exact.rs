@@ -446,7 +446,16 @@ fn normal_solve(
             let [t1, t2] = w.tangent[k];
             let (magnitude, limit) = (t1.hypot(t2), c.friction * w.normal[k]);
             if magnitude < STICKING_FRACTION * limit {
-                w.free.extend([row, row + 1]);
+                // A tangent along which neither body can move (a translation and the turns
+                // that would move the point locked, against a static body) has a zero row and
+                // column in A: its impulse changes no velocity, and in the block it would make
+                // the factorisation fail. It keeps its impulse.
+                let full = &w.full;
+                w.free.extend(
+                    [row, row + 1]
+                        .into_iter()
+                        .filter(|&r| full[r * m + r] > 0.0),
+                );
             } else if limit > 0.0 && magnitude > 0.0 {
                 let scale = c.friction as f64 / magnitude as f64;
                 sliding = Some([t1 as f64 * scale, t2 as f64 * scale]);
