@@ -152,6 +152,70 @@ fn a_box_rides_a_moving_platform() {
     }
 }
 
+/// A plank bridging two kinematic supports that move together at 1 m/s along z rides them both:
+/// its island has two guests, each with its own slot. The plank catches up with the supports
+/// as friction at both accelerates it, then moves at their speed, level, resting on both at
+/// their height, each carrying half its weight.
+#[test]
+fn a_plank_rides_two_supports_moving_together() {
+    let velocity = Vec3::new(0.0, 0.0, 1.0);
+    let mut w = world();
+    let supports: Vec<BodyHandle> = [-1.5f32, 1.5]
+        .into_iter()
+        .map(|x| {
+            w.insert(
+                BodyBuilder::kinematic(SharedShape::cuboid(0.25, 0.25, 0.25))
+                    .translation(Vec3::new(x, -0.25, 0.0))
+                    .linear_velocity(velocity)
+                    .friction(0.6),
+            )
+            .unwrap()
+        })
+        .collect();
+    let plank = w
+        .insert(
+            BodyBuilder::dynamic(SharedShape::cuboid(2.0, 0.1, 0.25))
+                .translation(Vec3::new(0.0, 0.1, 0.0))
+                .friction(0.6),
+        )
+        .unwrap();
+    for step in 1..=90 {
+        w.step().unwrap();
+        let islands = &w.diagnostics().islands;
+        assert_eq!(islands.len(), 1, "step {step}");
+        // Both supports' friction (μg = 5.9 m/s²) brings the plank to their speed in 0.17 s,
+        // ten steps; one support's alone would take twice as long.
+        if step < 13 {
+            continue;
+        }
+        let b = w.body(plank).unwrap();
+        let v = b.linear_velocity();
+        assert!(
+            (v - velocity).length() <= 0.01,
+            "step {step}: plank at {v} m/s on supports at {velocity} m/s"
+        );
+        let tilt = b.rotation().angle_between(Quat::IDENTITY);
+        assert!(tilt < 1e-3, "step {step}: plank tilted by {tilt} rad");
+        let height = b.translation().y - w.body(supports[0]).unwrap().translation().y;
+        assert!(
+            (height - 0.35).abs() < 0.005,
+            "step {step}: plank {height} m above"
+        );
+        // Symmetric supports: each carries half the plank's weight.
+        let half = 0.5 * b.mass() * 9.81 * DT;
+        for &support in &supports {
+            let carried = w
+                .contact_pair(support, plank)
+                .unwrap()
+                .total_normal_impulse();
+            assert!(
+                (carried - half).abs() < 0.02 * half,
+                "step {step}: a support carries {carried} N·s, half the weight is {half}"
+            );
+        }
+    }
+}
+
 /// A turntable turning at 1 rad/s about y carries a cube resting 1 m from its axis round with
 /// it: after the start, the cube moves at ω × r (1 m/s) within 1 %, r its position as each
 /// step begins, and stays at its radius (up to the step's own drift)
