@@ -892,6 +892,35 @@ mod tests {
         );
     }
 
+    /// The tangent block's inverse: K·K⁻¹ = I for a full-rank block, and for a rank-one block
+    /// K = tr(K)·u·uᵀ (bodies that can slide along one direction u only) the Moore–Penrose
+    /// pseudo-inverse K/tr(K)², which satisfies K·K⁺·K = K and K⁺·K·K⁺ = K⁺, here with u off
+    /// both tangents (u = (0.6, 0.8)); zeros for a zero block.
+    #[test]
+    fn the_tangent_block_inverse_is_the_inverse_or_the_pseudo_inverse() {
+        let product = |[a11, a12, a22]: [f32; 3], [b11, b12, b22]: [f32; 3]| {
+            [
+                a11 * b11 + a12 * b12,
+                a11 * b12 + a12 * b22,
+                a12 * b12 + a22 * b22,
+            ]
+        };
+        let close = |x: [f32; 3], y: [f32; 3]| (0..3).all(|i| (x[i] - y[i]).abs() < 1e-5);
+        let full = [2.0, 0.5, 1.0];
+        assert!(close(product(full, inverse_block(full)), [1.0, 0.0, 1.0]));
+        let rank_one = [2.0 * 0.36, 2.0 * 0.48, 2.0 * 0.64];
+        let pseudo = inverse_block(rank_one);
+        assert!(
+            close(product(product(rank_one, pseudo), rank_one), rank_one),
+            "{pseudo:?}"
+        );
+        assert!(
+            close(product(product(pseudo, rank_one), pseudo), pseudo),
+            "{pseudo:?}"
+        );
+        assert_eq!(inverse_block([0.0; 3]), [0.0; 3]);
+    }
+
     /// A speculative row is stale once its body has turned by more than
     /// [`SPECULATIVE_TURN`], not at it, and never when its lever arm lies along its normal (a
     /// ball's row, r × n = 0) or is zero.
