@@ -183,6 +183,15 @@ fn a_plank_rides_two_supports_moving_together() {
         w.step().unwrap();
         let islands = &w.diagnostics().islands;
         assert_eq!(islands.len(), 1, "step {step}");
+        // The supports are placed symmetrically about x = 0 and move along z: by symmetry the
+        // plank never moves across (x) or turns, also while it slips.
+        let b = w.body(plank).unwrap();
+        assert!(
+            b.linear_velocity().x.abs() < 1e-4 && b.angular_velocity().length() < 1e-3,
+            "step {step}: plank at {} m/s, turning at {} rad/s",
+            b.linear_velocity(),
+            b.angular_velocity()
+        );
         // Both supports' friction (μg = 5.9 m/s²) brings the plank to their speed in 0.17 s,
         // ten steps; one support's alone would take twice as long.
         if step < 13 {
