@@ -16,7 +16,7 @@ use crate::contact::constraints::ContactConstraint;
 use crate::settings::ContactRepair;
 use crate::settings::SolverMethod;
 use crate::solver::Velocities;
-use crate::solver::exact::{ExactFailure, ExactReport, ExactWorkspace, solve_exact};
+use crate::solver::exact::{ExactFailure, ExactReport, ExactWorkspace, MAX_ROUNDS, solve_exact};
 use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use glam::{DVec3, Vec3};
 use impulse_lcp::solvers::lemke;
@@ -293,6 +293,61 @@ fn sphere_on_two_spheres_matches_statics_and_lemke() {
     assert!(statics.linear[0].length() <= 1e-6, "{}", statics.linear[0]);
 }
 
+/// A solution is a fixed point of a round: the proximal regularisation acts on the change of
+/// the impulses, so entered from the exact impulses the exact path keeps them and needs one
+/// round. The scene: a frictionless sphere meeting two static ones at 45° from vertical (the
+/// normals at right angles, so the rows are uncoupled), arriving at 5 m/s with target 0; each
+/// row then takes γ = m·5/(2 cos 45°), a velocity change of 3.5 m/s on its own row. A
+/// Tikhonov term ε·A_ii·γ_i, or any term not cancelled at the fixed point, would leave
+/// 3.5e-6 m/s in w there, above the rounds' tolerance of 1e-6 m/s.
+#[test]
+fn the_exact_impulses_are_a_fixed_point_of_a_round() {
+    let r = 0.5f32;
+    let speed = 5.0f64;
+    let offset = r * std::f32::consts::SQRT_2;
+    let mut world = World::new(Vec3::ZERO, DT, settings()).unwrap();
+    for x in [-offset, offset] {
+        let desc = BodyDesc::new(
+            BodyKind::Static,
+            ShapeDesc::Sphere { radius: r },
+            [x, r, 0.0],
+        );
+        world.add_body(&desc, &material(0.0)).unwrap();
+    }
+    let desc = BodyDesc::new(
+        BodyKind::Dynamic,
+        ShapeDesc::Sphere { radius: r },
+        [0.0, r + offset, 0.0],
+    );
+    let top = world.add_body(&desc, &material(0.0)).unwrap();
+    world.step().unwrap();
+    let mut island = Island::of(&world).expect("one island");
+    assert_eq!(island.constraints.len(), 2);
+    let mass = world.bodies.mass(top) as f64;
+    let mut prospective = vec![(DVec3::ZERO, DVec3::ZERO); island.linear.len()];
+    prospective[0].0 = DVec3::new(0.0, -speed, 0.0);
+    let mut expected = vec![];
+    for c in &mut island.constraints {
+        let cos = c.normal.direction.y as f64;
+        assert!((cos.acos().to_degrees() - 45.0).abs() < 0.05);
+        c.target_normal_velocity = 0.0;
+        c.softness = (1.0, 0.0);
+        c.normal_impulse = (mass * speed / (2.0 * cos)) as f32;
+        expected.push(c.normal_impulse);
+    }
+    island.set_velocities(&prospective);
+    let report = island.solve(2, &mut ExactWorkspace::default()).unwrap();
+    assert_eq!(report.rounds, 1, "{report:?}");
+    assert!(report.residual <= 1e-6, "{report:?}");
+    for (c, expected) in island.constraints.iter().zip(expected) {
+        assert!(
+            (c.normal_impulse - expected).abs() <= 2e-7 * expected,
+            "γ = {}, entered at the solution {expected}",
+            c.normal_impulse
+        );
+    }
+}
+
 /// `count` unit cubes stacked on a static ground, μ = 0.5, under `gravity`, each moving at
 /// `velocity` at the start, stepped `steps` times.
 fn box_stack(count: usize, gravity: Vec3, velocity: Vec3, steps: usize) -> World {
@@ -455,6 +510,60 @@ fn box_stacks_with_friction_satisfy_the_contact_conditions() {
         }
         assert_eq!(island.linear.last(), Some(&Vec3::ZERO));
     }
+}
+
+/// Switching points between sticking and sliding can leave a round worse than the one before,
+/// and a sliding stack runs out of rounds above their tolerance: the exact path then returns
+/// its best round, whole. Over the first second of three boxes sliding from 2 m/s, each step's
+/// island entered from the engine's impulses is solved (never worse than it came in), the
+/// reported residual is that of the impulses and velocities returned, and those velocities are
+/// v* + M⁻¹Jᵀγ for the returned impulses.
+#[test]
+fn out_of_rounds_the_best_round_is_returned_whole() {
+    let mut world = box_stack(3, Vec3::new(0.0, -9.81, 0.0), Vec3::new(2.0, 0.0, 0.0), 0);
+    let mut workspace = ExactWorkspace::default();
+    let mut out_of_rounds = 0;
+    for step in 0..60 {
+        world.step().unwrap();
+        let mut island = Island::of(&world).expect("one island");
+        assert!(
+            island.constraints.iter().all(|c| c.softness == (1.0, 0.0)),
+            "rigid rows: the residual below has no soft term"
+        );
+        let entry = normal_residual(&island);
+        let prospective = island.prospective();
+        let report = island
+            .solve(usize::MAX, &mut workspace)
+            .unwrap_or_else(|e| panic!("step {step}: {e:?}"));
+        if report.rounds == MAX_ROUNDS && report.residual > 1e-6 {
+            out_of_rounds += 1;
+        }
+        assert!(
+            report.residual as f64 <= entry.max(1e-6),
+            "step {step}: {report:?}"
+        );
+        let returned = normal_residual(&island);
+        assert!(
+            (returned - report.residual as f64).abs() <= 1e-7 + 1e-3 * returned,
+            "step {step}: {report:?}, the returned state's residual {returned:.3e} m/s"
+        );
+        let delta = island.impulse_velocities(stored);
+        for k in 0..island.linear.len() - 1 {
+            let error = (island.linear[k].as_dvec3() - prospective[k].0 - delta[k].0)
+                .abs()
+                .max_element()
+                .max(
+                    (island.angular[k].as_dvec3() - prospective[k].1 - delta[k].1)
+                        .abs()
+                        .max_element(),
+                );
+            assert!(
+                error <= 1e-5,
+                "step {step}, slot {k}: velocity off by {error}"
+            );
+        }
+    }
+    assert!(out_of_rounds > 0, "no solve ran out of rounds");
 }
 
 /// Soft rows (soft contact without a relax solve leaves the last solve's normal rows soft):

@@ -201,6 +201,59 @@ fn box_sliding_in_lanes_goes_straight_and_stops_where_coulomb_says() {
     assert!(turn.abs() < 0.2, "turned by {turn}°");
 }
 
+/// The lanes measure convergence as the scalar sweep does: the largest row velocity change
+/// |Δγ|·k of the last sweep (m/s), on which both stop early and `auto` escalates. A 100 kg
+/// ball thrown along the ground with backspin, μ = 0.6, solved in one cold-started sweep per
+/// step with friction in the main solve: the normal row changes its velocity by g·dt, and the
+/// sliding friction's rows by up to μ·g·dt·3.5 (k_t = 1/m + r²/I = 3.5/m for a solid ball), so
+/// the measure is the friction's. With one contact point the lanes and the scalar sweep make
+/// the same updates and must report the same change. (A measure in N·s, |Δγ|, would be the
+/// tangent rows' effective mass, about 29 kg, times larger.)
+#[test]
+fn lanes_report_the_row_velocity_change_of_the_scalar_sweep() {
+    let run = |simd_island_contacts: u32| {
+        let settings = SolverSettings {
+            simd_island_contacts,
+            substeps: 1,
+            warm_start: 0.0,
+            friction_in_main_solve: true,
+            ..bundled(1)
+        };
+        let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
+        let ground = common::static_box(Vec3::new(50.0, 0.5, 50.0), Vec3::new(0.0, -0.5, 0.0));
+        w.add_body(&ground, &material(0.6, 0.0)).unwrap();
+        let mut ball = sphere(0.5, Vec3::new(0.0, 0.5, 0.0));
+        ball.mass = Some(100.0);
+        ball.linear_velocity = [3.0, 0.0, 1.0];
+        ball.angular_velocity = [-4.0, 0.0, 12.0];
+        w.add_body(&ball, &material(0.6, 0.0)).unwrap();
+        (0..20)
+            .map(|_| {
+                w.step().unwrap();
+                let islands = &w.diagnostics().islands;
+                assert_eq!(islands.len(), 1);
+                islands[0]
+            })
+            .collect::<Vec<_>>()
+    };
+    let (lanes, scalar) = (run(1), run(u32::MAX));
+    for (step, (l, s)) in lanes.iter().zip(&scalar).enumerate() {
+        assert!(l.simd && !s.simd, "step {step}");
+        assert_eq!(l.iterations, s.iterations, "step {step}");
+        let g_dt = 9.81 * DT;
+        assert!(
+            s.last_change > 1.5 * g_dt && s.last_change <= 0.6 * 3.5 * g_dt * 1.001,
+            "step {step}: the sliding friction's change, {s:?}"
+        );
+        assert!(
+            (l.last_change - s.last_change).abs() <= 1e-3 * s.last_change,
+            "step {step}: lanes {} m/s, scalar {} m/s",
+            l.last_change,
+            s.last_change
+        );
+    }
+}
+
 /// Lane groups of different lengths in one island: cubes side by side (four-point manifolds
 /// between them) landing on the sphere pile (one-point manifolds), solved in lanes. The padded
 /// rows of the shorter groups must change nothing, so the engine's LCP at exit satisfies
