@@ -903,11 +903,12 @@ fn is_finite(c: &ContactConstraint) -> bool {
         && c.inverse_mass_a.is_finite()
         && c.inverse_mass_b.is_finite()
         && row_is_finite(&c.normal)
-        && (c.friction <= 0.0
-            || (row_is_finite(&c.tangents[0])
-                && row_is_finite(&c.tangents[1])
-                && c.tangent_block.iter().all(|v| v.is_finite())
-                && c.tangent_inverse_block.iter().all(|v| v.is_finite())))
+        // A frictionless point's tangent rows are read too: its (zero) friction impulses are
+        // taken out of the velocities with them.
+        && row_is_finite(&c.tangents[0])
+        && row_is_finite(&c.tangents[1])
+        && c.tangent_block.iter().all(|v| v.is_finite())
+        && c.tangent_inverse_block.iter().all(|v| v.is_finite())
 }
 
 #[cfg(test)]

@@ -701,6 +701,97 @@ fn failures_leave_the_island_unchanged() {
     assert_ne!(image(&island), before);
 }
 
+/// Every number the exact path reads is checked before any work: NaN or infinity in any one
+/// field of one point (row data, masses, impulses, target, softness, friction, the tangent
+/// blocks) or in one velocity is refused as `NonFinite` naming that point or slot, leaving the
+/// island bitwise as it was.
+#[test]
+fn every_non_finite_input_is_refused_by_name() {
+    type Break = fn(&mut ContactConstraint);
+    let breaks: [(&str, Break); 20] = [
+        ("target", |c| c.target_normal_velocity = f32::NAN),
+        ("softness scale", |c| c.softness.0 = f32::INFINITY),
+        ("softness term", |c| c.softness.1 = f32::NAN),
+        ("friction", |c| c.friction = f32::INFINITY),
+        ("normal impulse", |c| c.normal_impulse = f32::NAN),
+        ("first tangent impulse", |c| {
+            c.tangent_impulses[0] = f32::NAN
+        }),
+        ("second tangent impulse", |c| {
+            c.tangent_impulses[1] = f32::NEG_INFINITY
+        }),
+        ("inverse mass a", |c| c.inverse_mass_a.y = f32::NAN),
+        ("inverse mass b", |c| c.inverse_mass_b.z = f32::INFINITY),
+        ("normal", |c| c.normal.direction.x = f32::NAN),
+        ("normal r × n, a", |c| c.normal.angular_a.z = f32::NAN),
+        ("normal r × n, b", |c| c.normal.angular_b.x = f32::NAN),
+        ("normal I⁻¹(r × n), a", |c| {
+            c.normal.inverse_inertia_angular_a.y = f32::NAN
+        }),
+        ("normal I⁻¹(r × n), b", |c| {
+            c.normal.inverse_inertia_angular_b.z = f32::NAN
+        }),
+        ("normal k", |c| c.normal.inverse_effective_mass = f32::NAN),
+        ("first tangent", |c| c.tangents[0].direction.y = f32::NAN),
+        ("second tangent's lever", |c| {
+            c.tangents[1].angular_a.x = f32::INFINITY
+        }),
+        ("second tangent k", |c| {
+            c.tangents[1].inverse_effective_mass = f32::NAN
+        }),
+        ("tangent block", |c| c.tangent_block[1] = f32::NAN),
+        ("tangent inverse block", |c| {
+            c.tangent_inverse_block[2] = f32::NAN
+        }),
+    ];
+    let world = box_stack(3, Vec3::new(0.0, -9.81, 0.0), Vec3::ZERO, 10);
+    let island = Island::of(&world).expect("one island");
+    let rows = island.constraints.len();
+    let k = rows - 2;
+    assert!(island.constraints[k].friction > 0.0);
+    let mut workspace = ExactWorkspace::default();
+    for (field, broken) in breaks {
+        let mut copy = island.clone();
+        broken(&mut copy.constraints[k]);
+        let before = image(&copy);
+        let error = copy.solve(rows, &mut workspace).unwrap_err();
+        assert!(
+            matches!(error, ExactFailure::NonFinite { what: "contact", index } if index == k),
+            "{field}: {error}"
+        );
+        assert_eq!(image(&copy), before, "{field}");
+    }
+    for slot in [0, island.linear.len() - 2] {
+        for angular in [false, true] {
+            let mut copy = island.clone();
+            let velocities = if angular {
+                &mut copy.angular
+            } else {
+                &mut copy.linear
+            };
+            velocities[slot].y = f32::NAN;
+            let before = image(&copy);
+            let error = copy.solve(rows, &mut workspace).unwrap_err();
+            assert!(
+                matches!(error, ExactFailure::NonFinite { what: "velocity", index } if index == slot),
+                "slot {slot}, angular {angular}: {error}"
+            );
+            assert_eq!(image(&copy), before);
+        }
+    }
+    // A frictionless point's tangent rows are read too (its zero friction impulses are taken
+    // out of the velocities with them).
+    let mut frictionless = island.clone();
+    frictionless.constraints[k].friction = 0.0;
+    frictionless.constraints[k].tangent_impulses = [0.0; 2];
+    frictionless.constraints[k].tangents[0].direction = Vec3::NAN;
+    let error = frictionless.solve(rows, &mut workspace).unwrap_err();
+    assert!(
+        matches!(error, ExactFailure::NonFinite { what: "contact", index } if index == k),
+        "frictionless: {error}"
+    );
+}
+
 /// max_i |min(w_i, γ_i·k_i)| over the normal rows (m/s): `ExactReport::residual` for rigid rows.
 fn normal_residual(island: &Island) -> f64 {
     island
