@@ -660,9 +660,21 @@ reference preset (auto, split impulse) with S substeps × I iterations. Rapier s
 (fixed contacts 2·H), `coulomb` Coulomb friction instead of Rapier's default simplified \
 friction; Rapier's defaults are `4×30Hz`.";
 
+/// How the tables name each scene's plot ([`plot_path`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Plots<'a> {
+    /// Not at all.
+    None,
+    /// As a path, for the terminal: "Plot: `DIR/front-<scene>.svg`".
+    Path(&'a Path),
+    /// As a Markdown image whose link is DIR/front-<scene>.svg, DIR being the plots' directory
+    /// as seen from the Markdown file's (empty when they are the same).
+    Image(&'a Path),
+}
+
 /// All tables of a `front` run: the summary, then per scene the bars and the fronts, the
-/// failed runs and the plot's file (from `plot_dir` when given).
-pub fn format_tables(fronts: &[SceneFront], plot_dir: Option<&Path>) -> String {
+/// failed runs and the plot.
+pub fn format_tables(fronts: &[SceneFront], plots: Plots<'_>) -> String {
     let mut out = String::new();
     out.push_str(LEGEND);
     out.push_str("\n\n");
@@ -692,8 +704,15 @@ pub fn format_tables(fronts: &[SceneFront], plot_dir: Option<&Path>) -> String {
                 );
             }
         }
-        if let Some(dir) = plot_dir {
-            let _ = writeln!(out, "\nPlot: `{}`", plot_path(dir, &front.scene).display());
+        match plots {
+            Plots::None => {}
+            Plots::Path(dir) => {
+                let _ = writeln!(out, "\nPlot: `{}`", plot_path(dir, &front.scene).display());
+            }
+            Plots::Image(dir) => {
+                let link = plot_path(dir, &front.scene);
+                let _ = writeln!(out, "\n![front-{}]({})", front.scene, link.display());
+            }
         }
     }
     out
@@ -702,7 +721,7 @@ pub fn format_tables(fronts: &[SceneFront], plot_dir: Option<&Path>) -> String {
 /// The Markdown file of a `front` run: the tables, the command and the machine.
 pub fn format_markdown(
     fronts: &[SceneFront],
-    plot_dir: Option<&Path>,
+    plots: Plots<'_>,
     command: &str,
     before: &MachineInfo,
     after: &MachineInfo,
@@ -710,7 +729,7 @@ pub fn format_markdown(
     format!(
         "{}\nCommand: `{command}`\n\nMachine: {} logical CPUs (nproc), CPU model \"{}\", {} \
          (UTC); load average (1, 5, 15 min) {} before, {} after.\n",
-        format_tables(fronts, plot_dir),
+        format_tables(fronts, plots),
         before.logical_cpus,
         before.cpu_model,
         before.date,
@@ -1039,7 +1058,16 @@ mod tests {
         assert!(svg.starts_with("<svg"), "{}", &svg[..svg.len().min(200)]);
         assert!(svg.contains("stack3") && svg.contains("Q50"));
 
-        let tables = format_tables(&fronts, Some(&dir));
+        let tables = format_tables(&fronts, Plots::Path(&dir));
+        assert!(tables.contains(&format!("Plot: `{}`", paths[0].display())));
+        let markdown = format_markdown(
+            &fronts,
+            Plots::Image(Path::new("")),
+            "impulse-bench front stack3",
+            &MachineInfo::current(),
+            &MachineInfo::current(),
+        );
+        assert!(markdown.contains("![front-stack3](front-stack3.svg)"));
         for bar in [
             "| Q50 (E ≤ 50 mm) |",
             "| Q5 (E ≤ 5 mm) |",

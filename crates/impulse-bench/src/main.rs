@@ -5,7 +5,7 @@
 //! cargo run --release -p impulse-bench -- front [SCENE...] [--steps N] [--large-steps M] [--out-dir DIR] [--markdown FILE] [--json FILE] [--quick]
 //! ```
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
@@ -230,7 +230,7 @@ fn run_front(args: FrontArgs) -> Result<bool> {
     })?;
     let after = MachineInfo::current();
     let plots = front::write_plots(&fronts, &args.out_dir)?;
-    let tables = front::format_tables(&fronts, Some(&args.out_dir));
+    let tables = front::format_tables(&fronts, front::Plots::Path(&args.out_dir));
     println!("{tables}");
     println!("command: {command}");
     println!("{machine}");
@@ -239,7 +239,14 @@ fn run_front(args: FrontArgs) -> Result<bool> {
         eprintln!("wrote {}", path.display());
     }
     if let Some(path) = &args.markdown {
-        let text = front::format_markdown(&fronts, Some(&args.out_dir), &command, &machine, &after);
+        let plots = plots_seen_from(path, &args.out_dir);
+        let text = front::format_markdown(
+            &fronts,
+            front::Plots::Image(&plots),
+            &command,
+            &machine,
+            &after,
+        );
         std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.json {
@@ -255,9 +262,41 @@ fn run_front(args: FrontArgs) -> Result<bool> {
     Ok(failed == 0)
 }
 
+/// The plots' directory `out_dir` as a link from the Markdown file `markdown`: empty when the
+/// file sits in it, `out_dir` below the file's directory relative to it, else `out_dir` made
+/// absolute (a link that still resolves, if not a portable one).
+fn plots_seen_from(markdown: &Path, out_dir: &Path) -> PathBuf {
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let parent = markdown.parent().filter(|p| !p.as_os_str().is_empty());
+    let base = absolute(parent.unwrap_or(Path::new(".")));
+    let plots = absolute(out_dir);
+    match plots.strip_prefix(&base) {
+        Ok(relative) => relative.to_path_buf(),
+        Err(_) => plots,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn plot_links_are_relative_to_the_markdown_file() {
+        let dir = Path::new("docs");
+        assert_eq!(
+            plots_seen_from(Path::new("docs/front.md"), dir),
+            Path::new("")
+        );
+        assert_eq!(
+            plots_seen_from(Path::new("front.md"), dir),
+            Path::new("docs")
+        );
+        let elsewhere = plots_seen_from(Path::new("/tmp/x/front.md"), dir);
+        assert!(
+            elsewhere.is_absolute() && elsewhere.ends_with("docs"),
+            "{elsewhere:?}"
+        );
+    }
 
     #[test]
     fn scenes_without_a_subcommand_still_parse() {
