@@ -439,11 +439,14 @@ fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
 /// as the scalar [`crate::contact::constraints::update_targets`] does: pyramid20's rows, with
 /// every moving body displaced by up to 2 mm and turned by up to 0.05 rad about all three axes
 /// (each point's move is Δx + Δθ × r), through the soft main solve and the relax solve, with
-/// the problem turned out of the pyramid's plane.
+/// the problem turned out of the pyramid's plane; then with every third body turned past the
+/// speculative limit since the step began, whose gap rows are stale on both.
 #[test]
 fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
     use super::Bundles;
-    use crate::contact::constraints::{ContactConstraint, update_targets};
+    use crate::contact::constraints::{
+        ContactConstraint, SPECULATIVE_TURN, STALE_TARGET, update_targets,
+    };
     use crate::solver::{SolvePass, Sweep, TargetInputs, Velocities};
     let (w, settled) = settled_pyramid20_rows();
     let n = w.bodies.len();
@@ -491,11 +494,24 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
         ..SolverSettings::default()
     };
     let h = DT / settings.substeps as f32;
-    for with_repair in [true, false] {
+    // Then with every third body turned past the speculative limit since the step began
+    // (`turn`, rad²): its gap rows with a lever arm off the normal are stale on the scalar
+    // sweep, and must be in lanes, while its neighbours' gap rows stay live.
+    let limit = SPECULATIVE_TURN * SPECULATIVE_TURN;
+    let turned: Vec<f32> = (0..=n)
+        .map(|k| {
+            if k < n && k % 3 == 0 {
+                1.5 * limit
+            } else {
+                0.5 * limit
+            }
+        })
+        .collect();
+    for (with_repair, turn) in [(true, &[][..]), (false, &[][..]), (true, &turned[..])] {
         let inputs = TargetInputs {
             displacement: &displacement,
             rotation: &rotation,
-            turn: &[],
+            turn,
             settings: &settings,
             h,
             with_repair,
@@ -505,7 +521,7 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
             &mut scalar,
             &displacement,
             &rotation,
-            &[],
+            turn,
             &settings,
             h,
             with_repair,
@@ -531,12 +547,25 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
         );
         let mut lanes = rows.clone();
         bundles.unpack(&mut lanes);
+        let is_stale = |c: &ContactConstraint| c.target_normal_velocity == STALE_TARGET;
         let largest = scalar
             .iter()
+            .filter(|c| !is_stale(c))
             .fold(0.0f32, |m, c| m.max(c.target_normal_velocity.abs()));
         assert!(largest > 1.0, "the moves should set targets: {largest} m/s");
+        let stale = scalar.iter().filter(|c| is_stale(c)).count();
+        assert_eq!(stale > 0, !turn.is_empty(), "{stale} stale rows");
         let (mut gaps, mut overlaps) = (0, 0);
         for (k, (l, s)) in lanes.iter().zip(&scalar).enumerate() {
+            assert_eq!(
+                is_stale(l),
+                is_stale(s),
+                "turned {}, point {k}",
+                !turn.is_empty()
+            );
+            if is_stale(s) {
+                continue;
+            }
             // The two compute the separation in different orders: a few f32 roundings of a
             // centimetre-sized move, divided by the substep.
             assert!(
