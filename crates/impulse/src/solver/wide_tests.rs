@@ -201,6 +201,37 @@ fn box_sliding_in_lanes_goes_straight_and_stops_where_coulomb_says() {
     assert!(turn.abs() < 0.2, "turned by {turn}°");
 }
 
+/// `simd_island_contacts` is the smallest island solved in lanes, and 0 turns the lanes off:
+/// pyramid20's one island (hundreds of points) in lanes at 1 and at its own size, not at one
+/// point more, nor at 0.
+#[test]
+fn the_lanes_threshold_counts_contact_points_and_zero_is_never() {
+    // Five steps at the default threshold, then one at `threshold`: the sixth step's points
+    // are found before its solve, so they do not depend on the threshold.
+    let sixth_step = |threshold: Option<u32>| {
+        let mut scene = builtin_scene("pyramid20").unwrap();
+        scene.solver.sleep = false;
+        scene.solver.method = SolverMethod::Pgs;
+        let mut w = World::from_scene(&scene).unwrap();
+        for _ in 0..5 {
+            w.step().unwrap();
+        }
+        if let Some(threshold) = threshold {
+            w.settings.simd_island_contacts = threshold;
+        }
+        w.step().unwrap();
+        let islands = &w.diagnostics().islands;
+        assert_eq!(islands.len(), 1);
+        assert!(islands[0].contacts > 100);
+        (islands[0].simd, islands[0].contacts)
+    };
+    let (_, contacts) = sixth_step(None);
+    assert_eq!(sixth_step(Some(1)), (true, contacts));
+    assert_eq!(sixth_step(Some(contacts)), (true, contacts));
+    assert_eq!(sixth_step(Some(contacts + 1)), (false, contacts));
+    assert_eq!(sixth_step(Some(0)), (false, contacts));
+}
+
 /// The lanes measure convergence as the scalar sweep does: the largest row velocity change
 /// |Δγ|·k of the last sweep (m/s), on which both stop early and `auto` escalates. A 100 kg
 /// ball thrown along the ground with backspin, μ = 0.6, solved in one cold-started sweep per
