@@ -9,7 +9,7 @@ mod common;
 use common::hash_state;
 use impulse::scene::builtin_scene;
 use impulse::scene::load_scene_file;
-use impulse::{Scene, World};
+use impulse::{Scene, SolverMethod, SolverSettings, World};
 
 /// `steps` steps of `scene` (sleeping off) on a pool of `threads` threads; the final state's
 /// hash.
@@ -56,4 +56,21 @@ fn a_scene_of_every_shape_is_the_same_on_any_thread_count_and_run() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/shapes.json");
     let scene = load_scene_file(std::path::Path::new(path)).unwrap();
     same_everywhere(&scene, 180);
+}
+
+/// Each method's own parallel paths (NNCG's momentum step, APGD's sums, the escalation of
+/// `auto` with split impulse) give the bits of one thread: pyramid20's one island of
+/// uncoloured scalar rows, solved by each method on 1, 2 and 4 threads.
+#[test]
+fn every_solver_method_is_the_same_on_any_thread_count() {
+    for (method, preset) in [
+        (SolverMethod::Nncg, SolverSettings::default()),
+        (SolverMethod::Apgd, SolverSettings::default()),
+        (SolverMethod::Auto, SolverSettings::reference()),
+    ] {
+        let mut scene = builtin_scene("pyramid20").unwrap();
+        scene.solver = SolverSettings { method, ..preset };
+        scene.name = format!("pyramid20 with {method:?}");
+        same_everywhere(&scene, 30);
+    }
 }
