@@ -12,7 +12,7 @@ use crate::test_support as common;
 use common::material;
 use std::time::Instant;
 
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::constraints::{ContactConstraint, JacobianRow};
 use crate::settings::ContactRepair;
 use crate::settings::SolverMethod;
 use crate::solver::Velocities;
@@ -154,18 +154,18 @@ impl Island {
     fn normal_w(&self) -> Vec<f64> {
         self.constraints
             .iter()
-            .map(|c| {
-                let (a, b) = (c.local_a as usize, c.local_b as usize);
-                let row = &c.normal;
-                let v = row
-                    .direction
-                    .as_dvec3()
-                    .dot(self.linear[a].as_dvec3() - self.linear[b].as_dvec3())
-                    + row.angular_a.as_dvec3().dot(self.angular[a].as_dvec3())
-                    - row.angular_b.as_dvec3().dot(self.angular[b].as_dvec3());
-                v - c.target_normal_velocity as f64
-            })
+            .map(|c| self.row_velocity(c, &c.normal) - c.target_normal_velocity as f64)
             .collect()
+    }
+
+    /// J·v of `row` of point `c` (m/s, f64).
+    fn row_velocity(&self, c: &ContactConstraint, row: &JacobianRow) -> f64 {
+        let (a, b) = (c.local_a as usize, c.local_b as usize);
+        row.direction
+            .as_dvec3()
+            .dot(self.linear[a].as_dvec3() - self.linear[b].as_dvec3())
+            + row.angular_a.as_dvec3().dot(self.angular[a].as_dvec3())
+            - row.angular_b.as_dvec3().dot(self.angular[b].as_dvec3())
     }
 }
 
@@ -403,7 +403,8 @@ enum Friction {
 }
 
 /// Box stacks with friction: one held by friction against a sideways pull (sticking
-/// contacts), one sliding along the ground (contacts on the disc's rim). Entered from half the
+/// contacts), two sliding along the ground, along a tangent and across both (contacts on the
+/// disc's rim), where Coulomb's law also fixes the friction's direction. Entered from half the
 /// engine's impulses, the exact path must return γ_n ≥ 0, w_n ≥ −1e-5 m/s with complementarity,
 /// friction inside the disc, and velocities equal to v* + M⁻¹Jᵀγ recomputed from scratch.
 #[test]
@@ -432,6 +433,14 @@ fn box_stacks_with_friction_satisfy_the_contact_conditions() {
             3,
             Vec3::new(0.0, -g, 0.0),
             Vec3::new(2.0, 0.0, 0.0),
+            3,
+            Friction::Sliding,
+        ),
+        (
+            "3 boxes sliding at 2.2 m/s off the tangents",
+            3,
+            Vec3::new(0.0, -g, 0.0),
+            Vec3::new(2.0, 0.0, 1.0),
             3,
             Friction::Sliding,
         ),
@@ -470,8 +479,30 @@ fn box_stacks_with_friction_satisfy_the_contact_conditions() {
                 tangent <= limit * (1.0 + 1e-5) + 1e-9,
                 "{name}, point {k}: |γ_t| = {tangent} > μγ_n = {limit}"
             );
+            // Coulomb's law at the post-impulse tangential velocity (the slip): a point inside
+            // the disc does not slip, and a slipping point's friction is on the rim, opposite
+            // to the slip (maximal dissipation). The friction passes are Gauss-Seidel sweeps,
+            // so a sticking point may keep a slip of some µm/s (up to 35 µm/s here).
+            let slip = [
+                island.row_velocity(c, &c.tangents[0]),
+                island.row_velocity(c, &c.tangents[1]),
+            ];
+            let speed = slip[0].hypot(slip[1]);
             if tangent >= 0.999 * limit && limit > 0.0 {
                 on_rim += 1;
+            } else {
+                assert!(
+                    speed <= 1e-4 || limit == 0.0,
+                    "{name}, point {k}: inside the disc ({tangent} < {limit}) slipping at {speed} m/s"
+                );
+            }
+            if speed > 1e-4 && limit > 0.0 {
+                let opposing =
+                    -(t1 as f64 * slip[0] + t2 as f64 * slip[1]) / (tangent as f64 * speed);
+                assert!(
+                    opposing >= 0.9999,
+                    "{name}, point {k}: friction at cos {opposing} to the slip's opposite"
+                );
             }
             largest_friction = largest_friction.max(tangent / limit.max(f32::MIN_POSITIVE));
             assert!(c.max_normal_impulse >= gamma);
