@@ -629,26 +629,29 @@ fn apgd_convergence_comparison() {
     }
 }
 
-/// The momentum and its restart pay: from a cold start, APGD brings the disc residual below
-/// 1e-4 within 32 iterations on the frictionless pile and on the sphere on two spheres with
-/// μ = 0.5 (25 and 21 iterations with this solver). Iteration counts, not timings: they depend
-/// only on the arithmetic. A restart test that fires when the step did not go uphill (so that
-/// the momentum is thrown away nearly every iteration) needs 43 and 53.
+/// The momentum and its restart pay: from a cold start, within 32 iterations APGD brings the
+/// disc residual below 1e-4 on the frictionless pile and below 1e-5 on the sphere on two
+/// spheres with μ = 0.5 (25 and 24 iterations with this solver; 1.1e-5 and 1.2e-6 after 32).
+/// Iteration counts, not timings: they depend only on the arithmetic. A restart test that fires
+/// when the step did not go uphill (so that the momentum is thrown away nearly every iteration)
+/// needs 43 and 53 iterations to 1e-4; Nesterov's factor β = θ(1 − θ)/(θ² + θ') with its
+/// product made a sum leaves the sphere at 9.6e-5 after 32.
 #[test]
 fn apgd_reaches_a_tight_residual_within_32_iterations() {
     let cases = [
-        ("pile, μ = 0", settled(pile(0.0), 60)),
+        ("pile, μ = 0", settled(pile(0.0), 60), 1e-4),
         (
             "sphere on two spheres, μ = 0.5",
             settled(sphere_on_two_spheres(0.5), 40),
+            1e-5,
         ),
     ];
-    for (name, p) in &cases {
+    for (name, p, bound) in &cases {
         let (constraints, _, _, report) = run(p, Method::Apgd, 0.0, 32, 0.0);
         assert_eq!(report.iterations, 32, "{name}");
         let residual = disc_residual(&constraints);
         assert!(
-            residual <= 1e-4,
+            residual <= *bound,
             "{name}: residual {residual:.2e} after 32 iterations"
         );
     }
