@@ -663,8 +663,6 @@ friction; Rapier's defaults are `4×30Hz`.";
 /// How the tables name each scene's plot ([`plot_path`]).
 #[derive(Clone, Copy, Debug)]
 pub enum Plots<'a> {
-    /// Not at all.
-    None,
     /// As a path, for the terminal: "Plot: `DIR/front-<scene>.svg`".
     Path(&'a Path),
     /// As a Markdown image whose link is DIR/front-<scene>.svg, DIR being the plots' directory
@@ -705,7 +703,6 @@ pub fn format_tables(fronts: &[SceneFront], plots: Plots<'_>) -> String {
             }
         }
         match plots {
-            Plots::None => {}
             Plots::Path(dir) => {
                 let _ = writeln!(out, "\nPlot: `{}`", plot_path(dir, &front.scene).display());
             }
