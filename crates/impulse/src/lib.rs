@@ -102,7 +102,7 @@ pub mod internals {
     pub use crate::solver::{Sweep, Velocities, warm_start};
 
     /// The last step's solved contact constraints (impulses as the solver left them).
-    pub fn contact_constraints(world: &crate::World) -> &[ContactConstraint] {
+    pub fn contact_constraints(world: &crate::World) -> Vec<ContactConstraint> {
         world.contact_constraints()
     }
 }

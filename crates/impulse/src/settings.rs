@@ -295,6 +295,15 @@ impl SolverSettings {
         matches!(self.repair, ContactRepair::SplitImpulse { .. })
     }
 
+    /// Whether an island of `contacts` contact points is solved in SIMD lanes
+    /// ([`Self::simd_island_contacts`]): PGS without split impulse, at or above the threshold.
+    pub fn solves_in_lanes(&self, contacts: usize) -> bool {
+        self.method == SolverMethod::Pgs
+            && !self.split_impulse()
+            && self.simd_island_contacts > 0
+            && contacts >= self.simd_island_contacts as usize
+    }
+
     /// The first of [`Self::problems`], if any.
     pub fn validate(&self) -> Result<(), SettingError> {
         match self.problems().into_iter().next() {

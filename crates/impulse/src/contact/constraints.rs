@@ -95,36 +95,42 @@ impl PairInverseMass {
 }
 
 impl JacobianRow {
-    /// The row for unit `direction` with lever arms `r_a`, `r_b` (m). Computed in SIMD
-    /// registers (`Vec3A`, `Mat3A`): the same products and sums in the same order as with
-    /// `Vec3`, so the same results to the bit, in fewer instructions.
+    /// The row for unit `direction` with lever arms `r_a`, `r_b` (m), its lever-arm products
+    /// ([`Self::inverse_inertia_angular_a`] and on) still zero: see [`Self::fill_products`].
     #[inline(always)]
-    fn new(
-        direction: Vec3,
-        r_a: Vec3A,
-        r_b: Vec3A,
+    fn geometric(direction: Vec3, r_a: Vec3A, r_b: Vec3A) -> Self {
+        let d = Vec3A::from(direction);
+        Self {
+            direction,
+            angular_a: r_a.cross(d).into(),
+            angular_b: r_b.cross(d).into(),
+            ..Self::default()
+        }
+    }
+
+    /// Computes I⁻¹(r × d) for both bodies and the row's effective mass from its angular parts,
+    /// for bodies of world inverse inertia `inverse_inertia_a`, `inverse_inertia_b`. In SIMD
+    /// registers (`Vec3A`, `Mat3A`): the same products and sums in the same order as with
+    /// `Vec3`, so the same results to the bit, in fewer instructions; the SIMD lanes compute
+    /// them in this order too (`wide::Bundles::pack`).
+    #[inline(always)]
+    fn fill_products(
+        &mut self,
         inverse_mass: PairInverseMass,
         inverse_inertia_a: &Mat3A,
         inverse_inertia_b: &Mat3A,
-    ) -> Self {
-        let d = Vec3A::from(direction);
-        let angular_a = r_a.cross(d);
-        let angular_b = r_b.cross(d);
+    ) {
+        let angular_a = Vec3A::from(self.angular_a);
+        let angular_b = Vec3A::from(self.angular_b);
         let inverse_inertia_angular_a = *inverse_inertia_a * angular_a;
         let inverse_inertia_angular_b = *inverse_inertia_b * angular_b;
-        let k = inverse_mass.along(direction)
+        let k = inverse_mass.along(self.direction)
             + angular_a.dot(inverse_inertia_angular_a)
             + angular_b.dot(inverse_inertia_angular_b);
-        Self {
-            direction,
-            angular_a: angular_a.into(),
-            angular_b: angular_b.into(),
-            inverse_inertia_angular_a: inverse_inertia_angular_a.into(),
-            inverse_inertia_angular_b: inverse_inertia_angular_b.into(),
-            effective_mass: if k > 0.0 { 1.0 / k } else { 0.0 },
-            inverse_effective_mass: k,
-            velocity_before: 0.0,
-        }
+        self.inverse_inertia_angular_a = inverse_inertia_angular_a.into();
+        self.inverse_inertia_angular_b = inverse_inertia_angular_b.into();
+        self.effective_mass = if k > 0.0 { 1.0 / k } else { 0.0 };
+        self.inverse_effective_mass = k;
     }
 
     /// J·v for the current velocities of A and B (m/s); positive means separating.
@@ -209,9 +215,32 @@ pub struct ContactConstraint {
     pub step_impulses: [f32; 3],
     /// Where the point lives: (pair, manifold, point) in the narrow phase, for write-back.
     pub source: (u32, u16, u16),
+    /// Whether the rows' lever-arm products are yet to be computed: each row's
+    /// `inverse_inertia_angular_a`/`_b`, `effective_mass` and `inverse_effective_mass`, and the
+    /// tangent blocks (zero until then). Directions, angular parts and the normal row's
+    /// `velocity_before` are always set. Assembly leaves the products to the SIMD lanes, which
+    /// compute them four points at a time as they pack (`wide::Bundles::pack`), for the points
+    /// of islands the lanes solve with no restitution solve after them, whose bodies have no
+    /// translation locked; [`complete_products`] computes them for any other reader.
+    pub products_pending: bool,
 }
 
 impl ContactConstraint {
+    /// Computes the rows' lever-arm products (see [`Self::products_pending`]) for bodies of
+    /// world inverse inertia `inverse_inertia_a` and `inverse_inertia_b` (1/(kg·m²)).
+    #[inline(always)]
+    fn fill_products(&mut self, inverse_inertia_a: &Mat3A, inverse_inertia_b: &Mat3A) {
+        let inverse_mass = PairInverseMass::new(self.inverse_mass_a, self.inverse_mass_b);
+        let [t1, t2] = &mut self.tangents;
+        for row in [&mut self.normal, t1, t2] {
+            row.fill_products(inverse_mass, inverse_inertia_a, inverse_inertia_b);
+        }
+        let block = tangent_block(&self.tangents, inverse_mass);
+        self.tangent_block = block;
+        self.tangent_inverse_block = inverse_block(block);
+        self.products_pending = false;
+    }
+
     /// The soft normal row's extra diagonal term of A (1/kg): a row with softness (s, i)
     /// updates by Δγ = m_eff·s·(target − v) − i·γ, whose fixed point with γ > 0 is
     /// (v − target) + (i/s)·(1/m_eff)·γ = 0, the rigid row plus (i/s)/m_eff on the diagonal
@@ -237,12 +266,20 @@ impl ContactConstraint {
 /// `PAIRS_PER_TASK` (1024) pairs are assembled on rayon's threads, each pair into its own rows of
 /// `out` (the narrow phase knows every pair's row count); the result is the same as on one
 /// thread.
+///
+/// With `lanes_compute_products`, the points of islands that `settings` solves in SIMD lanes
+/// ([`SolverSettings::solves_in_lanes`]) are left with their lever-arm products pending
+/// ([`ContactConstraint::products_pending`]): the lanes compute them as they pack, four points
+/// at a time. The caller passes it only when nothing reads those rows' products before the
+/// lanes have solved them (no restitution solve after the substeps).
+#[allow(clippy::too_many_arguments)]
 pub fn assemble(
     bodies: &Bodies,
     narrow_phase: &NarrowPhase,
     islands: &Islands,
     settings: &SolverSettings,
     world_inverse_inertia: &[Mat3],
+    lanes_compute_products: bool,
     parallel: bool,
     out: &mut Vec<ContactConstraint>,
 ) {
@@ -257,6 +294,7 @@ pub fn assemble(
         islands,
         settings,
         world_inverse_inertia,
+        lanes_compute_products,
     };
     if spread(parallel, pairs.len(), PAIRS_PER_TASK) {
         let rows = IslandRows {
@@ -325,6 +363,19 @@ struct Assembly<'a> {
     islands: &'a Islands,
     settings: &'a SolverSettings,
     world_inverse_inertia: &'a [Mat3],
+    lanes_compute_products: bool,
+}
+
+/// Computes the pending lever-arm products ([`ContactConstraint::products_pending`]) of
+/// `constraints`, with `world_inverse_inertia` per body (indexed by `body_a`, `body_b`): the
+/// tensors assembly had, so the products are those assembly would have computed, to the bit.
+/// For readers of the rows other than the SIMD lanes.
+pub fn complete_products(constraints: &mut [ContactConstraint], world_inverse_inertia: &[Mat3]) {
+    for c in constraints.iter_mut().filter(|c| c.products_pending) {
+        let inertia_a = Mat3A::from(world_inverse_inertia[c.body_a as usize]);
+        let inertia_b = Mat3A::from(world_inverse_inertia[c.body_b as usize]);
+        c.fill_products(&inertia_a, &inertia_b);
+    }
 }
 
 impl Assembly<'_> {
@@ -364,7 +415,12 @@ impl Assembly<'_> {
         let restitution = bodies.restitution[a].max(bodies.restitution[b]);
         let inverse_mass_a = bodies.effective_inverse_mass(a);
         let inverse_mass_b = bodies.effective_inverse_mass(b);
-        let pair_inverse_mass = PairInverseMass::new(inverse_mass_a, inverse_mass_b);
+        // The lanes compute the products of points whose bodies have no translation locked
+        // (the common case, which their arithmetic covers).
+        let lanes_compute_products = self.lanes_compute_products
+            && is_isotropic(inverse_mass_a)
+            && is_isotropic(inverse_mass_b)
+            && settings.solves_in_lanes(self.islands.constraint_range(island).len());
         let inertia_a = &Mat3A::from(self.world_inverse_inertia[a]);
         let inertia_b = &Mat3A::from(self.world_inverse_inertia[b]);
         let duplicates = pair.has_duplicate_points();
@@ -412,16 +468,7 @@ impl Assembly<'_> {
                 let r_a = at_a - com_a;
                 let r_b = at_b - com_b;
                 let (r_a_wide, r_b_wide) = (Vec3A::from(r_a), Vec3A::from(r_b));
-                let row = |d| {
-                    JacobianRow::new(
-                        d,
-                        r_a_wide,
-                        r_b_wide,
-                        pair_inverse_mass,
-                        inertia_a,
-                        inertia_b,
-                    )
-                };
+                let row = |d| JacobianRow::geometric(d, r_a_wide, r_b_wide);
                 // Only the normal row's v⁻ is read before the step ends (restitution); every
                 // row's is rewritten as the step ends ([`record_velocity_before`]).
                 let mut normal_row = row(normal);
@@ -432,7 +479,6 @@ impl Assembly<'_> {
                     bodies.angular_velocity[b],
                 );
                 let tangents = [row(t1), row(t2)];
-                let block = tangent_block(&tangents, pair_inverse_mass);
                 let depth = -point.dist;
                 let Some(slot) = slots.next() else {
                     debug_assert!(false, "fewer slots than the narrow phase's row count");
@@ -447,8 +493,8 @@ impl Assembly<'_> {
                     inverse_mass_b,
                     normal: normal_row,
                     tangents,
-                    tangent_inverse_block: inverse_block(block),
-                    tangent_block: block,
+                    tangent_inverse_block: [0.0; 3],
+                    tangent_block: [0.0; 3],
                     target_normal_velocity: 0.0,
                     softness: (1.0, 0.0),
                     position_target: 0.0,
@@ -469,7 +515,11 @@ impl Assembly<'_> {
                         warm.step_friction.dot(t2),
                     ],
                     source: (pair_index, manifold_index as u16, point_index as u16),
+                    products_pending: true,
                 };
+                if !lanes_compute_products {
+                    slot.fill_products(inertia_a, inertia_b);
+                }
             }
         }
         debug_assert!(slots.next().is_none(), "more slots than rows");

@@ -500,8 +500,7 @@ fn repeated_pile_rows(
     }
     let mut rows = Vec::new();
     for copy in 0..800 {
-        for c in world.contact_constraints() {
-            let mut c = *c;
+        for mut c in world.contact_constraints() {
             let scale = 1.0 + 0.001 * copy as f32;
             c.normal_impulse *= scale;
             c.tangent_impulses = c.tangent_impulses.map(|t| tangent_sign * t * scale);

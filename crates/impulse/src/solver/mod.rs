@@ -17,7 +17,7 @@
 //! - [`substep`]: one island's step (substeps, warm start, solves, relax, restitution), which
 //!   picks the method and calls it through the interface.
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 pub use crate::contact::constraints::cap_to_disc;
 use crate::contact::constraints::{self, ContactConstraint};
@@ -48,9 +48,18 @@ pub use substep::IslandReport;
 /// `finish`; the scalar methods work on the constraints themselves.
 pub trait ContactSolver {
     /// Readies the step's solves on the island's `constraints`, whose body slots are below
-    /// `slots` (`slots − 1` the immovable one); `parallel`: a colour's rows may be spread over
-    /// rayon's threads. Default: nothing to do.
-    fn prepare(&mut self, _constraints: &mut [ContactConstraint], _slots: usize, _parallel: bool) {}
+    /// `slots` (`slots − 1` the immovable one); `inverse_inertia` holds each slot's world
+    /// inverse inertia as assembly used it (1/(kg·m²); zero for the immovable slot), from which
+    /// pending lever-arm products are computed ([`ContactConstraint::products_pending`]);
+    /// `parallel`: a colour's rows may be spread over rayon's threads. Default: nothing to do.
+    fn prepare(
+        &mut self,
+        _constraints: &mut [ContactConstraint],
+        _slots: usize,
+        _inverse_inertia: &[Mat3],
+        _parallel: bool,
+    ) {
+    }
 
     /// Applies the accumulated impulses to `velocities` (warm starting) at the start of
     /// substep `substep` (from 0). From the second substep on these are the last substep's

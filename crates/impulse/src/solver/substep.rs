@@ -118,6 +118,8 @@ pub struct IslandWorkspace {
     pub(crate) friction_rows: usize,
     /// Split impulse: whether the last targets asked any row for overlap repair.
     position_repair: bool,
+    /// Per body slot, its world inverse inertia (for [`ContactSolver::prepare`]).
+    slot_inverse_inertia: Vec<Mat3>,
 }
 
 /// Every method's solver, so that an island keeps its work spaces from step to step.
@@ -231,6 +233,9 @@ pub struct StepContext<'a> {
     /// Whether any body has a restitution coefficient above zero; without one the
     /// restitution pass over the rows is skipped.
     pub restitution: bool,
+    /// World-frame inverse inertia of every body at the step's start (1/(kg·m²)), as assembly
+    /// used it: the SIMD lanes compute the rows' lever-arm products from it.
+    pub world_inverse_inertia: &'a [Mat3],
     /// Whether any body has a force or torque this step ([`Bodies::force`]); without one the
     /// substeps add gravity alone.
     pub forces: bool,
@@ -263,6 +268,7 @@ pub fn step_island(
         settings,
         parallel,
         restitution,
+        world_inverse_inertia,
         forces,
     } = *context;
     let slots = island_bodies.len() + guests.len() + 1;
@@ -356,10 +362,7 @@ pub fn step_island(
         EscalationLimits::new(settings, w.report.mass_ratio, gravity.length() * dt);
 
     // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
-    let bundled = settings.method == SolverMethod::Pgs
-        && !settings.split_impulse()
-        && settings.simd_island_contacts > 0
-        && constraints.len() >= settings.simd_island_contacts as usize;
+    let bundled = settings.solves_in_lanes(constraints.len());
     w.parallel = parallel;
     w.colour_starts.clear();
     let threshold = settings.parallel_island_contacts as usize;
@@ -370,9 +373,21 @@ pub fn step_island(
         // threads costs no convergence (unlike the scalar sweep). Smaller islands stay on
         // their thread: rayon's hand-offs then cost more than they spread.
         let spread = coloured_threads || constraints.len() >= PARALLEL_ISLAND_POINTS;
-        w.solvers
-            .wide
-            .prepare(constraints, slots, parallel && spread);
+        // Each slot's world inverse inertia, for the lever-arm products the lanes compute.
+        w.slot_inverse_inertia.clear();
+        w.slot_inverse_inertia.extend(
+            island_bodies
+                .iter()
+                .chain(guests)
+                .map(|&i| world_inverse_inertia[i as usize]),
+        );
+        w.slot_inverse_inertia.push(Mat3::ZERO);
+        w.solvers.wide.prepare(
+            constraints,
+            slots,
+            &w.slot_inverse_inertia,
+            parallel && spread,
+        );
     } else if coloured_threads {
         colour_constraints(
             constraints,

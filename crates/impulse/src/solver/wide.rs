@@ -25,7 +25,7 @@
 //! bundled, for `method: pgs`; split impulse, NNCG, APGD and the exact path keep the scalar
 //! sweep of [`crate::solver`].
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 use super::{
     ContactSolver, EscalationLevel, RowsReport, SolveOutcome, SolvePass, SolveReport, TargetInputs,
@@ -107,6 +107,20 @@ struct BundleGeometry {
     lever_b: LaneVec,
     /// Penetration depth at assembly (m), > 0 when overlapping.
     depth: Lane,
+    /// Per lane, whether the pack computes its lever-arm products: for a point whose products
+    /// are pending ([`ContactConstraint::products_pending`]), and for padding, whose zero
+    /// direction and lever arms give zero products.
+    pending: [bool; LANES],
+}
+
+impl BundleGeometry {
+    /// The geometry of a lane group's padding: no lever arms, no depth.
+    const PADDING: Self = Self {
+        lever_a: [Lane::ZERO; 3],
+        lever_b: [Lane::ZERO; 3],
+        depth: Lane::ZERO,
+        pending: [true; LANES],
+    };
 }
 
 /// Bundles that share their lanes' bodies: lane i of every bundle in `start..start + len`
@@ -310,7 +324,18 @@ impl Bundles {
     ///
     /// When every point has the same body slots as in the last pack (an island at rest), the
     /// last layout is reused and only the lanes are filled again; the result is the same.
-    pub fn pack(&mut self, constraints: &[ContactConstraint], slots: usize, parallel: bool) {
+    ///
+    /// Points whose lever-arm products are pending ([`ContactConstraint::products_pending`])
+    /// get them here, four lanes at a time, from their lever arms and directions and the world
+    /// inverse inertia of their bodies' slots (`inverse_inertia`, one per slot), in the order
+    /// of operations of the scalar assembly, so to the same bits.
+    pub fn pack(
+        &mut self,
+        constraints: &[ContactConstraint],
+        slots: usize,
+        inverse_inertia: &[Mat3],
+        parallel: bool,
+    ) {
         self.parallel = parallel;
         self.recorded = false;
         self.rows = None;
@@ -354,7 +379,7 @@ impl Bundles {
             self.geometry.clear();
         }
         self.bundles.resize(total, empty);
-        self.geometry.resize(total, BundleGeometry::default());
+        self.geometry.resize(total, BundleGeometry::PADDING);
         // The step totals start from zero: the packed bundles are this step's alone.
         self.step_totals.clear();
         self.step_totals.resize(total, [Lane::splat(0.0); 3]);
@@ -380,6 +405,56 @@ impl Bundles {
                     bundle.local_a[lane as usize] = a;
                     bundle.local_b[lane as usize] = b;
                 }
+            }
+        }
+        self.compute_products(inverse_inertia, parallel_fill);
+    }
+
+    /// The pending lever-arm products of [`Bundles::pack`], lane group by lane group (the
+    /// bodies' tensors gathered once per lane group); on rayon's threads with `parallel`.
+    fn compute_products(&mut self, inverse_inertia: &[Mat3], parallel: bool) {
+        let geometry = &self.geometry;
+        let group = |g: &Group, bundles: &mut [Bundle]| {
+            let range = g.start as usize..(g.start + g.len) as usize;
+            let geometry = &geometry[range];
+            if geometry.iter().all(|g| !g.pending.contains(&true)) {
+                return;
+            }
+            let Some(first) = bundles.first() else {
+                return;
+            };
+            let inertia_a = inertia_lanes(&first.local_a, inverse_inertia);
+            let inertia_b = inertia_lanes(&first.local_b, inverse_inertia);
+            for (b, g) in bundles.iter_mut().zip(geometry) {
+                if g.pending == [true; LANES] {
+                    bundle_products::<true>(b, g, &inertia_a, &inertia_b);
+                } else if g.pending.contains(&true) {
+                    bundle_products::<false>(b, g, &inertia_a, &inertia_b);
+                }
+            }
+        };
+        if parallel {
+            use rayon::prelude::*;
+            let bundles = SharedItems(self.bundles.as_mut_ptr());
+            let total = self.bundles.len();
+            self.groups
+                .par_iter()
+                .with_min_len(GROUPS_PER_TASK)
+                .for_each(|g| {
+                    // Capture the whole wrapper (Sync), not its raw-pointer field.
+                    #[allow(clippy::redundant_locals)]
+                    let bundles = bundles;
+                    let (start, len) = (g.start as usize, g.len as usize);
+                    assert!(start <= total && len <= total - start);
+                    // SAFETY: lane groups cover disjoint bundle ranges (`lay_out` gives each
+                    // its own run of bundles), inside the bundles (checked above).
+                    let mine = unsafe { std::slice::from_raw_parts_mut(bundles.0.add(start), len) };
+                    group(g, mine);
+                });
+        } else {
+            for g in &self.groups {
+                let range = g.start as usize..(g.start + g.len) as usize;
+                group(g, &mut self.bundles[range]);
             }
         }
     }
@@ -505,7 +580,7 @@ impl Bundles {
                     std::slice::from_raw_parts_mut(bundles.0.add(range.start), range.len())
                         .fill(*empty);
                     std::slice::from_raw_parts_mut(geometry.0.add(range.start), range.len())
-                        .fill(BundleGeometry::default());
+                        .fill(BundleGeometry::PADDING);
                 }
             }
             for k in low..high.min(constraints.len()) {
@@ -797,8 +872,14 @@ impl Bundles {
 /// solves always set targets from the separations (`pass.targets`) when asked, and ignore
 /// `pass.sweep` (the bundles are in colour order already).
 impl ContactSolver for Bundles {
-    fn prepare(&mut self, constraints: &mut [ContactConstraint], slots: usize, parallel: bool) {
-        self.pack(constraints, slots, parallel);
+    fn prepare(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        slots: usize,
+        inverse_inertia: &[Mat3],
+        parallel: bool,
+    ) {
+        self.pack(constraints, slots, inverse_inertia, parallel);
     }
 
     fn warm_start(
@@ -1218,24 +1299,37 @@ fn add_cross(linear: LaneVec, angular: LaneVec, lever: LaneVec) -> LaneVec {
     ]
 }
 
-/// Writes point `c` into lane `i` of a bundle.
+/// Writes point `c` into lane `i` of a bundle. A point with pending lever-arm products gets its
+/// directions, and in its normal row's `inverse_effective_mass` the linear part of every row's
+/// J M⁻¹ Jᵀ, 1/m_a + 1/m_b, for [`bundle_products`] to complete.
 #[inline(always)]
 fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &ContactConstraint) {
     b.local_a[i] = c.local_a;
     b.local_b[i] = c.local_b;
     set_vec(&mut b.inverse_mass_a, i, c.inverse_mass_a);
     set_vec(&mut b.inverse_mass_b, i, c.inverse_mass_b);
-    b.normal.set(i, &c.normal);
-    b.tangents[0].set(i, &c.tangents[0]);
-    b.tangents[1].set(i, &c.tangents[1]);
-    for k in 0..3 {
-        set(
-            &mut b.tangent_inverse_block[k],
-            i,
-            c.tangent_inverse_block[k],
-        );
+    if c.products_pending {
+        set_vec(&mut b.normal.direction, i, c.normal.direction);
+        set_vec(&mut b.tangents[0].direction, i, c.tangents[0].direction);
+        set_vec(&mut b.tangents[1].direction, i, c.tangents[1].direction);
+        // Pending only for bodies with no translation locked (see `products_pending`).
+        let linear = c.inverse_mass_a.x + c.inverse_mass_b.x;
+        set(&mut b.normal.inverse_effective_mass, i, linear);
+        g.pending[i] = true;
+    } else {
+        b.normal.set(i, &c.normal);
+        b.tangents[0].set(i, &c.tangents[0]);
+        b.tangents[1].set(i, &c.tangents[1]);
+        for k in 0..3 {
+            set(
+                &mut b.tangent_inverse_block[k],
+                i,
+                c.tangent_inverse_block[k],
+            );
+        }
+        set(&mut b.sliding_step, i, sliding_step(c.tangent_block));
+        g.pending[i] = false;
     }
-    set(&mut b.sliding_step, i, sliding_step(c.tangent_block));
     set(&mut b.friction, i, c.friction);
     set(&mut b.target, i, c.target_normal_velocity);
     set(&mut b.mass_scale, i, c.softness.0);
@@ -1247,6 +1341,113 @@ fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &ContactConstra
     set_vec(&mut g.lever_a, i, c.lever_a);
     set_vec(&mut g.lever_b, i, c.lever_b);
     set(&mut g.depth, i, c.depth);
+}
+
+/// The world inverse inertia tensors of the lanes' `slots`, as columns of lanes: `[c][r]` is
+/// entry (r, c) of each lane's tensor.
+#[inline(always)]
+fn inertia_lanes(slots: &[u32; LANES], inverse_inertia: &[Mat3]) -> [LaneVec; 3] {
+    let tensors = slots.map(|slot| inverse_inertia[slot as usize]);
+    [0, 1, 2].map(|c| lane_vec(tensors.map(|t| t.col(c))))
+}
+
+/// M·v per lane for tensors `m` from [`inertia_lanes`]: (m₀ᵣ·vₓ + m₁ᵣ·v_y) + m₂ᵣ·v_z per
+/// component r, the order of glam's `Mat3A * Vec3A`.
+#[inline(always)]
+fn mul_tensor(m: &[LaneVec; 3], v: LaneVec) -> LaneVec {
+    [0, 1, 2].map(|r| m[0][r] * v[0] + m[1][r] * v[1] + m[2][r] * v[2])
+}
+
+/// The lever-arm products of one row in the lanes of its bundle, where `pending`: r × d for
+/// both bodies, I⁻¹(r × d), and the row's J M⁻¹ Jᵀ = `linear` + (r_a × d)·I_a⁻¹(r_a × d) +
+/// (r_b × d)·I_b⁻¹(r_b × d) and its inverse, as `JacobianRow::fill_products` computes them.
+#[inline(always)]
+fn row_products<const ALL: bool>(
+    row: &mut RowLanes,
+    linear: Lane,
+    geometry: &BundleGeometry,
+    inertia: (&[LaneVec; 3], &[LaneVec; 3]),
+    pending: Lane,
+) {
+    let keep = |new: LaneVec, old: LaneVec| {
+        if ALL {
+            new
+        } else {
+            [0, 1, 2].map(|k| pending.select(new[k], old[k]))
+        }
+    };
+    let angular_a = cross(geometry.lever_a, row.direction);
+    let angular_b = cross(geometry.lever_b, row.direction);
+    let inverse_inertia_angular_a = mul_tensor(inertia.0, angular_a);
+    let inverse_inertia_angular_b = mul_tensor(inertia.1, angular_b);
+    let k = linear
+        + dot(angular_a, inverse_inertia_angular_a)
+        + dot(angular_b, inverse_inertia_angular_b);
+    let zero = Lane::splat(0.0);
+    let effective_mass = k.simd_gt(zero).select(Lane::splat(1.0) / k, zero);
+    row.angular_a = keep(angular_a, row.angular_a);
+    row.angular_b = keep(angular_b, row.angular_b);
+    row.inverse_inertia_angular_a = keep(inverse_inertia_angular_a, row.inverse_inertia_angular_a);
+    row.inverse_inertia_angular_b = keep(inverse_inertia_angular_b, row.inverse_inertia_angular_b);
+    row.effective_mass = select::<ALL>(pending, effective_mass, row.effective_mass);
+    row.inverse_effective_mass = select::<ALL>(pending, k, row.inverse_effective_mass);
+}
+
+/// `new` where `pending`, else `old`; `new` everywhere when `ALL` lanes are pending.
+#[inline(always)]
+fn select<const ALL: bool>(pending: Lane, new: Lane, old: Lane) -> Lane {
+    if ALL { new } else { pending.select(new, old) }
+}
+
+/// The pending lever-arm products of bundle `b` (see [`set_lane`]) for its lanes' tensors
+/// `inertia_a`, `inertia_b`: each row's (see [`row_products`]), the tangent block's inverse
+/// and the sliding step, per lane as the scalar `tangent_block`, `inverse_block` and
+/// [`sliding_step`] give them.
+///
+/// `ALL`: every lane is pending (the usual case), and the results are stored without
+/// selecting lanes.
+#[inline(always)]
+fn bundle_products<const ALL: bool>(
+    b: &mut Bundle,
+    geometry: &BundleGeometry,
+    inertia_a: &[LaneVec; 3],
+    inertia_b: &[LaneVec; 3],
+) {
+    let (zero, one) = (Lane::splat(0.0), Lane::splat(1.0));
+    let pending = Lane::new(geometry.pending.map(|p| if p { 1.0 } else { 0.0 })).simd_ne(zero);
+    let linear = b.normal.inverse_effective_mass;
+    let inertia = (inertia_a, inertia_b);
+    row_products::<ALL>(&mut b.normal, linear, geometry, inertia, pending);
+    row_products::<ALL>(&mut b.tangents[0], linear, geometry, inertia, pending);
+    row_products::<ALL>(&mut b.tangents[1], linear, geometry, inertia, pending);
+    // The tangent block K (the linear parts couple the tangents only through a locked
+    // translation axis, which pending points do not have).
+    let [t1, t2] = &b.tangents;
+    let k11 = t1.inverse_effective_mass;
+    let k22 = t2.inverse_effective_mass;
+    let k12 = dot(t1.angular_a, t2.inverse_inertia_angular_a)
+        + dot(t1.angular_b, t2.inverse_inertia_angular_b);
+    // Its inverse, or the pseudo-inverse of a rank-one block, or zero (`inverse_block`).
+    let determinant = k11 * k22 - k12 * k12;
+    let regular = determinant
+        .simd_gt(Lane::splat(f32::EPSILON) * (k11 * k22).max(Lane::splat(f32::MIN_POSITIVE)));
+    let inverse = one / determinant;
+    let trace = k11 + k22;
+    let rank_one = trace.simd_gt(zero) & trace.is_finite();
+    let scale = one / (trace * trace);
+    let inverse_block = [
+        regular.select(k22 * inverse, rank_one.select(k11 * scale, zero)),
+        regular.select(-k12 * inverse, rank_one.select(k12 * scale, zero)),
+        regular.select(k11 * inverse, rank_one.select(k22 * scale, zero)),
+    ];
+    for (lanes, new) in b.tangent_inverse_block.iter_mut().zip(inverse_block) {
+        *lanes = select::<ALL>(pending, new, *lanes);
+    }
+    // 1/k₁, k₁ the block's larger eigenvalue (`sliding_step`).
+    let k1 = Lane::splat(0.5) * (k11 + k22)
+        + (Lane::splat(0.25) * (k11 - k22) * (k11 - k22) + k12 * k12).sqrt();
+    let step = (k1.is_finite() & k1.simd_gt(zero)).select(one / k1, zero);
+    b.sliding_step = select::<ALL>(pending, step, b.sliding_step);
 }
 
 #[inline(always)]
@@ -1394,6 +1595,108 @@ mod tests {
         (0..STEPS).prop_map(move |k| low + (high - low) * (k as f32 / STEPS as f32))
     }
 
+    /// Every number of a bundle a sweep reads, as bits, in a fixed order.
+    fn bundle_bits(b: &Bundle) -> Vec<u32> {
+        let mut bits: Vec<u32> = b.local_a.iter().chain(&b.local_b).copied().collect();
+        let mut lanes: Vec<Lane> = Vec::new();
+        lanes.extend(b.inverse_mass_a.iter().chain(&b.inverse_mass_b));
+        for row in [&b.normal, &b.tangents[0], &b.tangents[1]] {
+            for v in [
+                &row.direction,
+                &row.angular_a,
+                &row.angular_b,
+                &row.inverse_inertia_angular_a,
+                &row.inverse_inertia_angular_b,
+            ] {
+                lanes.extend(v);
+            }
+            lanes.extend([row.effective_mass, row.inverse_effective_mass]);
+        }
+        lanes.extend(&b.tangent_inverse_block);
+        lanes.extend([b.sliding_step, b.friction, b.normal_impulse]);
+        lanes.extend(&b.tangent_impulses);
+        bits.extend(lanes.iter().flat_map(|l| l.as_array().map(f32::to_bits)));
+        bits
+    }
+
+    /// A symmetric positive semi-definite tensor L·Lᵀ from nine numbers (1/(kg·m²)).
+    fn tensor(entries: &[f32]) -> Mat3 {
+        let l = Mat3::from_cols_slice(entries);
+        l * l.transpose()
+    }
+
+    proptest! {
+        /// The lever-arm products the lanes compute from lever arms, directions and the
+        /// slots' tensors as they pack (`products_pending`) are those of the scalar assembly
+        /// (`complete_products` before packing) to the bit, padding lanes included: random
+        /// points between six moving slots of random mass and inertia, one slot that is
+        /// immovable by its masses, and the island's immovable slot.
+        #[test]
+        fn lanes_compute_the_lever_arm_products_of_the_scalar_assembly_to_the_bit(
+            masses in prop::collection::vec(float(0.05, 20.0), 7),
+            tensors in prop::collection::vec(prop::collection::vec(float(-1.0, 1.0), 9), 7),
+            points in prop::collection::vec(
+                (0u32..8, 0u32..8, prop::collection::vec(float(-1.0, 1.0), 9), 1usize..5),
+                1..24,
+            ),
+        ) {
+            // Slots 0–5 move; slot 6 has no mass or inertia (a body that cannot move); slot 7
+            // is the island's immovable slot. Body i sits in slot i.
+            let slots = 8;
+            let mut inertia: Vec<Mat3> = tensors.iter().map(|t| tensor(t)).collect();
+            inertia[6] = Mat3::ZERO;
+            inertia.push(Mat3::ZERO);
+            let inverse_mass = |slot: u32| match slot {
+                0..=5 => Vec3::splat(1.0 / masses[slot as usize]),
+                _ => Vec3::ZERO,
+            };
+            let mut pending = Vec::new();
+            for (a, b, numbers, repeat) in points {
+                let b = if a == b { 7 } else { b };
+                let normal = Vec3::new(numbers[0], numbers[1], numbers[2] + 1.5).normalize();
+                let (t1, t2) = normal.any_orthonormal_pair();
+                let lever_a = Vec3::new(numbers[3], numbers[4], numbers[5]);
+                let lever_b = Vec3::new(numbers[6], numbers[7], numbers[8]);
+                let row = |d: Vec3| JacobianRow {
+                    direction: d,
+                    angular_a: lever_a.cross(d),
+                    angular_b: lever_b.cross(d),
+                    ..JacobianRow::default()
+                };
+                // A manifold's points come together: `repeat` points of this pair.
+                for k in 0..repeat {
+                    pending.push(ContactConstraint {
+                        body_a: a,
+                        body_b: b,
+                        local_a: a,
+                        local_b: b,
+                        inverse_mass_a: inverse_mass(a),
+                        inverse_mass_b: inverse_mass(b),
+                        normal: row(normal),
+                        tangents: [row(t1), row(t2)],
+                        lever_a,
+                        lever_b,
+                        friction: 0.5,
+                        normal_impulse: k as f32,
+                        products_pending: true,
+                        ..ContactConstraint::default()
+                    });
+                }
+            }
+            let mut complete = pending.clone();
+            crate::contact::constraints::complete_products(&mut complete, &inertia);
+            prop_assert!(complete.iter().all(|c| !c.products_pending));
+            let mut from_lanes = Bundles::default();
+            from_lanes.pack(&pending, slots, &inertia, false);
+            let mut from_rows = Bundles::default();
+            from_rows.pack(&complete, slots, &inertia, false);
+            prop_assert_eq!(from_lanes.bundles.len(), from_rows.bundles.len());
+            for (index, (x, y)) in from_lanes.bundles.iter().zip(&from_rows.bundles).enumerate() {
+                prop_assert_eq!(bundle_bits(x), bundle_bits(y), "bundle {}", index);
+            }
+        }
+    }
+
     /// Packing cuts each pair's run of points into manifold groups of at most
     /// [`GROUP_POINTS`], puts every point in exactly one lane, keeps a group's points in order
     /// in one lane of one lane group, gives no two lane groups of a colour a common moving
@@ -1428,7 +1731,7 @@ mod tests {
             }
         }
         let mut packed = Bundles::default();
-        packed.pack(&constraints, 8, false);
+        packed.pack(&constraints, 8, &[Mat3::ZERO; 8], false);
         // Every point in exactly one lane, found where `slots` says.
         let mut seen = vec![0; constraints.len()];
         for (index, lanes) in packed.sources.iter().enumerate() {

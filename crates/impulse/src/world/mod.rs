@@ -9,7 +9,7 @@ use crate::body::rules::{self, ShapeClass};
 use crate::body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Handles, LockedAxes};
 use crate::collision::broad_phase::BroadPhase;
 use crate::collision::narrow_phase::{self, NarrowPhase};
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::constraints::{ContactConstraint, complete_products};
 use crate::diagnostics::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms};
 use crate::error::WorldError;
@@ -237,16 +237,39 @@ impl World {
         &self.diagnostics
     }
 
-    /// The last step's solved contact constraints (impulses as the solver left them).
+    /// The last step's solved contact constraints (impulses as the solver left them), with
+    /// every row's lever-arm products ([`ContactConstraint::products_pending`]).
     #[cfg(any(test, feature = "internals"))]
-    pub(crate) fn contact_constraints(&self) -> &[ContactConstraint] {
-        &self.constraints
+    pub(crate) fn contact_constraints(&self) -> Vec<ContactConstraint> {
+        self.complete_constraints().into_owned()
+    }
+
+    /// How many of the last step's constraints were left with their lever-arm products for
+    /// the SIMD lanes ([`ContactConstraint::products_pending`]).
+    #[cfg(test)]
+    pub(crate) fn pending_products(&self) -> usize {
+        self.constraints
+            .iter()
+            .filter(|c| c.products_pending)
+            .count()
+    }
+
+    /// The last step's constraints with every row's lever-arm products: borrowed when none is
+    /// pending (the SIMD lanes computed theirs in their own bundles), else a completed copy.
+    fn complete_constraints(&self) -> std::borrow::Cow<'_, [ContactConstraint]> {
+        if self.constraints.iter().any(|c| c.products_pending) {
+            let mut rows = self.constraints.clone();
+            complete_products(&mut rows, &self.world_inverse_inertia);
+            std::borrow::Cow::Owned(rows)
+        } else {
+            std::borrow::Cow::Borrowed(&self.constraints)
+        }
     }
 
     /// The last step's contact LCP, assembled from the rows the solver used, with the engine's
     /// impulses at exit. Errors only when the step produced non-finite data.
     pub fn contact_lcp(&self) -> Result<ContactLcp, impulse_lcp::ProblemError> {
-        assemble_lcp(&self.constraints)
+        assemble_lcp(&self.complete_constraints())
     }
 
     /// Wall-clock time of each stage of the last step (all zero before the first step).

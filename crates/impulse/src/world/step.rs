@@ -195,9 +195,16 @@ impl World {
             &self.islands,
             settings,
             &self.world_inverse_inertia,
+            !self.any_restitution(),
             self.parallel,
             &mut self.constraints,
         );
+    }
+
+    /// Whether any body has a restitution coefficient above zero (then islands end their step
+    /// with a restitution solve).
+    fn any_restitution(&self) -> bool {
+        self.bodies.restitution.iter().any(|&r| r > 0.0)
     }
 
     /// Stages 1, 5 and 6 per island: each island's substeps touch only its own bodies.
@@ -216,7 +223,8 @@ impl World {
                 dt,
                 settings,
                 parallel: self.parallel,
-                restitution: self.bodies.restitution.iter().any(|&r| r > 0.0),
+                restitution: self.any_restitution(),
+                world_inverse_inertia: &self.world_inverse_inertia,
                 forces: self.forces_pending,
             };
             // Each island ends its step with the passes that read its rows once more, while
@@ -303,6 +311,8 @@ impl World {
         // awake islands come out as their own record, to the last bits where the SIMD lanes
         // took it: see `wide::Bundles::record`).
         if self.island_awake.iter().take(islands).any(|awake| !awake) {
+            // The pass reads every row's I⁻¹(r × d), which the lanes keep in their bundles.
+            constraints::complete_products(&mut self.constraints, &self.world_inverse_inertia);
             constraints::record_velocity_before(
                 &mut self.constraints,
                 constraints::BodySlots::World,
