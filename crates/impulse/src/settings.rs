@@ -160,7 +160,9 @@ pub struct SolverSettings {
     /// lower bodies sideways and spreads the pile (Rapier's `friction_in_bias_pass`, off by
     /// default, makes the same choice). The friction impulses are applied throughout (warm
     /// start). Other methods, split impulse, and solves without a relax solve always sweep
-    /// friction with the normal rows ([`Self::main_solve_friction`]).
+    /// friction with the normal rows ([`Self::main_solve_friction`]), and so do islands whose
+    /// heaviest body is at least 200 times their lightest, where one friction sweep a substep
+    /// converges too slowly (docs/solvers.md, "The soft step").
     pub friction_in_main_solve: bool,
     /// Islands with at least this many contact points are swept colour by colour (greedy graph
     /// colouring: no two points of a colour share a moving body), one colour's points spread

@@ -220,6 +220,49 @@ fn resting_stack30_gains_no_kinetic_energy_and_does_not_drift() {
     }
 }
 
+/// Solver2D's `plate` (a 20×1×20 m plate on two cubes, 400:1) comes to rest at every soft-step
+/// preset with sleeping off: after two seconds the kinetic energy stays below 10 mJ (400 t of
+/// plate at 0.2 mm/s) and no body moves more than 1 mm sideways. With one friction sweep a
+/// substep (the relax solve's) the plate rocked sideways with growing amplitude, up to 600 J
+/// after 10 s at the default; islands this heavy on light bodies sweep friction in the main
+/// solve too (`HEAVY_ON_LIGHT_MASS_RATIO`).
+#[test]
+fn plate_on_two_cubes_comes_to_rest_at_every_preset() {
+    for preset in ["fast", "default", "precise"] {
+        let mut scene = builtin_scene("plate").expect("built-in scene");
+        scene.solver = SolverSettings {
+            sleep: false,
+            ..SolverSettings::preset(preset).unwrap()
+        };
+        let mut world = World::from_scene(&scene).unwrap();
+        let initial: Vec<Vec3> = world.bodies().pose.iter().map(|p| p.translation).collect();
+        let (mut energy, mut sideways) = (0.0f32, 0.0f32);
+        for step in 1..=600 {
+            let report = world.step().unwrap();
+            if step <= 120 {
+                continue;
+            }
+            energy = energy.max(report.kinetic_energy);
+            for (i, start) in initial.iter().enumerate() {
+                let d = world.bodies().pose[i].translation - *start;
+                sideways = sideways.max(Vec3::new(d.x, 0.0, d.z).length());
+            }
+        }
+        println!(
+            "plate {preset}: largest kinetic energy after 2 s {energy:.2e} J, sideways {:.3} mm",
+            sideways * 1e3
+        );
+        assert!(
+            energy < 1e-2,
+            "{preset}: kinetic energy up to {energy} J after 2 s"
+        );
+        assert!(
+            sideways < 1e-3,
+            "{preset}: a body moved {sideways} m sideways"
+        );
+    }
+}
+
 /// pyramid20 at the default, sleeping off, comes to rest: over its last two seconds the
 /// kinetic energy stays below 1 mJ (210 t of cubes). Measured: at most 19 µJ. With the
 /// contact spring at a quarter of the substep rate instead of a fifth, the pyramid rocked out of
