@@ -153,6 +153,16 @@ fn overlap_pyramid_recovers_without_explosion() {
     }
 }
 
+/// Built-in scene `name` at preset `preset` with sleeping off.
+fn awake_world(name: &str, preset: &str) -> World {
+    let mut scene = builtin_scene(name).expect("built-in scene");
+    scene.solver = SolverSettings {
+        sleep: false,
+        ..SolverSettings::preset(preset).unwrap()
+    };
+    World::from_scene(&scene).unwrap()
+}
+
 /// A resting stack stays at rest: stack30, sleeping off, 10 s, at the default and at the
 /// `precise` preset. In the first second the cubes fall into their contact springs; after two
 /// seconds the kinetic energy stays below 1 mJ (30 t of cubes: a cube at 1.4 mm/s) and ends
@@ -169,12 +179,7 @@ fn resting_stack30_gains_no_kinetic_energy_and_does_not_drift() {
     // 26 µm/s. `precise` sits at about 1 µJ from two seconds on.
     const NOISE_FLOOR: f32 = 1e-5;
     for (preset, drift_bound) in [("default", 0.005), ("precise", 0.001)] {
-        let mut scene = builtin_scene("stack30").expect("built-in scene");
-        scene.solver = SolverSettings {
-            sleep: false,
-            ..SolverSettings::preset(preset).unwrap()
-        };
-        let mut world = World::from_scene(&scene).unwrap();
+        let mut world = awake_world("stack30", preset);
         let initial: Vec<Vec3> = world.bodies().pose.iter().map(|p| p.translation).collect();
         let (mut energy, mut sideways, mut drift) = (0.0f32, 0.0f32, 0.0f32);
         let (mut energy_at_two_seconds, mut energy_in_last_second) = (f32::INFINITY, 0.0f32);
@@ -229,12 +234,7 @@ fn resting_stack30_gains_no_kinetic_energy_and_does_not_drift() {
 #[test]
 fn plate_on_two_cubes_comes_to_rest_at_every_preset() {
     for preset in ["fast", "default", "precise"] {
-        let mut scene = builtin_scene("plate").expect("built-in scene");
-        scene.solver = SolverSettings {
-            sleep: false,
-            ..SolverSettings::preset(preset).unwrap()
-        };
-        let mut world = World::from_scene(&scene).unwrap();
+        let mut world = awake_world("plate", preset);
         let initial: Vec<Vec3> = world.bodies().pose.iter().map(|p| p.translation).collect();
         let (mut energy, mut sideways) = (0.0f32, 0.0f32);
         for step in 1..=600 {
