@@ -1640,14 +1640,18 @@ mod tests {
                 1..24,
             ),
         ) {
-            // Slots 0–5 move; slot 6 has no mass or inertia (a body that cannot move); slot 7
+            // Slots 0–5 move; slot 5 is a heavy rod (1000 t, free to turn about x alone),
+            // whose friction block against an immovable body is nearly rank one and takes the
+            // pseudo-inverse; slot 6 has no mass or inertia (a body that cannot move); slot 7
             // is the island's immovable slot. Body i sits in slot i.
             let slots = 8;
             let mut inertia: Vec<Mat3> = tensors.iter().map(|t| tensor(t)).collect();
+            inertia[5] = Mat3::from_diagonal(Vec3::new(1000.0, 0.0, 0.0));
             inertia[6] = Mat3::ZERO;
             inertia.push(Mat3::ZERO);
             let inverse_mass = |slot: u32| match slot {
-                0..=5 => Vec3::splat(1.0 / masses[slot as usize]),
+                0..=4 => Vec3::splat(1.0 / masses[slot as usize]),
+                5 => Vec3::splat(1e-6),
                 _ => Vec3::ZERO,
             };
             let mut pending = Vec::new();
