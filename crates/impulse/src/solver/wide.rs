@@ -1629,8 +1629,9 @@ mod tests {
         /// The lever-arm products the lanes compute from lever arms, directions and the
         /// slots' tensors as they pack (`products_pending`) are those of the scalar assembly
         /// (`complete_products` before packing) to the bit, padding lanes included: random
-        /// points between six moving slots of random mass and inertia, one slot that is
-        /// immovable by its masses, and the island's immovable slot.
+        /// points between five moving slots of random mass and inertia, a heavy rod (friction
+        /// blocks of rank one, the pseudo-inverse), one slot that is immovable by its masses,
+        /// and the island's immovable slot.
         #[test]
         fn lanes_compute_the_lever_arm_products_of_the_scalar_assembly_to_the_bit(
             masses in prop::collection::vec(float(0.05, 20.0), 7),
