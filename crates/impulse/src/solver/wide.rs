@@ -407,7 +407,10 @@ impl Bundles {
                 }
             }
         }
-        self.compute_products(inverse_inertia, parallel_fill);
+        // Padding alone needs nothing computed: its products are the zeros it was reset to.
+        if constraints.iter().any(|c| c.products_pending) {
+            self.compute_products(inverse_inertia, parallel_fill);
+        }
     }
 
     /// The pending lever-arm products of [`Bundles::pack`], lane group by lane group (the
