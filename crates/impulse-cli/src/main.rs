@@ -311,6 +311,7 @@ fn report(summary: run::Summary, profile: bool) -> Result<ExitCode> {
     println!("{}", summary.line());
     if profile {
         println!("{}", summary.stage_line());
+        println!("{}", run::instruction_set_line());
     }
     if run::INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
         eprintln!("{}: {}", summary.scene, summary.status);

@@ -142,6 +142,16 @@ impl Summary {
     }
 }
 
+/// Which build of the SIMD kernels the steps ran on, as one line: `SIMD kernels: x86-64-v4`
+/// (or `baseline`), and how to choose the baseline.
+pub fn instruction_set_line() -> String {
+    format!(
+        "SIMD kernels: {} ({}=baseline for the baseline; the results are the same)",
+        impulse::InstructionSet::detected().name(),
+        impulse::INSTRUCTION_SET_VARIABLE
+    )
+}
+
 /// Where `--out` sends the written frames, by the file's extension.
 enum FrameOutput {
     /// `.csv` or `.jsonl`: each frame appended to the file as it is written.

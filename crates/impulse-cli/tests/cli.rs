@@ -324,3 +324,44 @@ fn keyframes_out_of_order_name_file_line_body_and_field() {
     assert!(err.contains("lift"), "{err}");
     assert!(err.contains("keyframes[1].t"), "{err}");
 }
+
+/// The x86-64-v4 build of the SIMD kernels (chosen when the CPU has AVX-512) gives the
+/// trajectories of the baseline build to the byte: the one island of pyramid3d10 on two
+/// threads (the parallel pack, sweeps and record), pyramid20 on one, and bouncing spheres
+/// (restitution, so assembly computes the lever-arm products itself). On a CPU without
+/// x86-64-v4 both runs take the baseline and the comparison says nothing; the test says so.
+#[test]
+fn instruction_sets_give_the_same_trajectories_to_the_byte() {
+    if !impulse::InstructionSet::X86_64V4.is_supported() {
+        eprintln!("this CPU has no x86-64-v4: both runs take the baseline kernels");
+    }
+    let runs: [&[&str]; 3] = [
+        &["pyramid3d10", "--steps", "20", "--threads", "2"],
+        &["pyramid20", "--steps", "60", "--threads", "1"],
+        &[
+            "scenes/example-three-spheres.json",
+            "--steps",
+            "90",
+            "--threads",
+            "1",
+        ],
+    ];
+    for (k, args) in runs.into_iter().enumerate() {
+        let trajectory = |set: Option<&str>| {
+            let path = temp(&format!("isa-{k}-{}.jsonl", set.unwrap_or("detected")));
+            let mut command = impulse();
+            command.current_dir(repo("")).arg("run").args(args);
+            command.args(["--no-sleep", "--quiet", "--out"]).arg(&path);
+            command.env_remove(impulse::INSTRUCTION_SET_VARIABLE);
+            if let Some(set) = set {
+                command.env(impulse::INSTRUCTION_SET_VARIABLE, set);
+            }
+            let out = command.output().unwrap();
+            assert_success(&out, &format!("{args:?}: "));
+            std::fs::read(&path).unwrap()
+        };
+        let (baseline, detected) = (trajectory(Some("baseline")), trajectory(None));
+        assert!(!baseline.is_empty());
+        assert!(baseline == detected, "{args:?}: the trajectories differ");
+    }
+}

@@ -45,6 +45,7 @@ mod continuous;
 mod diagnostics;
 mod error;
 mod graph;
+mod instruction_set;
 mod integrate;
 mod island;
 mod kinematic;
@@ -78,6 +79,7 @@ pub use body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use diagnostics::contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
+pub use instruction_set::{INSTRUCTION_SET_VARIABLE, InstructionSet};
 pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };

@@ -8,6 +8,7 @@ use glam::{Mat3, Mat3A, Vec3, Vec3A};
 
 use crate::body::Bodies;
 use crate::collision::narrow_phase::{ContactPair, NarrowPhase, repeats_earlier_point, same_point};
+use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::island::Islands;
 use crate::parallel::{PAIRS_PER_TASK, spread};
 use crate::settings::{ContactRepair, SolverSettings};
@@ -284,6 +285,7 @@ pub fn assemble(
     out: &mut Vec<ContactConstraint>,
 ) {
     let pairs = &narrow_phase.pairs;
+    let set = InstructionSet::detected();
     let total = islands.constraint_count();
     // Every slot is overwritten below; resizing only fills slots the vector did not have.
     out.truncate(total);
@@ -306,19 +308,23 @@ pub fn assemble(
             .enumerate()
             .for_each(|(chunk, run)| {
                 let first_pair = chunk * PAIRS_PER_TASK;
-                for (pair, first, count) in
-                    context.rows_in_memory_order(first_pair..first_pair + run.len())
-                {
-                    // SAFETY: `Islands::build` gives the pairs with constraints consecutive
-                    // row ranges in island order, so no two pairs' ranges overlap, and each
-                    // pair belongs to exactly one task; `get` checks the bounds.
-                    context.pair(pair, unsafe { rows.get(first, count) });
-                }
+                on_instruction_set!(set, {
+                    for (pair, first, count) in
+                        context.rows_in_memory_order(first_pair..first_pair + run.len())
+                    {
+                        // SAFETY: `Islands::build` gives the pairs with constraints consecutive
+                        // row ranges in island order, so no two pairs' ranges overlap, and each
+                        // pair belongs to exactly one task; `get` checks the bounds.
+                        context.pair(pair, unsafe { rows.get(first, count) });
+                    }
+                })
             });
     } else {
-        for (pair, first, count) in context.rows_in_memory_order(0..pairs.len()) {
-            context.pair(pair, &mut out[first..first + count]);
-        }
+        on_instruction_set!(set, {
+            for (pair, first, count) in context.rows_in_memory_order(0..pairs.len()) {
+                context.pair(pair, &mut out[first..first + count]);
+            }
+        });
     }
 }
 
@@ -396,7 +402,9 @@ impl Assembly<'_> {
         })
     }
 
-    /// Assembles pair `pair_index` into `out`, which has exactly its row count.
+    /// Assembles pair `pair_index` into `out`, which has exactly its row count. Inlined
+    /// into `assemble`'s loops, which are compiled for each instruction set.
+    #[inline(always)]
     fn pair(&self, pair_index: u32, out: &mut [ContactConstraint]) {
         let (bodies, settings) = (self.bodies, self.settings);
         let mut slots = out.iter_mut();

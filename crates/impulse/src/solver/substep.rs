@@ -416,6 +416,9 @@ pub fn step_island(
     // its guests too.
     let moving = island_bodies.len();
     let integrated = slots - 1;
+    // With no restitution solve to follow, the lanes record the rows' J·v* and residual
+    // while the bundles are in cache (`wide::Bundles::record`); `rows` then holds them.
+    let record_in_lanes = bundled && !restitution;
     for substep in 0..settings.substeps {
         // Every other substep, PGS takes each manifold's points from halfway round (see
         // `wide::sweep_groups`), so that no corner of a face always goes first. Split
@@ -461,6 +464,11 @@ pub fn step_island(
                 usize::from(*locked),
                 h,
             );
+        }
+        // The lanes' record takes v* = v − M⁻¹Jᵀγ, γ the final impulses: the velocities
+        // here, before the last substep applies its impulses (see `wide::Bundles::record`).
+        if record_in_lanes && substep + 1 == settings.substeps {
+            w.solvers.wide.keep_velocities_before(&w.linear, &w.angular);
         }
         let mut velocities = Velocities {
             linear: &mut w.linear,
@@ -551,9 +559,6 @@ pub fn step_island(
             w.targets_and_solve(constraints, settings, h, bundled, false, half_turn);
         }
     }
-    // With no restitution solve to follow, the lanes record the rows' J·v* and residual
-    // while the bundles are in cache (`wide::Bundles::record`); `rows` then holds them.
-    let record_in_lanes = bundled && !restitution;
     if record_in_lanes {
         w.solvers.wide.record(&w.linear, &w.angular);
     }

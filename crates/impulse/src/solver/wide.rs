@@ -35,6 +35,7 @@ use crate::contact::constraints::{
     ContactConstraint, JacobianRow, SPECULATIVE_TURN, STALE_TARGET, repair_terms,
 };
 use crate::graph::{COLOURS, greedy_colours};
+use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{
     GROUPS_PER_TASK, PARALLEL_PACK_POINTS, SharedItems, SharedVelocities, colour_after_colour,
     prefetch_lines, spread, threads,
@@ -156,6 +157,9 @@ pub struct Bundles {
     run_places: Vec<(u32, u32)>,
     /// Whether one colour's bundles may be updated on several threads.
     parallel: bool,
+    /// What the sweeps run on ([`InstructionSet::detected`] unless set otherwise); the
+    /// results are the same on any.
+    instruction_set: InstructionSet,
     /// Constraint index of each lane of each bundle; `u32::MAX` for padding.
     sources: Vec<[u32; LANES]>,
     /// Where each constraint went: bundle index × [`LANES`] + lane.
@@ -174,6 +178,9 @@ pub struct Bundles {
     records: Vec<BundleRecord>,
     before_linear: Vec<Vec3>,
     before_angular: Vec<Vec3>,
+    /// Whether `before_linear` and `before_angular` hold v* kept during the substeps
+    /// ([`Bundles::keep_velocities_before`]) for the next record.
+    before_kept: bool,
     recorded: bool,
     rows: Option<RowsReport>,
 }
@@ -337,7 +344,9 @@ impl Bundles {
         parallel: bool,
     ) {
         self.parallel = parallel;
+        self.instruction_set = InstructionSet::detected();
         self.recorded = false;
+        self.before_kept = false;
         self.rows = None;
         let immovable = (slots - 1) as u32;
         // The layout is a function of the points' body slots alone: when they repeat (an
@@ -387,10 +396,13 @@ impl Bundles {
             self.fill_parallel(constraints, &empty);
         } else {
             // The reads stream, and the writes go to one open lane group per colour.
-            for (c, &slot) in constraints.iter().zip(&self.slots) {
-                let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
-                set_lane(&mut self.bundles[index], &mut self.geometry[index], lane, c);
-            }
+            let (bundles, geometry, slots) = (&mut self.bundles, &mut self.geometry, &self.slots);
+            on_instruction_set!(self.instruction_set, {
+                for (c, &slot) in constraints.iter().zip(slots) {
+                    let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
+                    set_lane(&mut bundles[index], &mut geometry[index], lane, c);
+                }
+            });
         }
         // Padding of a lane whose group is shorter than its lane group names the group's
         // bodies, so that every bundle of a lane group names the same bodies per lane (as
@@ -416,7 +428,7 @@ impl Bundles {
     /// The pending lever-arm products of [`Bundles::pack`], lane group by lane group (the
     /// bodies' tensors gathered once per lane group); on rayon's threads with `parallel`.
     fn compute_products(&mut self, inverse_inertia: &[Mat3], parallel: bool) {
-        let geometry = &self.geometry;
+        let (geometry, set) = (&self.geometry, self.instruction_set);
         let group = |g: &Group, bundles: &mut [Bundle]| {
             let range = g.start as usize..(g.start + g.len) as usize;
             let geometry = &geometry[range];
@@ -452,13 +464,16 @@ impl Bundles {
                     // SAFETY: lane groups cover disjoint bundle ranges (`lay_out` gives each
                     // its own run of bundles), inside the bundles (checked above).
                     let mine = unsafe { std::slice::from_raw_parts_mut(bundles.0.add(start), len) };
-                    group(g, mine);
+                    on_instruction_set!(set, group(g, mine));
                 });
         } else {
-            for g in &self.groups {
-                let range = g.start as usize..(g.start + g.len) as usize;
-                group(g, &mut self.bundles[range]);
-            }
+            let (groups, bundles) = (&self.groups, &mut self.bundles);
+            on_instruction_set!(set, {
+                for g in groups {
+                    let range = g.start as usize..(g.start + g.len) as usize;
+                    group(g, &mut bundles[range]);
+                }
+            });
         }
     }
 
@@ -689,6 +704,19 @@ impl Bundles {
         self.rows.take()
     }
 
+    /// Keeps the velocities `linear`, `angular` (per island slot) as v* for
+    /// [`Bundles::record`]: call it just before the last substep's warm start, once its
+    /// gravity, forces, damping and gyroscopic term are in. From there to the step's end
+    /// the velocities change by the impulses alone: the warm start's γ of the substep before
+    /// and the sweeps' changes to it, M⁻¹Jᵀγ with γ the final impulses.
+    pub fn keep_velocities_before(&mut self, linear: &[Vec3], angular: &[Vec3]) {
+        self.before_linear.clear();
+        self.before_linear.extend_from_slice(linear);
+        self.before_angular.clear();
+        self.before_angular.extend_from_slice(angular);
+        self.before_kept = true;
+    }
+
     /// Records, as the island's step ends, what its diagnostics need from each point at the
     /// final velocities `linear`, `angular` (per island slot, as the sweeps had them): the
     /// rows' J·v*, with v* = v − M⁻¹Jᵀγ the velocities before the final impulses γ, and the
@@ -696,28 +724,24 @@ impl Bundles {
     /// sums the residual. Call it after the last solve, before `unpack`, and only when no
     /// solve on the constraints follows (restitution): it reads the bundles' impulses.
     ///
-    /// The same quantities as `diagnostics::record_velocity_before_and_residual` computes from
-    /// the unpacked constraints, which reads every 344-byte row twice (once to sum M⁻¹Jᵀγ per
-    /// body, once for the rows); here a sweep takes the impulses off a copy of the velocities
-    /// and one pass reads the bundles, a third of the bytes. The residual is the same to the
-    /// bit; v* sums each body's M⁻¹Jᵀγ in colour order rather than constraint order, so J·v*
-    /// may differ in its last bits.
+    /// v* is the velocities [`Bundles::keep_velocities_before`] kept in the last substep;
+    /// without them nothing is recorded (and [`Bundles::take_rows`] gives `None`, so the
+    /// caller records the unpacked rows itself). The same quantities as
+    /// `diagnostics::record_velocity_before_and_residual` computes from the unpacked
+    /// constraints, which reads every 344-byte row twice (once to sum M⁻¹Jᵀγ per body, once
+    /// for the rows); here one pass reads the bundles. The residual is the same to the bit
+    /// (it reads v and γ alone); J·v* may differ in its last bits, v* being the velocities
+    /// before the impulses rather than the final ones less M⁻¹Jᵀγ.
     pub fn record(&mut self, linear: &[Vec3], angular: &[Vec3]) {
-        let mut before_linear = std::mem::take(&mut self.before_linear);
-        let mut before_angular = std::mem::take(&mut self.before_angular);
-        before_linear.clear();
-        before_linear.extend_from_slice(linear);
-        before_angular.clear();
-        before_angular.extend_from_slice(angular);
-        let order = SweepOrder {
-            forward: true,
-            half_turn: false,
-        };
-        let mut before = Velocities {
-            linear: &mut before_linear,
-            angular: &mut before_angular,
-        };
-        self.sweep(order, &mut before, RemoveImpulses, NoTargets);
+        if !std::mem::take(&mut self.before_kept) {
+            debug_assert!(
+                false,
+                "record without the velocities before the last impulses"
+            );
+            return;
+        }
+        let before_linear = std::mem::take(&mut self.before_linear);
+        let before_angular = std::mem::take(&mut self.before_angular);
         // Per lane group, its bodies gathered once (as a sweep does) for all its bundles.
         let len = self.bundles.len();
         self.records.resize(len, BundleRecord::default());
@@ -745,13 +769,14 @@ impl Bundles {
                 }
             }
         };
+        let set = self.instruction_set;
         if spread(self.parallel, len * LANES, PARALLEL_PACK_POINTS - 1) {
             use rayon::prelude::*;
             self.groups
                 .par_chunks(PARALLEL_PACK_POINTS / (4 * LANES))
-                .for_each(fill);
+                .for_each(|groups| on_instruction_set!(set, fill(groups)));
         } else {
-            fill(&self.groups);
+            on_instruction_set!(set, fill(&self.groups));
         }
         self.before_linear = before_linear;
         self.before_angular = before_angular;
@@ -780,13 +805,15 @@ impl Bundles {
             immovable: velocities.linear.len() - 1,
         };
         let (bundles, len) = (SharedItems(self.bundles.as_mut_ptr()), self.bundles.len());
+        let set = self.instruction_set;
         if !spread(self.parallel, 1, 0) {
+            let groups = &self.groups;
             // SAFETY: `pack` gave every group a range inside the bundles and every lane slots
             // below the island's slot count (the velocities' length); the bundles and the
-            // velocities are borrowed exclusively here.
-            return unsafe {
-                sweep_groups(&self.groups, bundles, len, order, &shared, update, targets)
-            };
+            // velocities are borrowed exclusively here. `set` runs on this CPU (`pack`).
+            return on_instruction_set!(set, unsafe {
+                sweep_groups(groups, bundles, len, order, &shared, update, targets)
+            });
         }
         // Runs `update` on a run of lane groups of one colour, in order or in reverse.
         let run = |part: &mut [Group], forward: bool| {
@@ -796,7 +823,9 @@ impl Bundles {
             // SAFETY: as above, and within one colour no other lane group touches this run's
             // bundles or its lanes' moving slots (the immovable slot is only read).
             let order = SweepOrder { forward, ..order };
-            unsafe { sweep_groups(part, bundles, len, order, &shared, update, targets) }
+            on_instruction_set!(set, unsafe {
+                sweep_groups(part, bundles, len, order, &shared, update, targets)
+            })
         };
         let starts = &self.group_colour_starts;
         colour_after_colour(
@@ -968,22 +997,6 @@ impl BundleUpdate for WarmStart {
         b.normal.apply(b.normal_impulse, masses, v);
         b.tangents[0].apply(b.tangent_impulses[0], masses, v);
         b.tangents[1].apply(b.tangent_impulses[1], masses, v);
-        Lane::splat(0.0)
-    }
-}
-
-/// The accumulated impulses taken off the bodies (v − M⁻¹Jᵀγ, the warm start's reverse);
-/// changes no impulse. [`Bundles::record`]'s way to the velocities before the impulses.
-#[derive(Clone, Copy)]
-struct RemoveImpulses;
-
-impl BundleUpdate for RemoveImpulses {
-    #[inline(always)]
-    fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane {
-        let masses = (b.inverse_mass_a, b.inverse_mass_b);
-        b.normal.apply(-b.normal_impulse, masses, v);
-        b.tangents[0].apply(-b.tangent_impulses[0], masses, v);
-        b.tangents[1].apply(-b.tangent_impulses[1], masses, v);
         Lane::splat(0.0)
     }
 }

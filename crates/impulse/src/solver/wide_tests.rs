@@ -370,14 +370,16 @@ fn settled_pyramid20_rows() -> (World, Vec<crate::contact::constraints::ContactC
 /// The record the lanes take as an island's step ends (`Bundles::record`, summed by
 /// `Bundles::unpack`) against the scalar one over the unpacked constraints
 /// (`record_velocity_before_and_residual`): the same natural-map residual to the bit, the same
-/// friction-row count, each row's J·v* equal up to the order of the per-body sums, and the
-/// same bits on one and two threads. Rows: a settled pyramid's, repeated with scaled
+/// friction-row count, each row's J·v* equal up to rounding (the lanes take v* as kept before
+/// the impulses were applied, the scalar record takes M⁻¹Jᵀγ off the final velocities), and
+/// the same bits on one and two threads. Rows: a settled pyramid's, repeated with scaled
 /// impulses (every third copy frictionless) to pass the parallel and per-part thresholds.
 #[test]
 fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
     use super::Bundles;
     use crate::contact::constraints::{BodySlots, ContactConstraint};
     use crate::diagnostics::record_velocity_before_and_residual;
+    use crate::solver::{ContactSolver, Velocities};
     let (w, settled) = settled_pyramid20_rows();
     let n = w.bodies.len();
     let mut rows: Vec<ContactConstraint> = Vec::new();
@@ -396,10 +398,16 @@ fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
     }
     assert!(rows.len() > 2 * 4096, "{} rows", rows.len());
     let with_friction = rows.iter().filter(|c| c.friction > 0.0).count();
-    let mut linear = w.bodies.linear_velocity.clone();
-    let mut angular = w.bodies.angular_velocity.clone();
-    linear.push(Vec3::ZERO);
-    angular.push(Vec3::ZERO);
+    // v* as the last substep begins (any velocities of the moving slots; the immovable slot,
+    // last, at rest); the final v is v* with the impulses applied.
+    let wave = |k: usize, a: f32, b: f32, c: f32| {
+        let x = k as f32;
+        Vec3::new(a * x.sin(), b, c * x.cos())
+    };
+    let mut linear_before: Vec<Vec3> = (0..n).map(|k| wave(k, 0.1, -0.3, 0.05)).collect();
+    let mut angular_before: Vec<Vec3> = (0..n).map(|k| wave(k, 0.2, -0.1, 0.1)).collect();
+    linear_before.push(Vec3::ZERO);
+    angular_before.push(Vec3::ZERO);
     let before = |rows: &[ContactConstraint]| -> Vec<[f32; 3]> {
         rows.iter()
             .map(|c| {
@@ -421,6 +429,13 @@ fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
             let parallel = threads > 1;
             let mut bundles = Bundles::default();
             bundles.pack(&rows, n + 1, &vec![Mat3::ZERO; n + 1], parallel);
+            bundles.keep_velocities_before(&linear_before, &angular_before);
+            let (mut linear, mut angular) = (linear_before.clone(), angular_before.clone());
+            let mut velocities = Velocities {
+                linear: &mut linear,
+                angular: &mut angular,
+            };
+            bundles.warm_start(&mut [], &mut velocities, 0);
             bundles.record(&linear, &angular);
             let mut lanes = rows.clone();
             bundles.unpack(&mut lanes);

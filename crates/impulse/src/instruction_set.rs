@@ -1,0 +1,121 @@
+//! The one place that decides which instruction set the SIMD lanes' kernels run on.
+//!
+//! The default build targets the baseline of its architecture (SSE2 on x86-64), so a binary
+//! runs on every CPU of it. The lanes' sweeps are then short of registers: a bundle's update
+//! keeps its two bodies' velocities (twelve registers of four lanes) beside the row it
+//! updates, and x86-64's sixteen vector registers spill. AVX-512 gives thirty-two (with its
+//! `avx512vl` encoding of the same 4-lane operations), so the hot kernels are compiled a second
+//! time for x86-64-v4 and chosen at run time when the CPU has it ([`InstructionSet::detected`]).
+//! The operations are the same IEEE operations in the same order (Rust never fuses a multiply
+//! and an add unless asked to, whatever the target features), so both builds of a kernel give
+//! the same bits: the choice changes the time, never a trajectory.
+//!
+//! `IMPULSE_INSTRUCTION_SET=baseline` in the environment keeps the baseline kernels (to
+//! compare the two, or to rule the wider one out).
+
+use std::sync::OnceLock;
+
+/// An instruction set the lanes' kernels are compiled for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum InstructionSet {
+    /// The build's own target (SSE2 on x86-64 unless built with `-C target-cpu`).
+    #[default]
+    Baseline,
+    /// x86-64-v4: AVX-512 F, VL, BW, DQ and CD with AVX2 (thirty-two vector registers).
+    X86_64V4,
+}
+
+/// The environment variable that, set to `baseline`, keeps the baseline kernels.
+pub const INSTRUCTION_SET_VARIABLE: &str = "IMPULSE_INSTRUCTION_SET";
+
+impl InstructionSet {
+    /// The widest instruction set this CPU runs that the kernels are compiled for, unless
+    /// [`INSTRUCTION_SET_VARIABLE`] says `baseline`; detected once per process.
+    pub fn detected() -> Self {
+        static DETECTED: OnceLock<InstructionSet> = OnceLock::new();
+        *DETECTED.get_or_init(|| {
+            let forced = std::env::var(INSTRUCTION_SET_VARIABLE)
+                .is_ok_and(|value| value.eq_ignore_ascii_case("baseline"));
+            if forced {
+                Self::Baseline
+            } else {
+                Self::supported_widest()
+            }
+        })
+    }
+
+    /// The widest instruction set of the kernels that this CPU runs.
+    pub fn supported_widest() -> Self {
+        if Self::X86_64V4.is_supported() {
+            Self::X86_64V4
+        } else {
+            Self::Baseline
+        }
+    }
+
+    /// Its name: `baseline` or `x86-64-v4` (the x86-64 psABI's name of the level).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Baseline => "baseline",
+            Self::X86_64V4 => "x86-64-v4",
+        }
+    }
+
+    /// Whether this CPU runs kernels compiled for `self`.
+    pub fn is_supported(self) -> bool {
+        match self {
+            Self::Baseline => true,
+            Self::X86_64V4 => x86_64_v4_supported(),
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+fn x86_64_v4_supported() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+        && std::arch::is_x86_feature_detected!("avx512bw")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+        && std::arch::is_x86_feature_detected!("avx512cd")
+        && std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
+        && std::arch::is_x86_feature_detected!("bmi1")
+        && std::arch::is_x86_feature_detected!("bmi2")
+        && std::arch::is_x86_feature_detected!("lzcnt")
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn x86_64_v4_supported() -> bool {
+    false
+}
+
+/// Runs the expression `$call` (an `unsafe` call of an `#[inline(always)]` kernel) compiled
+/// for `$set`: for [`InstructionSet::X86_64V4`] inside a function with x86-64-v4's target
+/// features, into which the kernel inlines; otherwise as the build compiled it. The caller
+/// must have checked that the CPU runs `$set` ([`InstructionSet::is_supported`]).
+macro_rules! on_instruction_set {
+    ($set:expr, $call:expr) => {{
+        #[cfg(target_arch = "x86_64")]
+        {
+            if $set == $crate::instruction_set::InstructionSet::X86_64V4 {
+                #[target_feature(
+                    enable = "avx512f,avx512vl,avx512bw,avx512dq,avx512cd,avx2,fma,bmi1,bmi2,lzcnt"
+                )]
+                #[inline]
+                unsafe fn wide<R>(kernel: impl FnOnce() -> R) -> R {
+                    kernel()
+                }
+                let kernel = || $call;
+                // SAFETY: the caller checked that the CPU has these features.
+                unsafe { wide(kernel) }
+            } else {
+                $call
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            $call
+        }
+    }};
+}
+pub(crate) use on_instruction_set;
