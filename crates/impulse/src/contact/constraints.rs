@@ -477,15 +477,18 @@ impl Assembly<'_> {
                 let r_b = at_b - com_b;
                 let (r_a_wide, r_b_wide) = (Vec3A::from(r_a), Vec3A::from(r_b));
                 let row = |d| JacobianRow::geometric(d, r_a_wide, r_b_wide);
-                // Only the normal row's v⁻ is read before the step ends (restitution); every
-                // row's is rewritten as the step ends ([`record_velocity_before`]).
+                // Only the normal row's v⁻ is read before the step ends, by restitution, which
+                // a point with pending products never meets; every row's is rewritten as the
+                // step ends ([`record_velocity_before`], or the lanes' record).
                 let mut normal_row = row(normal);
-                normal_row.velocity_before = normal_row.velocity(
-                    bodies.linear_velocity[a],
-                    bodies.angular_velocity[a],
-                    bodies.linear_velocity[b],
-                    bodies.angular_velocity[b],
-                );
+                if !lanes_compute_products {
+                    normal_row.velocity_before = normal_row.velocity(
+                        bodies.linear_velocity[a],
+                        bodies.angular_velocity[a],
+                        bodies.linear_velocity[b],
+                        bodies.angular_velocity[b],
+                    );
+                }
                 let tangents = [row(t1), row(t2)];
                 let depth = -point.dist;
                 let Some(slot) = slots.next() else {

@@ -367,7 +367,8 @@ impl Bundles {
             self.keys.clear();
             self.keys.extend(constraints.iter().map(key));
         }
-        if self.layout_slots != slots || self.keys != self.layout_keys {
+        let new_layout = self.layout_slots != slots || self.keys != self.layout_keys;
+        if new_layout {
             std::mem::swap(&mut self.keys, &mut self.layout_keys);
             self.layout_slots = slots;
             self.lay_out(slots);
@@ -378,22 +379,30 @@ impl Bundles {
             local_b: [immovable; LANES],
             ..Bundle::default()
         };
-        if parallel_fill {
-            // Every bundle is reset by the task that fills it (pyramid100: 17 MB, which a
-            // serial reset here spent 1 % of a two-thread step on, the other thread idle).
-            self.bundles.truncate(total);
-            self.geometry.truncate(total);
-        } else {
-            self.bundles.clear();
-            self.geometry.clear();
+        // On the last pack's layout every lane is a point again, and the fill below writes
+        // every number of its bundle and geometry, or it is padding, which still holds what
+        // the reset gave it (its slots) and what the sweeps computed from its zero masses,
+        // directions and lever arms (zero impulses; targets, which every solve sets before
+        // reading). So only a new layout resets the bundles.
+        let reset = new_layout || self.bundles.len() != total || self.geometry.len() != total;
+        if reset {
+            if parallel_fill {
+                // Every bundle is reset by the task that fills it (pyramid100: 17 MB, which a
+                // serial reset here spent 1 % of a two-thread step on, the other thread idle).
+                self.bundles.truncate(total);
+                self.geometry.truncate(total);
+            } else {
+                self.bundles.clear();
+                self.geometry.clear();
+            }
+            self.bundles.resize(total, empty);
+            self.geometry.resize(total, BundleGeometry::PADDING);
         }
-        self.bundles.resize(total, empty);
-        self.geometry.resize(total, BundleGeometry::PADDING);
         // The step totals start from zero: the packed bundles are this step's alone.
         self.step_totals.clear();
         self.step_totals.resize(total, [Lane::splat(0.0); 3]);
         if parallel_fill {
-            self.fill_parallel(constraints, &empty);
+            self.fill_parallel(constraints, reset.then_some(&empty));
         } else {
             // The reads stream, and the writes go to one open lane group per colour.
             let (bundles, geometry, slots) = (&mut self.bundles, &mut self.geometry, &self.slots);
@@ -550,8 +559,9 @@ impl Bundles {
     /// every colour's bundles (so no two tasks write one bundle) and streams the constraints
     /// from the first to the last one it owns: as each colour is spread evenly over the
     /// constraints, that range is about a 1/tasks share and the tasks' ranges barely overlap.
-    /// Every lane gets the same value on any split.
-    fn fill_parallel(&mut self, constraints: &[ContactConstraint], empty: &Bundle) {
+    /// Every lane gets the same value on any split. With `empty`, each task first resets its
+    /// bundles to it (and their geometry to padding).
+    fn fill_parallel(&mut self, constraints: &[ContactConstraint], empty: Option<&Bundle>) {
         use rayon::prelude::*;
         let tasks = 2 * threads();
         // Bundle where each colour starts (its first lane group's start); on the stack, so a
@@ -594,11 +604,13 @@ impl Bundles {
                 // SAFETY: the parts of all tasks and colours are disjoint ranges inside the
                 // bundles and the geometry (`bundle_start` is non-decreasing, ending at the
                 // bundles' length), and only task t touches its own.
-                unsafe {
-                    std::slice::from_raw_parts_mut(bundles.0.add(range.start), range.len())
-                        .fill(*empty);
-                    std::slice::from_raw_parts_mut(geometry.0.add(range.start), range.len())
-                        .fill(BundleGeometry::PADDING);
+                if let Some(empty) = empty {
+                    unsafe {
+                        std::slice::from_raw_parts_mut(bundles.0.add(range.start), range.len())
+                            .fill(*empty);
+                        std::slice::from_raw_parts_mut(geometry.0.add(range.start), range.len())
+                            .fill(BundleGeometry::PADDING);
+                    }
                 }
             }
             for k in low..high.min(constraints.len()) {
@@ -1601,6 +1613,7 @@ fn cap_to_disc(impulse: [Lane; 2], limit: Lane) -> [Lane; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::Sweep;
     use proptest::prelude::*;
 
     /// Values in `low..high` on a grid of 2²⁰ steps. proptest's own f32 range sampler trips
@@ -1631,6 +1644,12 @@ mod tests {
         lanes.extend(&b.tangent_inverse_block);
         lanes.extend([b.sliding_step, b.friction, b.normal_impulse]);
         lanes.extend(&b.tangent_impulses);
+        lanes.extend([
+            b.target,
+            b.mass_scale,
+            b.impulse_scale,
+            b.max_normal_impulse,
+        ]);
         bits.extend(lanes.iter().flat_map(|l| l.as_array().map(f32::to_bits)));
         bits
     }
@@ -1647,7 +1666,8 @@ mod tests {
         /// (`complete_products` before packing) to the bit, padding lanes included: random
         /// points between five moving slots of random mass and inertia, a heavy rod (friction
         /// blocks of rank one, the pseudo-inverse), one slot that is immovable by its masses,
-        /// and the island's immovable slot.
+        /// and the island's immovable slot. And a pack on the last pack's layout, which resets
+        /// no bundle, gives the bits of a fresh pack.
         #[test]
         fn lanes_compute_the_lever_arm_products_of_the_scalar_assembly_to_the_bit(
             masses in prop::collection::vec(float(0.05, 20.0), 7),
@@ -1714,6 +1734,52 @@ mod tests {
             prop_assert_eq!(from_lanes.bundles.len(), from_rows.bundles.len());
             for (index, (x, y)) in from_lanes.bundles.iter().zip(&from_rows.bundles).enumerate() {
                 prop_assert_eq!(bundle_bits(x), bundle_bits(y), "bundle {}", index);
+            }
+            // A pack on the last pack's layout resets no bundle: whatever other rows of the
+            // same points, and a solve on them, left in the bundles, padding included, a pack
+            // of `pending` or `complete` overwrites to the bits of a fresh pack.
+            let other: Vec<ContactConstraint> = complete
+                .iter()
+                .map(|c| {
+                    let mut c = *c;
+                    let [t1, t2] = &mut c.tangents;
+                    for row in [&mut c.normal, t1, t2] {
+                        row.angular_a *= 2.0;
+                        row.angular_b *= -1.5;
+                        row.inverse_inertia_angular_a *= 3.0;
+                        row.inverse_inertia_angular_b *= 0.5;
+                        row.effective_mass *= 2.0;
+                        row.inverse_effective_mass *= 0.5;
+                    }
+                    c.tangent_inverse_block = c.tangent_inverse_block.map(|x| 2.0 * x + 1.0);
+                    c.tangent_block = c.tangent_block.map(|x| 3.0 * x + 0.5);
+                    (c.lever_a, c.lever_b) = (-c.lever_b, 2.0 * c.lever_a);
+                    (c.friction, c.normal_impulse) = (0.25, c.normal_impulse + 2.0);
+                    c.tangent_impulses = [0.125, -0.25];
+                    c.max_normal_impulse = 7.0;
+                    c
+                })
+                .collect();
+            let pass = SolvePass {
+                iterations: 2,
+                tolerance: 0.0,
+                friction: true,
+                half_turn: false,
+                escalate: false,
+                targets: None,
+                sweep: Sweep::default(),
+            };
+            for (rows, fresh) in [(&pending, &from_lanes), (&complete, &from_rows)] {
+                let mut reused = Bundles::default();
+                reused.pack(&other, slots, &inertia, false);
+                let (mut linear, mut angular) = (vec![Vec3::ZERO; slots], vec![Vec3::ZERO; slots]);
+                let mut velocities = Velocities { linear: &mut linear, angular: &mut angular };
+                reused.solve_pgs(&mut velocities, &pass);
+                reused.pack(rows, slots, &inertia, false);
+                prop_assert_eq!(reused.bundles.len(), fresh.bundles.len());
+                for (index, (x, y)) in reused.bundles.iter().zip(&fresh.bundles).enumerate() {
+                    prop_assert_eq!(bundle_bits(x), bundle_bits(y), "reused bundle {}", index);
+                }
             }
         }
     }
