@@ -96,17 +96,15 @@ impl PairInverseMass {
 }
 
 impl JacobianRow {
-    /// The row for unit `direction` with lever arms `r_a`, `r_b` (m), its lever-arm products
-    /// ([`Self::inverse_inertia_angular_a`] and on) still zero: see [`Self::fill_products`].
+    /// Sets the row's unit `direction` and its angular parts r × d for lever arms `r_a`, `r_b`
+    /// (m); its lever-arm products ([`Self::inverse_inertia_angular_a`] and on) and
+    /// `velocity_before` are left as they are: see [`Self::fill_products`].
     #[inline(always)]
-    fn geometric(direction: Vec3, r_a: Vec3A, r_b: Vec3A) -> Self {
+    fn set_geometric(&mut self, direction: Vec3, r_a: Vec3A, r_b: Vec3A) {
         let d = Vec3A::from(direction);
-        Self {
-            direction,
-            angular_a: r_a.cross(d).into(),
-            angular_b: r_b.cross(d).into(),
-            ..Self::default()
-        }
+        self.direction = direction;
+        self.angular_a = r_a.cross(d).into();
+        self.angular_b = r_b.cross(d).into();
     }
 
     /// Computes I⁻¹(r × d) for both bodies and the row's effective mass from its angular parts,
@@ -218,8 +216,10 @@ pub struct ContactConstraint {
     pub source: (u32, u16, u16),
     /// Whether the rows' lever-arm products are yet to be computed: each row's
     /// `inverse_inertia_angular_a`/`_b`, `effective_mass` and `inverse_effective_mass`, and the
-    /// tangent blocks (zero until then). Directions, angular parts and the normal row's
-    /// `velocity_before` are always set. Assembly leaves the products to the SIMD lanes, which
+    /// tangent blocks, which until then hold whatever the row held before (meaningless), as
+    /// does the normal row's `velocity_before` (v⁻, which only restitution reads; the step's
+    /// record sets every row's J·v* as the step ends). Directions and angular parts are always
+    /// set. Assembly leaves the products to the SIMD lanes, which
     /// compute them four points at a time as they pack (`wide::Bundles::pack`), for the points
     /// of islands the lanes solve with no restitution solve after them, whose bodies have no
     /// translation locked; [`complete_products`] computes them for any other reader.
@@ -287,7 +287,8 @@ pub fn assemble(
     let pairs = &narrow_phase.pairs;
     let set = InstructionSet::detected();
     let total = islands.constraint_count();
-    // Every slot is overwritten below; resizing only fills slots the vector did not have.
+    // Every slot's fields are set below (but a pending point's lever-arm products, see
+    // `ContactConstraint::products_pending`); resizing only fills slots the vector did not have.
     out.truncate(total);
     out.resize(total, ContactConstraint::default());
     let context = Assembly {
@@ -476,60 +477,55 @@ impl Assembly<'_> {
                 let r_a = at_a - com_a;
                 let r_b = at_b - com_b;
                 let (r_a_wide, r_b_wide) = (Vec3A::from(r_a), Vec3A::from(r_b));
-                let row = |d| JacobianRow::geometric(d, r_a_wide, r_b_wide);
-                // Only the normal row's v⁻ is read before the step ends, by restitution, which
-                // a point with pending products never meets; every row's is rewritten as the
-                // step ends ([`record_velocity_before`], or the lanes' record).
-                let mut normal_row = row(normal);
+                let Some(c) = slots.next() else {
+                    debug_assert!(false, "fewer slots than the narrow phase's row count");
+                    return;
+                };
+                // Field by field into the row, whose lever-arm products stay as the last step
+                // left them while pending (see `ContactConstraint::products_pending`): building
+                // the whole row and copying it in cost a sixth of assembly.
+                c.body_a = a as u32;
+                c.body_b = b as u32;
+                c.local_a = local_a;
+                c.local_b = local_b;
+                c.inverse_mass_a = inverse_mass_a;
+                c.inverse_mass_b = inverse_mass_b;
+                c.normal.set_geometric(normal, r_a_wide, r_b_wide);
+                c.tangents[0].set_geometric(t1, r_a_wide, r_b_wide);
+                c.tangents[1].set_geometric(t2, r_a_wide, r_b_wide);
+                c.target_normal_velocity = 0.0;
+                c.softness = (1.0, 0.0);
+                c.position_target = 0.0;
+                c.position_impulse = 0.0;
+                c.lever_a = r_a;
+                c.lever_b = r_b;
+                c.restitution = restitution;
+                c.friction = if settings.friction { friction } else { 0.0 };
+                c.normal_impulse = warm.normal;
+                c.tangent_impulses = [warm.friction.dot(t1), warm.friction.dot(t2)];
+                c.depth = -point.dist;
+                c.max_normal_impulse = 0.0;
+                // Last step's totals, which a sleeping island keeps reporting; an awake
+                // island's step starts them from zero.
+                c.step_impulses = [
+                    warm.step_normal,
+                    warm.step_friction.dot(t1),
+                    warm.step_friction.dot(t2),
+                ];
+                c.source = (pair_index, manifold_index as u16, point_index as u16);
+                c.products_pending = true;
                 if !lanes_compute_products {
-                    normal_row.velocity_before = normal_row.velocity(
+                    // Only the normal row's v⁻ is read before the step ends, by restitution,
+                    // which a point with pending products never meets; every row's is
+                    // rewritten as the step ends ([`record_velocity_before`], or the lanes'
+                    // record).
+                    c.normal.velocity_before = c.normal.velocity(
                         bodies.linear_velocity[a],
                         bodies.angular_velocity[a],
                         bodies.linear_velocity[b],
                         bodies.angular_velocity[b],
                     );
-                }
-                let tangents = [row(t1), row(t2)];
-                let depth = -point.dist;
-                let Some(slot) = slots.next() else {
-                    debug_assert!(false, "fewer slots than the narrow phase's row count");
-                    return;
-                };
-                *slot = ContactConstraint {
-                    body_a: a as u32,
-                    body_b: b as u32,
-                    local_a,
-                    local_b,
-                    inverse_mass_a,
-                    inverse_mass_b,
-                    normal: normal_row,
-                    tangents,
-                    tangent_inverse_block: [0.0; 3],
-                    tangent_block: [0.0; 3],
-                    target_normal_velocity: 0.0,
-                    softness: (1.0, 0.0),
-                    position_target: 0.0,
-                    position_impulse: 0.0,
-                    lever_a: r_a,
-                    lever_b: r_b,
-                    restitution,
-                    friction: if settings.friction { friction } else { 0.0 },
-                    normal_impulse: warm.normal,
-                    tangent_impulses: [warm.friction.dot(t1), warm.friction.dot(t2)],
-                    depth,
-                    max_normal_impulse: 0.0,
-                    // Last step's totals, which a sleeping island keeps reporting; an awake
-                    // island's step starts them from zero.
-                    step_impulses: [
-                        warm.step_normal,
-                        warm.step_friction.dot(t1),
-                        warm.step_friction.dot(t2),
-                    ],
-                    source: (pair_index, manifold_index as u16, point_index as u16),
-                    products_pending: true,
-                };
-                if !lanes_compute_products {
-                    slot.fill_products(inertia_a, inertia_b);
+                    c.fill_products(inertia_a, inertia_b);
                 }
             }
         }

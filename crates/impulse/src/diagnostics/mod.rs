@@ -345,13 +345,12 @@ pub fn energy_terms_on(bodies: &Bodies, gravity: Vec3, parallel: bool) -> Energy
         for i in start..(start + ENERGY_BODIES_PER_PART).min(n) {
             if bodies.inverse_mass[i] > 0.0 {
                 let m = 1.0 / bodies.inverse_mass[i];
+                let center = bodies.center_of_mass(i);
                 terms.kinetic += bodies.kinetic_energy(i) as f64;
-                terms.potential += (-m * gravity.dot(bodies.center_of_mass(i))) as f64;
+                terms.potential += (-m * gravity.dot(center)) as f64;
                 terms.mass += m as f64;
                 terms.momentum += bodies.linear_velocity[i] * m;
-                terms.largest_distance = terms
-                    .largest_distance
-                    .max(bodies.center_of_mass(i).length());
+                terms.largest_distance = terms.largest_distance.max(center.length());
                 terms.largest_speed = terms.largest_speed.max(bodies.linear_velocity[i].length());
             }
         }
