@@ -84,6 +84,7 @@ fn run_writes_csv_trajectory_and_summary_json() {
 fn profile_prints_the_median_of_every_stage() {
     let out = impulse()
         .args(["run", "stack3", "--steps", "5", "--quiet", "--profile"])
+        .env_remove(impulse::INSTRUCTION_SET_VARIABLE)
         .output()
         .unwrap();
     assert!(out.status.success());
@@ -95,6 +96,13 @@ fn profile_prints_the_median_of_every_stage() {
         .split(", ")
         .collect();
     assert_eq!(stages.len(), impulse::Stage::ALL.len(), "{line}");
+    // Then which build of the SIMD kernels ran: the widest this CPU runs.
+    let kernels = stdout.lines().nth(2).unwrap_or_default();
+    let name = impulse::InstructionSet::supported_widest().name();
+    assert!(
+        kernels.starts_with(&format!("SIMD kernels: {name} (")),
+        "{kernels}"
+    );
     for stage in stages {
         let (_, ms) = stage.rsplit_once(' ').unwrap();
         assert!(ms.parse::<f64>().unwrap() >= 0.0, "{stage}");
