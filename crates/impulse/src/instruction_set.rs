@@ -89,10 +89,11 @@ fn x86_64_v4_supported() -> bool {
     false
 }
 
-/// Runs the expression `$call` (an `unsafe` call of an `#[inline(always)]` kernel) compiled
-/// for `$set`: for [`InstructionSet::X86_64V4`] inside a function with x86-64-v4's target
-/// features, into which the kernel inlines; otherwise as the build compiled it. The caller
-/// must have checked that the CPU runs `$set` ([`InstructionSet::is_supported`]).
+/// Evaluates the expression `$call` (a kernel's loop, whose `#[inline(always)]` updates
+/// inline into it) compiled for `$set`: for [`InstructionSet::X86_64V4`] inside a function
+/// with x86-64-v4's target features, into which the expression inlines; otherwise as the build
+/// compiled it. The caller must have checked that the CPU runs `$set`
+/// ([`InstructionSet::is_supported`]; [`InstructionSet::detected`] always is).
 macro_rules! on_instruction_set {
     ($set:expr, $call:expr) => {{
         #[cfg(target_arch = "x86_64")]
@@ -102,12 +103,12 @@ macro_rules! on_instruction_set {
                     enable = "avx512f,avx512vl,avx512bw,avx512dq,avx512cd,avx2,fma,bmi1,bmi2,lzcnt"
                 )]
                 #[inline]
-                unsafe fn wide<R>(kernel: impl FnOnce() -> R) -> R {
+                unsafe fn with_x86_64_v4<R>(kernel: impl FnOnce() -> R) -> R {
                     kernel()
                 }
                 let kernel = || $call;
                 // SAFETY: the caller checked that the CPU has these features.
-                unsafe { wide(kernel) }
+                unsafe { with_x86_64_v4(kernel) }
             } else {
                 $call
             }

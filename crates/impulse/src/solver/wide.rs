@@ -157,7 +157,7 @@ pub struct Bundles {
     run_places: Vec<(u32, u32)>,
     /// Whether one colour's bundles may be updated on several threads.
     parallel: bool,
-    /// What the sweeps run on ([`InstructionSet::detected`] unless set otherwise); the
+    /// What the kernels run on: [`InstructionSet::detected`], taken by each pack; the
     /// results are the same on any.
     instruction_set: InstructionSet,
     /// Constraint index of each lane of each bundle; `u32::MAX` for padding.
