@@ -77,8 +77,9 @@ fn free_fall_matches_the_integrator_closed_form() {
     }
 }
 
-/// Head-on collision of unequal spheres: momentum conserved, and the restitution hypothesis
-/// v⁺ = −c_r·v⁻ holds for the relative normal velocity.
+/// Head-on collision of unequal spheres: momentum conserved (and reported so in the step's
+/// diagnostics), and the restitution hypothesis v⁺ = −c_r·v⁻ holds for the relative normal
+/// velocity.
 #[test]
 fn head_on_spheres_conserve_momentum_and_obey_restitution() {
     for c_r in [0.0f32, 0.5, 1.0] {
@@ -103,6 +104,12 @@ fn head_on_spheres_conserve_momentum_and_obey_restitution() {
             assert!(
                 (p - momentum_before).abs() < 1e-5,
                 "c_r {c_r}: momentum {p}"
+            );
+            // The step's diagnostics report the same momentum, Σ m·v.
+            let reported = w.diagnostics().linear_momentum;
+            assert!(
+                (reported[0] - momentum_before).abs() < 1e-5 && reported[1].abs() < 1e-6,
+                "c_r {c_r}: reported momentum {reported:?}"
             );
         }
         assert!(touched, "the spheres must have collided");

@@ -1788,6 +1788,37 @@ mod tests {
     /// [`GROUP_POINTS`], puts every point in exactly one lane, keeps a group's points in order
     /// in one lane of one lane group, gives no two lane groups of a colour a common moving
     /// body, and leaves every other lane empty: zero masses and impulses.
+    /// The same points in an island of one more slot (another immovable slot) are laid out
+    /// again: the padding lanes name the new immovable slot, as a fresh pack's do, though no
+    /// point's body slots changed.
+    #[test]
+    fn packing_with_another_slot_count_lays_out_again() {
+        let pairs: [((u32, u32), usize); 3] = [((0, 1), 4), ((1, 2), 1), ((2, 3), 3)];
+        let mut constraints = Vec::new();
+        for ((a, b), points) in pairs {
+            for _ in 0..points {
+                constraints.push(ContactConstraint {
+                    local_a: a,
+                    local_b: b,
+                    inverse_mass_a: Vec3::ONE,
+                    inverse_mass_b: Vec3::ONE,
+                    normal_impulse: 1.0,
+                    ..ContactConstraint::default()
+                });
+            }
+        }
+        let mut reused = Bundles::default();
+        reused.pack(&constraints, 5, &[Mat3::ZERO; 5], false);
+        reused.pack(&constraints, 6, &[Mat3::ZERO; 6], false);
+        let mut fresh = Bundles::default();
+        fresh.pack(&constraints, 6, &[Mat3::ZERO; 6], false);
+        assert!(fresh.bundles.iter().any(|b| b.local_a.contains(&5)));
+        assert_eq!(reused.bundles.len(), fresh.bundles.len());
+        for (index, (x, y)) in reused.bundles.iter().zip(&fresh.bundles).enumerate() {
+            assert_eq!(bundle_bits(x), bundle_bits(y), "bundle {index}");
+        }
+    }
+
     #[test]
     fn packing_puts_each_manifold_group_in_one_lane_of_one_lane_group() {
         // Slots 0–6 move, 7 is immovable. (pair, points): a box face (4), a ball (1), an edge
