@@ -157,9 +157,6 @@ pub struct Bundles {
     run_places: Vec<(u32, u32)>,
     /// Whether one colour's bundles may be updated on several threads.
     parallel: bool,
-    /// What the kernels run on: [`InstructionSet::detected`], taken by each pack; the
-    /// results are the same on any.
-    instruction_set: InstructionSet,
     /// Constraint index of each lane of each bundle; `u32::MAX` for padding.
     sources: Vec<[u32; LANES]>,
     /// Where each constraint went: bundle index × [`LANES`] + lane.
@@ -344,7 +341,6 @@ impl Bundles {
         parallel: bool,
     ) {
         self.parallel = parallel;
-        self.instruction_set = InstructionSet::detected();
         self.recorded = false;
         self.before_kept = false;
         self.rows = None;
@@ -406,7 +402,7 @@ impl Bundles {
         } else {
             // The reads stream, and the writes go to one open lane group per colour.
             let (bundles, geometry, slots) = (&mut self.bundles, &mut self.geometry, &self.slots);
-            on_instruction_set!(self.instruction_set, {
+            on_instruction_set!(InstructionSet::detected(), {
                 for (c, &slot) in constraints.iter().zip(slots) {
                     let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
                     set_lane(&mut bundles[index], &mut geometry[index], lane, c);
@@ -437,7 +433,7 @@ impl Bundles {
     /// The pending lever-arm products of [`Bundles::pack`], lane group by lane group (the
     /// bodies' tensors gathered once per lane group); on rayon's threads with `parallel`.
     fn compute_products(&mut self, inverse_inertia: &[Mat3], parallel: bool) {
-        let (geometry, set) = (&self.geometry, self.instruction_set);
+        let (geometry, set) = (&self.geometry, InstructionSet::detected());
         let group = |g: &Group, bundles: &mut [Bundle]| {
             let range = g.start as usize..(g.start + g.len) as usize;
             let geometry = &geometry[range];
@@ -781,7 +777,7 @@ impl Bundles {
                 }
             }
         };
-        let set = self.instruction_set;
+        let set = InstructionSet::detected();
         if spread(self.parallel, len * LANES, PARALLEL_PACK_POINTS - 1) {
             use rayon::prelude::*;
             self.groups
@@ -817,12 +813,12 @@ impl Bundles {
             immovable: velocities.linear.len() - 1,
         };
         let (bundles, len) = (SharedItems(self.bundles.as_mut_ptr()), self.bundles.len());
-        let set = self.instruction_set;
+        let set = InstructionSet::detected();
         if !spread(self.parallel, 1, 0) {
             let groups = &self.groups;
             // SAFETY: `pack` gave every group a range inside the bundles and every lane slots
             // below the island's slot count (the velocities' length); the bundles and the
-            // velocities are borrowed exclusively here. `set` runs on this CPU (`pack`).
+            // velocities are borrowed exclusively here. `set` runs on this CPU.
             return on_instruction_set!(set, unsafe {
                 sweep_groups(groups, bundles, len, order, &shared, update, targets)
             });
