@@ -63,8 +63,10 @@ pub trait ContactSolver {
 
     /// Applies the accumulated impulses to `velocities` (warm starting) at the start of
     /// substep `substep` (from 0). From the second substep on these are the last substep's
-    /// final impulses, which it also adds to each row's `step_impulses`. Default: on the
-    /// constraints themselves (`warm_start_substep`).
+    /// final impulses, which it also adds to each row's `step_impulses`; a solver whose last
+    /// solve took [`SolvePass::warm_start_follows`] may have summed both as it solved, and
+    /// then adds its sums (the SIMD lanes). Default: on the constraints themselves
+    /// (`warm_start_substep`).
     fn warm_start(
         &mut self,
         constraints: &mut [ContactConstraint],
@@ -108,6 +110,10 @@ pub struct SolvePass<'a> {
     pub half_turn: bool,
     /// Whether `method: auto` may escalate this solve ([`policy`]): a substep's main solve.
     pub escalate: bool,
+    /// Whether the next thing done with the impulses is another substep's warm start: a relax
+    /// solve before the step's last substep. A solver may then add each row's final impulse
+    /// to the next warm start as it goes ([`ContactSolver::warm_start`] adds the sum).
+    pub warm_start_follows: bool,
     /// Where the targets come from: the separations reached (`Some`), or the rows as they are
     /// (`None`: the restitution solve, whose targets were just set).
     pub targets: Option<TargetInputs<'a>>,

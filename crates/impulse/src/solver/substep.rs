@@ -162,20 +162,36 @@ impl Solvers {
     }
 }
 
+/// Which of a substep's solves [`IslandWorkspace::targets_and_solve`] runs.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum SubstepSolve {
+    /// The main solve: overlap repair, `iterations`, escalation allowed.
+    Main,
+    /// The relax solve (`relax_iterations`), no repair; `warm_start_follows` before the step's
+    /// last substep ([`SolvePass::warm_start_follows`]).
+    Relax { warm_start_follows: bool },
+}
+
 impl IslandWorkspace {
     /// One solve of a substep of `h` seconds: targets from the current separation, then the
-    /// main solve (`with_repair`: overlap repair, `iterations`, escalation allowed) or the relax
-    /// solve (`relax_iterations`), in lanes when the island is `bundled` and on the constraints
-    /// otherwise.
+    /// main or the relax solve (`which`), in lanes when the island is `bundled` and on the
+    /// constraints otherwise.
     fn targets_and_solve(
         &mut self,
         constraints: &mut [ContactConstraint],
         settings: &SolverSettings,
         h: f32,
         bundled: bool,
-        with_repair: bool,
+        which: SubstepSolve,
         half_turn: bool,
     ) {
+        let with_repair = which == SubstepSolve::Main;
+        let warm_start_follows = matches!(
+            which,
+            SubstepSolve::Relax {
+                warm_start_follows: true
+            }
+        );
         let pass = SolvePass {
             iterations: if with_repair {
                 settings.iterations
@@ -187,6 +203,7 @@ impl IslandWorkspace {
                 || settings.main_solve_friction()
                 || self.report.mass_ratio >= HEAVY_ON_LIGHT_MASS_RATIO,
             half_turn,
+            warm_start_follows,
             escalate: with_repair,
             targets: Some(TargetInputs {
                 displacement: &self.displacement,
@@ -490,7 +507,14 @@ pub fn step_island(
                 .extend(w.rotation.iter().map(|rotation| rotation.length_squared()));
         }
         w.position_repair = false;
-        w.targets_and_solve(constraints, settings, h, bundled, true, half_turn);
+        w.targets_and_solve(
+            constraints,
+            settings,
+            h,
+            bundled,
+            SubstepSolve::Main,
+            half_turn,
+        );
         // With no row to repair beyond the tolerance, positions move with the velocities alone
         // (at rest, the usual case in a pile; see `constraints::update_targets`).
         let split = settings.split_impulse() && w.position_repair;
@@ -556,7 +580,10 @@ pub fn step_island(
             );
         }
         if settings.relax_iterations > 0 && !settings.split_impulse() {
-            w.targets_and_solve(constraints, settings, h, bundled, false, half_turn);
+            let relax = SubstepSolve::Relax {
+                warm_start_follows: substep + 1 < settings.substeps,
+            };
+            w.targets_and_solve(constraints, settings, h, bundled, relax, half_turn);
         }
     }
     if record_in_lanes {
@@ -592,6 +619,7 @@ pub fn step_island(
             tolerance: settings.tolerance,
             friction: true,
             half_turn: false,
+            warm_start_follows: false,
             escalate: false,
             targets: None,
             sweep: Sweep {

@@ -178,6 +178,11 @@ pub struct Bundles {
     /// Whether `before_linear` and `before_angular` hold v* kept during the substeps
     /// ([`Bundles::keep_velocities_before`]) for the next record.
     before_kept: bool,
+    /// The next substep's warm start per island slot, M⁻¹Jᵀγ of the final impulses of a relax
+    /// sweep that added it as it went ([`RelaxCarrying`]); `carried` until that warm start.
+    carried_linear: Vec<Vec3>,
+    carried_angular: Vec<Vec3>,
+    carried: bool,
     recorded: bool,
     rows: Option<RowsReport>,
 }
@@ -343,6 +348,7 @@ impl Bundles {
         self.parallel = parallel;
         self.recorded = false;
         self.before_kept = false;
+        self.carried = false;
         self.rows = None;
         let immovable = (slots - 1) as u32;
         // The layout is a function of the points' body slots alone: when they repeat (an
@@ -879,7 +885,30 @@ impl Bundles {
             // A sweep that may meet stale rows is compiled apart, so that the usual one (no
             // body of the island turned past the limit) carries no test for them.
             let stale = first.is_some_and(|t| !t.turn.is_empty());
+            let carrying = friction && pass.warm_start_follows && pass.iterations == 1;
+            if carrying {
+                let slots = velocities.linear.len();
+                for carried in [&mut self.carried_linear, &mut self.carried_angular] {
+                    carried.clear();
+                    carried.resize(slots, Vec3::ZERO);
+                }
+                self.carried = true;
+            }
+            let carry = RelaxCarrying {
+                totals: SharedItems(self.step_totals.as_mut_ptr()),
+                carried: SharedVelocities {
+                    linear: self.carried_linear.as_mut_ptr(),
+                    angular: self.carried_angular.as_mut_ptr(),
+                    immovable: self.carried_linear.len().wrapping_sub(1),
+                },
+            };
             let largest = match (first, friction, stale) {
+                (Some(t), true, false) if carrying => {
+                    self.sweep(order, velocities, carry, Turned::<false>(t))
+                }
+                (Some(t), true, true) if carrying => {
+                    self.sweep(order, velocities, carry, Turned::<true>(t))
+                }
                 (Some(t), true, false) => {
                     self.sweep(order, velocities, VelocityRows::<true>, Turned::<false>(t))
                 }
@@ -892,6 +921,7 @@ impl Bundles {
                 (Some(t), false, true) => {
                     self.sweep(order, velocities, VelocityRows::<false>, Turned::<true>(t))
                 }
+                (None, true, _) if carrying => self.sweep(order, velocities, carry, NoTargets),
                 (None, true, _) => self.sweep(order, velocities, VelocityRows::<true>, NoTargets),
                 (None, false, _) => self.sweep(order, velocities, VelocityRows::<false>, NoTargets),
             };
@@ -928,6 +958,16 @@ impl ContactSolver for Bundles {
         velocities: &mut Velocities<'_>,
         substep: u32,
     ) {
+        if std::mem::take(&mut self.carried) {
+            // The relax sweep before added the impulses up per body (and to the totals).
+            for (v, carried) in velocities.linear.iter_mut().zip(&self.carried_linear) {
+                *v += *carried;
+            }
+            for (v, carried) in velocities.angular.iter_mut().zip(&self.carried_angular) {
+                *v += *carried;
+            }
+            return;
+        }
         let order = SweepOrder {
             forward: true,
             half_turn: false,
@@ -955,14 +995,30 @@ impl ContactSolver for Bundles {
 /// than a closure or function pointer so that the update is inlined into the sweep loop (a
 /// closure was not inlined).
 trait BundleUpdate: Copy + Sync {
-    fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane;
+    /// What an update keeps per lane group besides its bodies' velocities, from
+    /// [`BundleUpdate::begin`] to [`BundleUpdate::end`].
+    type Group;
 
-    /// [`BundleUpdate::update`] of bundle `index`, for updates that keep per-bundle data
-    /// outside the bundles.
-    #[inline(always)]
-    fn update_at(self, b: &mut Bundle, _index: usize, v: &mut BodyLanes) -> Lane {
-        self.update(b, v)
-    }
+    /// The group state of a lane group between the bodies at `slots_a` and `slots_b`.
+    ///
+    /// # Safety
+    /// As [`SharedLanes::gather`] for whatever the update reads per body.
+    unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::Group;
+
+    /// Updates bundle `index` (see the trait).
+    fn update_at(
+        self,
+        b: &mut Bundle,
+        index: usize,
+        v: &mut BodyLanes,
+        group: &mut Self::Group,
+    ) -> Lane;
+
+    /// Writes back what the group state holds per body.
+    ///
+    /// # Safety
+    /// As [`SharedLanes::scatter`].
+    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], group: &Self::Group);
 }
 
 /// The velocity rows ([`solve_bundle`]).
@@ -971,10 +1027,15 @@ trait BundleUpdate: Copy + Sync {
 struct VelocityRows<const FRICTION: bool = true>;
 
 impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
+    type Group = ();
     #[inline(always)]
-    fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane {
+    unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
+    #[inline(always)]
+    fn update_at(self, b: &mut Bundle, _: usize, v: &mut BodyLanes, _: &mut ()) -> Lane {
         solve_bundle::<FRICTION>(b, v)
     }
+    #[inline(always)]
+    unsafe fn end(self, _: &[u32; LANES], _: &[u32; LANES], _: &()) {}
 }
 
 /// The accumulated impulses applied to the bodies (warm start); changes no impulse. With
@@ -986,26 +1047,81 @@ struct WarmStart {
 }
 
 impl BundleUpdate for WarmStart {
+    type Group = ();
     #[inline(always)]
-    fn update(self, b: &mut Bundle, v: &mut BodyLanes) -> Lane {
-        self.update_at(b, usize::MAX, v)
-    }
+    unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
 
     #[inline(always)]
-    fn update_at(self, b: &mut Bundle, index: usize, v: &mut BodyLanes) -> Lane {
+    fn update_at(self, b: &mut Bundle, index: usize, v: &mut BodyLanes, _: &mut ()) -> Lane {
         if let Some(totals) = self.totals {
             // SAFETY: `totals` has one entry per bundle (`pack` sizes it so) and `index` is
             // the bundle's; no other thread touches this bundle's entry meanwhile.
-            let total = unsafe { &mut *totals.0.add(index) };
-            total[0] += b.normal_impulse;
-            total[1] += b.tangent_impulses[0];
-            total[2] += b.tangent_impulses[1];
+            add_to_totals(unsafe { &mut *totals.0.add(index) }, b);
         }
-        let masses = (b.inverse_mass_a, b.inverse_mass_b);
-        b.normal.apply(b.normal_impulse, masses, v);
-        b.tangents[0].apply(b.tangent_impulses[0], masses, v);
-        b.tangents[1].apply(b.tangent_impulses[1], masses, v);
+        apply_impulses(b, v);
         Lane::splat(0.0)
+    }
+
+    #[inline(always)]
+    unsafe fn end(self, _: &[u32; LANES], _: &[u32; LANES], _: &()) {}
+}
+
+/// Adds a bundle's impulses to its step totals.
+#[inline(always)]
+fn add_to_totals(total: &mut [Lane; 3], b: &Bundle) {
+    total[0] += b.normal_impulse;
+    total[1] += b.tangent_impulses[0];
+    total[2] += b.tangent_impulses[1];
+}
+
+/// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v`.
+#[inline(always)]
+fn apply_impulses(b: &Bundle, v: &mut BodyLanes) {
+    let masses = (b.inverse_mass_a, b.inverse_mass_b);
+    b.normal.apply(b.normal_impulse, masses, v);
+    b.tangents[0].apply(b.tangent_impulses[0], masses, v);
+    b.tangents[1].apply(b.tangent_impulses[1], masses, v);
+}
+
+/// The relax sweep of a substep that another substep follows: the velocity rows with friction
+/// ([`solve_bundle`]), and each bundle's final impulses, added to its step totals and applied
+/// to `carried`, the next substep's warm start per body ([`Bundles::warm_start`] adds it to
+/// the velocities once their gravity and gyroscopic term are in). The warm start's own pass
+/// read every bundle again; this reads each once.
+#[derive(Clone, Copy)]
+struct RelaxCarrying {
+    totals: SharedItems<[Lane; 3]>,
+    carried: SharedVelocities,
+}
+
+impl BundleUpdate for RelaxCarrying {
+    type Group = BodyLanes;
+
+    #[inline(always)]
+    unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
+        // SAFETY: the caller's contract.
+        unsafe { self.carried.gather(slots_a, slots_b) }
+    }
+
+    #[inline(always)]
+    fn update_at(
+        self,
+        b: &mut Bundle,
+        index: usize,
+        v: &mut BodyLanes,
+        carried: &mut BodyLanes,
+    ) -> Lane {
+        let largest = solve_bundle::<true>(b, v);
+        // SAFETY: as `WarmStart`'s.
+        add_to_totals(unsafe { &mut *self.totals.0.add(index) }, b);
+        apply_impulses(b, carried);
+        largest
+    }
+
+    #[inline(always)]
+    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], carried: &BodyLanes) {
+        // SAFETY: the caller's contract.
+        unsafe { self.carried.scatter(slots_a, slots_b, carried) }
     }
 }
 
@@ -1217,6 +1333,8 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
             (first.local_a, first.local_b)
         };
         let mut v = unsafe { velocities.gather(&slots_a, &slots_b) };
+        // SAFETY: the caller's contract covers what the update reads and writes per body.
+        let mut state = unsafe { update.begin(&slots_a, &slots_b) };
         let moved = targets.moved(&slots_a, &slots_b);
         let turn = if half_turn { count / 2 } else { 0 };
         for p in 0..count {
@@ -1243,10 +1361,13 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
             // SAFETY: the caller's contract.
             let b = unsafe { &mut *bundles.0.add(index) };
             targets.set(b, index, &moved);
-            largest = largest.max(update.update_at(b, index, &mut v));
+            largest = largest.max(update.update_at(b, index, &mut v, &mut state));
         }
         // SAFETY: the caller's contract.
-        unsafe { velocities.scatter(&slots_a, &slots_b, &v) };
+        unsafe {
+            velocities.scatter(&slots_a, &slots_b, &v);
+            update.end(&slots_a, &slots_b, &state);
+        }
     }
     largest
 }
@@ -1761,6 +1882,7 @@ mod tests {
                 tolerance: 0.0,
                 friction: true,
                 half_turn: false,
+                warm_start_follows: false,
                 escalate: false,
                 targets: None,
                 sweep: Sweep::default(),

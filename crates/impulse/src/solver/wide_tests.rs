@@ -580,6 +580,7 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
             tolerance: 0.0,
             friction: true,
             half_turn: false,
+            warm_start_follows: false,
             escalate: false,
             targets: Some(inputs),
             sweep: Sweep::default(),
@@ -678,4 +679,130 @@ fn lanes_computing_the_lever_arm_products_change_no_trajectory() {
             "row {row}: b {p} against {q}"
         );
     }
+}
+
+/// A relax sweep that carries the next substep's warm start (`warm_start_follows`) gives what
+/// the relax sweep and the separate warm-start pass give: the same impulses and step totals
+/// to the bit (the solve is the same; the totals get the same additions in the same order) and
+/// the same velocities after the next warm start up to rounding (M⁻¹Jᵀγ summed per body
+/// first, then added); the same bits on one and two threads. Rows: the settled pyramid's,
+/// repeated to pass the parallel threshold, with moving bodies and a soft relax target.
+#[test]
+fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
+    use super::Bundles;
+    use crate::contact::constraints::ContactConstraint;
+    use crate::solver::{ContactSolver, SolvePass, Sweep, TargetInputs, Velocities};
+    let (w, settled) = settled_pyramid20_rows();
+    let n = w.bodies.len();
+    let rows: Vec<ContactConstraint> = (0..4).flat_map(|_| settled.iter().copied()).collect();
+    assert!(rows.len() > 4096, "{} rows", rows.len());
+    let wave = |k: usize, a: f32, b: f32, c: f32| {
+        let x = k as f32;
+        Vec3::new(a * x.sin(), b, c * x.cos())
+    };
+    let mut linear_start: Vec<Vec3> = (0..n).map(|k| wave(k, 0.1, -0.3, 0.05)).collect();
+    let mut angular_start: Vec<Vec3> = (0..n).map(|k| wave(k, 0.2, -0.1, 0.1)).collect();
+    linear_start.push(Vec3::ZERO);
+    angular_start.push(Vec3::ZERO);
+    let still = vec![Vec3::ZERO; n + 1];
+    let settings = SolverSettings::default();
+    let inverse_inertia: Vec<Mat3> = (0..=n)
+        .map(|k| {
+            if k < n {
+                w.bodies.world_inverse_inertia(k)
+            } else {
+                Mat3::ZERO
+            }
+        })
+        .collect();
+    // Relax, then the next substep's warm start: (velocities, impulses, step totals).
+    let run = |carry: bool, threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut bundles = Bundles::default();
+            bundles.pack(&rows, n + 1, &inverse_inertia, threads > 1);
+            let (mut linear, mut angular) = (linear_start.clone(), angular_start.clone());
+            let mut velocities = Velocities {
+                linear: &mut linear,
+                angular: &mut angular,
+            };
+            bundles.warm_start(&mut [], &mut velocities, 0);
+            let pass = SolvePass {
+                iterations: 1,
+                tolerance: 0.0,
+                friction: true,
+                half_turn: false,
+                warm_start_follows: carry,
+                escalate: false,
+                targets: Some(TargetInputs {
+                    displacement: &still,
+                    rotation: &still,
+                    turn: &[],
+                    settings: &settings,
+                    h: DT / settings.substeps as f32,
+                    with_repair: false,
+                }),
+                sweep: Sweep::default(),
+            };
+            bundles.solve_pgs(&mut velocities, &pass);
+            bundles.warm_start(&mut [], &mut velocities, 1);
+            let mut unpacked = rows.clone();
+            bundles.unpack(&mut unpacked);
+            let impulses: Vec<u32> = unpacked
+                .iter()
+                .flat_map(|c| {
+                    [
+                        c.normal_impulse,
+                        c.tangent_impulses[0],
+                        c.tangent_impulses[1],
+                    ]
+                    .into_iter()
+                    .chain(c.step_impulses)
+                })
+                .map(f32::to_bits)
+                .collect();
+            (linear, angular, impulses)
+        })
+    };
+    let (linear, angular, impulses) = run(false, 1);
+    let largest = linear
+        .iter()
+        .chain(&angular)
+        .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+    assert!(largest > 0.1, "the bodies should move: {largest}");
+    let mut carried_bits = Vec::new();
+    for threads in [1, 2] {
+        let (carried_linear, carried_angular, carried_impulses) = run(true, threads);
+        assert!(
+            impulses == carried_impulses,
+            "{threads} threads: impulses or step totals differ"
+        );
+        for (k, (got, want)) in carried_linear
+            .iter()
+            .zip(&linear)
+            .chain(carried_angular.iter().zip(&angular))
+            .enumerate()
+        {
+            assert!(
+                (*got - *want).abs().max_element() <= 1e-5 * largest,
+                "{threads} threads, velocity {k}: {got} carried, {want} by the pass"
+            );
+        }
+        assert_eq!(
+            carried_linear[n],
+            Vec3::ZERO,
+            "the immovable slot stays at rest"
+        );
+        carried_bits.push(
+            carried_linear
+                .iter()
+                .chain(&carried_angular)
+                .flat_map(|v| v.to_array().map(f32::to_bits))
+                .collect::<Vec<_>>(),
+        );
+    }
+    assert_eq!(carried_bits[0], carried_bits[1], "1 and 2 threads");
 }
