@@ -263,13 +263,19 @@ unsafe impl Sync for SharedVelocities {}
 /// hide it.
 #[inline(always)]
 pub(crate) fn prefetch_lines<T>(value: &T) {
-    let start = (value as *const T).cast::<u8>();
-    let size = std::mem::size_of::<T>();
-    for offset in (0..size).step_by(64) {
+    prefetch_bytes(value as *const T, std::mem::size_of::<T>());
+}
+
+/// Asks the CPU for every cache line of the first `bytes` bytes at `start` (a hint: it never
+/// faults, whatever the address), for a sweep that reads only the start of each item.
+#[inline(always)]
+pub(crate) fn prefetch_bytes<T>(start: *const T, bytes: usize) {
+    let start = start.cast::<u8>();
+    for offset in (0..bytes).step_by(64) {
         prefetch(start.wrapping_add(offset));
     }
-    // The last line, when `value` straddles one more than its size fills.
-    prefetch(start.wrapping_add(size.saturating_sub(1)));
+    // The last line, when the bytes straddle one more line than their size fills.
+    prefetch(start.wrapping_add(bytes.saturating_sub(1)));
 }
 
 #[cfg(test)]

@@ -38,7 +38,7 @@ use crate::graph::{COLOURS, greedy_colours};
 use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{
     GROUPS_PER_TASK, PARALLEL_PACK_POINTS, SharedItems, SharedVelocities, colour_after_colour,
-    prefetch_lines, spread, threads,
+    prefetch_bytes, spread, threads,
 };
 
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
@@ -76,8 +76,11 @@ struct RowLanes {
     inverse_effective_mass: Lane,
 }
 
-/// What a sweep reads and writes for the points of one bundle.
+/// What a sweep reads and writes for the points of one bundle. What the normal rows' sweep
+/// (the main solve's) reads and writes comes first, up to [`NORMAL_PART`] bytes, so that it
+/// touches the bundle's first cache lines alone; bundles start on a cache line.
 #[derive(Clone, Copy, Default)]
+#[repr(C, align(64))]
 struct Bundle {
     /// Local slots of bodies A and B per lane (the immovable slot for padding).
     local_a: [u32; LANES],
@@ -86,20 +89,25 @@ struct Bundle {
     inverse_mass_a: LaneVec,
     inverse_mass_b: LaneVec,
     normal: RowLanes,
-    tangents: [RowLanes; 2],
-    tangent_inverse_block: [Lane; 3],
-    /// Step of a sliding lane's friction update, 1/k₁ with k₁ the tangent block's larger
-    /// eigenvalue (kg); 0 where both bodies are immovable (see [`solve_bundle`]).
-    sliding_step: Lane,
-    friction: Lane,
     /// Target normal velocity (m/s) and softness (mass scale, impulse scale) of the solve.
     target: Lane,
     mass_scale: Lane,
     impulse_scale: Lane,
     normal_impulse: Lane,
-    tangent_impulses: [Lane; 2],
     max_normal_impulse: Lane,
+    friction: Lane,
+    tangents: [RowLanes; 2],
+    tangent_inverse_block: [Lane; 3],
+    /// Step of a sliding lane's friction update, 1/k₁ with k₁ the tangent block's larger
+    /// eigenvalue (kg); 0 where both bodies are immovable (see [`solve_bundle`]).
+    sliding_step: Lane,
+    tangent_impulses: [Lane; 2],
 }
+
+/// Bytes at the start of a [`Bundle`] that the normal rows' sweep reads and writes: a third of
+/// the bundle, which a sweep over the normal rows alone asks the CPU for (see
+/// [`sweep_groups`]).
+const NORMAL_PART: usize = std::mem::offset_of!(Bundle, friction);
 
 /// What the target update of [`Bundles::solve_pgs`] reads: where the points are.
 #[derive(Clone, Copy, Default)]
@@ -995,6 +1003,9 @@ impl ContactSolver for Bundles {
 /// than a closure or function pointer so that the update is inlined into the sweep loop (a
 /// closure was not inlined).
 trait BundleUpdate: Copy + Sync {
+    /// Bytes at the start of each bundle that the update reads (see [`NORMAL_PART`]).
+    const READS: usize = std::mem::size_of::<Bundle>();
+
     /// What an update keeps per lane group besides its bodies' velocities, from
     /// [`BundleUpdate::begin`] to [`BundleUpdate::end`].
     type Group;
@@ -1027,6 +1038,11 @@ trait BundleUpdate: Copy + Sync {
 struct VelocityRows<const FRICTION: bool = true>;
 
 impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
+    const READS: usize = if FRICTION {
+        std::mem::size_of::<Bundle>()
+    } else {
+        NORMAL_PART
+    };
     type Group = ();
     #[inline(always)]
     unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
@@ -1300,11 +1316,13 @@ struct SweepOrder {
 /// starting halfway round in every other substep puts the diagonally opposite corner first and
 /// the torques cancel. Reversing the group instead leaves the first point on the same side.
 ///
-/// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first: a bundle is 16 cache lines, and
-/// once an island's bundles outgrow L2 (pyramid100: 17 MB) the sweep waited on L3 for them,
-/// which the hardware prefetcher did not hide (asking ahead made a one-thread pyramid100 step
-/// about a fifth faster when it was added). Groups lie in bundle order, so
-/// the bundle ahead in memory is the one the sweep visits next.
+/// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first, the part `update` reads
+/// ([`BundleUpdate::READS`]): a bundle is 18 cache lines, and once an island's bundles outgrow
+/// L2 (pyramid100: 17 MB) the sweep waited on L3 for them, which the hardware prefetcher did
+/// not hide (asking ahead made a one-thread pyramid100 step about a fifth faster when it was
+/// added). The normal rows' sweep asks for the first 8 lines alone ([`NORMAL_PART`]); asking
+/// for the whole bundle there had it read every line. Groups lie in bundle order, so the
+/// bundle ahead in memory is the one the sweep visits next.
 ///
 /// # Safety
 /// `bundles` points to `len` bundles, every group's range lies inside them, every lane's slots
@@ -1356,7 +1374,7 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
             };
             if ahead < len {
                 // SAFETY: in bounds; a prefetch reads nothing.
-                prefetch_lines(unsafe { &*bundles.0.add(ahead) });
+                prefetch_bytes(unsafe { bundles.0.add(ahead) }, F::READS);
             }
             // SAFETY: the caller's contract.
             let b = unsafe { &mut *bundles.0.add(index) };

@@ -806,3 +806,79 @@ fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
     }
     assert_eq!(carried_bits[0], carried_bits[1], "1 and 2 threads");
 }
+
+/// The normal rows' sweep (the soft step's main solve) reads and writes nothing past the
+/// bundle's first [`super::NORMAL_PART`] bytes, the part it asks the CPU for: with every byte
+/// after it set to a NaN, the sweep gives the bits it gives on the intact bundles.
+#[test]
+fn normal_rows_sweep_reads_only_the_normal_part_of_a_bundle() {
+    use super::{Bundle, Bundles, NORMAL_PART};
+    use crate::solver::{ContactSolver, SolvePass, Sweep, TargetInputs, Velocities};
+    const _: () = assert!(NORMAL_PART <= 512 && std::mem::size_of::<Bundle>() % 64 == 0);
+    let (w, rows) = settled_pyramid20_rows();
+    let n = w.bodies.len();
+    let settings = SolverSettings::default();
+    let still = vec![Vec3::ZERO; n + 1];
+    let run = |poison: bool| {
+        let mut bundles = Bundles::default();
+        bundles.pack(&rows, n + 1, &vec![Mat3::ZERO; n + 1], false);
+        let (mut linear, mut angular) = (vec![Vec3::ZERO; n + 1], vec![Vec3::ZERO; n + 1]);
+        let mut velocities = Velocities {
+            linear: &mut linear,
+            angular: &mut angular,
+        };
+        bundles.warm_start(&mut [], &mut velocities, 0);
+        if poison {
+            for b in &mut bundles.bundles {
+                let bytes = (b as *mut Bundle).cast::<u8>();
+                // SAFETY: within the bundle; every field past the normal part is made of f32s,
+                // for which any bit pattern is a value.
+                unsafe {
+                    std::ptr::write_bytes(
+                        bytes.add(NORMAL_PART),
+                        0xff,
+                        std::mem::size_of::<Bundle>() - NORMAL_PART,
+                    )
+                };
+            }
+        }
+        let pass = SolvePass {
+            iterations: 1,
+            tolerance: 0.0,
+            friction: false,
+            half_turn: true,
+            warm_start_follows: false,
+            escalate: true,
+            targets: Some(TargetInputs {
+                displacement: &still,
+                rotation: &still,
+                turn: &[],
+                settings: &settings,
+                h: DT / settings.substeps as f32,
+                with_repair: true,
+            }),
+            sweep: Sweep::default(),
+        };
+        bundles.solve_pgs(&mut velocities, &pass);
+        let impulses: Vec<u32> = bundles
+            .bundles
+            .iter()
+            .flat_map(|b| [b.normal_impulse, b.max_normal_impulse])
+            .flat_map(|lanes| lanes.to_array())
+            .map(f32::to_bits)
+            .collect();
+        let bits: Vec<u32> = linear
+            .iter()
+            .chain(&angular)
+            .flat_map(|v| v.to_array().map(f32::to_bits))
+            .chain(impulses)
+            .collect();
+        (bits, linear.iter().any(|v| v.length() > 1e-3))
+    };
+    let (intact, moved) = run(false);
+    assert!(moved, "the warm start and the sweep should move the bodies");
+    assert!(
+        intact == run(true).0,
+        "the poisoned part changed the normal sweep"
+    );
+}
