@@ -681,6 +681,34 @@ fn lanes_computing_the_lever_arm_products_change_no_trajectory() {
     }
 }
 
+/// One sweep of a substep of `settings` with no body moved since the step began (`still`, per
+/// slot): the main solve's (`main`: normal rows alone, repair, from halfway round) or the
+/// relax solve's (every row), with `warm_start_follows`.
+fn pass_at_rest<'a>(
+    still: &'a [Vec3],
+    settings: &'a SolverSettings,
+    main: bool,
+    warm_start_follows: bool,
+) -> crate::solver::SolvePass<'a> {
+    crate::solver::SolvePass {
+        iterations: 1,
+        tolerance: 0.0,
+        friction: !main,
+        half_turn: main,
+        warm_start_follows,
+        escalate: main,
+        targets: Some(crate::solver::TargetInputs {
+            displacement: still,
+            rotation: still,
+            turn: &[],
+            settings,
+            h: DT / settings.substeps as f32,
+            with_repair: main,
+        }),
+        sweep: crate::solver::Sweep::default(),
+    }
+}
+
 /// A relax sweep that carries the next substep's warm start (`warm_start_follows`) gives what
 /// the relax sweep and the separate warm-start pass give: the same impulses and step totals
 /// to the bit (the solve is the same; the totals get the same additions in the same order) and
@@ -691,7 +719,7 @@ fn lanes_computing_the_lever_arm_products_change_no_trajectory() {
 fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
     use super::Bundles;
     use crate::contact::constraints::ContactConstraint;
-    use crate::solver::{ContactSolver, SolvePass, Sweep, TargetInputs, Velocities};
+    use crate::solver::{ContactSolver, Velocities};
     let (w, settled) = settled_pyramid20_rows();
     let n = w.bodies.len();
     let rows: Vec<ContactConstraint> = (0..4).flat_map(|_| settled.iter().copied()).collect();
@@ -730,23 +758,7 @@ fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
                 angular: &mut angular,
             };
             bundles.warm_start(&mut [], &mut velocities, 0);
-            let pass = SolvePass {
-                iterations: 1,
-                tolerance: 0.0,
-                friction: true,
-                half_turn: false,
-                warm_start_follows: carry,
-                escalate: false,
-                targets: Some(TargetInputs {
-                    displacement: &still,
-                    rotation: &still,
-                    turn: &[],
-                    settings: &settings,
-                    h: DT / settings.substeps as f32,
-                    with_repair: false,
-                }),
-                sweep: Sweep::default(),
-            };
+            let pass = pass_at_rest(&still, &settings, false, carry);
             bundles.solve_pgs(&mut velocities, &pass);
             bundles.warm_start(&mut [], &mut velocities, 1);
             let mut unpacked = rows.clone();
@@ -813,7 +825,7 @@ fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
 #[test]
 fn normal_rows_sweep_reads_only_the_normal_part_of_a_bundle() {
     use super::{Bundle, Bundles, NORMAL_PART};
-    use crate::solver::{ContactSolver, SolvePass, Sweep, TargetInputs, Velocities};
+    use crate::solver::{ContactSolver, Velocities};
     const _: () = assert!(NORMAL_PART <= 512 && std::mem::size_of::<Bundle>().is_multiple_of(64));
     let (w, rows) = settled_pyramid20_rows();
     let n = w.bodies.len();
@@ -842,23 +854,7 @@ fn normal_rows_sweep_reads_only_the_normal_part_of_a_bundle() {
                 };
             }
         }
-        let pass = SolvePass {
-            iterations: 1,
-            tolerance: 0.0,
-            friction: false,
-            half_turn: true,
-            warm_start_follows: false,
-            escalate: true,
-            targets: Some(TargetInputs {
-                displacement: &still,
-                rotation: &still,
-                turn: &[],
-                settings: &settings,
-                h: DT / settings.substeps as f32,
-                with_repair: true,
-            }),
-            sweep: Sweep::default(),
-        };
+        let pass = pass_at_rest(&still, &settings, true, false);
         bundles.solve_pgs(&mut velocities, &pass);
         let impulses: Vec<u32> = bundles
             .bundles
