@@ -863,6 +863,24 @@ impl Bundles {
         )
     }
 
+    /// Zeroes the carried warm start for an island of `slots` slots, marks it for the next
+    /// [`ContactSolver::warm_start`], and returns the update that fills it.
+    fn start_carrying(&mut self, slots: usize) -> RelaxCarrying {
+        for carried in [&mut self.carried_linear, &mut self.carried_angular] {
+            carried.clear();
+            carried.resize(slots, Vec3::ZERO);
+        }
+        self.carried = true;
+        RelaxCarrying {
+            totals: SharedItems(self.step_totals.as_mut_ptr()),
+            carried: SharedVelocities {
+                linear: self.carried_linear.as_mut_ptr(),
+                angular: self.carried_angular.as_mut_ptr(),
+                immovable: slots.wrapping_sub(1),
+            },
+        }
+    }
+
     /// Sets every point's target normal velocity and softness from `targets` (as
     /// [`crate::contact::constraints::update_targets`] does for rigid or soft rows, not split impulse),
     /// then runs at most `iterations` sweeps, alternating forward and backward, until no row's
@@ -893,45 +911,37 @@ impl Bundles {
             // A sweep that may meet stale rows is compiled apart, so that the usual one (no
             // body of the island turned past the limit) carries no test for them.
             let stale = first.is_some_and(|t| !t.turn.is_empty());
-            let carrying = friction && pass.warm_start_follows && pass.iterations == 1;
-            if carrying {
-                let slots = velocities.linear.len();
-                for carried in [&mut self.carried_linear, &mut self.carried_angular] {
-                    carried.clear();
-                    carried.resize(slots, Vec3::ZERO);
+            // One relax sweep before another substep adds up that substep's warm start as it
+            // goes (`RelaxCarrying`). Not with several sweeps: each would add its impulses to
+            // the step totals.
+            let largest = if friction && pass.warm_start_follows && pass.iterations == 1 {
+                let carry = self.start_carrying(velocities.linear.len());
+                match first {
+                    Some(t) if stale => self.sweep(order, velocities, carry, Turned::<true>(t)),
+                    Some(t) => self.sweep(order, velocities, carry, Turned::<false>(t)),
+                    None => self.sweep(order, velocities, carry, NoTargets),
                 }
-                self.carried = true;
-            }
-            let carry = RelaxCarrying {
-                totals: SharedItems(self.step_totals.as_mut_ptr()),
-                carried: SharedVelocities {
-                    linear: self.carried_linear.as_mut_ptr(),
-                    angular: self.carried_angular.as_mut_ptr(),
-                    immovable: self.carried_linear.len().wrapping_sub(1),
-                },
-            };
-            let largest = match (first, friction, stale) {
-                (Some(t), true, false) if carrying => {
-                    self.sweep(order, velocities, carry, Turned::<false>(t))
+            } else {
+                match (first, friction, stale) {
+                    (Some(t), true, false) => {
+                        self.sweep(order, velocities, VelocityRows::<true>, Turned::<false>(t))
+                    }
+                    (Some(t), false, false) => {
+                        self.sweep(order, velocities, VelocityRows::<false>, Turned::<false>(t))
+                    }
+                    (Some(t), true, true) => {
+                        self.sweep(order, velocities, VelocityRows::<true>, Turned::<true>(t))
+                    }
+                    (Some(t), false, true) => {
+                        self.sweep(order, velocities, VelocityRows::<false>, Turned::<true>(t))
+                    }
+                    (None, true, _) => {
+                        self.sweep(order, velocities, VelocityRows::<true>, NoTargets)
+                    }
+                    (None, false, _) => {
+                        self.sweep(order, velocities, VelocityRows::<false>, NoTargets)
+                    }
                 }
-                (Some(t), true, true) if carrying => {
-                    self.sweep(order, velocities, carry, Turned::<true>(t))
-                }
-                (Some(t), true, false) => {
-                    self.sweep(order, velocities, VelocityRows::<true>, Turned::<false>(t))
-                }
-                (Some(t), false, false) => {
-                    self.sweep(order, velocities, VelocityRows::<false>, Turned::<false>(t))
-                }
-                (Some(t), true, true) => {
-                    self.sweep(order, velocities, VelocityRows::<true>, Turned::<true>(t))
-                }
-                (Some(t), false, true) => {
-                    self.sweep(order, velocities, VelocityRows::<false>, Turned::<true>(t))
-                }
-                (None, true, _) if carrying => self.sweep(order, velocities, carry, NoTargets),
-                (None, true, _) => self.sweep(order, velocities, VelocityRows::<true>, NoTargets),
-                (None, false, _) => self.sweep(order, velocities, VelocityRows::<false>, NoTargets),
             };
             let largest_change = largest.to_array().into_iter().fold(0.0f32, f32::max);
             report.iterations += 1;

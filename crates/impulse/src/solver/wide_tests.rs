@@ -553,7 +553,15 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
             }
         })
         .collect();
-    for (with_repair, turn) in [(true, &[][..]), (false, &[][..]), (true, &turned[..])] {
+    // The relax solve also as it runs before another substep, adding up that substep's warm
+    // start as it goes (`warm_start_follows`): the same targets.
+    for (with_repair, turn, warm_start_follows) in [
+        (true, &[][..], false),
+        (false, &[][..], false),
+        (false, &[][..], true),
+        (true, &turned[..], false),
+        (false, &turned[..], true),
+    ] {
         let inputs = TargetInputs {
             displacement: &displacement,
             rotation: &rotation,
@@ -580,7 +588,7 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
             tolerance: 0.0,
             friction: true,
             half_turn: false,
-            warm_start_follows: false,
+            warm_start_follows,
             escalate: false,
             targets: Some(inputs),
             sweep: Sweep::default(),
