@@ -96,13 +96,10 @@ impl PairInverseMass {
 }
 
 impl JacobianRow {
-    /// Sets the row's unit `direction` and its angular parts r × d for lever arms `r_a`, `r_b`
-    /// (m); its lever-arm products ([`Self::inverse_inertia_angular_a`] and on) and
-    /// `velocity_before` are left as they are: see [`Self::fill_products`].
+    /// Sets the row's angular parts r × d for its direction d and lever arms `r_a`, `r_b` (m).
     #[inline(always)]
-    fn set_geometric(&mut self, direction: Vec3, r_a: Vec3A, r_b: Vec3A) {
-        let d = Vec3A::from(direction);
-        self.direction = direction;
+    fn set_angular(&mut self, r_a: Vec3A, r_b: Vec3A) {
+        let d = Vec3A::from(self.direction);
         self.angular_a = r_a.cross(d).into();
         self.angular_b = r_b.cross(d).into();
     }
@@ -214,11 +211,12 @@ pub struct ContactConstraint {
     pub step_impulses: [f32; 3],
     /// Where the point lives: (pair, manifold, point) in the narrow phase, for write-back.
     pub source: (u32, u16, u16),
-    /// Whether the rows' lever-arm products are yet to be computed: each row's
+    /// Whether the rows' lever-arm products are yet to be computed: each row's angular parts
+    /// `angular_a`/`_b` (r × d, from the lever arms and the direction),
     /// `inverse_inertia_angular_a`/`_b`, `effective_mass` and `inverse_effective_mass`, and the
     /// tangent blocks, which until then hold whatever the row held before (meaningless), as
     /// does the normal row's `velocity_before` (v⁻, which only restitution reads; the step's
-    /// record sets every row's J·v* as the step ends). Directions and angular parts are always
+    /// record sets every row's J·v* as the step ends). Directions and lever arms are always
     /// set. Assembly leaves the products to the SIMD lanes, which
     /// compute them four points at a time as they pack (`wide::Bundles::pack`), for the points
     /// of islands the lanes solve with no restitution solve after them, whose bodies have no
@@ -227,13 +225,16 @@ pub struct ContactConstraint {
 }
 
 impl ContactConstraint {
-    /// Computes the rows' lever-arm products (see [`Self::products_pending`]) for bodies of
-    /// world inverse inertia `inverse_inertia_a` and `inverse_inertia_b` (1/(kg·m²)).
+    /// Computes the rows' angular parts and lever-arm products (see
+    /// [`Self::products_pending`]) from the directions and lever arms, for bodies of world
+    /// inverse inertia `inverse_inertia_a` and `inverse_inertia_b` (1/(kg·m²)).
     #[inline(always)]
     fn fill_products(&mut self, inverse_inertia_a: &Mat3A, inverse_inertia_b: &Mat3A) {
         let inverse_mass = PairInverseMass::new(self.inverse_mass_a, self.inverse_mass_b);
+        let (r_a, r_b) = (Vec3A::from(self.lever_a), Vec3A::from(self.lever_b));
         let [t1, t2] = &mut self.tangents;
         for row in [&mut self.normal, t1, t2] {
+            row.set_angular(r_a, r_b);
             row.fill_products(inverse_mass, inverse_inertia_a, inverse_inertia_b);
         }
         let block = tangent_block(&self.tangents, inverse_mass);
@@ -476,7 +477,6 @@ impl Assembly<'_> {
                 };
                 let r_a = at_a - com_a;
                 let r_b = at_b - com_b;
-                let (r_a_wide, r_b_wide) = (Vec3A::from(r_a), Vec3A::from(r_b));
                 let Some(c) = slots.next() else {
                     debug_assert!(false, "fewer slots than the narrow phase's row count");
                     return;
@@ -490,9 +490,9 @@ impl Assembly<'_> {
                 c.local_b = local_b;
                 c.inverse_mass_a = inverse_mass_a;
                 c.inverse_mass_b = inverse_mass_b;
-                c.normal.set_geometric(normal, r_a_wide, r_b_wide);
-                c.tangents[0].set_geometric(t1, r_a_wide, r_b_wide);
-                c.tangents[1].set_geometric(t2, r_a_wide, r_b_wide);
+                c.normal.direction = normal;
+                c.tangents[0].direction = t1;
+                c.tangents[1].direction = t2;
                 c.target_normal_velocity = 0.0;
                 c.softness = (1.0, 0.0);
                 c.position_target = 0.0;
@@ -519,13 +519,13 @@ impl Assembly<'_> {
                     // which a point with pending products never meets; every row's is
                     // rewritten as the step ends ([`record_velocity_before`], or the lanes'
                     // record).
+                    c.fill_products(inertia_a, inertia_b);
                     c.normal.velocity_before = c.normal.velocity(
                         bodies.linear_velocity[a],
                         bodies.angular_velocity[a],
                         bodies.linear_velocity[b],
                         bodies.angular_velocity[b],
                     );
-                    c.fill_products(inertia_a, inertia_b);
                 }
             }
         }
