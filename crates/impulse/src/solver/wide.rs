@@ -4,7 +4,7 @@
 //! `solve_bundle` below).
 //!
 //! A point's update reads and writes its two bodies' velocities, so the lanes of one bundle
-//! must not share a moving body. The island's points are cut into manifold groups (a pair's
+//! must not share a moving body. The island's points are cut into manifold groups (a manifold's
 //! consecutive points, at most four); the groups are coloured greedily (no two
 //! groups of a colour share a moving body; static bodies never conflict) and each colour's
 //! groups go [`LANES`] at a time into a lane group: as many consecutive bundles as its longest
@@ -12,8 +12,9 @@
 //! colour by colour, gathering their bodies' velocities once and updating their bundles in
 //! turn. This is the layout of Box2D v3's and Rapier's solvers ("graph colouring" + "wide"
 //! rows, per manifold; Catto, "Solver2D", 2024). Lanes a colour cannot fill, and the rows past
-//! a shorter group's points, are padding: every mass and impulse is zero, so their updates
-//! change nothing.
+//! a shorter group's points, are padding: every effective mass, lever arm and impulse is
+//! zero, so their updates change nothing. What a manifold group's points share (bodies,
+//! masses, normal, tangents, friction) the lane group keeps once, lane by lane ([`Group`]).
 //!
 //! Rows are packed once per step ([`Bundles::pack`]); the substep loop then warm-starts, sets
 //! targets and sweeps on the packed rows, and [`Bundles::unpack`] writes the impulses back to
@@ -64,10 +65,10 @@ type Lane = wide::f32x8;
 /// A vector per lane: x, y and z each in one register.
 type LaneVec = [Lane; 3];
 
-/// One Jacobian row (see [`JacobianRow`]) for the points of a bundle.
+/// One Jacobian row (see [`JacobianRow`]) for the points of a bundle; its direction is the
+/// lane group's ([`Group::directions`]).
 #[derive(Clone, Copy, Default)]
 struct RowLanes {
-    direction: LaneVec,
     angular_a: LaneVec,
     angular_b: LaneVec,
     inverse_inertia_angular_a: LaneVec,
@@ -76,18 +77,13 @@ struct RowLanes {
     inverse_effective_mass: Lane,
 }
 
-/// What a sweep reads and writes for the points of one bundle. What the normal rows' sweep
-/// (the main solve's) reads and writes comes first, up to [`NORMAL_PART`] bytes, so that it
-/// touches the bundle's first cache lines alone; bundles start on a cache line.
+/// What a sweep reads and writes for the points of one bundle, besides what its lane group's
+/// points share ([`Group`]). What the normal rows' sweep (the main solve's) reads and writes
+/// comes first, up to [`NORMAL_PART`] bytes, so that it touches the bundle's first cache
+/// lines alone; bundles start on a cache line.
 #[derive(Clone, Copy, Default)]
 #[repr(C, align(64))]
 struct Bundle {
-    /// Local slots of bodies A and B per lane (the immovable slot for padding).
-    local_a: [u32; LANES],
-    local_b: [u32; LANES],
-    /// Per-axis inverse masses of A and B (see [`ContactConstraint::inverse_mass_a`]).
-    inverse_mass_a: LaneVec,
-    inverse_mass_b: LaneVec,
     normal: RowLanes,
     /// Target normal velocity (m/s) and softness (mass scale, impulse scale) of the solve.
     target: Lane,
@@ -95,7 +91,6 @@ struct Bundle {
     impulse_scale: Lane,
     normal_impulse: Lane,
     max_normal_impulse: Lane,
-    friction: Lane,
     tangents: [RowLanes; 2],
     tangent_inverse_block: [Lane; 3],
     /// Step of a sliding lane's friction update, 1/k₁ with k₁ the tangent block's larger
@@ -107,7 +102,7 @@ struct Bundle {
 /// Bytes at the start of a [`Bundle`] that the normal rows' sweep reads and writes: a third of
 /// the bundle, which a sweep over the normal rows alone asks the CPU for (see
 /// [`sweep_groups`]).
-const NORMAL_PART: usize = std::mem::offset_of!(Bundle, friction);
+const NORMAL_PART: usize = std::mem::offset_of!(Bundle, tangents);
 
 /// What the target update of [`Bundles::solve_pgs`] reads: where the points are.
 #[derive(Clone, Copy, Default)]
@@ -117,8 +112,9 @@ struct BundleGeometry {
     /// Penetration depth at assembly (m), > 0 when overlapping.
     depth: Lane,
     /// Per lane, whether the pack computes its lever-arm products: for a point whose products
-    /// are pending ([`ContactConstraint::products_pending`]), and for padding, whose zero
-    /// direction and lever arms give zero products.
+    /// are pending ([`ContactConstraint::products_pending`]). Padding keeps the zero products
+    /// it was reset to (computed from its zero lever arms and its lane's direction, some would
+    /// come out as −0).
     pending: [bool; LANES],
 }
 
@@ -128,17 +124,47 @@ impl BundleGeometry {
         lever_a: [Lane::ZERO; 3],
         lever_b: [Lane::ZERO; 3],
         depth: Lane::ZERO,
-        pending: [true; LANES],
+        pending: [false; LANES],
     };
 }
 
 /// Bundles that share their lanes' bodies: lane i of every bundle in `start..start + len`
-/// holds a point of the same manifold group (the same two bodies), so a sweep gathers the
-/// lanes' velocities once, updates the `len` bundles in turn on them, and scatters once.
-#[derive(Clone, Copy, Default, Debug, PartialEq, Eq)]
+/// holds a point of the same manifold group (the same two bodies, one manifold), so a sweep
+/// gathers the lanes' velocities once, updates the `len` bundles in turn on them, and
+/// scatters once. What a manifold group's points share is kept here once, lane by lane,
+/// rather than in each of its bundles: a sweep then streams 144 fewer bytes per bundle of the
+/// normal rows (352 instead of 480) and 288 fewer of all rows, while the group stays in the
+/// first-level cache as its bundles are updated. Padding points get their lane's values;
+/// their zero lever arms, effective masses and impulses still make their updates change
+/// nothing.
+#[derive(Clone, Copy, Default, Debug, PartialEq)]
 struct Group {
     start: u32,
     len: u32,
+    /// Local slots of bodies A and B per lane (the immovable slot where the lane holds no
+    /// manifold group).
+    local_a: [u32; LANES],
+    local_b: [u32; LANES],
+    /// Per-axis inverse masses of A and B (see [`ContactConstraint::inverse_mass_a`]).
+    inverse_mass_a: LaneVec,
+    inverse_mass_b: LaneVec,
+    /// The rows' directions: the manifold's normal and its two tangents.
+    directions: [LaneVec; 3],
+    /// Coulomb coefficient μ of the pair.
+    friction: Lane,
+}
+
+/// What the layout of [`Bundles::pack`] is made from, per point: its body slots, its pair and
+/// its manifold in the pair ([`ContactConstraint::source`]). A manifold group is a run of
+/// consecutive points with the same key: one manifold's, whose normal and tangents its lane
+/// group keeps. The slots alone do not tell two manifolds apart (a pair's several manifolds,
+/// or a body's pairs with two static bodies, which share the immovable slot).
+#[derive(Clone, Copy, Default, Debug, PartialEq, Eq)]
+struct PointKey {
+    local_a: u32,
+    local_b: u32,
+    pair: u32,
+    manifold: u16,
 }
 
 /// Most points of one manifold group: a pair's run of points is cut into groups of at most
@@ -174,9 +200,9 @@ pub struct Bundles {
     colours: Vec<u8>,
     /// What the layout (`groups`, `runs`, `run_places`, `sources`, `slots`) was made for: each
     /// point's body slots (local A, local B), and the island's slot count.
-    layout_keys: Vec<(u32, u32)>,
+    layout_keys: Vec<PointKey>,
     /// This pack's body slots per point, before they are compared with `layout_keys`.
-    keys: Vec<(u32, u32)>,
+    keys: Vec<PointKey>,
     layout_slots: usize,
     /// What [`Bundles::record`] found per bundle, and the velocities v* it took them from;
     /// `recorded` until the next pack. `rows` is what [`Bundles::unpack`] summed from them.
@@ -241,10 +267,9 @@ fn cross(a: LaneVec, b: LaneVec) -> LaneVec {
 }
 
 impl RowLanes {
-    /// Writes `row` into lane `i`.
+    /// Writes `row` into lane `i` (but its direction, which the lane group keeps).
     #[inline(always)]
     fn set(&mut self, i: usize, row: &JacobianRow) {
-        set_vec(&mut self.direction, i, row.direction);
         set_vec(&mut self.angular_a, i, row.angular_a);
         set_vec(&mut self.angular_b, i, row.angular_b);
         set_vec(
@@ -265,20 +290,26 @@ impl RowLanes {
         );
     }
 
-    /// J·v per lane (m/s), as [`JacobianRow::velocity`].
+    /// J·v per lane (m/s) for the row's `direction`, as [`JacobianRow::velocity`].
     #[inline(always)]
-    fn velocity(&self, v: &BodyLanes) -> Lane {
-        dot(self.direction, sub(v.linear_a, v.linear_b)) + dot(self.angular_a, v.angular_a)
+    fn velocity(&self, direction: &LaneVec, v: &BodyLanes) -> Lane {
+        dot(*direction, sub(v.linear_a, v.linear_b)) + dot(self.angular_a, v.angular_a)
             - dot(self.angular_b, v.angular_b)
     }
 
-    /// Adds M⁻¹J_iᵀ·impulse to the two bodies of each lane.
+    /// Adds M⁻¹J_iᵀ·impulse to the two bodies of each lane, for the row's `direction`.
     #[inline(always)]
-    fn apply(&self, impulse: Lane, inverse_mass: (LaneVec, LaneVec), v: &mut BodyLanes) {
+    fn apply(
+        &self,
+        direction: &LaneVec,
+        impulse: Lane,
+        inverse_mass: (LaneVec, LaneVec),
+        v: &mut BodyLanes,
+    ) {
         let linear = [
-            self.direction[0] * impulse,
-            self.direction[1] * impulse,
-            self.direction[2] * impulse,
+            direction[0] * impulse,
+            direction[1] * impulse,
+            direction[2] * impulse,
         ];
         let [bx, by, bz] = inverse_mass.1;
         v.linear_a = add_scaled_per_axis(v.linear_a, linear, inverse_mass.0);
@@ -322,13 +353,14 @@ impl BodyLanes {
 impl Bundles {
     /// Packs the island's `constraints` (slots below `slots`; `slots − 1` is the immovable one),
     /// with their current impulses, into bundles. The points are first cut into manifold groups:
-    /// runs of consecutive points between the same two bodies (assembly writes a pair's points
+    /// runs of consecutive points of one manifold (assembly writes a manifold's points
     /// together), at most four each. The groups are coloured greedily (no two groups
     /// of a colour share a moving body), and each colour's groups, in constraint order, go
     /// [`LANES`] at a time into lane groups of as many bundles as their largest group has
-    /// points; a lane whose group is shorter is padded with rows of zero mass between the same
-    /// bodies, whose updates change nothing. Groups the colouring cannot place (a body in more
-    /// than `COLOURS` (64) colours) get a lane group each. O(points).
+    /// points; a lane whose group is shorter is padded with rows of zero effective mass between
+    /// the same bodies, whose updates change nothing. Groups the colouring cannot place (a body
+    /// in more than `COLOURS` (64) colours) get a lane group each. O(points). What a manifold
+    /// group's points share goes to its lane group ([`Group`]), the rest to the bundles.
     ///
     /// Why manifold groups (Box2D v3's and Box3D's wide contact constraints are per manifold
     /// too): a sweep gathers and scatters the bodies' velocities once per lane group instead of
@@ -359,13 +391,19 @@ impl Bundles {
         self.carried = false;
         self.rows = None;
         let immovable = (slots - 1) as u32;
-        // The layout is a function of the points' body slots alone: when they repeat (an
-        // island at rest keeps its points), last pack's layout stands. The slots are first
-        // copied out of the 344-byte rows (on rayon's threads for a large island), so that the
-        // comparison, the grouping and the colouring, which are serial, read 8 bytes a point:
-        // reading them from the rows was 2 % of the samples of a two-thread pyramid100 run.
+        // The layout is a function of the points' body slots and manifolds alone: when they
+        // repeat (an island at rest keeps its points), last pack's layout stands. They are
+        // first copied out of the 344-byte rows (on rayon's threads for a large island), so
+        // that the comparison, the grouping and the colouring, which are serial, read 16 bytes
+        // a point: reading them from the rows was 2 % of the samples of a two-thread
+        // pyramid100 run.
         let parallel_fill = spread(parallel, constraints.len(), PARALLEL_PACK_POINTS - 1);
-        let key = |c: &ContactConstraint| (c.local_a, c.local_b);
+        let key = |c: &ContactConstraint| PointKey {
+            local_a: c.local_a,
+            local_b: c.local_b,
+            pair: c.source.0,
+            manifold: c.source.1,
+        };
         if parallel_fill {
             use rayon::prelude::*;
             constraints
@@ -384,16 +422,12 @@ impl Bundles {
             self.lay_out(slots);
         }
         let total = self.groups.last().map_or(0, |g| (g.start + g.len) as usize);
-        let empty = Bundle {
-            local_a: [immovable; LANES],
-            local_b: [immovable; LANES],
-            ..Bundle::default()
-        };
+        let empty = Bundle::default();
         // On the last pack's layout every lane is a point again, and the fill below writes
         // every number of its bundle and geometry, or it is padding, which still holds what
-        // the reset gave it (its slots) and what the sweeps computed from its zero masses,
-        // directions and lever arms (zero impulses; targets, which every solve sets before
-        // reading). So only a new layout resets the bundles.
+        // the reset gave it and what the sweeps computed from its zero lever arms, effective
+        // masses and impulses (zero impulses; targets, which every solve sets before reading).
+        // So only a new layout resets the bundles.
         let reset = new_layout || self.bundles.len() != total || self.geometry.len() != total;
         if reset {
             if parallel_fill {
@@ -423,20 +457,28 @@ impl Bundles {
                 }
             });
         }
-        // Padding of a lane whose group is shorter than its lane group names the group's
-        // bodies, so that every bundle of a lane group names the same bodies per lane (as
-        // `Group` says); the sweeps and the target update read them from the first bundle.
+        // What each lane group's points share, lane by lane, from each manifold group's first
+        // point (lanes with no group: the immovable slot, zero masses and directions).
+        for g in &mut self.groups {
+            *g = Group {
+                start: g.start,
+                len: g.len,
+                local_a: [immovable; LANES],
+                local_b: [immovable; LANES],
+                ..Group::default()
+            };
+        }
         for (r, &(group, lane)) in self.run_places.iter().enumerate() {
-            let Group { start, len } = self.groups[group as usize];
-            let points = self.runs[r + 1] - self.runs[r];
-            if points < len {
-                let (a, b) = self.layout_keys[self.runs[r] as usize];
-                for index in start + points..start + len {
-                    let bundle = &mut self.bundles[index as usize];
-                    bundle.local_a[lane as usize] = a;
-                    bundle.local_b[lane as usize] = b;
-                }
-            }
+            let c = &constraints[self.runs[r] as usize];
+            let (g, i) = (&mut self.groups[group as usize], lane as usize);
+            g.local_a[i] = c.local_a;
+            g.local_b[i] = c.local_b;
+            set_vec(&mut g.inverse_mass_a, i, c.inverse_mass_a);
+            set_vec(&mut g.inverse_mass_b, i, c.inverse_mass_b);
+            set_vec(&mut g.directions[0], i, c.normal.direction);
+            set_vec(&mut g.directions[1], i, c.tangents[0].direction);
+            set_vec(&mut g.directions[2], i, c.tangents[1].direction);
+            set(&mut g.friction, i, c.friction);
         }
         // Padding alone needs nothing computed: its products are the zeros it was reset to.
         if constraints.iter().any(|c| c.products_pending) {
@@ -454,16 +496,14 @@ impl Bundles {
             if geometry.iter().all(|g| !g.pending.contains(&true)) {
                 return;
             }
-            let Some(first) = bundles.first() else {
-                return;
-            };
-            let inertia_a = inertia_lanes(&first.local_a, inverse_inertia);
-            let inertia_b = inertia_lanes(&first.local_b, inverse_inertia);
-            for (b, g) in bundles.iter_mut().zip(geometry) {
-                if g.pending == [true; LANES] {
-                    bundle_products::<true>(b, g, &inertia_a, &inertia_b);
-                } else if g.pending.contains(&true) {
-                    bundle_products::<false>(b, g, &inertia_a, &inertia_b);
+            let inertia_a = inertia_lanes(&g.local_a, inverse_inertia);
+            let inertia_b = inertia_lanes(&g.local_b, inverse_inertia);
+            let inertia = (&inertia_a, &inertia_b);
+            for (b, where_) in bundles.iter_mut().zip(geometry) {
+                if where_.pending == [true; LANES] {
+                    bundle_products::<true>(b, g, where_, inertia);
+                } else if where_.pending.contains(&true) {
+                    bundle_products::<false>(b, g, where_, inertia);
                 }
             }
         };
@@ -500,7 +540,7 @@ impl Bundles {
     /// manifold groups, their colours, lane groups and each point's slot.
     fn lay_out(&mut self, slots: usize) {
         let keys = &self.layout_keys;
-        // Manifold groups: runs of points between the same two bodies.
+        // Manifold groups: runs of points of one manifold (between the same two bodies).
         self.runs.clear();
         for (k, key) in keys.iter().enumerate() {
             let continues = self.runs.last().is_some_and(|&first| {
@@ -515,7 +555,10 @@ impl Bundles {
         let run_points = |runs: &[u32], r: usize| (runs[r + 1] - runs[r]) as usize;
         // Greedy colours of the groups, and the groups per colour.
         let runs = &self.runs;
-        let group_slots = (0..run_count).map(|r| keys[runs[r] as usize]);
+        let group_slots = (0..run_count).map(|r| {
+            let key = keys[runs[r] as usize];
+            (key.local_a, key.local_b)
+        });
         let counts = greedy_colours(group_slots, slots, &mut self.used, &mut self.colours);
         // Lane groups per colour (the last colour: one group each), and where each starts.
         let per_group = |colour: usize| if colour < COLOURS { LANES } else { 1 };
@@ -775,10 +818,7 @@ impl Bundles {
             let records = records;
             for group in groups {
                 let range = group.start as usize..(group.start + group.len) as usize;
-                let Some(first) = bundles.get(range.start) else {
-                    continue;
-                };
-                let (a, b) = (&first.local_a, &first.local_b);
+                let (a, b) = (&group.local_a, &group.local_b);
                 let before = BodyLanes::gather(a, b, before_linear_ref, before_angular_ref);
                 let after = BodyLanes::gather(a, b, linear, angular);
                 let end = range.end.min(len);
@@ -786,7 +826,7 @@ impl Bundles {
                     // SAFETY: `index` < the records' length (`len`); the groups' ranges are
                     // disjoint, so no other task writes this record.
                     unsafe {
-                        *records.0.add(index) = record_bundle(bundle, &before, &after);
+                        *records.0.add(index) = record_bundle(bundle, group, &before, &after);
                     }
                 }
             }
@@ -1026,10 +1066,11 @@ trait BundleUpdate: Copy + Sync {
     /// As [`SharedLanes::gather`] for whatever the update reads per body.
     unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::Group;
 
-    /// Updates bundle `index` (see the trait).
+    /// Updates bundle `index` of lane group `frame` (see the trait).
     fn update_at(
         self,
         b: &mut Bundle,
+        frame: &Group,
         index: usize,
         v: &mut BodyLanes,
         group: &mut Self::Group,
@@ -1057,8 +1098,15 @@ impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
     #[inline(always)]
     unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
     #[inline(always)]
-    fn update_at(self, b: &mut Bundle, _: usize, v: &mut BodyLanes, _: &mut ()) -> Lane {
-        solve_bundle::<FRICTION>(b, v)
+    fn update_at(
+        self,
+        b: &mut Bundle,
+        frame: &Group,
+        _: usize,
+        v: &mut BodyLanes,
+        _: &mut (),
+    ) -> Lane {
+        solve_bundle::<FRICTION>(b, frame, v)
     }
     #[inline(always)]
     unsafe fn end(self, _: &[u32; LANES], _: &[u32; LANES], _: &()) {}
@@ -1078,13 +1126,20 @@ impl BundleUpdate for WarmStart {
     unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
 
     #[inline(always)]
-    fn update_at(self, b: &mut Bundle, index: usize, v: &mut BodyLanes, _: &mut ()) -> Lane {
+    fn update_at(
+        self,
+        b: &mut Bundle,
+        frame: &Group,
+        index: usize,
+        v: &mut BodyLanes,
+        _: &mut (),
+    ) -> Lane {
         if let Some(totals) = self.totals {
             // SAFETY: `totals` has one entry per bundle (`pack` sizes it so) and `index` is
             // the bundle's; no other thread touches this bundle's entry meanwhile.
             add_to_totals(unsafe { &mut *totals.0.add(index) }, b);
         }
-        apply_impulses(b, v);
+        apply_impulses(b, frame, v);
         Lane::splat(0.0)
     }
 
@@ -1100,13 +1155,16 @@ fn add_to_totals(total: &mut [Lane; 3], b: &Bundle) {
     total[2] += b.tangent_impulses[1];
 }
 
-/// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v`.
+/// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v` (its lane group `frame`).
 #[inline(always)]
-fn apply_impulses(b: &Bundle, v: &mut BodyLanes) {
-    let masses = (b.inverse_mass_a, b.inverse_mass_b);
-    b.normal.apply(b.normal_impulse, masses, v);
-    b.tangents[0].apply(b.tangent_impulses[0], masses, v);
-    b.tangents[1].apply(b.tangent_impulses[1], masses, v);
+fn apply_impulses(b: &Bundle, frame: &Group, v: &mut BodyLanes) {
+    let (masses, [n, t1, t2]) = (
+        (frame.inverse_mass_a, frame.inverse_mass_b),
+        &frame.directions,
+    );
+    b.normal.apply(n, b.normal_impulse, masses, v);
+    b.tangents[0].apply(t1, b.tangent_impulses[0], masses, v);
+    b.tangents[1].apply(t2, b.tangent_impulses[1], masses, v);
 }
 
 /// The relax sweep of a substep that another substep follows: the velocity rows with friction
@@ -1133,14 +1191,15 @@ impl BundleUpdate for RelaxCarrying {
     fn update_at(
         self,
         b: &mut Bundle,
+        frame: &Group,
         index: usize,
         v: &mut BodyLanes,
         carried: &mut BodyLanes,
     ) -> Lane {
-        let largest = solve_bundle::<true>(b, v);
+        let largest = solve_bundle::<true>(b, frame, v);
         // SAFETY: as `WarmStart`'s.
         add_to_totals(unsafe { &mut *self.totals.0.add(index) }, b);
-        apply_impulses(b, carried);
+        apply_impulses(b, frame, carried);
         largest
     }
 
@@ -1155,15 +1214,16 @@ impl BundleUpdate for RelaxCarrying {
 /// with the operations of the scalar record in the same order (`JacobianRow::velocity`,
 /// `diagnostics::row_squared_natural_map`).
 #[inline(always)]
-fn record_bundle(b: &Bundle, before: &BodyLanes, after: &BodyLanes) -> BundleRecord {
+fn record_bundle(b: &Bundle, frame: &Group, before: &BodyLanes, after: &BodyLanes) -> BundleRecord {
     let [t1, t2] = &b.tangents;
-    let normal_velocity = b.normal.velocity(after) - b.target;
+    let [d_n, d_1, d_2] = &frame.directions;
+    let normal_velocity = b.normal.velocity(d_n, after) - b.target;
     let g = b.tangent_impulses;
-    let slip = [t1.velocity(after), t2.velocity(after)];
+    let slip = [t1.velocity(d_1, after), t2.velocity(d_2, after)];
     // `solver::cap_to_disc`'s steps per lane (the sweeps' lane version clamps its scale,
     // which may round differently).
     let (zero, trial) = (Lane::splat(0.0), [g[0] - slip[0], g[1] - slip[1]]);
-    let limit = b.friction * b.normal_impulse;
+    let limit = frame.friction * b.normal_impulse;
     let squared = trial[0] * trial[0] + trial[1] * trial[1];
     let inside = squared.simd_le(limit * limit);
     let positive = squared.simd_gt(zero);
@@ -1171,9 +1231,9 @@ fn record_bundle(b: &Bundle, before: &BodyLanes, after: &BodyLanes) -> BundleRec
     let projected = trial.map(|x| inside.select(x, positive.select(x * scale, zero)));
     BundleRecord {
         velocity_before: [
-            b.normal.velocity(before),
-            t1.velocity(before),
-            t2.velocity(before),
+            b.normal.velocity(d_n, before),
+            t1.velocity(d_1, before),
+            t2.velocity(d_2, before),
         ],
         phi: [
             b.normal_impulse.min(normal_velocity),
@@ -1188,7 +1248,7 @@ fn record_bundle(b: &Bundle, before: &BodyLanes, after: &BodyLanes) -> BundleRec
 trait SetTargets: Copy + Sync {
     type Moved;
     fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::Moved;
-    fn set(&self, b: &mut Bundle, index: usize, moved: &Self::Moved);
+    fn set(&self, b: &mut Bundle, frame: &Group, index: usize, moved: &Self::Moved);
 }
 
 /// A sweep that leaves the targets as they are.
@@ -1200,7 +1260,7 @@ impl SetTargets for NoTargets {
     #[inline(always)]
     fn moved(&self, _: &[u32; LANES], _: &[u32; LANES]) {}
     #[inline(always)]
-    fn set(&self, _: &mut Bundle, _: usize, _: &()) {}
+    fn set(&self, _: &mut Bundle, _: &Group, _: usize, _: &()) {}
 }
 
 /// The target update's constants as lanes, and what it reads.
@@ -1278,13 +1338,19 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
     /// ([`crate::contact::constraints::speculative_row_is_stale`]) gets
     /// [`STALE_TARGET`], as in [`crate::contact::constraints::update_targets`].
     #[inline(always)]
-    fn set(&self, b: &mut Bundle, index: usize, (moved, [turn_a, turn_b]): &Self::Moved) {
+    fn set(
+        &self,
+        b: &mut Bundle,
+        frame: &Group,
+        index: usize,
+        (moved, [turn_a, turn_b]): &Self::Moved,
+    ) {
         let t = self.0;
         let zero = Lane::splat(0.0);
         let g = &t.geometry[index];
         let at_a = add_cross(moved.linear_a, moved.angular_a, g.lever_a);
         let at_b = add_cross(moved.linear_b, moved.angular_b, g.lever_b);
-        let separation = dot(b.normal.direction, sub(at_a, at_b)) - g.depth;
+        let separation = dot(frame.directions[0], sub(at_a, at_b)) - g.depth;
         let gap = separation.simd_gt(zero);
         let repair = (t.repair_rate * (-separation - t.slop).max(zero)).min(t.max_repair);
         let overlap_target = if t.with_repair { repair } else { zero };
@@ -1351,15 +1417,10 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
     let mut largest = Lane::splat(0.0);
     let n = groups.len();
     for step in 0..n {
-        let group = groups[if forward { step } else { n - 1 - step }];
+        let group = &groups[if forward { step } else { n - 1 - step }];
         let (start, count) = (group.start as usize, group.len as usize);
         debug_assert!(start + count <= len);
-        // SAFETY: the caller's contract; the slots are copied out before any bundle is
-        // borrowed mutably.
-        let (slots_a, slots_b) = unsafe {
-            let first = &*bundles.0.add(start);
-            (first.local_a, first.local_b)
-        };
+        let (slots_a, slots_b) = (group.local_a, group.local_b);
         let mut v = unsafe { velocities.gather(&slots_a, &slots_b) };
         // SAFETY: the caller's contract covers what the update reads and writes per body.
         let mut state = unsafe { update.begin(&slots_a, &slots_b) };
@@ -1388,8 +1449,8 @@ unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
             }
             // SAFETY: the caller's contract.
             let b = unsafe { &mut *bundles.0.add(index) };
-            targets.set(b, index, &moved);
-            largest = largest.max(update.update_at(b, index, &mut v, &mut state));
+            targets.set(b, group, index, &moved);
+            largest = largest.max(update.update_at(b, group, index, &mut v, &mut state));
         }
         // SAFETY: the caller's contract.
         unsafe {
@@ -1472,19 +1533,13 @@ fn add_cross(linear: LaneVec, angular: LaneVec, lever: LaneVec) -> LaneVec {
     ]
 }
 
-/// Writes point `c` into lane `i` of a bundle. A point with pending lever-arm products gets its
-/// directions, and in its normal row's `inverse_effective_mass` the linear part of every row's
-/// J M⁻¹ Jᵀ, 1/m_a + 1/m_b, for [`bundle_products`] to complete.
+/// Writes point `c` into lane `i` of a bundle (what its manifold group's points share goes to
+/// their lane group, [`Group`]). A point with pending lever-arm products gets, in its normal
+/// row's `inverse_effective_mass`, the linear part of every row's J M⁻¹ Jᵀ, 1/m_a + 1/m_b,
+/// for [`bundle_products`] to complete.
 #[inline(always)]
 fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &ContactConstraint) {
-    b.local_a[i] = c.local_a;
-    b.local_b[i] = c.local_b;
-    set_vec(&mut b.inverse_mass_a, i, c.inverse_mass_a);
-    set_vec(&mut b.inverse_mass_b, i, c.inverse_mass_b);
     if c.products_pending {
-        set_vec(&mut b.normal.direction, i, c.normal.direction);
-        set_vec(&mut b.tangents[0].direction, i, c.tangents[0].direction);
-        set_vec(&mut b.tangents[1].direction, i, c.tangents[1].direction);
         // Pending only for bodies with no translation locked (see `products_pending`).
         let linear = c.inverse_mass_a.x + c.inverse_mass_b.x;
         set(&mut b.normal.inverse_effective_mass, i, linear);
@@ -1503,7 +1558,6 @@ fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &ContactConstra
         set(&mut b.sliding_step, i, sliding_step(c.tangent_block));
         g.pending[i] = false;
     }
-    set(&mut b.friction, i, c.friction);
     set(&mut b.target, i, c.target_normal_velocity);
     set(&mut b.mass_scale, i, c.softness.0);
     set(&mut b.impulse_scale, i, c.softness.1);
@@ -1531,12 +1585,14 @@ fn mul_tensor(m: &[LaneVec; 3], v: LaneVec) -> LaneVec {
     [0, 1, 2].map(|r| m[0][r] * v[0] + m[1][r] * v[1] + m[2][r] * v[2])
 }
 
-/// The lever-arm products of one row in the lanes of its bundle, where `pending`: r × d for
-/// both bodies, I⁻¹(r × d), and the row's J M⁻¹ Jᵀ = `linear` + (r_a × d)·I_a⁻¹(r_a × d) +
-/// (r_b × d)·I_b⁻¹(r_b × d) and its inverse, as `JacobianRow::fill_products` computes them.
+/// The lever-arm products of one row of direction d in the lanes of its bundle, where
+/// `pending`: r × d for both bodies, I⁻¹(r × d), and the row's J M⁻¹ Jᵀ = `linear` +
+/// (r_a × d)·I_a⁻¹(r_a × d) + (r_b × d)·I_b⁻¹(r_b × d) and its inverse, as
+/// `ContactConstraint::fill_products` computes them.
 #[inline(always)]
 fn row_products<const ALL: bool>(
     row: &mut RowLanes,
+    direction: LaneVec,
     linear: Lane,
     geometry: &BundleGeometry,
     inertia: (&[LaneVec; 3], &[LaneVec; 3]),
@@ -1549,8 +1605,8 @@ fn row_products<const ALL: bool>(
             [0, 1, 2].map(|k| pending.select(new[k], old[k]))
         }
     };
-    let angular_a = cross(geometry.lever_a, row.direction);
-    let angular_b = cross(geometry.lever_b, row.direction);
+    let angular_a = cross(geometry.lever_a, direction);
+    let angular_b = cross(geometry.lever_b, direction);
     let inverse_inertia_angular_a = mul_tensor(inertia.0, angular_a);
     let inverse_inertia_angular_b = mul_tensor(inertia.1, angular_b);
     let k = linear
@@ -1572,8 +1628,8 @@ fn select<const ALL: bool>(pending: Lane, new: Lane, old: Lane) -> Lane {
     if ALL { new } else { pending.select(new, old) }
 }
 
-/// The pending lever-arm products of bundle `b` (see [`set_lane`]) for its lanes' tensors
-/// `inertia_a`, `inertia_b`: each row's (see [`row_products`]), the tangent block's inverse
+/// The pending lever-arm products of bundle `b` (see [`set_lane`]) of lane group `frame`, for
+/// its lanes' tensors `inertia` (A's, B's): each row's (see [`row_products`]), the tangent block's inverse
 /// and the sliding step, per lane as the scalar `tangent_block`, `inverse_block` and
 /// [`sliding_step`] give them.
 ///
@@ -1582,17 +1638,17 @@ fn select<const ALL: bool>(pending: Lane, new: Lane, old: Lane) -> Lane {
 #[inline(always)]
 fn bundle_products<const ALL: bool>(
     b: &mut Bundle,
+    frame: &Group,
     geometry: &BundleGeometry,
-    inertia_a: &[LaneVec; 3],
-    inertia_b: &[LaneVec; 3],
+    inertia: (&[LaneVec; 3], &[LaneVec; 3]),
 ) {
     let (zero, one) = (Lane::splat(0.0), Lane::splat(1.0));
     let pending = Lane::new(geometry.pending.map(|p| if p { 1.0 } else { 0.0 })).simd_ne(zero);
     let linear = b.normal.inverse_effective_mass;
-    let inertia = (inertia_a, inertia_b);
-    row_products::<ALL>(&mut b.normal, linear, geometry, inertia, pending);
-    row_products::<ALL>(&mut b.tangents[0], linear, geometry, inertia, pending);
-    row_products::<ALL>(&mut b.tangents[1], linear, geometry, inertia, pending);
+    let [n, t1, t2] = frame.directions;
+    row_products::<ALL>(&mut b.normal, n, linear, geometry, inertia, pending);
+    row_products::<ALL>(&mut b.tangents[0], t1, linear, geometry, inertia, pending);
+    row_products::<ALL>(&mut b.tangents[1], t2, linear, geometry, inertia, pending);
     // The tangent block K (the linear parts couple the tangents only through a locked
     // translation axis, which pending points do not have).
     let [t1, t2] = &b.tangents;
@@ -1652,10 +1708,10 @@ fn set_vec(lanes: &mut LaneVec, i: usize, value: Vec3) {
 /// `fast` fell). A Newton iteration on the disc would keep a bundle waiting on its slowest
 /// lane; this step costs the same on every lane.
 #[inline(always)]
-fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
-    let normal = solve_normal(b, v);
+fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, frame: &Group, v: &mut BodyLanes) -> Lane {
+    let normal = solve_normal(b, frame, v);
     if FRICTION {
-        normal.max(solve_friction(b, v))
+        normal.max(solve_friction(b, frame, v))
     } else {
         normal
     }
@@ -1663,11 +1719,14 @@ fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, v: &mut BodyLanes) -> Lane
 
 /// The normal row's part of [`solve_bundle`]: returns each lane's row velocity change (m/s).
 #[inline(always)]
-fn solve_normal(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
+fn solve_normal(b: &mut Bundle, frame: &Group, v: &mut BodyLanes) -> Lane {
     let zero = Lane::splat(0.0);
-    let masses = (b.inverse_mass_a, b.inverse_mass_b);
+    let (masses, direction) = (
+        (frame.inverse_mass_a, frame.inverse_mass_b),
+        &frame.directions[0],
+    );
     let row = &b.normal;
-    let velocity = row.velocity(v);
+    let velocity = row.velocity(direction, v);
     let old = b.normal_impulse;
     let new = (old + row.effective_mass * b.mass_scale * (b.target - velocity)
         - b.impulse_scale * old)
@@ -1675,30 +1734,31 @@ fn solve_normal(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
     let delta = new - old;
     b.normal_impulse = new;
     b.max_normal_impulse = b.max_normal_impulse.max(new);
-    row.apply(delta, masses, v);
+    row.apply(direction, delta, masses, v);
     delta.abs() * row.inverse_effective_mass
 }
 
 /// The friction pair's part of [`solve_bundle`]: returns each lane's larger tangent row
 /// velocity change (m/s).
 #[inline(always)]
-fn solve_friction(b: &mut Bundle, v: &mut BodyLanes) -> Lane {
-    let masses = (b.inverse_mass_a, b.inverse_mass_b);
+fn solve_friction(b: &mut Bundle, frame: &Group, v: &mut BodyLanes) -> Lane {
+    let masses = (frame.inverse_mass_a, frame.inverse_mass_b);
     let [t1, t2] = &b.tangents;
-    let v1 = t1.velocity(v);
-    let v2 = t2.velocity(v);
+    let [_, d_1, d_2] = &frame.directions;
+    let v1 = t1.velocity(d_1, v);
+    let v2 = t2.velocity(d_2, v);
     let old = b.tangent_impulses;
     let new = friction_update(
         old,
         [v1, v2],
         b.tangent_inverse_block,
         b.sliding_step,
-        b.friction * b.normal_impulse,
+        frame.friction * b.normal_impulse,
     );
     let (d1, d2) = (new[0] - old[0], new[1] - old[1]);
     b.tangent_impulses = new;
-    t1.apply(d1, masses, v);
-    t2.apply(d2, masses, v);
+    t1.apply(d_1, d1, masses, v);
+    t2.apply(d_2, d2, masses, v);
     (d1.abs() * t1.inverse_effective_mass).max(d2.abs() * t2.inverse_effective_mass)
 }
 
@@ -1769,14 +1829,31 @@ mod tests {
         (0..STEPS).prop_map(move |k| low + (high - low) * (k as f32 / STEPS as f32))
     }
 
+    /// Every number of a lane group's shared part a sweep reads, as bits, in a fixed order.
+    fn group_bits(g: &Group) -> Vec<u32> {
+        let mut bits = vec![g.start, g.len];
+        bits.extend(g.local_a.iter().chain(&g.local_b));
+        let mut lanes: Vec<Lane> = Vec::new();
+        lanes.extend(g.inverse_mass_a.iter().chain(&g.inverse_mass_b));
+        lanes.extend(g.directions.iter().flatten());
+        lanes.push(g.friction);
+        bits.extend(lanes.iter().flat_map(|l| l.as_array().map(f32::to_bits)));
+        bits
+    }
+
+    /// [`group_bits`] of every lane group, then [`bundle_bits`] of every bundle, one entry each.
+    fn packed_bits(packed: &Bundles) -> Vec<Vec<u32>> {
+        let groups = packed.groups.iter().map(group_bits);
+        groups
+            .chain(packed.bundles.iter().map(bundle_bits))
+            .collect()
+    }
+
     /// Every number of a bundle a sweep reads, as bits, in a fixed order.
     fn bundle_bits(b: &Bundle) -> Vec<u32> {
-        let mut bits: Vec<u32> = b.local_a.iter().chain(&b.local_b).copied().collect();
         let mut lanes: Vec<Lane> = Vec::new();
-        lanes.extend(b.inverse_mass_a.iter().chain(&b.inverse_mass_b));
         for row in [&b.normal, &b.tangents[0], &b.tangents[1]] {
             for v in [
-                &row.direction,
                 &row.angular_a,
                 &row.angular_b,
                 &row.inverse_inertia_angular_a,
@@ -1787,7 +1864,7 @@ mod tests {
             lanes.extend([row.effective_mass, row.inverse_effective_mass]);
         }
         lanes.extend(&b.tangent_inverse_block);
-        lanes.extend([b.sliding_step, b.friction, b.normal_impulse]);
+        lanes.extend([b.sliding_step, b.normal_impulse]);
         lanes.extend(&b.tangent_impulses);
         lanes.extend([
             b.target,
@@ -1795,8 +1872,10 @@ mod tests {
             b.impulse_scale,
             b.max_normal_impulse,
         ]);
-        bits.extend(lanes.iter().flat_map(|l| l.as_array().map(f32::to_bits)));
-        bits
+        lanes
+            .iter()
+            .flat_map(|l| l.as_array().map(f32::to_bits))
+            .collect()
     }
 
     /// A symmetric positive semi-definite tensor L·Lᵀ from nine numbers (1/(kg·m²)).
@@ -1837,7 +1916,7 @@ mod tests {
                 _ => Vec3::ZERO,
             };
             let mut pending = Vec::new();
-            for (a, b, numbers, repeat) in points {
+            for (pair, (a, b, numbers, repeat)) in points.into_iter().enumerate() {
                 let b = if a == b { 7 } else { b };
                 let normal = Vec3::new(numbers[0], numbers[1], numbers[2] + 1.5).normalize();
                 let (t1, t2) = normal.any_orthonormal_pair();
@@ -1865,6 +1944,7 @@ mod tests {
                         friction: 0.5,
                         normal_impulse: k as f32,
                         products_pending: true,
+                        source: (pair as u32, 0, k as u16),
                         ..ContactConstraint::default()
                     });
                 }
@@ -1876,10 +1956,7 @@ mod tests {
             from_lanes.pack(&pending, slots, &inertia, false);
             let mut from_rows = Bundles::default();
             from_rows.pack(&complete, slots, &inertia, false);
-            prop_assert_eq!(from_lanes.bundles.len(), from_rows.bundles.len());
-            for (index, (x, y)) in from_lanes.bundles.iter().zip(&from_rows.bundles).enumerate() {
-                prop_assert_eq!(bundle_bits(x), bundle_bits(y), "bundle {}", index);
-            }
+            prop_assert_eq!(packed_bits(&from_lanes), packed_bits(&from_rows));
             // A pack on the last pack's layout resets no bundle: whatever other rows of the
             // same points, and a solve on them, left in the bundles, padding included, a pack
             // of `pending` or `complete` overwrites to the bits of a fresh pack.
@@ -1922,10 +1999,7 @@ mod tests {
                 let mut velocities = Velocities { linear: &mut linear, angular: &mut angular };
                 reused.solve_pgs(&mut velocities, &pass);
                 reused.pack(rows, slots, &inertia, false);
-                prop_assert_eq!(reused.bundles.len(), fresh.bundles.len());
-                for (index, (x, y)) in reused.bundles.iter().zip(&fresh.bundles).enumerate() {
-                    prop_assert_eq!(bundle_bits(x), bundle_bits(y), "reused bundle {}", index);
-                }
+                prop_assert_eq!(packed_bits(&reused), packed_bits(fresh));
             }
         }
     }
@@ -1933,7 +2007,9 @@ mod tests {
     /// Packing cuts each pair's run of points into manifold groups of at most
     /// [`GROUP_POINTS`], puts every point in exactly one lane, keeps a group's points in order
     /// in one lane of one lane group, gives no two lane groups of a colour a common moving
-    /// body, and leaves every other lane empty: zero masses and impulses.
+    /// body, keeps each lane's bodies and masses in the lane group, and leaves every other
+    /// lane without impulse or effective mass (a lane with no group: the immovable slot and
+    /// zero masses).
     /// The same points in an island of one more slot (another immovable slot) are laid out
     /// again: the padding lanes name the new immovable slot, as a fresh pack's do, though no
     /// point's body slots changed.
@@ -1958,11 +2034,8 @@ mod tests {
         reused.pack(&constraints, 6, &[Mat3::ZERO; 6], false);
         let mut fresh = Bundles::default();
         fresh.pack(&constraints, 6, &[Mat3::ZERO; 6], false);
-        assert!(fresh.bundles.iter().any(|b| b.local_a.contains(&5)));
-        assert_eq!(reused.bundles.len(), fresh.bundles.len());
-        for (index, (x, y)) in reused.bundles.iter().zip(&fresh.bundles).enumerate() {
-            assert_eq!(bundle_bits(x), bundle_bits(y), "bundle {index}");
-        }
+        assert!(fresh.groups.iter().any(|g| g.local_a.contains(&5)));
+        assert_eq!(packed_bits(&reused), packed_bits(&fresh));
     }
 
     #[test]
@@ -2003,10 +2076,7 @@ mod tests {
                 let b = &packed.bundles[index];
                 if k == u32::MAX {
                     assert_eq!(b.normal_impulse.as_array()[lane], 0.0);
-                    for axis in 0..3 {
-                        assert_eq!(b.inverse_mass_a[axis].as_array()[lane], 0.0);
-                        assert_eq!(b.inverse_mass_b[axis].as_array()[lane], 0.0);
-                    }
+                    assert_eq!(b.normal.effective_mass.as_array()[lane], 0.0);
                     continue;
                 }
                 seen[k as usize] += 1;
@@ -2015,30 +2085,37 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&n| n == 1), "{seen:?}");
-        // Lane groups: one pair of bodies per lane throughout, the group's points in order
-        // from the first bundle on, at most GROUP_POINTS of them.
+        // Lane groups: each lane holds one manifold group, whose bodies and masses the lane
+        // group keeps for the lane, its points in order from the first bundle on, at most
+        // GROUP_POINTS of them; a lane with none has the immovable slot and zero masses.
         for group in &packed.groups {
             let (start, len) = (group.start as usize, group.len as usize);
             assert!((1..=GROUP_POINTS).contains(&len));
             for lane in 0..LANES {
-                let first = &packed.bundles[start];
                 let mut previous = None;
                 let mut ended = false;
+                let slots = (group.local_a[lane], group.local_b[lane]);
+                let mass_b = group.inverse_mass_b[0].as_array()[lane];
                 for index in start..start + len {
-                    let b = &packed.bundles[index];
-                    assert_eq!(b.local_a[lane], first.local_a[lane]);
-                    assert_eq!(b.local_b[lane], first.local_b[lane]);
                     match packed.sources[index][lane] {
                         u32::MAX => ended = true,
                         k => {
                             assert!(!ended, "a hole inside lane {lane}'s group");
                             let c = &constraints[k as usize];
-                            assert_eq!((c.local_a, c.local_b), (b.local_a[lane], b.local_b[lane]));
+                            assert_eq!((c.local_a, c.local_b), slots);
+                            assert_eq!(c.inverse_mass_b.x, mass_b);
                             if let Some(p) = previous {
                                 assert_eq!(k, p + 1, "points out of order");
                             }
                             previous = Some(k);
                         }
+                    }
+                }
+                if previous.is_none() {
+                    assert_eq!(slots, (7, 7));
+                    for axis in 0..3 {
+                        assert_eq!(group.inverse_mass_a[axis].as_array()[lane], 0.0);
+                        assert_eq!(group.inverse_mass_b[axis].as_array()[lane], 0.0);
                     }
                 }
             }
@@ -2048,12 +2125,11 @@ mod tests {
             let mut bodies = std::collections::HashSet::new();
             let groups = packed.group_colour_starts[colour]..packed.group_colour_starts[colour + 1];
             for group in &packed.groups[groups] {
-                let b = &packed.bundles[group.start as usize];
                 for lane in 0..LANES {
                     if packed.sources[group.start as usize][lane] == u32::MAX {
                         continue;
                     }
-                    for slot in [b.local_a[lane], b.local_b[lane]] {
+                    for slot in [group.local_a[lane], group.local_b[lane]] {
                         assert!(
                             slot == 7 || bodies.insert(slot),
                             "slot {slot} twice in colour {colour}"
@@ -2068,6 +2144,54 @@ mod tests {
             lengths.iter().all(|&n| n as usize <= GROUP_POINTS),
             "{lengths:?}"
         );
+    }
+
+    /// A pair's manifolds (a compound's parts, a mesh's triangles) have normals of their own,
+    /// which their lane group keeps per lane: each manifold is a manifold group of its own,
+    /// even where its points follow another manifold's of the same pair, and its lane's
+    /// directions are its points'.
+    #[test]
+    fn packing_gives_each_manifold_of_a_pair_its_own_lane_and_directions() {
+        // One pair (slots 0 and 1, 2 immovable) with two manifolds of two points each, whose
+        // normals differ: up the y axis and tilted.
+        let tilted = Vec3::new(0.6, 0.8, 0.0);
+        let mut constraints = Vec::new();
+        for (manifold, normal) in [(0u16, Vec3::Y), (1, tilted)] {
+            for point in 0..2u16 {
+                let mut c = ContactConstraint {
+                    local_a: 0,
+                    local_b: 1,
+                    inverse_mass_a: Vec3::ONE,
+                    inverse_mass_b: Vec3::ONE,
+                    friction: 0.5,
+                    source: (0, manifold, point),
+                    ..ContactConstraint::default()
+                };
+                c.normal.direction = normal;
+                c.tangents[0].direction = normal.any_orthonormal_vector();
+                c.tangents[1].direction = normal.cross(c.tangents[0].direction);
+                constraints.push(c);
+            }
+        }
+        let mut packed = Bundles::default();
+        packed.pack(&constraints, 3, &[Mat3::ZERO; 3], false);
+        // Two manifold groups of two points: two lane groups (they share both bodies).
+        assert_eq!(packed.runs, [0, 2, 4]);
+        assert_eq!(packed.groups.len(), 2);
+        for (k, c) in constraints.iter().enumerate() {
+            let slot = packed.slots[k] as usize;
+            let (index, lane) = (slot / LANES, slot % LANES);
+            let group = packed
+                .groups
+                .iter()
+                .find(|g| (g.start as usize..(g.start + g.len) as usize).contains(&index))
+                .expect("every bundle belongs to a lane group");
+            let lanes = |v: &LaneVec| Vec3::from_array(v.map(|x| x.as_array()[lane]));
+            assert_eq!(lanes(&group.directions[0]), c.normal.direction);
+            assert_eq!(lanes(&group.directions[1]), c.tangents[0].direction);
+            assert_eq!(lanes(&group.directions[2]), c.tangents[1].direction);
+            assert_eq!(group.friction.as_array()[lane], 0.5);
+        }
     }
 
     #[test]
