@@ -132,9 +132,9 @@ impl BundleGeometry {
 /// holds a point of the same manifold group (the same two bodies, one manifold), so a sweep
 /// gathers the lanes' velocities once, updates the `len` bundles in turn on them, and
 /// scatters once. What a manifold group's points share is kept here once, lane by lane,
-/// rather than in each of its bundles: a sweep then streams 144 fewer bytes per bundle of the
-/// normal rows (352 instead of 480) and 288 fewer of all rows, while the group stays in the
-/// first-level cache as its bundles are updated. Padding points get their lane's values;
+/// rather than in each of its bundles: with four lanes a sweep of the normal rows then
+/// streams 304 bytes a bundle instead of 480, and a sweep of all rows 896 instead of 1,152,
+/// while the group stays in the first-level cache as its bundles are updated. Padding points get their lane's values;
 /// their zero lever arms, effective masses and impulses still make their updates change
 /// nothing.
 #[derive(Clone, Copy, Default, Debug, PartialEq)]
@@ -1058,29 +1058,29 @@ trait BundleUpdate: Copy + Sync {
 
     /// What an update keeps per lane group besides its bodies' velocities, from
     /// [`BundleUpdate::begin`] to [`BundleUpdate::end`].
-    type Group;
+    type GroupState;
 
     /// The group state of a lane group between the bodies at `slots_a` and `slots_b`.
     ///
     /// # Safety
     /// As [`SharedLanes::gather`] for whatever the update reads per body.
-    unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::Group;
+    unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::GroupState;
 
-    /// Updates bundle `index` of lane group `frame` (see the trait).
+    /// Updates bundle `index` of lane group `group` (see the trait).
     fn update_at(
         self,
         b: &mut Bundle,
-        frame: &Group,
+        group: &Group,
         index: usize,
         v: &mut BodyLanes,
-        group: &mut Self::Group,
+        state: &mut Self::GroupState,
     ) -> Lane;
 
     /// Writes back what the group state holds per body.
     ///
     /// # Safety
     /// As [`SharedLanes::scatter`].
-    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], group: &Self::Group);
+    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], group: &Self::GroupState);
 }
 
 /// The velocity rows ([`solve_bundle`]).
@@ -1094,19 +1094,19 @@ impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
     } else {
         NORMAL_PART
     };
-    type Group = ();
+    type GroupState = ();
     #[inline(always)]
     unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
     #[inline(always)]
     fn update_at(
         self,
         b: &mut Bundle,
-        frame: &Group,
+        group: &Group,
         _: usize,
         v: &mut BodyLanes,
         _: &mut (),
     ) -> Lane {
-        solve_bundle::<FRICTION>(b, frame, v)
+        solve_bundle::<FRICTION>(b, group, v)
     }
     #[inline(always)]
     unsafe fn end(self, _: &[u32; LANES], _: &[u32; LANES], _: &()) {}
@@ -1121,7 +1121,7 @@ struct WarmStart {
 }
 
 impl BundleUpdate for WarmStart {
-    type Group = ();
+    type GroupState = ();
     #[inline(always)]
     unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
 
@@ -1129,7 +1129,7 @@ impl BundleUpdate for WarmStart {
     fn update_at(
         self,
         b: &mut Bundle,
-        frame: &Group,
+        group: &Group,
         index: usize,
         v: &mut BodyLanes,
         _: &mut (),
@@ -1139,7 +1139,7 @@ impl BundleUpdate for WarmStart {
             // the bundle's; no other thread touches this bundle's entry meanwhile.
             add_to_totals(unsafe { &mut *totals.0.add(index) }, b);
         }
-        apply_impulses(b, frame, v);
+        apply_impulses(b, group, v);
         Lane::splat(0.0)
     }
 
@@ -1155,12 +1155,12 @@ fn add_to_totals(total: &mut [Lane; 3], b: &Bundle) {
     total[2] += b.tangent_impulses[1];
 }
 
-/// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v` (its lane group `frame`).
+/// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v` (its lane group `group`).
 #[inline(always)]
-fn apply_impulses(b: &Bundle, frame: &Group, v: &mut BodyLanes) {
+fn apply_impulses(b: &Bundle, group: &Group, v: &mut BodyLanes) {
     let (masses, [n, t1, t2]) = (
-        (frame.inverse_mass_a, frame.inverse_mass_b),
-        &frame.directions,
+        (group.inverse_mass_a, group.inverse_mass_b),
+        &group.directions,
     );
     b.normal.apply(n, b.normal_impulse, masses, v);
     b.tangents[0].apply(t1, b.tangent_impulses[0], masses, v);
@@ -1179,7 +1179,7 @@ struct RelaxCarrying {
 }
 
 impl BundleUpdate for RelaxCarrying {
-    type Group = BodyLanes;
+    type GroupState = BodyLanes;
 
     #[inline(always)]
     unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
@@ -1191,15 +1191,15 @@ impl BundleUpdate for RelaxCarrying {
     fn update_at(
         self,
         b: &mut Bundle,
-        frame: &Group,
+        group: &Group,
         index: usize,
         v: &mut BodyLanes,
         carried: &mut BodyLanes,
     ) -> Lane {
-        let largest = solve_bundle::<true>(b, frame, v);
+        let largest = solve_bundle::<true>(b, group, v);
         // SAFETY: as `WarmStart`'s.
         add_to_totals(unsafe { &mut *self.totals.0.add(index) }, b);
-        apply_impulses(b, frame, carried);
+        apply_impulses(b, group, carried);
         largest
     }
 
@@ -1214,16 +1214,16 @@ impl BundleUpdate for RelaxCarrying {
 /// with the operations of the scalar record in the same order (`JacobianRow::velocity`,
 /// `diagnostics::row_squared_natural_map`).
 #[inline(always)]
-fn record_bundle(b: &Bundle, frame: &Group, before: &BodyLanes, after: &BodyLanes) -> BundleRecord {
+fn record_bundle(b: &Bundle, group: &Group, before: &BodyLanes, after: &BodyLanes) -> BundleRecord {
     let [t1, t2] = &b.tangents;
-    let [d_n, d_1, d_2] = &frame.directions;
+    let [d_n, d_1, d_2] = &group.directions;
     let normal_velocity = b.normal.velocity(d_n, after) - b.target;
     let g = b.tangent_impulses;
     let slip = [t1.velocity(d_1, after), t2.velocity(d_2, after)];
     // `solver::cap_to_disc`'s steps per lane (the sweeps' lane version clamps its scale,
     // which may round differently).
     let (zero, trial) = (Lane::splat(0.0), [g[0] - slip[0], g[1] - slip[1]]);
-    let limit = frame.friction * b.normal_impulse;
+    let limit = group.friction * b.normal_impulse;
     let squared = trial[0] * trial[0] + trial[1] * trial[1];
     let inside = squared.simd_le(limit * limit);
     let positive = squared.simd_gt(zero);
@@ -1248,7 +1248,7 @@ fn record_bundle(b: &Bundle, frame: &Group, before: &BodyLanes, after: &BodyLane
 trait SetTargets: Copy + Sync {
     type Moved;
     fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::Moved;
-    fn set(&self, b: &mut Bundle, frame: &Group, index: usize, moved: &Self::Moved);
+    fn set(&self, b: &mut Bundle, group: &Group, index: usize, moved: &Self::Moved);
 }
 
 /// A sweep that leaves the targets as they are.
@@ -1341,7 +1341,7 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
     fn set(
         &self,
         b: &mut Bundle,
-        frame: &Group,
+        group: &Group,
         index: usize,
         (moved, [turn_a, turn_b]): &Self::Moved,
     ) {
@@ -1350,7 +1350,7 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
         let g = &t.geometry[index];
         let at_a = add_cross(moved.linear_a, moved.angular_a, g.lever_a);
         let at_b = add_cross(moved.linear_b, moved.angular_b, g.lever_b);
-        let separation = dot(frame.directions[0], sub(at_a, at_b)) - g.depth;
+        let separation = dot(group.directions[0], sub(at_a, at_b)) - g.depth;
         let gap = separation.simd_gt(zero);
         let repair = (t.repair_rate * (-separation - t.slop).max(zero)).min(t.max_repair);
         let overlap_target = if t.with_repair { repair } else { zero };
@@ -1628,7 +1628,7 @@ fn select<const ALL: bool>(pending: Lane, new: Lane, old: Lane) -> Lane {
     if ALL { new } else { pending.select(new, old) }
 }
 
-/// The pending lever-arm products of bundle `b` (see [`set_lane`]) of lane group `frame`, for
+/// The pending lever-arm products of bundle `b` (see [`set_lane`]) of lane group `group`, for
 /// its lanes' tensors `inertia` (A's, B's): each row's (see [`row_products`]), the tangent block's inverse
 /// and the sliding step, per lane as the scalar `tangent_block`, `inverse_block` and
 /// [`sliding_step`] give them.
@@ -1638,14 +1638,14 @@ fn select<const ALL: bool>(pending: Lane, new: Lane, old: Lane) -> Lane {
 #[inline(always)]
 fn bundle_products<const ALL: bool>(
     b: &mut Bundle,
-    frame: &Group,
+    group: &Group,
     geometry: &BundleGeometry,
     inertia: (&[LaneVec; 3], &[LaneVec; 3]),
 ) {
     let (zero, one) = (Lane::splat(0.0), Lane::splat(1.0));
     let pending = Lane::new(geometry.pending.map(|p| if p { 1.0 } else { 0.0 })).simd_ne(zero);
     let linear = b.normal.inverse_effective_mass;
-    let [n, t1, t2] = frame.directions;
+    let [n, t1, t2] = group.directions;
     row_products::<ALL>(&mut b.normal, n, linear, geometry, inertia, pending);
     row_products::<ALL>(&mut b.tangents[0], t1, linear, geometry, inertia, pending);
     row_products::<ALL>(&mut b.tangents[1], t2, linear, geometry, inertia, pending);
@@ -1708,10 +1708,10 @@ fn set_vec(lanes: &mut LaneVec, i: usize, value: Vec3) {
 /// `fast` fell). A Newton iteration on the disc would keep a bundle waiting on its slowest
 /// lane; this step costs the same on every lane.
 #[inline(always)]
-fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, frame: &Group, v: &mut BodyLanes) -> Lane {
-    let normal = solve_normal(b, frame, v);
+fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
+    let normal = solve_normal(b, group, v);
     if FRICTION {
-        normal.max(solve_friction(b, frame, v))
+        normal.max(solve_friction(b, group, v))
     } else {
         normal
     }
@@ -1719,11 +1719,11 @@ fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, frame: &Group, v: &mut Bod
 
 /// The normal row's part of [`solve_bundle`]: returns each lane's row velocity change (m/s).
 #[inline(always)]
-fn solve_normal(b: &mut Bundle, frame: &Group, v: &mut BodyLanes) -> Lane {
+fn solve_normal(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
     let zero = Lane::splat(0.0);
     let (masses, direction) = (
-        (frame.inverse_mass_a, frame.inverse_mass_b),
-        &frame.directions[0],
+        (group.inverse_mass_a, group.inverse_mass_b),
+        &group.directions[0],
     );
     let row = &b.normal;
     let velocity = row.velocity(direction, v);
@@ -1741,10 +1741,10 @@ fn solve_normal(b: &mut Bundle, frame: &Group, v: &mut BodyLanes) -> Lane {
 /// The friction pair's part of [`solve_bundle`]: returns each lane's larger tangent row
 /// velocity change (m/s).
 #[inline(always)]
-fn solve_friction(b: &mut Bundle, frame: &Group, v: &mut BodyLanes) -> Lane {
-    let masses = (frame.inverse_mass_a, frame.inverse_mass_b);
+fn solve_friction(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
+    let masses = (group.inverse_mass_a, group.inverse_mass_b);
     let [t1, t2] = &b.tangents;
-    let [_, d_1, d_2] = &frame.directions;
+    let [_, d_1, d_2] = &group.directions;
     let v1 = t1.velocity(d_1, v);
     let v2 = t2.velocity(d_2, v);
     let old = b.tangent_impulses;
@@ -1753,7 +1753,7 @@ fn solve_friction(b: &mut Bundle, frame: &Group, v: &mut BodyLanes) -> Lane {
         [v1, v2],
         b.tangent_inverse_block,
         b.sliding_step,
-        frame.friction * b.normal_impulse,
+        group.friction * b.normal_impulse,
     );
     let (d1, d2) = (new[0] - old[0], new[1] - old[1]);
     b.tangent_impulses = new;

@@ -834,9 +834,11 @@ fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
 fn normal_rows_sweep_reads_only_the_normal_part_of_a_bundle() {
     use super::{Bundle, Bundles, NORMAL_PART};
     use crate::solver::{ContactSolver, Velocities};
-    // Six cache lines of a bundle's eighteen, the normal rows' part past what its lane group
-    // keeps for all its bundles (bodies, masses, directions).
-    const _: () = assert!(NORMAL_PART <= 384 && std::mem::size_of::<Bundle>().is_multiple_of(64));
+    // Five cache lines of a bundle's fourteen (four lanes), the normal rows' part past what its
+    // lane group keeps for all its bundles (bodies, masses, directions).
+    const _: () = assert!(
+        NORMAL_PART <= 80 * super::LANES && std::mem::size_of::<Bundle>().is_multiple_of(64)
+    );
     let (w, rows) = settled_pyramid20_rows();
     let n = w.bodies.len();
     let settings = SolverSettings::default();
