@@ -134,9 +134,9 @@ impl BundleGeometry {
 /// scatters once. What a manifold group's points share is kept here once, lane by lane,
 /// rather than in each of its bundles: with four lanes a sweep of the normal rows then
 /// streams 304 bytes a bundle instead of 480, and a sweep of all rows 896 instead of 1,152,
-/// while the group stays in the first-level cache as its bundles are updated. Padding points get their lane's values;
-/// their zero lever arms, effective masses and impulses still make their updates change
-/// nothing.
+/// while the group stays in the first-level cache as its bundles are updated. Padding points
+/// get their lane's values; their zero lever arms, effective masses and impulses still make
+/// their updates change nothing.
 #[derive(Clone, Copy, Default, Debug, PartialEq)]
 struct Group {
     start: u32,
@@ -199,9 +199,9 @@ pub struct Bundles {
     used: Vec<u64>,
     colours: Vec<u8>,
     /// What the layout (`groups`, `runs`, `run_places`, `sources`, `slots`) was made for: each
-    /// point's body slots (local A, local B), and the island's slot count.
+    /// point's key (body slots, pair, manifold), and the island's slot count.
     layout_keys: Vec<PointKey>,
-    /// This pack's body slots per point, before they are compared with `layout_keys`.
+    /// This pack's key per point, before they are compared with `layout_keys`.
     keys: Vec<PointKey>,
     layout_slots: usize,
     /// What [`Bundles::record`] found per bundle, and the velocities v* it took them from;
@@ -371,7 +371,7 @@ impl Bundles {
     /// With `parallel`, each colour's lane groups are later spread over rayon's threads; the
     /// result is the same bit for bit, as the lane groups of one colour touch disjoint bodies.
     ///
-    /// When every point has the same body slots as in the last pack (an island at rest), the
+    /// When every point has the same key as in the last pack (an island at rest), the
     /// last layout is reused and only the lanes are filled again; the result is the same.
     ///
     /// Points whose lever-arm products are pending ([`ContactConstraint::products_pending`])
@@ -1080,7 +1080,7 @@ trait BundleUpdate: Copy + Sync {
     ///
     /// # Safety
     /// As [`SharedLanes::scatter`].
-    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], group: &Self::GroupState);
+    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], state: &Self::GroupState);
 }
 
 /// The velocity rows ([`solve_bundle`]).
