@@ -154,6 +154,14 @@ struct Group {
     friction: Lane,
 }
 
+impl Group {
+    /// The per-axis inverse masses of A and B, lane by lane.
+    #[inline(always)]
+    fn inverse_masses(&self) -> (LaneVec, LaneVec) {
+        (self.inverse_mass_a, self.inverse_mass_b)
+    }
+}
+
 /// What the layout of [`Bundles::pack`] is made from, per point: its body slots, its pair and
 /// its manifold in the pair ([`ContactConstraint::source`]). A manifold group is a run of
 /// consecutive points with the same key: one manifold's, whose normal and tangents its lane
@@ -390,7 +398,6 @@ impl Bundles {
         self.before_kept = false;
         self.carried = false;
         self.rows = None;
-        let immovable = (slots - 1) as u32;
         // The layout is a function of the points' body slots and manifolds alone: when they
         // repeat (an island at rest keeps its points), last pack's layout stands. They are
         // first copied out of the 344-byte rows (on rayon's threads for a large island), so
@@ -458,16 +465,8 @@ impl Bundles {
             });
         }
         // What each lane group's points share, lane by lane, from each manifold group's first
-        // point (lanes with no group: the immovable slot, zero masses and directions).
-        for g in &mut self.groups {
-            *g = Group {
-                start: g.start,
-                len: g.len,
-                local_a: [immovable; LANES],
-                local_b: [immovable; LANES],
-                ..Group::default()
-            };
-        }
+        // point; every field of a lane that holds a group (lanes with none keep what
+        // `lay_out` gave them: the immovable slot, zero masses and directions).
         for (r, &(group, lane)) in self.run_places.iter().enumerate() {
             let c = &constraints[self.runs[r] as usize];
             let (g, i) = (&mut self.groups[group as usize], lane as usize);
@@ -574,7 +573,13 @@ impl Bundles {
         // Each group to the next free lane of its colour, in constraint order; a lane group
         // is as long as its longest group.
         self.groups.clear();
-        self.groups.resize(total_groups, Group::default());
+        let immovable = (slots - 1) as u32;
+        let empty = Group {
+            local_a: [immovable; LANES],
+            local_b: [immovable; LANES],
+            ..Group::default()
+        };
+        self.groups.resize(total_groups, empty);
         self.run_places.clear();
         let mut filled = [0usize; COLOURS + 1];
         for r in 0..run_count {
@@ -1158,10 +1163,7 @@ fn add_to_totals(total: &mut [Lane; 3], b: &Bundle) {
 /// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v` (its lane group `group`).
 #[inline(always)]
 fn apply_impulses(b: &Bundle, group: &Group, v: &mut BodyLanes) {
-    let (masses, [n, t1, t2]) = (
-        (group.inverse_mass_a, group.inverse_mass_b),
-        &group.directions,
-    );
+    let (masses, [n, t1, t2]) = (group.inverse_masses(), &group.directions);
     b.normal.apply(n, b.normal_impulse, masses, v);
     b.tangents[0].apply(t1, b.tangent_impulses[0], masses, v);
     b.tangents[1].apply(t2, b.tangent_impulses[1], masses, v);
@@ -1629,9 +1631,9 @@ fn select<const ALL: bool>(pending: Lane, new: Lane, old: Lane) -> Lane {
 }
 
 /// The pending lever-arm products of bundle `b` (see [`set_lane`]) of lane group `group`, for
-/// its lanes' tensors `inertia` (A's, B's): each row's (see [`row_products`]), the tangent block's inverse
-/// and the sliding step, per lane as the scalar `tangent_block`, `inverse_block` and
-/// [`sliding_step`] give them.
+/// its lanes' tensors `inertia` (A's, B's): each row's (see [`row_products`]), the tangent
+/// block's inverse and the sliding step, per lane as the scalar `tangent_block`,
+/// `inverse_block` and [`sliding_step`] give them.
 ///
 /// `ALL`: every lane is pending (the usual case), and the results are stored without
 /// selecting lanes.
@@ -1721,10 +1723,7 @@ fn solve_bundle<const FRICTION: bool>(b: &mut Bundle, group: &Group, v: &mut Bod
 #[inline(always)]
 fn solve_normal(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
     let zero = Lane::splat(0.0);
-    let (masses, direction) = (
-        (group.inverse_mass_a, group.inverse_mass_b),
-        &group.directions[0],
-    );
+    let (masses, direction) = (group.inverse_masses(), &group.directions[0]);
     let row = &b.normal;
     let velocity = row.velocity(direction, v);
     let old = b.normal_impulse;
@@ -1742,7 +1741,7 @@ fn solve_normal(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
 /// velocity change (m/s).
 #[inline(always)]
 fn solve_friction(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
-    let masses = (group.inverse_mass_a, group.inverse_mass_b);
+    let masses = group.inverse_masses();
     let [t1, t2] = &b.tangents;
     let [_, d_1, d_2] = &group.directions;
     let v1 = t1.velocity(d_1, v);
