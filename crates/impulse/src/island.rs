@@ -127,7 +127,7 @@ impl Islands {
         self.pair_keys.extend(
             pairs
                 .iter()
-                .map(|p| (p.body1, p.body2, p.row_count() as u32)),
+                .map(|p| (p.body1, p.body2, p.point_count() as u32)),
         );
         if self.pair_keys == self.last_pair_keys
             && self.kinds == bodies.kind

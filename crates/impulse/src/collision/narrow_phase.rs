@@ -8,9 +8,7 @@
 
 use glam::Vec3;
 use parry3d::math::Pose;
-use parry3d::query::{
-    ContactManifold, ContactManifoldsWorkspace, PersistentQueryDispatcher, TrackedContact,
-};
+use parry3d::query::{ContactManifold, ContactManifoldsWorkspace, PersistentQueryDispatcher};
 use parry3d::utils::PoseOpt;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -88,11 +86,17 @@ pub struct ContactPair {
 /// stays the same from step to step (balls4096, steps 598–600: all 4101 bodies). A shape
 /// replaced in [`Bodies::shape`] has a new address; one changed in place behind its
 /// `SharedShape` is not seen until a pose changes.
+///
+/// It is also the reference a pair's manifolds are recycled against
+/// ([`ManifoldQuery::recycles_at`]): the query of the last time Parry was asked.
 #[derive(Clone, Copy)]
 struct ManifoldQuery {
     pose: Pose,
     distance: f32,
     shapes: [usize; 2],
+    /// For a pair whose manifolds may be recycled ([`recycle_reach`]), the farthest any point
+    /// of shape 2 lies from its frame's origin (m); `None` otherwise.
+    reach: Option<f32>,
 }
 
 impl ManifoldQuery {
@@ -106,15 +110,76 @@ impl ManifoldQuery {
         };
         bits(self) == bits(other) && self.shapes == other.shapes
     }
+
+    /// Whether `manifolds`, which Parry computed for this query (seams may have dropped
+    /// points since), stand for `now`: the same shapes, of kinds that may be recycled; every
+    /// manifold still with points; a speculative distance at most [`RECYCLE_DISTANCE`] longer;
+    /// and no point of shape 2 moved by more than [`RECYCLE_DISTANCE`] in shape 1's frame.
+    /// A point p of shape 2 moves there by (R p + t) − (R₀ p + t₀), at most
+    /// |t − t₀| + 2 sin(θ/2)·|p|, with θ the angle of R R₀⁻¹ (2 sin(θ/2) is the length of
+    /// the vector part of that quaternion, doubled).
+    fn recycles_at(&self, now: &Self, manifolds: &[Manifold]) -> bool {
+        let Some(reach) = self.reach else {
+            return false;
+        };
+        if self.shapes != now.shapes
+            || now.distance > self.distance + RECYCLE_DISTANCE
+            || manifolds.is_empty()
+            || manifolds.iter().any(|m| m.points.is_empty())
+        {
+            return false;
+        }
+        let turn = now.pose.rotation * self.pose.rotation.conjugate();
+        let shift = (now.pose.translation - self.pose.translation).length();
+        shift + 2.0 * turn.xyz().length() * reach <= RECYCLE_DISTANCE
+    }
+}
+
+/// How far (m) the bodies of a pair may move relative to each other, and its speculative
+/// distance grow, before its manifolds are computed again: while neither has, the manifolds
+/// of the last computation stand and only their points' separations are updated (each point
+/// is a point of each body, `ContactManifold::update_separations`). Rapier recycles a pair's
+/// contacts the same way (`IntegrationParameters::contact_recycling`, up to 5 cm of drift by
+/// default). Parry's own reuse (`ContactManifold::try_update_contacts`: within 1 mm and 1°
+/// of the points' last computation) checks every point, through a dispatch per pair, and
+/// stops whenever a point passes from gap to overlap, which a resting contact does back and
+/// forth; a pair recycled here skips the dispatch. The points are then at most Parry's
+/// tolerance plus this distance from where a full computation would put them, and a point
+/// the last computation did not find (beyond its speculative distance) is at least
+/// 2 × this distance short of the current one: as speculative points, such points only
+/// matter to bodies that close that far within a step, which moves them out of recycling.
+pub const RECYCLE_DISTANCE: f32 = 1.0e-3;
+
+/// For a pair of shapes whose manifolds may be recycled ([`ManifoldQuery::recycles_at`]),
+/// the farthest any point of `shape2` lies from its frame's origin (m); `None` for the rest.
+/// Recycled: pairs of convex polyhedra (cuboids, convex hulls) and half-spaces, whose
+/// manifolds are points of the bodies' flat faces, edges and corners. Not recycled: curved
+/// shapes, whose contact point moves over the surface as they roll (see
+/// [`has_curved_surface`]), and composite ones (meshes, compounds), whose parts' pairs
+/// come and go with the pose.
+fn recycle_reach(
+    shape1: &parry3d::shape::SharedShape,
+    shape2: &parry3d::shape::SharedShape,
+) -> Option<f32> {
+    use parry3d::shape::ShapeType;
+    let flat = |shape: &parry3d::shape::SharedShape| {
+        matches!(
+            shape.shape_type(),
+            ShapeType::Cuboid | ShapeType::ConvexPolyhedron | ShapeType::HalfSpace
+        )
+    };
+    if !(flat(shape1) && flat(shape2)) {
+        return None;
+    }
+    let sphere = shape2.compute_local_bounding_sphere();
+    let reach = sphere.center().length() + sphere.radius();
+    reach.is_finite().then_some(reach)
 }
 
 #[derive(Clone, Copy, Default)]
 struct PairSummary {
     points: u32,
-    rows: u32,
     max_depth: f32,
-    /// Whether some manifold lists a point twice ([`repeats_earlier_point`]).
-    duplicates: bool,
 }
 
 impl PairSummary {
@@ -122,12 +187,10 @@ impl PairSummary {
         let mut summary = Self::default();
         for manifold in manifolds {
             summary.points += manifold.points.len() as u32;
-            for (index, point) in manifold.points.iter().enumerate() {
+            for point in &manifold.points {
                 summary.max_depth = summary.max_depth.max(-point.dist);
-                summary.rows += u32::from(!repeats_earlier_point(&manifold.points, index));
             }
         }
-        summary.duplicates = summary.rows != summary.points;
         summary
     }
 }
@@ -140,15 +203,31 @@ pub(crate) fn same_point(p: Vec3, q: Vec3) -> bool {
     p.distance_squared(q) < DUPLICATE_POINT_DISTANCE_SQUARED
 }
 
-/// True when point `index` repeats an earlier point of its manifold. Parry's face-face cuboid
-/// manifolds can list a point twice (once per face clipped against the other); a duplicate
-/// row would only make A singular, so constraints are built for first copies only.
-pub(crate) fn repeats_earlier_point(
-    points: &[TrackedContact<ContactImpulse>],
-    index: usize,
-) -> bool {
-    let p = points[index].local_p1;
-    points[..index].iter().any(|q| same_point(q.local_p1, p))
+/// Keeps one copy of each point of `manifold`. Parry's face-face cuboid manifolds can list a
+/// point twice (once per face clipped against the other), which would give the LCP two equal
+/// rows (a singular A) and the point twice the weight; aligned boxes (every standard pyramid
+/// at its start) have them on half their pairs. The first copy stays, with the impulses of
+/// the copy that carries the largest normal impulse: which copy Parry lists first, and which
+/// one its next computation hands the impulses to (it matches points by feature), can change
+/// from one computation to the next.
+fn drop_duplicate_points(manifold: &mut Manifold) {
+    let points = &mut manifold.points;
+    let mut index = 1;
+    while index < points.len() {
+        let location = points[index].local_p1;
+        match points[..index]
+            .iter()
+            .position(|q| same_point(q.local_p1, location))
+        {
+            Some(first) => {
+                let copy = points.remove(index);
+                if copy.data.normal > points[first].data.normal {
+                    points[first].data = copy.data;
+                }
+            }
+            None => index += 1,
+        }
+    }
 }
 
 impl ContactPair {
@@ -170,20 +249,9 @@ impl ContactPair {
         self.summary.max_depth > 0.0
     }
 
-    /// Number of contact points over all manifolds (duplicates included).
+    /// Number of contact points over all manifolds, each a contact constraint.
     pub fn point_count(&self) -> usize {
         self.summary.points as usize
-    }
-
-    /// Number of contact constraints the pair yields: its points less repeated ones.
-    pub fn row_count(&self) -> usize {
-        self.summary.rows as usize
-    }
-
-    /// Whether some manifold of the pair lists a point twice, as of the last manifold update
-    /// ([`repeats_earlier_point`]): without, each point is its own row and its own warm start.
-    pub(crate) fn has_duplicate_points(&self) -> bool {
-        self.summary.duplicates
     }
 }
 
@@ -382,17 +450,27 @@ impl NarrowPhase {
             let prediction = margins.pair_prediction(bodies, a, b);
             let pos12 = bodies.pose[a].inv_mul(&bodies.pose[b]);
             let shape = |i: usize| std::sync::Arc::as_ptr(&bodies.shape[i].0) as *const () as usize;
-            let query = ManifoldQuery {
+            let mut query = ManifoldQuery {
                 pose: pos12,
                 distance: prediction,
                 shapes: [shape(a), shape(b)],
+                reach: None,
             };
-            if pair
-                .last_query
-                .as_ref()
-                .is_some_and(|last| last.same(&query))
-            {
-                return Ok(());
+            if let Some(last) = &pair.last_query {
+                if last.same(&query) {
+                    return Ok(());
+                }
+                if last.recycles_at(&query, &pair.manifolds) {
+                    let mut max_depth = 0.0f32;
+                    for manifold in &mut pair.manifolds {
+                        manifold.update_separations(&pos12);
+                        for point in &manifold.points {
+                            max_depth = max_depth.max(-point.dist);
+                        }
+                    }
+                    pair.summary.max_depth = max_depth;
+                    return Ok(());
+                }
             }
             if has_curved_surface(&bodies.shape[a]) || has_curved_surface(&bodies.shape[b]) {
                 for manifold in &mut pair.manifolds {
@@ -409,7 +487,11 @@ impl NarrowPhase {
                     &mut pair.workspace,
                 )
                 .map_err(|_| StepError::UnsupportedShapePair { body1: a, body2: b })?;
+            for manifold in &mut pair.manifolds {
+                drop_duplicate_points(manifold);
+            }
             pair.summary = PairSummary::of(&pair.manifolds);
+            query.reach = recycle_reach(&bodies.shape[a], &bodies.shape[b]);
             pair.last_query = Some(query);
             pair.recomputed = true;
             Ok(())
@@ -553,12 +635,19 @@ impl NarrowPhase {
                 } else {
                     [0, 0]
                 },
+                // A function of the shapes, which the snapshot's bodies carry.
+                reach: recycle_reach(&bodies.shape[a], &bodies.shape[b]),
             });
+            // Snapshots of earlier versions may hold a point twice.
+            let mut manifolds = state.manifolds;
+            for manifold in &mut manifolds {
+                drop_duplicate_points(manifold);
+            }
             restored.push(ContactPair {
                 body1: state.body1,
                 body2: state.body2,
-                summary: PairSummary::of(&state.manifolds),
-                manifolds: state.manifolds,
+                summary: PairSummary::of(&manifolds),
+                manifolds,
                 workspace: state.workspace,
                 last_query,
                 step_normal_impulse: state.step_normal_impulse,

@@ -1,7 +1,9 @@
 //! The narrow phase skips a pair's manifold update while the pair's relative pose, its
-//! speculative distance and its shapes are all unchanged. Whatever changes between steps (a
-//! pose moved by hand, a shape replaced), the next step must see the contact as it now is.
+//! speculative distance and its shapes are all unchanged, and recycles its points while they
+//! barely changed. Whatever changes between steps (a pose moved by hand, a shape replaced),
+//! the next step must see the contact as it now is.
 
+use super::*;
 use crate::test_support as common;
 
 use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
@@ -57,4 +59,174 @@ fn edits_between_steps_reach_the_contact() {
     w.bodies.shape[1] = SharedShape::ball(0.53);
     let depth = w.step().unwrap().max_depth;
     assert!((depth - 0.03).abs() < 1e-4, "after the new shape: {depth}");
+}
+
+/// A unit cube (dynamic) over a static box whose top face is at y = 0, its bottom face
+/// `gap` above it (m) and turned by `turn` (rad) about the vertical, without gravity.
+fn cube_over_ground(gap: f32, turn: f32) -> World {
+    let mut w = World::new(Vec3::ZERO, 1.0 / 60.0, SolverSettings::default()).unwrap();
+    let m = common::material(0.5);
+    w.add_body(
+        &common::static_box(Vec3::new(5.0, 0.5, 5.0), Vec3::new(0.0, -0.5, 0.0)),
+        &m,
+    )
+    .unwrap();
+    let mut cube = BodyDesc::new(
+        BodyKind::Dynamic,
+        ShapeDesc::Cuboid {
+            half_extents: [0.5; 3],
+        },
+        [0.0, 0.5 + gap, 0.0],
+    );
+    cube.orientation = glam::Quat::from_rotation_y(turn).to_array();
+    w.add_body(&cube, &m).unwrap();
+    w
+}
+
+/// The narrow phase of `w`'s two bodies after an update on their current poses: the same
+/// `narrow` again (as a step keeps it), or a new one when `narrow` is `None`.
+fn update_pair(w: &World, narrow: Option<NarrowPhase>) -> NarrowPhase {
+    let mut margins = SpeculativeMargins::default();
+    margins.update(&w.bodies, 0.02, Vec3::ZERO, 1.0 / 60.0);
+    let mut narrow = narrow.unwrap_or_default();
+    narrow
+        .update(&w.bodies, &[(0, 1)], &margins, false)
+        .unwrap();
+    narrow
+}
+
+/// Each point's separation (m) in `narrow`'s only pair.
+fn separations(narrow: &NarrowPhase) -> Vec<f32> {
+    let pair = &narrow.pairs[0];
+    pair.manifolds
+        .iter()
+        .flat_map(|m| m.points.iter().map(|p| p.dist))
+        .collect()
+}
+
+/// A pair whose bodies moved by less than [`RECYCLE_DISTANCE`] relative to each other keeps
+/// its points (the same body points) with their separations updated to the new pose, even
+/// where a point went from a gap to an overlap (which stops Parry's own reuse); the depths are
+/// those a new computation finds. Moved by more, it is computed again.
+#[test]
+fn a_pair_that_barely_moved_keeps_its_points_with_new_separations() {
+    let mut w = cube_over_ground(2e-4, 0.0);
+    let narrow = update_pair(&w, None);
+    assert!(narrow.pairs[0].recomputed);
+    let before: Vec<_> = narrow.pairs[0].manifolds[0].points.clone();
+    assert_eq!(before.len(), 4);
+    for d in separations(&narrow) {
+        assert!((d - 2e-4).abs() < 1e-6, "gap {d}");
+    }
+    // Down by 0.5 mm and sideways by 0.3 mm: 0.3 mm deep, within the recycling distance.
+    w.bodies.pose[1].translation += Vec3::new(3e-4, -5e-4, 0.0);
+    let narrow = update_pair(&w, Some(narrow));
+    let pair = &narrow.pairs[0];
+    assert!(!pair.recomputed, "recomputed after 0.58 mm");
+    for (kept, old) in pair.manifolds[0].points.iter().zip(&before) {
+        assert_eq!(kept.local_p1, old.local_p1);
+        assert_eq!(kept.local_p2, old.local_p2);
+    }
+    let fresh = update_pair(&w, None);
+    for (d, e) in separations(&narrow).iter().zip(separations(&fresh)) {
+        assert!(
+            (d + 3e-4).abs() < 1e-6 && (e + 3e-4).abs() < 1e-6,
+            "{d} against {e}"
+        );
+    }
+    assert!((narrow.max_depth() - 3e-4).abs() < 1e-6);
+    // Another 0.6 mm sideways: 0.9 mm from where the points were computed.
+    w.bodies.pose[1].translation.x += 6e-4;
+    let narrow = update_pair(&w, Some(narrow));
+    assert!(narrow.pairs[0].recomputed, "recycled after 0.9 mm sideways");
+}
+
+/// A turn moves shape 2's farthest points by about its angle times their distance from the
+/// centre (0.87 m for a unit cube): 1 mrad moves them 0.87 mm and the pair is recycled,
+/// 1.2 mrad moves them 1.04 mm and it is computed again.
+#[test]
+fn a_turn_counts_at_the_farthest_point_of_the_shape() {
+    for (turn, recycled) in [(1.0e-3, true), (1.2e-3, false)] {
+        let mut w = cube_over_ground(0.0, 0.0);
+        let narrow = update_pair(&w, None);
+        w.bodies.pose[1].rotation = glam::Quat::from_rotation_y(turn);
+        let narrow = update_pair(&w, Some(narrow));
+        assert_eq!(!narrow.pairs[0].recomputed, recycled, "turn {turn}");
+    }
+}
+
+/// Recycling is for flat shapes at rest relative to each other: a ball on the ground (a
+/// curved shape, whose contact point moves over its surface as it rolls) and a cube whose
+/// speculative distance grew (it now approaches the ground at 1 m/s) are computed again
+/// although they did not move.
+#[test]
+fn curved_shapes_and_a_longer_speculative_distance_are_computed_again() {
+    let mut w = ball_on_ground();
+    let narrow = update_pair(&w, None);
+    w.bodies.pose[1].translation.x += 1e-5;
+    assert!(update_pair(&w, Some(narrow)).pairs[0].recomputed, "ball");
+    let mut w = cube_over_ground(0.0, 0.0);
+    let narrow = update_pair(&w, None);
+    w.bodies.linear_velocity[1] = Vec3::new(0.0, -1.0, 0.0);
+    assert!(
+        update_pair(&w, Some(narrow)).pairs[0].recomputed,
+        "approaching cube"
+    );
+}
+
+/// Parry lists some corners of two aligned cubes' face-face manifold twice (once per face
+/// clipped against the other); the narrow phase keeps each point once, so a cube resting
+/// square on another has its four corners, one constraint each.
+#[test]
+fn aligned_cubes_have_each_corner_once() {
+    let mut w = World::new(Vec3::ZERO, 1.0 / 60.0, SolverSettings::default()).unwrap();
+    let m = common::material(0.5);
+    for y in [0.5, 1.5] {
+        let kind = if y < 1.0 {
+            BodyKind::Static
+        } else {
+            BodyKind::Dynamic
+        };
+        let cube = BodyDesc::new(
+            kind,
+            ShapeDesc::Cuboid {
+                half_extents: [0.5; 3],
+            },
+            [0.0, y, 0.0],
+        );
+        w.add_body(&cube, &m).unwrap();
+    }
+    let narrow = update_pair(&w, None);
+    let points = &narrow.pairs[0].manifolds[0].points;
+    assert_eq!(points.len(), 4);
+    for (i, p) in points.iter().enumerate() {
+        for q in &points[..i] {
+            assert!(p.local_p1.distance(q.local_p1) > 0.5, "{p:?} repeats {q:?}");
+        }
+    }
+    assert_eq!(narrow.pairs[0].point_count(), 4);
+}
+
+/// Of a point's copies, the one kept carries the largest normal impulse among them.
+#[test]
+fn the_copy_kept_carries_the_largest_impulse() {
+    let w = cube_over_ground(0.0, 0.0);
+    let narrow = update_pair(&w, None);
+    let mut manifold = narrow.pairs[0].manifolds[0].clone();
+    let mut copy = manifold.points[1];
+    copy.local_p1 += Vec3::splat(1e-6);
+    copy.data.normal = 7.0;
+    manifold.points[1].data.normal = 3.0;
+    manifold.points.push(copy);
+    let mut smaller = manifold.points[2];
+    smaller.data.normal = -1.0;
+    manifold.points.push(smaller);
+    drop_duplicate_points(&mut manifold);
+    assert_eq!(manifold.points.len(), 4);
+    assert_eq!(manifold.points[1].data.normal, 7.0);
+    assert_eq!(
+        manifold.points[1].local_p1,
+        narrow.pairs[0].manifolds[0].points[1].local_p1
+    );
+    assert_eq!(manifold.points[2].data.normal, 0.0);
 }

@@ -7,7 +7,7 @@
 use glam::{Mat3, Mat3A, Vec3, Vec3A};
 
 use crate::body::Bodies;
-use crate::collision::narrow_phase::{ContactPair, NarrowPhase, repeats_earlier_point, same_point};
+use crate::collision::narrow_phase::{ContactPair, NarrowPhase};
 use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::island::Islands;
 use crate::parallel::{PAIRS_PER_TASK, spread};
@@ -399,7 +399,7 @@ impl Assembly<'_> {
     ) -> impl Iterator<Item = (u32, usize, usize)> + '_ {
         pairs.filter_map(|index| {
             crate::collision::narrow_phase::prefetch_manifolds(self.pairs, index);
-            let count = self.pairs[index].row_count();
+            let count = self.pairs[index].point_count();
             (count > 0).then(|| (index as u32, self.islands.first_row(index), count))
         })
     }
@@ -433,7 +433,6 @@ impl Assembly<'_> {
             && settings.solves_in_lanes(self.islands.constraint_range(island).len());
         let inertia_a = &Mat3A::from(self.world_inverse_inertia[a]);
         let inertia_b = &Mat3A::from(self.world_inverse_inertia[b]);
-        let duplicates = pair.has_duplicate_points();
         for (manifold_index, manifold) in pair.manifolds.iter().enumerate() {
             if manifold.points.is_empty() {
                 continue;
@@ -444,22 +443,7 @@ impl Assembly<'_> {
             let normal = part_b.rotation * manifold.local_n1;
             let (t1, t2) = tangent_basis(normal, manifold.data.tangent);
             for (point_index, point) in manifold.points.iter().enumerate() {
-                // Which copy of a duplicated point comes first can change between steps, so
-                // the warm start takes the copy that carries an impulse and the write-back
-                // goes to every copy.
-                let warm = if duplicates {
-                    if repeats_earlier_point(&manifold.points, point_index) {
-                        continue;
-                    }
-                    manifold.points[point_index..]
-                        .iter()
-                        .filter(|q| same_point(q.local_p1, point.local_p1))
-                        .map(|q| q.data)
-                        .max_by(|x, y| x.normal.total_cmp(&y.normal))
-                        .unwrap_or(point.data)
-                } else {
-                    point.data
-                };
+                let warm = point.data;
                 // A speculative contact's impulse acts once its gap has closed, where the two
                 // witness points meet: each body's lever arm then reaches its own surface
                 // point, so a sphere's is its radius and an oblique impact spins it at the

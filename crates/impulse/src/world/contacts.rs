@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::World;
 use crate::body::BodyHandle;
-use crate::collision::narrow_phase::{self, ContactPair, repeats_earlier_point};
+use crate::collision::narrow_phase::{self, ContactPair};
 
 /// One contact point of a pair after the last step, in world coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,7 +45,7 @@ impl<'a> ContactPairView<'a> {
         self.world.handles.of_body[self.pair.body2 as usize]
     }
 
-    /// The pair's contact points (each point once, although Parry may list a point twice).
+    /// The pair's contact points.
     pub fn points(&self) -> impl Iterator<Item = ContactPoint> + 'a {
         let bodies = &self.world.bodies;
         let (pose1, pose2) = (
@@ -55,22 +55,17 @@ impl<'a> ContactPairView<'a> {
         self.pair.manifolds.iter().flat_map(move |manifold| {
             let (pose1, pose2) = narrow_phase::manifold_poses(manifold, &pose1, &pose2);
             let normal = pose1.rotation * manifold.local_n1;
-            manifold
-                .points
-                .iter()
-                .enumerate()
-                .filter(|&(index, _)| !repeats_earlier_point(&manifold.points, index))
-                .map(move |(_, point)| ContactPoint {
-                    position: 0.5
-                        * (pose1.transform_point(point.local_p1)
-                            + pose2.transform_point(point.local_p2)),
-                    normal,
-                    separation: point.dist,
-                    // The solver's normal pushes body 2 (its A) away from body 1 (its B), and
-                    // its friction vector is the impulse on A.
-                    normal_impulse: point.data.step_normal,
-                    friction_impulse: point.data.step_friction,
-                })
+            manifold.points.iter().map(move |point| ContactPoint {
+                position: 0.5
+                    * (pose1.transform_point(point.local_p1)
+                        + pose2.transform_point(point.local_p2)),
+                normal,
+                separation: point.dist,
+                // The solver's normal pushes body 2 (its A) away from body 1 (its B), and
+                // its friction vector is the impulse on A.
+                normal_impulse: point.data.step_normal,
+                friction_impulse: point.data.step_friction,
+            })
         })
     }
 
