@@ -461,14 +461,10 @@ impl NarrowPhase {
                     return Ok(());
                 }
                 if last.recycles_at(&query, &pair.manifolds) {
-                    let mut max_depth = 0.0f32;
                     for manifold in &mut pair.manifolds {
                         manifold.update_separations(&pos12);
-                        for point in &manifold.points {
-                            max_depth = max_depth.max(-point.dist);
-                        }
                     }
-                    pair.summary.max_depth = max_depth;
+                    pair.summary = PairSummary::of(&pair.manifolds);
                     return Ok(());
                 }
             }

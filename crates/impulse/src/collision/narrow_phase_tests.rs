@@ -141,15 +141,31 @@ fn a_pair_that_barely_moved_keeps_its_points_with_new_separations() {
     assert!(narrow.pairs[0].recomputed, "recycled after 0.9 mm sideways");
 }
 
+/// A pair whose manifold holds no point (its bodies farther apart than the speculative
+/// distance, 20 mm here) is computed again however little it moved: 0.7 mm closer, the cube
+/// comes within the distance and gets its four points.
+#[test]
+fn a_pair_without_points_is_computed_again() {
+    let mut w = cube_over_ground(0.0204, 0.0);
+    let narrow = update_pair(&w, None);
+    assert_eq!(narrow.pairs.len(), 1);
+    assert_eq!(narrow.pairs[0].point_count(), 0);
+    w.bodies.pose[1].translation.y -= 7e-4;
+    let narrow = update_pair(&w, Some(narrow));
+    assert!(narrow.pairs[0].recomputed);
+    assert_eq!(narrow.pairs[0].point_count(), 4);
+}
+
 /// A turn moves shape 2's farthest points by about its angle times their distance from the
-/// centre (0.87 m for a unit cube): 1 mrad moves them 0.87 mm and the pair is recycled,
-/// 1.2 mrad moves them 1.04 mm and it is computed again.
+/// centre (0.87 m for a unit cube): 1 mrad more than the cube's turn when the pair was
+/// computed (2 rad about the vertical) moves them 0.87 mm and the pair is recycled, 1.2 mrad
+/// moves them 1.04 mm and it is computed again.
 #[test]
 fn a_turn_counts_at_the_farthest_point_of_the_shape() {
     for (turn, recycled) in [(1.0e-3, true), (1.2e-3, false)] {
-        let mut w = cube_over_ground(0.0, 0.0);
+        let mut w = cube_over_ground(0.0, 2.0);
         let narrow = update_pair(&w, None);
-        w.bodies.pose[1].rotation = glam::Quat::from_rotation_y(turn);
+        w.bodies.pose[1].rotation = glam::Quat::from_rotation_y(2.0 + turn);
         let narrow = update_pair(&w, Some(narrow));
         assert_eq!(!narrow.pairs[0].recomputed, recycled, "turn {turn}");
     }
