@@ -71,7 +71,8 @@ pub struct ContactPair {
     /// step's diagnostics need not chase every manifold's heap block again (on balls16k that
     /// second pass over cold memory cost 5 % of the step).
     summary: PairSummary,
-    /// What the last manifold update was asked: see [`ManifoldQuery`].
+    /// What Parry was last asked for this pair (a recycled update leaves it): see
+    /// [`ManifoldQuery`].
     last_query: Option<ManifoldQuery>,
     /// The pair's normal impulse over the last step (N·s), summed as the impulses are written
     /// back: what contact events read without visiting every point.
