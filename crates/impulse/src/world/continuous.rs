@@ -35,19 +35,24 @@ impl World {
             if !b.is_dynamic(i) || b.asleep[i] || b.pose[i] == self.start_poses[i] {
                 continue;
             }
-            let sweep = Sweep::new(
-                self.start_poses[i],
-                b.pose[i],
-                b.local_center_of_mass[i],
-                b.angular_velocity[i] * self.dt,
-            );
+            let (start, end) = (self.start_poses[i], b.pose[i]);
+            let (center_of_mass, spin) =
+                (b.local_center_of_mass[i], b.angular_velocity[i] * self.dt);
             let shape = &*b.shape[i];
             let local = shape.compute_local_aabb();
             let half = local.half_extents();
             let min_half_extent = half.min_element();
-            let radius = (local.center() - sweep.local_center_of_mass).length() + half.length();
+            let radius = (local.center() - center_of_mass).length() + half.length();
+            // Most bodies are slow: a cheap bound settles them before the sweep's trigonometry.
+            let limit = FAST_FRACTION * min_half_extent;
+            if continuous::travel_bound(&start, &end, center_of_mass, spin, radius)
+                .is_some_and(|bound| bound <= limit)
+            {
+                continue;
+            }
+            let sweep = Sweep::new(start, end, center_of_mass, spin);
             let travel = sweep.travel(radius);
-            if !travel.is_finite() || travel <= FAST_FRACTION * min_half_extent {
+            if !travel.is_finite() || travel <= limit {
                 continue;
             }
             let body = FastBody {
