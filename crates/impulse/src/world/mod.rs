@@ -45,8 +45,8 @@ pub const BLOW_UP_SPEED: f32 = 1.0e4;
 /// 25 % overlapping, gains about 10 J/kg). 50 J/kg is every body lifted 5 m or moving at
 /// 10 m/s. A solve that fails to hold a pile can push it apart far faster than that while no
 /// body comes near [`BLOW_UP_SPEED`] (`impulse run pyramid100 --method pgs --substeps 4
-/// --iterations 1 --position-iterations 1` is such a solve; tests/blow_up.rs). Changing bodies between steps (velocities, poses, new bodies) restarts the
-/// reference.
+/// --iterations 1 --position-iterations 1` is such a solve; tests/blow_up.rs). Changing bodies between steps (velocities, poses, forces, new or removed
+/// bodies, gravity: every edit that wakes a body, [`World::wake_up`]) restarts the reference.
 pub const BLOW_UP_ENERGY_PER_KG: f64 = 50.0;
 
 /// Bodies, settings and the persistent contact state of a simulation.
@@ -332,12 +332,15 @@ impl World {
         self.parallel = parallel;
     }
 
-    /// Wakes the whole body `i` belongs to (its island wakes with it at the next step). Call
-    /// after changing a sleeping body's velocity or pose by hand.
+    /// Wakes the whole body `i` belongs to (its island wakes with it at the next step). Every
+    /// edit of a body between steps calls this, so it also restarts the blow-up check's
+    /// energy reference ([`BLOW_UP_ENERGY_PER_KG`]) at the next step: an edit may add energy
+    /// that no contact made.
     pub fn wake_up(&mut self, i: usize) {
         if i < self.bodies.len() {
             self.bodies.asleep[i] = false;
             self.bodies.sleep_time[i] = 0.0;
+            self.energy.started = false;
         }
     }
 

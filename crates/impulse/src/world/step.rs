@@ -15,14 +15,14 @@ use crate::parallel::{BODIES_PER_TASK, ISLANDS_PER_TASK, PAIRS_PER_TASK, SharedI
 use crate::settings::SolverSettings;
 use crate::solver::substep::{self, IslandWorkspace, StepContext};
 
-/// The energy check's state: the lowest mechanical energy since the last edit (J) and the
-/// energy at the end of the last step, to recognise edits made between steps.
+/// The energy check's state: the lowest mechanical energy since the last edit (J), and
+/// whether that reference holds. Every edit of the bodies between steps wakes a body
+/// ([`World::wake_up`]), which clears `started`; inserting a body changes `bodies`.
 #[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub(super) struct EnergyCheck {
     lowest: f64,
-    last: f64,
     bodies: usize,
-    started: bool,
+    pub(super) started: bool,
     /// What f32 rounding may have added since the reference restarted (J/kg).
     rounding: f64,
 }
@@ -117,41 +117,30 @@ impl World {
         Ok(&self.diagnostics)
     }
 
-    /// Speculative margins and candidate pairs on the poses and velocities at the step's start,
-    /// with the energy at the start summed beside them (read only to notice edits between
-    /// steps: the energy check's reference restarts whenever the bodies changed).
+    /// Speculative margins and candidate pairs on the poses and velocities at the step's start;
+    /// the energy check's reference restarts here after an edit.
     fn broad_phase_stage(&mut self, settings: &SolverSettings, parallel: bool) {
-        let dt = self.dt;
-        let (bodies, gravity) = (&self.bodies, self.gravity);
-        let (margins, broad_phase, candidates) = (
-            &mut self.margins,
-            &mut self.broad_phase,
-            &mut self.candidates,
-        );
-        let start_energy = || diagnostics::energy_terms(bodies, gravity).mechanical();
-        let mut broad = || {
-            margins.update(bodies, settings.prediction_distance, gravity, dt);
-            broad_phase.candidate_pairs(bodies, margins.margins(), parallel, candidates);
-        };
-        let start_energy = if parallel {
-            rayon::join(start_energy, broad).0
-        } else {
-            broad();
-            start_energy()
-        };
-        // The energy check's reference restarts whenever the bodies changed since the last step.
-        if !self.energy.started
-            || self.energy.bodies != self.bodies.len()
-            || start_energy != self.energy.last
-        {
+        if !self.energy.started || self.energy.bodies != self.bodies.len() {
+            let start_energy = diagnostics::energy_terms(&self.bodies, self.gravity).mechanical();
             self.energy = EnergyCheck {
                 lowest: start_energy,
-                last: start_energy,
                 bodies: self.bodies.len(),
                 started: true,
                 rounding: 0.0,
             };
         }
+        self.margins.update(
+            &self.bodies,
+            settings.prediction_distance,
+            self.gravity,
+            self.dt,
+        );
+        self.broad_phase.candidate_pairs(
+            &self.bodies,
+            self.margins.margins(),
+            parallel,
+            &mut self.candidates,
+        );
     }
 
     /// Contact manifolds of the candidate pairs (Parry), beside the broad phase tree's upkeep.
@@ -528,7 +517,6 @@ impl World {
         let energy = terms.mechanical();
         let gain = (energy - self.energy.lowest) / terms.mass.max(f64::MIN_POSITIVE);
         self.energy.lowest = self.energy.lowest.min(energy);
-        self.energy.last = energy;
         // Positions and velocities are f32: each substep's x += h·v and v += h·g round by up to
         // an ulp of |x| and |v|, which moves the energy per kg by up to |g|·ulp(|x|) and
         // |v|·ulp(|v|), the same way step after step in a long fall. Far from the origin or
