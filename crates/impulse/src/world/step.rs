@@ -461,9 +461,10 @@ impl World {
     ///
     /// Runs over the pairs (in parallel runs of [`PAIRS_PER_TASK`]), each finding
     /// its rows where assembly put them, so every manifold is written by one task and the
-    /// manifolds' scattered heap blocks are visited in memory order. An island swept colour by colour has its rows re-sorted by
-    /// colour; a row found under the wrong pair then sends the whole write-back to the serial
-    /// path, which follows each row's `source`.
+    /// manifolds' scattered heap blocks are visited in memory order. An island swept colour by
+    /// colour has its rows re-sorted by colour; a row found out of its place (its `source` not
+    /// the pair, manifold and point where assembly put it) then sends the whole write-back to
+    /// the serial path, which follows each row's `source`.
     fn store_impulses(&mut self) {
         let constraints = &self.constraints;
         let islands = &self.islands;
@@ -471,21 +472,36 @@ impl World {
             for i in 0..pairs.len() {
                 narrow_phase::prefetch_manifolds(pairs, i);
                 let (pair_index, pair) = (first_pair + i, &mut pairs[i]);
-                let first = if pair.point_count() > 0 {
+                let mut row = if pair.point_count() > 0 {
                     islands.first_row(pair_index)
                 } else {
                     0
                 };
                 let mut step_normal_impulse = 0.0;
-                for row in first..first + pair.point_count() {
-                    let Some(c) = constraints.get(row) else {
+                for (manifold_index, manifold) in pair.manifolds.iter_mut().enumerate() {
+                    let count = manifold.points.len();
+                    if count == 0 {
+                        continue;
+                    }
+                    let Some(rows) = constraints.get(row..row + count) else {
                         return false;
                     };
-                    if c.source.0 as usize != pair_index {
-                        return false;
+                    row += count;
+                    // Assembly gives every point of a manifold its friction directions, so
+                    // they are read once here and each point's row only for its impulses.
+                    let tangents = [rows[0].tangents[0].direction, rows[0].tangents[1].direction];
+                    manifold.data.tangent = tangents[0];
+                    for (point_index, (point, c)) in
+                        manifold.points.iter_mut().zip(rows).enumerate()
+                    {
+                        if c.source
+                            != (pair_index as u32, manifold_index as u16, point_index as u16)
+                        {
+                            return false;
+                        }
+                        point.data = contact_impulse(c, tangents);
+                        step_normal_impulse += c.step_impulses[0];
                     }
-                    write_impulse(c, &mut pair.manifolds);
-                    step_normal_impulse += c.step_impulses[0];
                 }
                 pair.step_normal_impulse = step_normal_impulse;
             }
@@ -507,7 +523,11 @@ impl World {
             }
             for c in constraints {
                 let pair = &mut pairs[c.source.0 as usize];
-                write_impulse(c, &mut pair.manifolds);
+                let (_, manifold, point) = c.source;
+                let manifold = &mut pair.manifolds[manifold as usize];
+                let tangents = [c.tangents[0].direction, c.tangents[1].direction];
+                manifold.data.tangent = tangents[0];
+                manifold.points[point as usize].data = contact_impulse(c, tangents);
                 pair.step_normal_impulse += c.step_impulses[0];
             }
         }
@@ -592,21 +612,15 @@ impl World {
     }
 }
 
-/// Writes constraint `c`'s impulses into its point (named by `c.source`) of `manifolds`, its
-/// pair's manifolds.
-fn write_impulse(c: &ContactConstraint, manifolds: &mut [narrow_phase::Manifold]) {
-    let (_, manifold, point) = c.source;
-    let data = ContactImpulse {
+/// Constraint `c`'s impulses as its point keeps them, friction as world vectors along
+/// `tangents`, its rows' two friction directions.
+fn contact_impulse(c: &ContactConstraint, [t1, t2]: [Vec3; 2]) -> ContactImpulse {
+    ContactImpulse {
         normal: c.normal_impulse,
-        friction: c.tangents[0].direction * c.tangent_impulses[0]
-            + c.tangents[1].direction * c.tangent_impulses[1],
+        friction: t1 * c.tangent_impulses[0] + t2 * c.tangent_impulses[1],
         step_normal: c.step_impulses[0],
-        step_friction: c.tangents[0].direction * c.step_impulses[1]
-            + c.tangents[1].direction * c.step_impulses[2],
-    };
-    let manifold = &mut manifolds[manifold as usize];
-    manifold.data.tangent = c.tangents[0].direction;
-    manifold.points[point as usize].data = data;
+        step_friction: t1 * c.step_impulses[1] + t2 * c.step_impulses[2],
+    }
 }
 
 /// Contact points with friction (μ > 0): each adds two tangent rows to the step's LCP.
