@@ -122,7 +122,7 @@ pub fn travel_bound(
     let sine_squared = Vec3::new(delta.x, delta.y, delta.z).length_squared();
     let norm_squared = sine_squared + delta.w * delta.w;
     let sine = (sine_squared / norm_squared).sqrt();
-    if !(sine <= 0.5) || spin.length_squared() > 1.0 {
+    if sine.is_nan() || sine > 0.5 || spin.length_squared() > 1.0 {
         return None;
     }
     let com = local_center_of_mass;

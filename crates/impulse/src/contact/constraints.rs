@@ -143,7 +143,8 @@ impl JacobianRow {
     }
 }
 
-/// All rows of one contact point.
+/// All rows of one contact point: 376 bytes, the size the solver's comments and
+/// docs/benchmarks.md reason with (checked below).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ContactConstraint {
     /// Body the normal points towards.
@@ -223,6 +224,8 @@ pub struct ContactConstraint {
     /// translation locked; [`complete_products`] computes them for any other reader.
     pub products_pending: bool,
 }
+
+const _: () = assert!(std::mem::size_of::<ContactConstraint>() == 376);
 
 impl ContactConstraint {
     /// Computes the rows' angular parts and lever-arm products (see

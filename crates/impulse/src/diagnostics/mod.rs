@@ -256,7 +256,7 @@ fn row_squared_natural_map(
 /// The results are those of the three passes to the bit (the residual's partial sums are
 /// taken over the same runs of rows and added in the same order) on any thread count.
 ///
-/// Why: each pass read every 344-byte row; a pile's rows outgrow the caches (pyramid100: 21
+/// Why: each pass read every 376-byte row; a pile's rows outgrow the caches (pyramid100: 22
 /// MB), so the passes waited on memory, and the friction count ran on one thread.
 pub fn record_velocity_before_and_residual(
     constraints: &mut [ContactConstraint],

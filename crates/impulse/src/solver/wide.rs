@@ -400,7 +400,7 @@ impl Bundles {
         self.rows = None;
         // The layout is a function of the points' body slots and manifolds alone: when they
         // repeat (an island at rest keeps its points), last pack's layout stands. They are
-        // first copied out of the 344-byte rows (on rayon's threads for a large island), so
+        // first copied out of the 376-byte rows (on rayon's threads for a large island), so
         // that the comparison, the grouping and the colouring, which are serial, read 16 bytes
         // a point: reading them from the rows was 2 % of the samples of a two-thread
         // pyramid100 run.
@@ -798,7 +798,7 @@ impl Bundles {
     /// without them nothing is recorded (and [`Bundles::take_rows`] gives `None`, so the
     /// caller records the unpacked rows itself). The same quantities as
     /// `diagnostics::record_velocity_before_and_residual` computes from the unpacked
-    /// constraints, which reads every 344-byte row twice (once to sum M⁻¹Jᵀγ per body, once
+    /// constraints, which reads every 376-byte row twice (once to sum M⁻¹Jᵀγ per body, once
     /// for the rows); here one pass reads the bundles. The residual is the same to the bit
     /// (it reads v and γ alone); J·v* may differ in its last bits, v* being the velocities
     /// before the impulses rather than the final ones less M⁻¹Jᵀγ.
