@@ -134,3 +134,54 @@ fn a_long_free_fall_is_not_a_blow_up() {
         "{v} against {expected}"
     );
 }
+
+/// Every kind of edit between steps restarts the reference, not a throw alone: a ball
+/// teleported 200 m up (1,962 J/kg of potential energy, 39 × the bound), gravity tripled
+/// (which triples at once the potential energy −m·g·y of the ball 195 m up), and a body
+/// removed and another inserted 500 m up, which leaves the body count as it was. Each is
+/// followed by steps that must run; the fall after the teleport must follow free fall.
+#[test]
+fn edits_between_steps_are_not_blow_ups() {
+    let settings = SolverSettings {
+        sleep: false,
+        ..SolverSettings::default()
+    };
+    let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
+    world
+        .insert(impulse::BodyBuilder::fixed(
+            impulse::SharedShape::halfspace(Vec3::Y),
+        ))
+        .unwrap();
+    let ball = |y: f32| {
+        impulse::BodyBuilder::dynamic(impulse::SharedShape::ball(0.5))
+            .translation(Vec3::new(0.0, y, 0.0))
+    };
+    let resting = world.insert(ball(0.5)).unwrap();
+    let other = world
+        .insert(ball(0.5).translation(Vec3::new(3.0, 0.5, 0.0)))
+        .unwrap();
+    let run = |world: &mut World, steps: usize, what: &str| {
+        for step in 1..=steps {
+            if let Err(e) = world.step() {
+                panic!("{what}: stopped {step} steps after the edit: {e}");
+            }
+        }
+    };
+    run(&mut world, 30, "at rest");
+    world
+        .set_pose(
+            resting,
+            Vec3::new(0.0, 200.5, 0.0),
+            impulse::glam::Quat::IDENTITY,
+        )
+        .unwrap();
+    run(&mut world, 60, "teleport");
+    // One second of free fall from rest: y = 200.5 − g·t²/2 up to the integrator's half step.
+    let y = world.body(resting).unwrap().translation().y;
+    assert!((y - (200.5 - 0.5 * 9.81)).abs() < 0.1, "fell to {y} m");
+    world.set_gravity(Vec3::new(0.0, -30.0, 0.0)).unwrap();
+    run(&mut world, 30, "gravity");
+    world.remove(other).unwrap();
+    world.insert(ball(500.0)).unwrap();
+    run(&mut world, 60, "remove and insert");
+}
