@@ -112,11 +112,7 @@ fn a_throw_between_steps_is_not_a_blow_up() {
 /// itself follows the semi-implicit Euler recurrence: after n steps v = −g·n·dt.
 #[test]
 fn a_long_free_fall_is_not_a_blow_up() {
-    let settings = SolverSettings {
-        sleep: false,
-        ..SolverSettings::default()
-    };
-    let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
+    let mut world = awake_world();
     let ball = world
         .insert(impulse::BodyBuilder::dynamic(impulse::SharedShape::ball(
             0.5,
@@ -142,11 +138,7 @@ fn a_long_free_fall_is_not_a_blow_up() {
 /// followed by steps that must run; the fall after the teleport must follow free fall.
 #[test]
 fn edits_between_steps_are_not_blow_ups() {
-    let settings = SolverSettings {
-        sleep: false,
-        ..SolverSettings::default()
-    };
-    let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
+    let mut world = awake_world();
     world
         .insert(impulse::BodyBuilder::fixed(
             impulse::SharedShape::halfspace(Vec3::Y),
@@ -184,4 +176,14 @@ fn edits_between_steps_are_not_blow_ups() {
     world.remove(other).unwrap();
     world.insert(ball(500.0)).unwrap();
     run(&mut world, 60, "remove and insert");
+}
+
+/// An empty world under standard gravity at dt = 1/60 s, the default settings with sleeping
+/// off.
+fn awake_world() -> World {
+    let settings = SolverSettings {
+        sleep: false,
+        ..SolverSettings::default()
+    };
+    World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap()
 }
