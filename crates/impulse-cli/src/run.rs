@@ -53,7 +53,8 @@ pub struct IslandSolves {
     pub exact_failures: u64,
 }
 
-/// What a run measured. Overlap and sink are measured from poses (docs/benchmarks.md, "What is measured, and how").
+/// What a run measured. Overlap and sink are measured from poses (docs/benchmarks.md, "What is
+/// measured, and how").
 #[derive(Debug, Serialize)]
 pub struct Summary {
     pub scene: String,

@@ -45,8 +45,9 @@ pub const BLOW_UP_SPEED: f32 = 1.0e4;
 /// 25 % overlapping, gains about 10 J/kg). 50 J/kg is every body lifted 5 m or moving at
 /// 10 m/s. A solve that fails to hold a pile can push it apart far faster than that while no
 /// body comes near [`BLOW_UP_SPEED`] (`impulse run pyramid100 --method pgs --substeps 4
-/// --iterations 1 --position-iterations 1` is such a solve; tests/blow_up.rs). Changing bodies between steps (velocities, poses, forces, new or removed
-/// bodies, gravity: every edit that wakes a body, [`World::wake_up`]) restarts the reference.
+/// --iterations 1 --position-iterations 1` is such a solve; tests/blow_up.rs). Changing
+/// bodies between steps (velocities, poses, forces, new or removed bodies, gravity: every
+/// edit that wakes a body, [`World::wake_up`]) restarts the reference.
 pub const BLOW_UP_ENERGY_PER_KG: f64 = 50.0;
 
 /// Bodies, settings and the persistent contact state of a simulation.
