@@ -1,5 +1,5 @@
-//! The committed corpus of the `lcp_readers` fuzz target (`fuzz/corpus/lcp_readers`,
-//! docs/fuzzing.md) through the same code path: both readers, then the JSON writer and the JSON
+//! The committed corpus and seeds of the `lcp_readers` fuzz target (`fuzz/corpus/lcp_readers`,
+//! `fuzz/seeds/lcp_readers`, docs/fuzzing.md) through the same code path: both readers, then the JSON writer and the JSON
 //! reader again. Every input must give an error or a problem, never a panic, and a problem that
 //! reads must survive the JSON round trip unchanged (the format promises exact numbers).
 
@@ -7,16 +7,22 @@ use std::path::{Path, PathBuf};
 
 use impulse_lcp::{parse_json, parse_siconos, to_json_string};
 
-/// The files of `fuzz/corpus/<target>` (libFuzzer names them by content hash), sorted.
+/// The files of `fuzz/corpus/<target>` (libFuzzer names them by content hash) and
+/// `fuzz/seeds/<target>`, sorted.
 fn corpus(target: &str) -> Vec<PathBuf> {
-    let directory = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fuzz/corpus")
-        .join(target);
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&directory)
-        .unwrap_or_else(|e| panic!("cannot list {}: {e}", directory.display()))
-        .map(|entry| entry.expect("directory entry").path())
-        .filter(|path| path.is_file())
-        .collect();
+    let fuzz = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
+    let mut files = Vec::new();
+    for directory in [
+        fuzz.join("corpus").join(target),
+        fuzz.join("seeds").join(target),
+    ] {
+        files.extend(
+            std::fs::read_dir(&directory)
+                .unwrap_or_else(|e| panic!("cannot list {}: {e}", directory.display()))
+                .map(|entry| entry.expect("directory entry").path())
+                .filter(|path| path.is_file()),
+        );
+    }
     files.sort();
     files
 }
