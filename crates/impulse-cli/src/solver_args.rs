@@ -156,8 +156,9 @@ impl SolverArgs {
     /// a repair method that has none (`--soft-hertz` with a bias, say).
     pub fn apply(&self, settings: &SolverSettings) -> Result<SolverSettings, String> {
         let mut s = match self.preset {
-            Some(preset) => settings
-                .with_effort_of(&SolverSettings::preset(preset.name()).unwrap_or_default()),
+            Some(preset) => {
+                settings.with_effort_of(&SolverSettings::preset(preset.name()).unwrap_or_default())
+            }
             None => settings.clone(),
         };
         let set = |field: &mut u32, value: Option<u32>| {

@@ -266,9 +266,8 @@ proptest::proptest! {
 fn lemke_refuses_a_problem_above_its_dense_limit() {
     use impulse_lcp::solvers::lemke;
     let n = 50_000;
-    let identity = || {
-        CsrMatrix::new(n, n, (0..=n).collect(), (0..n).collect(), vec![1.0; n]).unwrap()
-    };
+    let identity =
+        || CsrMatrix::new(n, n, (0..=n).collect(), (0..n).collect(), vec![1.0; n]).unwrap();
     // w = z − 1: the solution z = 1 needs a pivot per row.
     let lcp = Lcp::standard(identity(), vec![1.0; n]).unwrap();
     let err = SolverKind::Lemke
@@ -284,7 +283,10 @@ fn lemke_refuses_a_problem_above_its_dense_limit() {
         }
     );
     let message = err.to_string();
-    assert!(message.contains("n = 50000") && message.contains("80.0 GB"), "{message}");
+    assert!(
+        message.contains("n = 50000") && message.contains("80.0 GB"),
+        "{message}"
+    );
     // w = z + 1: z = 0 solves it.
     let trivial = Lcp::standard(identity(), vec![-1.0; n]).unwrap();
     let solution = SolverKind::Lemke

@@ -51,8 +51,7 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
             MAX_SCENE_FILE_BYTES
         )));
     }
-    let text =
-        std::fs::read_to_string(path).map_err(|e| io_error(format!("cannot read: {e}")))?;
+    let text = std::fs::read_to_string(path).map_err(|e| io_error(format!("cannot read: {e}")))?;
     let directory = path.parent().unwrap_or(Path::new(""));
     parse_scene_str_in(&text, &origin, directory)
 }
