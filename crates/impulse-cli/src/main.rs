@@ -39,8 +39,8 @@ enum Command {
     Run {
         /// JSON scene file, or the name of a built-in scene (see `impulse scenes`).
         scene: String,
-        /// Steps to take (default: the scene's, 600 for built-ins).
-        #[arg(long)]
+        /// Steps to take, ≥ 1 (default: the scene's, 600 for built-ins).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         steps: Option<u32>,
         /// Time step in seconds (default: the scene's); must be finite and > 0.
         #[arg(long, allow_negative_numbers = true)]
@@ -56,7 +56,8 @@ enum Command {
         /// in ms (plot them with `impulse plot`).
         #[arg(long)]
         stats: Option<PathBuf>,
-        /// Worker threads (default: all cores); 1 runs everything on the calling thread.
+        /// Worker threads, at most 4 × the machine's logical CPUs (default, or 0: all CPUs); 1
+        /// runs everything on the calling thread.
         #[arg(long)]
         threads: Option<usize>,
         /// Output file, by extension: a trajectory, `.csv` (frame,time,body,x,y,z,qx,qy,qz,qw) or
@@ -87,9 +88,9 @@ enum Command {
     Resume {
         /// Snapshot file, e.g. `checkpoints/step-000600.snapshot`.
         snapshot: PathBuf,
-        /// Steps to take after the snapshot's step (default: up to the last step of the run
-        /// that wrote it).
-        #[arg(long)]
+        /// Steps to take after the snapshot's step, ≥ 1 (default: up to the last step of the
+        /// run that wrote it).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         steps: Option<u32>,
         /// Trajectory file continuing the run's, `.csv` or `.jsonl`: the frames after the
         /// snapshot's step, numbered by step as the run numbers them.
@@ -99,7 +100,8 @@ enum Command {
         /// written).
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         every: Option<u32>,
-        /// Worker threads (default: all cores); the results do not depend on it.
+        /// Worker threads, at most 4 × the machine's logical CPUs (default, or 0: all CPUs);
+        /// the results do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
         /// Per-step diagnostics as CSV (as `impulse run --stats`).
@@ -133,8 +135,8 @@ enum Command {
         /// Animated GIF of the drawn frames (frame delay: K steps of the scene's dt).
         #[arg(long)]
         gif: Option<PathBuf>,
-        /// Steps to simulate (default: the scene's).
-        #[arg(long)]
+        /// Steps to simulate, ≥ 1 (default: the scene's).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         steps: Option<u32>,
         /// Draw every K-th step (step 0 and the last are always drawn).
         #[arg(long, default_value_t = 1)]
@@ -160,6 +162,9 @@ enum Command {
         speed_max: f32,
         #[command(flatten)]
         variation: variation_args::VariationArgs,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
     },
     /// Plot the columns of an `impulse run --stats` CSV over the run (SVG or PNG, one
     /// panel per column).
@@ -196,9 +201,12 @@ enum Command {
         /// Steps per scene.
         #[arg(long, default_value_t = impulse_bench::DEFAULT_STEPS)]
         steps: u32,
-        /// Worker threads.
+        /// Worker threads, at most 4 × the machine's logical CPUs (0: all CPUs).
         #[arg(long, default_value_t = 1)]
         threads: usize,
+        /// No progress lines ("measured … on …").
+        #[arg(long)]
+        quiet: bool,
     },
     /// Linear complementarity problems on their own.
     Lcp {
@@ -304,6 +312,98 @@ fn resolve_scene(arg: &str) -> Result<Scene> {
     }
 }
 
+/// Most worker threads per logical CPU `--threads` accepts: more only adds switching.
+const THREADS_PER_CPU: usize = 4;
+
+/// The machine's logical CPUs (1 if unknown).
+fn logical_cpus() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// `--threads` checked: `None` or 0 is all CPUs (`None`), at most [`THREADS_PER_CPU`] × the
+/// logical CPUs.
+fn worker_threads(threads: Option<usize>) -> Result<Option<usize>> {
+    let cpus = logical_cpus();
+    match threads {
+        Some(0) | None => Ok(None),
+        Some(n) if n > THREADS_PER_CPU * cpus => bail!(
+            "--threads {n}: at most {THREADS_PER_CPU} × this machine's {cpus} logical CPUs = {} \
+             (0 or no --threads: all CPUs)",
+            THREADS_PER_CPU * cpus
+        ),
+        Some(n) => Ok(Some(n)),
+    }
+}
+
+/// The path `path` names, for comparing outputs: canonical where it exists, else its
+/// directory's canonical path joined with its name (relative paths from the current directory).
+fn canonical(path: &Path) -> PathBuf {
+    if let Ok(p) = path.canonicalize() {
+        return p;
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    match (parent.canonicalize(), path.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf()),
+    }
+}
+
+/// Refuses, before anything runs, two of `outputs` (option name, path) that name the same
+/// file, an output that is one of `inputs` (what, path), and an output that is the checkpoint
+/// directory or a checkpoint file in it (`step-*.snapshot`). Existing files that are not
+/// regular files (`/dev/null`, a pipe) may be shared.
+fn check_outputs(
+    outputs: &[(&str, Option<&Path>)],
+    inputs: &[(&str, &Path)],
+    checkpoint_dir: Option<&Path>,
+) -> Result<()> {
+    let shareable = |p: &Path| std::fs::metadata(p).is_ok_and(|m| !m.is_file() && !m.is_dir());
+    let outputs: Vec<(&str, &Path, PathBuf)> = outputs
+        .iter()
+        .filter_map(|&(option, path)| path.map(|p| (option, p, canonical(p))))
+        .filter(|(_, p, _)| !shareable(p))
+        .collect();
+    for (i, (option, path, canonical_path)) in outputs.iter().enumerate() {
+        for (other, _, other_path) in &outputs[..i] {
+            if canonical_path == other_path {
+                bail!(
+                    "{other} and {option} both write {}: give each output its own file",
+                    path.display()
+                );
+            }
+        }
+        for (what, input) in inputs {
+            if *canonical_path == canonical(input) {
+                bail!(
+                    "{option} {} is the {what} this command reads: write elsewhere",
+                    path.display()
+                );
+            }
+        }
+        if let Some(dir) = checkpoint_dir {
+            let dir = canonical(dir);
+            let name = canonical_path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .unwrap_or("");
+            let checkpoint_name = name.starts_with("step-")
+                && name.ends_with(&format!(".{}", run::CHECKPOINT_EXTENSION));
+            if *canonical_path == dir
+                || (canonical_path.parent() == Some(dir.as_path()) && checkpoint_name)
+            {
+                bail!(
+                    "{option} {} is where --checkpoint-dir writes: write elsewhere",
+                    path.display()
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     match real_main() {
         Ok(code) => code,
@@ -349,6 +449,23 @@ fn real_main() -> Result<ExitCode> {
             variation,
         } => {
             let scene_arg = scene.clone();
+            let threads = worker_threads(threads)?;
+            let scene_path = Path::new(&scene).is_file().then(|| PathBuf::from(&scene));
+            let inputs: Vec<(&str, &Path)> = scene_path
+                .as_deref()
+                .map(|p| ("scene file", p))
+                .into_iter()
+                .collect();
+            check_outputs(
+                &[
+                    ("--out", out.as_deref()),
+                    ("--stats", stats.as_deref()),
+                    ("--summary-json", summary_json.as_deref()),
+                    ("--island-report", island_report.as_deref()),
+                ],
+                &inputs,
+                checkpoints.checkpoint_dir.as_deref(),
+            )?;
             let mut scene = resolve_scene(&scene)?;
             scene.solver = solver.apply(&scene.solver).map_err(anyhow::Error::msg)?;
             let scene = variation.apply(scene, &scene_arg)?;
@@ -382,6 +499,17 @@ fn real_main() -> Result<ExitCode> {
             profile,
             checkpoints,
         } => {
+            let threads = worker_threads(threads)?;
+            check_outputs(
+                &[
+                    ("--out", out.as_deref()),
+                    ("--stats", stats.as_deref()),
+                    ("--summary-json", summary_json.as_deref()),
+                    ("--island-report", island_report.as_deref()),
+                ],
+                &[("snapshot", &snapshot)],
+                checkpoints.checkpoint_dir.as_deref(),
+            )?;
             let options = run::RunOptions {
                 steps,
                 dt: None,
@@ -412,7 +540,9 @@ fn real_main() -> Result<ExitCode> {
             color,
             speed_max,
             variation,
+            quiet,
         } => {
+            check_outputs(&[("--gif", gif.as_deref())], &[], None)?;
             let options = render::RenderOptions {
                 steps,
                 every,
@@ -424,6 +554,7 @@ fn real_main() -> Result<ExitCode> {
                 fov_deg: fov,
                 colour: color,
                 speed_max,
+                quiet,
             };
             let (name, summary) = if scene.ends_with(".glb") {
                 if !variation.is_empty() {
@@ -481,7 +612,9 @@ fn real_main() -> Result<ExitCode> {
             scenes,
             steps,
             threads,
+            quiet,
         } => {
+            let threads = worker_threads(Some(threads))?.unwrap_or_else(logical_cpus);
             let mut config = impulse_bench::BenchConfig {
                 steps,
                 threads,
@@ -494,7 +627,11 @@ fn real_main() -> Result<ExitCode> {
             let machine = impulse_bench::MachineInfo::current();
             let rows = impulse_bench::run_benchmarks(
                 &config,
-                &mut |row| eprintln!("measured {} on {}", row.engine, row.scene),
+                &mut |row| {
+                    if !quiet {
+                        eprintln!("measured {} on {}", row.engine, row.scene)
+                    }
+                },
                 &mut |e| eprintln!("failed: {e:#}"),
             )?;
             println!("{}", impulse_bench::format_table(&rows));

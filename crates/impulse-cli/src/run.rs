@@ -78,6 +78,10 @@ pub struct Summary {
     /// The quality error E: the largest of |top sink|, largest overlap and largest drift (m),
     /// measured as `impulse-bench` measures it (docs/benchmarks.md).
     pub quality_error_m: f32,
+    /// Whether the scene started at rest ([`starts_at_rest`]): only then are top sink, drift
+    /// and E errors of the solve; in a moving scene they are the motion itself, and the
+    /// summary line labels them so.
+    pub starts_at_rest: bool,
     pub kinetic_energy_j: f32,
     /// Largest speed of any body at any step (m/s): a blow-up or an over-eager repair shows here.
     pub max_speed_m_s: f32,
@@ -105,11 +109,27 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// The one-line summary `impulse run` prints.
+    /// The one-line summary `impulse run` prints. Top sink, drift and E are quality measures
+    /// only for a scene that started at rest; for a moving one they are printed after
+    /// "moving scene, not errors:" and E is left out.
     pub fn line(&self) -> String {
+        let sink_and_drift = if self.starts_at_rest {
+            format!(
+                "top sink {:.2} mm, max drift {:.2} mm (E {:.2} mm)",
+                self.top_sink_m * 1e3,
+                self.max_drift_m * 1e3,
+                self.quality_error_m * 1e3,
+            )
+        } else {
+            format!(
+                "moving scene, not errors: top sink {:.2} mm, max drift {:.2} mm",
+                self.top_sink_m * 1e3,
+                self.max_drift_m * 1e3,
+            )
+        };
         format!(
             "{}: {} bodies, {} steps of {:.4} s, mean contacts {:.0}, {:.3} ms/step ({:.0} steps/s), \
-             max overlap {:.2} mm, top sink {:.2} mm, max drift {:.2} mm (E {:.2} mm), kinetic \
+             max overlap {:.2} mm, {sink_and_drift}, kinetic \
              energy {:.4} J, max speed {:.2} m/s, mean iterations {:.1}, LCP residual max {:.2e} \
              last {:.2e}",
             self.scene,
@@ -120,9 +140,6 @@ impl Summary {
             self.ms_per_step,
             self.steps_per_second,
             self.max_overlap_m * 1e3,
-            self.top_sink_m * 1e3,
-            self.max_drift_m * 1e3,
-            self.quality_error_m * 1e3,
             self.kinetic_energy_j,
             self.max_speed_m_s,
             self.mean_iterations,
@@ -195,11 +212,13 @@ impl FrameOutput {
     }
 }
 
-/// Set by Ctrl-C (SIGINT): the run stops after the step under way, writes that step's frame
-/// and every file as a finished run would, and `impulse` exits with status 130.
+/// Set by Ctrl-C (SIGINT), SIGTERM or SIGHUP: the run stops after the step under way, writes
+/// that step's frame, its checkpoint and every file as a finished run would, and `impulse`
+/// exits with status 130.
 pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
-/// Makes Ctrl-C set [`INTERRUPTED`]; a second Ctrl-C ends the process at once.
+/// Makes Ctrl-C, SIGTERM and SIGHUP (the `ctrlc` crate's `termination` feature) set
+/// [`INTERRUPTED`]; a second one ends the process at once.
 pub fn stop_on_ctrl_c() -> Result<()> {
     ctrlc::set_handler(|| {
         if INTERRUPTED.swap(true, Ordering::SeqCst) {
@@ -207,6 +226,38 @@ pub fn stop_on_ctrl_c() -> Result<()> {
         }
     })
     .context("cannot install the Ctrl-C handler")
+}
+
+/// The progress bar of a command taking `steps` steps of the scene `name` (on standard error;
+/// hidden with `quiet`).
+pub fn progress_bar(name: &str, steps: u64, quiet: bool) -> ProgressBar {
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(steps)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} steps ({per_sec}, eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message(name.to_string());
+    bar
+}
+
+/// Largest initial speed (m/s) of a scene that "starts at rest"; angular speeds are compared
+/// with it in rad/s.
+pub const AT_REST_SPEED: f32 = 0.01;
+
+/// Whether every body that can move starts with linear speed ≤ [`AT_REST_SPEED`] m/s and
+/// angular speed ≤ [`AT_REST_SPEED`] rad/s: a pile, stack or pyramid that is to stay put,
+/// whose top sink and drift measure the solve's error. A thrown, dropped-with-speed, spinning
+/// or kinematically driven body makes the scene a moving one.
+pub fn starts_at_rest(bodies: &impulse::Bodies) -> bool {
+    (0..bodies.len()).all(|i| {
+        bodies.kind[i] == impulse::BodyKind::Static
+            || (bodies.linear_velocity[i].length() <= AT_REST_SPEED
+                && bodies.angular_velocity[i].length() <= AT_REST_SPEED)
+    })
 }
 
 /// Overlap from poses is measured every this many steps (and at the last).
@@ -265,6 +316,12 @@ fn run_scene(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<S
         scene.solver.iterations = iterations;
     }
     let steps = options.steps.unwrap_or(scene.steps) as u64;
+    if steps == 0 {
+        anyhow::bail!(
+            "scene {:?} asks for 0 steps: nothing to run (give --steps N, N ≥ 1)",
+            scene.name
+        );
+    }
     let every = options.every.unwrap_or(1).max(1) as u64;
     let world = World::from_scene(&scene).context("cannot build the world")?;
     if !world
@@ -316,6 +373,12 @@ fn resume_snapshot(
              run`): give --steps"
         ),
     };
+    if steps == 0 {
+        anyhow::bail!(
+            "the snapshot is at step {start}, the last of its run: nothing to resume (give \
+             --steps N to go on, N ≥ 1)"
+        );
+    }
     let every = match (options.every, metadata.get(EVERY_KEY)) {
         (Some(every), _) => every as u64,
         (None, Some(every)) => every.parse().unwrap_or(1),
@@ -387,18 +450,10 @@ fn simulate(
     let top = metrics::top_body(world.bodies());
     let top_y0 = top.map(|i| world.bodies().pose[i].translation.y);
     let initial: Vec<_> = world.bodies().pose.iter().map(|p| p.translation).collect();
+    let at_rest = starts_at_rest(world.bodies());
     let mut max_drift = 0.0f32;
 
-    let bar = if options.quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(session.steps)
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} steps ({per_sec}, eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar.set_message(session.name.clone());
+    let bar = progress_bar(&session.name, session.steps, options.quiet);
 
     // Grown as the steps are taken: reserving for the whole run up front failed outright for a
     // run of 4 billion steps.
@@ -415,9 +470,12 @@ fn simulate(
     let mut failure = None;
     let mut island_solves = IslandSolves::default();
     let mut island_writer = match &options.island_report {
-        Some(path) => Some(std::io::BufWriter::new(
-            std::fs::File::create(path)
-                .with_context(|| format!("cannot create {}", path.display()))?,
+        Some(path) => Some((
+            path,
+            std::io::BufWriter::new(
+                std::fs::File::create(path)
+                    .with_context(|| format!("cannot create {}", path.display()))?,
+            ),
         )),
         None => None,
     };
@@ -453,7 +511,7 @@ fn simulate(
             island_solves.escalations += island.escalations as u64;
             island_solves.exact_failures += island.exact_failures as u64;
         }
-        if let Some(w) = island_writer.as_mut() {
+        if let Some((path, w)) = island_writer.as_mut() {
             use std::io::Write;
             serde_json::to_writer(
                 &mut *w,
@@ -463,8 +521,10 @@ fn simulate(
                     "stages": world.profile(),
                     "islands": &diagnostics.islands,
                 }),
-            )?;
-            writeln!(w)?;
+            )
+            .map_err(std::io::Error::from)
+            .and_then(|()| writeln!(w))
+            .with_context(|| format!("cannot write {}", path.display()))?;
         }
         if let Some(stats) = stats.as_mut() {
             stats.write_step(step as f64 * dt, diagnostics, world.profile())?;
@@ -509,6 +569,11 @@ fn simulate(
     if let Some(stats) = stats.as_mut() {
         stats.finish()?;
     }
+    if let Some((path, w)) = island_writer.as_mut() {
+        use std::io::Write;
+        w.flush()
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     // The animation file holds every frame written so far, also when a step failed.
     let exported = session.writer.as_ref().map_or(Ok(()), FrameOutput::finish);
 
@@ -538,6 +603,7 @@ fn simulate(
         top_sink_m: top_sink,
         max_drift_m: max_drift,
         quality_error_m: top_sink.abs().max(max_overlap).max(max_drift),
+        starts_at_rest: at_rest,
         kinetic_energy_j: world.diagnostics().kinetic_energy,
         max_speed_m_s: max_speed,
         mean_contacts: contacts_sum as f64 / taken,

@@ -73,8 +73,10 @@ pub struct SolverArgs {
     /// quality bar it meets on the standard scenes (E = largest of sink, overlap and drift
     /// after 10 s): `fast`/`q50` (the soft step at 8 substeps, E ≤ 50 mm), `default`/`q5`
     /// (20 substeps, E ≤ 5 mm), `precise`/`q1` (48 substeps, E ≤ 1 mm) or `reference` (NNCG
-    /// with split impulse and the exact path: the LCP solved tightly). The other options
-    /// apply on top of it; sleeping keeps the scene's setting.
+    /// with split impulse and the exact path: the LCP solved tightly). A preset sets only
+    /// the solver's effort (method, substeps, iterations, repair); the scene's physics
+    /// (restitution threshold, sleeping, continuous collision, gyroscopic motion, friction)
+    /// stay as the scene says. The other options apply on top of it.
     #[arg(long, alias = "quality", value_enum)]
     pub preset: Option<PresetArg>,
     /// Solver iterations per substep at most.
@@ -147,17 +149,16 @@ pub struct SolverArgs {
 }
 
 impl SolverArgs {
-    /// The settings these options make of `settings`: the preset first (keeping `sleep` and
-    /// `gyroscopic`, which are about the scene rather than the solve), then every option given.
+    /// The settings these options make of `settings`: the preset's solver effort first
+    /// ([`SolverSettings::with_effort_of`]: the scene keeps its physics, restitution threshold,
+    /// sleeping, continuous collision, gyroscopic motion and friction), then every option given.
     /// The world checks the values before its first step. Errors: a repair parameter given for
     /// a repair method that has none (`--soft-hertz` with a bias, say).
     pub fn apply(&self, settings: &SolverSettings) -> Result<SolverSettings, String> {
         let mut s = match self.preset {
-            Some(preset) => SolverSettings {
-                sleep: settings.sleep,
-                gyroscopic: settings.gyroscopic,
-                ..SolverSettings::preset(preset.name()).unwrap_or_default()
-            },
+            Some(preset) => {
+                settings.with_effort_of(&SolverSettings::preset(preset.name()).unwrap_or_default())
+            }
             None => settings.clone(),
         };
         let set = |field: &mut u32, value: Option<u32>| {

@@ -18,6 +18,8 @@ enum Format {
 pub struct TrajectoryWriter {
     out: BufWriter<File>,
     format: Format,
+    /// The file's path, for error messages.
+    path: std::path::PathBuf,
 }
 
 impl TrajectoryWriter {
@@ -35,13 +37,23 @@ impl TrajectoryWriter {
             File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
         let mut out = BufWriter::new(file);
         if let Format::Csv = format {
-            writeln!(out, "frame,time,body,x,y,z,qx,qy,qz,qw")?;
+            writeln!(out, "frame,time,body,x,y,z,qx,qy,qz,qw")
+                .with_context(|| format!("cannot write {}", path.display()))?;
         }
-        Ok(Self { out, format })
+        Ok(Self {
+            out,
+            format,
+            path: path.to_path_buf(),
+        })
     }
 
-    /// Appends one frame (all bodies, scene order) and flushes it.
+    /// Appends one frame (all bodies, scene order) and flushes it. Errors name the file.
     pub fn write_frame(&mut self, frame: u64, time: f64, bodies: &Bodies) -> Result<()> {
+        self.write_and_flush(frame, time, bodies)
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+
+    fn write_and_flush(&mut self, frame: u64, time: f64, bodies: &Bodies) -> std::io::Result<()> {
         match self.format {
             Format::Csv => {
                 for (i, pose) in bodies.pose.iter().enumerate() {

@@ -259,3 +259,41 @@ proptest::proptest! {
         let _ = parse_json(&json[..cut.min(json.len())], "fuzz.json");
     }
 }
+
+/// Lemke refuses a problem its dense tableau cannot hold, naming the size, instead of
+/// allocating it; a problem that `z = 0` already solves needs no tableau and is solved.
+#[test]
+fn lemke_refuses_a_problem_above_its_dense_limit() {
+    use impulse_lcp::solvers::lemke;
+    let n = 50_000;
+    let identity =
+        || CsrMatrix::new(n, n, (0..=n).collect(), (0..n).collect(), vec![1.0; n]).unwrap();
+    // w = z − 1: the solution z = 1 needs a pivot per row.
+    let lcp = Lcp::standard(identity(), vec![1.0; n]).unwrap();
+    let err = SolverKind::Lemke
+        .solve(&lcp, None, &SolverSettings::default())
+        .unwrap_err();
+    assert_eq!(
+        err,
+        SolveError::TooLarge {
+            solver: "Lemke",
+            n,
+            bytes: lemke::dense_bytes(n),
+            max_n: lemke::MAX_DIMENSION,
+        }
+    );
+    let message = err.to_string();
+    assert!(
+        message.contains("n = 50000") && message.contains("80.0 GB"),
+        "{message}"
+    );
+    // w = z + 1: z = 0 solves it.
+    let trivial = Lcp::standard(identity(), vec![-1.0; n]).unwrap();
+    let solution = SolverKind::Lemke
+        .solve(&trivial, None, &SolverSettings::default())
+        .unwrap();
+    assert!(solution.z.iter().all(|&z| z == 0.0));
+    // The largest size accepted is the documented one.
+    assert_eq!(lemke::MAX_DIMENSION, 8_000);
+    assert!(lemke::dense_bytes(lemke::MAX_DIMENSION) < 2_100_000_000);
+}

@@ -216,5 +216,6 @@ pub fn render_glb(path: &Path, options: &RenderOptions) -> Result<RenderSummary>
         let canvas = super::draw(&bodies, &poses, &colours, &ground, &camera, options);
         sink.write(k as u64, &canvas)?;
     }
+    sink.finish()?;
     Ok(RenderSummary { frames, camera })
 }

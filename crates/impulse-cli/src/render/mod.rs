@@ -58,6 +58,8 @@ pub struct RenderOptions {
     pub colour: ColourBy,
     /// Speed drawn in the hottest colour with `ColourBy::Speed` (m/s).
     pub speed_max: f32,
+    /// No progress bar.
+    pub quiet: bool,
 }
 
 /// What a render wrote.
@@ -159,8 +161,10 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
     });
 
     let mut frames = 0;
+    let bar = crate::run::progress_bar(&scene.name, steps, options.quiet);
     for step in 0..=steps {
         if step > 0 {
+            bar.inc(1);
             world
                 .step()
                 .with_context(|| format!("the simulation stopped at step {step}"))?;
@@ -181,6 +185,8 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
         )?;
         frames += 1;
     }
+    bar.finish_and_clear();
+    sink.finish()?;
     Ok(RenderSummary { frames, camera })
 }
 
@@ -216,10 +222,50 @@ fn checked_camera(centre: Vec3, radius: f32, options: &RenderOptions) -> Result<
     Ok(camera)
 }
 
+/// The GIF file under its encoder: a write error, and the flush when the encoder is dropped
+/// (which writes the GIF's trailer), are kept for [`FrameSink::finish`] to report, since the
+/// encoder drops them.
+struct GifFile {
+    out: std::io::BufWriter<std::fs::File>,
+    error: std::rc::Rc<std::cell::RefCell<Option<std::io::Error>>>,
+}
+
+impl GifFile {
+    fn keep<T>(&self, result: std::io::Result<T>) -> std::io::Result<T> {
+        if let Err(e) = &result {
+            let mut error = self.error.borrow_mut();
+            if error.is_none() {
+                *error = Some(std::io::Error::new(e.kind(), e.to_string()));
+            }
+        }
+        result
+    }
+}
+
+impl std::io::Write for GifFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let result = self.out.write(buf);
+        self.keep(result)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        let result = self.out.flush();
+        self.keep(result)
+    }
+}
+
+impl Drop for GifFile {
+    fn drop(&mut self) {
+        let _ = std::io::Write::flush(self);
+    }
+}
+
 /// Where drawn frames go: PNG files in a directory and/or one animated GIF.
 struct FrameSink {
     out_dir: Option<PathBuf>,
-    gif: Option<(PathBuf, GifEncoder<std::io::BufWriter<std::fs::File>>)>,
+    gif: Option<(PathBuf, GifEncoder<GifFile>)>,
+    /// The first write error of the GIF file, if any.
+    gif_error: std::rc::Rc<std::cell::RefCell<Option<std::io::Error>>>,
     /// GIF frame delay (ms).
     delay_ms: u32,
 }
@@ -231,11 +277,17 @@ impl FrameSink {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("cannot create the frame directory {}", dir.display()))?;
         }
+        let gif_error: std::rc::Rc<std::cell::RefCell<Option<std::io::Error>>> =
+            std::rc::Rc::default();
         let gif = match &options.gif {
             Some(path) => {
                 let file = std::fs::File::create(path)
                     .with_context(|| format!("cannot create {}", path.display()))?;
-                let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(file), 10);
+                let file = GifFile {
+                    out: std::io::BufWriter::new(file),
+                    error: gif_error.clone(),
+                };
+                let mut encoder = GifEncoder::new_with_speed(file, 10);
                 // A preview loops.
                 encoder
                     .set_repeat(Repeat::Infinite)
@@ -247,8 +299,20 @@ impl FrameSink {
         Ok(Self {
             out_dir: options.out_dir.clone(),
             gif,
+            gif_error,
             delay_ms,
         })
+    }
+
+    /// Ends the GIF (its trailer) and reports any error writing it, with its path.
+    fn finish(mut self) -> Result<()> {
+        if let Some((path, encoder)) = self.gif.take() {
+            drop(encoder);
+            if let Some(e) = self.gif_error.borrow_mut().take() {
+                return Err(e).with_context(|| format!("cannot write {}", path.display()));
+            }
+        }
+        Ok(())
     }
 
     /// Writes `canvas` as `frame_<number>.png` and/or the GIF's next frame.

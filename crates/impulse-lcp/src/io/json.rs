@@ -69,8 +69,10 @@ pub fn read_json(path: &Path) -> Result<Lcp, FileError> {
     parse_json(&read_text(path)?, &path.display().to_string())
 }
 
-/// Parses JSON problem text; `file` labels error messages.
+/// Parses JSON problem text; `file` labels error messages. A UTF-8 byte order mark at the
+/// start is skipped.
 pub fn parse_json(text: &str, file: &str) -> Result<Lcp, FileError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let err = |message: String| FileError::Json {
         file: file.to_string(),
         message,

@@ -37,14 +37,29 @@ const PIVOT_TOLERANCE: f64 = 1e-11;
 /// Lexicographic keys within this fraction of their scale of the minimum are ties (degeneracy).
 const TIE_TOLERANCE: f64 = 1e-10;
 
+/// Largest problem size `n` Lemke's method accepts: 8,000, whose dense storage
+/// ([`dense_bytes`]) is 2.0 GB. Contact islands solved exactly have at most a few hundred rows;
+/// a larger problem is solved iteratively instead of exhausting memory.
+pub const MAX_DIMENSION: usize = 8_000;
+
+/// Bytes of dense storage Lemke's method allocates for a problem of size `n`: the matrix `M`
+/// (n × n), the tableau (n × (2n + 2)) and the basis's LU factors (n × n), 8-byte floats.
+pub fn dense_bytes(n: usize) -> u64 {
+    let n = n as u64;
+    8 * (4 * n * n + 2 * n)
+}
+
 /// Solves the standard LCP `lcp` by Lemke's method with at most `settings.max_iterations` pivots;
 /// `Status::Converged` when the polished solution has normalised natural-map residual at most
 /// `settings.tolerance`. `initial` is validated but not used (the path starts from the artificial
 /// basis; warm starting a pivoting method needs a known complementary basis, not a point).
 /// `settings.relaxation` is unused.
 ///
-/// Errors: [`SolveError::UnsupportedBounds`] unless the bounds are exactly `γ ≥ 0`.
-/// Cost: `O(n²)` memory, `O(n²)` per pivot (plus a mat-vec for the residual history).
+/// Errors: [`SolveError::UnsupportedBounds`] unless the bounds are exactly `γ ≥ 0`;
+/// [`SolveError::TooLarge`] for `n` > [`MAX_DIMENSION`] when `q ≥ 0` does not already make
+/// `z = 0` the solution.
+/// Cost: `O(n²)` memory ([`dense_bytes`]), `O(n²)` per pivot (plus a mat-vec for the
+/// residual history).
 pub fn solve(
     lcp: &Lcp,
     initial: Option<&[f64]>,
@@ -55,7 +70,6 @@ pub fn solve(
         return Err(SolveError::UnsupportedBounds { solver: "Lemke" });
     }
     let n = lcp.n();
-    let m = lcp.a.to_dense();
     let q = lcp.q();
     let scale = residual_scale(&lcp.b);
     let residual_of = |z: &[f64]| natural_map_norm(&Bounds::NonNegative, z, &lcp.w(z)) / scale;
@@ -72,6 +86,16 @@ pub fn solve(
             status: Status::Converged,
         });
     }
+
+    if n > MAX_DIMENSION {
+        return Err(SolveError::TooLarge {
+            solver: "Lemke",
+            n,
+            bytes: dense_bytes(n),
+            max_n: MAX_DIMENSION,
+        });
+    }
+    let m = lcp.a.to_dense();
 
     if settings.max_iterations == 0 {
         let z = vec![0.0; n];

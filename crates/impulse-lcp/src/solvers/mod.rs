@@ -129,6 +129,19 @@ pub enum SolveError {
     },
     #[error("{solver} solves only the standard LCP (γ ≥ 0); these bounds are not supported")]
     UnsupportedBounds { solver: &'static str },
+    /// The problem is larger than the solver's dense storage allows (Lemke:
+    /// [`lemke::MAX_DIMENSION`]); `bytes` is what it would have allocated.
+    #[error(
+        "{solver} stores the problem densely: n = {n} would need {:.1} GB; it accepts n ≤ {max_n} \
+         (use an iterative solver, PGS or projected Jacobi, for larger problems)",
+        *bytes as f64 / 1e9
+    )]
+    TooLarge {
+        solver: &'static str,
+        n: usize,
+        bytes: u64,
+        max_n: usize,
+    },
 }
 
 /// The solvers by name, for command lines and configuration files.

@@ -17,24 +17,47 @@ use super::{
 };
 use crate::settings::SolverSettings;
 
-/// Reads, parses and validates the scene file at `path`.
+/// Largest scene file [`load_scene_file`] reads: 256 MiB (268,435,456 bytes). A scene of a
+/// million bodies is about 200 MB of JSON; anything larger is not a scene, and reading it whole
+/// would exhaust memory first.
+pub const MAX_SCENE_FILE_BYTES: u64 = 256 << 20;
+
+/// Reads, parses and validates the scene file at `path`. A UTF-8 byte order mark at the start
+/// is skipped.
 ///
 /// # Errors
-/// - [`SceneErrorKind::Io`] if the file cannot be read;
+/// - [`SceneErrorKind::Io`] if the file cannot be read, is not a regular file (a directory, a
+///   device such as `/dev/zero`, a pipe) or is larger than [`MAX_SCENE_FILE_BYTES`]; the last
+///   two are found from the file's metadata, before reading;
 /// - otherwise as [`parse_scene_str`], with the file's path (as given) as the origin.
 pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
     let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        let mut error = SceneError::new(SceneErrorKind::Io, None, format!("cannot read: {e}"));
+    let io_error = |message: String| {
+        let mut error = SceneError::new(SceneErrorKind::Io, None, message);
         error.origin = Some(origin.clone());
         error
-    })?;
+    };
+    let metadata = std::fs::metadata(path).map_err(|e| io_error(format!("cannot read: {e}")))?;
+    if !metadata.is_file() {
+        return Err(io_error(
+            "cannot read: not a regular file (a scene is read from a file)".to_string(),
+        ));
+    }
+    if metadata.len() > MAX_SCENE_FILE_BYTES {
+        return Err(io_error(format!(
+            "cannot read: the file has {} bytes, more than the {} bytes (256 MiB) a scene file \
+             may have",
+            metadata.len(),
+            MAX_SCENE_FILE_BYTES
+        )));
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| io_error(format!("cannot read: {e}")))?;
     let directory = path.parent().unwrap_or(Path::new(""));
     parse_scene_str_in(&text, &origin, directory)
 }
 
 /// Parses the JSON scene `text` and validates it. `origin` names the text in error messages
-/// (normally its file path).
+/// (normally its file path). A UTF-8 byte order mark at the start is skipped.
 ///
 /// # Errors
 /// The first problem found, with `origin` and, when it can be found, the line and column:
@@ -64,6 +87,9 @@ pub fn parse_scene_str(text: &str, origin: &str) -> Result<Scene, SceneError> {
 /// As [`parse_scene_str`]; also [`SceneErrorKind::Invalid`] at `bodies[i].shape.file` for a
 /// mesh file that cannot be read or is not a valid OBJ, glTF or GLB file.
 pub fn parse_scene_str_in(text: &str, origin: &str, directory: &Path) -> Result<Scene, SceneError> {
+    // A byte order mark is not JSON (RFC 8259 §8.1 lets a parser ignore it); editors on
+    // Windows write one.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let locate_error = |mut e: SceneError| {
         e.origin = Some(origin.to_string());
         if let Some(field) = &e.field {

@@ -439,6 +439,7 @@ pub use builtin::{
     builtin_scene,
 };
 pub use error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
+pub use json::MAX_SCENE_FILE_BYTES;
 pub use json::{
     load_scene_file, locate, locate_closest, parse_scene_str, parse_scene_str_in, to_json_string,
 };
