@@ -60,6 +60,7 @@ impl World {
                 sweep,
                 min_half_extent,
                 travel,
+                radius,
             };
             let swept = shape.compute_swept_aabb(&sweep.start, &sweep.end);
             let mut earliest = 1.0f32;
