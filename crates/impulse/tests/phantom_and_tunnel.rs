@@ -82,7 +82,11 @@ fn wall_case(seed: u64) -> Case {
     let speed = rng.range(10.0, 300.0);
     let theta = rng.range(0.0, 75.0f32.to_radians());
     let phi = rng.range(0.0, std::f32::consts::TAU);
-    let direction = Vec3::new(theta.cos(), theta.sin() * phi.cos(), theta.sin() * phi.sin());
+    let direction = Vec3::new(
+        theta.cos(),
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+    );
     let reach = half + 0.6;
     let aim = Vec3::new(0.0, rng.range(-reach, reach), rng.range(-reach, reach));
     let distance = rng.range(0.5, 4.0);
@@ -159,7 +163,10 @@ fn half_space_case(seed: u64) -> Case {
         start,
         velocity,
         steps,
-        target: Target::HalfSpace { normal, offset: 0.0 },
+        target: Target::HalfSpace {
+            normal,
+            offset: 0.0,
+        },
     }
 }
 
@@ -350,7 +357,9 @@ struct Tally {
 fn sweep(make: fn(u64) -> Case, first_seed: u64, misses: usize, hits: usize) -> Tally {
     let mut tally = Tally::default();
     let mut seed = first_seed;
-    while (tally.misses < misses || tally.hits < hits) && seed < first_seed + 20 * (misses + hits) as u64 {
+    while (tally.misses < misses || tally.hits < hits)
+        && seed < first_seed + 20 * (misses + hits) as u64
+    {
         let case = make(seed);
         seed += 1;
         let (kind, failure) = check(&case);
@@ -360,7 +369,9 @@ fn sweep(make: fn(u64) -> Case, first_seed: u64, misses: usize, hits: usize) -> 
             Kind::Graze => tally.grazes += 1,
         }
         if let Some(failure) = failure {
-            tally.failures.push(format!("seed {}: {failure}: {case:?}", case.seed));
+            tally
+                .failures
+                .push(format!("seed {}: {failure}: {case:?}", case.seed));
         }
     }
     tally
@@ -377,8 +388,15 @@ fn assert_clean(name: &str, tally: &Tally, misses: usize, hits: usize) {
     for failure in tally.failures.iter().take(20) {
         eprintln!("  {failure}");
     }
-    assert!(tally.misses >= misses && tally.hits >= hits, "{name}: {tally:?}");
-    assert!(tally.failures.is_empty(), "{name}: {} failures", tally.failures.len());
+    assert!(
+        tally.misses >= misses && tally.hits >= hits,
+        "{name}: {tally:?}"
+    );
+    assert!(
+        tally.failures.is_empty(),
+        "{name}: {} failures",
+        tally.failures.len()
+    );
 }
 
 /// The case: a 5 cm ball at 150 m/s from (−3.7, 0, 0) with velocity (150, −132, 0)
@@ -420,4 +438,85 @@ fn random_balls_full_sweep() {
     let half_spaces = sweep(half_space_case, 3_000_001, 1_000, 1_000);
     assert_clean("walls", &walls, 1_000, 1_000);
     assert_clean("half-spaces", &half_spaces, 1_000, 1_000);
+}
+
+/// Steps `w` `steps` times (every step must succeed: the energy check included) and returns
+/// the lowest height of `body`'s centre over the run.
+fn lowest_height(w: &mut World, body: BodyHandle, steps: usize, case: &str) -> f32 {
+    let mut lowest = f32::INFINITY;
+    for step in 0..steps {
+        match w.step() {
+            Ok(_) => {}
+            Err(other) => panic!("{case}, step {step}: {other}"),
+        }
+        lowest = lowest.min(w.body(body).expect("body").center_of_mass().y);
+    }
+    lowest
+}
+
+/// A 5 cm ball and a 10 cm cube at 350–1,000 m/s into a half-space ground (the plane y = 0),
+/// straight down and at 30° and 60° from the vertical, from 3 m up: 6–17 m a step, beyond
+/// the 2 m the speculative contacts look ahead, so only the sweep can stop them. The centre
+/// never goes below the plane. Frictionless: a ball rolling away at 600 m/s spins at over
+/// 10,000 rad/s, which the blow-up check takes for a blow-up.
+#[test]
+fn very_fast_bodies_do_not_pass_a_half_space() {
+    for speed in [350.0f32, 500.0, 1000.0] {
+        for angle in [0.0f32, 30.0, 60.0] {
+            for (name, shape) in [
+                ("ball", SharedShape::ball(0.05)),
+                ("cube", SharedShape::cuboid(0.05, 0.05, 0.05)),
+            ] {
+                let case = format!("{name} at {speed} m/s, {angle}°");
+                let mut w = World::new(GRAVITY, DT, settings()).expect("world");
+                w.insert(BodyBuilder::fixed(SharedShape::halfspace(Vector::Y)).friction(0.0))
+                    .expect("ground");
+                let a = angle.to_radians();
+                let body = w
+                    .insert(
+                        BodyBuilder::dynamic(shape)
+                            .friction(0.0)
+                            .translation(Vec3::new(0.0, 3.0, 0.0))
+                            .linear_velocity(speed * Vec3::new(a.sin(), -a.cos(), 0.0)),
+                    )
+                    .expect("body");
+                let lowest = lowest_height(&mut w, body, 30, &case);
+                assert!(lowest > 0.0, "{case}: its centre went down to y = {lowest}");
+            }
+        }
+    }
+}
+
+/// A 5 cm ball at 200–1,000 m/s into a height field (40 m square, 1 m cells, heights 0–0.3 m)
+/// at 0°, 30° and 60° from the vertical: its centre never goes below the lowest point of the
+/// terrain (y = 0), which it would have to pass through the terrain's surface to reach.
+#[test]
+fn very_fast_balls_do_not_pass_a_height_field() {
+    let cells = 40;
+    let heights: Vec<f32> = (0..(cells + 1) * (cells + 1))
+        .map(|k| 0.15 + 0.15 * ((k % 7) as f32 * 0.9).sin() * ((k / 7) as f32 * 0.7).cos())
+        .collect();
+    let field = SharedShape::heightfield(
+        impulse::parry3d::utils::Array2::new(cells + 1, cells + 1, heights),
+        Vector::new(cells as f32, 1.0, cells as f32),
+    );
+    for speed in [200.0f32, 500.0, 1000.0] {
+        for angle in [0.0f32, 30.0, 60.0] {
+            let case = format!("ball at {speed} m/s, {angle}°");
+            let mut w = World::new(GRAVITY, DT, settings()).expect("world");
+            w.insert(BodyBuilder::fixed(field.clone()).friction(0.0))
+                .expect("terrain");
+            let a = angle.to_radians();
+            let ball = w
+                .insert(
+                    BodyBuilder::dynamic(SharedShape::ball(0.05))
+                        .friction(0.0)
+                        .translation(Vec3::new(-2.0, 3.0, 1.3))
+                        .linear_velocity(speed * Vec3::new(a.sin(), -a.cos(), 0.0)),
+                )
+                .expect("ball");
+            let lowest = lowest_height(&mut w, ball, 30, &case);
+            assert!(lowest > 0.0, "{case}: its centre went down to y = {lowest}");
+        }
+    }
 }
