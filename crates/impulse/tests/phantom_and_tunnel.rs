@@ -432,7 +432,7 @@ fn random_balls_against_half_spaces() {
 
 /// The full sweep: docs/testing.md "Phantom hits and tunnels".
 #[test]
-#[ignore = "the full sweep, a minute or two: docs/testing.md"]
+#[ignore = "the full sweep, under a minute: docs/testing.md"]
 fn random_balls_full_sweep() {
     let walls = sweep(wall_case, 2_000_001, 1_000, 1_000);
     let half_spaces = sweep(half_space_case, 3_000_001, 1_000, 1_000);
