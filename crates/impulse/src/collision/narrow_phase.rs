@@ -376,8 +376,8 @@ impl SpeculativeMargins {
 /// A speculative point holds its pair's closing speed along the manifold's normal to the gap
 /// over the step, v·n ≥ −gap/dt: it acts as a plane through the witness point, unbounded
 /// across the normal. A path that passes beside the feature the point belongs to crosses
-/// that plane outside the feature and is stopped there, on nothing (a 5 cm ball at 200 m/s
-/// passing 0.23 m below a wall's edge stopped on the plane of its face). The pair's own
+/// that plane outside the feature and is stopped there, on nothing (a 5 cm ball at 150 m/s
+/// whose path passes 0.23 m below a wall's edge stopped on the plane of its face). The pair's own
 /// shape cast tells a real approach from such a passage: where the shapes, moved by the
 /// step's straight motion, never come within `distance`, no point of the pair can be
 /// reached in the step and all its points beyond `distance` are dropped. `distance` is the
