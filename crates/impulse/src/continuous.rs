@@ -5,6 +5,13 @@
 //! time of impact, less a small gap, and its velocity is left as it is, so that the next
 //! step's speculative contact stops it (docs/method.md, "Continuous collision").
 //!
+//! Half-spaces and height fields, which Parry's nonlinear cast does not take (neither is a
+//! support map nor, in Parry, a composite shape for that cast), are swept through the parts
+//! of them the body can reach in the step: for a half-space a box whose top face is the
+//! half-space's plane and which holds every point of the half-space the body can reach
+//! ([`half_space_slab`]), for a height field its triangles under the body's path
+//! ([`height_field_triangles`]), each with the target's own motion.
+//!
 //! This is the method of Rapier's CCD, which sweeps every fast dynamic body against the fixed
 //! colliders and clamps its motion to the first impact, leaving the velocities to the solver
 //! (rapier.rs user guide, "Rigid-body CCD"), and of Box2D v3's continuous collision against
@@ -13,10 +20,11 @@
 //! a surface is not stopped by it but one pushed through it is (Box2D v3.1,
 //! `b2ContinuousQueryCallback`).
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, distance};
-use parry3d::shape::{Ball, Shape};
+use parry3d::shape::{Ball, Cuboid, HalfSpace, HeightField, Shape, Triangle};
 
 use crate::kinematic::rotation_vector;
 
@@ -101,6 +109,26 @@ impl Sweep {
         (self.end.transform_point(com) - self.start.transform_point(com)).length()
             + self.turn.length() * radius
     }
+
+    /// The sweep of a part fixed at `part` in this body's frame: the same motion about the
+    /// same centre of mass.
+    fn of_part(&self, part: &Pose) -> Self {
+        Self {
+            start: self.start * *part,
+            end: self.end * *part,
+            local_center_of_mass: part.inverse_transform_point(self.local_center_of_mass),
+            turn: self.turn,
+        }
+    }
+
+    /// The centre of mass's world position at the step's start and end.
+    fn center_path(&self) -> (Vec3, Vec3) {
+        let com = self.local_center_of_mass;
+        (
+            self.start.transform_point(com),
+            self.end.transform_point(com),
+        )
+    }
 }
 
 /// A bound on [`Sweep::travel`] for the sweep of [`Sweep::new`] with the same arguments,
@@ -141,19 +169,123 @@ pub struct FastBody<'a> {
     pub min_half_extent: f32,
     /// A bound on how far any of its points moves in the step (m), > 0.
     pub travel: f32,
+    /// The farthest any of its points lies from its centre of mass (m).
+    pub radius: f32,
+}
+
+impl FastBody<'_> {
+    /// A box in `target`'s frame at the step's start that holds every point of this body
+    /// during the part of the step from fraction `from` to `to`, seen from `target`'s frame
+    /// at any time of the step. The body stays within [`FastBody::radius`] of its centre's
+    /// straight path; a point fixed in the world moves in a frame carried by `target` by at
+    /// most `target`'s travel for points that far from its centre of mass.
+    fn region_in(&self, target: &Sweep, from: f32, to: f32) -> Aabb {
+        let (a, b) = self.sweep.center_path();
+        let (a, b) = (a + (b - a) * from, a + (b - a) * to);
+        let (target_center, _) = target.center_path();
+        let far = (a - target_center)
+            .length()
+            .max((b - target_center).length())
+            + self.radius;
+        let slack = self.radius + target.travel(far);
+        let (a, b) = (
+            target.start.inverse_transform_point(a),
+            target.start.inverse_transform_point(b),
+        );
+        Aabb::new(a.min(b), a.max(b)).loosened(slack)
+    }
 }
 
 /// The fraction of the step, in [0, 1), to which `body`'s motion is clamped so that it does not
 /// pass `target` (a static or kinematic body's shape moving along `target_sweep`), or `None`
-/// when the motion needs no clamp. With the two apart by more than the gap at the start and no
-/// contact between them this step (`in_contact` false): the first time of impact of Parry's
-/// nonlinear cast, moved back by the gap along the motion. With the two touching at the start,
+/// when the motion needs no clamp ([`clamp_fraction_castable`]). A half-space is swept as the
+/// box of it that the body can reach ([`half_space_slab`]), a height field as its triangles
+/// under the body's path ([`height_field_triangles`]); every other shape as it is.
+pub fn clamp_fraction(
+    body: &FastBody<'_>,
+    target: &dyn Shape,
+    target_sweep: &Sweep,
+    in_contact: bool,
+) -> Option<f32> {
+    if let Some(half_space) = target.as_shape::<HalfSpace>() {
+        let region = body.region_in(target_sweep, 0.0, 1.0);
+        let (slab, pose) = half_space_slab(half_space.normal, &region)?;
+        let sweep = target_sweep.of_part(&pose);
+        return clamp_fraction_castable(body, &slab, &sweep, in_contact);
+    }
+    if let Some(height_field) = target.as_heightfield() {
+        return height_field_triangles(body, height_field, target_sweep)
+            .iter()
+            .filter_map(|triangle| {
+                clamp_fraction_castable(body, triangle, target_sweep, in_contact)
+            })
+            .min_by(f32::total_cmp);
+    }
+    clamp_fraction_castable(body, target, target_sweep, in_contact)
+}
+
+/// The box of the half-space below the plane through the origin with outward unit `normal`
+/// (the half-space's frame) that holds every point of it within `region` (same frame): its top
+/// face lies on the plane, across the projection of the ball around `region`, and it reaches
+/// down to that ball's lowest point. Within `region` the box and the half-space are the same
+/// set, so a body that stays in `region` meets the one where it meets the other. `None` when
+/// the ball lies wholly above the plane (nothing there to meet). Returns the box and its pose
+/// in the half-space's frame.
+pub fn half_space_slab(normal: Vec3, region: &Aabb) -> Option<(Cuboid, Pose)> {
+    let center = region.center();
+    let reach = region.half_extents().length();
+    let height = normal.dot(center);
+    if height.is_nan() || height > reach {
+        return None;
+    }
+    let half_depth = 0.5 * (reach - height).max(1.0e-3);
+    let top = center - normal * height;
+    let pose = Pose::from_parts(
+        top - normal * half_depth,
+        Quat::from_rotation_arc(Vec3::Y, normal),
+    );
+    Some((Cuboid::new(Vec3::new(reach, half_depth, reach)), pose))
+}
+
+/// Most slices of the body's path [`height_field_triangles`] gathers triangles over.
+const MAX_PATH_SLICES: usize = 64;
+
+/// The triangles of `height_field` (in its own frame) that `body` can reach in the step: those
+/// in the boxes of [`FastBody::region_in`] over slices of the step short enough that each box
+/// hugs the path (about the body's diameter of travel each, at most [`MAX_PATH_SLICES`]), each
+/// triangle once.
+pub fn height_field_triangles(
+    body: &FastBody<'_>,
+    height_field: &HeightField,
+    target_sweep: &Sweep,
+) -> Vec<Triangle> {
+    let (a, b) = body.sweep.center_path();
+    let slices = ((a - b).length() / (2.0 * body.radius).max(1.0e-3))
+        .ceil()
+        .clamp(1.0, MAX_PATH_SLICES as f32) as usize;
+    let mut found: Vec<(u32, Triangle)> = Vec::new();
+    for k in 0..slices {
+        let (from, to) = (k as f32 / slices as f32, (k + 1) as f32 / slices as f32);
+        let region = body.region_in(target_sweep, from, to);
+        height_field.map_elements_in_local_aabb(&region, &mut |id, triangle| {
+            found.push((id, *triangle));
+        });
+    }
+    found.sort_unstable_by_key(|&(id, _)| id);
+    found.dedup_by_key(|&mut (id, _)| id);
+    found.into_iter().map(|(_, triangle)| triangle).collect()
+}
+
+/// [`clamp_fraction`] for a target Parry's nonlinear cast takes (support maps, meshes,
+/// compounds). With the two apart by more than the gap at the start and no contact between
+/// them this step (`in_contact` false): the first time of impact of Parry's nonlinear cast,
+/// moved back by the gap along the motion. With the two touching at the start,
 /// or in contact this step (the solver already held them apart at the points the narrow phase
 /// found, speculative ones included): the time of impact of the body's core sphere, so that
 /// only a body driven through the target is stopped, and a body sliding or spinning along it
 /// is not held at its start pose step after step. Shape pairs Parry cannot cast are not
 /// clamped.
-pub fn clamp_fraction(
+pub fn clamp_fraction_castable(
     body: &FastBody<'_>,
     target: &dyn Shape,
     target_sweep: &Sweep,
@@ -235,6 +367,52 @@ mod tests {
             }
         }
         assert!(answered > 40);
+    }
+
+    /// Within the region it is built for, the half-space's box holds exactly the points of
+    /// the half-space: points of a grid over the region (tilted planes, the region above,
+    /// across and below the plane) are inside the box just when they are below the plane
+    /// (to within 10 µm of it). A region wholly above the plane gets no box.
+    #[test]
+    fn the_half_space_box_is_the_half_space_within_the_region() {
+        use parry3d::query::PointQuery;
+        let normals = [
+            Vec3::Y,
+            Vec3::new(0.3, 0.9, -0.2).normalize(),
+            Vec3::new(-0.7, 0.1, 0.7).normalize(),
+        ];
+        let mut checked = 0;
+        for normal in normals {
+            for height in [-3.0f32, -0.4, 0.0, 0.7, 1.9] {
+                let center = normal * height + Vec3::new(5.0, -2.0, 1.0).cross(normal);
+                let region = Aabb::new(
+                    center - Vec3::new(1.0, 0.5, 2.0),
+                    center + Vec3::new(1.0, 0.5, 2.0),
+                );
+                let Some((slab, pose)) = half_space_slab(normal, &region) else {
+                    assert!(normal.dot(center) > region.half_extents().length());
+                    continue;
+                };
+                for i in 0..=8 {
+                    for j in 0..=8 {
+                        for k in 0..=8 {
+                            let f = Vec3::new(i as f32, j as f32, k as f32) / 8.0;
+                            let p = region.mins + (region.maxs - region.mins) * f;
+                            let below = normal.dot(p);
+                            if below.abs() < 1.0e-5 {
+                                continue;
+                            }
+                            let inside = slab.contains_point(&pose, p);
+                            assert_eq!(inside, below < 0.0, "{normal} {height} {p}");
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 5000, "{checked}");
+        let above = Aabb::new(Vec3::new(-1.0, 5.0, -1.0), Vec3::new(1.0, 6.0, 1.0));
+        assert!(half_space_slab(Vec3::Y, &above).is_none());
     }
 
     /// A body that spins 20 rad about z in a step is swept 20 rad about z, the turn that ends

@@ -8,7 +8,10 @@
 
 use glam::Vec3;
 use parry3d::math::Pose;
-use parry3d::query::{ContactManifold, ContactManifoldsWorkspace, PersistentQueryDispatcher};
+use parry3d::query::{
+    ContactManifold, ContactManifoldsWorkspace, PersistentQueryDispatcher, QueryDispatcher,
+    ShapeCastOptions,
+};
 use parry3d::utils::PoseOpt;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -341,6 +344,99 @@ impl SpeculativeMargins {
             + gravity;
         (self.prediction_distance + closing * self.dt).min(self.margins[a] + self.margins[b])
     }
+
+    /// Pair (`a`, `b`)'s straight relative motion over the step and how near along it its
+    /// shapes must come for its speculative points to stand ([`SweptReach`]).
+    #[inline]
+    pub(crate) fn pair_reach(&self, bodies: &Bodies, a: usize, b: usize) -> SweptReach {
+        let velocity = |i: usize| {
+            if bodies.is_moving(i) {
+                bodies.linear_velocity[i]
+            } else {
+                Vec3::ZERO
+            }
+        };
+        let gravity = if bodies.is_dynamic(a) != bodies.is_dynamic(b) {
+            self.gravity_speed
+        } else {
+            0.0
+        };
+        SweptReach {
+            displacement: (velocity(b) - velocity(a)) * self.dt,
+            distance: self.prediction_distance
+                + (self.spin_speeds[a] + self.spin_speeds[b] + gravity) * self.dt,
+        }
+    }
+}
+
+/// What the speculative points of a pair must meet to stand: the pair's shapes, moved apart
+/// by the straight relative motion of the step (body 2 by `displacement` against body 1),
+/// come within `distance` of each other at some time of the step.
+///
+/// A speculative point holds its pair's closing speed along the manifold's normal to the gap
+/// over the step, v·n ≥ −gap/dt: it acts as a plane through the witness point, unbounded
+/// across the normal. A path that passes beside the feature the point belongs to crosses
+/// that plane outside the feature and is stopped there, on nothing (a 5 cm ball at 150 m/s
+/// whose path passes 0.23 m below a wall's edge stopped on the plane of its face). The pair's own
+/// shape cast tells a real approach from such a passage: where the shapes, moved by the
+/// step's straight motion, never come within `distance`, no point of the pair can be
+/// reached in the step and all its points beyond `distance` are dropped. `distance` is the
+/// part of the pair's prediction ([`SpeculativeMargins::pair_prediction`]) that is not that
+/// straight motion: the base prediction distance, which catches velocity changes within the
+/// step (a body pushed by its neighbours), how far rotation can carry any point of either
+/// body (|ω|·R·dt) and, for a dynamic body against a static or kinematic one, what gravity
+/// adds (|g|·dt²). Points within `distance` (every resting contact) are never dropped.
+///
+/// Box2D v3 avoids the same phantoms by keeping its speculative distance small (4 linear
+/// slops, `B2_SPECULATIVE_DISTANCE` in `constants.h`, the cut-off of every manifold function
+/// in `manifold.c`) and leaving fast bodies to its continuous collision; here the margin
+/// grows with the speed, so that fast bodies meet each other too, and the cast bounds it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SweptReach {
+    /// Displacement of body 2 relative to body 1 over the step (m, world frame).
+    pub displacement: Vec3,
+    /// Distance (m) within which the shapes must come along it.
+    pub distance: f32,
+}
+
+impl SweptReach {
+    /// Drops every point of `manifolds` (of a pair whose body 2 sits at `pos12` in body 1's
+    /// frame, body 1 at world rotation `rotation1`) beyond [`SweptReach::distance`] when the
+    /// shapes, moved by the step's straight motion, stay farther apart than that distance;
+    /// whether any point was dropped. Shape pairs Parry cannot cast keep their points.
+    pub(crate) fn drop_unreachable(
+        &self,
+        pos12: &Pose,
+        rotation1: glam::Quat,
+        shape1: &dyn parry3d::shape::Shape,
+        shape2: &dyn parry3d::shape::Shape,
+        manifolds: &mut [Manifold],
+    ) -> bool {
+        let beyond = |manifolds: &[Manifold]| {
+            manifolds
+                .iter()
+                .any(|m| m.points.iter().any(|p| p.dist > self.distance))
+        };
+        if !beyond(manifolds) {
+            return false;
+        }
+        let options = ShapeCastOptions {
+            max_time_of_impact: 1.0,
+            target_distance: self.distance,
+            stop_at_penetration: true,
+            compute_impact_geometry_on_penetration: false,
+        };
+        let local_displacement = rotation1.inverse() * self.displacement;
+        let cast =
+            ContactDispatcher.cast_shapes(pos12, local_displacement, shape1, shape2, options);
+        if !matches!(cast, Ok(None)) {
+            return false;
+        }
+        for manifold in manifolds.iter_mut() {
+            manifold.points.retain(|p| p.dist <= self.distance);
+        }
+        true
+    }
 }
 
 /// How many pairs ahead a pass over the pairs asks for the points' memory (twice as far for
@@ -487,6 +583,13 @@ impl NarrowPhase {
             for manifold in &mut pair.manifolds {
                 drop_duplicate_points(manifold);
             }
+            margins.pair_reach(bodies, a, b).drop_unreachable(
+                &pos12,
+                bodies.pose[a].rotation,
+                bodies.shape[a].as_ref(),
+                bodies.shape[b].as_ref(),
+                &mut pair.manifolds,
+            );
             pair.summary = PairSummary::of(&pair.manifolds);
             query.reach = recycle_reach(&bodies.shape[a], &bodies.shape[b]);
             pair.last_query = Some(query);

@@ -21,7 +21,7 @@ impl World {
     /// Sweeps every awake dynamic body that moved more than [`FAST_FRACTION`] of its smallest
     /// half extent this step against the static and kinematic bodies in its swept box (the
     /// broad phase's tree, and the moving kinematic bodies), and puts it back to the earliest
-    /// clamp ([`continuous::clamp_fraction`]). Each body's clamp reads only its own poses and
+    /// clamp ([`continuous::clamp_fraction`]) with the velocity gravity had given it by then. Each body's clamp reads only its own poses and
     /// the static and kinematic bodies', which no clamp changes, so the order does not matter.
     pub(super) fn continuous_stage(&mut self, settings: &SolverSettings) {
         let n = self.bodies.len();
@@ -60,6 +60,7 @@ impl World {
                 sweep,
                 min_half_extent,
                 travel,
+                radius,
             };
             let swept = shape.compute_swept_aabb(&sweep.start, &sweep.end);
             let mut earliest = 1.0f32;
@@ -101,11 +102,18 @@ impl World {
                 }
             }
             if earliest < 1.0 {
-                clamps.push((i, sweep.pose_at(earliest)));
+                clamps.push((i, sweep.pose_at(earliest), earliest));
             }
         }
-        for &(i, pose) in &clamps {
+        // A clamped body stands where it was at fraction t of the step, so it takes the
+        // velocity gravity had given it by then: with the whole step's, the potential energy
+        // of the (1 − t)·dt it did not travel would come back as kinetic energy
+        // (|v·g|·(1 − t)·dt per kg, 80 J/kg for a ball falling at 500 m/s at 60 Hz).
+        let gravity = self.gravity * self.dt;
+        for &(i, pose, t) in &clamps {
             self.bodies.pose[i] = pose;
+            let unspent = self.bodies.locked_axes[i].lock_linear_velocity(gravity * (1.0 - t));
+            self.bodies.linear_velocity[i] -= unspent;
         }
         self.clamps = clamps;
     }

@@ -93,8 +93,8 @@ pub struct World {
     start_poses: Vec<Pose>,
     /// Kinematic bodies moving this step, in index order.
     moving_kinematic: Vec<u32>,
-    /// The continuous stage's clamped poses (scratch).
-    clamps: Vec<(usize, Pose)>,
+    /// The continuous stage's clamps (scratch): body, clamped pose, fraction of the step.
+    clamps: Vec<(usize, Pose, f32)>,
 }
 
 impl World {
