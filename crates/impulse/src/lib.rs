@@ -83,7 +83,7 @@ pub use instruction_set::{INSTRUCTION_SET_VARIABLE, InstructionSet};
 pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };
-pub use settings::{ContactRepair, SettingError, SolverMethod, SolverSettings};
+pub use settings::{ContactRepair, ImpactModel, SettingError, SolverMethod, SolverSettings};
 pub use solver::{EscalationLevel, IslandReport};
 pub use world::{
     BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, BodyRef, ContactEvent, ContactPairView,
