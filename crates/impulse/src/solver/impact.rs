@@ -171,7 +171,13 @@ impl ImpactWorkspace {
         self.candidates.extend(0..rows as u32);
         let elastic_rounds = ROUNDS_BASE + ROUNDS_PER_ROW * rows;
         for round in 0..2 * elastic_rounds {
-            self.select_active(constraints, tolerance, dt, threshold, round < elastic_rounds);
+            self.select_active(
+                constraints,
+                tolerance,
+                dt,
+                threshold,
+                round < elastic_rounds,
+            );
             if self.active.is_empty() {
                 break;
             }

@@ -611,7 +611,8 @@ pub fn step_island(
             angular: &mut w.angular,
         };
         let island = (island_bodies, guests, bodies);
-        w.impact.propagate(constraints, island, &mut velocities, dt, settings)
+        w.impact
+            .propagate(constraints, island, &mut velocities, dt, settings)
     } else if spread {
         // Per point: any split gives the same targets.
         use rayon::prelude::*;
