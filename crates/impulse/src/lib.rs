@@ -84,7 +84,7 @@ pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };
 pub use scene::{Jitter, Override, Variation};
-pub use settings::{ContactRepair, SettingError, SolverMethod, SolverSettings};
+pub use settings::{ContactRepair, ImpactModel, SettingError, SolverMethod, SolverSettings};
 pub use solver::{EscalationLevel, IslandReport};
 pub use world::{
     BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, BodyRef, ContactEvent, ContactPairView,

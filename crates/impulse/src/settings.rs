@@ -88,6 +88,38 @@ impl ContactRepair {
     }
 }
 
+/// How the restitution of a step's impacts is resolved when several contacts collide at once
+/// (docs/method.md, "Simultaneous impacts"). In scene files, `solver.impact`: `"simultaneous"`
+/// (the default) or `"propagation"`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ImpactModel {
+    /// Newton's hypothesis v⁺ = −c_r·v⁻ on every colliding point together, in one LCP solve
+    /// after the substeps: the method's restitution. Touching bodies that did not approach
+    /// keep target 0, so a struck row of touching balls moves off together rather than
+    /// passing the impact on (Newton's cradle does not give 1 in → 1 out).
+    #[default]
+    Simultaneous,
+    /// Generalized reflections (Smith, Kaufman, Vouga, Tamstorf and Grinspun, "Reflections on
+    /// simultaneous impact", SIGGRAPH 2012): from the velocities before the step, the
+    /// contacts that approach are projected to rest together and reflected by 1 + c_r; the
+    /// contacts this leaves approaching are treated the same way, round after round, until
+    /// none approaches, so an impact travels through touching bodies as a sequence of
+    /// collisions (`solver::impact`). Newton's cradle gives 1 in → 1 out, kinetic energy and
+    /// momentum are kept at c_r = 1, and symmetric impacts stay symmetric.
+    Propagation,
+}
+
+impl ImpactModel {
+    /// The name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            ImpactModel::Simultaneous => "simultaneous",
+            ImpactModel::Propagation => "propagation",
+        }
+    }
+}
+
 /// Settings of the contact solve (steps 4 and 5 of docs/architecture.md).
 ///
 /// Defaults are chosen for the standard scenes at dt = 1/60 s. Units are SI.
@@ -193,6 +225,10 @@ pub struct SolverSettings {
     /// collision). Fast bodies then never pass through a thin wall, whatever their speed. On
     /// by default; the cost without fast bodies is a pass over the bodies' poses.
     pub continuous: bool,
+    /// How simultaneous impacts are resolved: `simultaneous` (one LCP with Newton's
+    /// restitution, the default) or `propagation` (generalized reflections). A physical
+    /// choice of the scene, like the restitution coefficients ([`ImpactModel`]).
+    pub impact: ImpactModel,
 }
 
 /// A solver setting outside its allowed range: which field, and what is allowed.
@@ -492,6 +528,7 @@ impl Default for SolverSettings {
             simd_island_contacts: 16,
             gyroscopic: true,
             continuous: true,
+            impact: ImpactModel::Simultaneous,
         }
     }
 }

@@ -14,6 +14,7 @@
 //! - [`wide`]: PGS in SIMD lanes on packed manifold groups;
 //! - [`policy`]: `method: auto`, the escalation from NNCG to more iterations or the exact path;
 //! - [`position`]: split impulse's position solve;
+//! - [`impact`]: `impact: propagation`, simultaneous impacts by generalized reflections;
 //! - [`substep`]: one island's step (substeps, warm start, solves, relax, restitution), which
 //!   picks the method and calls it through the interface.
 
@@ -26,6 +27,7 @@ use crate::settings::SolverSettings;
 
 pub mod apgd;
 pub mod exact;
+pub mod impact;
 pub mod nncg;
 pub mod pgs;
 pub mod policy;

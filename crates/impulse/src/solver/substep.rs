@@ -22,7 +22,7 @@ use crate::body::{Bodies, BodyKind, LockedAxes};
 use crate::contact::constraints::{self, ContactConstraint};
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
-use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
+use crate::settings::{ContactRepair, ImpactModel, SolverMethod, SolverSettings};
 
 /// What the solver did on one island during a step (step 7 of docs/architecture.md: every step can say how
 /// well its LCP was solved, here per island).
@@ -120,6 +120,8 @@ pub struct IslandWorkspace {
     position_repair: bool,
     /// Per body slot, its world inverse inertia (for [`ContactSolver::prepare`]).
     slot_inverse_inertia: Vec<Mat3>,
+    /// `impact: propagation`'s work space ([`super::impact`]).
+    impact: super::impact::ImpactWorkspace,
 }
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
@@ -603,6 +605,14 @@ pub fn step_island(
     let bounces = if !restitution {
         // No body bounces, so no pair does (a pair's coefficient is the larger of its bodies').
         false
+    } else if settings.impact == ImpactModel::Propagation {
+        let mut velocities = Velocities {
+            linear: &mut w.linear,
+            angular: &mut w.angular,
+        };
+        let island = (island_bodies, guests, bodies);
+        w.impact
+            .propagate(constraints, island, &mut velocities, dt, settings)
     } else if spread {
         // Per point: any split gives the same targets.
         use rayon::prelude::*;
@@ -615,7 +625,7 @@ pub fn step_island(
     };
     if bounces {
         let pass = SolvePass {
-            iterations: settings.iterations.max(settings.relax_iterations),
+            iterations: super::impact::restitution_iterations(settings),
             tolerance: settings.tolerance,
             friction: true,
             half_turn: false,
