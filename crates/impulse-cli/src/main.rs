@@ -132,8 +132,8 @@ enum Command {
         /// Animated GIF of the drawn frames (frame delay: K steps of the scene's dt).
         #[arg(long)]
         gif: Option<PathBuf>,
-        /// Steps to simulate, ≥ 1 (default: the scene's).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        /// Steps to simulate (default: the scene's); 0 draws the scene's initial state alone.
+        #[arg(long)]
         steps: Option<u32>,
         /// Draw every K-th step (step 0 and the last are always drawn).
         #[arg(long, default_value_t = 1)]
