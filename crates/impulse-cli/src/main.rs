@@ -270,6 +270,10 @@ enum LcpCommand {
         /// Output file: `.svg` or `.png`.
         #[arg(long)]
         out: PathBuf,
+        /// No progress bar (the command replays the run up to --step once per iteration count
+        /// and method).
+        #[arg(long)]
+        quiet: bool,
     },
     /// Plot residual against iteration for PGS, projected Jacobi and Lemke (SVG or
     /// PNG).
@@ -654,11 +658,13 @@ fn real_main() -> Result<ExitCode> {
                 step,
                 iterations,
                 out,
+                quiet,
             } => engine_convergence::engine_convergence(
                 &resolve_scene(&scene)?,
                 step,
                 iterations,
                 &out,
+                quiet,
             )?,
         },
     }

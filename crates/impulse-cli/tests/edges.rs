@@ -572,3 +572,23 @@ fn the_readme_examples_write_outside_tracked_files() {
     }
     assert!(checked >= 3, "only {checked} outputs found in the README");
 }
+
+/// `lcp engine-convergence` replays a run once per iteration count: it takes --quiet too.
+#[test]
+fn engine_convergence_takes_quiet() {
+    let svg = temp(SUITE, "engine.svg");
+    let out = output_within(
+        impulse()
+            .args(["lcp", "engine-convergence", "stack3", "--step", "3"])
+            .args(["--iterations", "2", "--quiet", "--out"])
+            .arg(&svg),
+        120,
+    );
+    assert_success(&out, "engine-convergence --quiet: ");
+    assert!(stderr(&out).is_empty(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("pgs   residual after 2 iterations"),
+        "{}",
+        stdout(&out)
+    );
+}
