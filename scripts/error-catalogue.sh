@@ -64,7 +64,21 @@ row "resume: damaged snapshot" resume "$dir/damaged.snapshot" --quiet
 row "resume: not a snapshot" resume "$(case_file scene_not_snapshot '{"name": "x", "bodies": []}')" --quiet
 row "resume: another format version" resume "$dir/newer.snapshot" --quiet
 row "resume: missing snapshot" resume "$dir/missing.snapshot" --quiet
-row "resume: animation output" resume "$good" --quiet --out "$dir/x.glb"
+row "resume: animation output" resume "$good" --steps 1 --quiet --out "$dir/x.glb"
 row "--checkpoint-every without --checkpoint-dir" run stack3 --steps 1 --quiet --checkpoint-every 10
 row "empty scene (a warning)" run "$(case_file empty '{"name": "empty", "bodies": []}')" --steps 1 --quiet
 row "bodies created overlapping (a warning)" run "$(case_file overlap "$(scene "$body, {\"kind\": \"dynamic\", \"shape\": {\"type\": \"sphere\", \"radius\": 0.5}, \"position\": [0, 2.2, 0]}")")" --steps 1 --quiet
+row "--threads above 4 per logical CPU" run stack3 --steps 1 --quiet --threads 1000000
+row "substeps beyond the maximum" run "$(case_file substeps '{"name": "x", "solver": {"substeps": 4294967295}, "bodies": []}')" --steps 1 --quiet
+row "--steps 0" run stack3 --steps 0 --quiet
+row "steps: 0 in the scene" run "$(case_file zero '{"name": "zero", "steps": 0, "bodies": []}')" --quiet
+row "not a regular file" run /dev/zero --quiet
+truncate -s 268435457 "$dir/big.json"
+row "scene file over 256 MiB" run "$dir/big.json" --quiet
+row "two outputs to one file" run stack3 --steps 1 --quiet --out "$dir/a.csv" --stats "$dir/a.csv"
+row "an output over the scene file" run "$(case_file own '{"name": "own", "bodies": []}')" --steps 1 --quiet --summary-json "$dir/own.json"
+ln -s /dev/full "$dir/full.csv"
+row "a full disk (write error)" run stack3 --steps 1 --quiet --out "$dir/full.csv"
+row "resume: snapshot at the run's end" resume "$good" --quiet
+python3 -c 'import json, sys; n = 50000; json.dump({"n": n, "a": {"csr": {"indptr": list(range(n + 1)), "indices": list(range(n)), "values": [1.0] * n}}, "b": [1.0] * n}, open(sys.argv[1], "w"))' "$dir/identity.json"
+row "lcp solve: Lemke above its size limit" lcp solve "$dir/identity.json" --solver lemke

@@ -16,7 +16,14 @@ use impulse::{SolverMethod, SolverSettings};
 use crate::lcp_command::Series;
 
 /// Residual after `k` iterations of `method` on step `step` of `scene`, for k = 1..=iterations.
-fn history(scene: &Scene, step: u64, method: SolverMethod, iterations: u32) -> Result<Vec<f64>> {
+/// Each step taken advances `bar` by one.
+fn history(
+    scene: &Scene,
+    step: u64,
+    method: SolverMethod,
+    iterations: u32,
+    bar: &indicatif::ProgressBar,
+) -> Result<Vec<f64>> {
     let mut out = Vec::with_capacity(iterations as usize);
     for k in 1..=iterations {
         let mut scene = scene.clone();
@@ -26,6 +33,7 @@ fn history(scene: &Scene, step: u64, method: SolverMethod, iterations: u32) -> R
             world
                 .step()
                 .context("the run stopped before the plotted step")?;
+            bar.inc(1);
         }
         world.set_settings(SolverSettings {
             substeps: 1,
@@ -38,6 +46,7 @@ fn history(scene: &Scene, step: u64, method: SolverMethod, iterations: u32) -> R
             .step()
             .context("the plotted step failed")?
             .natural_map_residual;
+        bar.inc(1);
         out.push(residual as f64);
     }
     Ok(out)
@@ -45,7 +54,14 @@ fn history(scene: &Scene, step: u64, method: SolverMethod, iterations: u32) -> R
 
 /// Writes `out_svg` (SVG or PNG after its extension): log10 of the natural-map residual of step `step` of `scene` against
 /// iterations (1..=`iterations`) for PGS, NNCG and APGD. Prints each method's final residual.
-pub fn engine_convergence(scene: &Scene, step: u64, iterations: u32, out_svg: &Path) -> Result<()> {
+/// It takes 3 × `iterations` × `step` steps, shown by a progress bar unless `quiet`.
+pub fn engine_convergence(
+    scene: &Scene,
+    step: u64,
+    iterations: u32,
+    out_svg: &Path,
+    quiet: bool,
+) -> Result<()> {
     if step == 0 || iterations == 0 {
         bail!("--step and --iterations must be at least 1");
     }
@@ -71,13 +87,17 @@ pub fn engine_convergence(scene: &Scene, step: u64, iterations: u32, out_svg: &P
         ),
     ];
     let mut series = Vec::new();
+    let total = (methods.len() as u64) * u64::from(iterations) * step;
+    let bar = crate::run::progress_bar(&scene.name, total, quiet);
     for (method, label, colour, dashed) in methods {
-        let values = history(scene, step, method, iterations)?;
-        println!(
-            "{:<5} residual after {iterations} iterations: {:.3e}",
-            method.name(),
-            values.last().copied().unwrap_or(f64::NAN)
-        );
+        let values = history(scene, step, method, iterations, &bar)?;
+        bar.suspend(|| {
+            println!(
+                "{:<5} residual after {iterations} iterations: {:.3e}",
+                method.name(),
+                values.last().copied().unwrap_or(f64::NAN)
+            )
+        });
         series.push(Series {
             label: label.to_string(),
             colour,
@@ -90,6 +110,7 @@ pub fn engine_convergence(scene: &Scene, step: u64, iterations: u32, out_svg: &P
             marker: None,
         });
     }
+    bar.finish_and_clear();
     let title = format!(
         "{}: natural-map residual of step {step} vs iterations",
         scene.name

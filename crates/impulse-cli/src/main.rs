@@ -135,8 +135,8 @@ enum Command {
         /// Animated GIF of the drawn frames (frame delay: K steps of the scene's dt).
         #[arg(long)]
         gif: Option<PathBuf>,
-        /// Steps to simulate, ≥ 1 (default: the scene's).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        /// Steps to simulate (default: the scene's); 0 draws the scene's initial state alone.
+        #[arg(long)]
         steps: Option<u32>,
         /// Draw every K-th step (step 0 and the last are always drawn).
         #[arg(long, default_value_t = 1)]
@@ -279,6 +279,10 @@ enum LcpCommand {
         /// Output file: `.svg` or `.png`.
         #[arg(long)]
         out: PathBuf,
+        /// No progress bar (the command replays the run up to --step once per iteration count
+        /// and method).
+        #[arg(long)]
+        quiet: bool,
     },
     /// Plot residual against iteration for PGS, projected Jacobi and Lemke (SVG or
     /// PNG).
@@ -680,11 +684,13 @@ fn real_main() -> Result<ExitCode> {
                 step,
                 iterations,
                 out,
+                quiet,
             } => engine_convergence::engine_convergence(
                 &resolve_scene(&scene)?,
                 step,
                 iterations,
                 &out,
+                quiet,
             )?,
         },
     }

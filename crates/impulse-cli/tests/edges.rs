@@ -385,14 +385,10 @@ fn sigterm_and_sighup_finish_the_frame_and_write_the_checkpoint() {
 }
 
 #[test]
-fn zero_steps_are_refused_with_a_clear_message() {
-    for command in [
-        &["run", "stack3"][..],
-        &["render", "stack3", "--gif", "x.gif"],
-    ] {
-        let out = output_within(impulse().args(command).args(["--steps", "0"]), 30);
-        assert_refused(&out, &["--steps", "0 is not in 1.."]);
-    }
+fn zero_steps_of_run_and_resume_are_refused_with_a_clear_message() {
+    // (`render --steps 0` draws the initial state: tests/render.rs.)
+    let out = output_within(impulse().args(["run", "stack3", "--steps", "0"]), 30);
+    assert_refused(&out, &["--steps", "0 is not in 1.."]);
     let snapshot = checkpoint("zero_steps");
     let out = output_within(
         impulse()
@@ -575,4 +571,24 @@ fn the_readme_examples_write_outside_tracked_files() {
         }
     }
     assert!(checked >= 3, "only {checked} outputs found in the README");
+}
+
+/// `lcp engine-convergence` replays a run once per iteration count: it takes --quiet too.
+#[test]
+fn engine_convergence_takes_quiet() {
+    let svg = temp(SUITE, "engine.svg");
+    let out = output_within(
+        impulse()
+            .args(["lcp", "engine-convergence", "stack3", "--step", "3"])
+            .args(["--iterations", "2", "--quiet", "--out"])
+            .arg(&svg),
+        120,
+    );
+    assert_success(&out, "engine-convergence --quiet: ");
+    assert!(stderr(&out).is_empty(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("pgs   residual after 2 iterations"),
+        "{}",
+        stdout(&out)
+    );
 }

@@ -190,7 +190,10 @@ pub fn render_glb(path: &Path, options: &RenderOptions) -> Result<RenderSummary>
         _ => 0.1,
     };
     let mut sink = FrameSink::create(options, (delay_s * 1e3).round().max(10.0) as u32)?;
+    let name = path.display().to_string();
+    let bar = crate::run::progress_bar(&name, frames as u64, options.quiet);
     for k in 0..frames {
+        bar.inc(1);
         let poses: Vec<(Quat, Vec3)> = nodes.iter().map(|n| n.pose(k)).collect();
         let colours: Vec<Vec3> = nodes
             .iter()
@@ -216,6 +219,7 @@ pub fn render_glb(path: &Path, options: &RenderOptions) -> Result<RenderSummary>
         let canvas = super::draw(&bodies, &poses, &colours, &ground, &camera, options);
         sink.write(k as u64, &canvas)?;
     }
+    bar.finish_and_clear();
     sink.finish()?;
     Ok(RenderSummary { frames, camera })
 }
