@@ -147,8 +147,8 @@ pub struct SolverArgs {
 }
 
 impl SolverArgs {
-    /// The settings these options make of `settings`: the preset first (keeping `sleep` and
-    /// `gyroscopic`, which are about the scene rather than the solve), then every option given.
+    /// The settings these options make of `settings`: the preset first (keeping `sleep`,
+    /// `gyroscopic` and `impact`, which are about the scene rather than the solve), then every option given.
     /// The world checks the values before its first step. Errors: a repair parameter given for
     /// a repair method that has none (`--soft-hertz` with a bias, say).
     pub fn apply(&self, settings: &SolverSettings) -> Result<SolverSettings, String> {
@@ -156,6 +156,7 @@ impl SolverArgs {
             Some(preset) => SolverSettings {
                 sleep: settings.sleep,
                 gyroscopic: settings.gyroscopic,
+                impact: settings.impact,
                 ..SolverSettings::preset(preset.name()).unwrap_or_default()
             },
             None => settings.clone(),

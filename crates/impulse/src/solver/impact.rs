@@ -33,15 +33,17 @@
 //!
 //! The result enters the step through the restitution solve after the substeps: each row the
 //! reflections pushed gets as its target the normal velocity the reflections left it, J_i·u⁺,
-//! and the impulse the substeps gave it over the step is replaced by the reflections' total,
-//! applied to the velocities as an impulse already given: the row's accumulated impulse restarts from zero.
-//! The solve thus starts at the reflected velocities and only adds what the rest of the step
-//! asks (support against gravity, friction, contacts the impact did not reach), and the next
-//! step's warm start, which reads the accumulated impulses, does not give the impact again.
+//! and the impulse the substeps gave it over the step is replaced by the reflections' total:
+//! the difference is applied to the velocities and added to the row's accumulated impulse, as
+//! the one-LCP restitution adds its bounce, so the friction disc allows μ times it. The solve
+//! thus starts at the reflected velocities and only adds what the rest of the step asks
+//! (support against gravity, friction, contacts the impact did not reach).
+//! [`ImpactWorkspace::finish`] then takes the addition back out of the accumulated impulses,
+//! which are the next step's warm start, so that the impact is not given a second time.
 
 use glam::Vec3;
 
-use super::{Velocities, apply_impulses};
+use super::{Velocities, apply_impulses, cap_to_disc};
 use crate::body::Bodies;
 use crate::contact::constraints::ContactConstraint;
 use crate::settings::{ImpactModel, SolverSettings};
@@ -103,6 +105,10 @@ pub struct ImpactWorkspace {
     slot_rows: Vec<u32>,
     /// Per moving slot, the next free place of its rows while they are listed.
     cursor: Vec<u32>,
+    /// Per row, what [`Self::propagate`] added to its accumulated normal impulse (N·s).
+    added: Vec<f32>,
+    /// Whether `added` is waiting for [`Self::finish`].
+    pending: bool,
     /// Rounds of the last propagation (0 when none ran).
     pub rounds: u32,
 }
@@ -187,25 +193,55 @@ impl ImpactWorkspace {
             self.queue_neighbours(constraints, moving, round as u32 + 1);
         }
 
-        // The reflections' impulses replace the substeps' on the rows they pushed, as impulses
-        // already applied: the rows' accumulated impulses restart from zero, so the solve that
-        // follows adds only what the rest of the step asks, and the next step's warm start
-        // does not push the bodies again with the impact.
+        // On the rows they pushed, the reflections' impulses replace what the substeps gave
+        // over the step (each substep's warm start applies the last one's impulse, so the
+        // velocities carry the step total). The difference is applied now and also added to the
+        // row's accumulated impulse, as the restitution solve of `Simultaneous` adds its bounce
+        // to it: the friction disc of the solve that follows then allows μ times the impulse
+        // beyond the substeps', and that solve may take back what the reflections added, no
+        // more. `finish` removes the addition again once the solve is done.
         let mut any = false;
-        for (c, &total) in constraints.iter_mut().zip(&self.impulse) {
+        self.added.clear();
+        self.added.resize(rows, 0.0);
+        for ((c, &total), added) in constraints
+            .iter_mut()
+            .zip(&self.impulse)
+            .zip(&mut self.added)
+        {
             if total <= 0.0 {
                 continue;
             }
             any = true;
-            // The substeps gave the row its step total (each substep's warm start applies the
-            // last one's impulse), which the reflections' total replaces.
             let change = total - c.step_impulses[0];
             push(c, change, velocities.linear, velocities.angular);
-            c.normal_impulse = 0.0;
+            let accumulated = (c.normal_impulse + change).max(0.0);
+            *added = accumulated - c.normal_impulse;
+            c.normal_impulse = accumulated;
+            // The restitution solve's bookkeeping subtracts the accumulated impulse before it
+            // and adds it after: the step total becomes the reflections' plus its change.
             c.step_impulses[0] = total;
             c.target_normal_velocity = normal_velocity(c, &self.linear, &self.angular);
         }
+        self.pending = any;
         any
+    }
+
+    /// After the restitution solve that followed [`Self::propagate`]: takes what it added
+    /// back out of each pushed row's accumulated impulse (at least zero) and keeps the friction
+    /// impulse inside the disc of what remains. The accumulated impulses are the next step's
+    /// warm start, which must not give the impact a second time (a struck row of balls left at
+    /// rest would be pushed apart again). The step totals keep the impact.
+    pub fn finish(&mut self, constraints: &mut [ContactConstraint]) {
+        if !std::mem::take(&mut self.pending) {
+            return;
+        }
+        for (c, &added) in constraints.iter_mut().zip(&self.added) {
+            if added == 0.0 {
+                continue;
+            }
+            c.normal_impulse = (c.normal_impulse - added).max(0.0);
+            c.tangent_impulses = cap_to_disc(c.tangent_impulses, c.friction * c.normal_impulse);
+        }
     }
 
     /// The velocities of the step's start per slot: the island's bodies, its guests, then the
