@@ -13,8 +13,10 @@
 //! 2. the active rows are **projected** to rest together: impulses λ ≥ 0 with J_i·u' ≥ 0 and
 //!    λ_i·J_i·u' = 0, u' = u + M⁻¹Jᵀλ (the inelastic LCP of the active rows alone, solved by
 //!    projected Gauss-Seidel to a tight tolerance);
-//! 3. the projection is **reflected**: u ← u + M⁻¹Jᵀ((1 + e_i)·λ_i), with e_i the pair's c_r
-//!    when the row approached faster than `restitution_threshold`, else 0;
+//! 3. the projection is **reflected**: u ← u + M⁻¹Jᵀ((1 + e)·λ), with one e for the set: when
+//!    some rows approach faster than `restitution_threshold` the set is those rows alone and e
+//!    the smallest of their pairs' c_r, otherwise e = 0 (a set with mixed coefficients could
+//!    gain energy);
 //! 4. the rows of the bodies that changed are examined again, until no row is active.
 //!
 //! Rows that were touching but not approaching take no impulse in a round, so bodies may break
@@ -91,8 +93,8 @@ pub struct ImpactWorkspace {
     impulse: Vec<f32>,
     /// Per row, the current round's projection impulse λ (N·s).
     projection: Vec<f32>,
-    /// Per row, the current round's restitution coefficient e.
-    coefficient: Vec<f32>,
+    /// The current round's restitution coefficient e, one for the whole active set.
+    coefficient: f32,
     /// Per row, the last round it was queued for, so each is examined once a round.
     queued: Vec<u32>,
     /// Rows to examine this round.
@@ -169,8 +171,6 @@ impl ImpactWorkspace {
         self.impulse.resize(rows, 0.0);
         self.projection.clear();
         self.projection.resize(rows, 0.0);
-        self.coefficient.clear();
-        self.coefficient.resize(rows, 0.0);
         self.queued.clear();
         self.queued.resize(rows, 0);
         self.candidates.clear();
@@ -287,8 +287,13 @@ impl ImpactWorkspace {
         }
     }
 
-    /// The active set among the candidates (module docs, step 1), in constraint order, with
-    /// each active row's restitution coefficient for this round (0 when `elastic` is false).
+    /// The active set among the candidates (module docs, step 1), in constraint order, and its
+    /// restitution coefficient. One coefficient for the whole set: with e_i differing within a
+    /// set the reflection can add energy (E⁺ = E' + |Jᵀ(e∘λ)|² in the metric of M⁻¹, which can
+    /// exceed E⁻ = E' + |Jᵀλ|² when impulses on one body partly cancel). So when some rows
+    /// approach faster than `threshold`, the set is those rows alone, with the smallest of their
+    /// pairs' coefficients (0 when `elastic` is false); otherwise it is the slower rows, with
+    /// e = 0. Every round then keeps or loses kinetic energy, never gains it.
     fn select_active(
         &mut self,
         constraints: &[ContactConstraint],
@@ -298,6 +303,7 @@ impl ImpactWorkspace {
         elastic: bool,
     ) {
         self.active.clear();
+        let mut fast = false;
         for &row in &self.candidates {
             let c = &constraints[row as usize];
             if c.normal.effective_mass <= 0.0 {
@@ -307,15 +313,25 @@ impl ImpactWorkspace {
             let gap = (-c.depth).max(0.0);
             let in_contact = c.max_normal_impulse > 0.0 || gap + v * dt < 0.0;
             if v < -tolerance && in_contact {
-                self.active.push(row);
-                self.coefficient[row as usize] = if elastic && v < -threshold {
-                    c.restitution
-                } else {
-                    0.0
-                };
+                if v < -threshold && !fast {
+                    // The first fast row: the slower ones found so far wait.
+                    fast = true;
+                    self.active.clear();
+                }
+                if !fast || v < -threshold {
+                    self.active.push(row);
+                }
             }
         }
         self.active.sort_unstable();
+        self.coefficient = if fast && elastic {
+            self.active
+                .iter()
+                .map(|&row| constraints[row as usize].restitution)
+                .fold(f32::INFINITY, f32::min)
+        } else {
+            0.0
+        };
     }
 
     /// The active rows' inelastic projection by projected Gauss-Seidel from λ = 0, sweeps in
@@ -347,13 +363,13 @@ impl ImpactWorkspace {
         }
     }
 
-    /// Adds e_i·λ_i of each active row on top of its projection (module docs, step 3) and
-    /// the round's (1 + e_i)·λ_i to the row's total.
+    /// Adds e·λ_i of each active row on top of its projection (module docs, step 3) and the
+    /// round's (1 + e)·λ_i to the row's total.
     fn reflect(&mut self, constraints: &[ContactConstraint]) {
         for &row in &self.active {
             let row = row as usize;
-            let (projection, coefficient) = (self.projection[row], self.coefficient[row]);
-            let extra = coefficient * projection;
+            let projection = self.projection[row];
+            let extra = self.coefficient * projection;
             if extra != 0.0 {
                 push(
                     &constraints[row],
