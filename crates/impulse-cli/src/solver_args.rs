@@ -151,7 +151,8 @@ pub struct SolverArgs {
 impl SolverArgs {
     /// The settings these options make of `settings`: the preset's solver effort first
     /// ([`SolverSettings::with_effort_of`]: the scene keeps its physics, restitution threshold,
-    /// sleeping, continuous collision, gyroscopic motion and friction), then every option given.
+    /// sleeping, continuous collision, gyroscopic motion, friction and the impact model), then every
+    /// option given.
     /// The world checks the values before its first step. Errors: a repair parameter given for
     /// a repair method that has none (`--soft-hertz` with a bias, say).
     pub fn apply(&self, settings: &SolverSettings) -> Result<SolverSettings, String> {

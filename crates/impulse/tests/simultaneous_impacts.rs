@@ -324,3 +324,47 @@ fn the_cradle_scene_file_gives_one_in_one_out() {
     let v: Vec<Vec3> = (1..=5).map(|i| world.bodies().linear_velocity[i]).collect();
     assert_close(&v, &[0.0, 0.0, 0.0, 0.0, 1.0], 1.0, "scene file");
 }
+
+/// An oblique bounce on the ground with propagation keeps Coulomb's friction impulse: a solid
+/// ball (I = 2/5·m·r²) arriving at (vₓ, −v_y) without spin takes the normal impulse
+/// J_n = m(1 + e)v_y and the friction impulse J_t = min(μJ_n, 2/7·m·vₓ) (it leaves rolling when
+/// μJ_n suffices), so vₓ' = vₓ − J_t/m, v_y' = e·v_y, ω' = −5/2·J_t/(m·r) (Stronge, "Impact
+/// Mechanics", 2000, ch. 3). No gravity.
+#[test]
+fn an_oblique_bounce_keeps_the_coulomb_friction_impulse() {
+    let (vx, vy, e) = (2.0f32, 3.0f32, 0.5f32);
+    for mu in [0.05f32, 1.0] {
+        let mut world = World::new(Vec3::ZERO, DT, settings(ImpactModel::Propagation)).unwrap();
+        world
+            .insert(
+                BodyBuilder::fixed(SharedShape::cuboid(20.0, 0.5, 20.0))
+                    .translation(Vec3::new(0.0, -0.5, 0.0))
+                    .friction(mu)
+                    .restitution(e),
+            )
+            .unwrap();
+        let ball = world
+            .insert(
+                BodyBuilder::dynamic(SharedShape::ball(RADIUS))
+                    .translation(Vec3::new(0.0, 0.5, 0.0))
+                    .linear_velocity(Vec3::new(vx, -vy, 0.0))
+                    .friction(mu)
+                    .restitution(e),
+            )
+            .unwrap();
+        for _ in 0..40 {
+            world.step().unwrap();
+        }
+        let body = world.body(ball).unwrap();
+        let (v, spin) = (body.linear_velocity(), body.angular_velocity().z);
+        let friction = (mu * (1.0 + e) * vy).min(2.0 / 7.0 * vx);
+        let want = (vx - friction, e * vy, -2.5 * friction / RADIUS);
+        let close = |got: f32, want: f32| (got - want).abs() <= 0.01 * want.abs().max(0.1);
+        assert!(
+            close(v.x, want.0) && close(v.y, want.1) && close(spin, want.2),
+            "μ = {mu}: ({}, {}) m/s, {spin} rad/s; closed form {want:?}",
+            v.x,
+            v.y
+        );
+    }
+}

@@ -13,8 +13,10 @@
 //! 2. the active rows are **projected** to rest together: impulses λ ≥ 0 with J_i·u' ≥ 0 and
 //!    λ_i·J_i·u' = 0, u' = u + M⁻¹Jᵀλ (the inelastic LCP of the active rows alone, solved by
 //!    projected Gauss-Seidel to a tight tolerance);
-//! 3. the projection is **reflected**: u ← u + M⁻¹Jᵀ((1 + e_i)·λ_i), with e_i the pair's c_r
-//!    when the row approached faster than `restitution_threshold`, else 0;
+//! 3. the projection is **reflected**: u ← u + M⁻¹Jᵀ((1 + e)·λ), with one e for the set: when
+//!    some rows approach faster than `restitution_threshold` the set is those rows alone and e
+//!    the smallest of their pairs' c_r, otherwise e = 0 (a set with mixed coefficients could
+//!    gain energy);
 //! 4. the rows of the bodies that changed are examined again, until no row is active.
 //!
 //! Rows that were touching but not approaching take no impulse in a round, so bodies may break
@@ -33,15 +35,17 @@
 //!
 //! The result enters the step through the restitution solve after the substeps: each row the
 //! reflections pushed gets as its target the normal velocity the reflections left it, J_i·u⁺,
-//! and the impulse the substeps gave it over the step is replaced by the reflections' total,
-//! applied to the velocities as an impulse already given: the row's accumulated impulse restarts from zero.
-//! The solve thus starts at the reflected velocities and only adds what the rest of the step
-//! asks (support against gravity, friction, contacts the impact did not reach), and the next
-//! step's warm start, which reads the accumulated impulses, does not give the impact again.
+//! and the impulse the substeps gave it over the step is replaced by the reflections' total:
+//! the difference is applied to the velocities and added to the row's accumulated impulse, as
+//! the one-LCP restitution adds its bounce, so the friction disc allows μ times it. The solve
+//! thus starts at the reflected velocities and only adds what the rest of the step asks
+//! (support against gravity, friction, contacts the impact did not reach).
+//! [`ImpactWorkspace::finish`] then takes the addition back out of the accumulated impulses,
+//! which are the next step's warm start, so that the impact is not given a second time.
 
 use glam::Vec3;
 
-use super::{Velocities, apply_impulses};
+use super::{Velocities, apply_impulses, cap_to_disc};
 use crate::body::Bodies;
 use crate::contact::constraints::ContactConstraint;
 use crate::settings::{ImpactModel, SolverSettings};
@@ -89,8 +93,8 @@ pub struct ImpactWorkspace {
     impulse: Vec<f32>,
     /// Per row, the current round's projection impulse λ (N·s).
     projection: Vec<f32>,
-    /// Per row, the current round's restitution coefficient e.
-    coefficient: Vec<f32>,
+    /// The current round's restitution coefficient e, one for the whole active set.
+    coefficient: f32,
     /// Per row, the last round it was queued for, so each is examined once a round.
     queued: Vec<u32>,
     /// Rows to examine this round.
@@ -103,6 +107,10 @@ pub struct ImpactWorkspace {
     slot_rows: Vec<u32>,
     /// Per moving slot, the next free place of its rows while they are listed.
     cursor: Vec<u32>,
+    /// Per row, what [`Self::propagate`] added to its accumulated normal impulse (N·s).
+    added: Vec<f32>,
+    /// Whether `added` is waiting for [`Self::finish`].
+    pending: bool,
     /// Rounds of the last propagation (0 when none ran).
     pub rounds: u32,
 }
@@ -163,8 +171,6 @@ impl ImpactWorkspace {
         self.impulse.resize(rows, 0.0);
         self.projection.clear();
         self.projection.resize(rows, 0.0);
-        self.coefficient.clear();
-        self.coefficient.resize(rows, 0.0);
         self.queued.clear();
         self.queued.resize(rows, 0);
         self.candidates.clear();
@@ -187,25 +193,55 @@ impl ImpactWorkspace {
             self.queue_neighbours(constraints, moving, round as u32 + 1);
         }
 
-        // The reflections' impulses replace the substeps' on the rows they pushed, as impulses
-        // already applied: the rows' accumulated impulses restart from zero, so the solve that
-        // follows adds only what the rest of the step asks, and the next step's warm start
-        // does not push the bodies again with the impact.
+        // On the rows they pushed, the reflections' impulses replace what the substeps gave
+        // over the step (each substep's warm start applies the last one's impulse, so the
+        // velocities carry the step total). The difference is applied now and also added to the
+        // row's accumulated impulse, as the restitution solve of `Simultaneous` adds its bounce
+        // to it: the friction disc of the solve that follows then allows μ times the impulse
+        // beyond the substeps', and that solve may take back what the reflections added, no
+        // more. `finish` removes the addition again once the solve is done.
         let mut any = false;
-        for (c, &total) in constraints.iter_mut().zip(&self.impulse) {
+        self.added.clear();
+        self.added.resize(rows, 0.0);
+        for ((c, &total), added) in constraints
+            .iter_mut()
+            .zip(&self.impulse)
+            .zip(&mut self.added)
+        {
             if total <= 0.0 {
                 continue;
             }
             any = true;
-            // The substeps gave the row its step total (each substep's warm start applies the
-            // last one's impulse), which the reflections' total replaces.
             let change = total - c.step_impulses[0];
             push(c, change, velocities.linear, velocities.angular);
-            c.normal_impulse = 0.0;
+            let accumulated = (c.normal_impulse + change).max(0.0);
+            *added = accumulated - c.normal_impulse;
+            c.normal_impulse = accumulated;
+            // The restitution solve's bookkeeping subtracts the accumulated impulse before it
+            // and adds it after: the step total becomes the reflections' plus its change.
             c.step_impulses[0] = total;
             c.target_normal_velocity = normal_velocity(c, &self.linear, &self.angular);
         }
+        self.pending = any;
         any
+    }
+
+    /// After the restitution solve that followed [`Self::propagate`]: takes what it added
+    /// back out of each pushed row's accumulated impulse (at least zero) and keeps the friction
+    /// impulse inside the disc of what remains. The accumulated impulses are the next step's
+    /// warm start, which must not give the impact a second time (a struck row of balls left at
+    /// rest would be pushed apart again). The step totals keep the impact.
+    pub fn finish(&mut self, constraints: &mut [ContactConstraint]) {
+        if !std::mem::take(&mut self.pending) {
+            return;
+        }
+        for (c, &added) in constraints.iter_mut().zip(&self.added) {
+            if added == 0.0 {
+                continue;
+            }
+            c.normal_impulse = (c.normal_impulse - added).max(0.0);
+            c.tangent_impulses = cap_to_disc(c.tangent_impulses, c.friction * c.normal_impulse);
+        }
     }
 
     /// The velocities of the step's start per slot: the island's bodies, its guests, then the
@@ -251,8 +287,13 @@ impl ImpactWorkspace {
         }
     }
 
-    /// The active set among the candidates (module docs, step 1), in constraint order, with
-    /// each active row's restitution coefficient for this round (0 when `elastic` is false).
+    /// The active set among the candidates (module docs, step 1), in constraint order, and its
+    /// restitution coefficient. One coefficient for the whole set: with e_i differing within a
+    /// set the reflection can add energy (E⁺ = E' + |Jᵀ(e∘λ)|² in the metric of M⁻¹, which can
+    /// exceed E⁻ = E' + |Jᵀλ|² when impulses on one body partly cancel). So when some rows
+    /// approach faster than `threshold`, the set is those rows alone, with the smallest of their
+    /// pairs' coefficients (0 when `elastic` is false); otherwise it is the slower rows, with
+    /// e = 0. Every round then keeps or loses kinetic energy, never gains it.
     fn select_active(
         &mut self,
         constraints: &[ContactConstraint],
@@ -262,6 +303,7 @@ impl ImpactWorkspace {
         elastic: bool,
     ) {
         self.active.clear();
+        let mut fast = false;
         for &row in &self.candidates {
             let c = &constraints[row as usize];
             if c.normal.effective_mass <= 0.0 {
@@ -271,15 +313,25 @@ impl ImpactWorkspace {
             let gap = (-c.depth).max(0.0);
             let in_contact = c.max_normal_impulse > 0.0 || gap + v * dt < 0.0;
             if v < -tolerance && in_contact {
-                self.active.push(row);
-                self.coefficient[row as usize] = if elastic && v < -threshold {
-                    c.restitution
-                } else {
-                    0.0
-                };
+                if v < -threshold && !fast {
+                    // The first fast row: the slower ones found so far wait.
+                    fast = true;
+                    self.active.clear();
+                }
+                if !fast || v < -threshold {
+                    self.active.push(row);
+                }
             }
         }
         self.active.sort_unstable();
+        self.coefficient = if fast && elastic {
+            self.active
+                .iter()
+                .map(|&row| constraints[row as usize].restitution)
+                .fold(f32::INFINITY, f32::min)
+        } else {
+            0.0
+        };
     }
 
     /// The active rows' inelastic projection by projected Gauss-Seidel from λ = 0, sweeps in
@@ -311,13 +363,13 @@ impl ImpactWorkspace {
         }
     }
 
-    /// Adds e_i·λ_i of each active row on top of its projection (module docs, step 3) and
-    /// the round's (1 + e_i)·λ_i to the row's total.
+    /// Adds e·λ_i of each active row on top of its projection (module docs, step 3) and the
+    /// round's (1 + e)·λ_i to the row's total.
     fn reflect(&mut self, constraints: &[ContactConstraint]) {
         for &row in &self.active {
             let row = row as usize;
-            let (projection, coefficient) = (self.projection[row], self.coefficient[row]);
-            let extra = coefficient * projection;
+            let projection = self.projection[row];
+            let extra = self.coefficient * projection;
             if extra != 0.0 {
                 push(
                     &constraints[row],

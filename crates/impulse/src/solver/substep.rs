@@ -656,6 +656,7 @@ pub fn step_island(
             super::add_step_impulses(c);
         }
         w.record(&outcome, false);
+        w.impact.finish(constraints);
     }
 }
 
