@@ -3,38 +3,49 @@ reading the positions of a large world.
 
     python crates/impulse-py/tools/overhead.py [--cli target/release/impulse] [--rounds 5]
 
-The Rust figure is `impulse run SCENE --steps N --quiet`'s mean ms/step (each `World::step`
-timed alone); the Python figure is the wall time of N calls of `world.step()` from a Python loop
-divided by N, on a fresh world of the same scene and settings. Rounds alternate the two and the
-medians are reported, since other work on the machine moves single runs.
+The Rust figures are `impulse run SCENE --steps N --summary-json F`'s median and mean time of
+one `World::step` (each timed alone); the Python figures time each call of `world.step()` from a
+Python loop alone, on a fresh world of the same scene and settings (the same steps: the runs are
+identical to the bit). Rounds alternate the two and the medians are reported, since other work on
+the machine moves single runs.
 """
 
 import argparse
-import re
+import json
+import os
 import statistics
 import subprocess
+import tempfile
 import time
 
 import impulse
 
 
-def rust_ms(cli: str, scene: str, steps: int) -> float:
-    out = subprocess.run(
-        [cli, "run", scene, "--steps", str(steps), "--quiet"],
-        check=True,
-        capture_output=True,
-        text=True,
-    ).stdout
-    return float(re.search(r"([0-9.]+) ms/step", out).group(1))
+def rust_ms(cli: str, scene: str, steps: int) -> tuple[float, float]:
+    """`impulse run`'s own timing of each `World::step`: (median, mean) ms per step."""
+    with tempfile.TemporaryDirectory() as directory:
+        summary = os.path.join(directory, "summary.json")
+        subprocess.run(
+            [cli, "run", scene, "--steps", str(steps), "--quiet", "--summary-json", summary],
+            check=True,
+            capture_output=True,
+        )
+        with open(summary) as file:
+            data = json.load(file)
+    return data["ms_per_step"], data["mean_ms_per_step"]
 
 
-def python_ms(scene: str, steps: int) -> float:
+def python_ms(scene: str, steps: int) -> tuple[float, float]:
+    """Each call of `world.step()` from a Python loop timed alone: (median, mean) ms per step."""
     world = impulse.World.from_scene(scene)
     step = world.step
-    start = time.perf_counter()
+    clock = time.perf_counter
+    times = []
     for _ in range(steps):
+        start = clock()
         step()
-    return (time.perf_counter() - start) * 1e3 / steps
+        times.append(clock() - start)
+    return statistics.median(times) * 1e3, statistics.fmean(times) * 1e3
 
 
 def main() -> None:
@@ -50,11 +61,25 @@ def main() -> None:
     for _ in range(args.rounds):
         rust.append(rust_ms(args.cli, args.scene, args.steps))
         python.append(python_ms(args.scene, args.steps))
-    r, p = statistics.median(rust), statistics.median(python)
-    print(f"{args.scene}, {args.steps} steps, default settings, median of {args.rounds} rounds:")
-    print(f"  Rust   World::step       {r:.4f} ms/step  (rounds: {', '.join(f'{x:.4f}' for x in rust)})")
-    print(f"  Python world.step()      {p:.4f} ms/step  (rounds: {', '.join(f'{x:.4f}' for x in python)})")
-    print(f"  Python / Rust            {p / r:.3f}")
+
+    def line(label: str, values: list[tuple[float, float]]) -> str:
+        medians = [m for m, _ in values]
+        means = [m for _, m in values]
+        return (
+            f"  {label:<22} median {statistics.median(medians):.4f} ms/step, "
+            f"mean {statistics.median(means):.4f} ms/step  "
+            f"(per-round medians: {', '.join(f'{x:.4f}' for x in medians)}; "
+            f"means: {', '.join(f'{x:.4f}' for x in means)})"
+        )
+
+    print(f"{args.scene}, {args.steps} steps, default settings, each step timed alone;")
+    print(f"median over {args.rounds} alternating rounds of each round's median and mean:")
+    print(line("impulse run (Rust)", rust))
+    print(line("world.step() (Python)", python))
+    for i, label in ((0, "median"), (1, "mean")):
+        r = statistics.median(v[i] for v in rust)
+        p = statistics.median(v[i] for v in python)
+        print(f"  Python / Rust, {label:<6} {p / r:.3f}")
 
     world = impulse.World.from_scene(args.large)
     n = len(world)
