@@ -1014,31 +1014,59 @@ def _trajectory_every(save_trajectories: bool | int) -> int:
 
 
 def _pickle_observe(observe: Callable[[Any], Any]) -> bytes:
-    """``observe`` as bytes for the workers: by reference with pickle, else by value with
-    cloudpickle where it is installed (lambdas, closures, functions of a ``__main__``)."""
+    """``observe`` as bytes for the workers. A function of an installed package goes by
+    reference (the workers import it); any other (a script's, a test's, a lambda, a closure)
+    by value with cloudpickle (standalone or Ray's), since a worker process, above all one on
+    another machine, may not find its module."""
     if not callable(observe):
         raise TypeError("observe must be a callable taking the world and returning a dict")
-    module = getattr(observe, "__module__", None)
-    if module not in (None, "__main__", "__mp_main__"):
+    module_name = getattr(observe, "__module__", None) or ""
+    package = sys.modules.get(module_name.partition(".")[0])
+    if package is not None and _is_installed(package):
         try:
             return pickle.dumps(observe)
         except Exception:
             pass
+    cloudpickle = _cloudpickle()
+    if cloudpickle is None:
+        try:
+            return pickle.dumps(observe)
+        except Exception as error:
+            raise TypeError(
+                f"observe cannot be sent to the workers ({error}): define it at the top of a "
+                "module, or install cloudpickle"
+            ) from None
+    if package is None or package.__name__ in ("__main__", "__mp_main__"):
+        return cloudpickle.dumps(observe)
+    cloudpickle.register_pickle_by_value(package)
+    try:
+        return cloudpickle.dumps(observe)
+    finally:
+        cloudpickle.unregister_pickle_by_value(package)
+
+
+def _cloudpickle() -> Any:
     try:
         import cloudpickle
     except ImportError:
         try:
             from ray import cloudpickle
         except ImportError:
-            cloudpickle = None
-    if cloudpickle is None:
-        try:
-            return pickle.dumps(observe)
-        except Exception as error:
-            raise TypeError(
-                f"observe cannot be sent to the workers ({error}): use a function defined at the top of a module, or install cloudpickle"
-            ) from None
-    return cloudpickle.dumps(observe)
+            return None
+    return cloudpickle
+
+
+def _is_installed(module: Any) -> bool:
+    """Whether ``module`` comes from the standard library or site-packages (every worker of
+    the same environment can import it)."""
+    import sysconfig
+
+    file = getattr(module, "__file__", None)
+    if file is None:
+        return module.__name__ in sys.builtin_module_names
+    file = os.path.realpath(file)
+    roots = {sysconfig.get_paths()[name] for name in ("stdlib", "platstdlib", "purelib", "platlib")}
+    return any(file.startswith(os.path.realpath(root) + os.sep) for root in roots)
 
 
 def _check_scene_loads(scene: Any, preset: str | None) -> None:
