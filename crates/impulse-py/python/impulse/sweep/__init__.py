@@ -299,14 +299,23 @@ def _finite_or_none(value: Any) -> Any:
     return None if value is None else float(value)
 
 
-def _measure(world: Any, steps: int, step_error: type[BaseException]) -> dict[str, Any]:
+def _measure(world: Any, steps: int, step_error: type[BaseException], frames: dict[str, list] | None = None, every: int = 1) -> dict[str, Any]:
     """Steps ``world`` ``steps`` times and measures what ``impulse run`` prints, with the same
     definitions (crates/impulse-cli/src/run.rs): overlap and drift from poses at the start,
     every ``OVERLAP_SAMPLE_EVERY`` steps and at the last; the top body's sink; the largest
     speed of any body at any step; contacts, iterations and the natural-map residual from each
     step's diagnostics. A failed step stops the run (status ``stopped``) with the metrics of
-    the steps before it."""
+    the steps before it. With ``frames`` (a dict of empty lists), also records the frames
+    ``World.simulate(steps, every)`` would: the start, every step that is a multiple of
+    ``every`` and the last."""
     import numpy as np
+
+    def record() -> None:
+        if frames is not None:
+            frames["positions"].append(np.array(world.positions, dtype=np.float32, copy=True))
+            frames["orientations"].append(np.array(world.orientations, dtype=np.float32, copy=True))
+            frames["steps"].append(world.step_count)
+            frames["times"].append(world.time)
 
     initial = np.array(world.positions, dtype=np.float32, copy=True)
     quality = world.quality(initial)
@@ -321,6 +330,7 @@ def _measure(world: Any, steps: int, step_error: type[BaseException]) -> dict[st
     max_speed = np.float32(0.0)
     status, error = COMPLETED, None
     last = world.step_count + steps
+    record()
     while world.step_count < last:
         start = time.perf_counter()
         try:
@@ -345,6 +355,8 @@ def _measure(world: Any, steps: int, step_error: type[BaseException]) -> dict[st
             final_overlap = float(quality["max_overlap_m"])
             max_overlap = max(max_overlap, final_overlap)
             max_drift = max(max_drift, float(quality["max_drift_m"]))
+        if step % every == 0 or step == last:
+            record()
     quality = world.quality(initial)
     top_sink = quality.get("top_sink_m")
     top_sink = 0.0 if top_sink is None else float(top_sink)
@@ -425,6 +437,8 @@ def _run_task(task: dict[str, Any]) -> dict[str, Any]:
 
 
 def _simulate(task: dict[str, Any], observe: Callable[[Any], Mapping[str, Any]] | None) -> dict[str, Any]:
+    import numpy as np
+
     import impulse
 
     world = impulse.World.from_scene(
@@ -434,19 +448,23 @@ def _simulate(task: dict[str, Any], observe: Callable[[Any], Mapping[str, Any]] 
         jitter=task["jitter"],
         settings=task["preset"],
     )
-    initial = pickle.dumps(world) if task.get("trajectory_every") else None
-    row = _measure(world, task["steps"], impulse.StepError)
+    every = task.get("trajectory_every") or 0
+    frames: dict[str, list] | None = {"positions": [], "orientations": [], "steps": [], "times": []} if every else None
+    row = _measure(world, task["steps"], impulse.StepError, frames, max(every, 1))
     if observe is not None:
         try:
             row.update(_observe_values(observe, world))
         except Exception as failure:
             row["status"] = FAILED
             row["error"] = f"observe: {type(failure).__name__}: {failure}"
-    if initial is not None:
-        # The trajectory of the same run, replayed from the pickled start (which round-trips to
-        # the bit), up to the step the measured run reached.
-        replay = pickle.loads(initial)
-        trajectory = replay.simulate(row["steps_taken"], every=task["trajectory_every"])
+    if frames is not None:
+        trajectory = impulse.Trajectory(
+            positions=np.stack(frames["positions"]),
+            orientations=np.stack(frames["orientations"]),
+            steps=np.array(frames["steps"], dtype=np.int64),
+            times=np.array(frames["times"], dtype=np.float64),
+            names=list(world.names),
+        )
         row["trajectory"] = _save_trajectory(trajectory, task["out"], task["key"])
     return row
 
@@ -865,8 +883,8 @@ def sweep(
     save_trajectories : bool | int
         ``True`` or K: also write each run's trajectory (every K-th step, ``True`` = every step)
         as ``out/trajectories/<run_key>.npz`` (``Trajectory.save``; ``impulse.load_trajectory``
-        reads it). The trajectory is replayed from the run's initial state, so a run costs
-        about twice as much.
+        reads it): the frames ``World.simulate(steps, every=K)`` records, up to the last step
+        taken.
     preset : str, optional
         ``"fast"`` | ``"default"`` | ``"precise"`` | ``"reference"``: solver effort, as
         ``impulse run --preset``.
