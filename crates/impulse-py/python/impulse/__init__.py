@@ -1,0 +1,50 @@
+"""impulse: simultaneous contact resolution for computer animation, from Python.
+
+Rigid bodies and particles in piles, stacks and pyramids, whose contact impulses are found
+together as one linear complementarity problem (LCP) per time step. SI units, y up.
+
+    import impulse
+    world = impulse.World.from_scene("pyramid20")       # a built-in, a .json file or a dict
+    start = world.positions.copy()                      # (N, 3) float32, metres
+    world.step(60)                                      # releases the GIL
+    print(world.quality(start), world.diagnostics["natural_map_residual"])
+    trajectory = world.simulate(120, every=4)           # (F, N, 3) and (F, N, 4) arrays
+    trajectory.save("pyramid.npz")
+
+See docs/python.md in the repository for the API, the arrays' lifetime rule, pickling and
+errors.
+"""
+
+from ._impulse import (
+    BodyBuilder,
+    BodyHandle,
+    SceneError,
+    Settings,
+    Shape,
+    StepError,
+    World,
+    WorldError,
+    __version__,
+    scenes,
+)
+from ._trajectory import Trajectory, load_trajectory
+
+__all__ = [
+    "BodyBuilder",
+    "BodyHandle",
+    "SceneError",
+    "Settings",
+    "Shape",
+    "StepError",
+    "Trajectory",
+    "World",
+    "WorldError",
+    "__version__",
+    "load_trajectory",
+    "scenes",
+]
+
+
+def _world_from_snapshot(data: bytes) -> World:
+    """Unpickles a world: the inverse of ``World.__reduce__`` (snapshot bytes)."""
+    return World.from_snapshot(data)

@@ -1,0 +1,227 @@
+//! Body state as NumPy arrays with no Python object per body.
+//!
+//! Reading: a read-only NumPy view of the engine's own storage (`impulse::Bodies`, one array
+//! per quantity, structure of arrays). Positions and orientations are strided views into the
+//! pose array (each pose is a quaternion then a translation, 32 bytes); the velocities are
+//! contiguous N×3 arrays. No copy and no per-body work.
+//!
+//! Lifetime rule: a view shows the world's current state (it changes as the world steps) and
+//! keeps the world alive. Storage moves only when bodies are inserted or removed, so those
+//! calls refuse, with `WorldError`, while any view of the world is alive; `.copy()` a view to
+//! keep the values of one moment.
+//!
+//! Writing: the setters take any array-like of shape (N, 3) or (N, 4), convert it to float32,
+//! check every value is finite, and apply it through the engine's own edits (which wake the
+//! bodies and refuse what a body cannot do); an edit that fails is undone for every body.
+
+use std::mem::{offset_of, size_of};
+use std::sync::Arc;
+
+use impulse::glam::{Quat, Vec3};
+use impulse::parry3d::math::Pose;
+use numpy::ndarray::{ArrayView2, ShapeBuilder};
+use numpy::{PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+
+use crate::WorldError;
+use crate::world::World;
+
+// The views index f32 elements of a pose with element strides.
+const _: () = assert!(size_of::<Pose>() % size_of::<f32>() == 0);
+const _: () = assert!(offset_of!(Pose, translation) % size_of::<f32>() == 0);
+const _: () = assert!(offset_of!(Pose, rotation) % size_of::<f32>() == 0);
+const _: () = assert!(size_of::<Vec3>() == 3 * size_of::<f32>());
+const _: () = assert!(size_of::<Quat>() == 4 * size_of::<f32>());
+
+/// A quantity of every body, as `World`'s array properties name it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Field {
+    Positions,
+    Orientations,
+    LinearVelocities,
+    AngularVelocities,
+}
+
+impl Field {
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Field::Positions => "positions",
+            Field::Orientations => "orientations",
+            Field::LinearVelocities => "linear_velocities",
+            Field::AngularVelocities => "angular_velocities",
+        }
+    }
+
+    fn columns(self) -> usize {
+        match self {
+            Field::Orientations => 4,
+            _ => 3,
+        }
+    }
+}
+
+/// The owner of a view's memory as NumPy sees it (the array's `base`): keeps the world alive and
+/// counts as a live view while any array derived from it exists.
+#[pyclass(module = "impulse._impulse", frozen)]
+pub(crate) struct ViewGuard {
+    _world: Py<World>,
+    _live: Arc<()>,
+}
+
+/// A read-only view of `field` of every body of `world`: shape (N, 3) or (N, 4), float32.
+pub(crate) fn view<'py>(
+    world: &Bound<'py, World>,
+    field: Field,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let py = world.py();
+    let borrowed = world.borrow();
+    let bodies = borrowed.inner.bodies();
+    let n = bodies.len();
+    let float = size_of::<f32>();
+    // (first element, element stride between bodies)
+    let (start, stride): (*const f32, usize) = match field {
+        Field::Positions => (
+            bodies
+                .pose
+                .as_ptr()
+                .cast::<u8>()
+                .wrapping_add(offset_of!(Pose, translation))
+                .cast(),
+            size_of::<Pose>() / float,
+        ),
+        Field::Orientations => (
+            bodies
+                .pose
+                .as_ptr()
+                .cast::<u8>()
+                .wrapping_add(offset_of!(Pose, rotation))
+                .cast(),
+            size_of::<Pose>() / float,
+        ),
+        Field::LinearVelocities => (bodies.linear_velocity.as_ptr().cast(), 3),
+        Field::AngularVelocities => (bodies.angular_velocity.as_ptr().cast(), 3),
+    };
+    // SAFETY: `start` points into a live Vec of `n` poses (or vectors), each holding the
+    // `columns` consecutive f32 read here; the stride steps from one body's to the next. For
+    // n == 0 nothing is read.
+    let array =
+        unsafe { ArrayView2::from_shape_ptr((n, field.columns()).strides((stride, 1)), start) };
+    let guard = Bound::new(
+        py,
+        ViewGuard {
+            _world: world.clone().unbind(),
+            _live: borrowed.views.clone(),
+        },
+    )?;
+    drop(borrowed);
+    // SAFETY: the guard keeps the world (and so its body storage) alive as long as the array;
+    // the storage is not reallocated while a guard lives (`World::refuse_if_viewed`).
+    let view = unsafe { PyArray2::borrow_from_array(&array, guard.into_any()) };
+    let kwargs = pyo3::types::PyDict::new(py);
+    kwargs.set_item("write", false)?;
+    view.call_method("setflags", (), Some(&kwargs))?;
+    Ok(view)
+}
+
+/// `value` as an (N, columns) float32 array, every element finite. Errors: `WorldError` naming
+/// the field and the expected shape, or the first non-finite element.
+fn rows(value: &Bound<'_, PyAny>, field: Field, n: usize) -> PyResult<Vec<f32>> {
+    let py = value.py();
+    let numpy = py.import("numpy")?;
+    let kwargs = pyo3::types::PyDict::new(py);
+    kwargs.set_item("dtype", numpy.getattr("float32")?)?;
+    let array = numpy
+        .call_method("ascontiguousarray", (value,), Some(&kwargs))
+        .map_err(|e| {
+            WorldError::new_err(format!(
+                "{}: cannot be read as an array of float32: {e}",
+                field.name()
+            ))
+        })?;
+    let array = array.cast_into::<PyArray2<f32>>().map_err(|_| {
+        WorldError::new_err(format!(
+            "{}: expected shape ({n}, {}), got {}",
+            field.name(),
+            field.columns(),
+            shape_text(value)
+        ))
+    })?;
+    let columns = field.columns();
+    if array.shape() != [n, columns] {
+        return Err(WorldError::new_err(format!(
+            "{}: expected shape ({n}, {columns}), got {:?}",
+            field.name(),
+            array.shape()
+        )));
+    }
+    let values = array.to_vec()?;
+    if let Some(at) = values.iter().position(|v| !v.is_finite()) {
+        return Err(WorldError::new_err(format!(
+            "{}: row {}, column {}: must be finite, got {}",
+            field.name(),
+            at / columns,
+            at % columns,
+            values[at]
+        )));
+    }
+    Ok(values)
+}
+
+fn shape_text(value: &Bound<'_, PyAny>) -> String {
+    value
+        .getattr("shape")
+        .and_then(|s| s.str())
+        .map(|s| s.to_string())
+        .unwrap_or_else(|_| "no array".to_string())
+}
+
+/// Sets `field` of every body from `value` (an array-like of shape (N, 3) or (N, 4)). Bodies
+/// whose row equals their current value bit for bit are left alone (not woken), so a static
+/// body's zero velocity may be passed back. On an engine error the bodies already edited get
+/// their old values back and the error is raised.
+pub(crate) fn assign(world: &mut World, field: Field, value: &Bound<'_, PyAny>) -> PyResult<()> {
+    let n = world.inner.body_count();
+    let values = rows(value, field, n)?;
+    let columns = field.columns();
+    let current = |w: &impulse::World, i: usize| -> Vec<f32> {
+        let b = w.bodies();
+        match field {
+            Field::Positions => b.pose[i].translation.to_array().to_vec(),
+            Field::Orientations => b.pose[i].rotation.to_array().to_vec(),
+            Field::LinearVelocities => b.linear_velocity[i].to_array().to_vec(),
+            Field::AngularVelocities => b.angular_velocity[i].to_array().to_vec(),
+        }
+    };
+    let set = |w: &mut impulse::World, i: usize, row: &[f32]| -> Result<(), impulse::WorldError> {
+        let handle = w.handle_of(i).expect("dense index below body_count");
+        let pose = w.bodies().pose[i];
+        match field {
+            Field::Positions => w.set_pose(handle, Vec3::from_slice(row), pose.rotation),
+            Field::Orientations => w.set_pose(handle, pose.translation, Quat::from_slice(row)),
+            Field::LinearVelocities => w.set_linear_velocity(handle, Vec3::from_slice(row)),
+            Field::AngularVelocities => w.set_angular_velocity(handle, Vec3::from_slice(row)),
+        }
+    };
+    crate::guarded(|| {
+        let mut undo: Vec<(usize, Vec<f32>)> = Vec::new();
+        for i in 0..n {
+            let row = &values[i * columns..(i + 1) * columns];
+            let old = current(&world.inner, i);
+            if old
+                .iter()
+                .zip(row)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+            {
+                continue;
+            }
+            if let Err(error) = set(&mut world.inner, i, row) {
+                for (j, old) in undo.iter().rev() {
+                    let _ = set(&mut world.inner, *j, old);
+                }
+                return Err(WorldError::new_err(format!("{}: {error}", field.name())));
+            }
+            undo.push((i, old));
+        }
+        Ok(())
+    })
+}

@@ -1,0 +1,225 @@
+//! `impulse.Shape` and `impulse.BodyBuilder`: bodies to insert into a world.
+//!
+//! A shape is held as the scene format's shape description, so the Python API takes the same
+//! shapes as a scene file, with the same checks (`impulse::scene::build_shape`).
+
+use impulse::glam::{Quat, Vec3};
+use impulse::scene::build_shape;
+use impulse::{BodyKind, ShapeDesc};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::WorldError;
+use crate::settings::{from_python, to_python};
+
+/// A collision shape, in the body frame (m): `Shape.ball(radius)`, `Shape.cuboid(hx, hy, hz)`
+/// (half extents), `Shape.capsule(half_height, radius)`, `Shape.cylinder(half_height,
+/// radius)` and `Shape.cone(half_height, radius)` (along y), `Shape.convex_hull(points)`
+/// ((K, 3) points), `Shape.halfspace(normal)` (the solid below the plane through the origin
+/// with outward `normal`; static bodies only), or `Shape.from_dict(d)` for any shape of the
+/// scene format (`{"type": "trimesh", "file": "mesh.obj"}`, compounds, height fields). Sizes
+/// are checked when a body is made of it (`WorldError` naming the field).
+#[pyclass(module = "impulse", frozen, eq)]
+#[derive(Clone, PartialEq)]
+pub struct Shape {
+    pub(crate) desc: ShapeDesc,
+}
+
+#[pymethods]
+impl Shape {
+    /// A sphere of `radius` (m).
+    #[staticmethod]
+    fn ball(radius: f32) -> Shape {
+        Shape {
+            desc: ShapeDesc::Sphere { radius },
+        }
+    }
+
+    /// A box of half extents `hx`, `hy`, `hz` (m).
+    #[staticmethod]
+    fn cuboid(hx: f32, hy: f32, hz: f32) -> Shape {
+        Shape {
+            desc: ShapeDesc::Cuboid {
+                half_extents: [hx, hy, hz],
+            },
+        }
+    }
+
+    /// A capsule along y: a cylinder of `half_height` (m) capped by hemispheres of `radius`.
+    #[staticmethod]
+    fn capsule(half_height: f32, radius: f32) -> Shape {
+        Shape {
+            desc: ShapeDesc::Capsule {
+                half_height,
+                radius,
+            },
+        }
+    }
+
+    /// A cylinder along y of `half_height` and `radius` (m).
+    #[staticmethod]
+    fn cylinder(half_height: f32, radius: f32) -> Shape {
+        Shape {
+            desc: ShapeDesc::Cylinder {
+                half_height,
+                radius,
+            },
+        }
+    }
+
+    /// A cone along y of `half_height` and base `radius` (m), apex up.
+    #[staticmethod]
+    fn cone(half_height: f32, radius: f32) -> Shape {
+        Shape {
+            desc: ShapeDesc::Cone {
+                half_height,
+                radius,
+            },
+        }
+    }
+
+    /// The convex hull of `points`, a sequence of (x, y, z) in metres (at least 4, not all in
+    /// a plane).
+    #[staticmethod]
+    fn convex_hull(points: Vec<[f32; 3]>) -> Shape {
+        Shape {
+            desc: ShapeDesc::ConvexHull { points },
+        }
+    }
+
+    /// The half-space below the plane through the body origin with outward `normal`.
+    #[staticmethod]
+    fn halfspace(normal: [f32; 3]) -> Shape {
+        Shape {
+            desc: ShapeDesc::HalfSpace { normal },
+        }
+    }
+
+    /// Any shape of the scene format, as its JSON object (`{"type": "sphere", "radius": 0.5}`).
+    /// Raises `WorldError` for an object that is not a shape.
+    #[staticmethod]
+    fn from_dict(shape: &Bound<'_, PyAny>) -> PyResult<Shape> {
+        Ok(Shape {
+            desc: from_python(shape, "shape")?,
+        })
+    }
+
+    /// The shape as the scene format's JSON object.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.desc)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Shape({})",
+            serde_json::to_string(&self.desc).unwrap_or_default()
+        )
+    }
+}
+
+/// A body to insert into a world (`world.insert(builder)`): a kind and a shape, then
+/// optional properties by keyword, e.g.
+/// `BodyBuilder.dynamic(Shape.cuboid(.5, .5, .5), translation=(0, 3, 0), friction=0.4)`.
+///
+/// Keywords (all optional): `translation` (m), `rotation` (quaternion x y z w),
+/// `linear_velocity` (m/s), `angular_velocity` (rad/s, world), `friction` (μ ≥ 0),
+/// `restitution` (0–1), `density` (kg/m³), `mass` (kg, overrides density), `name`,
+/// `linear_damping`, `angular_damping` (1/s), `lock_rotation` (bool). Defaults: at rest at the
+/// origin, friction 0.6, restitution 0, density 1000 kg/m³. Values are checked by
+/// `World.insert`.
+#[pyclass(module = "impulse", frozen)]
+#[derive(Clone)]
+pub struct BodyBuilder {
+    pub(crate) inner: impulse::BodyBuilder,
+}
+
+/// The builder of `kind` and `shape` with the keyword properties `props` (see `BodyBuilder`).
+/// Raises `WorldError` for an unknown keyword, a value of the wrong type, or a shape that
+/// cannot be built.
+fn configure(
+    kind: BodyKind,
+    shape: &Shape,
+    props: Option<&Bound<'_, PyDict>>,
+) -> PyResult<BodyBuilder> {
+    let shared = crate::guarded(|| {
+        build_shape(kind, &shape.desc).map_err(|e| WorldError::new_err(e.to_string()))
+    })?;
+    let mut b = impulse::BodyBuilder::new(kind, shared);
+    let Some(props) = props else {
+        return Ok(BodyBuilder { inner: b });
+    };
+    for (key, value) in props.iter() {
+        let key: String = key.extract()?;
+        let bad = |e: PyErr| WorldError::new_err(format!("{key}: {e}"));
+        let vec3 = |v: &Bound<'_, PyAny>| v.extract::<[f32; 3]>().map(Vec3::from).map_err(bad);
+        let float = |v: &Bound<'_, PyAny>| v.extract::<f32>().map_err(bad);
+        b = match key.as_str() {
+            "translation" => b.translation(vec3(&value)?),
+            "rotation" => b.rotation(Quat::from_array(value.extract::<[f32; 4]>().map_err(bad)?)),
+            "linear_velocity" => b.linear_velocity(vec3(&value)?),
+            "angular_velocity" => b.angular_velocity(vec3(&value)?),
+            "friction" => b.friction(float(&value)?),
+            "restitution" => b.restitution(float(&value)?),
+            "density" => b.density(float(&value)?),
+            "mass" => b.mass(float(&value)?),
+            "name" => b.name(value.extract::<String>().map_err(bad)?),
+            "linear_damping" => b.linear_damping(float(&value)?),
+            "angular_damping" => b.angular_damping(float(&value)?),
+            "lock_rotation" => b.lock_rotation(value.extract::<bool>().map_err(bad)?),
+            _ => {
+                return Err(WorldError::new_err(format!(
+                    "no body property '{key}'; properties: {}",
+                    PROPERTIES.join(", ")
+                )));
+            }
+        };
+    }
+    Ok(BodyBuilder { inner: b })
+}
+
+const PROPERTIES: [&str; 12] = [
+    "translation",
+    "rotation",
+    "linear_velocity",
+    "angular_velocity",
+    "friction",
+    "restitution",
+    "density",
+    "mass",
+    "name",
+    "linear_damping",
+    "angular_damping",
+    "lock_rotation",
+];
+
+#[pymethods]
+impl BodyBuilder {
+    /// A rigid body with mass and inertia (from the shape at the density, or scaled to
+    /// `mass`).
+    #[staticmethod]
+    #[pyo3(signature = (shape, **props))]
+    fn dynamic(shape: &Shape, props: Option<&Bound<'_, PyDict>>) -> PyResult<BodyBuilder> {
+        configure(BodyKind::Dynamic, shape, props)
+    }
+
+    /// A static body: never moves (ground, walls).
+    #[staticmethod]
+    #[pyo3(signature = (shape, **props))]
+    fn fixed(shape: &Shape, props: Option<&Bound<'_, PyDict>>) -> PyResult<BodyBuilder> {
+        configure(BodyKind::Static, shape, props)
+    }
+
+    /// A kinematic body: moves at its velocities, pushes dynamic bodies, is never pushed.
+    #[staticmethod]
+    #[pyo3(signature = (shape, **props))]
+    fn kinematic(shape: &Shape, props: Option<&Bound<'_, PyDict>>) -> PyResult<BodyBuilder> {
+        configure(BodyKind::Kinematic, shape, props)
+    }
+
+    /// A particle: a ball of `radius` (m) whose rotation is locked.
+    #[staticmethod]
+    #[pyo3(signature = (radius, **props))]
+    fn particle(radius: f32, props: Option<&Bound<'_, PyDict>>) -> PyResult<BodyBuilder> {
+        configure(BodyKind::Particle, &Shape::ball(radius), props)
+    }
+}

@@ -1,0 +1,720 @@
+//! `impulse.World`: a simulation world, its state as NumPy arrays, stepping, trajectories,
+//! quality metrics and pickling.
+
+use std::sync::Arc;
+
+use impulse::glam::Vec3;
+use impulse::{StepDiagnostics, WorldSnapshot, metrics};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+
+use crate::arrays::{self, Field};
+use crate::settings::{Settings, to_python};
+use crate::{SceneError, StepError, WorldError, guarded};
+
+/// A body's name in a world: valid while the body lives, never naming another body afterwards
+/// (a slot index and the slot's generation). Hashable; compare with `==`.
+#[pyclass(module = "impulse", frozen, eq, hash)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct BodyHandle {
+    pub(crate) inner: impulse::BodyHandle,
+}
+
+#[pymethods]
+impl BodyHandle {
+    /// The slot index.
+    #[getter]
+    fn index(&self) -> u32 {
+        self.inner.index()
+    }
+
+    /// The slot's generation.
+    #[getter]
+    fn generation(&self) -> u32 {
+        self.inner.generation()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "BodyHandle(index={}, generation={})",
+            self.inner.index(),
+            self.inner.generation()
+        )
+    }
+}
+
+/// A simulation world: bodies, gravity (m/s², y up), time step (s) and solver settings.
+///
+/// Make one with `World.from_scene(scene)` (a scene file, a built-in name or a dict of scene
+/// JSON) or `World(gravity=(0, -9.81, 0), dt=1/60, settings=None)` and `insert` bodies.
+///
+/// Body state reads as NumPy arrays without a Python object per body: `positions` (N, 3),
+/// `orientations` (N, 4, quaternion x y z w), `linear_velocities` and `angular_velocities`
+/// (N, 3), all float32, in dense body order (scene order while no body was removed). They are
+/// read-only views of the engine's storage: they show the current state (they change as the
+/// world steps) and keep the world alive; `insert` and `remove` raise `WorldError` while any
+/// view is alive (they may move the storage). `.copy()` a view to keep the values of one
+/// moment. Assigning an (N, 3)/(N, 4) array-like sets every body (validated, see the
+/// properties).
+///
+/// A world pickles through the snapshot format and round-trips to the bit.
+#[pyclass(module = "impulse", name = "World")]
+pub struct World {
+    pub(crate) inner: impulse::World,
+    /// One reference per live array view of the bodies (see `arrays`), plus this one.
+    pub(crate) views: Arc<()>,
+}
+
+impl World {
+    pub(crate) fn wrap(inner: impulse::World) -> Self {
+        World {
+            inner,
+            views: Arc::new(()),
+        }
+    }
+
+    /// Refuses an edit that may move the body storage while array views of it are alive.
+    fn refuse_if_viewed(&self, what: &str) -> PyResult<()> {
+        let live = Arc::strong_count(&self.views) - 1;
+        if live > 0 {
+            return Err(WorldError::new_err(format!(
+                "cannot {what} while {live} array view(s) of this world's bodies are alive \
+                 (they would point at moved storage): `del` them, or keep `.copy()`s instead"
+            )));
+        }
+        Ok(())
+    }
+
+    fn handle(&self, handle: &BodyHandle) -> PyResult<impulse::BodyHandle> {
+        if self.inner.contains(handle.inner) {
+            Ok(handle.inner)
+        } else {
+            Err(WorldError::new_err(
+                impulse::WorldError::UnknownBody(handle.inner).to_string(),
+            ))
+        }
+    }
+
+    fn diagnostics_dict<'py>(
+        py: Python<'py>,
+        diagnostics: &StepDiagnostics,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, diagnostics)
+    }
+}
+
+fn world_error(error: impulse::WorldError) -> PyErr {
+    WorldError::new_err(error.to_string())
+}
+
+fn step_error(error: impulse::StepError) -> PyErr {
+    StepError::new_err(error.to_string())
+}
+
+fn vec3(value: [f32; 3], what: &str) -> PyResult<Vec3> {
+    let v = Vec3::from(value);
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(WorldError::new_err(format!(
+            "{what}: must be finite, got {value:?}"
+        )))
+    }
+}
+
+/// Steps `world` `n` times without the GIL, checking for Ctrl-C between chunks of steps.
+fn step_world(py: Python<'_>, world: &mut impulse::World, n: u64) -> PyResult<()> {
+    const CHUNK: u64 = 16;
+    let mut left = n;
+    while left > 0 {
+        let chunk = left.min(CHUNK);
+        let result = py.detach(|| {
+            guarded(|| {
+                for _ in 0..chunk {
+                    world.step().map_err(step_error)?;
+                }
+                Ok(())
+            })
+        });
+        result?;
+        left -= chunk;
+        if left > 0 {
+            py.check_signals()?;
+        }
+    }
+    Ok(())
+}
+
+#[pymethods]
+impl World {
+    /// An empty world. `gravity` (m/s², 3 floats), `dt` (s, > 0), `settings` an
+    /// `impulse.Settings` or a preset name (default: the `default` preset). Raises `WorldError`
+    /// for a non-finite gravity, a bad dt or settings out of range.
+    #[new]
+    #[pyo3(signature = (gravity = [0.0, -9.81, 0.0], dt = 1.0 / 60.0, settings = None))]
+    fn new(gravity: [f32; 3], dt: f32, settings: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        let settings = match settings {
+            Some(s) => Settings::from_argument(s)?,
+            None => impulse::SolverSettings::default(),
+        };
+        let world = guarded(|| {
+            impulse::World::new(Vec3::from(gravity), dt, settings).map_err(world_error)
+        })?;
+        Ok(World::wrap(world))
+    }
+
+    /// The world a scene describes.
+    ///
+    /// `scene`: a file path (`str` or `os.PathLike`; a `str` ending in `.json` or naming an
+    /// existing file), a built-in name (`impulse.scenes()`), or a dict of scene JSON.
+    /// `overrides`: a mapping of JSON path to value (`{"materials.wood.friction": 0.2}`) or a
+    /// sequence of `"path=value"` strings, applied to the scene before it is built.
+    /// `seed`, `jitter`: a seeded random variation of the dynamic bodies; `jitter` a mapping
+    /// with optional keys `"position"` (m), `"angle"` (degrees), `"velocity"` (m/s).
+    /// `settings`: an `impulse.Settings` or a preset name replacing the scene's solver effort
+    /// as `impulse run --preset` does (the scene's `sleep` and `gyroscopic` are kept).
+    ///
+    /// Raises `SceneError` (message as `impulse run` prints it: file, line, body, field) for a
+    /// scene that cannot be read or built, `WorldError` for bad settings.
+    #[staticmethod]
+    #[pyo3(signature = (scene, *, overrides = None, seed = 0, jitter = None, settings = None))]
+    fn from_scene(
+        scene: &Bound<'_, PyAny>,
+        overrides: Option<&Bound<'_, PyAny>>,
+        seed: u64,
+        jitter: Option<&Bound<'_, PyAny>>,
+        settings: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let mut scene = crate::scene::resolve(scene)?;
+        scene = crate::scene::vary(scene, overrides, seed, jitter)?;
+        if let Some(settings) = settings {
+            let preset = Settings::from_argument(settings)?;
+            scene.solver = impulse::SolverSettings {
+                sleep: scene.solver.sleep,
+                gyroscopic: scene.solver.gyroscopic,
+                ..preset
+            };
+        }
+        let world = guarded(|| {
+            impulse::World::from_scene(&scene).map_err(|e| match e {
+                impulse::WorldError::InvalidSetting { .. } => world_error(e),
+                other => SceneError::new_err(format!("cannot build the world: {other}")),
+            })
+        })?;
+        Ok(World::wrap(world))
+    }
+
+    /// The world a snapshot (`World.snapshot()` bytes, or a file written by
+    /// `impulse run --checkpoint-dir`) holds, identical to the bit. Raises `WorldError` for
+    /// bytes that are not a snapshot of this version of impulse.
+    #[staticmethod]
+    fn from_snapshot(data: &[u8]) -> PyResult<Self> {
+        let world = guarded(|| {
+            WorldSnapshot::from_bytes(data)
+                .and_then(impulse::World::from_snapshot)
+                .map_err(|e| WorldError::new_err(e.to_string()))
+        })?;
+        Ok(World::wrap(world))
+    }
+
+    /// The whole world as bytes of impulse's snapshot format (what pickling uses).
+    fn snapshot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = guarded(|| {
+            self.inner
+                .snapshot()
+                .and_then(|s| s.to_bytes())
+                .map_err(|e| WorldError::new_err(e.to_string()))
+        })?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+        let restore = py.import("impulse")?.getattr("_world_from_snapshot")?;
+        Ok((restore, (self.snapshot(py)?,)))
+    }
+
+    fn __copy__(&self, py: Python<'_>) -> PyResult<Self> {
+        let bytes = self.snapshot(py)?;
+        World::from_snapshot(bytes.as_bytes())
+    }
+
+    fn __deepcopy__(&self, py: Python<'_>, _memo: &Bound<'_, PyAny>) -> PyResult<Self> {
+        self.__copy__(py)
+    }
+
+    /// Takes `n` steps (n ≥ 0) with the GIL released, so other Python threads run meanwhile
+    /// (do not read this world's array views from them while it steps). Ctrl-C stops between
+    /// steps. Raises `StepError` when a step fails (a blow-up names the step and the body);
+    /// the world keeps the failed step's state.
+    #[pyo3(signature = (n = 1))]
+    fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
+        step_world(py, &mut self.inner, n)
+    }
+
+    /// Takes `steps` steps and records a frame at the start and after every step whose number
+    /// (`step_count`) is a multiple of `every`, and after the last: an `impulse.Trajectory`
+    /// with `positions` (F, N, 3) and `orientations` (F, N, 4) float32, `steps` (F,) int64,
+    /// `times` (F,) float64 seconds and `names`. Raises `StepError` when a step fails; the
+    /// frames recorded before it are the exception's `trajectory` attribute.
+    #[pyo3(signature = (steps, every = 1))]
+    fn simulate<'py>(
+        &mut self,
+        py: Python<'py>,
+        steps: u64,
+        every: u64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if every == 0 {
+            return Err(WorldError::new_err("every: must be at least 1"));
+        }
+        let first = self.inner.step_count();
+        let last = first
+            .checked_add(steps)
+            .ok_or_else(|| WorldError::new_err("steps: too many"))?;
+        let n = self.inner.body_count();
+        let frames = 1 + (first + 1..=last)
+            .filter(|s| s % every == 0 || *s == last)
+            .count();
+        let mut positions: Vec<f32> = Vec::new();
+        let mut orientations: Vec<f32> = Vec::new();
+        let mut step_numbers: Vec<i64> = Vec::new();
+        let mut times: Vec<f64> = Vec::new();
+        positions
+            .try_reserve_exact(frames * n * 3)
+            .and_then(|_| orientations.try_reserve_exact(frames * n * 4))
+            .map_err(|_| {
+                WorldError::new_err(format!(
+                    "a trajectory of {frames} frames of {n} bodies does not fit in memory; \
+                     record fewer frames (every=)"
+                ))
+            })?;
+        let record = |world: &impulse::World,
+                      positions: &mut Vec<f32>,
+                      orientations: &mut Vec<f32>,
+                      step_numbers: &mut Vec<i64>,
+                      times: &mut Vec<f64>| {
+            for pose in &world.bodies().pose {
+                positions.extend_from_slice(&pose.translation.to_array());
+                orientations.extend_from_slice(&pose.rotation.to_array());
+            }
+            step_numbers.push(world.step_count() as i64);
+            times.push(world.time());
+        };
+        record(
+            &self.inner,
+            &mut positions,
+            &mut orientations,
+            &mut step_numbers,
+            &mut times,
+        );
+        let world = &mut self.inner;
+        let mut failure: Option<PyErr> = None;
+        while world.step_count() < last {
+            let chunk_end = (world.step_count() + 16).min(last);
+            let result = py.detach(|| {
+                guarded(|| {
+                    while world.step_count() < chunk_end {
+                        world.step().map_err(step_error)?;
+                        let s = world.step_count();
+                        if s % every == 0 || s == last {
+                            record(
+                                world,
+                                &mut positions,
+                                &mut orientations,
+                                &mut step_numbers,
+                                &mut times,
+                            );
+                        }
+                    }
+                    Ok(())
+                })
+            });
+            if let Err(error) = result {
+                failure = Some(error);
+                break;
+            }
+            if let Err(error) = py.check_signals() {
+                failure = Some(error);
+                break;
+            }
+        }
+        let f = step_numbers.len();
+        let names = names_of(world);
+        let positions = PyArray1::from_vec(py, positions).reshape([f, n, 3])?;
+        let orientations = PyArray1::from_vec(py, orientations).reshape([f, n, 4])?;
+        let trajectory = py
+            .import("impulse._trajectory")?
+            .getattr("Trajectory")?
+            .call1((
+                positions,
+                orientations,
+                PyArray1::from_vec(py, step_numbers),
+                PyArray1::from_vec(py, times),
+                names,
+            ))?;
+        match failure {
+            None => Ok(trajectory),
+            Some(error) => {
+                let value = error.value(py);
+                let _ = value.setattr("trajectory", trajectory);
+                Err(error)
+            }
+        }
+    }
+
+    /// Positions of the body frames (m): read-only view, shape (N, 3), float32. Assign an
+    /// (N, 3) array-like to teleport every body (velocities kept; bodies whose row is
+    /// unchanged are left alone). Raises `WorldError` for a wrong shape or non-finite values.
+    #[getter]
+    fn positions<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        arrays::view(slf, Field::Positions)
+    }
+
+    #[setter]
+    fn set_positions(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        arrays::assign(self, Field::Positions, value)
+    }
+
+    /// Orientations of the body frames, unit quaternions (x, y, z, w): read-only view, shape
+    /// (N, 4), float32. Assign an (N, 4) array-like to turn every body (each row normalised;
+    /// a zero row raises `WorldError`).
+    #[getter]
+    fn orientations<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        arrays::view(slf, Field::Orientations)
+    }
+
+    #[setter]
+    fn set_orientations(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        arrays::assign(self, Field::Orientations, value)
+    }
+
+    /// Linear velocities of the centres of mass (m/s): read-only view, shape (N, 3), float32.
+    /// Assign an (N, 3) array-like to set them; a static body's row must stay as it is
+    /// (zero), else `WorldError` names the body.
+    #[getter]
+    fn linear_velocities<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        arrays::view(slf, Field::LinearVelocities)
+    }
+
+    #[setter]
+    fn set_linear_velocities(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        arrays::assign(self, Field::LinearVelocities, value)
+    }
+
+    /// Angular velocities, world frame (rad/s): read-only view, shape (N, 3), float32. Assign
+    /// an (N, 3) array-like to set them (ignored for particles; locked axes dropped).
+    #[getter]
+    fn angular_velocities<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        arrays::view(slf, Field::AngularVelocities)
+    }
+
+    #[setter]
+    fn set_angular_velocities(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        arrays::assign(self, Field::AngularVelocities, value)
+    }
+
+    /// The bodies' names in dense order (`""` for a body without one).
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        names_of(&self.inner)
+    }
+
+    /// The bodies' kinds in dense order: `"dynamic"`, `"static"`, `"particle"`, `"kinematic"`.
+    #[getter]
+    fn kinds(&self) -> Vec<&'static str> {
+        self.inner
+            .bodies()
+            .kind
+            .iter()
+            .map(|k| match k {
+                impulse::BodyKind::Dynamic => "dynamic",
+                impulse::BodyKind::Static => "static",
+                impulse::BodyKind::Particle => "particle",
+                impulse::BodyKind::Kinematic => "kinematic",
+            })
+            .collect()
+    }
+
+    /// The bodies' masses (kg; `inf` for static and kinematic bodies): shape (N,), float32 (a
+    /// copy).
+    #[getter]
+    fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
+        let b = self.inner.bodies();
+        PyArray1::from_vec(py, (0..b.len()).map(|i| b.mass(i)).collect())
+    }
+
+    /// The last step's diagnostics (`impulse::StepDiagnostics`) as a dict: `step`,
+    /// `contact_pairs`, `contacts`, `rows`, `iterations`, `natural_map_residual` (m/s: how
+    /// well the step's LCP was solved), `islands` (per island: method, iterations, residual…),
+    /// `max_depth` (m), `kinetic_energy` (J), `linear_momentum` (kg·m/s). All zero before the
+    /// first step.
+    #[getter]
+    fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        World::diagnostics_dict(py, self.inner.diagnostics())
+    }
+
+    /// Wall-clock seconds of each stage of the last step (`broad_phase`, `narrow_phase`,
+    /// `islands`, `assembly`, `solve`, `scatter`, `continuous`, `store_impulses`, `finish`,
+    /// `total`), as a dict.
+    #[getter]
+    fn profile<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, self.inner.profile())
+    }
+
+    /// Pose-based quality of the current state, as `impulse run` measures it
+    /// (`impulse::metrics`): `max_overlap_m` (deepest overlap of any pair, m), `top_body`
+    /// (index of the highest dynamic body, or None), `top_sink_m` (how far that body is below
+    /// its initial height, m), `max_drift_m` (largest distance of a dynamic body from its
+    /// initial position, m), `kinetic_energy_j` (of the last step, J). The last two need
+    /// `initial_positions`, an (N, 3) array (e.g. a `.copy()` of `positions` taken at the
+    /// start); without it they are None. Raises `WorldError` for a wrong shape.
+    #[pyo3(signature = (initial_positions = None))]
+    fn quality<'py>(
+        &self,
+        py: Python<'py>,
+        initial_positions: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let bodies = self.inner.bodies();
+        let n = bodies.len();
+        let initial = match initial_positions {
+            Some(value) => {
+                let array = py
+                    .import("numpy")?
+                    .call_method1("asarray", (value, "float32"))?
+                    .cast_into::<PyArray2<f32>>()
+                    .map_err(|_| {
+                        WorldError::new_err(format!(
+                            "initial_positions: expected shape ({n}, 3)"
+                        ))
+                    })?;
+                if array.shape() != [n, 3] {
+                    return Err(WorldError::new_err(format!(
+                        "initial_positions: expected shape ({n}, 3), got {:?}",
+                        array.shape()
+                    )));
+                }
+                let values = array.to_vec()?;
+                Some(
+                    values
+                        .chunks_exact(3)
+                        .map(Vec3::from_slice)
+                        .collect::<Vec<_>>(),
+                )
+            }
+            None => None,
+        };
+        let (overlap, top) = py.detach(|| {
+            guarded(|| Ok((metrics::max_overlap(bodies), metrics::top_body(bodies))))
+        })?;
+        let result = PyDict::new(py);
+        result.set_item("max_overlap_m", overlap)?;
+        result.set_item("top_body", top)?;
+        match &initial {
+            Some(initial) => {
+                result.set_item(
+                    "top_sink_m",
+                    top.map(|i| initial[i].y - bodies.pose[i].translation.y),
+                )?;
+                result.set_item("max_drift_m", metrics::max_drift(bodies, initial))?;
+            }
+            None => {
+                result.set_item("top_sink_m", py.None())?;
+                result.set_item("max_drift_m", py.None())?;
+            }
+        }
+        result.set_item("kinetic_energy_j", self.inner.diagnostics().kinetic_energy)?;
+        Ok(result)
+    }
+
+    /// Steps taken since the world was made.
+    #[getter]
+    fn step_count(&self) -> u64 {
+        self.inner.step_count()
+    }
+
+    /// Simulated time (s): the sum of the steps' dt.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.inner.time()
+    }
+
+    /// The time step (s). Assign a finite value > 0 to change it (else `WorldError`).
+    #[getter]
+    fn dt(&self) -> f32 {
+        self.inner.dt()
+    }
+
+    #[setter]
+    fn set_dt(&mut self, dt: f32) -> PyResult<()> {
+        self.inner.set_dt(dt).map_err(world_error)
+    }
+
+    /// Gravity (m/s², 3 floats). Assign 3 finite floats to change it (wakes every body).
+    #[getter]
+    fn gravity(&self) -> [f32; 3] {
+        self.inner.gravity().to_array()
+    }
+
+    #[setter]
+    fn set_gravity(&mut self, gravity: [f32; 3]) -> PyResult<()> {
+        self.inner.set_gravity(Vec3::from(gravity)).map_err(world_error)
+    }
+
+    /// The solver settings (`impulse.Settings`). Assign a `Settings` or a preset name to
+    /// replace them from the next step on (`WorldError` when out of range).
+    #[getter]
+    fn settings(&self) -> Settings {
+        Settings {
+            inner: self.inner.settings().clone(),
+        }
+    }
+
+    #[setter]
+    fn set_settings(&mut self, settings: &Bound<'_, PyAny>) -> PyResult<()> {
+        let settings = Settings::from_argument(settings)?;
+        self.inner.set_settings(settings).map_err(world_error)
+    }
+
+    /// Whether the step spreads islands over rayon's worker threads (default True). Results
+    /// are the same to the bit either way.
+    #[getter]
+    fn parallel(&self) -> bool {
+        self.inner.parallel()
+    }
+
+    #[setter]
+    fn set_parallel(&mut self, parallel: bool) {
+        self.inner.set_parallel(parallel);
+    }
+
+    /// Number of bodies (also `len(world)`).
+    #[getter]
+    fn body_count(&self) -> usize {
+        self.inner.body_count()
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.body_count()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "World(bodies={}, step_count={}, dt={})",
+            self.inner.body_count(),
+            self.inner.step_count(),
+            self.inner.dt()
+        )
+    }
+
+    /// Inserts the body `builder` describes (an `impulse.BodyBuilder`) and returns its
+    /// `BodyHandle`; its dense index is the old `body_count`. Raises `WorldError` naming the
+    /// field for an invalid body, or while array views of the world are alive.
+    fn insert(&mut self, builder: &crate::builder::BodyBuilder) -> PyResult<BodyHandle> {
+        self.refuse_if_viewed("insert a body")?;
+        let builder = builder.inner.clone();
+        let handle = guarded(|| self.inner.insert(builder).map_err(world_error))?;
+        Ok(BodyHandle { inner: handle })
+    }
+
+    /// Removes the body `handle` names and returns its name (or None). The last body takes
+    /// its dense index. Raises `WorldError` for an unknown handle, or while array views of
+    /// the world are alive.
+    fn remove(&mut self, handle: &BodyHandle) -> PyResult<Option<String>> {
+        self.refuse_if_viewed("remove a body")?;
+        let handle = self.handle(handle)?;
+        guarded(|| self.inner.remove(handle).map_err(world_error))
+    }
+
+    /// The handle of the body at dense index `index`. Raises `IndexError` past the end.
+    fn handle_of(&self, index: usize) -> PyResult<BodyHandle> {
+        self.inner
+            .handle_of(index)
+            .map(|inner| BodyHandle { inner })
+            .ok_or_else(|| {
+                pyo3::exceptions::PyIndexError::new_err(format!(
+                    "no body at index {index} (the world has {})",
+                    self.inner.body_count()
+                ))
+            })
+    }
+
+    /// The dense index of the body `handle` names. Raises `WorldError` for an unknown handle.
+    fn index_of(&self, handle: &BodyHandle) -> PyResult<usize> {
+        let handle = self.handle(handle)?;
+        self.inner
+            .body(handle)
+            .map(|b| b.index())
+            .ok_or_else(|| PyRuntimeError::new_err("handle vanished"))
+    }
+
+    /// Adds a force (N, 3 floats, world frame) at the body's centre of mass, or at `point`
+    /// (m, world) when given, for the next step only (forces are cleared after each step).
+    /// Raises `WorldError` for a static or kinematic body, an unknown handle or non-finite
+    /// values.
+    #[pyo3(signature = (handle, force, point = None))]
+    fn apply_force(
+        &mut self,
+        handle: &BodyHandle,
+        force: [f32; 3],
+        point: Option<[f32; 3]>,
+    ) -> PyResult<()> {
+        let handle = self.handle(handle)?;
+        let force = vec3(force, "force")?;
+        match point {
+            None => self.inner.apply_force(handle, force),
+            Some(p) => self
+                .inner
+                .apply_force_at_point(handle, force, vec3(p, "point")?),
+        }
+        .map_err(world_error)
+    }
+
+    /// Adds a torque (N·m, world frame) for the next step only. Errors as `apply_force`.
+    fn apply_torque(&mut self, handle: &BodyHandle, torque: [f32; 3]) -> PyResult<()> {
+        let handle = self.handle(handle)?;
+        self.inner
+            .apply_torque(handle, vec3(torque, "torque")?)
+            .map_err(world_error)
+    }
+
+    /// Applies an impulse (N·s, world frame) now, at the centre of mass or at `point` (m,
+    /// world): the velocities change at once. Errors as `apply_force`.
+    #[pyo3(signature = (handle, impulse, point = None))]
+    fn apply_impulse(
+        &mut self,
+        handle: &BodyHandle,
+        impulse: [f32; 3],
+        point: Option<[f32; 3]>,
+    ) -> PyResult<()> {
+        let handle = self.handle(handle)?;
+        let impulse = vec3(impulse, "impulse")?;
+        match point {
+            None => self.inner.apply_impulse(handle, impulse),
+            Some(p) => self
+                .inner
+                .apply_impulse_at_point(handle, impulse, vec3(p, "point")?),
+        }
+        .map_err(world_error)
+    }
+
+    /// Applies an angular impulse (N·m·s, world frame) now. Errors as `apply_force`.
+    fn apply_torque_impulse(&mut self, handle: &BodyHandle, impulse: [f32; 3]) -> PyResult<()> {
+        let handle = self.handle(handle)?;
+        self.inner
+            .apply_torque_impulse(handle, vec3(impulse, "impulse")?)
+            .map_err(world_error)
+    }
+}
+
+pub(crate) fn names_of(world: &impulse::World) -> Vec<String> {
+    world
+        .bodies()
+        .name
+        .iter()
+        .map(|n| n.clone().unwrap_or_default())
+        .collect()
+}
