@@ -272,7 +272,7 @@ def _normalise_jitter(jitter: Mapping[str, float] | None) -> dict[str, float] | 
         if not math.isfinite(value) or value < 0.0:
             raise ValueError(f"jitter[{name!r}] = {value}: must be finite and ≥ 0")
         out[name] = value
-    return out
+    return out if any(out.values()) else None  # zero jitter is no jitter
 
 
 def run_key(digest: str, overrides: Mapping[str, Any], seed: int, steps: int, preset: str | None = None, jitter: Mapping[str, float] | None = None) -> str:
