@@ -83,6 +83,7 @@ pub use instruction_set::{INSTRUCTION_SET_VARIABLE, InstructionSet};
 pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };
+pub use scene::{Jitter, Override, Variation};
 pub use settings::{ContactRepair, SettingError, SolverMethod, SolverSettings};
 pub use solver::{EscalationLevel, IslandReport};
 pub use world::{

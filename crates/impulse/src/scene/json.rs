@@ -110,7 +110,7 @@ fn load_meshes(scene: &mut Scene, directory: &Path) -> Result<(), SceneError> {
 }
 
 /// Parses without validating; errors have no origin yet.
-fn parse_only(text: &str) -> Result<Scene, SceneError> {
+pub(crate) fn parse_only(text: &str) -> Result<Scene, SceneError> {
     let mut de = serde_json::Deserializer::from_str(text);
     let scene: Scene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let field = convert_path(e.path());

@@ -432,6 +432,7 @@ mod json_shape;
 mod mesh_file;
 mod shape;
 pub(crate) mod validate;
+mod variation;
 
 pub use builtin::{
     MAX_BALLS, MAX_PYRAMID_BASE, MAX_PYRAMID3D_BASE, MAX_STACK, builtin_families, builtin_names,
@@ -446,3 +447,4 @@ pub use mesh_file::{
 };
 pub use shape::build_shape;
 pub use validate::{validate, validate_all};
+pub use variation::{Jitter, ORIGIN_PREFIX, Override, Variation};
