@@ -219,7 +219,7 @@ def test_command_line(tmp_path, capsys):
     assert "4 runs: 4 completed, 0 stopped, 0 failed" in capsys.readouterr().out
     table = pq.read_table(out / RESULTS_FILE)
     assert table.column(FRICTION).to_pylist() == [0.2, 0.2, 0.5, 0.5]
-    assert cli_main(args[:2] + [f"{FRICTION}=-1"] + args[4:]) == 1
+    assert cli_main(args[:2] + [f"{FRICTION}=-1"] + args[3:]) == 1
     assert cli_main(["no-such-scene", "--steps", "1", "--out", str(out)]) == 2
 
 
