@@ -7,7 +7,8 @@
 Each configuration sweeps the same runs (one grid point, seeds 0 … runs−1, a small position
 jitter so that the runs differ) into a fresh directory. Runs per second = runs / the sweep's
 wall time, pool start-up included; Ray's own start-up (`ray.init`) is timed apart, since a
-cluster is started once for many sweeps. The per-run overhead of a backend is
+cluster is started once for many sweeps, and a sweep of tiny runs goes first, which also starts
+Ray's worker processes. The per-run overhead of a backend is
 (wall time × workers − the runs' own wall time in their workers) / runs: what a run costs
 beyond its simulation (sending, scheduling, returning the row, writing the table).
 Needs impulse, pyarrow and ray installed.
@@ -65,9 +66,10 @@ def main() -> None:
     start = time.perf_counter()
     ray.init(num_cpus=args.workers, include_dashboard=False, log_to_driver=False)
     print(f"ray.init(num_cpus={args.workers}): {time.perf_counter() - start:.2f} s", flush=True)
-    on_ray, ray_table = measure(f"ray, {args.workers} CPUs", os.path.join(out, "ray"), args.workers, backend="ray", **options)
+    # The tiny runs first: they also start Ray's worker processes, which a cluster keeps warm.
     tiny = dict(options, steps=args.overhead_steps)
     measure(f"ray, {args.workers} CPUs, {args.overhead_steps}-step runs", os.path.join(out, "ray-tiny"), args.workers, backend="ray", **tiny)
+    on_ray, ray_table = measure(f"ray, {args.workers} CPUs", os.path.join(out, "ray"), args.workers, backend="ray", **options)
     ray.shutdown()
     measure(f"local, {args.workers} workers, {args.overhead_steps}-step runs", os.path.join(out, "local-tiny"), args.workers, backend="local", **tiny)
 
