@@ -36,7 +36,8 @@ def measure(label, out, workers, **options):
     overhead_ms = (elapsed * workers - inside) / runs * 1e3
     print(
         f"{label:<28} {runs} runs in {elapsed:7.2f} s: {runs / elapsed:7.2f} runs/s; "
-        f"mean run in its worker {inside / runs * 1e3:7.1f} ms; overhead per run {overhead_ms:6.1f} ms "
+        f"mean run in its worker {inside / runs * 1e3:7.1f} ms; "
+        f"overhead per run {overhead_ms:6.1f} ms "
         f"(statuses {sorted(statuses)})",
         flush=True,
     )
@@ -51,15 +52,38 @@ def main() -> None:
     parser.add_argument("--preset", default="fast")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", default=None, help="scratch directory (default: a temporary one)")
-    parser.add_argument("--overhead-steps", type=int, default=1, help="steps of the runs that measure the per-run overhead alone")
+    parser.add_argument(
+        "--overhead-steps",
+        type=int,
+        default=1,
+        help="steps of the runs that measure the per-run overhead alone",
+    )
     args = parser.parse_args()
     out = args.out or tempfile.mkdtemp(prefix="sweep-speed-")
-    options = dict(scene=args.scene, seeds=args.runs, steps=args.steps, preset=args.preset, jitter={"position": 0.001})
-    print(f"{args.runs} runs of {args.scene}, {args.steps} steps, preset {args.preset}; os.cpu_count() = {os.cpu_count()}; "
-          f"load average {os.getloadavg()}", flush=True)
+    options = dict(
+        scene=args.scene,
+        seeds=args.runs,
+        steps=args.steps,
+        preset=args.preset,
+        jitter={"position": 0.001},
+    )
+    print(
+        f"{args.runs} runs of {args.scene}, {args.steps} steps, preset {args.preset}; "
+        f"os.cpu_count() = {os.cpu_count()}; "
+        f"load average {os.getloadavg()}",
+        flush=True,
+    )
 
-    one, single = measure("local, 1 worker", os.path.join(out, "one"), 1, backend="local", **options)
-    pool, local = measure(f"local, {args.workers} workers", os.path.join(out, "local"), args.workers, backend="local", **options)
+    one, single = measure(
+        "local, 1 worker", os.path.join(out, "one"), 1, backend="local", **options
+    )
+    pool, local = measure(
+        f"local, {args.workers} workers",
+        os.path.join(out, "local"),
+        args.workers,
+        backend="local",
+        **options,
+    )
 
     import ray
 
@@ -68,10 +92,28 @@ def main() -> None:
     print(f"ray.init(num_cpus={args.workers}): {time.perf_counter() - start:.2f} s", flush=True)
     # The tiny runs first: they also start Ray's worker processes, which a cluster keeps warm.
     tiny = dict(options, steps=args.overhead_steps)
-    measure(f"ray, {args.workers} CPUs, {args.overhead_steps}-step runs", os.path.join(out, "ray-tiny"), args.workers, backend="ray", **tiny)
-    on_ray, ray_table = measure(f"ray, {args.workers} CPUs", os.path.join(out, "ray"), args.workers, backend="ray", **options)
+    measure(
+        f"ray, {args.workers} CPUs, {args.overhead_steps}-step runs",
+        os.path.join(out, "ray-tiny"),
+        args.workers,
+        backend="ray",
+        **tiny,
+    )
+    on_ray, ray_table = measure(
+        f"ray, {args.workers} CPUs",
+        os.path.join(out, "ray"),
+        args.workers,
+        backend="ray",
+        **options,
+    )
     ray.shutdown()
-    measure(f"local, {args.workers} workers, {args.overhead_steps}-step runs", os.path.join(out, "local-tiny"), args.workers, backend="local", **tiny)
+    measure(
+        f"local, {args.workers} workers, {args.overhead_steps}-step runs",
+        os.path.join(out, "local-tiny"),
+        args.workers,
+        backend="local",
+        **tiny,
+    )
 
     from impulse.sweep import TIMING_COLUMNS
 
@@ -79,8 +121,11 @@ def main() -> None:
         return table.drop_columns(list(TIMING_COLUMNS)).to_pylist()
 
     same = simulated(single) == simulated(local) == simulated(ray_table)
-    print(f"speed-up over one worker: local {pool / one:.2f}x, ray {on_ray / one:.2f}x; "
-          f"the three tables equal to the bit: {same}; load average now {os.getloadavg()}", flush=True)
+    print(
+        f"speed-up over one worker: local {pool / one:.2f}x, ray {on_ray / one:.2f}x; "
+        f"the three tables equal to the bit: {same}; load average now {os.getloadavg()}",
+        flush=True,
+    )
     if args.out is None:
         shutil.rmtree(out, ignore_errors=True)
 

@@ -33,7 +33,11 @@ JITTER = {"position": 0.01, "angle": 2.0, "velocity": 0.05}
 
 
 def box(y: float) -> dict:
-    return {"kind": "dynamic", "shape": {"type": "cuboid", "half_extents": [0.5, 0.5, 0.5]}, "position": [0.0, y, 0.0]}
+    return {
+        "kind": "dynamic",
+        "shape": {"type": "cuboid", "half_extents": [0.5, 0.5, 0.5]},
+        "position": [0.0, y, 0.0],
+    }
 
 
 #: Three cubes stacked on the ground: contacts from the first step, tiny to step.
@@ -44,7 +48,12 @@ SCENE = {
     "steps": STEPS,
     "materials": {"default": {"friction": 0.6, "restitution": 0.0, "density": 1000.0}},
     "bodies": [
-        {"name": "ground", "kind": "static", "shape": {"type": "cuboid", "half_extents": [20.0, 0.5, 20.0]}, "position": [0.0, -0.5, 0.0]},
+        {
+            "name": "ground",
+            "kind": "static",
+            "shape": {"type": "cuboid", "half_extents": [20.0, 0.5, 20.0]},
+            "position": [0.0, -0.5, 0.0],
+        },
         box(0.5),
         box(1.5),
         box(2.5),
@@ -85,7 +94,16 @@ def test_expand_is_the_product_of_grid_and_seeds_in_order():
 
 @pytest.mark.parametrize(
     "grid, seeds",
-    [({"a": []}, 1), ({"a": 0.5}, 1), ({"a": "0.5"}, 1), ({"a": [float("nan")]}, 1), ({}, 0), ({}, [-1]), ({}, []), ({}, True)],
+    [
+        ({"a": []}, 1),
+        ({"a": 0.5}, 1),
+        ({"a": "0.5"}, 1),
+        ({"a": [float("nan")]}, 1),
+        ({}, 0),
+        ({}, [-1]),
+        ({}, []),
+        ({}, True),
+    ],
 )
 def test_expand_rejects_bad_grids_and_seeds(grid, seeds):
     with pytest.raises((ValueError, TypeError)):
@@ -137,7 +155,9 @@ def test_command_line_values_and_seeds():
 def test_resume_skips_runs_already_written(tmp_path):
     out = tmp_path / "sweep"
     grid = {FRICTION: [0.2, 0.8]}
-    first = sweep(SCENE, grid=grid, seeds=3, steps=STEPS, jitter=JITTER, out=out, workers=2, progress=False)
+    first = sweep(
+        SCENE, grid=grid, seeds=3, steps=STEPS, jitter=JITTER, out=out, workers=2, progress=False
+    )
     assert first.num_rows == 6
     assert first.column("status").to_pylist() == [COMPLETED] * 6
     assert first.column(FRICTION).to_pylist() == [0.2] * 3 + [0.8] * 3
@@ -145,14 +165,29 @@ def test_resume_skips_runs_already_written(tmp_path):
     assert first.column("steps_taken").to_pylist() == [STEPS] * 6
     assert pq.read_table(out / RESULTS_FILE).equals(first)
     manifest = json.loads((out / MANIFEST_FILE).read_text())
-    assert manifest["runs"] == 6 and manifest["completed"] == 6 and manifest["grid"] == {FRICTION: [0.2, 0.8]}
+    assert (
+        manifest["runs"] == 6
+        and manifest["completed"] == 6
+        and manifest["grid"] == {FRICTION: [0.2, 0.8]}
+    )
 
     # The same sweep again runs nothing: every row (with its wall time and worker) is the old one.
-    again = sweep(SCENE, grid=grid, seeds=3, steps=STEPS, jitter=JITTER, out=out, workers=2, progress=False)
+    again = sweep(
+        SCENE, grid=grid, seeds=3, steps=STEPS, jitter=JITTER, out=out, workers=2, progress=False
+    )
     assert again.equals(first)
 
     # A larger grid runs only what is new; the old rows stay as they were.
-    larger = sweep(SCENE, grid={FRICTION: [0.2, 0.5, 0.8]}, seeds=3, steps=STEPS, jitter=JITTER, out=out, workers=2, progress=False)
+    larger = sweep(
+        SCENE,
+        grid={FRICTION: [0.2, 0.5, 0.8]},
+        seeds=3,
+        steps=STEPS,
+        jitter=JITTER,
+        out=out,
+        workers=2,
+        progress=False,
+    )
     assert larger.num_rows == 9
     old = {row["run_key"]: row for row in first.to_pylist()}
     kept = [row for row in larger.to_pylist() if row["run_key"] in old]
@@ -161,12 +196,30 @@ def test_resume_skips_runs_already_written(tmp_path):
 
 
 def test_a_failing_run_is_recorded_and_the_others_go_on(tmp_path):
-    out = (tmp_path / "sweep").as_uri()  # through pyarrow's filesystem by URI, as for an object store
+    out = (
+        tmp_path / "sweep"
+    ).as_uri()  # through pyarrow's filesystem by URI, as for an object store
     grid = {FRICTION: [0.5, -1.0, 0.9], "bodies[2].linear_velocity": [[0.0, 0.0, 0.0]]}
-    table = sweep(SCENE, grid=grid, seeds=2, steps=STEPS, out=out, observe=final_state, workers=2, progress=False)
+    table = sweep(
+        SCENE,
+        grid=grid,
+        seeds=2,
+        steps=STEPS,
+        out=out,
+        observe=final_state,
+        workers=2,
+        progress=False,
+    )
     rows = table.to_pylist()
     assert [row[FRICTION] for row in rows] == [0.5, 0.5, -1.0, -1.0, 0.9, 0.9]
-    assert [row["status"] for row in rows] == [COMPLETED, COMPLETED, FAILED, FAILED, COMPLETED, COMPLETED]
+    assert [row["status"] for row in rows] == [
+        COMPLETED,
+        COMPLETED,
+        FAILED,
+        FAILED,
+        COMPLETED,
+        COMPLETED,
+    ]
     for row in rows[2:4]:
         assert "SceneError" in row["error"] and "friction" in row["error"]
         assert row["steps_taken"] is None and row["observe.top_y"] is None
@@ -175,7 +228,17 @@ def test_a_failing_run_is_recorded_and_the_others_go_on(tmp_path):
     assert read_results(out).equals(table)
 
     # Failed rows are kept on a resume, and run again when asked.
-    again = sweep(SCENE, grid=grid, seeds=2, steps=STEPS, out=out, observe=final_state, workers=2, progress=False, retry_failed=True)
+    again = sweep(
+        SCENE,
+        grid=grid,
+        seeds=2,
+        steps=STEPS,
+        out=out,
+        observe=final_state,
+        workers=2,
+        progress=False,
+        retry_failed=True,
+    )
     assert again.num_rows == 6
     assert [r["wall_time_s"] for r in again.to_pylist()][:2] == [r["wall_time_s"] for r in rows[:2]]
     assert again.column("status").to_pylist() == table.column("status").to_pylist()
@@ -189,32 +252,71 @@ def test_an_exception_in_observe_fails_that_run_only(tmp_path):
 
     # The top cube on the stack, or 10 m above it (it falls less than a metre in 4 steps).
     grid = {"bodies[3].position": [[0.0, 2.5, 0.0], [0.0, 10.0, 0.0]]}
-    table = sweep(SCENE, grid=grid, seeds=1, steps=4, out=tmp_path / "s", observe=observe, workers=2, progress=False)
+    table = sweep(
+        SCENE,
+        grid=grid,
+        seeds=1,
+        steps=4,
+        out=tmp_path / "s",
+        observe=observe,
+        workers=2,
+        progress=False,
+    )
     statuses = table.column("status").to_pylist()
     errors = table.column("error").to_pylist()
     assert statuses[0] == COMPLETED and errors[0] is None
-    assert statuses[1] == FAILED and errors[1] == "observe: ValueError: the top cube is still in the air"
+    assert (
+        statuses[1] == FAILED
+        and errors[1] == "observe: ValueError: the top cube is still in the air"
+    )
     assert table.column("steps_taken").to_pylist() == [4, 4]  # the metrics stay
     assert table.column("observe.top_y").to_pylist()[1] is None
 
 
 def test_trajectories_one_file_per_run(tmp_path):
     out = tmp_path / "sweep"
-    table = sweep(SCENE, grid={FRICTION: [0.3]}, seeds=2, steps=STEPS, jitter=JITTER, out=out, observe=final_state,
-                  save_trajectories=4, workers=2, progress=False)
+    table = sweep(
+        SCENE,
+        grid={FRICTION: [0.3]},
+        seeds=2,
+        steps=STEPS,
+        jitter=JITTER,
+        out=out,
+        observe=final_state,
+        save_trajectories=4,
+        workers=2,
+        progress=False,
+    )
     for row in table.to_pylist():
         trajectory = impulse.load_trajectory(row["trajectory"])
         assert list(trajectory.steps) == list(range(0, STEPS + 1, 4))
         assert trajectory.positions.shape == (len(trajectory.steps), 4, 3)
-        assert np.ascontiguousarray(trajectory.positions[-1]).tobytes().hex() == row["observe.positions"]
+        assert (
+            np.ascontiguousarray(trajectory.positions[-1]).tobytes().hex()
+            == row["observe.positions"]
+        )
 
 
 def test_command_line(tmp_path, capsys):
     scene = tmp_path / "stack3.json"
     scene.write_text(json.dumps(SCENE))
     out = tmp_path / "sweep"
-    args = [str(scene), "--grid", f"{FRICTION}=0.2,0.5", "--seeds", "0:2", "--steps", "8", "--out", str(out),
-            "--workers", "2", "--jitter-position", "0.01", "--no-progress"]
+    args = [
+        str(scene),
+        "--grid",
+        f"{FRICTION}=0.2,0.5",
+        "--seeds",
+        "0:2",
+        "--steps",
+        "8",
+        "--out",
+        str(out),
+        "--workers",
+        "2",
+        "--jitter-position",
+        "0.01",
+        "--no-progress",
+    ]
     assert cli_main(args) == 0
     assert "4 runs: 4 completed, 0 stopped, 0 failed" in capsys.readouterr().out
     table = pq.read_table(out / RESULTS_FILE)
@@ -240,7 +342,15 @@ def local_ray():
 def test_local_and_ray_sweeps_are_equal_to_the_bit(tmp_path, local_ray):
     grid = {FRICTION: [0.3, 0.9]}
     seeds = 32  # 64 runs
-    common = dict(grid=grid, seeds=seeds, steps=STEPS, jitter=JITTER, observe=final_state, preset="fast", progress=False)
+    common = dict(
+        grid=grid,
+        seeds=seeds,
+        steps=STEPS,
+        jitter=JITTER,
+        observe=final_state,
+        preset="fast",
+        progress=False,
+    )
     local = sweep(SCENE, backend="local", out=tmp_path / "local", workers=2, **common)
     on_ray = sweep(SCENE, backend="ray", out=tmp_path / "ray", **common)
     assert local.num_rows == on_ray.num_rows == 64
@@ -256,9 +366,20 @@ def test_local_and_ray_sweeps_are_equal_to_the_bit(tmp_path, local_ray):
     for index in (0, 33, 63):
         row = simulated(local.slice(index, 1))[0]
         overrides = {FRICTION: row[FRICTION]}
-        alone = run_one(SCENE, overrides=overrides, seed=row["seed"], steps=STEPS, preset="fast", jitter=JITTER,
-                        observe=final_state)
+        alone = run_one(
+            SCENE,
+            overrides=overrides,
+            seed=row["seed"],
+            steps=STEPS,
+            preset="fast",
+            jitter=JITTER,
+            observe=final_state,
+        )
         assert {k: v for k, v in alone.items() if k not in TIMING_COLUMNS} == row
-        world = impulse.World.from_scene(SCENE, overrides=overrides, seed=row["seed"], jitter=JITTER, settings="fast")
+        world = impulse.World.from_scene(
+            SCENE, overrides=overrides, seed=row["seed"], jitter=JITTER, settings="fast"
+        )
         world.step(STEPS)
-        assert final_state(world) == {k[len("observe."):]: v for k, v in row.items() if k.startswith("observe.")}
+        assert final_state(world) == {
+            k[len("observe.") :]: v for k, v in row.items() if k.startswith("observe.")
+        }

@@ -169,7 +169,9 @@ def _check_grid(grid: Mapping[str, Sequence[Any]] | None) -> dict[str, list[Any]
     out = {}
     for path, values in grid.items():
         if not isinstance(path, str) or not path:
-            raise ValueError(f"grid key {path!r} is not an override path (like 'materials.default.friction')")
+            raise ValueError(
+                f"grid key {path!r} is not an override path (like 'materials.default.friction')"
+            )
         if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
             raise ValueError(f"grid[{path!r}] must be a list of values, got {values!r}")
         values = list(values)
@@ -184,7 +186,9 @@ def _check_grid(grid: Mapping[str, Sequence[Any]] | None) -> dict[str, list[Any]
     return out
 
 
-def expand(grid: Mapping[str, Sequence[Any]] | None, seeds: int | Iterable[int] = 1) -> list[tuple[dict[str, Any], int]]:
+def expand(
+    grid: Mapping[str, Sequence[Any]] | None, seeds: int | Iterable[int] = 1
+) -> list[tuple[dict[str, Any], int]]:
     """The runs of a sweep as ``(overrides, seed)`` pairs: the product of the grid's values (in
     the grid's key order, the last key varying fastest) and the seeds (fastest of all).
 
@@ -196,7 +200,7 @@ def expand(grid: Mapping[str, Sequence[Any]] | None, seeds: int | Iterable[int] 
     seed_list = _seed_list(seeds)
     paths = list(grid)
     return [
-        (dict(zip(paths, values)), seed)
+        (dict(zip(paths, values, strict=True)), seed)
         for values in itertools.product(*(grid[p] for p in paths))
         for seed in seed_list
     ]
@@ -237,7 +241,9 @@ def _normalise_scene(scene: Any) -> tuple[Any, str]:
         return path, path
     if isinstance(scene, str):
         return scene, scene
-    raise TypeError(f"scene must be a file path, a built-in scene name or a dict, not {type(scene).__name__}")
+    raise TypeError(
+        f"scene must be a file path, a built-in scene name or a dict, not {type(scene).__name__}"
+    )
 
 
 def scene_digest(scene: Any) -> str:
@@ -262,10 +268,14 @@ def _normalise_jitter(jitter: Mapping[str, float] | None) -> dict[str, float] | 
     if jitter is None:
         return None
     if not isinstance(jitter, Mapping):
-        raise TypeError("jitter must be a mapping with keys 'position' (m), 'angle' (degrees), 'velocity' (m/s)")
+        raise TypeError(
+            "jitter must be a mapping with keys 'position' (m), 'angle' (degrees), 'velocity' (m/s)"
+        )
     unknown = set(jitter) - {"position", "angle", "velocity"}
     if unknown:
-        raise ValueError(f"jitter has unknown keys {sorted(unknown)}: use 'position', 'angle', 'velocity'")
+        raise ValueError(
+            f"jitter has unknown keys {sorted(unknown)}: use 'position', 'angle', 'velocity'"
+        )
     out = {}
     for name in ("position", "angle", "velocity"):
         value = float(jitter.get(name, 0.0))
@@ -275,7 +285,14 @@ def _normalise_jitter(jitter: Mapping[str, float] | None) -> dict[str, float] | 
     return out if any(out.values()) else None  # zero jitter is no jitter
 
 
-def run_key(digest: str, overrides: Mapping[str, Any], seed: int, steps: int, preset: str | None = None, jitter: Mapping[str, float] | None = None) -> str:
+def run_key(
+    digest: str,
+    overrides: Mapping[str, Any],
+    seed: int,
+    steps: int,
+    preset: str | None = None,
+    jitter: Mapping[str, float] | None = None,
+) -> str:
     """The key of one run (SHA-256, hex): a hash of the scene's content (``digest``, from
     :func:`scene_digest`), the overrides (as a set: their order does not matter), the seed, the
     step count and the settings (preset, jitter). Equal keys mean equal simulated results."""
@@ -299,7 +316,13 @@ def _finite_or_none(value: Any) -> Any:
     return None if value is None else float(value)
 
 
-def _measure(world: Any, steps: int, step_error: type[BaseException], frames: dict[str, list] | None = None, every: int = 1) -> dict[str, Any]:
+def _measure(
+    world: Any,
+    steps: int,
+    step_error: type[BaseException],
+    frames: dict[str, list] | None = None,
+    every: int = 1,
+) -> dict[str, Any]:
     """Steps ``world`` ``steps`` times and measures what ``impulse run`` prints, with the same
     definitions (crates/impulse-cli/src/run.rs): overlap and drift from poses at the start,
     every ``OVERLAP_SAMPLE_EVERY`` steps and at the last; the top body's sink; the largest
@@ -376,7 +399,9 @@ def _measure(world: Any, steps: int, step_error: type[BaseException], frames: di
         "top_sink_m": top_sink,
         "max_drift_m": max_drift,
         "quality_error_m": max(abs(top_sink), max_overlap, max_drift),
-        "kinetic_energy_j": _finite_or_none(diagnostics.get("kinetic_energy", quality.get("kinetic_energy_j"))),
+        "kinetic_energy_j": _finite_or_none(
+            diagnostics.get("kinetic_energy", quality.get("kinetic_energy_j"))
+        ),
         "max_speed_m_s": float(max_speed),
         "mean_contacts": contacts / taken,
         "mean_iterations": iterations / taken,
@@ -390,7 +415,9 @@ def _observe_values(observe: Callable[[Any], Mapping[str, Any]], world: Any) -> 
     None, NumPy scalars or arrays (stored as lists)."""
     values = observe(world)
     if not isinstance(values, Mapping):
-        raise TypeError(f"observe must return a dict of name -> value, returned {type(values).__name__}")
+        raise TypeError(
+            f"observe must return a dict of name -> value, returned {type(values).__name__}"
+        )
     out = {}
     for name, value in values.items():
         if not isinstance(name, str):
@@ -436,7 +463,9 @@ def _run_task(task: dict[str, Any]) -> dict[str, Any]:
     return row
 
 
-def _simulate(task: dict[str, Any], observe: Callable[[Any], Mapping[str, Any]] | None) -> dict[str, Any]:
+def _simulate(
+    task: dict[str, Any], observe: Callable[[Any], Mapping[str, Any]] | None
+) -> dict[str, Any]:
     import numpy as np
 
     import impulse
@@ -449,7 +478,9 @@ def _simulate(task: dict[str, Any], observe: Callable[[Any], Mapping[str, Any]] 
         settings=task["preset"],
     )
     every = task.get("trajectory_every") or 0
-    frames: dict[str, list] | None = {"positions": [], "orientations": [], "steps": [], "times": []} if every else None
+    frames: dict[str, list] | None = (
+        {"positions": [], "orientations": [], "steps": [], "times": []} if every else None
+    )
     row = _measure(world, task["steps"], impulse.StepError, frames, max(every, 1))
     if observe is not None:
         try:
@@ -506,7 +537,9 @@ def _run_task_in_process(task: dict[str, Any], observe: Any) -> dict[str, Any]:
     return row
 
 
-def _task(scene, overrides, seed, steps, preset, jitter, key, observe_bytes, out, trajectory_every) -> dict[str, Any]:
+def _task(
+    scene, overrides, seed, steps, preset, jitter, key, observe_bytes, out, trajectory_every
+) -> dict[str, Any]:
     return {
         "scene": scene,
         "overrides": overrides,
@@ -571,7 +604,10 @@ def _table(rows: list[dict[str, Any]], override_types: Mapping[str, Any]) -> Any
     names += [name for name, _ in _RUN_COLUMNS]
     names += sorted({k for row in rows for k in row if k.startswith(OBSERVE_PREFIX)})
     names += [name for name, _ in _TAIL_COLUMNS]
-    fixed = {"run_key": pa.string(), **{n: pa.type_for_alias(t) for n, t in (*_RUN_COLUMNS, *_TAIL_COLUMNS)}}
+    fixed = {
+        "run_key": pa.string(),
+        **{n: pa.type_for_alias(t) for n, t in (*_RUN_COLUMNS, *_TAIL_COLUMNS)},
+    }
     columns = {}
     for name in names:
         values = [row.get(name) for row in rows]
@@ -622,9 +658,23 @@ def _reorder_columns(table: Any, overrides_first: Sequence[str]) -> Any:
     tail = [name for name, _ in _TAIL_COLUMNS]
     names = table.column_names
     overrides = [n for n in overrides_first if n in names]
-    overrides += [n for n in names if n not in overrides and n not in run and n not in tail and n != "run_key" and not n.startswith(OBSERVE_PREFIX)]
+    overrides += [
+        n
+        for n in names
+        if n not in overrides
+        and n not in run
+        and n not in tail
+        and n != "run_key"
+        and not n.startswith(OBSERVE_PREFIX)
+    ]
     observed = sorted(n for n in names if n.startswith(OBSERVE_PREFIX))
-    order = ["run_key", *overrides, *[n for n in run if n in names], *observed, *[n for n in tail if n in names]]
+    order = [
+        "run_key",
+        *overrides,
+        *[n for n in run if n in names],
+        *observed,
+        *[n for n in tail if n in names],
+    ]
     return table.select(order)
 
 
@@ -643,7 +693,9 @@ def _part_paths(filesystem: Any, root: str) -> list[str]:
     if not _exists(filesystem, directory):
         return []
     infos = filesystem.get_file_info(pyarrow.fs.FileSelector(directory))
-    return sorted(i.path for i in infos if i.type == pyarrow.fs.FileType.File and i.path.endswith(".parquet"))
+    return sorted(
+        i.path for i in infos if i.type == pyarrow.fs.FileType.File and i.path.endswith(".parquet")
+    )
 
 
 def _read_all(filesystem: Any, root: str) -> Any:
@@ -720,7 +772,9 @@ class _LocalBackend:
                 pending[self.pool.submit(_run_task, task)] = task
             if not pending:
                 return
-            done, _ = concurrent.futures.wait(pending, return_when=concurrent.futures.FIRST_COMPLETED)
+            done, _ = concurrent.futures.wait(
+                pending, return_when=concurrent.futures.FIRST_COMPLETED
+            )
             suspects = []
             for future in done:
                 task = pending.pop(future)
@@ -742,7 +796,9 @@ class _LocalBackend:
                 self.pool = self._new_pool()
 
     def _run_alone(self, task: dict[str, Any]) -> dict[str, Any]:
-        pool = concurrent.futures.ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"))
+        pool = concurrent.futures.ProcessPoolExecutor(
+            max_workers=1, mp_context=multiprocessing.get_context("spawn")
+        )
         try:
             return pool.submit(_run_task, task).result()
         except BrokenProcessPool:
@@ -767,7 +823,11 @@ class _RayBackend:
         self.ray = ray
         self.started = False
         if not ray.is_initialized():
-            options: dict[str, Any] = {"address": address, "include_dashboard": False, "log_to_driver": False}
+            options: dict[str, Any] = {
+                "address": address,
+                "include_dashboard": False,
+                "log_to_driver": False,
+            }
             if address is None and workers is not None:
                 options["num_cpus"] = workers
             ray.init(**options)
@@ -819,7 +879,9 @@ class _Progress:
             except ImportError:
                 return
             description = f"sweep ({skipped} done before)" if skipped else "sweep"
-            self.bar = tqdm(total=total, unit="run", desc=description, dynamic_ncols=True, file=sys.stderr)
+            self.bar = tqdm(
+                total=total, unit="run", desc=description, dynamic_ncols=True, file=sys.stderr
+            )
             self.bar.set_postfix(failed=0)
 
     def update(self, row: dict[str, Any]) -> None:
@@ -927,7 +989,9 @@ def sweep(
     if steps is None:
         raise ValueError("steps is required: the number of steps of every run")
     steps = _check_steps(steps)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+    if workers is not None and (
+        isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
+    ):
         raise ValueError(f"workers = {workers!r}: must be an integer ≥ 1")
     trajectory_every = _trajectory_every(save_trajectories)
     scene_spec, scene_description = _normalise_scene(scene)
@@ -953,7 +1017,11 @@ def sweep(
     previous = _read_all(filesystem, root)
     done = set()
     if previous is not None:
-        for key, status in zip(previous.column("run_key").to_pylist(), previous.column("status").to_pylist()):
+        for key, status in zip(
+            previous.column("run_key").to_pylist(),
+            previous.column("status").to_pylist(),
+            strict=True,
+        ):
             if not (retry_failed and status == FAILED):
                 done.add(key)
     todo = [run for run in runs if run.key not in done]
@@ -977,7 +1045,18 @@ def sweep(
 
     by_key = {run.key: run for run in todo}
     tasks = (
-        _task(scene_spec, run.overrides, run.seed, steps, preset, jitter, run.key, observe_bytes, out, trajectory_every)
+        _task(
+            scene_spec,
+            run.overrides,
+            run.seed,
+            steps,
+            preset,
+            jitter,
+            run.key,
+            observe_bytes,
+            out,
+            trajectory_every,
+        )
         for run in todo
     )
     buffer: list[dict[str, Any]] = []
@@ -990,7 +1069,11 @@ def sweep(
         if buffer:
             table = _table(buffer, override_types)
             filesystem.create_dir(f"{root}/{PARTS_DIR}", recursive=True)
-            _write_parquet(filesystem, f"{root}/{PARTS_DIR}/part-{time.time_ns()}-{uuid.uuid4().hex[:8]}.parquet", table)
+            _write_parquet(
+                filesystem,
+                f"{root}/{PARTS_DIR}/part-{time.time_ns()}-{uuid.uuid4().hex[:8]}.parquet",
+                table,
+            )
             buffer = []
         last_flush = time.monotonic()
 
@@ -998,7 +1081,11 @@ def sweep(
     try:
         if todo:
             count = workers or os.cpu_count() or 1
-            runner = _LocalBackend(min(count, len(todo))) if backend == "local" else _RayBackend(workers, address)
+            runner = (
+                _LocalBackend(min(count, len(todo)))
+                if backend == "local"
+                else _RayBackend(workers, address)
+            )
             for row in runner.run(tasks):
                 run = by_key[row["run_key"]]
                 row.update(run.overrides)
@@ -1028,7 +1115,9 @@ def _trajectory_every(save_trajectories: bool | int) -> int:
         return 1
     if isinstance(save_trajectories, int) and save_trajectories >= 1:
         return int(save_trajectories)
-    raise ValueError(f"save_trajectories = {save_trajectories!r}: use False, True or a frame interval K ≥ 1")
+    raise ValueError(
+        f"save_trajectories = {save_trajectories!r}: use False, True or a frame interval K ≥ 1"
+    )
 
 
 def _pickle_observe(observe: Callable[[Any], Any]) -> bytes:
@@ -1124,7 +1213,9 @@ def _status_counts(table: Any, keys: set[str]) -> dict[str, int]:
     counts = {"completed": 0, "stopped": 0, "failed": 0}
     if table is None:
         return counts
-    for key, status in zip(table.column("run_key").to_pylist(), table.column("status").to_pylist()):
+    for key, status in zip(
+        table.column("run_key").to_pylist(), table.column("status").to_pylist(), strict=True
+    ):
         if key in keys:
             counts[status] = counts.get(status, 0) + 1
     return counts

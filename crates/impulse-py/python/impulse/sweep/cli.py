@@ -1,4 +1,5 @@
-"""Command line of :func:`impulse.sweep.sweep`: ``python -m impulse.sweep SCENE --grid ... --out DIR``."""
+"""Command line of :func:`impulse.sweep.sweep`:
+``python -m impulse.sweep SCENE --grid ... --out DIR``."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ from typing import Any
 EXAMPLES = """\
 examples:
   python -m impulse.sweep stack30 --grid materials.default.friction=0.2,0.5 \\
-      --seeds 0:64 --steps 600 --preset fast --jitter-position 0.01 --backend local --out sweep-stack30
+      --seeds 0:64 --steps 600 --preset fast --jitter-position 0.01 \\
+      --backend local --out sweep-stack30
   python -m impulse.sweep scenes/pyramid20.json --grid solver.substeps=8,12,20 \\
       --grid 'bodies[3].linear_velocity=[0,0,-5],[0,0,-10]' --steps 300 --backend ray --out s3://bucket/sweep
 
@@ -42,7 +44,9 @@ def parse_grid_item(text: str) -> tuple[str, list[Any]]:
     path, separator, values = text.partition("=")
     path = path.strip()
     if not separator or not path or not values.strip():
-        raise argparse.ArgumentTypeError(f"--grid {text!r}: expected PATH=V1,V2,... (like materials.default.friction=0.2,0.5)")
+        raise argparse.ArgumentTypeError(
+            f"--grid {text!r}: expected PATH=V1,V2,... (like materials.default.friction=0.2,0.5)"
+        )
     try:
         return path, parse_values(values)
     except ValueError as error:
@@ -60,7 +64,9 @@ def parse_seeds(text: str) -> list[int]:
         else:
             seeds = list(range(int(text)))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"--seeds {text!r}: expected A:B, N or S1,S2,...") from None
+        raise argparse.ArgumentTypeError(
+            f"--seeds {text!r}: expected A:B, N or S1,S2,..."
+        ) from None
     if not seeds or any(seed < 0 for seed in seeds):
         raise argparse.ArgumentTypeError(f"--seeds {text!r}: no seeds, or a negative seed")
     return seeds
@@ -69,25 +75,89 @@ def parse_seeds(text: str) -> list[int]:
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="python -m impulse.sweep",
-        description="Run a scene over a grid of overrides and seeds, on a local process pool or on Ray, "
-        "into one Parquet table (resumable).",
+        description="Run a scene over a grid of overrides and seeds, on a local process pool "
+        "or on Ray, into one Parquet table (resumable).",
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("scene", help="scene file (.json) or built-in scene name (python -c 'import impulse; print(impulse.scenes())')")
-    p.add_argument("--grid", action="append", type=parse_grid_item, default=[], metavar="PATH=V1,V2,...", help="an override path and its values (repeat for more; the runs are the product of all)")
-    p.add_argument("--seeds", type=parse_seeds, default=[0], metavar="A:B|N|S1,S2", help="seeds of each grid point (default: 0)")
+    p.add_argument(
+        "scene",
+        help="scene file (.json) or built-in scene name "
+        "(python -c 'import impulse; print(impulse.scenes())')",
+    )
+    p.add_argument(
+        "--grid",
+        action="append",
+        type=parse_grid_item,
+        default=[],
+        metavar="PATH=V1,V2,...",
+        help="an override path and its values (repeat for more; the runs are the product of all)",
+    )
+    p.add_argument(
+        "--seeds",
+        type=parse_seeds,
+        default=[0],
+        metavar="A:B|N|S1,S2",
+        help="seeds of each grid point (default: 0)",
+    )
     p.add_argument("--steps", type=int, required=True, help="steps of every run")
-    p.add_argument("--preset", choices=["fast", "default", "precise", "reference"], help="solver effort, as `impulse run --preset`")
-    p.add_argument("--jitter-position", type=float, default=0.0, metavar="M", help="per-seed position jitter of the dynamic bodies (m)")
-    p.add_argument("--jitter-angle", type=float, default=0.0, metavar="DEG", help="per-seed orientation jitter (degrees)")
-    p.add_argument("--jitter-velocity", type=float, default=0.0, metavar="V", help="per-seed velocity jitter (m/s)")
-    p.add_argument("--backend", choices=["local", "ray"], default="local", help="local process pool (default) or Ray tasks")
-    p.add_argument("--workers", type=int, help="worker processes (local) or CPUs of the local Ray it starts (default: all cores)")
-    p.add_argument("--address", help="Ray cluster to join (auto, ray://head:10001); default: start a local Ray")
-    p.add_argument("--out", required=True, help="results directory or URI (s3://bucket/prefix, through pyarrow's filesystems)")
-    p.add_argument("--save-trajectories", type=int, nargs="?", const=1, default=0, metavar="K", help="also write each run's trajectory, every K-th step (default K=1)")
-    p.add_argument("--retry-failed", action="store_true", help="run again the runs written as failed")
+    p.add_argument(
+        "--preset",
+        choices=["fast", "default", "precise", "reference"],
+        help="solver effort, as `impulse run --preset`",
+    )
+    p.add_argument(
+        "--jitter-position",
+        type=float,
+        default=0.0,
+        metavar="M",
+        help="per-seed position jitter of the dynamic bodies (m)",
+    )
+    p.add_argument(
+        "--jitter-angle",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="per-seed orientation jitter (degrees)",
+    )
+    p.add_argument(
+        "--jitter-velocity",
+        type=float,
+        default=0.0,
+        metavar="V",
+        help="per-seed velocity jitter (m/s)",
+    )
+    p.add_argument(
+        "--backend",
+        choices=["local", "ray"],
+        default="local",
+        help="local process pool (default) or Ray tasks",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        help="worker processes (local) or CPUs of the local Ray it starts (default: all cores)",
+    )
+    p.add_argument(
+        "--address", help="Ray cluster to join (auto, ray://head:10001); default: start a local Ray"
+    )
+    p.add_argument(
+        "--out",
+        required=True,
+        help="results directory or URI (s3://bucket/prefix, through pyarrow's filesystems)",
+    )
+    p.add_argument(
+        "--save-trajectories",
+        type=int,
+        nargs="?",
+        const=1,
+        default=0,
+        metavar="K",
+        help="also write each run's trajectory, every K-th step (default K=1)",
+    )
+    p.add_argument(
+        "--retry-failed", action="store_true", help="run again the runs written as failed"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
 
@@ -105,7 +175,11 @@ def main(argv: list[str] | None = None) -> int:
         grid[path] = values
     jitter = None
     if args.jitter_position or args.jitter_angle or args.jitter_velocity:
-        jitter = {"position": args.jitter_position, "angle": args.jitter_angle, "velocity": args.jitter_velocity}
+        jitter = {
+            "position": args.jitter_position,
+            "angle": args.jitter_angle,
+            "velocity": args.jitter_velocity,
+        }
     try:
         table = sweep(
             args.scene,
@@ -129,9 +203,11 @@ def main(argv: list[str] | None = None) -> int:
 
     manifest = _read_manifest(args.out, MANIFEST_FILE)
     counts = {k: manifest.get(k, 0) for k in ("completed", "stopped", "failed")}
+    rows = table.num_rows if table is not None else 0
     print(
-        f"{manifest.get('runs', 0)} runs: {counts['completed']} completed, {counts['stopped']} stopped, "
-        f"{counts['failed']} failed; {table.num_rows if table is not None else 0} rows in {args.out}/{RESULTS_FILE}"
+        f"{manifest.get('runs', 0)} runs: {counts['completed']} completed, "
+        f"{counts['stopped']} stopped, {counts['failed']} failed; "
+        f"{rows} rows in {args.out}/{RESULTS_FILE}"
     )
     return 0 if counts["stopped"] == 0 and counts["failed"] == 0 else 1
 
