@@ -11,6 +11,7 @@ mod run;
 mod solver_args;
 mod stats;
 mod trajectory;
+mod variation_args;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -78,6 +79,8 @@ enum Command {
         profile: bool,
         #[command(flatten)]
         checkpoints: CheckpointArgs,
+        #[command(flatten)]
+        variation: variation_args::VariationArgs,
     },
     /// Continue a run from a world snapshot (a checkpoint of `impulse run --checkpoint-dir`):
     /// the same steps, to the bit, as the run would have taken (docs/snapshots.md).
@@ -155,6 +158,8 @@ enum Command {
         /// Speed drawn in the hottest colour with `--color speed` (m/s).
         #[arg(long, default_value_t = 5.0)]
         speed_max: f32,
+        #[command(flatten)]
+        variation: variation_args::VariationArgs,
     },
     /// Plot the columns of an `impulse run --stats` CSV over the run (SVG or PNG, one
     /// panel per column).
@@ -179,6 +184,8 @@ enum Command {
         /// Output file (default: standard output).
         #[arg(long)]
         out: Option<PathBuf>,
+        #[command(flatten)]
+        variation: variation_args::VariationArgs,
     },
     /// Time impulse on built-in scenes (sleeping off, median ms/step) and measure quality from
     /// poses; `cargo run --release -p impulse-bench` adds Rapier side by side.
@@ -247,6 +254,8 @@ enum LcpCommand {
         /// Turn friction off so the problem is a standard LCP (Lemke can solve it).
         #[arg(long)]
         no_friction: bool,
+        #[command(flatten)]
+        variation: variation_args::VariationArgs,
     },
     /// Plot residual against iterations for the engine's own solvers (PGS, NNCG, APGD on the
     /// contact rows) on one step of a scene (SVG or PNG).
@@ -337,9 +346,12 @@ fn real_main() -> Result<ExitCode> {
             quiet,
             profile,
             checkpoints,
+            variation,
         } => {
+            let scene_arg = scene.clone();
             let mut scene = resolve_scene(&scene)?;
             scene.solver = solver.apply(&scene.solver).map_err(anyhow::Error::msg)?;
+            let scene = variation.apply(scene, &scene_arg)?;
             let options = run::RunOptions {
                 steps,
                 dt,
@@ -399,6 +411,7 @@ fn real_main() -> Result<ExitCode> {
             fov,
             color,
             speed_max,
+            variation,
         } => {
             let options = render::RenderOptions {
                 steps,
@@ -413,10 +426,13 @@ fn real_main() -> Result<ExitCode> {
                 speed_max,
             };
             let (name, summary) = if scene.ends_with(".glb") {
+                if !variation.is_empty() {
+                    bail!("--set and --jitter-* apply to scenes, not to a .glb animation");
+                }
                 let summary = render::glb::render_glb(Path::new(&scene), &options)?;
                 (scene, summary)
             } else {
-                let scene = resolve_scene(&scene)?;
+                let scene = variation.apply(resolve_scene(&scene)?, &scene)?;
                 let summary = render::render(&scene, &options)?;
                 (scene.name, summary)
             };
@@ -448,8 +464,12 @@ fn real_main() -> Result<ExitCode> {
                 println!("{pattern:<22} {description}");
             }
         }
-        Command::Export { scene, out } => {
-            let scene = resolve_scene(&scene)?;
+        Command::Export {
+            scene,
+            out,
+            variation,
+        } => {
+            let scene = variation.apply(resolve_scene(&scene)?, &scene)?;
             let text = to_json_string(&scene);
             match out {
                 Some(path) => std::fs::write(&path, text)
@@ -506,7 +526,13 @@ fn real_main() -> Result<ExitCode> {
                 step,
                 out,
                 no_friction,
-            } => lcp_command::dump(resolve_scene(&scene)?, step, &out, no_friction)?,
+                variation,
+            } => lcp_command::dump(
+                variation.apply(resolve_scene(&scene)?, &scene)?,
+                step,
+                &out,
+                no_friction,
+            )?,
             LcpCommand::Convergence {
                 file,
                 iterations,
