@@ -351,7 +351,7 @@ def test_local_and_ray_sweeps_are_equal_to_the_bit(tmp_path, local_ray):
         preset="fast",
         progress=False,
     )
-    local = sweep(SCENE, backend="local", out=tmp_path / "local", workers=2, **common)
+    local = impulse.sweep(SCENE, backend="local", out=tmp_path / "local", workers=2, **common)
     on_ray = sweep(SCENE, backend="ray", out=tmp_path / "ray", **common)
     assert local.num_rows == on_ray.num_rows == 64
     assert local.column("status").to_pylist() == [COMPLETED] * 64
