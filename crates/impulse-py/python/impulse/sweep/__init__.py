@@ -444,6 +444,14 @@ def _save_trajectory(trajectory: Any, out: str, key: str) -> str:
     return target
 
 
+def _worker_start() -> None:
+    """A local worker ignores Ctrl-C: the sweep's process handles it, keeps the finished runs
+    and shuts the pool down."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _run_task(task: dict[str, Any]) -> dict[str, Any]:
     """One run in a worker: the row the sweep records. Never raises: every failure becomes the
     row's status and error."""
@@ -759,7 +767,9 @@ class _LocalBackend:
 
     def _new_pool(self) -> concurrent.futures.ProcessPoolExecutor:
         return concurrent.futures.ProcessPoolExecutor(
-            max_workers=self.workers, mp_context=multiprocessing.get_context("spawn")
+            max_workers=self.workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_worker_start,
         )
 
     def run(self, tasks: Iterable[dict[str, Any]]):
@@ -797,7 +807,9 @@ class _LocalBackend:
 
     def _run_alone(self, task: dict[str, Any]) -> dict[str, Any]:
         pool = concurrent.futures.ProcessPoolExecutor(
-            max_workers=1, mp_context=multiprocessing.get_context("spawn")
+            max_workers=1,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_worker_start,
         )
         try:
             return pool.submit(_run_task, task).result()

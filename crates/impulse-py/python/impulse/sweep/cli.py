@@ -164,7 +164,8 @@ def parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Runs the sweep; prints the runs by status. Exit status 0 when every run of this sweep
-    completed, 1 when some stopped or failed, 2 for bad arguments or a scene that does not load."""
+    completed, 1 when some stopped or failed, 2 for bad arguments or a scene that does not load,
+    130 when interrupted (Ctrl-C; the finished runs are kept)."""
     from impulse.sweep import sweep
 
     args = parser().parse_args(argv)
@@ -199,6 +200,12 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, TypeError, OSError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(
+            f"interrupted: the finished runs are in {args.out}; the same command resumes the sweep",
+            file=sys.stderr,
+        )
+        return 130
     from impulse.sweep import MANIFEST_FILE, RESULTS_FILE
 
     manifest = _read_manifest(args.out, MANIFEST_FILE)
