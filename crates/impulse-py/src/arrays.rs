@@ -27,9 +27,9 @@ use crate::WorldError;
 use crate::world::World;
 
 // The views index f32 elements of a pose with element strides.
-const _: () = assert!(size_of::<Pose>() % size_of::<f32>() == 0);
-const _: () = assert!(offset_of!(Pose, translation) % size_of::<f32>() == 0);
-const _: () = assert!(offset_of!(Pose, rotation) % size_of::<f32>() == 0);
+const _: () = assert!(size_of::<Pose>().is_multiple_of(size_of::<f32>()));
+const _: () = assert!(offset_of!(Pose, translation).is_multiple_of(size_of::<f32>()));
+const _: () = assert!(offset_of!(Pose, rotation).is_multiple_of(size_of::<f32>()));
 const _: () = assert!(size_of::<Vec3>() == 3 * size_of::<f32>());
 const _: () = assert!(size_of::<Quat>() == 4 * size_of::<f32>());
 
@@ -207,11 +207,7 @@ pub(crate) fn assign(world: &mut World, field: Field, value: &Bound<'_, PyAny>) 
         for i in 0..n {
             let row = &values[i * columns..(i + 1) * columns];
             let old = current(&world.inner, i);
-            if old
-                .iter()
-                .zip(row)
-                .all(|(a, b)| a.to_bits() == b.to_bits())
-            {
+            if old.iter().zip(row).all(|(a, b)| a.to_bits() == b.to_bits()) {
                 continue;
             }
             if let Err(error) = set(&mut world.inner, i, row) {

@@ -187,8 +187,8 @@ impl World {
         jitter: Option<&Bound<'_, PyAny>>,
         settings: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let mut scene = crate::scene::resolve(scene)?;
-        scene = crate::scene::vary(scene, overrides, seed, jitter)?;
+        let (scene, directory) = crate::scene::resolve(scene)?;
+        let mut scene = crate::scene::vary(scene, &directory, overrides, seed, jitter)?;
         if let Some(settings) = settings {
             let preset = Settings::from_argument(settings)?;
             scene.solver = impulse::SolverSettings {
@@ -276,9 +276,10 @@ impl World {
             .checked_add(steps)
             .ok_or_else(|| WorldError::new_err("steps: too many"))?;
         let n = self.inner.body_count();
-        let frames = 1 + (first + 1..=last)
-            .filter(|s| s % every == 0 || *s == last)
-            .count();
+        let frames = 1
+            + (first + 1..=last)
+                .filter(|s| s.is_multiple_of(every) || *s == last)
+                .count();
         let mut positions: Vec<f32> = Vec::new();
         let mut orientations: Vec<f32> = Vec::new();
         let mut step_numbers: Vec<i64> = Vec::new();
@@ -320,7 +321,7 @@ impl World {
                     while world.step_count() < chunk_end {
                         world.step().map_err(step_error)?;
                         let s = world.step_count();
-                        if s % every == 0 || s == last {
+                        if s.is_multiple_of(every) || s == last {
                             record(
                                 world,
                                 &mut positions,
@@ -487,9 +488,7 @@ impl World {
                     .call_method1("asarray", (value, "float32"))?
                     .cast_into::<PyArray2<f32>>()
                     .map_err(|_| {
-                        WorldError::new_err(format!(
-                            "initial_positions: expected shape ({n}, 3)"
-                        ))
+                        WorldError::new_err(format!("initial_positions: expected shape ({n}, 3)"))
                     })?;
                 if array.shape() != [n, 3] {
                     return Err(WorldError::new_err(format!(
@@ -507,9 +506,8 @@ impl World {
             }
             None => None,
         };
-        let (overlap, top) = py.detach(|| {
-            guarded(|| Ok((metrics::max_overlap(bodies), metrics::top_body(bodies))))
-        })?;
+        let (overlap, top) = py
+            .detach(|| guarded(|| Ok((metrics::max_overlap(bodies), metrics::top_body(bodies)))))?;
         let result = PyDict::new(py);
         result.set_item("max_overlap_m", overlap)?;
         result.set_item("top_body", top)?;
@@ -561,7 +559,9 @@ impl World {
 
     #[setter]
     fn set_gravity(&mut self, gravity: [f32; 3]) -> PyResult<()> {
-        self.inner.set_gravity(Vec3::from(gravity)).map_err(world_error)
+        self.inner
+            .set_gravity(Vec3::from(gravity))
+            .map_err(world_error)
     }
 
     /// The solver settings (`impulse.Settings`). Assign a `Settings` or a preset name to
@@ -707,6 +707,259 @@ impl World {
         self.inner
             .apply_torque_impulse(handle, vec3(impulse, "impulse")?)
             .map_err(world_error)
+    }
+
+    /// The first body along the ray from `origin` (m) in `direction` within `max_distance`
+    /// (in units of the direction's length), or None. With `solid` (default True) a ray
+    /// starting inside a body hits it at distance 0. Returns a dict: `body` (BodyHandle),
+    /// `index` (dense index), `distance`, `point` (m), `normal` (unit, out of the body).
+    #[pyo3(signature = (origin, direction, max_distance = f32::MAX, solid = true))]
+    fn cast_ray<'py>(
+        &self,
+        py: Python<'py>,
+        origin: [f32; 3],
+        direction: [f32; 3],
+        max_distance: f32,
+        solid: bool,
+    ) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let hit = guarded(|| {
+            Ok(self.inner.cast_ray(
+                Vec3::from(origin),
+                Vec3::from(direction),
+                max_distance,
+                solid,
+            ))
+        })?;
+        let Some(hit) = hit else { return Ok(None) };
+        let d = PyDict::new(py);
+        d.set_item("body", BodyHandle { inner: hit.body })?;
+        d.set_item("index", self.inner.body(hit.body).map(|b| b.index()))?;
+        d.set_item("distance", hit.distance)?;
+        d.set_item("point", hit.point.to_array())?;
+        d.set_item("normal", hit.normal.to_array())?;
+        Ok(Some(d))
+    }
+
+    /// The first body that `shape` (an `impulse.Shape`), starting at `translation` (m) and
+    /// `rotation` (x y z w) and moving at `velocity` (m/s, no rotation), touches within
+    /// `max_time` (s), or None. Returns a dict: `body`, `index`, `time` (s), `witness_shape`,
+    /// `witness_body` (m, world), `normal` (unit, out of the moving shape). Raises `WorldError`
+    /// for a shape that cannot be built or a non-finite pose.
+    #[pyo3(signature = (shape, translation, velocity, max_time, rotation = [0.0, 0.0, 0.0, 1.0]))]
+    fn cast_shape<'py>(
+        &self,
+        py: Python<'py>,
+        shape: &crate::builder::Shape,
+        translation: [f32; 3],
+        velocity: [f32; 3],
+        max_time: f32,
+        rotation: [f32; 4],
+    ) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let shared = guarded(|| {
+            impulse::scene::build_shape(impulse::BodyKind::Dynamic, &shape.desc)
+                .map_err(|e| WorldError::new_err(e.to_string()))
+        })?;
+        let translation = vec3(translation, "translation")?;
+        let rotation = impulse::glam::Quat::from_array(rotation);
+        if !rotation.is_finite() || rotation.length_squared() == 0.0 {
+            return Err(WorldError::new_err(
+                "rotation: must be a finite, non-zero quaternion",
+            ));
+        }
+        let pose = impulse::parry3d::math::Pose::from_parts(translation, rotation.normalize());
+        let velocity = vec3(velocity, "velocity")?;
+        let hit = guarded(|| {
+            Ok(self
+                .inner
+                .cast_shape(&pose, velocity, shared.as_ref(), max_time))
+        })?;
+        let Some(hit) = hit else { return Ok(None) };
+        let d = PyDict::new(py);
+        d.set_item("body", BodyHandle { inner: hit.body })?;
+        d.set_item("index", self.inner.body(hit.body).map(|b| b.index()))?;
+        d.set_item("time", hit.time)?;
+        d.set_item("witness_shape", hit.witness_shape.to_array())?;
+        d.set_item("witness_body", hit.witness_body.to_array())?;
+        d.set_item("normal", hit.normal.to_array())?;
+        Ok(Some(d))
+    }
+
+    /// Pairs of bodies with contact points after the last step (speculative points too), as
+    /// a list of dicts: `body1`, `body2` (BodyHandle), `index1`, `index2` (dense indices),
+    /// `touching` (bool), `total_normal_impulse` (N·s), and `points`: a dict of arrays with
+    /// `position` (K, 3) m, `normal` (K, 3) unit from body 1 towards body 2, `separation` (K,)
+    /// m (negative: overlap), `normal_impulse` (K,) N·s, `friction_impulse` (K, 3) N·s on
+    /// body 2; all float32.
+    fn contact_pairs<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let index = |h: impulse::BodyHandle| self.inner.body(h).map(|b| b.index());
+        let mut list = Vec::new();
+        for pair in self.inner.contact_pairs() {
+            let points: Vec<impulse::ContactPoint> = pair.points().collect();
+            let k = points.len();
+            let flat3 = |f: &dyn Fn(&impulse::ContactPoint) -> Vec3| -> PyResult<_> {
+                let v: Vec<f32> = points.iter().flat_map(|p| f(p).to_array()).collect();
+                PyArray1::from_vec(py, v).reshape([k, 3])
+            };
+            let arrays = PyDict::new(py);
+            arrays.set_item("position", flat3(&|p| p.position)?)?;
+            arrays.set_item("normal", flat3(&|p| p.normal)?)?;
+            arrays.set_item(
+                "separation",
+                PyArray1::from_vec(py, points.iter().map(|p| p.separation).collect()),
+            )?;
+            arrays.set_item(
+                "normal_impulse",
+                PyArray1::from_vec(py, points.iter().map(|p| p.normal_impulse).collect()),
+            )?;
+            arrays.set_item("friction_impulse", flat3(&|p| p.friction_impulse)?)?;
+            let d = PyDict::new(py);
+            d.set_item(
+                "body1",
+                BodyHandle {
+                    inner: pair.body1(),
+                },
+            )?;
+            d.set_item(
+                "body2",
+                BodyHandle {
+                    inner: pair.body2(),
+                },
+            )?;
+            d.set_item("index1", index(pair.body1()))?;
+            d.set_item("index2", index(pair.body2()))?;
+            d.set_item("touching", pair.touching())?;
+            d.set_item("total_normal_impulse", pair.total_normal_impulse())?;
+            d.set_item("points", arrays)?;
+            list.push(d);
+        }
+        Ok(list)
+    }
+
+    /// The last step's contact events, as a list of dicts: `{"type": "started", "body1",
+    /// "body2", "normal_impulse"}` (N·s: how hard they met) or `{"type": "stopped", "body1",
+    /// "body2"}`; `body1` is the body with the smaller handle.
+    fn contact_events<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let mut list = Vec::new();
+        for event in self.inner.contact_events() {
+            let d = PyDict::new(py);
+            match *event {
+                impulse::ContactEvent::Started {
+                    body1,
+                    body2,
+                    normal_impulse,
+                } => {
+                    d.set_item("type", "started")?;
+                    d.set_item("body1", BodyHandle { inner: body1 })?;
+                    d.set_item("body2", BodyHandle { inner: body2 })?;
+                    d.set_item("normal_impulse", normal_impulse)?;
+                }
+                impulse::ContactEvent::Stopped { body1, body2 } => {
+                    d.set_item("type", "stopped")?;
+                    d.set_item("body1", BodyHandle { inner: body1 })?;
+                    d.set_item("body2", BodyHandle { inner: body2 })?;
+                }
+            }
+            list.push(d);
+        }
+        Ok(list)
+    }
+
+    /// The last step's contact LCP (`World::contact_lcp`): find γ within its bounds with
+    /// w = A·γ − b complementary to it. A dict: `A` (n × n; a `scipy.sparse.csr_array` when
+    /// SciPy is installed, else a dict of COO arrays `row`, `col` (int64), `data` (float64)
+    /// and `shape`), `b` (n,), `lo`, `hi` (n,) bounds (±inf where unbounded), `friction_index`
+    /// (n,) int64 (the normal row bounding a friction row by `mu`·γ_normal, −1 for none), `mu`
+    /// (n,), `engine_solution` (n,) the engine's impulses (N·s), `contact_of_row` (n,) int64.
+    /// Raises `StepError` when the last step produced non-finite data.
+    fn contact_lcp<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        use impulse::impulse_lcp::{Bounds, Matrix};
+        let lcp = guarded(|| {
+            self.inner
+                .contact_lcp()
+                .map_err(|e| StepError::new_err(e.to_string()))
+        })?;
+        let problem = &lcp.problem;
+        let n = problem.n();
+        let (mut rows, mut cols, mut data) = (Vec::new(), Vec::new(), Vec::new());
+        match &problem.a {
+            Matrix::Dense(m) => {
+                for i in 0..m.rows {
+                    for (j, &v) in m.row(i).iter().enumerate() {
+                        if v != 0.0 {
+                            rows.push(i as i64);
+                            cols.push(j as i64);
+                            data.push(v);
+                        }
+                    }
+                }
+            }
+            Matrix::Csr(m) => {
+                for i in 0..m.rows {
+                    let (indices, values) = m.row(i);
+                    for (&j, &v) in indices.iter().zip(values) {
+                        rows.push(i as i64);
+                        cols.push(j as i64);
+                        data.push(v);
+                    }
+                }
+            }
+        }
+        let (lo, hi, friction_index, mu) = match &problem.bounds {
+            Bounds::NonNegative => (
+                vec![0.0; n],
+                vec![f64::INFINITY; n],
+                vec![-1i64; n],
+                vec![0.0; n],
+            ),
+            Bounds::Box { lo, hi } => (lo.clone(), hi.clone(), vec![-1; n], vec![0.0; n]),
+            Bounds::Friction {
+                lo,
+                hi,
+                friction_index,
+                mu,
+            } => (
+                lo.clone(),
+                hi.clone(),
+                friction_index
+                    .iter()
+                    .map(|f| f.map_or(-1, |j| j as i64))
+                    .collect(),
+                mu.clone(),
+            ),
+        };
+        let rows = PyArray1::from_vec(py, rows);
+        let cols = PyArray1::from_vec(py, cols);
+        let data = PyArray1::from_vec(py, data);
+        let a: Bound<'py, PyAny> = match py.import("scipy.sparse") {
+            Ok(sparse) => sparse
+                .getattr("coo_array")?
+                .call1(((data, (rows, cols)), (n, n)))?
+                .call_method0("tocsr")?,
+            Err(_) => {
+                let coo = PyDict::new(py);
+                coo.set_item("row", rows)?;
+                coo.set_item("col", cols)?;
+                coo.set_item("data", data)?;
+                coo.set_item("shape", (n, n))?;
+                coo.into_any()
+            }
+        };
+        let d = PyDict::new(py);
+        d.set_item("A", a)?;
+        d.set_item("b", PyArray1::from_vec(py, problem.b.clone()))?;
+        d.set_item("lo", PyArray1::from_vec(py, lo))?;
+        d.set_item("hi", PyArray1::from_vec(py, hi))?;
+        d.set_item("friction_index", PyArray1::from_vec(py, friction_index))?;
+        d.set_item("mu", PyArray1::from_vec(py, mu))?;
+        d.set_item(
+            "engine_solution",
+            PyArray1::from_vec(py, lcp.engine_solution.clone()),
+        )?;
+        d.set_item(
+            "contact_of_row",
+            PyArray1::from_vec(py, lcp.contact_of_row.iter().map(|&c| c as i64).collect()),
+        )?;
+        Ok(d)
     }
 }
 
