@@ -24,11 +24,11 @@ import time
 
 
 def measure(label, out, workers, **options):
-    import impulse.sweep
+    from impulse.sweep import sweep
 
     shutil.rmtree(out, ignore_errors=True)
     start = time.perf_counter()
-    table = impulse.sweep.sweep(out=out, progress=False, workers=workers, **options)
+    table = sweep(out=out, progress=False, workers=workers, **options)
     elapsed = time.perf_counter() - start
     runs = table.num_rows
     statuses = set(table.column("status").to_pylist())
