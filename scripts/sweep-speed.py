@@ -10,7 +10,9 @@ wall time, pool start-up included; Ray's own start-up (`ray.init`) is timed apar
 cluster is started once for many sweeps, and a sweep of tiny runs goes first, which also starts
 Ray's worker processes. The per-run overhead of a backend is
 (wall time × workers − the runs' own wall time in their workers) / runs: what a run costs
-beyond its simulation (sending, scheduling, returning the row, writing the table).
+beyond its simulation (sending, scheduling, returning the row, writing the table). On a shared
+machine the runs' CPU time (`cpu_time_s`) tells what each configuration got: the cores the runs
+had = their CPU seconds / the sweep's wall time.
 Needs impulse, pyarrow and ray installed.
 """
 
@@ -33,12 +35,14 @@ def measure(label, out, workers, **options):
     runs = table.num_rows
     statuses = set(table.column("status").to_pylist())
     inside = sum(table.column("wall_time_s").to_pylist())
+    cpu = sum(table.column("cpu_time_s").to_pylist())
     overhead_ms = (elapsed * workers - inside) / runs * 1e3
     print(
         f"{label:<28} {runs} runs in {elapsed:7.2f} s: {runs / elapsed:7.2f} runs/s; "
         f"mean run in its worker {inside / runs * 1e3:7.1f} ms; "
         f"overhead per run {overhead_ms:6.1f} ms "
-        f"(statuses {sorted(statuses)})",
+        f"(statuses {sorted(statuses)}); CPU per run {cpu / runs * 1e3:6.1f} ms, "
+        f"runs per CPU-second {runs / cpu:6.2f}, cores the runs had {cpu / elapsed:4.2f}",
         flush=True,
     )
     return runs / elapsed, table

@@ -17,7 +17,7 @@ its status and error; the others go on.
 Every simulated number depends only on (scene, overrides, seed, steps, settings): the engine gives
 the same result on any thread count and machine, so a sweep on the local pool and on Ray gives
 equal tables, to the bit, in every column but the timings (``ms_per_step``,
-``mean_ms_per_step``, ``wall_time_s``) and ``worker``.
+``mean_ms_per_step``, ``wall_time_s``, ``cpu_time_s``) and ``worker``.
 
 Needs ``pyarrow`` (the table), ``tqdm`` (the progress bar, optional) and, for ``backend="ray"``,
 ``ray``. Command line: ``python -m impulse.sweep --help``.
@@ -107,12 +107,13 @@ _RUN_COLUMNS = (
 )
 _TAIL_COLUMNS = (
     ("wall_time_s", "float64"),
+    ("cpu_time_s", "float64"),
     ("worker", "string"),
     ("trajectory", "string"),
 )
 #: Columns that hold timings or where a run ran, not simulated values: they differ between two
 #: executions of the same run.
-TIMING_COLUMNS = ("ms_per_step", "mean_ms_per_step", "wall_time_s", "worker")
+TIMING_COLUMNS = ("ms_per_step", "mean_ms_per_step", "wall_time_s", "cpu_time_s", "worker")
 
 #: Prefix of the ``observe`` columns.
 OBSERVE_PREFIX = "observe."
@@ -459,6 +460,7 @@ def _run_task(task: dict[str, Any]) -> dict[str, Any]:
     # do not compete for cores (the results are the same on any thread count).
     os.environ.setdefault("RAYON_NUM_THREADS", "1")
     start = time.perf_counter()
+    cpu_start = time.process_time()
     row: dict[str, Any] = {"run_key": task["key"]}
     try:
         observe = pickle.loads(task["observe"]) if task.get("observe") else None
@@ -467,6 +469,7 @@ def _run_task(task: dict[str, Any]) -> dict[str, Any]:
         row["status"] = FAILED
         row["error"] = f"{type(failure).__name__}: {failure}"
     row["wall_time_s"] = time.perf_counter() - start
+    row["cpu_time_s"] = time.process_time() - cpu_start
     row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     return row
 
@@ -534,6 +537,7 @@ def run_one(
 
 def _run_task_in_process(task: dict[str, Any], observe: Any) -> dict[str, Any]:
     start = time.perf_counter()
+    cpu_start = time.process_time()
     row: dict[str, Any] = {"run_key": task["key"]}
     try:
         row.update(_simulate(task, observe))
@@ -541,6 +545,7 @@ def _run_task_in_process(task: dict[str, Any], observe: Any) -> dict[str, Any]:
         row["status"] = FAILED
         row["error"] = f"{type(failure).__name__}: {failure}"
     row["wall_time_s"] = time.perf_counter() - start
+    row["cpu_time_s"] = time.process_time() - cpu_start
     row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     return row
 
@@ -987,8 +992,9 @@ def sweep(
     ``max_overlap_m``, ``final_overlap_m``, ``top_body``, ``top_sink_m``, ``max_drift_m``,
     ``quality_error_m`` (E = max of |top sink|, overlap, drift), ``kinetic_energy_j``,
     ``max_speed_m_s``, ``mean_contacts``, ``mean_iterations``, ``max_natural_map_residual``,
-    ``final_natural_map_residual``; ``observe.<name>``; ``wall_time_s`` (the whole run in its
-    worker), ``worker`` (host:pid), ``trajectory`` (path or null).
+    ``final_natural_map_residual``; ``observe.<name>``; ``wall_time_s`` and ``cpu_time_s``
+    (the whole run in its worker, wall-clock and CPU), ``worker`` (host:pid), ``trajectory``
+    (path or null).
 
     Raises
     ------
