@@ -265,22 +265,33 @@ def test_a_blow_up_raises_step_error_with_the_frames_so_far():
 
 
 def test_step_releases_the_gil():
+    # While `step` runs without the GIL, another thread runs Python and finds the world
+    # mutably borrowed (a RuntimeError from pyo3): only possible if the GIL was released
+    # during the step.
     world = impulse.World.from_scene("pyramid20")
-    ticks = []
+    world.settings = world.settings.replace(sleep=False)
+    seen_inside = threading.Event()
     stop = threading.Event()
 
-    def count():
+    def probe():
         while not stop.is_set():
-            ticks.append(1)
+            try:
+                world.step_count
+            except RuntimeError:
+                seen_inside.set()
+                return
 
-    thread = threading.Thread(target=count)
+    thread = threading.Thread(target=probe)
     thread.start()
     try:
-        world.step(120)
+        for _ in range(200):
+            world.step(5)
+            if seen_inside.is_set():
+                break
     finally:
         stop.set()
         thread.join()
-    assert ticks, "another thread ran while the world stepped"
+    assert seen_inside.is_set(), "no other thread ran while the world stepped"
 
 
 def test_forces_and_impulses_change_momentum_as_newton_says():

@@ -177,3 +177,31 @@ class World:
         self, handle: BodyHandle, impulse: _Vec3, point: _Vec3 | None = None
     ) -> None: ...
     def apply_torque_impulse(self, handle: BodyHandle, impulse: _Vec3) -> None: ...
+    def cast_ray(
+        self,
+        origin: _Vec3,
+        direction: _Vec3,
+        max_distance: float = ...,
+        solid: bool = True,
+    ) -> dict[str, Any] | None:
+        """First hit: ``body``, ``index``, ``distance``, ``point`` (m), ``normal``; or None."""
+    def cast_shape(
+        self,
+        shape: Shape,
+        translation: _Vec3,
+        velocity: _Vec3,
+        max_time: float,
+        rotation: Sequence[float] = (0.0, 0.0, 0.0, 1.0),
+    ) -> dict[str, Any] | None:
+        """First touch: ``body``, ``index``, ``time`` (s), ``witness_shape``, ``witness_body``,
+        ``normal``; or None."""
+    def contact_pairs(self) -> list[dict[str, Any]]:
+        """Pairs after the last step with their points as arrays (see docs/python.md)."""
+    def contact_events(self) -> list[dict[str, Any]]:
+        """The last step's ``started`` / ``stopped`` events."""
+    def contact_lcp(self) -> dict[str, Any]:
+        """The last step's contact LCP: ``A`` (SciPy CSR array, or COO arrays without SciPy),
+        ``b``, ``lo``, ``hi``, ``friction_index``, ``mu``, ``engine_solution``,
+        ``contact_of_row``."""
+    def __copy__(self) -> World: ...
+    def __deepcopy__(self, memo: Any) -> World: ...
