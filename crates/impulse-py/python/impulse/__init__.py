@@ -29,6 +29,9 @@ from ._impulse import (
 )
 from ._trajectory import Trajectory, load_trajectory
 
+# `impulse.sweep` is the function; the module's other names: `from impulse.sweep import ...`.
+from .sweep import sweep
+
 __all__ = [
     "BodyBuilder",
     "BodyHandle",
@@ -42,6 +45,7 @@ __all__ = [
     "__version__",
     "load_trajectory",
     "scenes",
+    "sweep",
 ]
 
 
