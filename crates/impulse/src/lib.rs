@@ -84,7 +84,7 @@ pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };
 pub use settings::{ContactRepair, SettingError, SolverMethod, SolverSettings};
-pub use solver::{EscalationLevel, HeavyOnLight, IslandReport};
+pub use solver::{EscalationLevel, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, IslandReport};
 pub use world::{
     BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, BodyRef, ContactEvent, ContactPairView,
     ContactPoint, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World, WorldSnapshot,
