@@ -446,8 +446,8 @@ pub fn step_island(
     if settings.substeps != context.settings.substeps {
         // The heavy-on-light path starts cold: the carried impulses are the soft step's, per
         // substep of another length, and the exact solve needs no starting guess. Warm
-        // started, a 10,000:1 cube dropped onto stacks of four or five light cubes hovered on
-        // its speculative contact and then brought 4 of 16 seeded stacks down; cold, all held.
+        // started with them, a 10,000:1 cube dropped onto a stack of four or five light cubes
+        // can hover on its speculative contact and then bring the stack down.
         for c in constraints.iter_mut() {
             c.normal_impulse = 0.0;
             c.tangent_impulses = [0.0; 2];
