@@ -469,6 +469,7 @@ fn simulate(
     let mut status = "completed".to_string();
     let mut failure = None;
     let mut island_solves = IslandSolves::default();
+    let mut warned_heavy_on_light = false;
     let mut island_writer = match &options.island_report {
         Some(path) => Some((
             path,
@@ -507,6 +508,12 @@ fn simulate(
                 EscalationLevel::NncgExtended => island_solves.nncg_extended += 1,
                 EscalationLevel::Apgd => island_solves.apgd += 1,
                 EscalationLevel::Exact => island_solves.exact += 1,
+            }
+            if let Some(heavy) = island.heavy_on_light.filter(|h| !h.held)
+                && !warned_heavy_on_light
+            {
+                warned_heavy_on_light = true;
+                warn_of_heavy_on_light(&world, diagnostics.step, island, heavy);
             }
             island_solves.escalations += island.escalations as u64;
             island_solves.exact_failures += island.exact_failures as u64;
@@ -678,6 +685,41 @@ const START_OVERLAP_WARNING: f32 = 0.01;
 /// Warns of every pair of bodies that started overlapping by more than
 /// [`START_OVERLAP_WARNING`], naming both and the depth: the first step's contact points are
 /// found on the poses the scene gave.
+/// The one warning of a run that a heavy-on-light island is not held
+/// ([`impulse::HeavyOnLight::held`]), naming the contact's two bodies.
+fn warn_of_heavy_on_light(
+    world: &World,
+    step: u64,
+    island: &impulse::IslandReport,
+    heavy: impulse::HeavyOnLight,
+) {
+    let name = |index: u32| match world.handle_of(index as usize).and_then(|h| world.body(h)) {
+        Some(b) => match b.name() {
+            Some(name) => format!("{index} (\"{name}\")"),
+            None => index.to_string(),
+        },
+        None => index.to_string(),
+    };
+    let why = if heavy.exact {
+        "even on the exact path".to_string()
+    } else {
+        format!(
+            "its island has {} contact points, more than the exact path takes \
+             (solver.exact_max_contacts)",
+            island.contacts
+        )
+    };
+    eprintln!(
+        "warning: step {step}: body {} rests on body {}, {:.0} times lighter, and the island \
+         is not held ({why}): it overlaps by more than {} mm and may sink through; \
+         further such islands are not reported",
+        name(heavy.heavy_body),
+        name(heavy.light_body),
+        heavy.mass_ratio,
+        impulse::HEAVY_ON_LIGHT_HELD_OVERLAP * 1e3,
+    );
+}
+
 fn warn_of_overlaps_at_start(world: &World) {
     let name = |h: impulse::BodyHandle| match world.body(h) {
         Some(b) => match b.name() {

@@ -158,6 +158,16 @@ pub struct SolverSettings {
     /// `auto`: islands with at most this many contact points may escalate to the exact path
     /// (0 = never).
     pub exact_max_contacts: u32,
+    /// Methods other than `auto`: an island in which some contact joins two moving bodies
+    /// whose masses differ by more than this factor (heavy on light), and which has at most
+    /// `exact_max_contacts` points, is stepped as one LCP per step on rigid rows (velocity bias
+    /// at 12/s, relax solve after), solved exactly (Lemke, [`SolverMethod::Auto`]'s exact path),
+    /// instead of in substeps. The soft step cannot hold such an island: a soft row's spring is
+    /// as stiff as its effective mass, which is the light body's, so under a load R times the
+    /// light body's weight it sinks R·g/ω², and Gauss-Seidel moves the load from the heavy
+    /// body to the light one at a rate of about 1/R per sweep (docs/solvers.md, "Heavy on
+    /// light"). 0 = never; every other island takes the ordinary path unchanged.
+    pub heavy_on_light_mass_ratio: f32,
     /// Restitution hypothesis v⁺ = −c_r·v⁻ is applied only when the contact approaches faster
     /// than this (m/s), so resting contacts do not bounce (docs/method.md, "Targets: restitution, gaps and repair").
     pub restitution_threshold: f32,
@@ -308,6 +318,7 @@ impl SolverSettings {
             ("tolerance", self.tolerance),
             ("escalation_tolerance", self.escalation_tolerance),
             ("mass_ratio_threshold", self.mass_ratio_threshold),
+            ("heavy_on_light_mass_ratio", self.heavy_on_light_mass_ratio),
             (rate_field, rate),
             ("repair.damping_ratio", damping_ratio),
             ("sleep_linear_speed", self.sleep_linear_speed),
@@ -509,6 +520,7 @@ impl Default for SolverSettings {
             escalation_iterations: 4,
             mass_ratio_threshold: 10.0,
             exact_max_contacts: 32,
+            heavy_on_light_mass_ratio: 200.0,
             restitution_threshold: 0.5,
             repair: ContactRepair::Soft {
                 hertz: 240.0,

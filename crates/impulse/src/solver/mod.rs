@@ -37,7 +37,7 @@ pub mod wide;
 
 pub use pgs::Sweep;
 pub use policy::EscalationLevel;
-pub use substep::IslandReport;
+pub use substep::{HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, IslandReport};
 
 /// An island's contact solver, whatever its method: what the substep loop
 /// ([`substep::step_island`]) calls, in this order each step:
