@@ -85,6 +85,7 @@ pub use scene::{
 };
 pub use settings::{ContactRepair, SettingError, SolverMethod, SolverSettings};
 pub use solver::{EscalationLevel, IslandReport};
+pub use world::LeftWorld;
 pub use world::{
     BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, BodyRef, ContactEvent, ContactPairView,
     ContactPoint, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World, WorldSnapshot,

@@ -193,6 +193,10 @@ pub struct SolverSettings {
     /// collision). Fast bodies then never pass through a thin wall, whatever their speed. On
     /// by default; the cost without fast bodies is a pass over the bodies' poses.
     pub continuous: bool,
+    /// World bound (m): a moving body whose centre of mass ends a step farther than this from
+    /// the origin leaves the simulation ([`crate::World::left_world`]): it is frozen where it
+    /// is and the run goes on. Default 10⁵ m ([`crate::BLOW_UP_DISTANCE`]); must be > 0.
+    pub max_distance: f32,
 }
 
 /// A solver setting outside its allowed range: which field, and what is allowed.
@@ -276,6 +280,12 @@ impl SolverSettings {
                 continue;
             };
             problems.push(SettingError { field, message });
+        }
+        if self.max_distance.is_nan() || self.max_distance <= 0.0 {
+            problems.push(SettingError {
+                field: "max_distance",
+                message: format!("must be > 0, got {}", self.max_distance),
+            });
         }
         let warm_start = self.warm_start;
         if !warm_start.is_finite() {
@@ -436,6 +446,7 @@ impl Default for SolverSettings {
             simd_island_contacts: 16,
             gyroscopic: true,
             continuous: true,
+            max_distance: crate::world::BLOW_UP_DISTANCE,
         }
     }
 }
