@@ -142,7 +142,8 @@ pub(crate) const HEAVY_ON_LIGHT_MASS_RATIO: f32 = 200.0;
 /// corner's impulse spins the body, the last corners are left with the spin, and friction and
 /// the next substeps turn it into a rebound and a sideways drift (a cube dropped flat at
 /// restitution 0 left at 7 % of its impact speed, docs/method.md "Impacts"). Resting contacts,
-/// whose sweeps change velocities by about |g|·h, never take them.
+/// whose sweeps change velocities by about |g|·h, never take them. Only with soft or bias
+/// repair (the soft step's solves): split impulse's PGS keeps the sweeps it was given.
 pub(crate) const IMPACT_SWEEPS: u32 = 32;
 
 /// Every method's solver, so that an island keeps its work spaces from step to step.
@@ -250,7 +251,9 @@ impl IslandWorkspace {
         let solver = self.solvers.substeps(settings.method, bundled);
         let outcome = solver.solve(constraints, &mut velocities, &pass);
         self.impact = if with_repair {
-            settings.method == SolverMethod::Pgs && outcome.report.last_change > self.impact_speed
+            settings.method == SolverMethod::Pgs
+                && !settings.split_impulse()
+                && outcome.report.last_change > self.impact_speed
         } else {
             self.impact
         };
