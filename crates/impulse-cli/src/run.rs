@@ -500,6 +500,23 @@ fn simulate(
         if step == 1 {
             warn_of_overlaps_at_start(&world);
         }
+        for left in world.left_world() {
+            let name = left
+                .name
+                .as_ref()
+                .map(|n| format!(" (\"{n}\")"))
+                .unwrap_or_default();
+            bar.suspend(|| {
+                eprintln!(
+                    "warning: body {}{name} left the world at step {}: {:.0} m from the origin \
+                     (solver.max_distance {} m); it is frozen there and the run goes on",
+                    left.body,
+                    left.step,
+                    left.position.length(),
+                    left.bound
+                )
+            });
+        }
         let diagnostics = world.diagnostics();
         for island in &diagnostics.islands {
             match island.method {

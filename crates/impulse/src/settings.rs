@@ -239,6 +239,10 @@ pub struct SolverSettings {
     /// restitution, the default) or `propagation` (generalized reflections). A physical
     /// choice of the scene, like the restitution coefficients ([`ImpactModel`]).
     pub impact: ImpactModel,
+    /// World bound (m): a moving body whose centre of mass ends a step farther than this from
+    /// the origin leaves the simulation ([`crate::World::left_world`]): it is frozen where it
+    /// is and the run goes on. Default 10⁵ m ([`crate::BLOW_UP_DISTANCE`]); must be > 0.
+    pub max_distance: f32,
 }
 
 /// A solver setting outside its allowed range: which field, and what is allowed.
@@ -338,6 +342,12 @@ impl SolverSettings {
                 continue;
             };
             problems.push(SettingError { field, message });
+        }
+        if self.max_distance.is_nan() || self.max_distance <= 0.0 {
+            problems.push(SettingError {
+                field: "max_distance",
+                message: format!("must be > 0, got {}", self.max_distance),
+            });
         }
         let warm_start = self.warm_start;
         if !warm_start.is_finite() {
@@ -541,6 +551,7 @@ impl Default for SolverSettings {
             gyroscopic: true,
             continuous: true,
             impact: ImpactModel::Simultaneous,
+            max_distance: crate::world::BLOW_UP_DISTANCE,
         }
     }
 }

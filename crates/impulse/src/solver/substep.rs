@@ -160,6 +160,10 @@ pub struct IslandWorkspace {
     slot_inverse_inertia: Vec<Mat3>,
     /// `impact: propagation`'s work space ([`super::impact`]).
     impact: super::impact::ImpactWorkspace,
+    /// Whether this substep's main solve met an impact ([`IMPACT_SWEEPS`]).
+    impact_met: bool,
+    /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]).
+    impact_speed: f32,
 }
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
@@ -169,6 +173,18 @@ pub struct IslandWorkspace {
 /// solve's, let the 400:1 `plate` rock sideways with growing amplitude, up to 600 J after 10 s
 /// at the default; a second friction sweep a substep brings it to rest.
 pub(crate) const HEAVY_ON_LIGHT_MASS_RATIO: f32 = 200.0;
+
+/// Sweeps a PGS solve may take beyond its budget in an impact: when the main solve's last
+/// sweep still changed some row's velocity by more than the impact speed (the larger of
+/// |g|·dt, the speed gravity gives in a step, and `restitution_threshold`), it sweeps on until
+/// the tolerance or this many more, and so does the substep's relax solve. One sweep of
+/// Gauss-Seidel over the corners of a face that hits at speed does not converge: the first
+/// corner's impulse spins the body, the last corners are left with the spin, and friction and
+/// the next substeps turn it into a rebound and a sideways drift (a cube dropped flat at
+/// restitution 0 left at 7 % of its impact speed, docs/method.md "Impacts"). Resting contacts,
+/// whose sweeps change velocities by about |g|·h, never take them. Only with soft or bias
+/// repair (the soft step's solves): split impulse's PGS keeps the sweeps it was given.
+pub(crate) const IMPACT_SWEEPS: u32 = 32;
 
 /// Every method's solver, so that an island keeps its work spaces from step to step.
 #[derive(Default)]
@@ -258,16 +274,44 @@ impl IslandWorkspace {
                 parallel: self.parallel,
             },
         };
-        let outcome = self.solvers.substeps(settings.method, bundled).solve(
-            constraints,
-            &mut Velocities {
-                linear: &mut self.linear,
-                angular: &mut self.angular,
-            },
-            &pass,
-        );
+        // A substep whose main solve found an impact sweeps its relax solve to convergence too
+        // (more than one sweep, so the lanes do not carry the warm start; see `IMPACT_SWEEPS`).
+        let pass = if !with_repair && self.impact_met {
+            SolvePass {
+                iterations: pass.iterations.max(IMPACT_SWEEPS),
+                ..pass
+            }
+        } else {
+            pass
+        };
+        let mut velocities = Velocities {
+            linear: &mut self.linear,
+            angular: &mut self.angular,
+        };
+        let solver = self.solvers.substeps(settings.method, bundled);
+        let outcome = solver.solve(constraints, &mut velocities, &pass);
+        self.impact_met = if with_repair {
+            settings.method == SolverMethod::Pgs
+                && !settings.split_impulse()
+                && outcome.report.last_change > self.impact_speed
+        } else {
+            self.impact_met
+        };
+        let more = (with_repair && self.impact_met).then(|| {
+            // The targets are set; the sweeps go on from where the budget ended.
+            let more = SolvePass {
+                iterations: IMPACT_SWEEPS,
+                escalate: false,
+                targets: None,
+                ..pass
+            };
+            solver.solve(constraints, &mut velocities, &more)
+        });
         self.position_repair = outcome.position_repair;
         self.record(&outcome, with_repair);
+        if let Some(more) = more {
+            self.record(&more, true);
+        }
     }
 
     /// Adds one solve's outcome to the island's report; the main solve's last change is the
@@ -458,6 +502,8 @@ pub fn step_island(
     w.report.substeps = settings.substeps;
     w.solvers.auto.limits =
         EscalationLimits::new(settings, w.report.mass_ratio, gravity.length() * dt);
+    w.impact_speed = (gravity.length() * dt).max(settings.restitution_threshold);
+    w.impact_met = false;
 
     // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
     let bundled = settings.solves_in_lanes(constraints.len());

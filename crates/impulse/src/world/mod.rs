@@ -34,7 +34,9 @@ pub use contacts::{ContactEvent, ContactPairView, ContactPoint};
 pub use query::{RayHit, ShapeHit};
 pub use snapshot::{SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
 
-/// A body further than this from the origin (m) means the simulation has blown up.
+/// The default world bound (m), [`SolverSettings::max_distance`]: a moving body farther than
+/// this from the origin leaves the world ([`LeftWorld`]); the run goes on. A non-finite
+/// position is a blow-up.
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
 /// A body faster than this (m/s) means the simulation has blown up.
 pub const BLOW_UP_SPEED: f32 = 1.0e4;
@@ -95,6 +97,35 @@ pub struct World {
     moving_kinematic: Vec<u32>,
     /// The continuous stage's clamps (scratch): body, clamped pose, fraction of the step.
     clamps: Vec<(usize, Pose, f32)>,
+    /// Every body's pose before the continuous stage (empty when it is off): what the energy
+    /// check credits a clamp with.
+    unclamped_poses: Vec<Pose>,
+    /// The bodies that left the world in the last step ([`World::left_world`]).
+    left_world: Vec<LeftWorld>,
+}
+
+/// A body that left the world: its centre of mass ended a step farther from the origin than
+/// [`SolverSettings::max_distance`] (m). Such a body is taken out of the simulation, not
+/// treated as a blow-up: its velocities are zeroed, it is put to sleep, its collision groups,
+/// mass and inertia are cleared (it collides with nothing, nothing wakes it, and it no longer
+/// counts in [`World::energy`]), and it stays in [`World::bodies`] at its index with its last
+/// pose, so indices and written trajectories keep their shape (every later frame repeats
+/// that pose). [`World::remove`] takes it out for good. Read after the step that made it
+/// ([`World::left_world`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LeftWorld {
+    /// The body's index in [`World::bodies`].
+    pub body: usize,
+    /// Its handle (still valid: the body stays in the world).
+    pub handle: BodyHandle,
+    /// Its name, if it has one.
+    pub name: Option<String>,
+    /// The step (counted from 1) at whose end it was beyond the bound.
+    pub step: u64,
+    /// Its centre of mass then (m, world frame).
+    pub position: Vec3,
+    /// The bound it crossed (m), [`SolverSettings::max_distance`].
+    pub bound: f32,
 }
 
 impl World {
@@ -130,6 +161,8 @@ impl World {
             start_poses: Vec::new(),
             moving_kinematic: Vec::new(),
             clamps: Vec::new(),
+            unclamped_poses: Vec::new(),
+            left_world: Vec::new(),
         };
         world.check_settings()?;
         Ok(world)
@@ -343,6 +376,12 @@ impl World {
             self.bodies.sleep_time[i] = 0.0;
             self.energy.started = false;
         }
+    }
+
+    /// The bodies that left the world in the last step, in index order ([`LeftWorld`]);
+    /// empty in most steps. Each step starts the list anew.
+    pub fn left_world(&self) -> &[LeftWorld] {
+        &self.left_world
     }
 
     /// Wakes every body that can move.
