@@ -174,7 +174,9 @@ impl World {
     /// `seed`, `jitter`: a seeded random variation of the dynamic bodies; `jitter` a mapping
     /// with optional keys `"position"` (m), `"angle"` (degrees), `"velocity"` (m/s).
     /// `settings`: an `impulse.Settings` or a preset name replacing the scene's solver effort
-    /// as `impulse run --preset` does (the scene's `sleep` and `gyroscopic` are kept).
+    /// as `impulse run --preset` does (`SolverSettings::with_effort_of`: the scene keeps its
+    /// physics — restitution threshold, sleeping, continuous collision, gyroscopic motion,
+    /// friction, impact model, world bound).
     ///
     /// Raises `SceneError` (message as `impulse run` prints it: file, line, body, field) for a
     /// scene that cannot be read or built, `WorldError` for bad settings.
@@ -191,11 +193,7 @@ impl World {
         let mut scene = crate::scene::vary(scene, &directory, overrides, seed, jitter)?;
         if let Some(settings) = settings {
             let preset = Settings::from_argument(settings)?;
-            scene.solver = impulse::SolverSettings {
-                sleep: scene.solver.sleep,
-                gyroscopic: scene.solver.gyroscopic,
-                ..preset
-            };
+            scene.solver = scene.solver.with_effort_of(&preset);
         }
         let world = guarded(|| {
             impulse::World::from_scene(&scene).map_err(|e| match e {
