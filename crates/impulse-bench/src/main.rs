@@ -320,6 +320,40 @@ mod tests {
         assert!(args.command.is_none() && args.scenes.is_empty());
     }
 
+    /// Without the `rapier` feature a Rapier row or the front fails before any run, naming
+    /// the feature; `--no-rapier` still times impulse alone.
+    #[cfg(not(feature = "rapier"))]
+    #[test]
+    fn rapier_without_the_feature_is_a_clear_error() {
+        let args = Args::try_parse_from(["impulse-bench", "stack30", "--steps", "2"]).unwrap();
+        let error = run(args).unwrap_err().to_string();
+        assert!(
+            error.contains("--features rapier") && error.contains("--no-rapier"),
+            "{error}"
+        );
+        let args = Args::try_parse_from(["impulse-bench", "front", "stack30", "--quick"]).unwrap();
+        let Some(Command::Front(front)) = args.command else {
+            panic!("no front subcommand");
+        };
+        let error = run_front(front).unwrap_err().to_string();
+        assert!(error.contains("--features rapier"), "{error}");
+        let args = Args::try_parse_from([
+            "impulse-bench",
+            "stack30",
+            "--steps",
+            "2",
+            "--no-rapier",
+            "--rapier-variant",
+            "8:120",
+        ])
+        .unwrap();
+        assert!(run(args).is_err());
+        let args =
+            Args::try_parse_from(["impulse-bench", "stack30", "--steps", "2", "--no-rapier"])
+                .unwrap();
+        assert!(run(args).unwrap());
+    }
+
     #[test]
     fn front_subcommand_parses() {
         let args = Args::try_parse_from([
