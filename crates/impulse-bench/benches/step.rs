@@ -9,7 +9,7 @@
 //!
 //! Sleeping is off, as in every timing of this crate.
 //!
-//! `cargo bench -p impulse-bench --bench step`
+//! `cargo bench -p impulse-bench --features bench --bench step`
 
 use std::hint::black_box;
 use std::time::Duration;

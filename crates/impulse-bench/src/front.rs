@@ -440,7 +440,7 @@ pub fn measure_scene(
     on_point: &mut dyn FnMut(&str, u32, &FrontPoint),
 ) -> Result<SceneFront> {
     if !rapier.is_empty() && !cfg!(feature = "rapier") {
-        bail!("Rapier was asked for, but impulse-bench was built without the `rapier` feature");
+        bail!("{}", crate::NO_RAPIER);
     }
     let mut points = Vec::with_capacity(impulse.len() + rapier.len());
     let pool = thread_pool(1)?;

@@ -8,7 +8,7 @@
 //! that run, on that machine, next to the quality each reached.
 //!
 //! - [`bench_impulse`]: impulse on a scene, inside a rayon pool of a given size.
-//! - [`bench_rapier`] (feature `rapier`, on by default): Rapier 0.36 on the same scene.
+//! - [`bench_rapier`] (feature `rapier`, off by default: `--features rapier`): Rapier 0.36 on the same scene.
 //! - [`format_table`]: the results as one Markdown table.
 //! - [`run_benchmarks`]: a list of built-in scenes through both engines.
 //! - [`front`]: the quality/speed Pareto front of each engine over a grid of its settings.
@@ -35,6 +35,12 @@ pub use rapier_engine::{
     FRICTION_COMBINE, RESTITUTION_COMBINE, bench_rapier, bench_rapier_with,
     settings_text as rapier_settings_text,
 };
+
+/// The error when Rapier is asked for in a build without the `rapier` feature (the default
+/// build compiles neither Rapier nor criterion, to keep `cargo test --workspace` quick).
+pub const NO_RAPIER: &str = "Rapier was asked for, but impulse-bench was built without the \
+     `rapier` feature; build it with `--features rapier`, e.g. \
+     `cargo run --release -p impulse-bench --features rapier -- ...`";
 
 /// Scenes measured when none are named: the standard scenes (docs/scenes.md) plus `pyramid100`.
 pub const DEFAULT_SCENES: &[&str] = &[
@@ -392,7 +398,7 @@ impl EngineRun {
 /// dropped from the turns and the others go on.
 pub fn bench_scene(scene: &Scene, config: &BenchConfig) -> Result<Vec<Result<BenchRow>>> {
     if (config.rapier || !config.rapier_variants.is_empty()) && !cfg!(feature = "rapier") {
-        bail!("Rapier was asked for, but impulse-bench was built without the `rapier` feature");
+        bail!("{NO_RAPIER}");
     }
     let steps = config.steps;
     thread_pool(config.threads)?.install(|| {
@@ -467,7 +473,7 @@ pub fn run_benchmarks(
     on_error: &mut dyn FnMut(&anyhow::Error),
 ) -> Result<Vec<BenchRow>> {
     if (config.rapier || !config.rapier_variants.is_empty()) && !cfg!(feature = "rapier") {
-        bail!("Rapier was asked for, but impulse-bench was built without the `rapier` feature");
+        bail!("{NO_RAPIER}");
     }
     if config.steps == 0 {
         bail!("steps must be at least 1");

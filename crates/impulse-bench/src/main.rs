@@ -1,8 +1,8 @@
 //! `impulse-bench`: impulse and Rapier on the same built-in scenes, one Markdown table.
 //!
 //! ```text
-//! cargo run --release -p impulse-bench -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--impulse-fast] [--also-threads N] [--markdown FILE]
-//! cargo run --release -p impulse-bench -- front [SCENE...] [--steps N] [--large-steps M] [--out-dir DIR] [--markdown FILE] [--json FILE] [--quick]
+//! cargo run --release -p impulse-bench --features rapier -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--impulse-fast] [--also-threads N] [--markdown FILE]
+//! cargo run --release -p impulse-bench --features rapier -- front [SCENE...] [--steps N] [--large-steps M] [--out-dir DIR] [--markdown FILE] [--json FILE] [--quick]
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -37,7 +37,8 @@ struct Args {
     /// Threads of impulse's rayon pool (Rapier runs on one thread).
     #[arg(long, default_value_t = 1)]
     threads: usize,
-    /// Measure impulse only (no Rapier row with default settings).
+    /// Measure impulse only (no Rapier row with default settings); the only mode of a build
+    /// without the `rapier` feature.
     #[arg(long)]
     no_rapier: bool,
     /// Also measure Rapier with SUBSTEPS solver iterations and contact springs of HZ (fixed
@@ -119,6 +120,12 @@ fn main() -> ExitCode {
 
 /// Ok(false) when some run failed (the others are still reported).
 fn run(args: Args) -> Result<bool> {
+    if !cfg!(feature = "rapier") && (!args.no_rapier || !args.rapier_variant.is_empty()) {
+        anyhow::bail!(
+            "{}; or pass `--no-rapier` to time impulse alone",
+            impulse_bench::NO_RAPIER
+        );
+    }
     let config = BenchConfig {
         scenes: if args.scenes.is_empty() {
             DEFAULT_SCENES.iter().map(|s| s.to_string()).collect()
@@ -191,6 +198,10 @@ fn command_line() -> String {
 
 /// `impulse-bench front`. Ok(false) when some run failed (the others are still reported).
 fn run_front(args: FrontArgs) -> Result<bool> {
+    // The front is a comparison: without Rapier it would quietly be impulse's alone.
+    if !cfg!(feature = "rapier") {
+        anyhow::bail!("{}", impulse_bench::NO_RAPIER);
+    }
     let config = FrontConfig {
         scenes: if args.scenes.is_empty() {
             front::FRONT_SCENES.iter().map(|s| s.to_string()).collect()
@@ -307,6 +318,40 @@ mod tests {
         assert_eq!(args.steps, 5);
         let args = Args::try_parse_from(["impulse-bench"]).unwrap();
         assert!(args.command.is_none() && args.scenes.is_empty());
+    }
+
+    /// Without the `rapier` feature a Rapier row or the front fails before any run, naming
+    /// the feature; `--no-rapier` still times impulse alone.
+    #[cfg(not(feature = "rapier"))]
+    #[test]
+    fn rapier_without_the_feature_is_a_clear_error() {
+        let args = Args::try_parse_from(["impulse-bench", "stack30", "--steps", "2"]).unwrap();
+        let error = run(args).unwrap_err().to_string();
+        assert!(
+            error.contains("--features rapier") && error.contains("--no-rapier"),
+            "{error}"
+        );
+        let args = Args::try_parse_from(["impulse-bench", "front", "stack30", "--quick"]).unwrap();
+        let Some(Command::Front(front)) = args.command else {
+            panic!("no front subcommand");
+        };
+        let error = run_front(front).unwrap_err().to_string();
+        assert!(error.contains("--features rapier"), "{error}");
+        let args = Args::try_parse_from([
+            "impulse-bench",
+            "stack30",
+            "--steps",
+            "2",
+            "--no-rapier",
+            "--rapier-variant",
+            "8:120",
+        ])
+        .unwrap();
+        assert!(run(args).is_err());
+        let args =
+            Args::try_parse_from(["impulse-bench", "stack30", "--steps", "2", "--no-rapier"])
+                .unwrap();
+        assert!(run(args).unwrap());
     }
 
     #[test]

@@ -193,7 +193,7 @@ enum Command {
         variation: variation_args::VariationArgs,
     },
     /// Time impulse on built-in scenes (sleeping off, median ms/step) and measure quality from
-    /// poses; `cargo run --release -p impulse-bench` adds Rapier side by side.
+    /// poses; `cargo run --release -p impulse-bench --features rapier` adds Rapier side by side.
     Bench {
         /// Built-in scene names (default: pyramid20 pyramid100 pyramid3d10 stack30 massratio
         /// balls4096).
