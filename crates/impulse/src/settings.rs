@@ -245,6 +245,11 @@ pub struct SolverSettings {
     pub max_distance: f32,
 }
 
+/// The default world bound (m), [`SolverSettings::max_distance`]: a moving body farther than
+/// this from the origin leaves the world ([`crate::LeftWorld`]); the run goes on. A non-finite
+/// position is a blow-up.
+pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
+
 /// A solver setting outside its allowed range: which field, and what is allowed.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("solver.{field}: {message}")]
@@ -551,7 +556,7 @@ impl Default for SolverSettings {
             gyroscopic: true,
             continuous: true,
             impact: ImpactModel::Simultaneous,
-            max_distance: crate::world::BLOW_UP_DISTANCE,
+            max_distance: BLOW_UP_DISTANCE,
         }
     }
 }

@@ -34,10 +34,7 @@ pub use contacts::{ContactEvent, ContactPairView, ContactPoint};
 pub use query::{RayHit, ShapeHit};
 pub use snapshot::{SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
 
-/// The default world bound (m), [`SolverSettings::max_distance`]: a moving body farther than
-/// this from the origin leaves the world ([`LeftWorld`]); the run goes on. A non-finite
-/// position is a blow-up.
-pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
+pub use crate::settings::BLOW_UP_DISTANCE;
 /// A body faster than this (m/s) means the simulation has blown up.
 pub const BLOW_UP_SPEED: f32 = 1.0e4;
 /// Mechanical energy (kinetic + gravitational, [`crate::diagnostics::EnergyTerms`]) more than
