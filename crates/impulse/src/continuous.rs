@@ -323,7 +323,19 @@ pub fn clamp_fraction_castable(
     let hit = cast_shapes_nonlinear(&core_motion, &core, &target_motion, target, 0.0, 1.0, true)
         .ok()??;
     let t = hit.time_of_impact;
-    (t > 0.0 && t < 1.0).then_some(t)
+    if !(t > 0.0 && t < 1.0) {
+        return None;
+    }
+    // Moved back by the gap along the centre's path, as the whole body is above: a core sphere
+    // left touching the target casts a time of impact of 0 the next step, and so would not be
+    // clamped again however far the body then went through.
+    let (start, end) = body.sweep.center_path();
+    let center_travel = (end - start).length();
+    Some(if center_travel > gap {
+        (t - gap / center_travel).max(0.0)
+    } else {
+        0.0
+    })
 }
 
 #[cfg(test)]
