@@ -325,19 +325,8 @@ impl SpeculativeMargins {
     /// The separation (m) up to which pair (`a`, `b`) gets contact points this step.
     #[inline]
     pub fn pair_prediction(&self, bodies: &Bodies, a: usize, b: usize) -> f32 {
-        let velocity = |i: usize| {
-            if bodies.is_moving(i) {
-                bodies.linear_velocity[i]
-            } else {
-                Vec3::ZERO
-            }
-        };
-        // Gravity moves dynamic bodies alike, and kinematic and static ones not at all.
-        let gravity = if bodies.is_dynamic(a) != bodies.is_dynamic(b) {
-            self.gravity_speed
-        } else {
-            0.0
-        };
+        let velocity = |i: usize| moving_velocity(bodies, i);
+        let gravity = self.relative_gravity_speed(bodies, a, b);
         let closing = (velocity(a) - velocity(b)).length()
             + self.spin_speeds[a]
             + self.spin_speeds[b]
@@ -349,23 +338,34 @@ impl SpeculativeMargins {
     /// shapes must come for its speculative points to stand ([`SweptReach`]).
     #[inline]
     pub(crate) fn pair_reach(&self, bodies: &Bodies, a: usize, b: usize) -> SweptReach {
-        let velocity = |i: usize| {
-            if bodies.is_moving(i) {
-                bodies.linear_velocity[i]
-            } else {
-                Vec3::ZERO
-            }
-        };
-        let gravity = if bodies.is_dynamic(a) != bodies.is_dynamic(b) {
-            self.gravity_speed
-        } else {
-            0.0
-        };
+        let velocity = |i: usize| moving_velocity(bodies, i);
+        let gravity = self.relative_gravity_speed(bodies, a, b);
         SweptReach {
             displacement: (velocity(b) - velocity(a)) * self.dt,
             distance: self.prediction_distance
                 + (self.spin_speeds[a] + self.spin_speeds[b] + gravity) * self.dt,
         }
+    }
+
+    /// The speed (m/s) gravity can add to pair (`a`, `b`)'s closing: it moves dynamic bodies
+    /// alike, and kinematic and static ones not at all.
+    #[inline]
+    fn relative_gravity_speed(&self, bodies: &Bodies, a: usize, b: usize) -> f32 {
+        if bodies.is_dynamic(a) != bodies.is_dynamic(b) {
+            self.gravity_speed
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Body `i`'s linear velocity (m/s) if it moves, else zero.
+#[inline]
+fn moving_velocity(bodies: &Bodies, i: usize) -> Vec3 {
+    if bodies.is_moving(i) {
+        bodies.linear_velocity[i]
+    } else {
+        Vec3::ZERO
     }
 }
 

@@ -116,23 +116,38 @@ fn load_meshes(scene: &mut Scene, directory: &Path) -> Result<(), SceneError> {
             ..
         } = &mut body.shape
         {
-            let path = directory.join(file.as_str());
-            let mesh = super::mesh_file::load_mesh_file(&path).map_err(|e| {
-                let mut error = SceneError::new(
-                    SceneErrorKind::Invalid,
-                    Some(FieldPath::body(index).key("shape").key("file")),
-                    e.to_string(),
-                );
-                error.body = Some(BodyRef {
-                    index,
-                    name: body.name.clone(),
-                });
-                error
-            })?;
-            *loaded = Some(super::mesh_file::LoadedMesh(std::sync::Arc::new(mesh)));
+            *loaded = Some(read_body_mesh(
+                index,
+                body.name.as_deref(),
+                file,
+                directory,
+            )?);
         }
     }
     Ok(())
+}
+
+/// Reads body `index`'s mesh `file` relative to `directory`. Errors name the body and
+/// `shape.file` but have no origin yet.
+pub(crate) fn read_body_mesh(
+    index: usize,
+    name: Option<&str>,
+    file: &str,
+    directory: &Path,
+) -> Result<super::mesh_file::LoadedMesh, SceneError> {
+    let mesh = super::mesh_file::load_mesh_file(&directory.join(file)).map_err(|e| {
+        let mut error = SceneError::new(
+            SceneErrorKind::Invalid,
+            Some(FieldPath::body(index).key("shape").key("file")),
+            e.to_string(),
+        );
+        error.body = Some(BodyRef {
+            index,
+            name: name.map(str::to_string),
+        });
+        error
+    })?;
+    Ok(super::mesh_file::LoadedMesh(std::sync::Arc::new(mesh)))
 }
 
 /// Parses without validating; errors have no origin yet.

@@ -11,7 +11,6 @@
 
 use std::fmt;
 use std::path::Path;
-use std::sync::Arc;
 
 use rand::RngExt;
 use rand::SeedableRng;
@@ -21,7 +20,6 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use super::error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind};
-use super::mesh_file::{LoadedMesh, load_mesh_file};
 use super::validate::validate;
 use super::{BodyKind, Scene, ShapeDesc, WorldAxis};
 
@@ -478,21 +476,12 @@ fn load_meshes(varied: &mut Scene, original: &Scene, directory: &Path) -> Result
             });
         *loaded = match kept {
             Some(mesh) => Some(mesh),
-            None => {
-                let mesh = load_mesh_file(&directory.join(file.as_str())).map_err(|e| {
-                    let mut error = SceneError::new(
-                        SceneErrorKind::Invalid,
-                        Some(FieldPath::body(index).key("shape").key("file")),
-                        e.to_string(),
-                    );
-                    error.body = Some(BodyRef {
-                        index,
-                        name: body.name.clone(),
-                    });
-                    error
-                })?;
-                Some(LoadedMesh(Arc::new(mesh)))
-            }
+            None => Some(super::json::read_body_mesh(
+                index,
+                body.name.as_deref(),
+                file,
+                directory,
+            )?),
         };
     }
     Ok(())
