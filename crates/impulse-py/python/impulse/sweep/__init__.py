@@ -459,13 +459,22 @@ def _run_task(task: dict[str, Any]) -> dict[str, Any]:
     # A sweep's parallelism is its workers: each run steps on its own worker's thread, so runs
     # do not compete for cores (the results are the same on any thread count).
     os.environ.setdefault("RAYON_NUM_THREADS", "1")
+    return _timed_row(
+        task, lambda: pickle.loads(task["observe"]) if task.get("observe") else None
+    )
+
+
+def _timed_row(
+    task: dict[str, Any], load_observe: Callable[[], Any]
+) -> dict[str, Any]:
+    """The run's row with its wall and CPU time and worker; a failure (loading `observe`
+    included) is recorded, never raised, so the other runs go on."""
     start = time.perf_counter()
     cpu_start = time.process_time()
     row: dict[str, Any] = {"run_key": task["key"]}
     try:
-        observe = pickle.loads(task["observe"]) if task.get("observe") else None
-        row.update(_simulate(task, observe))
-    except Exception as failure:  # recorded, never raised: the other runs go on
+        row.update(_simulate(task, load_observe()))
+    except Exception as failure:
         row["status"] = FAILED
         row["error"] = f"{type(failure).__name__}: {failure}"
     row["wall_time_s"] = time.perf_counter() - start
@@ -536,18 +545,7 @@ def run_one(
 
 
 def _run_task_in_process(task: dict[str, Any], observe: Any) -> dict[str, Any]:
-    start = time.perf_counter()
-    cpu_start = time.process_time()
-    row: dict[str, Any] = {"run_key": task["key"]}
-    try:
-        row.update(_simulate(task, observe))
-    except Exception as failure:
-        row["status"] = FAILED
-        row["error"] = f"{type(failure).__name__}: {failure}"
-    row["wall_time_s"] = time.perf_counter() - start
-    row["cpu_time_s"] = time.process_time() - cpu_start
-    row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
-    return row
+    return _timed_row(task, lambda: observe)
 
 
 def _task(
