@@ -5,7 +5,8 @@ Every `.rs` file reached from a crate root (`lib.rs`, `main.rs`, `bin/*.rs`) thr
 declarations is a node, inline modules (`mod m { ... }`) belonging to their file. File A
 depends on file B when A's code names an item that B defines:
 - a `use` of an item (`use crate::x::Item;`, `use super::{A, B};`, `use super::*;`);
-- a path in code (`crate::x::f()`, `super::Item`, `child::f()`, `alias::f()` after `use x as alias`).
+- a path in code (`crate::x::f()`, `super::Item`, `child::f()`, `alias::f()` after `use x as alias`),
+  or in an attribute's string (`#[serde(from = "json::Shape")]`).
 A path is resolved along the module tree; a name a module imports or re-exports (`pub use`)
 is followed to the file that defines it, so a re-export is a facade, not a dependency of its
 own: a `pub use` line counts only when its module's code also uses the name. A `use` of a
@@ -25,6 +26,9 @@ import tempfile
 
 IDENT = r"[A-Za-z_][A-Za-z0-9_]*"
 ITEM_KINDS = r"fn|struct|enum|trait|type|const|static|union|macro_rules!"
+PATH = IDENT + r"(::" + IDENT + r")*"
+# Attribute arguments whose string is a path the code depends on (serde's and the like).
+ATTRIBUTE_PATH = r"\b(from|into|try_from|with|serialize_with|deserialize_with|default)\s*=\s*$"
 
 
 def strip_code(text):
@@ -64,7 +68,11 @@ def strip_code(text):
             while j < n and text[j] != '"':
                 j += 2 if text[j] == "\\" else 1
             j = min(j + 1, n)
-            out.append('""' + blank(text[i + 2 : j]))
+            content = text[i + 1 : j - 1]
+            if re.search(ATTRIBUTE_PATH, text[max(0, i - 40) : i]) and re.fullmatch(PATH, content):
+                out.append(" " + content + " ")  # a path in an attribute: code, not text
+            else:
+                out.append('""' + blank(text[i + 2 : j]))
             i = j
         elif c == "'":
             # A char literal ('a', '\n', '\u{1F}'), else a lifetime or label ('a).
@@ -365,6 +373,8 @@ class Crate:
                     if outside_uses[k] != "\n":
                         outside_uses[k] = " "
             outside_uses = "".join(outside_uses)
+            # A `mod name` declaration names a module, not an item imported under that name.
+            outside_uses = re.sub(r"\bmod\s+" + IDENT, lambda m: " " * len(m.group()), outside_uses)
             for alias, (segments, line, reexport) in module.imports.items():
                 if reexport and not re.search(r"\b" + re.escape(alias) + r"\b", outside_uses):
                     continue
@@ -476,6 +486,11 @@ FIXTURES = {
         "pub fn build() -> Shape { check(); Shape }\n",
         "validate.rs": "pub fn check() { let _ = crate::Shape; }\n",
     },
+    # A circle through a path in an attribute's string.
+    "attribute": {
+        "lib.rs": "mod json;\n#[serde(from = \"json::ShapeJson\")]\npub struct Shape;\n",
+        "json.rs": "pub struct ShapeJson;\nimpl From<ShapeJson> for super::Shape {}\n",
+    },
     # The same files with the shared piece moved one way; the back references live in
     # comments, a string and a test module only.
     "acyclic": {
@@ -500,7 +515,7 @@ FIXTURES = {
         "solver/pgs.rs": "use super::Sweep;\npub fn solve(_: Sweep) {}\n",
     },
 }
-EXPECTED = {"circle": 1, "acyclic": 0, "nested": 1, "facade": 0}
+EXPECTED = {"circle": 1, "attribute": 1, "acyclic": 0, "nested": 1, "facade": 0}
 
 
 def self_test():
