@@ -565,6 +565,23 @@ mod tests {
     use impulse::scene::builtin_scene;
     use std::path::PathBuf;
 
+    /// docs/lcp.md states the two limits of Lemke's curve as the code fixes them.
+    #[test]
+    fn docs_state_the_lemke_limits() {
+        let doc = include_str!("../../../docs/lcp.md")
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        for (name, value) in [
+            ("LEMKE_MAX_ROWS", LEMKE_MAX_ROWS),
+            ("LEMKE_REGULARISED_MAX_ROWS", LEMKE_REGULARISED_MAX_ROWS),
+        ] {
+            let stated = format!("n ≤ {value} (`{name}`");
+            assert!(doc.contains(&stated), "docs/lcp.md does not say {stated:?}");
+        }
+        assert!(doc.contains("A + 10⁻⁶·diag(A)") && LEMKE_REGULARISATION == 1e-6);
+    }
+
     fn docs() -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs")
     }
