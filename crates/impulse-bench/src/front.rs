@@ -16,11 +16,12 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use impulse::{Scene, SolverSettings};
 use serde::Serialize;
 
-use crate::{BenchRow, MachineInfo, RapierVariant, scene_by_name, thread_pool};
+use crate::threads::thread_pool;
+use crate::{BenchRow, MachineInfo, RapierVariant, scene_by_name};
 
 /// Scenes measured when none are named.
 pub const FRONT_SCENES: &[&str] = &[
@@ -762,20 +763,6 @@ pub fn plot_path(dir: &Path, scene: &str) -> PathBuf {
     dir.join(format!("front-{scene}.svg"))
 }
 
-/// Writes one plot per scene to `dir` ([`plot_path`]), creating `dir`; returns the paths.
-pub fn write_plots(fronts: &[SceneFront], dir: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    fronts
-        .iter()
-        .map(|front| {
-            let path = plot_path(dir, &front.scene);
-            crate::plot::write_front_svg(front, &path)
-                .with_context(|| format!("plotting {}", path.display()))?;
-            Ok(path)
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1049,7 +1036,7 @@ mod tests {
         assert!(!pareto_front(&front.points, IMPULSE).is_empty());
 
         let dir = std::env::temp_dir().join(format!("impulse-front-test-{}", std::process::id()));
-        let paths = write_plots(&fronts, &dir).unwrap();
+        let paths = crate::plot::write_plots(&fronts, &dir).unwrap();
         assert_eq!(paths, [dir.join("front-stack3.svg")]);
         let svg = std::fs::read_to_string(&paths[0]).unwrap();
         assert!(svg.starts_with("<svg"), "{}", &svg[..svg.len().min(200)]);

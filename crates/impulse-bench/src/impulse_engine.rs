@@ -6,8 +6,8 @@ use anyhow::{Context, Result};
 use impulse::{ContactRepair, SolverMethod};
 use impulse::{Scene, SolverSettings, World};
 
-use crate::BenchRow;
 use crate::quality::{self, Quality};
+use crate::row::BenchRow;
 
 /// Engine name in [`BenchRow::engine`].
 pub const ENGINE: &str = "impulse";
@@ -25,7 +25,7 @@ pub fn threads_engine_name(engine: &str, threads: usize) -> String {
 /// each `World::step`, and measures quality from the poses (metric time is not timed).
 /// The scene's solver settings are used as they are, except that sleeping is turned off.
 pub fn bench_impulse(scene: &Scene, steps: u32, threads: usize) -> Result<BenchRow> {
-    crate::thread_pool(threads)?.install(|| {
+    crate::threads::thread_pool(threads)?.install(|| {
         let mut run = ImpulseRun::new(scene, steps, threads, None)?;
         run.advance(steps)?;
         Ok(run.finish())
@@ -80,7 +80,7 @@ impl ImpulseRun {
         threads: usize,
         settings: Option<SolverSettings>,
     ) -> Result<Self> {
-        let pool = crate::thread_pool(threads)?;
+        let pool = crate::threads::thread_pool(threads)?;
         Self::build(scene, steps, threads, settings, Some(pool), None)
     }
 

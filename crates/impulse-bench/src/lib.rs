@@ -20,21 +20,26 @@ mod plot;
 pub mod quality;
 #[cfg(feature = "rapier")]
 mod rapier_engine;
+mod row;
+mod threads;
 
 use std::fmt::Write as _;
 
 use anyhow::{Context, Result, bail};
 use impulse::Scene;
 
+use crate::threads::thread_pool;
+
 pub use impulse_engine::{bench_impulse, settings_text as impulse_settings_text};
 pub use machine::MachineInfo;
-pub use plot::register_plot_font;
+pub use plot::{register_plot_font, write_plots};
 pub use quality::QualityReport;
 #[cfg(feature = "rapier")]
 pub use rapier_engine::{
     FRICTION_COMBINE, RESTITUTION_COMBINE, bench_rapier, bench_rapier_with,
     settings_text as rapier_settings_text,
 };
+pub use row::{BenchRow, TURN_STEPS};
 
 /// The error when Rapier is asked for in a build without the `rapier` feature (the default
 /// build compiles neither Rapier nor criterion, to keep `cargo test --workspace` quick).
@@ -54,68 +59,6 @@ pub const DEFAULT_SCENES: &[&str] = &[
 
 /// Steps per scene when not told otherwise (10 s at dt = 1/60 s).
 pub const DEFAULT_STEPS: u32 = 600;
-
-/// One engine on one scene.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BenchRow {
-    /// Scene name.
-    pub scene: String,
-    /// `"impulse"` or `"rapier"`.
-    pub engine: String,
-    /// Bodies, static ones included.
-    pub bodies: usize,
-    /// Steps taken.
-    pub steps: u32,
-    /// Median wall-clock time of one step (ms).
-    pub ms_per_step_median: f64,
-    /// Wall-clock time of each turn of [`TURN_STEPS`] steps, in order (ms): the k-th turns of
-    /// two rows of one run were taken one right after the other, so their ratio is a paired
-    /// measurement ([`paired_speed_up`]).
-    pub turn_ms: Vec<f64>,
-    /// 1000 / `ms_per_step_median`.
-    pub steps_per_second: f64,
-    /// Initial y − final y of the moving body that started highest (m).
-    pub top_sink_m: f64,
-    /// Largest penetration depth between two bodies, sampled every 10 steps and after the
-    /// last (m).
-    pub max_overlap_m: f64,
-    /// Largest distance of a moving body from its start, at the same samples (m).
-    pub max_drift_m: f64,
-    /// The engine's settings: iterations, substeps, threads, and anything else that matters.
-    pub settings: String,
-}
-
-impl BenchRow {
-    /// A row from per-step times (ms; reordered in place) and a quality report.
-    pub fn new(
-        scene: &str,
-        engine: &str,
-        bodies: usize,
-        steps: u32,
-        times_ms: &mut [f64],
-        quality: QualityReport,
-        settings: String,
-    ) -> Self {
-        let turn_ms = times_ms
-            .chunks(TURN_STEPS as usize)
-            .map(|turn| turn.iter().sum())
-            .collect();
-        let median = quality::median(times_ms);
-        Self {
-            scene: scene.to_string(),
-            engine: engine.to_string(),
-            bodies,
-            steps,
-            ms_per_step_median: median,
-            turn_ms,
-            steps_per_second: if median > 0.0 { 1e3 / median } else { 0.0 },
-            top_sink_m: quality.top_sink.into(),
-            max_overlap_m: quality.max_overlap.into(),
-            max_drift_m: quality.max_drift.into(),
-            settings,
-        }
-    }
-}
 
 /// The rows as one Markdown table, in the given order. The ratio column is impulse's median
 /// time divided by Rapier's for the same scene (< 1: impulse is faster), shown on impulse rows
@@ -352,17 +295,6 @@ impl Default for BenchConfig {
 pub fn scene_by_name(name: &str) -> Result<Scene> {
     impulse::scene::builtin_scene(name)
         .with_context(|| format!("no built-in scene named \"{name}\""))
-}
-
-/// Steps per turn when engines take turns on a scene (the metrics' sampling interval).
-pub const TURN_STEPS: u32 = quality::SAMPLE_EVERY;
-
-/// A rayon pool of `threads` threads.
-pub(crate) fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("building the rayon thread pool")
 }
 
 /// One engine's run of a scene, advanced a turn at a time.

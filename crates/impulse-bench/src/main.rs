@@ -240,7 +240,7 @@ fn run_front(args: FrontArgs) -> Result<bool> {
         }
     })?;
     let after = MachineInfo::current();
-    let plots = front::write_plots(&fronts, &args.out_dir)?;
+    let plots = impulse_bench::write_plots(&fronts, &args.out_dir)?;
     let tables = front::format_tables(&fronts, front::Plots::Path(&args.out_dir));
     println!("{tables}");
     println!("command: {command}");

@@ -5,13 +5,15 @@
 //! measures text with a registered font: [`register_plot_font`] registers DejaVu Sans, compiled
 //! in, so no font files, font-kit or fontconfig are needed to write a plot.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Result, anyhow};
+use anyhow::{Context, Result, anyhow};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::front::{BARS, FrontPoint, IMPULSE, PLOT_E_FLOOR_MM, RAPIER, SceneFront, pareto_front};
+use crate::front::{
+    BARS, FrontPoint, IMPULSE, PLOT_E_FLOOR_MM, RAPIER, SceneFront, pareto_front, plot_path,
+};
 
 /// DejaVu Sans 2.37 (Bitstream Vera licence, `crates/impulse-cli/assets/fonts/`).
 static DEJAVU_SANS: &[u8] = include_bytes!("../../impulse-cli/assets/fonts/DejaVuSans.ttf");
@@ -256,6 +258,20 @@ fn draw(front: &SceneFront, path: &Path) -> Result<(), Box<dyn std::error::Error
         .draw()?;
     root.present()?;
     Ok(())
+}
+
+/// Writes one plot per scene to `dir` ([`plot_path`]), creating `dir`; returns the paths.
+pub fn write_plots(fronts: &[SceneFront], dir: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    fronts
+        .iter()
+        .map(|front| {
+            let path = plot_path(dir, &front.scene);
+            write_front_svg(front, &path)
+                .with_context(|| format!("plotting {}", path.display()))?;
+            Ok(path)
+        })
+        .collect()
 }
 
 #[cfg(test)]

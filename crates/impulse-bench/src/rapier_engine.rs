@@ -18,8 +18,8 @@ use rapier3d::prelude::{
     PhysicsPipeline, RigidBodyBuilder, RigidBodyHandle, RigidBodySet, SoftBodySet, Vector,
 };
 
-use crate::BenchRow;
 use crate::quality::{self, Quality};
+use crate::row::BenchRow;
 
 /// Engine name in [`BenchRow::engine`].
 pub const ENGINE: &str = "rapier";

@@ -13,7 +13,7 @@ use anyhow::{Context, Result, bail};
 use impulse::{Scene, World};
 use impulse::{SolverMethod, SolverSettings};
 
-use crate::lcp_command::Series;
+use crate::residual_plot::Series;
 
 /// Residual after `k` iterations of `method` on step `step` of `scene`, for k = 1..=iterations.
 /// Each step taken advances `bar` by one.

@@ -16,6 +16,8 @@ use impulse_lcp::{
     natural_map_residual, normalised_natural_map_residual, read_lcp, residual_scale, write_json,
 };
 
+use crate::residual_plot::{Series, write_plot};
+
 /// Largest `n` for which the summary prints `z` in full.
 const PRINT_Z_UP_TO: usize = 20;
 /// Residual histories longer than this are printed as head … tail.
@@ -241,16 +243,6 @@ const POWER_ITERATIONS: usize = 100;
 /// How often Jacobi is retried with half the damping after diverging.
 const JACOBI_RETRIES: usize = 4;
 
-/// One solver's run as plotted: `(x, residual)` with x the sweep or pivot count (0 = start).
-pub(crate) struct Series {
-    pub(crate) label: String,
-    pub(crate) colour: &'static str,
-    pub(crate) dashed: bool,
-    pub(crate) points: Vec<(f64, f64)>,
-    /// Lemke's final (polished) residual, drawn as a marker at its pivot count.
-    pub(crate) marker: Option<(f64, f64)>,
-}
-
 /// Reads an LCP (`.json` or Siconos `.dat`), runs projected Gauss–Seidel, damped projected
 /// Jacobi and, when the bounds are plain `γ ≥ 0` and `n ≤` [`LEMKE_MAX_ROWS`], Lemke's method,
 /// each from `γ = 0`, and writes `out_svg` (SVG or PNG after its extension): log10 of the normalised natural-map residual
@@ -432,7 +424,7 @@ pub fn convergence(path: &Path, iterations: usize, out_svg: &Path) -> Result<()>
         "n = {n}, {} nonzeros, {bounds}; every solver starts from γ = 0",
         nonzeros(&lcp.a)
     );
-    crate::residual_plot::write_plot(
+    write_plot(
         out_svg,
         &title,
         &subtitle,
@@ -572,6 +564,23 @@ mod tests {
     use super::*;
     use impulse::scene::builtin_scene;
     use std::path::PathBuf;
+
+    /// docs/lcp.md states the two limits of Lemke's curve as the code fixes them.
+    #[test]
+    fn docs_state_the_lemke_limits() {
+        let doc = include_str!("../../../docs/lcp.md")
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        for (name, value) in [
+            ("LEMKE_MAX_ROWS", LEMKE_MAX_ROWS),
+            ("LEMKE_REGULARISED_MAX_ROWS", LEMKE_REGULARISED_MAX_ROWS),
+        ] {
+            let stated = format!("n ≤ {value} (`{name}`");
+            assert!(doc.contains(&stated), "docs/lcp.md does not say {stated:?}");
+        }
+        assert!(doc.contains("A + 10⁻⁶·diag(A)") && LEMKE_REGULARISATION == 1e-6);
+    }
 
     fn docs() -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs")

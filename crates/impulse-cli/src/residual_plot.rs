@@ -10,8 +10,17 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::lcp_command::Series;
 use crate::plot_output::{self, FONT};
+
+/// One solver's run as plotted: `(x, residual)` with x the sweep or pivot count (0 = start).
+pub(crate) struct Series {
+    pub(crate) label: String,
+    pub(crate) colour: &'static str,
+    pub(crate) dashed: bool,
+    pub(crate) points: Vec<(f64, f64)>,
+    /// Lemke's final (polished) residual, drawn as a marker at its pivot count.
+    pub(crate) marker: Option<(f64, f64)>,
+}
 
 /// Plot size (pixels).
 const SIZE: (u32, u32) = (820, 600);

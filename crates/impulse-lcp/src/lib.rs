@@ -20,6 +20,7 @@ pub mod io;
 pub mod matrix;
 pub mod merit;
 pub mod problem;
+mod problem_error;
 pub mod solvers;
 
 pub use io::json::{parse_json, read_json, to_json_string, write_json};

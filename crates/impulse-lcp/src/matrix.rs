@@ -8,7 +8,7 @@
 //! matrix–vector product — so those are the whole shared interface, implemented once on the
 //! [`Matrix`] enum (no trait: two concrete storages do not need one).
 
-use crate::problem::ProblemError;
+use crate::problem_error::ProblemError;
 
 /// Dense `rows × cols` matrix of `f64`, row-major: entry `(i, j)` is `data[i * cols + j]`.
 #[derive(Debug, Clone, PartialEq)]

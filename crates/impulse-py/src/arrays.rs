@@ -23,8 +23,7 @@ use numpy::ndarray::{ArrayView2, ShapeBuilder};
 use numpy::{PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use crate::WorldError;
-use crate::world::World;
+use crate::errors::{WorldError, guarded};
 
 // The views index f32 elements of a pose with element strides.
 const _: () = assert!(size_of::<Pose>().is_multiple_of(size_of::<f32>()));
@@ -64,18 +63,21 @@ impl Field {
 /// counts as a live view while any array derived from it exists.
 #[pyclass(module = "impulse._impulse", frozen)]
 pub(crate) struct ViewGuard {
-    _world: Py<World>,
+    _world: Py<PyAny>,
     _live: Arc<()>,
 }
 
 /// A read-only view of `field` of every body of `world`: shape (N, 3) or (N, 4), float32.
+/// `owner` is the Python object that owns `world` (kept alive by the view) and `views` its
+/// count of live views.
 pub(crate) fn view<'py>(
-    world: &Bound<'py, World>,
+    owner: &Bound<'py, PyAny>,
+    world: &impulse::World,
+    views: &Arc<()>,
     field: Field,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let py = world.py();
-    let borrowed = world.borrow();
-    let bodies = borrowed.inner.bodies();
+    let py = owner.py();
+    let bodies = world.bodies();
     let n = bodies.len();
     let float = size_of::<f32>();
     // (first element, element stride between bodies)
@@ -109,11 +111,10 @@ pub(crate) fn view<'py>(
     let guard = Bound::new(
         py,
         ViewGuard {
-            _world: world.clone().unbind(),
-            _live: borrowed.views.clone(),
+            _world: owner.clone().unbind(),
+            _live: views.clone(),
         },
     )?;
-    drop(borrowed);
     // SAFETY: the guard keeps the world (and so its body storage) alive as long as the array;
     // the storage is not reallocated while a guard lives (`World::refuse_if_viewed`).
     let view = unsafe { PyArray2::borrow_from_array(&array, guard.into_any()) };
@@ -179,8 +180,12 @@ fn shape_text(value: &Bound<'_, PyAny>) -> String {
 /// whose row equals their current value bit for bit are left alone (not woken), so a static
 /// body's zero velocity may be passed back. On an engine error the bodies already edited get
 /// their old values back and the error is raised.
-pub(crate) fn assign(world: &mut World, field: Field, value: &Bound<'_, PyAny>) -> PyResult<()> {
-    let n = world.inner.body_count();
+pub(crate) fn assign(
+    world: &mut impulse::World,
+    field: Field,
+    value: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let n = world.body_count();
     let values = rows(value, field, n)?;
     let columns = field.columns();
     let current = |w: &impulse::World, i: usize| -> Vec<f32> {
@@ -202,17 +207,17 @@ pub(crate) fn assign(world: &mut World, field: Field, value: &Bound<'_, PyAny>) 
             Field::AngularVelocities => w.set_angular_velocity(handle, Vec3::from_slice(row)),
         }
     };
-    crate::guarded(|| {
+    guarded(|| {
         let mut undo: Vec<(usize, Vec<f32>)> = Vec::new();
         for i in 0..n {
             let row = &values[i * columns..(i + 1) * columns];
-            let old = current(&world.inner, i);
+            let old = current(world, i);
             if old.iter().zip(row).all(|(a, b)| a.to_bits() == b.to_bits()) {
                 continue;
             }
-            if let Err(error) = set(&mut world.inner, i, row) {
+            if let Err(error) = set(world, i, row) {
                 for (j, old) in undo.iter().rev() {
-                    let _ = set(&mut world.inner, *j, old);
+                    let _ = set(world, *j, old);
                 }
                 return Err(WorldError::new_err(format!("{}: {error}", field.name())));
             }

@@ -9,7 +9,7 @@ use impulse::{BodyKind, ShapeDesc};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::WorldError;
+use crate::errors::WorldError;
 use crate::settings::{from_python, to_python};
 
 /// A collision shape, in the body frame (m): `Shape.ball(radius)`, `Shape.cuboid(hx, hy, hz)`
@@ -141,7 +141,7 @@ fn configure(
     shape: &Shape,
     props: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<BodyBuilder> {
-    let shared = crate::guarded(|| {
+    let shared = crate::errors::guarded(|| {
         build_shape(kind, &shape.desc).map_err(|e| WorldError::new_err(e.to_string()))
     })?;
     let mut b = impulse::BodyBuilder::new(kind, shared);

@@ -9,7 +9,7 @@ use impulse::scene::{
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
-use crate::SceneError;
+use crate::errors::SceneError;
 
 /// The scene `scene` names: a `dict` (or other mapping) of scene JSON, an `os.PathLike`, or a
 /// `str` that is a file path (ends in `.json` or exists) or else a built-in name, the rule of
@@ -27,7 +27,7 @@ pub(crate) fn resolve(scene: &Bound<'_, PyAny>) -> PyResult<(Scene, PathBuf)> {
             .call_method("dumps", (scene,), Some(&kwargs))
             .map_err(|e| SceneError::new_err(format!("the scene dict is not JSON: {e}")))?
             .extract()?;
-        let parsed = crate::guarded(|| {
+        let parsed = crate::errors::guarded(|| {
             parse_scene_str(&text, "<dict>").map_err(|e| SceneError::new_err(e.to_string()))
         })?;
         return Ok((parsed, PathBuf::new()));
@@ -61,8 +61,9 @@ pub(crate) fn resolve(scene: &Bound<'_, PyAny>) -> PyResult<(Scene, PathBuf)> {
 }
 
 fn load_file(path: &Path) -> PyResult<(Scene, PathBuf)> {
-    let scene =
-        crate::guarded(|| load_scene_file(path).map_err(|e| SceneError::new_err(e.to_string())))?;
+    let scene = crate::errors::guarded(|| {
+        load_scene_file(path).map_err(|e| SceneError::new_err(e.to_string()))
+    })?;
     let directory = path.parent().map(Path::to_path_buf).unwrap_or_default();
     Ok((scene, directory))
 }
@@ -95,7 +96,7 @@ pub(crate) fn vary(
     if variation == Variation::default() {
         return Ok(scene);
     }
-    crate::guarded(|| {
+    crate::errors::guarded(|| {
         variation
             .apply_in(&scene, directory)
             .map_err(|e| SceneError::new_err(e.to_string()))

@@ -5,7 +5,7 @@ use impulse::SolverSettings;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
-use crate::WorldError;
+use crate::errors::WorldError;
 
 /// Solver settings: the `solver` object of the scene format (docs/scene-format.md), with the
 /// same field names and units. Immutable; `replace(**fields)` makes a changed copy.

@@ -11,8 +11,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 
 use crate::arrays::{self, Field};
+use crate::errors::{SceneError, StepError, WorldError, guarded};
 use crate::settings::{Settings, to_python};
-use crate::{SceneError, StepError, WorldError, guarded};
 
 /// A body's name in a world: valid while the body lives, never naming another body afterwards
 /// (a slot index and the slot's generation). Hashable; compare with `==`.
@@ -370,12 +370,13 @@ impl World {
     /// unchanged are left alone). Raises `WorldError` for a wrong shape or non-finite values.
     #[getter]
     fn positions<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        arrays::view(slf, Field::Positions)
+        let world = slf.borrow();
+        arrays::view(slf.as_any(), &world.inner, &world.views, Field::Positions)
     }
 
     #[setter]
     fn set_positions(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        arrays::assign(self, Field::Positions, value)
+        arrays::assign(&mut self.inner, Field::Positions, value)
     }
 
     /// Orientations of the body frames, unit quaternions (x, y, z, w): read-only view, shape
@@ -383,12 +384,18 @@ impl World {
     /// a zero row raises `WorldError`).
     #[getter]
     fn orientations<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        arrays::view(slf, Field::Orientations)
+        let world = slf.borrow();
+        arrays::view(
+            slf.as_any(),
+            &world.inner,
+            &world.views,
+            Field::Orientations,
+        )
     }
 
     #[setter]
     fn set_orientations(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        arrays::assign(self, Field::Orientations, value)
+        arrays::assign(&mut self.inner, Field::Orientations, value)
     }
 
     /// Linear velocities of the centres of mass (m/s): read-only view, shape (N, 3), float32.
@@ -396,24 +403,36 @@ impl World {
     /// (zero), else `WorldError` names the body.
     #[getter]
     fn linear_velocities<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        arrays::view(slf, Field::LinearVelocities)
+        let world = slf.borrow();
+        arrays::view(
+            slf.as_any(),
+            &world.inner,
+            &world.views,
+            Field::LinearVelocities,
+        )
     }
 
     #[setter]
     fn set_linear_velocities(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        arrays::assign(self, Field::LinearVelocities, value)
+        arrays::assign(&mut self.inner, Field::LinearVelocities, value)
     }
 
     /// Angular velocities, world frame (rad/s): read-only view, shape (N, 3), float32. Assign
     /// an (N, 3) array-like to set them (ignored for particles; locked axes dropped).
     #[getter]
     fn angular_velocities<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        arrays::view(slf, Field::AngularVelocities)
+        let world = slf.borrow();
+        arrays::view(
+            slf.as_any(),
+            &world.inner,
+            &world.views,
+            Field::AngularVelocities,
+        )
     }
 
     #[setter]
     fn set_angular_velocities(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        arrays::assign(self, Field::AngularVelocities, value)
+        arrays::assign(&mut self.inner, Field::AngularVelocities, value)
     }
 
     /// The bodies' names in dense order (`""` for a body without one).

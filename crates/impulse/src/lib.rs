@@ -63,6 +63,9 @@ pub mod scene;
 extern crate self as impulse;
 #[cfg(test)]
 mod test_support;
+// The numbers the docs state that the code fixes, checked against the code.
+#[cfg(test)]
+mod doc_facts_tests;
 
 /// The vector types of the API (the version Parry uses), so a user needs no glam of their own.
 pub use glam;

@@ -452,8 +452,8 @@ impl SolverSettings {
     /// SIMD lanes. The quality error of the standard scenes falls about as 1/`substeps`²
     /// (docs/benchmarks.md, "The front"). Overlap is repaired at most at 0.5 m/s per contact:
     /// a repair velocity is partly kept by the bodies it separates and adds up along a chain of
-    /// overlapping bodies (the `overlap_pyramid` scene, 25 % overlapped, ejects bodies at up to
-    /// about eight times the cap; at 1 m/s a row of it flew apart and the pile fell).
+    /// overlapping bodies, so a larger cap throws an overlapped pile apart (the
+    /// `overlap_pyramid` scene).
     /// Everything else, the method, the sweeps, the slop and the repair cap included, as
     /// [`Self::default`], which is this step at 20 substeps.
     pub fn soft_step(substeps: u32) -> Self {

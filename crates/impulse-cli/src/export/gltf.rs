@@ -20,8 +20,8 @@ use base64::Engine as _;
 use gltf::json;
 use json::validation::{Checked::Valid, USize64};
 
+use super::animation::{Animation, PALETTE, STATIC_GREY, palette_indices};
 use super::mesh::shape_mesh;
-use super::{Animation, PALETTE, STATIC_GREY, palette_indices};
 
 /// Writes `animation` as binary glTF (`.glb`).
 pub fn write_glb(animation: &Animation, path: &Path) -> Result<()> {

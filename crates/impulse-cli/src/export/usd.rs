@@ -22,8 +22,8 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use impulse::ShapeDesc;
 
+use super::animation::{Animation, PoseSample, body_colours};
 use super::mesh::{Hull, bounds, convex_hull, cross, ground_corners, normalize, sub};
-use super::{Animation, PoseSample, body_colours};
 
 /// Writes `animation` as a USD ASCII stage.
 pub fn write_usda(animation: &Animation, path: &Path) -> Result<()> {

@@ -27,7 +27,7 @@
 //! Unknown fields are rejected, so a misspelt `"friction_idx"` is an error rather than silently
 //! ignored. Numbers round-trip exactly (shortest representation that parses back to the same f64).
 
-use super::{FileError, read_text};
+use super::file_error::{FileError, read_text};
 use crate::matrix::{CsrMatrix, DenseMatrix, Matrix};
 use crate::problem::{Bounds, Lcp};
 use serde::{Deserialize, Serialize};

@@ -4,40 +4,14 @@
 //! Every error names the file and what is wrong in it (token number or JSON field), because
 //! these files are written by hand or by other programs and the first question is always "where".
 
+mod file_error;
 pub mod json;
 pub mod siconos;
 
-use crate::problem::{Lcp, ProblemError};
-use std::path::Path;
-use thiserror::Error;
+pub use file_error::FileError;
 
-/// A file that could not be read, parsed or written. `file` is the path as given (or a label for
-/// in-memory text).
-#[derive(Debug, Error)]
-pub enum FileError {
-    // The causes are part of the message (not `#[source]`), so that a plain `to_string()` is
-    // complete and error reporters that print the chain do not repeat them.
-    #[error("{file}: {error}")]
-    Io { file: String, error: std::io::Error },
-    /// Siconos `.dat`: `token` is the 1-based number of the whitespace-separated token.
-    #[error("{file}: token {token}: {message}")]
-    Siconos {
-        file: String,
-        token: usize,
-        message: String,
-    },
-    /// Valid file, but a feature this reader does not implement (e.g. Siconos storage type 2).
-    #[error("{file}: unsupported: {message}")]
-    Unsupported { file: String, message: String },
-    /// JSON syntax or a field with the wrong type or size; `message` names the field.
-    #[error("{file}: {message}")]
-    Json { file: String, message: String },
-    /// The file parsed, but the problem it describes is invalid.
-    #[error("{file}: invalid problem: {problem}")]
-    Invalid { file: String, problem: ProblemError },
-    #[error("{file}: unknown extension; expected .dat (Siconos) or .json")]
-    UnknownFormat { file: String },
-}
+use crate::problem::Lcp;
+use std::path::Path;
 
 /// Which convention a file uses, so that callers can print results in the file's own terms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -69,11 +43,4 @@ pub fn read_lcp(path: &Path) -> Result<(Lcp, FileFormat), FileError> {
             file: path.display().to_string(),
         }),
     }
-}
-
-fn read_text(path: &Path) -> Result<String, FileError> {
-    std::fs::read_to_string(path).map_err(|error| FileError::Io {
-        file: path.display().to_string(),
-        error,
-    })
 }

@@ -18,7 +18,7 @@
 //! Sparse-block files become a [`CsrMatrix`] (zeros dropped), dense ones a [`DenseMatrix`].
 //! Storage type 2 (Siconos' general sparse) is reported as [`FileError::Unsupported`].
 
-use super::{FileError, read_text};
+use super::file_error::{FileError, read_text};
 use crate::matrix::{CsrMatrix, DenseMatrix, Matrix};
 use crate::problem::Lcp;
 use std::path::Path;

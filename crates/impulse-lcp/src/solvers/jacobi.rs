@@ -7,9 +7,8 @@
 //! ω ≲ 1/k). Too little damping shows up as [`Status::Diverged`](super::Status::Diverged).
 //! Friction bounds use the normal values of the previous iterate.
 
-use super::{
-    Solution, SolveError, SolverSettings, check_relaxation, inverse_diagonal, iterate, prepare,
-};
+use super::interface::{Solution, SolveError, SolverSettings};
+use super::iteration::{check_relaxation, inverse_diagonal, iterate, prepare};
 use crate::merit::mid;
 use crate::problem::Lcp;
 

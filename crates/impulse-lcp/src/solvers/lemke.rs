@@ -25,8 +25,9 @@
 //! ray-terminates only if the LCP is infeasible. For other matrices it may ray-terminate although
 //! solutions exist (Siconos' bimatrix game `lcp_CPS_3` is such a case).
 
+use super::interface::{Solution, SolveError, SolverSettings, Status};
+use super::iteration::prepare;
 use super::lu::Lu;
-use super::{Solution, SolveError, SolverSettings, Status, prepare};
 use crate::matrix::DenseMatrix;
 use crate::merit::{natural_map_norm, residual_scale};
 use crate::problem::{Bounds, Lcp};

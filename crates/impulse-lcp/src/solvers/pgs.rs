@@ -12,9 +12,8 @@
 //! guaranteed, though it is the usual practice in games and animation.
 //! A zero or negative `A_ii` is an error ([`SolveError::NonPositiveDiagonal`]), never skipped.
 
-use super::{
-    Solution, SolveError, SolverSettings, check_relaxation, inverse_diagonal, iterate, prepare,
-};
+use super::interface::{Solution, SolveError, SolverSettings};
+use super::iteration::{check_relaxation, inverse_diagonal, iterate, prepare};
 use crate::merit::mid;
 use crate::problem::Lcp;
 

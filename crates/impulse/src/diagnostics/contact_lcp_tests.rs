@@ -21,9 +21,9 @@ const DT: f32 = 1.0 / 60.0;
 
 /// How far the engine's f32 velocities may be from an exact (f64) solution, m/s. Speeds in the
 /// piles below stay under ~5 m/s, where one f32 rounding is ~3e-7 m/s; the solver accumulates
-/// per-body velocity deltas over hundreds of sweeps (measured gaps to Lemke's f64 solution:
-/// ≤ 1.3e-7 m/s; in looser piles ~1e-6 m/s). 1e-5 m/s leaves room for that and is still
-/// 0.2 µm per step at 60 Hz, far below anything visible.
+/// per-body velocity deltas over hundreds of sweeps, so its gap to Lemke's f64 solution is a
+/// few roundings. 1e-5 m/s leaves room for that and is still 0.2 µm per step at 60 Hz, far
+/// below anything visible.
 const VELOCITY_TOLERANCE: f64 = 1e-5;
 
 /// Lemke's f64 solution must meet the natural-map residual (normalised by ‖b‖₂) to this.
@@ -452,7 +452,7 @@ fn friction_pile_engine_is_in_the_disc_and_pyramid_pgs_converges() {
 
 /// Soft contact (`repair: soft`) without a relax solve leaves the last solve's normal
 /// rows soft, Δγ = m_eff·s·(target − v) − i·γ; the export must add their regularisation to A's
-/// diagonal, or the engine's impulses do not solve it (measured residual ~1e-2 without).
+/// diagonal, or the engine's impulses do not solve it.
 #[test]
 fn soft_rows_are_exported_with_their_regularisation() {
     let mut world = pile(false);

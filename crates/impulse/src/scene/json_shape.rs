@@ -1,8 +1,10 @@
 //! The JSON form of [`ShapeDesc`]: one object per shape with a `"type"`, where a rounded
 //! shape is its inner shape's object with a `"border_radius"` (`docs/scene-format.md`).
-//! [`ShapeDesc`] is read and written through [`ShapeJson`].
+//! [`ShapeDesc`] is read and written through [`ShapeJson`], as serde's `from` and `into`
+//! container attributes would do it, written out here so that the description does not
+//! depend on its JSON form.
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::{CompoundPart, ShapeDesc};
 
@@ -228,5 +230,17 @@ impl From<ShapeDesc> for ShapeJson {
                 other => other,
             },
         }
+    }
+}
+
+impl Serialize for ShapeDesc {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        ShapeJson::from(self.clone()).serialize(serializer)
+    }
+}
+
+impl<'de> Deserialize<'de> for ShapeDesc {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        ShapeJson::deserialize(deserializer).map(ShapeDesc::from)
     }
 }

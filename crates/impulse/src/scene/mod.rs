@@ -62,9 +62,9 @@ impl Default for Material {
 /// Collision shape of a body, in the body's local frame (centred on its origin).
 ///
 /// In JSON each shape is an object with a `"type"` (`docs/scene-format.md`); a rounded
-/// shape is its inner shape's object with a `"border_radius"`, read into [`ShapeDesc::Round`].
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(from = "json_shape::ShapeJson", into = "json_shape::ShapeJson")]
+/// shape is its inner shape's object with a `"border_radius"`, read into [`ShapeDesc::Round`]
+/// (its `Serialize` and `Deserialize` go through that JSON form, in `json_shape.rs`).
+#[derive(Clone, Debug, PartialEq)]
 pub enum ShapeDesc {
     /// A sphere.
     Sphere {
@@ -426,6 +426,7 @@ impl BodyDesc {
 }
 
 mod builtin;
+mod degeneracy;
 mod error;
 pub(crate) mod json;
 mod json_shape;
@@ -446,6 +447,5 @@ pub use json::{
 pub use mesh_file::{
     LoadedMesh, MeshData, MeshFileError, MeshFormat, load_mesh_file, read_mesh_bytes,
 };
-pub use shape::build_shape;
-pub use validate::{validate, validate_all};
+pub use validate::{build_shape, validate, validate_all};
 pub use variation::{Jitter, ORIGIN_PREFIX, Override, Variation};

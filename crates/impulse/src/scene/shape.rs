@@ -4,30 +4,13 @@ use glam::{Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
-use super::error::{FieldPath, SceneError, SceneErrorKind};
-use super::{BodyKind, ShapeDesc};
+use super::ShapeDesc;
+use super::degeneracy::mesh_problem;
+use super::error::FieldPath;
+use super::mesh_file::MeshData;
+use crate::body::rules;
 
-/// The Parry shape of `shape` for a body of `kind`, after the checks of
-/// [`validate`](super::validate::validate) for that shape. A triangle mesh whose file was
-/// not read with its scene ([`super::load_scene_file`]) is read here, relative to the
-/// current directory. The same shapes `World::from_scene` builds (the Rapier comparison
-/// uses it too).
-///
-/// # Errors
-/// A [`SceneError`] of kind [`SceneErrorKind::Invalid`] whose field is the path from the
-/// body (`shape.parts[1].shape.radius`): an invalid value, an unreadable or degenerate mesh
-/// file, a hull Parry cannot build.
-pub fn build_shape(kind: BodyKind, shape: &ShapeDesc) -> Result<SharedShape, SceneError> {
-    let error = |(field, message): (String, String)| {
-        SceneError::new(SceneErrorKind::Invalid, FieldPath::parse(&field), message)
-    };
-    if let Some(problem) = super::validate::shape_problem(kind, shape) {
-        return Err(error(problem));
-    }
-    shape_of(shape).map_err(error)
-}
-
-/// The Parry shape of `shape`, which [`super::validate::shape_problem`] found valid.
+/// The Parry shape of `shape`, which `validate::shape_problem` found valid.
 /// A triangle mesh whose file was not read with the scene is read here, relative to the
 /// current directory.
 ///
@@ -106,8 +89,7 @@ pub(crate) fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String
                         two_sided: *two_sided,
                         loaded: Some(super::LoadedMesh(std::sync::Arc::new(mesh.clone()))),
                     };
-                    if let Some(problem) = super::validate::shape_problem(BodyKind::Static, &loaded)
-                    {
+                    if let Some(problem) = loaded_mesh_problem(&loaded, &mesh) {
                         return Err(problem);
                     }
                     mesh
@@ -160,4 +142,19 @@ pub(crate) fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String
             SharedShape::compound(built)
         }
     })
+}
+
+/// The first problem of a triangle mesh read from its file (`loaded` holds `mesh`), as
+/// (field path from the body, message): the checks validation makes of a trimesh on a static
+/// body, its data and then the extent of the shape built from it.
+fn loaded_mesh_problem(loaded: &ShapeDesc, mesh: &MeshData) -> Option<(String, String)> {
+    if let Some(problem) = mesh_problem(mesh) {
+        let field = FieldPath::root().key("shape").key("file");
+        return Some((field.to_string(), problem.message().to_string()));
+    }
+    let built = shape_of(loaded).ok()?;
+    let field = FieldPath::root().key("shape");
+    rules::shape_extent(&built)
+        .err()
+        .map(|message| (field.to_string(), message))
 }
