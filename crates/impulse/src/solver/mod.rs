@@ -11,7 +11,7 @@
 //! - [`nncg`]: nonsmooth nonlinear conjugate gradient (PGS sweeps with momentum);
 //! - [`apgd`]: accelerated projected gradient descent;
 //! - [`exact`]: Lemke's pivoting on an island's assembled LCP;
-//! - [`wide`]: PGS in SIMD lanes on packed manifold groups;
+//! - [`lanes`]: PGS in SIMD lanes on packed manifold groups;
 //! - [`policy`]: `method: auto`, the escalation from NNCG to more iterations or the exact path;
 //! - [`position`]: split impulse's position solve;
 //! - [`impact`]: `impact: propagation`, simultaneous impacts by generalized reflections;
@@ -28,12 +28,12 @@ use crate::settings::SolverSettings;
 pub mod apgd;
 pub mod exact;
 pub mod impact;
+pub mod lanes;
 pub mod nncg;
 pub mod pgs;
 pub mod policy;
 pub mod position;
 pub mod substep;
-pub mod wide;
 
 pub use pgs::Sweep;
 pub use policy::EscalationLevel;
@@ -46,7 +46,7 @@ pub use substep::{HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, IslandReport};
 /// then [`finish`](ContactSolver::finish) once.
 ///
 /// The rows live in the island's `constraints`: a method that solves a copy of them in another
-/// layout (the SIMD lanes of [`wide`]) makes it in `prepare` and writes the impulses back in
+/// layout (the SIMD lanes of [`lanes`]) makes it in `prepare` and writes the impulses back in
 /// `finish`; the scalar methods work on the constraints themselves.
 pub trait ContactSolver {
     /// Readies the step's solves on the island's `constraints`, whose body slots are below
@@ -245,7 +245,7 @@ pub struct Velocities<'a> {
 
 /// What the record of an island's rows found as its step ended
 /// ([`crate::diagnostics::record_velocity_before_and_residual`], or the SIMD lanes'
-/// [`wide::Bundles::record`]).
+/// [`lanes::Bundles::record`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct RowsReport {
     /// Natural-map residual of the rows ([`crate::StepDiagnostics::natural_map_residual`]).

@@ -11,10 +11,10 @@ use glam::{Mat3, Quat, Vec3};
 use parry3d::math::Pose;
 
 use super::apgd::Apgd;
+use super::lanes::Bundles;
 use super::nncg::Nncg;
 use super::pgs::{Pgs, Sweep, colour_constraints};
 use super::policy::{Auto, EscalationLevel, EscalationLimits};
-use super::wide::Bundles;
 use super::{
     ContactSolver, RowsReport, SolveOutcome, SolvePass, TargetInputs, Velocities, position,
 };
@@ -551,11 +551,11 @@ pub fn step_island(
     let moving = island_bodies.len();
     let integrated = slots - 1;
     // With no restitution solve to follow, the lanes record the rows' J·v* and residual
-    // while the bundles are in cache (`wide::Bundles::record`); `rows` then holds them.
+    // while the bundles are in cache (`lanes::Bundles::record`); `rows` then holds them.
     let record_in_lanes = bundled && !restitution;
     for substep in 0..settings.substeps {
         // Every other substep, PGS takes each manifold's points from halfway round (see
-        // `wide::sweep_groups`), so that no corner of a face always goes first. Split
+        // `lanes::schedule`), so that no corner of a face always goes first. Split
         // impulse keeps one order: its rigid rows are solved to the tolerance, where the order
         // matters little, and its results are compared with exact solutions.
         let half_turn = substep % 2 == 1 && !settings.split_impulse();
@@ -600,7 +600,7 @@ pub fn step_island(
             );
         }
         // The lanes' record takes v* = v − M⁻¹Jᵀγ, γ the final impulses: the velocities
-        // here, before the last substep applies its impulses (see `wide::Bundles::record`).
+        // here, before the last substep applies its impulses (see `lanes::Bundles::record`).
         if record_in_lanes && substep + 1 == settings.substeps {
             w.solvers.wide.keep_velocities_before(&w.linear, &w.angular);
         }

@@ -1,6 +1,6 @@
-//! The SIMD-lane solver (`crate::solver::wide`): the same LCP conditions as the scalar sweep, exact
-//! momentum with padding lanes, Coulomb's law for a sliding box, and the `fast` preset standing
-//! on a standard scene.
+//! The SIMD-lane solver ([`crate::solver::lanes`]) on whole scenes: the same LCP conditions as
+//! the scalar sweep, exact momentum with padding lanes, Coulomb's law for a sliding box, and
+//! the `fast` preset standing on a standard scene.
 
 use crate::test_support as common;
 
