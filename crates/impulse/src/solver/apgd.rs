@@ -16,7 +16,7 @@ use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
     apply_impulses, cap_to_disc, impulses, solve_scalar,
 };
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 
 /// APGD as a [`ContactSolver`], with its work vectors.
 #[derive(Default)]

@@ -9,7 +9,7 @@
 //! folded into the rows, like the island's immovable slot), so a solver can be run on them
 //! from any starting impulses.
 
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::diagnostics::contact_lcp::assemble_lcp;
 use crate::settings::ContactRepair;
 use crate::solver::apgd::{ApgdWorkspace, solve_apgd};
@@ -666,7 +666,7 @@ fn apgd_reaches_a_tight_residual_within_32_iterations() {
 fn apgd_residual_is_zero_exactly_at_solutions() {
     let c = ContactConstraint {
         friction: 0.5,
-        normal: crate::contact::constraints::JacobianRow {
+        normal: crate::contact::JacobianRow {
             inverse_effective_mass: 1.0,
             ..Default::default()
         },

@@ -39,7 +39,7 @@ use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
     apply_impulses, project_to_friction_disc, set_scalar_targets,
 };
-use crate::contact::constraints::{ContactConstraint, JacobianRow, is_isotropic};
+use crate::contact::{ContactConstraint, JacobianRow, is_isotropic};
 
 /// The exact path as a [`ContactSolver`]: [`solve_exact`] on islands of at most `max_contacts`
 /// points. A failed solve leaves the rows and velocities as they were and says so in

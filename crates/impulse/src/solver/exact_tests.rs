@@ -12,7 +12,7 @@ use crate::test_support as common;
 use common::material;
 use std::time::Instant;
 
-use crate::contact::constraints::{ContactConstraint, JacobianRow};
+use crate::contact::{ContactConstraint, JacobianRow};
 use crate::settings::ContactRepair;
 use crate::settings::SolverMethod;
 use crate::solver::Velocities;

@@ -47,7 +47,7 @@ use glam::Vec3;
 
 use super::{Velocities, apply_impulses, cap_to_disc};
 use crate::body::Bodies;
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::settings::{ImpactModel, SolverSettings};
 
 /// Rounds of reflections per island and step before the remaining ones are made plastic:

@@ -20,8 +20,8 @@
 
 use glam::{Mat3, Vec3};
 
-pub use crate::contact::constraints::cap_to_disc;
-use crate::contact::constraints::{self, ContactConstraint};
+pub use crate::contact::cap_to_disc;
+use crate::contact::{self, ContactConstraint};
 use crate::parallel::{RESIDUAL_ROWS_PER_TASK, SharedItems, SharedVelocities, parts_in_order};
 use crate::settings::SolverSettings;
 
@@ -79,7 +79,7 @@ pub trait ContactSolver {
     }
 
     /// One solve: with `pass.targets`, first sets every row's target velocity and softness from
-    /// the separation its point has reached (scalar rows: [`constraints::update_targets`]);
+    /// the separation its point has reached (scalar rows: [`contact::update_targets`]);
     /// then at most `pass.iterations` iterations, until no row's velocity changes by more than
     /// `pass.tolerance` (m/s).
     fn solve(
@@ -133,8 +133,8 @@ pub struct TargetInputs<'a> {
     /// Per slot, rotation vector (rad).
     pub rotation: &'a [Vec3],
     /// Per slot, the square of the angle (rad²) turned since the step began, as the substep
-    /// started: stale speculative rows ([`constraints::speculative_row_is_stale`]). Empty when
-    /// no body has turned past [`constraints::SPECULATIVE_TURN`]: no row is stale.
+    /// started: stale speculative rows ([`contact::speculative_row_is_stale`]). Empty when
+    /// no body has turned past [`contact::SPECULATIVE_TURN`]: no row is stale.
     pub turn: &'a [f32],
     /// Soft contact, repair rate, slop and the repair's speed cap.
     pub settings: &'a SolverSettings,
@@ -220,7 +220,7 @@ pub(crate) fn set_scalar_targets(
     pass: &SolvePass<'_>,
 ) -> bool {
     match pass.targets {
-        Some(t) => constraints::update_targets(
+        Some(t) => contact::update_targets(
             constraints,
             t.displacement,
             t.rotation,

@@ -5,7 +5,7 @@ use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
     apply_impulses, impulses, solve_scalar,
 };
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::graph::COLOURS;
 use crate::parallel::{
     NORM_POINTS_PER_TASK, SWEEP_POINTS_PER_TASK, SharedVelocities, parts_in_order, spread,

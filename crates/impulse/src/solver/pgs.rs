@@ -11,7 +11,7 @@ use super::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
     project_to_friction_disc, solve_scalar,
 };
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours};
 use crate::parallel::{
     SWEEP_POINTS_PER_TASK, SharedVelocities, colour_after_colour, prefetch_lines, spread,

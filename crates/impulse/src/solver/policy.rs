@@ -4,7 +4,7 @@
 use super::exact::Exact;
 use super::nncg::Nncg;
 use super::{ContactSolver, SolveOutcome, SolvePass, SolveReport, Velocities};
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::settings::SolverSettings;
 
 /// The methods of the automatic policy, weakest first.

@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::Velocities;
 use super::pgs::{FORWARD, PointUpdate, Sweep, sweep_points};
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 
 /// The position row of a point ([`solve_position_point`]).
 #[derive(Clone, Copy)]

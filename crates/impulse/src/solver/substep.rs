@@ -19,7 +19,7 @@ use super::{
     ContactSolver, RowsReport, SolveOutcome, SolvePass, TargetInputs, Velocities, position,
 };
 use crate::body::{Bodies, BodyKind, LockedAxes};
-use crate::contact::constraints::{self, ContactConstraint};
+use crate::contact::{self, ContactConstraint};
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
 use crate::settings::{ContactRepair, ImpactModel, SolverMethod, SolverSettings};
@@ -111,7 +111,7 @@ pub struct IslandWorkspace {
     pub rotation: Vec<Vec3>,
     /// Per slot, the square of the angle (rad²) turned since the start of the step, as the
     /// current substep started: which speculative rows are stale
-    /// ([`constraints::speculative_row_is_stale`]).
+    /// ([`contact::speculative_row_is_stale`]).
     turn: Vec<f32>,
     /// Orientations, integrated substep by substep.
     pub orientation: Vec<Quat>,
@@ -140,7 +140,7 @@ pub struct IslandWorkspace {
     used_colours: Vec<u64>,
     colours: Vec<u8>,
     colour_scratch: Vec<ContactConstraint>,
-    /// Per part of rows, per slot: M⁻¹Jᵀγ of [`constraints::record_velocity_before`].
+    /// Per part of rows, per slot: M⁻¹Jᵀγ of [`contact::record_velocity_before`].
     pub(crate) record_scratch: Vec<(Vec3, Vec3)>,
     /// The rows' record as the step ended when the SIMD lanes took it (the rows' J·v* are
     /// then in the constraints); `None` leaves it to
@@ -618,7 +618,7 @@ pub fn step_island(
         // while no body of the island has turned past the limit (every ordinary step), so
         // that the target updates skip the test.
         w.turn.clear();
-        let limit = constraints::SPECULATIVE_TURN * constraints::SPECULATIVE_TURN;
+        let limit = contact::SPECULATIVE_TURN * contact::SPECULATIVE_TURN;
         if w.rotation.iter().any(|r| r.length_squared() > limit) {
             w.turn
                 .extend(w.rotation.iter().map(|rotation| rotation.length_squared()));
@@ -633,7 +633,7 @@ pub fn step_island(
             half_turn,
         );
         // With no row to repair beyond the tolerance, positions move with the velocities alone
-        // (at rest, the usual case in a pile; see `constraints::update_targets`).
+        // (at rest, the usual case in a pile; see `contact::update_targets`).
         let split = settings.split_impulse() && w.position_repair;
         if split {
             // Positions move with v + the pseudo-velocity of the repair solve.
@@ -733,10 +733,10 @@ pub fn step_island(
         use rayon::prelude::*;
         constraints
             .par_chunks_mut(RESTITUTION_POINTS_PER_TASK)
-            .map(|part| constraints::restitution_targets(part, threshold))
+            .map(|part| contact::restitution_targets(part, threshold))
             .reduce(|| false, |x, y| x || y)
     } else {
-        constraints::restitution_targets(constraints, threshold)
+        contact::restitution_targets(constraints, threshold)
     };
     if bounces {
         let pass = SolvePass {

@@ -95,7 +95,7 @@ pub(super) fn set_vec(lanes: &mut LaneVec, i: usize, value: Vec3) {
     set(&mut lanes[2], i, value.z);
 }
 
-/// [`crate::contact::constraints::cap_to_disc`] per lane: the radial projection of a friction
+/// [`crate::contact::cap_to_disc`] per lane: the radial projection of a friction
 /// impulse onto Coulomb's disc of radius `limit` (N·s), with the scalar function's operations
 /// in the same order, so each lane gets the scalar result to the bit.
 #[inline(always)]

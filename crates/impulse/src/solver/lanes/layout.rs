@@ -7,7 +7,7 @@ use glam::Vec3;
 use super::lane::{
     LANES, Lane, LaneVec, add_scaled, add_scaled_per_axis, dot, lane_vec, set, set_vec, sub, unlane,
 };
-use crate::contact::constraints::{ContactConstraint, JacobianRow};
+use crate::contact::{ContactConstraint, JacobianRow};
 use crate::parallel::SharedVelocities;
 
 /// One Jacobian row (see [`JacobianRow`]) for the points of a bundle; its direction is the

@@ -8,7 +8,7 @@ use super::bundles::Bundles;
 use super::lane::{LANES, Lane, set, set_vec};
 use super::layout::{Bundle, BundleGeometry, GROUP_POINTS, Group, PointKey, set_lane};
 use super::products::compute_products;
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours};
 use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{PARALLEL_PACK_POINTS, SharedItems, spread, threads};

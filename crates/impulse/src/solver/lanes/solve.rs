@@ -8,7 +8,7 @@ use super::bundles::Bundles;
 use super::schedule::SweepOrder;
 use super::sweep::{VelocityRows, WarmStart};
 use super::targets::{NoTargets, Targets, Turned};
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::parallel::SharedItems;
 use crate::solver::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
@@ -16,7 +16,7 @@ use crate::solver::{
 
 impl Bundles {
     /// Sets every point's target normal velocity and softness from `targets` (as
-    /// [`crate::contact::constraints::update_targets`] does for rigid or soft rows, not split impulse),
+    /// [`crate::contact::update_targets`] does for rigid or soft rows, not split impulse),
     /// then runs at most `iterations` sweeps, alternating forward and backward, until no row's
     /// velocity changes by more than `tolerance` (m/s).
     ///

@@ -6,7 +6,7 @@ use glam::Vec3;
 
 use super::lane::{LANES, Lane, add_cross, dot, sub};
 use super::layout::{BodyLanes, Bundle, BundleGeometry, Group};
-use crate::contact::constraints::{SPECULATIVE_TURN, STALE_TARGET, repair_terms};
+use crate::contact::{SPECULATIVE_TURN, STALE_TARGET, repair_terms};
 use crate::solver::TargetInputs;
 
 /// Whether a sweep sets the targets of each lane group before solving it: `&Targets` does,
@@ -101,8 +101,8 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
     /// Sets bundle `index`'s targets from the separation its points have reached: a gap is
     /// closed in one substep, an overlap deeper than the slop is repaired at the repair rate
     /// (main solve only), with the soft contact's mass and impulse scales. A stale gap
-    /// ([`crate::contact::constraints::speculative_row_is_stale`]) gets
-    /// [`STALE_TARGET`], as in [`crate::contact::constraints::update_targets`].
+    /// ([`crate::contact::speculative_row_is_stale`]) gets
+    /// [`STALE_TARGET`], as in [`crate::contact::update_targets`].
     #[inline(always)]
     fn set(
         &self,

@@ -5,7 +5,7 @@ use super::bundles::Bundles;
 use super::lane::*;
 use super::layout::*;
 use super::sweep::*;
-use crate::contact::constraints::{ContactConstraint, JacobianRow};
+use crate::contact::{ContactConstraint, JacobianRow};
 use crate::graph::COLOURS;
 use crate::solver::{SolvePass, Sweep, Velocities};
 use glam::{Mat3, Vec3};
@@ -140,7 +140,7 @@ proptest! {
             }
         }
         let mut complete = pending.clone();
-        crate::contact::constraints::complete_products(&mut complete, &inertia);
+        crate::contact::complete_products(&mut complete, &inertia);
         prop_assert!(complete.iter().all(|c| !c.products_pending));
         let mut from_lanes = Bundles::default();
         from_lanes.pack(&pending, slots, &inertia, false);
