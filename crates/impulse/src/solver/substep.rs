@@ -372,193 +372,340 @@ pub fn step_island(
     context: &StepContext<'_>,
     workspace: &mut IslandWorkspace,
 ) {
-    let StepContext {
-        bodies,
-        gravity,
-        dt,
-        settings,
-        parallel,
-        restitution,
-        world_inverse_inertia,
-        forces,
-    } = *context;
-    let slots = island_bodies.len() + guests.len() + 1;
     let w = workspace;
-    w.linear.clear();
-    w.angular.clear();
-    w.orientation.clear();
-    for &i in island_bodies.iter().chain(guests) {
-        w.linear.push(bodies.linear_velocity[i as usize]);
-        w.angular.push(bodies.angular_velocity[i as usize]);
-        w.orientation.push(bodies.pose[i as usize].rotation);
+    // The substep length of the step's settings, also on the heavy-on-light path.
+    let h = context.dt / context.settings.substeps as f32;
+    w.gather(island_bodies, guests, context);
+    w.step_constants(island_bodies, context, h);
+    w.start_report(island_bodies, constraints, context.bodies);
+    let heavy = w.heavy_on_light_path(island_bodies, constraints, context);
+    let settings = heavy.as_ref().unwrap_or(context.settings);
+    w.start_solves(constraints, settings, context);
+    let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
+    for substep in 0..settings.substeps {
+        w.substep(constraints, settings, context.gravity, &plan, substep);
     }
-    w.linear.push(Vec3::ZERO);
-    w.angular.push(Vec3::ZERO);
-    // The bodies' accelerations from applied forces and torques, constant over the step.
-    w.acceleration.clear();
-    if forces {
-        w.acceleration.extend(island_bodies.iter().map(|&i| {
-            let i = i as usize;
-            (
-                bodies.force[i] * bodies.effective_inverse_mass(i),
-                bodies.world_inverse_inertia(i) * bodies.torque[i],
-            )
-        }));
-    }
-    // The gyroscopic term's tensors; kept only when some body of the island has one, so
-    // islands of balls, cubes and particles skip the pass.
-    w.inertia.clear();
-    w.rotation_locks.clear();
-    if settings.gyroscopic {
-        w.inertia.extend(island_bodies.iter().map(|&i| {
-            let i = i as usize;
-            // A body with a locked rotation axis takes the constrained step below, or none: with
-            // two or three axes locked, ω lies along the free axis (or is zero), so ω × I_w·ω is
-            // normal to it and has no free component.
-            if bodies.kind[i] == BodyKind::Dynamic && !bodies.locked_axes[i].locks_rotation() {
-                integrate::gyroscopic_inertia(&bodies.local_inverse_inertia[i])
-            } else {
-                Mat3::ZERO
-            }
-        }));
-        if w.inertia.iter().all(|t| *t == Mat3::ZERO) {
-            w.inertia.clear();
+    w.finish_solves(constraints, settings, &plan);
+    w.restitution(island_bodies, guests, constraints, settings, context, &plan);
+}
+
+/// How an island's solves run in a step, decided before its substeps.
+struct SolvePlan {
+    /// Substep length (s).
+    h: f32,
+    /// The island's body slots: its bodies, its guests, the immovable slot.
+    slots: usize,
+    /// The island's own bodies, the slots gravity, forces and damping act on.
+    moving: usize,
+    /// Whether the substeps' solves run in SIMD lanes.
+    bundled: bool,
+    /// Whether the island's passes over all its points or bodies go on rayon's threads too.
+    spread: bool,
+    /// Whether the lanes record the rows' J·v* and residual as the step ends.
+    record_in_lanes: bool,
+}
+
+impl IslandWorkspace {
+    /// The island's velocities and orientations, its guests' after its bodies', then the
+    /// immovable slot's zero velocity.
+    fn gather(&mut self, island_bodies: &[u32], guests: &[u32], context: &StepContext<'_>) {
+        let bodies = context.bodies;
+        let w = self;
+        w.linear.clear();
+        w.angular.clear();
+        w.orientation.clear();
+        for &i in island_bodies.iter().chain(guests) {
+            w.linear.push(bodies.linear_velocity[i as usize]);
+            w.angular.push(bodies.angular_velocity[i as usize]);
+            w.orientation.push(bodies.pose[i as usize].rotation);
         }
-        w.rotation_locks
-            .extend(island_bodies.iter().enumerate().filter_map(|(k, &i)| {
+        w.linear.push(Vec3::ZERO);
+        w.angular.push(Vec3::ZERO);
+    }
+
+    /// What stays constant over the step's substeps of `h` seconds: the bodies' accelerations
+    /// from applied forces, the gyroscopic term's tensors, damping factors and translation
+    /// locks; and zero displacements and rotations.
+    fn step_constants(&mut self, island_bodies: &[u32], context: &StepContext<'_>, h: f32) {
+        let StepContext {
+            bodies,
+            settings,
+            forces,
+            ..
+        } = *context;
+        let slots = self.linear.len();
+        let w = self;
+        // The bodies' accelerations from applied forces and torques, constant over the step.
+        w.acceleration.clear();
+        if forces {
+            w.acceleration.extend(island_bodies.iter().map(|&i| {
                 let i = i as usize;
-                let rotations = bodies.locked_axes[i].bits() & LockedAxes::ALL_ROTATIONS.bits();
-                if bodies.kind[i] != BodyKind::Dynamic || rotations.count_ones() != 1 {
-                    return None;
-                }
-                // Rotation bits are 3–5 (x, y, z).
-                let locked = rotations.trailing_zeros() as u8 - 3;
-                let tensor = integrate::gyroscopic_inertia(&bodies.local_inverse_inertia[i]);
-                (tensor != Mat3::ZERO).then_some((k as u32, locked, tensor))
+                (
+                    bodies.force[i] * bodies.effective_inverse_mass(i),
+                    bodies.world_inverse_inertia(i) * bodies.torque[i],
+                )
             }));
+        }
+        // The gyroscopic term's tensors; kept only when some body of the island has one, so
+        // islands of balls, cubes and particles skip the pass.
+        w.inertia.clear();
+        w.rotation_locks.clear();
+        if settings.gyroscopic {
+            w.inertia.extend(island_bodies.iter().map(|&i| {
+                let i = i as usize;
+                // A body with a locked rotation axis takes the constrained step below, or none:
+                // with two or three axes locked, ω lies along the free axis (or is zero), so
+                // ω × I_w·ω is normal to it and has no free component.
+                if bodies.kind[i] == BodyKind::Dynamic && !bodies.locked_axes[i].locks_rotation() {
+                    integrate::gyroscopic_inertia(&bodies.local_inverse_inertia[i])
+                } else {
+                    Mat3::ZERO
+                }
+            }));
+            if w.inertia.iter().all(|t| *t == Mat3::ZERO) {
+                w.inertia.clear();
+            }
+            w.rotation_locks
+                .extend(island_bodies.iter().enumerate().filter_map(|(k, &i)| {
+                    let i = i as usize;
+                    let rotations = bodies.locked_axes[i].bits() & LockedAxes::ALL_ROTATIONS.bits();
+                    if bodies.kind[i] != BodyKind::Dynamic || rotations.count_ones() != 1 {
+                        return None;
+                    }
+                    // Rotation bits are 3–5 (x, y, z).
+                    let locked = rotations.trailing_zeros() as u8 - 3;
+                    let tensor = integrate::gyroscopic_inertia(&bodies.local_inverse_inertia[i]);
+                    (tensor != Mat3::ZERO).then_some((k as u32, locked, tensor))
+                }));
+        }
+        w.damping.clear();
+        if island_bodies.iter().any(|&i| {
+            bodies.linear_damping[i as usize] > 0.0 || bodies.angular_damping[i as usize] > 0.0
+        }) {
+            w.damping.extend(island_bodies.iter().map(|&i| {
+                let i = i as usize;
+                (
+                    1.0 / (1.0 + h * bodies.linear_damping[i]),
+                    1.0 / (1.0 + h * bodies.angular_damping[i]),
+                )
+            }));
+        }
+        w.translation_locks.clear();
+        w.translation_locks
+            .extend(island_bodies.iter().enumerate().filter_map(|(k, &i)| {
+                let locked = bodies.locked_axes[i as usize];
+                locked
+                    .locks_translation()
+                    .then(|| (k as u32, locked.translation_factor()))
+            }));
+        w.displacement.clear();
+        w.displacement.resize(slots, Vec3::ZERO);
+        w.rotation.clear();
+        w.rotation.resize(slots, Vec3::ZERO);
     }
-    let h = dt / settings.substeps as f32;
-    w.damping.clear();
-    if island_bodies.iter().any(|&i| {
-        bodies.linear_damping[i as usize] > 0.0 || bodies.angular_damping[i as usize] > 0.0
-    }) {
-        w.damping.extend(island_bodies.iter().map(|&i| {
-            let i = i as usize;
-            (
-                1.0 / (1.0 + h * bodies.linear_damping[i]),
-                1.0 / (1.0 + h * bodies.angular_damping[i]),
-            )
-        }));
+
+    /// The island's report, before any solve.
+    fn start_report(
+        &mut self,
+        island_bodies: &[u32],
+        constraints: &[ContactConstraint],
+        bodies: &Bodies,
+    ) {
+        self.report = IslandReport {
+            first_body: island_bodies.iter().copied().min().unwrap_or(0),
+            bodies: island_bodies.len() as u32,
+            contacts: constraints.len() as u32,
+            mass_ratio: mass_ratio(island_bodies, bodies),
+            ..IslandReport::default()
+        };
     }
-    w.translation_locks.clear();
-    w.translation_locks
-        .extend(island_bodies.iter().enumerate().filter_map(|(k, &i)| {
-            let locked = bodies.locked_axes[i as usize];
-            locked
-                .locks_translation()
-                .then(|| (k as u32, locked.translation_factor()))
-        }));
-    w.displacement.clear();
-    w.displacement.resize(slots, Vec3::ZERO);
-    w.rotation.clear();
-    w.rotation.resize(slots, Vec3::ZERO);
-    w.report = IslandReport {
-        first_body: island_bodies.iter().copied().min().unwrap_or(0),
-        bodies: island_bodies.len() as u32,
-        contacts: constraints.len() as u32,
-        mass_ratio: mass_ratio(island_bodies, bodies),
-        ..IslandReport::default()
-    };
-    // Heavy on light: one exact LCP a step on rigid rows, when the island is small enough.
-    let threshold = settings.heavy_on_light_mass_ratio;
-    let heavy_settings;
-    let settings =
-        if threshold > 0.0 && w.report.mass_ratio > threshold && !settings.split_impulse() {
-            w.report.heavy_on_light = heavy_on_light(island_bodies, constraints, bodies, threshold)
-                .map(|mut heavy| {
+
+    /// Heavy on light: one exact LCP a step on rigid rows, when the island is small enough.
+    /// Reports the heavy-on-light contact, and returns the path's settings
+    /// ([`heavy_on_light_settings`]) when the island takes it.
+    fn heavy_on_light_path(
+        &mut self,
+        island_bodies: &[u32],
+        constraints: &[ContactConstraint],
+        context: &StepContext<'_>,
+    ) -> Option<SolverSettings> {
+        let settings = context.settings;
+        let threshold = settings.heavy_on_light_mass_ratio;
+        if !(threshold > 0.0 && self.report.mass_ratio > threshold && !settings.split_impulse()) {
+            return None;
+        }
+        self.report.heavy_on_light =
+            heavy_on_light(island_bodies, constraints, context.bodies, threshold).map(
+                |mut heavy| {
                     heavy.exact = constraints.len() <= settings.exact_max_contacts as usize;
                     heavy
-                });
-            match w.report.heavy_on_light {
-                Some(HeavyOnLight { exact: true, .. }) => {
-                    heavy_settings = heavy_on_light_settings(settings);
-                    &heavy_settings
-                }
-                _ => settings,
-            }
-        } else {
-            settings
-        };
-    if settings.substeps != context.settings.substeps {
-        // The heavy-on-light path starts cold: the carried impulses are the soft step's, per
-        // substep of another length, and the exact solve needs no starting guess. Warm
-        // started with them, a 10,000:1 cube dropped onto a stack of four or five light cubes
-        // can hover on its speculative contact and then bring the stack down.
-        for c in constraints.iter_mut() {
-            c.normal_impulse = 0.0;
-            c.tangent_impulses = [0.0; 2];
+                },
+            );
+        match self.report.heavy_on_light {
+            Some(HeavyOnLight { exact: true, .. }) => Some(heavy_on_light_settings(settings)),
+            _ => None,
         }
     }
-    w.report.substeps = settings.substeps;
-    w.solvers.auto.limits =
-        EscalationLimits::new(settings, w.report.mass_ratio, gravity.length() * dt);
-    w.impact_speed = (gravity.length() * dt).max(settings.restitution_threshold);
-    w.impact_met = false;
 
-    // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
-    let bundled = settings.solves_in_lanes(constraints.len());
-    w.parallel = parallel;
-    w.colour_starts.clear();
-    let threshold = settings.parallel_island_contacts as usize;
-    w.report.simd = bundled;
-    let coloured_threads = threshold > 0 && constraints.len() >= threshold;
-    if bundled {
-        // Bundles are in colour order on any thread count, so spreading a colour over the
-        // threads costs no convergence (unlike the scalar sweep). Smaller islands stay on
-        // their thread: rayon's hand-offs then cost more than they spread.
-        let spread = coloured_threads || constraints.len() >= PARALLEL_ISLAND_POINTS;
-        // Each slot's world inverse inertia, for the lever-arm products the lanes compute.
-        w.slot_inverse_inertia.clear();
-        w.slot_inverse_inertia.extend(
-            island_bodies
-                .iter()
-                .chain(guests)
-                .map(|&i| world_inverse_inertia[i as usize]),
-        );
-        w.slot_inverse_inertia.push(Mat3::ZERO);
-        w.solvers.wide.prepare(
-            constraints,
-            slots,
-            &w.slot_inverse_inertia,
-            parallel && spread,
-        );
-    } else if coloured_threads {
-        colour_constraints(
-            constraints,
-            slots,
-            &mut w.used_colours,
-            &mut w.colours,
-            &mut w.colour_scratch,
-            &mut w.colour_starts,
-        );
+    /// Readies the step's solves under `settings` (the step's, or the heavy-on-light path's):
+    /// a cold start for the heavy-on-light path, the escalation limits and the impact speed.
+    fn start_solves(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        settings: &SolverSettings,
+        context: &StepContext<'_>,
+    ) {
+        let (gravity, dt) = (context.gravity, context.dt);
+        if settings.substeps != context.settings.substeps {
+            // The heavy-on-light path starts cold: the carried impulses are the soft step's,
+            // per substep of another length, and the exact solve needs no starting guess.
+            // Warm started with them, a 10,000:1 cube dropped onto a stack of four or five
+            // light cubes can hover on its speculative contact and then bring the stack down.
+            for c in constraints.iter_mut() {
+                c.normal_impulse = 0.0;
+                c.tangent_impulses = [0.0; 2];
+            }
+        }
+        self.report.substeps = settings.substeps;
+        self.solvers.auto.limits =
+            EscalationLimits::new(settings, self.report.mass_ratio, gravity.length() * dt);
+        self.impact_speed = (gravity.length() * dt).max(settings.restitution_threshold);
+        self.impact_met = false;
     }
 
-    // Whether this island's passes over all its points or bodies go on rayon's threads too.
-    let spread = parallel::spread(w.parallel, 1, 0)
-        && (coloured_threads || (bundled && w.solvers.wide.parallel()));
-    // Gravity, forces and damping act on the island's bodies; positions are integrated for
-    // its guests too.
-    let moving = island_bodies.len();
-    let integrated = slots - 1;
-    // With no restitution solve to follow, the lanes record the rows' J·v* and residual
-    // while the bundles are in cache (`lanes::Bundles::record`); `rows` then holds them.
-    let record_in_lanes = bundled && !restitution;
-    for substep in 0..settings.substeps {
+    /// Picks how the island is solved (SIMD lanes, coloured rows on several threads, or one
+    /// thread's sweep) and prepares it: packs the lanes or colours the rows.
+    fn prepare_solver(
+        &mut self,
+        island_bodies: &[u32],
+        guests: &[u32],
+        constraints: &mut [ContactConstraint],
+        settings: &SolverSettings,
+        context: &StepContext<'_>,
+        h: f32,
+    ) -> SolvePlan {
+        let (parallel, world_inverse_inertia) = (context.parallel, context.world_inverse_inertia);
+        let slots = island_bodies.len() + guests.len() + 1;
+        let w = self;
+        // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
+        let bundled = settings.solves_in_lanes(constraints.len());
+        w.parallel = parallel;
+        w.colour_starts.clear();
+        let threshold = settings.parallel_island_contacts as usize;
+        w.report.simd = bundled;
+        let coloured_threads = threshold > 0 && constraints.len() >= threshold;
+        if bundled {
+            // Bundles are in colour order on any thread count, so spreading a colour over the
+            // threads costs no convergence (unlike the scalar sweep). Smaller islands stay on
+            // their thread: rayon's hand-offs then cost more than they spread.
+            let spread = coloured_threads || constraints.len() >= PARALLEL_ISLAND_POINTS;
+            // Each slot's world inverse inertia, for the lever-arm products the lanes compute.
+            w.slot_inverse_inertia.clear();
+            w.slot_inverse_inertia.extend(
+                island_bodies
+                    .iter()
+                    .chain(guests)
+                    .map(|&i| world_inverse_inertia[i as usize]),
+            );
+            w.slot_inverse_inertia.push(Mat3::ZERO);
+            w.solvers.wide.prepare(
+                constraints,
+                slots,
+                &w.slot_inverse_inertia,
+                parallel && spread,
+            );
+        } else if coloured_threads {
+            colour_constraints(
+                constraints,
+                slots,
+                &mut w.used_colours,
+                &mut w.colours,
+                &mut w.colour_scratch,
+                &mut w.colour_starts,
+            );
+        }
+        SolvePlan {
+            h,
+            slots,
+            moving: island_bodies.len(),
+            bundled,
+            spread: parallel::spread(w.parallel, 1, 0)
+                && (coloured_threads || (bundled && w.solvers.wide.parallel())),
+            // With no restitution solve to follow, the lanes record the rows' J·v* and residual
+            // while the bundles are in cache (`lanes::Bundles::record`); `rows` then holds them.
+            record_in_lanes: bundled && !context.restitution,
+        }
+    }
+
+    /// Substep `substep` (from 0): gravity, forces, damping and the gyroscopic term, the warm
+    /// start, the main solve, position integration and the relax solve.
+    fn substep(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        settings: &SolverSettings,
+        gravity: Vec3,
+        plan: &SolvePlan,
+        substep: u32,
+    ) {
+        let (h, bundled) = (plan.h, plan.bundled);
         // Every other substep, PGS takes each manifold's points from halfway round (see
         // `lanes::schedule`), so that no corner of a face always goes first. Split
         // impulse keeps one order: its rigid rows are solved to the tolerance, where the order
         // matters little, and its results are compared with exact solutions.
         let half_turn = substep % 2 == 1 && !settings.split_impulse();
+        self.apply_forces(gravity, plan);
+        // The lanes' record takes v* = v − M⁻¹Jᵀγ, γ the final impulses: the velocities
+        // here, before the last substep applies its impulses (see `lanes::Bundles::record`).
+        if plan.record_in_lanes && substep + 1 == settings.substeps {
+            self.solvers
+                .wide
+                .keep_velocities_before(&self.linear, &self.angular);
+        }
+        let mut velocities = Velocities {
+            linear: &mut self.linear,
+            angular: &mut self.angular,
+        };
+        self.solvers.substeps(settings.method, bundled).warm_start(
+            constraints,
+            &mut velocities,
+            substep,
+        );
+        // Both solves of the substep take the turn as it started, so that the relax solve
+        // does not release what the main solve gave a row before the body turned. Left empty
+        // while no body of the island has turned past the limit (every ordinary step), so
+        // that the target updates skip the test.
+        self.turn.clear();
+        let limit = contact::SPECULATIVE_TURN * contact::SPECULATIVE_TURN;
+        if self.rotation.iter().any(|r| r.length_squared() > limit) {
+            self.turn.extend(
+                self.rotation
+                    .iter()
+                    .map(|rotation| rotation.length_squared()),
+            );
+        }
+        self.position_repair = false;
+        self.targets_and_solve(
+            constraints,
+            settings,
+            h,
+            bundled,
+            SubstepSolve::Main,
+            half_turn,
+        );
+        self.integrate_positions(constraints, settings, plan);
+        if settings.relax_iterations > 0 && !settings.split_impulse() {
+            let relax = SubstepSolve::Relax {
+                warm_start_follows: substep + 1 < settings.substeps,
+            };
+            self.targets_and_solve(constraints, settings, h, bundled, relax, half_turn);
+        }
+    }
+
+    /// A substep's velocity changes before the contacts are solved: gravity, applied forces,
+    /// damping, locked axes and the gyroscopic term.
+    fn apply_forces(&mut self, gravity: Vec3, plan: &SolvePlan) {
+        let (h, moving) = (plan.h, plan.moving);
+        let w = self;
         integrate::prospective_velocities(&mut w.linear[..moving], gravity, h);
         for (k, &(linear, angular)) in w.acceleration.iter().enumerate() {
             w.linear[k] += linear * h;
@@ -578,7 +725,7 @@ pub fn step_island(
         // updates before the contacts are solved (as Bullet applies it with the external forces).
         if !w.inertia.is_empty() {
             let angular = &mut w.angular[..moving];
-            if spread {
+            if plan.spread {
                 use rayon::prelude::*;
                 angular
                     .par_chunks_mut(BODIES_PER_TASK)
@@ -599,39 +746,20 @@ pub fn step_island(
                 h,
             );
         }
-        // The lanes' record takes v* = v − M⁻¹Jᵀγ, γ the final impulses: the velocities
-        // here, before the last substep applies its impulses (see `lanes::Bundles::record`).
-        if record_in_lanes && substep + 1 == settings.substeps {
-            w.solvers.wide.keep_velocities_before(&w.linear, &w.angular);
-        }
-        let mut velocities = Velocities {
-            linear: &mut w.linear,
-            angular: &mut w.angular,
-        };
-        w.solvers.substeps(settings.method, bundled).warm_start(
-            constraints,
-            &mut velocities,
-            substep,
-        );
-        // Both solves of the substep take the turn as it started, so that the relax solve
-        // does not release what the main solve gave a row before the body turned. Left empty
-        // while no body of the island has turned past the limit (every ordinary step), so
-        // that the target updates skip the test.
-        w.turn.clear();
-        let limit = contact::SPECULATIVE_TURN * contact::SPECULATIVE_TURN;
-        if w.rotation.iter().any(|r| r.length_squared() > limit) {
-            w.turn
-                .extend(w.rotation.iter().map(|rotation| rotation.length_squared()));
-        }
-        w.position_repair = false;
-        w.targets_and_solve(
-            constraints,
-            settings,
-            h,
-            bundled,
-            SubstepSolve::Main,
-            half_turn,
-        );
+    }
+
+    /// Moves the island's bodies and guests by a substep's velocities; with split impulse and
+    /// a repair to make, by the velocities plus the pseudo-velocities of the position solve.
+    fn integrate_positions(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        settings: &SolverSettings,
+        plan: &SolvePlan,
+    ) {
+        let (h, slots) = (plan.h, plan.slots);
+        // Positions are integrated for the island's guests too.
+        let integrated = slots - 1;
+        let w = self;
         // With no row to repair beyond the tolerance, positions move with the velocities alone
         // (at rest, the usual case in a pile; see `contact::update_targets`).
         let split = settings.split_impulse() && w.position_repair;
@@ -675,9 +803,8 @@ pub fn step_island(
             &mut w.displacement[..integrated],
             &mut w.rotation[..integrated],
         );
-        if spread {
-            // Per body, so any split gives the same poses; serial, this was 0.4 % of a
-            // two-thread `fast` pyramid100 step with the other thread idle.
+        if plan.spread {
+            // Per body, so any split gives the same poses.
             use rayon::prelude::*;
             linear
                 .par_chunks(BODIES_PER_TASK)
@@ -696,49 +823,69 @@ pub fn step_island(
                 h,
             );
         }
-        if settings.relax_iterations > 0 && !settings.split_impulse() {
-            let relax = SubstepSolve::Relax {
-                warm_start_follows: substep + 1 < settings.substeps,
-            };
-            w.targets_and_solve(constraints, settings, h, bundled, relax, half_turn);
+    }
+
+    /// Ends the substeps' solves: the lanes' record (when they take it), the impulses written
+    /// back to the constraints, and the record's rows.
+    fn finish_solves(
+        &mut self,
+        constraints: &mut [ContactConstraint],
+        settings: &SolverSettings,
+        plan: &SolvePlan,
+    ) {
+        let w = self;
+        if plan.record_in_lanes {
+            w.solvers.wide.record(&w.linear, &w.angular);
         }
-    }
-    if record_in_lanes {
-        w.solvers.wide.record(&w.linear, &w.angular);
-    }
-    w.solvers
-        .substeps(settings.method, bundled)
-        .finish(constraints);
-    w.rows = if record_in_lanes {
-        w.solvers.wide.take_rows()
-    } else {
-        None
-    };
-    // Restitution after the substeps (Newton's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
-    // for the points that collided.
-    let threshold = settings.restitution_threshold;
-    let bounces = if !restitution {
-        // No body bounces, so no pair does (a pair's coefficient is the larger of its bodies').
-        false
-    } else if settings.impact == ImpactModel::Propagation {
-        let mut velocities = Velocities {
-            linear: &mut w.linear,
-            angular: &mut w.angular,
+        w.solvers
+            .substeps(settings.method, plan.bundled)
+            .finish(constraints);
+        w.rows = if plan.record_in_lanes {
+            w.solvers.wide.take_rows()
+        } else {
+            None
         };
-        let island = (island_bodies, guests, bodies);
-        w.impact
-            .propagate(constraints, island, &mut velocities, dt, settings)
-    } else if spread {
-        // Per point: any split gives the same targets.
-        use rayon::prelude::*;
-        constraints
-            .par_chunks_mut(RESTITUTION_POINTS_PER_TASK)
-            .map(|part| contact::restitution_targets(part, threshold))
-            .reduce(|| false, |x, y| x || y)
-    } else {
-        contact::restitution_targets(constraints, threshold)
-    };
-    if bounces {
+    }
+
+    /// Restitution after the substeps (Newton's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
+    /// for the points that collided: their targets (or `impact: propagation`'s reflections),
+    /// then one solve when any point bounces.
+    fn restitution(
+        &mut self,
+        island_bodies: &[u32],
+        guests: &[u32],
+        constraints: &mut [ContactConstraint],
+        settings: &SolverSettings,
+        context: &StepContext<'_>,
+        plan: &SolvePlan,
+    ) {
+        let w = self;
+        let threshold = settings.restitution_threshold;
+        let bounces = if !context.restitution {
+            // No body bounces, so no pair does (a pair's coefficient is the larger of its
+            // bodies').
+            false
+        } else if settings.impact == ImpactModel::Propagation {
+            let mut velocities = Velocities {
+                linear: &mut w.linear,
+                angular: &mut w.angular,
+            };
+            let island = (island_bodies, guests, context.bodies);
+            w.impact
+                .propagate(constraints, island, &mut velocities, context.dt, settings)
+        } else if plan.spread {
+            // Per point: any split gives the same targets.
+            use rayon::prelude::*;
+            constraints
+                .par_chunks_mut(RESTITUTION_POINTS_PER_TASK)
+                .map(|part| contact::restitution_targets(part, threshold))
+                .reduce(|| false, |x, y| x || y)
+        } else {
+            contact::restitution_targets(constraints, threshold)
+        };
+        if !bounces {
+            return;
+        }
         let pass = SolvePass {
             iterations: super::impact::restitution_iterations(settings),
             tolerance: settings.tolerance,
