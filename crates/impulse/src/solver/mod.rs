@@ -14,6 +14,9 @@
 //! - [`lanes`]: PGS in SIMD lanes on packed manifold groups;
 //! - [`policy`]: `method: auto`, the escalation from NNCG to more iterations or the exact path;
 //! - [`position`]: split impulse's position solve;
+//! - [`heavy_on_light`]: the heavy-on-light path's detection and settings;
+//! - [`island_workspace`]: an island's local state and solvers during a step;
+//! - [`island_report`]: what the solver did on an island ([`IslandReport`]);
 //! - [`impact`]: `impact: propagation`, simultaneous impacts by generalized reflections;
 //! - [`substep`]: one island's step (substeps, warm start, solves, relax, restitution), which
 //!   picks the method and calls it through the interface.
@@ -27,7 +30,10 @@ use crate::settings::SolverSettings;
 
 pub mod apgd;
 pub mod exact;
+pub mod heavy_on_light;
 pub mod impact;
+pub mod island_report;
+pub mod island_workspace;
 pub mod lanes;
 pub mod nncg;
 pub mod pgs;
@@ -35,9 +41,10 @@ pub mod policy;
 pub mod position;
 pub mod substep;
 
+pub use heavy_on_light::{HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight};
+pub use island_report::IslandReport;
 pub use pgs::Sweep;
 pub use policy::EscalationLevel;
-pub use substep::{HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, IslandReport};
 
 /// An island's contact solver, whatever its method: what the substep loop
 /// ([`substep::step_island`]) calls, in this order each step:

@@ -7,164 +7,20 @@
 //! and scattered at the end, so islands can run on separate threads without sharing anything
 //! mutable.
 
-use glam::{Mat3, Quat, Vec3};
+use glam::{Mat3, Vec3};
 use parry3d::math::Pose;
 
-use super::apgd::Apgd;
-use super::lanes::Bundles;
-use super::nncg::Nncg;
-use super::pgs::{Pgs, Sweep, colour_constraints};
-use super::policy::{Auto, EscalationLevel, EscalationLimits};
-use super::{
-    ContactSolver, RowsReport, SolveOutcome, SolvePass, TargetInputs, Velocities, position,
-};
+use super::heavy_on_light::{HeavyOnLight, heavy_on_light, heavy_on_light_settings, mass_ratio};
+use super::island_report::IslandReport;
+pub use super::island_workspace::IslandWorkspace;
+use super::pgs::{Sweep, colour_constraints};
+use super::policy::EscalationLimits;
+use super::{ContactSolver, SolveOutcome, SolvePass, TargetInputs, Velocities, position};
 use crate::body::{Bodies, BodyKind, LockedAxes};
 use crate::contact::{self, ContactConstraint};
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
 use crate::settings::{ContactRepair, ImpactModel, SolverMethod, SolverSettings};
-
-/// What the solver did on one island during a step (step 7 of docs/architecture.md: every step can say how
-/// well its LCP was solved, here per island).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct IslandReport {
-    /// Smallest body index in the island: a stable name for it within the step.
-    pub first_body: u32,
-    /// Moving bodies in the island.
-    pub bodies: u32,
-    /// Contact points (normal rows) in the island.
-    pub contacts: u32,
-    /// Heaviest to lightest moving body mass (1 for one body).
-    pub mass_ratio: f32,
-    /// The strongest method any of its solves used: `pgs`, `nncg`, `apgd`, `nncg_extended` or
-    /// `exact`. For `auto`: `exact` if any solve was exact, as `last_change` is then the exact
-    /// solve's residual (m/s).
-    pub method: EscalationLevel,
-    /// Solves (one per substep) that escalated beyond their first method.
-    pub escalations: u32,
-    /// Exact solves attempted that failed (their iterative result was kept).
-    pub exact_failures: u32,
-    /// Lemke pivots of the exact solves.
-    pub exact_pivots: u32,
-    /// Iterations used in the step, all solves and methods together.
-    pub iterations: u32,
-    /// Largest row velocity change of the last iteration of the last main solve (m/s): how far
-    /// from converged the island's final solve stopped.
-    pub last_change: f32,
-    /// Whether the substeps' solves ran in SIMD lanes.
-    pub simd: bool,
-    /// Natural-map residual of the island's rows at the end of the step (see
-    /// [`crate::diagnostics::StepDiagnostics::natural_map_residual`]); set by the world as the
-    /// island's step ends.
-    pub natural_map_residual: f32,
-    /// Substeps the island took in the step: the settings' `substeps`, or 1 on the
-    /// heavy-on-light path ([`HeavyOnLight::exact`]).
-    #[serde(default)]
-    pub substeps: u32,
-    /// The island's contact of largest mass ratio between two moving bodies, when that ratio
-    /// exceeds [`SolverSettings::heavy_on_light_mass_ratio`]; `None` otherwise (and for
-    /// split-impulse repair, which holds such islands on its own).
-    #[serde(default)]
-    pub heavy_on_light: Option<HeavyOnLight>,
-}
-
-/// A heavy-on-light island: its contact of largest mass ratio, and how the island was treated
-/// ([`IslandReport::heavy_on_light`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct HeavyOnLight {
-    /// Index of the heavier body of that contact.
-    pub heavy_body: u32,
-    /// Index of the lighter body.
-    pub light_body: u32,
-    /// Their mass ratio, heavier over lighter (> 1).
-    pub mass_ratio: f32,
-    /// Whether the island took the heavy-on-light path: one exact LCP per step on rigid rows
-    /// (it has at most [`SolverSettings::exact_max_contacts`] points). If not, it took the
-    /// ordinary path.
-    pub exact: bool,
-    /// Whether the island looks held: its deepest overlap at the step's start is at most
-    /// [`HEAVY_ON_LIGHT_HELD_OVERLAP`]. An island not held is sinking through, or has sunk.
-    pub held: bool,
-}
-
-/// Deepest overlap (m) of a heavy-on-light island that is still reported as held
-/// ([`HeavyOnLight::held`]). A held island's contacts overlap by far less: the soft step's
-/// spring holds a contact at the 200:1 threshold at R·g/ω² ≈ 0.9 mm (240 Hz), the exact path
-/// holds it at the slop; an island the soft step lets sink passes this within a few steps.
-pub const HEAVY_ON_LIGHT_HELD_OVERLAP: f32 = 0.01;
-
-/// The heavy-on-light path's overlap repair: a velocity bias at this rate (1/s), removed by
-/// the relax solve, on rigid rows.
-const HEAVY_ON_LIGHT_REPAIR_RATE: f32 = 12.0;
-
-/// Local state of one island during a step.
-#[derive(Default)]
-pub struct IslandWorkspace {
-    /// Linear velocities (m/s) of the island's bodies, then its guests (kinematic bodies),
-    /// then the immovable slot.
-    pub linear: Vec<Vec3>,
-    /// Angular velocities (rad/s), same layout.
-    pub angular: Vec<Vec3>,
-    /// Centre-of-mass displacement since the start of the step (m).
-    pub displacement: Vec<Vec3>,
-    /// Rotation vector accumulated since the start of the step (rad), for separations.
-    pub rotation: Vec<Vec3>,
-    /// Per slot, the square of the angle (rad²) turned since the start of the step, as the
-    /// current substep started: which speculative rows are stale
-    /// ([`contact::speculative_row_is_stale`]).
-    turn: Vec<f32>,
-    /// Orientations, integrated substep by substep.
-    pub orientation: Vec<Quat>,
-    /// Per body, the linear and angular acceleration of its applied force and torque (m/s²,
-    /// rad/s²); empty in a step without forces.
-    acceleration: Vec<(Vec3, Vec3)>,
-    /// Per body, the body-frame inertia tensor of its gyroscopic term
-    /// ([`integrate::gyroscopic_inertia`]); empty when no body of the island has one. Zero for
-    /// bodies with a locked rotation axis.
-    inertia: Vec<Mat3>,
-    /// The island's bodies with exactly one locked rotation axis and a gyroscopic term: their
-    /// slot, the locked world axis (0, 1, 2 for x, y, z) and their body-frame tensor, for
-    /// [`integrate::gyroscopic_in_plane`].
-    rotation_locks: Vec<(u32, u8, Mat3)>,
-    /// Per body, the factors 1/(1 + h·c) of its linear and angular damping for one substep;
-    /// empty when no body of the island is damped.
-    damping: Vec<(f32, f32)>,
-    /// The island's bodies with a locked translation axis: their slot and
-    /// [`crate::body::LockedAxes::translation_factor`], which takes gravity's share off the
-    /// locked axes (forces and impulses go through the per-axis inverse mass, zero there).
-    translation_locks: Vec<(u32, Vec3)>,
-    pseudo_linear: Vec<Vec3>,
-    pseudo_angular: Vec<Vec3>,
-    /// Colour offsets of the island's constraints when it is coloured (see [`Sweep`]).
-    colour_starts: Vec<u32>,
-    used_colours: Vec<u64>,
-    colours: Vec<u8>,
-    colour_scratch: Vec<ContactConstraint>,
-    /// Per part of rows, per slot: M⁻¹Jᵀγ of [`contact::record_velocity_before`].
-    pub(crate) record_scratch: Vec<(Vec3, Vec3)>,
-    /// The rows' record as the step ended when the SIMD lanes took it (the rows' J·v* are
-    /// then in the constraints); `None` leaves it to
-    /// [`crate::diagnostics::record_velocity_before_and_residual`].
-    pub(crate) rows: Option<RowsReport>,
-    /// Whether one colour may be solved on several threads.
-    parallel: bool,
-    /// The methods, each with its work space, kept between steps.
-    solvers: Solvers,
-    /// What the solver did on this island in the step.
-    pub report: IslandReport,
-    /// Rows with friction (μ > 0), counted by the world as the island's step ends.
-    pub(crate) friction_rows: usize,
-    /// Split impulse: whether the last targets asked any row for overlap repair.
-    position_repair: bool,
-    /// Per body slot, its world inverse inertia (for [`ContactSolver::prepare`]).
-    slot_inverse_inertia: Vec<Mat3>,
-    /// `impact: propagation`'s work space ([`super::impact`]).
-    impact: super::impact::ImpactWorkspace,
-    /// Whether this substep's main solve met an impact ([`IMPACT_SWEEPS`]).
-    impact_met: bool,
-    /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]).
-    impact_speed: f32,
-}
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
 /// friction rows too, whatever [`SolverSettings::friction_in_main_solve`] says. Friction
@@ -185,38 +41,6 @@ pub(crate) const HEAVY_ON_LIGHT_MASS_RATIO: f32 = 200.0;
 /// whose sweeps change velocities by about |g|·h, never take them. Only with soft or bias
 /// repair (the soft step's solves): split impulse's PGS keeps the sweeps it was given.
 pub(crate) const IMPACT_SWEEPS: u32 = 32;
-
-/// Every method's solver, so that an island keeps its work spaces from step to step.
-#[derive(Default)]
-struct Solvers {
-    pgs: Pgs,
-    nncg: Nncg,
-    apgd: Apgd,
-    auto: Auto,
-    /// The island's points in SIMD bundles, when it is solved in lanes.
-    wide: Bundles,
-}
-
-impl Solvers {
-    /// The solver of `method` on the constraints themselves.
-    fn scalar(&mut self, method: SolverMethod) -> &mut dyn ContactSolver {
-        match method {
-            SolverMethod::Pgs => &mut self.pgs,
-            SolverMethod::Nncg => &mut self.nncg,
-            SolverMethod::Apgd => &mut self.apgd,
-            SolverMethod::Auto => &mut self.auto,
-        }
-    }
-
-    /// The substeps' solver: the lanes when the island is `bundled`, else [`Solvers::scalar`].
-    fn substeps(&mut self, method: SolverMethod, bundled: bool) -> &mut dyn ContactSolver {
-        if bundled {
-            &mut self.wide
-        } else {
-            self.scalar(method)
-        }
-    }
-}
 
 /// Which of a substep's solves [`IslandWorkspace::targets_and_solve`] runs.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -954,78 +778,4 @@ pub fn scatter_body(
     *angular = workspace.angular[k];
     pose.rotation = rotation;
     pose.translation = com - rotation * local_center_of_mass;
-}
-
-/// The settings of the heavy-on-light path ([`SolverSettings::heavy_on_light_mass_ratio`]):
-/// the basic method's one LCP per step (one substep), on rigid rows with a velocity bias
-/// ([`HEAVY_ON_LIGHT_REPAIR_RATE`]) and a relax solve, solved by the automatic policy with every
-/// solve escalating to the exact path (Lemke; NNCG's result stands if pivoting fails). The
-/// rest, repair cap, friction and warm start included, is `settings`'.
-fn heavy_on_light_settings(settings: &SolverSettings) -> SolverSettings {
-    SolverSettings {
-        method: SolverMethod::Auto,
-        substeps: 1,
-        relax_iterations: settings.relax_iterations.max(1),
-        mass_ratio_threshold: 0.0,
-        repair: ContactRepair::Bias {
-            rate: HEAVY_ON_LIGHT_REPAIR_RATE,
-        },
-        ..settings.clone()
-    }
-}
-
-/// The contact of `constraints` of largest mass ratio between two moving bodies, if above
-/// `threshold`, with `held` from the deepest overlap of any contact (`exact` left false).
-fn heavy_on_light(
-    island_bodies: &[u32],
-    constraints: &[ContactConstraint],
-    bodies: &Bodies,
-    threshold: f32,
-) -> Option<HeavyOnLight> {
-    let mut found: Option<HeavyOnLight> = None;
-    let mut deepest = 0.0f32;
-    let moving = |slot: u32| {
-        let body = *island_bodies.get(slot as usize)?;
-        let inverse_mass = bodies.inverse_mass[body as usize];
-        (inverse_mass > 0.0).then_some((body, inverse_mass))
-    };
-    for c in constraints {
-        deepest = deepest.max(c.depth);
-        let (Some(a), Some(b)) = (moving(c.local_a), moving(c.local_b)) else {
-            continue;
-        };
-        // The heavier body has the smaller inverse mass.
-        let (heavy, light) = if a.1 <= b.1 { (a, b) } else { (b, a) };
-        let mass_ratio = light.1 / heavy.1;
-        if mass_ratio > threshold && found.is_none_or(|f| mass_ratio > f.mass_ratio) {
-            found = Some(HeavyOnLight {
-                heavy_body: heavy.0,
-                light_body: light.0,
-                mass_ratio,
-                exact: false,
-                held: false,
-            });
-        }
-    }
-    found.map(|f| HeavyOnLight {
-        held: deepest <= HEAVY_ON_LIGHT_HELD_OVERLAP,
-        ..f
-    })
-}
-
-/// Heaviest to lightest moving body of an island (1 when it has one body).
-fn mass_ratio(island_bodies: &[u32], bodies: &Bodies) -> f32 {
-    let (mut lightest, mut heaviest) = (f32::INFINITY, 0.0f32);
-    for &i in island_bodies {
-        let inverse_mass = bodies.inverse_mass[i as usize];
-        if inverse_mass > 0.0 {
-            lightest = lightest.min(1.0 / inverse_mass);
-            heaviest = heaviest.max(1.0 / inverse_mass);
-        }
-    }
-    if heaviest > 0.0 {
-        heaviest / lightest
-    } else {
-        1.0
-    }
 }
