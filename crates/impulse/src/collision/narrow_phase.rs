@@ -71,8 +71,8 @@ pub struct ContactPair {
     pub manifolds: Vec<Manifold>,
     workspace: Option<ContactManifoldsWorkspace>,
     /// Point count and deepest penetration (m, ≥ 0) as of the last update, kept here so the
-    /// step's diagnostics need not chase every manifold's heap block again (on balls16k that
-    /// second pass over cold memory cost 5 % of the step).
+    /// step's diagnostics need not chase every manifold's heap block again (a second pass over
+    /// cold memory).
     summary: PairSummary,
     /// What Parry was last asked for this pair (a recycled update leaves it): see
     /// [`ManifoldQuery`].
@@ -446,8 +446,8 @@ pub(crate) const PREFETCH_AHEAD: usize = 8;
 /// Before visiting pair `i` of `pairs`: asks for the manifolds' block of pair
 /// i + 2·[`PREFETCH_AHEAD`] and the first manifold's points of pair i + [`PREFETCH_AHEAD`]
 /// (its address is in the manifolds' block, asked for earlier). Each pair's manifolds and
-/// points are two heap blocks away from the pair, and on large scenes both are cache misses:
-/// asking ahead halved the manifold update's time on balls16k (perf samples).
+/// points are two heap blocks away from the pair, and on large scenes both are cache misses,
+/// which asking ahead hides.
 #[inline(always)]
 pub(crate) fn prefetch_manifolds(pairs: &[ContactPair], i: usize) {
     if let Some(ahead) = pairs.get(i + 2 * PREFETCH_AHEAD) {
@@ -515,8 +515,7 @@ impl NarrowPhase {
         parallel: bool,
     ) -> Result<(), StepError> {
         // Last step's pairs and this step's candidates are both sorted by (body1, body2): a
-        // merge join carries each surviving pair over without hashing (a hash map here was 11 %
-        // of a balls16k step).
+        // merge join carries each surviving pair over without hashing.
         debug_assert!(candidates.windows(2).all(|w| w[0] < w[1]));
         // At rest the broad phase's pairs stand from step to step: then every pair stays where
         // it is, and the join, which moves every pair (serially), is skipped.

@@ -28,9 +28,8 @@ impl Bundles {
     ///
     /// Why manifold groups (Box2D v3's and Box3D's wide contact constraints are per manifold
     /// too): a sweep gathers and scatters the bodies' velocities once per lane group instead of
-    /// once per bundle, and a body's groups need far fewer colours than its points (pyramid100
-    /// settled: 11 colours of groups against 32 of points, each a wait per sweep on two
-    /// threads).
+    /// once per bundle, and a body's groups need far fewer colours than its points (each colour
+    /// a wait per sweep on several threads).
     ///
     /// With `parallel`, each colour's lane groups are later spread over rayon's threads; the
     /// result is the same bit for bit, as the lane groups of one colour touch disjoint bodies.
@@ -58,8 +57,7 @@ impl Bundles {
         // repeat (an island at rest keeps its points), last pack's layout stands. They are
         // first copied out of the 376-byte rows (on rayon's threads for a large island), so
         // that the comparison, the grouping and the colouring, which are serial, read 16 bytes
-        // a point: reading them from the rows was 2 % of the samples of a two-thread
-        // pyramid100 run.
+        // a point.
         let parallel_fill = spread(parallel, constraints.len(), PARALLEL_PACK_POINTS - 1);
         let key = |c: &ContactConstraint| PointKey {
             local_a: c.local_a,
@@ -94,8 +92,8 @@ impl Bundles {
         let reset = new_layout || self.bundles.len() != total || self.geometry.len() != total;
         if reset {
             if parallel_fill {
-                // Every bundle is reset by the task that fills it (pyramid100: 17 MB, which a
-                // serial reset here spent 1 % of a two-thread step on, the other thread idle).
+                // Every bundle is reset by the task that fills it, so that a large island's
+                // reset is spread over the threads too.
                 self.bundles.truncate(total);
                 self.geometry.truncate(total);
             } else {

@@ -96,10 +96,9 @@ pub(super) struct SweepOrder {
 ///
 /// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first, the part `update` reads
 /// ([`BundleUpdate::READS`]): a bundle is 18 cache lines, and once an island's bundles outgrow
-/// L2 (pyramid100: 17 MB) the sweep waited on L3 for them, which the hardware prefetcher did
-/// not hide (asking ahead made a one-thread pyramid100 step about a fifth faster when it was
-/// added). The normal rows' sweep asks for the first 8 lines alone ([`NORMAL_PART`]); asking
-/// for the whole bundle there had it read every line. Groups lie in bundle order, so the
+/// L2 the sweep waits on L3 for them, which the hardware prefetcher does not hide. The normal
+/// rows' sweep asks for the first 8 lines alone ([`NORMAL_PART`]): asking for the whole bundle
+/// would have it read every line. Groups lie in bundle order, so the
 /// bundle ahead in memory is the one the sweep visits next.
 ///
 /// # Safety

@@ -22,8 +22,8 @@ impl Bundles {
     ///
     /// The targets are set inside the first sweep, each lane group's just before it is solved:
     /// they depend on the bodies' displacements only, which a sweep does not change, so the
-    /// result is the same as a separate pass over the bundles first. That pass read and wrote
-    /// a third of the bytes of a sweep, twice a substep (pyramid100's bundles are 17 MB).
+    /// result is the same as a separate pass over the bundles first, which would read and
+    /// write a third of the bytes of a sweep, twice a substep.
     pub fn solve_pgs(
         &mut self,
         velocities: &mut Velocities<'_>,

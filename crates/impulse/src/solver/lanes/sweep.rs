@@ -202,8 +202,7 @@ impl BundleUpdate for RelaxCarrying {
 /// the step has v_t/k₁ along the disc's outward normal, so v_t = −s·γ_t with s ≥ 0. Capping q
 /// itself, as Rapier does, would not: its fixed point has v_t opposite Kγ_t, friction off the
 /// slip wherever K is anisotropic (a box's corner points). A step of 1/k₁ is a descent step for
-/// the block's quadratic; the larger 2/(k₁ + k₂) was tried and not kept (`card_house` with
-/// `fast` fell). A Newton iteration on the disc would keep a bundle waiting on its slowest
+/// the block's quadratic; with the larger 2/(k₁ + k₂), `card_house` with `fast` falls. A Newton iteration on the disc would keep a bundle waiting on its slowest
 /// lane; this step costs the same on every lane.
 #[inline(always)]
 pub(super) fn solve_bundle<const FRICTION: bool>(
