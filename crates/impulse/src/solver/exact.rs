@@ -35,10 +35,10 @@ use glam::Vec3;
 use impulse_lcp::solvers::lemke;
 use impulse_lcp::{Bounds, DenseMatrix, Lcp, Matrix, SolveError, SolverSettings, Status};
 
-use super::{
-    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
-    apply_impulses, project_to_friction_disc, set_scalar_targets,
+use super::interface::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, set_scalar_targets,
 };
+use super::rows::{Velocities, apply_impulses, project_to_friction_disc};
 use crate::contact::{ContactConstraint, JacobianRow, is_isotropic};
 
 /// The exact path as a [`ContactSolver`]: [`solve_exact`] on islands of at most `max_contacts`

@@ -15,8 +15,8 @@ use std::time::Instant;
 use crate::contact::{ContactConstraint, JacobianRow};
 use crate::settings::ContactRepair;
 use crate::settings::SolverMethod;
-use crate::solver::Velocities;
 use crate::solver::exact::{ExactFailure, ExactReport, ExactWorkspace, MAX_ROUNDS, solve_exact};
+use crate::solver::rows::Velocities;
 use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 
 use super::*;

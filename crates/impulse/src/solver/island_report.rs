@@ -2,7 +2,7 @@
 //! diagnostics.
 
 use super::heavy_on_light::HeavyOnLight;
-use super::policy::EscalationLevel;
+use super::interface::EscalationLevel;
 #[cfg(doc)]
 use crate::settings::SolverSettings;
 

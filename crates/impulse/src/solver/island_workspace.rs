@@ -6,12 +6,12 @@ use glam::{Mat3, Quat, Vec3};
 
 use super::apgd::Apgd;
 use super::impact::ImpactWorkspace;
+use super::interface::{ContactSolver, RowsReport};
 use super::island_report::IslandReport;
 use super::lanes::Bundles;
 use super::nncg::Nncg;
 use super::pgs::Pgs;
 use super::policy::Auto;
-use super::{ContactSolver, RowsReport};
 use crate::contact::ContactConstraint;
 use crate::settings::SolverMethod;
 #[cfg(doc)]

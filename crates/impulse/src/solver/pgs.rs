@@ -7,10 +7,10 @@
 
 use glam::Vec3;
 
-use super::{
-    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
-    project_to_friction_disc, solve_scalar,
+use super::interface::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Sweep, solve_scalar,
 };
+use super::rows::{Velocities, project_to_friction_disc};
 use crate::contact::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours};
 use crate::parallel::{
@@ -40,41 +40,6 @@ impl ContactSolver for Pgs {
             )
         })
     }
-}
-
-/// How a sweep visits an island's points: in constraint order, or colour by colour.
-///
-/// A coloured island has its constraints sorted by colour (`colour_constraints`);
-/// colour k is `starts[k]..starts[k + 1]`. Points of one colour below `COLOURS` (64) share no
-/// moving body, so with `parallel` their updates run on rayon's threads at once; the
-/// forward sweep visits colours in order, the backward sweep in reverse. Colour `COLOURS`
-/// (when present) holds the points the greedy colouring could not place and always runs
-/// sequentially.
-///
-/// Outside the crate only [`Sweep::SEQUENTIAL`] can be made: the parallel sweep writes the
-/// bodies' velocities from several threads, which is sound only for constraints that
-/// `colour_constraints` has just sorted, as the island step does.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Sweep<'a> {
-    /// Colour offsets into the constraints (empty: not coloured).
-    pub(crate) starts: &'a [u32],
-    /// Whether one colour's points may be updated on several threads.
-    pub(crate) parallel: bool,
-}
-
-impl Sweep<'_> {
-    /// True when the island's `points` are sorted by colour ([`colour_constraints`]).
-    pub(crate) fn coloured(&self, points: usize) -> bool {
-        let colours = self.starts.len().saturating_sub(1);
-        colours > 0 && self.starts[colours] as usize == points
-    }
-
-    /// Constraint order, one thread: the sweep of [`solve_pgs`]'s documentation.
-    #[cfg(any(test, feature = "internals"))]
-    pub const SEQUENTIAL: Sweep<'static> = Sweep {
-        starts: &[],
-        parallel: false,
-    };
 }
 
 /// One point's update in a sweep: takes the point and its two bodies' velocities (linear and

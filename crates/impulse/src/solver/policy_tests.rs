@@ -1,6 +1,6 @@
 //! Unit tests of `method: auto`'s escalation policy ([`super`]).
 
-use super::EscalationLevel;
+use crate::solver::EscalationLevel;
 
 /// `name` is the level as the summary JSON writes it (serde's snake case), one per level.
 #[test]

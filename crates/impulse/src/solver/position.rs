@@ -3,8 +3,9 @@
 
 use glam::Vec3;
 
-use super::Velocities;
-use super::pgs::{FORWARD, PointUpdate, Sweep, sweep_points};
+use super::interface::Sweep;
+use super::pgs::{FORWARD, PointUpdate, sweep_points};
+use super::rows::Velocities;
 use crate::contact::ContactConstraint;
 
 /// The position row of a point ([`solve_position_point`]).

@@ -11,11 +11,14 @@ use glam::{Mat3, Vec3};
 use parry3d::math::Pose;
 
 use super::heavy_on_light::{HeavyOnLight, heavy_on_light, heavy_on_light_settings, mass_ratio};
+use super::interface::Sweep;
+use super::interface::{ContactSolver, SolveOutcome, SolvePass, TargetInputs};
 use super::island_report::IslandReport;
 pub use super::island_workspace::IslandWorkspace;
-use super::pgs::{Sweep, colour_constraints};
+use super::pgs::colour_constraints;
 use super::policy::EscalationLimits;
-use super::{ContactSolver, SolveOutcome, SolvePass, TargetInputs, Velocities, position};
+use super::position;
+use super::rows::Velocities;
 use crate::body::{Bodies, BodyKind, LockedAxes};
 use crate::contact::{self, ContactConstraint};
 use crate::integrate;
@@ -725,7 +728,7 @@ impl IslandWorkspace {
         };
         // The step totals gain what the restitution solve adds to each impulse.
         for c in constraints.iter_mut() {
-            let before = super::impulses(c);
+            let before = super::rows::impulses(c);
             for (total, before) in c.step_impulses.iter_mut().zip(before) {
                 *total -= before;
             }
@@ -739,7 +742,7 @@ impl IslandWorkspace {
             &pass,
         );
         for c in constraints.iter_mut() {
-            super::add_step_impulses(c);
+            super::rows::add_step_impulses(c);
         }
         w.record(&outcome, false);
         w.impact.finish(constraints);

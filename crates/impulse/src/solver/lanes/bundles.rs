@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::lane::{LANES, Lane};
 use super::layout::{Bundle, BundleGeometry, BundleRecord, Group, PointKey};
-use crate::solver::RowsReport;
+use crate::solver::interface::RowsReport;
 
 /// An island's contact points packed in bundles, manifold group by manifold group, colour by
 /// colour.

@@ -12,7 +12,7 @@ use crate::contact::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours};
 use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{PARALLEL_PACK_POINTS, SharedItems, spread, threads};
-use crate::solver::RowsReport;
+use crate::solver::interface::RowsReport;
 
 impl Bundles {
     /// Packs the island's `constraints` (slots below `slots`; `slots − 1` is the immovable one),

@@ -10,7 +10,7 @@ use super::lane::{LANES, cap_to_disc};
 use super::layout::{BodyLanes, Bundle, BundleRecord, Group};
 use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{PARALLEL_PACK_POINTS, SharedItems, spread};
-use crate::solver::RowsReport;
+use crate::solver::interface::RowsReport;
 
 impl Bundles {
     /// The island's natural-map residual and friction rows that the last [`Bundles::unpack`]

@@ -13,7 +13,7 @@ use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{
     GROUPS_PER_TASK, SharedItems, SharedVelocities, colour_after_colour, prefetch_bytes, spread,
 };
-use crate::solver::Velocities;
+use crate::solver::rows::Velocities;
 
 impl Bundles {
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane

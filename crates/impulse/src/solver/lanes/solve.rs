@@ -10,9 +10,10 @@ use super::sweep::{VelocityRows, WarmStart};
 use super::targets::{NoTargets, Targets, Turned};
 use crate::contact::ContactConstraint;
 use crate::parallel::SharedItems;
-use crate::solver::{
-    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
+use crate::solver::interface::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport,
 };
+use crate::solver::rows::Velocities;
 
 impl Bundles {
     /// Sets every point's target normal velocity and softness from `targets` (as

@@ -7,7 +7,7 @@ use glam::Vec3;
 use super::lane::{LANES, Lane, add_cross, dot, sub};
 use super::layout::{BodyLanes, Bundle, BundleGeometry, Group};
 use crate::contact::{SPECULATIVE_TURN, STALE_TARGET, repair_terms};
-use crate::solver::TargetInputs;
+use crate::solver::interface::TargetInputs;
 
 /// Whether a sweep sets the targets of each lane group before solving it: `&Targets` does,
 /// [`NoTargets`] compiles to nothing.

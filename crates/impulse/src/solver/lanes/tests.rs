@@ -7,7 +7,8 @@ use super::layout::*;
 use super::sweep::*;
 use crate::contact::{ContactConstraint, JacobianRow};
 use crate::graph::COLOURS;
-use crate::solver::{SolvePass, Sweep, Velocities};
+use crate::solver::interface::{SolvePass, Sweep};
+use crate::solver::rows::Velocities;
 use glam::{Mat3, Vec3};
 use proptest::prelude::*;
 
