@@ -11,7 +11,8 @@
 //! - [`pgs`]: Projected Gauss-Seidel, and the scalar sweep the other scalar methods build on;
 //! - [`nncg`]: nonsmooth nonlinear conjugate gradient (PGS sweeps with momentum);
 //! - [`apgd`]: accelerated projected gradient descent;
-//! - [`exact`]: Lemke's pivoting on an island's assembled LCP;
+//! - [`exact`]: Lemke's pivoting on an island's assembled LCP (its dense factorisation in
+//!   [`cholesky`], its report in [`exact_report`]);
 //! - [`lanes`]: PGS in SIMD lanes on packed manifold groups;
 //! - [`policy`]: `method: auto`, the escalation from NNCG to more iterations or the exact path;
 //! - [`position`]: split impulse's position solve;
@@ -25,7 +26,9 @@
 pub use crate::contact::cap_to_disc;
 
 pub mod apgd;
+pub mod cholesky;
 pub mod exact;
+pub mod exact_report;
 pub mod heavy_on_light;
 pub mod impact;
 pub mod interface;
