@@ -13,7 +13,7 @@ pub struct BroadPhase {
     workspace: BvhWorkspace,
     /// Kept between steps and refitted: bodies move little per step, so refitting plus
     /// Parry's incremental optimisation ([`Self::optimize`]) costs a fraction of a fresh
-    /// binned build (10 % of a pyramid20 step under callgrind).
+    /// binned build.
     tree: Option<Bvh>,
     /// Each leaf's box as stored in the tree: the body's box fattened by
     /// [`CHANGE_DETECTION_SKIN`] when it was last updated.
@@ -55,8 +55,8 @@ fn stale(stored: &Aabb, new: &Aabb) -> bool {
 }
 
 /// The pairs are updated by querying the changed leaves alone while at most one leaf in this
-/// many changed; above it the whole tree is traversed against itself. pyramid100 during its
-/// settling rewrites about 600 of 5051 leaves a step.
+/// many changed; above it the whole tree is traversed against itself. A settling pile changes
+/// far fewer of its leaves a step.
 const FEW_CHANGED_LEAVES: usize = 4;
 
 /// `a` and `b` sorted and without common elements, merged into `out` (sorted).
@@ -239,7 +239,7 @@ impl BroadPhase {
     /// Rebuilds the next part of the tree (Parry's `optimize_incremental`, which cycles
     /// through the tree in successive calls), so the tree stays tight as bodies move. Only
     /// the speed of later [`Self::candidate_pairs`] calls depends on it, never their pairs,
-    /// so a step runs it while the narrow phase works (about 0.6 % of a balls16k step).
+    /// so a step runs it while the narrow phase works.
     /// Skipped while no leaf has changed since the last call: the tree is as good as it was.
     pub fn optimize(&mut self) {
         if let Some(tree) = &mut self.tree

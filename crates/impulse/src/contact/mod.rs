@@ -1,5 +1,26 @@
 //! Contact constraints, stage 4 of the step: one constraint per contact point, assembled from
 //! the manifolds (Jacobian rows, effective masses, restitution and repair targets, softness)
 //! and warm-started from the impulses of the last step.
+//!
+//! One job per file, each using only the files listed before it:
+//! - [`row`]: the row type ([`ContactConstraint`], [`JacobianRow`]) and its lever-arm products;
+//! - [`assembly`]: contact points → rows, island by island, warm-started;
+//! - [`targets`]: the rows' target velocities, per substep, and restitution's;
+//! - [`record`]: J·v* per row for the step's diagnostics.
 
-pub(crate) mod constraints;
+pub(crate) mod assembly;
+pub(crate) mod record;
+pub(crate) mod row;
+pub(crate) mod targets;
+
+pub use assembly::*;
+pub use record::*;
+pub use row::*;
+pub use targets::*;
+
+/// The same items under the path the step's callers name them by
+/// (`contact::constraints::assemble`).
+pub(crate) use crate::contact as constraints;
+
+#[cfg(test)]
+mod tests;

@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 use impulse_lcp::{Bounds, CsrMatrix, Lcp, ProblemError};
 
-use crate::contact::constraints::{ContactConstraint, JacobianRow, linear_inverse_mass};
+use crate::contact::{ContactConstraint, JacobianRow, linear_inverse_mass};
 
 /// A step's contact LCP together with what the engine found for it.
 #[derive(Clone, Debug)]

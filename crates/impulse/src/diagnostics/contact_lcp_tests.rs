@@ -5,7 +5,7 @@
 //! Convention (docs/method.md): find γ with w = Aγ − b ≥ 0, γ ≥ 0, wᵀγ = 0, where A = J M⁻¹ Jᵀ and
 //! b = target − J·v*. w is a velocity (m/s), γ an impulse (N·s).
 
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::settings::ContactRepair;
 use crate::test_support as common;
 use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
@@ -227,7 +227,7 @@ fn exported_rows_match_the_constraints() {
             panic!("the contact LCP is sparse")
         };
         let diagonal = lcp.a.diagonal();
-        let row_data = |r: usize| -> (&crate::contact::constraints::JacobianRow, f32, f32) {
+        let row_data = |r: usize| -> (&crate::contact::JacobianRow, f32, f32) {
             let c = &constraints[exported.contact_of_row[r]];
             match r % rows_per_contact {
                 0 => (&c.normal, c.target_normal_velocity, c.normal_impulse),
@@ -519,7 +519,7 @@ fn repeated_pile_rows(
 /// on two threads, and each row's J·v* matches v* = v − M⁻¹Jᵀγ summed directly in f64.
 #[test]
 fn velocity_before_in_parts_is_the_same_on_any_thread_count_and_matches_a_direct_sum() {
-    use crate::contact::constraints::{BodySlots, record_velocity_before};
+    use crate::contact::{BodySlots, record_velocity_before};
     let (world, rows) = repeated_pile_rows(-1.0, None);
     assert!(rows.len() > 20_000, "{} rows", rows.len());
     let bodies = &world.bodies;
@@ -600,7 +600,7 @@ fn velocity_before_in_parts_is_the_same_on_any_thread_count_and_matches_a_direct
 /// of the velocity-change sums are exercised.
 #[test]
 fn fused_record_and_residual_equals_the_separate_passes_on_any_thread_count() {
-    use crate::contact::constraints::{BodySlots, record_velocity_before};
+    use crate::contact::{BodySlots, record_velocity_before};
     use crate::diagnostics::{natural_map_residual_in, record_velocity_before_and_residual};
     let (world, rows) = repeated_pile_rows(1.0, Some(3));
     let with_friction = rows.iter().filter(|c| c.friction > 0.0).count();

@@ -12,11 +12,12 @@
 
 use glam::Vec3;
 
-use super::{
-    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
-    apply_impulses, cap_to_disc, impulses, solve_scalar,
+use super::interface::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, solve_scalar,
 };
-use crate::contact::constraints::ContactConstraint;
+use super::rows::{Velocities, apply_impulses, impulses};
+use crate::contact::ContactConstraint;
+use crate::contact::cap_to_disc;
 
 /// APGD as a [`ContactSolver`], with its work vectors.
 #[derive(Default)]

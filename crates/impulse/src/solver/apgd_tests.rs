@@ -9,13 +9,14 @@
 //! folded into the rows, like the island's immovable slot), so a solver can be run on them
 //! from any starting impulses.
 
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::diagnostics::contact_lcp::assemble_lcp;
 use crate::settings::ContactRepair;
 use crate::solver::apgd::{ApgdWorkspace, solve_apgd};
+use crate::solver::interface::{SolveReport, Sweep};
 use crate::solver::nncg::{NncgWorkspace, solve_nncg};
 use crate::solver::pgs::solve_pgs;
-use crate::solver::{SolveReport, Sweep, Velocities};
+use crate::solver::rows::Velocities;
 use crate::test_support as common;
 use crate::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use common::{material, static_box};
@@ -666,7 +667,7 @@ fn apgd_reaches_a_tight_residual_within_32_iterations() {
 fn apgd_residual_is_zero_exactly_at_solutions() {
     let c = ContactConstraint {
         friction: 0.5,
-        normal: crate::contact::constraints::JacobianRow {
+        normal: crate::contact::JacobianRow {
             inverse_effective_mass: 1.0,
             ..Default::default()
         },

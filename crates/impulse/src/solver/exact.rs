@@ -22,24 +22,23 @@
 //! friction direction. Step 2 then projects points whose solution left the disc and updates
 //! the sliding directions, which reclassifies points for the next round. Why: holding friction
 //! fixed converges slowly wherever friction and normal loads are coupled, as on stacks, where
-//! friction torques shift the load between a box's corners. Measured from half the engine's
-//! impulses: a 4-box stack pulled sideways at 0.2 g still had a normal residual of 8e-4 m/s
-//! after 12 plain rounds and an upright stack stalled at 2e-5 m/s, while with sticking rows
-//! in the LCP both finish in one round; a sliding 3-box stack ended at 1.4e-3 m/s after 4
-//! plain rounds and at 7e-7 m/s in 3 rounds with the sliding rows folded in.
+//! friction torques shift the load between a box's corners; with the sticking and sliding
+//! rows in the LCP, stacks pushed sideways or sliding finish in a round or a few.
 //!
 //! Everything happens on copies of the impulses and velocities, written back only when the
 //! solve succeeded, so a failure leaves the caller's (iterative) result untouched.
 
 use glam::Vec3;
 use impulse_lcp::solvers::lemke;
-use impulse_lcp::{Bounds, DenseMatrix, Lcp, Matrix, SolveError, SolverSettings, Status};
+use impulse_lcp::{Bounds, DenseMatrix, Lcp, Matrix, SolverSettings, Status};
 
-use super::{
-    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
-    apply_impulses, project_to_friction_disc, set_scalar_targets,
+use super::cholesky::{cholesky, cholesky_solve, cholesky_solve_columns};
+pub use super::exact_report::{ExactFailure, ExactReport};
+use super::interface::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, set_scalar_targets,
 };
-use crate::contact::constraints::{ContactConstraint, JacobianRow, is_isotropic};
+use super::rows::{Velocities, apply_impulses, project_to_friction_disc};
+use crate::contact::{ContactConstraint, JacobianRow, is_isotropic};
 
 /// The exact path as a [`ContactSolver`]: [`solve_exact`] on islands of at most `max_contacts`
 /// points. A failed solve leaves the rows and velocities as they were and says so in
@@ -173,78 +172,6 @@ pub struct ExactWorkspace {
     best_linear: Vec<Vec3>,
     /// See `best_normal`.
     best_angular: Vec<Vec3>,
-}
-
-/// What a successful exact solve did.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ExactReport {
-    /// Lemke pivots, summed over the rounds.
-    pub pivots: u32,
-    /// Rounds run (normal LCP solves), 1 ..= [`MAX_ROUNDS`]; 0 for an island without contacts.
-    pub rounds: u32,
-    /// Largest natural-map residual of the normal rows at exit, in m/s:
-    /// max_i |min(w_i, γ_i·k_i)|, where w_i = J_i·v − target_i (+ the soft term of a soft row)
-    /// is the row's velocity error after the impulses and k_i = `inverse_effective_mass` turns
-    /// the impulse into the velocity change it causes on its own row. Zero exactly when
-    /// γ ≥ 0, w ≥ 0 and γ_i·w_i = 0 for every row. The regularisation is not part of w.
-    pub residual: f32,
-}
-
-/// Why the exact path gave up; the constraints and velocities are then as they were on entry.
-#[derive(Clone, Debug, thiserror::Error)]
-pub enum ExactFailure {
-    /// The island has more normal rows (contact points) than the caller allows.
-    #[error("{rows} contact rows exceed the exact path's limit of {max_rows}")]
-    TooManyRows {
-        /// Normal rows of the island.
-        rows: usize,
-        /// The caller's limit.
-        max_rows: usize,
-    },
-    /// A contact point's data or a velocity is NaN or infinite (a blown-up step).
-    #[error("non-finite {what} at index {index}")]
-    NonFinite {
-        /// Which data: "contact" (row data, impulses or target) or "velocity".
-        what: &'static str,
-        /// Contact point or velocity slot.
-        index: usize,
-    },
-    /// The regularised tangent block of the sticking points was not numerically positive
-    /// definite (Cholesky met a non-positive pivot).
-    #[error("sticking tangent block ({rows} rows) is not positive definite in round {round}")]
-    Factorisation {
-        /// Tangent rows in the block.
-        rows: usize,
-        /// Round, from 1.
-        round: u32,
-    },
-    /// Lemke ended without a solution: a secondary ray, the pivot limit, or a final residual
-    /// above its tolerance (`Inaccurate`).
-    #[error(
-        "Lemke ended with {status} after {pivots} pivots (residual {residual:.1e}) in round {round}"
-    )]
-    Lemke {
-        /// How Lemke ended (never [`Status::Converged`]).
-        status: Status,
-        /// Pivots of that solve.
-        pivots: usize,
-        /// Lemke's normalised natural-map residual ‖min(γ, w)‖₂ / ‖b‖₂ at the end.
-        residual: f64,
-        /// Round, from 1.
-        round: u32,
-    },
-    /// Lemke refused the assembled problem (it validates every input).
-    #[error("Lemke refused the problem: {0}")]
-    Refused(#[from] SolveError),
-    /// The rounds ended with a larger normal residual than the impulses had on entry (m/s):
-    /// the iterative result is the better one.
-    #[error("exact residual {residual:.3e} m/s is not below the entry residual {entry:.3e} m/s")]
-    NotImproved {
-        /// Residual after the last round (m/s, see [`ExactReport::residual`]).
-        residual: f32,
-        /// Residual of the impulses on entry (m/s).
-        entry: f32,
-    },
 }
 
 /// Solves an island's contact rows exactly (normal rows by Lemke, friction by staggered
@@ -737,95 +664,6 @@ fn sides(c: &ContactConstraint, row: &JacobianRow) -> [Option<Side>; 2] {
     ]
 }
 
-/// In-place Cholesky factorisation of the symmetric s × s matrix whose lower triangle is in
-/// `a` (row-major): on success the lower triangle holds L with A = L Lᵀ. False when a pivot
-/// is not positive (not numerically positive definite).
-fn cholesky(a: &mut [f64], s: usize) -> bool {
-    for j in 0..s {
-        let pivot = a[j * s + j] - (0..j).map(|k| a[j * s + k] * a[j * s + k]).sum::<f64>();
-        if !(pivot > 0.0 && pivot.is_finite()) {
-            return false;
-        }
-        let pivot = pivot.sqrt();
-        a[j * s + j] = pivot;
-        let (above, below) = a.split_at_mut((j + 1) * s);
-        let row_j = &above[j * s..j * s + j];
-        for row_i in below.chunks_exact_mut(s) {
-            let dot: f64 = row_i[..j].iter().zip(row_j).map(|(x, y)| x * y).sum();
-            row_i[j] = (row_i[j] - dot) / pivot;
-        }
-    }
-    true
-}
-
-/// Solves L Lᵀ x = b in place for the factor of [`cholesky`].
-fn cholesky_solve(l: &[f64], s: usize, b: &mut [f64]) {
-    for i in 0..s {
-        let dot: f64 = (0..i).map(|k| l[i * s + k] * b[k]).sum();
-        b[i] = (b[i] - dot) / l[i * s + i];
-    }
-    for i in (0..s).rev() {
-        let dot: f64 = (i + 1..s).map(|k| l[k * s + i] * b[k]).sum();
-        b[i] = (b[i] - dot) / l[i * s + i];
-    }
-}
-
-/// [`cholesky_solve`] on every column of `columns` (column-major, `s` rows each), four at a
-/// time: the four sums are independent chains, so they overlap in the pipeline where one
-/// column's sum waits on each addition. Each column's sums run in the same order as
-/// [`cholesky_solve`]'s, so the results are the same bit for bit.
-fn cholesky_solve_columns(l: &[f64], s: usize, columns: &mut [f64]) {
-    if s == 0 {
-        return;
-    }
-    let mut groups = columns.chunks_exact_mut(4 * s);
-    for group in groups.by_ref() {
-        let (c0, rest) = group.split_at_mut(s);
-        let (c1, rest) = rest.split_at_mut(s);
-        let (c2, c3) = rest.split_at_mut(s);
-        let mut c = [c0, c1, c2, c3];
-        for i in 0..s {
-            substitute_four(&mut c, i, l[i * s..i * s + i].iter(), 0, l[i * s + i]);
-        }
-        for i in (0..s).rev() {
-            // Column i of L below the diagonal, read down the rows.
-            let below = l.get((i + 1) * s + i..).unwrap_or(&[]).iter().step_by(s);
-            substitute_four(&mut c, i, below, i + 1, l[i * s + i]);
-        }
-    }
-    for column in groups.into_remainder().chunks_exact_mut(s) {
-        cholesky_solve(l, s, column);
-    }
-}
-
-/// One substitution step in four columns at once: x_i ← (x_i − Σ_k f_k·x_{from+k}) / pivot,
-/// the sum over `factors` in order from −0.0, as `Iterator::sum` adds.
-#[inline(always)]
-fn substitute_four<'a>(
-    columns: &mut [&mut [f64]; 4],
-    i: usize,
-    factors: impl Iterator<Item = &'a f64>,
-    from: usize,
-    pivot: f64,
-) {
-    let mut dot = [-0.0f64; 4];
-    let [c0, c1, c2, c3] = columns;
-    for ((((factor, x0), x1), x2), x3) in factors
-        .zip(&c0[from..])
-        .zip(&c1[from..])
-        .zip(&c2[from..])
-        .zip(&c3[from..])
-    {
-        dot[0] += factor * x0;
-        dot[1] += factor * x1;
-        dot[2] += factor * x2;
-        dot[3] += factor * x3;
-    }
-    for (column, dot) in columns.iter_mut().zip(dot) {
-        column[i] = (column[i] - dot) / pivot;
-    }
-}
-
 /// Step 2 of a round: symmetric Gauss-Seidel passes over the friction pairs with the normal
 /// impulses fixed. Per point, the 2×2 block solve projected onto the disc |γ_t| ≤ μ·γ_n in
 /// the metric of the tangent block, as [`crate::solver::solve_pgs`] does it.
@@ -912,50 +750,5 @@ fn is_finite(c: &ContactConstraint) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The four-column solve gives each column exactly what one solve at a time gives, and
-    /// both solve A x = b: on a 7 × 7 symmetric positive definite A (tridiagonal, like a
-    /// column of balls, plus a dense coupling), with 6 right-hand sides (one group of four and
-    /// a remainder of two).
-    #[test]
-    fn column_solves_match_single_solves_and_solve_the_system() {
-        let s: usize = 7;
-        let a: Vec<f64> = (0..s * s)
-            .map(|index| {
-                let (i, j) = (index / s, index % s);
-                let coupling = 0.05 / (1.0 + (i + j) as f64);
-                match i.abs_diff(j) {
-                    0 => 4.0 + i as f64 * 0.1 + coupling,
-                    1 => -1.0 + coupling,
-                    _ => coupling,
-                }
-            })
-            .collect();
-        let mut factor = a.clone();
-        assert!(cholesky(&mut factor, s));
-        let columns: Vec<f64> = (0..6 * s)
-            .map(|index| ((index * 37 % 11) as f64 - 5.0) * 0.3)
-            .collect();
-        let mut together = columns.clone();
-        cholesky_solve_columns(&factor, s, &mut together);
-        for (j, (column, solved)) in columns
-            .chunks_exact(s)
-            .zip(together.chunks_exact(s))
-            .enumerate()
-        {
-            let mut alone = column.to_vec();
-            cholesky_solve(&factor, s, &mut alone);
-            assert_eq!(alone, solved, "column {j}");
-            for i in 0..s {
-                let product: f64 = (0..s).map(|k| a[i * s + k] * solved[k]).sum();
-                assert!((product - column[i]).abs() < 1e-12, "column {j}, row {i}");
-            }
-        }
-    }
-}
-
-#[cfg(test)]
 #[path = "exact_tests.rs"]
-mod world_tests;
+mod tests;

@@ -45,9 +45,10 @@
 
 use glam::Vec3;
 
-use super::{Velocities, apply_impulses, cap_to_disc};
+use super::rows::{Velocities, apply_impulses};
 use crate::body::Bodies;
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
+use crate::contact::cap_to_disc;
 use crate::settings::{ImpactModel, SolverSettings};
 
 /// Rounds of reflections per island and step before the remaining ones are made plastic:

@@ -1,11 +1,12 @@
 //! Nonsmooth nonlinear conjugate gradient: PGS sweeps with Fletcher–Reeves momentum.
 
-use super::pgs::{BACKWARD, FORWARD, FrictionFirstRows, Sweep, sweep_points};
-use super::{
-    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
-    apply_impulses, impulses, solve_scalar,
+use super::interface::Sweep;
+use super::interface::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, solve_scalar,
 };
-use crate::contact::constraints::ContactConstraint;
+use super::pgs::{BACKWARD, FORWARD, FrictionFirstRows, sweep_points};
+use super::rows::{Velocities, apply_impulses, impulses};
+use crate::contact::ContactConstraint;
 use crate::graph::COLOURS;
 use crate::parallel::{
     NORM_POINTS_PER_TASK, SWEEP_POINTS_PER_TASK, SharedVelocities, parts_in_order, spread,

@@ -7,11 +7,11 @@
 
 use glam::Vec3;
 
-use super::{
-    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Velocities,
-    project_to_friction_disc, solve_scalar,
+use super::interface::{
+    ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, Sweep, solve_scalar,
 };
-use crate::contact::constraints::ContactConstraint;
+use super::rows::{Velocities, project_to_friction_disc};
+use crate::contact::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours};
 use crate::parallel::{
     SWEEP_POINTS_PER_TASK, SharedVelocities, colour_after_colour, prefetch_lines, spread,
@@ -42,41 +42,6 @@ impl ContactSolver for Pgs {
     }
 }
 
-/// How a sweep visits an island's points: in constraint order, or colour by colour.
-///
-/// A coloured island has its constraints sorted by colour (`colour_constraints`);
-/// colour k is `starts[k]..starts[k + 1]`. Points of one colour below `COLOURS` (64) share no
-/// moving body, so with `parallel` their updates run on rayon's threads at once; the
-/// forward sweep visits colours in order, the backward sweep in reverse. Colour `COLOURS`
-/// (when present) holds the points the greedy colouring could not place and always runs
-/// sequentially.
-///
-/// Outside the crate only [`Sweep::SEQUENTIAL`] can be made: the parallel sweep writes the
-/// bodies' velocities from several threads, which is sound only for constraints that
-/// `colour_constraints` has just sorted, as the island step does.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Sweep<'a> {
-    /// Colour offsets into the constraints (empty: not coloured).
-    pub(crate) starts: &'a [u32],
-    /// Whether one colour's points may be updated on several threads.
-    pub(crate) parallel: bool,
-}
-
-impl Sweep<'_> {
-    /// True when the island's `points` are sorted by colour ([`colour_constraints`]).
-    pub(crate) fn coloured(&self, points: usize) -> bool {
-        let colours = self.starts.len().saturating_sub(1);
-        colours > 0 && self.starts[colours] as usize == points
-    }
-
-    /// Constraint order, one thread: the sweep of [`solve_pgs`]'s documentation.
-    #[cfg(any(test, feature = "internals"))]
-    pub const SEQUENTIAL: Sweep<'static> = Sweep {
-        starts: &[],
-        parallel: false,
-    };
-}
-
 /// One point's update in a sweep: takes the point and its two bodies' velocities (linear and
 /// angular of A, then of B) and returns them updated, with the largest row velocity change
 /// (m/s). A trait rather than a closure so that the update is inlined into the sweep loop.
@@ -99,9 +64,7 @@ impl<const FRICTION: bool> PointUpdate for VelocityRows<FRICTION> {
 /// The velocity rows of a point with the friction pair first, capped by the normal impulse of
 /// the previous update, and the normal row last ([`solve_point_friction_first`]): NNCG's
 /// sweeps. NNCG iterates towards convergence, so the cap catches up within a solve, and in
-/// this order it converged in fewer iterations: the `reference` preset on pyramid20 took 18.2
-/// iterations a step against 24.8 with the normal row first, at about half the time (`impulse
-/// run pyramid20 --steps 300 --no-sleep --preset reference --threads 1 --quiet`).
+/// this order it converges in fewer iterations than with the normal row first.
 #[derive(Clone, Copy)]
 pub(super) struct FrictionFirstRows;
 
@@ -484,119 +447,5 @@ pub(crate) fn colour_constraints(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Points between `slots − 1` moving bodies (slot `slots − 1` is the immovable one), in
-    /// narrow-phase order `source.0 = index`.
-    fn points(pairs: &[(u32, u32)]) -> Vec<ContactConstraint> {
-        pairs
-            .iter()
-            .enumerate()
-            .map(|(i, &(a, b))| ContactConstraint {
-                local_a: a,
-                local_b: b,
-                source: (i as u32, 0, 0),
-                ..ContactConstraint::default()
-            })
-            .collect()
-    }
-
-    /// What the parallel sweeps rely on: every point in exactly one colour, the colours covering
-    /// all points (so the sweep knows the island is coloured), no moving body twice in one of
-    /// the first [`COLOURS`] colours (the immovable slot may repeat), narrow-phase order kept
-    /// within a colour, and each point in the lowest colour its bodies left free.
-    fn check(pairs: &[(u32, u32)], slots: usize) -> Vec<u32> {
-        let mut constraints = points(pairs);
-        let n = constraints.len();
-        let (mut used, mut colours, mut scratch, mut starts) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        colour_constraints(
-            &mut constraints,
-            slots,
-            &mut used,
-            &mut colours,
-            &mut scratch,
-            &mut starts,
-        );
-        assert_eq!(starts.first(), Some(&0));
-        assert_eq!(starts.last().map(|&s| s as usize), Some(n));
-        assert!(
-            starts.windows(2).all(|w| w[0] < w[1]),
-            "empty colour: {starts:?}"
-        );
-        let sweep = Sweep {
-            starts: &starts,
-            parallel: true,
-        };
-        assert!(sweep.coloured(n));
-        let mut seen: Vec<u32> = constraints.iter().map(|c| c.source.0).collect();
-        seen.sort_unstable();
-        assert_eq!(seen, (0..n as u32).collect::<Vec<_>>());
-        let immovable = (slots - 1) as u32;
-        let mut colour_of = vec![0usize; n];
-        for (k, w) in starts.windows(2).enumerate() {
-            let colour = &constraints[w[0] as usize..w[1] as usize];
-            assert!(colour.windows(2).all(|p| p[0].source.0 < p[1].source.0));
-            for c in colour {
-                colour_of[c.source.0 as usize] = k;
-            }
-            if k < COLOURS {
-                let mut bodies: Vec<u32> = colour
-                    .iter()
-                    .flat_map(|c| [c.local_a, c.local_b])
-                    .filter(|&s| s != immovable)
-                    .collect();
-                bodies.sort_unstable();
-                assert!(
-                    bodies.windows(2).all(|b| b[0] != b[1]),
-                    "colour {k} shares a body"
-                );
-            }
-        }
-        // Greedy: a point below the shared colour met each lower colour in an earlier point of
-        // one of its bodies.
-        for (i, &(a, b)) in pairs.iter().enumerate() {
-            for lower in 0..colour_of[i].min(COLOURS) {
-                assert!(
-                    pairs[..i].iter().enumerate().any(|(j, &(c, d))| {
-                        colour_of[j] == lower
-                            && [c, d].iter().any(|&s| s != immovable && (s == a || s == b))
-                    }),
-                    "point {i} could have taken colour {lower}"
-                );
-            }
-        }
-        starts
-    }
-
-    #[test]
-    fn colouring_covers_every_point_and_no_colour_shares_a_moving_body() {
-        // A pile: 300 points between 80 bodies and the ground (slot 80), from a fixed LCG.
-        let mut state = 12345u32;
-        let mut next = |m: u32| {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) % m
-        };
-        let pile: Vec<(u32, u32)> = (0..300)
-            .map(|_| {
-                let a = next(80);
-                // A point joins two different bodies.
-                let b = if next(4) == 0 {
-                    80
-                } else {
-                    (a + 1 + next(79)) % 80
-                };
-                (a, b)
-            })
-            .collect();
-        check(&pile, 81);
-        // One point: one colour.
-        assert_eq!(check(&[(0, 1)], 2), vec![0, 1]);
-        // A body touched by 100 points: 64 colours of one point, then the shared colour.
-        let star: Vec<(u32, u32)> = (0..100).map(|i| (0, 1 + i % 7)).collect();
-        let starts = check(&star, 9);
-        assert_eq!(starts.len(), COLOURS + 2);
-        assert_eq!(starts[COLOURS + 1] - starts[COLOURS], 100 - COLOURS as u32);
-    }
-}
+#[path = "pgs_tests.rs"]
+mod tests;

@@ -2,51 +2,11 @@
 //! converge to more NNCG iterations or, for a small island, to the exact path ([`super::exact`]).
 
 use super::exact::Exact;
+use super::interface::{ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport};
 use super::nncg::Nncg;
-use super::{ContactSolver, SolveOutcome, SolvePass, SolveReport, Velocities};
-use crate::contact::constraints::ContactConstraint;
+use super::rows::Velocities;
+use crate::contact::ContactConstraint;
 use crate::settings::SolverSettings;
-
-/// The methods of the automatic policy, weakest first.
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    PartialOrd,
-    Ord,
-    serde::Serialize,
-    serde::Deserialize,
-)]
-#[serde(rename_all = "snake_case")]
-pub enum EscalationLevel {
-    /// Projected Gauss-Seidel alone (`method: pgs`).
-    #[default]
-    Pgs,
-    /// Nonsmooth nonlinear conjugate gradient within the iteration budget.
-    Nncg,
-    /// Accelerated projected gradient (`method: apgd`).
-    Apgd,
-    /// NNCG given `escalation_iterations` more after the budget left it unconverged.
-    NncgExtended,
-    /// Pivoting on the island's assembled LCP.
-    Exact,
-}
-
-impl EscalationLevel {
-    /// Lower-case name, as in the summary JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            EscalationLevel::Pgs => "pgs",
-            EscalationLevel::Nncg => "nncg",
-            EscalationLevel::Apgd => "apgd",
-            EscalationLevel::NncgExtended => "nncg_extended",
-            EscalationLevel::Exact => "exact",
-        }
-    }
-}
 
 /// What the escalation decides on, besides the solve's own outcome: the settings' thresholds
 /// and the island's heaviest-to-lightest mass ratio and impact speed.
@@ -157,27 +117,5 @@ impl ContactSolver for Auto {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::EscalationLevel;
-
-    /// `name` is the level as the summary JSON writes it (serde's snake case), one per level.
-    #[test]
-    fn names_are_the_serialized_levels() {
-        let levels = [
-            EscalationLevel::Pgs,
-            EscalationLevel::Nncg,
-            EscalationLevel::Apgd,
-            EscalationLevel::NncgExtended,
-            EscalationLevel::Exact,
-        ];
-        for level in levels {
-            let serialized = serde_json::to_value(level).unwrap();
-            assert_eq!(
-                serialized,
-                serde_json::Value::from(level.name()),
-                "{level:?}"
-            );
-        }
-        assert_eq!(EscalationLevel::NncgExtended.name(), "nncg_extended");
-    }
-}
+#[path = "policy_tests.rs"]
+mod tests;

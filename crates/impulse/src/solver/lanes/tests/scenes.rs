@@ -1,6 +1,6 @@
-//! The SIMD-lane solver (`crate::solver::wide`): the same LCP conditions as the scalar sweep, exact
-//! momentum with padding lanes, Coulomb's law for a sliding box, and the `fast` preset standing
-//! on a standard scene.
+//! The SIMD-lane solver ([`crate::solver::lanes`]) on whole scenes: the same LCP conditions as
+//! the scalar sweep, exact momentum with padding lanes, Coulomb's law for a sliding box, and
+//! the `fast` preset standing on a standard scene.
 
 use crate::test_support as common;
 
@@ -340,7 +340,7 @@ fn cubes_on_a_sphere_pile_in_lanes_satisfy_complementarity() {
 
 /// pyramid20 after 30 steps, and its contact rows with world indices as slots: every
 /// immovable body in the last slot, `bodies.len()`.
-fn settled_pyramid20_rows() -> (World, Vec<crate::contact::constraints::ContactConstraint>) {
+fn settled_pyramid20_rows() -> (World, Vec<crate::contact::ContactConstraint>) {
     let mut scene = builtin_scene("pyramid20").unwrap();
     scene.solver.sleep = false;
     let mut w = World::from_scene(&scene).unwrap();
@@ -377,7 +377,7 @@ fn settled_pyramid20_rows() -> (World, Vec<crate::contact::constraints::ContactC
 #[test]
 fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
     use super::Bundles;
-    use crate::contact::constraints::{BodySlots, ContactConstraint};
+    use crate::contact::{BodySlots, ContactConstraint};
     use crate::diagnostics::record_velocity_before_and_residual;
     use crate::solver::{ContactSolver, Velocities};
     let (w, settled) = settled_pyramid20_rows();
@@ -482,7 +482,7 @@ fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
 }
 
 /// The lanes set each row's target and softness from the separation the bodies have reached,
-/// as the scalar [`crate::contact::constraints::update_targets`] does: pyramid20's rows, with
+/// as the scalar [`crate::contact::update_targets`] does: pyramid20's rows, with
 /// every moving body displaced by up to 2 mm and turned by up to 0.05 rad about all three axes
 /// (each point's move is Δx + Δθ × r), through the soft main solve and the relax solve, with
 /// the problem turned out of the pyramid's plane; then with every third body turned past the
@@ -490,9 +490,7 @@ fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
 #[test]
 fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
     use super::Bundles;
-    use crate::contact::constraints::{
-        ContactConstraint, SPECULATIVE_TURN, STALE_TARGET, update_targets,
-    };
+    use crate::contact::{ContactConstraint, SPECULATIVE_TURN, STALE_TARGET, update_targets};
     use crate::solver::{SolvePass, Sweep, TargetInputs, Velocities};
     let (w, settled) = settled_pyramid20_rows();
     let n = w.bodies.len();
@@ -728,7 +726,7 @@ fn pass_at_rest<'a>(
 #[test]
 fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
     use super::Bundles;
-    use crate::contact::constraints::ContactConstraint;
+    use crate::contact::ContactConstraint;
     use crate::solver::{ContactSolver, Velocities};
     let (w, settled) = settled_pyramid20_rows();
     let n = w.bodies.len();

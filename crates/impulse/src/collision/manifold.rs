@@ -1,0 +1,48 @@
+//! A contact manifold as the engine keeps it across steps: Parry's manifold with the solver's
+//! impulses per point ([`ContactImpulse`]) and the friction basis per manifold
+//! ([`ManifoldState`]), and the world poses of its two shapes.
+
+use glam::Vec3;
+use parry3d::math::Pose;
+use parry3d::query::ContactManifold;
+use parry3d::utils::PoseOpt;
+use serde::{Deserialize, Serialize};
+
+/// Impulses a contact point received in the last solve, kept with the point across steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ContactImpulse {
+    /// Normal impulse γ_n ≥ 0 (N·s).
+    pub normal: f32,
+    /// Friction impulse as a world vector (N·s), so it survives a change of tangent basis.
+    pub friction: Vec3,
+    /// Normal impulse over the whole last step (N·s): every substep's together. `normal` is
+    /// the last substep's alone, which is what warm starting reads.
+    pub step_normal: f32,
+    /// Friction impulse over the whole last step, world vector (N·s).
+    pub step_friction: Vec3,
+}
+
+/// Per-manifold state kept across steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ManifoldState {
+    /// First friction direction of the last step (zero before the first solve). Reusing it
+    /// keeps the friction basis continuous: a basis rebuilt from the normal alone can flip
+    /// between steps, and warm-started friction then lands on the wrong axes.
+    pub tangent: Vec3,
+}
+
+/// Parry's manifold type with our per-manifold and per-point data.
+pub type Manifold = ContactManifold<ManifoldState, ContactImpulse>;
+
+/// The world poses of a manifold's two shapes: the bodies' poses `pose1`, `pose2` with the
+/// manifold's sub-shape poses (a compound's part) appended. Parry gives a composite shape's
+/// points and normal in the frame of the part that touches (`subshape_pos1`/`subshape_pos2`,
+/// absent for convex shapes, triangle meshes and height fields, whose parts are in the
+/// shape's own frame).
+#[inline]
+pub fn manifold_poses(manifold: &Manifold, pose1: &Pose, pose2: &Pose) -> (Pose, Pose) {
+    (
+        manifold.subshape_pos1().prepend_to(pose1),
+        manifold.subshape_pos2().prepend_to(pose2),
+    )
+}

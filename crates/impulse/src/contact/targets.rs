@@ -1,0 +1,155 @@
+//! The rows' targets, set per substep: the normal rows' target velocities and softness from
+//! the separation each point has reached (gap closing, overlap repair, stale speculative
+//! rows), the soft contact's terms, and restitution's targets after the substeps.
+
+use glam::Vec3;
+
+use super::row::ContactConstraint;
+use crate::settings::{ContactRepair, SolverSettings};
+
+/// Sets every normal row's target for a solve of duration `h` (s), from the separation the
+/// contact has now: its separation at assembly plus the normal component of the two bodies'
+/// displacement since then, Δp = Δx + Δθ × r (linearised; `displacement` and `rotation` are
+/// per body, m and rad). With separation s (= −depth):
+///
+/// - s > 0, a speculative gap: v⁺ ≥ −s/h, the bodies may close the gap but not overlap;
+/// - s ≤ 0, overlap d = −s, `with_repair`: the overlap repair (Baumgarte) v⁺ ≥ c_d·max(d − slop, 0),
+///   capped at `max_repair_speed`. With soft repair ([`ContactRepair::Soft`]), c_d and the row's softness
+///   come from a damped spring instead ([`soft_contact`]);
+/// - s ≤ 0 without repair (the relax solve): v⁺ ≥ 0, rigid.
+///
+/// A speculative row of a body that had turned by more than [`SPECULATIVE_TURN`] since the step
+/// began, as the substep started (`turn`: per body, the square of that angle), is stale
+/// ([`speculative_row_is_stale`]) and gets no push: its target is [`STALE_TARGET`], which
+/// releases the impulse the warm start gave it. A row whose lever arm lies along its normal (a ball's)
+/// does not depend on the body's rotation and is never stale.
+///
+/// With split impulse, returns whether any row has a repair to make, a position target above
+/// `settings.tolerance`: when none has, the position solve would end after its first sweep
+/// having changed no row's velocity by more than the tolerance, and the caller skips it. At rest
+/// this is the usual case: the repair decays exponentially towards the slop and never quite
+/// reaches it. Without split impulse, returns false.
+pub fn update_targets(
+    constraints: &mut [ContactConstraint],
+    displacement: &[Vec3],
+    rotation: &[Vec3],
+    turn: &[f32],
+    settings: &SolverSettings,
+    h: f32,
+    with_repair: bool,
+) -> bool {
+    let mut any_repair = false;
+    let (repair_rate, softness) = repair_terms(&settings.repair, h);
+    for c in constraints.iter_mut() {
+        let (a, b) = (c.local_a as usize, c.local_b as usize);
+        let moved = (displacement[a] + rotation[a].cross(c.lever_a))
+            - (displacement[b] + rotation[b].cross(c.lever_b));
+        let separation = -c.depth + c.normal.direction.dot(moved);
+        let stale = separation > 0.0
+            && !turn.is_empty()
+            && (speculative_row_is_stale(turn[a], c.normal.angular_a, c.lever_a)
+                || speculative_row_is_stale(turn[b], c.normal.angular_b, c.lever_b));
+        let gap_target = if stale { STALE_TARGET } else { -separation / h };
+        let repair = (repair_rate * (-separation - settings.overlap_slop).max(0.0))
+            .min(settings.max_repair_speed);
+        if settings.split_impulse() {
+            // The repair goes to the position solve; the velocity rows stay rigid.
+            c.position_target = repair;
+            c.position_impulse = 0.0;
+            any_repair |= repair > settings.tolerance;
+            c.target_normal_velocity = if separation > 0.0 { gap_target } else { 0.0 };
+            c.softness = (1.0, 0.0);
+            continue;
+        }
+        (c.target_normal_velocity, c.softness) = if separation > 0.0 {
+            (gap_target, (1.0, 0.0))
+        } else if with_repair {
+            (repair, softness)
+        } else {
+            (0.0, (1.0, 0.0))
+        };
+    }
+    any_repair
+}
+
+/// How far (rad) a body may have turned since the step began for its speculative rows to
+/// still push it. A row's gap and its lever arm were taken at the step's start; each substep
+/// moves the contact point by the linearised Δθ × r, off by about |Δθ|²·|r|/2, and its
+/// response (r × n and I⁻¹ at the start orientation) no longer matches the body. Turned by
+/// several radians, a gap that the real motion has opened reads as closed, and the row stops
+/// a body where nothing touches it (a "ghost" contact); worse, its impulse, applied through
+/// the start orientation's inverse inertia, can add energy as the body's inertia now counts it
+/// (a dart that hit a wall at 200 m/s and spins at 460–970 rad/s gained 265–1,140 J/kg in one
+/// or two substeps so, tests/ccd.rs). At an eighth of a turn the linearised point is already
+/// off by 0.3·|r|. Over the tumbling impacts of tests/ccd.rs (darts and plates at 0, 30 and
+/// 100 rad/s about three axes, four angles), the largest energy rise above the lowest was 28
+/// J/kg with this limit or with 0.5 rad, 36 J/kg with a quarter turn, and 851 J/kg (21 runs
+/// over the blow-up guard) without one. Touching and overlapping rows keep acting: dropping
+/// them too let darts through the wall; they hold a body where it is pressed, and continuous
+/// collision sweeps its true motion as the step ends.
+pub const SPECULATIVE_TURN: f32 = std::f32::consts::FRAC_PI_4;
+
+/// The target (m/s) of a stale speculative row: far below any approach speed (the blow-up guard
+/// stops a body at 10⁴ m/s), so the row's impulse goes to zero, yet small enough that no
+/// solver's products of it overflow.
+pub const STALE_TARGET: f32 = -1.0e15;
+
+/// Whether a body's part of a speculative row is stale: the body had turned by more than
+/// [`SPECULATIVE_TURN`] since the step began (`turn`, the square of that angle, rad²) and the
+/// row's angular part `angular` (r × n) is not negligible next to its lever arm `lever`. A
+/// lever arm along the normal (|r × n| ≤ 10⁻³·|r|) gives n·(Δθ × r) = Δθ·(r × n) ≈ 0 and no
+/// torque: the row does not depend on the body's rotation.
+#[inline]
+pub fn speculative_row_is_stale(turn: f32, angular: Vec3, lever: Vec3) -> bool {
+    turn > SPECULATIVE_TURN * SPECULATIVE_TURN
+        && angular.length_squared() > 1e-6 * lever.length_squared()
+}
+
+/// The stiffest contact spring the soft step takes, as a fraction of the substep rate 1/h.
+/// With one sweep a substep, a spring at a quarter of the rate (Box2D v3's cap) pumped energy
+/// into resting piles: pyramid20 gained tens of joules, the 400:1 `plate` kept rising; at a
+/// fifth they come to rest (docs/benchmarks.md, "Why the soft step is set this way").
+pub const MAX_SOFT_HERTZ_PER_SUBSTEP_RATE: f32 = 0.2;
+
+/// Soft contact as a damped spring of frequency `hertz` (capped at a fifth of the substep
+/// rate, [`MAX_SOFT_HERTZ_PER_SUBSTEP_RATE`]) and damping ratio ζ, discretised implicitly over
+/// `h` (Catto, "Solver2D" and Box2D v3 `b2MakeSoft`): returns the repair rate (1/s) and (mass
+/// scale, impulse scale).
+pub fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32)) {
+    let hertz = hertz.min(MAX_SOFT_HERTZ_PER_SUBSTEP_RATE / h);
+    let omega = 2.0 * std::f32::consts::PI * hertz;
+    let a1 = 2.0 * damping_ratio + h * omega;
+    let a2 = h * omega * a1;
+    let a3 = 1.0 / (1.0 + a2);
+    (omega / a1, (a2 * a3, a3))
+}
+
+/// The repair rate (1/s) and the soft rows' (mass scale, impulse scale) of `repair` for a
+/// substep of `h` seconds: the spring's for soft repair ([`soft_contact`]), the rate with
+/// rigid rows (1, 0) otherwise.
+pub fn repair_terms(repair: &ContactRepair, h: f32) -> (f32, (f32, f32)) {
+    match *repair {
+        ContactRepair::Soft {
+            hertz,
+            damping_ratio,
+        } => soft_contact(hertz, damping_ratio, h),
+        ContactRepair::Bias { rate } | ContactRepair::SplitImpulse { rate, .. } => {
+            (rate, (1.0, 0.0))
+        }
+    }
+}
+
+/// Newton's restitution hypothesis, v⁺ = −c_r·v⁻, for the points that collided this
+/// step: approach speed −v⁻ above the threshold and a normal impulse received. Sets their
+/// targets and returns whether any point bounces; other targets are left as they are.
+pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32) -> bool {
+    let mut any = false;
+    for c in constraints.iter_mut() {
+        let approach = c.normal.velocity_before;
+        if c.restitution > 0.0 && approach < -threshold && c.max_normal_impulse > 0.0 {
+            c.target_normal_velocity = -c.restitution * approach;
+            any = true;
+        }
+    }
+    any
+}

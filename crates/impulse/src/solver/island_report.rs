@@ -1,0 +1,51 @@
+//! What the solver did on one island in a step ([`IslandReport`]), part of every step's
+//! diagnostics.
+
+use super::heavy_on_light::HeavyOnLight;
+use super::interface::EscalationLevel;
+#[cfg(doc)]
+use crate::settings::SolverSettings;
+
+/// What the solver did on one island during a step (step 7 of docs/architecture.md: every step can say how
+/// well its LCP was solved, here per island).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct IslandReport {
+    /// Smallest body index in the island: a stable name for it within the step.
+    pub first_body: u32,
+    /// Moving bodies in the island.
+    pub bodies: u32,
+    /// Contact points (normal rows) in the island.
+    pub contacts: u32,
+    /// Heaviest to lightest moving body mass (1 for one body).
+    pub mass_ratio: f32,
+    /// The strongest method any of its solves used: `pgs`, `nncg`, `apgd`, `nncg_extended` or
+    /// `exact`. For `auto`: `exact` if any solve was exact, as `last_change` is then the exact
+    /// solve's residual (m/s).
+    pub method: EscalationLevel,
+    /// Solves (one per substep) that escalated beyond their first method.
+    pub escalations: u32,
+    /// Exact solves attempted that failed (their iterative result was kept).
+    pub exact_failures: u32,
+    /// Lemke pivots of the exact solves.
+    pub exact_pivots: u32,
+    /// Iterations used in the step, all solves and methods together.
+    pub iterations: u32,
+    /// Largest row velocity change of the last iteration of the last main solve (m/s): how far
+    /// from converged the island's final solve stopped.
+    pub last_change: f32,
+    /// Whether the substeps' solves ran in SIMD lanes.
+    pub simd: bool,
+    /// Natural-map residual of the island's rows at the end of the step (see
+    /// [`crate::diagnostics::StepDiagnostics::natural_map_residual`]); set by the world as the
+    /// island's step ends.
+    pub natural_map_residual: f32,
+    /// Substeps the island took in the step: the settings' `substeps`, or 1 on the
+    /// heavy-on-light path ([`HeavyOnLight::exact`]).
+    #[serde(default)]
+    pub substeps: u32,
+    /// The island's contact of largest mass ratio between two moving bodies, when that ratio
+    /// exceeds [`SolverSettings::heavy_on_light_mass_ratio`]; `None` otherwise (and for
+    /// split-impulse repair, which holds such islands on its own).
+    #[serde(default)]
+    pub heavy_on_light: Option<HeavyOnLight>,
+}

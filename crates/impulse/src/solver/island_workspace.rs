@@ -1,0 +1,123 @@
+//! An island's work space: its bodies' local state during a step (velocities, displacements,
+//! orientations, per-step constants), its solvers' work spaces kept from step to step, and
+//! what the solver reports for it.
+
+use glam::{Mat3, Quat, Vec3};
+
+use super::apgd::Apgd;
+use super::impact::ImpactWorkspace;
+use super::interface::{ContactSolver, RowsReport};
+use super::island_report::IslandReport;
+use super::lanes::Bundles;
+use super::nncg::Nncg;
+use super::pgs::Pgs;
+use super::policy::Auto;
+use crate::contact::ContactConstraint;
+use crate::settings::SolverMethod;
+#[cfg(doc)]
+use crate::{contact, integrate, solver::Sweep};
+
+/// Local state of one island during a step.
+#[derive(Default)]
+pub struct IslandWorkspace {
+    /// Linear velocities (m/s) of the island's bodies, then its guests (kinematic bodies),
+    /// then the immovable slot.
+    pub linear: Vec<Vec3>,
+    /// Angular velocities (rad/s), same layout.
+    pub angular: Vec<Vec3>,
+    /// Centre-of-mass displacement since the start of the step (m).
+    pub displacement: Vec<Vec3>,
+    /// Rotation vector accumulated since the start of the step (rad), for separations.
+    pub rotation: Vec<Vec3>,
+    /// Per slot, the square of the angle (rad²) turned since the start of the step, as the
+    /// current substep started: which speculative rows are stale
+    /// ([`contact::speculative_row_is_stale`]).
+    pub(super) turn: Vec<f32>,
+    /// Orientations, integrated substep by substep.
+    pub orientation: Vec<Quat>,
+    /// Per body, the linear and angular acceleration of its applied force and torque (m/s²,
+    /// rad/s²); empty in a step without forces.
+    pub(super) acceleration: Vec<(Vec3, Vec3)>,
+    /// Per body, the body-frame inertia tensor of its gyroscopic term
+    /// ([`integrate::gyroscopic_inertia`]); empty when no body of the island has one. Zero for
+    /// bodies with a locked rotation axis.
+    pub(super) inertia: Vec<Mat3>,
+    /// The island's bodies with exactly one locked rotation axis and a gyroscopic term: their
+    /// slot, the locked world axis (0, 1, 2 for x, y, z) and their body-frame tensor, for
+    /// [`integrate::gyroscopic_in_plane`].
+    pub(super) rotation_locks: Vec<(u32, u8, Mat3)>,
+    /// Per body, the factors 1/(1 + h·c) of its linear and angular damping for one substep;
+    /// empty when no body of the island is damped.
+    pub(super) damping: Vec<(f32, f32)>,
+    /// The island's bodies with a locked translation axis: their slot and
+    /// [`crate::body::LockedAxes::translation_factor`], which takes gravity's share off the
+    /// locked axes (forces and impulses go through the per-axis inverse mass, zero there).
+    pub(super) translation_locks: Vec<(u32, Vec3)>,
+    pub(super) pseudo_linear: Vec<Vec3>,
+    pub(super) pseudo_angular: Vec<Vec3>,
+    /// Colour offsets of the island's constraints when it is coloured (see [`Sweep`]).
+    pub(super) colour_starts: Vec<u32>,
+    pub(super) used_colours: Vec<u64>,
+    pub(super) colours: Vec<u8>,
+    pub(super) colour_scratch: Vec<ContactConstraint>,
+    /// Per part of rows, per slot: M⁻¹Jᵀγ of [`contact::record_velocity_before`].
+    pub(crate) record_scratch: Vec<(Vec3, Vec3)>,
+    /// The rows' record as the step ended when the SIMD lanes took it (the rows' J·v* are
+    /// then in the constraints); `None` leaves it to
+    /// [`crate::diagnostics::record_velocity_before_and_residual`].
+    pub(crate) rows: Option<RowsReport>,
+    /// Whether one colour may be solved on several threads.
+    pub(super) parallel: bool,
+    /// The methods, each with its work space, kept between steps.
+    pub(super) solvers: Solvers,
+    /// What the solver did on this island in the step.
+    pub report: IslandReport,
+    /// Rows with friction (μ > 0), counted by the world as the island's step ends.
+    pub(crate) friction_rows: usize,
+    /// Split impulse: whether the last targets asked any row for overlap repair.
+    pub(super) position_repair: bool,
+    /// Per body slot, its world inverse inertia (for [`ContactSolver::prepare`]).
+    pub(super) slot_inverse_inertia: Vec<Mat3>,
+    /// `impact: propagation`'s work space ([`super::impact`]).
+    pub(super) impact: ImpactWorkspace,
+    /// Whether this substep's main solve met an impact ([`IMPACT_SWEEPS`]).
+    pub(super) impact_met: bool,
+    /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]).
+    pub(super) impact_speed: f32,
+}
+
+/// Every method's solver, so that an island keeps its work spaces from step to step.
+#[derive(Default)]
+pub(super) struct Solvers {
+    pub(super) pgs: Pgs,
+    pub(super) nncg: Nncg,
+    pub(super) apgd: Apgd,
+    pub(super) auto: Auto,
+    /// The island's points in SIMD bundles, when it is solved in lanes.
+    pub(super) wide: Bundles,
+}
+
+impl Solvers {
+    /// The solver of `method` on the constraints themselves.
+    pub(super) fn scalar(&mut self, method: SolverMethod) -> &mut dyn ContactSolver {
+        match method {
+            SolverMethod::Pgs => &mut self.pgs,
+            SolverMethod::Nncg => &mut self.nncg,
+            SolverMethod::Apgd => &mut self.apgd,
+            SolverMethod::Auto => &mut self.auto,
+        }
+    }
+
+    /// The substeps' solver: the lanes when the island is `bundled`, else [`Solvers::scalar`].
+    pub(super) fn substeps(
+        &mut self,
+        method: SolverMethod,
+        bundled: bool,
+    ) -> &mut dyn ContactSolver {
+        if bundled {
+            &mut self.wide
+        } else {
+            self.scalar(method)
+        }
+    }
+}

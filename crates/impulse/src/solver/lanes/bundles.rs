@@ -1,0 +1,65 @@
+//! The lanes solver's state for one island: its packed bundles, lane groups and colours, the
+//! layout they were made for, and the scratch of packing, recording and carrying.
+
+use glam::Vec3;
+
+use super::lane::{LANES, Lane};
+use super::layout::{Bundle, BundleGeometry, BundleRecord, Group, PointKey};
+use crate::solver::interface::RowsReport;
+
+/// An island's contact points packed in bundles, manifold group by manifold group, colour by
+/// colour.
+#[derive(Default)]
+pub struct Bundles {
+    pub(super) bundles: Vec<Bundle>,
+    pub(super) geometry: Vec<BundleGeometry>,
+    /// Per bundle, the impulses (normal, tangent 1, tangent 2) of the substeps so far, lane by
+    /// lane (see [`ContactConstraint::step_impulses`]).
+    pub(super) step_totals: Vec<[Lane; 3]>,
+    /// The lane groups (see [`Group`]) in bundle order; colour k's are
+    /// `group_colour_starts[k]..group_colour_starts[k + 1]`. The last colour holds the manifold
+    /// groups the colouring could not place, one per lane group, and always runs on one thread.
+    pub(super) groups: Vec<Group>,
+    pub(super) group_colour_starts: Vec<usize>,
+    /// Packing scratch: per manifold group (a run of at most [`GROUP_POINTS`] consecutive
+    /// points between the same two bodies), its first point, and its lane group and lane.
+    pub(super) runs: Vec<u32>,
+    pub(super) run_places: Vec<(u32, u32)>,
+    /// Whether one colour's bundles may be updated on several threads.
+    pub(super) parallel: bool,
+    /// Constraint index of each lane of each bundle; `u32::MAX` for padding.
+    pub(super) sources: Vec<[u32; LANES]>,
+    /// Where each constraint went: bundle index × [`LANES`] + lane.
+    pub(super) slots: Vec<u32>,
+    /// Greedy colouring scratch: per slot, the colours its groups use; per group, its colour.
+    pub(super) used: Vec<u64>,
+    pub(super) colours: Vec<u8>,
+    /// What the layout (`groups`, `runs`, `run_places`, `sources`, `slots`) was made for: each
+    /// point's key (body slots, pair, manifold), and the island's slot count.
+    pub(super) layout_keys: Vec<PointKey>,
+    /// This pack's key per point, before they are compared with `layout_keys`.
+    pub(super) keys: Vec<PointKey>,
+    pub(super) layout_slots: usize,
+    /// What [`Bundles::record`] found per bundle, and the velocities v* it took them from;
+    /// `recorded` until the next pack. `rows` is what [`Bundles::unpack`] summed from them.
+    pub(super) records: Vec<BundleRecord>,
+    pub(super) before_linear: Vec<Vec3>,
+    pub(super) before_angular: Vec<Vec3>,
+    /// Whether `before_linear` and `before_angular` hold v* kept during the substeps
+    /// ([`Bundles::keep_velocities_before`]) for the next record.
+    pub(super) before_kept: bool,
+    /// The next substep's warm start per island slot, M⁻¹Jᵀγ of the final impulses of a relax
+    /// sweep that added it as it went ([`RelaxCarrying`]); `carried` until that warm start.
+    pub(super) carried_linear: Vec<Vec3>,
+    pub(super) carried_angular: Vec<Vec3>,
+    pub(super) carried: bool,
+    pub(super) recorded: bool,
+    pub(super) rows: Option<RowsReport>,
+}
+
+impl Bundles {
+    /// Whether [`Bundles::pack`] was asked to spread colours over rayon's threads.
+    pub fn parallel(&self) -> bool {
+        self.parallel
+    }
+}

@@ -1,0 +1,109 @@
+//! The SIMD vocabulary of the lanes solver: [`LANES`] `f32`s in one register ([`Lane`]), a
+//! vector per lane ([`LaneVec`]) and their arithmetic, lane writes and reads.
+
+use glam::Vec3;
+
+/// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
+/// AArch64), so no target feature is needed. The `lanes8` feature makes it 8 (a 256-bit AVX
+/// register when built with `-C target-cpu=native` on a CPU that has AVX2), not the default:
+/// gathering and scattering eight lanes' bodies and the padding of small colours cost more
+/// than the wider arithmetic saves on the standard scenes (docs/benchmarks.md, "Solver cost
+/// per row"). The sweep order is the same either way (colour by colour; the lanes of a bundle
+/// hold independent manifold groups of one colour), so results differ only where padding and
+/// the colouring's overflow groups fall differently.
+#[cfg(not(feature = "lanes8"))]
+pub const LANES: usize = 4;
+/// See the 4-lane constant.
+#[cfg(feature = "lanes8")]
+pub const LANES: usize = 8;
+
+/// One SIMD register of [`LANES`] `f32`s.
+#[cfg(not(feature = "lanes8"))]
+pub(super) type Lane = wide::f32x4;
+#[cfg(feature = "lanes8")]
+pub(super) type Lane = wide::f32x8;
+
+/// A vector per lane: x, y and z each in one register.
+pub(super) type LaneVec = [Lane; 3];
+
+#[inline(always)]
+pub(super) fn lane_vec(vectors: [Vec3; LANES]) -> LaneVec {
+    [
+        Lane::new(vectors.map(|v| v.x)),
+        Lane::new(vectors.map(|v| v.y)),
+        Lane::new(vectors.map(|v| v.z)),
+    ]
+}
+
+#[inline(always)]
+pub(super) fn dot(a: LaneVec, b: LaneVec) -> Lane {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+pub(super) fn add_scaled(a: LaneVec, b: LaneVec, s: Lane) -> LaneVec {
+    [a[0] + b[0] * s, a[1] + b[1] * s, a[2] + b[2] * s]
+}
+
+/// a + b·s component by component: a scale per axis (a per-axis inverse mass).
+#[inline(always)]
+pub(super) fn add_scaled_per_axis(a: LaneVec, b: LaneVec, s: LaneVec) -> LaneVec {
+    [a[0] + b[0] * s[0], a[1] + b[1] * s[1], a[2] + b[2] * s[2]]
+}
+
+#[inline(always)]
+pub(super) fn cross(a: LaneVec, b: LaneVec) -> LaneVec {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[inline(always)]
+pub(super) fn sub(a: LaneVec, b: LaneVec) -> LaneVec {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// The lanes of a vector as [`LANES`] vectors.
+#[inline(always)]
+pub(super) fn unlane(v: &LaneVec) -> [Vec3; LANES] {
+    let [x, y, z] = [v[0].to_array(), v[1].to_array(), v[2].to_array()];
+    std::array::from_fn(|i| Vec3::new(x[i], y[i], z[i]))
+}
+
+/// Δx + Δθ × r per lane.
+#[inline(always)]
+pub(super) fn add_cross(linear: LaneVec, angular: LaneVec, lever: LaneVec) -> LaneVec {
+    let turn = cross(angular, lever);
+    [
+        linear[0] + turn[0],
+        linear[1] + turn[1],
+        linear[2] + turn[2],
+    ]
+}
+
+#[inline(always)]
+pub(super) fn set(lane: &mut Lane, i: usize, value: f32) {
+    lane.as_mut_array()[i] = value;
+}
+
+#[inline(always)]
+pub(super) fn set_vec(lanes: &mut LaneVec, i: usize, value: Vec3) {
+    set(&mut lanes[0], i, value.x);
+    set(&mut lanes[1], i, value.y);
+    set(&mut lanes[2], i, value.z);
+}
+
+/// [`crate::contact::cap_to_disc`] per lane: the radial projection of a friction
+/// impulse onto Coulomb's disc of radius `limit` (N·s), with the scalar function's operations
+/// in the same order, so each lane gets the scalar result to the bit.
+#[inline(always)]
+pub(super) fn cap_to_disc(impulse: [Lane; 2], limit: Lane) -> [Lane; 2] {
+    let zero = Lane::splat(0.0);
+    let squared = impulse[0] * impulse[0] + impulse[1] * impulse[1];
+    let inside = squared.simd_le(limit * limit);
+    let positive = squared.simd_gt(zero);
+    let scale = limit / squared.sqrt();
+    impulse.map(|x| inside.select(x, positive.select(x * scale, zero)))
+}

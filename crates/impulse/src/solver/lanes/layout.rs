@@ -1,0 +1,314 @@
+//! What the lanes hold: a bundle's rows (one point per lane), a lane group's shared part
+//! (bodies, masses, directions, friction), the points' geometry for the targets, the record
+//! per bundle, the two bodies' velocities per lane and how one point is written into a lane.
+
+use glam::Vec3;
+
+use super::lane::{
+    LANES, Lane, LaneVec, add_scaled, add_scaled_per_axis, dot, lane_vec, set, set_vec, sub, unlane,
+};
+use crate::contact::{ContactConstraint, JacobianRow};
+use crate::parallel::SharedVelocities;
+
+/// One Jacobian row (see [`JacobianRow`]) for the points of a bundle; its direction is the
+/// lane group's ([`Group::directions`]).
+#[derive(Clone, Copy, Default)]
+pub(super) struct RowLanes {
+    pub(super) angular_a: LaneVec,
+    pub(super) angular_b: LaneVec,
+    pub(super) inverse_inertia_angular_a: LaneVec,
+    pub(super) inverse_inertia_angular_b: LaneVec,
+    pub(super) effective_mass: Lane,
+    pub(super) inverse_effective_mass: Lane,
+}
+
+/// What a sweep reads and writes for the points of one bundle, besides what its lane group's
+/// points share ([`Group`]). What the normal rows' sweep (the main solve's) reads and writes
+/// comes first, up to [`NORMAL_PART`] bytes, so that it touches the bundle's first cache
+/// lines alone; bundles start on a cache line.
+#[derive(Clone, Copy, Default)]
+#[repr(C, align(64))]
+pub(super) struct Bundle {
+    pub(super) normal: RowLanes,
+    /// Target normal velocity (m/s) and softness (mass scale, impulse scale) of the solve.
+    pub(super) target: Lane,
+    pub(super) mass_scale: Lane,
+    pub(super) impulse_scale: Lane,
+    pub(super) normal_impulse: Lane,
+    pub(super) max_normal_impulse: Lane,
+    pub(super) tangents: [RowLanes; 2],
+    pub(super) tangent_inverse_block: [Lane; 3],
+    /// Step of a sliding lane's friction update, 1/k₁ with k₁ the tangent block's larger
+    /// eigenvalue (kg); 0 where both bodies are immovable (see [`solve_bundle`]).
+    pub(super) sliding_step: Lane,
+    pub(super) tangent_impulses: [Lane; 2],
+}
+
+/// Bytes at the start of a [`Bundle`] that the normal rows' sweep reads and writes: a third of
+/// the bundle, which a sweep over the normal rows alone asks the CPU for (see
+/// [`sweep_groups`]).
+pub(super) const NORMAL_PART: usize = std::mem::offset_of!(Bundle, tangents);
+
+/// What the target update of [`Bundles::solve_pgs`] reads: where the points are.
+#[derive(Clone, Copy, Default)]
+pub(super) struct BundleGeometry {
+    pub(super) lever_a: LaneVec,
+    pub(super) lever_b: LaneVec,
+    /// Penetration depth at assembly (m), > 0 when overlapping.
+    pub(super) depth: Lane,
+    /// Per lane, whether the pack computes its lever-arm products: for a point whose products
+    /// are pending ([`ContactConstraint::products_pending`]). Padding keeps the zero products
+    /// it was reset to (computed from its zero lever arms and its lane's direction, some would
+    /// come out as −0).
+    pub(super) pending: [bool; LANES],
+}
+
+impl BundleGeometry {
+    /// The geometry of a lane group's padding: no lever arms, no depth.
+    pub(super) const PADDING: Self = Self {
+        lever_a: [Lane::ZERO; 3],
+        lever_b: [Lane::ZERO; 3],
+        depth: Lane::ZERO,
+        pending: [false; LANES],
+    };
+}
+
+/// Bundles that share their lanes' bodies: lane i of every bundle in `start..start + len`
+/// holds a point of the same manifold group (the same two bodies, one manifold), so a sweep
+/// gathers the lanes' velocities once, updates the `len` bundles in turn on them, and
+/// scatters once. What a manifold group's points share is kept here once, lane by lane,
+/// rather than in each of its bundles: with four lanes a sweep of the normal rows then
+/// streams 304 bytes a bundle instead of 480, and a sweep of all rows 896 instead of 1,152,
+/// while the group stays in the first-level cache as its bundles are updated. Padding points
+/// get their lane's values; their zero lever arms, effective masses and impulses still make
+/// their updates change nothing.
+#[derive(Clone, Copy, Default, Debug, PartialEq)]
+pub(super) struct Group {
+    pub(super) start: u32,
+    pub(super) len: u32,
+    /// Local slots of bodies A and B per lane (the immovable slot where the lane holds no
+    /// manifold group).
+    pub(super) local_a: [u32; LANES],
+    pub(super) local_b: [u32; LANES],
+    /// Per-axis inverse masses of A and B (see [`ContactConstraint::inverse_mass_a`]).
+    pub(super) inverse_mass_a: LaneVec,
+    pub(super) inverse_mass_b: LaneVec,
+    /// The rows' directions: the manifold's normal and its two tangents.
+    pub(super) directions: [LaneVec; 3],
+    /// Coulomb coefficient μ of the pair.
+    pub(super) friction: Lane,
+}
+
+impl Group {
+    /// The per-axis inverse masses of A and B, lane by lane.
+    #[inline(always)]
+    pub(super) fn inverse_masses(&self) -> (LaneVec, LaneVec) {
+        (self.inverse_mass_a, self.inverse_mass_b)
+    }
+}
+
+/// What the layout of [`Bundles::pack`] is made from, per point: its body slots, its pair and
+/// its manifold in the pair ([`ContactConstraint::source`]). A manifold group is a run of
+/// consecutive points with the same key: one manifold's, whose normal and tangents its lane
+/// group keeps. The slots alone do not tell two manifolds apart (a pair's several manifolds,
+/// or a body's pairs with two static bodies, which share the immovable slot).
+#[derive(Clone, Copy, Default, Debug, PartialEq, Eq)]
+pub(super) struct PointKey {
+    pub(super) local_a: u32,
+    pub(super) local_b: u32,
+    pub(super) pair: u32,
+    pub(super) manifold: u16,
+}
+
+/// Most points of one manifold group: a pair's run of points is cut into groups of at most
+/// this many (a box face on a box gives four).
+pub(super) const GROUP_POINTS: usize = 4;
+
+/// A bundle's rows as its island's step ends, per lane (see [`Bundles::record`]).
+#[derive(Clone, Copy, Default)]
+pub(super) struct BundleRecord {
+    /// J·v* of the normal row and the two tangent rows (m/s).
+    pub(super) velocity_before: [Lane; 3],
+    /// The natural map φ of the rows: min(γ_n, J_n·v − target) for the normal row and
+    /// γ_t − Proj_disc(γ_t − J_t·v) for the friction pair (N·s and m/s mixed, as
+    /// [`crate::StepDiagnostics::natural_map_residual`] sums them).
+    pub(super) phi: [Lane; 3],
+}
+
+impl RowLanes {
+    /// Writes `row` into lane `i` (but its direction, which the lane group keeps).
+    #[inline(always)]
+    pub(super) fn set(&mut self, i: usize, row: &JacobianRow) {
+        set_vec(&mut self.angular_a, i, row.angular_a);
+        set_vec(&mut self.angular_b, i, row.angular_b);
+        set_vec(
+            &mut self.inverse_inertia_angular_a,
+            i,
+            row.inverse_inertia_angular_a,
+        );
+        set_vec(
+            &mut self.inverse_inertia_angular_b,
+            i,
+            row.inverse_inertia_angular_b,
+        );
+        set(&mut self.effective_mass, i, row.effective_mass);
+        set(
+            &mut self.inverse_effective_mass,
+            i,
+            row.inverse_effective_mass,
+        );
+    }
+
+    /// J·v per lane (m/s) for the row's `direction`, as [`JacobianRow::velocity`].
+    #[inline(always)]
+    pub(super) fn velocity(&self, direction: &LaneVec, v: &BodyLanes) -> Lane {
+        dot(*direction, sub(v.linear_a, v.linear_b)) + dot(self.angular_a, v.angular_a)
+            - dot(self.angular_b, v.angular_b)
+    }
+
+    /// Adds M⁻¹J_iᵀ·impulse to the two bodies of each lane, for the row's `direction`.
+    #[inline(always)]
+    pub(super) fn apply(
+        &self,
+        direction: &LaneVec,
+        impulse: Lane,
+        inverse_mass: (LaneVec, LaneVec),
+        v: &mut BodyLanes,
+    ) {
+        let linear = [
+            direction[0] * impulse,
+            direction[1] * impulse,
+            direction[2] * impulse,
+        ];
+        let [bx, by, bz] = inverse_mass.1;
+        v.linear_a = add_scaled_per_axis(v.linear_a, linear, inverse_mass.0);
+        v.linear_b = add_scaled_per_axis(v.linear_b, linear, [-bx, -by, -bz]);
+        v.angular_a = add_scaled(v.angular_a, self.inverse_inertia_angular_a, impulse);
+        v.angular_b = add_scaled(v.angular_b, self.inverse_inertia_angular_b, -impulse);
+    }
+}
+
+/// The two bodies' velocities (or displacements) of each lane of a bundle.
+#[derive(Clone, Copy)]
+pub(super) struct BodyLanes {
+    pub(super) linear_a: LaneVec,
+    pub(super) angular_a: LaneVec,
+    pub(super) linear_b: LaneVec,
+    pub(super) angular_b: LaneVec,
+}
+
+impl BodyLanes {
+    #[inline(always)]
+    pub(super) fn gather(
+        bundle_a: &[u32; LANES],
+        bundle_b: &[u32; LANES],
+        linear: &[Vec3],
+        angular: &[Vec3],
+    ) -> Self {
+        Self {
+            linear_a: lane_vec(bundle_a.map(|k| linear[k as usize])),
+            angular_a: lane_vec(bundle_a.map(|k| angular[k as usize])),
+            linear_b: lane_vec(bundle_b.map(|k| linear[k as usize])),
+            angular_b: lane_vec(bundle_b.map(|k| angular[k as usize])),
+        }
+    }
+}
+
+/// [`BodyLanes`] through the velocity pointers that one colour's threads share.
+pub(super) trait SharedLanes {
+    /// [`BodyLanes::gather`] through the shared pointers, for lanes between the bodies at
+    /// `slots_a` and `slots_b`.
+    ///
+    /// # Safety
+    /// Every slot is in bounds, and no other thread writes them meanwhile.
+    unsafe fn gather(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes;
+
+    /// [`BodyLanes::scatter`] through the shared pointers; the immovable slot is not written.
+    ///
+    /// # Safety
+    /// As [`SharedLanes::gather`], and no other thread reads these moving slots meanwhile.
+    unsafe fn scatter(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], v: &BodyLanes);
+}
+
+impl SharedLanes for SharedVelocities {
+    #[inline(always)]
+    unsafe fn gather(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
+        // SAFETY: the caller's contract.
+        let load = |p: *mut Vec3, slots: &[u32; LANES]| {
+            lane_vec(slots.map(|k| unsafe { *p.add(k as usize) }))
+        };
+        BodyLanes {
+            linear_a: load(self.linear, slots_a),
+            angular_a: load(self.angular, slots_a),
+            linear_b: load(self.linear, slots_b),
+            angular_b: load(self.angular, slots_b),
+        }
+    }
+
+    #[inline(always)]
+    unsafe fn scatter(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], v: &BodyLanes) {
+        let [la, aa, lb, ab] = [&v.linear_a, &v.angular_a, &v.linear_b, &v.angular_b].map(unlane);
+        for i in 0..LANES {
+            let (a, bb) = (slots_a[i] as usize, slots_b[i] as usize);
+            // SAFETY: the caller's contract.
+            unsafe {
+                if a != self.immovable {
+                    *self.linear.add(a) = la[i];
+                    *self.angular.add(a) = aa[i];
+                }
+                if bb != self.immovable {
+                    *self.linear.add(bb) = lb[i];
+                    *self.angular.add(bb) = ab[i];
+                }
+            }
+        }
+    }
+}
+
+/// Writes point `c` into lane `i` of a bundle (what its manifold group's points share goes to
+/// their lane group, [`Group`]). A point with pending lever-arm products gets, in its normal
+/// row's `inverse_effective_mass`, the linear part of every row's J M⁻¹ Jᵀ, 1/m_a + 1/m_b,
+/// for [`bundle_products`] to complete.
+#[inline(always)]
+pub(super) fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &ContactConstraint) {
+    if c.products_pending {
+        // Pending only for bodies with no translation locked (see `products_pending`).
+        let linear = c.inverse_mass_a.x + c.inverse_mass_b.x;
+        set(&mut b.normal.inverse_effective_mass, i, linear);
+        g.pending[i] = true;
+    } else {
+        b.normal.set(i, &c.normal);
+        b.tangents[0].set(i, &c.tangents[0]);
+        b.tangents[1].set(i, &c.tangents[1]);
+        for k in 0..3 {
+            set(
+                &mut b.tangent_inverse_block[k],
+                i,
+                c.tangent_inverse_block[k],
+            );
+        }
+        set(&mut b.sliding_step, i, sliding_step(c.tangent_block));
+        g.pending[i] = false;
+    }
+    set(&mut b.target, i, c.target_normal_velocity);
+    set(&mut b.mass_scale, i, c.softness.0);
+    set(&mut b.impulse_scale, i, c.softness.1);
+    set(&mut b.normal_impulse, i, c.normal_impulse);
+    set(&mut b.tangent_impulses[0], i, c.tangent_impulses[0]);
+    set(&mut b.tangent_impulses[1], i, c.tangent_impulses[1]);
+    set(&mut b.max_normal_impulse, i, c.max_normal_impulse);
+    set_vec(&mut g.lever_a, i, c.lever_a);
+    set_vec(&mut g.lever_b, i, c.lever_b);
+    set(&mut g.depth, i, c.depth);
+}
+
+/// 1/k₁ for the tangent block (K₁₁, K₁₂, K₂₂) (1/kg), k₁ its larger eigenvalue; 0 for a zero
+/// (both bodies immovable) or non-finite block, whose lanes then only cap their impulse.
+pub(super) fn sliding_step([a, b, d]: [f32; 3]) -> f32 {
+    let k1 = 0.5 * (a + d) + (0.25 * (a - d) * (a - d) + b * b).sqrt();
+    if k1.is_finite() && k1 > 0.0 {
+        1.0 / k1
+    } else {
+        0.0
+    }
+}

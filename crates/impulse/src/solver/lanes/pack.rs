@@ -1,0 +1,374 @@
+//! Packing and unpacking: an island's constraints laid out in lane groups (manifold groups,
+//! their colours, each point's bundle and lane) and written into the bundles once per step,
+//! and the bundles' impulses written back to the constraints when the substeps are done.
+
+use glam::Mat3;
+
+use super::bundles::Bundles;
+use super::lane::{LANES, Lane, set, set_vec};
+use super::layout::{Bundle, BundleGeometry, GROUP_POINTS, Group, PointKey, set_lane};
+use super::products::compute_products;
+use crate::contact::ContactConstraint;
+use crate::graph::{COLOURS, greedy_colours};
+use crate::instruction_set::{InstructionSet, on_instruction_set};
+use crate::parallel::{PARALLEL_PACK_POINTS, SharedItems, spread, threads};
+use crate::solver::interface::RowsReport;
+
+impl Bundles {
+    /// Packs the island's `constraints` (slots below `slots`; `slots − 1` is the immovable one),
+    /// with their current impulses, into bundles. The points are first cut into manifold groups:
+    /// runs of consecutive points of one manifold (assembly writes a manifold's points
+    /// together), at most four each. The groups are coloured greedily (no two groups
+    /// of a colour share a moving body), and each colour's groups, in constraint order, go
+    /// [`LANES`] at a time into lane groups of as many bundles as their largest group has
+    /// points; a lane whose group is shorter is padded with rows of zero effective mass between
+    /// the same bodies, whose updates change nothing. Groups the colouring cannot place (a body
+    /// in more than `COLOURS` (64) colours) get a lane group each. O(points). What a manifold
+    /// group's points share goes to its lane group ([`Group`]), the rest to the bundles.
+    ///
+    /// Why manifold groups (Box2D v3's and Box3D's wide contact constraints are per manifold
+    /// too): a sweep gathers and scatters the bodies' velocities once per lane group instead of
+    /// once per bundle, and a body's groups need far fewer colours than its points (each colour
+    /// a wait per sweep on several threads).
+    ///
+    /// With `parallel`, each colour's lane groups are later spread over rayon's threads; the
+    /// result is the same bit for bit, as the lane groups of one colour touch disjoint bodies.
+    ///
+    /// When every point has the same key as in the last pack (an island at rest), the
+    /// last layout is reused and only the lanes are filled again; the result is the same.
+    ///
+    /// Points whose lever-arm products are pending ([`ContactConstraint::products_pending`])
+    /// get them here, four lanes at a time, from their lever arms and directions and the world
+    /// inverse inertia of their bodies' slots (`inverse_inertia`, one per slot), in the order
+    /// of operations of the scalar assembly, so to the same bits.
+    pub fn pack(
+        &mut self,
+        constraints: &[ContactConstraint],
+        slots: usize,
+        inverse_inertia: &[Mat3],
+        parallel: bool,
+    ) {
+        self.parallel = parallel;
+        self.recorded = false;
+        self.before_kept = false;
+        self.carried = false;
+        self.rows = None;
+        // The layout is a function of the points' body slots and manifolds alone: when they
+        // repeat (an island at rest keeps its points), last pack's layout stands. They are
+        // first copied out of the 376-byte rows (on rayon's threads for a large island), so
+        // that the comparison, the grouping and the colouring, which are serial, read 16 bytes
+        // a point.
+        let parallel_fill = spread(parallel, constraints.len(), PARALLEL_PACK_POINTS - 1);
+        let key = |c: &ContactConstraint| PointKey {
+            local_a: c.local_a,
+            local_b: c.local_b,
+            pair: c.source.0,
+            manifold: c.source.1,
+        };
+        if parallel_fill {
+            use rayon::prelude::*;
+            constraints
+                .par_iter()
+                .with_min_len(PARALLEL_PACK_POINTS / 4)
+                .map(key)
+                .collect_into_vec(&mut self.keys);
+        } else {
+            self.keys.clear();
+            self.keys.extend(constraints.iter().map(key));
+        }
+        let new_layout = self.layout_slots != slots || self.keys != self.layout_keys;
+        if new_layout {
+            std::mem::swap(&mut self.keys, &mut self.layout_keys);
+            self.layout_slots = slots;
+            self.lay_out(slots);
+        }
+        let total = self.groups.last().map_or(0, |g| (g.start + g.len) as usize);
+        let empty = Bundle::default();
+        // On the last pack's layout every lane is a point again, and the fill below writes
+        // every number of its bundle and geometry, or it is padding, which still holds what
+        // the reset gave it and what the sweeps computed from its zero lever arms, effective
+        // masses and impulses (zero impulses; targets, which every solve sets before reading).
+        // So only a new layout resets the bundles.
+        let reset = new_layout || self.bundles.len() != total || self.geometry.len() != total;
+        if reset {
+            if parallel_fill {
+                // Every bundle is reset by the task that fills it, so that a large island's
+                // reset is spread over the threads too.
+                self.bundles.truncate(total);
+                self.geometry.truncate(total);
+            } else {
+                self.bundles.clear();
+                self.geometry.clear();
+            }
+            self.bundles.resize(total, empty);
+            self.geometry.resize(total, BundleGeometry::PADDING);
+        }
+        // The step totals start from zero: the packed bundles are this step's alone.
+        self.step_totals.clear();
+        self.step_totals.resize(total, [Lane::splat(0.0); 3]);
+        if parallel_fill {
+            self.fill_parallel(constraints, reset.then_some(&empty));
+        } else {
+            // The reads stream, and the writes go to one open lane group per colour.
+            let (bundles, geometry, slots) = (&mut self.bundles, &mut self.geometry, &self.slots);
+            on_instruction_set!(InstructionSet::detected(), {
+                for (c, &slot) in constraints.iter().zip(slots) {
+                    let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
+                    set_lane(&mut bundles[index], &mut geometry[index], lane, c);
+                }
+            });
+        }
+        // What each lane group's points share, lane by lane, from each manifold group's first
+        // point; every field of a lane that holds a group (lanes with none keep what
+        // `lay_out` gave them: the immovable slot, zero masses and directions).
+        for (r, &(group, lane)) in self.run_places.iter().enumerate() {
+            let c = &constraints[self.runs[r] as usize];
+            let (g, i) = (&mut self.groups[group as usize], lane as usize);
+            g.local_a[i] = c.local_a;
+            g.local_b[i] = c.local_b;
+            set_vec(&mut g.inverse_mass_a, i, c.inverse_mass_a);
+            set_vec(&mut g.inverse_mass_b, i, c.inverse_mass_b);
+            set_vec(&mut g.directions[0], i, c.normal.direction);
+            set_vec(&mut g.directions[1], i, c.tangents[0].direction);
+            set_vec(&mut g.directions[2], i, c.tangents[1].direction);
+            set(&mut g.friction, i, c.friction);
+        }
+        // Padding alone needs nothing computed: its products are the zeros it was reset to.
+        if constraints.iter().any(|c| c.products_pending) {
+            compute_products(
+                &mut self.bundles,
+                &self.geometry,
+                &self.groups,
+                inverse_inertia,
+                parallel_fill,
+            );
+        }
+    }
+
+    /// The layout part of [`Bundles::pack`] for the points' body slots in `layout_keys`:
+    /// manifold groups, their colours, lane groups and each point's slot.
+    fn lay_out(&mut self, slots: usize) {
+        let keys = &self.layout_keys;
+        // Manifold groups: runs of points of one manifold (between the same two bodies).
+        self.runs.clear();
+        for (k, key) in keys.iter().enumerate() {
+            let continues = self.runs.last().is_some_and(|&first| {
+                keys[first as usize] == *key && k - (first as usize) < GROUP_POINTS
+            });
+            if !continues {
+                self.runs.push(k as u32);
+            }
+        }
+        let run_count = self.runs.len();
+        self.runs.push(keys.len() as u32);
+        let run_points = |runs: &[u32], r: usize| (runs[r + 1] - runs[r]) as usize;
+        // Greedy colours of the groups, and the groups per colour.
+        let runs = &self.runs;
+        let group_slots = (0..run_count).map(|r| {
+            let key = keys[runs[r] as usize];
+            (key.local_a, key.local_b)
+        });
+        let counts = greedy_colours(group_slots, slots, &mut self.used, &mut self.colours);
+        // Lane groups per colour (the last colour: one group each), and where each starts.
+        let per_group = |colour: usize| if colour < COLOURS { LANES } else { 1 };
+        self.group_colour_starts.clear();
+        self.group_colour_starts.push(0);
+        for colour in 0..=COLOURS {
+            let groups =
+                ((counts[colour + 1] - counts[colour]) as usize).div_ceil(per_group(colour));
+            let last = *self.group_colour_starts.last().unwrap_or(&0);
+            self.group_colour_starts.push(last + groups);
+        }
+        let total_groups = *self.group_colour_starts.last().unwrap_or(&0);
+        // Each group to the next free lane of its colour, in constraint order; a lane group
+        // is as long as its longest group.
+        self.groups.clear();
+        let immovable = (slots - 1) as u32;
+        let empty = Group {
+            local_a: [immovable; LANES],
+            local_b: [immovable; LANES],
+            ..Group::default()
+        };
+        self.groups.resize(total_groups, empty);
+        self.run_places.clear();
+        let mut filled = [0usize; COLOURS + 1];
+        for r in 0..run_count {
+            let colour = self.colours[r] as usize;
+            let position = filled[colour];
+            filled[colour] += 1;
+            let per = per_group(colour);
+            let group = self.group_colour_starts[colour] + position / per;
+            let lane = position % per;
+            let g = &mut self.groups[group];
+            g.len = g.len.max(run_points(&self.runs, r) as u32);
+            self.run_places.push((group as u32, lane as u32));
+        }
+        let mut total = 0u32;
+        for g in self.groups.iter_mut() {
+            g.start = total;
+            total += g.len;
+        }
+        // Each point to its group's lane, in the bundle of its place in the group.
+        self.sources.clear();
+        self.sources.resize(total as usize, [u32::MAX; LANES]);
+        self.slots.clear();
+        for r in 0..run_count {
+            let (group, lane) = self.run_places[r];
+            let start = self.groups[group as usize].start as usize;
+            for (p, k) in (self.runs[r]..self.runs[r + 1]).enumerate() {
+                let index = start + p;
+                self.sources[index][lane as usize] = k;
+                self.slots.push((index * LANES + lane as usize) as u32);
+            }
+        }
+    }
+
+    /// The lane writes of [`Bundles::pack`] on rayon's threads. Task t owns the t-th part of
+    /// every colour's bundles (so no two tasks write one bundle) and streams the constraints
+    /// from the first to the last one it owns: as each colour is spread evenly over the
+    /// constraints, that range is about a 1/tasks share and the tasks' ranges barely overlap.
+    /// Every lane gets the same value on any split. With `empty`, each task first resets its
+    /// bundles to it (and their geometry to padding).
+    fn fill_parallel(&mut self, constraints: &[ContactConstraint], empty: Option<&Bundle>) {
+        use rayon::prelude::*;
+        let tasks = 2 * threads();
+        // Bundle where each colour starts (its first lane group's start); on the stack, so a
+        // pack allocates nothing.
+        let total = self.bundles.len();
+        let mut bundle_start = [total; COLOURS + 2];
+        for (start, &g) in bundle_start.iter_mut().zip(&self.group_colour_starts) {
+            *start = self
+                .groups
+                .get(g)
+                .map_or(total, |group| group.start as usize);
+        }
+        // Task t's bundles of colour c: the t-th of `tasks` equal parts of the colour.
+        let part = move |t: usize, c: usize| {
+            let count = bundle_start[c + 1] - bundle_start[c];
+            bundle_start[c] + count * t / tasks..bundle_start[c] + count * (t + 1) / tasks
+        };
+        let colour_of = move |index: usize| {
+            bundle_start[..=COLOURS + 1].partition_point(|&start| start <= index) - 1
+        };
+        let (sources, slots) = (&self.sources, &self.slots);
+        let bundles = SharedItems(self.bundles.as_mut_ptr());
+        let geometry = SharedItems(self.geometry.as_mut_ptr());
+        (0..tasks).into_par_iter().for_each(|t| {
+            // Capture the whole wrappers (Sync), not their raw-pointer fields.
+            #[allow(clippy::redundant_locals)]
+            let (bundles, geometry) = (bundles, geometry);
+            // The task's constraint range, from the lanes it owns (a lane group's lanes hold
+            // groups in constraint order, but its later bundles may be padding).
+            let mut low = usize::MAX;
+            let mut high = 0;
+            for c in 0..=COLOURS {
+                let range = part(t, c);
+                for lanes in &sources[range.clone()] {
+                    for &k in lanes.iter().filter(|&&k| k != u32::MAX) {
+                        low = low.min(k as usize);
+                        high = high.max(k as usize + 1);
+                    }
+                }
+                // SAFETY: the parts of all tasks and colours are disjoint ranges inside the
+                // bundles and the geometry (`bundle_start` is non-decreasing, ending at the
+                // bundles' length), and only task t touches its own.
+                if let Some(empty) = empty {
+                    unsafe {
+                        std::slice::from_raw_parts_mut(bundles.0.add(range.start), range.len())
+                            .fill(*empty);
+                        std::slice::from_raw_parts_mut(geometry.0.add(range.start), range.len())
+                            .fill(BundleGeometry::PADDING);
+                    }
+                }
+            }
+            for k in low..high.min(constraints.len()) {
+                let (index, lane) = (slots[k] as usize / LANES, slots[k] as usize % LANES);
+                if index >= total || !part(t, colour_of(index)).contains(&index) {
+                    continue;
+                }
+                // SAFETY: as above: `index` lies in one of this task's parts.
+                unsafe {
+                    set_lane(
+                        &mut *bundles.0.add(index),
+                        &mut *geometry.0.add(index),
+                        lane,
+                        &constraints[k],
+                    );
+                }
+            }
+        });
+    }
+
+    /// Writes the bundles' impulses (and largest normal impulses) back to `constraints`, the
+    /// slice [`Bundles::pack`] read. On rayon's threads when packing was. After
+    /// [`Bundles::record`], also each row's J·v* (`velocity_before`), and sums the island's
+    /// natural-map residual and friction rows ([`Bundles::take_rows`]): over the points in
+    /// constraint order, in runs of the same length and added in the same order as
+    /// `diagnostics::record_velocity_before_and_residual`, so the residual is its to the bit.
+    pub fn unpack(&mut self, constraints: &mut [ContactConstraint]) {
+        let (bundles, totals, records) = (&self.bundles, &self.step_totals, &self.records);
+        let recorded = self.recorded;
+        // Writes one point back; returns its rows' φ² (0 unless recorded).
+        let write = |c: &mut ContactConstraint, slot: u32| -> f64 {
+            let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
+            let b = &bundles[index];
+            let at = |x: &Lane| x.as_array()[lane];
+            c.normal_impulse = at(&b.normal_impulse);
+            c.tangent_impulses = [at(&b.tangent_impulses[0]), at(&b.tangent_impulses[1])];
+            c.max_normal_impulse = at(&b.max_normal_impulse);
+            let total = &totals[index];
+            c.step_impulses = [
+                at(&total[0]) + c.normal_impulse,
+                at(&total[1]) + c.tangent_impulses[0],
+                at(&total[2]) + c.tangent_impulses[1],
+            ];
+            c.target_normal_velocity = at(&b.target);
+            c.softness = (at(&b.mass_scale), at(&b.impulse_scale));
+            if !recorded {
+                return 0.0;
+            }
+            let r = &records[index];
+            c.normal.velocity_before = at(&r.velocity_before[0]);
+            c.tangents[0].velocity_before = at(&r.velocity_before[1]);
+            c.tangents[1].velocity_before = at(&r.velocity_before[2]);
+            let phi = at(&r.phi[0]) as f64;
+            let mut squared = phi * phi;
+            if c.friction > 0.0 {
+                for k in 1..3 {
+                    let phi = at(&r.phi[k]) as f64;
+                    squared += phi * phi;
+                }
+            }
+            squared
+        };
+        let slots = &self.slots;
+        let parallel = spread(self.parallel, constraints.len(), PARALLEL_PACK_POINTS - 1);
+        if !recorded {
+            if parallel {
+                use rayon::prelude::*;
+                constraints
+                    .par_iter_mut()
+                    .zip(slots.par_iter())
+                    .with_min_len(PARALLEL_PACK_POINTS / 4)
+                    .for_each(|(c, &slot)| {
+                        write(c, slot);
+                    });
+            } else {
+                for (c, &slot) in constraints.iter_mut().zip(slots) {
+                    write(c, slot);
+                }
+            }
+            return;
+        }
+        // One run of points from `start`: its φ² sum and its points with friction.
+        let run = |start: usize, rows: &mut [ContactConstraint]| {
+            let (mut sum, mut friction_rows) = (0.0f64, 0usize);
+            for (c, &slot) in rows.iter_mut().zip(&slots[start..]) {
+                sum += write(c, slot);
+                friction_rows += usize::from(c.friction > 0.0);
+            }
+            (sum, friction_rows)
+        };
+        self.rows = Some(RowsReport::sum_in_runs(constraints, parallel, run));
+    }
+}

@@ -1,0 +1,166 @@
+//! The order and the threads of a sweep: lane groups colour by colour (forward or backward,
+//! each group's bundles from its first or from halfway round), each group's bodies gathered
+//! once and scattered once, a colour's lane groups spread over rayon's threads (they share
+//! no moving body), the next bundles asked of the CPU ahead of the update.
+
+use super::bundles::Bundles;
+use super::lane::Lane;
+use super::layout::{Bundle, Group, SharedLanes};
+use super::sweep::BundleUpdate;
+use super::targets::SetTargets;
+use crate::graph::COLOURS;
+use crate::instruction_set::{InstructionSet, on_instruction_set};
+use crate::parallel::{
+    GROUPS_PER_TASK, SharedItems, SharedVelocities, colour_after_colour, prefetch_bytes, spread,
+};
+use crate::solver::rows::Velocities;
+
+impl Bundles {
+    /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
+    /// group's bodies gathered into lanes once and scattered back after its bundles; returns the
+    /// lane-wise largest of what `update` returned. With `parallel` (see [`Bundles::pack`])
+    /// each colour is split over rayon's threads, in parts of at least [`GROUPS_PER_TASK`]
+    /// lane groups ([`crate::parallel::colour_after_colour`]).
+    pub(super) fn sweep<F, T>(
+        &mut self,
+        order: SweepOrder,
+        velocities: &mut Velocities<'_>,
+        update: F,
+        targets: T,
+    ) -> Lane
+    where
+        F: BundleUpdate,
+        T: SetTargets,
+    {
+        let shared = SharedVelocities {
+            linear: velocities.linear.as_mut_ptr(),
+            angular: velocities.angular.as_mut_ptr(),
+            immovable: velocities.linear.len() - 1,
+        };
+        let (bundles, len) = (SharedItems(self.bundles.as_mut_ptr()), self.bundles.len());
+        let set = InstructionSet::detected();
+        if !spread(self.parallel, 1, 0) {
+            let groups = &self.groups;
+            // SAFETY: `pack` gave every group a range inside the bundles and every lane slots
+            // below the island's slot count (the velocities' length); the bundles and the
+            // velocities are borrowed exclusively here. `set` runs on this CPU.
+            return on_instruction_set!(set, unsafe {
+                sweep_groups(groups, bundles, len, order, &shared, update, targets)
+            });
+        }
+        // Runs `update` on a run of lane groups of one colour, in order or in reverse.
+        let run = |part: &mut [Group], forward: bool| {
+            // Capture the whole wrappers (Sync), not their raw-pointer fields.
+            #[allow(clippy::redundant_locals)]
+            let (shared, bundles) = (shared, bundles);
+            // SAFETY: as above, and within one colour no other lane group touches this run's
+            // bundles or its lanes' moving slots (the immovable slot is only read).
+            let order = SweepOrder { forward, ..order };
+            on_instruction_set!(set, unsafe {
+                sweep_groups(part, bundles, len, order, &shared, update, targets)
+            })
+        };
+        let starts = &self.group_colour_starts;
+        colour_after_colour(
+            &mut self.groups,
+            starts.len() - 1,
+            |k| starts[k],
+            order.forward,
+            COLOURS,
+            GROUPS_PER_TASK,
+            Lane::splat(0.0),
+            run,
+            |x, y| x.max(y),
+        )
+    }
+}
+
+/// The order of a sweep: lane groups first to last (`forward`) or last to first, and each
+/// group's bundles from its first (or, backward, its last) or, with `half_turn`, from halfway
+/// round (two, three, zero, one of four).
+#[derive(Clone, Copy)]
+pub(super) struct SweepOrder {
+    pub(super) forward: bool,
+    pub(super) half_turn: bool,
+}
+
+/// Runs `update` on the bundles of `groups` in order (`forward`) or in reverse, the bundles of
+/// each group in the same direction, from the group's first bundle or, with `half_turn`, from
+/// halfway round it; the group's bodies are gathered once and scattered once.
+///
+/// The half turn is why a resting stack stays still. With one sweep a solve, the point of a
+/// face updated first takes more of the load than the others in every substep, a steady torque
+/// that set a 30-cube stack swaying by millimetres; a box face's points go round the face, so
+/// starting halfway round in every other substep puts the diagonally opposite corner first and
+/// the torques cancel. Reversing the group instead leaves the first point on the same side.
+///
+/// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first, the part `update` reads
+/// ([`BundleUpdate::READS`]): a bundle is 18 cache lines, and once an island's bundles outgrow
+/// L2 the sweep waits on L3 for them, which the hardware prefetcher does not hide. The normal
+/// rows' sweep asks for the first 8 lines alone ([`NORMAL_PART`]): asking for the whole bundle
+/// would have it read every line. Groups lie in bundle order, so the
+/// bundle ahead in memory is the one the sweep visits next.
+///
+/// # Safety
+/// `bundles` points to `len` bundles, every group's range lies inside them, every lane's slots
+/// are below the velocities' length, and no other thread touches these bundles or their lanes'
+/// moving slots meanwhile.
+#[inline(always)]
+pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
+    groups: &[Group],
+    bundles: SharedItems<Bundle>,
+    len: usize,
+    SweepOrder { forward, half_turn }: SweepOrder,
+    velocities: &SharedVelocities,
+    update: F,
+    targets: T,
+) -> Lane {
+    let mut largest = Lane::splat(0.0);
+    let n = groups.len();
+    for step in 0..n {
+        let group = &groups[if forward { step } else { n - 1 - step }];
+        let (start, count) = (group.start as usize, group.len as usize);
+        debug_assert!(start + count <= len);
+        let (slots_a, slots_b) = (group.local_a, group.local_b);
+        let mut v = unsafe { velocities.gather(&slots_a, &slots_b) };
+        // SAFETY: the caller's contract covers what the update reads and writes per body.
+        let mut state = unsafe { update.begin(&slots_a, &slots_b) };
+        let moved = targets.moved(&slots_a, &slots_b);
+        let turn = if half_turn { count / 2 } else { 0 };
+        for p in 0..count {
+            // (p + turn) mod count, without a division per bundle.
+            let p = if p + turn < count {
+                p + turn
+            } else {
+                p + turn - count
+            };
+            let index = if forward {
+                start + p
+            } else {
+                start + count - 1 - p
+            };
+            let ahead = if forward {
+                index + PREFETCH_BUNDLES
+            } else {
+                index.wrapping_sub(PREFETCH_BUNDLES)
+            };
+            if ahead < len {
+                // SAFETY: in bounds; a prefetch reads nothing.
+                prefetch_bytes(unsafe { bundles.0.add(ahead) }, F::READS);
+            }
+            // SAFETY: the caller's contract.
+            let b = unsafe { &mut *bundles.0.add(index) };
+            targets.set(b, group, index, &moved);
+            largest = largest.max(update.update_at(b, group, index, &mut v, &mut state));
+        }
+        // SAFETY: the caller's contract.
+        unsafe {
+            velocities.scatter(&slots_a, &slots_b, &v);
+            update.end(&slots_a, &slots_b, &state);
+        }
+    }
+    largest
+}
+
+/// How many bundles ahead a sweep asks for (see [`sweep_groups`]).
+pub(super) const PREFETCH_BUNDLES: usize = 2;

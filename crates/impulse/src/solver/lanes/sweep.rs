@@ -1,0 +1,307 @@
+//! What a sweep does to one bundle: the projected Gauss-Seidel update of its points' normal
+//! and friction rows ([`solve_bundle`]), the warm start, and the relax sweep that also carries
+//! the next substep's warm start; each an implementation of [`BundleUpdate`], which the sweep's
+//! loop ([`super::schedule`]) inlines.
+
+use glam::Vec3;
+
+use super::bundles::Bundles;
+use super::lane::{LANES, Lane};
+use super::layout::{BodyLanes, Bundle, Group, NORMAL_PART, SharedLanes};
+use crate::parallel::{SharedItems, SharedVelocities};
+
+impl Bundles {
+    /// Zeroes the carried warm start for an island of `slots` slots, marks it for the next
+    /// [`ContactSolver::warm_start`], and returns the update that fills it.
+    pub(super) fn start_carrying(&mut self, slots: usize) -> RelaxCarrying {
+        for carried in [&mut self.carried_linear, &mut self.carried_angular] {
+            carried.clear();
+            carried.resize(slots, Vec3::ZERO);
+        }
+        self.carried = true;
+        RelaxCarrying {
+            totals: SharedItems(self.step_totals.as_mut_ptr()),
+            carried: SharedVelocities {
+                linear: self.carried_linear.as_mut_ptr(),
+                angular: self.carried_angular.as_mut_ptr(),
+                immovable: slots.wrapping_sub(1),
+            },
+        }
+    }
+}
+
+/// One bundle's update in a sweep: takes the bundle and its bodies' velocities in lanes,
+/// updates both, and returns each lane's largest row velocity change (m/s). A trait rather
+/// than a closure or function pointer so that the update is inlined into the sweep loop (a
+/// closure was not inlined).
+pub(super) trait BundleUpdate: Copy + Sync {
+    /// Bytes at the start of each bundle that the update reads (see [`NORMAL_PART`]).
+    const READS: usize = std::mem::size_of::<Bundle>();
+
+    /// What an update keeps per lane group besides its bodies' velocities, from
+    /// [`BundleUpdate::begin`] to [`BundleUpdate::end`].
+    type GroupState;
+
+    /// The group state of a lane group between the bodies at `slots_a` and `slots_b`.
+    ///
+    /// # Safety
+    /// As [`SharedLanes::gather`] for whatever the update reads per body.
+    unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::GroupState;
+
+    /// Updates bundle `index` of lane group `group` (see the trait).
+    fn update_at(
+        self,
+        b: &mut Bundle,
+        group: &Group,
+        index: usize,
+        v: &mut BodyLanes,
+        state: &mut Self::GroupState,
+    ) -> Lane;
+
+    /// Writes back what the group state holds per body.
+    ///
+    /// # Safety
+    /// As [`SharedLanes::scatter`].
+    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], state: &Self::GroupState);
+}
+
+/// The velocity rows ([`solve_bundle`]).
+/// Without `FRICTION`, the normal rows alone (see [`solve_bundle`]).
+#[derive(Clone, Copy)]
+pub(super) struct VelocityRows<const FRICTION: bool = true>;
+
+impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
+    const READS: usize = if FRICTION {
+        std::mem::size_of::<Bundle>()
+    } else {
+        NORMAL_PART
+    };
+    type GroupState = ();
+    #[inline(always)]
+    unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
+    #[inline(always)]
+    fn update_at(
+        self,
+        b: &mut Bundle,
+        group: &Group,
+        _: usize,
+        v: &mut BodyLanes,
+        _: &mut (),
+    ) -> Lane {
+        solve_bundle::<FRICTION>(b, group, v)
+    }
+    #[inline(always)]
+    unsafe fn end(self, _: &[u32; LANES], _: &[u32; LANES], _: &()) {}
+}
+
+/// The accumulated impulses applied to the bodies (warm start); changes no impulse. With
+/// `totals`, also adds them to each bundle's step totals (every substep's warm start but the
+/// first's), which live apart from the bundles: the sweeps never read them.
+#[derive(Clone, Copy)]
+pub(super) struct WarmStart {
+    pub(super) totals: Option<SharedItems<[Lane; 3]>>,
+}
+
+impl BundleUpdate for WarmStart {
+    type GroupState = ();
+    #[inline(always)]
+    unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
+
+    #[inline(always)]
+    fn update_at(
+        self,
+        b: &mut Bundle,
+        group: &Group,
+        index: usize,
+        v: &mut BodyLanes,
+        _: &mut (),
+    ) -> Lane {
+        if let Some(totals) = self.totals {
+            // SAFETY: `totals` has one entry per bundle (`pack` sizes it so) and `index` is
+            // the bundle's; no other thread touches this bundle's entry meanwhile.
+            add_to_totals(unsafe { &mut *totals.0.add(index) }, b);
+        }
+        apply_impulses(b, group, v);
+        Lane::splat(0.0)
+    }
+
+    #[inline(always)]
+    unsafe fn end(self, _: &[u32; LANES], _: &[u32; LANES], _: &()) {}
+}
+
+/// Adds a bundle's impulses to its step totals.
+#[inline(always)]
+pub(super) fn add_to_totals(total: &mut [Lane; 3], b: &Bundle) {
+    total[0] += b.normal_impulse;
+    total[1] += b.tangent_impulses[0];
+    total[2] += b.tangent_impulses[1];
+}
+
+/// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v` (its lane group `group`).
+#[inline(always)]
+pub(super) fn apply_impulses(b: &Bundle, group: &Group, v: &mut BodyLanes) {
+    let (masses, [n, t1, t2]) = (group.inverse_masses(), &group.directions);
+    b.normal.apply(n, b.normal_impulse, masses, v);
+    b.tangents[0].apply(t1, b.tangent_impulses[0], masses, v);
+    b.tangents[1].apply(t2, b.tangent_impulses[1], masses, v);
+}
+
+/// The relax sweep of a substep that another substep follows: the velocity rows with friction
+/// ([`solve_bundle`]), and each bundle's final impulses, added to its step totals and applied
+/// to `carried`, the next substep's warm start per body ([`Bundles::warm_start`] adds it to
+/// the velocities once their gravity and gyroscopic term are in). The warm start's own pass
+/// read every bundle again; this reads each once.
+#[derive(Clone, Copy)]
+pub(super) struct RelaxCarrying {
+    pub(super) totals: SharedItems<[Lane; 3]>,
+    pub(super) carried: SharedVelocities,
+}
+
+impl BundleUpdate for RelaxCarrying {
+    type GroupState = BodyLanes;
+
+    #[inline(always)]
+    unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
+        // SAFETY: the caller's contract.
+        unsafe { self.carried.gather(slots_a, slots_b) }
+    }
+
+    #[inline(always)]
+    fn update_at(
+        self,
+        b: &mut Bundle,
+        group: &Group,
+        index: usize,
+        v: &mut BodyLanes,
+        carried: &mut BodyLanes,
+    ) -> Lane {
+        let largest = solve_bundle::<true>(b, group, v);
+        // SAFETY: as `WarmStart`'s.
+        add_to_totals(unsafe { &mut *self.totals.0.add(index) }, b);
+        apply_impulses(b, group, carried);
+        largest
+    }
+
+    #[inline(always)]
+    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], carried: &BodyLanes) {
+        // SAFETY: the caller's contract.
+        unsafe { self.carried.scatter(slots_a, slots_b, carried) }
+    }
+}
+
+/// One Gauss-Seidel update of every lane's point: the normal row clamped to γ_n ≥ 0, then the
+/// friction pair inside the disc of that γ_n (the order of the scalar update, see
+/// [`crate::solver::pgs`]). Returns each lane's largest row velocity change (m/s).
+///
+/// The friction pair is solved as a 2×2 block, as in [`crate::solver`]'s scalar update, while
+/// the block's solution q = γ_t − K⁻¹v_t sticks (lies in Coulomb's disc |γ_t| ≤ μγ_n). A lane
+/// that slides takes a projected gradient step instead, γ_t ← cap(γ_t − v_t/k₁), with k₁ the
+/// larger eigenvalue of K and `cap` the radial projection onto the disc, where the scalar
+/// update projects q onto the disc in K's metric by a Newton iteration. Both have the same
+/// fixed point, maximal dissipation (γ_t on the rim, opposite the slip v_t): a fixed point of
+/// the step has v_t/k₁ along the disc's outward normal, so v_t = −s·γ_t with s ≥ 0. Capping q
+/// itself, as Rapier does, would not: its fixed point has v_t opposite Kγ_t, friction off the
+/// slip wherever K is anisotropic (a box's corner points). A step of 1/k₁ is a descent step for
+/// the block's quadratic; with the larger 2/(k₁ + k₂), `card_house` with `fast` falls. A Newton iteration on the disc would keep a bundle waiting on its slowest
+/// lane; this step costs the same on every lane.
+#[inline(always)]
+pub(super) fn solve_bundle<const FRICTION: bool>(
+    b: &mut Bundle,
+    group: &Group,
+    v: &mut BodyLanes,
+) -> Lane {
+    let normal = solve_normal(b, group, v);
+    if FRICTION {
+        normal.max(solve_friction(b, group, v))
+    } else {
+        normal
+    }
+}
+
+/// The normal row's part of [`solve_bundle`]: returns each lane's row velocity change (m/s).
+#[inline(always)]
+pub(super) fn solve_normal(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
+    let zero = Lane::splat(0.0);
+    let (masses, direction) = (group.inverse_masses(), &group.directions[0]);
+    let row = &b.normal;
+    let velocity = row.velocity(direction, v);
+    let old = b.normal_impulse;
+    let new = (old + row.effective_mass * b.mass_scale * (b.target - velocity)
+        - b.impulse_scale * old)
+        .max(zero);
+    let delta = new - old;
+    b.normal_impulse = new;
+    b.max_normal_impulse = b.max_normal_impulse.max(new);
+    row.apply(direction, delta, masses, v);
+    delta.abs() * row.inverse_effective_mass
+}
+
+/// The friction pair's part of [`solve_bundle`]: returns each lane's larger tangent row
+/// velocity change (m/s).
+#[inline(always)]
+pub(super) fn solve_friction(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
+    let masses = group.inverse_masses();
+    let [t1, t2] = &b.tangents;
+    let [_, d_1, d_2] = &group.directions;
+    let v1 = t1.velocity(d_1, v);
+    let v2 = t2.velocity(d_2, v);
+    let old = b.tangent_impulses;
+    let new = friction_update(
+        old,
+        [v1, v2],
+        b.tangent_inverse_block,
+        b.sliding_step,
+        group.friction * b.normal_impulse,
+    );
+    let (d1, d2) = (new[0] - old[0], new[1] - old[1]);
+    b.tangent_impulses = new;
+    t1.apply(d_1, d1, masses, v);
+    t2.apply(d_2, d2, masses, v);
+    (d1.abs() * t1.inverse_effective_mass).max(d2.abs() * t2.inverse_effective_mass)
+}
+
+/// The friction pair's update of [`solve_bundle`] per lane: from impulses `old` (N·s) and the
+/// tangent velocities `velocity` (m/s), with K⁻¹ as (K⁻¹₁₁, K⁻¹₁₂, K⁻¹₂₂) (kg), the step 1/k₁
+/// (kg) and the disc's radius μγ_n (N·s).
+#[inline(always)]
+pub(super) fn friction_update(
+    old: [Lane; 2],
+    velocity: [Lane; 2],
+    [i11, i12, i22]: [Lane; 3],
+    step: Lane,
+    limit: Lane,
+) -> [Lane; 2] {
+    let [v1, v2] = velocity;
+    let sticking = [
+        old[0] - (i11 * v1 + i12 * v2),
+        old[1] - (i12 * v1 + i22 * v2),
+    ];
+    let sticks = (sticking[0] * sticking[0] + sticking[1] * sticking[1]).simd_le(limit * limit);
+    if sticks.all() {
+        return sticking;
+    }
+    // A zero limit (padding, or no normal impulse yet) caps to zero.
+    let slide = cap_to_disc_clamped([old[0] - step * v1, old[1] - step * v2], limit);
+    [
+        sticks.select(sticking[0], slide[0]),
+        sticks.select(sticking[1], slide[1]),
+    ]
+}
+
+/// Radial projection onto |λ| ≤ `limit` per lane (zero where `limit` ≤ 0) for the sliding
+/// friction update: [`cap_to_disc`](super::lane::cap_to_disc) with its scale clamped to
+/// [0, 1], so a rounding of `limit / |λ|` above one never lengthens the impulse. The sweeps
+/// have always used this form (the trajectories depend on it); the record, which must match
+/// the scalar diagnostics, uses the unclamped one.
+#[inline(always)]
+fn cap_to_disc_clamped(impulse: [Lane; 2], limit: Lane) -> [Lane; 2] {
+    let zero = Lane::splat(0.0);
+    let squared = impulse[0] * impulse[0] + impulse[1] * impulse[1];
+    let inside = squared.simd_le(limit * limit);
+    let scale = (limit.max(zero) / squared.sqrt()).min(Lane::splat(1.0));
+    let scale = squared.simd_gt(zero).select(scale, zero);
+    [
+        inside.select(impulse[0], impulse[0] * scale),
+        inside.select(impulse[1], impulse[1] * scale),
+    ]
+}
