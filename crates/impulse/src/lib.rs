@@ -75,7 +75,7 @@ pub use parry3d;
 /// (along y), `::convex_hull(&points)`, `::halfspace(normal)`.
 pub use parry3d::shape::SharedShape;
 
-pub use body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
+pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use diagnostics::contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
@@ -98,12 +98,18 @@ pub use world::{
 #[cfg(feature = "internals")]
 #[doc(hidden)]
 pub mod internals {
+    pub use crate::body::Bodies;
     pub use crate::collision::broad_phase::BroadPhase;
     pub use crate::collision::narrow_phase::{NarrowPhase, SpeculativeMargins};
     pub use crate::contact::constraints::ContactConstraint;
     pub use crate::solver::nncg::{NncgWorkspace, solve_nncg};
     pub use crate::solver::pgs::solve_pgs;
     pub use crate::solver::{Sweep, Velocities, warm_start};
+
+    /// The world's body storage, as the stages read it.
+    pub fn bodies(world: &crate::World) -> &Bodies {
+        &world.bodies
+    }
 
     /// The last step's solved contact constraints (impulses as the solver left them).
     pub fn contact_constraints(world: &crate::World) -> Vec<ContactConstraint> {

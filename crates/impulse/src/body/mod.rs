@@ -47,6 +47,11 @@ impl BodyKind {
     pub fn is_dynamic(self) -> bool {
         matches!(self, BodyKind::Dynamic | BodyKind::Particle)
     }
+
+    /// Whether bodies of this kind may move: every kind but [`BodyKind::Static`].
+    pub fn is_moving(self) -> bool {
+        self != BodyKind::Static
+    }
 }
 
 /// The world axes along which a dynamic body may not translate or about which it may not
@@ -617,59 +622,61 @@ impl BodyBuilder {
     }
 }
 
-/// All bodies of a world. Index `i` of every array is body `i` in scene order.
+/// All bodies of a world. Index `i` of every array is body `i` in scene order. Private to the
+/// engine (the stages read and write the arrays directly); users read them through
+/// [`crate::World::poses`] and the other read views.
 ///
 /// Velocities are those of the centre of mass; `pose` is the body frame the scene gave
 /// (trajectories report it), and `local_center_of_mass` locates the centre of mass in it.
 #[derive(Clone, Default, Serialize, Deserialize)]
 pub struct Bodies {
     /// Dynamic, static, particle or kinematic.
-    pub kind: Vec<BodyKind>,
+    pub(crate) kind: Vec<BodyKind>,
     /// Body frame in world coordinates.
-    pub pose: Vec<Pose>,
+    pub(crate) pose: Vec<Pose>,
     /// Centre of mass in the body frame (m).
-    pub local_center_of_mass: Vec<Vec3>,
+    pub(crate) local_center_of_mass: Vec<Vec3>,
     /// Linear velocity of the centre of mass (m/s).
-    pub linear_velocity: Vec<Vec3>,
+    pub(crate) linear_velocity: Vec<Vec3>,
     /// Angular velocity, world frame (rad/s). Always zero for particles and static bodies;
     /// a kinematic body's is its prescribed one.
-    pub angular_velocity: Vec<Vec3>,
+    pub(crate) angular_velocity: Vec<Vec3>,
     /// 1/m (1/kg); 0 for static and kinematic bodies.
-    pub inverse_mass: Vec<f32>,
+    pub(crate) inverse_mass: Vec<f32>,
     /// Inverse inertia tensor about the centre of mass, body frame (1/(kg·m²)); zero for
     /// static and kinematic bodies and particles (rotation locked).
-    pub local_inverse_inertia: Vec<Mat3>,
+    pub(crate) local_inverse_inertia: Vec<Mat3>,
     /// Collision shape in the body frame.
-    pub shape: Vec<SharedShape>,
+    pub(crate) shape: Vec<SharedShape>,
     /// Coulomb friction coefficient μ.
-    pub friction: Vec<f32>,
+    pub(crate) friction: Vec<f32>,
     /// Restitution coefficient c_r.
-    pub restitution: Vec<f32>,
+    pub(crate) restitution: Vec<f32>,
     /// Asleep: skipped by the step until something awake touches its island. A kinematic
     /// body counts as asleep exactly while it does not move (zero velocities).
-    pub asleep: Vec<bool>,
+    pub(crate) asleep: Vec<bool>,
     /// How long (s) the body has been below the sleep thresholds.
-    pub sleep_time: Vec<f32>,
+    pub(crate) sleep_time: Vec<f32>,
     /// Force (N) applied at the centre of mass during the next step, then cleared.
-    pub force: Vec<Vec3>,
+    pub(crate) force: Vec<Vec3>,
     /// Torque (N·m, world frame) applied during the next step, then cleared.
-    pub torque: Vec<Vec3>,
+    pub(crate) torque: Vec<Vec3>,
     /// Name given when the body was made.
-    pub name: Vec<Option<String>>,
+    pub(crate) name: Vec<Option<String>>,
     /// The caller's number for the body ([`BodyBuilder::user_data`]).
-    pub user_data: Vec<u128>,
+    pub(crate) user_data: Vec<u128>,
     /// Linear damping c (1/s): v ← v/(1 + h·c) per substep ([`BodyBuilder::linear_damping`]).
-    pub linear_damping: Vec<f32>,
+    pub(crate) linear_damping: Vec<f32>,
     /// Angular damping c (1/s): ω ← ω/(1 + h·c) per substep.
-    pub angular_damping: Vec<f32>,
+    pub(crate) angular_damping: Vec<f32>,
     /// Collision groups the body belongs to, one bit each ([`BodyBuilder::collision_groups`]).
-    pub groups: Vec<u32>,
+    pub(crate) groups: Vec<u32>,
     /// Collision groups the body collides with.
-    pub mask: Vec<u32>,
+    pub(crate) mask: Vec<u32>,
     /// The world axes the body may not translate along or rotate about
     /// ([`BodyBuilder::locked_axes`]); always [`LockedAxes::NONE`] for static and kinematic
     /// bodies.
-    pub locked_axes: Vec<LockedAxes>,
+    pub(crate) locked_axes: Vec<LockedAxes>,
 }
 
 impl Bodies {
@@ -731,48 +738,48 @@ impl Bodies {
     }
 
     /// Number of bodies.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.kind.len()
     }
 
     /// True when there are no bodies.
-    pub fn is_empty(&self) -> bool {
+    pub(crate) fn is_empty(&self) -> bool {
         self.kind.is_empty()
     }
 
     /// True for moving bodies that are awake: the dynamic bodies the step simulates, and
     /// kinematic bodies in motion.
-    pub fn is_awake(&self, i: usize) -> bool {
+    pub(crate) fn is_awake(&self, i: usize) -> bool {
         self.kind[i] != BodyKind::Static && !self.asleep[i]
     }
 
     /// True for bodies that may move: dynamic rigid bodies, particles and kinematic bodies.
-    pub fn is_moving(&self, i: usize) -> bool {
+    pub(crate) fn is_moving(&self, i: usize) -> bool {
         self.kind[i] != BodyKind::Static
     }
 
     /// True for bodies moved by forces and contacts (dynamic rigid bodies and particles): the
     /// bodies of islands. Static and kinematic bodies take no impulse.
-    pub fn is_dynamic(&self, i: usize) -> bool {
+    pub(crate) fn is_dynamic(&self, i: usize) -> bool {
         self.kind[i].is_dynamic()
     }
 
     /// Whether bodies `a` and `b` may collide by their collision groups:
     /// `(groups_a & mask_b) != 0 && (groups_b & mask_a) != 0`.
     #[inline]
-    pub fn groups_interact(&self, a: usize, b: usize) -> bool {
+    pub(crate) fn groups_interact(&self, a: usize, b: usize) -> bool {
         (self.groups[a] & self.mask[b]) != 0 && (self.groups[b] & self.mask[a]) != 0
     }
 
     /// World position of body `i`'s centre of mass (m).
-    pub fn center_of_mass(&self, i: usize) -> Vec3 {
+    pub(crate) fn center_of_mass(&self, i: usize) -> Vec3 {
         self.pose[i].transform_point(self.local_center_of_mass[i])
     }
 
     /// World-frame inverse inertia R·I⁻¹·Rᵀ of body `i` (1/(kg·m²)), restricted to the
     /// rotations its locked axes leave free ([`LockedAxes::world_inverse_inertia`]); zero for a
     /// body that does not rotate.
-    pub fn world_inverse_inertia(&self, i: usize) -> Mat3 {
+    pub(crate) fn world_inverse_inertia(&self, i: usize) -> Mat3 {
         let local = &self.local_inverse_inertia[i];
         if *local == Mat3::ZERO {
             return Mat3::ZERO;
@@ -785,7 +792,7 @@ impl Bodies {
     /// kinematic bodies. A linear impulse p changes the velocity of the centre of mass by
     /// `effective_inverse_mass * p`, component by component.
     #[inline]
-    pub fn effective_inverse_mass(&self, i: usize) -> Vec3 {
+    pub(crate) fn effective_inverse_mass(&self, i: usize) -> Vec3 {
         let inverse_mass = Vec3::splat(self.inverse_mass[i]);
         let locked = self.locked_axes[i];
         if locked.locks_translation() {
@@ -796,7 +803,7 @@ impl Bodies {
     }
 
     /// Mass (kg) of body `i`; infinity for static and kinematic bodies.
-    pub fn mass(&self, i: usize) -> f32 {
+    pub(crate) fn mass(&self, i: usize) -> f32 {
         if self.inverse_mass[i] > 0.0 {
             1.0 / self.inverse_mass[i]
         } else {
@@ -806,7 +813,7 @@ impl Bodies {
 
     /// Kinetic energy ½mv² + ½ωᵀIω of body `i` (J); 0 for static and kinematic bodies
     /// (infinite mass: their motion is prescribed, not part of the system's energy).
-    pub fn kinetic_energy(&self, i: usize) -> f32 {
+    pub(crate) fn kinetic_energy(&self, i: usize) -> f32 {
         if self.inverse_mass[i] == 0.0 {
             return 0.0;
         }

@@ -105,13 +105,13 @@ pub struct World {
 /// [`SolverSettings::max_distance`] (m). Such a body is taken out of the simulation, not
 /// treated as a blow-up: its velocities are zeroed, it is put to sleep, its collision groups,
 /// mass and inertia are cleared (it collides with nothing, nothing wakes it, and it no longer
-/// counts in [`World::energy`]), and it stays in [`World::bodies`] at its index with its last
+/// counts in [`World::energy`]), and it stays in the world at its index ([`World::poses`]) with its last
 /// pose, so indices and written trajectories keep their shape (every later frame repeats
 /// that pose). [`World::remove`] takes it out for good. Read after the step that made it
 /// ([`World::left_world`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LeftWorld {
-    /// The body's index in [`World::bodies`].
+    /// The body's dense index ([`World::poses`], [`World::body_at`]).
     pub body: usize,
     /// Its handle (still valid: the body stays in the world).
     pub handle: BodyHandle,
@@ -306,13 +306,6 @@ impl World {
     /// Wall-clock time of each stage of the last step (all zero before the first step).
     pub fn profile(&self) -> &StepProfile {
         &self.profile
-    }
-
-    /// Every body's state, one array per quantity indexed by body index ([`BodyRef::index`],
-    /// [`Self::handle_of`]): read-only; edit bodies through [`Self::set_pose`],
-    /// [`Self::set_linear_velocity`] and the other setters, which wake them.
-    pub fn bodies(&self) -> &Bodies {
-        &self.bodies
     }
 
     /// Kinetic and gravitational energy, mass and momentum of the moving bodies now (the

@@ -67,10 +67,11 @@ pub fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
 }
 
 /// Index of the body whose origin is highest (largest y): the top of a pile.
-pub fn highest_body(bodies: &impulse::Bodies) -> usize {
-    (0..bodies.len())
+pub fn highest_body(world: &impulse::World) -> usize {
+    let poses = world.poses();
+    (0..poses.len())
         .max_by(|&i, &j| {
-            let (a, b) = (bodies.pose[i].translation.y, bodies.pose[j].translation.y);
+            let (a, b) = (poses[i].translation.y, poses[j].translation.y);
             a.total_cmp(&b)
         })
         .unwrap()
@@ -86,13 +87,17 @@ pub fn hash_state(world: &impulse::World) -> u64 {
             hash = hash.wrapping_mul(0x0100_0000_01b3);
         }
     };
-    let b = world.bodies();
-    for i in 0..b.len() {
-        let (t, q) = (b.pose[i].translation, b.pose[i].rotation);
+    let (poses, linear, angular) = (
+        world.poses(),
+        world.linear_velocities(),
+        world.angular_velocities(),
+    );
+    for i in 0..world.body_count() {
+        let (t, q) = (poses[i].translation, poses[i].rotation);
         for x in [t.x, t.y, t.z, q.x, q.y, q.z, q.w] {
             add(x);
         }
-        for v in [b.linear_velocity[i], b.angular_velocity[i]] {
+        for v in [linear[i], angular[i]] {
             v.to_array().into_iter().for_each(&mut add);
         }
     }
