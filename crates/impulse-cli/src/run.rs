@@ -166,8 +166,8 @@ impl Summary {
 pub fn instruction_set_line() -> String {
     format!(
         "SIMD kernels: {} ({}=baseline for the baseline; the results are the same)",
-        impulse::InstructionSet::detected().name(),
-        impulse::INSTRUCTION_SET_VARIABLE
+        impulse::simd::InstructionSet::detected().name(),
+        impulse::simd::INSTRUCTION_SET_VARIABLE
     )
 }
 

@@ -45,7 +45,6 @@ mod continuous;
 mod diagnostics;
 mod error;
 mod graph;
-mod instruction_set;
 mod integrate;
 mod island;
 mod kinematic;
@@ -56,6 +55,7 @@ mod world;
 
 pub mod metrics;
 pub mod scene;
+pub mod simd;
 
 // The unit tests share `tests/common` with the integration tests, whose paths start with
 // `impulse::`.
@@ -79,7 +79,6 @@ pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use diagnostics::contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
-pub use instruction_set::{INSTRUCTION_SET_VARIABLE, InstructionSet};
 pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };

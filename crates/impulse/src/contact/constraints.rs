@@ -8,10 +8,10 @@ use glam::{Mat3, Mat3A, Vec3, Vec3A};
 
 use crate::body::Bodies;
 use crate::collision::narrow_phase::{ContactPair, NarrowPhase};
-use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::island::Islands;
 use crate::parallel::{PAIRS_PER_TASK, spread};
 use crate::settings::{ContactRepair, SolverSettings};
+use crate::simd::{InstructionSet, on_instruction_set};
 use rayon::prelude::*;
 
 /// One row of J for a direction d, with the products the solver reuses every sweep.

@@ -34,7 +34,7 @@
 
 use std::collections::BTreeMap;
 
-use super::error::{BodyRef, FieldPath, SceneError, SceneErrorKind};
+use super::error::{BodyLocation, FieldPath, SceneError, SceneErrorKind};
 use super::mesh_file::MeshData;
 use super::{BodyDesc, BodyKind, KeyframeDesc, Material, MaterialRef, Scene, ShapeDesc};
 use crate::body::rules::{self, ShapeClass};
@@ -87,7 +87,7 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
     }
 
     for (index, body) in scene.bodies.iter().enumerate() {
-        c.body = Some(BodyRef {
+        c.body = Some(BodyLocation {
             index,
             name: body.name.clone(),
         });
@@ -114,7 +114,7 @@ pub(crate) fn shape_problem(kind: BodyKind, shape: &ShapeDesc) -> Option<(String
 /// Collects errors; `body` is attached to each error raised while it is set.
 struct Checker {
     errors: Vec<SceneError>,
-    body: Option<BodyRef>,
+    body: Option<BodyLocation>,
 }
 
 impl Checker {

@@ -36,11 +36,11 @@ use crate::contact::constraints::{
     ContactConstraint, JacobianRow, SPECULATIVE_TURN, STALE_TARGET, repair_terms,
 };
 use crate::graph::{COLOURS, greedy_colours};
-use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{
     GROUPS_PER_TASK, PARALLEL_PACK_POINTS, SharedItems, SharedVelocities, colour_after_colour,
     prefetch_bytes, spread, threads,
 };
+use crate::simd::{InstructionSet, on_instruction_set};
 
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
 /// AArch64), so no target feature is needed. The `lanes8` feature makes it 8 (a 256-bit AVX
