@@ -165,6 +165,20 @@ impl World {
 
     /// Builds the world a scene describes. Bodies keep scene order. Named materials resolve
     /// through `scene.materials` (`"default"` is [`Material::default`] unless redefined).
+    /// Errors name the body and the field ([`WorldError::InvalidBody`]) or the setting.
+    ///
+    /// ```
+    /// use impulse::{Scene, World, scene::builtin_scene};
+    ///
+    /// let scene: Scene = builtin_scene("pyramid20").expect("a built-in scene");
+    /// let mut world = World::from_scene(&scene)?;
+    /// assert_eq!(world.body_count(), scene.bodies.len());
+    /// world.step()?;
+    /// // A pyramid at rest does not move in one step.
+    /// let top = impulse::metrics::top_body(&world, world.poses()).expect("moving bodies");
+    /// assert!(world.linear_velocities()[top].length() < 0.1);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn from_scene(scene: &Scene) -> Result<Self, WorldError> {
         let mut world = Self::new(Vec3::from(scene.gravity), scene.dt, scene.solver.clone())?;
         for (index, desc) in scene.bodies.iter().enumerate() {
@@ -333,7 +347,22 @@ impl World {
     }
 
     /// Replaces the solver settings from the next step on. Errors, leaving the settings as they
-    /// were, when one is out of range ([`SolverSettings::validate`]).
+    /// were, when one is out of range ([`SolverSettings::validate`]): settings are checked here
+    /// and in [`Self::new`], so a step never meets invalid ones.
+    ///
+    /// ```
+    /// use impulse::glam::Vec3;
+    /// use impulse::{SolverSettings, World, WorldError};
+    ///
+    /// let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 0.01, SolverSettings::default())?;
+    /// let bad = SolverSettings { iterations: 0, ..SolverSettings::default() };
+    /// let Err(WorldError::InvalidSettings(problem)) = world.set_settings(bad) else {
+    ///     panic!("0 iterations accepted");
+    /// };
+    /// assert_eq!(problem.field, "iterations");
+    /// assert_eq!(world.settings().iterations, SolverSettings::default().iterations);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), WorldError> {
         let previous = std::mem::replace(&mut self.settings, settings);
         if let Err(error) = self.check_settings() {
@@ -386,9 +415,7 @@ impl World {
         if !self.gravity.is_finite() {
             return Err(setting("gravity", "must be finite"));
         }
-        self.settings
-            .validate()
-            .map_err(|problem| setting(&format!("solver.{}", problem.field), &problem.message))
+        Ok(self.settings.validate()?)
     }
 }
 
