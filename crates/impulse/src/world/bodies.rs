@@ -243,6 +243,22 @@ impl World {
 
     /// The body at dense index `index` (the index of the slices above), or `None` past the
     /// end.
+    ///
+    /// ```
+    /// use impulse::glam::Vec3;
+    /// use impulse::{BodyBuilder, BodyKind, SharedShape, SolverSettings, World};
+    ///
+    /// let mut world = World::new(Vec3::ZERO, 0.01, SolverSettings::default())?;
+    /// world.insert(BodyBuilder::fixed(SharedShape::cuboid(1.0, 1.0, 1.0)))?;
+    /// let ball = world.insert(BodyBuilder::dynamic(SharedShape::ball(0.5)).mass(2.0).name("ball"))?;
+    /// let body = world.body_at(1).expect("two bodies");
+    /// assert_eq!(body.handle(), ball);
+    /// assert_eq!(body.kind(), BodyKind::Dynamic);
+    /// assert_eq!(body.name(), Some("ball"));
+    /// assert!((body.inverse_mass() - 0.5).abs() < 1e-6);
+    /// assert!(world.body_at(2).is_none());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn body_at(&self, index: usize) -> Option<BodyRef<'_>> {
         let handle = self.handle_of(index)?;
         Some(BodyRef {
