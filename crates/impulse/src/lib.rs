@@ -34,12 +34,17 @@
 //! maps them.
 
 #![warn(missing_docs)]
+#![warn(unreachable_pub)]
 
 // Every stage is private: the public API is the re-exports below, plus two namespaces,
 // [`scene`] (the JSON scene format and the built-in scenes) and [`metrics`] (quality measures
 // of a simulation's state).
 mod body;
+// The stages the hidden `internals` module re-exports keep those items `pub`: without the
+// feature they are unreachable, which is their point.
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 mod collision;
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 mod contact;
 mod continuous;
 mod diagnostics;
@@ -50,6 +55,7 @@ mod island;
 mod kinematic;
 mod parallel;
 mod settings;
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 mod solver;
 mod world;
 

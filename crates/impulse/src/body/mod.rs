@@ -19,4 +19,6 @@ pub use handle::BodyHandle;
 pub(crate) use handle::Handles;
 pub use kind::{BodyKind, Keyframe};
 pub use locked_axes::LockedAxes;
+// Public for the hidden `internals` module only.
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 pub use storage::Bodies;

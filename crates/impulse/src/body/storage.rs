@@ -17,6 +17,7 @@ use super::{BodyKind, LockedAxes};
 /// Velocities are those of the centre of mass; `pose` is the body frame the scene gave
 /// (trajectories report it), and `local_center_of_mass` locates the centre of mass in it.
 #[derive(Clone, Default, Serialize, Deserialize)]
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 pub struct Bodies {
     /// Dynamic, static, particle or kinematic.
     pub(crate) kind: Vec<BodyKind>,

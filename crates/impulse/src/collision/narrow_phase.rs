@@ -45,7 +45,7 @@ pub struct ManifoldState {
 }
 
 /// Parry's manifold type with our per-manifold and per-point data.
-pub type Manifold = ContactManifold<ManifoldState, ContactImpulse>;
+pub(crate) type Manifold = ContactManifold<ManifoldState, ContactImpulse>;
 
 /// The world poses of a manifold's two shapes: the bodies' poses `pose1`, `pose2` with the
 /// manifold's sub-shape poses (a compound's part) appended. Parry gives a composite shape's
@@ -53,7 +53,7 @@ pub type Manifold = ContactManifold<ManifoldState, ContactImpulse>;
 /// absent for convex shapes, triangle meshes and height fields, whose parts are in the
 /// shape's own frame).
 #[inline]
-pub fn manifold_poses(manifold: &Manifold, pose1: &Pose, pose2: &Pose) -> (Pose, Pose) {
+pub(crate) fn manifold_poses(manifold: &Manifold, pose1: &Pose, pose2: &Pose) -> (Pose, Pose) {
     (
         manifold.subshape_pos1().prepend_to(pose1),
         manifold.subshape_pos2().prepend_to(pose2),
@@ -152,7 +152,7 @@ impl ManifoldQuery {
 /// the last computation did not find (beyond its speculative distance) is at least
 /// 2 × this distance short of the current one: as speculative points, such points only
 /// matter to bodies that close that far within a step, which moves them out of recycling.
-pub const RECYCLE_DISTANCE: f32 = 1.0e-3;
+pub(crate) const RECYCLE_DISTANCE: f32 = 1.0e-3;
 
 /// For a pair of shapes whose manifolds may be recycled ([`ManifoldQuery::recycles_at`]),
 /// the farthest any point of `shape2` lies from its frame's origin (m); `None` for the rest.
@@ -484,7 +484,7 @@ fn has_curved_surface(shape: &parry3d::shape::SharedShape) -> bool {
 
 /// Cap on a body's speculative margin (m), so a body thrown at absurd speed does not pair
 /// with the whole scene.
-pub const MAX_SPECULATIVE_MARGIN: f32 = 2.0;
+pub(crate) const MAX_SPECULATIVE_MARGIN: f32 = 2.0;
 
 /// All pairs that the broad phase reported this step, with their manifolds.
 #[derive(Default)]
@@ -795,7 +795,7 @@ impl NarrowPhase {
 /// along the floor, so (3) fails and both contacts stay. Decisions are taken from the
 /// manifolds as Parry left them, before any point is dropped, so the result does not depend
 /// on the order of the pairs.
-pub mod seams {
+pub(crate) mod seams {
     use glam::Vec3;
     use parry3d::math::Pose;
 
@@ -803,12 +803,12 @@ pub mod seams {
     use crate::body::Bodies;
 
     /// How close (m) a contact point must be to the other static body to be on it.
-    pub const SEAM_TOLERANCE: f32 = 1.0e-4;
+    pub(crate) const SEAM_TOLERANCE: f32 = 1.0e-4;
     /// Normals whose dot product is at least this are the same (about 0.8°).
-    pub const SEAM_COS: f32 = 0.9999;
+    pub(crate) const SEAM_COS: f32 = 0.9999;
     /// Length (m) of the probe along the other body's normal; the rule holds for
     /// penetrations up to half of it.
-    pub const SEAM_PROBE: f32 = 0.01;
+    pub(crate) const SEAM_PROBE: f32 = 0.01;
 
     /// One contact point seen from the static body: witness point and outward normal (world).
     struct StaticSide {

@@ -278,7 +278,7 @@ impl ContactConstraint {
 /// at a time. The caller passes it only when nothing reads those rows' products before the
 /// lanes have solved them (no restitution solve after the substeps).
 #[allow(clippy::too_many_arguments)]
-pub fn assemble(
+pub(crate) fn assemble(
     bodies: &Bodies,
     narrow_phase: &NarrowPhase,
     islands: &Islands,
@@ -366,7 +366,7 @@ impl IslandRows {
 /// lever arms that switched with every micrometre of gap made the `reference` preset's
 /// iterations on pyramid20 converge several times more slowly, while the spin error of the
 /// middle, gap/(2r), is below 0.5 % of a 10 cm ball's spin under 1 mm.
-pub const WITNESS_LEVER_GAP: f32 = 1e-3;
+pub(crate) const WITNESS_LEVER_GAP: f32 = 1e-3;
 
 struct Assembly<'a> {
     bodies: &'a Bodies,
@@ -381,7 +381,10 @@ struct Assembly<'a> {
 /// `constraints`, with `world_inverse_inertia` per body (indexed by `body_a`, `body_b`): the
 /// tensors assembly had, so the products are those assembly would have computed, to the bit.
 /// For readers of the rows other than the SIMD lanes.
-pub fn complete_products(constraints: &mut [ContactConstraint], world_inverse_inertia: &[Mat3]) {
+pub(crate) fn complete_products(
+    constraints: &mut [ContactConstraint],
+    world_inverse_inertia: &[Mat3],
+) {
     for c in constraints.iter_mut().filter(|c| c.products_pending) {
         let inertia_a = Mat3A::from(world_inverse_inertia[c.body_a as usize]);
         let inertia_b = Mat3A::from(world_inverse_inertia[c.body_b as usize]);
@@ -599,7 +602,7 @@ fn tangent_basis(normal: Vec3, previous: Vec3) -> (Vec3, Vec3) {
 /// having changed no row's velocity by more than the tolerance, and the caller skips it. At rest
 /// this is the usual case: the repair decays exponentially towards the slop and never quite
 /// reaches it. Without split impulse, returns false.
-pub fn update_targets(
+pub(crate) fn update_targets(
     constraints: &mut [ContactConstraint],
     displacement: &[Vec3],
     rotation: &[Vec3],
@@ -657,12 +660,12 @@ pub fn update_targets(
 /// over the blow-up guard) without one. Touching and overlapping rows keep acting: dropping
 /// them too let darts through the wall; they hold a body where it is pressed, and continuous
 /// collision sweeps its true motion as the step ends.
-pub const SPECULATIVE_TURN: f32 = std::f32::consts::FRAC_PI_4;
+pub(crate) const SPECULATIVE_TURN: f32 = std::f32::consts::FRAC_PI_4;
 
 /// The target (m/s) of a stale speculative row: far below any approach speed (the blow-up guard
 /// stops a body at 10⁴ m/s), so the row's impulse goes to zero, yet small enough that no
 /// solver's products of it overflow.
-pub const STALE_TARGET: f32 = -1.0e15;
+pub(crate) const STALE_TARGET: f32 = -1.0e15;
 
 /// Whether a body's part of a speculative row is stale: the body had turned by more than
 /// [`SPECULATIVE_TURN`] since the step began (`turn`, the square of that angle, rad²) and the
@@ -670,7 +673,7 @@ pub const STALE_TARGET: f32 = -1.0e15;
 /// lever arm along the normal (|r × n| ≤ 10⁻³·|r|) gives n·(Δθ × r) = Δθ·(r × n) ≈ 0 and no
 /// torque: the row does not depend on the body's rotation.
 #[inline]
-pub fn speculative_row_is_stale(turn: f32, angular: Vec3, lever: Vec3) -> bool {
+pub(crate) fn speculative_row_is_stale(turn: f32, angular: Vec3, lever: Vec3) -> bool {
     turn > SPECULATIVE_TURN * SPECULATIVE_TURN
         && angular.length_squared() > 1e-6 * lever.length_squared()
 }
@@ -679,13 +682,13 @@ pub fn speculative_row_is_stale(turn: f32, angular: Vec3, lever: Vec3) -> bool {
 /// With one sweep a substep, a spring at a quarter of the rate (Box2D v3's cap) pumped energy
 /// into resting piles: pyramid20 gained tens of joules, the 400:1 `plate` kept rising; at a
 /// fifth they come to rest (docs/benchmarks.md, "Why the soft step is set this way").
-pub const MAX_SOFT_HERTZ_PER_SUBSTEP_RATE: f32 = 0.2;
+pub(crate) const MAX_SOFT_HERTZ_PER_SUBSTEP_RATE: f32 = 0.2;
 
 /// Soft contact as a damped spring of frequency `hertz` (capped at a fifth of the substep
 /// rate, [`MAX_SOFT_HERTZ_PER_SUBSTEP_RATE`]) and damping ratio ζ, discretised implicitly over
 /// `h` (Catto, "Solver2D" and Box2D v3 `b2MakeSoft`): returns the repair rate (1/s) and (mass
 /// scale, impulse scale).
-pub fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32)) {
+pub(crate) fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32)) {
     let hertz = hertz.min(MAX_SOFT_HERTZ_PER_SUBSTEP_RATE / h);
     let omega = 2.0 * std::f32::consts::PI * hertz;
     let a1 = 2.0 * damping_ratio + h * omega;
@@ -697,7 +700,7 @@ pub fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32))
 /// The repair rate (1/s) and the soft rows' (mass scale, impulse scale) of `repair` for a
 /// substep of `h` seconds: the spring's for soft repair ([`soft_contact`]), the rate with
 /// rigid rows (1, 0) otherwise.
-pub fn repair_terms(repair: &ContactRepair, h: f32) -> (f32, (f32, f32)) {
+pub(crate) fn repair_terms(repair: &ContactRepair, h: f32) -> (f32, (f32, f32)) {
     match *repair {
         ContactRepair::Soft {
             hertz,
@@ -712,7 +715,7 @@ pub fn repair_terms(repair: &ContactRepair, h: f32) -> (f32, (f32, f32)) {
 /// Newton's restitution hypothesis, v⁺ = −c_r·v⁻, for the points that collided this
 /// step: approach speed −v⁻ above the threshold and a normal impulse received. Sets their
 /// targets and returns whether any point bounces; other targets are left as they are.
-pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32) -> bool {
+pub(crate) fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32) -> bool {
     let mut any = false;
     for c in constraints.iter_mut() {
         let approach = c.normal.velocity_before;
@@ -738,7 +741,7 @@ pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32
 /// ([`crate::diagnostics::record_velocity_before_and_residual`]).
 ///
 /// `slots` says how rows name their bodies, and so how `linear` and `angular` are indexed.
-pub fn record_velocity_before(
+pub(crate) fn record_velocity_before(
     constraints: &mut [ContactConstraint],
     slots: BodySlots,
     linear: &[Vec3],
@@ -854,7 +857,7 @@ pub(crate) fn record_row(
 }
 
 /// Most parts of [`record_velocity_before`]'s first pass: each costs a per-body array.
-pub const RECORD_PARTS: usize = 4;
+pub(crate) const RECORD_PARTS: usize = 4;
 
 /// Rows per part of [`record_velocity_before`]'s first pass below [`RECORD_PARTS`] parts:
 /// smaller sets of rows are summed in one part, as before the parts existed.
@@ -862,7 +865,7 @@ const RECORD_POINTS_PER_PART: usize = 8192;
 
 /// Which indices of a [`ContactConstraint`] name its bodies in a pass over velocity arrays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BodySlots {
+pub(crate) enum BodySlots {
     /// `body_a` / `body_b`: the world's body arrays.
     World,
     /// `local_a` / `local_b`: one island's local arrays (the immovable slot last, at rest).
@@ -884,7 +887,7 @@ impl BodySlots {
 
 /// Scales the impulses carried over from the last step by `fraction` (0 = cold start) and
 /// keeps the friction impulse inside its disc.
-pub fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
+pub(crate) fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
     for c in constraints.iter_mut() {
         c.normal_impulse *= fraction;
         c.tangent_impulses[0] *= fraction;
@@ -896,7 +899,7 @@ pub fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
 
 /// Projects a friction impulse onto Coulomb's disc of radius `limit` (N·s).
 #[inline(always)]
-pub fn cap_to_disc(impulse: [f32; 2], limit: f32) -> [f32; 2] {
+pub(crate) fn cap_to_disc(impulse: [f32; 2], limit: f32) -> [f32; 2] {
     let squared = impulse[0] * impulse[0] + impulse[1] * impulse[1];
     if squared <= limit * limit {
         impulse

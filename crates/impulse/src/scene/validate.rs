@@ -41,12 +41,12 @@ use crate::body::rules::{self, ShapeClass};
 
 /// Smallest norm of an orientation quaternion or a half-space normal that is accepted;
 /// below it the vector counts as zero (its direction is not defined in f32).
-pub const MIN_NORM: f32 = rules::MIN_NORM;
+pub(crate) const MIN_NORM: f32 = rules::MIN_NORM;
 
 /// Relative tolerance of the convex-hull volume test: the points count as coincident,
 /// collinear or coplanar when they deviate from a point, line or plane by at most
 /// this fraction of their extent.
-pub const HULL_FLATNESS_TOLERANCE: f64 = 1e-5;
+pub(crate) const HULL_FLATNESS_TOLERANCE: f64 = 1e-5;
 
 /// Checks `scene` and returns the first problem, in this order: world settings (gravity,
 /// dt, solver), the materials, then the bodies in scene order.
@@ -588,7 +588,7 @@ fn len(a: V) -> f64 {
 /// p0p1p2. The set is degenerate when L = 0, or the distance to the line or plane is at most
 /// [`HULL_FLATNESS_TOLERANCE`]·L. If every point lies on that line (plane), they are all
 /// collinear (coplanar), so the test is exact up to the tolerance.
-pub fn hull_degeneracy(points: &[[f32; 3]]) -> Option<&'static str> {
+pub(crate) fn hull_degeneracy(points: &[[f32; 3]]) -> Option<&'static str> {
     let p: Vec<V> = points
         .iter()
         .map(|q| [f64::from(q[0]), f64::from(q[1]), f64::from(q[2])])

@@ -45,7 +45,7 @@ use crate::contact::constraints::{ContactConstraint, JacobianRow, is_isotropic};
 /// points. A failed solve leaves the rows and velocities as they were and says so in
 /// [`SolveOutcome::exact_failed`]; its iterations are zero and its change is the residual.
 #[derive(Default)]
-pub struct Exact {
+pub(crate) struct Exact {
     /// Work space, kept between solves.
     pub workspace: ExactWorkspace,
     /// Largest island solved; larger ones fail with [`ExactFailure::TooManyRows`].
@@ -99,11 +99,11 @@ impl ContactSolver for Exact {
 /// active row's velocity off by ε·A_ii·γ_i, which under a 100 t box on a 1 t box was 4e-6 m/s,
 /// while the proximal one vanishes as the rounds settle, and among the many load splits of
 /// redundant contacts it keeps the one closest to the entry impulses.
-pub const REGULARISATION: f64 = 1e-6;
+pub(crate) const REGULARISATION: f64 = 1e-6;
 
 /// Most rounds (normal LCP + friction passes) per solve. Frictionless islands need one, unless
 /// it changed a velocity by more than 1 m/s (see [`REGULARISATION`]).
-pub const MAX_ROUNDS: u32 = 4;
+pub(crate) const MAX_ROUNDS: u32 = 4;
 
 /// Symmetric Gauss-Seidel passes over the friction pairs per round.
 const FRICTION_PASSES: u32 = 4;
@@ -127,7 +127,7 @@ const MIN_PIVOTS: usize = 16;
 
 /// Buffers reused between calls: the dense blocks and the trial impulses and velocities.
 #[derive(Default)]
-pub struct ExactWorkspace {
+pub(crate) struct ExactWorkspace {
     /// A = J M⁻¹ Jᵀ over the island's rows (normals, then tangent pairs), row-major (1/kg).
     full: Vec<f64>,
     /// Per row of `full`: (point, 0 for the normal or 1, 2 for a tangent).
@@ -177,7 +177,7 @@ pub struct ExactWorkspace {
 
 /// What a successful exact solve did.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ExactReport {
+pub(crate) struct ExactReport {
     /// Lemke pivots, summed over the rounds.
     pub pivots: u32,
     /// Rounds run (normal LCP solves), 1 ..= [`MAX_ROUNDS`]; 0 for an island without contacts.
@@ -192,7 +192,7 @@ pub struct ExactReport {
 
 /// Why the exact path gave up; the constraints and velocities are then as they were on entry.
 #[derive(Clone, Debug, thiserror::Error)]
-pub enum ExactFailure {
+pub(crate) enum ExactFailure {
     /// The island has more normal rows (contact points) than the caller allows.
     #[error("{rows} contact rows exceed the exact path's limit of {max_rows}")]
     TooManyRows {
@@ -272,7 +272,7 @@ pub enum ExactFailure {
 /// residual and 1e-6 m/s (friction rounds that did not settle).
 ///
 /// Panics if a local index is outside `velocities`, as the iterative solvers do.
-pub fn solve_exact(
+pub(crate) fn solve_exact(
     constraints: &mut [ContactConstraint],
     velocities: &mut Velocities<'_>,
     max_rows: usize,

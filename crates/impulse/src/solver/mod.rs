@@ -20,20 +20,20 @@
 
 use glam::{Mat3, Vec3};
 
-pub use crate::contact::constraints::cap_to_disc;
+pub(crate) use crate::contact::constraints::cap_to_disc;
 use crate::contact::constraints::{self, ContactConstraint};
 use crate::parallel::{RESIDUAL_ROWS_PER_TASK, SharedItems, SharedVelocities, parts_in_order};
 use crate::settings::SolverSettings;
 
-pub mod apgd;
-pub mod exact;
-pub mod impact;
-pub mod nncg;
-pub mod pgs;
-pub mod policy;
-pub mod position;
-pub mod substep;
-pub mod wide;
+pub(crate) mod apgd;
+pub(crate) mod exact;
+pub(crate) mod impact;
+pub(crate) mod nncg;
+pub(crate) mod pgs;
+pub(crate) mod policy;
+pub(crate) mod position;
+pub(crate) mod substep;
+pub(crate) mod wide;
 
 pub use pgs::Sweep;
 pub use policy::EscalationLevel;
@@ -48,7 +48,7 @@ pub use substep::{HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, IslandReport};
 /// The rows live in the island's `constraints`: a method that solves a copy of them in another
 /// layout (the SIMD lanes of [`wide`]) makes it in `prepare` and writes the impulses back in
 /// `finish`; the scalar methods work on the constraints themselves.
-pub trait ContactSolver {
+pub(crate) trait ContactSolver {
     /// Readies the step's solves on the island's `constraints`, whose body slots are below
     /// `slots` (`slots − 1` the immovable one); `inverse_inertia` holds each slot's world
     /// inverse inertia as assembly used it (1/(kg·m²); zero for the immovable slot), from which
@@ -100,7 +100,7 @@ pub trait ContactSolver {
 
 /// What one [`ContactSolver::solve`] is asked to do.
 #[derive(Clone, Copy)]
-pub struct SolvePass<'a> {
+pub(crate) struct SolvePass<'a> {
     /// Most iterations (sweeps).
     pub iterations: u32,
     /// Early exit: largest row velocity change of an iteration (m/s).
@@ -127,7 +127,7 @@ pub struct SolvePass<'a> {
 /// the step began (m, rad; the immovable slot zero), the settings and the substep `h` (s), and
 /// whether this is the main solve, with overlap repair, or the relax solve.
 #[derive(Clone, Copy)]
-pub struct TargetInputs<'a> {
+pub(crate) struct TargetInputs<'a> {
     /// Per slot, displacement of the centre of mass (m).
     pub displacement: &'a [Vec3],
     /// Per slot, rotation vector (rad).
@@ -146,7 +146,7 @@ pub struct TargetInputs<'a> {
 
 /// What one [`ContactSolver::solve`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SolveOutcome {
+pub(crate) struct SolveOutcome {
     /// Iterations and the last one's largest change (for an exact solve, its residual).
     pub report: SolveReport,
     /// The strongest method the solve used.
@@ -163,7 +163,7 @@ pub struct SolveOutcome {
 
 impl SolveOutcome {
     /// An outcome of `level` that is `report` alone.
-    pub fn of(level: EscalationLevel, report: SolveReport) -> Self {
+    pub(crate) fn of(level: EscalationLevel, report: SolveReport) -> Self {
         Self {
             report,
             level,
@@ -339,7 +339,7 @@ pub fn warm_start(constraints: &[ContactConstraint], velocities: &mut Velocities
 /// With K = U diag(k) Uᵀ, λ(ν) = (K + νI)⁻¹ K q and ‖λ(ν)‖ = limit is found by Newton's method
 /// on 1/‖λ(ν)‖ (Moré and Sorensen's trust-region iteration), which converges in a few steps.
 #[inline(always)]
-pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f32; 2] {
+pub(crate) fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f32; 2] {
     let squared = q[0] * q[0] + q[1] * q[1];
     if squared <= limit * limit {
         return q;
@@ -375,7 +375,7 @@ pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f3
 /// (k₁₁, k₁₂, k₂₂) in 1/kg, with k₁ ≥ k₂ and u₂ = u₁ rotated by +90°: what
 /// [`project_to_friction_disc`] works in.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TangentEigen {
+pub(crate) struct TangentEigen {
     /// Larger eigenvalue (1/kg).
     pub k1: f32,
     /// Smaller eigenvalue (1/kg).
@@ -388,7 +388,7 @@ impl TangentEigen {
     /// The decomposition of `block`; `None` when K is not positive definite (k₂ ≤ 0 or NaN:
     /// an immovable pair), where the projection falls back to the radial cap.
     #[inline(always)]
-    pub fn of(block: [f32; 3]) -> Option<Self> {
+    pub(crate) fn of(block: [f32; 3]) -> Option<Self> {
         let [a, b, d] = block;
         let half_trace = 0.5 * (a + d);
         let radius = (0.25 * (a - d) * (a - d) + b * b).sqrt();

@@ -99,7 +99,7 @@ const HEAVY_ON_LIGHT_REPAIR_RATE: f32 = 12.0;
 
 /// Local state of one island during a step.
 #[derive(Default)]
-pub struct IslandWorkspace {
+pub(crate) struct IslandWorkspace {
     /// Linear velocities (m/s) of the island's bodies, then its guests (kinematic bodies),
     /// then the immovable slot.
     pub linear: Vec<Vec3>,
@@ -330,7 +330,7 @@ impl IslandWorkspace {
 }
 
 /// Everything an island's step reads besides its own bodies and constraints.
-pub struct StepContext<'a> {
+pub(crate) struct StepContext<'a> {
     /// All bodies (read only).
     pub bodies: &'a Bodies,
     /// Gravity (m/s²).
@@ -365,7 +365,7 @@ pub struct StepContext<'a> {
 /// impulse changes (their inverse mass and inertia are zero) and no gravity or force
 /// touches; their displacement is integrated with the island's so that the contacts'
 /// separations follow their motion. They are not written back.
-pub fn step_island(
+pub(crate) fn step_island(
     island_bodies: &[u32],
     guests: &[u32],
     constraints: &mut [ContactConstraint],
@@ -776,7 +776,7 @@ pub fn step_island(
 }
 
 /// Writes an island's velocities and poses back into the bodies.
-pub fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut Bodies) {
+pub(crate) fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut Bodies) {
     for (k, &i) in island_bodies.iter().enumerate() {
         let i = i as usize;
         scatter_body(
@@ -793,7 +793,7 @@ pub fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut 
 /// Writes the body at local index `k` of `workspace`'s island back: its velocities and its
 /// pose (the centre of mass moved by the island's displacement, at its new orientation).
 #[inline]
-pub fn scatter_body(
+pub(crate) fn scatter_body(
     workspace: &IslandWorkspace,
     k: usize,
     local_center_of_mass: Vec3,

@@ -51,7 +51,7 @@ use crate::simd::{InstructionSet, on_instruction_set};
 /// hold independent manifold groups of one colour), so results differ only where padding and
 /// the colouring's overflow groups fall differently.
 #[cfg(not(feature = "lanes8"))]
-pub const LANES: usize = 4;
+pub(crate) const LANES: usize = 4;
 /// See the 4-lane constant.
 #[cfg(feature = "lanes8")]
 pub const LANES: usize = 8;
@@ -182,7 +182,7 @@ const GROUP_POINTS: usize = 4;
 /// An island's contact points packed in bundles, manifold group by manifold group, colour by
 /// colour.
 #[derive(Default)]
-pub struct Bundles {
+pub(crate) struct Bundles {
     bundles: Vec<Bundle>,
     geometry: Vec<BundleGeometry>,
     /// Per bundle, the impulses (normal, tangent 1, tangent 2) of the substeps so far, lane by
@@ -386,7 +386,7 @@ impl Bundles {
     /// get them here, four lanes at a time, from their lever arms and directions and the world
     /// inverse inertia of their bodies' slots (`inverse_inertia`, one per slot), in the order
     /// of operations of the scalar assembly, so to the same bits.
-    pub fn pack(
+    pub(crate) fn pack(
         &mut self,
         constraints: &[ContactConstraint],
         slots: usize,
@@ -690,7 +690,7 @@ impl Bundles {
     }
 
     /// Whether [`Bundles::pack`] was asked to spread colours over rayon's threads.
-    pub fn parallel(&self) -> bool {
+    pub(crate) fn parallel(&self) -> bool {
         self.parallel
     }
 
@@ -700,7 +700,7 @@ impl Bundles {
     /// natural-map residual and friction rows ([`Bundles::take_rows`]): over the points in
     /// constraint order, in runs of the same length and added in the same order as
     /// `diagnostics::record_velocity_before_and_residual`, so the residual is its to the bit.
-    pub fn unpack(&mut self, constraints: &mut [ContactConstraint]) {
+    pub(crate) fn unpack(&mut self, constraints: &mut [ContactConstraint]) {
         let (bundles, totals, records) = (&self.bundles, &self.step_totals, &self.records);
         let recorded = self.recorded;
         // Writes one point back; returns its rows' φ² (0 unless recorded).
@@ -779,7 +779,7 @@ impl Bundles {
     /// gravity, forces, damping and gyroscopic term are in. From there to the step's end
     /// the velocities change by the impulses alone: the warm start's γ of the substep before
     /// and the sweeps' changes to it, M⁻¹Jᵀγ with γ the final impulses.
-    pub fn keep_velocities_before(&mut self, linear: &[Vec3], angular: &[Vec3]) {
+    pub(crate) fn keep_velocities_before(&mut self, linear: &[Vec3], angular: &[Vec3]) {
         self.before_linear.clear();
         self.before_linear.extend_from_slice(linear);
         self.before_angular.clear();
@@ -802,7 +802,7 @@ impl Bundles {
     /// for the rows); here one pass reads the bundles. The residual is the same to the bit
     /// (it reads v and γ alone); J·v* may differ in its last bits, v* being the velocities
     /// before the impulses rather than the final ones less M⁻¹Jᵀγ.
-    pub fn record(&mut self, linear: &[Vec3], angular: &[Vec3]) {
+    pub(crate) fn record(&mut self, linear: &[Vec3], angular: &[Vec3]) {
         if !std::mem::take(&mut self.before_kept) {
             debug_assert!(
                 false,
@@ -935,7 +935,7 @@ impl Bundles {
     /// they depend on the bodies' displacements only, which a sweep does not change, so the
     /// result is the same as a separate pass over the bundles first. That pass read and wrote
     /// a third of the bytes of a sweep, twice a substep (pyramid100's bundles are 17 MB).
-    pub fn solve_pgs(
+    pub(crate) fn solve_pgs(
         &mut self,
         velocities: &mut Velocities<'_>,
         pass: &SolvePass<'_>,

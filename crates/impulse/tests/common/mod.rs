@@ -6,7 +6,7 @@ use glam::Vec3;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc};
 
 /// Material with Coulomb coefficient `friction`, no restitution, density 1000 kg/m³.
-pub fn material(friction: f32) -> Material {
+pub(crate) fn material(friction: f32) -> Material {
     Material {
         friction,
         restitution: 0.0,
@@ -15,7 +15,7 @@ pub fn material(friction: f32) -> Material {
 }
 
 /// A static cuboid of half extents `half` (m) centred at `position` (m).
-pub fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
+pub(crate) fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
     BodyDesc::new(
         BodyKind::Static,
         ShapeDesc::Cuboid {
@@ -28,7 +28,7 @@ pub fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
 /// The 64-sphere pile of the complementarity tests: 4 layers of 4×4 frictionless spheres
 /// (r = 0.45 m, jittered) on a static ground inside four static walls, with `settings`,
 /// dt = 1/60 s, gravity −9.81 m/s² along y.
-pub fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
+pub(crate) fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
     let mut w = impulse::World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
     w.add_body(
         &static_box(Vec3::new(50.0, 0.5, 50.0), Vec3::new(0.0, -0.5, 0.0)),
@@ -67,7 +67,7 @@ pub fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
 }
 
 /// Index of the body whose origin is highest (largest y): the top of a pile.
-pub fn highest_body(world: &impulse::World) -> usize {
+pub(crate) fn highest_body(world: &impulse::World) -> usize {
     let poses = world.poses();
     (0..poses.len())
         .max_by(|&i, &j| {
@@ -79,7 +79,7 @@ pub fn highest_body(world: &impulse::World) -> usize {
 
 /// FNV-1a hash of a world's state: every body's pose and velocities and every contact point's
 /// impulses and separation, as f32 bits. Equal hashes mean the same state to the bit.
-pub fn hash_state(world: &impulse::World) -> u64 {
+pub(crate) fn hash_state(world: &impulse::World) -> u64 {
     let mut hash = 0xcbf2_9ce4_8422_2325u64;
     let mut add = |x: f32| {
         for byte in x.to_bits().to_le_bytes() {
