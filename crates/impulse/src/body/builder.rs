@@ -7,7 +7,6 @@ use parry3d::shape::SharedShape;
 
 use super::rules::{self, ShapeClass};
 use super::{BodyKind, Keyframe, LockedAxes};
-use crate::error::WorldError;
 
 /// A body to insert into a [`crate::World`]: shape, kind, pose, velocities, material and mass,
 /// with glam types. Units SI; velocities are those of the body origin, angular velocity in
@@ -241,11 +240,18 @@ pub(crate) struct BuiltBody {
     pub(crate) locked_axes: LockedAxes,
 }
 
-/// An invalid field of body `index` built from `builder`.
-fn invalid_built(index: usize, builder: &BodyBuilder, field: &str, message: String) -> WorldError {
-    WorldError::InvalidBody {
-        body: index,
-        name: builder.name.clone(),
+/// A builder's field that cannot be simulated: its path as in the scene format (`position`,
+/// `material.friction`, `keyframes[2].t`, …) and what is wrong. The world adds the body's index
+/// and name ([`crate::WorldError::InvalidBody`]).
+#[derive(Debug)]
+pub(crate) struct InvalidField {
+    pub(crate) field: String,
+    pub(crate) message: String,
+}
+
+/// An invalid field of a builder.
+fn invalid_built(field: &str, message: String) -> InvalidField {
+    InvalidField {
         field: field.to_string(),
         message,
     }
@@ -254,11 +260,11 @@ fn invalid_built(index: usize, builder: &BodyBuilder, field: &str, message: Stri
 /// Turns a builder into state, rejecting every value that would make the simulation
 /// meaningless (the library never panics on user input). Fields are named as in the scene
 /// format (`position` for the translation, `material.friction`, …).
-pub(crate) fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
+pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
     let check = |field: &str, rule: Result<(), String>| {
-        rule.map_err(|message| invalid_built(index, b, field, message))
+        rule.map_err(|message| invalid_built(field, message))
     };
-    let bad = |field: &str, message: String| Err(invalid_built(index, b, field, message));
+    let bad = |field: &str, message: String| Err(invalid_built(field, message));
     check("position", rules::finite(&b.translation.to_array()))?;
     check("orientation", rules::orientation(b.rotation.to_array()))?;
     check(
@@ -283,7 +289,7 @@ pub(crate) fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldErr
     if !b.locked_axes.is_empty() {
         check("locked_axes", rules::locked_axes_for_kind(b.kind))?;
     }
-    let keyframes = check_keyframes(index, b)?;
+    let keyframes = check_keyframes(b)?;
     let rotation = b.rotation.normalize();
     let pose = Pose::from_parts(b.translation, rotation);
     let (inverse_mass, local_center_of_mass, local_inverse_inertia) = match b.kind {
@@ -368,12 +374,12 @@ pub(crate) fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldErr
 /// velocities of their own; times finite, > 0 and increasing; translations finite; rotations
 /// finite and non-zero) and with normalised rotations. Fields are named as in the scene format
 /// (`keyframes[i].t`, `.position`, `.orientation`).
-fn check_keyframes(index: usize, b: &BodyBuilder) -> Result<Vec<Keyframe>, WorldError> {
+fn check_keyframes(b: &BodyBuilder) -> Result<Vec<Keyframe>, InvalidField> {
     if b.keyframes.is_empty() {
         return Ok(Vec::new());
     }
     let check = |field: String, rule: Result<(), String>| {
-        rule.map_err(|message| invalid_built(index, b, &field, message))
+        rule.map_err(|message| invalid_built(&field, message))
     };
     check("keyframes".into(), rules::keyframes_for_kind(b.kind))?;
     for (field, velocity) in [

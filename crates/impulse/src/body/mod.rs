@@ -1,9 +1,8 @@
 //! Bodies: what a body is ([`BodyKind`], [`LockedAxes`], [`Keyframe`]), how it is named
-//! ([`BodyHandle`]), described ([`BodyBuilder`], from a builder or a scene's description) and
+//! ([`BodyHandle`]), described ([`BodyBuilder`]) and
 //! stored ([`Bodies`], one array per quantity).
 
 mod builder;
-mod from_scene;
 mod handle;
 mod kind;
 mod locked_axes;
@@ -14,7 +13,6 @@ mod tests;
 
 pub use builder::BodyBuilder;
 pub(crate) use builder::build;
-pub(crate) use from_scene::{builder_of, invalid};
 pub use handle::BodyHandle;
 pub(crate) use handle::Handles;
 pub use kind::{BodyKind, Keyframe};

@@ -20,6 +20,7 @@ use crate::solver::substep::IslandWorkspace;
 mod bodies;
 mod contacts;
 mod continuous;
+mod from_scene;
 mod kinematic;
 mod query;
 mod snapshot;
@@ -188,7 +189,7 @@ impl World {
                     Some(m) => m.clone(),
                     None if name == "default" => Material::default(),
                     None => {
-                        return Err(crate::body::invalid(
+                        return Err(from_scene::invalid(
                             index,
                             desc,
                             "material",
@@ -208,7 +209,7 @@ impl World {
     /// Errors name the body and the field ([`WorldError::InvalidBody`]).
     pub fn add_body(&mut self, desc: &BodyDesc, material: &Material) -> Result<usize, WorldError> {
         let index = self.bodies.len();
-        let builder = crate::body::builder_of(index, desc, material)?;
+        let builder = from_scene::builder_of(index, desc, material)?;
         self.insert(builder)?;
         Ok(index)
     }
@@ -217,7 +218,12 @@ impl World {
     /// finite or out of range (see [`BodyBuilder`]); the world is then unchanged.
     pub fn insert(&mut self, builder: BodyBuilder) -> Result<BodyHandle, WorldError> {
         let index = self.bodies.len();
-        let built = crate::body::build(index, &builder)?;
+        let built = crate::body::build(&builder).map_err(|error| WorldError::InvalidBody {
+            body: index,
+            name: builder.name.clone(),
+            field: error.field,
+            message: error.message,
+        })?;
         let b = &mut self.bodies;
         b.kind.push(builder.kind);
         b.pose.push(built.pose);

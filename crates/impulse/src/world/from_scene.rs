@@ -4,7 +4,7 @@
 use glam::{Quat, Vec3};
 use parry3d::shape::SharedShape;
 
-use super::{BodyBuilder, BodyKind, Keyframe, LockedAxes};
+use crate::body::{BodyBuilder, BodyKind, Keyframe, LockedAxes};
 use crate::error::WorldError;
 use crate::scene::{BodyDesc, Material, ShapeDesc};
 
