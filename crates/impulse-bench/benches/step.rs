@@ -19,7 +19,7 @@ use glam::Vec3;
 use impulse::World;
 use impulse::internals::{
     BroadPhase, ContactConstraint, NarrowPhase, NncgWorkspace, SpeculativeMargins, Sweep,
-    Velocities, contact_constraints, solve_nncg, solve_pgs, warm_start,
+    Velocities, bodies, contact_constraints, solve_nncg, solve_pgs, warm_start,
 };
 use impulse::scene::builtin_scene;
 
@@ -55,7 +55,7 @@ fn step(c: &mut Criterion) {
 fn margins(world: &World) -> SpeculativeMargins {
     let mut margins = SpeculativeMargins::default();
     margins.update(
-        world.bodies(),
+        bodies(world),
         world.settings().prediction_distance,
         world.gravity(),
         world.dt(),
@@ -71,7 +71,7 @@ fn broad_phase(c: &mut Criterion) {
     c.bench_function("broad_phase/pyramid20", |b| {
         b.iter(|| {
             broad_phase.candidate_pairs(
-                black_box(world.bodies()),
+                black_box(bodies(&world)),
                 margins.margins(),
                 false,
                 &mut pairs,
@@ -85,7 +85,7 @@ fn broad_phase(c: &mut Criterion) {
     c.bench_function("broad_phase/pyramid20_fresh", |b| {
         b.iter(|| {
             BroadPhase::default().candidate_pairs(
-                black_box(world.bodies()),
+                black_box(bodies(&world)),
                 margins.margins(),
                 false,
                 &mut pairs,
@@ -99,15 +99,15 @@ fn narrow_phase(c: &mut Criterion) {
     let world = settled_world();
     let margins = margins(&world);
     let mut pairs = Vec::new();
-    BroadPhase::default().candidate_pairs(world.bodies(), margins.margins(), false, &mut pairs);
+    BroadPhase::default().candidate_pairs(bodies(&world), margins.margins(), false, &mut pairs);
     let mut narrow_phase = NarrowPhase::default();
     narrow_phase
-        .update(world.bodies(), &pairs, &margins, false)
+        .update(bodies(&world), &pairs, &margins, false)
         .expect("pyramid20 shapes are supported");
     c.bench_function("narrow_phase/pyramid20", |b| {
         b.iter(|| {
             narrow_phase
-                .update(black_box(world.bodies()), &pairs, &margins, false)
+                .update(black_box(bodies(&world)), &pairs, &margins, false)
                 .expect("pyramid20 shapes are supported");
             black_box(narrow_phase.pairs.len())
         })
@@ -118,8 +118,8 @@ fn narrow_phase(c: &mut Criterion) {
 /// velocities v* = v − M⁻¹Jᵀγ the step's impulses γ started from: the step's LCP, unsolved.
 fn cold_problem(world: &World) -> (Vec<ContactConstraint>, Vec<Vec3>, Vec<Vec3>) {
     let mut constraints = contact_constraints(world).to_vec();
-    let mut linear = world.bodies().linear_velocity.clone();
-    let mut angular = world.bodies().angular_velocity.clone();
+    let mut linear = world.linear_velocities().to_vec();
+    let mut angular = world.angular_velocities().to_vec();
     for c in &mut constraints {
         // The solver indexes velocities by `local_a`/`local_b`; here the world's arrays.
         c.local_a = c.body_a;

@@ -116,7 +116,7 @@ impl ImpulseRun {
         Ok(Self {
             scene: scene.name.clone(),
             engine,
-            quality: Quality::new(world.bodies()),
+            quality: Quality::new(&world, world.poses()),
             world,
             times_ms: Vec::with_capacity(steps as usize),
             step: 0,
@@ -150,7 +150,7 @@ impl ImpulseRun {
                 format!("{}, scene {}, step {}", self.engine, self.scene, self.step)
             })?;
             if quality::is_sample_step(self.step, self.steps) {
-                self.quality.sample(self.world.bodies());
+                self.quality.sample(&self.world, self.world.poses());
             }
         }
         Ok(())
@@ -158,11 +158,11 @@ impl ImpulseRun {
 
     /// The row of the steps taken so far.
     pub(crate) fn finish(mut self) -> BenchRow {
-        let report = self.quality.finish(self.world.bodies());
+        let report = self.quality.finish(self.world.poses());
         BenchRow::new(
             &self.scene,
             &self.engine,
-            self.world.bodies().len(),
+            self.world.body_count(),
             self.step,
             &mut self.times_ms,
             report,

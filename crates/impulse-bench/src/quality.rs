@@ -1,10 +1,11 @@
 //! Quality metrics (docs/benchmarks.md, "What is measured, and how") taken from poses alone, the
-//! same way for every engine: each engine writes its poses into a [`Bodies`] in scene order and
-//! the functions of `impulse::metrics` measure them.
+//! same way for every engine: each engine gives its poses in scene order, and the functions of
+//! `impulse::metrics` measure them with the shapes, kinds and collision groups of the impulse
+//! world built from the same scene.
 
 use glam::Vec3;
-use impulse::Bodies;
-use impulse::metrics;
+use impulse::{World, metrics};
+use parry3d::math::Pose;
 
 /// Poses are measured after every `SAMPLE_EVERY`-th step, and after the last one.
 pub const SAMPLE_EVERY: u32 = 10;
@@ -35,29 +36,29 @@ pub struct QualityReport {
 }
 
 impl Quality {
-    /// Records the initial state: `bodies` with the poses the scene gives.
-    pub fn new(bodies: &Bodies) -> Self {
+    /// Records the initial state: the bodies of `world` at `poses`, the poses the scene gives.
+    pub fn new(world: &World, poses: &[Pose]) -> Self {
         Self {
-            initial: bodies.pose.iter().map(|p| p.translation).collect(),
-            top: metrics::top_body(bodies),
+            initial: poses.iter().map(|p| p.translation).collect(),
+            top: metrics::top_body(world, poses),
             max_overlap: 0.0,
             max_drift: 0.0,
         }
     }
 
-    /// Measures one sample: `bodies` with the current poses.
-    pub fn sample(&mut self, bodies: &Bodies) {
-        self.max_overlap = self.max_overlap.max(metrics::max_overlap(bodies));
+    /// Measures one sample: the bodies of `world` at the current `poses`.
+    pub fn sample(&mut self, world: &World, poses: &[Pose]) {
+        self.max_overlap = self.max_overlap.max(metrics::max_overlap(world, poses));
         self.max_drift = self
             .max_drift
-            .max(metrics::max_drift(bodies, &self.initial));
+            .max(metrics::max_drift(world, poses, &self.initial));
     }
 
-    /// The report, with the sink measured on `bodies` at their final poses.
-    pub fn finish(&self, bodies: &Bodies) -> QualityReport {
+    /// The report, with the sink measured at the final `poses`.
+    pub fn finish(&self, poses: &[Pose]) -> QualityReport {
         let top_sink = self
             .top
-            .map(|i| self.initial[i].y - bodies.pose[i].translation.y)
+            .map(|i| self.initial[i].y - poses[i].translation.y)
             .unwrap_or(0.0);
         QualityReport {
             top_sink,

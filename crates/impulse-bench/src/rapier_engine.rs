@@ -3,14 +3,14 @@
 //! from Rapier's poses.
 //!
 //! Rapier 0.36 and impulse share parry3d 0.31, so Rapier's poses are `parry3d::math::Pose`
-//! values already (glam-based); they are copied into a `Bodies` in scene order.
+//! values already (glam-based); they are copied out in scene order.
 
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use impulse::Bodies;
 use impulse::scene::{BodyKind, Material, MaterialRef, ShapeDesc};
 use impulse::{Scene, World};
+use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 use rapier3d::prelude::{
     CCDSolver, CoefficientCombineRule, ColliderBuilder, ColliderSet, DefaultBroadPhase,
@@ -55,8 +55,11 @@ pub(crate) struct RapierRun {
     scene: String,
     engine: String,
     sim: RapierScene,
-    /// The impulse world's bodies with Rapier's poses written in, for the metrics.
-    bodies: Bodies,
+    /// The impulse world built from the same scene: the shapes, kinds and collision groups
+    /// the metrics measure Rapier's poses with.
+    world: World,
+    /// Rapier's poses, scene order.
+    poses: Vec<Pose>,
     quality: Quality,
     times_ms: Vec<f64>,
     step: u32,
@@ -71,17 +74,18 @@ impl RapierRun {
         engine: &str,
     ) -> Result<Self> {
         // The impulse world validates the scene and gives the shapes, the body kinds and the
-        // initial state in scene order; the metrics read a copy of its bodies.
+        // initial state in scene order; the metrics read its shapes with Rapier's poses.
         let world = World::from_scene(scene)
             .with_context(|| format!("building scene {} in impulse", scene.name))?;
         let sim = RapierScene::build(scene, &world, params)?;
-        let bodies = world.bodies().clone();
+        let poses = world.poses().to_vec();
         Ok(Self {
             scene: scene.name.clone(),
             engine: engine.to_string(),
             sim,
-            quality: Quality::new(&bodies),
-            bodies,
+            quality: Quality::new(&world, &poses),
+            world,
+            poses,
             times_ms: Vec::with_capacity(steps as usize),
             step: 0,
             steps,
@@ -97,9 +101,9 @@ impl RapierRun {
             self.sim.step();
             self.times_ms.push(start.elapsed().as_secs_f64() * 1e3);
             if quality::is_sample_step(self.step, self.steps) {
-                self.sim.copy_poses(&mut self.bodies);
-                check_finite(&self.bodies, &self.engine, &self.scene, self.step)?;
-                self.quality.sample(&self.bodies);
+                self.sim.copy_poses(&mut self.poses);
+                check_finite(&self.poses, &self.engine, &self.scene, self.step)?;
+                self.quality.sample(&self.world, &self.poses);
             }
         }
         Ok(())
@@ -107,12 +111,12 @@ impl RapierRun {
 
     /// The row of the steps taken so far.
     pub(crate) fn finish(mut self) -> BenchRow {
-        self.sim.copy_poses(&mut self.bodies);
-        let report = self.quality.finish(&self.bodies);
+        self.sim.copy_poses(&mut self.poses);
+        let report = self.quality.finish(&self.poses);
         BenchRow::new(
             &self.scene,
             &self.engine,
-            self.bodies.len(),
+            self.poses.len(),
             self.step,
             &mut self.times_ms,
             report,
@@ -143,7 +147,6 @@ impl RapierScene {
         let mut bodies = RigidBodySet::new();
         let mut colliders = ColliderSet::new();
         let mut handles = Vec::with_capacity(scene.bodies.len());
-        let built = world.bodies();
         for (i, desc) in scene.bodies.iter().enumerate() {
             let material = resolve_material(scene, &desc.material)?;
             if desc.keyframes.is_some() {
@@ -160,9 +163,9 @@ impl RapierScene {
             }
             // The pose as impulse built it (quaternion normalised), velocities of the centre
             // of mass (Rapier's convention too), no sleeping.
-            .pose(built.pose[i])
-            .linvel(built.linear_velocity[i])
-            .angvel(built.angular_velocity[i])
+            .pose(world.poses()[i])
+            .linvel(world.linear_velocities()[i])
+            .angvel(world.angular_velocities()[i])
             .can_sleep(false)
             .build();
             let handle = bodies.insert(body);
@@ -220,9 +223,9 @@ impl RapierScene {
     }
 
     /// Writes Rapier's body poses into `out` (scene order).
-    fn copy_poses(&self, out: &mut Bodies) {
+    fn copy_poses(&self, out: &mut [Pose]) {
         for (i, &handle) in self.handles.iter().enumerate() {
-            out.pose[i] = *self.bodies[handle].position();
+            out[i] = *self.bodies[handle].position();
         }
     }
 }
@@ -277,8 +280,8 @@ fn collider_builder(kind: BodyKind, shape: &ShapeDesc) -> Result<ColliderBuilder
     })
 }
 
-fn check_finite(bodies: &Bodies, engine: &str, scene: &str, step: u32) -> Result<()> {
-    for (i, pose) in bodies.pose.iter().enumerate() {
+fn check_finite(poses: &[Pose], engine: &str, scene: &str, step: u32) -> Result<()> {
+    for (i, pose) in poses.iter().enumerate() {
         if !(pose.translation.is_finite() && pose.rotation.is_finite()) {
             bail!("{engine}, scene {scene}, step {step}: body {i} has a non-finite pose");
         }
@@ -378,9 +381,9 @@ mod tests {
         assert_eq!(sim.handles.len(), scene.bodies.len());
         for (i, &handle) in sim.handles.iter().enumerate() {
             let body = &sim.bodies[handle];
-            assert_eq!(*body.position(), world.bodies().pose[i], "body {i} pose");
-            let expected_mass = if world.bodies().inverse_mass[i] > 0.0 {
-                1.0 / world.bodies().inverse_mass[i]
+            assert_eq!(*body.position(), world.poses()[i], "body {i} pose");
+            let expected_mass = if world.body_at(i).unwrap().inverse_mass() > 0.0 {
+                1.0 / world.body_at(i).unwrap().inverse_mass()
             } else {
                 0.0
             };
@@ -389,10 +392,13 @@ mod tests {
                 (mass - expected_mass).abs() <= 1e-4 * expected_mass.max(1.0),
                 "body {i}: rapier mass {mass}, impulse mass {expected_mass}"
             );
-            assert!((body.linvel() - world.bodies().linear_velocity[i]).length() < 1e-6);
+            assert!((body.linvel() - world.linear_velocities()[i]).length() < 1e-6);
             let collider = &sim.colliders[body.colliders()[0]];
-            assert_eq!(collider.friction(), world.bodies().friction[i]);
-            assert_eq!(collider.restitution(), world.bodies().restitution[i]);
+            assert_eq!(collider.friction(), world.body_at(i).unwrap().friction());
+            assert_eq!(
+                collider.restitution(),
+                world.body_at(i).unwrap().restitution()
+            );
             assert_eq!(collider.friction_combine_rule(), FRICTION_COMBINE);
             assert_eq!(collider.restitution_combine_rule(), RESTITUTION_COMBINE);
         }

@@ -1,5 +1,6 @@
 //! `impulse run`: step a scene, write its trajectory, print and save a summary.
 
+use parry3d::math::Pose;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -165,8 +166,8 @@ impl Summary {
 pub fn instruction_set_line() -> String {
     format!(
         "SIMD kernels: {} ({}=baseline for the baseline; the results are the same)",
-        impulse::InstructionSet::detected().name(),
-        impulse::INSTRUCTION_SET_VARIABLE
+        impulse::simd::InstructionSet::detected().name(),
+        impulse::simd::INSTRUCTION_SET_VARIABLE
     )
 }
 
@@ -193,11 +194,11 @@ impl FrameOutput {
         }
     }
 
-    fn write_frame(&mut self, step: u64, time: f64, bodies: &impulse::Bodies) -> Result<()> {
+    fn write_frame(&mut self, step: u64, time: f64, poses: &[Pose]) -> Result<()> {
         match self {
-            Self::Trajectory(writer) => writer.write_frame(step, time, bodies),
+            Self::Trajectory(writer) => writer.write_frame(step, time, poses),
             Self::Animation(recording) => {
-                recording.record(step, bodies);
+                recording.record(step, poses);
                 Ok(())
             }
         }
@@ -252,11 +253,15 @@ pub const AT_REST_SPEED: f32 = 0.01;
 /// angular speed ≤ [`AT_REST_SPEED`] rad/s: a pile, stack or pyramid that is to stay put,
 /// whose top sink and drift measure the solve's error. A thrown, dropped-with-speed, spinning
 /// or kinematically driven body makes the scene a moving one.
-pub fn starts_at_rest(bodies: &impulse::Bodies) -> bool {
-    (0..bodies.len()).all(|i| {
-        bodies.kind[i] == impulse::BodyKind::Static
-            || (bodies.linear_velocity[i].length() <= AT_REST_SPEED
-                && bodies.angular_velocity[i].length() <= AT_REST_SPEED)
+pub fn starts_at_rest(world: &World) -> bool {
+    let (kinds, linear, angular) = (
+        world.body_kinds(),
+        world.linear_velocities(),
+        world.angular_velocities(),
+    );
+    (0..kinds.len()).all(|i| {
+        kinds[i] == impulse::BodyKind::Static
+            || (linear[i].length() <= AT_REST_SPEED && angular[i].length() <= AT_REST_SPEED)
     })
 }
 
@@ -325,8 +330,7 @@ fn run_scene(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<S
     let every = options.every.unwrap_or(1).max(1) as u64;
     let world = World::from_scene(&scene).context("cannot build the world")?;
     if !world
-        .bodies()
-        .kind
+        .body_kinds()
         .iter()
         .any(|&k| k != impulse::BodyKind::Static)
     {
@@ -340,7 +344,7 @@ fn run_scene(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<S
         None => None,
     };
     if let Some(w) = writer.as_mut() {
-        w.write_frame(0, 0.0, world.bodies())?;
+        w.write_frame(0, 0.0, world.poses())?;
     }
     let session = Session {
         name: scene.name.clone(),
@@ -447,10 +451,10 @@ fn simulate(
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create the checkpoint directory {}", dir.display()))?;
     }
-    let top = metrics::top_body(world.bodies());
-    let top_y0 = top.map(|i| world.bodies().pose[i].translation.y);
-    let initial: Vec<_> = world.bodies().pose.iter().map(|p| p.translation).collect();
-    let at_rest = starts_at_rest(world.bodies());
+    let top = metrics::top_body(&world, world.poses());
+    let top_y0 = top.map(|i| world.poses()[i].translation.y);
+    let initial: Vec<_> = world.poses().iter().map(|p| p.translation).collect();
+    let at_rest = starts_at_rest(&world);
     let mut max_drift = 0.0f32;
 
     let bar = progress_bar(&session.name, session.steps, options.quiet);
@@ -464,7 +468,7 @@ fn simulate(
     let mut iterations_sum = 0u64;
     let mut max_residual = 0.0f32;
     let mut max_speed = 0.0f32;
-    let mut max_overlap = metrics::max_overlap(world.bodies());
+    let mut max_overlap = metrics::max_overlap(&world, world.poses());
     let mut final_overlap = max_overlap;
     let mut status = "completed".to_string();
     let mut failure = None;
@@ -556,19 +560,19 @@ fn simulate(
         contacts_sum += diagnostics.contacts as u64;
         iterations_sum += diagnostics.iterations as u64;
         max_residual = max_residual.max(diagnostics.natural_map_residual);
-        for v in &world.bodies().linear_velocity {
+        for v in world.linear_velocities() {
             max_speed = max_speed.max(v.length());
         }
         if step.is_multiple_of(OVERLAP_SAMPLE_EVERY) || step == last {
-            final_overlap = metrics::max_overlap(world.bodies());
+            final_overlap = metrics::max_overlap(&world, world.poses());
             max_overlap = max_overlap.max(final_overlap);
-            max_drift = max_drift.max(metrics::max_drift(world.bodies(), &initial));
+            max_drift = max_drift.max(metrics::max_drift(&world, world.poses(), &initial));
         }
         let interrupted = INTERRUPTED.load(Ordering::SeqCst);
         if let Some(w) = session.writer.as_mut()
             && (step.is_multiple_of(every) || step == last || interrupted)
         {
-            w.write_frame(step, step as f64 * dt, world.bodies())?;
+            w.write_frame(step, step as f64 * dt, world.poses())?;
         }
         if let (Some(k), Some(dir)) = (options.checkpoint_every, &options.checkpoint_dir)
             && step.is_multiple_of(k)
@@ -605,13 +609,13 @@ fn simulate(
     let mean_ms = step_ms.iter().sum::<f64>() / taken;
     let median_ms = median(&mut step_ms);
     let top_sink = match (top, top_y0) {
-        (Some(i), Some(y0)) => y0 - world.bodies().pose[i].translation.y,
+        (Some(i), Some(y0)) => y0 - world.poses()[i].translation.y,
         _ => 0.0,
     };
     let settings = world.settings();
     let summary = Summary {
         scene: session.name.clone(),
-        bodies: world.bodies().len(),
+        bodies: world.body_count(),
         steps: world.step_count(),
         dt: world.dt(),
         ms_per_step: median_ms,

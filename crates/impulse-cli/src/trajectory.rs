@@ -6,7 +6,7 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use impulse::Bodies;
+use parry3d::math::Pose;
 
 /// Output format, chosen from the file extension.
 enum Format {
@@ -47,16 +47,17 @@ impl TrajectoryWriter {
         })
     }
 
-    /// Appends one frame (all bodies, scene order) and flushes it. Errors name the file.
-    pub fn write_frame(&mut self, frame: u64, time: f64, bodies: &Bodies) -> Result<()> {
-        self.write_and_flush(frame, time, bodies)
+    /// Appends one frame (the pose of every body, scene order) and flushes it. Errors name the
+    /// file.
+    pub fn write_frame(&mut self, frame: u64, time: f64, poses: &[Pose]) -> Result<()> {
+        self.write_and_flush(frame, time, poses)
             .with_context(|| format!("cannot write {}", self.path.display()))
     }
 
-    fn write_and_flush(&mut self, frame: u64, time: f64, bodies: &Bodies) -> std::io::Result<()> {
+    fn write_and_flush(&mut self, frame: u64, time: f64, poses: &[Pose]) -> std::io::Result<()> {
         match self.format {
             Format::Csv => {
-                for (i, pose) in bodies.pose.iter().enumerate() {
+                for (i, pose) in poses.iter().enumerate() {
                     let t = pose.translation;
                     let q = pose.rotation;
                     writeln!(
@@ -67,8 +68,7 @@ impl TrajectoryWriter {
                 }
             }
             Format::JsonLines => {
-                let poses: Vec<[f32; 7]> = bodies
-                    .pose
+                let poses: Vec<[f32; 7]> = poses
                     .iter()
                     .map(|p| {
                         let (t, q) = (p.translation, p.rotation);

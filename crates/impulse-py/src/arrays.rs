@@ -1,6 +1,6 @@
 //! Body state as NumPy arrays with no Python object per body.
 //!
-//! Reading: a read-only NumPy view of the engine's own storage (`impulse::Bodies`, one array
+//! Reading: a read-only NumPy view of the engine's own storage (`impulse::World::poses` and the other read views, one array
 //! per quantity, structure of arrays). Positions and orientations are strided views into the
 //! pose array (each pose is a quaternion then a translation, 32 bytes); the velocities are
 //! contiguous N×3 arrays. No copy and no per-body work.
@@ -77,14 +77,14 @@ pub(crate) fn view<'py>(
     field: Field,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let py = owner.py();
-    let bodies = world.bodies();
-    let n = bodies.len();
+    let engine = world;
+    let n = engine.body_count();
     let float = size_of::<f32>();
     // (first element, element stride between bodies)
     let (start, stride): (*const f32, usize) = match field {
         Field::Positions => (
-            bodies
-                .pose
+            engine
+                .poses()
                 .as_ptr()
                 .cast::<u8>()
                 .wrapping_add(offset_of!(Pose, translation))
@@ -92,16 +92,16 @@ pub(crate) fn view<'py>(
             size_of::<Pose>() / float,
         ),
         Field::Orientations => (
-            bodies
-                .pose
+            engine
+                .poses()
                 .as_ptr()
                 .cast::<u8>()
                 .wrapping_add(offset_of!(Pose, rotation))
                 .cast(),
             size_of::<Pose>() / float,
         ),
-        Field::LinearVelocities => (bodies.linear_velocity.as_ptr().cast(), 3),
-        Field::AngularVelocities => (bodies.angular_velocity.as_ptr().cast(), 3),
+        Field::LinearVelocities => (engine.linear_velocities().as_ptr().cast(), 3),
+        Field::AngularVelocities => (engine.angular_velocities().as_ptr().cast(), 3),
     };
     // SAFETY: `start` points into a live Vec of `n` poses (or vectors), each holding the
     // `columns` consecutive f32 read here; the stride steps from one body's to the next. For
@@ -189,17 +189,16 @@ pub(crate) fn assign(
     let values = rows(value, field, n)?;
     let columns = field.columns();
     let current = |w: &impulse::World, i: usize| -> Vec<f32> {
-        let b = w.bodies();
         match field {
-            Field::Positions => b.pose[i].translation.to_array().to_vec(),
-            Field::Orientations => b.pose[i].rotation.to_array().to_vec(),
-            Field::LinearVelocities => b.linear_velocity[i].to_array().to_vec(),
-            Field::AngularVelocities => b.angular_velocity[i].to_array().to_vec(),
+            Field::Positions => w.poses()[i].translation.to_array().to_vec(),
+            Field::Orientations => w.poses()[i].rotation.to_array().to_vec(),
+            Field::LinearVelocities => w.linear_velocities()[i].to_array().to_vec(),
+            Field::AngularVelocities => w.angular_velocities()[i].to_array().to_vec(),
         }
     };
     let set = |w: &mut impulse::World, i: usize, row: &[f32]| -> Result<(), impulse::WorldError> {
         let handle = w.handle_of(i).expect("dense index below body_count");
-        let pose = w.bodies().pose[i];
+        let pose = w.poses()[i];
         match field {
             Field::Positions => w.set_pose(handle, Vec3::from_slice(row), pose.rotation),
             Field::Orientations => w.set_pose(handle, pose.translation, Quat::from_slice(row)),

@@ -296,7 +296,7 @@ impl World {
                       orientations: &mut Vec<f32>,
                       step_numbers: &mut Vec<i64>,
                       times: &mut Vec<f64>| {
-            for pose in &world.bodies().pose {
+            for pose in world.poses() {
                 positions.extend_from_slice(&pose.translation.to_array());
                 orientations.extend_from_slice(&pose.rotation.to_array());
             }
@@ -445,8 +445,7 @@ impl World {
     #[getter]
     fn kinds(&self) -> Vec<&'static str> {
         self.inner
-            .bodies()
-            .kind
+            .body_kinds()
             .iter()
             .map(|k| match k {
                 impulse::BodyKind::Dynamic => "dynamic",
@@ -461,8 +460,7 @@ impl World {
     /// copy).
     #[getter]
     fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
-        let b = self.inner.bodies();
-        PyArray1::from_vec(py, (0..b.len()).map(|i| b.mass(i)).collect())
+        PyArray1::from_vec(py, self.inner.iter_bodies().map(|b| b.mass()).collect())
     }
 
     /// The last step's diagnostics (`impulse::StepDiagnostics`) as a dict: `step`,
@@ -496,8 +494,8 @@ impl World {
         py: Python<'py>,
         initial_positions: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let bodies = self.inner.bodies();
-        let n = bodies.len();
+        let world = &self.inner;
+        let n = world.body_count();
         let initial = match initial_positions {
             Some(value) => {
                 let array = py
@@ -523,8 +521,14 @@ impl World {
             }
             None => None,
         };
-        let (overlap, top) = py
-            .detach(|| guarded(|| Ok((metrics::max_overlap(bodies), metrics::top_body(bodies)))))?;
+        let (overlap, top) = py.detach(|| {
+            guarded(|| {
+                Ok((
+                    metrics::max_overlap(world, world.poses()),
+                    metrics::top_body(world, world.poses()),
+                ))
+            })
+        })?;
         let result = PyDict::new(py);
         result.set_item("max_overlap_m", overlap)?;
         result.set_item("top_body", top)?;
@@ -532,9 +536,12 @@ impl World {
             Some(initial) => {
                 result.set_item(
                     "top_sink_m",
-                    top.map(|i| initial[i].y - bodies.pose[i].translation.y),
+                    top.map(|i| initial[i].y - world.poses()[i].translation.y),
                 )?;
-                result.set_item("max_drift_m", metrics::max_drift(bodies, initial))?;
+                result.set_item(
+                    "max_drift_m",
+                    metrics::max_drift(world, world.poses(), initial),
+                )?;
             }
             None => {
                 result.set_item("top_sink_m", py.None())?;
@@ -982,8 +989,7 @@ impl World {
 
 pub(crate) fn names_of(world: &impulse::World) -> Vec<String> {
     world
-        .bodies()
-        .name
+        .names()
         .iter()
         .map(|n| n.clone().unwrap_or_default())
         .collect()

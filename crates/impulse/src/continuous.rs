@@ -31,20 +31,20 @@ use crate::kinematic::rotation_vector;
 /// A body is swept when it moved more than this fraction of its smallest half extent in a
 /// step (Box2D v3's safety factor: a slower body cannot pass through anything the contacts
 /// see, and needs no sweep).
-pub const FAST_FRACTION: f32 = 0.5;
+pub(crate) const FAST_FRACTION: f32 = 0.5;
 
 /// The gap (m) a clamped body is left short of the surface it would hit, at most (Box2D's
 /// linear slop), and at most this fraction of its smallest half extent for small bodies.
-pub const CLAMP_GAP: f32 = 0.005;
+pub(crate) const CLAMP_GAP: f32 = 0.005;
 
 /// Radius of the core sphere of a body that starts the step touching a surface, as a fraction
 /// of its smallest half extent (Box2D v3.1 uses a quarter of the shape's minimum extent).
-pub const CORE_FRACTION: f32 = 0.25;
+pub(crate) const CORE_FRACTION: f32 = 0.25;
 
 /// One body's motion over a step: from `start` to `end` (body frames), about its centre of
 /// mass at `local_center_of_mass`, turning by the rotation vector `turn`.
 #[derive(Clone, Copy, Debug)]
-pub struct Sweep {
+pub(crate) struct Sweep {
     /// Pose at the step's start.
     pub start: Pose,
     /// Pose at the step's end.
@@ -63,7 +63,7 @@ impl Sweep {
     /// turns that brings it closest to `spin`: the same end orientation, but a body spinning by
     /// more than half a turn a step (a dart that hit a wall at 200 m/s spins at over 1,000
     /// rad/s, 20 rad a step at 60 Hz) is swept round the way it turned, not the short way back.
-    pub fn new(start: Pose, end: Pose, local_center_of_mass: Vec3, spin: Vec3) -> Self {
+    pub(crate) fn new(start: Pose, end: Pose, local_center_of_mass: Vec3, spin: Vec3) -> Self {
         let shortest = rotation_vector(start.rotation, end.rotation);
         let angle = shortest.length();
         let turn = if angle > 0.0 {
@@ -87,7 +87,7 @@ impl Sweep {
     /// The motion as Parry's [`NonlinearRigidMotion`] over the time interval [0, 1]: the centre
     /// of mass moving at constant velocity and the body turning at constant angular velocity
     /// (`turn`) about it.
-    pub fn motion(&self) -> NonlinearRigidMotion {
+    pub(crate) fn motion(&self) -> NonlinearRigidMotion {
         let com = self.local_center_of_mass;
         NonlinearRigidMotion::new(
             self.start,
@@ -98,13 +98,13 @@ impl Sweep {
     }
 
     /// The pose at fraction `t` ∈ [0, 1] of the step along [`Sweep::motion`].
-    pub fn pose_at(&self, t: f32) -> Pose {
+    pub(crate) fn pose_at(&self, t: f32) -> Pose {
         self.motion().position_at_time(t)
     }
 
     /// A bound on how far (m) any point within `radius` of the centre of mass moves along the
     /// sweep: the centre's travel plus the turned angle times `radius`.
-    pub fn travel(&self, radius: f32) -> f32 {
+    pub(crate) fn travel(&self, radius: f32) -> f32 {
         let com = self.local_center_of_mass;
         (self.end.transform_point(com) - self.start.transform_point(com)).length()
             + self.turn.length() * radius
@@ -139,7 +139,7 @@ impl Sweep {
 /// With x = sin(θ/2) of the shortest turn θ, θ = 2·asin(x) ≤ π·x; below those limits the
 /// sweep's turn is the shortest one (|spin·axis − θ| < π gives no whole turn), so the travel
 /// is at most the centre's travel plus π·x·`radius`.
-pub fn travel_bound(
+pub(crate) fn travel_bound(
     start: &Pose,
     end: &Pose,
     local_center_of_mass: Vec3,
@@ -160,7 +160,7 @@ pub fn travel_bound(
 
 /// What the sweep needs to know of the fast body's shape.
 #[derive(Clone, Copy)]
-pub struct FastBody<'a> {
+pub(crate) struct FastBody<'a> {
     /// Its shape (body frame).
     pub shape: &'a dyn Shape,
     /// Its motion over the step.
@@ -201,7 +201,7 @@ impl FastBody<'_> {
 /// when the motion needs no clamp ([`clamp_fraction_castable`]). A half-space is swept as the
 /// box of it that the body can reach ([`half_space_slab`]), a height field as its triangles
 /// under the body's path ([`height_field_triangles`]); every other shape as it is.
-pub fn clamp_fraction(
+pub(crate) fn clamp_fraction(
     body: &FastBody<'_>,
     target: &dyn Shape,
     target_sweep: &Sweep,
@@ -231,7 +231,7 @@ pub fn clamp_fraction(
 /// set, so a body that stays in `region` meets the one where it meets the other. `None` when
 /// the ball lies wholly above the plane (nothing there to meet). Returns the box and its pose
 /// in the half-space's frame.
-pub fn half_space_slab(normal: Vec3, region: &Aabb) -> Option<(Cuboid, Pose)> {
+pub(crate) fn half_space_slab(normal: Vec3, region: &Aabb) -> Option<(Cuboid, Pose)> {
     let center = region.center();
     let reach = region.half_extents().length();
     let height = normal.dot(center);
@@ -254,7 +254,7 @@ const MAX_PATH_SLICES: usize = 64;
 /// in the boxes of [`FastBody::region_in`] over slices of the step short enough that each box
 /// hugs the path (about the body's diameter of travel each, at most [`MAX_PATH_SLICES`]), each
 /// triangle once.
-pub fn height_field_triangles(
+pub(crate) fn height_field_triangles(
     body: &FastBody<'_>,
     height_field: &HeightField,
     target_sweep: &Sweep,
@@ -285,7 +285,7 @@ pub fn height_field_triangles(
 /// only a body driven through the target is stopped, and a body sliding or spinning along it
 /// is not held at its start pose step after step. Shape pairs Parry cannot cast are not
 /// clamped.
-pub fn clamp_fraction_castable(
+pub(crate) fn clamp_fraction_castable(
     body: &FastBody<'_>,
     target: &dyn Shape,
     target_sweep: &Sweep,

@@ -21,18 +21,23 @@ pub enum WorldError {
     /// world's).
     #[error("no body {0:?} in this world (removed, or another world's handle)")]
     UnknownBody(crate::body::BodyHandle),
-    /// A world-wide setting is invalid (time step, gravity, solver settings).
+    /// The time step or gravity is invalid.
     #[error("{field}: {message}")]
     InvalidSetting {
-        /// Field path, e.g. `dt` or `solver.iterations`.
+        /// `dt` or `gravity`.
         field: String,
         /// What is wrong.
         message: String,
     },
+    /// A solver setting is out of range ([`crate::SolverSettings::validate`]; displayed as
+    /// `solver.<field>: <message>`).
+    #[error(transparent)]
+    InvalidSettings(#[from] crate::settings::SettingError),
 }
 
-/// A step that could not be completed. The world is left as it was after the last good step
-/// only for errors raised before integration; a blow-up is detected after integration and the
+/// A step that could not be completed. Settings and bodies are checked when they enter the
+/// world ([`WorldError`]), never by the step. The world is left as it was after the last good
+/// step only for errors raised before integration; a blow-up is detected after integration and the
 /// offending state is kept so it can be inspected.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum StepError {
@@ -71,9 +76,6 @@ pub enum StepError {
         /// Its speed (m/s).
         speed: f32,
     },
-    /// A setting was changed to an invalid value between steps.
-    #[error("invalid settings: {0}")]
-    InvalidSettings(String),
     /// Parry cannot generate contacts for this pair of shapes.
     #[error("no contact generator for the shapes of bodies {body1} and {body2}")]
     UnsupportedShapePair {

@@ -2,7 +2,7 @@
 //! one colour share no moving body, so their updates can run at once, on threads or in lanes.
 
 /// Independent colours of a sweep; items past them share one sequential colour.
-pub const COLOURS: usize = 64;
+pub(crate) const COLOURS: usize = 64;
 
 /// Greedy colouring (the scalar sweep's `colour_constraints` then sorts by it), for items (points, or the
 /// SIMD lanes' manifold groups) given by their two body slots: each item's colour (the lowest

@@ -6,7 +6,7 @@ use glam::{Mat3, Quat, Vec3};
 /// Stage 1: v* = v + h·M⁻¹·f_ext with gravity the only external force (docs/method.md: "compute
 /// prospective velocities of all objects for this time step"). `linear` holds moving bodies
 /// only.
-pub fn prospective_velocities(linear: &mut [Vec3], gravity: Vec3, h: f32) {
+pub(crate) fn prospective_velocities(linear: &mut [Vec3], gravity: Vec3, h: f32) {
     let dv = gravity * h;
     for v in linear {
         *v += dv;
@@ -16,7 +16,7 @@ pub fn prospective_velocities(linear: &mut [Vec3], gravity: Vec3, h: f32) {
 /// Stage 6: x += h·v for the centres of mass (accumulated in `displacement`, m), the rotation
 /// vector Σ h·ω (`rotation`, rad, used for contact separations), and
 /// q ← normalize(q + h/2·ω⊗q) for the orientations. All slices are indexed alike.
-pub fn integrate_positions(
+pub(crate) fn integrate_positions(
     linear: &[Vec3],
     angular: &[Vec3],
     displacement: &mut [Vec3],
@@ -35,7 +35,7 @@ pub fn integrate_positions(
 }
 
 /// q ← normalize(q + h/2·ω⊗q): first-order orientation update (step 6 of docs/architecture.md).
-pub fn integrate_orientation(q: Quat, omega: Vec3, h: f32) -> Quat {
+pub(crate) fn integrate_orientation(q: Quat, omega: Vec3, h: f32) -> Quat {
     let spin = Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0) * q;
     Quat::from_xyzw(
         q.x + 0.5 * h * spin.x,
@@ -60,7 +60,7 @@ pub fn integrate_orientation(q: Quat, omega: Vec3, h: f32) -> Quat {
 /// (kg·m²), or zero for a body with no gyroscopic term (a particle, a body that does not
 /// rotate, an isotropic tensor for which ω × I·ω = 0); `orientation` its current orientation.
 /// A body whose Newton matrix is singular or whose result is not finite keeps its ω.
-pub fn gyroscopic(angular: &mut [Vec3], orientation: &[Quat], inertia: &[Mat3], h: f32) {
+pub(crate) fn gyroscopic(angular: &mut [Vec3], orientation: &[Quat], inertia: &[Mat3], h: f32) {
     for ((omega, &q), tensor) in angular.iter_mut().zip(orientation).zip(inertia) {
         if *omega == Vec3::ZERO || *tensor == Mat3::ZERO {
             continue;
@@ -103,7 +103,7 @@ pub fn gyroscopic(angular: &mut [Vec3], orientation: &[Quat], inertia: &[Mat3], 
 /// `inertia` is the body-frame tensor of [`gyroscopic_inertia`] (kg·m², zero for no term),
 /// `orientation` the body's current orientation, `omega` its world angular velocity (rad/s).
 /// A singular 2×2 system or a result that is not finite leaves ω as it is.
-pub fn gyroscopic_in_plane(
+pub(crate) fn gyroscopic_in_plane(
     omega: &mut Vec3,
     orientation: Quat,
     inertia: &Mat3,
@@ -151,7 +151,7 @@ fn skew(a: Vec3) -> Mat3 {
 /// its inverse, or zero when the gyroscopic term vanishes or cannot be formed (a particle or
 /// static body, a singular tensor, or an isotropic one such as a ball's or a cube's, for which
 /// ω × I·ω = 0 for every ω).
-pub fn gyroscopic_inertia(inverse: &Mat3) -> Mat3 {
+pub(crate) fn gyroscopic_inertia(inverse: &Mat3) -> Mat3 {
     let diagonal = Vec3::new(inverse.x_axis.x, inverse.y_axis.y, inverse.z_axis.z);
     let off_diagonal = inverse.x_axis.y != 0.0
         || inverse.x_axis.z != 0.0

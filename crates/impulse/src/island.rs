@@ -14,7 +14,7 @@ use crate::collision::narrow_phase::ContactPair;
 /// Islands of one step: body lists, and the order in which the narrow phase's pairs are
 /// assembled so that each island's constraints come out contiguous.
 #[derive(Default)]
-pub struct Islands {
+pub(crate) struct Islands {
     /// Island k's bodies are `bodies[body_start[k]..body_start[k + 1]]`.
     body_start: Vec<u32>,
     bodies: Vec<u32>,
@@ -50,24 +50,24 @@ type PairKey = (u32, u32, u32);
 
 impl Islands {
     /// Number of islands.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.constraint_start.len().saturating_sub(1)
     }
 
     /// Bodies of island `k`, in increasing index order.
-    pub fn bodies(&self, k: usize) -> &[u32] {
+    pub(crate) fn bodies(&self, k: usize) -> &[u32] {
         &self.bodies[self.body_start[k] as usize..self.body_start[k + 1] as usize]
     }
 
     /// Index of moving body `body` among its island's bodies ([`Islands::bodies`]).
-    pub fn local_index(&self, body: usize) -> usize {
+    pub(crate) fn local_index(&self, body: usize) -> usize {
         self.parent[body] as usize
     }
 
     /// Kinematic bodies touching island `k` (its guests), in increasing index order. Their
     /// slots in the island's local arrays follow the island's bodies, in this order; the
     /// immovable slot comes last.
-    pub fn guests(&self, k: usize) -> &[u32] {
+    pub(crate) fn guests(&self, k: usize) -> &[u32] {
         match self.guest_start.get(k..k + 2) {
             Some(range) => &self.guests[range[0] as usize..range[1] as usize],
             None => &[],
@@ -77,7 +77,7 @@ impl Islands {
     /// `body`'s slot in its island's local arrays, where the island is `island`: its local
     /// index if it is dynamic; after the island's bodies, its guest slot if it is kinematic;
     /// the immovable slot after those if it is static.
-    pub fn slot(&self, body: usize, island: usize) -> u32 {
+    pub(crate) fn slot(&self, body: usize, island: usize) -> u32 {
         if self.island_of_body[body] != u32::MAX {
             return self.parent[body];
         }
@@ -90,7 +90,7 @@ impl Islands {
     }
 
     /// Island of the constraints of a pair of bodies (the moving one's, or either's).
-    pub fn island_of_pair(&self, body1: usize, body2: usize) -> usize {
+    pub(crate) fn island_of_pair(&self, body1: usize, body2: usize) -> usize {
         let k = self.island_of_body[body2];
         if k != u32::MAX {
             k as usize
@@ -100,17 +100,17 @@ impl Islands {
     }
 
     /// Constraints of all islands together: the length of the assembled array.
-    pub fn constraint_count(&self) -> usize {
+    pub(crate) fn constraint_count(&self) -> usize {
         self.constraint_start.last().map_or(0, |&end| end as usize)
     }
 
     /// Index of pair `pair`'s first constraint in the assembled array.
-    pub fn first_row(&self, pair: usize) -> usize {
+    pub(crate) fn first_row(&self, pair: usize) -> usize {
         self.pair_first_row[pair] as usize
     }
 
     /// Constraint index range of island `k`.
-    pub fn constraint_range(&self, k: usize) -> std::ops::Range<usize> {
+    pub(crate) fn constraint_range(&self, k: usize) -> std::ops::Range<usize> {
         self.constraint_start[k] as usize..self.constraint_start[k + 1] as usize
     }
 
@@ -120,7 +120,7 @@ impl Islands {
     /// island, narrow-phase order). Sorting 4-byte pair indices here replaces moving the
     /// assembled constraints of several hundred bytes each. When every pair's bodies and constraint count and every body's kind are
     /// as in the last build, the islands are too, and nothing is rebuilt.
-    pub fn build(&mut self, bodies: &Bodies, pairs: &[ContactPair]) {
+    pub(crate) fn build(&mut self, bodies: &Bodies, pairs: &[ContactPair]) {
         let n = bodies.len();
         std::mem::swap(&mut self.pair_keys, &mut self.last_pair_keys);
         self.pair_keys.clear();

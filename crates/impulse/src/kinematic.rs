@@ -34,7 +34,7 @@ pub(crate) struct Script {
 /// time, linear interpolation of the translation and slerp of the rotation in between (the
 /// shorter way round), the last pose held after the last keyframe. `keyframes` must be sorted
 /// by time with times > 0; an empty list holds the initial pose.
-pub fn keyframed_pose(initial: &Pose, keyframes: &[Keyframe], time: f64) -> Pose {
+pub(crate) fn keyframed_pose(initial: &Pose, keyframes: &[Keyframe], time: f64) -> Pose {
     let mut before = (0.0f64, initial.translation, initial.rotation);
     for k in keyframes {
         let t = f64::from(k.time);
@@ -58,7 +58,7 @@ pub fn keyframed_pose(initial: &Pose, keyframes: &[Keyframe], time: f64) -> Pose
 /// world frame) that carry a body from pose `from` to pose `to` in `dt` seconds, its centre of
 /// mass at `local_center_of_mass` in the body frame: Δc/dt and the rotation vector of
 /// `to.rotation · from.rotation⁻¹` (the shorter way round) over dt.
-pub fn velocity_between(
+pub(crate) fn velocity_between(
     from: &Pose,
     to: &Pose,
     local_center_of_mass: Vec3,
@@ -71,7 +71,7 @@ pub fn velocity_between(
 }
 
 /// The rotation vector (axis × angle, rad, angle in [0, π]) of `to · from⁻¹`.
-pub fn rotation_vector(from: Quat, to: Quat) -> Vec3 {
+pub(crate) fn rotation_vector(from: Quat, to: Quat) -> Vec3 {
     let mut delta = to * from.inverse();
     if delta.w < 0.0 {
         delta = -delta;
@@ -88,7 +88,7 @@ pub fn rotation_vector(from: Quat, to: Quat) -> Vec3 {
 /// mass (at `local_center_of_mass` in the body frame) moves by `linear`·dt and the body turns
 /// by the rotation vector `angular`·dt about it (exact for a constant ω, unlike the island's
 /// first-order orientation update).
-pub fn advance(
+pub(crate) fn advance(
     pose: &Pose,
     local_center_of_mass: Vec3,
     linear: Vec3,

@@ -34,28 +34,34 @@
 //! maps them.
 
 #![warn(missing_docs)]
+#![warn(unreachable_pub)]
 
 // Every stage is private: the public API is the re-exports below, plus two namespaces,
 // [`scene`] (the JSON scene format and the built-in scenes) and [`metrics`] (quality measures
 // of a simulation's state).
 mod body;
+// The stages the hidden `internals` module re-exports keep those items `pub`: without the
+// feature they are unreachable, which is their point.
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 mod collision;
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 mod contact;
 mod continuous;
 mod diagnostics;
 mod error;
 mod graph;
-mod instruction_set;
 mod integrate;
 mod island;
 mod kinematic;
 mod parallel;
 mod settings;
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 mod solver;
 mod world;
 
 pub mod metrics;
 pub mod scene;
+pub mod simd;
 
 // The unit tests share `tests/integration/common.rs` with the integration tests, whose paths start with
 // `impulse::`.
@@ -78,11 +84,10 @@ pub use parry3d;
 /// (along y), `::convex_hull(&points)`, `::halfspace(normal)`.
 pub use parry3d::shape::SharedShape;
 
-pub use body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
+pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use diagnostics::contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
-pub use instruction_set::{INSTRUCTION_SET_VARIABLE, InstructionSet};
 pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };
@@ -101,12 +106,18 @@ pub use world::{
 #[cfg(feature = "internals")]
 #[doc(hidden)]
 pub mod internals {
+    pub use crate::body::Bodies;
     pub use crate::collision::broad_phase::BroadPhase;
     pub use crate::collision::narrow_phase::{NarrowPhase, SpeculativeMargins};
     pub use crate::contact::constraints::ContactConstraint;
     pub use crate::solver::nncg::{NncgWorkspace, solve_nncg};
     pub use crate::solver::pgs::solve_pgs;
     pub use crate::solver::{Sweep, Velocities, warm_start};
+
+    /// The world's body storage, as the stages read it.
+    pub fn bodies(world: &crate::World) -> &Bodies {
+        &world.bodies
+    }
 
     /// The last step's solved contact constraints (impulses as the solver left them).
     pub fn contact_constraints(world: &crate::World) -> Vec<ContactConstraint> {

@@ -6,16 +6,35 @@ use parry3d::math::Pose;
 use parry3d::query::{self, ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d::shape::SharedShape;
 
+use crate::World;
 use crate::body::Bodies;
 use crate::collision::broad_phase::BroadPhase;
 
-/// Largest penetration depth (m) between any two bodies at the given poses, found with Parry's
-/// exact contact query on the pairs whose bounding boxes overlap. 0 when nothing overlaps.
-pub fn max_overlap(bodies: &Bodies) -> f32 {
+/// Largest penetration depth (m) between any two bodies of `world` at `poses` (one per body, in
+/// the order of [`World::poses`]; pass `world.poses()` for the world's own state, or another
+/// engine's poses of the same bodies), found with Parry's exact contact query on the pairs
+/// whose bounding boxes overlap and whose collision groups interact. 0 when nothing overlaps.
+/// Bodies past the shorter of `poses` and the world's bodies are left out.
+pub fn max_overlap(world: &World, poses: &[Pose]) -> f32 {
+    let bodies = &world.bodies;
     let mut broad_phase = BroadPhase::default();
     let mut pairs = Vec::new();
-    broad_phase.candidate_pairs(bodies, &[], false, &mut pairs);
-    max_overlap_of_pairs(&bodies.shape, &bodies.pose, &pairs)
+    if std::ptr::eq(poses, bodies.pose.as_slice()) {
+        broad_phase.candidate_pairs(bodies, &[], false, &mut pairs);
+    } else {
+        // The broad phase reads kinds, shapes, poses and groups: a copy of those at `poses`.
+        let n = poses.len().min(bodies.len());
+        let at_poses = Bodies {
+            kind: bodies.kind[..n].to_vec(),
+            pose: poses[..n].to_vec(),
+            shape: bodies.shape[..n].to_vec(),
+            groups: bodies.groups[..n].to_vec(),
+            mask: bodies.mask[..n].to_vec(),
+            ..Bodies::default()
+        };
+        broad_phase.candidate_pairs(&at_poses, &[], false, &mut pairs);
+    }
+    max_overlap_of_pairs(&bodies.shape, poses, &pairs)
 }
 
 /// Largest penetration depth (m) among `pairs` of shapes at `poses`.
@@ -64,23 +83,36 @@ pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u3
     deepest
 }
 
-/// Index of the dynamic body whose position is highest (largest y), the "top body" whose sink
-/// the benchmarks measure. `None` when no body moves.
-pub fn top_body(bodies: &Bodies) -> Option<usize> {
-    (0..bodies.len())
-        .filter(|&i| bodies.is_dynamic(i))
-        .max_by(|&a, &b| {
-            bodies.pose[a]
-                .translation
-                .y
-                .total_cmp(&bodies.pose[b].translation.y)
-        })
+/// Index of the dynamic body of `world` whose position in `poses` (one per body, as for
+/// [`max_overlap`]) is highest (largest y), the "top body" whose sink the benchmarks measure.
+/// `None` when no body moves.
+///
+/// ```
+/// use impulse::glam::Vec3;
+/// use impulse::{BodyBuilder, SharedShape, SolverSettings, World, metrics};
+///
+/// let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, SolverSettings::default())?;
+/// world.insert(BodyBuilder::fixed(SharedShape::cuboid(5.0, 0.5, 5.0)).translation(Vec3::new(0.0, 9.0, 0.0)))?;
+/// world.insert(BodyBuilder::particle(0.5).translation(Vec3::new(0.0, 1.0, 0.0)))?;
+/// world.insert(BodyBuilder::particle(0.5).translation(Vec3::new(3.0, 2.0, 0.0)))?;
+/// // The static body is higher, but only moving bodies count.
+/// assert_eq!(metrics::top_body(&world, world.poses()), Some(2));
+/// assert_eq!(metrics::max_overlap(&world, world.poses()), 0.0);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn top_body(world: &World, poses: &[Pose]) -> Option<usize> {
+    let kinds = world.body_kinds();
+    (0..kinds.len().min(poses.len()))
+        .filter(|&i| kinds[i].is_dynamic())
+        .max_by(|&a, &b| poses[a].translation.y.total_cmp(&poses[b].translation.y))
 }
 
-/// Largest distance (m) any dynamic body has moved from `initial` positions.
-pub fn max_drift(bodies: &Bodies, initial: &[Vec3]) -> f32 {
-    (0..bodies.len())
-        .filter(|&i| bodies.is_dynamic(i))
-        .map(|i| (bodies.pose[i].translation - initial[i]).length())
+/// Largest distance (m) any dynamic body of `world` at `poses` (one per body, as for
+/// [`max_overlap`]) is from its `initial` position.
+pub fn max_drift(world: &World, poses: &[Pose], initial: &[Vec3]) -> f32 {
+    let kinds = world.body_kinds();
+    (0..kinds.len().min(poses.len()).min(initial.len()))
+        .filter(|&i| kinds[i].is_dynamic())
+        .map(|i| (poses[i].translation - initial[i]).length())
         .fold(0.0, f32::max)
 }

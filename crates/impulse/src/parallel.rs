@@ -46,7 +46,7 @@ pub(crate) const GROUPS_PER_TASK: usize = 8;
 /// Islands of at least this many points spread the SIMD sweep's colours over rayon's threads
 /// (whatever `parallel_island_contacts` says). On balls4096 with `fast` (256 columns of 16
 /// points), spreading every island made a two-thread step slower (docs/benchmarks.md).
-pub const PARALLEL_ISLAND_POINTS: usize = 1024;
+pub(crate) const PARALLEL_ISLAND_POINTS: usize = 1024;
 
 /// Islands of at least this many points are packed into and unpacked from SIMD lanes on
 /// rayon's threads.

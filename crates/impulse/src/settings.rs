@@ -264,7 +264,8 @@ pub struct SettingError {
 impl SolverSettings {
     /// Every setting outside its allowed range, in field order; empty when all are valid.
     /// The one check of solver settings: the scene loader reports each problem at its place in
-    /// the file, [`crate::World::new`] and [`crate::World::step`] the first one. Counts
+    /// the file; [`crate::World::new`], [`crate::World::set_settings`] and the snapshot loader
+    /// the first one (the step trusts settings that came through them). Counts
     /// (`iterations`, `substeps`, split impulse's `repair.iterations`, `escalation_iterations`)
     /// must be ≥ 1 and ≤ [`Self::MAX_COUNT`] (`relax_iterations` ≤ it, 0 allowed); a soft repair's `hertz` > 0;
     /// tolerances, thresholds, rates, speeds, distances, frequencies and times finite and ≥ 0;

@@ -19,8 +19,8 @@ pub use animation::{Animation, BodyInfo, Frame, PALETTE, PoseSample, STATIC_GREY
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use impulse::Bodies;
-use impulse::Scene;
+use impulse::{BodyKind, Scene, ShapeDesc};
+use parry3d::math::Pose;
 
 /// An animation file format, chosen from the file extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,16 +71,15 @@ impl Recording {
         })
     }
 
-    /// Keeps the poses of `bodies` (scene order) at `step`.
+    /// Keeps `poses` (one per body, scene order) at `step`.
     ///
     /// A rotation quaternion whose dot product with the body's previous keyframe is negative is
     /// negated (q and −q are the same rotation), so consecutive keyframes lie in one hemisphere
     /// and tools that interpolate quaternions component by component (Blender's f-curves) turn
     /// the short way.
-    pub fn record(&mut self, step: u64, bodies: &Bodies) {
+    pub fn record(&mut self, step: u64, poses: &[Pose]) {
         let previous = self.animation.frames.last();
-        let poses = bodies
-            .pose
+        let poses = poses
             .iter()
             .enumerate()
             .map(|(i, p)| {

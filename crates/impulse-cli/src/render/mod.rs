@@ -147,7 +147,7 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
             .enumerate()
             .filter(|(_, b)| b.kind == BodyKind::Static)
             .flat_map(|(i, b)| {
-                let pose = world.bodies().pose[i];
+                let pose = world.poses()[i];
                 b.mesh
                     .positions
                     .iter()
@@ -173,8 +173,7 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderSummary> {
             continue;
         }
         let poses: Vec<(Quat, Vec3)> = world
-            .bodies()
-            .pose
+            .poses()
             .iter()
             .map(|p| (p.rotation, p.translation))
             .collect();
@@ -355,7 +354,7 @@ fn moving_bounds(scene: &Scene, world: &World) -> (Vec3, Vec3) {
         let Ok(mesh) = shape_mesh(&desc.shape, 1.0) else {
             continue;
         };
-        let pose = world.bodies().pose[i];
+        let pose = world.poses()[i];
         for p in &mesh.positions {
             let w = pose.rotation * Vec3::from(*p) + pose.translation;
             min = min.min(w);
@@ -411,7 +410,7 @@ fn drawn_bodies(
     let mut ground: Option<(usize, f32)> = None;
     let mut bodies = Vec::with_capacity(scene.bodies.len());
     for (i, desc) in scene.bodies.iter().enumerate() {
-        let pose = world.bodies().pose[i];
+        let pose = world.poses()[i];
         let top = match (&desc.kind, &desc.shape) {
             (BodyKind::Static, ShapeDesc::HalfSpace { normal }) => {
                 let up = pose.rotation * Vec3::from(*normal).normalize_or_zero();
@@ -513,7 +512,7 @@ fn body_colours(world: &World, bodies: &[DrawnBody], options: &RenderOptions) ->
                 ColourBy::Body => palette(moving - 1),
                 ColourBy::Island => palette(island_root.as_ref().map_or(i, |roots| roots[i])),
                 ColourBy::Speed => {
-                    let v = world.bodies().linear_velocity[i].length();
+                    let v = world.linear_velocities()[i].length();
                     heat((v / options.speed_max.max(1e-6)).clamp(0.0, 1.0)) * tint(i)
                 }
             }

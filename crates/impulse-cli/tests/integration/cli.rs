@@ -84,7 +84,7 @@ fn run_writes_csv_trajectory_and_summary_json() {
 fn profile_prints_the_median_of_every_stage() {
     let out = impulse()
         .args(["run", "stack3", "--steps", "5", "--quiet", "--profile"])
-        .env_remove(impulse::INSTRUCTION_SET_VARIABLE)
+        .env_remove(impulse::simd::INSTRUCTION_SET_VARIABLE)
         .output()
         .unwrap();
     assert!(out.status.success());
@@ -98,7 +98,7 @@ fn profile_prints_the_median_of_every_stage() {
     assert_eq!(stages.len(), impulse::Stage::ALL.len(), "{line}");
     // Then which build of the SIMD kernels ran: the widest this CPU runs.
     let kernels = stdout.lines().nth(2).unwrap_or_default();
-    let name = impulse::InstructionSet::supported_widest().name();
+    let name = impulse::simd::InstructionSet::supported_widest().name();
     assert!(
         kernels.starts_with(&format!("SIMD kernels: {name} (")),
         "{kernels}"
@@ -340,7 +340,7 @@ fn keyframes_out_of_order_name_file_line_body_and_field() {
 /// x86-64-v4 both runs take the baseline and the comparison says nothing; the test says so.
 #[test]
 fn instruction_sets_give_the_same_trajectories_to_the_byte() {
-    if !impulse::InstructionSet::X86_64V4.is_supported() {
+    if !impulse::simd::InstructionSet::X86_64V4.is_supported() {
         eprintln!("this CPU has no x86-64-v4: both runs take the baseline kernels");
     }
     let runs: [&[&str]; 3] = [
@@ -360,9 +360,9 @@ fn instruction_sets_give_the_same_trajectories_to_the_byte() {
             let mut command = impulse();
             command.current_dir(repo("")).arg("run").args(args);
             command.args(["--no-sleep", "--quiet", "--out"]).arg(&path);
-            command.env_remove(impulse::INSTRUCTION_SET_VARIABLE);
+            command.env_remove(impulse::simd::INSTRUCTION_SET_VARIABLE);
             if let Some(set) = set {
-                command.env(impulse::INSTRUCTION_SET_VARIABLE, set);
+                command.env(impulse::simd::INSTRUCTION_SET_VARIABLE, set);
             }
             let out = command.output().unwrap();
             assert_success(&out, &format!("{args:?}: "));

@@ -46,7 +46,7 @@ pub struct BroadPhase {
 /// and below the gaps of the standard scenes (0.2 m between ball columns). The extra
 /// candidates it lets through are at most 4 skins apart and get no contact points from the
 /// narrow phase, which uses the exact per-pair speculative distance.
-pub const CHANGE_DETECTION_SKIN: f32 = 0.01;
+pub(crate) const CHANGE_DETECTION_SKIN: f32 = 0.01;
 
 /// Whether a leaf stored as `stored` must be rewritten for a body now bounded by `new`: the
 /// body left it, or it is more than two skins too large on some side.

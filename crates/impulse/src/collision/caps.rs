@@ -45,13 +45,13 @@ use parry3d::shape::{FeatureId, PackedFeatureId, PolygonalFeature, Shape, TypedS
 /// r·(1 − cos(π/128)) = 0.03 % of the radius from the rim, and a vertex lies above the rim's
 /// lowest point over a face by at most r·sin θ·(1 − cos(π/128)) (0.1 mm for r = 0.35 m tilted
 /// by θ = 60°).
-pub const RIM_VERTICES: u32 = 128;
+pub(crate) const RIM_VERTICES: u32 = 128;
 /// Contact points are made at every polygon vertex within this many vertices (11.25°) of the
 /// one nearest the rim's lowest point over the face…
-pub const FINE_WINDOW: u32 = 4;
+pub(crate) const FINE_WINDOW: u32 = 4;
 /// … and at every `COARSE_STEP`-th vertex elsewhere: a 16-gon, whose edges lie within 2 % of
 /// the radius from the rim, which carries a cap resting flat.
-pub const COARSE_STEP: u32 = 8;
+pub(crate) const COARSE_STEP: u32 = 8;
 
 /// First feature id of the cap points (above the ids Parry gives a cylinder's or cone's
 /// features, so that impulses are not carried over from Parry's square to a rim vertex).

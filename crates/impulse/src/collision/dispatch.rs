@@ -50,7 +50,7 @@ use crate::body::rules::rounded_parts;
 /// and a fine polygon for a cylinder's or cone's flat cap on a flat face (see the module's
 /// documentation).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct ContactDispatcher;
+pub(crate) struct ContactDispatcher;
 
 impl QueryDispatcher for ContactDispatcher {
     fn intersection_test(

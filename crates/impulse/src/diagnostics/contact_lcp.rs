@@ -37,7 +37,7 @@ impl ContactLcp {
 
 /// Builds the LCP of `constraints` (as left by the solver). Errors only if the assembled data
 /// is not finite, which a blown-up step can cause.
-pub fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, ProblemError> {
+pub(crate) fn assemble_lcp(constraints: &[ContactConstraint]) -> Result<ContactLcp, ProblemError> {
     let with_friction = |c: &ContactConstraint| c.friction > 0.0;
     // Row layout and per-body incidence lists.
     struct Incidence {

@@ -679,7 +679,7 @@ fn pile_of_spheres_satisfies_complementarity_at_exit() {
         ..SolverSettings::default()
     };
     let mut w = common::sphere_pile(settings);
-    assert_eq!(w.bodies().len(), 5 + 64);
+    assert_eq!(w.body_count(), 5 + 64);
     let mut checked_steps = 0;
     for _ in 0..90 {
         w.step().unwrap();

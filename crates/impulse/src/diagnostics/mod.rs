@@ -258,7 +258,7 @@ fn row_squared_natural_map(
 ///
 /// Why: each pass read every 376-byte row; a pile's rows outgrow the caches (pyramid100: 22
 /// MB), so the passes waited on memory, and the friction count ran on one thread.
-pub fn record_velocity_before_and_residual(
+pub(crate) fn record_velocity_before_and_residual(
     constraints: &mut [ContactConstraint],
     slots: BodySlots,
     linear: &[Vec3],
@@ -331,14 +331,14 @@ impl std::ops::Add for EnergyTerms {
 }
 
 /// [`EnergyTerms`] of the moving bodies under `gravity` (m/s²), on the calling thread.
-pub fn energy_terms(bodies: &Bodies, gravity: Vec3) -> EnergyTerms {
+pub(crate) fn energy_terms(bodies: &Bodies, gravity: Vec3) -> EnergyTerms {
     energy_terms_on(bodies, gravity, false)
 }
 
 /// [`EnergyTerms`] of the moving bodies under `gravity` (m/s²); with `parallel`, the partial
 /// sums run on rayon's threads (a serial pass would leave the other threads idle). The same
 /// result either way: the parts are fixed by the body count and added in order.
-pub fn energy_terms_on(bodies: &Bodies, gravity: Vec3, parallel: bool) -> EnergyTerms {
+pub(crate) fn energy_terms_on(bodies: &Bodies, gravity: Vec3, parallel: bool) -> EnergyTerms {
     let n = bodies.len();
     let part = |start: usize| {
         let mut terms = EnergyTerms::default();

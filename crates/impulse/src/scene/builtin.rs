@@ -19,19 +19,19 @@ use std::collections::BTreeMap;
 use super::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
 
 /// Half extent (m) of the standard cube (side 1 m).
-pub const CUBE_HALF_EXTENT: f32 = 0.5;
+pub(super) const CUBE_HALF_EXTENT: f32 = 0.5;
 /// Radius (m) of the balls of the `ballsN` scenes.
-pub const BALL_RADIUS: f32 = 0.5;
+pub(super) const BALL_RADIUS: f32 = 0.5;
 /// Centre-to-centre spacing (m) of the balls' starting grid.
-pub const BALL_SPACING: f64 = 1.2;
+pub(super) const BALL_SPACING: f64 = 1.2;
 /// Height (m) of the lowest ball centres.
-pub const BALL_START_Y: f64 = 1.0;
+pub(super) const BALL_START_Y: f64 = 1.0;
 /// Gap (m) between the grid's outermost ball surfaces and the inner faces of the walls.
-pub const WALL_MARGIN: f64 = 0.5;
+pub(super) const WALL_MARGIN: f64 = 0.5;
 /// Thickness (m) of the walls (half extent 0.5).
-pub const WALL_THICKNESS: f64 = 1.0;
+pub(super) const WALL_THICKNESS: f64 = 1.0;
 /// Half extent (m) of the ground in x and z, unless a ball box needs more.
-pub const GROUND_HALF_WIDTH: f64 = 150.0;
+pub(super) const GROUND_HALF_WIDTH: f64 = 150.0;
 
 /// Largest base of `pyramid<N>`.
 pub const MAX_PYRAMID_BASE: usize = 1000;
@@ -355,11 +355,11 @@ fn plate() -> Scene {
 
 /// Half extents (m) of a card of `card_house`: thickness along local x, height along local y,
 /// width along local z.
-pub const CARD_HALF_EXTENTS: [f32; 3] = [0.02, 0.5, 0.35];
+pub(super) const CARD_HALF_EXTENTS: [f32; 3] = [0.02, 0.5, 0.35];
 /// Tilt (degrees) of the leaning cards of `card_house` from the vertical.
-pub const CARD_TILT_DEGREES: f64 = 22.5;
+pub(super) const CARD_TILT_DEGREES: f64 = 22.5;
 /// Distance (m) in x between the apexes of the two bottom A-frames of `card_house`.
-pub const CARD_APEX_SPACING: f64 = 0.86;
+pub(super) const CARD_APEX_SPACING: f64 = 0.86;
 
 /// A card at `position` turned by `angle` (radians) about the z axis.
 fn card(position: [f64; 3], angle: f64) -> BodyDesc {
@@ -424,11 +424,11 @@ fn card_house() -> Scene {
 }
 
 /// Voussoirs of `arch`.
-pub const ARCH_BLOCKS: usize = 13;
+pub(super) const ARCH_BLOCKS: usize = 13;
 /// Inner and outer radius (m) of `arch`.
-pub const ARCH_RADII: [f64; 2] = [4.0, 5.0];
+pub(super) const ARCH_RADII: [f64; 2] = [4.0, 5.0];
 /// Depth (m) of `arch` along z (centred on z = 0).
-pub const ARCH_DEPTH: f64 = 1.0;
+pub(super) const ARCH_DEPTH: f64 = 1.0;
 
 /// A semicircular arch standing on the ground, centre of the circle at the origin: block
 /// k = 0 … 12 spans the angles α = kπ/13 … (k + 1)π/13 (from +x over the top to −x) between
@@ -508,7 +508,7 @@ fn base_cubes(name: &str) -> Scene {
 /// The starting grid of `balls<N>`: `nx` × `nz` balls per layer, `ny` layers, filled x
 /// fastest, then z, then y. `nx·ny·nz ≥ N`, and equal unless the top layer is partial.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BallGrid {
+pub(super) struct BallGrid {
     /// Balls along x.
     pub nx: usize,
     /// Layers (along y).
@@ -524,7 +524,7 @@ pub struct BallGrid {
 ///    1000 → 10³, 4096 → 16³, 16000 → 32×20×25 (nx×ny×nz), 64000 → 40³.
 /// 2. Otherwise (e.g. n prime) a square footprint nx = nz = s, s = ⌈∛n⌉, with
 ///    ny = ⌈n / s²⌉ layers, the top one partial. 2500 → s = 14, 13 layers, 148 balls on top.
-pub fn balls_grid(n: usize) -> BallGrid {
+pub(super) fn balls_grid(n: usize) -> BallGrid {
     let mut best: Option<(usize, usize, usize)> = None;
     let mut a = 1;
     while a * a * a <= n {

@@ -145,9 +145,10 @@ impl fmt::Display for FieldPath {
     }
 }
 
-/// A body that an error is about.
+/// The body a scene error is about: its index in scene order and its name (the scene file's
+/// place of a body, not a view of a world's body, which is [`crate::BodyRef`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct BodyRef {
+pub struct BodyLocation {
     /// Index of the body in scene order (`bodies[index]`).
     pub index: usize,
     /// The body's `name`, if it has one (and, for parse errors, if it could be read).
@@ -210,7 +211,7 @@ pub struct SceneError {
     /// validation errors.
     pub position: Option<TextPosition>,
     /// The body concerned, if the error is inside `bodies[i]`.
-    pub body: Option<BodyRef>,
+    pub body: Option<BodyLocation>,
     /// Path of the offending value from the root of the scene (e.g. `bodies[3].shape.radius`,
     /// `dt`, `solver.iterations`). `None` when unknown (e.g. an unreadable file).
     pub field: Option<FieldPath>,
@@ -337,7 +338,7 @@ mod tests {
             e.to_string(),
             "bodies[3].shape.radius: must be > 0, got -0.5"
         );
-        e.body = Some(BodyRef {
+        e.body = Some(BodyLocation {
             index: 3,
             name: Some("lid".into()),
         });

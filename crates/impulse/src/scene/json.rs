@@ -10,7 +10,9 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
+use super::error::{
+    BodyLocation, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition,
+};
 use super::validate::validate;
 use super::{
     BodyDesc, BodyKind, KeyframeDesc, LockedAxesDesc, Material, MaterialRef, Scene, ShapeDesc,
@@ -141,7 +143,7 @@ pub(crate) fn read_body_mesh(
             Some(FieldPath::body(index).key("shape").key("file")),
             e.to_string(),
         );
-        error.body = Some(BodyRef {
+        error.body = Some(BodyLocation {
             index,
             name: name.map(str::to_string),
         });
@@ -190,7 +192,7 @@ fn json_error(text: &str, mut field: FieldPath, inner: &serde_json::Error) -> Sc
             }
         }
     }
-    let body = field.body_index().map(|index| BodyRef {
+    let body = field.body_index().map(|index| BodyLocation {
         index,
         name: string_at(text, &FieldPath::body(index).key("name")),
     });

@@ -439,7 +439,7 @@ pub use builtin::{
     MAX_BALLS, MAX_PYRAMID_BASE, MAX_PYRAMID3D_BASE, MAX_STACK, builtin_families, builtin_names,
     builtin_scene,
 };
-pub use error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
+pub use error::{BodyLocation, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
 pub use json::MAX_SCENE_FILE_BYTES;
 pub use json::{
     load_scene_file, locate, locate_closest, parse_scene_str, parse_scene_str_in, to_json_string,

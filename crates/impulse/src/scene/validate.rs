@@ -38,7 +38,7 @@ use parry3d::shape::SharedShape;
 
 pub(crate) use super::degeneracy::mesh_problem;
 use super::degeneracy::{MeshProblem, hull_degeneracy};
-use super::error::{BodyRef, FieldPath, SceneError, SceneErrorKind};
+use super::error::{BodyLocation, FieldPath, SceneError, SceneErrorKind};
 use super::mesh_file::MeshData;
 use super::shape::shape_of;
 use super::{BodyDesc, BodyKind, KeyframeDesc, Material, MaterialRef, Scene, ShapeDesc};
@@ -46,7 +46,7 @@ use crate::body::rules::{self, ShapeClass};
 
 /// Smallest norm of an orientation quaternion or a half-space normal that is accepted;
 /// below it the vector counts as zero (its direction is not defined in f32).
-pub const MIN_NORM: f32 = rules::MIN_NORM;
+pub(crate) const MIN_NORM: f32 = rules::MIN_NORM;
 
 /// Checks `scene` and returns the first problem, in this order: world settings (gravity,
 /// dt, solver), the materials, then the bodies in scene order.
@@ -87,7 +87,7 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
     }
 
     for (index, body) in scene.bodies.iter().enumerate() {
-        c.body = Some(BodyRef {
+        c.body = Some(BodyLocation {
             index,
             name: body.name.clone(),
         });
@@ -133,7 +133,7 @@ pub(crate) fn shape_problem(kind: BodyKind, shape: &ShapeDesc) -> Option<(String
 /// Collects errors; `body` is attached to each error raised while it is set.
 struct Checker {
     errors: Vec<SceneError>,
-    body: Option<BodyRef>,
+    body: Option<BodyLocation>,
 }
 
 impl Checker {

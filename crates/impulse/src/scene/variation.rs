@@ -19,7 +19,7 @@ use rand_distr::{Distribution, UnitBall, UnitSphere};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use super::error::{BodyRef, FieldPath, PathSegment, SceneError, SceneErrorKind};
+use super::error::{BodyLocation, FieldPath, PathSegment, SceneError, SceneErrorKind};
 use super::validate::validate;
 use super::{BodyKind, Scene, ShapeDesc, WorldAxis};
 
@@ -328,7 +328,7 @@ fn with_body(mut error: SceneError, json: &Value) -> SceneError {
             .pointer(&format!("/bodies/{index}/name"))
             .and_then(Value::as_str)
             .map(str::to_string);
-        error.body = Some(BodyRef { index, name });
+        error.body = Some(BodyLocation { index, name });
     }
     error
 }

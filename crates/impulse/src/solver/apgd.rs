@@ -21,7 +21,7 @@ use crate::contact::cap_to_disc;
 
 /// APGD as a [`ContactSolver`], with its work vectors.
 #[derive(Default)]
-pub struct Apgd {
+pub(crate) struct Apgd {
     /// Work vectors, kept between solves.
     pub workspace: ApgdWorkspace,
 }
@@ -50,7 +50,7 @@ impl ContactSolver for Apgd {
 /// are stored as (normal, tangent 1, tangent 2). The extrapolated point y has impulses and a
 /// gradient but no velocities of its own (see [`solve_apgd`]).
 #[derive(Default)]
-pub struct ApgdWorkspace {
+pub(crate) struct ApgdWorkspace {
     /// γ₀, the impulses on entry.
     initial: Vec<[f32; 3]>,
     /// γ_k, the last accepted iterate, and its gradient.
@@ -111,7 +111,7 @@ const MAX_BACKTRACKS: u32 = 40;
 /// would otherwise let rounding between impulses and velocities grow without bound. The
 /// gradient at y needs no velocities of y: the gradient is affine in γ, so it is extrapolated
 /// with the same β from the gradients at γ_{k+1} and γ_k.
-pub fn solve_apgd(
+pub(crate) fn solve_apgd(
     constraints: &mut [ContactConstraint],
     iterations: u32,
     tolerance: f32,

@@ -54,10 +54,10 @@ use crate::settings::{ImpactModel, SolverSettings};
 /// Rounds of reflections per island and step before the remaining ones are made plastic:
 /// this plus [`ROUNDS_PER_ROW`] per normal row. A chain of n bodies struck at one end takes
 /// n − 1 rounds; a packed rack of 15 billiard balls a few tens.
-pub const ROUNDS_BASE: usize = 64;
+pub(crate) const ROUNDS_BASE: usize = 64;
 
 /// See [`ROUNDS_BASE`].
-pub const ROUNDS_PER_ROW: usize = 4;
+pub(crate) const ROUNDS_PER_ROW: usize = 4;
 
 /// Most projected Gauss-Seidel sweeps of one round's projection. A round's active set is
 /// usually one contact or a few around one body, solved in one or two sweeps.
@@ -66,7 +66,7 @@ const PROJECTION_SWEEPS: u32 = 256;
 /// Sweeps (at most; early exit at `tolerance`) of the restitution solve after a propagation.
 /// It starts at the reflected velocities, so it only has to add what the rest of the step
 /// asks, but that can be a chain's support against gravity, which one sweep does not carry.
-pub const RESTITUTION_SWEEPS: u32 = 32;
+pub(crate) const RESTITUTION_SWEEPS: u32 = 32;
 
 /// Velocity tolerance of the propagation relative to the fastest approach that set it off: a
 /// row approaching slower than this fraction of that speed (or `tolerance`, if larger) counts
@@ -75,7 +75,7 @@ const RELATIVE_TOLERANCE: f32 = 1e-5;
 
 /// Sweeps of the restitution solve after the substeps for `settings`: the larger of the
 /// solve and relax budgets, and at least [`RESTITUTION_SWEEPS`] with propagation.
-pub fn restitution_iterations(settings: &SolverSettings) -> u32 {
+pub(crate) fn restitution_iterations(settings: &SolverSettings) -> u32 {
     let sweeps = settings.iterations.max(settings.relax_iterations);
     match settings.impact {
         ImpactModel::Simultaneous => sweeps,
@@ -85,7 +85,7 @@ pub fn restitution_iterations(settings: &SolverSettings) -> u32 {
 
 /// Work space of one island's propagation, kept between steps.
 #[derive(Default)]
-pub struct ImpactWorkspace {
+pub(crate) struct ImpactWorkspace {
     /// Per slot, the propagation's linear velocities (m/s), from the step's start.
     linear: Vec<Vec3>,
     /// Per slot, angular velocities (rad/s).
@@ -143,7 +143,7 @@ impl ImpactWorkspace {
     /// still hold the velocities of the step's
     /// start, the pre-impact u⁻. `velocities` are the island's after the substeps, which are
     /// shifted by the change of each pushed row's impulse; `dt` is the step (s).
-    pub fn propagate(
+    pub(crate) fn propagate(
         &mut self,
         constraints: &mut [ContactConstraint],
         (island_bodies, guests, bodies): (&[u32], &[u32], &Bodies),
@@ -232,7 +232,7 @@ impl ImpactWorkspace {
     /// impulse inside the disc of what remains. The accumulated impulses are the next step's
     /// warm start, which must not give the impact a second time (a struck row of balls left at
     /// rest would be pushed apart again). The step totals keep the impact.
-    pub fn finish(&mut self, constraints: &mut [ContactConstraint]) {
+    pub(crate) fn finish(&mut self, constraints: &mut [ContactConstraint]) {
         if !std::mem::take(&mut self.pending) {
             return;
         }

@@ -14,7 +14,7 @@ use crate::parallel::{
 
 /// NNCG as a [`ContactSolver`], with its work vectors.
 #[derive(Default)]
-pub struct Nncg {
+pub(crate) struct Nncg {
     /// Work vectors, kept between solves.
     pub workspace: NncgWorkspace,
 }

@@ -19,7 +19,7 @@ use crate::parallel::{
 
 /// Projected Gauss-Seidel as a [`ContactSolver`] on the constraints themselves.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Pgs;
+pub(crate) struct Pgs;
 
 impl ContactSolver for Pgs {
     fn solve(
@@ -279,7 +279,7 @@ pub fn solve_pgs(
 /// consecutive points between the same two bodies (a manifold) is taken from halfway round (the
 /// soft step does so every other substep, so that no corner of a face is always updated first;
 /// see [`super::wide`]'s sweep); sweeps colour by colour over threads ignore it.
-pub fn solve_pgs_rows(
+pub(crate) fn solve_pgs_rows(
     constraints: &mut [ContactConstraint],
     sweep: Sweep<'_>,
     iterations: u32,

@@ -11,7 +11,7 @@ use crate::settings::SolverSettings;
 /// What the escalation decides on, besides the solve's own outcome: the settings' thresholds
 /// and the island's heaviest-to-lightest mass ratio and impact speed.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct EscalationLimits {
+pub(crate) struct EscalationLimits {
     /// Escalate when the last iteration changed a row velocity by more than this (m/s).
     pub tolerance: f32,
     /// NNCG iterations given to an island that escalates.
@@ -29,7 +29,7 @@ pub struct EscalationLimits {
 impl EscalationLimits {
     /// The thresholds of `settings` for an island of `mass_ratio` in a step whose impact speed
     /// is `impact_speed` (m/s).
-    pub fn new(settings: &SolverSettings, mass_ratio: f32, impact_speed: f32) -> Self {
+    pub(crate) fn new(settings: &SolverSettings, mass_ratio: f32, impact_speed: f32) -> Self {
         Self {
             tolerance: settings.escalation_tolerance,
             iterations: settings.escalation_iterations,
@@ -43,7 +43,7 @@ impl EscalationLimits {
 
 /// The automatic policy as a [`ContactSolver`] (see [`crate::settings::SolverMethod::Auto`]).
 #[derive(Default)]
-pub struct Auto {
+pub(crate) struct Auto {
     /// The first method, and the one an unconverged island gets more of.
     pub nncg: Nncg,
     /// The exact path.

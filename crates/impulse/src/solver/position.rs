@@ -24,7 +24,7 @@ impl PointUpdate for PositionRows {
 /// pseudo-impulses clamped ≥ 0. Rows with no target take part only as non-penetration
 /// (target 0), so a push on one body does not drive it into another. Stops early when no row's
 /// pseudo-velocity changed by more than `tolerance` (m/s); returns the sweeps used.
-pub fn solve_positions(
+pub(crate) fn solve_positions(
     constraints: &mut [ContactConstraint],
     sweep: Sweep<'_>,
     iterations: u32,

@@ -1,7 +1,7 @@
 //! The world's bodies through handles: reading a body, editing it (every edit wakes it),
 //! forces and impulses, and removal.
 
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
@@ -24,7 +24,7 @@ impl<'a> BodyRef<'a> {
         self.handle
     }
 
-    /// Its dense index in [`World::bodies`] (changes when another body is removed).
+    /// Its dense index in the slices of [`World::poses`] and the other read views (changes when another body is removed).
     pub fn index(&self) -> usize {
         self.index
     }
@@ -104,6 +104,169 @@ impl<'a> BodyRef<'a> {
     pub fn is_asleep(&self) -> bool {
         self.world.bodies.asleep[self.index]
     }
+
+    /// How long (s) it has been below the sleep thresholds (0 while it moves faster).
+    pub fn sleep_time(&self) -> f32 {
+        self.world.bodies.sleep_time[self.index]
+    }
+
+    /// 1/m (1/kg); 0 for a static or kinematic body.
+    pub fn inverse_mass(&self) -> f32 {
+        self.world.bodies.inverse_mass[self.index]
+    }
+
+    /// Inverse inertia tensor about the centre of mass, body frame (1/(kg·m²)); zero for a
+    /// static or kinematic body and a particle.
+    pub fn local_inverse_inertia(&self) -> Mat3 {
+        self.world.bodies.local_inverse_inertia[self.index]
+    }
+
+    /// World-frame inverse inertia R·I⁻¹·Rᵀ (1/(kg·m²)) at its current orientation,
+    /// restricted to the rotations its locked axes leave free
+    /// ([`LockedAxes::world_inverse_inertia`]); zero for a body that does not rotate.
+    pub fn world_inverse_inertia(&self) -> Mat3 {
+        self.world.bodies.world_inverse_inertia(self.index)
+    }
+
+    /// Coulomb friction coefficient μ.
+    pub fn friction(&self) -> f32 {
+        self.world.bodies.friction[self.index]
+    }
+
+    /// Restitution coefficient.
+    pub fn restitution(&self) -> f32 {
+        self.world.bodies.restitution[self.index]
+    }
+
+    /// Linear and angular damping (1/s), as [`crate::BodyBuilder::linear_damping`] and
+    /// [`crate::BodyBuilder::angular_damping`].
+    pub fn damping(&self) -> (f32, f32) {
+        (
+            self.world.bodies.linear_damping[self.index],
+            self.world.bodies.angular_damping[self.index],
+        )
+    }
+
+    /// Collision groups `(groups, mask)`, as [`crate::BodyBuilder::collision_groups`].
+    pub fn collision_groups(&self) -> (u32, u32) {
+        (
+            self.world.bodies.groups[self.index],
+            self.world.bodies.mask[self.index],
+        )
+    }
+
+    /// Force (N, at the centre of mass) and torque (N·m, world frame) applied during the next
+    /// step ([`World::apply_force`], [`World::apply_torque`]); zero after each step.
+    pub fn pending_force(&self) -> (Vec3, Vec3) {
+        (
+            self.world.bodies.force[self.index],
+            self.world.bodies.torque[self.index],
+        )
+    }
+}
+
+/// Read views of every body at once: one slice per quantity, indexed by the body's dense index
+/// ([`BodyRef::index`], [`World::handle_of`]; scene order while no body has been removed), each
+/// as long as [`World::body_count`]. They are the engine's own arrays, so reading them copies
+/// nothing; edit bodies through [`World::set_pose`], [`World::set_linear_velocity`] and the
+/// other setters, which check the values and wake the bodies.
+///
+/// ```
+/// use impulse::glam::Vec3;
+/// use impulse::{BodyBuilder, SharedShape, SolverSettings, World};
+///
+/// let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 0.01, SolverSettings::default())?;
+/// for x in [0.0, 2.0] {
+///     world.insert(BodyBuilder::particle(0.5).translation(Vec3::new(x, 10.0, 0.0)))?;
+/// }
+/// world.step()?;
+/// // Both fell freely for one step: v = g·dt, the same for every body.
+/// for (pose, velocity) in world.poses().iter().zip(world.linear_velocities()) {
+///     assert!(pose.translation.y < 10.0);
+///     assert!((velocity.y + 9.81 * 0.01).abs() < 1e-5);
+/// }
+/// assert_eq!(world.poses().len(), world.body_count());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+impl World {
+    /// Every body frame in world coordinates (the pose the body was built with, moved by the
+    /// steps): `poses()[i].translation` is body `i`'s origin (m), `.rotation` its orientation.
+    pub fn poses(&self) -> &[Pose] {
+        &self.bodies.pose
+    }
+
+    /// Every body's linear velocity of the centre of mass (m/s).
+    pub fn linear_velocities(&self) -> &[Vec3] {
+        &self.bodies.linear_velocity
+    }
+
+    /// Every body's angular velocity, world frame (rad/s); zero for particles and static
+    /// bodies, the prescribed one for kinematic bodies.
+    pub fn angular_velocities(&self) -> &[Vec3] {
+        &self.bodies.angular_velocity
+    }
+
+    /// Every body's centre of mass in its body frame (m).
+    pub fn local_centers_of_mass(&self) -> &[Vec3] {
+        &self.bodies.local_center_of_mass
+    }
+
+    /// Every body's kind (dynamic, static, particle or kinematic).
+    pub fn body_kinds(&self) -> &[BodyKind] {
+        &self.bodies.kind
+    }
+
+    /// Every body's collision shape, body frame.
+    pub fn shapes(&self) -> &[SharedShape] {
+        &self.bodies.shape
+    }
+
+    /// Every body's name, `None` where none was given.
+    pub fn names(&self) -> &[Option<String>] {
+        &self.bodies.name
+    }
+
+    /// Every body's inverse mass 1/m (1/kg); 0 for static and kinematic bodies.
+    pub fn inverse_masses(&self) -> &[f32] {
+        &self.bodies.inverse_mass
+    }
+
+    /// Whether each body sleeps ([`BodyRef::is_asleep`]).
+    pub fn asleep(&self) -> &[bool] {
+        &self.bodies.asleep
+    }
+
+    /// How long (s) each body has been below the sleep thresholds ([`BodyRef::sleep_time`]).
+    pub fn sleep_times(&self) -> &[f32] {
+        &self.bodies.sleep_time
+    }
+
+    /// The body at dense index `index` (the index of the slices above), or `None` past the
+    /// end.
+    ///
+    /// ```
+    /// use impulse::glam::Vec3;
+    /// use impulse::{BodyBuilder, BodyKind, SharedShape, SolverSettings, World};
+    ///
+    /// let mut world = World::new(Vec3::ZERO, 0.01, SolverSettings::default())?;
+    /// world.insert(BodyBuilder::fixed(SharedShape::cuboid(1.0, 1.0, 1.0)))?;
+    /// let ball = world.insert(BodyBuilder::dynamic(SharedShape::ball(0.5)).mass(2.0).name("ball"))?;
+    /// let body = world.body_at(1).expect("two bodies");
+    /// assert_eq!(body.handle(), ball);
+    /// assert_eq!(body.kind(), BodyKind::Dynamic);
+    /// assert_eq!(body.name(), Some("ball"));
+    /// assert!((body.inverse_mass() - 0.5).abs() < 1e-6);
+    /// assert!(world.body_at(2).is_none());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn body_at(&self, index: usize) -> Option<BodyRef<'_>> {
+        let handle = self.handle_of(index)?;
+        Some(BodyRef {
+            world: self,
+            index,
+            handle,
+        })
+    }
 }
 
 impl World {
@@ -140,7 +303,7 @@ impl World {
             })
     }
 
-    /// The handle of the body at dense index `index` ([`World::bodies`], scene order while
+    /// The handle of the body at dense index `index` ([`World::poses`], scene order while
     /// none has been removed).
     pub fn handle_of(&self, index: usize) -> Option<BodyHandle> {
         self.handles.of_body.get(index).copied()
@@ -368,7 +531,7 @@ impl World {
     }
 
     /// Removes the body and returns its name. The last body moves into its dense index (so
-    /// [`World::bodies`] indices after it change; handles do not); the contacts of both are
+    /// [`World::poses`] indices after it change; handles do not); the contacts of both are
     /// dropped and rebuilt by the next step, which costs them one step of warm starting. The
     /// bodies that touched the removed one wake.
     pub fn remove(&mut self, handle: BodyHandle) -> Result<Option<String>, WorldError> {

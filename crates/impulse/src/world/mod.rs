@@ -1,12 +1,10 @@
 //! The world and its step. `World::step` reads as the pipeline of docs/architecture.md: each call is one stage,
 //! each stage lives in its own module, and data flows one way through them.
 
-use glam::{Mat3, Quat, Vec3};
+use glam::{Mat3, Vec3};
 use parry3d::math::Pose;
-use parry3d::shape::SharedShape;
 
-use crate::body::rules::{self, ShapeClass};
-use crate::body::{Bodies, BodyBuilder, BodyHandle, BodyKind, Handles, LockedAxes};
+use crate::body::{Bodies, BodyBuilder, BodyHandle, Handles};
 use crate::collision::broad_phase::BroadPhase;
 use crate::collision::narrow_phase::{self, NarrowPhase};
 use crate::contact::constraints::{ContactConstraint, complete_products};
@@ -15,13 +13,14 @@ use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms
 use crate::error::WorldError;
 use crate::island::Islands;
 use crate::kinematic::Script;
-use crate::scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
+use crate::scene::{BodyDesc, Material, MaterialRef, Scene};
 use crate::settings::SolverSettings;
 use crate::solver::substep::IslandWorkspace;
 
 mod bodies;
 mod contacts;
 mod continuous;
+mod from_scene;
 mod kinematic;
 mod query;
 mod snapshot;
@@ -105,13 +104,13 @@ pub struct World {
 /// [`SolverSettings::max_distance`] (m). Such a body is taken out of the simulation, not
 /// treated as a blow-up: its velocities are zeroed, it is put to sleep, its collision groups,
 /// mass and inertia are cleared (it collides with nothing, nothing wakes it, and it no longer
-/// counts in [`World::energy`]), and it stays in [`World::bodies`] at its index with its last
+/// counts in [`World::energy`]), and it stays in the world at its index ([`World::poses`]) with its last
 /// pose, so indices and written trajectories keep their shape (every later frame repeats
 /// that pose). [`World::remove`] takes it out for good. Read after the step that made it
 /// ([`World::left_world`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LeftWorld {
-    /// The body's index in [`World::bodies`].
+    /// The body's dense index ([`World::poses`], [`World::body_at`]).
     pub body: usize,
     /// Its handle (still valid: the body stays in the world).
     pub handle: BodyHandle,
@@ -167,6 +166,20 @@ impl World {
 
     /// Builds the world a scene describes. Bodies keep scene order. Named materials resolve
     /// through `scene.materials` (`"default"` is [`Material::default`] unless redefined).
+    /// Errors name the body and the field ([`WorldError::InvalidBody`]) or the setting.
+    ///
+    /// ```
+    /// use impulse::{Scene, World, scene::builtin_scene};
+    ///
+    /// let scene: Scene = builtin_scene("pyramid20").expect("a built-in scene");
+    /// let mut world = World::from_scene(&scene)?;
+    /// assert_eq!(world.body_count(), scene.bodies.len());
+    /// world.step()?;
+    /// // A pyramid at rest does not move in one step.
+    /// let top = impulse::metrics::top_body(&world, world.poses()).expect("moving bodies");
+    /// assert!(world.linear_velocities()[top].length() < 0.1);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn from_scene(scene: &Scene) -> Result<Self, WorldError> {
         let mut world = Self::new(Vec3::from(scene.gravity), scene.dt, scene.solver.clone())?;
         for (index, desc) in scene.bodies.iter().enumerate() {
@@ -176,7 +189,7 @@ impl World {
                     Some(m) => m.clone(),
                     None if name == "default" => Material::default(),
                     None => {
-                        return Err(invalid(
+                        return Err(from_scene::invalid(
                             index,
                             desc,
                             "material",
@@ -196,7 +209,7 @@ impl World {
     /// Errors name the body and the field ([`WorldError::InvalidBody`]).
     pub fn add_body(&mut self, desc: &BodyDesc, material: &Material) -> Result<usize, WorldError> {
         let index = self.bodies.len();
-        let builder = builder_of(index, desc, material)?;
+        let builder = from_scene::builder_of(index, desc, material)?;
         self.insert(builder)?;
         Ok(index)
     }
@@ -205,7 +218,12 @@ impl World {
     /// finite or out of range (see [`BodyBuilder`]); the world is then unchanged.
     pub fn insert(&mut self, builder: BodyBuilder) -> Result<BodyHandle, WorldError> {
         let index = self.bodies.len();
-        let built = build(index, &builder)?;
+        let built = crate::body::build(&builder).map_err(|error| WorldError::InvalidBody {
+            body: index,
+            name: builder.name.clone(),
+            field: error.field,
+            message: error.message,
+        })?;
         let b = &mut self.bodies;
         b.kind.push(builder.kind);
         b.pose.push(built.pose);
@@ -308,13 +326,6 @@ impl World {
         &self.profile
     }
 
-    /// Every body's state, one array per quantity indexed by body index ([`BodyRef::index`],
-    /// [`Self::handle_of`]): read-only; edit bodies through [`Self::set_pose`],
-    /// [`Self::set_linear_velocity`] and the other setters, which wake them.
-    pub fn bodies(&self) -> &Bodies {
-        &self.bodies
-    }
-
     /// Kinetic and gravitational energy, mass and momentum of the moving bodies now (the
     /// quantities the blow-up check watches).
     pub fn energy(&self) -> EnergyTerms {
@@ -342,7 +353,22 @@ impl World {
     }
 
     /// Replaces the solver settings from the next step on. Errors, leaving the settings as they
-    /// were, when one is out of range ([`SolverSettings::validate`]).
+    /// were, when one is out of range ([`SolverSettings::validate`]): settings are checked here
+    /// and in [`Self::new`], so a step never meets invalid ones.
+    ///
+    /// ```
+    /// use impulse::glam::Vec3;
+    /// use impulse::{SolverSettings, World, WorldError};
+    ///
+    /// let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 0.01, SolverSettings::default())?;
+    /// let bad = SolverSettings { iterations: 0, ..SolverSettings::default() };
+    /// let Err(WorldError::InvalidSettings(problem)) = world.set_settings(bad) else {
+    ///     panic!("0 iterations accepted");
+    /// };
+    /// assert_eq!(problem.field, "iterations");
+    /// assert_eq!(world.settings().iterations, SolverSettings::default().iterations);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), WorldError> {
         let previous = std::mem::replace(&mut self.settings, settings);
         if let Err(error) = self.check_settings() {
@@ -395,9 +421,7 @@ impl World {
         if !self.gravity.is_finite() {
             return Err(setting("gravity", "must be finite"));
         }
-        self.settings
-            .validate()
-            .map_err(|problem| setting(&format!("solver.{}", problem.field), &problem.message))
+        Ok(self.settings.validate()?)
     }
 }
 
@@ -414,355 +438,4 @@ fn setting(field: &str, message: &str) -> WorldError {
         field: field.to_string(),
         message: message.to_string(),
     }
-}
-
-fn invalid(index: usize, desc: &BodyDesc, field: &str, message: String) -> WorldError {
-    WorldError::InvalidBody {
-        body: index,
-        name: desc.name.clone(),
-        field: field.to_string(),
-        message,
-    }
-}
-
-struct BuiltBody {
-    keyframes: Vec<crate::body::Keyframe>,
-    pose: Pose,
-    local_center_of_mass: Vec3,
-    linear_velocity: Vec3,
-    angular_velocity: Vec3,
-    inverse_mass: f32,
-    local_inverse_inertia: Mat3,
-    shape: SharedShape,
-    locked_axes: LockedAxes,
-}
-
-fn positive(index: usize, desc: &BodyDesc, field: &str, value: f32) -> Result<(), WorldError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(
-            index,
-            desc,
-            field,
-            format!("must be finite and > 0, got {value}"),
-        ))
-    }
-}
-
-/// Turns a scene's body description into a builder: the shape from its description (each
-/// size checked, with the scene's field names), the rest copied for [`build`] to check.
-fn builder_of(
-    index: usize,
-    desc: &BodyDesc,
-    material: &Material,
-) -> Result<BodyBuilder, WorldError> {
-    let shape = match &desc.shape {
-        ShapeDesc::Sphere { radius } => {
-            positive(index, desc, "shape.radius", *radius)?;
-            SharedShape::ball(*radius)
-        }
-        ShapeDesc::Cuboid { half_extents: h } => {
-            for (k, axis) in ["x", "y", "z"].iter().enumerate() {
-                positive(index, desc, &format!("shape.half_extents.{axis}"), h[k])?;
-            }
-            SharedShape::cuboid(h[0], h[1], h[2])
-        }
-        ShapeDesc::Capsule {
-            half_height,
-            radius,
-        } => {
-            positive(index, desc, "shape.radius", *radius)?;
-            if !(half_height.is_finite() && *half_height >= 0.0) {
-                return Err(invalid(
-                    index,
-                    desc,
-                    "shape.half_height",
-                    format!("must be finite and ≥ 0, got {half_height}"),
-                ));
-            }
-            SharedShape::capsule_y(*half_height, *radius)
-        }
-        ShapeDesc::Cylinder {
-            half_height,
-            radius,
-        } => {
-            positive(index, desc, "shape.half_height", *half_height)?;
-            positive(index, desc, "shape.radius", *radius)?;
-            SharedShape::cylinder(*half_height, *radius)
-        }
-        ShapeDesc::Cone {
-            half_height,
-            radius,
-        } => {
-            positive(index, desc, "shape.half_height", *half_height)?;
-            positive(index, desc, "shape.radius", *radius)?;
-            SharedShape::cone(*half_height, *radius)
-        }
-        ShapeDesc::ConvexHull { points } => {
-            let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
-            if !points.iter().all(|p| p.is_finite()) {
-                return Err(invalid(
-                    index,
-                    desc,
-                    "shape.points",
-                    "must be finite".into(),
-                ));
-            }
-            let hull = if points.len() >= 4 {
-                SharedShape::convex_hull(&points)
-            } else {
-                None
-            };
-            let volume = hull
-                .as_ref()
-                .map(|h| h.mass_properties(1.0).mass())
-                .unwrap_or(0.0);
-            match hull {
-                Some(h) if volume > 1e-9 => h,
-                _ => {
-                    return Err(invalid(
-                        index,
-                        desc,
-                        "shape.points",
-                        "need at least 4 points spanning a volume".into(),
-                    ));
-                }
-            }
-        }
-        ShapeDesc::Trimesh { .. }
-        | ShapeDesc::HeightField { .. }
-        | ShapeDesc::Compound { .. }
-        | ShapeDesc::Round { .. } => {
-            crate::scene::build_shape(desc.kind, &desc.shape).map_err(|e| {
-                let field = e.field.map(|f| f.to_string()).unwrap_or_default();
-                invalid(index, desc, &field, e.message)
-            })?
-        }
-        ShapeDesc::HalfSpace { normal } => {
-            let n = Vec3::from(*normal);
-            if desc.kind != BodyKind::Static {
-                return Err(invalid(
-                    index,
-                    desc,
-                    "shape",
-                    "a half-space must be a static body".into(),
-                ));
-            }
-            if !n.is_finite() || n.length() < 1e-6 {
-                return Err(invalid(
-                    index,
-                    desc,
-                    "shape.normal",
-                    "must be a finite non-zero vector".into(),
-                ));
-            }
-            SharedShape::halfspace(n.normalize())
-        }
-    };
-    let q = Quat::from_array(desc.orientation);
-    Ok(BodyBuilder {
-        kind: desc.kind,
-        shape,
-        translation: Vec3::from(desc.position),
-        rotation: q,
-        linear_velocity: Vec3::from(desc.linear_velocity),
-        angular_velocity: Vec3::from(desc.angular_velocity),
-        friction: material.friction,
-        restitution: material.restitution,
-        density: material.density,
-        mass: desc.mass,
-        name: desc.name.clone(),
-        user_data: 0,
-        linear_damping: desc.linear_damping,
-        angular_damping: desc.angular_damping,
-        locked_axes: if desc.lock_rotation {
-            desc.locked_axes.to_locked_axes() | LockedAxes::ALL_ROTATIONS
-        } else {
-            desc.locked_axes.to_locked_axes()
-        },
-        groups: desc.groups,
-        mask: desc.mask,
-        keyframes: desc
-            .keyframes
-            .iter()
-            .flatten()
-            .map(|k| crate::body::Keyframe {
-                time: k.t,
-                translation: Vec3::from(k.position),
-                rotation: Quat::from_array(k.orientation),
-            })
-            .collect(),
-    })
-}
-
-/// An invalid field of body `index` built from `builder`.
-fn invalid_built(index: usize, builder: &BodyBuilder, field: &str, message: String) -> WorldError {
-    WorldError::InvalidBody {
-        body: index,
-        name: builder.name.clone(),
-        field: field.to_string(),
-        message,
-    }
-}
-
-/// Turns a builder into state, rejecting every value that would make the simulation
-/// meaningless (the library never panics on user input). Fields are named as in the scene
-/// format (`position` for the translation, `material.friction`, …).
-fn build(index: usize, b: &BodyBuilder) -> Result<BuiltBody, WorldError> {
-    let check = |field: &str, rule: Result<(), String>| {
-        rule.map_err(|message| invalid_built(index, b, field, message))
-    };
-    let bad = |field: &str, message: String| Err(invalid_built(index, b, field, message));
-    check("position", rules::finite(&b.translation.to_array()))?;
-    check("orientation", rules::orientation(b.rotation.to_array()))?;
-    check(
-        "linear_velocity",
-        rules::finite(&b.linear_velocity.to_array()),
-    )?;
-    check(
-        "angular_velocity",
-        rules::finite(&b.angular_velocity.to_array()),
-    )?;
-    check("material.friction", rules::non_negative(b.friction))?;
-    check("material.restitution", rules::unit_interval(b.restitution))?;
-    check("linear_damping", rules::non_negative(b.linear_damping))?;
-    check("angular_damping", rules::non_negative(b.angular_damping))?;
-    let shape = b.shape.clone();
-    let type_name = format!("{:?}", shape.shape_type()).to_lowercase();
-    check(
-        "shape.type",
-        rules::shape_for_kind(b.kind, ShapeClass::of(&shape), &type_name),
-    )?;
-    check("shape", rules::shape_extent(&shape))?;
-    if !b.locked_axes.is_empty() {
-        check("locked_axes", rules::locked_axes_for_kind(b.kind))?;
-    }
-    let keyframes = check_keyframes(index, b)?;
-    let rotation = b.rotation.normalize();
-    let pose = Pose::from_parts(b.translation, rotation);
-    let (inverse_mass, local_center_of_mass, local_inverse_inertia) = match b.kind {
-        BodyKind::Static => (0.0, Vec3::ZERO, Mat3::ZERO),
-        BodyKind::Kinematic => {
-            // No mass; the velocities are those of the shape's centroid, as for a dynamic
-            // body of uniform density.
-            let centroid = shape.mass_properties(1.0).local_com;
-            let centroid = if centroid.is_finite() {
-                centroid
-            } else {
-                Vec3::ZERO
-            };
-            (0.0, centroid, Mat3::ZERO)
-        }
-        BodyKind::Dynamic | BodyKind::Particle => {
-            check("material.density", rules::positive(b.density))?;
-            let props = shape.mass_properties(b.density);
-            let computed_mass = props.mass();
-            // Scaling mass and inertia together keeps the shape's mass distribution.
-            let scale = match b.mass {
-                Some(m) => {
-                    check("mass", rules::positive(m))?;
-                    m / computed_mass
-                }
-                None => 1.0,
-            };
-            let inverse_mass = props.inv_mass / scale;
-            if !(inverse_mass.is_finite() && inverse_mass > 0.0) {
-                return bad(
-                    "mass",
-                    format!("mass must be finite and > 0, got {}", 1.0 / inverse_mass),
-                );
-            }
-            // A body with locked rotations keeps its inertia: the locks act on the world
-            // tensor ([`Bodies::world_inverse_inertia`]), so they may be lifted later.
-            let inertia = if b.kind == BodyKind::Particle {
-                Mat3::ZERO
-            } else {
-                props.reconstruct_inverse_inertia_matrix() / scale
-            };
-            if !inertia.is_finite() || !props.local_com.is_finite() {
-                return bad("shape", "mass properties are not finite".into());
-            }
-            (inverse_mass, props.local_com, inertia)
-        }
-    };
-    // Locks act on dynamic bodies only; a particle never rotates.
-    let locked_axes = match b.kind {
-        BodyKind::Dynamic => b.locked_axes,
-        BodyKind::Particle => b.locked_axes.difference(LockedAxes::ALL_ROTATIONS),
-        BodyKind::Static | BodyKind::Kinematic => LockedAxes::NONE,
-    };
-    let angular_velocity = match b.kind {
-        BodyKind::Kinematic => b.angular_velocity,
-        BodyKind::Dynamic => locked_axes.lock_angular_velocity(b.angular_velocity),
-        BodyKind::Static | BodyKind::Particle => Vec3::ZERO,
-    };
-    // The builder gives the velocity of the body origin; the solver works at the centre of
-    // mass.
-    let linear_velocity = if b.kind == BodyKind::Static {
-        Vec3::ZERO
-    } else {
-        locked_axes.lock_linear_velocity(
-            b.linear_velocity + angular_velocity.cross(rotation * local_center_of_mass),
-        )
-    };
-    Ok(BuiltBody {
-        keyframes,
-        pose,
-        local_center_of_mass,
-        linear_velocity,
-        angular_velocity,
-        inverse_mass,
-        local_inverse_inertia,
-        shape,
-        locked_axes,
-    })
-}
-
-/// A builder's keyframes, checked by the rules of [`rules`] (kinematic bodies only, with no
-/// velocities of their own; times finite, > 0 and increasing; translations finite; rotations
-/// finite and non-zero) and with normalised rotations. Fields are named as in the scene format
-/// (`keyframes[i].t`, `.position`, `.orientation`).
-fn check_keyframes(
-    index: usize,
-    b: &BodyBuilder,
-) -> Result<Vec<crate::body::Keyframe>, WorldError> {
-    if b.keyframes.is_empty() {
-        return Ok(Vec::new());
-    }
-    let check = |field: String, rule: Result<(), String>| {
-        rule.map_err(|message| invalid_built(index, b, &field, message))
-    };
-    check("keyframes".into(), rules::keyframes_for_kind(b.kind))?;
-    for (field, velocity) in [
-        ("linear_velocity", b.linear_velocity),
-        ("angular_velocity", b.angular_velocity),
-    ] {
-        check(
-            field.into(),
-            rules::keyframed_velocity(field, velocity.to_array()),
-        )?;
-    }
-    let mut previous = 0.0f32;
-    let mut out = Vec::with_capacity(b.keyframes.len());
-    for (k, key) in b.keyframes.iter().enumerate() {
-        check(
-            format!("keyframes[{k}].t"),
-            rules::keyframe_time(k, key.time, previous),
-        )?;
-        previous = key.time;
-        check(
-            format!("keyframes[{k}].position"),
-            rules::finite(&key.translation.to_array()),
-        )?;
-        check(
-            format!("keyframes[{k}].orientation"),
-            rules::orientation(key.rotation.to_array()),
-        )?;
-        out.push(crate::body::Keyframe {
-            rotation: key.rotation.normalize(),
-            ..*key
-        });
-    }
-    Ok(out)
 }

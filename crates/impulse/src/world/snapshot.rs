@@ -69,7 +69,7 @@ const HEADER_LEN: usize = 16 + 4 + 8 + 4;
 /// let mut restored = World::from_snapshot(WorldSnapshot::from_bytes(&bytes)?)?;
 /// world.step()?;
 /// restored.step()?;
-/// assert_eq!(world.bodies().pose[1], restored.bodies().pose[1]);
+/// assert_eq!(world.poses()[1], restored.poses()[1]);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Clone, Serialize, Deserialize)]

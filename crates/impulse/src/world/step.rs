@@ -83,9 +83,6 @@ impl World {
 
     /// [`World::step`] on the calling thread.
     fn step_here(&mut self) -> Result<&StepDiagnostics, StepError> {
-        if let Err(e) = self.check_settings() {
-            return Err(StepError::InvalidSettings(e.to_string()));
-        }
         let settings = self.settings.clone();
         self.step_count += 1;
         self.left_world.clear();

@@ -97,7 +97,7 @@ fn a_throw_between_steps_is_not_a_blow_up() {
     let mut highest = 0.0f32;
     for _ in 0..300 {
         world.step().unwrap();
-        highest = highest.max(world.bodies().pose[b].translation.y);
+        highest = highest.max(world.poses()[b].translation.y);
     }
     // v²/2g above the start: 81.5 m (the first step's half-step of gravity aside).
     assert!(

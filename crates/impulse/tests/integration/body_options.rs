@@ -257,11 +257,14 @@ fn the_scene_format_reads_and_writes_the_options() {
     );
     assert!(!written.lines().nth(7).unwrap_or("").contains("groups"));
     let world = World::from_scene(&scene).unwrap();
-    assert_eq!(world.bodies().groups[1], 2);
-    assert_eq!(world.bodies().mask[1], 5);
-    assert_eq!(world.bodies().locked_axes[1], LockedAxes::ALL_ROTATIONS);
+    assert_eq!(world.body_at(1).unwrap().collision_groups().0, 2);
+    assert_eq!(world.body_at(1).unwrap().collision_groups().1, 5);
     assert_eq!(
-        world.bodies().world_inverse_inertia(1),
+        world.body_at(1).unwrap().locked_axes(),
+        LockedAxes::ALL_ROTATIONS
+    );
+    assert_eq!(
+        world.body_at(1).unwrap().world_inverse_inertia(),
         impulse::glam::Mat3::ZERO
     );
 }
@@ -594,7 +597,12 @@ fn a_torque_impulse_on_a_turned_locked_body_meets_reactions_about_the_locked_axe
         world.apply_torque_impulse(body, torque).unwrap();
         let change = world.body(body).unwrap().angular_velocity();
         let r = DMat3::from_quat(world.body(body).unwrap().rotation().as_dquat().normalize());
-        let local = world.bodies().local_inverse_inertia[0].as_dmat3().inverse();
+        let local = world
+            .body_at(0)
+            .unwrap()
+            .local_inverse_inertia()
+            .as_dmat3()
+            .inverse();
         let tensor = r * local * r.transpose();
         let reaction = tensor * change.as_dvec3() - torque.as_dvec3();
         let free = locked.rotation_factor().as_dvec3();
@@ -802,7 +810,7 @@ fn the_scene_format_reads_locked_axes_and_names_unknown_axes() {
         scene
     );
     let world = World::from_scene(&scene).unwrap();
-    assert_eq!(world.bodies().locked_axes[0], PLANAR);
+    assert_eq!(world.body_at(0).unwrap().locked_axes(), PLANAR);
 
     let text = "{\"bodies\": [\n  {\"name\": \"door\", \"kind\": \"dynamic\",\n   \
                 \"shape\": {\"type\": \"sphere\", \"radius\": 1},\n   \

@@ -5,7 +5,7 @@ use glam::Vec3;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc};
 
 /// Material with Coulomb coefficient `friction`, no restitution, density 1000 kg/m³.
-pub fn material(friction: f32) -> Material {
+pub(crate) fn material(friction: f32) -> Material {
     Material {
         friction,
         restitution: 0.0,
@@ -14,7 +14,7 @@ pub fn material(friction: f32) -> Material {
 }
 
 /// A static cuboid of half extents `half` (m) centred at `position` (m).
-pub fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
+pub(crate) fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
     BodyDesc::new(
         BodyKind::Static,
         ShapeDesc::Cuboid {
@@ -28,7 +28,7 @@ pub fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
 /// (r = 0.45 m, jittered) on a static ground inside four static walls, with `settings`,
 /// dt = 1/60 s, gravity −9.81 m/s² along y. Used by the unit tests (through `test_support`).
 #[allow(dead_code)]
-pub fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
+pub(crate) fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
     let mut w = impulse::World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
     w.add_body(
         &static_box(Vec3::new(50.0, 0.5, 50.0), Vec3::new(0.0, -0.5, 0.0)),
@@ -67,10 +67,11 @@ pub fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
 }
 
 /// Index of the body whose origin is highest (largest y): the top of a pile.
-pub fn highest_body(bodies: &impulse::Bodies) -> usize {
-    (0..bodies.len())
+pub(crate) fn highest_body(world: &impulse::World) -> usize {
+    let poses = world.poses();
+    (0..poses.len())
         .max_by(|&i, &j| {
-            let (a, b) = (bodies.pose[i].translation.y, bodies.pose[j].translation.y);
+            let (a, b) = (poses[i].translation.y, poses[j].translation.y);
             a.total_cmp(&b)
         })
         .unwrap()
@@ -78,7 +79,7 @@ pub fn highest_body(bodies: &impulse::Bodies) -> usize {
 
 /// FNV-1a hash of a world's state: every body's pose and velocities and every contact point's
 /// impulses and separation, as f32 bits. Equal hashes mean the same state to the bit.
-pub fn hash_state(world: &impulse::World) -> u64 {
+pub(crate) fn hash_state(world: &impulse::World) -> u64 {
     let mut hash = 0xcbf2_9ce4_8422_2325u64;
     let mut add = |x: f32| {
         for byte in x.to_bits().to_le_bytes() {
@@ -86,13 +87,17 @@ pub fn hash_state(world: &impulse::World) -> u64 {
             hash = hash.wrapping_mul(0x0100_0000_01b3);
         }
     };
-    let b = world.bodies();
-    for i in 0..b.len() {
-        let (t, q) = (b.pose[i].translation, b.pose[i].rotation);
+    let (poses, linear, angular) = (
+        world.poses(),
+        world.linear_velocities(),
+        world.angular_velocities(),
+    );
+    for i in 0..world.body_count() {
+        let (t, q) = (poses[i].translation, poses[i].rotation);
         for x in [t.x, t.y, t.z, q.x, q.y, q.z, q.w] {
             add(x);
         }
-        for v in [b.linear_velocity[i], b.angular_velocity[i]] {
+        for v in [linear[i], angular[i]] {
             v.to_array().into_iter().for_each(&mut add);
         }
     }

@@ -115,10 +115,14 @@ fn trajectory_hash(scene: &Scene, steps: u32, threads: usize) -> u64 {
             world
                 .step()
                 .unwrap_or_else(|e| panic!("{}: step {step}: {e}", scene.name));
-            let bodies = world.bodies();
-            for i in 0..bodies.len() {
-                let (t, q) = (bodies.pose[i].translation, bodies.pose[i].rotation);
-                let (v, w) = (bodies.linear_velocity[i], bodies.angular_velocity[i]);
+            let (poses, linear, angular) = (
+                world.poses(),
+                world.linear_velocities(),
+                world.angular_velocities(),
+            );
+            for i in 0..world.body_count() {
+                let (t, q) = (poses[i].translation, poses[i].rotation);
+                let (v, w) = (linear[i], angular[i]);
                 for x in [
                     t.x, t.y, t.z, q.x, q.y, q.z, q.w, v.x, v.y, v.z, w.x, w.y, w.z,
                 ] {

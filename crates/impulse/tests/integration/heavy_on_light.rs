@@ -133,7 +133,7 @@ fn sink_after(
     for _ in 0..steps {
         world.step().unwrap();
     }
-    let y = world.bodies().pose[heavy].translation.y;
+    let y = world.poses()[heavy].translation.y;
     (rest - y, world.diagnostics().islands.clone())
 }
 
@@ -226,7 +226,7 @@ fn an_island_the_path_cannot_take_is_reported_not_held() {
                 }
             }
         }
-        let sink = rest - world.bodies().pose[heavy].translation.y;
+        let sink = rest - world.poses()[heavy].translation.y;
         assert!(sink > 10.0 * SINK_BAR, "sink {:.1} mm", sink * 1e3);
         if !off {
             let found = not_held.expect("reported as not held");

@@ -81,15 +81,11 @@ fn parallel_islands_match_sequential_bit_for_bit() {
     for island in islands {
         assert_eq!((island.bodies, island.contacts), (5, 20), "{island:?}");
     }
-    for i in 0..sequential.bodies().len() {
+    for i in 0..sequential.body_count() {
+        assert_eq!(sequential.poses()[i], parallel.poses()[i], "body {i}");
         assert_eq!(
-            sequential.bodies().pose[i],
-            parallel.bodies().pose[i],
-            "body {i}"
-        );
-        assert_eq!(
-            sequential.bodies().linear_velocity[i],
-            parallel.bodies().linear_velocity[i]
+            sequential.linear_velocities()[i],
+            parallel.linear_velocities()[i]
         );
     }
 }
@@ -101,13 +97,10 @@ fn a_quiet_island_sleeps_and_a_falling_box_wakes_it() {
         w.step().unwrap();
     }
     for i in 1..=3 {
-        assert!(
-            w.bodies().asleep[i],
-            "body {i} should sleep after 2 s at rest"
-        );
-        assert_eq!(w.bodies().linear_velocity[i], Vec3::ZERO);
+        assert!(w.asleep()[i], "body {i} should sleep after 2 s at rest");
+        assert_eq!(w.linear_velocities()[i], Vec3::ZERO);
     }
-    let resting_y = w.bodies().pose[3].translation.y;
+    let resting_y = w.poses()[3].translation.y;
     // A box dropped onto the sleeping stack.
     let dropped = w
         .add_body(
@@ -122,11 +115,11 @@ fn a_quiet_island_sleeps_and_a_falling_box_wakes_it() {
     let mut woke = false;
     for _ in 0..60 {
         w.step().unwrap();
-        woke |= (1..=3).all(|i| !w.bodies().asleep[i]);
+        woke |= (1..=3).all(|i| !w.asleep()[i]);
     }
     assert!(woke, "the stack must wake when the box lands on it");
     // The dropped box ends resting on the stack, which still stands.
-    let top = w.bodies().pose[dropped].translation.y;
+    let top = w.poses()[dropped].translation.y;
     assert!(
         (top - (resting_y + 1.0)).abs() < 0.01,
         "dropped box at y = {top}"
@@ -160,8 +153,8 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
             ..settings
         };
         let (mut one, mut two, pool) = one_and_two_threads(&scene);
-        let top = common::highest_body(one.bodies());
-        let top_y = one.bodies().pose[top].translation.y;
+        let top = common::highest_body(&one);
+        let top_y = one.poses()[top].translation.y;
         for _ in 0..30 {
             one.step().unwrap();
             pool.install(|| two.step().unwrap());
@@ -172,14 +165,11 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
                     .all(|island| island.simd == simd)
             );
         }
-        for i in 0..one.bodies().len() {
-            assert_eq!(one.bodies().pose[i], two.bodies().pose[i], "body {i}");
-            assert_eq!(
-                one.bodies().angular_velocity[i],
-                two.bodies().angular_velocity[i]
-            );
+        for i in 0..one.body_count() {
+            assert_eq!(one.poses()[i], two.poses()[i], "body {i}");
+            assert_eq!(one.angular_velocities()[i], two.angular_velocities()[i]);
         }
-        let sink = top_y - one.bodies().pose[top].translation.y;
+        let sink = top_y - one.poses()[top].translation.y;
         assert!(sink < largest_sink, "top cube sank {sink} m in 0.5 s");
     }
 }
@@ -204,16 +194,10 @@ fn many_bodies_on_two_threads_match_one_thread_bit_for_bit() {
         contacts > 1024,
         "only {contacts} contacts: the parallel paths were not taken"
     );
-    for i in 0..one.bodies().len() {
-        assert_eq!(one.bodies().pose[i], two.bodies().pose[i], "body {i}");
-        assert_eq!(
-            one.bodies().linear_velocity[i],
-            two.bodies().linear_velocity[i]
-        );
-        assert_eq!(
-            one.bodies().angular_velocity[i],
-            two.bodies().angular_velocity[i]
-        );
+    for i in 0..one.body_count() {
+        assert_eq!(one.poses()[i], two.poses()[i], "body {i}");
+        assert_eq!(one.linear_velocities()[i], two.linear_velocities()[i]);
+        assert_eq!(one.angular_velocities()[i], two.angular_velocities()[i]);
     }
 }
 
@@ -244,18 +228,13 @@ fn many_bodies_fall_asleep_alike_on_one_and_two_threads() {
         let a = one.step().unwrap().clone();
         let b = pool.install(|| two.step().unwrap().clone());
         assert_eq!(a, b, "diagnostics of step {}", a.step);
-        assert_eq!(one.bodies().asleep, two.bodies().asleep, "step {}", a.step);
-        assert_eq!(
-            one.bodies().sleep_time,
-            two.bodies().sleep_time,
-            "step {}",
-            a.step
-        );
-        if first_sleep.is_none() && one.bodies().asleep.iter().any(|&s| s) {
+        assert_eq!(one.asleep(), two.asleep(), "step {}", a.step);
+        assert_eq!(one.sleep_times(), two.sleep_times(), "step {}", a.step);
+        if first_sleep.is_none() && one.asleep().iter().any(|&s| s) {
             first_sleep = Some(a.step);
         }
     }
-    let asleep = one.bodies().asleep.iter().filter(|&&s| s).count();
+    let asleep = one.asleep().iter().filter(|&&s| s).count();
     assert!(
         first_sleep.is_some() && asleep > 1024,
         "only {asleep} bodies asleep after 4 s: the sleep paths were not taken"

@@ -28,17 +28,17 @@ fn scratch(name: &str) -> PathBuf {
 
 /// Largest depth (m) by which any moving body of `world` overlaps static body `ground`.
 fn deepest_into(world: &World, ground: usize) -> f32 {
-    let b = world.bodies();
+    let (poses, shapes) = (world.poses(), world.shapes());
     let mut deepest = 0.0f32;
-    for i in 0..b.len() {
-        if i == ground || !b.is_moving(i) {
+    for i in 0..world.body_count() {
+        if i == ground || !world.body_kinds()[i].is_moving() {
             continue;
         }
         if let Ok(Some(contact)) = query::contact(
-            &b.pose[ground],
-            b.shape[ground].as_ref(),
-            &b.pose[i],
-            b.shape[i].as_ref(),
+            &poses[ground],
+            shapes[ground].as_ref(),
+            &poses[i],
+            shapes[i].as_ref(),
             0.0,
         ) {
             deepest = deepest.max(-contact.dist);
@@ -59,16 +59,16 @@ fn pile_on_the_mesh_terrain_comes_to_rest_without_falling_through() {
     let mut deepest = 0.0f32;
     let mut steps = 0;
     let settled =
-        |w: &World| (1..w.bodies().len()).all(|i| !w.bodies().is_moving(i) || w.bodies().asleep[i]);
+        |w: &World| (1..w.body_count()).all(|i| !w.body_kinds()[i].is_moving() || w.asleep()[i]);
     while !settled(&world) {
         assert!(steps < 1800, "the pile is not at rest after 30 s");
         world.step().unwrap();
         steps += 1;
         deepest = deepest.max(deepest_into(&world, 0));
     }
-    for i in 1..world.bodies().len() {
+    for i in 1..world.body_count() {
         // The terrain's lowest point is at y = −0.4 m.
-        let p = world.bodies().pose[i].translation;
+        let p = world.poses()[i].translation;
         assert!(p.y > -0.4, "body {i} fell through: {p}");
     }
     assert!(deepest < 0.01, "a body sank {deepest} m into the terrain");
@@ -120,14 +120,13 @@ fn caps_set_down_across_terrain_triangles_come_to_rest() {
             let mut world = World::from_scene(&pile).unwrap();
             let steps = (0..600).take_while(|_| {
                 world.step().unwrap();
-                !world.bodies().asleep[1]
+                !world.asleep()[1]
             });
             if steps.count() == 600 {
-                let b = world.bodies();
                 failures.push(format!(
                     "{name} at ({x}, {z}) awake after 10 s: {:.3} m/s, {:.3} rad/s",
-                    b.linear_velocity[1].length(),
-                    b.angular_velocity[1].length()
+                    world.linear_velocities()[1].length(),
+                    world.angular_velocities()[1].length()
                 ));
             }
         }
@@ -443,13 +442,13 @@ fn drift(bodies: Vec<BodyDesc>) -> f32 {
         ..Scene::default()
     };
     let mut world = World::from_scene(&scene).unwrap();
-    let start: Vec<Vec3> = world.bodies().pose.iter().map(|p| p.translation).collect();
+    let start: Vec<Vec3> = world.poses().iter().map(|p| p.translation).collect();
     for _ in 0..600 {
         world.step().unwrap();
     }
-    (0..world.bodies().len())
-        .filter(|&i| world.bodies().is_moving(i))
-        .map(|i| world.bodies().pose[i].translation.distance(start[i]))
+    (0..world.body_count())
+        .filter(|&i| world.body_kinds()[i].is_moving())
+        .map(|i| world.poses()[i].translation.distance(start[i]))
         .fold(0.0, f32::max)
 }
 

@@ -67,8 +67,8 @@ fn free_fall_matches_the_integrator_closed_form() {
         let m = (n * substeps) as f32;
         let v = v0 + g * (m * h);
         let x = x0 + v0 * (m * h) + g * (h * h * m * (m + 1.0) / 2.0);
-        let got_v = w.bodies().linear_velocity[0];
-        let got_x = w.bodies().pose[0].translation;
+        let got_v = w.linear_velocities()[0];
+        let got_x = w.poses()[0].translation;
         assert!((got_v - v).abs().max_element() <= 1e-5 * (1.0 + v.abs().max_element()) * nf);
         assert!((got_x - x).abs().max_element() <= 2e-6 * x.abs().max_element() * nf.sqrt() + 1e-6);
         assert_eq!(w.diagnostics().contacts, 0);
@@ -98,7 +98,7 @@ fn head_on_spheres_conserve_momentum_and_obey_restitution() {
             touched |= w
                 .contact_pairs()
                 .any(|pair| pair.total_normal_impulse() > 0.0);
-            let p = 2.0 * w.bodies().linear_velocity[0].x + 0.5 * w.bodies().linear_velocity[1].x;
+            let p = 2.0 * w.linear_velocities()[0].x + 0.5 * w.linear_velocities()[1].x;
             assert!(
                 (p - momentum_before).abs() < 1e-5,
                 "c_r {c_r}: momentum {p}"
@@ -111,14 +111,14 @@ fn head_on_spheres_conserve_momentum_and_obey_restitution() {
             );
         }
         assert!(touched, "the spheres must have collided");
-        let relative_after = w.bodies().linear_velocity[1].x - w.bodies().linear_velocity[0].x;
+        let relative_after = w.linear_velocities()[1].x - w.linear_velocities()[0].x;
         assert!(
             (relative_after - (-c_r * relative_before)).abs() < 1e-4,
             "c_r {c_r}: relative velocity after {relative_after}, expected {}",
             -c_r * relative_before
         );
         for i in 0..2 {
-            assert!(w.bodies().linear_velocity[i].y.abs() < 1e-6);
+            assert!(w.linear_velocities()[i].y.abs() < 1e-6);
         }
     }
 }
@@ -152,7 +152,7 @@ fn sphere_resting_on_two_spheres() {
             &material(0.0, 0.0),
         )
         .unwrap();
-    let mass_top = w.bodies().mass(top);
+    let mass_top = w.body_at(top).unwrap().mass();
     let mut depth_after_one_second = 0.0;
     for step in 1..=600 {
         w.step().unwrap();
@@ -198,7 +198,7 @@ fn sphere_resting_on_two_spheres() {
         "overlap grew: {depth_after_one_second} → {depth}"
     );
     assert!(depth < 0.01);
-    let top_y_now = w.bodies().pose[top].translation.y;
+    let top_y_now = w.poses()[top].translation.y;
     assert!(
         (top_y_now - top_y).abs() < 0.01,
         "top sphere moved to {top_y_now}"
@@ -241,12 +241,12 @@ fn body_moving_away_from_contact_is_not_held_back() {
     for c in between {
         assert_eq!(c.normal_impulse, 0.0);
     }
-    let vy = w.bodies().linear_velocity[upper].y;
+    let vy = w.linear_velocities()[upper].y;
     assert!(
         (vy - (4.0 + g.y * DT)).abs() < 1e-5,
         "upper box held back: v = {vy}"
     );
-    assert!(w.bodies().linear_velocity[lower].length() < 1e-3);
+    assert!(w.linear_velocities()[lower].length() < 1e-3);
 }
 
 #[test]
@@ -265,7 +265,7 @@ fn box_resting_on_ground_does_not_drift_or_gain_energy() {
         w.step().unwrap();
         largest_energy = largest_energy.max(w.diagnostics().kinetic_energy);
     }
-    let drift = (w.bodies().pose[b].translation - start).length();
+    let drift = (w.poses()[b].translation - start).length();
     assert!(drift < 1e-3, "drift {drift} m");
     // Energy of one step of gravity-induced velocity is m(g·dt)²/2 ≈ 0.013 J; anything above
     // means the contact pumps energy in.
@@ -273,7 +273,7 @@ fn box_resting_on_ground_does_not_drift_or_gain_energy() {
         largest_energy < 0.02,
         "kinetic energy reached {largest_energy} J"
     );
-    let angle = w.bodies().pose[b].rotation.angle_between(Quat::IDENTITY);
+    let angle = w.poses()[b].rotation.angle_between(Quat::IDENTITY);
     assert!(angle < 1e-3);
 }
 
@@ -298,15 +298,15 @@ fn box_on_incline_sticks_or_slides_by_coulomb() {
         for _ in 0..60 {
             w.step().unwrap();
         }
-        let x0 = w.bodies().pose[b].translation.dot(down_slope);
-        let v0 = w.bodies().linear_velocity[b].dot(down_slope);
+        let x0 = w.poses()[b].translation.dot(down_slope);
+        let v0 = w.linear_velocities()[b].dot(down_slope);
         let steps = 120;
         for _ in 0..steps {
             w.step().unwrap();
         }
         let t = steps as f32 * DT;
-        let x1 = w.bodies().pose[b].translation.dot(down_slope);
-        let v1 = w.bodies().linear_velocity[b].dot(down_slope);
+        let x1 = w.poses()[b].translation.dot(down_slope);
+        let v1 = w.linear_velocities()[b].dot(down_slope);
         if slides {
             let expected = g * (theta.sin() - mu * theta.cos());
             let measured = (v1 - v0) / t;
@@ -398,7 +398,7 @@ fn split_impulse_repairs_an_overlap_down_to_the_slop_and_then_rests() {
     for _ in 0..90 {
         w.step().unwrap();
     }
-    let depth = radius - w.bodies().pose[ball].translation.y;
+    let depth = radius - w.poses()[ball].translation.y;
     let ContactRepair::SplitImpulse { rate, .. } = w.settings().repair else {
         panic!("split impulse");
     };
@@ -407,12 +407,12 @@ fn split_impulse_repairs_an_overlap_down_to_the_slop_and_then_rests() {
         depth > slop - 1e-6 && depth < slop + tolerance_depth + 1e-6,
         "depth {depth} m after 1.5 s, slop {slop} m"
     );
-    let speed = w.bodies().linear_velocity[ball].length();
+    let speed = w.linear_velocities()[ball].length();
     assert!(speed < 1e-3, "the repair left {speed} m/s of velocity");
-    let rest = w.bodies().pose[ball].translation;
+    let rest = w.poses()[ball].translation;
     for _ in 0..60 {
         w.step().unwrap();
     }
-    let moved = (w.bodies().pose[ball].translation - rest).length();
+    let moved = (w.poses()[ball].translation - rest).length();
     assert!(moved < 1e-5, "moved {moved} m while resting");
 }

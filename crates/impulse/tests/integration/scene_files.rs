@@ -274,12 +274,12 @@ fn world_of(name: &str) -> World {
 /// Signed distance (m) between bodies `i` and `j` of `world`: negative when they overlap;
 /// `None` when they are more than 1 cm apart.
 fn gap(world: &World, i: usize, j: usize) -> Option<f32> {
-    let b = world.bodies();
+    let (poses, shapes) = (world.poses(), world.shapes());
     parry3d::query::contact(
-        &b.pose[i],
-        b.shape[i].as_ref(),
-        &b.pose[j],
-        b.shape[j].as_ref(),
+        &poses[i],
+        shapes[i].as_ref(),
+        &poses[j],
+        shapes[j].as_ref(),
         0.01,
     )
     .unwrap()
@@ -365,7 +365,7 @@ fn solver2d_counts_and_materials() {
             .count();
         assert_eq!(heavies, 1, "{name}");
         let world = World::from_scene(&scene).unwrap();
-        let ratio_built = world.bodies().mass(55) / world.bodies().mass(54);
+        let ratio_built = world.body_at(55).unwrap().mass() / world.body_at(54).unwrap().mass();
         assert!((ratio_built - ratio).abs() < 1e-3 * ratio, "{name}");
         // Otherwise the pyramid20 construction with base 10.
         let pyramid = builtin_scene("pyramid10").unwrap();
@@ -376,9 +376,9 @@ fn solver2d_counts_and_materials() {
     }
     // The plate weighs 400 cubes.
     let world = world_of("plate");
-    let ratio = world.bodies().mass(3) / world.bodies().mass(1);
+    let ratio = world.body_at(3).unwrap().mass() / world.body_at(1).unwrap().mass();
     assert!((ratio - 400.0).abs() < 1e-3, "plate: mass ratio {ratio}");
-    assert!((world.bodies().mass(1) - 1000.0).abs() < 1e-3);
+    assert!((world.body_at(1).unwrap().mass() - 1000.0).abs() < 1e-3);
 }
 
 #[test]
@@ -465,7 +465,7 @@ fn solver2d_card_house_poses() {
     // cards of the bottom A-frames rest on the ground, the cards of each A-frame meet at the
     // top, the flat cards lie on the A-frames below them, the upper A-frame on a flat card.
     let world = world_of("card_house");
-    let overlap = metrics::max_overlap(world.bodies());
+    let overlap = metrics::max_overlap(&world, world.poses());
     assert!(overlap < 1e-3, "card_house: initial overlap {overlap} m");
     for (i, j) in [
         (0, 1),
@@ -531,7 +531,7 @@ fn solver2d_arch_blocks() {
     }
     // No overlap at t = 0; neighbours share a face, the end blocks stand on the ground.
     let world = world_of("arch");
-    let overlap = metrics::max_overlap(world.bodies());
+    let overlap = metrics::max_overlap(&world, world.poses());
     assert!(overlap < 1e-3, "arch: initial overlap {overlap} m");
     for k in 1..13 {
         assert_touch("arch", &world, k, k + 1);
@@ -547,7 +547,7 @@ fn solver2d_arch_blocks() {
 fn solver2d_initial_overlaps() {
     // Cubes that touch exactly: nothing overlaps.
     for name in ["vertical_stack15", "plate", "mass_ratio_pyramid100"] {
-        let overlap = metrics::max_overlap(world_of(name).bodies());
+        let overlap = metrics::max_overlap(&world_of(name), world_of(name).poses());
         assert!(overlap < 1e-5, "{name}: initial overlap {overlap} m");
     }
     let plate = world_of("plate");
@@ -556,7 +556,7 @@ fn solver2d_initial_overlaps() {
     }
     // overlap_pyramid: neighbours overlap by 0.25 m, the bottom row and the ground by 0.125 m.
     let world = world_of("overlap_pyramid");
-    let overlap = metrics::max_overlap(world.bodies());
+    let overlap = metrics::max_overlap(&world, world.poses());
     assert!(
         (overlap - 0.25).abs() < 1e-4,
         "overlap_pyramid: {overlap} m"

@@ -321,7 +321,7 @@ fn the_cradle_scene_file_gives_one_in_one_out() {
     for _ in 0..60 {
         world.step().unwrap();
     }
-    let v: Vec<Vec3> = (1..=5).map(|i| world.bodies().linear_velocity[i]).collect();
+    let v: Vec<Vec3> = (1..=5).map(|i| world.linear_velocities()[i]).collect();
     assert_close(&v, &[0.0, 0.0, 0.0, 0.0, 1.0], 1.0, "scene file");
 }
 

@@ -67,8 +67,7 @@ fn resumes_bit_for_bit(
         // Parry's work spaces of composite shapes hold hash maps, whose serialised order is
         // not fixed: for those the stepped state (above) is what must agree.
         let composite = resumed
-            .bodies()
-            .shape
+            .shapes()
             .iter()
             .any(|s| s.as_composite_shape().is_some());
         let resumed_bytes = resumed.snapshot().unwrap().to_bytes().unwrap();
@@ -136,8 +135,8 @@ fn meshes_height_fields_and_compounds_resume_bit_for_bit() {
 fn a_sleeping_pyramid_woken_by_a_falling_ball_resumes_bit_for_bit() {
     let make = || {
         let mut world = world_of(&builtin_scene("pyramid20").unwrap());
-        let top = impulse::metrics::top_body(world.bodies()).unwrap();
-        let top = world.bodies().pose[top].translation;
+        let top = impulse::metrics::top_body(&world, world.poses()).unwrap();
+        let top = world.poses()[top].translation;
         world
             .insert(
                 BodyBuilder::dynamic(SharedShape::ball(0.4))
@@ -147,7 +146,7 @@ fn a_sleeping_pyramid_woken_by_a_falling_ball_resumes_bit_for_bit() {
             .unwrap();
         world
     };
-    let asleep = |world: &World| world.bodies().asleep.iter().filter(|&&a| a).count();
+    let asleep = |world: &World| world.asleep().iter().filter(|&&a| a).count();
     let mut probe = make();
     steps(&mut probe, 50, 1);
     let sleeping = asleep(&probe);
@@ -189,7 +188,7 @@ fn edits_between_steps_resume_bit_for_bit() {
     let edited = || {
         let mut world = World::from_scene(&builtin_scene("pyramid20").unwrap()).unwrap();
         steps(&mut world, 20, 1);
-        let handles: Vec<_> = (0..world.bodies().len())
+        let handles: Vec<_> = (0..world.body_count())
             .map(|i| world.handle_of(i).unwrap())
             .collect();
         world.remove(handles[5]).unwrap();

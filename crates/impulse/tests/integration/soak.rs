@@ -38,9 +38,9 @@ fn balls4096_for_20000_steps_stays_finite_boxed_and_dissipative() {
             let e = energy(&world);
             highest = highest.max(e);
             assert!(e.is_finite(), "step {step}: energy {e}");
-            let b = world.bodies();
-            for i in (0..b.len()).filter(|&i| b.kind[i] != BodyKind::Static) {
-                let p = b.pose[i].translation;
+            let kinds = world.body_kinds();
+            for i in (0..kinds.len()).filter(|&i| kinds[i] != BodyKind::Static) {
+                let p = world.poses()[i].translation;
                 assert!(p.is_finite(), "step {step}: body {i} at {p}");
                 let r = 0.5;
                 assert!(

@@ -48,10 +48,10 @@ fn bodies_moving_together_get_no_speculative_contact() {
         );
     }
     for i in 0..2 {
-        assert_eq!(w.bodies().linear_velocity[i], velocity, "ball {i}");
+        assert_eq!(w.linear_velocities()[i], velocity, "ball {i}");
     }
     let expected_y = 10.0 - 20.0 * 3.0 * DT;
-    assert!((w.bodies().pose[0].translation.y - expected_y).abs() < 1e-4);
+    assert!((w.poses()[0].translation.y - expected_y).abs() < 1e-4);
 }
 
 /// A ball 0.2 m above the ground falling at 20 m/s (0.33 m per step) gets a speculative
@@ -74,8 +74,8 @@ fn a_fast_body_is_caught_within_its_reach_and_free_beyond_it() {
             )
             .unwrap();
         w.step().unwrap();
-        let y = w.bodies().pose[ball_index].translation.y;
-        let vy = w.bodies().linear_velocity[ball_index].y;
+        let y = w.poses()[ball_index].translation.y;
+        let vy = w.linear_velocities()[ball_index].y;
         if caught {
             assert!(y >= 0.5 - 1e-3, "gap {gap}: the ball sank to y = {y}");
             assert!(vy > -20.0, "gap {gap}: the ball was not slowed ({vy} m/s)");
@@ -107,12 +107,12 @@ fn bodies_closing_on_each_other_are_caught_by_their_relative_speed() {
     )
     .unwrap();
     w.step().unwrap();
-    let distance = (w.bodies().pose[1].translation - w.bodies().pose[0].translation).length();
+    let distance = (w.poses()[1].translation - w.poses()[0].translation).length();
     assert!(
         distance >= 1.0 - 1e-3,
         "the balls overlap: centres {distance} m apart"
     );
     // Equal masses, no restitution: the impulse stops both (momentum stays zero).
-    let momentum = w.bodies().linear_velocity[0] + w.bodies().linear_velocity[1];
+    let momentum = w.linear_velocities()[0] + w.linear_velocities()[1];
     assert!(momentum.length() < 1e-3, "momentum {momentum}");
 }

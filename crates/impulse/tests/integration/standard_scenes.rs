@@ -12,23 +12,23 @@ use impulse::scene::builtin_scene;
 fn run(name: &str) -> (f32, f32, f32, f32) {
     let scene = builtin_scene(name).expect("built-in scene");
     let mut world = World::from_scene(&scene).unwrap();
-    let initial: Vec<Vec3> = world.bodies().pose.iter().map(|p| p.translation).collect();
-    let top = metrics::top_body(world.bodies()).unwrap();
+    let initial: Vec<Vec3> = world.poses().iter().map(|p| p.translation).collect();
+    let top = metrics::top_body(&world, world.poses()).unwrap();
     let mut largest_overlap = 0.0f32;
     for step in 1..=scene.steps {
         world.step().unwrap();
         if step % 60 == 0 {
-            largest_overlap = largest_overlap.max(metrics::max_overlap(world.bodies()));
+            largest_overlap = largest_overlap.max(metrics::max_overlap(&world, world.poses()));
         }
     }
-    let sink = initial[top].y - world.bodies().pose[top].translation.y;
+    let sink = initial[top].y - world.poses()[top].translation.y;
     let mut horizontal = 0.0f32;
     let mut speed = 0.0f32;
     for (i, start) in initial.iter().enumerate() {
-        if world.bodies().is_moving(i) {
-            let d = world.bodies().pose[i].translation - *start;
+        if world.body_kinds()[i].is_moving() {
+            let d = world.poses()[i].translation - *start;
             horizontal = horizontal.max(Vec3::new(d.x, 0.0, d.z).length());
-            speed = speed.max(world.bodies().linear_velocity[i].length());
+            speed = speed.max(world.linear_velocities()[i].length());
         }
     }
     println!(
@@ -67,19 +67,19 @@ fn run_awake(name: &str) -> (f32, f32, f32) {
     let mut scene = builtin_scene(name).expect("built-in scene");
     scene.solver.sleep = false;
     let mut world = World::from_scene(&scene).unwrap();
-    let top = metrics::top_body(world.bodies()).unwrap();
-    let top_y = world.bodies().pose[top].translation.y;
+    let top = metrics::top_body(&world, world.poses()).unwrap();
+    let top_y = world.poses()[top].translation.y;
     let (mut overlap, mut speed) = (0.0f32, 0.0f32);
     for step in 1..=scene.steps {
         world.step().unwrap();
-        for v in &world.bodies().linear_velocity {
+        for v in world.linear_velocities() {
             speed = speed.max(v.length());
         }
         if step % 60 == 0 {
-            overlap = overlap.max(metrics::max_overlap(world.bodies()));
+            overlap = overlap.max(metrics::max_overlap(&world, world.poses()));
         }
     }
-    let sink = top_y - world.bodies().pose[top].translation.y;
+    let sink = top_y - world.poses()[top].translation.y;
     println!(
         "{name}: top sink {:.2} mm, largest overlap {:.2} mm (sampled each second), largest speed {speed:.3} m/s",
         sink * 1e3,
@@ -120,16 +120,16 @@ fn overlap_pyramid_recovers_without_explosion() {
             ..SolverSettings::preset(preset).unwrap()
         };
         let mut world = World::from_scene(&scene).unwrap();
-        let top = metrics::top_body(world.bodies()).unwrap();
-        let top_y = world.bodies().pose[top].translation.y;
+        let top = metrics::top_body(&world, world.poses()).unwrap();
+        let top_y = world.poses()[top].translation.y;
         let mut speed = 0.0f32;
         for step in 1..=scene.steps {
             world.step().unwrap();
-            for v in &world.bodies().linear_velocity {
+            for v in world.linear_velocities() {
                 speed = speed.max(v.length());
             }
             if step == 90 {
-                let overlap = metrics::max_overlap(world.bodies());
+                let overlap = metrics::max_overlap(&world, world.poses());
                 println!(
                     "overlap_pyramid {preset}: largest overlap at 1.5 s {:.2} mm",
                     overlap * 1e3
@@ -137,8 +137,8 @@ fn overlap_pyramid_recovers_without_explosion() {
                 assert!(overlap < 0.005, "{preset}: overlap at 1.5 s {overlap} m");
             }
         }
-        let overlap = metrics::max_overlap(world.bodies());
-        let sink = top_y - world.bodies().pose[top].translation.y;
+        let overlap = metrics::max_overlap(&world, world.poses());
+        let sink = top_y - world.poses()[top].translation.y;
         println!(
             "overlap_pyramid {preset}: final overlap {:.2} mm, sink {sink} m, largest speed \
              {speed} m/s",
@@ -180,7 +180,7 @@ fn resting_stack30_gains_no_kinetic_energy_and_does_not_drift() {
     const NOISE_FLOOR: f32 = 1e-5;
     for (preset, drift_bound) in [("default", 0.005), ("precise", 0.001)] {
         let mut world = awake_world("stack30", preset);
-        let initial: Vec<Vec3> = world.bodies().pose.iter().map(|p| p.translation).collect();
+        let initial: Vec<Vec3> = world.poses().iter().map(|p| p.translation).collect();
         let (mut energy, mut sideways, mut drift) = (0.0f32, 0.0f32, 0.0f32);
         let (mut energy_at_two_seconds, mut energy_in_last_second) = (f32::INFINITY, 0.0f32);
         for step in 1..=600 {
@@ -198,8 +198,8 @@ fn resting_stack30_gains_no_kinetic_energy_and_does_not_drift() {
                 continue;
             }
             for (i, start) in initial.iter().enumerate() {
-                if world.bodies().is_moving(i) {
-                    let d = world.bodies().pose[i].translation - *start;
+                if world.body_kinds()[i].is_moving() {
+                    let d = world.poses()[i].translation - *start;
                     sideways = sideways.max(Vec3::new(d.x, 0.0, d.z).length());
                     drift = drift.max(d.length());
                 }
@@ -235,7 +235,7 @@ fn resting_stack30_gains_no_kinetic_energy_and_does_not_drift() {
 fn plate_on_two_cubes_comes_to_rest_at_every_preset() {
     for preset in ["fast", "default", "precise"] {
         let mut world = awake_world("plate", preset);
-        let initial: Vec<Vec3> = world.bodies().pose.iter().map(|p| p.translation).collect();
+        let initial: Vec<Vec3> = world.poses().iter().map(|p| p.translation).collect();
         let (mut energy, mut sideways) = (0.0f32, 0.0f32);
         for step in 1..=600 {
             let report = world.step().unwrap();
@@ -244,7 +244,7 @@ fn plate_on_two_cubes_comes_to_rest_at_every_preset() {
             }
             energy = energy.max(report.kinetic_energy);
             for (i, start) in initial.iter().enumerate() {
-                let d = world.bodies().pose[i].translation - *start;
+                let d = world.poses()[i].translation - *start;
                 sideways = sideways.max(Vec3::new(d.x, 0.0, d.z).length());
             }
         }

@@ -111,7 +111,7 @@ fn fast_preset_keeps_pyramid20_standing_with_impulses_inside_their_bounds() {
         ..SolverSettings::fast()
     };
     let mut w = World::from_scene(&scene).unwrap();
-    let top = common::highest_body(&w.bodies);
+    let top = common::highest_body(&w);
     let top_y = w.bodies.pose[top].translation.y;
     for _ in 0..300 {
         w.step().unwrap();

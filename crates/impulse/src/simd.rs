@@ -1,4 +1,14 @@
-//! The one place that decides which instruction set the SIMD lanes' kernels run on.
+//! SIMD dispatch: the one place that decides which instruction set the SIMD lanes' kernels run
+//! on.
+//!
+//! ```
+//! use impulse::simd::{INSTRUCTION_SET_VARIABLE, InstructionSet};
+//!
+//! let set = InstructionSet::detected();
+//! assert!(set.is_supported());
+//! assert!(["baseline", "x86-64-v4"].contains(&set.name()));
+//! assert_eq!(INSTRUCTION_SET_VARIABLE, "IMPULSE_INSTRUCTION_SET");
+//! ```
 //!
 //! The default build targets the baseline of its architecture (SSE2 on x86-64), so a binary
 //! runs on every CPU of it. The lanes' sweeps are then short of registers: a bundle's update
@@ -98,7 +108,7 @@ macro_rules! on_instruction_set {
     ($set:expr, $call:expr) => {{
         #[cfg(target_arch = "x86_64")]
         {
-            if $set == $crate::instruction_set::InstructionSet::X86_64V4 {
+            if $set == $crate::simd::InstructionSet::X86_64V4 {
                 #[target_feature(
                     enable = "avx512f,avx512vl,avx512bw,avx512dq,avx512cd,avx2,fma,bmi1,bmi2,lzcnt"
                 )]
