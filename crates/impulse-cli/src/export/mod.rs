@@ -19,7 +19,7 @@ pub use animation::{Animation, BodyInfo, Frame, PALETTE, PoseSample, STATIC_GREY
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use impulse::{BodyKind, Scene, ShapeDesc};
+use impulse::Scene;
 use parry3d::math::Pose;
 
 /// An animation file format, chosen from the file extension.

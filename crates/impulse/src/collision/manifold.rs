@@ -32,7 +32,7 @@ pub struct ManifoldState {
 }
 
 /// Parry's manifold type with our per-manifold and per-point data.
-pub type Manifold = ContactManifold<ManifoldState, ContactImpulse>;
+pub(crate) type Manifold = ContactManifold<ManifoldState, ContactImpulse>;
 
 /// The world poses of a manifold's two shapes: the bodies' poses `pose1`, `pose2` with the
 /// manifold's sub-shape poses (a compound's part) appended. Parry gives a composite shape's
@@ -40,7 +40,7 @@ pub type Manifold = ContactManifold<ManifoldState, ContactImpulse>;
 /// absent for convex shapes, triangle meshes and height fields, whose parts are in the
 /// shape's own frame).
 #[inline]
-pub fn manifold_poses(manifold: &Manifold, pose1: &Pose, pose2: &Pose) -> (Pose, Pose) {
+pub(crate) fn manifold_poses(manifold: &Manifold, pose1: &Pose, pose2: &Pose) -> (Pose, Pose) {
     (
         manifold.subshape_pos1().prepend_to(pose1),
         manifold.subshape_pos2().prepend_to(pose2),

@@ -12,7 +12,7 @@ use crate::body::Bodies;
 
 /// Cap on a body's speculative margin (m), so a body thrown at absurd speed does not pair
 /// with the whole scene.
-pub const MAX_SPECULATIVE_MARGIN: f32 = 2.0;
+pub(crate) const MAX_SPECULATIVE_MARGIN: f32 = 2.0;
 
 /// How far ahead the broad and narrow phases look in one step (speculative contacts), from
 /// the poses and velocities at the step's start.

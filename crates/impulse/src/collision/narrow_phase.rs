@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::dispatch::ContactDispatcher;
-pub use super::manifold::{ContactImpulse, Manifold, manifold_poses};
+pub(crate) use super::manifold::{ContactImpulse, Manifold, manifold_poses};
 pub use super::margins::SpeculativeMargins;
 use crate::body::Bodies;
 use crate::error::StepError;
@@ -111,7 +111,7 @@ impl ManifoldQuery {
 /// the last computation did not find (beyond its speculative distance) is at least
 /// 2 × this distance short of the current one: as speculative points, such points only
 /// matter to bodies that close that far within a step, which moves them out of recycling.
-pub const RECYCLE_DISTANCE: f32 = 1.0e-3;
+pub(crate) const RECYCLE_DISTANCE: f32 = 1.0e-3;
 
 /// For a pair of shapes whose manifolds may be recycled ([`ManifoldQuery::recycles_at`]),
 /// the farthest any point of `shape2` lies from its frame's origin (m); `None` for the rest.
@@ -569,7 +569,7 @@ impl NarrowPhase {
 /// along the floor, so (3) fails and both contacts stay. Decisions are taken from the
 /// manifolds as Parry left them, before any point is dropped, so the result does not depend
 /// on the order of the pairs.
-pub mod seams {
+pub(crate) mod seams {
     use glam::Vec3;
     use parry3d::math::Pose;
 
@@ -577,12 +577,12 @@ pub mod seams {
     use crate::body::Bodies;
 
     /// How close (m) a contact point must be to the other static body to be on it.
-    pub const SEAM_TOLERANCE: f32 = 1.0e-4;
+    pub(crate) const SEAM_TOLERANCE: f32 = 1.0e-4;
     /// Normals whose dot product is at least this are the same (about 0.8°).
-    pub const SEAM_COS: f32 = 0.9999;
+    pub(crate) const SEAM_COS: f32 = 0.9999;
     /// Length (m) of the probe along the other body's normal; the rule holds for
     /// penetrations up to half of it.
-    pub const SEAM_PROBE: f32 = 0.01;
+    pub(crate) const SEAM_PROBE: f32 = 0.01;
 
     /// One contact point seen from the static body: witness point and outward normal (world).
     struct StaticSide {

@@ -7,10 +7,10 @@ use glam::{Mat3, Mat3A, Vec3};
 use super::row::{ContactConstraint, cap_to_disc, is_isotropic};
 use crate::body::Bodies;
 use crate::collision::narrow_phase::{ContactPair, NarrowPhase};
-use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::island::Islands;
 use crate::parallel::{PAIRS_PER_TASK, spread};
 use crate::settings::SolverSettings;
+use crate::simd::{InstructionSet, on_instruction_set};
 use rayon::prelude::*;
 
 /// Builds one constraint per contact point, laid out island by island as `islands` placed
@@ -30,7 +30,7 @@ use rayon::prelude::*;
 /// at a time. The caller passes it only when nothing reads those rows' products before the
 /// lanes have solved them (no restitution solve after the substeps).
 #[allow(clippy::too_many_arguments)]
-pub fn assemble(
+pub(crate) fn assemble(
     bodies: &Bodies,
     narrow_phase: &NarrowPhase,
     islands: &Islands,
@@ -118,7 +118,7 @@ impl IslandRows {
 /// lever arms that switched with every micrometre of gap made the `reference` preset's
 /// iterations on pyramid20 converge several times more slowly, while the spin error of the
 /// middle, gap/(2r), is below 0.5 % of a 10 cm ball's spin under 1 mm.
-pub const WITNESS_LEVER_GAP: f32 = 1e-3;
+pub(crate) const WITNESS_LEVER_GAP: f32 = 1e-3;
 
 struct Assembly<'a> {
     bodies: &'a Bodies,
@@ -133,7 +133,10 @@ struct Assembly<'a> {
 /// `constraints`, with `world_inverse_inertia` per body (indexed by `body_a`, `body_b`): the
 /// tensors assembly had, so the products are those assembly would have computed, to the bit.
 /// For readers of the rows other than the SIMD lanes.
-pub fn complete_products(constraints: &mut [ContactConstraint], world_inverse_inertia: &[Mat3]) {
+pub(crate) fn complete_products(
+    constraints: &mut [ContactConstraint],
+    world_inverse_inertia: &[Mat3],
+) {
     for c in constraints.iter_mut().filter(|c| c.products_pending) {
         let inertia_a = Mat3A::from(world_inverse_inertia[c.body_a as usize]);
         let inertia_b = Mat3A::from(world_inverse_inertia[c.body_b as usize]);
@@ -290,7 +293,7 @@ fn tangent_basis(normal: Vec3, previous: Vec3) -> (Vec3, Vec3) {
 
 /// Scales the impulses carried over from the last step by `fraction` (0 = cold start) and
 /// keeps the friction impulse inside its disc.
-pub fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
+pub(crate) fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
     for c in constraints.iter_mut() {
         c.normal_impulse *= fraction;
         c.tangent_impulses[0] *= fraction;

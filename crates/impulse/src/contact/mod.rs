@@ -13,10 +13,10 @@ pub(crate) mod record;
 pub(crate) mod row;
 pub(crate) mod targets;
 
-pub use assembly::*;
-pub use record::*;
+pub(crate) use assembly::*;
+pub(crate) use record::*;
 pub use row::*;
-pub use targets::*;
+pub(crate) use targets::*;
 
 /// The same items under the path the step's callers name them by
 /// (`contact::constraints::assemble`).

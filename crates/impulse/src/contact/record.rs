@@ -21,7 +21,7 @@ use rayon::prelude::*;
 /// ([`crate::diagnostics::record_velocity_before_and_residual`]).
 ///
 /// `slots` says how rows name their bodies, and so how `linear` and `angular` are indexed.
-pub fn record_velocity_before(
+pub(crate) fn record_velocity_before(
     constraints: &mut [ContactConstraint],
     slots: BodySlots,
     linear: &[Vec3],
@@ -137,7 +137,7 @@ pub(crate) fn record_row(
 }
 
 /// Most parts of [`record_velocity_before`]'s first pass: each costs a per-body array.
-pub const RECORD_PARTS: usize = 4;
+pub(crate) const RECORD_PARTS: usize = 4;
 
 /// Rows per part of [`record_velocity_before`]'s first pass below [`RECORD_PARTS`] parts:
 /// smaller sets of rows are summed in one part, as before the parts existed.
@@ -145,7 +145,7 @@ const RECORD_POINTS_PER_PART: usize = 8192;
 
 /// Which indices of a [`ContactConstraint`] name its bodies in a pass over velocity arrays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BodySlots {
+pub(crate) enum BodySlots {
     /// `body_a` / `body_b`: the world's body arrays.
     World,
     /// `local_a` / `local_b`: one island's local arrays (the immovable slot last, at rest).

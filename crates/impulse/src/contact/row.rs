@@ -298,7 +298,7 @@ pub(super) fn inverse_block([k11, k12, k22]: [f32; 3]) -> [f32; 3] {
 
 /// Projects a friction impulse onto Coulomb's disc of radius `limit` (N·s).
 #[inline(always)]
-pub fn cap_to_disc(impulse: [f32; 2], limit: f32) -> [f32; 2] {
+pub(crate) fn cap_to_disc(impulse: [f32; 2], limit: f32) -> [f32; 2] {
     let squared = impulse[0] * impulse[0] + impulse[1] * impulse[1];
     if squared <= limit * limit {
         impulse

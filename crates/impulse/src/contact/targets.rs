@@ -29,7 +29,7 @@ use crate::settings::{ContactRepair, SolverSettings};
 /// having changed no row's velocity by more than the tolerance, and the caller skips it. At rest
 /// this is the usual case: the repair decays exponentially towards the slop and never quite
 /// reaches it. Without split impulse, returns false.
-pub fn update_targets(
+pub(crate) fn update_targets(
     constraints: &mut [ContactConstraint],
     displacement: &[Vec3],
     rotation: &[Vec3],
@@ -87,12 +87,12 @@ pub fn update_targets(
 /// over the blow-up guard) without one. Touching and overlapping rows keep acting: dropping
 /// them too let darts through the wall; they hold a body where it is pressed, and continuous
 /// collision sweeps its true motion as the step ends.
-pub const SPECULATIVE_TURN: f32 = std::f32::consts::FRAC_PI_4;
+pub(crate) const SPECULATIVE_TURN: f32 = std::f32::consts::FRAC_PI_4;
 
 /// The target (m/s) of a stale speculative row: far below any approach speed (the blow-up guard
 /// stops a body at 10⁴ m/s), so the row's impulse goes to zero, yet small enough that no
 /// solver's products of it overflow.
-pub const STALE_TARGET: f32 = -1.0e15;
+pub(crate) const STALE_TARGET: f32 = -1.0e15;
 
 /// Whether a body's part of a speculative row is stale: the body had turned by more than
 /// [`SPECULATIVE_TURN`] since the step began (`turn`, the square of that angle, rad²) and the
@@ -100,7 +100,7 @@ pub const STALE_TARGET: f32 = -1.0e15;
 /// lever arm along the normal (|r × n| ≤ 10⁻³·|r|) gives n·(Δθ × r) = Δθ·(r × n) ≈ 0 and no
 /// torque: the row does not depend on the body's rotation.
 #[inline]
-pub fn speculative_row_is_stale(turn: f32, angular: Vec3, lever: Vec3) -> bool {
+pub(crate) fn speculative_row_is_stale(turn: f32, angular: Vec3, lever: Vec3) -> bool {
     turn > SPECULATIVE_TURN * SPECULATIVE_TURN
         && angular.length_squared() > 1e-6 * lever.length_squared()
 }
@@ -109,13 +109,13 @@ pub fn speculative_row_is_stale(turn: f32, angular: Vec3, lever: Vec3) -> bool {
 /// With one sweep a substep, a spring at a quarter of the rate (Box2D v3's cap) pumped energy
 /// into resting piles: pyramid20 gained tens of joules, the 400:1 `plate` kept rising; at a
 /// fifth they come to rest (docs/benchmarks.md, "Why the soft step is set this way").
-pub const MAX_SOFT_HERTZ_PER_SUBSTEP_RATE: f32 = 0.2;
+pub(crate) const MAX_SOFT_HERTZ_PER_SUBSTEP_RATE: f32 = 0.2;
 
 /// Soft contact as a damped spring of frequency `hertz` (capped at a fifth of the substep
 /// rate, [`MAX_SOFT_HERTZ_PER_SUBSTEP_RATE`]) and damping ratio ζ, discretised implicitly over
 /// `h` (Catto, "Solver2D" and Box2D v3 `b2MakeSoft`): returns the repair rate (1/s) and (mass
 /// scale, impulse scale).
-pub fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32)) {
+pub(crate) fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32)) {
     let hertz = hertz.min(MAX_SOFT_HERTZ_PER_SUBSTEP_RATE / h);
     let omega = 2.0 * std::f32::consts::PI * hertz;
     let a1 = 2.0 * damping_ratio + h * omega;
@@ -127,7 +127,7 @@ pub fn soft_contact(hertz: f32, damping_ratio: f32, h: f32) -> (f32, (f32, f32))
 /// The repair rate (1/s) and the soft rows' (mass scale, impulse scale) of `repair` for a
 /// substep of `h` seconds: the spring's for soft repair ([`soft_contact`]), the rate with
 /// rigid rows (1, 0) otherwise.
-pub fn repair_terms(repair: &ContactRepair, h: f32) -> (f32, (f32, f32)) {
+pub(crate) fn repair_terms(repair: &ContactRepair, h: f32) -> (f32, (f32, f32)) {
     match *repair {
         ContactRepair::Soft {
             hertz,
@@ -142,7 +142,7 @@ pub fn repair_terms(repair: &ContactRepair, h: f32) -> (f32, (f32, f32)) {
 /// Newton's restitution hypothesis, v⁺ = −c_r·v⁻, for the points that collided this
 /// step: approach speed −v⁻ above the threshold and a normal impulse received. Sets their
 /// targets and returns whether any point bounces; other targets are left as they are.
-pub fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32) -> bool {
+pub(crate) fn restitution_targets(constraints: &mut [ContactConstraint], threshold: f32) -> bool {
     let mut any = false;
     for c in constraints.iter_mut() {
         let approach = c.normal.velocity_before;

@@ -33,7 +33,7 @@ use impulse_lcp::solvers::lemke;
 use impulse_lcp::{Bounds, DenseMatrix, Lcp, Matrix, SolverSettings, Status};
 
 use super::cholesky::{cholesky, cholesky_solve, cholesky_solve_columns};
-pub use super::exact_report::{ExactFailure, ExactReport};
+pub(crate) use super::exact_report::{ExactFailure, ExactReport};
 use super::interface::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, set_scalar_targets,
 };
@@ -44,7 +44,7 @@ use crate::contact::{ContactConstraint, JacobianRow, is_isotropic};
 /// points. A failed solve leaves the rows and velocities as they were and says so in
 /// [`SolveOutcome::exact_failed`]; its iterations are zero and its change is the residual.
 #[derive(Default)]
-pub struct Exact {
+pub(crate) struct Exact {
     /// Work space, kept between solves.
     pub workspace: ExactWorkspace,
     /// Largest island solved; larger ones fail with [`ExactFailure::TooManyRows`].
@@ -98,11 +98,11 @@ impl ContactSolver for Exact {
 /// active row's velocity off by ε·A_ii·γ_i, which under a 100 t box on a 1 t box was 4e-6 m/s,
 /// while the proximal one vanishes as the rounds settle, and among the many load splits of
 /// redundant contacts it keeps the one closest to the entry impulses.
-pub const REGULARISATION: f64 = 1e-6;
+pub(crate) const REGULARISATION: f64 = 1e-6;
 
 /// Most rounds (normal LCP + friction passes) per solve. Frictionless islands need one, unless
 /// it changed a velocity by more than 1 m/s (see [`REGULARISATION`]).
-pub const MAX_ROUNDS: u32 = 4;
+pub(crate) const MAX_ROUNDS: u32 = 4;
 
 /// Symmetric Gauss-Seidel passes over the friction pairs per round.
 const FRICTION_PASSES: u32 = 4;
@@ -126,7 +126,7 @@ const MIN_PIVOTS: usize = 16;
 
 /// Buffers reused between calls: the dense blocks and the trial impulses and velocities.
 #[derive(Default)]
-pub struct ExactWorkspace {
+pub(crate) struct ExactWorkspace {
     /// A = J M⁻¹ Jᵀ over the island's rows (normals, then tangent pairs), row-major (1/kg).
     full: Vec<f64>,
     /// Per row of `full`: (point, 0 for the normal or 1, 2 for a tangent).
@@ -199,7 +199,7 @@ pub struct ExactWorkspace {
 /// residual and 1e-6 m/s (friction rounds that did not settle).
 ///
 /// Panics if a local index is outside `velocities`, as the iterative solvers do.
-pub fn solve_exact(
+pub(crate) fn solve_exact(
     constraints: &mut [ContactConstraint],
     velocities: &mut Velocities<'_>,
     max_rows: usize,

@@ -5,7 +5,7 @@ use impulse_lcp::{SolveError, Status};
 
 /// What a successful exact solve did.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ExactReport {
+pub(crate) struct ExactReport {
     /// Lemke pivots, summed over the rounds.
     pub pivots: u32,
     /// Rounds run (normal LCP solves), 1 ..= [`MAX_ROUNDS`](super::exact::MAX_ROUNDS); 0 for an island without contacts.
@@ -20,7 +20,7 @@ pub struct ExactReport {
 
 /// Why the exact path gave up; the constraints and velocities are then as they were on entry.
 #[derive(Clone, Debug, thiserror::Error)]
-pub enum ExactFailure {
+pub(crate) enum ExactFailure {
     /// The island has more normal rows (contact points) than the caller allows.
     #[error("{rows} contact rows exceed the exact path's limit of {max_rows}")]
     TooManyRows {

@@ -19,7 +19,7 @@ use crate::settings::SolverSettings;
 /// The rows live in the island's `constraints`: a method that solves a copy of them in another
 /// layout (the SIMD lanes of [`lanes`]) makes it in `prepare` and writes the impulses back in
 /// `finish`; the scalar methods work on the constraints themselves.
-pub trait ContactSolver {
+pub(crate) trait ContactSolver {
     /// Readies the step's solves on the island's `constraints`, whose body slots are below
     /// `slots` (`slots − 1` the immovable one); `inverse_inertia` holds each slot's world
     /// inverse inertia as assembly used it (1/(kg·m²); zero for the immovable slot), from which
@@ -71,7 +71,7 @@ pub trait ContactSolver {
 
 /// What one [`ContactSolver::solve`] is asked to do.
 #[derive(Clone, Copy)]
-pub struct SolvePass<'a> {
+pub(crate) struct SolvePass<'a> {
     /// Most iterations (sweeps).
     pub iterations: u32,
     /// Early exit: largest row velocity change of an iteration (m/s).
@@ -98,7 +98,7 @@ pub struct SolvePass<'a> {
 /// the step began (m, rad; the immovable slot zero), the settings and the substep `h` (s), and
 /// whether this is the main solve, with overlap repair, or the relax solve.
 #[derive(Clone, Copy)]
-pub struct TargetInputs<'a> {
+pub(crate) struct TargetInputs<'a> {
     /// Per slot, displacement of the centre of mass (m).
     pub displacement: &'a [Vec3],
     /// Per slot, rotation vector (rad).
@@ -117,7 +117,7 @@ pub struct TargetInputs<'a> {
 
 /// What one [`ContactSolver::solve`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SolveOutcome {
+pub(crate) struct SolveOutcome {
     /// Iterations and the last one's largest change (for an exact solve, its residual).
     pub report: SolveReport,
     /// The strongest method the solve used.
@@ -134,7 +134,7 @@ pub struct SolveOutcome {
 
 impl SolveOutcome {
     /// An outcome of `level` that is `report` alone.
-    pub fn of(level: EscalationLevel, report: SolveReport) -> Self {
+    pub(crate) fn of(level: EscalationLevel, report: SolveReport) -> Self {
         Self {
             report,
             level,

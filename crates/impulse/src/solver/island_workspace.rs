@@ -19,7 +19,7 @@ use crate::{contact, integrate, solver::Sweep};
 
 /// Local state of one island during a step.
 #[derive(Default)]
-pub struct IslandWorkspace {
+pub(crate) struct IslandWorkspace {
     /// Linear velocities (m/s) of the island's bodies, then its guests (kinematic bodies),
     /// then the immovable slot.
     pub linear: Vec<Vec3>,

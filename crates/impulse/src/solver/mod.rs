@@ -23,24 +23,24 @@
 //! - [`substep`]: one island's step (substeps, warm start, solves, relax, restitution), which
 //!   picks the method and calls it through the interface.
 
-pub use crate::contact::cap_to_disc;
+pub(crate) use crate::contact::cap_to_disc;
 
-pub mod apgd;
-pub mod cholesky;
-pub mod exact;
-pub mod exact_report;
-pub mod heavy_on_light;
-pub mod impact;
-pub mod interface;
-pub mod island_report;
-pub mod island_workspace;
-pub mod lanes;
-pub mod nncg;
-pub mod pgs;
-pub mod policy;
-pub mod position;
-pub mod rows;
-pub mod substep;
+pub(crate) mod apgd;
+pub(crate) mod cholesky;
+pub(crate) mod exact;
+pub(crate) mod exact_report;
+pub(crate) mod heavy_on_light;
+pub(crate) mod impact;
+pub(crate) mod interface;
+pub(crate) mod island_report;
+pub(crate) mod island_workspace;
+pub(crate) mod lanes;
+pub(crate) mod nncg;
+pub(crate) mod pgs;
+pub(crate) mod policy;
+pub(crate) mod position;
+pub(crate) mod rows;
+pub(crate) mod substep;
 
 pub use heavy_on_light::{HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight};
 pub use interface::*;
@@ -49,6 +49,6 @@ pub use island_report::IslandReport;
 #[cfg(any(test, feature = "internals"))]
 pub use rows::Velocities;
 #[cfg(test)]
-pub use rows::project_to_friction_disc;
+pub(crate) use rows::project_to_friction_disc;
 #[cfg(feature = "internals")]
 pub use rows::warm_start;

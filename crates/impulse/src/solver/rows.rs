@@ -62,7 +62,7 @@ pub fn warm_start(constraints: &[ContactConstraint], velocities: &mut Velocities
 /// With K = U diag(k) Uᵀ, λ(ν) = (K + νI)⁻¹ K q and ‖λ(ν)‖ = limit is found by Newton's method
 /// on 1/‖λ(ν)‖ (Moré and Sorensen's trust-region iteration), which converges in a few steps.
 #[inline(always)]
-pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f32; 2] {
+pub(crate) fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f32; 2] {
     let squared = q[0] * q[0] + q[1] * q[1];
     if squared <= limit * limit {
         return q;
@@ -98,7 +98,7 @@ pub fn project_to_friction_disc(q: [f32; 2], block: [f32; 3], limit: f32) -> [f3
 /// (k₁₁, k₁₂, k₂₂) in 1/kg, with k₁ ≥ k₂ and u₂ = u₁ rotated by +90°: what
 /// [`project_to_friction_disc`] works in.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TangentEigen {
+pub(crate) struct TangentEigen {
     /// Larger eigenvalue (1/kg).
     pub k1: f32,
     /// Smaller eigenvalue (1/kg).
@@ -111,7 +111,7 @@ impl TangentEigen {
     /// The decomposition of `block`; `None` when K is not positive definite (k₂ ≤ 0 or NaN:
     /// an immovable pair), where the projection falls back to the radial cap.
     #[inline(always)]
-    pub fn of(block: [f32; 3]) -> Option<Self> {
+    pub(crate) fn of(block: [f32; 3]) -> Option<Self> {
         let [a, b, d] = block;
         let half_trace = 0.5 * (a + d);
         let radius = (0.25 * (a - d) * (a - d) + b * b).sqrt();

@@ -14,7 +14,7 @@ use super::heavy_on_light::{HeavyOnLight, heavy_on_light, heavy_on_light_setting
 use super::interface::Sweep;
 use super::interface::{ContactSolver, SolveOutcome, SolvePass, TargetInputs};
 use super::island_report::IslandReport;
-pub use super::island_workspace::IslandWorkspace;
+pub(crate) use super::island_workspace::IslandWorkspace;
 use super::pgs::colour_constraints;
 use super::policy::EscalationLimits;
 use super::position;
@@ -157,7 +157,7 @@ impl IslandWorkspace {
 }
 
 /// Everything an island's step reads besides its own bodies and constraints.
-pub struct StepContext<'a> {
+pub(crate) struct StepContext<'a> {
     /// All bodies (read only).
     pub bodies: &'a Bodies,
     /// Gravity (m/s²).
@@ -192,7 +192,7 @@ pub struct StepContext<'a> {
 /// impulse changes (their inverse mass and inertia are zero) and no gravity or force
 /// touches; their displacement is integrated with the island's so that the contacts'
 /// separations follow their motion. They are not written back.
-pub fn step_island(
+pub(crate) fn step_island(
     island_bodies: &[u32],
     guests: &[u32],
     constraints: &mut [ContactConstraint],
@@ -750,7 +750,7 @@ impl IslandWorkspace {
 }
 
 /// Writes an island's velocities and poses back into the bodies.
-pub fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut Bodies) {
+pub(crate) fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut Bodies) {
     for (k, &i) in island_bodies.iter().enumerate() {
         let i = i as usize;
         scatter_body(
@@ -767,7 +767,7 @@ pub fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut 
 /// Writes the body at local index `k` of `workspace`'s island back: its velocities and its
 /// pose (the centre of mass moved by the island's displacement, at its new orientation).
 #[inline]
-pub fn scatter_body(
+pub(crate) fn scatter_body(
     workspace: &IslandWorkspace,
     k: usize,
     local_center_of_mass: Vec3,

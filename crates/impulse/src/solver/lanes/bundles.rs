@@ -10,7 +10,7 @@ use crate::solver::interface::RowsReport;
 /// An island's contact points packed in bundles, manifold group by manifold group, colour by
 /// colour.
 #[derive(Default)]
-pub struct Bundles {
+pub(crate) struct Bundles {
     pub(super) bundles: Vec<Bundle>,
     pub(super) geometry: Vec<BundleGeometry>,
     /// Per bundle, the impulses (normal, tangent 1, tangent 2) of the substeps so far, lane by
@@ -59,7 +59,7 @@ pub struct Bundles {
 
 impl Bundles {
     /// Whether [`Bundles::pack`] was asked to spread colours over rayon's threads.
-    pub fn parallel(&self) -> bool {
+    pub(crate) fn parallel(&self) -> bool {
         self.parallel
     }
 }

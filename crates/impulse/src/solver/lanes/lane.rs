@@ -12,7 +12,7 @@ use glam::Vec3;
 /// hold independent manifold groups of one colour), so results differ only where padding and
 /// the colouring's overflow groups fall differently.
 #[cfg(not(feature = "lanes8"))]
-pub const LANES: usize = 4;
+pub(super) const LANES: usize = 4;
 /// See the 4-lane constant.
 #[cfg(feature = "lanes8")]
 pub const LANES: usize = 8;

@@ -50,7 +50,7 @@ mod solve;
 mod sweep;
 mod targets;
 
-pub use bundles::Bundles;
+pub(crate) use bundles::Bundles;
 
 #[cfg(test)]
 mod tests;

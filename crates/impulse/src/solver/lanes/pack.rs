@@ -10,8 +10,8 @@ use super::layout::{Bundle, BundleGeometry, GROUP_POINTS, Group, PointKey, set_l
 use super::products::compute_products;
 use crate::contact::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours};
-use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{PARALLEL_PACK_POINTS, SharedItems, spread, threads};
+use crate::simd::{InstructionSet, on_instruction_set};
 use crate::solver::interface::RowsReport;
 
 impl Bundles {
@@ -41,7 +41,7 @@ impl Bundles {
     /// get them here, four lanes at a time, from their lever arms and directions and the world
     /// inverse inertia of their bodies' slots (`inverse_inertia`, one per slot), in the order
     /// of operations of the scalar assembly, so to the same bits.
-    pub fn pack(
+    pub(crate) fn pack(
         &mut self,
         constraints: &[ContactConstraint],
         slots: usize,
@@ -305,7 +305,7 @@ impl Bundles {
     /// natural-map residual and friction rows ([`Bundles::take_rows`]): over the points in
     /// constraint order, in runs of the same length and added in the same order as
     /// `diagnostics::record_velocity_before_and_residual`, so the residual is its to the bit.
-    pub fn unpack(&mut self, constraints: &mut [ContactConstraint]) {
+    pub(crate) fn unpack(&mut self, constraints: &mut [ContactConstraint]) {
         let (bundles, totals, records) = (&self.bundles, &self.step_totals, &self.records);
         let recorded = self.recorded;
         // Writes one point back; returns its rows' φ² (0 unless recorded).

@@ -7,8 +7,8 @@ use glam::Mat3;
 
 use super::lane::{LANES, Lane, LaneVec, cross, dot, lane_vec};
 use super::layout::{Bundle, BundleGeometry, Group, RowLanes};
-use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{GROUPS_PER_TASK, SharedItems};
+use crate::simd::{InstructionSet, on_instruction_set};
 
 /// The pending lever-arm products of [`Bundles::pack`](super::Bundles::pack) for the
 /// lane groups `groups` of `bundles` and their `geometry`, lane group by lane group (the

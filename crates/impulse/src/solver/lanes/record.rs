@@ -8,8 +8,8 @@ use glam::Vec3;
 use super::bundles::Bundles;
 use super::lane::{LANES, cap_to_disc};
 use super::layout::{BodyLanes, Bundle, BundleRecord, Group};
-use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{PARALLEL_PACK_POINTS, SharedItems, spread};
+use crate::simd::{InstructionSet, on_instruction_set};
 use crate::solver::interface::RowsReport;
 
 impl Bundles {
@@ -25,7 +25,7 @@ impl Bundles {
     /// gravity, forces, damping and gyroscopic term are in. From there to the step's end
     /// the velocities change by the impulses alone: the warm start's γ of the substep before
     /// and the sweeps' changes to it, M⁻¹Jᵀγ with γ the final impulses.
-    pub fn keep_velocities_before(&mut self, linear: &[Vec3], angular: &[Vec3]) {
+    pub(crate) fn keep_velocities_before(&mut self, linear: &[Vec3], angular: &[Vec3]) {
         self.before_linear.clear();
         self.before_linear.extend_from_slice(linear);
         self.before_angular.clear();
@@ -48,7 +48,7 @@ impl Bundles {
     /// for the rows); here one pass reads the bundles. The residual is the same to the bit
     /// (it reads v and γ alone); J·v* may differ in its last bits, v* being the velocities
     /// before the impulses rather than the final ones less M⁻¹Jᵀγ.
-    pub fn record(&mut self, linear: &[Vec3], angular: &[Vec3]) {
+    pub(crate) fn record(&mut self, linear: &[Vec3], angular: &[Vec3]) {
         if !std::mem::take(&mut self.before_kept) {
             debug_assert!(
                 false,

@@ -9,10 +9,10 @@ use super::layout::{Bundle, Group, SharedLanes};
 use super::sweep::BundleUpdate;
 use super::targets::SetTargets;
 use crate::graph::COLOURS;
-use crate::instruction_set::{InstructionSet, on_instruction_set};
 use crate::parallel::{
     GROUPS_PER_TASK, SharedItems, SharedVelocities, colour_after_colour, prefetch_bytes, spread,
 };
+use crate::simd::{InstructionSet, on_instruction_set};
 use crate::solver::rows::Velocities;
 
 impl Bundles {

@@ -25,7 +25,7 @@ impl Bundles {
     /// they depend on the bodies' displacements only, which a sweep does not change, so the
     /// result is the same as a separate pass over the bundles first, which would read and
     /// write a third of the bytes of a sweep, twice a substep.
-    pub fn solve_pgs(
+    pub(crate) fn solve_pgs(
         &mut self,
         velocities: &mut Velocities<'_>,
         pass: &SolvePass<'_>,
