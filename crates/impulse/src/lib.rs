@@ -41,14 +41,12 @@
 mod body;
 mod collision;
 mod contact;
-mod continuous;
 mod diagnostics;
 mod error;
 mod graph;
 mod instruction_set;
 mod integrate;
 mod island;
-mod kinematic;
 mod parallel;
 mod settings;
 mod solver;

@@ -14,20 +14,18 @@ use crate::diagnostics::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms};
 use crate::error::WorldError;
 use crate::island::Islands;
-use crate::kinematic::Script;
 use crate::scene::{BodyDesc, Material, MaterialRef, Scene, ShapeDesc};
 use crate::settings::SolverSettings;
 use crate::solver::substep::IslandWorkspace;
 
 mod bodies;
 mod contacts;
-mod continuous;
-mod kinematic;
 mod query;
 mod snapshot;
 mod step;
 
 use step::EnergyCheck;
+use step::kinematic::Script;
 
 pub use bodies::BodyRef;
 pub use contacts::{ContactEvent, ContactPairView, ContactPoint};

@@ -1,4 +1,4 @@
-//! Continuous collision (motion clamping): a dynamic body that moved more than a fraction of
+//! The continuous stage ([`crate::Stage::Continuous`]), continuous collision (motion clamping): a dynamic body that moved more than a fraction of
 //! its own size in a step is swept from its pose at the step's start to its pose at the end
 //! against the static and kinematic bodies in its swept box, with Parry's nonlinear shape
 //! cast (translation and rotation); if it would pass one, its pose is put back to the first
@@ -26,34 +26,37 @@ use parry3d::math::Pose;
 use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, distance};
 use parry3d::shape::{Ball, Cuboid, HalfSpace, HeightField, Shape, Triangle};
 
-use crate::kinematic::rotation_vector;
+use super::kinematic::rotation_vector;
+use crate::World;
+use crate::body::BodyKind;
+use crate::settings::SolverSettings;
 
 /// A body is swept when it moved more than this fraction of its smallest half extent in a
 /// step (Box2D v3's safety factor: a slower body cannot pass through anything the contacts
 /// see, and needs no sweep).
-pub const FAST_FRACTION: f32 = 0.5;
+pub(crate) const FAST_FRACTION: f32 = 0.5;
 
 /// The gap (m) a clamped body is left short of the surface it would hit, at most (Box2D's
 /// linear slop), and at most this fraction of its smallest half extent for small bodies.
-pub const CLAMP_GAP: f32 = 0.005;
+pub(crate) const CLAMP_GAP: f32 = 0.005;
 
 /// Radius of the core sphere of a body that starts the step touching a surface, as a fraction
 /// of its smallest half extent (Box2D v3.1 uses a quarter of the shape's minimum extent).
-pub const CORE_FRACTION: f32 = 0.25;
+pub(crate) const CORE_FRACTION: f32 = 0.25;
 
 /// One body's motion over a step: from `start` to `end` (body frames), about its centre of
 /// mass at `local_center_of_mass`, turning by the rotation vector `turn`.
 #[derive(Clone, Copy, Debug)]
-pub struct Sweep {
+pub(crate) struct Sweep {
     /// Pose at the step's start.
-    pub start: Pose,
+    pub(crate) start: Pose,
     /// Pose at the step's end.
-    pub end: Pose,
+    pub(crate) end: Pose,
     /// Centre of mass in the body frame (m).
-    pub local_center_of_mass: Vec3,
+    pub(crate) local_center_of_mass: Vec3,
     /// Rotation vector of the turn from `start` to `end` (rad, world frame): see
     /// [`Sweep::new`].
-    pub turn: Vec3,
+    pub(crate) turn: Vec3,
 }
 
 impl Sweep {
@@ -63,7 +66,7 @@ impl Sweep {
     /// turns that brings it closest to `spin`: the same end orientation, but a body spinning by
     /// more than half a turn a step (a dart that hit a wall at 200 m/s spins at over 1,000
     /// rad/s, 20 rad a step at 60 Hz) is swept round the way it turned, not the short way back.
-    pub fn new(start: Pose, end: Pose, local_center_of_mass: Vec3, spin: Vec3) -> Self {
+    pub(crate) fn new(start: Pose, end: Pose, local_center_of_mass: Vec3, spin: Vec3) -> Self {
         let shortest = rotation_vector(start.rotation, end.rotation);
         let angle = shortest.length();
         let turn = if angle > 0.0 {
@@ -87,7 +90,7 @@ impl Sweep {
     /// The motion as Parry's [`NonlinearRigidMotion`] over the time interval [0, 1]: the centre
     /// of mass moving at constant velocity and the body turning at constant angular velocity
     /// (`turn`) about it.
-    pub fn motion(&self) -> NonlinearRigidMotion {
+    pub(crate) fn motion(&self) -> NonlinearRigidMotion {
         let com = self.local_center_of_mass;
         NonlinearRigidMotion::new(
             self.start,
@@ -98,13 +101,13 @@ impl Sweep {
     }
 
     /// The pose at fraction `t` ∈ [0, 1] of the step along [`Sweep::motion`].
-    pub fn pose_at(&self, t: f32) -> Pose {
+    pub(crate) fn pose_at(&self, t: f32) -> Pose {
         self.motion().position_at_time(t)
     }
 
     /// A bound on how far (m) any point within `radius` of the centre of mass moves along the
     /// sweep: the centre's travel plus the turned angle times `radius`.
-    pub fn travel(&self, radius: f32) -> f32 {
+    pub(crate) fn travel(&self, radius: f32) -> f32 {
         let com = self.local_center_of_mass;
         (self.end.transform_point(com) - self.start.transform_point(com)).length()
             + self.turn.length() * radius
@@ -139,7 +142,7 @@ impl Sweep {
 /// With x = sin(θ/2) of the shortest turn θ, θ = 2·asin(x) ≤ π·x; below those limits the
 /// sweep's turn is the shortest one (|spin·axis − θ| < π gives no whole turn), so the travel
 /// is at most the centre's travel plus π·x·`radius`.
-pub fn travel_bound(
+pub(crate) fn travel_bound(
     start: &Pose,
     end: &Pose,
     local_center_of_mass: Vec3,
@@ -160,17 +163,17 @@ pub fn travel_bound(
 
 /// What the sweep needs to know of the fast body's shape.
 #[derive(Clone, Copy)]
-pub struct FastBody<'a> {
+pub(crate) struct FastBody<'a> {
     /// Its shape (body frame).
-    pub shape: &'a dyn Shape,
+    pub(crate) shape: &'a dyn Shape,
     /// Its motion over the step.
-    pub sweep: Sweep,
+    pub(crate) sweep: Sweep,
     /// Its smallest half extent (m): the core sphere's and the gap's scale.
-    pub min_half_extent: f32,
+    pub(crate) min_half_extent: f32,
     /// A bound on how far any of its points moves in the step (m), > 0.
-    pub travel: f32,
+    pub(crate) travel: f32,
     /// The farthest any of its points lies from its centre of mass (m).
-    pub radius: f32,
+    pub(crate) radius: f32,
 }
 
 impl FastBody<'_> {
@@ -201,7 +204,7 @@ impl FastBody<'_> {
 /// when the motion needs no clamp ([`clamp_fraction_castable`]). A half-space is swept as the
 /// box of it that the body can reach ([`half_space_slab`]), a height field as its triangles
 /// under the body's path ([`height_field_triangles`]); every other shape as it is.
-pub fn clamp_fraction(
+pub(crate) fn clamp_fraction(
     body: &FastBody<'_>,
     target: &dyn Shape,
     target_sweep: &Sweep,
@@ -231,7 +234,7 @@ pub fn clamp_fraction(
 /// set, so a body that stays in `region` meets the one where it meets the other. `None` when
 /// the ball lies wholly above the plane (nothing there to meet). Returns the box and its pose
 /// in the half-space's frame.
-pub fn half_space_slab(normal: Vec3, region: &Aabb) -> Option<(Cuboid, Pose)> {
+pub(crate) fn half_space_slab(normal: Vec3, region: &Aabb) -> Option<(Cuboid, Pose)> {
     let center = region.center();
     let reach = region.half_extents().length();
     let height = normal.dot(center);
@@ -254,7 +257,7 @@ const MAX_PATH_SLICES: usize = 64;
 /// in the boxes of [`FastBody::region_in`] over slices of the step short enough that each box
 /// hugs the path (about the body's diameter of travel each, at most [`MAX_PATH_SLICES`]), each
 /// triangle once.
-pub fn height_field_triangles(
+pub(crate) fn height_field_triangles(
     body: &FastBody<'_>,
     height_field: &HeightField,
     target_sweep: &Sweep,
@@ -285,7 +288,7 @@ pub fn height_field_triangles(
 /// only a body driven through the target is stopped, and a body sliding or spinning along it
 /// is not held at its start pose step after step. Shape pairs Parry cannot cast are not
 /// clamped.
-pub fn clamp_fraction_castable(
+pub(crate) fn clamp_fraction_castable(
     body: &FastBody<'_>,
     target: &dyn Shape,
     target_sweep: &Sweep,
@@ -336,6 +339,119 @@ pub fn clamp_fraction_castable(
     } else {
         0.0
     })
+}
+
+impl World {
+    /// Keeps the step's start poses for the sweep (when continuous collision is on).
+    pub(super) fn record_start_poses(&mut self, settings: &SolverSettings) {
+        if settings.continuous {
+            self.start_poses.clone_from(&self.bodies.pose);
+        } else {
+            self.start_poses.clear();
+        }
+    }
+
+    /// Sweeps every awake dynamic body that moved more than [`FAST_FRACTION`] of its smallest
+    /// half extent this step against the static and kinematic bodies in its swept box (the
+    /// broad phase's tree, and the moving kinematic bodies), and puts it back to the earliest
+    /// clamp ([`clamp_fraction`]) with the velocity gravity had given it by then. Each body's clamp reads only its own poses and
+    /// the static and kinematic bodies', which no clamp changes, so the order does not matter.
+    pub(super) fn continuous_stage(&mut self, settings: &SolverSettings) {
+        if settings.continuous {
+            // The poses before any clamp, for the energy check's credit (`credit_clamps`).
+            self.unclamped_poses.clone_from(&self.bodies.pose);
+        }
+        let n = self.bodies.len();
+        if !settings.continuous || self.start_poses.len() != n {
+            return;
+        }
+        let mut clamps = std::mem::take(&mut self.clamps);
+        clamps.clear();
+        let b = &self.bodies;
+        for i in 0..n {
+            if !b.is_dynamic(i) || b.asleep[i] || b.pose[i] == self.start_poses[i] {
+                continue;
+            }
+            let (start, end) = (self.start_poses[i], b.pose[i]);
+            let (center_of_mass, spin) =
+                (b.local_center_of_mass[i], b.angular_velocity[i] * self.dt);
+            let shape = &*b.shape[i];
+            let local = shape.compute_local_aabb();
+            let half = local.half_extents();
+            let min_half_extent = half.min_element();
+            let radius = (local.center() - center_of_mass).length() + half.length();
+            // Most bodies are slow: a cheap bound settles them before the sweep's trigonometry.
+            let limit = FAST_FRACTION * min_half_extent;
+            if travel_bound(&start, &end, center_of_mass, spin, radius)
+                .is_some_and(|bound| bound <= limit)
+            {
+                continue;
+            }
+            let sweep = Sweep::new(start, end, center_of_mass, spin);
+            let travel = sweep.travel(radius);
+            if !travel.is_finite() || travel <= limit {
+                continue;
+            }
+            let body = FastBody {
+                shape,
+                sweep,
+                min_half_extent,
+                travel,
+                radius,
+            };
+            let swept = shape.compute_swept_aabb(&sweep.start, &sweep.end);
+            let mut earliest = 1.0f32;
+            let mut visit = |j: usize| {
+                if j == i || !b.groups_interact(i, j) {
+                    return;
+                }
+                let target = Sweep::new(
+                    self.start_poses[j],
+                    b.pose[j],
+                    b.local_center_of_mass[j],
+                    b.angular_velocity[j] * self.dt,
+                );
+                let in_contact = self.narrow_phase.has_points(i as u32, j as u32);
+                if let Some(t) = clamp_fraction(&body, &*b.shape[j], &target, in_contact) {
+                    earliest = earliest.min(t);
+                }
+            };
+            // Static bodies and resting kinematic ones from the tree (their boxes there are
+            // where they are); moving kinematic bodies from their own swept boxes.
+            for j in self.broad_phase.bodies_in(&swept) {
+                let j = j as usize;
+                if j < n
+                    && (b.kind[j] == BodyKind::Static
+                        || (b.kind[j] == BodyKind::Kinematic && b.asleep[j]))
+                {
+                    visit(j);
+                }
+            }
+            for &j in &self.moving_kinematic {
+                let j = j as usize;
+                if b.shape[j]
+                    .compute_swept_aabb(&self.start_poses[j], &b.pose[j])
+                    .intersects(&swept)
+                {
+                    visit(j);
+                }
+            }
+            if earliest < 1.0 {
+                clamps.push((i, sweep.pose_at(earliest), earliest));
+            }
+        }
+        // A clamped body stands where it was at fraction t of the step, so it takes the
+        // velocity gravity had given it by then: with the whole step's, the potential energy
+        // of the (1 − t)·dt it did not travel would come back as kinetic energy
+        // (|v·g|·(1 − t)·dt per kg, 80 J/kg for a ball falling at 500 m/s at 60 Hz).
+        let gravity = self.gravity * self.dt;
+        for &(i, pose, t) in &clamps {
+            self.bodies.pose[i] = pose;
+            let unspent = self.bodies.locked_axes[i].lock_linear_velocity(gravity * (1.0 - t));
+            self.bodies.linear_velocity[i] -= unspent;
+        }
+        self.clamps = clamps;
+    }
 }
 
 #[cfg(test)]
