@@ -268,8 +268,8 @@ fn row_squared_natural_map(
 /// The results are those of the three passes to the bit (the residual's partial sums are
 /// taken over the same runs of rows and added in the same order) on any thread count.
 ///
-/// Why: each pass read every 376-byte row; a pile's rows outgrow the caches (pyramid100: 22
-/// MB), so the passes waited on memory, and the friction count ran on one thread.
+/// Why: each pass reads every row, and a pile's rows outgrow the caches, so separate passes
+/// would wait on memory three times (and the friction count would run on one thread).
 pub fn record_velocity_before_and_residual(
     constraints: &mut [ContactConstraint],
     slots: BodySlots,

@@ -1,4 +1,4 @@
-//! One island's step (stages 1, 5 and 6 on one island): per substep, gravity and the
+//! One island's part of the solve stage ([`crate::Stage::Solve`]): per substep, gravity and the
 //! gyroscopic term, warm start, the
 //! solve with overlap repair, position integration and the relax solve; then the restitution
 //! solve. The method is picked here, per island, and called through [`ContactSolver`].
@@ -24,8 +24,8 @@ use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
 use crate::settings::{ContactRepair, ImpactModel, SolverMethod, SolverSettings};
 
-/// What the solver did on one island during a step (step 7 of docs/architecture.md: every step can say how
-/// well its LCP was solved, here per island).
+/// What the solver did on one island during a step: every step can say how well its LCP was
+/// solved, here per island.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct IslandReport {
     /// Smallest body index in the island: a stable name for it within the step.
@@ -352,7 +352,7 @@ pub struct StepContext<'a> {
     pub forces: bool,
 }
 
-/// Runs stages 1, 5 and 6 of one step on one island: per substep of h = dt/substeps, gravity,
+/// Runs one island's part of the solve stage ([`crate::Stage::Solve`]): per substep of h = dt/substeps, gravity,
 /// warm start, the solve with overlap repair, position integration, and the relax solve; then
 /// the restitution solve. Results stay in `workspace` until [`scatter`]. The rows' J·v*
 /// (`velocity_before`) and the residual are recorded here when the SIMD lanes solved the
