@@ -485,7 +485,10 @@ pub(crate) fn prefetch_bytes<T>(start: *const T, bytes: usize) {
 
 #[cfg(test)]
 mod tests {
-    use super::{COLOURS, colour_after_colour};
+    use super::{
+        COLOURS, all_in_chunks, colour_after_colour, find_first, for_each_indexed,
+        for_each_of_three, for_each_with_rows, indices_where, map_into,
+    };
     use proptest::prelude::*;
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicU64, Ordering};
@@ -580,6 +583,116 @@ mod tests {
             let (items, count) = pool.install(|| visit(&sizes, forward, min_chunk));
             check(&sizes, forward, &items, count);
         }
+    }
+
+    /// Items and their runs of rows, `gaps[k]` rows skipped before item k's `lens[k]`.
+    fn ranges(gaps: &[usize], lens: &[usize]) -> Vec<std::ops::Range<usize>> {
+        let mut start = 0;
+        gaps.iter()
+            .zip(lens)
+            .map(|(&gap, &len)| {
+                let range = start + gap..start + gap + len;
+                start = range.end;
+                range
+            })
+            .collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Each item gets exactly its own rows, once, with or without threads; rows outside
+        /// every range are left alone.
+        #[test]
+        fn each_item_gets_its_own_rows(
+            runs in proptest::collection::vec((0usize..3, 0usize..9), 0..40),
+            parallel in any::<bool>(),
+            threads in 1usize..4,
+        ) {
+            let (gaps, lens): (Vec<usize>, Vec<usize>) = runs.into_iter().unzip();
+            let ranges = ranges(&gaps, &lens);
+            let total = ranges.last().map_or(0, |r| r.end) + 2;
+            let mut rows = vec![usize::MAX; total];
+            let mut items = vec![0usize; ranges.len()];
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                for_each_with_rows(parallel, &mut items, &mut rows, |k| ranges[k].clone(), 2, |k, item, mine| {
+                    *item = mine.len();
+                    mine.iter_mut().for_each(|row| {
+                        assert_eq!(*row, usize::MAX, "a row given twice");
+                        *row = k;
+                    });
+                })
+            });
+            for (k, range) in ranges.iter().enumerate() {
+                prop_assert_eq!(items[k], range.len());
+                prop_assert!(rows[range.clone()].iter().all(|&row| row == k));
+            }
+            let covered: usize = ranges.iter().map(|r| r.len()).sum();
+            prop_assert_eq!(rows.iter().filter(|&&row| row == usize::MAX).count(), total - covered);
+        }
+
+        /// The other helpers give what their serial loops give, on one to three threads.
+        #[test]
+        fn helpers_match_their_serial_loops(
+            values in proptest::collection::vec(0u32..100, 0..3000),
+            threads in 1usize..4,
+        ) {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let n = values.len();
+            let test = |i: usize| values[i] % 7 == 3;
+            pool.install(|| {
+                for parallel in [false, true] {
+                    assert_eq!(find_first(parallel, n, 16, test), (0..n).find(|&i| test(i)));
+                    assert_eq!(
+                        indices_where(parallel, n, test),
+                        (0..n).filter(|&i| test(i)).collect::<Vec<_>>()
+                    );
+                    let mut out = vec![7u64];
+                    map_into(parallel, n, 16, |i| u64::from(values[i]) * 3, &mut out);
+                    assert_eq!(out, values.iter().map(|&v| u64::from(v) * 3).collect::<Vec<_>>());
+                    let mut items = values.clone();
+                    for_each_indexed(parallel, &mut items, 16, |i, v| *v += i as u32);
+                    assert!(items.iter().enumerate().all(|(i, &v)| v == values[i] + i as u32));
+                    let (mut a, mut b, mut c) = (values.clone(), vec![0usize; n], vec![0u8; n]);
+                    for_each_of_three(parallel, (&mut a, &mut b, &mut c), 16, |i, a, b, c| {
+                        *a += 1;
+                        *b = i;
+                        *c = 1;
+                    });
+                    assert!((0..n).all(|i| a[i] == values[i] + 1 && b[i] == i && c[i] == 1));
+                    let mut items = values.clone();
+                    let small = |first: usize, chunk: &mut [u32]| {
+                        // `first` places the chunk: its items are the values from there.
+                        chunk
+                            .iter()
+                            .enumerate()
+                            .all(|(k, &v)| v == values[first + k] && v < 99)
+                    };
+                    assert_eq!(
+                        all_in_chunks(parallel, &mut items, 64, small),
+                        values.iter().all(|&v| v < 99)
+                    );
+                }
+            });
+        }
+    }
+
+    /// Ranges that overlap are refused before any item runs.
+    #[test]
+    #[should_panic(expected = "row ranges out of order")]
+    fn overlapping_ranges_are_refused() {
+        let mut rows = [0u8; 8];
+        let mut items = [0u8; 2];
+        let ranges = [0..4, 3..6];
+        for_each_with_rows(
+            true,
+            &mut items,
+            &mut rows,
+            |k| ranges[k].clone(),
+            1,
+            |_, _, _| {},
+        );
     }
 
     /// Sweeps started from inside other rayon jobs (as island jobs start theirs) all end, each
