@@ -25,7 +25,7 @@ mod snapshot;
 mod step;
 
 use step::EnergyCheck;
-use step::kinematic::Script;
+use step::kinematic_script::Script;
 
 pub use bodies::BodyRef;
 pub use contacts::{ContactEvent, ContactPairView, ContactPoint};
@@ -33,20 +33,7 @@ pub use query::{RayHit, ShapeHit};
 pub use snapshot::{SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
 
 pub use crate::settings::BLOW_UP_DISTANCE;
-/// A body faster than this (m/s) means the simulation has blown up.
-pub const BLOW_UP_SPEED: f32 = 1.0e4;
-/// Mechanical energy (kinetic + gravitational, [`crate::diagnostics::EnergyTerms`]) more than
-/// this many joules per kilogram of moving mass above the lowest it has been since the last
-/// edit means the simulation has blown up. Contacts only take energy out; what the overlap
-/// repair puts in is lifting bodies out of each other (the `overlap_pyramid` scene, started
-/// 25 % overlapping, gains about 10 J/kg). 50 J/kg is every body lifted 5 m or moving at
-/// 10 m/s. A solve that fails to hold a pile can push it apart far faster than that while no
-/// body comes near [`BLOW_UP_SPEED`] (`impulse run pyramid100 --method pgs --substeps 4
-/// --iterations 1 --position-iterations 1` is such a solve; tests/blow_up.rs). Changing
-/// bodies between steps (velocities, poses, forces, new or removed bodies, gravity: every
-/// edit that wakes a body, [`World::wake_up`]) restarts the reference.
-pub const BLOW_UP_ENERGY_PER_KG: f64 = 50.0;
-
+pub use step::{BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED};
 /// Bodies, settings and the persistent contact state of a simulation.
 pub struct World {
     /// The bodies, in scene order while none has been removed (a removal moves the last body

@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 use super::World;
 use super::contacts::ContactEvents;
 use super::step::EnergyCheck;
-use super::step::kinematic::Script;
+use super::step::kinematic_script::Script;
 use crate::body::{Bodies, BodyKind, Handles};
 use crate::collision::broad_phase::{BroadPhase, BroadPhaseState};
 use crate::collision::narrow_phase::{NarrowPhase, PairState};

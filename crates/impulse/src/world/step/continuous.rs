@@ -351,12 +351,21 @@ impl World {
         }
     }
 
+    /// The continuous stage: fast bodies swept and clamped, then the energy check credited
+    /// with what the clamps gave back ([`super::EnergyCheck::credit_clamps`]).
+    pub(super) fn continuous_stage(&mut self, settings: &SolverSettings) {
+        self.sweep_and_clamp(settings);
+        let (clamps, unclamped) = (&self.clamps, &self.unclamped_poses);
+        self.energy
+            .credit_clamps(clamps, unclamped, &self.bodies, self.gravity);
+    }
+
     /// Sweeps every awake dynamic body that moved more than [`FAST_FRACTION`] of its smallest
     /// half extent this step against the static and kinematic bodies in its swept box (the
     /// broad phase's tree, and the moving kinematic bodies), and puts it back to the earliest
     /// clamp ([`clamp_fraction`]) with the velocity gravity had given it by then. Each body's clamp reads only its own poses and
     /// the static and kinematic bodies', which no clamp changes, so the order does not matter.
-    pub(super) fn continuous_stage(&mut self, settings: &SolverSettings) {
+    fn sweep_and_clamp(&mut self, settings: &SolverSettings) {
         if settings.continuous {
             // The poses before any clamp, for the energy check's credit (`credit_clamps`).
             self.unclamped_poses.clone_from(&self.bodies.pose);

@@ -14,26 +14,11 @@
 use glam::{Quat, Vec3};
 use parry3d::math::Pose;
 
+use super::kinematic_script::Script;
 use crate::World;
 use crate::body::{BodyHandle, BodyKind, Keyframe};
 use crate::error::WorldError;
 use crate::settings::SolverSettings;
-
-/// The prescribed motion of one position-based kinematic body.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub(crate) struct Script {
-    /// The body it moves.
-    pub(crate) handle: BodyHandle,
-    /// The body's pose at time 0, where the keyframed motion starts.
-    pub(crate) initial: Pose,
-    /// Keyframes, times > 0 increasing (empty for a body moved by a target alone).
-    pub(crate) keyframes: Vec<Keyframe>,
-    /// A pose to reach at the end of the next step ([`crate::World::set_kinematic_target`]),
-    /// before the keyframes.
-    pub(crate) target: Option<Pose>,
-    /// The pose the current step ends at, set as the step starts.
-    pub(crate) step_target: Option<Pose>,
-}
 
 /// The keyframed pose at `time` (s): the initial pose at time 0, each keyframe's pose at its
 /// time, linear interpolation of the translation and slerp of the rotation in between (the

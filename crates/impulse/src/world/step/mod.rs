@@ -14,8 +14,10 @@
 //! | [`Stage::StoreImpulses`] | `store_impulses.rs` | impulses into the manifolds for the next warm start |
 //! | [`Stage::Finish`] | `finish.rs` | sleep (`sleep.rs`), energy, momentum, the diagnostics |
 //!
-//! After the stages the step ends (`energy.rs`): contact events, the end of the step's forces
-//! and the blow-up check. Every thread decision goes through [`crate::parallel`].
+//! After the stages the step ends (`finish.rs`): contact events, the end of the step's forces
+//! and the energy and blow-up check (`energy.rs`). The state the world keeps for the step's
+//! concerns lives in files that do not reach back into the world (`energy.rs`,
+//! `kinematic_script.rs`), so that files import one way. Every thread decision goes through [`crate::parallel`].
 
 mod assembly;
 mod broad_phase;
@@ -23,7 +25,8 @@ mod continuous;
 mod energy;
 mod finish;
 mod islands;
-pub(super) mod kinematic;
+mod kinematic;
+pub(super) mod kinematic_script;
 mod narrow_phase;
 mod record;
 mod scatter;
@@ -32,6 +35,7 @@ mod solve;
 mod store_impulses;
 
 pub(super) use energy::EnergyCheck;
+pub use energy::{BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED};
 
 use crate::World;
 use crate::diagnostics::{Stage, StepDiagnostics, StepProfile};
@@ -97,7 +101,7 @@ impl World {
         let mut clock = StageClock::start();
         self.kinematic_stage(&settings);
         clock.end(Stage::Kinematic);
-        self.start_energy_check();
+        self.energy.start(&self.bodies, self.gravity);
         self.broad_phase_stage(&settings, parallel);
         clock.end(Stage::BroadPhase);
         self.narrow_phase_stage(parallel)?;
@@ -111,7 +115,6 @@ impl World {
         self.scatter_stage();
         clock.end(Stage::Scatter);
         self.continuous_stage(&settings);
-        self.credit_clamps();
         clock.end(Stage::Continuous);
         self.store_impulses_stage();
         clock.end(Stage::StoreImpulses);
