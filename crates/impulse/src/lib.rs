@@ -55,7 +55,7 @@ mod world;
 pub mod metrics;
 pub mod scene;
 
-// The unit tests share `tests/common` with the integration tests, whose paths start with
+// The unit tests share `tests/integration/common.rs` with the integration tests, whose paths start with
 // `impulse::`.
 #[cfg(test)]
 extern crate self as impulse;

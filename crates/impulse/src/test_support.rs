@@ -1,7 +1,10 @@
-//! Helpers of the unit tests: the integration tests' scene pieces (`tests/common`, compiled
-//! here as well through the `impulse` alias of lib.rs) and checks that need the engine's rows.
+//! Helpers of the unit tests: the integration tests' scene pieces
+//! (`tests/integration/common.rs`, compiled here as well through the `impulse` alias of lib.rs)
+//! and checks that need the engine's rows.
 
-#[path = "../tests/common/mod.rs"]
+// The unit tests use a part of the pieces.
+#[allow(dead_code)]
+#[path = "../tests/integration/common.rs"]
 mod common;
 
 pub(crate) use common::*;

@@ -1,6 +1,5 @@
-//! What the CLI's test binaries share: the `impulse` command under test, scratch paths and
-//! the success check. Each binary uses a part of it.
-#![allow(dead_code)]
+//! What the CLI's integration tests share: the `impulse` command under test, scratch paths
+//! and the success check.
 
 use std::path::PathBuf;
 use std::process::{Command, Output};

@@ -8,8 +8,8 @@ use std::process::Output;
 use base64::Engine as _;
 use gltf::animation::util::ReadOutputs;
 
-mod common;
-use common::{assert_success, impulse, repo};
+use crate::common;
+use crate::common::{assert_success, impulse, repo};
 
 fn temp(name: &str) -> PathBuf {
     common::temp("export", name)

@@ -2,11 +2,9 @@
 //! from a checkpoint writes the same trajectory rows, to the last digit, as the run that was
 //! never stopped, on one and two threads; a damaged snapshot is a clear error.
 
-mod common;
-
 use std::path::Path;
 
-use common::{assert_success, fresh_dir, impulse, temp};
+use crate::common::{assert_success, fresh_dir, impulse, temp};
 
 const SUITE: &str = "checkpoint";
 

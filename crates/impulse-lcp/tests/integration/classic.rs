@@ -9,9 +9,7 @@
 //! - Fathi (1979): `M = L Lᵀ` with `L` lower triangular, 1 on the diagonal, 2 below: symmetric
 //!   positive definite (so PGS applies too). With `q = −e` the solution is `z = e_1`.
 
-mod common;
-
-use common::{assert_solves, siconos_w};
+use crate::common::{assert_solves, siconos_w};
 use impulse_lcp::{DenseMatrix, Lcp, SolverKind, SolverSettings, Status};
 
 fn murty(n: usize) -> DenseMatrix {

@@ -16,8 +16,8 @@ use impulse::scene::validate_all;
 
 /// The fuzz targets' own caps and input handling, so that the corpora are replayed exactly as
 /// the fuzzer ran them.
-#[path = "../../../fuzz/fuzz_targets/common.rs"]
-mod common;
+#[path = "../../../../fuzz/fuzz_targets/common.rs"]
+mod fuzz_common;
 
 /// The files of `fuzz/corpus/<target>`, `fuzz/seeds/<target>` and `tests/data/fuzz/<target>`
 /// (each read if it exists), sorted.
@@ -59,7 +59,7 @@ fn parse_and_build(text: &str) {
 #[test]
 fn scene_parser_inputs_give_errors_not_panics() {
     for path in inputs("scene_parser") {
-        if let Some(text) = text_of(&path).filter(|text| !common::names_a_file(text)) {
+        if let Some(text) = text_of(&path).filter(|text| !fuzz_common::names_a_file(text)) {
             parse_and_build(&text);
         }
     }
@@ -69,8 +69,9 @@ fn scene_parser_inputs_give_errors_not_panics() {
 fn short_simulation_inputs_give_errors_not_panics() {
     let mut stepped = 0;
     for path in inputs("short_simulation") {
-        if let Some(text) = text_of(&path).filter(|text| !common::names_a_file(text))
-            && parse_scene_str(&text, "fuzz.json").is_ok_and(|scene| common::run_capped(&scene) > 0)
+        if let Some(text) = text_of(&path).filter(|text| !fuzz_common::names_a_file(text))
+            && parse_scene_str(&text, "fuzz.json")
+                .is_ok_and(|scene| fuzz_common::run_capped(&scene) > 0)
         {
             stepped += 1;
         }
@@ -93,7 +94,7 @@ fn inputs_that_stepped(target: &str, run: fn(&[u8]) -> Option<usize>) -> usize {
 fn mesh_reader_inputs_give_errors_not_panics() {
     // The corpus starts from an OBJ terrain and glTF files the exporter wrote.
     assert!(
-        inputs_that_stepped("mesh_readers", common::mesh_input) > 0,
+        inputs_that_stepped("mesh_readers", fuzz_common::mesh_input) > 0,
         "no mesh_readers input read and stepped"
     );
 }
@@ -102,7 +103,7 @@ fn mesh_reader_inputs_give_errors_not_panics() {
 fn snapshot_reader_inputs_give_errors_not_panics() {
     // The corpus starts from checkpoints of small scenes.
     assert!(
-        inputs_that_stepped("snapshot_reader", common::snapshot_input) > 0,
+        inputs_that_stepped("snapshot_reader", fuzz_common::snapshot_input) > 0,
         "no snapshot_reader input restored and stepped"
     );
 }

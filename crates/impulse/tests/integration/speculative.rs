@@ -2,7 +2,7 @@
 //! bodies can close in one step, so a fast body neither tunnels nor overlaps, while bodies
 //! moving together get no contact and stay in separate islands.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};

@@ -2,7 +2,7 @@
 //! island is reported, and the escalations it makes hold PGS's hard cases (tall stacks, heavy on
 //! light) still.
 
-mod common;
+use crate::common;
 
 use impulse::EscalationLevel;
 use impulse::SolverMethod;

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-mod common;
-use common::{assert_success, impulse, repo};
+use crate::common;
+use crate::common::{assert_success, impulse, repo};
 
 fn temp(name: &str) -> PathBuf {
     common::temp("variation", name)

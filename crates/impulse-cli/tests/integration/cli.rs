@@ -2,8 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
-use common::{assert_success, impulse, repo};
+use crate::common;
+use crate::common::{assert_success, impulse, repo};
 
 fn temp(name: &str) -> PathBuf {
     common::temp("cli", name)

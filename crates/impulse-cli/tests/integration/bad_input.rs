@@ -2,8 +2,7 @@
 
 use std::time::Duration;
 
-mod common;
-use common::impulse;
+use crate::common::impulse;
 
 fn stderr_of(args: &[&str]) -> (bool, String) {
     let out = impulse().args(args).output().unwrap();

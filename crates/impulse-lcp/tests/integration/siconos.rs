@@ -18,9 +18,7 @@
 //! | deudeu, trivial, ortiz, murty, murty2, mmc, enum_fails | solution, known or unique | P-matrices (unique solution) |
 //! | tobenna | solution | degenerate: needs the lexicographic rule |
 
-mod common;
-
-use common::{assert_solves, enumerate_solutions, siconos_dir, violations};
+use crate::common::{assert_solves, enumerate_solutions, siconos_dir, violations};
 use impulse_lcp::{
     DenseMatrix, Lcp, Matrix, Solution, SolveError, SolverKind, SolverSettings, Status,
     read_siconos,

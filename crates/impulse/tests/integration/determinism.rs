@@ -4,9 +4,7 @@
 //! impulses and separation, as f32 bits). `tests/snapshot.rs` checks that a world restored
 //! from a snapshot continues to the same state.
 
-mod common;
-
-use common::hash_state;
+use crate::common::hash_state;
 use impulse::scene::builtin_scene;
 use impulse::scene::load_scene_file;
 use impulse::{Scene, SolverMethod, SolverSettings, World};

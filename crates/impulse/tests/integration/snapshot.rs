@@ -9,9 +9,7 @@
 //! boxes, energy reference), and a hash of every body's pose and velocities and every contact
 //! point's impulses read through the public API agrees.
 
-mod common;
-
-use common::hash_state;
+use crate::common::hash_state;
 use impulse::glam::Vec3;
 use impulse::scene::builtin_scene;
 use impulse::scene::load_scene_file;

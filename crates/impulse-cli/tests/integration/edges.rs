@@ -6,8 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
-use common::{assert_success, fresh_dir, impulse, repo, temp};
+use crate::common::{assert_success, fresh_dir, impulse, repo, temp};
 
 const SUITE: &str = "edges";
 

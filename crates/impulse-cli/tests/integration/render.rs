@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use image::AnimationDecoder;
 use image::codecs::gif::GifDecoder;
 
-mod common;
-use common::{assert_success, impulse};
+use crate::common;
+use crate::common::{assert_success, impulse};
 
 /// A fresh directory for one test's files.
 fn temp_dir(name: &str) -> PathBuf {

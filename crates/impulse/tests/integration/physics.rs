@@ -2,8 +2,6 @@
 //! simultaneous-contact cases (a body on two others, a body pulled away from its contact) and
 //! complementarity of the contact LCP at exit.
 
-mod common;
-
 use glam::{Quat, Vec3};
 use impulse::ContactRepair;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};

@@ -1,7 +1,6 @@
 //! Test oracles written independently of the crate's merit functions and solvers, so that a bug
 //! there cannot hide itself: LCP conditions checked entry by entry, and brute-force enumeration
 //! of complementary bases for small problems.
-#![allow(dead_code)] // each test binary uses a different subset
 
 use impulse_lcp::DenseMatrix;
 use std::path::PathBuf;

@@ -1,7 +1,7 @@
 //! Islands and sleeping: independent islands give the same result in parallel as in sequence,
 //! quiet islands fall asleep, and an awake body touching a sleeping island wakes all of it.
 
-mod common;
+use crate::common;
 
 use glam::Vec3;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};

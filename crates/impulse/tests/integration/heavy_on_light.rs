@@ -242,7 +242,7 @@ fn an_island_the_path_cannot_take_is_reported_not_held() {
 /// off so that every step is solved), the sink after 600 steps and the mean time per step, on
 /// the heavy-on-light path (the default) and on the ordinary soft step
 /// (`heavy_on_light_mass_ratio: 0`). Prints; asserts nothing. Run with
-/// `cargo test -p impulse --test heavy_on_light -- --ignored --nocapture`.
+/// `cargo test -p impulse --test integration heavy_on_light:: -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn heavy_on_light_table() {

@@ -1,7 +1,7 @@
 //! Soak: balls4096 for 20,000 steps (5.6 min of simulated time) at the default settings, sleeping
 //! off: no NaN, no ball outside its box, and the mechanical energy never above where it began
 //! (contacts only dissipate). On demand, not in the default suite:
-//! `cargo test --release -p impulse --test soak -- --ignored --nocapture`.
+//! `cargo test --release -p impulse --test integration soak:: -- --ignored --nocapture`.
 
 use impulse::scene::builtin_scene;
 use impulse::{BodyKind, World};

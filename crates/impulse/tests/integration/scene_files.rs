@@ -2,7 +2,7 @@
 //! the standard scenes have the counts docs/scenes.md gives, and malformed scenes are rejected
 //! with errors that name the file, line, body and field.
 //!
-//! `cargo test -p impulse --test scene_files -- --ignored regenerate` rewrites the files.
+//! `cargo test -p impulse --test integration scene_files:: -- --ignored regenerate` rewrites the files.
 
 use std::path::{Path, PathBuf};
 
@@ -62,7 +62,7 @@ fn every_builtin_file_exists_and_equals_its_builtin() {
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(
             text == to_json_string(&built),
-            "{} is stale: run `cargo test -p impulse --test scene_files -- --ignored regenerate`",
+            "{} is stale: run `cargo test -p impulse --test integration scene_files:: -- --ignored regenerate`",
             path.display()
         );
     }

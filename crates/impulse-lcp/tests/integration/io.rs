@@ -1,8 +1,6 @@
 //! The JSON writer round-trips every Siconos problem exactly, through a real file.
 
-mod common;
-
-use common::siconos_dir;
+use crate::common::siconos_dir;
 use impulse_lcp::{FileFormat, read_json, read_lcp, read_siconos, write_json};
 
 #[test]

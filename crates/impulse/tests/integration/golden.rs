@@ -9,7 +9,7 @@
 //! moves any body by one bit fails here until the stored file is rewritten on purpose:
 //!
 //! ```text
-//! IMPULSE_BLESS=1 cargo test -p impulse --test golden
+//! IMPULSE_BLESS=1 cargo test -p impulse --test integration golden::
 //! ```
 //!
 //! and committed with the reason in the commit message.
@@ -23,7 +23,7 @@ use impulse::scene::{builtin_scene, load_scene_file};
 use impulse::{Scene, World};
 
 /// The command that rewrites the stored hashes.
-const BLESS: &str = "IMPULSE_BLESS=1 cargo test -p impulse --test golden";
+const BLESS: &str = "IMPULSE_BLESS=1 cargo test -p impulse --test integration golden::";
 
 /// A scene of the golden set and the steps it is run.
 struct Case {
@@ -133,7 +133,7 @@ fn trajectory_hash(scene: &Scene, steps: u32, threads: usize) -> u64 {
 /// The stored file's text for `results` (name, steps, hash), one line per scene.
 fn render(results: &[(String, u32, u64)]) -> String {
     let mut text = String::from(
-        "# Golden trajectories (crates/impulse/tests/golden.rs): scene, steps, 64-bit FNV-1a of\n\
+        "# Golden trajectories (crates/impulse/tests/integration/golden.rs): scene, steps, 64-bit FNV-1a of\n\
          # every body's position, orientation, linear and angular velocity (f32, little-endian)\n\
          # after every step, the same on 1 and 2 threads. Rewritten only on purpose, by\n",
     );

@@ -1,6 +1,5 @@
-//! Scene pieces shared by the tests (`mod common;` in each integration test that uses them;
-//! the unit tests reach them through `test_support`). Public API only.
-#![allow(dead_code)] // each test binary uses its own subset
+//! Scene pieces shared by the integration tests (the unit tests reach them through
+//! `test_support`). Public API only.
 
 use glam::Vec3;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc};
@@ -27,7 +26,8 @@ pub fn static_box(half: Vec3, position: Vec3) -> BodyDesc {
 
 /// The 64-sphere pile of the complementarity tests: 4 layers of 4×4 frictionless spheres
 /// (r = 0.45 m, jittered) on a static ground inside four static walls, with `settings`,
-/// dt = 1/60 s, gravity −9.81 m/s² along y.
+/// dt = 1/60 s, gravity −9.81 m/s² along y. Used by the unit tests (through `test_support`).
+#[allow(dead_code)]
 pub fn sphere_pile(settings: impulse::SolverSettings) -> impulse::World {
     let mut w = impulse::World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
     w.add_body(

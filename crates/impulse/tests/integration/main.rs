@@ -1,0 +1,34 @@
+//! The crate's integration tests, as one test binary: one binary links the crate once, where a
+//! binary per file would link it once per file (the build's time and disk grow with each).
+//! Run one file's tests with a filter on its module, e.g.
+//! `cargo test -p impulse --test integration api::`.
+
+mod api;
+mod auto_policy;
+mod blow_up;
+mod body_options;
+mod ccd;
+mod common;
+mod dead_impacts;
+mod determinism;
+mod fuzz_regressions;
+mod golden;
+mod guards;
+mod gyroscopic;
+mod heavy_on_light;
+mod impacts;
+mod islands;
+mod kinematic;
+mod meshes;
+mod phantom_and_tunnel;
+mod physics;
+mod profile;
+mod scene_files;
+mod seams;
+mod shapes;
+mod simultaneous_impacts;
+mod snapshot;
+mod soak;
+mod speculative;
+mod standard_scenes;
+mod variation;
