@@ -54,7 +54,7 @@ fn the_stages_have_one_name_everywhere() {
     for stage in Stage::ALL {
         assert_eq!(serde_json::to_value(stage).unwrap(), stage.name());
     }
-    let doc = include_str!("../../../docs/architecture.md");
+    let doc = include_str!("../../../../docs/architecture.md");
     let section = doc
         .split("## `World::step`, stage by stage")
         .nth(1)
