@@ -74,8 +74,9 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
-        /// After the summary, print the median wall time of each stage of the step (broad
-        /// phase, narrow phase, islands, assembly, solve, scatter, impulse write-back, finish).
+        /// After the summary, print the median wall time of each stage of the step (kinematic,
+        /// broad phase, narrow phase, islands, assembly, solve, scatter, continuous, store
+        /// impulses, finish; `impulse::Stage`).
         #[arg(long)]
         profile: bool,
         #[command(flatten)]

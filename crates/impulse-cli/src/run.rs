@@ -673,6 +673,7 @@ fn median_profile(profiles: &[StepProfile]) -> StepProfile {
         median(&mut times) as f32
     };
     StepProfile {
+        kinematic: of(|p| p.kinematic),
         broad_phase: of(|p| p.broad_phase),
         narrow_phase: of(|p| p.narrow_phase),
         islands: of(|p| p.islands),

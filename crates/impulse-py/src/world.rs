@@ -473,9 +473,9 @@ impl World {
         World::diagnostics_dict(py, self.inner.diagnostics())
     }
 
-    /// Wall-clock seconds of each stage of the last step (`broad_phase`, `narrow_phase`,
-    /// `islands`, `assembly`, `solve`, `scatter`, `continuous`, `store_impulses`, `finish`,
-    /// `total`), as a dict.
+    /// Wall-clock seconds of each stage of the last step (`kinematic`, `broad_phase`,
+    /// `narrow_phase`, `islands`, `assembly`, `solve`, `scatter`, `continuous`,
+    /// `store_impulses`, `finish`, `total`), as a dict.
     #[getter]
     fn profile<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, self.inner.profile())

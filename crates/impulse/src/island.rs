@@ -1,5 +1,6 @@
-//! Islands: the connected components of the contact graph, which are solved independently
-//! ([`crate::solver::substep`] runs one island's step).
+//! Islands: the connected components of the contact graph, found by the islands stage
+//! ([`crate::Stage::Islands`]) and solved independently by the solve stage
+//! ([`crate::solver::substep`] runs one island's part of it).
 //!
 //! Two dynamic bodies are in one island when a chain of contacts joins them; static and
 //! kinematic bodies join nothing (they take no impulse). A kinematic body touching an island
@@ -115,11 +116,12 @@ impl Islands {
     }
 
     /// Finds the islands of the narrow phase's `pairs` (union-find over pairs with constraints
-    /// between dynamic bodies), each island's guests (the kinematic bodies it touches) and the order in which to assemble the pairs so that each
-    /// island's constraints are contiguous (a stable counting sort of pair indices: within an
-    /// island, narrow-phase order). Sorting 4-byte pair indices here replaces moving the
-    /// assembled constraints of several hundred bytes each. When every pair's bodies and constraint count and every body's kind are
-    /// as in the last build, the islands are too, and nothing is rebuilt.
+    /// between dynamic bodies), each island's guests (the kinematic bodies it touches) and the
+    /// order in which to assemble the pairs so that each island's constraints are contiguous (a
+    /// stable counting sort of pair indices: within an island, narrow-phase order). Sorting
+    /// 4-byte pair indices here replaces moving the assembled constraints of several hundred
+    /// bytes each. When every pair's bodies and constraint count and every body's kind are as
+    /// in the last build, the islands are too, and nothing is rebuilt.
     pub(crate) fn build(&mut self, bodies: &Bodies, pairs: &[ContactPair]) {
         let n = bodies.len();
         std::mem::swap(&mut self.pair_keys, &mut self.last_pair_keys);

@@ -46,13 +46,11 @@ mod body;
 mod collision;
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 mod contact;
-mod continuous;
 mod diagnostics;
 mod error;
 mod graph;
 mod integrate;
 mod island;
-mod kinematic;
 mod parallel;
 mod settings;
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]

@@ -44,8 +44,8 @@ pub(crate) const NORM_POINTS_PER_TASK: usize = 4096;
 pub(crate) const GROUPS_PER_TASK: usize = 8;
 
 /// Islands of at least this many points spread the SIMD sweep's colours over rayon's threads
-/// (whatever `parallel_island_contacts` says). On balls4096 with `fast` (256 columns of 16
-/// points), spreading every island made a two-thread step slower (docs/benchmarks.md).
+/// (whatever `parallel_island_contacts` says); below it a colour is too small for the hand-off
+/// to pay (docs/benchmarks.md).
 pub(crate) const PARALLEL_ISLAND_POINTS: usize = 1024;
 
 /// Islands of at least this many points are packed into and unpacked from SIMD lanes on
@@ -63,6 +63,212 @@ pub(crate) const SWEEP_POINTS_PER_TASK: usize = 256;
 #[inline]
 pub(crate) fn spread(allowed: bool, items: usize, more_than: usize) -> bool {
     allowed && items > more_than && rayon::current_num_threads() > 1
+}
+
+/// Runs `run` on a thread of rayon's pool when threads are `allowed` and the caller is outside
+/// any pool (a program's main thread), else on the calling thread. Work spread from outside a
+/// pool waits for each piece to be handed over and back, and a step spreads hundreds of pieces
+/// (each colour of each substep), so a step is better run inside the pool as a whole.
+pub(crate) fn in_pool<R: Send>(allowed: bool, run: impl FnOnce() -> R + Send) -> R {
+    if allowed && rayon::current_thread_index().is_none() {
+        rayon::scope(|_| run())
+    } else {
+        run()
+    }
+}
+
+/// `a` and `b` beside each other on rayon's threads when `parallel`, else `a` then `b`.
+/// They must not depend on each other.
+pub(crate) fn both<RA: Send, RB: Send>(
+    parallel: bool,
+    a: impl FnOnce() -> RA + Send,
+    b: impl FnOnce() -> RB + Send,
+) -> (RA, RB) {
+    if parallel {
+        rayon::join(a, b)
+    } else {
+        let ra = a();
+        (ra, b())
+    }
+}
+
+/// Runs `run(k, &mut items[k], rows)` for every item, `rows` being `rows[range(k)]`; the ranges
+/// must follow one another in item order, each starting where the last ended (or later) and
+/// none past the end of `rows` (checked: a range out of order panics). With `parallel`, on
+/// rayon's threads, at most `max_per_task` items a task: items that differ in cost by orders
+/// of magnitude (islands) are split finely enough for work stealing to even them out.
+pub(crate) fn for_each_with_rows<T: Send, R: Send>(
+    parallel: bool,
+    items: &mut [T],
+    rows: &mut [R],
+    range: impl Fn(usize) -> std::ops::Range<usize> + Sync,
+    max_per_task: usize,
+    run: impl Fn(usize, &mut T, &mut [R]) + Sync,
+) {
+    use rayon::prelude::*;
+    let mut end = 0;
+    for k in 0..items.len() {
+        let r = range(k);
+        assert!(
+            end <= r.start && r.start <= r.end,
+            "row ranges out of order"
+        );
+        end = r.end;
+    }
+    assert!(end <= rows.len(), "row ranges beyond the rows");
+    if !parallel {
+        let mut rest = rows;
+        let mut taken = 0;
+        for (k, item) in items.iter_mut().enumerate() {
+            let r = range(k);
+            let (_, tail) = std::mem::take(&mut rest).split_at_mut(r.start - taken);
+            let (mine, others) = tail.split_at_mut(r.len());
+            rest = others;
+            taken = r.end;
+            run(k, item, mine);
+        }
+        return;
+    }
+    let base = SharedItems(rows.as_mut_ptr());
+    items
+        .par_iter_mut()
+        .enumerate()
+        .with_max_len(max_per_task)
+        .for_each(|(k, item)| {
+            // Capture the whole wrapper (Sync), not its raw-pointer field.
+            #[allow(clippy::redundant_locals)]
+            let base = base;
+            let r = range(k);
+            // SAFETY: the ranges are in order, disjoint and inside `rows` (checked above), and
+            // each item, with its range, is visited once.
+            let mine = unsafe { std::slice::from_raw_parts_mut(base.0.add(r.start), r.len()) };
+            run(k, item, mine);
+        });
+}
+
+/// Runs `run(i, &mut a[i], &mut b[i], &mut c[i])` for every index of the three slices (of one
+/// length), on rayon's threads in runs of at least `min_per_task` when `parallel`.
+pub(crate) fn for_each_of_three<A: Send, B: Send, C: Send>(
+    parallel: bool,
+    (a, b, c): (&mut [A], &mut [B], &mut [C]),
+    min_per_task: usize,
+    run: impl Fn(usize, &mut A, &mut B, &mut C) + Sync + Send,
+) {
+    use rayon::prelude::*;
+    if parallel {
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .zip(c.par_iter_mut())
+            .enumerate()
+            .with_min_len(min_per_task)
+            .for_each(|(i, ((a, b), c))| run(i, a, b, c));
+    } else {
+        a.iter_mut()
+            .zip(b.iter_mut())
+            .zip(c.iter_mut())
+            .enumerate()
+            .for_each(|(i, ((a, b), c))| run(i, a, b, c));
+    }
+}
+
+/// Runs `run(i, &mut items[i])` for every item, on rayon's threads in runs of at least
+/// `min_per_task` when `parallel`.
+pub(crate) fn for_each_indexed<T: Send>(
+    parallel: bool,
+    items: &mut [T],
+    min_per_task: usize,
+    run: impl Fn(usize, &mut T) + Sync + Send,
+) {
+    use rayon::prelude::*;
+    if parallel {
+        items
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(min_per_task)
+            .for_each(|(i, item)| run(i, item));
+    } else {
+        items
+            .iter_mut()
+            .enumerate()
+            .for_each(|(i, item)| run(i, item));
+    }
+}
+
+/// Whether `run(first, chunk)` holds for every run of `chunk` items (`first` the index of the
+/// run's first item), each run on a rayon thread, when `parallel`; otherwise `run(0, items)`
+/// once for them all.
+pub(crate) fn all_in_chunks<T: Send>(
+    parallel: bool,
+    items: &mut [T],
+    chunk: usize,
+    run: impl Fn(usize, &mut [T]) -> bool + Sync + Send,
+) -> bool {
+    use rayon::prelude::*;
+    if parallel {
+        items
+            .par_chunks_mut(chunk)
+            .enumerate()
+            .map(|(k, items)| run(k * chunk, items))
+            .reduce(|| true, |x, y| x && y)
+    } else {
+        run(0, items)
+    }
+}
+
+/// The first index below `n` for which `test` holds, tested in runs of at least `min_per_task`
+/// on rayon's threads when `parallel` (the first in index order either way).
+pub(crate) fn find_first(
+    parallel: bool,
+    n: usize,
+    min_per_task: usize,
+    test: impl Fn(usize) -> bool + Sync + Send,
+) -> Option<usize> {
+    use rayon::prelude::*;
+    if parallel {
+        (0..n)
+            .into_par_iter()
+            .with_min_len(min_per_task)
+            .find_first(|&i| test(i))
+    } else {
+        (0..n).find(|&i| test(i))
+    }
+}
+
+/// The indices below `n` for which `test` holds, in order, tested on rayon's threads when
+/// `parallel`.
+pub(crate) fn indices_where(
+    parallel: bool,
+    n: usize,
+    test: impl Fn(usize) -> bool + Sync + Send,
+) -> Vec<usize> {
+    use rayon::prelude::*;
+    if parallel {
+        (0..n).into_par_iter().filter(|&i| test(i)).collect()
+    } else {
+        (0..n).filter(|&i| test(i)).collect()
+    }
+}
+
+/// `out` becomes `[item(0), …, item(n − 1)]`, computed in runs of at least `min_per_task` on
+/// rayon's threads when `parallel`.
+pub(crate) fn map_into<T: Send>(
+    parallel: bool,
+    n: usize,
+    min_per_task: usize,
+    item: impl Fn(usize) -> T + Sync + Send,
+    out: &mut Vec<T>,
+) {
+    use rayon::prelude::*;
+    if parallel {
+        (0..n)
+            .into_par_iter()
+            .with_min_len(min_per_task)
+            .map(item)
+            .collect_into_vec(out);
+    } else {
+        out.clear();
+        out.extend((0..n).map(item));
+    }
 }
 
 /// Threads available to the current pass (rayon's pool, or 1 outside it).
@@ -89,8 +295,8 @@ pub(crate) fn prefetch<T>(pointer: *const T) {
 /// items; colours from `whole_from` on are one chunk (their items may share bodies). `run`
 /// gets a chunk and `forward`, and must touch nothing another chunk of its colour touches.
 ///
-/// Why not a rayon call per colour: a coloured island has 24–34 colours and a `fast` step
-/// sweeps it 24 times, so a fork-join per colour was paid some 700 times a step. Here the
+/// Why not a rayon call per colour: an island has tens of colours and a step sweeps it many
+/// times, so a fork-join per colour would be paid hundreds of times a step. Here the
 /// threads are forked once per sweep and claim chunks, each its own (the chunk of its rayon
 /// thread index) first, then any left; a chunk waits (spinning) until every chunk of the
 /// colours before its own has finished. A thread moves on to a colour only once every chunk
@@ -98,8 +304,7 @@ pub(crate) fn prefetch<T>(pointer: *const T) {
 /// running them or waiting in turn on earlier ones, and a chunk never calls into rayon:
 /// every wait ends on any nesting of rayon jobs;
 /// a thread that joins late, or never, leaves more chunks to the others. One contiguous chunk
-/// per thread keeps each thread's reads a single stream: chunks of 32 bundles claimed in turn
-/// were slower than the fork-joins, halves faster. The
+/// per thread keeps each thread's reads a single stream. The
 /// chunks of a colour touch disjoint bodies and colours run in order, so the result is the
 /// same on any number of threads (`combine` must not depend on order, as a maximum does not).
 #[allow(clippy::too_many_arguments)]
@@ -280,7 +485,10 @@ pub(crate) fn prefetch_bytes<T>(start: *const T, bytes: usize) {
 
 #[cfg(test)]
 mod tests {
-    use super::{COLOURS, colour_after_colour};
+    use super::{
+        COLOURS, all_in_chunks, colour_after_colour, find_first, for_each_indexed,
+        for_each_of_three, for_each_with_rows, indices_where, map_into,
+    };
     use proptest::prelude::*;
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicU64, Ordering};
@@ -375,6 +583,116 @@ mod tests {
             let (items, count) = pool.install(|| visit(&sizes, forward, min_chunk));
             check(&sizes, forward, &items, count);
         }
+    }
+
+    /// Items and their runs of rows, `gaps[k]` rows skipped before item k's `lens[k]`.
+    fn ranges(gaps: &[usize], lens: &[usize]) -> Vec<std::ops::Range<usize>> {
+        let mut start = 0;
+        gaps.iter()
+            .zip(lens)
+            .map(|(&gap, &len)| {
+                let range = start + gap..start + gap + len;
+                start = range.end;
+                range
+            })
+            .collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Each item gets exactly its own rows, once, with or without threads; rows outside
+        /// every range are left alone.
+        #[test]
+        fn each_item_gets_its_own_rows(
+            runs in proptest::collection::vec((0usize..3, 0usize..9), 0..40),
+            parallel in any::<bool>(),
+            threads in 1usize..4,
+        ) {
+            let (gaps, lens): (Vec<usize>, Vec<usize>) = runs.into_iter().unzip();
+            let ranges = ranges(&gaps, &lens);
+            let total = ranges.last().map_or(0, |r| r.end) + 2;
+            let mut rows = vec![usize::MAX; total];
+            let mut items = vec![0usize; ranges.len()];
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                for_each_with_rows(parallel, &mut items, &mut rows, |k| ranges[k].clone(), 2, |k, item, mine| {
+                    *item = mine.len();
+                    mine.iter_mut().for_each(|row| {
+                        assert_eq!(*row, usize::MAX, "a row given twice");
+                        *row = k;
+                    });
+                })
+            });
+            for (k, range) in ranges.iter().enumerate() {
+                prop_assert_eq!(items[k], range.len());
+                prop_assert!(rows[range.clone()].iter().all(|&row| row == k));
+            }
+            let covered: usize = ranges.iter().map(|r| r.len()).sum();
+            prop_assert_eq!(rows.iter().filter(|&&row| row == usize::MAX).count(), total - covered);
+        }
+
+        /// The other helpers give what their serial loops give, on one to three threads.
+        #[test]
+        fn helpers_match_their_serial_loops(
+            values in proptest::collection::vec(0u32..100, 0..3000),
+            threads in 1usize..4,
+        ) {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let n = values.len();
+            let test = |i: usize| values[i] % 7 == 3;
+            pool.install(|| {
+                for parallel in [false, true] {
+                    assert_eq!(find_first(parallel, n, 16, test), (0..n).find(|&i| test(i)));
+                    assert_eq!(
+                        indices_where(parallel, n, test),
+                        (0..n).filter(|&i| test(i)).collect::<Vec<_>>()
+                    );
+                    let mut out = vec![7u64];
+                    map_into(parallel, n, 16, |i| u64::from(values[i]) * 3, &mut out);
+                    assert_eq!(out, values.iter().map(|&v| u64::from(v) * 3).collect::<Vec<_>>());
+                    let mut items = values.clone();
+                    for_each_indexed(parallel, &mut items, 16, |i, v| *v += i as u32);
+                    assert!(items.iter().enumerate().all(|(i, &v)| v == values[i] + i as u32));
+                    let (mut a, mut b, mut c) = (values.clone(), vec![0usize; n], vec![0u8; n]);
+                    for_each_of_three(parallel, (&mut a, &mut b, &mut c), 16, |i, a, b, c| {
+                        *a += 1;
+                        *b = i;
+                        *c = 1;
+                    });
+                    assert!((0..n).all(|i| a[i] == values[i] + 1 && b[i] == i && c[i] == 1));
+                    let mut items = values.clone();
+                    let small = |first: usize, chunk: &mut [u32]| {
+                        // `first` places the chunk: its items are the values from there.
+                        chunk
+                            .iter()
+                            .enumerate()
+                            .all(|(k, &v)| v == values[first + k] && v < 99)
+                    };
+                    assert_eq!(
+                        all_in_chunks(parallel, &mut items, 64, small),
+                        values.iter().all(|&v| v < 99)
+                    );
+                }
+            });
+        }
+    }
+
+    /// Ranges that overlap are refused before any item runs.
+    #[test]
+    #[should_panic(expected = "row ranges out of order")]
+    fn overlapping_ranges_are_refused() {
+        let mut rows = [0u8; 8];
+        let mut items = [0u8; 2];
+        let ranges = [0..4, 3..6];
+        for_each_with_rows(
+            true,
+            &mut items,
+            &mut rows,
+            |k| ranges[k].clone(),
+            1,
+            |_, _, _| {},
+        );
     }
 
     /// Sweeps started from inside other rayon jobs (as island jobs start theirs) all end, each

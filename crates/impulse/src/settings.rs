@@ -184,7 +184,7 @@ pub struct SolverSettings {
     /// Contacts are generated up to this separation (m) ahead of touching ("speculative"
     /// contacts): a row with gap g > 0 only forbids closing faster than g/dt.
     pub prediction_distance: f32,
-    /// Let quiet islands sleep (step 6 of docs/architecture.md). Off for benchmarks.
+    /// Let quiet islands sleep (the finish stage, docs/architecture.md). Off for benchmarks.
     pub sleep: bool,
     /// A body slower than this (m/s) …
     pub sleep_linear_speed: f32,

@@ -4,9 +4,6 @@
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
-#[cfg(doc)]
-use super::BodyBuilder;
-
 /// How a body moves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -25,7 +22,7 @@ pub enum BodyKind {
     Kinematic,
 }
 
-/// A timed pose of a keyframed kinematic body ([`BodyBuilder::keyframes`]): at `time`
+/// A timed pose of a keyframed kinematic body ([`crate::BodyBuilder::keyframes`]): at `time`
 /// seconds after the world's start the body frame is at `translation` with `rotation`.
 /// Between keyframes the pose is interpolated linearly in translation and by slerp in
 /// rotation; after the last one it is held.

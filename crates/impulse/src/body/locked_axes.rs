@@ -4,9 +4,6 @@
 use glam::{Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
-#[cfg(doc)]
-use super::BodyBuilder;
-
 /// The world axes along which a dynamic body may not translate or about which it may not
 /// rotate (Rapier's `LockedAxes`, Bullet's linear and angular factors, Box2D's fixed
 /// rotation): a set of six flags, combined with `|`.
@@ -49,7 +46,7 @@ impl LockedAxes {
     pub const ROTATION_Z: Self = Self(1 << 5);
     /// The three translations.
     pub const ALL_TRANSLATIONS: Self = Self(0b000_111);
-    /// The three rotations ([`BodyBuilder::lock_rotation`]).
+    /// The three rotations ([`crate::BodyBuilder::lock_rotation`]).
     pub const ALL_ROTATIONS: Self = Self(0b111_000);
     /// Every axis: the body does not move.
     pub const ALL: Self = Self(0b111_111);

@@ -1,4 +1,4 @@
-//! Stage 2 of the step: axis-aligned bounding boxes → candidate pairs, through Parry's `Bvh`.
+//! The broad phase ([`crate::Stage::BroadPhase`]): axis-aligned bounding boxes → candidate pairs, through Parry's `Bvh`.
 
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhLeafUpdateStatus, BvhWorkspace};

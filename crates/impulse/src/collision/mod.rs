@@ -1,5 +1,6 @@
-//! Collision detection, stages 2 and 3 of the step: the broad phase turns loosened bounding
-//! boxes into candidate pairs, the narrow phase turns candidates into persistent contact
+//! Collision detection, the broad phase and narrow phase stages of the step
+//! ([`crate::Stage::BroadPhase`], [`crate::Stage::NarrowPhase`]): the broad phase turns loosened
+//! bounding boxes into candidate pairs, the narrow phase turns candidates into persistent contact
 //! manifolds (Parry) with the speculative margins that decide how far ahead points are made.
 
 pub(crate) mod broad_phase;

@@ -1,4 +1,4 @@
-//! Stage 3 of the step: candidate pairs → persistent contact manifolds (Parry).
+//! The narrow phase ([`crate::Stage::NarrowPhase`]): candidate pairs → persistent contact manifolds (Parry).
 //!
 //! Each pair keeps its manifolds from step to step, so Parry can match new contact points to
 //! old ones by feature id and carry the solver's impulses over ([`ContactImpulse`]): that is

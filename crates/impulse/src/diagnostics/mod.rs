@@ -1,4 +1,5 @@
-//! Stage 7 of the step: what the step did and how well its contact LCP was solved.
+//! What a step did and how well its contact LCP was solved ([`StepDiagnostics`], written by
+//! the finish stage), and where its time went, stage by stage ([`Stage`], [`StepProfile`]).
 
 pub(crate) mod contact_lcp;
 
@@ -49,6 +50,9 @@ pub struct StepDiagnostics {
 /// like any timing: it says where a step's time went, it is not a measure of quality.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct StepProfile {
+    /// Kinematic bodies' velocities for the step (and the start poses for continuous
+    /// collision).
+    pub kinematic: f32,
     /// Speculative margins and broad phase (with the energy at the step's start beside them).
     pub broad_phase: f32,
     /// Narrow phase: contact manifolds of the candidate pairs.
@@ -72,11 +76,15 @@ pub struct StepProfile {
     pub total: f32,
 }
 
-/// The stages of a step, in order: what [`StepProfile`] times and docs/architecture.md
-/// describes. `World::step` calls one method per stage.
+/// The stages of a step, in order: the one vocabulary of the step. [`crate::World::step`]
+/// calls one method per stage (each in its file of `world/step/`), [`StepProfile`] times them,
+/// and docs/architecture.md describes them by these names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Stage {
+    /// Kinematic bodies' velocities for the step, from their keyframes or target poses (and
+    /// every body's start pose when continuous collision is on).
+    Kinematic,
     /// Speculative margins and candidate pairs (with the energy at the step's start).
     BroadPhase,
     /// Contact manifolds of the candidate pairs.
@@ -101,7 +109,8 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage, in step order.
-    pub const ALL: [Stage; 9] = [
+    pub const ALL: [Stage; 10] = [
+        Stage::Kinematic,
         Stage::BroadPhase,
         Stage::NarrowPhase,
         Stage::Islands,
@@ -116,6 +125,7 @@ impl Stage {
     /// Snake-case name, as in JSON and the CLI's profile.
     pub fn name(self) -> &'static str {
         match self {
+            Stage::Kinematic => "kinematic",
             Stage::BroadPhase => "broad_phase",
             Stage::NarrowPhase => "narrow_phase",
             Stage::Islands => "islands",
@@ -133,6 +143,7 @@ impl StepProfile {
     /// The time of `stage` (ms).
     pub fn get(&self, stage: Stage) -> f32 {
         match stage {
+            Stage::Kinematic => self.kinematic,
             Stage::BroadPhase => self.broad_phase,
             Stage::NarrowPhase => self.narrow_phase,
             Stage::Islands => self.islands,
@@ -148,6 +159,7 @@ impl StepProfile {
     /// Sets the time of `stage` (ms).
     pub fn set(&mut self, stage: Stage, ms: f32) {
         let field = match stage {
+            Stage::Kinematic => &mut self.kinematic,
             Stage::BroadPhase => &mut self.broad_phase,
             Stage::NarrowPhase => &mut self.narrow_phase,
             Stage::Islands => &mut self.islands,
@@ -162,7 +174,7 @@ impl StepProfile {
     }
 
     /// The stages as (name, ms) pairs, in step order (without `total`).
-    pub fn stages(&self) -> [(&'static str, f32); 9] {
+    pub fn stages(&self) -> [(&'static str, f32); 10] {
         Stage::ALL.map(|stage| (stage.name(), self.get(stage)))
     }
 }
@@ -256,8 +268,8 @@ fn row_squared_natural_map(
 /// The results are those of the three passes to the bit (the residual's partial sums are
 /// taken over the same runs of rows and added in the same order) on any thread count.
 ///
-/// Why: each pass read every 376-byte row; a pile's rows outgrow the caches (pyramid100: 22
-/// MB), so the passes waited on memory, and the friction count ran on one thread.
+/// Why: each pass reads every row, and a pile's rows outgrow the caches, so separate passes
+/// would wait on memory three times (and the friction count would run on one thread).
 pub(crate) fn record_velocity_before_and_residual(
     constraints: &mut [ContactConstraint],
     slots: BodySlots,

@@ -8,7 +8,7 @@ use crate::contact::ContactConstraint;
 use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 
 /// A heavy-on-light island: its contact of largest mass ratio, and how the island was treated
-/// ([`IslandReport::heavy_on_light`]).
+/// ([`crate::IslandReport::heavy_on_light`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct HeavyOnLight {
     /// Index of the heavier body of that contact.

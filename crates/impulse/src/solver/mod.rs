@@ -1,4 +1,4 @@
-//! Stage 5 of the step: the contact rows of one island solved for their impulses.
+//! The solve stage ([`crate::Stage::Solve`]): the contact rows of one island solved for their impulses.
 //!
 //! Every method keeps per-body accumulated impulses: rather than summing the other rows'
 //! impulses for every row, each body carries the velocity those impulses have produced so far,

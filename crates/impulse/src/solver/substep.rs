@@ -1,4 +1,4 @@
-//! One island's step (stages 1, 5 and 6 on one island): per substep, gravity and the
+//! One island's part of the solve stage ([`crate::Stage::Solve`]): per substep, gravity and the
 //! gyroscopic term, warm start, the
 //! solve with overlap repair, position integration and the relax solve; then the restitution
 //! solve. The method is picked here, per island, and called through [`ContactSolver`].
@@ -179,7 +179,7 @@ pub(crate) struct StepContext<'a> {
     pub forces: bool,
 }
 
-/// Runs stages 1, 5 and 6 of one step on one island: per substep of h = dt/substeps, gravity,
+/// Runs one island's part of the solve stage ([`crate::Stage::Solve`]): per substep of h = dt/substeps, gravity,
 /// warm start, the solve with overlap repair, position integration, and the relax solve; then
 /// the restitution solve. Results stay in `workspace` until [`scatter`]. The rows' J·v*
 /// (`velocity_before`) and the residual are recorded here when the SIMD lanes solved the

@@ -2,9 +2,9 @@
 //! impulses, and the events of the last step (pairs that started or stopped touching).
 
 use glam::Vec3;
-use serde::{Deserialize, Serialize};
 
 use super::World;
+use super::contact_events::ContactEvent;
 use crate::body::BodyHandle;
 use crate::collision::narrow_phase::{self, ContactPair};
 
@@ -78,39 +78,6 @@ impl<'a> ContactPairView<'a> {
     pub fn touching(&self) -> bool {
         touching(self.pair)
     }
-}
-
-/// A change in which pairs of bodies touch, from one step to the next ([`World::contact_events`]).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum ContactEvent {
-    /// The bodies touch now and did not at the end of the step before.
-    Started {
-        /// The body with the smaller handle.
-        body1: BodyHandle,
-        /// The other body.
-        body2: BodyHandle,
-        /// Their total normal impulse in the step (N·s): how hard they met.
-        normal_impulse: f32,
-    },
-    /// The bodies touched at the end of the step before and do not now (one may have been
-    /// removed).
-    Stopped {
-        /// The body with the smaller handle.
-        body1: BodyHandle,
-        /// The other body.
-        body2: BodyHandle,
-    },
-}
-
-/// Which pairs touched at the end of the last step, and the events that step produced. Both
-/// lists are kept and reused, so tracking events allocates nothing once they have grown.
-#[derive(Clone, Default, Serialize, Deserialize)]
-pub(crate) struct ContactEvents {
-    /// Touching pairs (smaller handle first) with their total normal impulse, sorted.
-    touching: Vec<(BodyHandle, BodyHandle, f32)>,
-    /// The same for the step just taken, before it replaces `touching`.
-    now: Vec<(BodyHandle, BodyHandle, f32)>,
-    events: Vec<ContactEvent>,
 }
 
 /// Sum of a pair's normal impulses in the last step (N·s), each point once (summed as the

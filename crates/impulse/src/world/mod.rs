@@ -12,42 +12,29 @@ use crate::diagnostics::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms};
 use crate::error::WorldError;
 use crate::island::Islands;
-use crate::kinematic::Script;
 use crate::scene::{BodyDesc, Material, MaterialRef, Scene};
 use crate::settings::SolverSettings;
 use crate::solver::substep::IslandWorkspace;
 
 mod bodies;
+mod contact_events;
 mod contacts;
-mod continuous;
 mod from_scene;
-mod kinematic;
 mod query;
 mod snapshot;
 mod step;
 
 use step::EnergyCheck;
+use step::kinematic_script::Script;
 
 pub use bodies::BodyRef;
-pub use contacts::{ContactEvent, ContactPairView, ContactPoint};
+pub use contact_events::ContactEvent;
+pub use contacts::{ContactPairView, ContactPoint};
 pub use query::{RayHit, ShapeHit};
 pub use snapshot::{SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
 
 pub use crate::settings::BLOW_UP_DISTANCE;
-/// A body faster than this (m/s) means the simulation has blown up.
-pub const BLOW_UP_SPEED: f32 = 1.0e4;
-/// Mechanical energy (kinetic + gravitational, [`crate::diagnostics::EnergyTerms`]) more than
-/// this many joules per kilogram of moving mass above the lowest it has been since the last
-/// edit means the simulation has blown up. Contacts only take energy out; what the overlap
-/// repair puts in is lifting bodies out of each other (the `overlap_pyramid` scene, started
-/// 25 % overlapping, gains about 10 J/kg). 50 J/kg is every body lifted 5 m or moving at
-/// 10 m/s. A solve that fails to hold a pile can push it apart far faster than that while no
-/// body comes near [`BLOW_UP_SPEED`] (`impulse run pyramid100 --method pgs --substeps 4
-/// --iterations 1 --position-iterations 1` is such a solve; tests/blow_up.rs). Changing
-/// bodies between steps (velocities, poses, forces, new or removed bodies, gravity: every
-/// edit that wakes a body, [`World::wake_up`]) restarts the reference.
-pub const BLOW_UP_ENERGY_PER_KG: f64 = 50.0;
-
+pub use step::{BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED};
 /// Bodies, settings and the persistent contact state of a simulation.
 pub struct World {
     /// The bodies, in scene order while none has been removed (a removal moves the last body
@@ -81,7 +68,7 @@ pub struct World {
     /// Body indices, for edits that visit a body's neighbours.
     scratch_bodies: Vec<u32>,
     /// Contact pairs touching at the end of the last step, and this step's events.
-    contact_events: contacts::ContactEvents,
+    contact_events: contact_events::ContactEvents,
     /// Simulated time (s): the sum of the steps' dt.
     time: f64,
     /// The position-based kinematic bodies' keyframes and targets.
@@ -151,7 +138,7 @@ impl World {
             profile: StepProfile::default(),
             forces_pending: false,
             scratch_bodies: Vec::new(),
-            contact_events: contacts::ContactEvents::default(),
+            contact_events: contact_events::ContactEvents::default(),
             time: 0.0,
             scripts: Vec::new(),
             start_poses: Vec::new(),

@@ -23,14 +23,14 @@ use parry3d::shape::{Shape, SharedShape, TypedShape};
 use serde::{Deserialize, Serialize};
 
 use super::World;
-use super::contacts::ContactEvents;
+use super::contact_events::ContactEvents;
 use super::step::EnergyCheck;
+use super::step::kinematic_script::Script;
 use crate::body::{Bodies, BodyKind, Handles};
 use crate::collision::broad_phase::{BroadPhase, BroadPhaseState};
 use crate::collision::narrow_phase::{NarrowPhase, PairState};
 use crate::diagnostics::StepDiagnostics;
 use crate::error::SnapshotError;
-use crate::kinematic::Script;
 use crate::scene::MeshData;
 use crate::scene::validate::mesh_problem;
 use crate::settings::SolverSettings;

@@ -174,7 +174,7 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
     }
 }
 
-/// The per-body and per-pair passes (assembly, impulse write-back, scatter of island results,
+/// The per-body and per-pair passes (assembly, store impulses, scatter of island results,
 /// world inertia, residuals) split their work over threads only above a thousand bodies or
 /// pairs: 4096 falling balls, landing in 256 columns, take every one of those paths, and two
 /// threads must reproduce one thread exactly, diagnostics included.

@@ -1,0 +1,24 @@
+//! The broad phase stage ([`crate::Stage::BroadPhase`]): speculative margins and candidate
+//! pairs on the poses and velocities at the step's start (`collision/broad_phase.rs`).
+
+use crate::World;
+use crate::settings::SolverSettings;
+
+impl World {
+    /// Each body's speculative margin, then the candidate pairs of bodies whose loosened boxes
+    /// overlap.
+    pub(super) fn broad_phase_stage(&mut self, settings: &SolverSettings, parallel: bool) {
+        self.margins.update(
+            &self.bodies,
+            settings.prediction_distance,
+            self.gravity,
+            self.dt,
+        );
+        self.broad_phase.candidate_pairs(
+            &self.bodies,
+            self.margins.margins(),
+            parallel,
+            &mut self.candidates,
+        );
+    }
+}

@@ -1,0 +1,36 @@
+//! The islands stage ([`crate::Stage::Islands`]): islands from the pairs (`island.rs`), and
+//! every body's world inverse inertia tensor beside them.
+
+use glam::Mat3;
+
+use crate::World;
+use crate::body::Bodies;
+use crate::parallel::{BODIES_PER_TASK, both, map_into, spread};
+
+impl World {
+    /// Islands from the pairs first, so that assembly writes each island's constraints
+    /// contiguously and nothing has to be moved afterwards. The union-find is serial; the
+    /// world inertia tensors (from the poses alone) are computed beside it.
+    pub(super) fn islands_stage(&mut self, parallel: bool) {
+        let (islands, world_inverse_inertia) = (&mut self.islands, &mut self.world_inverse_inertia);
+        let (bodies, pairs) = (&self.bodies, &self.narrow_phase.pairs);
+        both(
+            parallel,
+            || world_inverse_inertia_of(bodies, parallel, world_inverse_inertia),
+            || islands.build(bodies, pairs),
+        );
+    }
+}
+
+/// World-frame inverse inertia tensors I⁻¹ = R I_local⁻¹ Rᵀ (1/(kg·m²)) of every body at its
+/// current pose, restricted to the free rotations of bodies with locked rotation axes
+/// (`Bodies::world_inverse_inertia`); zero for bodies that do not rotate.
+fn world_inverse_inertia_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Mat3>) {
+    map_into(
+        spread(parallel, 1, 0),
+        bodies.len(),
+        BODIES_PER_TASK,
+        |i| bodies.world_inverse_inertia(i),
+        out,
+    );
+}

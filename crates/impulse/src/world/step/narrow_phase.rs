@@ -1,0 +1,18 @@
+//! The narrow phase stage ([`crate::Stage::NarrowPhase`]): contact manifolds of the candidate
+//! pairs (Parry, `collision/narrow_phase.rs`), beside the broad phase tree's upkeep.
+
+use crate::World;
+use crate::error::StepError;
+use crate::parallel::both;
+
+impl World {
+    /// The manifolds of the candidate pairs, with the broad phase's tree optimised beside them
+    /// (neither reads what the other writes).
+    pub(super) fn narrow_phase_stage(&mut self, parallel: bool) -> Result<(), StepError> {
+        let (broad_phase, narrow_phase) = (&mut self.broad_phase, &mut self.narrow_phase);
+        let (bodies, candidates, margins) = (&self.bodies, &self.candidates, &self.margins);
+        let narrow = || narrow_phase.update(bodies, candidates, margins, parallel);
+        both(parallel, || broad_phase.optimize(), narrow).1?;
+        Ok(())
+    }
+}
