@@ -200,13 +200,13 @@ pub(crate) fn step_island(
     workspace: &mut IslandWorkspace,
 ) {
     let w = workspace;
-    // The substep length of the step's settings, also on the heavy-on-light path.
-    let h = context.dt / context.settings.substeps as f32;
     w.gather(island_bodies, guests, context);
-    w.step_constants(island_bodies, context, h);
     w.start_report(island_bodies, constraints, context.bodies);
     let heavy = w.heavy_on_light_path(island_bodies, constraints, context);
     let settings = heavy.as_ref().unwrap_or(context.settings);
+    // The substeps cover the whole step: on the heavy-on-light path, one substep of dt.
+    let h = context.dt / settings.substeps as f32;
+    w.step_constants(island_bodies, context, h);
     w.start_solves(constraints, settings, context);
     let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
     for substep in 0..settings.substeps {
