@@ -18,18 +18,25 @@ class ImpulseBakeSettings(bpy.types.PropertyGroup):
         name="Quality",
         description="impulse's solver preset: more substeps cost more and hold stacks better",
         items=(
-            ("fast", "Fast", "The soft step at 480 substeps a second (20 a frame at 24 fps): cheapest"),
-            ("default", "Default", "The soft step at 1,200 substeps a second (50 a frame at 24 fps)"),
-            ("precise", "Precise", "The soft step at 2,880 substeps a second (120 a frame at 24 fps): slowest"),
+            ("fast", "Fast", "The soft step at 480 substeps a second: cheapest"),
+            ("default", "Default", "The soft step at 1,200 substeps a second"),
+            ("precise", "Precise", "The soft step at 2,880 substeps a second: slowest"),
         ),
         default="default",
     )
     substeps: bpy.props.IntProperty(
         name="Substeps",
-        description="Substeps per frame; 0 takes the preset's rate of substeps a second",
+        description="Substeps per step; 0 takes the preset's rate of substeps a second",
         default=0,
         min=0,
         soft_max=200,
+    )
+    steps_per_frame: bpy.props.IntProperty(
+        name="Steps per Frame",
+        description="Simulation steps per frame (contacts are found once a step); 0 keeps a step within 1/60 s",
+        default=0,
+        min=0,
+        soft_max=16,
     )
 
 
@@ -61,7 +68,7 @@ class IMPULSE_OT_bake(bpy.types.Operator):
     def _start(self, context):
         settings = context.scene.impulse_bake
         try:
-            return bake.Baker(context.scene, settings.preset, settings.substeps)
+            return bake.Baker(context.scene, settings.preset, settings.substeps, settings.steps_per_frame)
         except scene_reader.UnsupportedScene as error:
             for problem in error.problems:
                 self.report({"ERROR"}, problem)
@@ -132,6 +139,7 @@ def _draw(layout, context):
     column = layout.column()
     column.prop(settings, "preset")
     column.prop(settings, "substeps")
+    column.prop(settings, "steps_per_frame")
     column.operator(IMPULSE_OT_bake.bl_idname, icon="PHYSICS")
 
 

@@ -28,7 +28,7 @@ def error_at_end(info, positions, orientations, static_scene):
     """E (m) of poses (N, 3) and (N, 4) of the bodies of ``info`` (a ``SceneInfo``) at the end:
     for a scene meant to stay at rest the largest of overlap, drift and top sink; else the
     overlap. Also returns the quality dict."""
-    world = bake.make_world(info.scene)
+    world, _ = bake.make_world(info.scene)
     initial = world.positions.copy()
     world.positions = positions
     world.orientations = orientations
