@@ -145,3 +145,19 @@ def test_settings_map_to_the_scene_format():
     assert bodies["ground"].kind == "static"
     assert info.dt == pytest.approx(1 / 30)
     assert info.scene["gravity"] == pytest.approx([0.0, -9.81, 0.0])
+
+
+def test_a_bake_in_chunks_stopped_early_keeps_the_frames_done():
+    # What the modal operator does: chunks of frames between events, Esc → write what is done.
+    scene = scenes.dominoes(FRAMES)
+    whole = bake.bake_scene(scene)
+    expected = np.stack(whole.positions)
+    baker = bake.Baker(scene)
+    while baker.frames_done < 10:
+        baker.advance(max_frames=3, max_seconds=0.0)  # at least one frame a call
+    assert baker.frames_done == 10 and not baker.done
+    baker.write()
+    np.testing.assert_array_equal(np.stack(baker.positions), expected[:10])
+    locations, _ = keyed(scene.objects["domino05"])
+    assert locations.shape == (10, 2, 3)
+    np.testing.assert_array_equal(locations[:, 0, 0], np.arange(1, 11))
