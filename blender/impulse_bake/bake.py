@@ -12,6 +12,7 @@ or :func:`bake_scene` for all of it at once.
 """
 
 import math
+import re
 import time
 
 import numpy as np
@@ -74,6 +75,14 @@ def make_world(scene_dict, preset="default", substeps=0, frame_steps=0):
     return impulse.World.from_scene(scene_dict, settings=settings), count
 
 
+def _name_the_body(message, info):
+    """impulse's scene error (``bodies[3].shape.points: ...``) led by the object's name."""
+    found = re.search(r"bodies\[(\d+)\]", message)
+    if found is None or int(found.group(1)) >= len(info.bodies):
+        return f"{info.scene.get('name', 'scene')}: {message}"
+    return f"{info.bodies[int(found.group(1))].object_name}: {message}"
+
+
 class Baker:
     """One bake of a scene's Rigid Body World: reads it (undoing an earlier bake first),
     builds the impulse world, steps it frame by frame on :meth:`advance` (``frame_steps``
@@ -89,7 +98,10 @@ class Baker:
         objects = scene_reader.rigid_body_objects(scene)
         scene_reader.restore_rest_poses(objects)
         self.info = scene_reader.read_scene(scene)
-        self.world, self.frame_steps = make_world(self.info.scene, preset, substeps, frame_steps)
+        try:
+            self.world, self.frame_steps = make_world(self.info.scene, preset, substeps, frame_steps)
+        except import_impulse().SceneError as error:
+            raise scene_reader.UnsupportedScene([_name_the_body(str(error), self.info)]) from error
         self.dynamic = [i for i, b in enumerate(self.info.bodies) if b.kind == "dynamic"]
         self.positions = [self.world.positions[self.dynamic].copy()]
         self.orientations = [self.world.orientations[self.dynamic].copy()]

@@ -120,6 +120,23 @@ def test_unsupported_things_are_reported_naming_the_object():
     assert any(p.startswith("hinge: ") and "constraint" in p for p in problems), problems
 
 
+def test_a_shape_impulse_refuses_is_reported_naming_the_object():
+    # A flat plane as a convex hull: impulse needs hull points that span a volume.
+    scene = scenes.stack30(4)
+    plane = bpy.data.meshes.new("plane")
+    plane.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
+    obj = bpy.data.objects.new("flat", plane)
+    scene.collection.objects.link(obj)
+    obj.location = (5.0, 0.0, 1.0)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.ops.rigidbody.object_add(type="ACTIVE")
+    obj.rigid_body.collision_shape = "CONVEX_HULL"
+    with pytest.raises(scene_reader.UnsupportedScene) as raised:
+        bake.Baker(scene)
+    assert raised.value.problems[0].startswith("flat: "), raised.value.problems
+
+
 def test_settings_map_to_the_scene_format():
     scene = scenes.heavy_on_light(4)
     heavy = scene.objects["heavy"]
