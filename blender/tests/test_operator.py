@@ -1,0 +1,99 @@
+"""The add-on registered in Blender and its operator run from a script.
+
+With ``IMPULSE_BLENDER_ADDON_ZIP`` set (``.ci/run`` sets it to the plain add-on zip the build
+script made), the zip is unpacked and its add-on registered (its ``impulse`` package from the
+zip's ``vendor/`` when none is installed); otherwise the source directory ``blender/`` is.
+"""
+
+import importlib
+import importlib.util
+import os
+import pathlib
+import subprocess
+import sys
+import zipfile
+
+import bpy
+import pytest
+from impulse_bake import keyframes
+
+import scenes
+
+SOURCE = pathlib.Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="module")
+def addon(tmp_path_factory):
+    # Registered by hand rather than enabled through addon_utils: the scene builders reload
+    # factory settings, which would disable an enabled add-on again.
+    archive = os.environ.get("IMPULSE_BLENDER_ADDON_ZIP")
+    if archive:
+        target = tmp_path_factory.mktemp("addons")
+        with zipfile.ZipFile(archive) as packed:
+            packed.extractall(target)
+        sys.path.insert(0, str(target))
+        module = importlib.import_module("impulse_blender")
+        assert pathlib.Path(module.__file__).parent == target / "impulse_blender"
+    else:
+        spec = importlib.util.spec_from_file_location(
+            "impulse_blender", SOURCE / "__init__.py", submodule_search_locations=[str(SOURCE)]
+        )
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["impulse_blender"] = module
+        spec.loader.exec_module(module)
+    module.register()
+    yield module
+    module.unregister()
+
+
+def test_the_operator_bakes_the_scene(addon):
+    scene = scenes.heavy_on_light(12)
+    scene.impulse_bake.preset = "fast"
+    assert bpy.ops.impulse.bake.poll()
+    assert bpy.ops.impulse.bake() == {"FINISHED"}
+    heavy = scene.objects["heavy"]
+    assert heavy.rotation_mode == "QUATERNION"
+    assert not scene.rigidbody_world.enabled
+    fcurve = keyframes._fcurve_collection(heavy, create=False).find("location", index=2)
+    assert len(fcurve.keyframe_points) == 12
+
+
+def test_the_operator_reports_an_unsupported_scene(addon):
+    scene = scenes.stack30(4)
+    scene.objects["cube05"].rigid_body.collision_shape = "COMPOUND"
+    with pytest.raises(RuntimeError, match="cube05: the Compound Parent collision shape is not supported"):
+        bpy.ops.impulse.bake()
+    assert scene.rigidbody_world.enabled
+
+
+EXTENSION_CHECK = """
+import bpy
+bpy.context.preferences.system.use_online_access = False
+result = bpy.ops.extensions.package_install_files(
+    filepath={archive!r}, repo="user_default", enable_on_install=True
+)
+assert result == {{"FINISHED"}}, result
+assert "bake" in dir(bpy.ops.impulse)
+print("installed")
+"""
+
+
+@pytest.mark.skipif(
+    not os.environ.get("IMPULSE_BLENDER_EXTENSION_ZIP"), reason="needs IMPULSE_BLENDER_EXTENSION_ZIP (set by .ci/run)"
+)
+def test_the_extension_installs_with_its_wheel(tmp_path):
+    # In a child process with its own home: installing writes to Blender's user directories.
+    archive = os.environ["IMPULSE_BLENDER_EXTENSION_ZIP"]
+    environment = dict(os.environ, HOME=str(tmp_path))
+    result = subprocess.run(
+        [sys.executable, "-c", EXTENSION_CHECK.format(archive=str(pathlib.Path(archive).resolve()))],
+        env=environment,
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "installed" in result.stdout
+    # Blender installed the bundled wheel into the extensions' own site-packages.
+    assert list(tmp_path.glob(".config/blender/*/extensions/.local/lib/python*/site-packages/impulse/_impulse*"))
