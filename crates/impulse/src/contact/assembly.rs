@@ -1,4 +1,4 @@
-//! Assembly, stage 4 of the step: contact points → constraint rows, laid out island by island,
+//! The assembly stage ([`crate::Stage::Assembly`]): contact points → constraint rows, laid out island by island,
 //! with friction directions kept from the last step and the impulses of the last step scaled
 //! for the warm start.
 

@@ -204,7 +204,7 @@ pub struct ContactConstraint {
     /// the sum of each substep's final impulses, plus what the restitution solve added. What
     /// the world reports per contact; the solver never reads it.
     pub step_impulses: [f32; 3],
-    /// Where the point lives: (pair, manifold, point) in the narrow phase, for write-back.
+    /// Where the point lives: (pair, manifold, point) in the narrow phase, where the store-impulses stage writes the impulses back.
     pub source: (u32, u16, u16),
     /// Whether the rows' lever-arm products are yet to be computed: each row's angular parts
     /// `angular_a`/`_b` (r × d, from the lever arms and the direction),

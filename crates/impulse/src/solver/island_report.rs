@@ -6,8 +6,8 @@ use super::interface::EscalationLevel;
 #[cfg(doc)]
 use crate::settings::SolverSettings;
 
-/// What the solver did on one island during a step (step 7 of docs/architecture.md: every step can say how
-/// well its LCP was solved, here per island).
+/// What the solver did on one island during a step: every step can say how well its LCP was
+/// solved, here per island.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct IslandReport {
     /// Smallest body index in the island: a stable name for it within the step.

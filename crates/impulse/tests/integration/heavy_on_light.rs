@@ -312,7 +312,10 @@ fn the_heavy_on_light_path_advances_the_whole_step() {
                 .iter()
                 .any(|island| island.heavy_on_light.is_some());
         }
-        assert!(took_the_path, "substeps {substeps}: the island took the ordinary path");
+        assert!(
+            took_the_path,
+            "substeps {substeps}: the island took the ordinary path"
+        );
         let x = world.poses()[heavy].translation.x;
         assert!(
             (x - 2.0).abs() < 0.02,

@@ -1,4 +1,4 @@
-//! Stage 5 in SIMD lanes: the PGS sweep of [`crate::solver::solve_pgs`] run on
+//! The solve stage in SIMD lanes: the PGS sweep of [`crate::solver::solve_pgs`] run on
 //! [`LANES`](lane::LANES) contact points at once, one point per lane, each lane taking a
 //! manifold's points in turn. A sliding point's friction takes a cheaper update with the same
 //! fixed point as the scalar sweep's (see [`sweep::solve_bundle`]).

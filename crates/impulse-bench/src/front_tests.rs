@@ -1,0 +1,307 @@
+//! Unit tests of `front.rs`: the front's dominance, bars and tables on hand-made points.
+
+use super::*;
+use impulse::SolverMethod;
+
+fn point(engine: &str, setting: &str, ms: f64, e_mm: f64) -> FrontPoint {
+    FrontPoint {
+        engine: engine.into(),
+        setting: setting.into(),
+        ms_per_step: ms,
+        e_mm,
+        sink_mm: e_mm,
+        overlap_mm: 0.0,
+        drift_mm: 0.0,
+        steps: 10,
+        details: String::new(),
+        failed: None,
+    }
+}
+
+fn names(points: &[&FrontPoint]) -> Vec<String> {
+    points.iter().map(|p| p.setting.clone()).collect()
+}
+
+#[test]
+fn pareto_front_drops_dominated_points_and_keeps_ties() {
+    let mut failed = point(IMPULSE, "failed", 0.01, 0.0);
+    failed.failed = Some("blew up".into());
+    let points = vec![
+        point(IMPULSE, "slow good", 4.0, 0.5),
+        point(IMPULSE, "fast bad", 1.0, 40.0),
+        point(IMPULSE, "mid", 2.0, 3.0),
+        // Slower and worse than "mid".
+        point(IMPULSE, "dominated", 3.0, 4.0),
+        // As fast as "mid", worse: dominated.
+        point(IMPULSE, "same time worse", 2.0, 3.5),
+        // As good as "slow good", slower: dominated.
+        point(IMPULSE, "same e slower", 5.0, 0.5),
+        // The same time and E as "mid": neither dominates the other.
+        point(IMPULSE, "mid twin", 2.0, 3.0),
+        failed,
+        point(IMPULSE, "nan", f64::NAN, 1.0),
+        // Another engine's point would dominate everything.
+        point(RAPIER, "other engine", 0.1, 0.1),
+    ];
+    let front = pareto_front(&points, IMPULSE);
+    assert_eq!(names(&front), ["fast bad", "mid", "mid twin", "slow good"]);
+    assert_eq!(names(&pareto_front(&points, RAPIER)), ["other engine"]);
+    assert!(pareto_front(&points, "nobody").is_empty());
+}
+
+#[test]
+fn cheapest_meeting_each_bar() {
+    let mut failed = point(IMPULSE, "failed", 0.1, 0.0);
+    failed.failed = Some("blew up".into());
+    let points = vec![
+        point(IMPULSE, "a", 1.0, 30.0),
+        point(IMPULSE, "b", 2.0, 4.0),
+        point(IMPULSE, "c", 3.0, 5.0),
+        point(IMPULSE, "d", 2.0, 2.0),
+        failed,
+        point(RAPIER, "r", 0.5, 0.9),
+    ];
+    let at = |bar| cheapest_meeting(&points, IMPULSE, bar).map(|p| p.setting.as_str());
+    assert_eq!(at(50.0), Some("a"));
+    // At the same time the smaller E wins.
+    assert_eq!(at(5.0), Some("d"));
+    // E equal to the bar meets it.
+    assert_eq!(at(30.0), Some("a"));
+    assert_eq!(at(1.0), None);
+    let rapier = cheapest_meeting(&points, RAPIER, 1.0).unwrap();
+    assert_eq!(rapier.setting, "r");
+}
+
+#[test]
+fn error_is_the_largest_of_sink_overlap_and_drift() {
+    assert_eq!(error_mm(-7.0, 2.0, 3.0), 7.0);
+    assert_eq!(error_mm(1.0, 2.0, 3.0), 3.0);
+    assert_eq!(error_mm(0.0, 0.0, 0.0), 0.0);
+    assert!(error_mm(f64::NAN, 0.0, 0.0).is_nan());
+    assert_eq!(error_mm(f64::INFINITY, 0.0, 0.0), f64::INFINITY);
+}
+
+/// A run that blew up is a failed point, and so is one whose result is not finite.
+#[test]
+fn failed_runs_are_failed_points() {
+    let mut row = BenchRow::new(
+        "s",
+        "impulse",
+        2,
+        10,
+        &mut [1.0; 10],
+        crate::QualityReport::default(),
+        "settings".into(),
+    );
+    row.top_sink_m = -0.002;
+    let ok = FrontPoint::from_row(IMPULSE, "fast", &row, None);
+    assert!(ok.counts());
+    assert_eq!((ok.e_mm, ok.sink_mm, ok.ms_per_step), (2.0, -2.0, 1.0));
+    let error = Some("step 7: blew up".to_string());
+    let blown = FrontPoint::from_row(IMPULSE, "fast", &row, error.clone());
+    assert!(!blown.counts());
+    assert_eq!(blown.failed, error);
+    row.max_drift_m = f64::NAN;
+    let nan = FrontPoint::from_row(IMPULSE, "fast", &row, None);
+    assert_eq!(nan.failed.as_deref(), Some("non-finite result"));
+    let points = [ok, blown, nan];
+    assert_eq!(pareto_front(&points, IMPULSE).len(), 1);
+    let json = serde_json::to_value(&points[2]).unwrap();
+    assert!(json["e_mm"].is_null() && json["failed"].is_string());
+}
+
+#[test]
+fn tables_mark_bars_no_setting_meets() {
+    let front = SceneFront {
+        scene: "s".into(),
+        bodies: 4,
+        steps: 20,
+        points: vec![
+            point(IMPULSE, "fast", 1.0, 30.0),
+            point(IMPULSE, "default", 4.0, 0.5),
+            point(RAPIER, "4×30Hz", 2.0, 40.0),
+            point(RAPIER, "32×480Hz", 8.0, 3.0),
+        ],
+    };
+    let table = format_bar_table(&front);
+    let lines: Vec<&str> = table.lines().collect();
+    assert_eq!(lines.len(), 5, "{table}");
+    assert_eq!(
+        lines[2],
+        "| Q50 (E ≤ 50 mm) | fast | 1.00 | 30.0 | 4×30Hz | 2.00 | 40.0 | 0.50 |"
+    );
+    assert_eq!(
+        lines[3],
+        "| Q5 (E ≤ 5 mm) | default | 4.00 | 0.500 | 32×480Hz | 8.00 | 3.00 | 0.50 |"
+    );
+    assert_eq!(
+        lines[4],
+        "| Q1 (E ≤ 1 mm) | default | 4.00 | 0.500 | — | — | — | impulse only |"
+    );
+    let summary = format_summary_table(std::slice::from_ref(&front));
+    assert!(
+        summary.contains("| s | 4 | 20 | 0.50 | 0.50 | impulse only |"),
+        "{summary}"
+    );
+
+    // Neither engine meets Q1; only Rapier meets Q5.
+    let front = SceneFront {
+        points: vec![
+            point(IMPULSE, "fast", 1.0, 30.0),
+            point(RAPIER, "32×480Hz", 8.0, 3.0),
+        ],
+        ..front
+    };
+    let table = format_bar_table(&front);
+    let lines: Vec<&str> = table.lines().collect();
+    assert!(lines[3].starts_with("| Q5 (E ≤ 5 mm) | — | — | — | 32×480Hz |"));
+    assert!(lines[3].ends_with("| rapier only |"), "{}", lines[3]);
+    assert_eq!(lines[4], "| Q1 (E ≤ 1 mm) | — | — | — | — | — | — | — |");
+
+    // Without Rapier measured at all, impulse alone is not "impulse only".
+    let front = SceneFront {
+        points: vec![point(IMPULSE, "fast", 1.0, 0.5)],
+        ..front
+    };
+    assert!(
+        format_bar_table(&front)
+            .lines()
+            .all(|l| !l.contains("only"))
+    );
+
+    let fronts = format_front_table(&SceneFront {
+        points: vec![
+            point(IMPULSE, "fast", 1.0, 30.0),
+            point(IMPULSE, "worse", 2.0, 31.0),
+            point(RAPIER, "4×30Hz", 2.0, 40.0),
+        ],
+        ..front
+    });
+    assert_eq!(fronts.lines().count(), 4, "{fronts}");
+    assert!(fronts.contains("| impulse | fast | 1.00 | 30.0 | 30.0 | 0.000 | 0.000 |"));
+    assert!(!fronts.contains("worse"));
+}
+
+#[test]
+fn grids_have_the_documented_sizes_and_names() {
+    let grid = impulse_grid();
+    assert_eq!(grid.len(), 4 + 14 + 3 + 5);
+    assert_eq!(grid[0], ("default".to_string(), None));
+    assert_eq!(grid[1].1, Some(SolverSettings::fast()));
+    // The presets are soft steps the grid does not repeat.
+    let (name, settings) = grid.iter().find(|(name, _)| name == "soft 16").unwrap();
+    assert_eq!(
+        settings.as_ref(),
+        Some(&SolverSettings::soft_step(16)),
+        "{name}"
+    );
+    let settings: Vec<&SolverSettings> = grid.iter().filter_map(|(_, s)| s.as_ref()).collect();
+    for preset in ["default", "fast", "precise", "reference"] {
+        let preset = SolverSettings::preset(preset).unwrap();
+        let copies = settings.iter().filter(|s| ***s == preset).count();
+        assert!(copies <= 1, "{preset:?} measured {copies} times");
+    }
+    let names: std::collections::HashSet<&String> = grid.iter().map(|(n, _)| n).collect();
+    assert_eq!(names.len(), grid.len(), "names are unique");
+    let (_, split) = grid.iter().find(|(n, _)| n == "reference 2×4").unwrap();
+    let split = split.as_ref().unwrap();
+    assert!(split.split_impulse() && split.method == SolverMethod::Auto);
+    assert_eq!((split.substeps, split.iterations), (2, 4));
+    assert!(impulse_quick_grid().len() < 5);
+    #[cfg(feature = "rapier")]
+    {
+        let grid = rapier_grid();
+        assert_eq!(grid.len(), 40);
+        let names: std::collections::HashSet<String> =
+            grid.iter().map(|v| v.setting_name()).collect();
+        assert_eq!(names.len(), 40);
+        assert!(names.contains("4×30Hz") && names.contains("32×480Hz coulomb"));
+        assert!(rapier_quick_grid().len() < 5);
+    }
+}
+
+#[test]
+fn large_scenes_run_fewer_steps() {
+    let config = FrontConfig {
+        steps: 600,
+        large_steps: 120,
+        ..FrontConfig::default()
+    };
+    let small = scene_by_name("stack3").unwrap();
+    let large = scene_by_name("pyramid100").unwrap();
+    assert_eq!(config.steps_for(&small), 600);
+    assert_eq!(config.steps_for(&large), 120);
+}
+
+/// `front --quick` on a small scene, end to end: points of both engines (with `rapier`),
+/// a table row per bar, a plot per scene.
+#[test]
+fn quick_front_on_a_small_stack() {
+    let config = FrontConfig {
+        scenes: vec!["stack3".into()],
+        steps: 20,
+        large_steps: 20,
+        quick: true,
+    };
+    let mut progress = Vec::new();
+    let fronts = run_front(&config, &mut |p| {
+        progress.push((p.done, p.total, p.point.engine.clone()))
+    })
+    .unwrap();
+    assert_eq!(fronts.len(), 1);
+    let front = &fronts[0];
+    assert_eq!((front.scene.as_str(), front.steps), ("stack3", 20));
+    let expected = config.impulse_settings().len() + config.rapier_settings().len();
+    assert_eq!(front.points.len(), expected);
+    assert_eq!(progress.len(), expected);
+    assert_eq!(progress.last().unwrap().0, progress.last().unwrap().1);
+    // The engines take turns.
+    assert_eq!(front.points[0].engine, IMPULSE);
+    if cfg!(feature = "rapier") {
+        assert_eq!(front.points[1].engine, RAPIER);
+        assert!(front.measured(RAPIER));
+    }
+    for p in &front.points {
+        assert!(p.counts(), "{p:?}");
+        assert_eq!(p.steps, 20);
+        assert!(p.ms_per_step > 0.0);
+        // A three-cube stack stands within a few centimetres for every setting.
+        assert!(p.e_mm < 50.0, "{p:?}");
+    }
+    assert!(!pareto_front(&front.points, IMPULSE).is_empty());
+
+    let dir = std::env::temp_dir().join(format!("impulse-front-test-{}", std::process::id()));
+    let paths = crate::plot::write_plots(&fronts, &dir).unwrap();
+    assert_eq!(paths, [dir.join("front-stack3.svg")]);
+    let svg = std::fs::read_to_string(&paths[0]).unwrap();
+    assert!(svg.starts_with("<svg"), "{}", &svg[..svg.len().min(200)]);
+    assert!(svg.contains("stack3") && svg.contains("Q50"));
+
+    let tables = format_tables(&fronts, Plots::Path(&dir));
+    assert!(tables.contains(&format!("Plot: `{}`", paths[0].display())));
+    let markdown = format_markdown(
+        &fronts,
+        Plots::Image(Path::new("")),
+        "impulse-bench front stack3",
+        &MachineInfo::current(),
+        &MachineInfo::current(),
+    );
+    assert!(markdown.contains("![front-stack3](front-stack3.svg)"));
+    for bar in [
+        "| Q50 (E ≤ 50 mm) |",
+        "| Q5 (E ≤ 5 mm) |",
+        "| Q1 (E ≤ 1 mm) |",
+    ] {
+        let rows = tables.lines().filter(|l| l.starts_with(bar)).count();
+        assert_eq!(rows, 1, "{bar}: {tables}");
+    }
+    assert!(tables.contains("#### stack3 (4 bodies, 20 steps,"));
+    let machine = MachineInfo::current();
+    let json = front_json(&fronts, "impulse-bench front stack3", &machine, &machine);
+    assert_eq!(
+        json["scenes"][0]["points"].as_array().unwrap().len(),
+        expected
+    );
+    assert_eq!(json["scenes"][0]["steps"], 20);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

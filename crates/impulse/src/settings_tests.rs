@@ -1,0 +1,328 @@
+//! Unit tests of `settings.rs`.
+
+use super::*;
+
+/// The one problem of `settings`, as "field: message".
+fn problem(settings: SolverSettings) -> String {
+    let problems = settings.problems();
+    assert_eq!(problems.len(), 1, "{problems:?}");
+    assert_eq!(settings.validate(), Err(problems[0].clone()));
+    format!("{}: {}", problems[0].field, problems[0].message)
+}
+
+#[test]
+fn presets_are_valid() {
+    for settings in [
+        SolverSettings::default(),
+        SolverSettings::fast(),
+        SolverSettings::precise(),
+        SolverSettings::reference(),
+        SolverSettings::soft_step(1),
+    ] {
+        assert_eq!(settings.problems(), Vec::new());
+        assert_eq!(settings.validate(), Ok(()));
+    }
+}
+
+#[test]
+fn each_rule_names_its_field_and_what_is_allowed() {
+    let base = SolverSettings::default;
+    let cases = [
+        (
+            SolverSettings {
+                iterations: 0,
+                ..base()
+            },
+            "iterations: must be ≥ 1, got 0",
+        ),
+        (
+            SolverSettings {
+                substeps: 0,
+                ..base()
+            },
+            "substeps: must be ≥ 1, got 0",
+        ),
+        (
+            SolverSettings {
+                escalation_iterations: 0,
+                ..base()
+            },
+            "escalation_iterations: must be ≥ 1, got 0",
+        ),
+        (
+            SolverSettings {
+                repair: ContactRepair::SplitImpulse {
+                    rate: 10.0,
+                    iterations: 0,
+                },
+                ..base()
+            },
+            "repair.iterations: must be ≥ 1, got 0",
+        ),
+        (
+            SolverSettings {
+                repair: ContactRepair::Soft {
+                    hertz: 0.0,
+                    damping_ratio: 1.0,
+                },
+                ..base()
+            },
+            "repair.hertz: must be > 0, got 0",
+        ),
+        (
+            SolverSettings {
+                repair: ContactRepair::Soft {
+                    hertz: f32::NAN,
+                    damping_ratio: 1.0,
+                },
+                ..base()
+            },
+            "repair.hertz: must be finite, got NaN",
+        ),
+        (
+            SolverSettings {
+                repair: ContactRepair::Soft {
+                    hertz: 30.0,
+                    damping_ratio: -1.0,
+                },
+                ..base()
+            },
+            "repair.damping_ratio: must be ≥ 0, got -1",
+        ),
+        (
+            SolverSettings {
+                repair: ContactRepair::Bias { rate: f32::NAN },
+                ..base()
+            },
+            "repair.rate: must be finite, got NaN",
+        ),
+        (
+            SolverSettings {
+                tolerance: -1.0,
+                ..base()
+            },
+            "tolerance: must be ≥ 0, got -1",
+        ),
+        (
+            SolverSettings {
+                time_to_sleep: f32::INFINITY,
+                ..base()
+            },
+            "time_to_sleep: must be finite, got inf",
+        ),
+        (
+            SolverSettings {
+                max_repair_speed: -0.5,
+                ..base()
+            },
+            "max_repair_speed: must be ≥ 0, got -0.5",
+        ),
+        (
+            SolverSettings {
+                warm_start: 1.5,
+                ..base()
+            },
+            "warm_start: must be in [0, 1], got 1.5",
+        ),
+        (
+            SolverSettings {
+                warm_start: f32::NAN,
+                ..base()
+            },
+            "warm_start: must be finite, got NaN",
+        ),
+    ];
+    for (settings, expected) in cases {
+        assert_eq!(problem(settings), expected);
+    }
+}
+
+#[test]
+fn every_problem_is_listed_in_field_order() {
+    let settings = SolverSettings {
+        iterations: 0,
+        tolerance: -1.0,
+        warm_start: 2.0,
+        ..SolverSettings::default()
+    };
+    let fields: Vec<_> = settings.problems().iter().map(|p| p.field).collect();
+    assert_eq!(fields, ["iterations", "tolerance", "warm_start"]);
+    assert_eq!(settings.validate().unwrap_err().field, "iterations");
+}
+
+/// The documented rule of `friction_in_main_solve`: only `pgs` with a relax solve and no
+/// split impulse keeps friction out of the repairing solve, and only when asked to.
+#[test]
+fn friction_leaves_the_main_solve_only_for_pgs_with_a_relax_solve() {
+    let base = SolverSettings::default;
+    assert_eq!(base().method, SolverMethod::Pgs);
+    assert!(!base().main_solve_friction());
+    assert!(
+        SolverSettings {
+            friction_in_main_solve: true,
+            ..base()
+        }
+        .main_solve_friction()
+    );
+    for method in [SolverMethod::Nncg, SolverMethod::Apgd, SolverMethod::Auto] {
+        assert!(SolverSettings { method, ..base() }.main_solve_friction());
+    }
+    assert!(
+        SolverSettings {
+            repair: ContactRepair::SplitImpulse {
+                rate: 10.0,
+                iterations: 1
+            },
+            ..base()
+        }
+        .main_solve_friction()
+    );
+    assert!(
+        SolverSettings {
+            relax_iterations: 0,
+            ..base()
+        }
+        .main_solve_friction()
+    );
+}
+
+/// The soft step is one PGS sweep and one relax sweep a substep, springs at a fifth of
+/// the substep rate (12·S Hz at dt = 1/60 s), no slop, repair capped at 0.5 m/s; the
+/// default is that step at 20 substeps, `fast` at 8 and `precise` at 48.
+#[test]
+fn the_presets_are_the_soft_step() {
+    for substeps in [1, 8, 20, 48] {
+        let s = SolverSettings::soft_step(substeps);
+        assert_eq!(
+            (s.method, s.substeps, s.iterations, s.relax_iterations),
+            (SolverMethod::Pgs, substeps, 1, 1)
+        );
+        assert_eq!(
+            s.repair,
+            ContactRepair::Soft {
+                hertz: 12.0 * substeps as f32,
+                damping_ratio: 10.0
+            }
+        );
+        assert_eq!((s.overlap_slop, s.max_repair_speed), (0.0, 0.5));
+    }
+    assert_eq!(SolverSettings::soft_step(0).substeps, 1);
+    assert_eq!(SolverSettings::default(), SolverSettings::soft_step(20));
+    assert_eq!(SolverSettings::fast(), SolverSettings::soft_step(8));
+    assert_eq!(SolverSettings::precise(), SolverSettings::soft_step(48));
+    for (name, preset) in [
+        ("fast", SolverSettings::fast()),
+        ("q50", SolverSettings::fast()),
+        ("default", SolverSettings::default()),
+        ("q5", SolverSettings::default()),
+        ("precise", SolverSettings::precise()),
+        ("q1", SolverSettings::precise()),
+        ("reference", SolverSettings::reference()),
+    ] {
+        assert_eq!(SolverSettings::preset(name), Some(preset), "{name}");
+    }
+    assert_eq!(SolverSettings::preset("fastest"), None);
+}
+
+/// `reference` as documented: the automatic policy, 4 substeps of at most 8 iterations,
+/// split impulse at 12/s above a 2 mm slop, repair capped at 1 m/s.
+#[test]
+fn the_reference_preset_is_as_documented() {
+    let r = SolverSettings::reference();
+    assert_eq!(
+        (r.method, r.substeps, r.iterations),
+        (SolverMethod::Auto, 4, 8)
+    );
+    assert_eq!(
+        r.repair,
+        ContactRepair::SplitImpulse {
+            rate: 12.0,
+            iterations: 16
+        }
+    );
+    assert!(r.split_impulse() && !SolverSettings::default().split_impulse());
+    assert_eq!((r.overlap_slop, r.max_repair_speed), (0.002, 1.0));
+}
+
+/// A preset applied to a scene's settings changes the solve and keeps the physics.
+#[test]
+fn a_preset_sets_effort_and_keeps_the_scenes_physics() {
+    let scene = SolverSettings {
+        restitution_threshold: 2.0,
+        prediction_distance: 0.05,
+        sleep: false,
+        sleep_linear_speed: 0.1,
+        sleep_angular_speed: 0.2,
+        time_to_sleep: 3.0,
+        friction: false,
+        gyroscopic: false,
+        continuous: false,
+        ..SolverSettings::default()
+    };
+    for name in SolverSettings::PRESETS {
+        let preset = SolverSettings::preset(name).unwrap();
+        let s = scene.with_effort_of(&preset);
+        // Effort from the preset.
+        let effort = SolverSettings {
+            restitution_threshold: preset.restitution_threshold,
+            prediction_distance: preset.prediction_distance,
+            sleep: preset.sleep,
+            sleep_linear_speed: preset.sleep_linear_speed,
+            sleep_angular_speed: preset.sleep_angular_speed,
+            time_to_sleep: preset.time_to_sleep,
+            friction: preset.friction,
+            gyroscopic: preset.gyroscopic,
+            continuous: preset.continuous,
+            ..s.clone()
+        };
+        assert_eq!(effort, preset, "{name}");
+        // Physics from the scene.
+        assert_eq!(
+            s.with_effort_of(&scene),
+            scene,
+            "{name}: only effort fields changed"
+        );
+    }
+}
+
+#[test]
+fn counts_have_a_maximum() {
+    let s = SolverSettings {
+        substeps: u32::MAX,
+        ..SolverSettings::default()
+    };
+    assert_eq!(problem(s), "substeps: must be ≤ 10000, got 4294967295");
+    let s = SolverSettings {
+        iterations: SolverSettings::MAX_COUNT,
+        ..SolverSettings::default()
+    };
+    assert_eq!(s.validate(), Ok(()));
+}
+
+/// The names the CLI and reports print are the scene format's.
+#[test]
+fn names_are_the_scene_format_names() {
+    for method in [
+        SolverMethod::Pgs,
+        SolverMethod::Nncg,
+        SolverMethod::Apgd,
+        SolverMethod::Auto,
+    ] {
+        let json = serde_json::to_string(&method).unwrap();
+        assert_eq!(json, format!("\"{}\"", method.name()));
+    }
+    for repair in [
+        ContactRepair::Bias { rate: 1.0 },
+        ContactRepair::SplitImpulse {
+            rate: 1.0,
+            iterations: 1,
+        },
+        ContactRepair::Soft {
+            hertz: 1.0,
+            damping_ratio: 1.0,
+        },
+    ] {
+        let json = serde_json::to_value(repair).unwrap();
+        assert_eq!(json["type"], repair.name());
+    }
+}
