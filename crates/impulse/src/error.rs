@@ -17,6 +17,21 @@ pub enum WorldError {
         /// What is wrong.
         message: String,
     },
+    /// A joint's description is invalid (`joint` is its index in insertion or scene order).
+    #[error("joint {joint}{}: {field}: {message}", name.as_ref().map(|n| format!(" (\"{n}\")")).unwrap_or_default())]
+    InvalidJoint {
+        /// Index of the joint (the scene's `joints` order, or the number of joints before it).
+        joint: usize,
+        /// The joint's name, if it has one.
+        name: Option<String>,
+        /// Field path inside the joint, e.g. `limits.lower`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A handle names no joint of this world (removed, or another world's handle).
+    #[error("no joint {0:?} in this world (removed, or another world's handle)")]
+    UnknownJoint(crate::joint::JointHandle),
     /// A handle names no body of this world (the body was removed, or the handle is another
     /// world's).
     #[error("no body {0:?} in this world (removed, or another world's handle)")]

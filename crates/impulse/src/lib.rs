@@ -51,6 +51,7 @@ mod error;
 mod graph;
 mod integrate;
 mod island;
+mod joint;
 mod parallel;
 mod settings;
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
@@ -86,6 +87,10 @@ pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use diagnostics::contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
+pub use joint::{
+    AxisMode, JointAxis, JointBuilder, JointDof, JointEvent, JointHandle, JointKind, JointRef,
+    JointStiffness, Motor, MotorMode, Spring,
+};
 pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };

@@ -56,9 +56,20 @@ impl ContactSolver for Exact {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
+        joints: &mut [crate::joint::JointConstraint],
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         let position_repair = set_scalar_targets(constraints, pass);
+        if !joints.is_empty() {
+            // The joints' rows make the island's problem a mixed (boxed) LCP, which Lemke's
+            // standard form does not take: the iterative result stands
+            // (docs/solvers.md, "Joints").
+            return SolveOutcome {
+                exact_failed: true,
+                position_repair,
+                ..SolveOutcome::of(EscalationLevel::Exact, SolveReport::default())
+            };
+        }
         let outcome = match solve_exact(
             constraints,
             velocities,

@@ -60,13 +60,16 @@ impl ContactSolver for Auto {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
+        joints: &mut [crate::joint::JointConstraint],
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         let limits = self.limits;
-        let mut outcome = self.nncg.solve(constraints, velocities, pass);
+        let mut outcome = self.nncg.solve(constraints, velocities, joints, pass);
         let unconverged = outcome.report.last_change > limits.tolerance;
         let heavy = limits.mass_ratio > limits.mass_ratio_threshold;
-        let small = constraints.len() <= limits.exact_max_contacts as usize;
+        // An island with joints is a mixed LCP, which the exact path does not take yet: it
+        // escalates to more NNCG iterations instead.
+        let small = constraints.len() <= limits.exact_max_contacts as usize && joints.is_empty();
         // Unconverged in an impact, the island takes more iterations rather than the exact
         // path: the next steps repair what an impact leaves, while pivoting every landing
         // column of a pile is the cost of hundreds of exact solves a substep. Asked only when
@@ -87,7 +90,7 @@ impl ContactSolver for Auto {
         if escalate && small && (persistent || heavy) {
             outcome.escalated = true;
             self.exact.max_contacts = limits.exact_max_contacts as usize;
-            let exact = self.exact.solve(constraints, velocities, &again);
+            let exact = self.exact.solve(constraints, velocities, joints, &again);
             if exact.exact_failed {
                 // The iterative result stands; the failure is counted and reported.
                 outcome.exact_failed = true;
@@ -101,6 +104,7 @@ impl ContactSolver for Auto {
             let more = self.nncg.solve(
                 constraints,
                 velocities,
+                joints,
                 &SolvePass {
                     iterations: limits.iterations,
                     ..again

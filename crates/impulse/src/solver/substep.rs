@@ -111,12 +111,18 @@ impl IslandWorkspace {
         } else {
             pass
         };
+        if !self.joints.is_empty() && pass.targets.is_some() {
+            for joint in &mut self.joints {
+                joint.update_targets(&self.displacement, &self.orientation, with_repair);
+            }
+        }
         let mut velocities = Velocities {
             linear: &mut self.linear,
             angular: &mut self.angular,
         };
+        let joints = &mut self.joints[..];
         let solver = self.solvers.substeps(settings.method, bundled);
-        let outcome = solver.solve(constraints, &mut velocities, &pass);
+        let outcome = solver.solve(constraints, &mut velocities, joints, &pass);
         self.impact_met = if with_repair {
             settings.method == SolverMethod::Pgs
                 && !settings.split_impulse()
@@ -132,7 +138,7 @@ impl IslandWorkspace {
                 targets: None,
                 ..pass
             };
-            solver.solve(constraints, &mut velocities, &more)
+            solver.solve(constraints, &mut velocities, joints, &more)
         });
         self.position_repair = outcome.position_repair;
         self.record(&outcome, with_repair);
@@ -207,6 +213,9 @@ pub(crate) fn step_island(
     // The substeps cover the whole step: on the heavy-on-light path, one substep of dt.
     let h = context.dt / settings.substeps as f32;
     w.step_constants(island_bodies, context, h);
+    for joint in &mut w.joints {
+        joint.start_step(h);
+    }
     w.start_solves(constraints, settings, context);
     let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
     for substep in 0..settings.substeps {
@@ -214,6 +223,7 @@ pub(crate) fn step_island(
     }
     w.finish_solves(constraints, settings, &plan);
     w.restitution(island_bodies, guests, constraints, settings, context, &plan);
+    w.record_joints();
 }
 
 /// How an island's solves run in a step, decided before its substeps.
@@ -358,7 +368,13 @@ impl IslandWorkspace {
     ) -> Option<SolverSettings> {
         let settings = context.settings;
         let threshold = settings.heavy_on_light_mass_ratio;
-        if !(threshold > 0.0 && self.report.mass_ratio > threshold && !settings.split_impulse()) {
+        // Joints keep the soft step: the path's one rigid LCP a step is solved exactly, which
+        // an island with joints (a mixed LCP) cannot be yet.
+        if !(threshold > 0.0
+            && self.report.mass_ratio > threshold
+            && !settings.split_impulse()
+            && self.joints.is_empty())
+        {
             return None;
         }
         self.report.heavy_on_light =
@@ -415,7 +431,9 @@ impl IslandWorkspace {
         let slots = island_bodies.len() + guests.len() + 1;
         let w = self;
         // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
-        let bundled = settings.solves_in_lanes(constraints.len());
+        // Joints are swept by the scalar path, so an island with joints is not packed into
+        // lanes (docs/solvers.md, "Joints").
+        let bundled = settings.solves_in_lanes(constraints.len()) && w.joints.is_empty();
         w.parallel = parallel;
         w.colour_starts.clear();
         let threshold = settings.parallel_island_contacts as usize;
@@ -492,6 +510,15 @@ impl IslandWorkspace {
             linear: &mut self.linear,
             angular: &mut self.angular,
         };
+        // Joints first, as in every sweep (Box2D v3's warm start order).
+        for joint in &mut self.joints {
+            joint.warm_start(
+                &mut velocities,
+                &self.displacement,
+                &self.orientation,
+                substep,
+            );
+        }
         self.solvers.substeps(settings.method, bundled).warm_start(
             constraints,
             &mut velocities,
@@ -667,6 +694,9 @@ impl IslandWorkspace {
         w.solvers
             .substeps(settings.method, plan.bundled)
             .finish(constraints);
+        for joint in &mut w.joints {
+            joint.add_step_impulses();
+        }
         w.rows = if plan.record_in_lanes {
             w.solvers.wide.take_rows()
         } else {
@@ -733,12 +763,15 @@ impl IslandWorkspace {
                 *total -= before;
             }
         }
+        // The joints hold through the bounce with the relax solve's targets, set after the
+        // last substep's positions.
         let outcome = w.solvers.scalar(settings.method).solve(
             constraints,
             &mut Velocities {
                 linear: &mut w.linear,
                 angular: &mut w.angular,
             },
+            &mut w.joints,
             &pass,
         );
         for c in constraints.iter_mut() {

@@ -12,6 +12,7 @@ use crate::diagnostics::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms};
 use crate::error::WorldError;
 use crate::island::Islands;
+use crate::joint::{JointEvent, Joints};
 use crate::scene::{BodyDesc, Material, MaterialRef, Scene};
 use crate::settings::SolverSettings;
 use crate::solver::substep::IslandWorkspace;
@@ -20,6 +21,7 @@ mod bodies;
 mod contact_events;
 mod contacts;
 mod from_scene;
+mod joints;
 mod query;
 mod snapshot;
 mod step;
@@ -85,6 +87,10 @@ pub struct World {
     unclamped_poses: Vec<Pose>,
     /// The bodies that left the world in the last step ([`World::left_world`]).
     left_world: Vec<LeftWorld>,
+    /// The joints, with their warm-start impulses.
+    pub(crate) joints: Joints,
+    /// The last step's joint events ([`World::joint_events`]).
+    joint_events: Vec<JointEvent>,
 }
 
 /// A body that left the world: its centre of mass ended a step farther from the origin than
@@ -146,6 +152,8 @@ impl World {
             clamps: Vec::new(),
             unclamped_poses: Vec::new(),
             left_world: Vec::new(),
+            joints: Joints::default(),
+            joint_events: Vec::new(),
         };
         world.check_settings()?;
         Ok(world)
@@ -303,9 +311,18 @@ impl World {
     }
 
     /// The last step's contact LCP, assembled from the rows the solver used, with the engine's
-    /// impulses at exit. Errors only when the step produced non-finite data.
+    /// impulses at exit; with joints, their rows follow the contacts' with their bounds (a
+    /// mixed LCP: [`ContactLcp::joint_of_row`]). Errors only when the step produced
+    /// non-finite data.
     pub fn contact_lcp(&self) -> Result<ContactLcp, impulse_lcp::ProblemError> {
-        assemble_lcp(&self.complete_constraints())
+        let joints: Vec<&crate::joint::JointConstraint> = self
+            .workspaces
+            .iter()
+            .zip(&self.island_awake)
+            .filter(|(_, awake)| **awake)
+            .flat_map(|(workspace, _)| &workspace.joints)
+            .collect();
+        assemble_lcp(&self.complete_constraints(), &joints)
     }
 
     /// Wall-clock time of each stage of the last step (all zero before the first step).

@@ -31,13 +31,14 @@ use crate::collision::broad_phase::{BroadPhase, BroadPhaseState};
 use crate::collision::narrow_phase::{NarrowPhase, PairState};
 use crate::diagnostics::StepDiagnostics;
 use crate::error::SnapshotError;
+use crate::joint::Joints;
 use crate::scene::MeshData;
 use crate::scene::validate::mesh_problem;
 use crate::settings::SolverSettings;
 
 /// The snapshot format this build writes and reads. Raised whenever the stored state changes
 /// shape; a snapshot of another version is refused ([`SnapshotError::VersionMismatch`]).
-pub const SNAPSHOT_FORMAT_VERSION: u32 = 2;
+pub const SNAPSHOT_FORMAT_VERSION: u32 = 3;
 
 /// The first bytes of a snapshot file.
 const MAGIC: &[u8; 16] = b"IMPULSE-WORLD\0\0\0";
@@ -94,6 +95,8 @@ pub struct WorldSnapshot {
     time: f64,
     /// The position-based kinematic bodies' keyframes and pending targets.
     scripts: Vec<Script>,
+    /// The joints, with their handles and warm-start impulses.
+    joints: Joints,
 }
 
 impl WorldSnapshot {
@@ -262,6 +265,7 @@ impl World {
             diagnostics: self.diagnostics.clone(),
             time: self.time,
             scripts: self.scripts.clone(),
+            joints: self.joints.clone(),
         })
     }
 
@@ -346,6 +350,8 @@ impl World {
             }
         }
         world.scripts = snapshot.scripts;
+        check_joints(&world, &snapshot.joints).map_err(invalid)?;
+        world.joints = snapshot.joints;
         Ok(world)
     }
 
@@ -364,6 +370,32 @@ impl World {
 /// The body values a step relies on, checked before a snapshot's bodies are trusted: finite
 /// poses, velocities, forces and mass properties, materials in range, shapes valid for their
 /// kind.
+/// A snapshot's joints before they are trusted: handles consistent, bodies in the world,
+/// frames and impulses finite, degrees of freedom within the rules of `World::insert_joint`.
+fn check_joints(world: &World, joints: &Joints) -> Result<(), String> {
+    joints.handles.check(joints.joints.len())?;
+    for (k, joint) in joints.joints.iter().enumerate() {
+        for body in [joint.body_a, joint.body_b] {
+            if world.handles.body(body).is_none() {
+                return Err(format!(
+                    "joint {k} names a body that is not in the world ({body:?})"
+                ));
+            }
+        }
+        let finite = joint.anchor_a.is_finite()
+            && joint.anchor_b.is_finite()
+            && joint.rotation_a.is_finite()
+            && joint.rotation_b.is_finite()
+            && joint.impulses.iter().flatten().all(|x| x.is_finite());
+        if !finite {
+            return Err(format!("joint {k}: a frame or impulse is not finite"));
+        }
+        crate::joint::rules::check_dofs(joint.kind, &joint.dofs)
+            .map_err(|p| format!("joint {k}: {}: {}", p.field, p.message))?;
+    }
+    Ok(())
+}
+
 fn check_bodies(b: &Bodies) -> Result<(), String> {
     let finite3 = |v: &Vec3| v.is_finite();
     for i in 0..b.len() {

@@ -18,6 +18,7 @@ mod gyroscopic;
 mod heavy_on_light;
 mod impacts;
 mod islands;
+mod joints;
 mod kinematic;
 mod meshes;
 mod phantom_and_tunnel;

@@ -277,7 +277,7 @@ fn damaged_files_give_typed_errors() {
     newer[16] += 1;
     let message = read(&newer).to_string();
     assert!(
-        message.contains("format version 3") && message.contains("reads version 2"),
+        message.contains("format version 4") && message.contains("reads version 3"),
         "{message}"
     );
     let mut longer = bytes.clone();

@@ -1,0 +1,1 @@
+//! Chains hanging at rest.
