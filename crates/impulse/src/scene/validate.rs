@@ -93,6 +93,7 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
         });
         c.body(&FieldPath::body(index), body, &scene.materials);
     }
+    c.errors.extend(super::joint_desc::joint_errors(scene));
     c.errors
 }
 

@@ -195,6 +195,23 @@ impl World {
             };
             world.add_body(desc, &material)?;
         }
+        let names: Vec<Option<String>> = scene.bodies.iter().map(|b| b.name.clone()).collect();
+        for (k, desc) in scene.joints.iter().enumerate() {
+            let invalid = |field: &str, message: String| WorldError::InvalidJoint {
+                joint: k,
+                name: desc.name.clone(),
+                field: field.to_string(),
+                message,
+            };
+            let body = |name, field: &str| {
+                crate::scene::joint_desc::resolve_body(name, &names)
+                    .map(|i| world.handles.of_body[i])
+                    .map_err(|m| invalid(field, m))
+            };
+            let (a, b) = (body(&desc.body_a, "body_a")?, body(&desc.body_b, "body_b")?);
+            let builder = desc.builder(a, b).map_err(|(f, m)| invalid(&f, m))?;
+            world.insert_joint(builder)?;
+        }
         Ok(world)
     }
 
