@@ -4,6 +4,7 @@
 //! breakable wall; and the API's checks, snapshots and the exported mixed LCP.
 
 mod chains;
+mod devices;
 mod pendulum;
 
 use impulse::glam::Vec3;
