@@ -6,7 +6,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::error::{FieldPath, SceneError, SceneErrorKind};
-use crate::body::BodyHandle;
+use crate::body::{BodyHandle, BodyKind};
 use crate::joint::rules::{check_dofs, check_options};
 use crate::joint::{
     AxisMode, JointAxis, JointBuilder, JointDof, JointKind, JointStiffness, Motor, MotorMode,
@@ -350,17 +350,21 @@ pub(crate) fn resolve_body(name: &BodyName, names: &[Option<String>]) -> Result<
 
 /// Every problem of the scene's joints, with their paths (`joints[2].limits`): bodies that
 /// exist and differ, at least one of them not static, frames, limits, springs, motors.
-pub(crate) fn joint_errors(scene: &super::Scene) -> Vec<SceneError> {
-    let names: Vec<Option<String>> = scene.bodies.iter().map(|b| b.name.clone()).collect();
+/// `kinds` and `names` are the scene's bodies'.
+pub(crate) fn joint_errors(
+    joints: &[JointDesc],
+    kinds: &[BodyKind],
+    names: &[Option<String>],
+) -> Vec<SceneError> {
     let mut errors = Vec::new();
-    for (k, joint) in scene.joints.iter().enumerate() {
+    for (k, joint) in joints.iter().enumerate() {
         let path = FieldPath::root().key("joints").index(k);
         let fail = |field: &str, message: String| {
             let path = field.split('.').fold(path.clone(), |p, key| p.key(key));
             SceneError::new(SceneErrorKind::Invalid, Some(path), message)
         };
-        let a = resolve_body(&joint.body_a, &names).map_err(|m| fail("body_a", m));
-        let b = resolve_body(&joint.body_b, &names).map_err(|m| fail("body_b", m));
+        let a = resolve_body(&joint.body_a, names).map_err(|m| fail("body_a", m));
+        let b = resolve_body(&joint.body_b, names).map_err(|m| fail("body_b", m));
         let (a, b) = match (a, b) {
             (Ok(a), Ok(b)) => (a, b),
             (a, b) => {
@@ -373,10 +377,7 @@ pub(crate) fn joint_errors(scene: &super::Scene) -> Vec<SceneError> {
             errors.push(fail("body_b", "must differ from body_a".into()));
             continue;
         }
-        let moves = |i: usize| {
-            scene.bodies[i].kind == super::BodyKind::Dynamic
-                || scene.bodies[i].kind == super::BodyKind::Particle
-        };
+        let moves = |i: usize| kinds[i] == BodyKind::Dynamic || kinds[i] == BodyKind::Particle;
         if !moves(a) && !moves(b) {
             errors.push(fail(
                 "body_b",

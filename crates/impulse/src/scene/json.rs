@@ -504,7 +504,7 @@ pub fn to_json_string(scene: &Scene) -> String {
     );
     if !joints.is_empty() {
         out.push_str(",\n  \"joints\": ");
-        list(&mut out, '[', ']', joints.iter().map(|j| one_line(j)));
+        list(&mut out, '[', ']', joints.iter().map(one_line));
     }
     out.push_str("\n}\n");
     out
