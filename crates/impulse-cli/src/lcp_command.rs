@@ -25,7 +25,10 @@ const HISTORY_SHOWN: usize = 10;
 
 /// Solves the LCP in `path` with `solver` (`pgs`, `jacobi` or `lemke`), at most `iterations`
 /// sweeps or pivots, stopping at normalised natural-map residual `tolerance`; `relaxation` is ω
-/// for PGS/PSOR and the damping of Jacobi. Prints a summary; with `json_out`, writes
+/// for PGS/PSOR and the damping of Jacobi. Every solver takes `γ ≥ 0` and box bounds (free,
+/// one-sided, two-sided and fixed rows: a mixed LCP, which Lemke solves exactly through its
+/// reduction to a standard LCP); friction (findex) rows only PGS and Jacobi. Prints a summary
+/// (with the bounds by kind); with `json_out`, writes
 /// `{"solver","status","iterations","z","w","residual","residual_history"}` there.
 ///
 /// Returns `Ok(true)` if the solver converged, `Ok(false)` if it ran but did not (no solution
@@ -56,11 +59,13 @@ pub fn solve_file(
     };
     println!("file        {} ({convention})", path.display());
     println!("n           {}", lcp.n());
+    println!("bounds      {}", bounds_name(&lcp.bounds));
     println!("solver      {kind}");
     println!("status      {}", solution.status);
     println!("iterations  {}", solution.iterations);
     println!(
-        "residual    {:.3e}  (‖min-map‖₂ / ‖b‖₂, tolerance {tolerance:.1e})",
+        "residual    {:.3e}  (natural map ‖γ − mid(lo, γ − w, hi)‖₂ / ‖b‖₂, \
+         tolerance {tolerance:.1e})",
         solution.residual
     );
     if lcp.n() <= PRINT_Z_UP_TO {
@@ -155,7 +160,7 @@ pub fn dump(mut scene: Scene, step: u64, out: &Path, no_friction: bool) -> Resul
 
     let z = &contact_lcp.engine_solution;
     let report = merit_report(lcp, z);
-    let friction = !lcp.bounds.is_nonnegative();
+    let friction = has_friction_rows(&lcp.bounds);
     let contacts = contact_lcp.contact_points();
     println!("scene       {name}, step {step}");
     println!(
@@ -172,14 +177,14 @@ pub fn dump(mut scene: Scene, step: u64, out: &Path, no_friction: bool) -> Resul
         }
     );
     println!("nonzeros    {} in A", nonzeros(&lcp.a));
-    println!(
-        "bounds      {}",
-        if friction {
-            "friction rows |γ_ti| ≤ μ·γ_n (pyramid; the engine used the disc)"
-        } else {
-            "γ ≥ 0 (standard LCP)"
-        }
-    );
+    let bounds = if friction {
+        "friction rows |γ_ti| ≤ μ·γ_n (pyramid; the engine used the disc)".to_string()
+    } else if lcp.bounds.is_nonnegative() {
+        "γ ≥ 0 (standard LCP)".to_string()
+    } else {
+        bounds_name(&lcp.bounds)
+    };
+    println!("bounds      {bounds}");
     println!("‖b‖₂        {:.6e}", residual_scale(&lcp.b));
     println!(
         "engine      natural-map residual {:.3e} (normalised {:.3e}), most negative w {:.3e}, \
@@ -197,13 +202,35 @@ pub fn dump(mut scene: Scene, step: u64, out: &Path, no_friction: bool) -> Resul
     Ok(())
 }
 
-/// How a problem's bounds read in a summary or a plot's subtitle.
-fn bounds_name(bounds: &Bounds) -> &'static str {
-    match bounds {
-        _ if bounds.is_nonnegative() => "γ ≥ 0",
-        Bounds::Friction { .. } => "friction (pyramid) bounds",
-        _ => "box bounds",
+/// True when some row's bounds are `±μ·γ_j` of another row (ODE's findex).
+fn has_friction_rows(bounds: &Bounds) -> bool {
+    matches!(bounds, Bounds::Friction { friction_index, .. }
+        if friction_index.iter().any(Option::is_some))
+}
+
+/// How a problem's bounds read in a summary or a plot's subtitle: `γ ≥ 0`, friction rows, or
+/// the rows of a mixed (box) LCP by kind.
+fn bounds_name(bounds: &Bounds) -> String {
+    let (lo, hi) = match bounds {
+        _ if bounds.is_nonnegative() => return "γ ≥ 0".into(),
+        _ if has_friction_rows(bounds) => return "friction (pyramid) bounds".into(),
+        Bounds::NonNegative => return "γ ≥ 0".into(),
+        Bounds::Box { lo, hi } | Bounds::Friction { lo, hi, .. } => (lo, hi),
+    };
+    let (mut free, mut lower, mut upper, mut two_sided, mut fixed) = (0, 0, 0, 0, 0);
+    for (&l, &h) in lo.iter().zip(hi) {
+        match (l.is_finite(), h.is_finite()) {
+            (false, false) => free += 1,
+            (true, false) => lower += 1,
+            (false, true) => upper += 1,
+            (true, true) if l == h => fixed += 1,
+            (true, true) => two_sided += 1,
+        }
     }
+    format!(
+        "mixed (box) LCP: {free} free, {lower} lower-bounded, {upper} upper-bounded, \
+         {two_sided} two-sided, {fixed} fixed rows"
+    )
 }
 
 /// Stored entries of `A` (all `n²` for a dense matrix).
@@ -244,13 +271,15 @@ const POWER_ITERATIONS: usize = 100;
 const JACOBI_RETRIES: usize = 4;
 
 /// Reads an LCP (`.json` or Siconos `.dat`), runs projected Gauss–Seidel, damped projected
-/// Jacobi and, when the bounds are plain `γ ≥ 0` and `n ≤` [`LEMKE_MAX_ROWS`], Lemke's method,
-/// each from `γ = 0`, and writes `out_svg` (SVG or PNG after its extension): log10 of the normalised natural-map residual
-/// `‖min-map(γ)‖₂ / ‖b‖₂` against sweeps (PGS, Jacobi, at most `iterations` each) or pivots
-/// (Lemke), with its final polished residual as a marker. Prints each solver's status, count,
-/// final residual and time. When Lemke does not converge (redundant contacts: `A` singular) and
-/// `n ≤` [`LEMKE_REGULARISED_MAX_ROWS`], it is rerun on `A + ε·diag(A)` and that curve is added,
-/// its marker at the residual of its solution on the original problem.
+/// Jacobi and, when there are no friction (findex) rows and `n ≤` [`LEMKE_MAX_ROWS`], Lemke's
+/// method (`γ ≥ 0` or box bounds; otherwise it prints why it skipped Lemke), each from `γ = 0`,
+/// and writes `out_svg` (SVG or PNG after its extension): log10 of the normalised natural-map
+/// residual `‖γ − mid(lo, γ − w, hi)‖₂ / ‖b‖₂` (the min-map for `γ ≥ 0`) against sweeps (PGS,
+/// Jacobi, at most `iterations` each) or pivots (Lemke), with its final polished residual as a
+/// marker. Prints each solver's status, count, final residual and time. When Lemke does not
+/// converge (redundant contacts: `A` singular) and `n ≤` [`LEMKE_REGULARISED_MAX_ROWS`], it is
+/// rerun on `A + ε·diag(A)` and that curve is added, its marker at the residual of its solution
+/// on the original problem.
 ///
 /// Jacobi's damping is ω = 1/λ̂ with λ̂ the power-iteration estimate of λ_max(D⁻¹A) (theory
 /// asks ω < 2/λ_max for symmetric positive semidefinite `A`); if it still diverges, ω is halved
@@ -347,8 +376,11 @@ pub fn convergence(path: &Path, iterations: usize, out_svg: &Path) -> Result<()>
     }
 
     // Lemke, if it applies and is affordable.
-    if !lcp.bounds.is_nonnegative() {
-        println!("lemke       not run: it solves only γ ≥ 0, and this problem has other bounds");
+    if has_friction_rows(&lcp.bounds) {
+        println!(
+            "lemke       not run: friction (findex) rows have bounds that move with the normal \
+             impulses, which Lemke's method does not solve (PGS and Jacobi do)"
+        );
     } else if n > LEMKE_MAX_ROWS {
         println!(
             "lemke       not run: n = {n} > {LEMKE_MAX_ROWS} (dense tableau of {:.0} MB, O(n²) per pivot)",

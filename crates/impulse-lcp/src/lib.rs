@@ -15,6 +15,22 @@
 //! assert_eq!(sol.status, Status::Converged);
 //! assert!((sol.z[0] - 4.0 / 3.0).abs() < 1e-12 && (sol.z[1] - 7.0 / 3.0).abs() < 1e-12);
 //! ```
+//!
+//! Joints make the problem mixed: free rows (equalities), one-sided rows (contacts, limits) and
+//! two-sided boxes (motors), all [`Bounds::Box`]. Lemke's method solves them exactly too
+//! ([`solvers::lemke`]), PGS and projected Jacobi iteratively:
+//!
+//! ```
+//! use impulse_lcp::{Bounds, DenseMatrix, Lcp, SolverKind, SolverSettings, Status};
+//! let a = DenseMatrix::from_rows(&[vec![2.0, 1.0], vec![1.0, 2.0]]).unwrap();
+//! // Row 0 a motor with impulse in [0, 1], row 1 a contact (γ ≥ 0).
+//! let bounds = Bounds::Box { lo: vec![0.0, 0.0], hi: vec![1.0, f64::INFINITY] };
+//! let lcp = Lcp::new(a, vec![5.0, 6.0], bounds).unwrap();
+//! let sol = SolverKind::Lemke.solve(&lcp, None, &SolverSettings::default()).unwrap();
+//! assert_eq!(sol.status, Status::Converged);
+//! // The motor saturates (γ₀ = 1, w₀ = −1/2 ≤ 0); the contact meets its target (w₁ = 0).
+//! assert!((sol.z[0] - 1.0).abs() < 1e-12 && (sol.z[1] - 2.5).abs() < 1e-12);
+//! ```
 
 pub mod io;
 pub mod matrix;

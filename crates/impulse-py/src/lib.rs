@@ -9,9 +9,12 @@ use pyo3::prelude::*;
 
 mod arrays;
 mod builder;
+mod contacts;
 mod errors;
+mod handle;
 mod scene;
 mod settings;
+mod stepping;
 mod world;
 
 use errors::{SceneError, StepError, WorldError};
@@ -33,7 +36,7 @@ fn _impulse(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("StepError", py.get_type::<StepError>())?;
     m.add_class::<settings::Settings>()?;
     m.add_class::<world::World>()?;
-    m.add_class::<world::BodyHandle>()?;
+    m.add_class::<handle::BodyHandle>()?;
     m.add_class::<builder::Shape>()?;
     m.add_class::<builder::BodyBuilder>()?;
     m.add_function(wrap_pyfunction!(scenes, m)?)?;

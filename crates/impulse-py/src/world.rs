@@ -11,39 +11,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 
 use crate::arrays::{self, Field};
-use crate::errors::{SceneError, StepError, WorldError, guarded};
+use crate::contacts;
+use crate::errors::{SceneError, WorldError, guarded};
+use crate::handle::BodyHandle;
 use crate::settings::{Settings, to_python};
-
-/// A body's name in a world: valid while the body lives, never naming another body afterwards
-/// (a slot index and the slot's generation). Hashable; compare with `==`.
-#[pyclass(module = "impulse", frozen, eq, hash)]
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
-pub struct BodyHandle {
-    pub(crate) inner: impulse::BodyHandle,
-}
-
-#[pymethods]
-impl BodyHandle {
-    /// The slot index.
-    #[getter]
-    fn index(&self) -> u32 {
-        self.inner.index()
-    }
-
-    /// The slot's generation.
-    #[getter]
-    fn generation(&self) -> u32 {
-        self.inner.generation()
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "BodyHandle(index={}, generation={})",
-            self.inner.index(),
-            self.inner.generation()
-        )
-    }
-}
+use crate::stepping::{self, names_of, step_world};
 
 /// A simulation world: bodies, gravity (m/s², y up), time step (s) and solver settings.
 ///
@@ -109,10 +81,6 @@ fn world_error(error: impulse::WorldError) -> PyErr {
     WorldError::new_err(error.to_string())
 }
 
-fn step_error(error: impulse::StepError) -> PyErr {
-    StepError::new_err(error.to_string())
-}
-
 fn vec3(value: [f32; 3], what: &str) -> PyResult<Vec3> {
     let v = Vec3::from(value);
     if v.is_finite() {
@@ -122,29 +90,6 @@ fn vec3(value: [f32; 3], what: &str) -> PyResult<Vec3> {
             "{what}: must be finite, got {value:?}"
         )))
     }
-}
-
-/// Steps `world` `n` times without the GIL, checking for Ctrl-C between chunks of steps.
-fn step_world(py: Python<'_>, world: &mut impulse::World, n: u64) -> PyResult<()> {
-    const CHUNK: u64 = 16;
-    let mut left = n;
-    while left > 0 {
-        let chunk = left.min(CHUNK);
-        let result = py.detach(|| {
-            guarded(|| {
-                for _ in 0..chunk {
-                    world.step().map_err(step_error)?;
-                }
-                Ok(())
-            })
-        });
-        result?;
-        left -= chunk;
-        if left > 0 {
-            py.check_signals()?;
-        }
-    }
-    Ok(())
 }
 
 #[pymethods]
@@ -266,103 +211,7 @@ impl World {
         steps: u64,
         every: u64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        if every == 0 {
-            return Err(WorldError::new_err("every: must be at least 1"));
-        }
-        let first = self.inner.step_count();
-        let last = first
-            .checked_add(steps)
-            .ok_or_else(|| WorldError::new_err("steps: too many"))?;
-        let n = self.inner.body_count();
-        let frames = 1
-            + (first + 1..=last)
-                .filter(|s| s.is_multiple_of(every) || *s == last)
-                .count();
-        let mut positions: Vec<f32> = Vec::new();
-        let mut orientations: Vec<f32> = Vec::new();
-        let mut step_numbers: Vec<i64> = Vec::new();
-        let mut times: Vec<f64> = Vec::new();
-        positions
-            .try_reserve_exact(frames * n * 3)
-            .and_then(|_| orientations.try_reserve_exact(frames * n * 4))
-            .map_err(|_| {
-                WorldError::new_err(format!(
-                    "a trajectory of {frames} frames of {n} bodies does not fit in memory; \
-                     record fewer frames (every=)"
-                ))
-            })?;
-        let record = |world: &impulse::World,
-                      positions: &mut Vec<f32>,
-                      orientations: &mut Vec<f32>,
-                      step_numbers: &mut Vec<i64>,
-                      times: &mut Vec<f64>| {
-            for pose in world.poses() {
-                positions.extend_from_slice(&pose.translation.to_array());
-                orientations.extend_from_slice(&pose.rotation.to_array());
-            }
-            step_numbers.push(world.step_count() as i64);
-            times.push(world.time());
-        };
-        record(
-            &self.inner,
-            &mut positions,
-            &mut orientations,
-            &mut step_numbers,
-            &mut times,
-        );
-        let world = &mut self.inner;
-        let mut failure: Option<PyErr> = None;
-        while world.step_count() < last {
-            let chunk_end = (world.step_count() + 16).min(last);
-            let result = py.detach(|| {
-                guarded(|| {
-                    while world.step_count() < chunk_end {
-                        world.step().map_err(step_error)?;
-                        let s = world.step_count();
-                        if s.is_multiple_of(every) || s == last {
-                            record(
-                                world,
-                                &mut positions,
-                                &mut orientations,
-                                &mut step_numbers,
-                                &mut times,
-                            );
-                        }
-                    }
-                    Ok(())
-                })
-            });
-            if let Err(error) = result {
-                failure = Some(error);
-                break;
-            }
-            if let Err(error) = py.check_signals() {
-                failure = Some(error);
-                break;
-            }
-        }
-        let f = step_numbers.len();
-        let names = names_of(world);
-        let positions = PyArray1::from_vec(py, positions).reshape([f, n, 3])?;
-        let orientations = PyArray1::from_vec(py, orientations).reshape([f, n, 4])?;
-        let trajectory = py
-            .import("impulse._trajectory")?
-            .getattr("Trajectory")?
-            .call1((
-                positions,
-                orientations,
-                PyArray1::from_vec(py, step_numbers),
-                PyArray1::from_vec(py, times),
-                names,
-            ))?;
-        match failure {
-            None => Ok(trajectory),
-            Some(error) => {
-                let value = error.value(py);
-                let _ = value.setattr("trajectory", trajectory);
-                Err(error)
-            }
-        }
+        stepping::simulate(py, &mut self.inner, steps, every)
     }
 
     /// Positions of the body frames (m): read-only view, shape (N, 3), float32. Assign an
@@ -815,77 +664,14 @@ impl World {
     /// m (negative: overlap), `normal_impulse` (K,) N·s, `friction_impulse` (K, 3) N·s on
     /// body 2; all float32.
     fn contact_pairs<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        let index = |h: impulse::BodyHandle| self.inner.body(h).map(|b| b.index());
-        let mut list = Vec::new();
-        for pair in self.inner.contact_pairs() {
-            let points: Vec<impulse::ContactPoint> = pair.points().collect();
-            let k = points.len();
-            let flat3 = |f: &dyn Fn(&impulse::ContactPoint) -> Vec3| -> PyResult<_> {
-                let v: Vec<f32> = points.iter().flat_map(|p| f(p).to_array()).collect();
-                PyArray1::from_vec(py, v).reshape([k, 3])
-            };
-            let arrays = PyDict::new(py);
-            arrays.set_item("position", flat3(&|p| p.position)?)?;
-            arrays.set_item("normal", flat3(&|p| p.normal)?)?;
-            arrays.set_item(
-                "separation",
-                PyArray1::from_vec(py, points.iter().map(|p| p.separation).collect()),
-            )?;
-            arrays.set_item(
-                "normal_impulse",
-                PyArray1::from_vec(py, points.iter().map(|p| p.normal_impulse).collect()),
-            )?;
-            arrays.set_item("friction_impulse", flat3(&|p| p.friction_impulse)?)?;
-            let d = PyDict::new(py);
-            d.set_item(
-                "body1",
-                BodyHandle {
-                    inner: pair.body1(),
-                },
-            )?;
-            d.set_item(
-                "body2",
-                BodyHandle {
-                    inner: pair.body2(),
-                },
-            )?;
-            d.set_item("index1", index(pair.body1()))?;
-            d.set_item("index2", index(pair.body2()))?;
-            d.set_item("touching", pair.touching())?;
-            d.set_item("total_normal_impulse", pair.total_normal_impulse())?;
-            d.set_item("points", arrays)?;
-            list.push(d);
-        }
-        Ok(list)
+        contacts::contact_pairs(py, &self.inner)
     }
 
     /// The last step's contact events, as a list of dicts: `{"type": "started", "body1",
     /// "body2", "normal_impulse"}` (N·s: how hard they met) or `{"type": "stopped", "body1",
     /// "body2"}`; `body1` is the body with the smaller handle.
     fn contact_events<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        let mut list = Vec::new();
-        for event in self.inner.contact_events() {
-            let d = PyDict::new(py);
-            match *event {
-                impulse::ContactEvent::Started {
-                    body1,
-                    body2,
-                    normal_impulse,
-                } => {
-                    d.set_item("type", "started")?;
-                    d.set_item("body1", BodyHandle { inner: body1 })?;
-                    d.set_item("body2", BodyHandle { inner: body2 })?;
-                    d.set_item("normal_impulse", normal_impulse)?;
-                }
-                impulse::ContactEvent::Stopped { body1, body2 } => {
-                    d.set_item("type", "stopped")?;
-                    d.set_item("body1", BodyHandle { inner: body1 })?;
-                    d.set_item("body2", BodyHandle { inner: body2 })?;
-                }
-            }
-            list.push(d);
-        }
-        Ok(list)
+        contacts::contact_events(py, &self.inner)
     }
 
     /// The last step's contact LCP (`World::contact_lcp`): find γ within its bounds with
@@ -896,101 +682,6 @@ impl World {
     /// (n,), `engine_solution` (n,) the engine's impulses (N·s), `contact_of_row` (n,) int64.
     /// Raises `StepError` when the last step produced non-finite data.
     fn contact_lcp<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        use impulse::impulse_lcp::{Bounds, Matrix};
-        let lcp = guarded(|| {
-            self.inner
-                .contact_lcp()
-                .map_err(|e| StepError::new_err(e.to_string()))
-        })?;
-        let problem = &lcp.problem;
-        let n = problem.n();
-        let (mut rows, mut cols, mut data) = (Vec::new(), Vec::new(), Vec::new());
-        match &problem.a {
-            Matrix::Dense(m) => {
-                for i in 0..m.rows {
-                    for (j, &v) in m.row(i).iter().enumerate() {
-                        if v != 0.0 {
-                            rows.push(i as i64);
-                            cols.push(j as i64);
-                            data.push(v);
-                        }
-                    }
-                }
-            }
-            Matrix::Csr(m) => {
-                for i in 0..m.rows {
-                    let (indices, values) = m.row(i);
-                    for (&j, &v) in indices.iter().zip(values) {
-                        rows.push(i as i64);
-                        cols.push(j as i64);
-                        data.push(v);
-                    }
-                }
-            }
-        }
-        let (lo, hi, friction_index, mu) = match &problem.bounds {
-            Bounds::NonNegative => (
-                vec![0.0; n],
-                vec![f64::INFINITY; n],
-                vec![-1i64; n],
-                vec![0.0; n],
-            ),
-            Bounds::Box { lo, hi } => (lo.clone(), hi.clone(), vec![-1; n], vec![0.0; n]),
-            Bounds::Friction {
-                lo,
-                hi,
-                friction_index,
-                mu,
-            } => (
-                lo.clone(),
-                hi.clone(),
-                friction_index
-                    .iter()
-                    .map(|f| f.map_or(-1, |j| j as i64))
-                    .collect(),
-                mu.clone(),
-            ),
-        };
-        let rows = PyArray1::from_vec(py, rows);
-        let cols = PyArray1::from_vec(py, cols);
-        let data = PyArray1::from_vec(py, data);
-        let a: Bound<'py, PyAny> = match py.import("scipy.sparse") {
-            Ok(sparse) => sparse
-                .getattr("coo_array")?
-                .call1(((data, (rows, cols)), (n, n)))?
-                .call_method0("tocsr")?,
-            Err(_) => {
-                let coo = PyDict::new(py);
-                coo.set_item("row", rows)?;
-                coo.set_item("col", cols)?;
-                coo.set_item("data", data)?;
-                coo.set_item("shape", (n, n))?;
-                coo.into_any()
-            }
-        };
-        let d = PyDict::new(py);
-        d.set_item("A", a)?;
-        d.set_item("b", PyArray1::from_vec(py, problem.b.clone()))?;
-        d.set_item("lo", PyArray1::from_vec(py, lo))?;
-        d.set_item("hi", PyArray1::from_vec(py, hi))?;
-        d.set_item("friction_index", PyArray1::from_vec(py, friction_index))?;
-        d.set_item("mu", PyArray1::from_vec(py, mu))?;
-        d.set_item(
-            "engine_solution",
-            PyArray1::from_vec(py, lcp.engine_solution.clone()),
-        )?;
-        d.set_item(
-            "contact_of_row",
-            PyArray1::from_vec(py, lcp.contact_of_row.iter().map(|&c| c as i64).collect()),
-        )?;
-        Ok(d)
+        contacts::contact_lcp(py, &self.inner)
     }
-}
-
-pub(crate) fn names_of(world: &impulse::World) -> Vec<String> {
-    world
-        .names()
-        .iter()
-        .map(|n| n.clone().unwrap_or_default())
-        .collect()
 }

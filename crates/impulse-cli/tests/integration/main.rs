@@ -10,5 +10,6 @@ mod common;
 mod edges;
 mod export;
 mod interrupt;
+mod lcp_box;
 mod render;
 mod variation;

@@ -17,9 +17,13 @@
 //!   `{"csr": {"indptr": [...], "indices": [...], "values": [...]}}` (row pointers of length
 //!   `n + 1`, column indices strictly increasing within each row; see [`CsrMatrix`]).
 //! - `b`: right-hand side.
-//! - `lo`, `hi` (optional): bounds; `null` means `−∞` in `lo` and `+∞` in `hi` (JSON has no
-//!   infinity). A missing `lo` means all 0, a missing `hi` all `+∞`. Without `lo`, `hi` and
-//!   `friction_index` the problem is the standard LCP `γ ≥ 0`.
+//! - `lo`, `hi` (optional): bounds, for free rows (equalities), one-sided rows (contacts, limits)
+//!   and two-sided boxes (motors) alike. JSON has no infinity, so the infinite end of a bound is
+//!   `null` (`−∞` in `lo`, `+∞` in `hi`: what the writer emits), or, for files written by hand,
+//!   one of the strings `"-inf"`, `"inf"`, `"+inf"`, `"-infinity"`, `"infinity"`, `"+infinity"`
+//!   (any case). A free row is `lo: null, hi: null`; a contact `lo: 0, hi: null`. A missing `lo`
+//!   means all 0, a missing `hi` all `+∞`. Without `lo`, `hi` and `friction_index` the problem is
+//!   the standard LCP `γ ≥ 0`. Files written before the strings were accepted read unchanged.
 //! - `friction_index` (optional, requires `mu`): per row `null` or the index `j` of its normal
 //!   row; such a row gets bounds `±mu[i]·γ_j` and ignores its `lo`/`hi` (ODE's `findex`). See
 //!   [`Bounds::Friction`].
@@ -41,13 +45,46 @@ struct JsonLcp {
     a: Value,
     b: Vec<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    lo: Option<Vec<Option<f64>>>,
+    lo: Option<Vec<Option<JsonBound>>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    hi: Option<Vec<Option<f64>>>,
+    hi: Option<Vec<Option<JsonBound>>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     friction_index: Option<Vec<Option<usize>>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     mu: Option<Vec<f64>>,
+}
+
+/// One entry of `lo` or `hi`: a number, or an infinity spelled as a string (`null` is the
+/// `None` around it).
+#[derive(Serialize, Deserialize)]
+#[serde(untagged)]
+enum JsonBound {
+    Number(f64),
+    Text(String),
+}
+
+/// The bounds of field `field` (`lo` or `hi`), `null` standing for `missing` (−∞ or +∞).
+fn bound_values(
+    field: &str,
+    values: Vec<Option<JsonBound>>,
+    missing: f64,
+) -> Result<Vec<f64>, String> {
+    values
+        .into_iter()
+        .enumerate()
+        .map(|(i, v)| match v {
+            None => Ok(missing),
+            Some(JsonBound::Number(x)) => Ok(x),
+            Some(JsonBound::Text(t)) => match t.to_ascii_lowercase().as_str() {
+                "inf" | "+inf" | "infinity" | "+infinity" => Ok(f64::INFINITY),
+                "-inf" | "-infinity" => Ok(f64::NEG_INFINITY),
+                _ => Err(format!(
+                    "field {field}[{i}] is {t:?}: a bound is a number, null (no bound), \
+                     \"-inf\" or \"inf\""
+                )),
+            },
+        })
+        .collect()
 }
 
 #[derive(Serialize, Deserialize)]
@@ -115,16 +152,16 @@ pub fn parse_json(text: &str, file: &str) -> Result<Lcp, FileError> {
         }
     };
     check_len("b", raw.b.len())?;
-    let lo = raw.lo.map(|v| {
-        v.into_iter()
-            .map(|x| x.unwrap_or(f64::NEG_INFINITY))
-            .collect::<Vec<_>>()
-    });
-    let hi = raw.hi.map(|v| {
-        v.into_iter()
-            .map(|x| x.unwrap_or(f64::INFINITY))
-            .collect::<Vec<_>>()
-    });
+    let lo = raw
+        .lo
+        .map(|v| bound_values("lo", v, f64::NEG_INFINITY))
+        .transpose()
+        .map_err(err)?;
+    let hi = raw
+        .hi
+        .map(|v| bound_values("hi", v, f64::INFINITY))
+        .transpose()
+        .map_err(err)?;
     if let Some(lo) = &lo {
         check_len("lo", lo.len())?;
     }
@@ -183,7 +220,7 @@ pub fn to_json_string(lcp: &Lcp) -> Result<String, FileError> {
     };
     let finite = |v: &[f64]| {
         v.iter()
-            .map(|&x| x.is_finite().then_some(x))
+            .map(|&x| x.is_finite().then_some(JsonBound::Number(x)))
             .collect::<Vec<_>>()
     };
     let mut raw = JsonLcp {
@@ -255,6 +292,34 @@ mod tests {
         assert_eq!(hi[0], f64::INFINITY);
         let back = parse_json(&to_json_string(&lcp).unwrap(), "t").unwrap();
         assert_eq!(back, lcp);
+    }
+
+    #[test]
+    fn infinities_as_null_or_strings() {
+        let text = r#"{"n": 4, "a": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], "b": [1,2,3,4],
+          "lo": [null, "-inf", 0, "-Infinity"], "hi": ["inf", null, "+INF", 2.5]}"#;
+        let lcp = parse_json(text, "t").unwrap();
+        let inf = f64::INFINITY;
+        assert_eq!(
+            lcp.bounds,
+            Bounds::Box {
+                lo: vec![-inf, -inf, 0.0, -inf],
+                hi: vec![inf, inf, inf, 2.5],
+            }
+        );
+        // The writer uses null, which every reader of this format reads.
+        let written = to_json_string(&lcp).unwrap();
+        assert!(
+            written.contains(r#""lo":[null,null,0.0,null],"hi":[null,null,null,2.5]"#),
+            "{written}"
+        );
+        assert_eq!(parse_json(&written, "t").unwrap(), lcp);
+        let msg = |t: &str| parse_json(t, "p.json").unwrap_err().to_string();
+        let bad = msg(r#"{"n":1,"a":[[1]],"b":[1],"lo":["-infty"]}"#);
+        assert!(bad.contains("lo[0]") && bad.contains("-infty"), "{bad}");
+        // "inf" as a lower bound is a valid spelling of an invalid bound (lo < +∞ is required).
+        assert!(msg(r#"{"n":1,"a":[[1]],"b":[1],"lo":["inf"]}"#).contains("invalid problem"));
+        assert!(msg(r#"{"n":1,"a":[[1]],"b":[1],"lo":[true]}"#).contains("p.json"));
     }
 
     #[test]

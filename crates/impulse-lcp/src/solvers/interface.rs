@@ -39,9 +39,9 @@ pub enum Status {
     MaxIterations,
     /// Iterative solver produced a non-finite value (e.g. Jacobi with too little damping).
     Diverged,
-    /// Lemke ended on a secondary ray: it found no solution. For copositive-plus `A` (e.g. positive
-    /// semidefinite) this proves the LCP infeasible (Cottle–Pang–Stone §4.4); for other
-    /// matrices a solution may still exist. `z` is the last almost-complementary point.
+    /// Lemke ended on a secondary ray: no solution found. That proves the LCP infeasible for
+    /// copositive-plus `A` (e.g. PSD; mixed LCP: PSD, free block nonsingular; CPS §4.4), not for
+    /// others. `z` is the last almost-complementary point (mixed LCP: the best point found).
     RayTermination,
     /// Lemke used `max_iterations` pivots without terminating.
     PivotLimit,
@@ -110,10 +110,28 @@ pub enum SolveError {
         index: usize,
         value: f64,
     },
-    #[error("{solver} solves only the standard LCP (γ ≥ 0); these bounds are not supported")]
+    /// Lemke's method and friction (findex) rows: their bounds `±μ·γ_j` move with the normal
+    /// impulses, so the problem is not a box LCP (PGS and projected Jacobi solve it).
+    #[error(
+        "{solver} does not solve friction (findex) bounds, whose limits move with the normal \
+         impulses; use PGS or projected Jacobi"
+    )]
     UnsupportedBounds { solver: &'static str },
+    /// Lemke's method on a mixed LCP eliminates the free rows (`lo = −∞`, `hi = +∞`) through
+    /// their block `A_FF`, which must be nonsingular: `row` (an index into the problem) is the
+    /// first free row found dependent on the free rows before it. Its share of the load is then
+    /// undetermined; removing the redundant equality or regularising (adding a small `ε` to the
+    /// diagonal of the free rows, constraint force mixing) makes the block nonsingular.
+    #[error(
+        "{solver}: the block of free rows (lo = −∞, hi = +∞) is singular: free row {row} is a \
+         linear combination of the free rows before it; remove the redundant equality or add a \
+         small ε to the free rows' diagonal of A"
+    )]
+    SingularFreeBlock { solver: &'static str, row: usize },
     /// The problem is larger than the solver's dense storage allows (Lemke:
-    /// [`lemke::MAX_DIMENSION`](super::lemke::MAX_DIMENSION)); `bytes` is what it would have allocated.
+    /// [`lemke::MAX_DIMENSION`](super::lemke::MAX_DIMENSION)); `bytes` is what it would have
+    /// allocated. For a mixed LCP `n` counts free rows, bounded rows and one more per two-sided
+    /// box ([`lemke::mixed_dense_bytes`](super::lemke::mixed_dense_bytes)).
     #[error(
         "{solver} stores the problem densely: n = {n} would need {:.1} GB; it accepts n ≤ {max_n} \
          (use an iterative solver, PGS or projected Jacobi, for larger problems)",

@@ -1,4 +1,5 @@
-//! Dense LU with partial pivoting, only for Lemke's small systems (basis refresh and polishing).
+//! Dense LU with partial pivoting, only for Lemke's small systems (basis refresh, polishing, and
+//! the free block of a mixed LCP).
 
 /// LU factors of an `n × n` row-major matrix: `P A = L U`, `L` unit lower, stored in place.
 pub(crate) struct Lu {
@@ -10,17 +11,27 @@ pub(crate) struct Lu {
 impl Lu {
     /// Factorises `a` (row-major, `n × n`). `None` if a pivot is zero or below `1e-14` times the
     /// largest entry of `a` (numerically singular: the caller falls back to its unpolished data).
-    pub(crate) fn new(mut a: Vec<f64>, n: usize) -> Option<Lu> {
+    pub(crate) fn new(a: Vec<f64>, n: usize) -> Option<Lu> {
+        Lu::factor(a, n, 1e-14).ok()
+    }
+
+    /// Factorises `a` (row-major, `n × n`), refusing pivots at or below `relative_tolerance`
+    /// times the largest entry of `a`. The error is the column `k` whose pivot vanished: with
+    /// partial (row) pivoting, column `k` is then numerically a combination of columns `0..k`
+    /// (the first dependent column). An empty, all-zero or non-finite `a` fails at column 0.
+    pub(crate) fn factor(mut a: Vec<f64>, n: usize, relative_tolerance: f64) -> Result<Lu, usize> {
         debug_assert_eq!(a.len(), n * n);
         let scale = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         if !(scale.is_finite() && scale > 0.0) {
-            return None;
+            return Err(0);
         }
         let mut perm: Vec<usize> = (0..n).collect();
         for k in 0..n {
-            let p = (k..n).max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))?;
-            if a[p * n + k].abs() <= 1e-14 * scale {
-                return None;
+            let p = (k..n)
+                .max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))
+                .ok_or(k)?;
+            if a[p * n + k].abs() <= relative_tolerance * scale {
+                return Err(k);
             }
             if p != k {
                 for j in 0..n {
@@ -39,7 +50,7 @@ impl Lu {
                 }
             }
         }
-        Some(Lu { n, lu: a, perm })
+        Ok(Lu { n, lu: a, perm })
     }
 
     /// Solves `A x = b`.

@@ -5,7 +5,9 @@
 //! - [`pgs`]: projected Gauss–Seidel / projected SOR, the engine's method (docs/method.md); all
 //!   bound kinds.
 //! - [`jacobi`]: projected Jacobi with damping; all bound kinds; order-independent (parallel-friendly).
-//! - [`lemke`]: Lemke's complementary pivoting, the exact reference for standard LCPs.
+//! - [`lemke`]: Lemke's complementary pivoting, the exact reference for standard LCPs and, by
+//!   reduction to a standard LCP, for mixed (box) LCPs: free, one-sided and two-sided rows in
+//!   any mix. Not friction (findex) rows.
 //!
 //! Every solver reports the natural-map residual normalised by `‖b‖₂` (Siconos'
 //! `lcp_compute_error`, see [`crate::merit`]) after each iteration or pivot, and stops with
@@ -15,6 +17,8 @@ mod interface;
 mod iteration;
 pub mod jacobi;
 pub mod lemke;
+mod lemke_mixed;
+mod lemke_path;
 mod lu;
 pub mod pgs;
 

@@ -1,4 +1,5 @@
-//! Box and friction bounds on hand-checkable problems; PGS and Jacobi must agree.
+//! Box and friction bounds on hand-checkable problems; PGS and Jacobi must agree, and Lemke on the
+//! box problems (friction rows it refuses).
 //!
 //! Friction case: a block of mass m resting on the ground (normal +y) at one contact point, with
 //! a pre-step velocity `v⁻ = (v_x, −g·dt, 0)`. Rows: normal, tangent x, tangent z. With `J` the
@@ -140,7 +141,9 @@ fn box_bounds_upper_bound_active() {
         },
     )
     .unwrap();
-    for s in both(&lcp) {
+    let lemke = SolverKind::Lemke.solve(&lcp, None, &settings()).unwrap();
+    for s in both(&lcp).into_iter().chain([lemke]) {
+        assert_eq!(s.status, Status::Converged);
         assert_close(&s.z, &[1.0, 2.5], "box");
         assert!((s.w[0] + 0.5).abs() < 1e-12 && s.w[1].abs() < 1e-12);
     }
@@ -164,7 +167,7 @@ fn free_variables_solve_the_linear_system() {
         tolerance: 1e-12,
         relaxation: 0.6,
     };
-    for kind in [SolverKind::Pgs, SolverKind::Jacobi] {
+    for kind in SolverKind::ALL {
         let s = kind.solve(&lcp, None, &settings).unwrap();
         assert_eq!(s.status, Status::Converged, "{kind}");
         // Residual ≤ 1e-12·‖b‖ with cond(A) = 3 bounds the error by about 1e-10.
@@ -173,7 +176,7 @@ fn free_variables_solve_the_linear_system() {
 }
 
 #[test]
-fn lemke_rejects_bounds_it_cannot_solve_but_accepts_the_standard_box() {
+fn lemke_rejects_friction_rows_and_solves_the_standard_box_as_the_standard_lcp() {
     let a = DenseMatrix::from_rows(&[vec![2.0, 1.0], vec![1.0, 2.0]]).unwrap();
     let friction = block_on_ground(1.0, [0, 1, 2]);
     assert!(

@@ -145,3 +145,79 @@ pub fn enumerate_solutions(m: &DenseMatrix, q: &[f64]) -> Vec<Vec<f64>> {
     }
     found
 }
+
+/// How well `z` satisfies the mixed (box) LCP `w = Az − b`, `lo ≤ z ≤ hi`, `z_i = lo_i ⇒ w_i ≥ 0`,
+/// `z_i = hi_i ⇒ w_i ≤ 0`, inside ⇒ `w_i = 0`, each condition separately, in plain loops.
+#[derive(Debug, Clone, Copy)]
+pub struct BoxViolations {
+    /// `‖z − mid(lo, z − w, hi)‖₂ / ‖b‖₂` (`‖b‖ = 0` → absolute).
+    pub normalised_natural_map: f64,
+    /// Largest distance of `z` outside `[lo, hi]`, relative to `max(1, ‖z‖∞)`.
+    pub bound: f64,
+    /// Largest `max(w_i, 0)·(z_i − lo_i)` and `max(−w_i, 0)·(hi_i − z_i)` over the finite bounds,
+    /// and `|w_i|` of free rows, relative to `max(1, ‖z‖∞)·max(1, ‖w‖∞)`: a push away from a
+    /// bound that `z` does not sit on.
+    pub complementarity: f64,
+}
+
+pub fn box_violations(
+    a: &DenseMatrix,
+    b: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+    z: &[f64],
+) -> BoxViolations {
+    let n = b.len();
+    let w: Vec<f64> = (0..n)
+        .map(|i| (0..n).map(|j| a.data[i * n + j] * z[j]).sum::<f64>() - b[i])
+        .collect();
+    let b_norm = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let natural = (0..n)
+        .map(|i| (z[i] - (z[i] - w[i]).max(lo[i]).min(hi[i])).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let z_scale = z.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+    let w_scale = w.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+    let mut bound = 0.0_f64;
+    let mut complementarity = 0.0_f64;
+    for i in 0..n {
+        bound = bound.max(lo[i] - z[i]).max(z[i] - hi[i]);
+        let push_up = if lo[i].is_finite() {
+            w[i].max(0.0) * (z[i] - lo[i]).abs()
+        } else {
+            w[i].max(0.0) * z_scale
+        };
+        let push_down = if hi[i].is_finite() {
+            (-w[i]).max(0.0) * (hi[i] - z[i]).abs()
+        } else {
+            (-w[i]).max(0.0) * z_scale
+        };
+        complementarity = complementarity.max(push_up).max(push_down);
+    }
+    BoxViolations {
+        normalised_natural_map: if b_norm > f64::EPSILON {
+            natural / b_norm
+        } else {
+            natural
+        },
+        bound: bound / z_scale,
+        complementarity: complementarity / (z_scale * w_scale),
+    }
+}
+
+/// Asserts every box condition to `tol`.
+pub fn assert_solves_box(
+    a: &DenseMatrix,
+    b: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+    z: &[f64],
+    tol: f64,
+    what: &str,
+) {
+    let v = box_violations(a, b, lo, hi, z);
+    assert!(
+        v.normalised_natural_map <= tol && v.bound <= tol && v.complementarity <= tol,
+        "{what}: z = {z:?} violates the box LCP: {v:?}"
+    );
+}

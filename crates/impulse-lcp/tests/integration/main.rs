@@ -9,5 +9,7 @@ mod common;
 mod errors;
 mod fuzz_regressions;
 mod io;
+mod mixed;
+mod mixed_random;
 mod random_contacts;
 mod siconos;

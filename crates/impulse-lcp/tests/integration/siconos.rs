@@ -20,7 +20,7 @@
 
 use crate::common::{assert_solves, enumerate_solutions, siconos_dir, violations};
 use impulse_lcp::{
-    DenseMatrix, Lcp, Matrix, Solution, SolveError, SolverKind, SolverSettings, Status,
+    Bounds, DenseMatrix, Lcp, Matrix, Solution, SolveError, SolverKind, SolverSettings, Status,
     read_siconos,
 };
 
@@ -301,6 +301,64 @@ fn block_files_equal_their_dense_twins() {
         let (sd, sb) = (lemke(&dense), lemke(&block));
         assert_eq!(sb.status, Status::Converged);
         assert_close(&sb.z, &sd.z, 1e-14, name);
+    }
+}
+
+/// The mixed-LCP path of Lemke's method on every file Lemke solves, in two disguises with the
+/// same solutions: shifted (`γ' = γ + c`, `lo = c`, `b' = b + Ac`) and mirrored (`γ' = −γ`,
+/// `γ' ≤ 0`, `b' = −b`, so `w' = −w`). Both reduce to the original standard LCP, so the mixed
+/// path must solve them too; the solutions, mapped back, satisfy the original problem by the
+/// test's own oracle.
+#[test]
+fn files_in_box_form_are_solved_by_the_mixed_path() {
+    let unsolvable = ["lcp_CPS_3", "lcp_Pang_isolated_sol_perturbed"];
+    let settings = SolverSettings {
+        max_iterations: 10_000,
+        tolerance: 1e-9,
+        relaxation: 1.0,
+    };
+    for entry in std::fs::read_dir(siconos_dir()).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        if unsolvable.contains(&name.as_str()) {
+            continue;
+        }
+        let p = load(&name);
+        let n = p.lcp.n();
+        let c: Vec<f64> = (0..n).map(|i| 0.5 + (i % 3) as f64).collect();
+        let mut ac = vec![0.0; n];
+        p.lcp.a.mul_vec(&c, &mut ac);
+        let shifted = Lcp::new(
+            p.lcp.a.clone(),
+            p.lcp.b.iter().zip(&ac).map(|(b, a)| b + a).collect(),
+            Bounds::Box {
+                lo: c.clone(),
+                hi: vec![f64::INFINITY; n],
+            },
+        )
+        .unwrap();
+        let mirrored = Lcp::new(
+            p.lcp.a.clone(),
+            p.lcp.b.iter().map(|b| -b).collect(),
+            Bounds::Box {
+                lo: vec![f64::NEG_INFINITY; n],
+                hi: vec![0.0; n],
+            },
+        )
+        .unwrap();
+        for (what, lcp, back) in [
+            (
+                "shifted",
+                &shifted,
+                &(|z: &[f64], i: usize| z[i] - c[i]) as &dyn Fn(&[f64], usize) -> f64,
+            ),
+            ("mirrored", &mirrored, &|z: &[f64], i: usize| -z[i]),
+        ] {
+            let s = SolverKind::Lemke.solve(lcp, None, &settings).unwrap();
+            assert_eq!(s.status, Status::Converged, "{name} {what}: {s:?}");
+            let z: Vec<f64> = (0..n).map(|i| back(&s.z, i)).collect();
+            assert_solves(&p.m, &p.q, &z, 1e-9, &format!("{name} {what}"));
+        }
     }
 }
 

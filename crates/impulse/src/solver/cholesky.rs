@@ -90,3 +90,7 @@ fn substitute_four<'a>(
         column[i] = (column[i] - dot) / pivot;
     }
 }
+
+#[cfg(test)]
+#[path = "cholesky_tests.rs"]
+mod tests;

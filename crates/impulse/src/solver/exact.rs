@@ -761,5 +761,5 @@ fn is_finite(c: &ContactConstraint) -> bool {
 }
 
 #[cfg(test)]
-#[path = "exact_tests.rs"]
+#[path = "exact_tests/mod.rs"]
 mod tests;
