@@ -115,15 +115,18 @@ pub enum SnapshotError {
     /// The bytes do not start with the snapshot header: not a snapshot file.
     #[error("not an impulse world snapshot (the file does not start with \"IMPULSE-WORLD\")")]
     NotASnapshot,
-    /// The snapshot was written in another format version than this build reads.
+    /// The snapshot was written in a format version this build does not read (it reads
+    /// [`crate::world::OLDEST_SNAPSHOT_FORMAT_VERSION`] to `supported`).
     #[error(
-        "snapshot format version {found}, but this build of impulse reads version {supported} \
-         (snapshots are not portable across impulse versions)"
+        "snapshot format version {found}, but this build of impulse reads versions {oldest} to \
+         {supported} (snapshots are not portable across impulse versions)",
+        oldest = crate::world::OLDEST_SNAPSHOT_FORMAT_VERSION
     )]
     VersionMismatch {
         /// The file's format version.
         found: u32,
-        /// The version this build reads and writes ([`crate::world::SNAPSHOT_FORMAT_VERSION`]).
+        /// The version this build writes, the newest it reads
+        /// ([`crate::world::SNAPSHOT_FORMAT_VERSION`]).
         supported: u32,
     },
     /// Fewer bytes than the header promised: the file was cut short.

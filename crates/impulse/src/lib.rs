@@ -100,7 +100,8 @@ pub use solver::{EscalationLevel, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, Isl
 pub use world::LeftWorld;
 pub use world::{
     BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, BodyRef, ContactEvent, ContactPairView,
-    ContactPoint, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World, WorldSnapshot,
+    ContactPoint, OLDEST_SNAPSHOT_FORMAT_VERSION, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World,
+    WorldSnapshot,
 };
 
 /// The engine's stages for benchmarks that time them one by one (`impulse-bench`'s

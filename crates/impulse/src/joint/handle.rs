@@ -78,7 +78,8 @@ impl JointHandles {
     }
 
     /// Checks that slots, free list and per-joint handles agree for `joints` joints (a
-    /// snapshot's handles before they are trusted).
+    /// snapshot's handles before they are trusted): each joint's handle names its slot, each
+    /// free slot is listed once and holds no joint, and no slot is neither.
     pub(crate) fn check(&self, joints: usize) -> Result<(), String> {
         if self.of_joint.len() != joints {
             return Err(format!(
@@ -89,6 +90,13 @@ impl JointHandles {
         for (joint, handle) in self.of_joint.iter().enumerate() {
             if self.slots.get(handle.index as usize) != Some(&(handle.generation, joint as u32)) {
                 return Err(format!("the handle of joint {joint} names another slot"));
+            }
+        }
+        let mut seen = vec![false; self.slots.len()];
+        for &index in &self.free {
+            match self.slots.get(index as usize) {
+                Some(&(_, u32::MAX)) if !seen[index as usize] => seen[index as usize] = true,
+                _ => return Err(format!("free joint handle slot {index} is not a free slot")),
             }
         }
         if self.free.len() + joints != self.slots.len() {

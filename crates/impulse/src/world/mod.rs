@@ -33,7 +33,7 @@ pub use bodies::BodyRef;
 pub use contact_events::ContactEvent;
 pub use contacts::{ContactPairView, ContactPoint};
 pub use query::{RayHit, ShapeHit};
-pub use snapshot::{SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
+pub use snapshot::{OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
 
 pub use crate::settings::BLOW_UP_DISTANCE;
 pub use step::{BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED};
