@@ -434,6 +434,14 @@ impl IslandWorkspace {
         // Joints are swept by the scalar path, so an island with joints is not packed into
         // lanes (docs/solvers.md, "Joints").
         let bundled = settings.solves_in_lanes(constraints.len()) && w.joints.is_empty();
+        // Assembly leaves the lever-arm products and effective masses of the rows of islands
+        // the step's settings would solve in lanes to the lanes (`products_pending`). An island
+        // that does not go to the lanes after all (it has joints, or takes the heavy-on-light
+        // path) computes them here: left pending, its contacts would have no effective mass
+        // and push nothing.
+        if !bundled && context.settings.solves_in_lanes(constraints.len()) {
+            contact::complete_products(constraints, world_inverse_inertia);
+        }
         w.parallel = parallel;
         w.colour_starts.clear();
         let threshold = settings.parallel_island_contacts as usize;
