@@ -222,6 +222,9 @@ pub(crate) struct JointConstraint {
     block_inverse: [Mat3; 2],
     /// J·v* of each row with the island's joint impulses taken out (for the exported LCP).
     pub velocity_before: [f32; 6],
+    /// What the restitution solve added to the impulses (zero without a bounce): part of the
+    /// step's impulse, not of the next step's warm start.
+    pub bounce: JointImpulses,
 }
 
 impl JointConstraint {
@@ -261,6 +264,7 @@ impl JointConstraint {
             targets: [[RowTarget::default(); ROWS_PER_DOF]; 6],
             block_inverse: [Mat3::IDENTITY; 2],
             velocity_before: [0.0; 6],
+            bounce: [[0.0; ROWS_PER_DOF]; 6],
         }
     }
 
@@ -460,6 +464,38 @@ impl JointConstraint {
             }
         }
         self.store(velocities, v);
+    }
+
+    /// Before the restitution solve: notes the impulses it starts from.
+    pub(crate) fn start_bounce(&mut self) {
+        self.bounce = self.impulses;
+    }
+
+    /// After the restitution solve: what it added goes into the step totals and is kept in
+    /// `bounce`, which the next step's warm start leaves out (the bounce is not given twice).
+    pub(crate) fn finish_bounce(&mut self) {
+        for ((total, bounce), now) in self
+            .step_impulses
+            .iter_mut()
+            .zip(&mut self.bounce)
+            .zip(&self.impulses)
+        {
+            for ((t, b), n) in total.iter_mut().zip(bounce.iter_mut()).zip(now) {
+                *b = n - *b;
+                *t += *b;
+            }
+        }
+    }
+
+    /// The impulses the next step starts from: the last ones without the bounce.
+    pub(crate) fn warm_start_impulses(&self) -> JointImpulses {
+        let mut impulses = self.impulses;
+        for (rows, bounce) in impulses.iter_mut().zip(&self.bounce) {
+            for (x, b) in rows.iter_mut().zip(bounce) {
+                *x -= b;
+            }
+        }
+        impulses
     }
 
     /// Adds the current impulses to the step totals (after the last substep).

@@ -304,7 +304,7 @@ impl World {
             }
             for c in &workspace.joints {
                 let joint = &mut self.joints.joints[c.joint as usize];
-                joint.impulses = c.impulses;
+                joint.impulses = c.warm_start_impulses();
                 let (mut force, mut torque) = (Vec3::ZERO, Vec3::ZERO);
                 for (i, rows) in c.step_impulses.iter().enumerate() {
                     let total = rows[crate::joint::LOCK] + rows[crate::joint::LOWER]
