@@ -309,9 +309,12 @@ impl JointBuilder {
         self
     }
 
-    /// Makes the joint breakable: it breaks at the end of a step in which its reaction force
-    /// exceeded `force` (N) or its reaction torque exceeded `torque` (N·m) (either may be
-    /// infinite), and is then no longer solved; [`crate::World::joint_events`] reports it.
+    /// Makes the joint breakable with strength `force` (N) for its locked translations and
+    /// `torque` (N·m) for its locked rotations (either may be infinite). The solver bounds the
+    /// locked rows' impulse by strength × substep (as friction by its disc); a substep that
+    /// ends at that bound breaks the joint there, so neighbours receive at most that pulse
+    /// (the brittle failure of Bullet's and PhysX's breaking impulse thresholds). It is then
+    /// no longer solved; [`crate::World::joint_events`] reports it at the end of the step.
     pub fn breakable(mut self, force: f32, torque: f32) -> Self {
         self.break_force = Some(force);
         self.break_torque = Some(torque);

@@ -22,10 +22,7 @@ pub(crate) use builder::{Anchors, Axes, shortest_arc};
 pub(crate) use frames::{LocalFrames, frame_state};
 pub use handle::JointHandle;
 pub(crate) use handle::JointHandles;
-pub(crate) use rows::{
-    JointBody, JointConstraint, JointImpulses, LOCK, LOWER, MOTOR, ROWS_PER_DOF, SPRING, UPPER,
-    sweep_joints,
-};
+pub(crate) use rows::{JointBody, JointConstraint, JointImpulses, ROWS_PER_DOF, sweep_joints};
 pub use types::{
     AxisMode, JointAxis, JointDof, JointKind, JointStiffness, Motor, MotorMode, Spring,
 };
@@ -161,17 +158,18 @@ impl<'a> JointRef<'a> {
 /// What happened to a joint in a step ([`crate::World::joint_events`]).
 #[derive(Clone, Debug, PartialEq)]
 pub enum JointEvent {
-    /// The joint's reaction exceeded a break threshold
-    /// ([`JointBuilder::breakable`]); it is no longer solved from the next step on, and stays
-    /// in the world (readable, removable) with [`JointRef::broken`] set.
+    /// The joint's reaction reached a break threshold ([`JointBuilder::breakable`]) in a
+    /// substep of this step; it passed no load from there on, and stays in the world
+    /// (readable, removable) with [`JointRef::broken`] set.
     Broken {
         /// The joint.
         joint: JointHandle,
         /// Its name, if it has one.
         name: Option<String>,
-        /// Its reaction force in the step (N).
+        /// Its reaction force in the substep where it broke (N): the force threshold when the
+        /// translations broke it.
         force: f32,
-        /// Its reaction torque in the step (N·m).
+        /// Its reaction torque in that substep (N·m).
         torque: f32,
     },
 }

@@ -225,6 +225,14 @@ pub(crate) struct JointConstraint {
     /// What the restitution solve added to the impulses (zero without a bounce): part of the
     /// step's impulse, not of the next step's warm start.
     pub bounce: JointImpulses,
+    /// Break thresholds (N, N·m; infinite: unbreakable): the strength of the locked
+    /// translations and rotations, which bounds their impulse in a solve of h seconds to
+    /// threshold·h.
+    break_force: f32,
+    break_torque: f32,
+    /// The force and torque (N, N·m, world) of the substep in which the joint broke; `None`
+    /// while it holds. A broken joint takes no further part in the step.
+    pub broke: Option<(Vec3, Vec3)>,
 }
 
 impl JointConstraint {
@@ -239,6 +247,7 @@ impl JointConstraint {
         distance: bool,
         stiffness: JointStiffness,
         impulses: JointImpulses,
+        (break_force, break_torque): (Option<f32>, Option<f32>),
     ) -> Self {
         Self {
             joint,
@@ -265,6 +274,9 @@ impl JointConstraint {
             block_inverse: [Mat3::IDENTITY; 2],
             velocity_before: [0.0; 6],
             bounce: [[0.0; ROWS_PER_DOF]; 6],
+            break_force: break_force.unwrap_or(f32::INFINITY),
+            break_torque: break_torque.unwrap_or(f32::INFINITY),
+            broke: None,
         }
     }
 
@@ -386,6 +398,9 @@ impl JointConstraint {
         orientation: &[Quat],
         with_repair: bool,
     ) {
+        if self.broke.is_some() {
+            return;
+        }
         self.update_geometry(displacement, orientation);
         let h = self.h;
         let repair = if with_repair {
@@ -453,6 +468,9 @@ impl JointConstraint {
         } else {
             self.step_impulses = [[0.0; ROWS_PER_DOF]; 6];
         }
+        if self.broke.is_some() {
+            return;
+        }
         self.update_geometry(displacement, orientation);
         let mut v = self.load(velocities);
         for i in 0..6 {
@@ -464,6 +482,76 @@ impl JointConstraint {
             }
         }
         self.store(velocities, v);
+    }
+
+    /// A locked group's impulse as a world vector (N·s or N·m·s): `local[k]` along row
+    /// `start + k`'s direction (its linear part for the translations, its axis for the
+    /// rotations).
+    fn group_impulse(&self, group: usize, local: Vec3) -> Vec3 {
+        let start = 3 * group;
+        (0..3)
+            .filter(|&k| self.locked(start + k))
+            .map(|k| {
+                let row = &self.rows[start + k];
+                let direction = if group == 0 {
+                    row.linear
+                } else {
+                    row.angular_b
+                };
+                direction * local[k]
+            })
+            .sum()
+    }
+
+    /// The force and torque on B (N, N·m; world) of `impulses` over `duration` seconds: every
+    /// row's impulse along its direction.
+    pub(crate) fn reaction(&self, impulses: &JointImpulses, duration: f32) -> (Vec3, Vec3) {
+        let (mut force, mut torque) = (Vec3::ZERO, Vec3::ZERO);
+        for (i, rows) in impulses.iter().enumerate() {
+            let total = rows[LOCK] + rows[LOWER] - rows[UPPER] + rows[SPRING] + rows[MOTOR];
+            let row = &self.rows[i];
+            if i < 3 {
+                force += row.linear * (total / duration);
+            } else {
+                torque += row.angular_b * (total / duration);
+            }
+        }
+        (force, torque)
+    }
+
+    /// The strength of a locked group over a solve of h seconds (N·s or N·m·s; infinite:
+    /// unbreakable): group 0 the translations, group 1 the rotations.
+    fn strength(&self, group: usize) -> f32 {
+        if group == 0 {
+            self.break_force * self.h
+        } else {
+            self.break_torque * self.h
+        }
+    }
+
+    /// Whether a locked group's current impulse is at its strength (to rounding: the solve
+    /// bounds it by the strength itself).
+    fn group_at_strength(&self, group: usize) -> bool {
+        let strength = self.strength(group);
+        if !strength.is_finite() {
+            return false;
+        }
+        let start = 3 * group;
+        let local = Vec3::from_array(std::array::from_fn(|k| self.impulses[start + k][LOCK]));
+        self.group_impulse(group, local).length() >= strength * (1.0 - 1e-3)
+    }
+
+    /// After a substep: a breakable joint breaks when the substep ended with one of its locked
+    /// groups at its strength. The solves bound the locked groups' impulses by the strength
+    /// (`solve`), so a substep converged at that bound is a load the joint could not carry,
+    /// where the unbounded force would have exceeded its threshold. The joint breaks there, as
+    /// a real one would, and passes no more load for the rest of the step: what its neighbours
+    /// received is the short pulse up to its strength.
+    fn check_break(&mut self) {
+        if self.broke.is_none() && (self.group_at_strength(0) || self.group_at_strength(1)) {
+            self.broke = Some(self.reaction(&self.impulses, self.h));
+            self.impulses = [[0.0; ROWS_PER_DOF]; 6];
+        }
     }
 
     /// Before the restitution solve: notes the impulses it starts from.
@@ -498,13 +586,15 @@ impl JointConstraint {
         impulses
     }
 
-    /// Adds the current impulses to the step totals (after the last substep).
+    /// Adds the current impulses to the step totals (after each substep), then breaks the
+    /// joint if they left a locked group at its strength ([`Self::check_break`]).
     pub(crate) fn add_step_impulses(&mut self) {
         for (total, now) in self.step_impulses.iter_mut().zip(&self.impulses) {
             for (t, n) in total.iter_mut().zip(now) {
                 *t += n;
             }
         }
+        self.check_break();
     }
 
     fn load(&self, velocities: &Velocities<'_>) -> [Vec3; 4] {
@@ -535,6 +625,9 @@ impl JointConstraint {
     /// One Gauss-Seidel pass over the joint's rows; returns the largest row velocity change
     /// (m/s or rad/s).
     pub(crate) fn solve(&mut self, velocities: &mut Velocities<'_>) -> f32 {
+        if self.broke.is_some() {
+            return 0.0;
+        }
         let mut v = self.load(velocities);
         let mut largest = 0.0f32;
         for kind in [SPRING, MOTOR, LOWER, UPPER] {
@@ -577,7 +670,19 @@ impl JointConstraint {
                     scales = (target.mass_scale, target.impulse_scale);
                 }
             }
-            let delta = -(self.block_inverse[group] * rhs) * scales.0 - old * scales.1;
+            let mut delta = -(self.block_inverse[group] * rhs) * scales.0 - old * scales.1;
+            // A breakable joint's locked group transmits at most its strength: the group's
+            // impulse is projected onto the ball of radius threshold·h (as friction onto its
+            // disc); a substep ending there breaks the joint at the end of the step
+            // (`check_break`).
+            let strength = self.strength(group);
+            if strength.is_finite() {
+                let total = self.group_impulse(group, old + delta);
+                let length = total.length();
+                if length > strength {
+                    delta = (old + delta) * (strength / length) - old;
+                }
+            }
             for k in 0..3 {
                 if locked[k] && delta[k] != 0.0 {
                     self.impulses[start + k][LOCK] += delta[k];

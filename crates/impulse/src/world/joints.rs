@@ -285,6 +285,7 @@ impl World {
                 joint.kind == JointKind::Distance,
                 joint.stiffness,
                 impulses,
+                (joint.break_force, joint.break_torque),
             );
             self.workspaces[island].joints.push(constraint);
         }
@@ -305,24 +306,10 @@ impl World {
             for c in &workspace.joints {
                 let joint = &mut self.joints.joints[c.joint as usize];
                 joint.impulses = c.warm_start_impulses();
-                let (mut force, mut torque) = (Vec3::ZERO, Vec3::ZERO);
-                for (i, rows) in c.step_impulses.iter().enumerate() {
-                    let total = rows[crate::joint::LOCK] + rows[crate::joint::LOWER]
-                        - rows[crate::joint::UPPER]
-                        + rows[crate::joint::SPRING]
-                        + rows[crate::joint::MOTOR];
-                    let row = &c.rows[i];
-                    if i < 3 {
-                        force += row.linear * (total / dt);
-                    } else {
-                        torque += row.angular_b * (total / dt);
-                    }
-                }
-                joint.force = force;
-                joint.torque = torque;
-                let breaks = joint.break_force.is_some_and(|f| force.length() > f)
-                    || joint.break_torque.is_some_and(|t| torque.length() > t);
-                if breaks && !joint.broken {
+                (joint.force, joint.torque) = c.reaction(&c.step_impulses, dt);
+                if let Some((force, torque)) = c.broke
+                    && !joint.broken
+                {
                     joint.broken = true;
                     joint.impulses = [[0.0; ROWS_PER_DOF]; 6];
                     self.joint_events.push(JointEvent::Broken {
