@@ -8,6 +8,8 @@
 //! its serial path on the calling thread. Friction combines as the geometric mean and
 //! restitution as the maximum (Box3D's defaults, impulse's rules).
 
+use std::sync::{Mutex, MutexGuard};
+
 use anyhow::{Result, bail};
 use boxddd_sys::ffi as b3;
 use glam::{Quat, Vec3};
@@ -42,6 +44,17 @@ pub(crate) fn box3d_run(
     })
 }
 
+/// Box3D keeps its worlds in a global array whose free slots `b3CreateWorld` and
+/// `b3DestroyWorld` find and release without synchronisation, so worlds are created and
+/// destroyed one at a time (tests create them on several threads).
+static LIFECYCLE: Mutex<()> = Mutex::new(());
+
+fn lifecycle() -> MutexGuard<'static, ()> {
+    LIFECYCLE
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
 /// A Box3D world; `bodies[i]` is scene body `i`. Destroyed on drop.
 pub(crate) struct Box3dWorld {
     world: b3::b3WorldId,
@@ -52,6 +65,7 @@ pub(crate) struct Box3dWorld {
 
 impl Drop for Box3dWorld {
     fn drop(&mut self) {
+        let _guard = lifecycle();
         // SAFETY: the world was created by `b3CreateWorld` and is destroyed once, here.
         unsafe { b3::b3DestroyWorld(self.world) };
     }
@@ -87,7 +101,13 @@ impl Box3dWorld {
             def.enableSleep = false;
             // One worker and no task callbacks: Box3D's serial path, on the calling thread.
             def.workerCount = 1;
-            let id = b3::b3CreateWorld(&def);
+            let id = {
+                let _guard = lifecycle();
+                b3::b3CreateWorld(&def)
+            };
+            if id.index1 == 0 {
+                bail!("Box3D could not create a world (all its world slots are in use)");
+            }
             let mut sim = Self {
                 world: id,
                 bodies: Vec::with_capacity(scene.bodies.len()),

@@ -238,7 +238,7 @@ are `c1 v10 p2`.";
 pub enum Plots<'a> {
     /// As a path, for the terminal: "Plot: `DIR/front-<scene>.svg`".
     Path(&'a Path),
-    /// As a Markdown image whose link is DIR/front-<scene>.svg, DIR being the plots' directory
+    /// As a Markdown image whose link is `DIR/front-<scene>.svg`, DIR being the plots' directory
     /// as seen from the Markdown file's (empty when they are the same).
     Image(&'a Path),
 }

@@ -290,7 +290,14 @@ fn grids_have_the_documented_sizes_and_names() {
     let box3d = box3d_grid();
     let box3d_names = names(box3d.iter().map(|s| s.setting_name()).collect());
     assert_eq!(box3d.len(), 22, "{box3d_names:?}");
-    for name in ["1×30Hz", "4×30Hz", "8×60Hz", "16×30Hz", "32×240Hz", "64×480Hz"] {
+    for name in [
+        "1×30Hz",
+        "4×30Hz",
+        "8×60Hz",
+        "16×30Hz",
+        "32×240Hz",
+        "64×480Hz",
+    ] {
         assert!(box3d_names.contains(name), "{name}");
     }
     for name in ["4×60Hz", "24×30Hz", "64×60Hz"] {
@@ -298,7 +305,10 @@ fn grids_have_the_documented_sizes_and_names() {
     }
     for setting in &box3d {
         let run = setting.effective_contact_hz(1.0 / 60.0);
-        assert!(setting.substeps < 4 || run >= 0.9999 * setting.contact_hz, "{setting:?}");
+        assert!(
+            setting.substeps < 4 || run >= 0.9999 * setting.contact_hz,
+            "{setting:?}"
+        );
     }
     assert_eq!(box3d_quick_grid()[0], Box3dSetting::default());
 

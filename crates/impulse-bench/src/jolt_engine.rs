@@ -158,60 +158,68 @@ impl JoltWorld {
         let bodies = u32::try_from(scene.bodies.len())?;
         // SAFETY: joltc calls on objects created here for this world; ids passed back were
         // returned by it.
-        let mut sim = unsafe {
-            let layers = j::JPH_BroadPhaseLayerInterfaceTable_Create(2, 2);
-            j::JPH_BroadPhaseLayerInterfaceTable_MapObjectToBroadPhaseLayer(layers, NON_MOVING, 0);
-            j::JPH_BroadPhaseLayerInterfaceTable_MapObjectToBroadPhaseLayer(layers, MOVING, 1);
-            let pairs = j::JPH_ObjectLayerPairFilterTable_Create(2);
-            j::JPH_ObjectLayerPairFilterTable_EnableCollision(pairs, MOVING, NON_MOVING);
-            j::JPH_ObjectLayerPairFilterTable_EnableCollision(pairs, MOVING, MOVING);
-            let object_vs_broad_phase =
-                j::JPH_ObjectVsBroadPhaseLayerFilterTable_Create(layers, 2, pairs, 2);
-            // Room for every body and, per body, more pairs and contacts than a resting pile
-            // has (Jolt's defaults are 65536 pairs and 10240 contact constraints).
-            let system_settings = j::JPH_PhysicsSystemSettings {
-                maxBodies: bodies.max(1),
-                numBodyMutexes: 0,
-                maxBodyPairs: (16 * bodies).max(65536),
-                maxContactConstraints: (16 * bodies).max(10240),
-                _padding: 0,
-                broadPhaseLayerInterface: layers,
-                objectLayerPairFilter: pairs,
-                objectVsBroadPhaseLayerFilter: object_vs_broad_phase,
-            };
-            let system = j::JPH_PhysicsSystem_Create(&system_settings);
-            let config = j::JPH_JobSystemConfig {
-                context: std::ptr::null_mut(),
-                queueJob: Some(run_job),
-                queueJobs: Some(run_jobs),
-                maxConcurrency: 1,
-                maxBarriers: 0,
-            };
-            let jobs = j::JPH_JobSystemCallback_Create(&config);
-            let temp = j::JPH_TempAllocator_Create(TEMP_ALLOCATOR_BYTES);
-            let mut sim = Self {
-                system,
-                jobs,
-                temp,
-                bodies: Vec::with_capacity(scene.bodies.len()),
-                dt: scene.dt,
-                setting: *setting,
-                physics: std::mem::zeroed(),
-            };
-            if system.is_null() || jobs.is_null() || temp.is_null() {
-                bail!("Jolt could not create its physics system");
+        let sim: Result<Self, Self> = unsafe {
+            'built: {
+                let layers = j::JPH_BroadPhaseLayerInterfaceTable_Create(2, 2);
+                j::JPH_BroadPhaseLayerInterfaceTable_MapObjectToBroadPhaseLayer(
+                    layers, NON_MOVING, 0,
+                );
+                j::JPH_BroadPhaseLayerInterfaceTable_MapObjectToBroadPhaseLayer(layers, MOVING, 1);
+                let pairs = j::JPH_ObjectLayerPairFilterTable_Create(2);
+                j::JPH_ObjectLayerPairFilterTable_EnableCollision(pairs, MOVING, NON_MOVING);
+                j::JPH_ObjectLayerPairFilterTable_EnableCollision(pairs, MOVING, MOVING);
+                let object_vs_broad_phase =
+                    j::JPH_ObjectVsBroadPhaseLayerFilterTable_Create(layers, 2, pairs, 2);
+                // Room for every body and, per body, more pairs and contacts than a resting pile
+                // has (Jolt's defaults are 65536 pairs and 10240 contact constraints).
+                let system_settings = j::JPH_PhysicsSystemSettings {
+                    maxBodies: bodies.max(1),
+                    numBodyMutexes: 0,
+                    maxBodyPairs: bodies.saturating_mul(16).max(65536),
+                    maxContactConstraints: bodies.saturating_mul(16).max(10240),
+                    _padding: 0,
+                    broadPhaseLayerInterface: layers,
+                    objectLayerPairFilter: pairs,
+                    objectVsBroadPhaseLayerFilter: object_vs_broad_phase,
+                };
+                let system = j::JPH_PhysicsSystem_Create(&system_settings);
+                let config = j::JPH_JobSystemConfig {
+                    context: std::ptr::null_mut(),
+                    queueJob: Some(run_job),
+                    queueJobs: Some(run_jobs),
+                    maxConcurrency: 1,
+                    maxBarriers: 0,
+                };
+                let jobs = j::JPH_JobSystemCallback_Create(&config);
+                let temp = j::JPH_TempAllocator_Create(TEMP_ALLOCATOR_BYTES);
+                let mut sim = Self {
+                    system,
+                    jobs,
+                    temp,
+                    bodies: Vec::with_capacity(scene.bodies.len()),
+                    dt: scene.dt,
+                    setting: *setting,
+                    physics: std::mem::zeroed(),
+                };
+                if system.is_null() || jobs.is_null() || temp.is_null() {
+                    // Dropped (taking the lock again) after the lock is released below.
+                    break 'built Err(sim);
+                }
+                j::JPH_PhysicsSystem_SetGravity(system, &vec3(Vec3::from(scene.gravity)));
+                let mut physics = std::mem::zeroed::<j::JPH_PhysicsSettings>();
+                j::JPH_PhysicsSystem_GetPhysicsSettings(system, &mut physics);
+                physics.numVelocitySteps = setting.velocity_steps;
+                physics.numPositionSteps = setting.position_steps;
+                physics.allowSleeping = false;
+                j::JPH_PhysicsSystem_SetPhysicsSettings(system, &mut physics);
+                j::JPH_PhysicsSystem_GetPhysicsSettings(system, &mut sim.physics);
+                Ok(sim)
             }
-            j::JPH_PhysicsSystem_SetGravity(system, &vec3(Vec3::from(scene.gravity)));
-            let mut physics = std::mem::zeroed::<j::JPH_PhysicsSettings>();
-            j::JPH_PhysicsSystem_GetPhysicsSettings(system, &mut physics);
-            physics.numVelocitySteps = setting.velocity_steps;
-            physics.numPositionSteps = setting.position_steps;
-            physics.allowSleeping = false;
-            j::JPH_PhysicsSystem_SetPhysicsSettings(system, &mut physics);
-            j::JPH_PhysicsSystem_GetPhysicsSettings(system, &mut sim.physics);
-            sim
         };
         drop(guard);
+        let Ok(mut sim) = sim else {
+            bail!("Jolt could not create its physics system");
+        };
         for (i, desc) in scene.bodies.iter().enumerate() {
             check_carried_over(i, desc, "Jolt")?;
             let material = resolve_material(scene, &desc.material)?;

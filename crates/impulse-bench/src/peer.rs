@@ -5,7 +5,9 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use impulse::scene::{BodyDesc, Material, MaterialRef, ShapeDesc};
+#[cfg(any(feature = "box3d", feature = "jolt"))]
+use impulse::scene::ShapeDesc;
+use impulse::scene::{BodyDesc, Material, MaterialRef};
 use impulse::{Scene, World};
 use parry3d::math::Pose;
 
@@ -158,6 +160,7 @@ pub(crate) fn check_carried_over(index: usize, body: &BodyDesc, engine: &str) ->
 }
 
 /// The scene-format name of a shape's kind, for errors.
+#[cfg(any(feature = "box3d", feature = "jolt"))]
 pub(crate) fn shape_kind(shape: &ShapeDesc) -> &'static str {
     match shape {
         ShapeDesc::Sphere { .. } => "sphere",
@@ -195,7 +198,7 @@ pub(crate) fn impulse_mass(world: &World, i: usize) -> f32 {
 /// One body of every shape that every peer builds (sphere, cuboid, capsule, convex hull; a
 /// particle with a given mass), apart from each other, above a static ground cuboid whose top
 /// face is y = 0, for the peers' tests of their bodies.
-#[cfg(test)]
+#[cfg(all(test, any(feature = "box3d", feature = "jolt")))]
 pub(crate) fn peer_zoo() -> Scene {
     use impulse::scene::BodyKind;
     let mut scene = Scene {
