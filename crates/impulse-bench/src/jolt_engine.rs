@@ -312,8 +312,9 @@ unsafe fn make_shape(shape: &ShapeDesc, density: f32) -> Result<*mut j::JPH_Shap
         match shape {
             ShapeDesc::Sphere { radius } => j::JPH_SphereShape_Create(*radius).cast(),
             ShapeDesc::Cuboid { half_extents: h } => {
-                // Jolt's default convex radius (edges rounded inside the same extents), less
-                // for a box thinner than twice that.
+                // Jolt's default convex radius (edges rounded inside the same extents); for a
+                // box thinner than four times that, half its smallest half extent (Jolt needs
+                // the radius inside the box).
                 let radius = radius.min(0.5 * h[0].min(h[1]).min(h[2]));
                 let half = vec3(Vec3::from(*h));
                 j::JPH_BoxShape_Create(&half, radius).cast()
