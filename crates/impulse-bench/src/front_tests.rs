@@ -1,6 +1,8 @@
 //! Unit tests of `front.rs`: the front's dominance, bars and tables on hand-made points.
 
 use super::*;
+use crate::MachineInfo;
+use crate::peer_settings::{Box3dSetting, JoltSetting, RapierVariant};
 use impulse::SolverMethod;
 
 fn point(engine: &str, setting: &str, ms: f64, e_mm: f64) -> FrontPoint {
@@ -126,21 +128,24 @@ fn tables_mark_bars_no_setting_meets() {
     let table = format_bar_table(&front);
     let lines: Vec<&str> = table.lines().collect();
     assert_eq!(lines.len(), 5, "{table}");
+    assert!(lines[0].ends_with(
+        "| Rapier: cheapest setting | ms/step | E (mm) | cheapest peer | time impulse/cheapest peer |"
+    ));
     assert_eq!(
         lines[2],
-        "| Q50 (E ≤ 50 mm) | fast | 1.00 | 30.0 | 4×30Hz | 2.00 | 40.0 | 0.50 |"
+        "| Q50 (E ≤ 50 mm) | fast | 1.00 | 30.0 | 4×30Hz | 2.00 | 40.0 | rapier | 0.50 |"
     );
     assert_eq!(
         lines[3],
-        "| Q5 (E ≤ 5 mm) | default | 4.00 | 0.500 | 32×480Hz | 8.00 | 3.00 | 0.50 |"
+        "| Q5 (E ≤ 5 mm) | default | 4.00 | 0.500 | 32×480Hz | 8.00 | 3.00 | rapier | 0.50 |"
     );
     assert_eq!(
         lines[4],
-        "| Q1 (E ≤ 1 mm) | default | 4.00 | 0.500 | — | — | — | impulse only |"
+        "| Q1 (E ≤ 1 mm) | default | 4.00 | 0.500 | — | — | — | — | impulse only |"
     );
     let summary = format_summary_table(std::slice::from_ref(&front));
     assert!(
-        summary.contains("| s | 4 | 20 | 0.50 | 0.50 | impulse only |"),
+        summary.contains("| s | 4 | 20 | 0.50 (rapier) | 0.50 (rapier) | impulse only |"),
         "{summary}"
     );
 
@@ -155,10 +160,17 @@ fn tables_mark_bars_no_setting_meets() {
     let table = format_bar_table(&front);
     let lines: Vec<&str> = table.lines().collect();
     assert!(lines[3].starts_with("| Q5 (E ≤ 5 mm) | — | — | — | 32×480Hz |"));
-    assert!(lines[3].ends_with("| rapier only |"), "{}", lines[3]);
-    assert_eq!(lines[4], "| Q1 (E ≤ 1 mm) | — | — | — | — | — | — | — |");
+    assert!(
+        lines[3].ends_with("| rapier | rapier only |"),
+        "{}",
+        lines[3]
+    );
+    assert_eq!(
+        lines[4],
+        "| Q1 (E ≤ 1 mm) | — | — | — | — | — | — | — | — |"
+    );
 
-    // Without Rapier measured at all, impulse alone is not "impulse only".
+    // Without a peer measured at all, impulse alone is not "impulse only".
     let front = SceneFront {
         points: vec![point(IMPULSE, "fast", 1.0, 0.5)],
         ..front
@@ -180,6 +192,59 @@ fn tables_mark_bars_no_setting_meets() {
     assert_eq!(fronts.lines().count(), 4, "{fronts}");
     assert!(fronts.contains("| impulse | fast | 1.00 | 30.0 | 30.0 | 0.000 | 0.000 |"));
     assert!(!fronts.contains("worse"));
+}
+
+/// With several peers: a column group per peer measured, impulse's ratio to the cheapest peer
+/// meeting the bar, and the peers named when impulse meets none.
+#[test]
+fn tables_compare_impulse_with_the_cheapest_peer() {
+    let front = SceneFront {
+        scene: "s".into(),
+        bodies: 4,
+        steps: 20,
+        points: vec![
+            point(IMPULSE, "fast", 1.0, 30.0),
+            point(RAPIER, "4×30Hz", 4.0, 40.0),
+            point(BOX3D, "4×30Hz", 2.0, 20.0),
+            point(BOX3D, "32×240Hz", 10.0, 2.0),
+            point(JOLT, "c1 v10 p2", 3.0, 45.0),
+            point(JOLT, "c4 v40 p8", 20.0, 3.0),
+        ],
+    };
+    let table = format_bar_table(&front);
+    let lines: Vec<&str> = table.lines().collect();
+    assert!(
+        lines[0].contains("| Rapier: cheapest setting |")
+            && lines[0].contains("| Box3D: cheapest setting |")
+            && lines[0].contains("| Jolt: cheapest setting |"),
+        "{}",
+        lines[0]
+    );
+    assert_eq!(
+        lines[2],
+        "| Q50 (E ≤ 50 mm) | fast | 1.00 | 30.0 | 4×30Hz | 4.00 | 40.0 | 4×30Hz | 2.00 | 20.0 \
+         | c1 v10 p2 | 3.00 | 45.0 | box3d | 0.50 |"
+    );
+    assert!(
+        lines[3].ends_with("| box3d | box3d, jolt only |"),
+        "{}",
+        lines[3]
+    );
+    let summary = format_summary_table(std::slice::from_ref(&front));
+    assert!(
+        summary.contains("| s | 4 | 20 | 0.50 (box3d) | box3d, jolt only | — |"),
+        "{summary}"
+    );
+    let fronts = format_front_table(&front);
+    for engine in ["| impulse |", "| rapier |", "| box3d |", "| jolt |"] {
+        assert!(fronts.contains(engine), "{engine}: {fronts}");
+    }
+    // A peer measured on no scene gets no columns.
+    let no_jolt = SceneFront {
+        points: front.points[..4].to_vec(),
+        ..front
+    };
+    assert!(!format_bar_table(&no_jolt).contains("Jolt"));
 }
 
 #[test]
@@ -208,16 +273,49 @@ fn grids_have_the_documented_sizes_and_names() {
     assert!(split.split_impulse() && split.method == SolverMethod::Auto);
     assert_eq!((split.substeps, split.iterations), (2, 4));
     assert!(impulse_quick_grid().len() < 5);
-    #[cfg(feature = "rapier")]
-    {
-        let grid = rapier_grid();
-        assert_eq!(grid.len(), 40);
-        let names: std::collections::HashSet<String> =
-            grid.iter().map(|v| v.setting_name()).collect();
-        assert_eq!(names.len(), 40);
-        assert!(names.contains("4×30Hz") && names.contains("32×480Hz coulomb"));
-        assert!(rapier_quick_grid().len() < 5);
+    let names = |names: Vec<String>| -> std::collections::HashSet<String> {
+        let count = names.len();
+        let set: std::collections::HashSet<String> = names.into_iter().collect();
+        assert_eq!(set.len(), count, "names are unique");
+        set
+    };
+    let rapier = names(rapier_grid().iter().map(|v| v.setting_name()).collect());
+    assert_eq!(rapier.len(), 40);
+    assert!(rapier.contains("4×30Hz") && rapier.contains("32×480Hz coulomb"));
+    assert!(rapier_quick_grid().len() < 5);
+    assert_eq!(rapier_quick_grid()[0], RapierVariant::default());
+
+    // Box3D: hertz run as asked and within two octaves of the clamp, and the default 30 Hz
+    // (clamped) below 4 substeps.
+    let box3d = box3d_grid();
+    let box3d_names = names(box3d.iter().map(|s| s.setting_name()).collect());
+    assert_eq!(box3d.len(), 22, "{box3d_names:?}");
+    for name in [
+        "1×30Hz",
+        "4×30Hz",
+        "8×60Hz",
+        "16×30Hz",
+        "32×240Hz",
+        "64×480Hz",
+    ] {
+        assert!(box3d_names.contains(name), "{name}");
     }
+    for name in ["4×60Hz", "24×30Hz", "64×60Hz"] {
+        assert!(!box3d_names.contains(name), "{name}");
+    }
+    for setting in &box3d {
+        let run = setting.effective_contact_hz(1.0 / 60.0);
+        assert!(
+            setting.substeps < 4 || run >= 0.9999 * setting.contact_hz,
+            "{setting:?}"
+        );
+    }
+    assert_eq!(box3d_quick_grid()[0], Box3dSetting::default());
+
+    let jolt = names(jolt_grid().iter().map(|s| s.setting_name()).collect());
+    assert_eq!(jolt.len(), 20);
+    assert!(jolt.contains("c1 v10 p2") && jolt.contains("c16 v40 p2"));
+    assert_eq!(jolt_quick_grid()[0], JoltSetting::default());
 }
 
 #[test]
@@ -233,8 +331,8 @@ fn large_scenes_run_fewer_steps() {
     assert_eq!(config.steps_for(&large), 120);
 }
 
-/// `front --quick` on a small scene, end to end: points of both engines (with `rapier`),
-/// a table row per bar, a plot per scene.
+/// `front --quick` on a small scene, end to end: points of every engine compiled in, a table
+/// row per bar, a plot per scene.
 #[test]
 fn quick_front_on_a_small_stack() {
     let config = FrontConfig {
@@ -242,6 +340,7 @@ fn quick_front_on_a_small_stack() {
         steps: 20,
         large_steps: 20,
         quick: true,
+        ..FrontConfig::default()
     };
     let mut progress = Vec::new();
     let fronts = run_front(&config, &mut |p| {
@@ -251,15 +350,20 @@ fn quick_front_on_a_small_stack() {
     assert_eq!(fronts.len(), 1);
     let front = &fronts[0];
     assert_eq!((front.scene.as_str(), front.steps), ("stack3", 20));
-    let expected = config.impulse_settings().len() + config.rapier_settings().len();
+    let peers = config.peer_settings().unwrap();
+    let expected = config.impulse_settings().len() + peers.iter().map(Vec::len).sum::<usize>();
     assert_eq!(front.points.len(), expected);
     assert_eq!(progress.len(), expected);
     assert_eq!(progress.last().unwrap().0, progress.last().unwrap().1);
-    // The engines take turns.
+    // The engines take turns: impulse, then each peer compiled in.
+    let compiled: Vec<&str> = PEERS
+        .into_iter()
+        .filter(|p| crate::peer_settings::peer_compiled(p))
+        .collect();
     assert_eq!(front.points[0].engine, IMPULSE);
-    if cfg!(feature = "rapier") {
-        assert_eq!(front.points[1].engine, RAPIER);
-        assert!(front.measured(RAPIER));
+    for (k, peer) in compiled.iter().enumerate() {
+        assert_eq!(front.points[1 + k].engine, *peer);
+        assert!(front.measured(peer));
     }
     for p in &front.points {
         assert!(p.counts(), "{p:?}");

@@ -202,3 +202,13 @@ pub fn settings_text(s: &SolverSettings, threads: usize) -> String {
         if threads == 1 { "" } else { "s" },
     )
 }
+
+impl crate::peer::EngineRun for ImpulseRun {
+    fn advance(&mut self, n: u32) -> Result<()> {
+        ImpulseRun::advance(self, n)
+    }
+
+    fn finish(self: Box<Self>) -> BenchRow {
+        ImpulseRun::finish(*self)
+    }
+}

@@ -1,21 +1,41 @@
-//! Benchmarks of impulse, and the side-by-side harness against Rapier (the standard scenes of
-//! docs/scenes.md; the metrics of docs/benchmarks.md, "What is measured, and how").
+//! Benchmarks of impulse, and the side-by-side harness against the peer engines Rapier, Box3D
+//! and Jolt (the standard scenes of docs/scenes.md; the metrics of docs/benchmarks.md, "What is
+//! measured, and how").
 //!
-//! Both engines get the same scene, body for body and in scene order; time is the median
+//! Every engine gets the same scene, body for body and in scene order; time is the median
 //! wall-clock time of one step with sleeping off; quality is measured from poses alone with
 //! `impulse::metrics`, never from an engine's own contact report, and metric time is not
-//! timed. The claim to make from a run is the ratio of the two engines' times measured in
-//! that run, on that machine, next to the quality each reached.
+//! timed. The claim to make from a run is the ratio of the engines' times measured in that
+//! run, on that machine, next to the quality each reached.
+//!
+//! Each peer is behind a feature, off by default, so that `cargo test --workspace` compiles
+//! none of them: `rapier` (Rapier 0.36), `box3d` (Box3D's C through `boxddd-sys`), `jolt` (Jolt
+//! through `oxijolt-sys`, built with CMake).
 //!
 //! - [`bench_impulse`]: impulse on a scene, inside a rayon pool of a given size.
-//! - [`bench_rapier`] (feature `rapier`, off by default: `--features rapier`): Rapier 0.36 on the same scene.
+//! - `bench_rapier`, `bench_box3d`, `bench_jolt` (with their features): a peer on the same
+//!   scene.
 //! - [`format_table`]: the results as one Markdown table.
-//! - [`run_benchmarks`]: a list of built-in scenes through both engines.
+//! - [`run_benchmarks`]: a list of built-in scenes through impulse and the peers.
 //! - [`front`]: the quality/speed Pareto front of each engine over a grid of its settings.
 
+#[cfg(feature = "box3d")]
+mod box3d_engine;
+mod engines;
 pub mod front;
+mod front_grids;
+mod front_tables;
 mod impulse_engine;
+#[cfg(feature = "jolt")]
+mod jolt_engine;
 pub mod machine;
+// Its runs and helpers serve the peer engines, each behind its feature.
+#[cfg_attr(
+    not(any(feature = "rapier", feature = "box3d", feature = "jolt")),
+    allow(dead_code)
+)]
+mod peer;
+pub mod peer_settings;
 mod plot;
 pub mod quality;
 #[cfg(feature = "rapier")]
@@ -28,10 +48,17 @@ use std::fmt::Write as _;
 use anyhow::{Context, Result, bail};
 use impulse::Scene;
 
+use crate::peer::EngineRun;
+use crate::peer_settings::{BOX3D, JOLT, PEERS, RAPIER, missing_peer};
 use crate::threads::thread_pool;
 
+#[cfg(feature = "box3d")]
+pub use box3d_engine::{bench_box3d, settings_text as box3d_settings_text};
 pub use impulse_engine::{bench_impulse, settings_text as impulse_settings_text};
+#[cfg(feature = "jolt")]
+pub use jolt_engine::bench_jolt;
 pub use machine::MachineInfo;
+pub use peer_settings::{Box3dSetting, JoltSetting, PeerSetting, RapierVariant};
 pub use plot::{register_plot_font, write_plots};
 pub use quality::QualityReport;
 #[cfg(feature = "rapier")]
@@ -42,7 +69,7 @@ pub use rapier_engine::{
 pub use row::{BenchRow, TURN_STEPS};
 
 /// The error when Rapier is asked for in a build without the `rapier` feature (the default
-/// build compiles neither Rapier nor criterion, to keep `cargo test --workspace` quick).
+/// build compiles no peer and no criterion, to keep `cargo test --workspace` quick).
 pub const NO_RAPIER: &str = "Rapier was asked for, but impulse-bench was built without the \
      `rapier` feature; build it with `--features rapier`, e.g. \
      `cargo run --release -p impulse-bench --features rapier -- ...`";
@@ -60,36 +87,51 @@ pub const DEFAULT_SCENES: &[&str] = &[
 /// Steps per scene when not told otherwise (10 s at dt = 1/60 s).
 pub const DEFAULT_STEPS: u32 = 600;
 
-/// The rows as one Markdown table, in the given order. The ratio column is impulse's median
-/// time divided by Rapier's for the same scene (< 1: impulse is faster), shown on impulse rows
-/// when a Rapier row of the same scene exists.
+/// True for the rows of impulse (its settings, `impulse fast`, `… on N threads`).
+fn is_impulse_row(row: &BenchRow) -> bool {
+    row.engine == impulse_engine::ENGINE || row.engine.starts_with("impulse ")
+}
+
+/// The rows as one Markdown table, in the given order. For each peer (Rapier, Box3D, Jolt)
+/// with a row at its defaults (engine `rapier`, `box3d`, `jolt`) there is a column "time
+/// impulse/PEER": on impulse rows, impulse's median time divided by that peer's on the same
+/// scene (< 1: impulse is faster).
 pub fn format_table(rows: &[BenchRow]) -> String {
-    let mut out = String::new();
-    out.push_str(
-        "| scene | engine | bodies | steps | ms/step (median) | steps/s | time impulse/rapier \
-         | top sink (mm) | largest overlap (mm) | largest drift (mm) | settings |\n",
-    );
-    out.push_str("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+    let peers: Vec<&str> = PEERS
+        .into_iter()
+        .filter(|peer| rows.iter().any(|r| r.engine == *peer))
+        .collect();
+    let mut out = String::from("| scene | engine | bodies | steps | ms/step (median) | steps/s |");
+    let mut rule = String::from("|---|---|---:|---:|---:|---:|");
+    for peer in &peers {
+        let _ = write!(out, " time impulse/{peer} |");
+        rule.push_str("---:|");
+    }
+    out.push_str(" top sink (mm) | largest overlap (mm) | largest drift (mm) | settings |\n");
+    rule.push_str("---:|---:|---:|---|\n");
+    out.push_str(&rule);
     for row in rows {
-        let ratio = if row.engine == impulse_engine::ENGINE || row.engine.starts_with("impulse ") {
-            rows.iter()
-                .find(|r| r.scene == row.scene && r.engine == "rapier")
-                .filter(|r| r.ms_per_step_median > 0.0)
-                .map(|r| format!("{:.2}", row.ms_per_step_median / r.ms_per_step_median))
-                .unwrap_or_default()
-        } else {
-            String::new()
-        };
+        let ratios: String = peers
+            .iter()
+            .map(|peer| {
+                let ratio = rows
+                    .iter()
+                    .find(|r| r.scene == row.scene && r.engine == *peer)
+                    .filter(|r| is_impulse_row(row) && r.ms_per_step_median > 0.0)
+                    .map(|r| format!("{:.2}", row.ms_per_step_median / r.ms_per_step_median))
+                    .unwrap_or_default();
+                format!(" {ratio} |")
+            })
+            .collect();
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {:.0} | {} | {:.1} | {:.1} | {:.1} | {} |",
+            "| {} | {} | {} | {} | {} | {:.0} |{ratios} {:.1} | {:.1} | {:.1} | {} |",
             row.scene,
             row.engine,
             row.bodies,
             row.steps,
             format_ms(row.ms_per_step_median),
             row.steps_per_second,
-            ratio,
             row.top_sink_m * 1e3,
             row.max_overlap_m * 1e3,
             row.max_drift_m * 1e3,
@@ -183,12 +225,16 @@ pub struct BenchConfig {
     pub scenes: Vec<String>,
     /// Steps per scene.
     pub steps: u32,
-    /// Threads of impulse's rayon pool (Rapier always runs on one).
+    /// Threads of impulse's rayon pool (the peers always run on one).
     pub threads: usize,
-    /// Also measure Rapier (needs the `rapier` feature).
+    /// Also measure Rapier at its defaults (needs the `rapier` feature).
     pub rapier: bool,
     /// Extra Rapier rows with other settings than the defaults (needs `rapier`).
     pub rapier_variants: Vec<RapierVariant>,
+    /// Also measure Box3D at its defaults (needs the `box3d` feature).
+    pub box3d: bool,
+    /// Also measure Jolt at its defaults (needs the `jolt` feature).
+    pub jolt: bool,
     /// Measure impulse at each scene's own solver settings (row "impulse").
     pub impulse_defaults: bool,
     /// Also measure impulse with `SolverSettings::fast()` (row "impulse fast").
@@ -199,83 +245,6 @@ pub struct BenchConfig {
     pub also_threads: Option<usize>,
 }
 
-/// Rapier with other settings than its defaults, to compare the engines at similar quality.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RapierVariant {
-    /// `IntegrationParameters::num_solver_iterations` (Rapier's substeps; default 4).
-    pub substeps: usize,
-    /// `contact_softness.natural_frequency` (Hz; default 30); contacts with a fixed body get
-    /// twice this (`static_contact_softness`), as in Rapier's defaults.
-    pub contact_hz: f32,
-    /// `FrictionModel::Coulomb` (one friction disc per contact point, impulse's formulation)
-    /// instead of Rapier's default `Simplified` (one per manifold of up to four points, plus a
-    /// twist row).
-    pub coulomb_friction: bool,
-}
-
-impl RapierVariant {
-    /// Engine name of its rows, e.g. `rapier 8×120Hz` or `rapier 4×30Hz coulomb`.
-    pub fn engine_name(&self) -> String {
-        format!("rapier {}", self.setting_name())
-    }
-
-    /// The settings alone, e.g. `8×120Hz` or `4×30Hz coulomb` (substeps × contact spring
-    /// frequency, and the friction model when it is Coulomb).
-    pub fn setting_name(&self) -> String {
-        let friction = if self.coulomb_friction {
-            " coulomb"
-        } else {
-            ""
-        };
-        format!("{}×{}Hz{friction}", self.substeps, self.contact_hz)
-    }
-}
-
-#[cfg(feature = "rapier")]
-impl RapierVariant {
-    /// Rapier's default integration parameters with this variant's substeps and springs.
-    pub fn integration_parameters(&self) -> rapier3d::prelude::IntegrationParameters {
-        let mut params = rapier3d::prelude::IntegrationParameters {
-            num_solver_iterations: self.substeps,
-            ..Default::default()
-        };
-        params.contact_softness.natural_frequency = self.contact_hz;
-        params.static_contact_softness.natural_frequency = 2.0 * self.contact_hz;
-        if self.coulomb_friction {
-            params.friction_model = rapier3d::prelude::FrictionModel::Coulomb;
-        }
-        params
-    }
-}
-
-impl std::str::FromStr for RapierVariant {
-    type Err = String;
-
-    /// `SUBSTEPS:HZ[:coulomb]`, e.g. `8:120` or `4:30:coulomb`.
-    fn from_str(s: &str) -> Result<Self, String> {
-        let (s, coulomb_friction) = match s.rsplit_once(':') {
-            Some((rest, "coulomb")) => (rest, true),
-            _ => (s, false),
-        };
-        let (substeps, hz) = s.split_once(':').ok_or_else(|| {
-            format!("expected SUBSTEPS:HZ[:coulomb] (e.g. 8:120 or 4:30:coulomb), got \"{s}\"")
-        })?;
-        let substeps: usize = substeps
-            .trim()
-            .parse()
-            .map_err(|e| format!("substeps \"{substeps}\": {e}"))?;
-        let contact_hz: f32 = hz.trim().parse().map_err(|e| format!("hz \"{hz}\": {e}"))?;
-        if substeps == 0 || !(contact_hz.is_finite() && contact_hz > 0.0) {
-            return Err(format!("substeps must be ≥ 1 and hz > 0, got \"{s}\""));
-        }
-        Ok(Self {
-            substeps,
-            contact_hz,
-            coulomb_friction,
-        })
-    }
-}
-
 impl Default for BenchConfig {
     fn default() -> Self {
         Self {
@@ -284,6 +253,8 @@ impl Default for BenchConfig {
             threads: 1,
             rapier: cfg!(feature = "rapier"),
             rapier_variants: Vec::new(),
+            box3d: cfg!(feature = "box3d"),
+            jolt: cfg!(feature = "jolt"),
             impulse_defaults: true,
             impulse_fast: false,
             also_threads: None,
@@ -297,41 +268,51 @@ pub fn scene_by_name(name: &str) -> Result<Scene> {
         .with_context(|| format!("no built-in scene named \"{name}\""))
 }
 
-/// One engine's run of a scene, advanced a turn at a time.
-enum EngineRun {
-    Impulse(Box<impulse_engine::ImpulseRun>),
-    #[cfg(feature = "rapier")]
-    Rapier(Box<rapier_engine::RapierRun>),
-}
-
-impl EngineRun {
-    fn advance(&mut self, n: u32) -> Result<()> {
-        match self {
-            EngineRun::Impulse(run) => run.advance(n),
-            #[cfg(feature = "rapier")]
-            EngineRun::Rapier(run) => run.advance(n),
+impl BenchConfig {
+    /// The peer rows asked for, in order (Rapier at its defaults, its variants, Box3D, Jolt),
+    /// each with its row's engine name.
+    fn peer_rows(&self) -> Vec<(PeerSetting, String)> {
+        let mut rows = Vec::new();
+        if self.rapier {
+            rows.push((
+                PeerSetting::Rapier(RapierVariant::default()),
+                RAPIER.to_string(),
+            ));
         }
+        for variant in &self.rapier_variants {
+            rows.push((PeerSetting::Rapier(*variant), variant.engine_name()));
+        }
+        if self.box3d {
+            rows.push((
+                PeerSetting::Box3d(Box3dSetting::default()),
+                BOX3D.to_string(),
+            ));
+        }
+        if self.jolt {
+            rows.push((PeerSetting::Jolt(JoltSetting::default()), JOLT.to_string()));
+        }
+        rows
     }
 
-    fn finish(self) -> BenchRow {
-        match self {
-            EngineRun::Impulse(run) => run.finish(),
-            #[cfg(feature = "rapier")]
-            EngineRun::Rapier(run) => run.finish(),
+    /// Fails, naming the feature, when a peer asked for is not compiled in.
+    fn check_peers_compiled(&self) -> Result<()> {
+        for (setting, _) in self.peer_rows() {
+            if !peer_settings::peer_compiled(setting.engine()) {
+                bail!("{}", missing_peer(setting.engine()));
+            }
         }
+        Ok(())
     }
 }
 
-/// Runs one scene through impulse and, as `config` asks, Rapier and its variants. The
-/// engines take turns of [`TURN_STEPS`] steps on the same thread, so that other work on the
-/// machine slows all of them alike and the ratio of their times stays meaningful. Everything
-/// runs inside a rayon pool of `config.threads` (Rapier does not use it). One result per
-/// engine, in the order impulse, Rapier, variants; an engine that fails (a blow-up, say) is
-/// dropped from the turns and the others go on.
+/// Runs one scene through impulse and, as `config` asks, the peers (Rapier and its variants,
+/// Box3D, Jolt). The engines take turns of [`TURN_STEPS`] steps on the same thread, so that
+/// other work on the machine slows all of them alike and the ratio of their times stays
+/// meaningful. Everything runs inside a rayon pool of `config.threads` (the peers do not use
+/// it). One result per engine, in the order impulse, Rapier, its variants, Box3D, Jolt; an
+/// engine that fails (a blow-up, say) is dropped from the turns and the others go on.
 pub fn bench_scene(scene: &Scene, config: &BenchConfig) -> Result<Vec<Result<BenchRow>>> {
-    if (config.rapier || !config.rapier_variants.is_empty()) && !cfg!(feature = "rapier") {
-        bail!("{NO_RAPIER}");
-    }
+    config.check_peers_compiled()?;
     let steps = config.steps;
     thread_pool(config.threads)?.install(|| {
         // The impulse configurations: the scene's settings (None) and `fast`, as asked.
@@ -341,41 +322,23 @@ pub fn bench_scene(scene: &Scene, config: &BenchConfig) -> Result<Vec<Result<Ben
             .then(|| Some(impulse::SolverSettings::fast()));
         let impulse_settings: Vec<Option<impulse::SolverSettings>> =
             defaults.into_iter().chain(fast).collect();
-        let mut runs: Vec<Result<EngineRun>> = Vec::new();
+        let mut runs: Vec<Result<Box<dyn EngineRun>>> = Vec::new();
         for settings in &impulse_settings {
             runs.push(
                 impulse_engine::ImpulseRun::new(scene, steps, config.threads, settings.clone())
-                    .map(|run| EngineRun::Impulse(Box::new(run))),
+                    .map(|run| Box::new(run) as Box<dyn EngineRun>),
             );
         }
         if let Some(threads) = config.also_threads {
             for settings in impulse_settings {
                 runs.push(
                     impulse_engine::ImpulseRun::on_threads(scene, steps, threads, settings)
-                        .map(|run| EngineRun::Impulse(Box::new(run))),
+                        .map(|run| Box::new(run) as Box<dyn EngineRun>),
                 );
             }
         }
-        #[cfg(feature = "rapier")]
-        {
-            if config.rapier {
-                let params = rapier3d::prelude::IntegrationParameters::default();
-                runs.push(
-                    rapier_engine::RapierRun::new(scene, steps, &params, rapier_engine::ENGINE)
-                        .map(|run| EngineRun::Rapier(Box::new(run))),
-                );
-            }
-            for variant in &config.rapier_variants {
-                runs.push(
-                    rapier_engine::RapierRun::new(
-                        scene,
-                        steps,
-                        &variant.integration_parameters(),
-                        &variant.engine_name(),
-                    )
-                    .map(|run| EngineRun::Rapier(Box::new(run))),
-                );
-            }
+        for (setting, engine) in config.peer_rows() {
+            runs.push(engines::start_peer(scene, steps, &setting, &engine));
         }
         let mut done = 0;
         while done < steps {
@@ -397,16 +360,14 @@ pub fn bench_scene(scene: &Scene, config: &BenchConfig) -> Result<Vec<Result<Ben
 
 /// Runs every scene of `config` (see [`bench_scene`]), calling `on_row` as each row is
 /// measured. A failed run is passed to `on_error` and left out of the rows; unknown scene
-/// names, zero steps or threads, and a Rapier request without the feature fail before
+/// names, zero steps or threads, and a peer asked for without its feature fail before
 /// anything runs.
 pub fn run_benchmarks(
     config: &BenchConfig,
     on_row: &mut dyn FnMut(&BenchRow),
     on_error: &mut dyn FnMut(&anyhow::Error),
 ) -> Result<Vec<BenchRow>> {
-    if (config.rapier || !config.rapier_variants.is_empty()) && !cfg!(feature = "rapier") {
-        bail!("{NO_RAPIER}");
-    }
+    config.check_peers_compiled()?;
     if config.steps == 0 {
         bail!("steps must be at least 1");
     }
@@ -481,6 +442,8 @@ mod tests {
             threads: 1,
             rapier: false,
             rapier_variants: Vec::new(),
+            box3d: false,
+            jolt: false,
             impulse_defaults: true,
             impulse_fast: true,
             also_threads: Some(2),
@@ -608,6 +571,8 @@ mod tests {
             } else {
                 Vec::new()
             },
+            box3d: cfg!(feature = "box3d"),
+            jolt: cfg!(feature = "jolt"),
             impulse_defaults: true,
             impulse_fast: true,
             also_threads: None,
@@ -624,15 +589,38 @@ mod tests {
         assert_eq!(rows[0].max_drift_m, alone.max_drift_m);
         assert_eq!(rows[1].engine, "impulse fast");
         assert!(rows[1].settings.starts_with("PGS"), "{}", rows[1].settings);
+        let engines: Vec<&str> = rows.iter().map(|r| r.engine.as_str()).collect();
+        let mut expected = vec!["impulse", "impulse fast"];
+        if cfg!(feature = "rapier") {
+            expected.extend(["rapier", "rapier 8×60Hz"]);
+        }
+        if cfg!(feature = "box3d") {
+            expected.push("box3d");
+        }
+        if cfg!(feature = "jolt") {
+            expected.push("jolt");
+        }
+        assert_eq!(engines, expected);
+        let row = |engine: &str| rows.iter().find(|r| r.engine == engine).unwrap();
+        assert!(rows.iter().all(|r| r.steps == 25));
         #[cfg(feature = "rapier")]
         {
-            assert_eq!(rows.len(), 4);
             let alone = bench_rapier(&scene, 25).unwrap();
-            assert_eq!(rows[2].engine, "rapier");
-            assert_eq!(rows[2].top_sink_m, alone.top_sink_m);
-            assert_eq!(rows[3].engine, "rapier 8×60Hz");
-            assert_eq!(rows[3].steps, 25);
+            assert_eq!(row("rapier").top_sink_m, alone.top_sink_m);
         }
+        #[cfg(feature = "box3d")]
+        {
+            let alone = bench_box3d(&scene, 25, &Box3dSetting::default()).unwrap();
+            assert_eq!(row("box3d").top_sink_m, alone.top_sink_m);
+            assert_eq!(row("box3d").max_drift_m, alone.max_drift_m);
+        }
+        #[cfg(feature = "jolt")]
+        {
+            let alone = bench_jolt(&scene, 25, &JoltSetting::default()).unwrap();
+            assert_eq!(row("jolt").top_sink_m, alone.top_sink_m);
+            assert_eq!(row("jolt").max_drift_m, alone.max_drift_m);
+        }
+        let _ = row;
     }
 
     #[test]
@@ -646,7 +634,7 @@ mod tests {
     }
 
     #[test]
-    fn both_engines_measure_a_small_stack() {
+    fn every_engine_measures_a_small_stack() {
         let scene = scene_by_name("stack3").unwrap();
         let impulse_row = bench_impulse(&scene, 30, 1).unwrap();
         assert_eq!(impulse_row.bodies, 4);
@@ -662,5 +650,46 @@ mod tests {
             assert!(rapier_row.top_sink_m.abs() < 0.05);
             assert!(rapier_row.settings.contains("4 substeps"));
         }
+        #[cfg(feature = "box3d")]
+        {
+            let row = bench_box3d(&scene, 30, &Box3dSetting::default()).unwrap();
+            assert_eq!(row.bodies, 4);
+            assert!(
+                row.max_overlap_m < 0.05 && row.top_sink_m.abs() < 0.05,
+                "{row:?}"
+            );
+        }
+        #[cfg(feature = "jolt")]
+        {
+            let row = bench_jolt(&scene, 30, &JoltSetting::default()).unwrap();
+            assert_eq!(row.bodies, 4);
+            assert!(
+                row.max_overlap_m < 0.05 && row.top_sink_m.abs() < 0.05,
+                "{row:?}"
+            );
+        }
+    }
+
+    /// A ratio column per peer at its defaults, filled on impulse rows only.
+    #[test]
+    fn table_has_a_ratio_column_per_peer() {
+        let rows = [
+            row("s", "impulse", 2.0),
+            row("s", "rapier", 4.0),
+            row("s", "jolt", 8.0),
+            row("s", "rapier 8×120Hz", 1.0),
+        ];
+        let table = format_table(&rows);
+        let lines: Vec<&str> = table.lines().collect();
+        assert!(lines[0].contains("| time impulse/rapier | time impulse/jolt | top sink"));
+        assert!(!lines[0].contains("box3d"));
+        assert!(
+            lines[2].contains("| 500 | 0.50 | 0.25 | 1.2 |"),
+            "{}",
+            lines[2]
+        );
+        assert!(lines[3].contains("| 250 |  |  | 1.2 |"), "{}", lines[3]);
+        // Without any peer row there is no ratio column.
+        assert!(!format_table(&rows[..1]).contains("time impulse/"));
     }
 }

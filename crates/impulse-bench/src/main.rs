@@ -1,8 +1,9 @@
-//! `impulse-bench`: impulse and Rapier on the same built-in scenes, one Markdown table.
+//! `impulse-bench`: impulse and its peers (Rapier, Box3D, Jolt: each with its feature) on the
+//! same built-in scenes, one Markdown table.
 //!
 //! ```text
-//! cargo run --release -p impulse-bench --features rapier -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--impulse-fast] [--also-threads N] [--markdown FILE]
-//! cargo run --release -p impulse-bench --features rapier -- front [SCENE...] [--steps N] [--large-steps M] [--out-dir DIR] [--markdown FILE] [--json FILE] [--quick]
+//! cargo run --release -p impulse-bench --features rapier,box3d,jolt -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--no-box3d] [--no-jolt] [--impulse-fast] [--also-threads N] [--markdown FILE]
+//! cargo run --release -p impulse-bench --features rapier,box3d,jolt -- front [SCENE...] [--steps N] [--large-steps M] [--peers rapier,box3d,jolt] [--out-dir DIR] [--markdown FILE] [--json FILE] [--quick]
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -11,13 +12,15 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use impulse_bench::front::{self, FrontConfig};
+use impulse_bench::peer_settings::{BOX3D, JOLT, PEERS, RAPIER, peer_compiled};
 use impulse_bench::{
     BenchConfig, DEFAULT_SCENES, DEFAULT_STEPS, MachineInfo, RapierVariant, format_table,
     format_thread_table,
 };
 
-/// Times impulse and Rapier on the same built-in scenes (sleeping off, median ms/step) and
-/// measures both from poses: top-body sink, largest overlap, largest drift.
+/// Times impulse and its peers (Rapier, Box3D and Jolt, those compiled in) on the same built-in
+/// scenes (sleeping off, median ms/step) and measures each from poses: top-body sink, largest
+/// overlap, largest drift.
 #[derive(Parser)]
 #[command(
     name = "impulse-bench",
@@ -34,13 +37,18 @@ struct Args {
     /// Steps per scene.
     #[arg(long, default_value_t = DEFAULT_STEPS)]
     steps: u32,
-    /// Threads of impulse's rayon pool (Rapier runs on one thread).
+    /// Threads of impulse's rayon pool (the peers run on one thread).
     #[arg(long, default_value_t = 1)]
     threads: usize,
-    /// Measure impulse only (no Rapier row with default settings); the only mode of a build
-    /// without the `rapier` feature.
+    /// No Rapier row with default settings; needed in a build without the `rapier` feature.
     #[arg(long)]
     no_rapier: bool,
+    /// No Box3D row (a build without the `box3d` feature has none anyway).
+    #[arg(long)]
+    no_box3d: bool,
+    /// No Jolt row (a build without the `jolt` feature has none anyway).
+    #[arg(long)]
+    no_jolt: bool,
     /// Also measure Rapier with SUBSTEPS solver iterations and contact springs of HZ (fixed
     /// contacts 2·HZ), e.g. `--rapier-variant 8:120`; repeatable. Rapier's defaults are 4:30.
     /// A third field `coulomb` takes Rapier's per-point Coulomb friction, impulse's
@@ -70,11 +78,12 @@ struct Args {
 
 #[derive(Subcommand)]
 enum Command {
-    /// The quality/speed Pareto front of impulse and of Rapier: each engine over a grid of its
-    /// settings, one run per setting (one thread, sleeping off, engines interleaved). Prints
-    /// Markdown tables of each engine's cheapest setting meeting E ≤ 50, 5 and 1 mm
-    /// (E = max(|top sink|, largest overlap, largest drift)) and of each engine's front, and
-    /// writes a plot per scene to DIR/front-<scene>.svg.
+    /// The quality/speed Pareto front of impulse and of its peers (Rapier, Box3D, Jolt: those
+    /// compiled in, or `--peers`): each engine over a grid of its settings, one run per setting
+    /// (one thread, sleeping off, engines interleaved). Prints Markdown tables of each engine's
+    /// cheapest setting meeting E ≤ 50, 5 and 1 mm (E = max(|top sink|, largest overlap,
+    /// largest drift)) with impulse's time over the cheapest peer's, and of each engine's
+    /// front, and writes a plot per scene to DIR/front-<scene>.svg.
     Front(FrontArgs),
 }
 
@@ -88,6 +97,10 @@ struct FrontArgs {
     /// Steps per scene of more than 2000 bodies (pyramid100).
     #[arg(long, default_value_t = front::FRONT_LARGE_STEPS)]
     large_steps: u32,
+    /// The peers to measure, comma-separated (default: every peer compiled in; each needs its
+    /// feature).
+    #[arg(long, value_delimiter = ',', value_name = "PEER,...")]
+    peers: Option<Vec<String>>,
     /// Directory of the plots (created if missing).
     #[arg(long, default_value = "docs", value_name = "DIR")]
     out_dir: PathBuf,
@@ -136,6 +149,8 @@ fn run(args: Args) -> Result<bool> {
         threads: args.threads,
         rapier: !args.no_rapier,
         rapier_variants: args.rapier_variant,
+        box3d: !args.no_box3d && peer_compiled(BOX3D),
+        jolt: !args.no_jolt && peer_compiled(JOLT),
         impulse_defaults: !args.fast_only,
         impulse_fast: args.impulse_fast || args.fast_only,
         also_threads: args.also_threads,
@@ -143,6 +158,11 @@ fn run(args: Args) -> Result<bool> {
     let machine = MachineInfo::current();
     let command = command_line();
     eprintln!("before: {machine}");
+    report_peers(&[
+        (RAPIER, config.rapier),
+        (BOX3D, config.box3d),
+        (JOLT, config.jolt),
+    ]);
     let mut failures = 0;
     let rows = impulse_bench::run_benchmarks(
         &config,
@@ -196,13 +216,35 @@ fn command_line() -> String {
         .join(" ")
 }
 
+/// Says on stderr which peers run and which are not compiled in.
+fn report_peers(asked: &[(&str, bool)]) {
+    let running: Vec<&str> = asked
+        .iter()
+        .filter(|(_, on)| *on)
+        .map(|(p, _)| *p)
+        .collect();
+    let missing: Vec<&str> = PEERS.into_iter().filter(|p| !peer_compiled(p)).collect();
+    eprintln!(
+        "peers: {}{}",
+        if running.is_empty() {
+            "none".to_string()
+        } else {
+            running.join(", ")
+        },
+        if missing.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " (not compiled in: {}; features of the same names)",
+                missing.join(", ")
+            )
+        }
+    );
+}
+
 /// `impulse-bench front`. Ok(false) when some run failed (the others are still reported).
 fn run_front(args: FrontArgs) -> Result<bool> {
-    // The front is a comparison: without Rapier it would quietly be impulse's alone.
-    if !cfg!(feature = "rapier") {
-        anyhow::bail!("{}", impulse_bench::NO_RAPIER);
-    }
-    let config = FrontConfig {
+    let mut config = FrontConfig {
         scenes: if args.scenes.is_empty() {
             front::FRONT_SCENES.iter().map(|s| s.to_string()).collect()
         } else {
@@ -211,10 +253,27 @@ fn run_front(args: FrontArgs) -> Result<bool> {
         steps: args.steps,
         large_steps: args.large_steps,
         quick: args.quick,
+        ..FrontConfig::default()
     };
+    if let Some(peers) = args.peers {
+        config.peers = peers;
+    }
+    // The front is a comparison: without a peer it would quietly be impulse's alone.
+    if config.peers.is_empty() {
+        anyhow::bail!(
+            "the front needs at least one peer, and none is compiled in; {}",
+            impulse_bench::peer_settings::missing_peer(RAPIER)
+        );
+    }
+    config.peer_settings()?;
     let machine = MachineInfo::current();
     let command = command_line();
     eprintln!("before: {machine}");
+    let asked: Vec<(&str, bool)> = PEERS
+        .into_iter()
+        .map(|p| (p, config.peers.iter().any(|q| q == p)))
+        .collect();
+    report_peers(&asked);
     let fronts = front::run_front(&config, &mut |p| {
         let point = p.point;
         match &point.failed {
@@ -320,9 +379,9 @@ mod tests {
         assert!(args.command.is_none() && args.scenes.is_empty());
     }
 
-    /// Without the `rapier` feature a Rapier row or the front fails before any run, naming
-    /// the feature; `--no-rapier` still times impulse alone.
-    #[cfg(not(feature = "rapier"))]
+    /// Without the `rapier` feature a Rapier row fails before any run, naming the feature, and
+    /// so does the front without any peer; `--no-rapier` still times impulse alone.
+    #[cfg(not(any(feature = "rapier", feature = "box3d", feature = "jolt")))]
     #[test]
     fn rapier_without_the_feature_is_a_clear_error() {
         let args = Args::try_parse_from(["impulse-bench", "stack30", "--steps", "2"]).unwrap();
@@ -388,5 +447,35 @@ mod tests {
         assert!(front.scenes.is_empty() && !front.quick);
         assert_eq!(front.steps, front::FRONT_STEPS);
         assert_eq!(front.out_dir, PathBuf::from("docs"));
+        assert!(front.peers.is_none());
+        let args =
+            Args::try_parse_from(["impulse-bench", "front", "--peers", "box3d,jolt"]).unwrap();
+        let Some(Command::Front(front)) = args.command else {
+            panic!("no front subcommand");
+        };
+        assert_eq!(front.peers.unwrap(), ["box3d", "jolt"]);
+    }
+
+    /// An unknown peer, or one not compiled in, fails before any run and says why.
+    #[test]
+    fn front_names_a_peer_it_cannot_run() {
+        let args = Args::try_parse_from(["impulse-bench", "front", "--peers", "bullet", "--quick"])
+            .unwrap();
+        let Some(Command::Front(front)) = args.command else {
+            panic!("no front subcommand");
+        };
+        let error = run_front(front).unwrap_err().to_string();
+        assert!(
+            error.contains("bullet") && error.contains("box3d"),
+            "{error}"
+        );
+        if !peer_compiled(JOLT) {
+            let args = Args::try_parse_from(["impulse-bench", "front", "--peers", "jolt"]).unwrap();
+            let Some(Command::Front(front)) = args.command else {
+                panic!("no front subcommand");
+            };
+            let error = run_front(front).unwrap_err().to_string();
+            assert!(error.contains("--features jolt"), "{error}");
+        }
     }
 }

@@ -12,7 +12,8 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::front::{
-    BARS, FrontPoint, IMPULSE, PLOT_E_FLOOR_MM, RAPIER, SceneFront, pareto_front, plot_path,
+    BARS, BOX3D, FrontPoint, IMPULSE, JOLT, PLOT_E_FLOOR_MM, RAPIER, SceneFront, display_name,
+    pareto_front, plot_path,
 };
 
 /// DejaVu Sans 2.37 (Bitstream Vera licence, `crates/impulse-cli/assets/fonts/`).
@@ -35,9 +36,11 @@ pub fn register_plot_font() -> Result<()> {
 /// Plot size in SVG pixels.
 const SIZE: (u32, u32) = (960, 640);
 const FONT: &str = "sans-serif";
-/// impulse's colour (blue) and Rapier's (orange).
+/// impulse's colour (blue) and the peers': Rapier orange, Box3D green, Jolt purple.
 const IMPULSE_COLOUR: RGBColor = RGBColor(31, 100, 200);
 const RAPIER_COLOUR: RGBColor = RGBColor(230, 110, 0);
+const BOX3D_COLOUR: RGBColor = RGBColor(30, 150, 60);
+const JOLT_COLOUR: RGBColor = RGBColor(150, 60, 170);
 const BAR_COLOUR: RGBColor = RGBColor(110, 110, 110);
 
 /// Font size of the names of front points (SVG pixels).
@@ -192,7 +195,14 @@ fn draw(front: &SceneFront, path: &Path) -> Result<(), Box<dyn std::error::Error
 
     // Boxes of the names written so far (backend pixels: top left, bottom right).
     let mut labels: Vec<PixelBox> = Vec::new();
-    for (engine, colour) in [(IMPULSE, IMPULSE_COLOUR), (RAPIER, RAPIER_COLOUR)] {
+    let engines = [
+        (IMPULSE, IMPULSE_COLOUR),
+        (RAPIER, RAPIER_COLOUR),
+        (BOX3D, BOX3D_COLOUR),
+        (JOLT, JOLT_COLOUR),
+    ];
+    for (engine, colour) in engines {
+        let name = display_name(engine);
         let all: Vec<&FrontPoint> = points
             .iter()
             .copied()
@@ -205,12 +215,12 @@ fn draw(front: &SceneFront, path: &Path) -> Result<(), Box<dyn std::error::Error
         if engine == IMPULSE {
             chart
                 .draw_series(markers.map(|c| Circle::new(c, 3, colour.mix(0.55).filled())))?
-                .label(format!("{engine}: every setting"))
+                .label(format!("{name}: every setting"))
                 .legend(move |(x, y)| Circle::new((x + 10, y), 3, colour.mix(0.55).filled()));
         } else {
             chart
                 .draw_series(markers.map(|c| TriangleMarker::new(c, 4, colour.mix(0.55).filled())))?
-                .label(format!("{engine}: every setting"))
+                .label(format!("{name}: every setting"))
                 .legend(move |(x, y)| {
                     TriangleMarker::new((x + 10, y), 4, colour.mix(0.55).filled())
                 });
@@ -218,7 +228,7 @@ fn draw(front: &SceneFront, path: &Path) -> Result<(), Box<dyn std::error::Error
         let best = pareto_front(&front.points, engine);
         chart
             .draw_series(LineSeries::new(staircase(&best), colour.stroke_width(2)))?
-            .label(format!("{engine}: Pareto front"))
+            .label(format!("{name}: Pareto front"))
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
             });

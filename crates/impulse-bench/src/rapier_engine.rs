@@ -5,10 +5,8 @@
 //! Rapier 0.36 and impulse share parry3d 0.31, so Rapier's poses are `parry3d::math::Pose`
 //! values already (glam-based); they are copied out in scene order.
 
-use std::time::Instant;
-
 use anyhow::{Context, Result, bail};
-use impulse::scene::{BodyKind, Material, MaterialRef, ShapeDesc};
+use impulse::scene::{BodyKind, ShapeDesc};
 use impulse::{Scene, World};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
@@ -18,7 +16,7 @@ use rapier3d::prelude::{
     PhysicsPipeline, RigidBodyBuilder, RigidBodyHandle, RigidBodySet, SoftBodySet, Vector,
 };
 
-use crate::quality::{self, Quality};
+use crate::peer::{PeerRun, PeerWorld, check_carried_over, resolve_material};
 use crate::row::BenchRow;
 
 /// Engine name in [`BenchRow::engine`].
@@ -45,88 +43,28 @@ pub fn bench_rapier_with(
     params: &IntegrationParameters,
     engine: &str,
 ) -> Result<BenchRow> {
-    let mut run = RapierRun::new(scene, steps, params, engine)?;
+    let mut run = rapier_run(scene, steps, params, engine)?;
     run.advance(steps)?;
     Ok(run.finish())
 }
 
-/// A Rapier run that can be advanced a few steps at a time (see `ImpulseRun`).
-pub(crate) struct RapierRun {
-    scene: String,
-    engine: String,
-    sim: RapierScene,
-    /// The impulse world built from the same scene: the shapes, kinds and collision groups
-    /// the metrics measure Rapier's poses with.
-    world: World,
-    /// Rapier's poses, scene order.
-    poses: Vec<Pose>,
-    quality: Quality,
-    times_ms: Vec<f64>,
-    step: u32,
+/// A Rapier run that can be advanced a few steps at a time.
+pub(crate) type RapierRun = PeerRun<RapierScene>;
+
+/// A Rapier run of `scene` with `params` (dt from the scene), named `engine` in its row.
+pub(crate) fn rapier_run(
+    scene: &Scene,
     steps: u32,
-}
-
-impl RapierRun {
-    pub(crate) fn new(
-        scene: &Scene,
-        steps: u32,
-        params: &IntegrationParameters,
-        engine: &str,
-    ) -> Result<Self> {
-        // The impulse world validates the scene and gives the shapes, the body kinds and the
-        // initial state in scene order; the metrics read its shapes with Rapier's poses.
-        let world = World::from_scene(scene)
-            .with_context(|| format!("building scene {} in impulse", scene.name))?;
-        let sim = RapierScene::build(scene, &world, params)?;
-        let poses = world.poses().to_vec();
-        Ok(Self {
-            scene: scene.name.clone(),
-            engine: engine.to_string(),
-            sim,
-            quality: Quality::new(&world, &poses),
-            world,
-            poses,
-            times_ms: Vec::with_capacity(steps as usize),
-            step: 0,
-            steps,
-        })
-    }
-
-    /// Takes up to `n` more steps (never past `steps`).
-    pub(crate) fn advance(&mut self, n: u32) -> Result<()> {
-        let end = self.steps.min(self.step.saturating_add(n));
-        while self.step < end {
-            self.step += 1;
-            let start = Instant::now();
-            self.sim.step();
-            self.times_ms.push(start.elapsed().as_secs_f64() * 1e3);
-            if quality::is_sample_step(self.step, self.steps) {
-                self.sim.copy_poses(&mut self.poses);
-                check_finite(&self.poses, &self.engine, &self.scene, self.step)?;
-                self.quality.sample(&self.world, &self.poses);
-            }
-        }
-        Ok(())
-    }
-
-    /// The row of the steps taken so far.
-    pub(crate) fn finish(mut self) -> BenchRow {
-        self.sim.copy_poses(&mut self.poses);
-        let report = self.quality.finish(&self.poses);
-        BenchRow::new(
-            &self.scene,
-            &self.engine,
-            self.poses.len(),
-            self.step,
-            &mut self.times_ms,
-            report,
-            settings_text(&self.sim.params),
-        )
-    }
+    params: &IntegrationParameters,
+    engine: &str,
+) -> Result<RapierRun> {
+    PeerRun::new(scene, steps, engine, |scene, world| {
+        RapierScene::build(scene, world, params)
+    })
 }
 
 /// Rapier's state for one scene; `handles[i]` is scene body `i`.
-struct RapierScene {
+pub(crate) struct RapierScene {
     gravity: Vector,
     params: IntegrationParameters,
     pipeline: PhysicsPipeline,
@@ -148,17 +86,16 @@ impl RapierScene {
         let mut colliders = ColliderSet::new();
         let mut handles = Vec::with_capacity(scene.bodies.len());
         for (i, desc) in scene.bodies.iter().enumerate() {
+            check_carried_over(i, desc, "Rapier")?;
             let material = resolve_material(scene, &desc.material)?;
-            if desc.keyframes.is_some() {
-                bail!(
-                    "body {i}: keyframed kinematic bodies are not supported by the Rapier comparison"
-                );
-            }
             let body = match desc.kind {
                 BodyKind::Static => RigidBodyBuilder::fixed(),
+                BodyKind::Dynamic if desc.lock_rotation => {
+                    RigidBodyBuilder::dynamic().lock_rotations()
+                }
                 BodyKind::Dynamic => RigidBodyBuilder::dynamic(),
                 BodyKind::Particle => RigidBodyBuilder::dynamic().lock_rotations(),
-                // Rapier has no keyframes: a keyframed body is refused below.
+                // Keyframed bodies were refused above.
                 BodyKind::Kinematic => RigidBodyBuilder::kinematic_velocity_based(),
             }
             // The pose as impulse built it (quaternion normalised), velocities of the centre
@@ -203,8 +140,10 @@ impl RapierScene {
             handles,
         })
     }
+}
 
-    fn step(&mut self) {
+impl PeerWorld for RapierScene {
+    fn step(&mut self) -> Result<()> {
         self.pipeline.step(
             self.gravity,
             &self.params,
@@ -220,26 +159,18 @@ impl RapierScene {
             &(),
             &(),
         );
+        Ok(())
     }
 
-    /// Writes Rapier's body poses into `out` (scene order).
     fn copy_poses(&self, out: &mut [Pose]) {
         for (i, &handle) in self.handles.iter().enumerate() {
             out[i] = *self.bodies[handle].position();
         }
     }
-}
 
-/// The material a body refers to, resolved as `World::from_scene` does.
-fn resolve_material(scene: &Scene, material: &MaterialRef) -> Result<Material> {
-    Ok(match material {
-        MaterialRef::Inline(m) => m.clone(),
-        MaterialRef::Named(name) => match scene.materials.get(name) {
-            Some(m) => m.clone(),
-            None if name == "default" => Material::default(),
-            None => bail!("no material named \"{name}\""),
-        },
-    })
+    fn settings_text(&self) -> String {
+        settings_text(&self.params)
+    }
 }
 
 /// The Rapier collider of a scene shape (the same Parry shape impulse builds: triangle meshes,
@@ -280,15 +211,6 @@ fn collider_builder(kind: BodyKind, shape: &ShapeDesc) -> Result<ColliderBuilder
     })
 }
 
-fn check_finite(poses: &[Pose], engine: &str, scene: &str, step: u32) -> Result<()> {
-    for (i, pose) in poses.iter().enumerate() {
-        if !(pose.translation.is_finite() && pose.rotation.is_finite()) {
-            bail!("{engine}, scene {scene}, step {step}: body {i} has a non-finite pose");
-        }
-    }
-    Ok(())
-}
-
 /// Rapier's integration parameters as one line, read from the struct (the Rapier version,
 /// combine rules and sleeping are the same in every run: see docs/benchmarks.md).
 pub fn settings_text(p: &IntegrationParameters) -> String {
@@ -314,7 +236,7 @@ fn on_off(b: bool) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use impulse::scene::BodyDesc;
+    use impulse::scene::{BodyDesc, Material, MaterialRef};
 
     /// One body of every shape and kind, apart from each other, above a half-space ground.
     fn zoo() -> Scene {
@@ -382,11 +304,7 @@ mod tests {
         for (i, &handle) in sim.handles.iter().enumerate() {
             let body = &sim.bodies[handle];
             assert_eq!(*body.position(), world.poses()[i], "body {i} pose");
-            let expected_mass = if world.body_at(i).unwrap().inverse_mass() > 0.0 {
-                1.0 / world.body_at(i).unwrap().inverse_mass()
-            } else {
-                0.0
-            };
+            let expected_mass = crate::peer::impulse_mass(&world, i);
             let mass = if body.is_dynamic() { body.mass() } else { 0.0 };
             assert!(
                 (mass - expected_mass).abs() <= 1e-4 * expected_mass.max(1.0),

@@ -194,7 +194,8 @@ enum Command {
         variation: variation_args::VariationArgs,
     },
     /// Time impulse on built-in scenes (sleeping off, median ms/step) and measure quality from
-    /// poses; `cargo run --release -p impulse-bench --features rapier` adds Rapier side by side.
+    /// poses; `cargo run --release -p impulse-bench --features rapier,box3d,jolt` adds the peer
+    /// engines (Rapier, Box3D, Jolt) side by side.
     Bench {
         /// Built-in scene names (default: pyramid20 pyramid100 pyramid3d10 stack30 massratio
         /// balls4096).
@@ -624,6 +625,8 @@ fn real_main() -> Result<ExitCode> {
                 steps,
                 threads,
                 rapier: false,
+                box3d: false,
+                jolt: false,
                 ..impulse_bench::BenchConfig::default()
             };
             if !scenes.is_empty() {

@@ -190,11 +190,6 @@ fn settings() -> SolverSettings {
     }
 }
 
-/// A frictionless dynamic sphere of radius r on two static ones touching it, centres 2r apart
-/// with the two contact normals 30° from vertical. The statics: each contact carries
-/// m·g/(2 cos 30°); over a solve of h from rest, v* = −g·h·ŷ, the exact impulses are
-/// m·g·h/(2 cos θ) with θ each normal's angle from vertical, and both rows are active (w = 0).
-
 /// `count` unit cubes stacked on a static ground, μ = 0.5, under `gravity`, each moving at
 /// `velocity` at the start, stepped `steps` times.
 fn box_stack(count: usize, gravity: Vec3, velocity: Vec3, steps: usize) -> World {
@@ -248,12 +243,6 @@ enum Friction {
     /// Some points slide, friction on the disc's rim.
     Sliding,
 }
-
-/// Box stacks with friction: one held by friction against a sideways pull (sticking
-/// contacts), two sliding along the ground, along a tangent and across both (contacts on the
-/// disc's rim), where Coulomb's law also fixes the friction's direction. Entered from half the
-/// engine's impulses, the exact path must return γ_n ≥ 0, w_n ≥ −1e-5 m/s with complementarity,
-/// friction inside the disc, and velocities equal to v* + M⁻¹Jᵀγ recomputed from scratch.
 
 /// max_i |min(w_i, γ_i·k_i)| over the normal rows (m/s): `ExactReport::residual` for rigid rows.
 fn normal_residual(island: &Island) -> f64 {

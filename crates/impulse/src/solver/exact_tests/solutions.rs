@@ -2,6 +2,10 @@
 
 use super::*;
 
+/// A frictionless dynamic sphere of radius r on two static ones touching it, centres 2r apart
+/// with the two contact normals 30° from vertical. The statics: each contact carries
+/// m·g/(2 cos 30°); over a solve of h from rest, v* = −g·h·ŷ, the exact impulses are
+/// m·g·h/(2 cos θ) with θ each normal's angle from vertical, and both rows are active (w = 0).
 #[test]
 fn sphere_on_two_spheres_matches_statics_and_lemke() {
     let g = 9.81f32;
@@ -159,6 +163,11 @@ fn the_exact_impulses_are_a_fixed_point_of_a_round() {
     }
 }
 
+/// Box stacks with friction: one held by friction against a sideways pull (sticking
+/// contacts), two sliding along the ground, along a tangent and across both (contacts on the
+/// disc's rim), where Coulomb's law also fixes the friction's direction. Entered from half the
+/// engine's impulses, the exact path must return γ_n ≥ 0, w_n ≥ −1e-5 m/s with complementarity,
+/// friction inside the disc, and velocities equal to v* + M⁻¹Jᵀγ recomputed from scratch.
 #[test]
 fn box_stacks_with_friction_satisfy_the_contact_conditions() {
     let g = 9.81;
