@@ -116,15 +116,17 @@ pub enum SnapshotError {
     #[error("not an impulse world snapshot (the file does not start with \"IMPULSE-WORLD\")")]
     NotASnapshot,
     /// The snapshot was written in a format version this build does not read (it reads
-    /// [`crate::world::OLDEST_SNAPSHOT_FORMAT_VERSION`] to `supported`).
+    /// `oldest` to `supported`).
     #[error(
         "snapshot format version {found}, but this build of impulse reads versions {oldest} to \
-         {supported} (snapshots are not portable across impulse versions)",
-        oldest = crate::world::OLDEST_SNAPSHOT_FORMAT_VERSION
+         {supported} (snapshots are not portable across impulse versions)"
     )]
     VersionMismatch {
         /// The file's format version.
         found: u32,
+        /// The oldest version this build reads
+        /// ([`crate::world::OLDEST_SNAPSHOT_FORMAT_VERSION`]).
+        oldest: u32,
         /// The version this build writes, the newest it reads
         /// ([`crate::world::SNAPSHOT_FORMAT_VERSION`]).
         supported: u32,

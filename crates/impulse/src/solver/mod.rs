@@ -39,6 +39,7 @@ pub(crate) mod nncg;
 pub(crate) mod pgs;
 pub(crate) mod policy;
 pub(crate) mod position;
+pub(crate) mod restitution_solve;
 pub(crate) mod rows;
 pub(crate) mod substep;
 

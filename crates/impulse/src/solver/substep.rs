@@ -22,8 +22,8 @@ use super::rows::Velocities;
 use crate::body::{Bodies, BodyKind, LockedAxes};
 use crate::contact::{self, ContactConstraint};
 use crate::integrate;
-use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
-use crate::settings::{ContactRepair, ImpactModel, SolverMethod, SolverSettings};
+use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS};
+use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
 /// friction rows too, whatever [`SolverSettings::friction_in_main_solve`] says. Friction
@@ -149,7 +149,7 @@ impl IslandWorkspace {
 
     /// Adds one solve's outcome to the island's report; the main solve's last change is the
     /// island's.
-    fn record(&mut self, outcome: &SolveOutcome, main: bool) {
+    pub(super) fn record(&mut self, outcome: &SolveOutcome, main: bool) {
         let report = &mut self.report;
         report.method = report.method.max(outcome.level);
         report.escalations += u32::from(outcome.escalated);
@@ -222,7 +222,14 @@ pub(crate) fn step_island(
         w.substep(constraints, settings, context.gravity, &plan, substep);
     }
     w.finish_solves(constraints, settings, &plan);
-    w.restitution(island_bodies, guests, constraints, settings, context, &plan);
+    w.restitution(
+        island_bodies,
+        guests,
+        constraints,
+        settings,
+        context,
+        plan.spread,
+    );
     w.record_joints();
 }
 
@@ -710,99 +717,6 @@ impl IslandWorkspace {
         } else {
             None
         };
-    }
-
-    /// Restitution after the substeps (Newton's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
-    /// for the points that collided: their targets (or `impact: propagation`'s reflections),
-    /// then one solve when any point bounces.
-    fn restitution(
-        &mut self,
-        island_bodies: &[u32],
-        guests: &[u32],
-        constraints: &mut [ContactConstraint],
-        settings: &SolverSettings,
-        context: &StepContext<'_>,
-        plan: &SolvePlan,
-    ) {
-        let w = self;
-        let threshold = settings.restitution_threshold;
-        let bounces = if !context.restitution {
-            // No body bounces, so no pair does (a pair's coefficient is the larger of its
-            // bodies').
-            false
-        } else if settings.impact == ImpactModel::Propagation {
-            let mut velocities = Velocities {
-                linear: &mut w.linear,
-                angular: &mut w.angular,
-            };
-            let island = (island_bodies, guests, context.bodies);
-            w.impact
-                .propagate(constraints, island, &mut velocities, context.dt, settings)
-        } else if plan.spread {
-            // Per point: any split gives the same targets.
-            use rayon::prelude::*;
-            constraints
-                .par_chunks_mut(RESTITUTION_POINTS_PER_TASK)
-                .map(|part| contact::restitution_targets(part, threshold))
-                .reduce(|| false, |x, y| x || y)
-        } else {
-            contact::restitution_targets(constraints, threshold)
-        };
-        if !bounces {
-            return;
-        }
-        // With joints the bounce is a coupled problem: one sweep (the soft step's) takes the
-        // joints first and the contacts after them, so the bounce would be that of bodies the
-        // joints do not hold (a hinged door struck by a ball spun 37 % faster than the closed
-        // form), and the joints would answer only in the next step. It sweeps to the tolerance,
-        // like an impact's substeps (`IMPACT_SWEEPS`).
-        let sweeps = super::impact::restitution_iterations(settings);
-        let pass = SolvePass {
-            iterations: if w.joints.is_empty() {
-                sweeps
-            } else {
-                sweeps.max(IMPACT_SWEEPS)
-            },
-            tolerance: settings.tolerance,
-            friction: true,
-            half_turn: false,
-            warm_start_follows: false,
-            escalate: false,
-            targets: None,
-            sweep: Sweep {
-                starts: &w.colour_starts,
-                parallel: w.parallel,
-            },
-        };
-        // The step totals gain what the restitution solve adds to each impulse.
-        for c in constraints.iter_mut() {
-            let before = super::rows::impulses(c);
-            for (total, before) in c.step_impulses.iter_mut().zip(before) {
-                *total -= before;
-            }
-        }
-        // The joints hold through the bounce with the relax solve's targets, set after the
-        // last substep's positions.
-        for joint in &mut w.joints {
-            joint.start_bounce();
-        }
-        let outcome = w.solvers.scalar(settings.method).solve(
-            constraints,
-            &mut Velocities {
-                linear: &mut w.linear,
-                angular: &mut w.angular,
-            },
-            &mut w.joints,
-            &pass,
-        );
-        for c in constraints.iter_mut() {
-            super::rows::add_step_impulses(c);
-        }
-        for joint in &mut w.joints {
-            joint.finish_bounce();
-        }
-        w.record(&outcome, false);
-        w.impact.finish(constraints);
     }
 }
 

@@ -185,6 +185,7 @@ impl WorldSnapshot {
         if !readable(found) {
             return Err(SnapshotError::VersionMismatch {
                 found,
+                oldest: OLDEST_SNAPSHOT_FORMAT_VERSION,
                 supported: SNAPSHOT_FORMAT_VERSION,
             });
         }
@@ -307,6 +308,7 @@ impl World {
         if !readable(snapshot.format_version) {
             return Err(SnapshotError::VersionMismatch {
                 found: snapshot.format_version,
+                oldest: OLDEST_SNAPSHOT_FORMAT_VERSION,
                 supported: SNAPSHOT_FORMAT_VERSION,
             });
         }

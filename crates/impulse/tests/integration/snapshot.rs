@@ -368,7 +368,8 @@ fn an_inconsistent_snapshot_is_invalid() {
         World::from_snapshot(snapshot),
         Err(SnapshotError::VersionMismatch {
             found: 99,
-            supported: SNAPSHOT_FORMAT_VERSION
+            supported: SNAPSHOT_FORMAT_VERSION,
+            ..
         })
     ));
 }
