@@ -20,6 +20,8 @@ mod impacts;
 mod islands;
 mod joints;
 mod kinematic;
+mod locked_axes;
+mod malformed_meshes;
 mod malformed_scenes;
 mod meshes;
 mod phantom_and_tunnel;
