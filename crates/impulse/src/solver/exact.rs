@@ -44,14 +44,15 @@ use impulse_lcp::{Bounds, DenseMatrix, Lcp, Matrix, SolverSettings, Status};
 use super::cholesky::{cholesky, cholesky_solve, cholesky_solve_columns};
 pub(crate) use super::exact_report::{ExactFailure, ExactReport};
 use super::exact_rows::{
-    ExactJointRow, Side, apply_joint, breakable_joint, collect_joint_rows, contact_sides,
-    joint_residual, joint_row_count, joint_row_is_finite, joint_sides, joint_velocity,
+    ExactJointRow, Side, apply_joint, breakable_joint, collect_joint_rows, contact_is_finite,
+    contact_sides, coupling, joint_row_count, joint_row_is_finite, joint_sides, joint_velocity,
+    residual, velocity,
 };
 use super::interface::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, set_scalar_targets,
 };
 use super::rows::{Velocities, apply_impulses, project_to_friction_disc};
-use crate::contact::{ContactConstraint, JacobianRow, is_isotropic};
+use crate::contact::ContactConstraint;
 use crate::joint::JointConstraint;
 
 /// The exact path as a [`ContactSolver`]: [`solve_exact`] on islands of at most `max_contacts`
@@ -250,7 +251,7 @@ pub(crate) fn solve_exact(
     if let Some(joint) = breakable_joint(joints) {
         return Err(ExactFailure::BreakableJoint { joint });
     }
-    if let Some(index) = constraints.iter().position(|c| !is_finite(c)) {
+    if let Some(index) = constraints.iter().position(|c| !contact_is_finite(c)) {
         return Err(ExactFailure::NonFinite {
             what: "contact",
             index,
@@ -710,28 +711,7 @@ fn assemble(constraints: &[ContactConstraint], joints: &[JointConstraint], w: &m
         let p = &w.sides[i];
         for j in i..m {
             let q = &w.sides[j];
-            let mut value = 0.0f64;
-            for side_p in p.iter().flatten() {
-                for side_q in q.iter().flatten() {
-                    if side_p.slot == side_q.slot {
-                        let angular = side_p
-                            .angular
-                            .as_dvec3()
-                            .dot(side_q.inverse_inertia_angular.as_dvec3());
-                        // d_pᵀ M⁻¹ d_q with the per-axis inverse mass (zero on locked axes).
-                        let linear = if is_isotropic(side_p.inverse_mass) {
-                            side_p.inverse_mass.x as f64
-                                * side_p.direction.as_dvec3().dot(side_q.direction.as_dvec3())
-                        } else {
-                            side_p
-                                .direction
-                                .as_dvec3()
-                                .dot(side_p.inverse_mass.as_dvec3() * side_q.direction.as_dvec3())
-                        };
-                        value += side_p.sign * side_q.sign * (linear + angular);
-                    }
-                }
-            }
+            let value = coupling(p, q);
             w.full[i * m + j] = value;
             w.full[j * m + i] = value;
         }
@@ -774,88 +754,6 @@ fn friction_passes(constraints: &[ContactConstraint], w: &mut ExactWorkspace) {
             apply(c, delta, &mut w.linear, &mut w.angular);
         }
     }
-}
-
-/// J·v of `row` of contact `c` (m/s).
-#[inline]
-fn velocity(row: &JacobianRow, c: &ContactConstraint, linear: &[Vec3], angular: &[Vec3]) -> f32 {
-    let (a, b) = (c.local_a as usize, c.local_b as usize);
-    row.velocity(linear[a], angular[a], linear[b], angular[b])
-}
-
-/// The residual [`ExactReport::residual`] reports: [`normal_residual`] of the contacts and,
-/// with joint rows, the larger of it and their [`joint_residual`] at `joint_impulse`.
-#[allow(clippy::too_many_arguments)]
-fn residual(
-    constraints: &[ContactConstraint],
-    joints: &[JointConstraint],
-    joint_rows: &[ExactJointRow],
-    linear: &[Vec3],
-    angular: &[Vec3],
-    state: impl Fn(usize) -> (f32, f32),
-    joint_impulse: &[f32],
-) -> f32 {
-    let contacts = normal_residual(constraints, linear, angular, state);
-    if joint_rows.is_empty() {
-        contacts
-    } else {
-        contacts.max(joint_residual(
-            joints,
-            joint_rows,
-            joint_impulse,
-            linear,
-            angular,
-        ))
-    }
-}
-
-/// max_i |min(w_i, γ_i·k_i)| (m/s) for (normal impulse, soft term) = `state(i)`; see
-/// [`ExactReport::residual`].
-fn normal_residual(
-    constraints: &[ContactConstraint],
-    linear: &[Vec3],
-    angular: &[Vec3],
-    state: impl Fn(usize) -> (f32, f32),
-) -> f32 {
-    let mut largest = 0.0f32;
-    for (k, c) in constraints.iter().enumerate() {
-        let (gamma, softness) = state(k);
-        let w =
-            velocity(&c.normal, c, linear, angular) - c.target_normal_velocity + softness * gamma;
-        largest = largest.max(w.min(gamma * c.normal.inverse_effective_mass).abs());
-    }
-    largest
-}
-
-/// Whether every number of `c` the exact path reads is finite.
-fn is_finite(c: &ContactConstraint) -> bool {
-    let row_is_finite = |r: &JacobianRow| {
-        r.direction.is_finite()
-            && r.angular_a.is_finite()
-            && r.angular_b.is_finite()
-            && r.inverse_inertia_angular_a.is_finite()
-            && r.inverse_inertia_angular_b.is_finite()
-            && r.inverse_effective_mass.is_finite()
-    };
-    let scalars = [
-        c.target_normal_velocity,
-        c.softness.0,
-        c.softness.1,
-        c.friction,
-        c.normal_impulse,
-        c.tangent_impulses[0],
-        c.tangent_impulses[1],
-    ];
-    scalars.iter().all(|v| v.is_finite())
-        && c.inverse_mass_a.is_finite()
-        && c.inverse_mass_b.is_finite()
-        && row_is_finite(&c.normal)
-        // A frictionless point's tangent rows are read too: its (zero) friction impulses are
-        // taken out of the velocities with them.
-        && row_is_finite(&c.tangents[0])
-        && row_is_finite(&c.tangents[1])
-        && c.tangent_block.iter().all(|v| v.is_finite())
-        && c.tangent_inverse_block.iter().all(|v| v.is_finite())
 }
 
 #[cfg(test)]

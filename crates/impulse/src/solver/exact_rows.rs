@@ -1,7 +1,8 @@
 //! The exact path's rows as its dense assembly sees them: each row's movable sides ([`Side`])
-//! for contact rows ([`contact_sides`]) and joint rows ([`joint_sides`]), and the joint rows of
-//! an island ([`ExactJointRow`]): their bounds, velocities, impulse updates and natural-map
-//! residual.
+//! for contact rows ([`contact_sides`]) and joint rows ([`joint_sides`]) and the entries of
+//! A = J M⁻¹ Jᵀ between them ([`coupling`]); the joint rows of an island ([`ExactJointRow`]):
+//! their bounds, velocities, impulse updates and natural-map residual; and the residual the
+//! exact path reports over normal and joint rows ([`residual`]), with the input checks.
 //!
 //! Joint rows enter the exact path as the exported LCP has them
 //! ([`crate::diagnostics::contact_lcp`]): a locked row or a spring is a free variable, a limit
@@ -11,7 +12,7 @@
 
 use glam::Vec3;
 
-use crate::contact::{ContactConstraint, JacobianRow};
+use crate::contact::{ContactConstraint, JacobianRow, is_isotropic};
 use crate::joint::{JointConstraint, ROWS_PER_DOF};
 
 /// One side of a row on a body that can move.
@@ -73,6 +74,34 @@ pub(super) fn contact_sides(c: &ContactConstraint, row: &JacobianRow) -> [Option
             row.inverse_inertia_angular_b,
         ),
     ]
+}
+
+/// A_pq = J_p M⁻¹ J_qᵀ of two rows given by their sides: over the bodies they share,
+/// s_p·s_q·(d_pᵀ M⁻¹ d_q + (r×d)_p·I⁻¹(r×d)_q), in f64 from the f32 row data.
+pub(super) fn coupling(p: &[Option<Side>; 2], q: &[Option<Side>; 2]) -> f64 {
+    let mut value = 0.0f64;
+    for side_p in p.iter().flatten() {
+        for side_q in q.iter().flatten() {
+            if side_p.slot == side_q.slot {
+                let angular = side_p
+                    .angular
+                    .as_dvec3()
+                    .dot(side_q.inverse_inertia_angular.as_dvec3());
+                // d_pᵀ M⁻¹ d_q with the per-axis inverse mass (zero on locked axes).
+                let linear = if is_isotropic(side_p.inverse_mass) {
+                    side_p.inverse_mass.x as f64
+                        * side_p.direction.as_dvec3().dot(side_q.direction.as_dvec3())
+                } else {
+                    side_p
+                        .direction
+                        .as_dvec3()
+                        .dot(side_p.inverse_mass.as_dvec3() * side_q.direction.as_dvec3())
+                };
+                value += side_p.sign * side_q.sign * (linear + angular);
+            }
+        }
+    }
+    value
 }
 
 /// One active row of a joint in the exact path: which row it is, and what it asks in the
@@ -271,4 +300,91 @@ pub(crate) fn breakable_joint(joints: &[JointConstraint]) -> Option<usize> {
     joints
         .iter()
         .position(|j| j.broke.is_none() && j.is_breakable())
+}
+
+/// J·v of `row` of contact `c` (m/s).
+#[inline]
+pub(super) fn velocity(
+    row: &JacobianRow,
+    c: &ContactConstraint,
+    linear: &[Vec3],
+    angular: &[Vec3],
+) -> f32 {
+    let (a, b) = (c.local_a as usize, c.local_b as usize);
+    row.velocity(linear[a], angular[a], linear[b], angular[b])
+}
+
+/// The residual [`ExactReport::residual`](super::exact_report::ExactReport::residual) reports: [`normal_residual`] of the contacts and,
+/// with joint rows, the larger of it and their [`joint_residual`] at `joint_impulse`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn residual(
+    constraints: &[ContactConstraint],
+    joints: &[JointConstraint],
+    joint_rows: &[ExactJointRow],
+    linear: &[Vec3],
+    angular: &[Vec3],
+    state: impl Fn(usize) -> (f32, f32),
+    joint_impulse: &[f32],
+) -> f32 {
+    let contacts = normal_residual(constraints, linear, angular, state);
+    if joint_rows.is_empty() {
+        contacts
+    } else {
+        contacts.max(joint_residual(
+            joints,
+            joint_rows,
+            joint_impulse,
+            linear,
+            angular,
+        ))
+    }
+}
+
+/// max_i |min(w_i, γ_i·k_i)| (m/s) for (normal impulse, soft term) = `state(i)`; see
+/// [`ExactReport::residual`](super::exact_report::ExactReport::residual).
+pub(super) fn normal_residual(
+    constraints: &[ContactConstraint],
+    linear: &[Vec3],
+    angular: &[Vec3],
+    state: impl Fn(usize) -> (f32, f32),
+) -> f32 {
+    let mut largest = 0.0f32;
+    for (k, c) in constraints.iter().enumerate() {
+        let (gamma, softness) = state(k);
+        let w =
+            velocity(&c.normal, c, linear, angular) - c.target_normal_velocity + softness * gamma;
+        largest = largest.max(w.min(gamma * c.normal.inverse_effective_mass).abs());
+    }
+    largest
+}
+
+/// Whether every number of `c` the exact path reads is finite.
+pub(super) fn contact_is_finite(c: &ContactConstraint) -> bool {
+    let row_is_finite = |r: &JacobianRow| {
+        r.direction.is_finite()
+            && r.angular_a.is_finite()
+            && r.angular_b.is_finite()
+            && r.inverse_inertia_angular_a.is_finite()
+            && r.inverse_inertia_angular_b.is_finite()
+            && r.inverse_effective_mass.is_finite()
+    };
+    let scalars = [
+        c.target_normal_velocity,
+        c.softness.0,
+        c.softness.1,
+        c.friction,
+        c.normal_impulse,
+        c.tangent_impulses[0],
+        c.tangent_impulses[1],
+    ];
+    scalars.iter().all(|v| v.is_finite())
+        && c.inverse_mass_a.is_finite()
+        && c.inverse_mass_b.is_finite()
+        && row_is_finite(&c.normal)
+        // A frictionless point's tangent rows are read too: its (zero) friction impulses are
+        // taken out of the velocities with them.
+        && row_is_finite(&c.tangents[0])
+        && row_is_finite(&c.tangents[1])
+        && c.tangent_block.iter().all(|v| v.is_finite())
+        && c.tangent_inverse_block.iter().all(|v| v.is_finite())
 }
