@@ -519,6 +519,11 @@ impl JointConstraint {
         (force, torque)
     }
 
+    /// Whether a strength bounds the joint's locked groups (a finite break force or torque).
+    pub(crate) fn is_breakable(&self) -> bool {
+        self.break_force.is_finite() || self.break_torque.is_finite()
+    }
+
     /// The strength of a locked group over a solve of h seconds (N·s or N·m·s; infinite:
     /// unbreakable): group 0 the translations, group 1 the rotations.
     fn strength(&self, group: usize) -> f32 {

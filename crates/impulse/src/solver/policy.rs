@@ -2,6 +2,7 @@
 //! converge to more NNCG iterations or, for a small island, to the exact path ([`super::exact`]).
 
 use super::exact::Exact;
+use super::exact_rows::{breakable_joint, joint_row_count};
 use super::interface::{ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport};
 use super::nncg::Nncg;
 use super::rows::Velocities;
@@ -16,7 +17,7 @@ pub(crate) struct EscalationLimits {
     pub tolerance: f32,
     /// NNCG iterations given to an island that escalates.
     pub iterations: u32,
-    /// Islands of at most this many points may take the exact path.
+    /// Islands of at most this many contact points plus joint rows may take the exact path.
     pub exact_max_contacts: u32,
     /// Islands whose mass ratio exceeds this take the exact path whenever they are small.
     pub mass_ratio_threshold: f32,
@@ -67,9 +68,14 @@ impl ContactSolver for Auto {
         let mut outcome = self.nncg.solve(constraints, velocities, joints, pass);
         let unconverged = outcome.report.last_change > limits.tolerance;
         let heavy = limits.mass_ratio > limits.mass_ratio_threshold;
-        // An island with joints is a mixed LCP, which the exact path does not take yet: it
-        // escalates to more NNCG iterations instead.
-        let small = constraints.len() <= limits.exact_max_contacts as usize && joints.is_empty();
+        // An island is small when its contact points plus joint rows (the exact path's Lemke
+        // rows) are at most the limit; a breakable joint (a ball bound, not a box) keeps the
+        // island on NNCG.
+        let small = (joints.is_empty() && constraints.len() <= limits.exact_max_contacts as usize)
+            || (!joints.is_empty()
+                && constraints.len() + joint_row_count(joints)
+                    <= limits.exact_max_contacts as usize
+                && breakable_joint(joints).is_none());
         // Unconverged in an impact, the island takes more iterations rather than the exact
         // path: the next steps repair what an impact leaves, while pivoting every landing
         // column of a pile is the cost of hundreds of exact solves a substep. Asked only when

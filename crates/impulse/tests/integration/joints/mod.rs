@@ -5,6 +5,7 @@
 
 mod chains;
 mod devices;
+mod exact;
 mod pendulum;
 
 use impulse::glam::Vec3;
