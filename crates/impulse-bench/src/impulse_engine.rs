@@ -212,6 +212,7 @@ impl crate::peer::EngineRun for ImpulseRun {
         ImpulseRun::finish(*self)
     }
 
+    #[cfg(test)]
     fn poses(&mut self) -> Vec<parry3d::math::Pose> {
         self.world.poses().to_vec()
     }

@@ -114,6 +114,7 @@ pub(crate) trait EngineRun {
     /// The row of the steps taken so far.
     fn finish(self: Box<Self>) -> BenchRow;
     /// The body poses now (body origins, world frame), scene order.
+    #[cfg(test)]
     fn poses(&mut self) -> Vec<Pose>;
 }
 
@@ -126,6 +127,7 @@ impl<W: PeerWorld> EngineRun for PeerRun<W> {
         PeerRun::finish(*self)
     }
 
+    #[cfg(test)]
     fn poses(&mut self) -> Vec<Pose> {
         self.sim.copy_poses(&mut self.poses);
         self.poses.clone()
