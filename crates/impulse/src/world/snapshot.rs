@@ -446,7 +446,6 @@ fn check_joints(world: &World, joints: &Joints) -> Result<(), String> {
 /// The body values a step relies on, checked before a snapshot's bodies are trusted: finite
 /// poses, velocities, forces and mass properties, materials in range, shapes valid for their
 /// kind.
-
 fn check_bodies(b: &Bodies) -> Result<(), String> {
     let finite3 = |v: &Vec3| v.is_finite();
     for i in 0..b.len() {
