@@ -110,6 +110,10 @@ const NAMES: &[(&str, &str)] = &[
         "joints: 20 links on ball joints swinging down from a horizontal start",
     ),
     (
+        "chain20heavy",
+        "joints: chain20 with a ball of 100 links' mass at its end",
+    ),
+    (
         "ragdoll",
         "joints: an 11-body ragdoll (hinges with limits, ball joints) dropped on stairs",
     ),
@@ -172,6 +176,7 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
         "arch" => return Some(arch()),
         "overlap_pyramid" => return Some(overlap_pyramid(name, 10)),
         "chain20" => return Some(super::builtin_joints::chain20()),
+        "chain20heavy" => return Some(super::builtin_joints::chain20heavy()),
         "ragdoll" => return Some(super::builtin_joints::ragdoll()),
         "bridge" => return Some(super::builtin_joints::bridge()),
         _ => {}

@@ -1,5 +1,6 @@
 //! The built-in scenes with joints: `chain20` (a chain of 20 links swinging down from a
-//! horizontal start), `ragdoll` (an 11-body ragdoll dropped on stairs) and `bridge` (a plank
+//! horizontal start), `chain20heavy` (the same chain with a ball of 100 links' mass at its
+//! end), `ragdoll` (an 11-body ragdoll dropped on stairs) and `bridge` (a plank
 //! bridge on hinges carrying falling boxes).
 
 use super::joint_desc::{DofDesc, MotorDesc};
@@ -59,6 +60,37 @@ pub(super) fn chain20() -> Scene {
         ));
         previous = index;
     }
+    scene
+}
+
+/// The end ball of `chain20heavy`: radius (m) and mass (kg), 100 times a link's 2.5 kg (a
+/// 0.1 × 0.25 × 0.1 m box of density 1000 kg/m³).
+const HEAVY_BALL: (f32, f32) = (0.2, 250.0);
+
+/// `chain20` with a ball of [`HEAVY_BALL`] joined to its last link by a spherical joint, the
+/// whole chain released horizontally along x. The chain swings down as a pendulum carrying the
+/// ball, whose pull at the bottom of the swing is about three times its weight (a point
+/// pendulum released from horizontal: T = 3 m g at the bottom): a 1:100 mass ratio under the
+/// largest load a free swing gives. Links, ball and post are the geometry of the hanging chain
+/// in the joints' integration tests.
+pub(super) fn chain20heavy() -> Scene {
+    let mut scene = chain20();
+    scene.name = "chain20heavy".into();
+    let last = scene.bodies.len() - 1;
+    let end = 0.1 + 0.125 * 40.0;
+    let (radius, mass) = HEAVY_BALL;
+    let mut ball = body(
+        BodyKind::Dynamic,
+        ShapeDesc::Sphere { radius },
+        [end + radius, 6.0, 0.0],
+    );
+    ball.name = Some("ball".into());
+    ball.mass = Some(mass);
+    scene.bodies.push(ball);
+    let index = scene.bodies.len() - 1;
+    scene
+        .joints
+        .push(joint(JointKind::Spherical, last, index, [end, 6.0, 0.0]));
     scene
 }
 

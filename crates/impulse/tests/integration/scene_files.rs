@@ -27,6 +27,7 @@ const FILE_SCENES: &[&str] = &[
     "plate",
     "card_house",
     "chain20",
+    "chain20heavy",
     "ragdoll",
     "bridge",
     "arch",
