@@ -68,7 +68,7 @@ class IMPULSE_OT_bake(bpy.types.Operator):
     def _start(self, context):
         settings = context.scene.impulse_bake
         try:
-            return bake.Baker(context.scene, settings.preset, settings.substeps, settings.steps_per_frame)
+            baker = bake.Baker(context.scene, settings.preset, settings.substeps, settings.steps_per_frame)
         except scene_reader.UnsupportedScene as error:
             for problem in error.problems:
                 self.report({"ERROR"}, problem)
@@ -77,6 +77,9 @@ class IMPULSE_OT_bake(bpy.types.Operator):
             # impulse's SceneError / WorldError / StepError, or a missing package.
             self.report({"ERROR"}, f"impulse: {error}")
             return None
+        for warning in baker.info.warnings:
+            self.report({"WARNING"}, f"impulse: {warning}")
+        return baker
 
     def execute(self, context):
         baker = self._start(context)

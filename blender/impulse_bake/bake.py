@@ -76,7 +76,12 @@ def make_world(scene_dict, preset="default", substeps=0, frame_steps=0):
 
 
 def _name_the_body(message, info):
-    """impulse's scene error (``bodies[3].shape.points: ...``) led by the object's name."""
+    """impulse's scene error (``bodies[3].shape.points: ...``, ``joints[0].limits: ...``) led
+    by the body's or the constraint's object name."""
+    joint = re.search(r"joints\[(\d+)\]", message)
+    joints = info.scene.get("joints", [])
+    if joint is not None and int(joint.group(1)) < len(joints):
+        return f"{joints[int(joint.group(1))]['name']}: {message}"
     found = re.search(r"bodies\[(\d+)\]", message)
     if found is None or int(found.group(1)) >= len(info.bodies):
         return f"{info.scene.get('name', 'scene')}: {message}"

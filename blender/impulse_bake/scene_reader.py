@@ -21,9 +21,11 @@ What maps to what (docs/blender.md has the animator's version):
   as √(μa·μb) and max(ea, eb), Bullet as μa·μb and ea·eb); Blender's damping d (the fraction of
   velocity lost per second) as impulse's rate −ln(1 − d) (1/s), the same decay per second;
 - collision collections: the body's ``groups`` and ``mask`` are both the bit set of its
-  collections, so two bodies collide when they share one, as in Blender.
+  collections, so two bodies collide when they share one, as in Blender;
+- rigid body constraints: the scene's ``joints`` (:mod:`constraints`), read at the first frame;
+  settings impulse does not follow are ``SceneInfo.warnings``.
 
-Unsupported things (rigid body constraints, the compound-parent shape, a parent on a simulated
+Unsupported things (the compound-parent shape, a parent on a simulated
 object, negative scale, a shape without geometry) are collected and raised together as
 :class:`UnsupportedScene`, each message naming the object.
 """
@@ -34,7 +36,7 @@ from dataclasses import dataclass, field
 import bpy
 import mathutils
 
-from . import axes
+from . import axes, constraints
 
 #: Custom property holding an active object's pose before the first bake, so that a second
 #: bake starts where the first one did and replaces it.
@@ -69,7 +71,8 @@ class SceneInfo:
 
     ``scene`` is the scene-format dict (bodies in ``bodies`` order); ``frame_start`` and
     ``frame_end`` the inclusive frame range, whose first frame is the initial state; ``dt`` the
-    step (s), one per frame.
+    step (s), one per frame; ``warnings`` one message per constraint setting impulse does not
+    follow (:mod:`constraints`), each naming the constraint object.
     """
 
     scene: dict
@@ -77,6 +80,7 @@ class SceneInfo:
     frame_start: int = 1
     frame_end: int = 250
     dt: float = 1.0 / 24.0
+    warnings: list = field(default_factory=list)
 
     @property
     def steps(self):
@@ -271,12 +275,6 @@ def read_scene(scene, depsgraph=None):
     fps = _frame_rate(scene)
     dt = world.time_scale / fps
     problems = []
-    for constraint_object in world.constraints.all_objects if world.constraints else []:
-        if constraint_object.rigid_body_constraint is not None:
-            problems.append(
-                f"{constraint_object.name}: rigid body constraints "
-                f"({constraint_object.rigid_body_constraint.type.lower()}) are not supported"
-            )
 
     was_enabled = world.enabled
     frame_before = scene.frame_current
@@ -317,6 +315,12 @@ def read_scene(scene, depsgraph=None):
                 body["angular_damping"] = _damping_rate(rigid_body.angular_damping)
             bodies.append(BodyInfo(obj.name, kind, body))
 
+        joints, warnings = constraints.read_constraints(
+            scene,
+            {b.object_name: b.kind for b in bodies},
+            {b.object_name: b.body["mass"] for b in bodies if b.kind == "dynamic"},
+        )
+
         kinematic = [b for b in bodies if b.kind == "kinematic"]
         if kinematic and not problems:
             samples = {b.object_name: [] for b in kinematic}
@@ -348,4 +352,6 @@ def read_scene(scene, depsgraph=None):
         "steps": frame_end - frame_start,
         "bodies": [b.body for b in bodies],
     }
-    return SceneInfo(impulse_scene, bodies, frame_start, frame_end, dt)
+    if joints:
+        impulse_scene["joints"] = joints
+    return SceneInfo(impulse_scene, bodies, frame_start, frame_end, dt, warnings)

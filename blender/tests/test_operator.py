@@ -66,6 +66,21 @@ def test_the_operator_reports_an_unsupported_scene(addon):
     assert scene.rigidbody_world.enabled
 
 
+def test_the_operator_warns_of_constraint_settings_it_does_not_follow(addon, capfd):
+    scene = scenes.heavy_on_light(4)
+    empty = bpy.data.objects.new("off", None)
+    scene.collection.objects.link(empty)
+    bpy.context.view_layer.objects.active = empty
+    empty.select_set(True)
+    bpy.ops.rigidbody.constraint_add(type="FIXED")
+    empty.rigid_body_constraint.object1 = scene.objects["light0"]
+    empty.rigid_body_constraint.object2 = scene.objects["light1"]
+    empty.rigid_body_constraint.enabled = False
+    assert bpy.ops.impulse.bake() == {"FINISHED"}
+    output = capfd.readouterr()
+    assert "off: the constraint is disabled" in output.out + output.err
+
+
 EXTENSION_CHECK = """
 import bpy
 bpy.context.preferences.system.use_online_access = False

@@ -134,24 +134,29 @@ pub fn mesh_input(data: &[u8]) -> Option<usize> {
 }
 
 /// What `snapshot_reader` does with one input: the first byte picks what the rest is (odd: a
-/// whole snapshot file; even: the CBOR payload alone, given a valid header so that the decoder
+/// whole snapshot file; even: the CBOR payload alone, given a valid header of the payload's own format version so that the decoder
 /// is reached past the checksum), then `WorldSnapshot::from_bytes`, `World::from_snapshot`
 /// and at most [`MAX_STEPS`] capped steps. Returns the steps taken without error, `None` when
 /// the snapshot was refused or has more than [`MAX_BODIES`] bodies.
 pub fn snapshot_input(data: &[u8]) -> Option<usize> {
-    use impulse::{SNAPSHOT_FORMAT_VERSION, World, WorldSnapshot};
+    use impulse::{OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION, World, WorldSnapshot};
     let (&selector, rest) = data.split_first()?;
-    let file = if selector % 2 == 1 {
-        rest.to_vec()
+    let snapshot = if selector % 2 == 1 {
+        WorldSnapshot::from_bytes(rest).ok()?
     } else {
-        let mut file = b"IMPULSE-WORLD\0\0\0".to_vec();
-        file.extend_from_slice(&SNAPSHOT_FORMAT_VERSION.to_le_bytes());
-        file.extend_from_slice(&(rest.len() as u64).to_le_bytes());
-        file.extend_from_slice(&crc32fast::hash(rest).to_le_bytes());
-        file.extend_from_slice(rest);
-        file
+        // The header must give the payload's own version: try each readable one.
+        let header = |version: u32| {
+            let mut file = b"IMPULSE-WORLD\0\0\0".to_vec();
+            file.extend_from_slice(&version.to_le_bytes());
+            file.extend_from_slice(&(rest.len() as u64).to_le_bytes());
+            file.extend_from_slice(&crc32fast::hash(rest).to_le_bytes());
+            file.extend_from_slice(rest);
+            file
+        };
+        (OLDEST_SNAPSHOT_FORMAT_VERSION..=SNAPSHOT_FORMAT_VERSION)
+            .rev()
+            .find_map(|version| WorldSnapshot::from_bytes(&header(version)).ok())?
     };
-    let snapshot = WorldSnapshot::from_bytes(&file).ok()?;
     if snapshot.body_count() > MAX_BODIES {
         return None;
     }

@@ -17,7 +17,9 @@ use impulse::scene::{BodyKind, ShapeDesc};
 use impulse::{Scene, World};
 use parry3d::math::Pose;
 
-use crate::peer::{PeerRun, PeerWorld, check_carried_over, resolve_material, shape_kind};
+use crate::peer::{
+    PeerRun, PeerWorld, check_carried_over, resolve_material, shape_kind, spherical_joints,
+};
 use crate::peer_settings::{BOX3D, Box3dSetting};
 use crate::row::BenchRow;
 
@@ -164,6 +166,28 @@ impl Box3dWorld {
                     b3::b3Body_SetMassData(body, data);
                 }
                 sim.bodies.push(body);
+            }
+            // Spherical joints: joint frames at the anchors in the body frames, identity
+            // rotations (a spherical joint without limits does not use them), Box3D's default
+            // joint softness, no contacts between the joined bodies (as impulse).
+            let identity = b3::b3Quat {
+                v: vec3(Vec3::ZERO),
+                s: 1.0,
+            };
+            for joint in spherical_joints(world, "Box3D")? {
+                let mut def = b3::b3DefaultSphericalJointDef();
+                def.base.bodyIdA = sim.bodies[joint.body_a];
+                def.base.bodyIdB = sim.bodies[joint.body_b];
+                def.base.localFrameA = b3::b3Transform {
+                    p: vec3(joint.anchor_a),
+                    q: identity,
+                };
+                def.base.localFrameB = b3::b3Transform {
+                    p: vec3(joint.anchor_b),
+                    q: identity,
+                };
+                def.base.collideConnected = false;
+                b3::b3CreateSphericalJoint(id, &def);
             }
             Ok(sim)
         }

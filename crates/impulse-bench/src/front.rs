@@ -3,8 +3,10 @@
 //!
 //! Each engine runs a scene once per setting of a grid ([`impulse_grid`], [`rapier_grid`],
 //! [`box3d_grid`], [`jolt_grid`]; a peer only when its feature is compiled in). A run gives a
-//! point: its median time per step and its quality error
-//! E = max(|top sink|, largest overlap, largest drift) after the run, in mm. An engine's
+//! point: its median time per step and its quality error E in mm: for a scene without joints
+//! E = max(|top sink|, largest overlap, largest drift) after the run; for a scene with joints
+//! (`chain20heavy`) E is the largest joint gap over the run (the distances between each
+//! joint's two anchors, summed: a chain's stretch; `quality::joint_gap`). An engine's
 //! Pareto front is its points that no other point of the same engine beats on both time and
 //! E ([`pareto_front`]); at each quality bar ([`BARS`]) the engines are compared by their
 //! cheapest setting meeting the bar ([`cheapest_meeting`]), and impulse by its time over the
@@ -27,8 +29,9 @@ use crate::threads::thread_pool;
 use crate::{BenchRow, scene_by_name};
 
 pub use crate::front_grids::{
-    ImpulseSetting, box3d_grid, box3d_quick_grid, impulse_grid, impulse_quick_grid, jolt_grid,
-    jolt_quick_grid, rapier_grid, rapier_quick_grid,
+    ImpulseSetting, box3d_grid, box3d_joint_grid, box3d_quick_grid, impulse_grid,
+    impulse_quick_grid, jolt_grid, jolt_joint_grid, jolt_quick_grid, rapier_grid,
+    rapier_joint_grid, rapier_quick_grid,
 };
 pub use crate::front_tables::{
     Plots, display_name, format_bar_table, format_front_table, format_markdown,
@@ -43,6 +46,7 @@ pub const FRONT_SCENES: &[&str] = &[
     "stack30",
     "massratio",
     "pyramid100",
+    "chain20heavy",
 ];
 
 /// Steps per scene when not told otherwise (10 s at dt = 1/60 s).
@@ -75,7 +79,8 @@ pub struct FrontPoint {
     pub setting: String,
     /// Median wall-clock time of one step (ms), over the steps taken.
     pub ms_per_step: f64,
-    /// The quality error: max(|sink|, overlap, drift) (mm).
+    /// The quality error (mm): the joint gap for a scene with joints, max(|sink|, overlap,
+    /// drift) otherwise.
     pub e_mm: f64,
     /// Initial y − final y of the moving body that started highest (mm).
     pub sink_mm: f64,
@@ -83,6 +88,9 @@ pub struct FrontPoint {
     pub overlap_mm: f64,
     /// Largest distance of a moving body from its start over the samples (mm).
     pub drift_mm: f64,
+    /// Largest joint gap over the samples (mm; `quality::joint_gap`); None for a scene
+    /// without joints.
+    pub joint_gap_mm: Option<f64>,
     /// Steps taken (fewer than asked when the run failed).
     pub steps: u32,
     /// The engine's settings in full, as the engine ran them.
@@ -99,7 +107,8 @@ impl FrontPoint {
         let sink_mm = row.top_sink_m * 1e3;
         let overlap_mm = row.max_overlap_m * 1e3;
         let drift_mm = row.max_drift_m * 1e3;
-        let e_mm = error_mm(sink_mm, overlap_mm, drift_mm);
+        let joint_gap_mm = row.max_joint_gap_m.map(|gap| gap * 1e3);
+        let e_mm = joint_gap_mm.unwrap_or_else(|| error_mm(sink_mm, overlap_mm, drift_mm));
         let failed = error.or_else(|| {
             (!(e_mm.is_finite() && row.ms_per_step_median.is_finite()))
                 .then(|| "non-finite result".to_string())
@@ -112,6 +121,7 @@ impl FrontPoint {
             sink_mm,
             overlap_mm,
             drift_mm,
+            joint_gap_mm,
             steps: row.steps,
             details: row.settings.clone(),
             failed,
@@ -128,6 +138,7 @@ impl FrontPoint {
             sink_mm: f64::NAN,
             overlap_mm: f64::NAN,
             drift_mm: f64::NAN,
+            joint_gap_mm: None,
             steps: 0,
             details: String::new(),
             failed: Some(format!("{error:#}")),
@@ -268,7 +279,9 @@ impl FrontConfig {
 
     /// Each peer's grid (quick or full), in the order of [`PEERS`], for the peers of
     /// [`Self::peers`]; an error naming an unknown peer or the feature of one not compiled in.
-    pub fn peer_settings(&self) -> Result<Vec<Vec<PeerSetting>>> {
+    /// The full grids of a scene with joints are [`rapier_joint_grid`], [`box3d_joint_grid`]
+    /// and [`jolt_joint_grid`].
+    pub fn peer_settings(&self, scene: &Scene) -> Result<Vec<Vec<PeerSetting>>> {
         for peer in &self.peers {
             if !PEERS.contains(&peer.as_str()) {
                 bail!(
@@ -280,31 +293,43 @@ impl FrontConfig {
                 bail!("{}", missing_peer(peer));
             }
         }
+        let joints = !scene.joints.is_empty();
+        let pick = |quick: fn() -> Vec<PeerSetting>,
+                    joint: fn() -> Vec<PeerSetting>,
+                    full: fn() -> Vec<PeerSetting>| {
+            if self.quick {
+                quick()
+            } else if joints {
+                joint()
+            } else {
+                full()
+            }
+        };
+        fn wrap<T>(grid: Vec<T>, f: fn(T) -> PeerSetting) -> Vec<PeerSetting> {
+            grid.into_iter().map(f).collect()
+        }
         let wanted = |engine: &str| self.peers.iter().any(|p| p == engine);
         let mut grids = Vec::new();
         if wanted(RAPIER) {
-            let grid = if self.quick {
-                rapier_quick_grid()
-            } else {
-                rapier_grid()
-            };
-            grids.push(grid.into_iter().map(PeerSetting::Rapier).collect());
+            grids.push(pick(
+                || wrap(rapier_quick_grid(), PeerSetting::Rapier),
+                || wrap(rapier_joint_grid(), PeerSetting::Rapier),
+                || wrap(rapier_grid(), PeerSetting::Rapier),
+            ));
         }
         if wanted(BOX3D) {
-            let grid = if self.quick {
-                box3d_quick_grid()
-            } else {
-                box3d_grid()
-            };
-            grids.push(grid.into_iter().map(PeerSetting::Box3d).collect());
+            grids.push(pick(
+                || wrap(box3d_quick_grid(), PeerSetting::Box3d),
+                || wrap(box3d_joint_grid(), PeerSetting::Box3d),
+                || wrap(box3d_grid(), PeerSetting::Box3d),
+            ));
         }
         if wanted(JOLT) {
-            let grid = if self.quick {
-                jolt_quick_grid()
-            } else {
-                jolt_grid()
-            };
-            grids.push(grid.into_iter().map(PeerSetting::Jolt).collect());
+            grids.push(pick(
+                || wrap(jolt_quick_grid(), PeerSetting::Jolt),
+                || wrap(jolt_joint_grid(), PeerSetting::Jolt),
+                || wrap(jolt_grid(), PeerSetting::Jolt),
+            ));
         }
         Ok(grids)
     }
@@ -340,18 +365,24 @@ pub fn run_front(
         .map(|name| scene_by_name(name))
         .collect::<Result<Vec<_>>>()?;
     let impulse = config.impulse_settings();
-    let peers = config.peer_settings()?;
-    let per_scene = impulse.len() + peers.iter().map(Vec::len).sum::<usize>();
-    let total = scenes.len() * per_scene;
+    let peers = scenes
+        .iter()
+        .map(|scene| config.peer_settings(scene))
+        .collect::<Result<Vec<_>>>()?;
+    let total = peers
+        .iter()
+        .map(|grids| impulse.len() + grids.iter().map(Vec::len).sum::<usize>())
+        .sum();
     let mut done = 0;
     scenes
         .iter()
-        .map(|scene| {
+        .zip(&peers)
+        .map(|(scene, peers)| {
             measure_scene(
                 scene,
                 config.steps_for(scene),
                 &impulse,
-                &peers,
+                peers,
                 &mut |scene, steps, point| {
                     done += 1;
                     on_point(&Progress {

@@ -1,6 +1,8 @@
 //! The grids of settings `impulse-bench front` runs each engine over: impulse's presets and
 //! soft steps, Rapier's substeps × springs × friction, Box3D's substeps × contact hertz,
-//! Jolt's collision steps × velocity iterations; and the small grids of `--quick`.
+//! Jolt's collision steps × velocity iterations; the peers' grids for a scene with joints,
+//! where contact springs do not matter and joint solving does; and the small grids of
+//! `--quick`.
 
 use impulse::SolverSettings;
 
@@ -193,4 +195,51 @@ pub fn jolt_quick_grid() -> Vec<JoltSetting> {
             position_steps: 2,
         },
     ]
+}
+
+/// Rapier's settings for a scene with joints: substeps {1, 2, 4, 8, 16, 32, 64} at Rapier's
+/// default springs and friction. Rapier's impulse joints are solved once per substep with the
+/// joint spring of `IntegrationParameters` (its defaults), so the substeps are the setting that
+/// makes them stiffer; contact springs and friction act on contacts only.
+pub fn rapier_joint_grid() -> Vec<RapierVariant> {
+    [1, 2, 4, 8, 16, 32, 64]
+        .into_iter()
+        .map(|substeps| RapierVariant {
+            substeps,
+            ..RapierVariant::default()
+        })
+        .collect()
+}
+
+/// Box3D's settings for a scene with joints: substeps {1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48,
+/// 64} at Box3D's default 30 Hz contacts (Box3D's joints are solved in every substep with
+/// their own `jointHertz` and `jointDampingRatio`, left at Box3D's defaults).
+pub fn box3d_joint_grid() -> Vec<Box3dSetting> {
+    [1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64]
+        .into_iter()
+        .map(|substeps| Box3dSetting {
+            substeps,
+            ..Box3dSetting::default()
+        })
+        .collect()
+}
+
+/// Jolt's settings for a scene with joints: collision steps {1, 2, 4, 8} × velocity iterations
+/// {10, 20, 40} × position iterations {2, 10}: Jolt's position iterations solve the joints'
+/// position error (its Baumgarte-free position pass), so they matter here as they do not on
+/// resting piles.
+pub fn jolt_joint_grid() -> Vec<JoltSetting> {
+    let mut grid = Vec::new();
+    for collision_steps in [1, 2, 4, 8] {
+        for velocity_steps in [10, 20, 40] {
+            for position_steps in [2, 10] {
+                grid.push(JoltSetting {
+                    collision_steps,
+                    velocity_steps,
+                    position_steps,
+                });
+            }
+        }
+    }
+    grid
 }

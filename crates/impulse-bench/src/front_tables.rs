@@ -216,7 +216,9 @@ pub fn format_summary_table(fronts: &[SceneFront]) -> String {
 
 /// What the setting names and columns mean, for the top of the Markdown.
 const LEGEND: &str = "E = max(|top sink|, largest overlap, largest drift) after the run (mm); \
-bars Q50: E ≤ 50 mm, Q5: E ≤ 5 mm, Q1: E ≤ 1 mm. ms/step: median wall-clock time of one step, \
+for a scene with joints (chain20heavy) E is the largest joint gap over the run (the distances \
+between each joint's two anchors, summed: the chain's stretch, mm; 50 mm is 1 % of \
+chain20heavy's 5 m of links). Bars Q50: E ≤ 50 mm, Q5: E ≤ 5 mm, Q1: E ≤ 1 mm. ms/step: median wall-clock time of one step, \
 one thread, sleeping off, each setting run on its own with the engines interleaved. Time \
 impulse/cheapest peer: impulse's ms/step at its cheapest setting meeting the bar over the \
 lowest ms/step of any peer (Rapier, Box3D, Jolt) meeting it (< 1: impulse is faster); \

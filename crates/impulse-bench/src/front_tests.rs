@@ -14,6 +14,7 @@ fn point(engine: &str, setting: &str, ms: f64, e_mm: f64) -> FrontPoint {
         sink_mm: e_mm,
         overlap_mm: 0.0,
         drift_mm: 0.0,
+        joint_gap_mm: None,
         steps: 10,
         details: String::new(),
         failed: None,
@@ -350,7 +351,9 @@ fn quick_front_on_a_small_stack() {
     assert_eq!(fronts.len(), 1);
     let front = &fronts[0];
     assert_eq!((front.scene.as_str(), front.steps), ("stack3", 20));
-    let peers = config.peer_settings().unwrap();
+    let peers = config
+        .peer_settings(&scene_by_name("stack3").unwrap())
+        .unwrap();
     let expected = config.impulse_settings().len() + peers.iter().map(Vec::len).sum::<usize>();
     assert_eq!(front.points.len(), expected);
     assert_eq!(progress.len(), expected);

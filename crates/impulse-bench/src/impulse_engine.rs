@@ -211,4 +211,9 @@ impl crate::peer::EngineRun for ImpulseRun {
     fn finish(self: Box<Self>) -> BenchRow {
         ImpulseRun::finish(*self)
     }
+
+    #[cfg(test)]
+    fn poses(&mut self) -> Vec<parry3d::math::Pose> {
+        self.world.poses().to_vec()
+    }
 }

@@ -20,7 +20,9 @@ use impulse::{Scene, World};
 use oxijolt_sys as j;
 use parry3d::math::Pose;
 
-use crate::peer::{PeerRun, PeerWorld, check_carried_over, resolve_material, shape_kind};
+use crate::peer::{
+    PeerRun, PeerWorld, check_carried_over, resolve_material, shape_kind, spherical_joints,
+};
 use crate::peer_settings::{JOLT, JoltSetting};
 use crate::row::BenchRow;
 
@@ -220,6 +222,28 @@ impl JoltWorld {
         let Ok(mut sim) = sim else {
             bail!("Jolt could not create its physics system");
         };
+        let joints = spherical_joints(world, "Jolt")?;
+        // Jolt's constraints do not keep their bodies from colliding: with joints, every body
+        // is in one collision group, its own subgroup, and the table of that group turns off
+        // the pairs a joint joins (impulse's default).
+        // SAFETY: the table is created here; each body holds its own reference to it, and
+        // ours is released once the bodies are built.
+        let group_filter = unsafe {
+            if joints.is_empty() {
+                std::ptr::null_mut()
+            } else {
+                let table = j::JPH_GroupFilterTable_Create(bodies);
+                for joint in &joints {
+                    j::JPH_GroupFilterTable_DisableCollision(
+                        table,
+                        u32::try_from(joint.body_a)?,
+                        u32::try_from(joint.body_b)?,
+                    );
+                }
+                table
+            }
+        };
+        let mut body_pointers = Vec::with_capacity(scene.bodies.len());
         for (i, desc) in scene.bodies.iter().enumerate() {
             check_carried_over(i, desc, "Jolt")?;
             let material = resolve_material(scene, &desc.material)?;
@@ -280,20 +304,63 @@ impl JoltWorld {
                     );
                     j::JPH_BodyCreationSettings_SetMassPropertiesOverride(settings, &properties);
                 }
+                if !group_filter.is_null() {
+                    let group = j::JPH_CollisionGroup {
+                        groupFilter: group_filter.cast(),
+                        groupID: 0,
+                        subGroupID: u32::try_from(i)?,
+                    };
+                    j::JPH_BodyCreationSettings_SetCollisionGroup(settings, &group);
+                }
                 let bodies = j::JPH_PhysicsSystem_GetBodyInterface(sim.system);
-                let id = j::JPH_BodyInterface_CreateAndAddBody(
-                    bodies,
-                    settings,
-                    j::JPH_Activation_Activate,
-                );
+                let body = j::JPH_BodyInterface_CreateBody(bodies, settings);
                 j::JPH_BodyCreationSettings_Destroy(settings);
                 j::JPH_Shape_Destroy(shape);
-                id
+                if body.is_null() {
+                    INVALID_BODY
+                } else {
+                    let id = j::JPH_Body_GetID(body);
+                    j::JPH_BodyInterface_AddBody(bodies, id, j::JPH_Activation_Activate);
+                    body_pointers.push(body);
+                    id
+                }
             };
             if id == INVALID_BODY {
                 bail!("body {i}: Jolt could not create the body");
             }
             sim.bodies.push(id);
+        }
+        // SAFETY: the bodies hold their references to the table; this releases ours.
+        unsafe {
+            if !group_filter.is_null() {
+                j::JPH_GroupFilter_Destroy(group_filter.cast());
+            }
+        }
+        // Spherical joints as Jolt's point constraints, both points at the anchor's world
+        // position at the start (Jolt's world-space settings), Jolt's default constraint
+        // settings. The system keeps its own reference to each constraint.
+        for (k, joint) in joints.iter().enumerate() {
+            let pose = world.poses()[joint.body_a];
+            let anchor = vec3(pose.rotation * joint.anchor_a + pose.translation);
+            // SAFETY: the bodies are alive in this system; the settings are initialised by
+            // `JPH_PointConstraintSettings_Init`.
+            unsafe {
+                let mut settings = std::mem::zeroed::<j::JPH_PointConstraintSettings>();
+                j::JPH_PointConstraintSettings_Init(&mut settings);
+                settings.space = j::JPH_ConstraintSpace_WorldSpace;
+                settings.point1 = anchor;
+                settings.point2 = anchor;
+                let constraint = j::JPH_PointConstraint_Create(
+                    &settings,
+                    body_pointers[joint.body_a],
+                    body_pointers[joint.body_b],
+                );
+                if constraint.is_null() {
+                    bail!("joint {k}: Jolt could not create the point constraint");
+                }
+                j::JPH_PhysicsSystem_AddConstraint(sim.system, constraint.cast());
+                j::JPH_Constraint_Destroy(constraint.cast());
+            }
         }
         // SAFETY: the system is alive.
         unsafe { j::JPH_PhysicsSystem_OptimizeBroadPhase(sim.system) };

@@ -26,6 +26,8 @@ pub mod front;
 mod front_grids;
 mod front_tables;
 mod impulse_engine;
+#[cfg(test)]
+mod joint_scene_tests;
 #[cfg(feature = "jolt")]
 mod jolt_engine;
 pub mod machine;
@@ -410,6 +412,7 @@ mod tests {
             top_sink_m: 0.0012,
             max_overlap_m: 0.0,
             max_drift_m: 0.5,
+            max_joint_gap_m: None,
             settings: "a | b".into(),
         }
     }

@@ -265,7 +265,7 @@ fn run_front(args: FrontArgs) -> Result<bool> {
             impulse_bench::peer_settings::missing_peer(RAPIER)
         );
     }
-    config.peer_settings()?;
+    config.peer_settings(&impulse::Scene::default())?;
     let machine = MachineInfo::current();
     let command = command_line();
     eprintln!("before: {machine}");

@@ -11,7 +11,7 @@ use impulse::scene::{BodyDesc, Material, MaterialRef};
 use impulse::{Scene, World};
 use parry3d::math::Pose;
 
-use crate::quality::{self, Quality};
+use crate::quality::{self, JointAnchors, Quality};
 use crate::row::BenchRow;
 
 /// A peer engine's world built from a scene, bodies in scene order.
@@ -113,6 +113,9 @@ pub(crate) trait EngineRun {
     fn advance(&mut self, n: u32) -> Result<()>;
     /// The row of the steps taken so far.
     fn finish(self: Box<Self>) -> BenchRow;
+    /// The body poses now (body origins, world frame), scene order.
+    #[cfg(test)]
+    fn poses(&mut self) -> Vec<Pose>;
 }
 
 impl<W: PeerWorld> EngineRun for PeerRun<W> {
@@ -122,6 +125,12 @@ impl<W: PeerWorld> EngineRun for PeerRun<W> {
 
     fn finish(self: Box<Self>) -> BenchRow {
         PeerRun::finish(*self)
+    }
+
+    #[cfg(test)]
+    fn poses(&mut self) -> Vec<Pose> {
+        self.sim.copy_poses(&mut self.poses);
+        self.poses.clone()
     }
 }
 
@@ -157,6 +166,36 @@ pub(crate) fn check_carried_over(index: usize, body: &BodyDesc, engine: &str) ->
         refuse("collision groups and masks")?;
     }
     Ok(())
+}
+
+/// The joints of `world` a peer builds, each with its bodies' scene indices and its anchors
+/// in their body frames (m, from the body origins): spherical joints only, stiff, without
+/// limits, springs, motors or break thresholds, and with contacts between their two bodies
+/// off (impulse's default). Anything else is refused with an error naming the joint and
+/// `engine`.
+pub(crate) fn spherical_joints(world: &World, engine: &str) -> Result<Vec<JointAnchors>> {
+    use impulse::{AxisMode, JointDof, JointKind, JointStiffness};
+    for (k, joint) in world.joints().enumerate() {
+        let plain_rotation = [JointDof::AngularX, JointDof::AngularY, JointDof::AngularZ]
+            .into_iter()
+            .map(|dof| joint.dof(dof))
+            .all(|axis| {
+                axis.mode == AxisMode::Free && axis.spring.is_none() && axis.motor.is_none()
+            });
+        if joint.kind() != JointKind::Spherical
+            || !plain_rotation
+            || joint.stiffness() != JointStiffness::Stiff
+            || joint.break_thresholds().is_some()
+            || joint.collide_connected()
+        {
+            bail!(
+                "joint {k}: only plain spherical joints (no limits, springs, motors, softness, \
+                 break thresholds or contacts between the joined bodies) are carried over to \
+                 the {engine} comparison"
+            );
+        }
+    }
+    Ok(quality::joint_anchors(world))
 }
 
 /// The scene-format name of a shape's kind, for errors.

@@ -13,10 +13,11 @@ use parry3d::shape::SharedShape;
 use rapier3d::prelude::{
     CCDSolver, CoefficientCombineRule, ColliderBuilder, ColliderSet, DefaultBroadPhase,
     ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet, NarrowPhase,
-    PhysicsPipeline, RigidBodyBuilder, RigidBodyHandle, RigidBodySet, SoftBodySet, Vector,
+    PhysicsPipeline, RigidBodyBuilder, RigidBodyHandle, RigidBodySet, SoftBodySet,
+    SphericalJointBuilder, Vector,
 };
 
-use crate::peer::{PeerRun, PeerWorld, check_carried_over, resolve_material};
+use crate::peer::{PeerRun, PeerWorld, check_carried_over, resolve_material, spherical_joints};
 use crate::row::BenchRow;
 
 /// Engine name in [`BenchRow::engine`].
@@ -120,6 +121,21 @@ impl RapierScene {
             colliders.insert_with_parent(collider, handle, &mut bodies);
             handles.push(handle);
         }
+        // Spherical joints as Rapier's impulse joints (its default kind of joint), anchors in
+        // the body frames, no contacts between the joined bodies (as impulse).
+        let mut impulse_joints = ImpulseJointSet::new();
+        for joint in spherical_joints(world, "Rapier")? {
+            let spherical = SphericalJointBuilder::new()
+                .local_anchor1(joint.anchor_a)
+                .local_anchor2(joint.anchor_b)
+                .contacts_enabled(false);
+            impulse_joints.insert(
+                handles[joint.body_a],
+                handles[joint.body_b],
+                spherical,
+                true,
+            );
+        }
         let params = IntegrationParameters {
             dt: scene.dt,
             ..*params
@@ -133,7 +149,7 @@ impl RapierScene {
             narrow_phase: NarrowPhase::new(),
             bodies,
             colliders,
-            impulse_joints: ImpulseJointSet::new(),
+            impulse_joints,
             multibody_joints: MultibodyJointSet::new(),
             soft_bodies: SoftBodySet::new(),
             ccd: CCDSolver::new(),

@@ -32,6 +32,9 @@ pub struct BenchRow {
     pub max_overlap_m: f64,
     /// Largest distance of a moving body from its start, at the same samples (m).
     pub max_drift_m: f64,
+    /// Largest joint gap (the distances between each joint's two anchors, summed over the
+    /// joints; `quality::joint_gap`) at the same samples (m); None for a scene without joints.
+    pub max_joint_gap_m: Option<f64>,
     /// The engine's settings: iterations, substeps, threads, and anything else that matters.
     pub settings: String,
 }
@@ -63,6 +66,7 @@ impl BenchRow {
             top_sink_m: quality.top_sink.into(),
             max_overlap_m: quality.max_overlap.into(),
             max_drift_m: quality.max_drift.into(),
+            max_joint_gap_m: quality.max_joint_gap.map(f64::from),
             settings,
         }
     }

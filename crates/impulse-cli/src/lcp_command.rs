@@ -167,13 +167,24 @@ pub fn dump(mut scene: Scene, step: u64, out: &Path, no_friction: bool) -> Resul
         "file        {} (impulse JSON, w = Aγ − b, A as CSR)",
         out.display()
     );
+    let joint_rows = contact_lcp.joint_of_row.iter().flatten().count();
+    let joints = {
+        let mut joints: Vec<usize> = contact_lcp.joint_of_row.iter().flatten().copied().collect();
+        joints.dedup();
+        joints.len()
+    };
     println!(
-        "rows        {} ({contacts} contact points{})",
+        "rows        {} ({contacts} contact points{}{})",
         lcp.n(),
         if friction {
             ", normal + 2 tangents each"
         } else {
             ", normal rows only"
+        },
+        if joint_rows > 0 {
+            format!("; {joint_rows} joint rows of {joints} joints, after the contacts' rows")
+        } else {
+            String::new()
         }
     );
     println!("nonzeros    {} in A", nonzeros(&lcp.a));

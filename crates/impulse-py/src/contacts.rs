@@ -174,9 +174,26 @@ pub(crate) fn contact_lcp<'py>(
         "engine_solution",
         PyArray1::from_vec(py, lcp.engine_solution.clone()),
     )?;
+    // −1 marks a row of the other kind (a joint row has no contact point, and back).
+    let contact_of_row = lcp.contact_of_row.iter().zip(&lcp.joint_of_row);
     d.set_item(
         "contact_of_row",
-        PyArray1::from_vec(py, lcp.contact_of_row.iter().map(|&c| c as i64).collect()),
+        PyArray1::from_vec(
+            py,
+            contact_of_row
+                .map(|(&c, j)| if j.is_some() { -1 } else { c as i64 })
+                .collect(),
+        ),
+    )?;
+    d.set_item(
+        "joint_of_row",
+        PyArray1::from_vec(
+            py,
+            lcp.joint_of_row
+                .iter()
+                .map(|j| j.map_or(-1, |j| j as i64))
+                .collect(),
+        ),
     )?;
     Ok(d)
 }

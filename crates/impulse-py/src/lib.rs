@@ -1,5 +1,5 @@
 //! The native module `impulse._impulse` of the Python package `impulse`: worlds, settings,
-//! shapes, body builders and the exceptions, with the state of every body as NumPy arrays.
+//! shapes, body builders, joints and the exceptions, with the state of every body as NumPy arrays.
 //!
 //! The Python package (`python/impulse/`) re-exports these classes and adds trajectories
 //! (`Trajectory`, `load_trajectory`) on top. Every entry point catches Rust panics and turns
@@ -12,6 +12,7 @@ mod builder;
 mod contacts;
 mod errors;
 mod handle;
+mod joints;
 mod scene;
 mod settings;
 mod stepping;
@@ -39,6 +40,8 @@ fn _impulse(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<handle::BodyHandle>()?;
     m.add_class::<builder::Shape>()?;
     m.add_class::<builder::BodyBuilder>()?;
+    m.add_class::<joints::JointHandle>()?;
+    m.add_class::<joints::JointBuilder>()?;
     m.add_function(wrap_pyfunction!(scenes, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -14,6 +14,7 @@ use crate::arrays::{self, Field};
 use crate::contacts;
 use crate::errors::{SceneError, WorldError, guarded};
 use crate::handle::BodyHandle;
+use crate::joints::{self, JointBuilder, JointHandle};
 use crate::settings::{Settings, to_python};
 use crate::stepping::{self, names_of, step_world};
 
@@ -79,6 +80,10 @@ impl World {
 
 fn world_error(error: impulse::WorldError) -> PyErr {
     WorldError::new_err(error.to_string())
+}
+
+fn unknown_joint(handle: &JointHandle) -> PyErr {
+    world_error(impulse::WorldError::UnknownJoint(handle.inner))
 }
 
 fn vec3(value: [f32; 3], what: &str) -> PyResult<Vec3> {
@@ -679,9 +684,79 @@ impl World {
     /// SciPy is installed, else a dict of COO arrays `row`, `col` (int64), `data` (float64)
     /// and `shape`), `b` (n,), `lo`, `hi` (n,) bounds (±inf where unbounded), `friction_index`
     /// (n,) int64 (the normal row bounding a friction row by `mu`·γ_normal, −1 for none), `mu`
-    /// (n,), `engine_solution` (n,) the engine's impulses (N·s), `contact_of_row` (n,) int64.
+    /// (n,), `engine_solution` (n,) the engine's impulses (N·s), `contact_of_row` (n,) int64
+    /// (the row's contact point in solve order, −1 for a joint row) and `joint_of_row` (n,)
+    /// int64 (the row's joint in `joints()` order, −1 for a contact row); joint rows come
+    /// after every contact row.
     /// Raises `StepError` when the last step produced non-finite data.
     fn contact_lcp<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         contacts::contact_lcp(py, &self.inner)
+    }
+
+    /// Inserts the joint `builder` describes (an `impulse.JointBuilder`; world anchors and
+    /// axes are placed at the bodies' current poses) and returns its `JointHandle`; wakes both
+    /// bodies. Raises `WorldError` naming the joint and field for a removed body, a joint of a
+    /// body with itself or of two non-dynamic bodies, or values out of range.
+    fn insert_joint(&mut self, builder: &JointBuilder) -> PyResult<JointHandle> {
+        let builder = builder.inner.clone();
+        let inner = guarded(|| self.inner.insert_joint(builder).map_err(world_error))?;
+        Ok(JointHandle { inner })
+    }
+
+    /// Removes the joint `handle` names and returns its name (or None); wakes its bodies.
+    /// Raises `WorldError` for a removed or foreign handle.
+    fn remove_joint(&mut self, handle: &JointHandle) -> PyResult<Option<String>> {
+        guarded(|| self.inner.remove_joint(handle.inner).map_err(world_error))
+    }
+
+    /// A joint's read view as a dict: `handle`, `kind` (str), `name` (str or None), `body_a`,
+    /// `body_b` (BodyHandle), `broken` (bool), `force` (3,) float32 N and `torque` (3,) N·m
+    /// (the reaction on B at the anchor over the last step it was solved, world frame; A's is
+    /// the opposite), `collide_connected`, `break_thresholds` ((N, N·m) or None) and
+    /// `coordinates` (as `joint_coordinates`, or None when a body was removed). Raises
+    /// `WorldError` for a removed or foreign handle.
+    fn joint<'py>(&self, py: Python<'py>, handle: &JointHandle) -> PyResult<Bound<'py, PyDict>> {
+        let joint = self
+            .inner
+            .joint(handle.inner)
+            .ok_or_else(|| unknown_joint(handle))?;
+        joints::joint_dict(py, &self.inner, &joint)
+    }
+
+    /// Every joint's read view (as `joint`), in dense joint order (broken ones included).
+    fn joints<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let inner = &self.inner;
+        inner
+            .joints()
+            .map(|j| joints::joint_dict(py, inner, &j))
+            .collect()
+    }
+
+    /// Number of joints (broken ones included).
+    #[getter]
+    fn joint_count(&self) -> usize {
+        self.inner.joint_count()
+    }
+
+    /// The six coordinates of B's joint frame relative to A's at the current poses, (6,)
+    /// float32: m along A's frame axes x, y, z, then rad about them (a hinge's angle is
+    /// element 3, a slider's position or a distance joint's length element 0). Raises
+    /// `WorldError` for a removed or foreign handle, or a joint whose body was removed.
+    fn joint_coordinates<'py>(
+        &self,
+        py: Python<'py>,
+        handle: &JointHandle,
+    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        let c = guarded(|| Ok(self.inner.joint_coordinates(handle.inner)))?;
+        let c = c.ok_or_else(|| unknown_joint(handle))?;
+        Ok(PyArray1::from_vec(py, c.to_vec()))
+    }
+
+    /// The last step's joint events, in dense joint order, as dicts `{"type": "broken",
+    /// "joint": JointHandle, "name": str | None, "force": N, "torque": N·m}` (the reaction in
+    /// the substep where the joint broke). Only the last step's: with `step(n)`, n > 1, read
+    /// them after each step.
+    fn joint_events<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        joints::joint_events(py, &self.inner)
     }
 }

@@ -17,6 +17,21 @@ pub enum WorldError {
         /// What is wrong.
         message: String,
     },
+    /// A joint's description is invalid (`joint` is its index in insertion or scene order).
+    #[error("joint {joint}{}: {field}: {message}", name.as_ref().map(|n| format!(" (\"{n}\")")).unwrap_or_default())]
+    InvalidJoint {
+        /// Index of the joint (the scene's `joints` order, or the number of joints before it).
+        joint: usize,
+        /// The joint's name, if it has one.
+        name: Option<String>,
+        /// Field path inside the joint, e.g. `limits.lower`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A handle names no joint of this world (removed, or another world's handle).
+    #[error("no joint {0:?} in this world (removed, or another world's handle)")]
+    UnknownJoint(crate::joint::JointHandle),
     /// A handle names no body of this world (the body was removed, or the handle is another
     /// world's).
     #[error("no body {0:?} in this world (removed, or another world's handle)")]
@@ -100,15 +115,20 @@ pub enum SnapshotError {
     /// The bytes do not start with the snapshot header: not a snapshot file.
     #[error("not an impulse world snapshot (the file does not start with \"IMPULSE-WORLD\")")]
     NotASnapshot,
-    /// The snapshot was written in another format version than this build reads.
+    /// The snapshot was written in a format version this build does not read (it reads
+    /// `oldest` to `supported`).
     #[error(
-        "snapshot format version {found}, but this build of impulse reads version {supported} \
-         (snapshots are not portable across impulse versions)"
+        "snapshot format version {found}, but this build of impulse reads versions {oldest} to \
+         {supported} (snapshots are not portable across impulse versions)"
     )]
     VersionMismatch {
         /// The file's format version.
         found: u32,
-        /// The version this build reads and writes ([`crate::world::SNAPSHOT_FORMAT_VERSION`]).
+        /// The oldest version this build reads
+        /// ([`crate::world::OLDEST_SNAPSHOT_FORMAT_VERSION`]).
+        oldest: u32,
+        /// The version this build writes, the newest it reads
+        /// ([`crate::world::SNAPSHOT_FORMAT_VERSION`]).
         supported: u32,
     },
     /// Fewer bytes than the header promised: the file was cut short.

@@ -44,6 +44,10 @@ pub(crate) struct Islands {
     kinds: Vec<BodyKind>,
     /// Counting-sort scratch of the build, kept so that a rebuild allocates nothing.
     fill: Vec<u32>,
+    /// The bodies of each solved joint, this build's and the last: joints link islands as
+    /// contacts do.
+    joint_keys: Vec<(u32, u32)>,
+    last_joint_keys: Vec<(u32, u32)>,
 }
 
 /// A pair as the island build reads it: its two bodies and its number of constraints.
@@ -122,8 +126,21 @@ impl Islands {
     /// 4-byte pair indices here replaces moving the assembled constraints of several hundred
     /// bytes each. When every pair's bodies and constraint count and every body's kind are as
     /// in the last build, the islands are too, and nothing is rebuilt.
-    pub(crate) fn build(&mut self, bodies: &Bodies, pairs: &[ContactPair]) {
+    ///
+    /// `joints` are the dense body indices of the joints solved this step (and the joint's
+    /// index, unused here): a joint links its two bodies' islands, and a kinematic body joined
+    /// to an island is one of its guests.
+    pub(crate) fn build(
+        &mut self,
+        bodies: &Bodies,
+        pairs: &[ContactPair],
+        joints: &[(u32, u32, u32)],
+    ) {
         let n = bodies.len();
+        std::mem::swap(&mut self.joint_keys, &mut self.last_joint_keys);
+        self.joint_keys.clear();
+        self.joint_keys
+            .extend(joints.iter().map(|&(a, b, _)| (a, b)));
         std::mem::swap(&mut self.pair_keys, &mut self.last_pair_keys);
         self.pair_keys.clear();
         self.pair_keys.extend(
@@ -132,6 +149,7 @@ impl Islands {
                 .map(|p| (p.body1, p.body2, p.point_count() as u32)),
         );
         if self.pair_keys == self.last_pair_keys
+            && self.joint_keys == self.last_joint_keys
             && self.kinds == bodies.kind
             && self.island_of_body.len() == n
         {
@@ -141,7 +159,8 @@ impl Islands {
         let keys = &self.pair_keys;
         self.parent.clear();
         self.parent.extend(0..n as u32);
-        for &(a, b, _) in keys.iter().filter(|k| k.2 > 0) {
+        let joined = self.joint_keys.iter().map(|&(a, b)| (a, b, 1));
+        for (a, b, _) in keys.iter().copied().filter(|k| k.2 > 0).chain(joined) {
             let (a, b) = (a as usize, b as usize);
             if bodies.is_dynamic(a) && bodies.is_dynamic(b) {
                 let (ra, rb) = (find(&mut self.parent, a), find(&mut self.parent, b));
@@ -200,7 +219,8 @@ impl Islands {
         }
         // Guests: the kinematic bodies of pairs with constraints, per island of their partner.
         self.guest_pairs.clear();
-        for &(a, b, _) in keys.iter().filter(|k| k.2 > 0) {
+        let joined = self.joint_keys.iter().map(|&(a, b)| (a, b, 1));
+        for (a, b, _) in keys.iter().copied().filter(|k| k.2 > 0).chain(joined) {
             let (a, b) = (a as usize, b as usize);
             let (kinematic, other) = match (self.kinds[a], self.kinds[b]) {
                 (BodyKind::Kinematic, _) => (a, b),

@@ -51,6 +51,7 @@ mod error;
 mod graph;
 mod integrate;
 mod island;
+mod joint;
 mod parallel;
 mod settings;
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
@@ -86,6 +87,10 @@ pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use diagnostics::contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
+pub use joint::{
+    AxisMode, JointAxis, JointBuilder, JointDof, JointEvent, JointHandle, JointKind, JointRef,
+    JointStiffness, Motor, MotorMode, Spring,
+};
 pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };
@@ -95,7 +100,8 @@ pub use solver::{EscalationLevel, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, Isl
 pub use world::LeftWorld;
 pub use world::{
     BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, BodyRef, ContactEvent, ContactPairView,
-    ContactPoint, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World, WorldSnapshot,
+    ContactPoint, OLDEST_SNAPSHOT_FORMAT_VERSION, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World,
+    WorldSnapshot,
 };
 
 /// The engine's stages for benchmarks that time them one by one (`impulse-bench`'s

@@ -219,6 +219,36 @@ fn lcp_dump_writes_a_step_problem_that_solve_reads() {
     );
 }
 
+/// A scene with joints and no contacts (chain20 swinging in the air): the dump has the
+/// joints' rows, free (bilateral) rows as a mixed LCP, and Lemke solves it.
+#[test]
+fn lcp_dump_of_a_chain_has_its_joint_rows_and_lemke_solves_it() {
+    let path = temp("chain-lcp.json");
+    let out = impulse()
+        .args(["lcp", "dump", "chain20", "--step", "5", "--out"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert_success(&out, "");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("0 contact points") && stdout.contains("joint rows of 20 joints"),
+        "{stdout}"
+    );
+    let solved = impulse()
+        .args(["lcp", "solve"])
+        .arg(&path)
+        .args(["--solver", "lemke"])
+        .output()
+        .unwrap();
+    assert!(
+        solved.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&solved.stdout),
+        String::from_utf8_lossy(&solved.stderr)
+    );
+}
+
 #[test]
 fn a_blow_up_stops_with_the_step_and_keeps_the_frames_written() {
     // A runaway body: a sideways "gravity" of 5970 m/s² adds 99.5 m/s per step, so its speed

@@ -18,6 +18,8 @@ errors.
 from ._impulse import (
     BodyBuilder,
     BodyHandle,
+    JointBuilder,
+    JointHandle,
     SceneError,
     Settings,
     Shape,
@@ -35,6 +37,8 @@ from .sweep import sweep
 __all__ = [
     "BodyBuilder",
     "BodyHandle",
+    "JointBuilder",
+    "JointHandle",
     "SceneError",
     "Settings",
     "Shape",

@@ -105,6 +105,22 @@ const NAMES: &[(&str, &str)] = &[
         "overlap_pyramid",
         "Solver2D: pyramid of base 10 (55 cubes) started 25% overlapping",
     ),
+    (
+        "chain20",
+        "joints: 20 links on ball joints swinging down from a horizontal start",
+    ),
+    (
+        "chain20heavy",
+        "joints: chain20 with a ball of 100 links' mass at its end",
+    ),
+    (
+        "ragdoll",
+        "joints: an 11-body ragdoll (hinges with limits, ball joints) dropped on stairs",
+    ),
+    (
+        "bridge",
+        "joints: 16 planks on hinges between two abutments, six cubes dropped on it",
+    ),
 ];
 
 /// The named standard scenes as (name, one-line description). [`builtin_scene`] also accepts
@@ -159,6 +175,10 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
         "card_house" => return Some(card_house()),
         "arch" => return Some(arch()),
         "overlap_pyramid" => return Some(overlap_pyramid(name, 10)),
+        "chain20" => return Some(super::builtin_joints::chain20()),
+        "chain20heavy" => return Some(super::builtin_joints::chain20heavy()),
+        "ragdoll" => return Some(super::builtin_joints::ragdoll()),
+        "bridge" => return Some(super::builtin_joints::bridge()),
         _ => {}
     }
     // Longest prefix first: "pyramid3d" before "pyramid".

@@ -471,6 +471,7 @@ pub fn to_json_string(scene: &Scene) -> String {
         solver,
         materials,
         bodies,
+        joints,
     } = scene;
     let mut out = String::from("{\n");
     let mut members = vec![
@@ -501,6 +502,10 @@ pub fn to_json_string(scene: &Scene) -> String {
         ']',
         bodies.iter().map(|b| one_line(&BodyOut::from(b))),
     );
+    if !joints.is_empty() {
+        out.push_str(",\n  \"joints\": ");
+        list(&mut out, '[', ']', joints.iter().map(one_line));
+    }
     out.push_str("\n}\n");
     out
 }

@@ -35,6 +35,9 @@ pub struct Scene {
     pub materials: BTreeMap<String, Material>,
     /// The bodies, in scene order (trajectory output uses this index).
     pub bodies: Vec<BodyDesc>,
+    /// The joints between bodies (docs/scene-format.md, "Joints").
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joints: Vec<JointDesc>,
 }
 
 /// Surface and bulk properties of a body.
@@ -397,6 +400,7 @@ impl Default for Scene {
             solver: SolverSettings::default(),
             materials: BTreeMap::new(),
             bodies: Vec::new(),
+            joints: Vec::new(),
         }
     }
 }
@@ -426,8 +430,10 @@ impl BodyDesc {
 }
 
 mod builtin;
+mod builtin_joints;
 mod degeneracy;
 mod error;
+pub(crate) mod joint_desc;
 pub(crate) mod json;
 mod json_shape;
 mod mesh_file;
@@ -440,6 +446,7 @@ pub use builtin::{
     builtin_scene,
 };
 pub use error::{BodyLocation, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
+pub use joint_desc::{BodyName, DofDesc, DofMode, JointDesc, MotorDesc, StiffnessDesc};
 pub use json::MAX_SCENE_FILE_BYTES;
 pub use json::{
     load_scene_file, locate, locate_closest, parse_scene_str, parse_scene_str_in, to_json_string,

@@ -93,6 +93,13 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
         });
         c.body(&FieldPath::body(index), body, &scene.materials);
     }
+    let kinds: Vec<BodyKind> = scene.bodies.iter().map(|b| b.kind).collect();
+    let names: Vec<Option<String>> = scene.bodies.iter().map(|b| b.name.clone()).collect();
+    c.errors.extend(super::joint_desc::joint_errors(
+        &scene.joints,
+        &kinds,
+        &names,
+    ));
     c.errors
 }
 

@@ -241,7 +241,7 @@ fn run(
 /// The LCP of the problem (A, b and bounds do not depend on the impulses) and the solution
 /// `constraints` hold, in its row order.
 fn lcp_and_solution(constraints: &[ContactConstraint]) -> (Lcp, Vec<f64>) {
-    let exported = assemble_lcp(constraints).unwrap();
+    let exported = assemble_lcp(constraints, &[]).unwrap();
     (exported.problem, exported.engine_solution)
 }
 

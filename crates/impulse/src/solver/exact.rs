@@ -25,6 +25,15 @@
 //! friction torques shift the load between a box's corners; with the sticking and sliding
 //! rows in the LCP, stacks pushed sideways or sliding finish in a round or a few.
 //!
+//! Joints (docs/method.md, "Joints"): an island's joint rows join the normal rows in step 1,
+//! as the exported LCP has them ([`crate::diagnostics::contact_lcp`]): locked rows and springs
+//! free, limits λ ≥ 0, motors boxed by ±max_force·h, soft rows with their diagonal term. Lemke
+//! then takes a box LCP ([`impulse_lcp::Bounds::Box`]) and eliminates the free rows itself by
+//! a Schur complement; the sticking tangents are eliminated before, as without joints. An
+//! island without joints takes exactly the arithmetic it took before joints existed. A
+//! breakable joint is refused ([`ExactFailure::BreakableJoint`]): its strength bounds a locked
+//! group's impulse by a ball, not a box.
+//!
 //! Everything happens on copies of the impulses and velocities, written back only when the
 //! solve succeeded, so a failure leaves the caller's (iterative) result untouched.
 
@@ -34,20 +43,27 @@ use impulse_lcp::{Bounds, DenseMatrix, Lcp, Matrix, SolverSettings, Status};
 
 use super::cholesky::{cholesky, cholesky_solve, cholesky_solve_columns};
 pub(crate) use super::exact_report::{ExactFailure, ExactReport};
+use super::exact_rows::{
+    ExactJointRow, Side, apply_joint, breakable_joint, collect_joint_rows, contact_is_finite,
+    contact_sides, coupling, joint_row_count, joint_row_is_finite, joint_sides, joint_velocity,
+    residual, velocity,
+};
 use super::interface::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, set_scalar_targets,
 };
 use super::rows::{Velocities, apply_impulses, project_to_friction_disc};
-use crate::contact::{ContactConstraint, JacobianRow, is_isotropic};
+use crate::contact::ContactConstraint;
+use crate::joint::JointConstraint;
 
 /// The exact path as a [`ContactSolver`]: [`solve_exact`] on islands of at most `max_contacts`
-/// points. A failed solve leaves the rows and velocities as they were and says so in
+/// rows (contact points plus joint rows). A failed solve leaves the rows and velocities as they were and says so in
 /// [`SolveOutcome::exact_failed`]; its iterations are zero and its change is the residual.
 #[derive(Default)]
 pub(crate) struct Exact {
     /// Work space, kept between solves.
     pub workspace: ExactWorkspace,
-    /// Largest island solved; larger ones fail with [`ExactFailure::TooManyRows`].
+    /// Largest island solved (contact points plus joint rows); larger ones fail with
+    /// [`ExactFailure::TooManyRows`].
     pub max_contacts: usize,
 }
 
@@ -56,11 +72,13 @@ impl ContactSolver for Exact {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
+        joints: &mut [JointConstraint],
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         let position_repair = set_scalar_targets(constraints, pass);
         let outcome = match solve_exact(
             constraints,
+            joints,
             velocities,
             self.max_contacts,
             &mut self.workspace,
@@ -118,8 +136,9 @@ const STICKING_FRACTION: f32 = 0.999;
 /// Lemke must reach a normalised natural-map residual ‖min(γ, w)‖₂ / ‖b‖₂ of this (f64).
 const LEMKE_TOLERANCE: f64 = 1e-9;
 
-/// Lemke's pivot limit is this many pivots per normal row, and at least [`MIN_PIVOTS`]: a
-/// complementary path on a positive definite matrix takes about one pivot per active row.
+/// Lemke's pivot limit is this many pivots per normal row (twice that per joint row, which
+/// may be a two-sided box: two unknowns), and at least [`MIN_PIVOTS`]: a complementary path
+/// on a positive definite matrix takes about one pivot per active row.
 const PIVOTS_PER_ROW: usize = 4;
 /// See [`PIVOTS_PER_ROW`].
 const MIN_PIVOTS: usize = 16;
@@ -127,15 +146,24 @@ const MIN_PIVOTS: usize = 16;
 /// Buffers reused between calls: the dense blocks and the trial impulses and velocities.
 #[derive(Default)]
 pub(crate) struct ExactWorkspace {
-    /// A = J M⁻¹ Jᵀ over the island's rows (normals, then tangent pairs), row-major (1/kg).
+    /// A = J M⁻¹ Jᵀ over the island's rows (normals, joint rows, then tangent pairs),
+    /// row-major (1/kg).
     full: Vec<f64>,
-    /// Per row of `full`: (point, 0 for the normal or 1, 2 for a tangent).
+    /// Per row of `full`: (point, 0 for the normal or 1, 2 for a tangent), or (joint row,
+    /// [`JOINT`]).
     rows: Vec<(usize, usize)>,
+    /// The island's joint rows in this solve ([`collect_joint_rows`]).
+    joint_rows: Vec<ExactJointRow>,
+    /// Trial impulses of the joint rows (N·s or N·m·s).
+    joint_impulse: Vec<f32>,
+    /// See `best_normal`.
+    best_joint: Vec<f32>,
     /// Per row of `full`: its movable sides.
     sides: Vec<[Option<Side>; 2]>,
     /// Per point: index in `full` of its first tangent row, if it has friction.
     tangent_row: Vec<Option<usize>>,
     /// Per row of `full`: the diagonal added for the solve (soft-row term + ε·A_ii) (1/kg).
+    /// Lemke's rows are the first n + p: the normals, then the joint rows.
     extra: Vec<f64>,
     /// Rows of `full` of this round's sticking tangents.
     free: Vec<usize>,
@@ -174,8 +202,11 @@ pub(crate) struct ExactWorkspace {
     best_angular: Vec<Vec3>,
 }
 
-/// Solves an island's contact rows exactly (normal rows by Lemke, friction by staggered
-/// projections, see the module documentation).
+/// The `rows` tag of a joint row in [`ExactWorkspace`].
+const JOINT: usize = 3;
+
+/// Solves an island's contact and joint rows exactly (normal and joint rows by Lemke, friction
+/// by staggered projections, see the module documentation).
 ///
 /// On entry `velocities` are the island-local velocities v = v* + M⁻¹Jᵀγ for the impulses γ
 /// stored in `constraints` (any γ, e.g. an iterative solver's result), indexed by `local_a`
@@ -183,33 +214,44 @@ pub(crate) struct ExactWorkspace {
 /// γ_n ≥ 0, w_n = J_n·v − `target_normal_velocity` ≥ 0 and γ_n·w_n = 0 (a soft row adds
 /// (impulse_scale / mass_scale)·k·γ_n to w_n, as [`crate::diagnostics::contact_lcp`] derives), and with
 /// friction the pair (γ_t1, γ_t2) lies in the disc |γ_t| ≤ μ·γ_n. Sign convention: positive
-/// w_n separates; the normal points from B towards A.
+/// w_n separates; the normal points from B towards A. Per active row of an unbroken joint of
+/// `joints` (targets already set, velocities including its impulses), lo ≤ λ ≤ hi with
+/// w = s·J·v + bias + k_soft·λ ≥ 0 at lo, ≤ 0 at hi and = 0 inside ([`super::exact_rows`]).
 ///
-/// On success the constraints hold the new impulses (N·s), `max_normal_impulse` is raised to
-/// the new γ_n where larger, and the velocities were changed by M⁻¹Jᵀ(γ_new − γ_old), so the
+/// On success the constraints and joints hold the new impulses (N·s; N·m·s on a joint's
+/// rotation rows), `max_normal_impulse` is raised to the new γ_n where larger, and the velocities were changed by M⁻¹Jᵀ(γ_new − γ_old), so the
 /// entry invariant holds again. Cost, for n points and s sticking ones: O(n²) to assemble
 /// the dense blocks, O(s³ + s²n + sn²) per round for the Schur complement, and O(n²) per
 /// Lemke pivot.
 ///
-/// Errors (constraints and velocities then bitwise unchanged): [`ExactFailure::TooManyRows`]
-/// when n > `max_rows`, checked before any work; [`ExactFailure::NonFinite`] for NaN or
-/// infinite input; [`ExactFailure::Factorisation`], [`ExactFailure::Lemke`] or
+/// Errors (constraints, joints and velocities then bitwise unchanged):
+/// [`ExactFailure::TooManyRows`] when n + p > `max_rows` (p joint rows), and
+/// [`ExactFailure::BreakableJoint`] for an unbroken breakable joint, both checked before any
+/// work; [`ExactFailure::NonFinite`] for NaN or infinite input; [`ExactFailure::Factorisation`], [`ExactFailure::Lemke`] or
 /// [`ExactFailure::Refused`] when the linear algebra or pivoting does not give a solution;
-/// [`ExactFailure::NotImproved`] when the normal residual at exit is above both the entry
+/// [`ExactFailure::NotImproved`] when the residual (normal and joint rows) at exit is above both the entry
 /// residual and 1e-6 m/s (friction rounds that did not settle).
 ///
 /// Panics if a local index is outside `velocities`, as the iterative solvers do.
 pub(crate) fn solve_exact(
     constraints: &mut [ContactConstraint],
+    joints: &mut [JointConstraint],
     velocities: &mut Velocities<'_>,
     max_rows: usize,
     workspace: &mut ExactWorkspace,
 ) -> Result<ExactReport, ExactFailure> {
     let n = constraints.len();
-    if n > max_rows {
-        return Err(ExactFailure::TooManyRows { rows: n, max_rows });
+    let p = joint_row_count(joints);
+    if n + p > max_rows {
+        return Err(ExactFailure::TooManyRows {
+            rows: n + p,
+            max_rows,
+        });
     }
-    if let Some(index) = constraints.iter().position(|c| !is_finite(c)) {
+    if let Some(joint) = breakable_joint(joints) {
+        return Err(ExactFailure::BreakableJoint { joint });
+    }
+    if let Some(index) = constraints.iter().position(|c| !contact_is_finite(c)) {
         return Err(ExactFailure::NonFinite {
             what: "contact",
             index,
@@ -224,13 +266,39 @@ pub(crate) fn solve_exact(
             index,
         });
     }
-    let entry = normal_residual(constraints, velocities.linear, velocities.angular, |k| {
-        (
-            constraints[k].normal_impulse,
-            constraints[k].soft_diagonal(),
-        )
-    });
-    if n == 0 {
+    let w = workspace;
+    collect_joint_rows(joints, &mut w.joint_rows);
+    if let Some(r) = w
+        .joint_rows
+        .iter()
+        .find(|r| !joint_row_is_finite(joints, r))
+    {
+        return Err(ExactFailure::NonFinite {
+            what: "joint",
+            index: r.joint,
+        });
+    }
+    w.joint_impulse.clear();
+    w.joint_impulse.extend(
+        w.joint_rows
+            .iter()
+            .map(|r| joints[r.joint].impulses[r.dof][r.kind]),
+    );
+    let entry = residual(
+        constraints,
+        joints,
+        &w.joint_rows,
+        velocities.linear,
+        velocities.angular,
+        |k| {
+            (
+                constraints[k].normal_impulse,
+                constraints[k].soft_diagonal(),
+            )
+        },
+        &w.joint_impulse,
+    );
+    if n + p == 0 {
         return Ok(ExactReport {
             pivots: 0,
             rounds: 0,
@@ -239,7 +307,6 @@ pub(crate) fn solve_exact(
     }
 
     // Trial state: copies, written back only on success.
-    let w = workspace;
     w.normal.clear();
     w.normal
         .extend(constraints.iter().map(|c| c.normal_impulse));
@@ -253,24 +320,38 @@ pub(crate) fn solve_exact(
     w.softness.clear();
     w.softness
         .extend(constraints.iter().map(ContactConstraint::soft_diagonal));
-    assemble(constraints, w);
+    assemble(constraints, joints, w);
 
     // Lemke takes the problem by value; the buffers go back into the workspace afterwards.
+    // With joints it is a box LCP: the normal rows [0, ∞), then the joint rows' bounds.
+    let bounds = if p == 0 {
+        Bounds::NonNegative
+    } else {
+        let rows = &w.joint_rows;
+        Bounds::Box {
+            lo: (std::iter::repeat_n(0.0, n))
+                .chain(rows.iter().map(|r| r.lower as f64))
+                .collect(),
+            hi: (std::iter::repeat_n(f64::INFINITY, n))
+                .chain(rows.iter().map(|r| r.upper as f64))
+                .collect(),
+        }
+    };
     let mut lcp = Lcp {
         a: Matrix::Dense(DenseMatrix {
-            rows: n,
-            cols: n,
+            rows: n + p,
+            cols: n + p,
             data: std::mem::take(&mut w.matrix),
         }),
         b: std::mem::take(&mut w.rhs),
-        bounds: Bounds::NonNegative,
+        bounds,
     };
     let settings = SolverSettings {
-        max_iterations: (PIVOTS_PER_ROW * n).max(MIN_PIVOTS),
+        max_iterations: (PIVOTS_PER_ROW * (n + 2 * p)).max(MIN_PIVOTS),
         tolerance: LEMKE_TOLERANCE,
         relaxation: 1.0,
     };
-    let result = rounds(constraints, &mut lcp, &settings, w);
+    let result = rounds(constraints, joints, &mut lcp, &settings, w);
     if let Matrix::Dense(dense) = lcp.a {
         w.matrix = dense.data;
     }
@@ -285,6 +366,9 @@ pub(crate) fn solve_exact(
         c.tangent_impulses = w.tangent[k];
         c.max_normal_impulse = c.max_normal_impulse.max(w.normal[k]);
     }
+    for (r, &lambda) in w.joint_rows.iter().zip(&w.joint_impulse) {
+        joints[r.joint].impulses[r.dof][r.kind] = lambda;
+    }
     velocities.linear.copy_from_slice(&w.linear);
     velocities.angular.copy_from_slice(&w.angular);
     Ok(ExactReport {
@@ -297,6 +381,7 @@ pub(crate) fn solve_exact(
 /// The rounds on the trial state in `w`; returns (pivots, rounds, residual at exit).
 fn rounds(
     constraints: &[ContactConstraint],
+    joints: &[JointConstraint],
     lcp: &mut Lcp,
     settings: &SolverSettings,
     w: &mut ExactWorkspace,
@@ -308,13 +393,19 @@ fn rounds(
     let mut round = 0;
     while round < MAX_ROUNDS {
         round += 1;
-        pivots += normal_solve(constraints, lcp, settings, w, round)?;
+        pivots += normal_solve(constraints, joints, lcp, settings, w, round)?;
         if with_friction {
             friction_passes(constraints, w);
         }
-        let residual = normal_residual(constraints, &w.linear, &w.angular, |k| {
-            (w.normal[k], w.softness[k])
-        });
+        let residual = residual(
+            constraints,
+            joints,
+            &w.joint_rows,
+            &w.linear,
+            &w.angular,
+            |k| (w.normal[k], w.softness[k]),
+            &w.joint_impulse,
+        );
         // Without friction a round is exact up to the proximal term, ε times the velocity
         // change it made, so a second round is needed only after changes above 1 m/s.
         if residual <= ROUND_TOLERANCE {
@@ -327,6 +418,7 @@ fn rounds(
             best_round = round;
             w.best_normal.clone_from(&w.normal);
             w.best_tangent.clone_from(&w.tangent);
+            w.best_joint.clone_from(&w.joint_impulse);
             w.best_linear.clone_from(&w.linear);
             w.best_angular.clone_from(&w.angular);
         }
@@ -334,6 +426,7 @@ fn rounds(
     if best_round != round {
         w.normal.clone_from(&w.best_normal);
         w.tangent.clone_from(&w.best_tangent);
+        w.joint_impulse.clone_from(&w.best_joint);
         w.linear.clone_from(&w.best_linear);
         w.angular.clone_from(&w.best_angular);
     }
@@ -355,14 +448,20 @@ fn rounds(
 /// standard LCP in γ'_N with matrix C_NN + E_N − A_NF (A_FF + E_F)⁻¹ C_FN: without sliding
 /// points a Schur complement of a positive definite matrix, which Lemke always solves; the
 /// sliding terms make it non-symmetric, and Lemke may then end on a ray (a failure).
+///
+/// Joint rows join N (Lemke's rows are the normals, then the joint rows, and their columns of
+/// C are A's): the LCP in γ'_N is then a box LCP, whose free rows Lemke eliminates in turn.
 fn normal_solve(
     constraints: &[ContactConstraint],
+    joints: &[JointConstraint],
     lcp: &mut Lcp,
     settings: &SolverSettings,
     w: &mut ExactWorkspace,
     round: u32,
 ) -> Result<u32, ExactFailure> {
     let n = constraints.len();
+    // Lemke's rows: the normals, then the joint rows.
+    let nk = n + w.joint_rows.len();
     let m = w.rows.len();
     // This round's sticking tangent rows and sliding directions.
     w.free.clear();
@@ -394,10 +493,14 @@ fn normal_solve(
     let full = &w.full;
     let tangent_row = &w.tangent_row;
     let sliding = &w.sliding;
-    // Column j of C at row r: A_rj plus, for a sliding point j, μ_j·u_j along its tangents.
+    // Column j of C at row r: A_rj plus, for a sliding point j, μ_j·u_j along its tangents
+    // (a joint row, j ≥ n, is never sliding).
     let c_entry = |r: usize, j: usize| -> f64 {
         let direct = full[r * m + j];
-        match (sliding[j], tangent_row[j]) {
+        match (
+            sliding.get(j).copied().flatten(),
+            tangent_row.get(j).copied().flatten(),
+        ) {
             (Some(u), Some(t)) => direct + full[r * m + t] * u[0] + full[r * m + t + 1] * u[1],
             _ => direct,
         }
@@ -407,11 +510,11 @@ fn normal_solve(
     let b_free = &mut w.free_rhs;
     b_free.clear();
     lcp.b.clear();
-    for target in 0..n + s {
-        let r = if target < n {
+    for target in 0..nk + s {
+        let r = if target < nk {
             target
         } else {
-            w.free[target - n]
+            w.free[target - nk]
         };
         let mut a_gamma = 0.0f64;
         for k in 0..n {
@@ -421,26 +524,41 @@ fn normal_solve(
                 a_gamma += full[r * m + t] * t1 as f64 + full[r * m + t + 1] * t2 as f64;
             }
         }
+        for (q, &lambda) in w.joint_impulse.iter().enumerate() {
+            a_gamma += full[r * m + n + q] * lambda as f64;
+        }
         for &q in &w.free {
             let (k, t) = w.rows[q];
             a_gamma += full[r * m + q] * w.tangent[k][t - 1] as f64;
         }
         let (k, t) = w.rows[r];
-        let c = &constraints[k];
         let (error, current) = match t {
-            0 => (
-                velocity(&c.normal, c, &w.linear, &w.angular) - c.target_normal_velocity,
-                w.normal[k],
-            ),
-            t => (
-                velocity(&c.tangents[t - 1], c, &w.linear, &w.angular),
-                w.tangent[k][t - 1],
-            ),
+            JOINT => {
+                let row = &w.joint_rows[k];
+                (
+                    joint_velocity(joints, row, &w.linear, &w.angular) + row.bias,
+                    w.joint_impulse[k],
+                )
+            }
+            0 => {
+                let c = &constraints[k];
+                (
+                    velocity(&c.normal, c, &w.linear, &w.angular) - c.target_normal_velocity,
+                    w.normal[k],
+                )
+            }
+            t => {
+                let c = &constraints[k];
+                (
+                    velocity(&c.tangents[t - 1], c, &w.linear, &w.angular),
+                    w.tangent[k][t - 1],
+                )
+            }
         };
         // The regularisation is proximal: it acts on γ' − γ, so its share of E moves to b.
         let proximal = REGULARISATION * full[r * m + r] * current as f64;
         let b = a_gamma + proximal - error as f64;
-        if target < n {
+        if target < nk {
             lcp.b.push(b);
         } else {
             b_free.push(b);
@@ -462,8 +580,8 @@ fn normal_solve(
     // Column-major (column j at j·s..(j+1)·s), so that each solve and each dot product below
     // runs over contiguous memory.
     w.coupling.clear();
-    w.coupling.resize(s * n, 0.0);
-    for (j, column) in w.coupling.chunks_exact_mut(s.max(1)).enumerate().take(n) {
+    w.coupling.resize(s * nk, 0.0);
+    for (j, column) in w.coupling.chunks_exact_mut(s.max(1)).enumerate().take(nk) {
         for (value, &ri) in column.iter_mut().zip(&w.free) {
             *value = c_entry(ri, j);
         }
@@ -476,21 +594,21 @@ fn normal_solve(
         unreachable!("the exact path hands Lemke a dense matrix")
     };
     dense.data.clear();
-    dense.data.resize(n * n, 0.0);
+    dense.data.resize(nk * nk, 0.0);
     let row = &mut w.column;
-    for i in 0..n {
+    for i in 0..nk {
         // A_iF, gathered once per row.
         row.clear();
         row.extend(w.free.iter().map(|&f| full[i * m + f]));
-        for j in 0..n {
+        for j in 0..nk {
             let reduction: f64 = row
                 .iter()
                 .zip(&w.coupling[j * s..(j + 1) * s])
                 .map(|(a, c)| a * c)
                 .sum();
-            dense.data[i * n + j] = c_entry(i, j) - reduction;
+            dense.data[i * nk + j] = c_entry(i, j) - reduction;
         }
-        dense.data[i * n + i] += w.extra[i];
+        dense.data[i * nk + i] += w.extra[i];
         lcp.b[i] -= row
             .iter()
             .zip(b_free.iter())
@@ -509,9 +627,13 @@ fn normal_solve(
     }
 
     // γ'_F = (A_FF + E_F)⁻¹ b_F − coupling·γ'_N and γ'_S = D γ'_N; apply every change.
-    let gamma = |j: usize| solution.z[j].max(0.0);
+    let joint_rows = &w.joint_rows;
+    let gamma = |j: usize| match j.checked_sub(n) {
+        None => solution.z[j].max(0.0),
+        Some(q) => solution.z[j].clamp(joint_rows[q].lower as f64, joint_rows[q].upper as f64),
+    };
     for (f, value) in b_free.iter_mut().enumerate() {
-        *value -= (0..n)
+        *value -= (0..nk)
             .map(|j| w.coupling[j * s + f] * gamma(j))
             .sum::<f64>();
     }
@@ -526,6 +648,12 @@ fn normal_solve(
             w.tangent[k] = friction;
         }
         apply(c, delta, &mut w.linear, &mut w.angular);
+    }
+    for (q, r) in joint_rows.iter().enumerate() {
+        let new = gamma(n + q) as f32;
+        let delta = new - w.joint_impulse[q];
+        w.joint_impulse[q] = new;
+        apply_joint(joints, r, delta, &mut w.linear, &mut w.angular);
     }
     for (f, &value) in b_free.iter().enumerate() {
         let (k, t) = w.rows[w.free[f]];
@@ -546,17 +674,19 @@ fn apply(c: &ContactConstraint, delta: [f32; 3], linear: &mut [Vec3], angular: &
     }
 }
 
-/// Fills the row layout and the dense A = J M⁻¹ Jᵀ over all rows (each point's normal, then
-/// the tangent pairs of points with friction), and the diagonal `extra` a solve adds: the
-/// soft-row term on normal rows plus ε·A_ii ([`REGULARISATION`]) on every row.
+/// Fills the row layout and the dense A = J M⁻¹ Jᵀ over all rows (each point's normal, the
+/// joint rows, then the tangent pairs of points with friction), and the diagonal `extra` a
+/// solve adds: the soft-row term on normal and joint rows plus ε·A_ii ([`REGULARISATION`]) on
+/// every row.
 ///
 /// A_ij = Σ over bodies shared by rows i and j of s_i·s_j·(m⁻¹·d_i·d_j + (r×d)_i·I⁻¹(r×d)_j),
 /// with s = +1 on side A and −1 on side B. The immovable slot (zero inverse mass and inertia)
 /// couples nothing. Only the upper triangle is computed and mirrored, so A is exactly
 /// symmetric in spite of the f32 rounding of the stored I⁻¹(r×d).
-fn assemble(constraints: &[ContactConstraint], w: &mut ExactWorkspace) {
+fn assemble(constraints: &[ContactConstraint], joints: &[JointConstraint], w: &mut ExactWorkspace) {
     w.rows.clear();
     w.rows.extend((0..constraints.len()).map(|k| (k, 0)));
+    w.rows.extend((0..w.joint_rows.len()).map(|q| (q, JOINT)));
     w.tangent_row.clear();
     for (k, c) in constraints.iter().enumerate() {
         if c.friction > 0.0 {
@@ -569,16 +699,11 @@ fn assemble(constraints: &[ContactConstraint], w: &mut ExactWorkspace) {
     let m = w.rows.len();
     // Each row's sides once, not once per entry of A.
     w.sides.clear();
-    w.sides.extend(w.rows.iter().map(|&(k, t)| {
-        let c = &constraints[k];
-        sides(
-            c,
-            if t == 0 {
-                &c.normal
-            } else {
-                &c.tangents[t - 1]
-            },
-        )
+    let joint_rows = &w.joint_rows;
+    w.sides.extend(w.rows.iter().map(|&(k, t)| match t {
+        JOINT => joint_sides(joints, &joint_rows[k]),
+        0 => contact_sides(&constraints[k], &constraints[k].normal),
+        t => contact_sides(&constraints[k], &constraints[k].tangents[t - 1]),
     }));
     w.full.clear();
     w.full.resize(m * m, 0.0);
@@ -586,82 +711,20 @@ fn assemble(constraints: &[ContactConstraint], w: &mut ExactWorkspace) {
         let p = &w.sides[i];
         for j in i..m {
             let q = &w.sides[j];
-            let mut value = 0.0f64;
-            for side_p in p.iter().flatten() {
-                for side_q in q.iter().flatten() {
-                    if side_p.slot == side_q.slot {
-                        let angular = side_p
-                            .angular
-                            .as_dvec3()
-                            .dot(side_q.inverse_inertia_angular.as_dvec3());
-                        // d_pᵀ M⁻¹ d_q with the per-axis inverse mass (zero on locked axes).
-                        let linear = if is_isotropic(side_p.inverse_mass) {
-                            side_p.inverse_mass.x as f64
-                                * side_p.direction.as_dvec3().dot(side_q.direction.as_dvec3())
-                        } else {
-                            side_p
-                                .direction
-                                .as_dvec3()
-                                .dot(side_p.inverse_mass.as_dvec3() * side_q.direction.as_dvec3())
-                        };
-                        value += side_p.sign * side_q.sign * (linear + angular);
-                    }
-                }
-            }
+            let value = coupling(p, q);
             w.full[i * m + j] = value;
             w.full[j * m + i] = value;
         }
     }
     w.extra.clear();
     for (i, &(k, t)) in w.rows.iter().enumerate() {
-        let soft = if t == 0 { w.softness[k] as f64 } else { 0.0 };
+        let soft = match t {
+            0 => w.softness[k] as f64,
+            JOINT => w.joint_rows[k].softness as f64,
+            _ => 0.0,
+        };
         w.extra.push(soft + REGULARISATION * w.full[i * m + i]);
     }
-}
-
-/// One side of a row on a body that can move.
-#[derive(Clone, Copy, Debug)]
-struct Side {
-    slot: u32,
-    /// +1 for body A, −1 for body B.
-    sign: f64,
-    /// Per-axis inverse mass (1/kg; zero on locked translation axes).
-    inverse_mass: Vec3,
-    direction: Vec3,
-    /// r × d.
-    angular: Vec3,
-    /// I⁻¹ (r × d).
-    inverse_inertia_angular: Vec3,
-}
-
-/// The movable sides of `row` of contact `c`; `None` for an immovable side.
-fn sides(c: &ContactConstraint, row: &JacobianRow) -> [Option<Side>; 2] {
-    let side = |slot, sign, inverse_mass: Vec3, angular, inverse_inertia_angular: Vec3| {
-        (inverse_mass != Vec3::ZERO || inverse_inertia_angular != Vec3::ZERO).then_some(Side {
-            slot,
-            sign,
-            inverse_mass,
-            direction: row.direction,
-            angular,
-            inverse_inertia_angular,
-        })
-    };
-    [
-        side(
-            c.local_a,
-            1.0,
-            c.inverse_mass_a,
-            row.angular_a,
-            row.inverse_inertia_angular_a,
-        ),
-        side(
-            c.local_b,
-            -1.0,
-            c.inverse_mass_b,
-            row.angular_b,
-            row.inverse_inertia_angular_b,
-        ),
-    ]
 }
 
 /// Step 2 of a round: symmetric Gauss-Seidel passes over the friction pairs with the normal
@@ -691,62 +754,6 @@ fn friction_passes(constraints: &[ContactConstraint], w: &mut ExactWorkspace) {
             apply(c, delta, &mut w.linear, &mut w.angular);
         }
     }
-}
-
-/// J·v of `row` of contact `c` (m/s).
-#[inline]
-fn velocity(row: &JacobianRow, c: &ContactConstraint, linear: &[Vec3], angular: &[Vec3]) -> f32 {
-    let (a, b) = (c.local_a as usize, c.local_b as usize);
-    row.velocity(linear[a], angular[a], linear[b], angular[b])
-}
-
-/// max_i |min(w_i, γ_i·k_i)| (m/s) for (normal impulse, soft term) = `state(i)`; see
-/// [`ExactReport::residual`].
-fn normal_residual(
-    constraints: &[ContactConstraint],
-    linear: &[Vec3],
-    angular: &[Vec3],
-    state: impl Fn(usize) -> (f32, f32),
-) -> f32 {
-    let mut largest = 0.0f32;
-    for (k, c) in constraints.iter().enumerate() {
-        let (gamma, softness) = state(k);
-        let w =
-            velocity(&c.normal, c, linear, angular) - c.target_normal_velocity + softness * gamma;
-        largest = largest.max(w.min(gamma * c.normal.inverse_effective_mass).abs());
-    }
-    largest
-}
-
-/// Whether every number of `c` the exact path reads is finite.
-fn is_finite(c: &ContactConstraint) -> bool {
-    let row_is_finite = |r: &JacobianRow| {
-        r.direction.is_finite()
-            && r.angular_a.is_finite()
-            && r.angular_b.is_finite()
-            && r.inverse_inertia_angular_a.is_finite()
-            && r.inverse_inertia_angular_b.is_finite()
-            && r.inverse_effective_mass.is_finite()
-    };
-    let scalars = [
-        c.target_normal_velocity,
-        c.softness.0,
-        c.softness.1,
-        c.friction,
-        c.normal_impulse,
-        c.tangent_impulses[0],
-        c.tangent_impulses[1],
-    ];
-    scalars.iter().all(|v| v.is_finite())
-        && c.inverse_mass_a.is_finite()
-        && c.inverse_mass_b.is_finite()
-        && row_is_finite(&c.normal)
-        // A frictionless point's tangent rows are read too: its (zero) friction impulses are
-        // taken out of the velocities with them.
-        && row_is_finite(&c.tangents[0])
-        && row_is_finite(&c.tangents[1])
-        && c.tangent_block.iter().all(|v| v.is_finite())
-        && c.tangent_inverse_block.iter().all(|v| v.is_finite())
 }
 
 #[cfg(test)]

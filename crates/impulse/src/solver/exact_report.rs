@@ -10,32 +10,44 @@ pub(crate) struct ExactReport {
     pub pivots: u32,
     /// Rounds run (normal LCP solves), 1 ..= [`MAX_ROUNDS`](super::exact::MAX_ROUNDS); 0 for an island without contacts.
     pub rounds: u32,
-    /// Largest natural-map residual of the normal rows at exit, in m/s:
-    /// max_i |min(w_i, γ_i·k_i)|, where w_i = J_i·v − target_i (+ the soft term of a soft row)
-    /// is the row's velocity error after the impulses and k_i = `inverse_effective_mass` turns
-    /// the impulse into the velocity change it causes on its own row. Zero exactly when
-    /// γ ≥ 0, w ≥ 0 and γ_i·w_i = 0 for every row. The regularisation is not part of w.
+    /// Largest natural-map residual of the normal rows and joint rows at exit, in m/s (rad/s
+    /// on a joint's rotation rows): max_i |min(w_i, γ_i·k_i)| over the normal rows, where
+    /// w_i = J_i·v − target_i (+ the soft term of a soft row) is the row's velocity error
+    /// after the impulses and k_i = `inverse_effective_mass` turns the impulse into the
+    /// velocity change it causes on its own row; on a joint row with bounds [lo, hi],
+    /// |mid(k_i·(λ_i − hi), w_i, k_i·(λ_i − lo))| (the same natural map, k_i = J M⁻¹ Jᵀ of
+    /// the row). Zero exactly when every row meets its conditions (γ ≥ 0, w ≥ 0, γ_i·w_i = 0 on
+    /// a normal row). The regularisation is not part of w.
     pub residual: f32,
 }
 
 /// Why the exact path gave up; the constraints and velocities are then as they were on entry.
 #[derive(Clone, Debug, thiserror::Error)]
 pub(crate) enum ExactFailure {
-    /// The island has more normal rows (contact points) than the caller allows.
-    #[error("{rows} contact rows exceed the exact path's limit of {max_rows}")]
+    /// The island has more Lemke rows (contact points plus joint rows) than the caller allows.
+    #[error("{rows} contact and joint rows exceed the exact path's limit of {max_rows}")]
     TooManyRows {
-        /// Normal rows of the island.
+        /// Normal rows (contact points) plus joint rows of the island.
         rows: usize,
         /// The caller's limit.
         max_rows: usize,
     },
-    /// A contact point's data or a velocity is NaN or infinite (a blown-up step).
+    /// A contact point's data, a joint row's or a velocity is NaN or infinite (a blown-up
+    /// step), or a joint row's bounds are out of order.
     #[error("non-finite {what} at index {index}")]
     NonFinite {
-        /// Which data: "contact" (row data, impulses or target) or "velocity".
+        /// Which data: "contact" (row data, impulses or target), "joint" (row data, impulse,
+        /// target or bounds) or "velocity".
         what: &'static str,
-        /// Contact point or velocity slot.
+        /// Contact point, joint (in the island's joint order) or velocity slot.
         index: usize,
+    },
+    /// A joint of the island is breakable and unbroken: its strength bounds a locked group's
+    /// impulse by a ball (|λ_group| ≤ threshold·h), which is not a box the LCP can take.
+    #[error("joint {joint} of the island is breakable (its strength is not a box bound)")]
+    BreakableJoint {
+        /// The joint, in the island's joint order.
+        joint: usize,
     },
     /// The regularised tangent block of the sticking points was not numerically positive
     /// definite (Cholesky met a non-positive pivot).

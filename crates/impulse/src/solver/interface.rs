@@ -7,6 +7,7 @@ use glam::{Mat3, Vec3};
 
 use super::rows::{Velocities, add_step_impulses, warm_start_substep};
 use crate::contact::{self, ContactConstraint};
+use crate::joint::JointConstraint;
 use crate::parallel::{RESIDUAL_ROWS_PER_TASK, SharedItems, parts_in_order};
 use crate::settings::SolverSettings;
 
@@ -52,11 +53,14 @@ pub(crate) trait ContactSolver {
     /// One solve: with `pass.targets`, first sets every row's target velocity and softness from
     /// the separation its point has reached (scalar rows: [`contact::update_targets`]);
     /// then at most `pass.iterations` iterations, until no row's velocity changes by more than
-    /// `pass.tolerance` (m/s).
+    /// `pass.tolerance` (m/s). The island's `joints` (their targets already set) are swept in
+    /// the same iterations, before the contacts in a forward sweep and after them in a
+    /// backward one; a method that cannot take them (the SIMD lanes) is given none.
     fn solve(
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
+        joints: &mut [JointConstraint],
         pass: &SolvePass<'_>,
     ) -> SolveOutcome;
 

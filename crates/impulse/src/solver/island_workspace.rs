@@ -12,7 +12,9 @@ use super::lanes::Bundles;
 use super::nncg::Nncg;
 use super::pgs::Pgs;
 use super::policy::Auto;
+use super::rows::Velocities;
 use crate::contact::ContactConstraint;
+use crate::joint::JointConstraint;
 use crate::settings::SolverMethod;
 #[cfg(doc)]
 use crate::{contact, integrate, solver::Sweep};
@@ -84,6 +86,31 @@ pub(crate) struct IslandWorkspace {
     pub(super) impact_met: bool,
     /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]).
     pub(super) impact_speed: f32,
+    /// The rows of the island's joints, written by the assembly stage.
+    pub(crate) joints: Vec<JointConstraint>,
+}
+
+impl IslandWorkspace {
+    /// The joints' rows' J·v* for the exported LCP, as the island's step ends: the velocities
+    /// with every joint's M⁻¹Jᵀλ taken out (the contacts' record takes the contacts' out, so
+    /// the export adds the coupling back: `diagnostics::contact_lcp`).
+    pub(crate) fn record_joints(&mut self) {
+        if self.joints.is_empty() {
+            return;
+        }
+        self.pseudo_linear.clone_from(&self.linear);
+        self.pseudo_angular.clone_from(&self.angular);
+        let mut unjoined = Velocities {
+            linear: &mut self.pseudo_linear,
+            angular: &mut self.pseudo_angular,
+        };
+        for joint in &self.joints {
+            joint.remove_impulses(&mut unjoined);
+        }
+        for joint in &mut self.joints {
+            joint.record(&unjoined);
+        }
+    }
 }
 
 /// Every method's solver, so that an island keeps its work spaces from step to step.

@@ -12,7 +12,8 @@
 //! - [`nncg`]: nonsmooth nonlinear conjugate gradient (PGS sweeps with momentum);
 //! - [`apgd`]: accelerated projected gradient descent;
 //! - [`exact`]: Lemke's pivoting on an island's assembled LCP (its dense factorisation in
-//!   [`cholesky`], its report in [`exact_report`]);
+//!   [`cholesky`], its rows (contact and joint) in [`exact_rows`], its report in
+//!   [`exact_report`]);
 //! - [`lanes`]: PGS in SIMD lanes on packed manifold groups;
 //! - [`policy`]: `method: auto`, the escalation from NNCG to more iterations or the exact path;
 //! - [`position`]: split impulse's position solve;
@@ -29,6 +30,7 @@ pub(crate) mod apgd;
 pub(crate) mod cholesky;
 pub(crate) mod exact;
 pub(crate) mod exact_report;
+pub(crate) mod exact_rows;
 pub(crate) mod heavy_on_light;
 pub(crate) mod impact;
 pub(crate) mod interface;
@@ -39,6 +41,7 @@ pub(crate) mod nncg;
 pub(crate) mod pgs;
 pub(crate) mod policy;
 pub(crate) mod position;
+pub(crate) mod restitution_solve;
 pub(crate) mod rows;
 pub(crate) mod substep;
 

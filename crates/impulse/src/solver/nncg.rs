@@ -8,6 +8,7 @@ use super::pgs::{BACKWARD, FORWARD, FrictionFirstRows, sweep_points};
 use super::rows::{Velocities, apply_impulses, impulses};
 use crate::contact::ContactConstraint;
 use crate::graph::COLOURS;
+use crate::joint::{JointConstraint, sweep_joints};
 use crate::parallel::{
     NORM_POINTS_PER_TASK, SWEEP_POINTS_PER_TASK, SharedVelocities, parts_in_order, spread,
 };
@@ -24,16 +25,18 @@ impl ContactSolver for Nncg {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
+        joints: &mut [JointConstraint],
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         solve_scalar(constraints, pass, EscalationLevel::Nncg, |rows| {
-            solve_nncg(
+            solve_nncg_with_joints(
                 rows,
                 pass.sweep,
                 pass.iterations,
                 pass.tolerance,
                 velocities,
                 &mut self.workspace,
+                joints,
             )
         })
     }
@@ -54,6 +57,7 @@ pub struct NncgWorkspace {
 /// stack, PGS needs O(L²) sweeps to carry the load down; the conjugate directions cut that to
 /// about O(L). The last iteration is a plain sweep, so the result satisfies the bounds.
 /// Matrix-free: the momentum step updates velocities through M⁻¹Jᵀ like any impulse.
+#[cfg(any(test, feature = "internals"))]
 pub fn solve_nncg(
     constraints: &mut [ContactConstraint],
     sweep: Sweep<'_>,
@@ -61,6 +65,29 @@ pub fn solve_nncg(
     tolerance: f32,
     velocities: &mut Velocities<'_>,
     workspace: &mut NncgWorkspace,
+) -> SolveReport {
+    solve_nncg_with_joints(
+        constraints,
+        sweep,
+        iterations,
+        tolerance,
+        velocities,
+        workspace,
+        &mut [],
+    )
+}
+
+/// [`solve_nncg`] with an island's joints swept in every iteration's symmetric sweep (first
+/// going forward, last coming back). The conjugate step moves the contact impulses only: the
+/// joints' rows are solved by the sweeps, a block Gauss-Seidel between joints and contacts.
+pub(crate) fn solve_nncg_with_joints(
+    constraints: &mut [ContactConstraint],
+    sweep: Sweep<'_>,
+    iterations: u32,
+    tolerance: f32,
+    velocities: &mut Velocities<'_>,
+    workspace: &mut NncgWorkspace,
+    joints: &mut [JointConstraint],
 ) -> SolveReport {
     let n = constraints.len();
     workspace.previous.clear();
@@ -72,9 +99,18 @@ pub fn solve_nncg(
     for iteration in 0..iterations {
         // One fixed symmetric sweep (forward then backward) is the "PGS step": conjugate
         // directions need the same operator every iteration.
+        let joint_forward = if joints.is_empty() {
+            0.0
+        } else {
+            sweep_joints(joints, velocities, true)
+        };
         let forward = sweep_points(constraints, sweep, FORWARD, velocities, FrictionFirstRows);
         let backward = sweep_points(constraints, sweep, BACKWARD, velocities, FrictionFirstRows);
-        let largest_change = forward.max(backward);
+        let mut largest_change = forward.max(backward);
+        if !joints.is_empty() {
+            let joint_backward = sweep_joints(joints, velocities, false);
+            largest_change = largest_change.max(joint_forward).max(joint_backward);
+        }
         report.iterations += 1;
         report.last_change = largest_change;
         if largest_change <= tolerance || iteration + 1 == iterations {

@@ -13,6 +13,7 @@ use super::interface::{
 use super::rows::{Velocities, project_to_friction_disc};
 use crate::contact::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours};
+use crate::joint::{JointConstraint, sweep_joints};
 use crate::parallel::{
     SWEEP_POINTS_PER_TASK, SharedVelocities, colour_after_colour, prefetch_lines, spread,
 };
@@ -26,6 +27,7 @@ impl ContactSolver for Pgs {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
+        joints: &mut [JointConstraint],
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         solve_scalar(constraints, pass, EscalationLevel::Pgs, |rows| {
@@ -37,6 +39,7 @@ impl ContactSolver for Pgs {
                 velocities,
                 pass.friction,
                 pass.half_turn,
+                joints,
             )
         })
     }
@@ -269,6 +272,7 @@ pub fn solve_pgs(
         velocities,
         true,
         false,
+        &mut [],
     )
 }
 
@@ -278,7 +282,10 @@ pub fn solve_pgs(
 /// friction ([`crate::SolverSettings::friction_in_main_solve`]). With `half_turn`, each run of
 /// consecutive points between the same two bodies (a manifold) is taken from halfway round (the
 /// soft step does so every other substep, so that no corner of a face is always updated first;
-/// see [`super::wide`]'s sweep); sweeps colour by colour over threads ignore it.
+/// see [`super::wide`]'s sweep); sweeps colour by colour over threads ignore it. The island's
+/// `joints` are swept in each iteration too: before the contacts going forward, after them
+/// going back, as Box2D v3 solves joints before contacts.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_pgs_rows(
     constraints: &mut [ContactConstraint],
     sweep: Sweep<'_>,
@@ -287,6 +294,7 @@ pub(crate) fn solve_pgs_rows(
     velocities: &mut Velocities<'_>,
     friction: bool,
     half_turn: bool,
+    joints: &mut [JointConstraint],
 ) -> SolveReport {
     let mut report = SolveReport::default();
     for iteration in 0..iterations {
@@ -295,11 +303,21 @@ pub(crate) fn solve_pgs_rows(
         // so alternating converges far faster than either direction alone.
         let forward = iteration % 2 == 0;
         let order = PointOrder { forward, half_turn };
-        let largest_change = if friction {
+        let mut joint_change = 0.0f32;
+        if forward && !joints.is_empty() {
+            joint_change = sweep_joints(joints, velocities, true);
+        }
+        let mut largest_change = if friction {
             sweep_points(constraints, sweep, order, velocities, VelocityRows::<true>)
         } else {
             sweep_points(constraints, sweep, order, velocities, VelocityRows::<false>)
         };
+        if !forward && !joints.is_empty() {
+            joint_change = sweep_joints(joints, velocities, false);
+        }
+        if !joints.is_empty() {
+            largest_change = largest_change.max(joint_change);
+        }
         report.iterations += 1;
         report.last_change = largest_change;
         if largest_change <= tolerance {

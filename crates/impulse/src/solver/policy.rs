@@ -2,6 +2,7 @@
 //! converge to more NNCG iterations or, for a small island, to the exact path ([`super::exact`]).
 
 use super::exact::Exact;
+use super::exact_rows::{breakable_joint, joint_row_count};
 use super::interface::{ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport};
 use super::nncg::Nncg;
 use super::rows::Velocities;
@@ -16,7 +17,7 @@ pub(crate) struct EscalationLimits {
     pub tolerance: f32,
     /// NNCG iterations given to an island that escalates.
     pub iterations: u32,
-    /// Islands of at most this many points may take the exact path.
+    /// Islands of at most this many contact points plus joint rows may take the exact path.
     pub exact_max_contacts: u32,
     /// Islands whose mass ratio exceeds this take the exact path whenever they are small.
     pub mass_ratio_threshold: f32,
@@ -60,13 +61,21 @@ impl ContactSolver for Auto {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
+        joints: &mut [crate::joint::JointConstraint],
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         let limits = self.limits;
-        let mut outcome = self.nncg.solve(constraints, velocities, pass);
+        let mut outcome = self.nncg.solve(constraints, velocities, joints, pass);
         let unconverged = outcome.report.last_change > limits.tolerance;
         let heavy = limits.mass_ratio > limits.mass_ratio_threshold;
-        let small = constraints.len() <= limits.exact_max_contacts as usize;
+        // An island is small when its contact points plus joint rows (the exact path's Lemke
+        // rows) are at most the limit; a breakable joint (a ball bound, not a box) keeps the
+        // island on NNCG.
+        let small = (joints.is_empty() && constraints.len() <= limits.exact_max_contacts as usize)
+            || (!joints.is_empty()
+                && constraints.len() + joint_row_count(joints)
+                    <= limits.exact_max_contacts as usize
+                && breakable_joint(joints).is_none());
         // Unconverged in an impact, the island takes more iterations rather than the exact
         // path: the next steps repair what an impact leaves, while pivoting every landing
         // column of a pile is the cost of hundreds of exact solves a substep. Asked only when
@@ -87,7 +96,7 @@ impl ContactSolver for Auto {
         if escalate && small && (persistent || heavy) {
             outcome.escalated = true;
             self.exact.max_contacts = limits.exact_max_contacts as usize;
-            let exact = self.exact.solve(constraints, velocities, &again);
+            let exact = self.exact.solve(constraints, velocities, joints, &again);
             if exact.exact_failed {
                 // The iterative result stands; the failure is counted and reported.
                 outcome.exact_failed = true;
@@ -101,6 +110,7 @@ impl ContactSolver for Auto {
             let more = self.nncg.solve(
                 constraints,
                 velocities,
+                joints,
                 &SolvePass {
                     iterations: limits.iterations,
                     ..again

@@ -22,8 +22,8 @@ use super::rows::Velocities;
 use crate::body::{Bodies, BodyKind, LockedAxes};
 use crate::contact::{self, ContactConstraint};
 use crate::integrate;
-use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS, RESTITUTION_POINTS_PER_TASK};
-use crate::settings::{ContactRepair, ImpactModel, SolverMethod, SolverSettings};
+use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS};
+use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
 /// friction rows too, whatever [`SolverSettings::friction_in_main_solve`] says. Friction
@@ -111,12 +111,18 @@ impl IslandWorkspace {
         } else {
             pass
         };
+        if !self.joints.is_empty() && pass.targets.is_some() {
+            for joint in &mut self.joints {
+                joint.update_targets(&self.displacement, &self.orientation, with_repair);
+            }
+        }
         let mut velocities = Velocities {
             linear: &mut self.linear,
             angular: &mut self.angular,
         };
+        let joints = &mut self.joints[..];
         let solver = self.solvers.substeps(settings.method, bundled);
-        let outcome = solver.solve(constraints, &mut velocities, &pass);
+        let outcome = solver.solve(constraints, &mut velocities, joints, &pass);
         self.impact_met = if with_repair {
             settings.method == SolverMethod::Pgs
                 && !settings.split_impulse()
@@ -132,7 +138,7 @@ impl IslandWorkspace {
                 targets: None,
                 ..pass
             };
-            solver.solve(constraints, &mut velocities, &more)
+            solver.solve(constraints, &mut velocities, joints, &more)
         });
         self.position_repair = outcome.position_repair;
         self.record(&outcome, with_repair);
@@ -143,7 +149,7 @@ impl IslandWorkspace {
 
     /// Adds one solve's outcome to the island's report; the main solve's last change is the
     /// island's.
-    fn record(&mut self, outcome: &SolveOutcome, main: bool) {
+    pub(super) fn record(&mut self, outcome: &SolveOutcome, main: bool) {
         let report = &mut self.report;
         report.method = report.method.max(outcome.level);
         report.escalations += u32::from(outcome.escalated);
@@ -207,13 +213,24 @@ pub(crate) fn step_island(
     // The substeps cover the whole step: on the heavy-on-light path, one substep of dt.
     let h = context.dt / settings.substeps as f32;
     w.step_constants(island_bodies, context, h);
+    for joint in &mut w.joints {
+        joint.start_step(h);
+    }
     w.start_solves(constraints, settings, context);
     let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
     for substep in 0..settings.substeps {
         w.substep(constraints, settings, context.gravity, &plan, substep);
     }
     w.finish_solves(constraints, settings, &plan);
-    w.restitution(island_bodies, guests, constraints, settings, context, &plan);
+    w.restitution(
+        island_bodies,
+        guests,
+        constraints,
+        settings,
+        context,
+        plan.spread,
+    );
+    w.record_joints();
 }
 
 /// How an island's solves run in a step, decided before its substeps.
@@ -358,7 +375,13 @@ impl IslandWorkspace {
     ) -> Option<SolverSettings> {
         let settings = context.settings;
         let threshold = settings.heavy_on_light_mass_ratio;
-        if !(threshold > 0.0 && self.report.mass_ratio > threshold && !settings.split_impulse()) {
+        // Joints keep the soft step: the path's one rigid LCP a step is solved exactly, which
+        // an island with joints (a mixed LCP) cannot be yet.
+        if !(threshold > 0.0
+            && self.report.mass_ratio > threshold
+            && !settings.split_impulse()
+            && self.joints.is_empty())
+        {
             return None;
         }
         self.report.heavy_on_light =
@@ -415,7 +438,17 @@ impl IslandWorkspace {
         let slots = island_bodies.len() + guests.len() + 1;
         let w = self;
         // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
-        let bundled = settings.solves_in_lanes(constraints.len());
+        // Joints are swept by the scalar path, so an island with joints is not packed into
+        // lanes (docs/solvers.md, "Joints").
+        let bundled = settings.solves_in_lanes(constraints.len()) && w.joints.is_empty();
+        // Assembly leaves the lever-arm products and effective masses of the rows of islands
+        // the step's settings would solve in lanes to the lanes (`products_pending`). An island
+        // that does not go to the lanes after all (it has joints, or takes the heavy-on-light
+        // path) computes them here: left pending, its contacts would have no effective mass
+        // and push nothing.
+        if !bundled && context.settings.solves_in_lanes(constraints.len()) {
+            contact::complete_products(constraints, world_inverse_inertia);
+        }
         w.parallel = parallel;
         w.colour_starts.clear();
         let threshold = settings.parallel_island_contacts as usize;
@@ -492,6 +525,15 @@ impl IslandWorkspace {
             linear: &mut self.linear,
             angular: &mut self.angular,
         };
+        // Joints first, as in every sweep (Box2D v3's warm start order).
+        for joint in &mut self.joints {
+            joint.warm_start(
+                &mut velocities,
+                &self.displacement,
+                &self.orientation,
+                substep,
+            );
+        }
         self.solvers.substeps(settings.method, bundled).warm_start(
             constraints,
             &mut velocities,
@@ -667,85 +709,14 @@ impl IslandWorkspace {
         w.solvers
             .substeps(settings.method, plan.bundled)
             .finish(constraints);
+        for joint in &mut w.joints {
+            joint.add_step_impulses();
+        }
         w.rows = if plan.record_in_lanes {
             w.solvers.wide.take_rows()
         } else {
             None
         };
-    }
-
-    /// Restitution after the substeps (Newton's v⁺ = −c_r·v⁻, v⁻ from the start of the step),
-    /// for the points that collided: their targets (or `impact: propagation`'s reflections),
-    /// then one solve when any point bounces.
-    fn restitution(
-        &mut self,
-        island_bodies: &[u32],
-        guests: &[u32],
-        constraints: &mut [ContactConstraint],
-        settings: &SolverSettings,
-        context: &StepContext<'_>,
-        plan: &SolvePlan,
-    ) {
-        let w = self;
-        let threshold = settings.restitution_threshold;
-        let bounces = if !context.restitution {
-            // No body bounces, so no pair does (a pair's coefficient is the larger of its
-            // bodies').
-            false
-        } else if settings.impact == ImpactModel::Propagation {
-            let mut velocities = Velocities {
-                linear: &mut w.linear,
-                angular: &mut w.angular,
-            };
-            let island = (island_bodies, guests, context.bodies);
-            w.impact
-                .propagate(constraints, island, &mut velocities, context.dt, settings)
-        } else if plan.spread {
-            // Per point: any split gives the same targets.
-            use rayon::prelude::*;
-            constraints
-                .par_chunks_mut(RESTITUTION_POINTS_PER_TASK)
-                .map(|part| contact::restitution_targets(part, threshold))
-                .reduce(|| false, |x, y| x || y)
-        } else {
-            contact::restitution_targets(constraints, threshold)
-        };
-        if !bounces {
-            return;
-        }
-        let pass = SolvePass {
-            iterations: super::impact::restitution_iterations(settings),
-            tolerance: settings.tolerance,
-            friction: true,
-            half_turn: false,
-            warm_start_follows: false,
-            escalate: false,
-            targets: None,
-            sweep: Sweep {
-                starts: &w.colour_starts,
-                parallel: w.parallel,
-            },
-        };
-        // The step totals gain what the restitution solve adds to each impulse.
-        for c in constraints.iter_mut() {
-            let before = super::rows::impulses(c);
-            for (total, before) in c.step_impulses.iter_mut().zip(before) {
-                *total -= before;
-            }
-        }
-        let outcome = w.solvers.scalar(settings.method).solve(
-            constraints,
-            &mut Velocities {
-                linear: &mut w.linear,
-                angular: &mut w.angular,
-            },
-            &pass,
-        );
-        for c in constraints.iter_mut() {
-            super::rows::add_step_impulses(c);
-        }
-        w.record(&outcome, false);
-        w.impact.finish(constraints);
     }
 }
 

@@ -536,6 +536,7 @@ impl World {
     /// bodies that touched the removed one wake.
     pub fn remove(&mut self, handle: BodyHandle) -> Result<Option<String>, WorldError> {
         let i = self.index_of(handle)?;
+        self.remove_joints_of(handle);
         self.wake_touching(i);
         let last = self.bodies.len() - 1;
         self.narrow_phase.remove_pairs_of(i as u32, last as u32);

@@ -12,6 +12,7 @@ use crate::diagnostics::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms};
 use crate::error::WorldError;
 use crate::island::Islands;
+use crate::joint::{JointEvent, Joints};
 use crate::scene::{BodyDesc, Material, MaterialRef, Scene};
 use crate::settings::SolverSettings;
 use crate::solver::substep::IslandWorkspace;
@@ -20,6 +21,7 @@ mod bodies;
 mod contact_events;
 mod contacts;
 mod from_scene;
+mod joints;
 mod query;
 mod snapshot;
 mod step;
@@ -31,7 +33,7 @@ pub use bodies::BodyRef;
 pub use contact_events::ContactEvent;
 pub use contacts::{ContactPairView, ContactPoint};
 pub use query::{RayHit, ShapeHit};
-pub use snapshot::{SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
+pub use snapshot::{OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
 
 pub use crate::settings::BLOW_UP_DISTANCE;
 pub use step::{BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED};
@@ -85,6 +87,10 @@ pub struct World {
     unclamped_poses: Vec<Pose>,
     /// The bodies that left the world in the last step ([`World::left_world`]).
     left_world: Vec<LeftWorld>,
+    /// The joints, with their warm-start impulses.
+    pub(crate) joints: Joints,
+    /// The last step's joint events ([`World::joint_events`]).
+    joint_events: Vec<JointEvent>,
 }
 
 /// A body that left the world: its centre of mass ended a step farther from the origin than
@@ -146,6 +152,8 @@ impl World {
             clamps: Vec::new(),
             unclamped_poses: Vec::new(),
             left_world: Vec::new(),
+            joints: Joints::default(),
+            joint_events: Vec::new(),
         };
         world.check_settings()?;
         Ok(world)
@@ -186,6 +194,23 @@ impl World {
                 },
             };
             world.add_body(desc, &material)?;
+        }
+        let names: Vec<Option<String>> = scene.bodies.iter().map(|b| b.name.clone()).collect();
+        for (k, desc) in scene.joints.iter().enumerate() {
+            let invalid = |field: &str, message: String| WorldError::InvalidJoint {
+                joint: k,
+                name: desc.name.clone(),
+                field: field.to_string(),
+                message,
+            };
+            let body = |name, field: &str| {
+                crate::scene::joint_desc::resolve_body(name, &names)
+                    .map(|i| world.handles.of_body[i])
+                    .map_err(|m| invalid(field, m))
+            };
+            let (a, b) = (body(&desc.body_a, "body_a")?, body(&desc.body_b, "body_b")?);
+            let builder = desc.builder(a, b).map_err(|(f, m)| invalid(&f, m))?;
+            world.insert_joint(builder)?;
         }
         Ok(world)
     }
@@ -303,9 +328,18 @@ impl World {
     }
 
     /// The last step's contact LCP, assembled from the rows the solver used, with the engine's
-    /// impulses at exit. Errors only when the step produced non-finite data.
+    /// impulses at exit; with joints, their rows follow the contacts' with their bounds (a
+    /// mixed LCP: [`ContactLcp::joint_of_row`]). Errors only when the step produced
+    /// non-finite data.
     pub fn contact_lcp(&self) -> Result<ContactLcp, impulse_lcp::ProblemError> {
-        assemble_lcp(&self.complete_constraints())
+        let joints: Vec<&crate::joint::JointConstraint> = self
+            .workspaces
+            .iter()
+            .zip(&self.island_awake)
+            .filter(|(_, awake)| **awake)
+            .flat_map(|(workspace, _)| &workspace.joints)
+            .collect();
+        assemble_lcp(&self.complete_constraints(), &joints)
     }
 
     /// Wall-clock time of each stage of the last step (all zero before the first step).

@@ -31,13 +31,25 @@ use crate::collision::broad_phase::{BroadPhase, BroadPhaseState};
 use crate::collision::narrow_phase::{NarrowPhase, PairState};
 use crate::diagnostics::StepDiagnostics;
 use crate::error::SnapshotError;
+use crate::joint::Joints;
 use crate::scene::MeshData;
 use crate::scene::validate::mesh_problem;
 use crate::settings::SolverSettings;
 
-/// The snapshot format this build writes and reads. Raised whenever the stored state changes
-/// shape; a snapshot of another version is refused ([`SnapshotError::VersionMismatch`]).
-pub const SNAPSHOT_FORMAT_VERSION: u32 = 2;
+/// The snapshot format this build writes. Raised whenever the stored state changes shape; a
+/// snapshot of a version this build cannot read is refused ([`SnapshotError::VersionMismatch`]).
+/// Version 3 added the joints; it reads version 2 ([`OLDEST_SNAPSHOT_FORMAT_VERSION`]) as a
+/// world without joints.
+pub const SNAPSHOT_FORMAT_VERSION: u32 = 3;
+
+/// The oldest snapshot format this build reads: version 2, the format before joints, whose
+/// payload is version 3's without the `joints` field.
+pub const OLDEST_SNAPSHOT_FORMAT_VERSION: u32 = 2;
+
+/// Whether this build reads snapshots of format `version`.
+fn readable(version: u32) -> bool {
+    (OLDEST_SNAPSHOT_FORMAT_VERSION..=SNAPSHOT_FORMAT_VERSION).contains(&version)
+}
 
 /// The first bytes of a snapshot file.
 const MAGIC: &[u8; 16] = b"IMPULSE-WORLD\0\0\0";
@@ -94,6 +106,10 @@ pub struct WorldSnapshot {
     time: f64,
     /// The position-based kinematic bodies' keyframes and pending targets.
     scripts: Vec<Script>,
+    /// The joints, with their handles and warm-start impulses (absent from version 2: no
+    /// joints).
+    #[serde(default)]
+    joints: Joints,
 }
 
 impl WorldSnapshot {
@@ -140,7 +156,7 @@ impl WorldSnapshot {
         let (length, checksum) = (payload.len() as u64, crc32fast::hash(payload));
         let mut header = Vec::with_capacity(HEADER_LEN);
         header.extend_from_slice(MAGIC);
-        header.extend_from_slice(&SNAPSHOT_FORMAT_VERSION.to_le_bytes());
+        header.extend_from_slice(&self.format_version.to_le_bytes());
         header.extend_from_slice(&length.to_le_bytes());
         header.extend_from_slice(&checksum.to_le_bytes());
         bytes[..HEADER_LEN].copy_from_slice(&header);
@@ -150,7 +166,9 @@ impl WorldSnapshot {
     /// Reads a snapshot written by [`Self::to_bytes`]. Errors: [`SnapshotError::NotASnapshot`]
     /// (wrong magic), [`SnapshotError::VersionMismatch`], [`SnapshotError::Truncated`],
     /// [`SnapshotError::ChecksumMismatch`] (damaged), [`SnapshotError::Decode`] (bytes that
-    /// pass the checksum but are not a snapshot). Never panics, whatever the bytes.
+    /// pass the checksum but are not a snapshot, or a payload of another version than the
+    /// header's). Never panics, whatever the bytes. A snapshot of an older readable format
+    /// comes back as the current format ([`OLDEST_SNAPSHOT_FORMAT_VERSION`]).
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, SnapshotError> {
         let magic_len = bytes.len().min(MAGIC.len());
         if bytes[..magic_len] != MAGIC[..magic_len] || bytes.is_empty() {
@@ -164,9 +182,10 @@ impl WorldSnapshot {
             return Err(truncated(HEADER_LEN));
         }
         let found = u32::from_le_bytes(bytes[16..20].try_into().unwrap_or_default());
-        if found != SNAPSHOT_FORMAT_VERSION {
+        if !readable(found) {
             return Err(SnapshotError::VersionMismatch {
                 found,
+                oldest: OLDEST_SNAPSHOT_FORMAT_VERSION,
                 supported: SNAPSHOT_FORMAT_VERSION,
             });
         }
@@ -195,7 +214,19 @@ impl WorldSnapshot {
                 found: checksum,
             });
         }
-        ciborium::from_reader(payload).map_err(|e| SnapshotError::Decode(e.to_string()))
+        let mut snapshot: WorldSnapshot =
+            ciborium::from_reader(payload).map_err(|e| SnapshotError::Decode(e.to_string()))?;
+        // The header's version is outside the checksum: a payload of another version than the
+        // header's is a damaged header (versions 2 and 3 differ in one bit).
+        if snapshot.format_version != found {
+            return Err(SnapshotError::Decode(format!(
+                "the header says format version {found}, the payload {}",
+                snapshot.format_version
+            )));
+        }
+        // An older format decodes to the current one (version 2: no joints).
+        snapshot.format_version = SNAPSHOT_FORMAT_VERSION;
+        Ok(snapshot)
     }
 
     /// Writes [`Self::to_bytes`] to `path` atomically: to a temporary file beside it, which is
@@ -262,6 +293,7 @@ impl World {
             diagnostics: self.diagnostics.clone(),
             time: self.time,
             scripts: self.scripts.clone(),
+            joints: self.joints.clone(),
         })
     }
 
@@ -273,9 +305,10 @@ impl World {
     /// out-of-range body value or shape, inconsistent handles, a pair naming a missing body,
     /// an invalid setting.
     pub fn from_snapshot(snapshot: WorldSnapshot) -> Result<World, SnapshotError> {
-        if snapshot.format_version != SNAPSHOT_FORMAT_VERSION {
+        if !readable(snapshot.format_version) {
             return Err(SnapshotError::VersionMismatch {
                 found: snapshot.format_version,
+                oldest: OLDEST_SNAPSHOT_FORMAT_VERSION,
                 supported: SNAPSHOT_FORMAT_VERSION,
             });
         }
@@ -346,6 +379,8 @@ impl World {
             }
         }
         world.scripts = snapshot.scripts;
+        check_joints(&world, &snapshot.joints).map_err(invalid)?;
+        world.joints = snapshot.joints;
         Ok(world)
     }
 
@@ -359,6 +394,53 @@ impl World {
     pub fn read_snapshot(path: &Path) -> Result<World, SnapshotError> {
         World::from_snapshot(WorldSnapshot::read_file(path)?)
     }
+}
+
+/// A snapshot's joints before they are trusted: handles consistent, bodies in the world,
+/// frames, impulses and reactions finite, degrees of freedom, stiffness and break thresholds
+/// within the rules of `World::insert_joint`.
+fn check_joints(world: &World, joints: &Joints) -> Result<(), String> {
+    joints.handles.check(joints.joints.len())?;
+    for (k, joint) in joints.joints.iter().enumerate() {
+        let mut indices = [0; 2];
+        for (index, body) in indices.iter_mut().zip([joint.body_a, joint.body_b]) {
+            *index = world.handles.body(body).ok_or_else(|| {
+                format!("joint {k} names a body that is not in the world ({body:?})")
+            })?;
+        }
+        if indices[0] == indices[1] {
+            return Err(format!("joint {k} joins a body to itself"));
+        }
+        let finite = joint.anchor_a.is_finite()
+            && joint.anchor_b.is_finite()
+            && joint.impulses.iter().flatten().all(|x| x.is_finite())
+            && joint.force.is_finite()
+            && joint.torque.is_finite();
+        if !finite {
+            return Err(format!(
+                "joint {k}: an anchor, impulse or reaction is not finite"
+            ));
+        }
+        // `insert_joint` stores unit quaternions; a rotation far from one would scale the rows.
+        for rotation in [joint.rotation_a, joint.rotation_b] {
+            if !(rotation.is_finite() && (rotation.length() - 1.0).abs() < 1e-3) {
+                return Err(format!(
+                    "joint {k}: a frame rotation is not a unit quaternion ({:?})",
+                    rotation.to_array()
+                ));
+            }
+        }
+        crate::joint::rules::check_dofs(joint.kind, &joint.dofs)
+            .and_then(|()| {
+                crate::joint::rules::check_options(
+                    joint.stiffness,
+                    joint.break_force,
+                    joint.break_torque,
+                )
+            })
+            .map_err(|p| format!("joint {k}: {}: {}", p.field, p.message))?;
+    }
+    Ok(())
 }
 
 /// The body values a step relies on, checked before a snapshot's bodies are trusted: finite

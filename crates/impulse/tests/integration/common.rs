@@ -77,8 +77,8 @@ pub(crate) fn highest_body(world: &impulse::World) -> usize {
         .unwrap()
 }
 
-/// FNV-1a hash of a world's state: every body's pose and velocities and every contact point's
-/// impulses and separation, as f32 bits. Equal hashes mean the same state to the bit.
+/// FNV-1a hash of a world's state: every body's pose and velocities, every contact point's
+/// impulses and separation, and every joint's reaction and broken flag, as f32 bits. Equal hashes mean the same state to the bit.
 pub(crate) fn hash_state(world: &impulse::World) -> u64 {
     let mut hash = 0xcbf2_9ce4_8422_2325u64;
     let mut add = |x: f32| {
@@ -111,6 +111,12 @@ pub(crate) fn hash_state(world: &impulse::World) -> u64 {
                 .for_each(&mut add);
             add(point.separation);
         }
+    }
+    for joint in world.joints() {
+        for v in [joint.force(), joint.torque()] {
+            v.to_array().into_iter().for_each(&mut add);
+        }
+        add(if joint.broken() { 1.0 } else { 0.0 });
     }
     hash
 }

@@ -1,16 +1,15 @@
 //! Triangle meshes, height fields, compounds and rounded shapes through the scene format:
 //! files read (OBJ, glTF, GLB), piles coming to rest on a mesh terrain without falling
-//! through, every shape resting on every ground and on the flat-topped shapes, and bad input
-//! (degenerate or missing meshes, meshes on moving bodies) refused with the file, line, body
-//! and field.
+//! through, every shape resting on every ground and on the flat-topped shapes. Bad input is
+//! in `malformed_meshes.rs`.
 
 use std::path::{Path, PathBuf};
 
 use impulse::glam::Vec3;
 use impulse::parry3d::query;
 use impulse::scene::{
-    BodyDesc, BodyKind, CompoundPart, MeshFormat, Scene, SceneErrorKind, ShapeDesc, load_mesh_file,
-    load_scene_file, parse_scene_str, read_mesh_bytes,
+    BodyDesc, BodyKind, CompoundPart, MeshFormat, Scene, ShapeDesc, load_mesh_file,
+    load_scene_file, read_mesh_bytes,
 };
 use impulse::{SolverSettings, World};
 
@@ -19,7 +18,7 @@ fn scenes_dir() -> PathBuf {
 }
 
 /// A scratch directory of this test binary, emptied first.
-fn scratch(name: &str) -> PathBuf {
+pub(crate) fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("impulse-meshes-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
@@ -578,258 +577,4 @@ fn every_shape_rests_on_the_flat_topped_shapes_for_10_s() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-}
-
-// ---------------------------------------------------------------------------------------------
-// Bad input: each refused with the file, line, body and field, never a panic.
-
-/// A scene whose body 1 (`"thing"`, on line 4) is `body`, in a file `name.json` of a scratch
-/// directory holding `extra` files too; the error of loading it.
-fn load_error(name: &str, body: &str, extra: &[(&str, &[u8])]) -> impulse::scene::SceneError {
-    let dir = scratch(name);
-    for (file, content) in extra {
-        std::fs::write(dir.join(file), content).unwrap();
-    }
-    let text = format!(
-        "{{\n  \"bodies\": [\n    {{\"kind\": \"static\", \"shape\": {{\"type\": \"half_space\", \"normal\": [0, 1, 0]}}}},\n    {{\"name\": \"thing\", {body}}}\n  ]\n}}\n"
-    );
-    let path = dir.join(format!("{name}.json"));
-    std::fs::write(&path, text).unwrap();
-    let error = load_scene_file(&path).expect_err("the scene must be refused");
-    let _ = std::fs::remove_dir_all(dir);
-    error
-}
-
-fn check(error: &impulse::scene::SceneError, field: &str, message: &str) {
-    let text = error.to_string();
-    assert_eq!(error.kind, SceneErrorKind::Invalid, "{text}");
-    assert_eq!(
-        error.field.as_ref().map(ToString::to_string).as_deref(),
-        Some(field),
-        "{text}"
-    );
-    assert_eq!(error.body.as_ref().map(|b| b.index), Some(1), "{text}");
-    assert_eq!(error.line(), Some(4), "{text}");
-    assert!(error.origin.is_some(), "{text}");
-    assert!(
-        error.message.contains(message),
-        "{text}\nshould contain: {message}"
-    );
-    assert!(text.contains("(\"thing\")"), "{text}");
-}
-
-const TRIANGLE: &str = r#""vertices": [[0, 0, 0], [1, 0, 0], [0, 0, 1]], "indices": [[0, 2, 1]]"#;
-
-#[test]
-fn a_trimesh_on_a_moving_body_is_refused() {
-    let error = load_error(
-        "dynamic-mesh",
-        &format!(r#""kind": "dynamic", "shape": {{"type": "trimesh", {TRIANGLE}}}"#),
-        &[],
-    );
-    check(
-        &error,
-        "bodies[1].shape.type",
-        "a trimesh shape is only allowed on a static body, this body is dynamic",
-    );
-}
-
-#[test]
-fn a_heightfield_on_a_moving_body_is_refused() {
-    let error = load_error(
-        "dynamic-field",
-        r#""kind": "dynamic", "shape": {"type": "heightfield", "heights": [[0, 0], [0, 0]], "scale": [1, 1, 1]}"#,
-        &[],
-    );
-    check(
-        &error,
-        "bodies[1].shape.type",
-        "a heightfield shape is only allowed on a static body",
-    );
-}
-
-#[test]
-fn a_missing_mesh_file_is_refused() {
-    let error = load_error(
-        "missing-mesh",
-        r#""kind": "static", "shape": {"type": "trimesh", "file": "nowhere.obj"}"#,
-        &[],
-    );
-    check(&error, "bodies[1].shape.file", "cannot read");
-    assert!(error.message.contains("nowhere.obj"), "{error}");
-}
-
-#[test]
-fn a_corrupt_obj_file_is_refused() {
-    let error = load_error(
-        "corrupt-obj",
-        r#""kind": "static", "shape": {"type": "trimesh", "file": "bad.obj"}"#,
-        &[("bad.obj", b"v 0 0 0\nv 1 0 x\nf 1 2 3\n")],
-    );
-    check(&error, "bodies[1].shape.file", "not a valid OBJ file");
-}
-
-#[test]
-fn a_corrupt_gltf_file_is_refused() {
-    let error = load_error(
-        "corrupt-gltf",
-        r#""kind": "static", "shape": {"type": "trimesh", "file": "bad.glb"}"#,
-        &[("bad.glb", b"glTF\x02\0\0\0 truncated")],
-    );
-    check(&error, "bodies[1].shape.file", "not a valid glTF file");
-}
-
-#[test]
-fn a_mesh_file_of_unknown_type_is_refused() {
-    let error = load_error(
-        "stl-mesh",
-        r#""kind": "static", "shape": {"type": "trimesh", "file": "part.stl"}"#,
-        &[("part.stl", b"solid x\nendsolid x\n")],
-    );
-    check(&error, "bodies[1].shape.file", "allowed: .obj");
-}
-
-#[test]
-fn an_obj_file_without_triangles_is_refused() {
-    let error = load_error(
-        "empty-obj",
-        r#""kind": "static", "shape": {"type": "trimesh", "file": "points.obj"}"#,
-        &[("points.obj", b"v 0 0 0\nv 1 0 0\n")],
-    );
-    check(&error, "bodies[1].shape.file", "no triangles");
-}
-
-#[test]
-fn a_mesh_file_with_a_degenerate_triangle_is_refused() {
-    let error = load_error(
-        "flat-obj",
-        r#""kind": "static", "shape": {"type": "trimesh", "file": "line.obj"}"#,
-        &[(
-            "line.obj",
-            b"v 0 0 0\nv 1 0 0\nv 0 0 1\nv 2 0 0\nf 1 3 2\nf 1 2 4\n",
-        )],
-    );
-    check(
-        &error,
-        "bodies[1].shape.file",
-        "has no area: its corners coincide or are collinear",
-    );
-}
-
-#[test]
-fn an_inline_mesh_with_an_index_out_of_range_is_refused() {
-    let error = load_error(
-        "index-range",
-        r#""kind": "static", "shape": {"type": "trimesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 0, 1]], "indices": [[0, 2, 1], [0, 1, 3]]}"#,
-        &[],
-    );
-    check(
-        &error,
-        "bodies[1].shape.indices[1]",
-        "triangle 1 refers to vertex 3, but there are 3 vertices",
-    );
-}
-
-#[test]
-fn a_trimesh_with_both_file_and_vertices_is_refused() {
-    let error = load_error(
-        "both-sources",
-        &format!(
-            r#""kind": "static", "shape": {{"type": "trimesh", "file": "t.obj", {TRIANGLE}}}"#
-        ),
-        &[("t.obj", b"v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 3 2\n")],
-    );
-    check(&error, "bodies[1].shape.file", "not both");
-}
-
-#[test]
-fn a_ragged_heightfield_is_refused() {
-    let error = load_error(
-        "ragged-field",
-        r#""kind": "static", "shape": {"type": "heightfield", "heights": [[0, 0, 0], [0, 0]], "scale": [1, 1, 1]}"#,
-        &[],
-    );
-    check(
-        &error,
-        "bodies[1].shape.heights[1]",
-        "the same number of heights as the first (3), got 2",
-    );
-}
-
-#[test]
-fn a_compound_of_a_mesh_is_refused() {
-    let error = load_error(
-        "compound-mesh",
-        &format!(
-            r#""kind": "dynamic", "shape": {{"type": "compound", "parts": [{{"shape": {{"type": "trimesh", {TRIANGLE}}}}}]}}"#
-        ),
-        &[],
-    );
-    check(
-        &error,
-        "bodies[1].shape.parts[0].shape.type",
-        "a compound part must be a sphere, cuboid, capsule, cylinder, cone or convex_hull, got trimesh",
-    );
-}
-
-#[test]
-fn a_negative_border_radius_is_refused() {
-    let error = load_error(
-        "border",
-        r#""kind": "dynamic", "shape": {"type": "cuboid", "half_extents": [1, 1, 1], "border_radius": -0.1}"#,
-        &[],
-    );
-    check(
-        &error,
-        "bodies[1].shape.border_radius",
-        "must be > 0, got -0.1",
-    );
-}
-
-/// Each size within bounds, but a compound part 900 km out and 200 km long reaches beyond
-/// 1,000 km of the body's origin: refused at the shape, with the reach; a mesh vertex beyond
-/// it likewise.
-#[test]
-fn a_shape_reaching_beyond_1000_km_is_refused() {
-    let error = load_error(
-        "reach",
-        r#""kind": "dynamic", "shape": {"type": "compound", "parts": [{"shape": {"type": "cuboid", "half_extents": [2e5, 1, 1]}, "position": [9e5, 0, 0]}]}"#,
-        &[],
-    );
-    check(
-        &error,
-        "bodies[1].shape",
-        "the shape reaches 1100000 m from the body's origin; at most 1000000 m",
-    );
-    let error = load_error(
-        "far_vertex",
-        r#""kind": "static", "shape": {"type": "trimesh", "vertices": [[0, 0, 0], [2e6, 0, 0], [0, 0, 1]], "indices": [[0, 2, 1]]}"#,
-        &[],
-    );
-    check(&error, "bodies[1].shape", "the shape reaches 2000000 m");
-}
-
-/// The library refuses the same shapes when a world is built from a scene made in code (not
-/// validated): a typed error, no panic.
-#[test]
-fn world_from_an_unvalidated_scene_refuses_bad_meshes() {
-    let mut scene = parse_scene_str(r#"{"bodies": []}"#, "code").unwrap();
-    scene.bodies.push(BodyDesc::new(
-        BodyKind::Static,
-        ShapeDesc::trimesh(
-            vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]],
-            vec![[0, 1, 2]],
-        ),
-        [0.0; 3],
-    ));
-    let error = World::from_scene(&scene).err().expect("a degenerate mesh");
-    assert!(error.to_string().contains("has no area"), "{error}");
-    scene.bodies[0].shape = ShapeDesc::trimesh_file("/no/such/mesh.obj");
-    let error = World::from_scene(&scene)
-        .err()
-        .expect("a missing mesh file");
-    assert!(error.to_string().contains("shape.file"), "{error}");
-    scene.bodies[0].shape = ShapeDesc::Compound { parts: Vec::new() };
-    let error = World::from_scene(&scene).err().expect("an empty compound");
-    assert!(error.to_string().contains("at least one part"), "{error}");
 }

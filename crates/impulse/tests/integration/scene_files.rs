@@ -26,6 +26,10 @@ const FILE_SCENES: &[&str] = &[
     "mass_ratio_pyramid300",
     "plate",
     "card_house",
+    "chain20",
+    "chain20heavy",
+    "ragdoll",
+    "bridge",
     "arch",
     "overlap_pyramid",
 ];
@@ -123,7 +127,11 @@ fn writer_round_trips_every_builtin() {
         assert!(back == scene, "{name} does not round-trip");
         // One body per line.
         let body_lines = text.lines().filter(|l| l.starts_with("    {\"")).count();
-        assert_eq!(body_lines, scene.bodies.len(), "{name}");
+        assert_eq!(
+            body_lines,
+            scene.bodies.len() + scene.joints.len(),
+            "{name}"
+        );
     }
 }
 

@@ -1,7 +1,8 @@
 //! World snapshots: a world restored from a snapshot steps on to the bit as the world it was
 //! taken from (pyramid20, balls4096, a scene of every shape, a sleeping pile woken by a
-//! projectile, the `reference` preset, edits between steps), on 1 and 2 threads either side of
-//! the snapshot; and a damaged or invalid snapshot gives a typed error, never a panic.
+//! projectile, the `reference` preset, edits between steps, joints), on 1 and 2 threads either
+//! side of the snapshot; a damaged or invalid snapshot gives a typed error, never a panic; a
+//! snapshot of the format before joints still reads.
 //!
 //! "To the bit" is checked twice: the uninterrupted world's and the restored world's own
 //! snapshots after the same steps are the same bytes (every stored field: poses, velocities,
@@ -14,7 +15,8 @@ use impulse::glam::Vec3;
 use impulse::scene::builtin_scene;
 use impulse::scene::load_scene_file;
 use impulse::{
-    BodyBuilder, Scene, SharedShape, SnapshotError, SolverSettings, World, WorldSnapshot,
+    BodyBuilder, JointBuilder, OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION, Scene,
+    SharedShape, SnapshotError, SolverSettings, World, WorldSnapshot,
 };
 
 /// Runs `f` on a pool of `threads` threads (1: everything on the calling thread).
@@ -277,7 +279,7 @@ fn damaged_files_give_typed_errors() {
     newer[16] += 1;
     let message = read(&newer).to_string();
     assert!(
-        message.contains("format version 3") && message.contains("reads version 2"),
+        message.contains("format version 4") && message.contains("reads versions 2 to 3"),
         "{message}"
     );
     let mut longer = bytes.clone();
@@ -366,7 +368,8 @@ fn an_inconsistent_snapshot_is_invalid() {
         World::from_snapshot(snapshot),
         Err(SnapshotError::VersionMismatch {
             found: 99,
-            supported: 2
+            supported: SNAPSHOT_FORMAT_VERSION,
+            ..
         })
     ));
 }
@@ -391,4 +394,190 @@ fn files_round_trip_and_a_missing_file_is_an_io_error() {
         .unwrap();
     assert!(matches!(missing, SnapshotError::Io { .. }), "{missing}");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Joints cross the snapshot with their warm-start impulses: the chain of 20 links swinging
+/// from its start, and a world of every joint kind with a limit reached, a motor, springs and
+/// a joint broken before the snapshot (its flag and the pair it no longer joins).
+#[test]
+fn worlds_with_joints_resume_bit_for_bit() {
+    let mut scene = builtin_scene("chain20").unwrap();
+    scene.solver.sleep = false;
+    resumes_bit_for_bit("chain20", || world_of(&scene), 45, 45, &BOTH_WAYS);
+    let mut probe = joint_zoo();
+    steps(&mut probe, 30, 1);
+    assert!(
+        probe.joints().any(|j| j.broken()),
+        "the breakable joint breaks before the snapshot"
+    );
+    resumes_bit_for_bit("joint zoo", joint_zoo, 30, 40, &BOTH_WAYS);
+}
+
+/// Every joint kind on small bodies over a ground: a door on a hinge with a limit it reaches,
+/// a motorised wheel, a slider on a spring, a rope, a spherical pendulum, a generic joint and
+/// a breakable fixed joint loaded past its threshold.
+fn joint_zoo() -> World {
+    let mut world = World::new(
+        Vec3::new(0.0, -9.81, 0.0),
+        1.0 / 60.0,
+        SolverSettings {
+            sleep: false,
+            ..SolverSettings::default()
+        },
+    )
+    .unwrap();
+    world
+        .insert(
+            BodyBuilder::fixed(SharedShape::cuboid(5.0, 0.5, 5.0))
+                .translation(Vec3::new(0.0, -0.5, 0.0)),
+        )
+        .unwrap();
+    let post = world
+        .insert(
+            BodyBuilder::fixed(SharedShape::cuboid(0.05, 1.0, 0.05))
+                .translation(Vec3::new(0.0, 1.5, 0.0)),
+        )
+        .unwrap();
+    let body = |world: &mut World, at: Vec3| {
+        world
+            .insert(BodyBuilder::dynamic(SharedShape::cuboid(0.2, 0.1, 0.1)).translation(at))
+            .unwrap()
+    };
+    let door = body(&mut world, Vec3::new(0.3, 2.0, 0.0));
+    world
+        .insert_joint(
+            JointBuilder::revolute(post, door)
+                .world_anchor(Vec3::new(0.05, 2.0, 0.0))
+                .world_axis(Vec3::Z)
+                .limits(-0.3, 0.3),
+        )
+        .unwrap();
+    let wheel = body(&mut world, Vec3::new(-0.3, 2.0, 0.0));
+    world
+        .insert_joint(
+            JointBuilder::revolute(post, wheel)
+                .world_anchor(Vec3::new(-0.3, 2.0, 0.0))
+                .world_axis(Vec3::X)
+                .motor_velocity(3.0, 2.0),
+        )
+        .unwrap();
+    let slider = body(&mut world, Vec3::new(0.3, 1.2, 0.0));
+    world
+        .insert_joint(
+            JointBuilder::prismatic(post, slider)
+                .world_anchor(Vec3::new(0.3, 1.2, 0.0))
+                .world_axis(Vec3::Y)
+                .spring(2.0, 0.3, 0.0)
+                .limits(-0.5, 0.5),
+        )
+        .unwrap();
+    let bob = body(&mut world, Vec3::new(-0.6, 1.4, 0.2));
+    world
+        .insert_joint(
+            JointBuilder::distance(post, bob, 0.0, 0.8)
+                .world_anchors(Vec3::new(0.0, 2.2, 0.0), Vec3::new(-0.6, 1.4, 0.2)),
+        )
+        .unwrap();
+    let ball = body(&mut world, Vec3::new(0.0, 2.7, 0.5));
+    world
+        .insert_joint(JointBuilder::spherical(post, ball).world_anchor(Vec3::new(0.0, 2.5, 0.0)))
+        .unwrap();
+    let free = body(&mut world, Vec3::new(0.6, 0.6, 0.0));
+    world
+        .insert_joint(
+            JointBuilder::generic(post, free)
+                .world_anchor(Vec3::new(0.6, 0.6, 0.0))
+                .dof(impulse::JointDof::LinearY, impulse::AxisMode::Free)
+                .dof(
+                    impulse::JointDof::AngularX,
+                    impulse::AxisMode::Limited {
+                        lower: -0.2,
+                        upper: 0.2,
+                    },
+                ),
+        )
+        .unwrap();
+    let weak = body(&mut world, Vec3::new(-0.6, 0.6, 0.0));
+    world
+        .insert_joint(
+            JointBuilder::fixed(post, weak)
+                .world_anchor(Vec3::new(-0.6, 0.6, 0.0))
+                .breakable(5.0, f32::INFINITY),
+        )
+        .unwrap();
+    world
+}
+
+/// A checkpoint written by the format before joints (version 2: the `snapshot_reader` fuzz
+/// seed of two bodies, as `impulse run --checkpoint-every` wrote it) reads as a world without
+/// joints and steps; the re-taken snapshot is of the current format. A version older than
+/// that is refused by name.
+#[test]
+fn a_snapshot_of_the_format_before_joints_reads_as_a_world_without_joints() {
+    let path = format!(
+        "{}/../../fuzz/seeds/snapshot_reader/boxes-file.bin",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let seed = std::fs::read(path).unwrap();
+    let file = &seed[1..]; // the fuzz target's selector byte: odd, a whole file
+    assert_eq!(u32::from_le_bytes(file[16..20].try_into().unwrap()), 2);
+    let mut world = World::from_snapshot(WorldSnapshot::from_bytes(file).unwrap()).unwrap();
+    assert_eq!(world.joint_count(), 0);
+    assert!(world.body_count() > 0);
+    steps(&mut world, 10, 1);
+    let again = world.snapshot().unwrap().to_bytes().unwrap();
+    assert_eq!(
+        u32::from_le_bytes(again[16..20].try_into().unwrap()),
+        SNAPSHOT_FORMAT_VERSION
+    );
+    let mut older = file.to_vec();
+    older[16..20].copy_from_slice(&(OLDEST_SNAPSHOT_FORMAT_VERSION - 1).to_le_bytes());
+    let message = WorldSnapshot::from_bytes(&older).err().unwrap().to_string();
+    assert!(
+        message.contains("format version 1") && message.contains("reads versions 2 to 3"),
+        "{message}"
+    );
+}
+
+/// A snapshot whose joints would make the world unsteppable is refused, naming the joint.
+#[test]
+fn a_snapshot_with_inconsistent_joints_is_invalid() {
+    let mut world = joint_zoo();
+    steps(&mut world, 3, 1);
+    let value = serde_json::to_value(world.snapshot().unwrap()).unwrap();
+    let refused = |edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut value = value.clone();
+        edit(&mut value);
+        let snapshot: WorldSnapshot = serde_json::from_value(value).unwrap();
+        match World::from_snapshot(snapshot) {
+            Err(SnapshotError::Invalid(message)) => message,
+            Err(e) => panic!("another error: {e}"),
+            Ok(_) => panic!("accepted"),
+        }
+    };
+    let joint = |v: &mut serde_json::Value| v["joints"]["joints"][2].clone();
+    let message = refused(&|v| {
+        let mut j = joint(v);
+        j["body_b"] = j["body_a"].clone();
+        v["joints"]["joints"][2] = j;
+    });
+    assert!(
+        message.contains("joint 2 joins a body to itself"),
+        "{message}"
+    );
+    let message = refused(&|v| v["joints"]["joints"][1]["impulses"][3][0] = 1e39.into());
+    assert!(message.contains("joint 1: an anchor, impulse"), "{message}");
+    let message = refused(&|v| {
+        v["joints"]["joints"][0]["rotation_a"] = serde_json::json!([0.0, 0.0, 0.0, 3.0])
+    });
+    assert!(message.contains("joint 0: a frame rotation"), "{message}");
+    let message = refused(&|v| v["joints"]["joints"][6]["break_force"] = (-1.0).into());
+    assert!(message.contains("joint 6: break_force"), "{message}");
+    let message = refused(&|v| {
+        v["joints"]["joints"][0]["dofs"][3]["mode"] =
+            serde_json::json!({"limited": {"lower": 1.0, "upper": -1.0}})
+    });
+    assert!(message.contains("joint 0: limits"), "{message}");
+    let message = refused(&|v| v["joints"]["handles"]["free"] = serde_json::json!([7]));
+    assert!(message.contains("free joint handle slot 7"), "{message}");
 }

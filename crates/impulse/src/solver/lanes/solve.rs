@@ -133,8 +133,11 @@ impl ContactSolver for Bundles {
         &mut self,
         _constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
+        joints: &mut [crate::joint::JointConstraint],
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
+        // Islands with joints are never packed into lanes (`IslandWorkspace::prepare_solver`).
+        debug_assert!(joints.is_empty());
         SolveOutcome::of(EscalationLevel::Pgs, self.solve_pgs(velocities, pass))
     }
 

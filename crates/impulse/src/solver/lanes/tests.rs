@@ -1,5 +1,6 @@
 //! The lanes solver's tests: unit tests of the packing, the lever-arm products, the update and
-//! the record against the scalar rows (here), and whole scenes solved in lanes ([`scenes`]).
+//! the record against the scalar rows (here), whole scenes solved in lanes ([`scenes`]), and
+//! the lanes against the scalar rows on whole scenes ([`scalar_agreement`]).
 
 use super::bundles::Bundles;
 use super::lane::*;
@@ -464,4 +465,5 @@ proptest! {
     }
 }
 
+mod scalar_agreement;
 mod scenes;

@@ -18,6 +18,7 @@ impl World {
             self.parallel,
             &mut self.constraints,
         );
+        self.assemble_joints(settings.warm_start);
     }
 
     /// Whether any body has a restitution coefficient above zero (then islands end their step

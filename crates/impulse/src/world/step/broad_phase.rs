@@ -20,5 +20,13 @@ impl World {
             parallel,
             &mut self.candidates,
         );
+        // Bodies joined by a joint do not collide unless the joint says so.
+        if !self.joints.is_empty() {
+            let joined = self.joined_pairs();
+            if !joined.is_empty() {
+                self.candidates
+                    .retain(|&(a, b)| joined.binary_search(&(a.min(b), a.max(b))).is_err());
+            }
+        }
     }
 }

@@ -362,7 +362,8 @@ impl World {
 
     /// Sweeps every awake dynamic body that moved more than [`FAST_FRACTION`] of its smallest
     /// half extent this step against the static and kinematic bodies in its swept box (the
-    /// broad phase's tree, and the moving kinematic bodies), and puts it back to the earliest
+    /// broad phase's tree, and the moving kinematic bodies; not the bodies it is joined to unless
+    /// the joint lets them collide), and puts it back to the earliest
     /// clamp ([`clamp_fraction`]) with the velocity gravity had given it by then. Each body's clamp reads only its own poses and
     /// the static and kinematic bodies', which no clamp changes, so the order does not matter.
     fn sweep_and_clamp(&mut self, settings: &SolverSettings) {
@@ -376,6 +377,9 @@ impl World {
         }
         let mut clamps = std::mem::take(&mut self.clamps);
         clamps.clear();
+        // Bodies joined without `collide_connected` pass through each other, as in the broad
+        // phase: a door sweeping through its own post is not clamped there.
+        let joined = self.joined_pairs();
         let b = &self.bodies;
         for i in 0..n {
             if !b.is_dynamic(i) || b.asleep[i] || b.pose[i] == self.start_poses[i] {
@@ -411,7 +415,12 @@ impl World {
             let swept = shape.compute_swept_aabb(&sweep.start, &sweep.end);
             let mut earliest = 1.0f32;
             let mut visit = |j: usize| {
-                if j == i || !b.groups_interact(i, j) {
+                if j == i
+                    || !b.groups_interact(i, j)
+                    || joined
+                        .binary_search(&(i.min(j) as u32, i.max(j) as u32))
+                        .is_ok()
+                {
                     return;
                 }
                 let target = Sweep::new(

@@ -12,12 +12,17 @@ impl World {
     /// contiguously and nothing has to be moved afterwards. The union-find is serial; the
     /// world inertia tensors (from the poses alone) are computed beside it.
     pub(super) fn islands_stage(&mut self, parallel: bool) {
+        let joints = if self.joints.is_empty() {
+            Vec::new()
+        } else {
+            self.active_joints()
+        };
         let (islands, world_inverse_inertia) = (&mut self.islands, &mut self.world_inverse_inertia);
         let (bodies, pairs) = (&self.bodies, &self.narrow_phase.pairs);
         both(
             parallel,
             || world_inverse_inertia_of(bodies, parallel, world_inverse_inertia),
-            || islands.build(bodies, pairs),
+            || islands.build(bodies, pairs, &joints),
         );
     }
 }

@@ -18,6 +18,7 @@ impl World {
     /// the pair, manifold and point where assembly put it) then sends the whole stage to the
     /// serial path, which follows each row's `source`.
     pub(super) fn store_impulses_stage(&mut self) {
+        self.store_joint_impulses();
         let constraints = &self.constraints;
         let islands = &self.islands;
         let store = |first_pair: usize, pairs: &mut [narrow_phase::ContactPair]| {

@@ -1,0 +1,81 @@
+//! Every engine on `chain20heavy` (a chain of 20 links with a ball of 100 links' mass at its
+//! end, released horizontally): at its finest setting of the front's grid the chain holds
+//! together, and the ball swings at the chain's length from the pivot.
+
+use glam::Vec3;
+
+use crate::peer::EngineRun;
+use crate::peer_settings::PeerSetting;
+use crate::{BenchRow, scene_by_name};
+
+/// Steps of each run: 2 s at dt = 1/60 s, through the bottom of the first swing, where the
+/// chain pulls hardest.
+const STEPS: u32 = 120;
+
+/// The pivot: the post's face the first link hangs from (m).
+const PIVOT: Vec3 = Vec3::new(0.1, 6.0, 0.0);
+
+/// The rest distance from the pivot to the ball's centre (m): 20 links of 0.25 m and the
+/// ball's radius.
+const REACH: f32 = 20.0 * 0.25 + 0.2;
+
+/// Runs `run` for [`STEPS`] and checks the joint gap and the ball's distance from the pivot:
+/// the gap below `gap_bound` (m; the bound 0.1 m, 2 % of the links' 5 m, is a sanity bound, the
+/// front measures the gap), the ball no farther than the rest distance plus the gap, and the
+/// chain nearly straight (the heavy end pulls it taut).
+fn check(name: &str, mut run: Box<dyn EngineRun>, gap_bound: f64) -> BenchRow {
+    run.advance(STEPS).unwrap();
+    let poses = run.poses();
+    let row = run.finish();
+    let gap = row
+        .max_joint_gap_m
+        .expect("a scene with joints has a joint gap");
+    assert!(gap < gap_bound, "{name}: joint gap {gap} m");
+    let ball = poses.last().unwrap().translation;
+    let reach = (ball - PIVOT).length();
+    assert!(
+        reach <= REACH + gap as f32 + 1e-3 && reach > 0.97 * REACH,
+        "{name}: ball at {reach} m from the pivot, rest distance {REACH} m"
+    );
+    // Through the bottom of the swing, on the other side of the pivot, and below it.
+    assert!(
+        ball.x < PIVOT.x && ball.y < PIVOT.y,
+        "{name}: ball at {ball}"
+    );
+    println!(
+        "{name}: joint gap {:.2} mm, ball at {reach:.4} m",
+        gap * 1e3
+    );
+    row
+}
+
+#[test]
+fn impulse_holds_the_heavy_chain_at_its_default_setting() {
+    let scene = scene_by_name("chain20heavy").unwrap();
+    let run = crate::impulse_engine::ImpulseRun::new(&scene, STEPS, 1, None).unwrap();
+    check("impulse default", Box::new(run), 0.1);
+}
+
+/// Each peer compiled in, at the last (finest) setting of its joint grid.
+#[test]
+fn every_peer_holds_the_heavy_chain_at_its_finest_setting() {
+    let scene = scene_by_name("chain20heavy").unwrap();
+    let config = crate::front::FrontConfig {
+        scenes: vec![scene.name.clone()],
+        ..Default::default()
+    };
+    for grid in config.peer_settings(&scene).unwrap() {
+        let setting: PeerSetting = *grid.last().unwrap();
+        let name = format!("{} {}", setting.engine(), setting.setting_name());
+        let run = crate::engines::start_peer(&scene, STEPS, &setting, &name).unwrap();
+        // Box3D solves its joints as springs of `constraintHertz` (its default 60 Hz, damping
+        // ratio 2, which the front keeps): the heavy ball stretches them by tens of
+        // centimetres whatever the substeps.
+        let bound = if setting.engine() == crate::peer_settings::BOX3D {
+            1.5
+        } else {
+            0.1
+        };
+        check(&name, run, bound);
+    }
+}

@@ -1,0 +1,172 @@
+//! The rules of a joint's values, checked with the same messages by [`crate::World::insert_joint`]
+//! and the scene validator (which adds the file, line and field path).
+
+use std::f32::consts::PI;
+
+use super::types::{AxisMode, JointAxis, JointDof, JointKind, JointStiffness, MotorMode};
+
+/// A broken rule: the field (relative to the joint, e.g. `limits.lower`) and what is wrong.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct JointProblem {
+    pub field: String,
+    pub message: String,
+}
+
+fn problem(field: impl Into<String>, message: impl Into<String>) -> JointProblem {
+    JointProblem {
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+/// `value` finite and > 0.
+fn positive(field: &str, value: f32) -> Result<(), JointProblem> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(problem(
+            field,
+            format!("must be finite and > 0, got {value}"),
+        ))
+    }
+}
+
+/// `value` finite and ≥ 0.
+fn non_negative(field: &str, value: f32) -> Result<(), JointProblem> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(problem(
+            field,
+            format!("must be finite and ≥ 0, got {value}"),
+        ))
+    }
+}
+
+fn finite(field: &str, value: f32) -> Result<(), JointProblem> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(problem(field, format!("must be finite, got {value}")))
+    }
+}
+
+/// The field name of a degree of freedom's part: the kind's main one is named as its builder
+/// calls name it (`limits`, `spring`, `motor`), the others `dofs.<name>.<part>`.
+pub(crate) fn dof_field(kind: JointKind, dof: JointDof, part: &str) -> String {
+    if super::JointBuilder::main_dof(kind) == Some(dof) && kind != JointKind::Generic {
+        part.to_string()
+    } else {
+        format!("dofs.{}.{part}", dof.name())
+    }
+}
+
+/// Checks the degrees of freedom of a joint of `kind`: limits ordered and finite (angles within
+/// [−π, π], a distance joint's lengths ≥ 0 and not both 0), springs and motors well formed
+/// and on non-locked degrees of freedom only.
+pub(crate) fn check_dofs(kind: JointKind, dofs: &[JointAxis; 6]) -> Result<(), JointProblem> {
+    for dof in JointDof::ALL {
+        let axis = &dofs[dof.index()];
+        let field = |part: &str| dof_field(kind, dof, part);
+        if let AxisMode::Limited { lower, upper } = axis.mode {
+            finite(&format!("{}.lower", field("limits")), lower)?;
+            finite(&format!("{}.upper", field("limits")), upper)?;
+            if lower > upper {
+                return Err(problem(
+                    field("limits"),
+                    format!("lower ({lower}) must be ≤ upper ({upper})"),
+                ));
+            }
+            if dof.is_angular() && (lower < -PI || upper > PI) {
+                return Err(problem(
+                    field("limits"),
+                    format!("angles must be within [−π, π], got [{lower}, {upper}]"),
+                ));
+            }
+            if kind == JointKind::Distance
+                && dof == JointDof::LinearX
+                && (lower < 0.0 || upper <= 0.0)
+            {
+                return Err(problem(
+                    field("limits"),
+                    format!("lengths must be ≥ 0 with max > 0, got [{lower}, {upper}]"),
+                ));
+            }
+        }
+        let locked = axis.mode == AxisMode::Locked;
+        if let Some(spring) = axis.spring {
+            if locked {
+                return Err(problem(
+                    field("spring"),
+                    "a locked degree of freedom takes no spring",
+                ));
+            }
+            positive(&format!("{}.hertz", field("spring")), spring.hertz)?;
+            non_negative(
+                &format!("{}.damping_ratio", field("spring")),
+                spring.damping_ratio,
+            )?;
+            finite(&format!("{}.rest", field("spring")), spring.rest)?;
+        }
+        if let Some(motor) = axis.motor {
+            if locked {
+                return Err(problem(
+                    field("motor"),
+                    "a locked degree of freedom takes no motor",
+                ));
+            }
+            non_negative(&format!("{}.max_force", field("motor")), motor.max_force)?;
+            match motor.mode {
+                MotorMode::Velocity { speed } => {
+                    finite(&format!("{}.velocity", field("motor")), speed)?
+                }
+                MotorMode::Position {
+                    target,
+                    hertz,
+                    damping_ratio,
+                } => {
+                    finite(&format!("{}.position", field("motor")), target)?;
+                    positive(&format!("{}.hertz", field("motor")), hertz)?;
+                    non_negative(&format!("{}.damping_ratio", field("motor")), damping_ratio)?;
+                }
+            }
+        }
+    }
+    if kind == JointKind::Distance
+        && !matches!(dofs[0].mode, AxisMode::Limited { .. })
+        && dofs[0].spring.is_none()
+    {
+        return Err(problem(
+            "limits",
+            "a distance joint needs its lengths (min, max) or a spring",
+        ));
+    }
+    Ok(())
+}
+
+/// Checks the repair stiffness and the break thresholds.
+pub(crate) fn check_options(
+    stiffness: JointStiffness,
+    break_force: Option<f32>,
+    break_torque: Option<f32>,
+) -> Result<(), JointProblem> {
+    if let JointStiffness::Soft {
+        hertz,
+        damping_ratio,
+    } = stiffness
+    {
+        positive("stiffness.hertz", hertz)?;
+        non_negative("stiffness.damping_ratio", damping_ratio)?;
+    }
+    for (field, value) in [("break_force", break_force), ("break_torque", break_torque)] {
+        if let Some(value) = value
+            && (value.is_nan() || value <= 0.0)
+        {
+            return Err(problem(
+                field,
+                format!("must be > 0 (may be infinite), got {value}"),
+            ));
+        }
+    }
+    Ok(())
+}

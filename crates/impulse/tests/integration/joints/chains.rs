@@ -1,0 +1,92 @@
+//! Chains hanging at rest: stretch of a 20-link chain, and of one with a ball 100 times a
+//! link's mass at its end.
+
+use impulse::glam::Vec3;
+use impulse::{BodyBuilder, BodyHandle, JointBuilder, SharedShape, SolverSettings, World};
+
+use super::{anchor, world};
+
+/// Half the length of a link (m): links are 0.1 × 0.25 × 0.1 m boxes of 2.5 kg.
+const HALF: f32 = 0.125;
+const LINKS: usize = 20;
+const TOP: f32 = 10.0;
+
+/// A chain of `LINKS` links hanging straight down from a static anchor at (0, TOP, 0), joined
+/// by spherical joints at their ends, with a ball of `end_mass` kg (radius 0.2 m) at its end
+/// when given. Returns the world, the last link and the ball.
+pub(crate) fn hanging_chain(
+    settings: SolverSettings,
+    end_mass: Option<f32>,
+) -> (World, BodyHandle, Option<BodyHandle>) {
+    let mut world = world(settings);
+    let top = anchor(&mut world, Vec3::new(0.0, TOP, 0.0));
+    let mut previous = top;
+    for k in 0..LINKS {
+        let center = Vec3::new(0.0, TOP - HALF * (2 * k + 1) as f32, 0.0);
+        let link = world
+            .insert(BodyBuilder::dynamic(SharedShape::cuboid(0.05, HALF, 0.05)).translation(center))
+            .unwrap();
+        world
+            .insert_joint(
+                JointBuilder::spherical(previous, link)
+                    .world_anchor(center + Vec3::new(0.0, HALF, 0.0)),
+            )
+            .unwrap();
+        previous = link;
+    }
+    let end = TOP - 2.0 * HALF * LINKS as f32;
+    let ball = end_mass.map(|mass| {
+        let ball = world
+            .insert(
+                BodyBuilder::dynamic(SharedShape::ball(0.2))
+                    .translation(Vec3::new(0.0, end - 0.2, 0.0))
+                    .mass(mass),
+            )
+            .unwrap();
+        world
+            .insert_joint(
+                JointBuilder::spherical(previous, ball).world_anchor(Vec3::new(0.0, end, 0.0)),
+            )
+            .unwrap();
+        ball
+    });
+    (world, previous, ball)
+}
+
+/// The chain's stretch after `steps` steps: the distance from the anchor to the last link's
+/// lower end over the chain's length, minus 1.
+pub(crate) fn stretch(world: &World, last: BodyHandle) -> f32 {
+    let body = world.body(last).unwrap();
+    let end = body.translation() + body.rotation() * Vec3::new(0.0, -HALF, 0.0);
+    let length = 2.0 * HALF * LINKS as f32;
+    (Vec3::new(0.0, TOP, 0.0) - end).length() / length - 1.0
+}
+
+fn settled(end_mass: Option<f32>) -> f32 {
+    let settings = SolverSettings {
+        sleep: false,
+        ..SolverSettings::default()
+    };
+    let (mut world, last, _) = hanging_chain(settings, end_mass);
+    for _ in 0..300 {
+        world.step().unwrap();
+    }
+    stretch(&world, last)
+}
+
+#[test]
+fn a_chain_of_twenty_links_hangs_at_rest_without_stretching() {
+    let stretch = settled(None);
+    println!("chain20: stretch after 5 s {:.4} %", 100.0 * stretch);
+    assert!(stretch.abs() < 0.001, "stretch {stretch}");
+}
+
+#[test]
+fn a_heavy_ball_on_a_light_chain_stretches_it_less_than_one_percent() {
+    let stretch = settled(Some(250.0));
+    println!(
+        "chain20 with a 1:100 end ball: stretch after 5 s {:.4} %",
+        100.0 * stretch
+    );
+    assert!(stretch.abs() < 0.01, "stretch {stretch}");
+}
