@@ -13,8 +13,10 @@ use crate::collision::broad_phase::BroadPhase;
 /// Largest penetration depth (m) between any two bodies of `world` at `poses` (one per body, in
 /// the order of [`World::poses`]; pass `world.poses()` for the world's own state, or another
 /// engine's poses of the same bodies), found with Parry's exact contact query on the pairs
-/// whose bounding boxes overlap and whose collision groups interact. 0 when nothing overlaps.
-/// Bodies past the shorter of `poses` and the world's bodies are left out.
+/// whose bounding boxes overlap and whose collision groups interact, leaving out the pairs a
+/// joint joins without letting them collide (their shapes may overlap at the joint by design).
+/// 0 when nothing overlaps. Bodies past the shorter of `poses` and the world's bodies are left
+/// out.
 pub fn max_overlap(world: &World, poses: &[Pose]) -> f32 {
     let bodies = &world.bodies;
     let mut broad_phase = BroadPhase::default();
@@ -33,6 +35,10 @@ pub fn max_overlap(world: &World, poses: &[Pose]) -> f32 {
             ..Bodies::default()
         };
         broad_phase.candidate_pairs(&at_poses, &[], false, &mut pairs);
+    }
+    let joined = world.joined_pairs();
+    if !joined.is_empty() {
+        pairs.retain(|&(a, b)| joined.binary_search(&(a.min(b), a.max(b))).is_err());
     }
     max_overlap_of_pairs(&bodies.shape, poses, &pairs)
 }

@@ -231,7 +231,7 @@ impl World {
 
     /// Sorted pairs (lower index first) of bodies joined by an unbroken joint that does not
     /// let them collide.
-    pub(super) fn joined_pairs(&self) -> Vec<(u32, u32)> {
+    pub(crate) fn joined_pairs(&self) -> Vec<(u32, u32)> {
         let mut pairs: Vec<(u32, u32)> = self
             .joints
             .joints
