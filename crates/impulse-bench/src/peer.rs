@@ -237,9 +237,9 @@ pub(crate) fn impulse_mass(world: &World, i: usize) -> f32 {
 /// One body of every shape that every peer builds (sphere, cuboid, capsule, convex hull; a
 /// particle with a given mass), apart from each other, above a static ground cuboid whose top
 /// face is y = 0, for the peers' tests of their bodies.
-#[cfg(all(test, any(feature = "box3d", feature = "jolt")))]
+#[cfg(all(test, any(feature = "rapier", feature = "box3d", feature = "jolt")))]
 pub(crate) fn peer_zoo() -> Scene {
-    use impulse::scene::BodyKind;
+    use impulse::scene::{BodyKind, ShapeDesc};
     let mut scene = Scene {
         name: "zoo".into(),
         ..Scene::default()

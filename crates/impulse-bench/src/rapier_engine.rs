@@ -252,62 +252,19 @@ fn on_off(b: bool) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use impulse::scene::{BodyDesc, Material, MaterialRef};
+    use impulse::scene::BodyDesc;
 
-    /// One body of every shape and kind, apart from each other, above a half-space ground.
+    /// The peers' zoo ([`crate::peer::peer_zoo`]) on a half-space ground (normal given
+    /// unnormalised), which Rapier builds and the other peers do not.
     fn zoo() -> Scene {
-        let mut scene = Scene {
-            name: "zoo".into(),
-            ..Scene::default()
-        };
-        scene.materials.insert(
-            "light".into(),
-            Material {
-                friction: 0.2,
-                restitution: 0.3,
-                density: 300.0,
-            },
-        );
-        scene.bodies.push(BodyDesc::new(
+        let mut scene = crate::peer::peer_zoo();
+        scene.bodies[0] = BodyDesc::new(
             BodyKind::Static,
             ShapeDesc::HalfSpace {
                 normal: [0.0, 2.0, 0.0],
             },
             [0.0, 0.0, 0.0],
-        ));
-        let shapes = [
-            ShapeDesc::Sphere { radius: 0.5 },
-            ShapeDesc::Cuboid {
-                half_extents: [0.5, 0.25, 1.0],
-            },
-            ShapeDesc::Capsule {
-                half_height: 0.5,
-                radius: 0.25,
-            },
-            ShapeDesc::ConvexHull {
-                points: vec![
-                    [0.0, 0.0, 0.0],
-                    [1.0, 0.0, 0.0],
-                    [0.0, 1.0, 0.0],
-                    [0.0, 0.0, 1.0],
-                ],
-            },
-        ];
-        for (k, shape) in shapes.into_iter().enumerate() {
-            let mut body = BodyDesc::new(BodyKind::Dynamic, shape, [3.0 * k as f32, 5.0, 0.0]);
-            body.orientation = [0.0, 0.0, 0.38268343, 0.9238795];
-            body.angular_velocity = [0.0, 1.0, 0.0];
-            body.material = MaterialRef::Named("light".into());
-            scene.bodies.push(body);
-        }
-        let mut particle = BodyDesc::new(
-            BodyKind::Particle,
-            ShapeDesc::Sphere { radius: 0.25 },
-            [-3.0, 6.0, 0.0],
         );
-        particle.mass = Some(7.0);
-        particle.linear_velocity = [0.0, 0.0, 1.0];
-        scene.bodies.push(particle);
         scene
     }
 
