@@ -5,9 +5,11 @@
 //! `types.rs` the public description of the degrees of freedom, `builder.rs` [`JointBuilder`],
 //! `handle.rs` generational [`JointHandle`]s, `rules.rs` the checks shared with the scene
 //! validator, `frames.rs` the frames and coordinates at given poses, `rows.rs` the rows an
-//! island's step solves ([`JointConstraint`]).
+//! island's step solves ([`JointConstraint`]), `direct.rs` an island's locked rows solved
+//! together ([`IslandJoints`]).
 
 mod builder;
+mod direct;
 mod frames;
 mod handle;
 mod rows;
@@ -19,10 +21,11 @@ use serde::{Deserialize, Serialize};
 
 pub use builder::JointBuilder;
 pub(crate) use builder::{Anchors, Axes, shortest_arc};
+pub(crate) use direct::{IslandJoints, sweep_joints};
 pub(crate) use frames::{LocalFrames, frame_state};
 pub use handle::JointHandle;
 pub(crate) use handle::JointHandles;
-pub(crate) use rows::{JointBody, JointConstraint, JointImpulses, ROWS_PER_DOF, sweep_joints};
+pub(crate) use rows::{JointBody, JointConstraint, JointImpulses, ROWS_PER_DOF};
 pub use types::{
     AxisMode, JointAxis, JointDof, JointKind, JointStiffness, Motor, MotorMode, Spring,
 };

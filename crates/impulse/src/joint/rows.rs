@@ -103,12 +103,17 @@ pub(crate) struct JointRow {
 
 impl JointRow {
     #[inline(always)]
-    fn velocity(&self, [la, aa, lb, ab]: &[Vec3; 4]) -> f32 {
+    pub(super) fn velocity(&self, [la, aa, lb, ab]: &[Vec3; 4]) -> f32 {
         self.linear.dot(*lb - *la) + self.angular_b.dot(*ab) - self.angular_a.dot(*aa)
     }
 
     #[inline(always)]
-    fn apply(&self, j: &JointConstraint, impulse: f32, [la, aa, lb, ab]: &mut [Vec3; 4]) {
+    pub(super) fn apply(
+        &self,
+        j: &JointConstraint,
+        impulse: f32,
+        [la, aa, lb, ab]: &mut [Vec3; 4],
+    ) {
         *la -= j.inverse_mass_a * self.linear * impulse;
         *lb += j.inverse_mass_b * self.linear * impulse;
         *aa -= self.response_a * impulse;
@@ -122,6 +127,17 @@ impl JointRow {
             + self.angular_a.dot(other.response_a)
             + self.angular_b.dot(other.response_b)
     }
+}
+
+/// One row's Jacobian on one movable body: J = sign·(linear, angular) on (v, ω), the body's
+/// per-axis inverse mass and the angular response I⁻¹·angular.
+pub(super) struct RowSide {
+    pub slot: u32,
+    pub sign: f32,
+    pub linear: Vec3,
+    pub inverse_mass: Vec3,
+    pub angular: Vec3,
+    pub response: Vec3,
 }
 
 /// What one row asks in the current solve: whether it acts, the sign of its row (−1 for an
@@ -602,7 +618,7 @@ impl JointConstraint {
         self.check_break();
     }
 
-    fn load(&self, velocities: &Velocities<'_>) -> [Vec3; 4] {
+    pub(super) fn load(&self, velocities: &Velocities<'_>) -> [Vec3; 4] {
         let (a, b) = (self.slot_a as usize, self.slot_b as usize);
         [
             velocities.linear[a],
@@ -614,7 +630,7 @@ impl JointConstraint {
 
     /// Writes the bodies' velocities back; the immovable slot (whose inverse masses are zero,
     /// so nothing changed it) is left alone.
-    fn store(&self, velocities: &mut Velocities<'_>, [la, aa, lb, ab]: [Vec3; 4]) {
+    pub(super) fn store(&self, velocities: &mut Velocities<'_>, [la, aa, lb, ab]: [Vec3; 4]) {
         let (a, b) = (self.slot_a as usize, self.slot_b as usize);
         let immovable = velocities.linear.len() - 1;
         if a != immovable {
@@ -627,9 +643,70 @@ impl JointConstraint {
         }
     }
 
-    /// One Gauss-Seidel pass over the joint's rows; returns the largest row velocity change
-    /// (m/s or rad/s).
-    pub(crate) fn solve(&mut self, velocities: &mut Velocities<'_>) -> f32 {
+    /// The degrees of freedom in a locked group, in order (rotations 3..6 after
+    /// translations 0..3); none for a broken joint.
+    pub(super) fn locked_dofs(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..6).filter(|&i| self.broke.is_none() && self.locked(i))
+    }
+
+    /// Whether side A (`false`) or B (`true`) is a body impulses move (a static or kinematic
+    /// body, or the island's immovable slot, is not).
+    fn movable(&self, b: bool) -> bool {
+        if b {
+            self.inverse_mass_b != Vec3::ZERO || self.inverse_inertia_b != Mat3::ZERO
+        } else {
+            self.inverse_mass_a != Vec3::ZERO || self.inverse_inertia_a != Mat3::ZERO
+        }
+    }
+
+    /// The island slots of the joint's movable bodies.
+    pub(super) fn movable_slots(&self) -> impl Iterator<Item = u32> + '_ {
+        [(self.slot_a, false), (self.slot_b, true)]
+            .into_iter()
+            .filter(|&(_, b)| self.movable(b))
+            .map(|(slot, _)| slot)
+    }
+
+    /// Row `i`'s Jacobian on each movable body, with that body's inverse mass and the row's
+    /// angular response I⁻¹·J_ω: the pieces of K = J M⁻¹ Jᵀ's entries.
+    pub(super) fn movable_sides(&self, i: usize) -> impl Iterator<Item = RowSide> + '_ {
+        let row = &self.rows[i];
+        [
+            (
+                false,
+                self.slot_a,
+                -1.0,
+                self.inverse_mass_a,
+                row.angular_a,
+                row.response_a,
+            ),
+            (
+                true,
+                self.slot_b,
+                1.0,
+                self.inverse_mass_b,
+                row.angular_b,
+                row.response_b,
+            ),
+        ]
+        .into_iter()
+        .filter(|side| self.movable(side.0))
+        .map(
+            move |(_, slot, sign, inverse_mass, angular, response)| RowSide {
+                slot,
+                sign,
+                linear: row.linear,
+                inverse_mass,
+                angular,
+                response,
+            },
+        )
+    }
+
+    /// One Gauss-Seidel pass over the joint's rows, its locked groups as blocks unless
+    /// `locked_groups` is false (the island solves them together: [`super::direct`]); returns
+    /// the largest row velocity change (m/s or rad/s).
+    pub(crate) fn solve(&mut self, velocities: &mut Velocities<'_>, locked_groups: bool) -> f32 {
         if self.broke.is_some() {
             return 0.0;
         }
@@ -661,7 +738,7 @@ impl JointConstraint {
         }
         for (group, start) in [(1, 3), (0, 0)] {
             let locked: [bool; 3] = std::array::from_fn(|k| self.locked(start + k));
-            if !locked.contains(&true) {
+            if !locked_groups || !locked.contains(&true) {
                 continue;
             }
             let mut rhs = Vec3::ZERO;
@@ -724,26 +801,6 @@ impl JointConstraint {
         }
         self.store(velocities, v);
     }
-}
-
-/// Sweeps the joints' rows once, first to last (`forward`) or last to first; returns the
-/// largest row velocity change.
-pub(crate) fn sweep_joints(
-    joints: &mut [JointConstraint],
-    velocities: &mut Velocities<'_>,
-    forward: bool,
-) -> f32 {
-    let mut largest = 0.0f32;
-    if forward {
-        for j in joints.iter_mut() {
-            largest = largest.max(j.solve(velocities));
-        }
-    } else {
-        for j in joints.iter_mut().rev() {
-            largest = largest.max(j.solve(velocities));
-        }
-    }
-    largest
 }
 
 /// An angle difference brought into (−π, π].

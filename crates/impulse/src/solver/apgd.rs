@@ -18,7 +18,7 @@ use super::interface::{
 use super::rows::{Velocities, apply_impulses, impulses};
 use crate::contact::ContactConstraint;
 use crate::contact::cap_to_disc;
-use crate::joint::{JointConstraint, sweep_joints};
+use crate::joint::{IslandJoints, sweep_joints};
 
 /// APGD as a [`ContactSolver`], with its work vectors.
 #[derive(Default)]
@@ -32,7 +32,7 @@ impl ContactSolver for Apgd {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
-        joints: &mut [JointConstraint],
+        joints: &mut IslandJoints,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         solve_scalar(constraints, pass, EscalationLevel::Apgd, |rows| {

@@ -53,7 +53,7 @@ use super::interface::{
 };
 use super::rows::{Velocities, apply_impulses, project_to_friction_disc};
 use crate::contact::ContactConstraint;
-use crate::joint::JointConstraint;
+use crate::joint::{IslandJoints, JointConstraint};
 
 /// The exact path as a [`ContactSolver`]: [`solve_exact`] on islands of at most `max_contacts`
 /// rows (contact points plus joint rows). A failed solve leaves the rows and velocities as they were and says so in
@@ -72,7 +72,7 @@ impl ContactSolver for Exact {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
-        joints: &mut [JointConstraint],
+        joints: &mut IslandJoints,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         let position_repair = set_scalar_targets(constraints, pass);
@@ -235,7 +235,7 @@ const JOINT: usize = 3;
 /// Panics if a local index is outside `velocities`, as the iterative solvers do.
 pub(crate) fn solve_exact(
     constraints: &mut [ContactConstraint],
-    joints: &mut [JointConstraint],
+    joints: &mut IslandJoints,
     velocities: &mut Velocities<'_>,
     max_rows: usize,
     workspace: &mut ExactWorkspace,

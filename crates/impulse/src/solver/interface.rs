@@ -7,7 +7,7 @@ use glam::{Mat3, Vec3};
 
 use super::rows::{Velocities, add_step_impulses, warm_start_substep};
 use crate::contact::{self, ContactConstraint};
-use crate::joint::JointConstraint;
+use crate::joint::IslandJoints;
 use crate::parallel::{RESIDUAL_ROWS_PER_TASK, SharedItems, parts_in_order};
 use crate::settings::SolverSettings;
 
@@ -60,7 +60,7 @@ pub(crate) trait ContactSolver {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
-        joints: &mut [JointConstraint],
+        joints: &mut IslandJoints,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome;
 

@@ -14,7 +14,7 @@ use super::pgs::Pgs;
 use super::policy::Auto;
 use super::rows::Velocities;
 use crate::contact::ContactConstraint;
-use crate::joint::JointConstraint;
+use crate::joint::IslandJoints;
 use crate::settings::SolverMethod;
 #[cfg(doc)]
 use crate::{contact, integrate, solver::Sweep};
@@ -87,7 +87,7 @@ pub(crate) struct IslandWorkspace {
     /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]).
     pub(super) impact_speed: f32,
     /// The rows of the island's joints, written by the assembly stage.
-    pub(crate) joints: Vec<JointConstraint>,
+    pub(crate) joints: IslandJoints,
 }
 
 impl IslandWorkspace {

@@ -8,7 +8,7 @@ use super::pgs::{BACKWARD, FORWARD, FrictionFirstRows, sweep_points};
 use super::rows::{Velocities, apply_impulses, impulses};
 use crate::contact::ContactConstraint;
 use crate::graph::COLOURS;
-use crate::joint::{JointConstraint, sweep_joints};
+use crate::joint::{IslandJoints, sweep_joints};
 use crate::parallel::{
     NORM_POINTS_PER_TASK, SWEEP_POINTS_PER_TASK, SharedVelocities, parts_in_order, spread,
 };
@@ -25,7 +25,7 @@ impl ContactSolver for Nncg {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
-        joints: &mut [JointConstraint],
+        joints: &mut IslandJoints,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         solve_scalar(constraints, pass, EscalationLevel::Nncg, |rows| {
@@ -87,7 +87,7 @@ pub(crate) fn solve_nncg_with_joints(
     tolerance: f32,
     velocities: &mut Velocities<'_>,
     workspace: &mut NncgWorkspace,
-    joints: &mut [JointConstraint],
+    joints: &mut IslandJoints,
 ) -> SolveReport {
     let n = constraints.len();
     workspace.previous.clear();

@@ -13,7 +13,7 @@ use super::interface::{
 use super::rows::{Velocities, project_to_friction_disc};
 use crate::contact::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours};
-use crate::joint::{JointConstraint, sweep_joints};
+use crate::joint::{IslandJoints, sweep_joints};
 use crate::parallel::{
     SWEEP_POINTS_PER_TASK, SharedVelocities, colour_after_colour, prefetch_lines, spread,
 };
@@ -27,7 +27,7 @@ impl ContactSolver for Pgs {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
-        joints: &mut [JointConstraint],
+        joints: &mut IslandJoints,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         solve_scalar(constraints, pass, EscalationLevel::Pgs, |rows| {
@@ -294,7 +294,7 @@ pub(crate) fn solve_pgs_rows(
     velocities: &mut Velocities<'_>,
     friction: bool,
     half_turn: bool,
-    joints: &mut [JointConstraint],
+    joints: &mut IslandJoints,
 ) -> SolveReport {
     let mut report = SolveReport::default();
     for iteration in 0..iterations {

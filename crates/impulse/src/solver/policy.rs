@@ -61,7 +61,7 @@ impl ContactSolver for Auto {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
-        joints: &mut [crate::joint::JointConstraint],
+        joints: &mut crate::joint::IslandJoints,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         let limits = self.limits;

@@ -112,15 +112,14 @@ impl IslandWorkspace {
             pass
         };
         if !self.joints.is_empty() && pass.targets.is_some() {
-            for joint in &mut self.joints {
-                joint.update_targets(&self.displacement, &self.orientation, with_repair);
-            }
+            self.joints
+                .update_targets(&self.displacement, &self.orientation, with_repair);
         }
         let mut velocities = Velocities {
             linear: &mut self.linear,
             angular: &mut self.angular,
         };
-        let joints = &mut self.joints[..];
+        let joints = &mut self.joints;
         let solver = self.solvers.substeps(settings.method, bundled);
         let outcome = solver.solve(constraints, &mut velocities, joints, &pass);
         self.impact_met = if with_repair {
@@ -213,9 +212,7 @@ pub(crate) fn step_island(
     // The substeps cover the whole step: on the heavy-on-light path, one substep of dt.
     let h = context.dt / settings.substeps as f32;
     w.step_constants(island_bodies, context, h);
-    for joint in &mut w.joints {
-        joint.start_step(h);
-    }
+    w.joints.start_step(h);
     w.start_solves(constraints, settings, context);
     let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
     for substep in 0..settings.substeps {

@@ -133,7 +133,7 @@ impl ContactSolver for Bundles {
         &mut self,
         _constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
-        joints: &mut [crate::joint::JointConstraint],
+        joints: &mut crate::joint::IslandJoints,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
         // Islands with joints are never packed into lanes (`IslandWorkspace::prepare_solver`).

@@ -1,0 +1,456 @@
+//! An island's locked joint rows solved together ([`IslandJoints`]): one sparse Cholesky
+//! factorization of their K = J M⁻¹ Jᵀ per solve, and each sweep's update of all of them at once
+//! from it, in place of one locked group after another.
+//!
+//! Gauss-Seidel over the joints of a chain passes a load on by one link a sweep, and a heavy
+//! body at the end of light links needs far more sweeps than a substep has (a 100:1 chain
+//! swinging at the default preset stretched by 1.7 % of its length). The locked rows are
+//! equalities, so their block of the LCP is a linear system: solved directly, a chain or a
+//! ragdoll holds its joints exactly after every sweep, whatever the mass ratio, and the
+//! sweeps are left to the contacts, limits, springs and motors (block Gauss-Seidel with the
+//! locked rows as one block). The soft form is the locked groups' (docs/method.md,
+//! "Joints"): Δλ = −s_m·K⁻¹(J·v + bias) − s_i·λ row by row, so a rigid solve (the relax
+//! solve's) leaves J·v = 0 on every locked row.
+//!
+//! K is sparse: two joints' rows couple only through a body they share. The joints are put in
+//! reverse Cuthill-McKee order over that graph (Cuthill and McKee 1969; George and Liu,
+//! "Computer Solution of Large Sparse Positive Definite Systems", 1981), which keeps every
+//! row's nonzeros close to the diagonal, and the factor is stored in that envelope (a
+//! skyline): a chain or a tree of joints factors in time linear in its rows, without fill
+//! beyond the envelope. The factorization is in f64: a chain with a 100:1 end mass makes K
+//! ill-conditioned for f32's 24 bits.
+//!
+//! Breakable joints keep the per-joint groups: their groups' impulses are bounded by their
+//! strength one group at a time ([`JointConstraint::solve`]).
+
+use std::ops::{Deref, DerefMut};
+
+use super::rows::{JointConstraint, LOCK};
+use crate::solver::rows::Velocities;
+
+/// Diagonal regularization relative to each locked row's K_pp: keeps K positive definite when
+/// rows are redundant (a loop of joints, or two joints holding the same degree of freedom),
+/// as the locked groups' blocks do.
+const REGULARIZATION: f64 = 1e-6;
+
+/// Most locked rows an island solves directly (its envelope grows with the joint graph's
+/// bandwidth; a larger island keeps the per-joint groups).
+const MAX_DIRECT_ROWS: usize = 4096;
+
+/// Most factor entries per row (the envelope's mean width) an island solves directly.
+const MAX_ENVELOPE_PER_ROW: usize = 96;
+
+/// The joints of an island's step: their rows ([`JointConstraint`], the vector this derefs to)
+/// and, when the island has two or more joints with locked rows and none breakable, the
+/// factorization that solves those rows together.
+#[derive(Debug, Default)]
+pub(crate) struct IslandJoints {
+    constraints: Vec<JointConstraint>,
+    direct: Option<LockedRows>,
+}
+
+impl Deref for IslandJoints {
+    type Target = Vec<JointConstraint>;
+    fn deref(&self) -> &Vec<JointConstraint> {
+        &self.constraints
+    }
+}
+
+impl DerefMut for IslandJoints {
+    fn deref_mut(&mut self) -> &mut Vec<JointConstraint> {
+        &mut self.constraints
+    }
+}
+
+impl<'a> IntoIterator for &'a IslandJoints {
+    type Item = &'a JointConstraint;
+    type IntoIter = std::slice::Iter<'a, JointConstraint>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.constraints.iter()
+    }
+}
+
+impl<'a> IntoIterator for &'a mut IslandJoints {
+    type Item = &'a mut JointConstraint;
+    type IntoIter = std::slice::IterMut<'a, JointConstraint>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.constraints.iter_mut()
+    }
+}
+
+impl IslandJoints {
+    /// Starts a step of substeps of `h` seconds: every joint's substep length, and the order
+    /// and envelope of the locked rows (the joints were assembled for this step).
+    pub(crate) fn start_step(&mut self, h: f32) {
+        for joint in &mut self.constraints {
+            joint.start_step(h);
+        }
+        self.direct = LockedRows::new(&self.constraints);
+    }
+
+    /// Every joint's targets at the island's current poses (the main solve with repair, the
+    /// relax solve without; [`JointConstraint::update_targets`]), then the locked rows' K
+    /// factorized at those poses.
+    pub(crate) fn update_targets(
+        &mut self,
+        displacement: &[glam::Vec3],
+        orientation: &[glam::Quat],
+        with_repair: bool,
+    ) {
+        for joint in &mut self.constraints {
+            joint.update_targets(displacement, orientation, with_repair);
+        }
+        if let Some(direct) = &mut self.direct {
+            direct.factorize(&self.constraints);
+        }
+    }
+
+    /// Whether this island's locked rows are solved together (for tests and reports).
+    #[cfg(test)]
+    pub(crate) fn solves_directly(&self) -> bool {
+        self.direct.as_ref().is_some_and(|d| d.factorized)
+    }
+}
+
+/// Sweeps the joints' rows once, first to last (`forward`) or last to first; returns the
+/// largest row velocity change (m/s or rad/s). With the locked rows factorized, each joint's
+/// springs, motors and limits are swept and then every locked row is solved at once;
+/// otherwise each joint takes its rows in turn, its locked groups as blocks.
+pub(crate) fn sweep_joints(
+    joints: &mut IslandJoints,
+    velocities: &mut Velocities<'_>,
+    forward: bool,
+) -> f32 {
+    let IslandJoints {
+        constraints,
+        direct,
+    } = joints;
+    let direct = direct.as_mut().filter(|d| d.factorized);
+    let locked_groups = direct.is_none();
+    let mut largest = 0.0f32;
+    if forward {
+        for j in constraints.iter_mut() {
+            largest = largest.max(j.solve(velocities, locked_groups));
+        }
+    } else {
+        for j in constraints.iter_mut().rev() {
+            largest = largest.max(j.solve(velocities, locked_groups));
+        }
+    }
+    if let Some(direct) = direct {
+        largest = largest.max(direct.solve(constraints, velocities));
+    }
+    largest
+}
+
+/// The locked rows of an island's joints in elimination order, and the Cholesky factor of
+/// their K in its envelope.
+#[derive(Debug)]
+struct LockedRows {
+    /// (joint, degree of freedom) of each row, in elimination order; a joint's rows are
+    /// consecutive.
+    rows: Vec<(u32, u8)>,
+    /// The first column of each row's envelope (the first row of the earliest joint sharing a
+    /// body with its joint, or of its own joint).
+    first: Vec<u32>,
+    /// Where each row's envelope starts in `factor` (one more entry than rows).
+    offsets: Vec<usize>,
+    /// L (K = L·Lᵀ) by rows: row p holds columns first[p]..=p.
+    factor: Vec<f64>,
+    /// 1/L_pp.
+    inverse_diagonal: Vec<f64>,
+    /// Whether `factor` holds the factorization of the current K.
+    factorized: bool,
+    /// Work space: the right-hand side, then the solution.
+    work: Vec<f64>,
+    /// Each row's velocity J·v before the update (m/s or rad/s).
+    velocity: Vec<f32>,
+    /// Each row's Jacobian on its (up to two) movable bodies.
+    sides: Vec<[SignedSide; 2]>,
+}
+
+/// A row's Jacobian on one movable body, its sign folded in: J = (linear, angular) on (v, ω),
+/// M⁻¹Jᵀ = (moved, response).
+#[derive(Clone, Copy, Debug)]
+struct SignedSide {
+    /// The body's island slot; `u32::MAX` for no body.
+    slot: u32,
+    linear: glam::Vec3,
+    moved: glam::Vec3,
+    angular: glam::Vec3,
+    response: glam::Vec3,
+}
+
+impl SignedSide {
+    const IMMOVABLE: Self = Self {
+        slot: u32::MAX,
+        linear: glam::Vec3::ZERO,
+        moved: glam::Vec3::ZERO,
+        angular: glam::Vec3::ZERO,
+        response: glam::Vec3::ZERO,
+    };
+}
+
+impl LockedRows {
+    /// The elimination order and envelope of `joints`' locked rows; `None` when they are not
+    /// solved together (fewer than two joints with locked rows, a breakable joint, or too many
+    /// rows).
+    fn new(joints: &[JointConstraint]) -> Option<Self> {
+        if joints.iter().any(JointConstraint::is_breakable) {
+            return None;
+        }
+        let with_rows: Vec<usize> = (0..joints.len())
+            .filter(|&j| joints[j].broke.is_none() && joints[j].locked_dofs().next().is_some())
+            .collect();
+        if with_rows.len() < 2 {
+            return None;
+        }
+        let order = reverse_cuthill_mckee(joints, &with_rows);
+        let mut rows = Vec::new();
+        let mut start_row = vec![u32::MAX; joints.len()];
+        let mut position = vec![usize::MAX; joints.len()];
+        for (p, &j) in order.iter().enumerate() {
+            position[j] = p;
+            start_row[j] = rows.len() as u32;
+            rows.extend(joints[j].locked_dofs().map(|i| (j as u32, i as u8)));
+        }
+        if rows.len() > MAX_DIRECT_ROWS {
+            return None;
+        }
+        let neighbours = neighbours(joints, &with_rows);
+        let mut first = Vec::with_capacity(rows.len());
+        let mut offsets = Vec::with_capacity(rows.len() + 1);
+        offsets.push(0);
+        for (p, &(j, _)) in rows.iter().enumerate() {
+            let j = j as usize;
+            let earliest = neighbours[j]
+                .iter()
+                .filter(|&&k| position[k] < position[j])
+                .map(|&k| start_row[k])
+                .fold(start_row[j], u32::min);
+            first.push(earliest);
+            offsets.push(offsets[p] + p + 1 - earliest as usize);
+        }
+        // A joint graph of wide bandwidth (a dense mesh of joints) keeps the per-joint groups.
+        if offsets[rows.len()] > MAX_ENVELOPE_PER_ROW * rows.len() {
+            return None;
+        }
+        Some(Self {
+            factor: vec![0.0; offsets[rows.len()]],
+            work: vec![0.0; rows.len()],
+            velocity: vec![0.0; rows.len()],
+            inverse_diagonal: vec![0.0; rows.len()],
+            sides: vec![[SignedSide::IMMOVABLE; 2]; rows.len()],
+            rows,
+            first,
+            offsets,
+            factorized: false,
+        })
+    }
+
+    /// Each row's Jacobian on its movable bodies at the joints' current rows.
+    fn gather_sides(&mut self, joints: &[JointConstraint]) {
+        for (p, &(j, i)) in self.rows.iter().enumerate() {
+            let mut sides = [SignedSide::IMMOVABLE; 2];
+            for (side, row) in sides
+                .iter_mut()
+                .zip(joints[j as usize].movable_sides(i as usize))
+            {
+                *side = SignedSide {
+                    slot: row.slot,
+                    linear: row.sign * row.linear,
+                    moved: row.sign * row.inverse_mass * row.linear,
+                    angular: row.sign * row.angular,
+                    response: row.sign * row.response,
+                };
+            }
+            self.sides[p] = sides;
+        }
+    }
+
+    /// K at the joints' current rows, factorized in place; leaves `factorized` false (the
+    /// per-joint groups take over) if a pivot is not positive and finite.
+    fn factorize(&mut self, joints: &[JointConstraint]) {
+        self.factorized = false;
+        self.gather_sides(joints);
+        let n = self.rows.len();
+        for p in 0..n {
+            let first_p = self.first[p] as usize;
+            let (done, current) = self.factor.split_at_mut(self.offsets[p]);
+            let (offsets, sides) = (&self.offsets, &self.sides);
+            let row_p = &mut current[..=p - first_p];
+            for q in first_p..p {
+                let first_q = self.first[q] as usize;
+                let row_q = &done[offsets[q]..offsets[q + 1]];
+                let start = first_p.max(first_q);
+                let mut s = coupling(sides, p, q);
+                for (a, b) in row_p[start - first_p..q - first_p]
+                    .iter()
+                    .zip(&row_q[start - first_q..q - first_q])
+                {
+                    s -= a * b;
+                }
+                row_p[q - first_p] = s * self.inverse_diagonal[q];
+            }
+            let diagonal = coupling(sides, p, p);
+            // A row no body responds to (both sides immovable on it) is left inert.
+            if diagonal <= 1e-12 {
+                row_p.fill(0.0);
+                row_p[p - first_p] = 1.0;
+                self.inverse_diagonal[p] = 1.0;
+                continue;
+            }
+            let (off_diagonal, pivot) = row_p.split_at_mut(p - first_p);
+            let s =
+                diagonal * (1.0 + REGULARIZATION) - off_diagonal.iter().map(|l| l * l).sum::<f64>();
+            if !(s.is_finite() && s > diagonal * REGULARIZATION * 0.5) {
+                return;
+            }
+            pivot[0] = s.sqrt();
+            self.inverse_diagonal[p] = 1.0 / pivot[0];
+        }
+        self.factorized = true;
+    }
+
+    /// One update of every locked row at once: r = J·v + bias at the current velocities,
+    /// x = K⁻¹·r, Δλ = −s_m·x − s_i·λ, applied to the bodies. Returns the largest row velocity
+    /// change.
+    fn solve(&mut self, joints: &mut [JointConstraint], velocities: &mut Velocities<'_>) -> f32 {
+        let n = self.rows.len();
+        let mut p = 0;
+        while p < n {
+            let j = self.rows[p].0 as usize;
+            let joint = &joints[j];
+            let v = joint.load(velocities);
+            while p < n && self.rows[p].0 as usize == j {
+                let i = self.rows[p].1 as usize;
+                let velocity = joint.rows[i].velocity(&v);
+                self.velocity[p] = velocity;
+                self.work[p] = f64::from(velocity + joint.targets[i][LOCK].bias);
+                p += 1;
+            }
+        }
+        // L·y = r, then Lᵀ·x = y, both in the envelope.
+        for p in 0..n {
+            let first = self.first[p] as usize;
+            let row = self.offsets[p];
+            let mut s = self.work[p];
+            for k in first..p {
+                s -= self.factor[row + k - first] * self.work[k];
+            }
+            self.work[p] = s * self.inverse_diagonal[p];
+        }
+        for p in (0..n).rev() {
+            let first = self.first[p] as usize;
+            let row = self.offsets[p];
+            let x = self.work[p] * self.inverse_diagonal[p];
+            self.work[p] = x;
+            for k in first..p {
+                self.work[k] -= self.factor[row + k - first] * x;
+            }
+        }
+        let mut p = 0;
+        while p < n {
+            let j = self.rows[p].0 as usize;
+            let joint = &mut joints[j];
+            let mut v = joint.load(velocities);
+            while p < n && self.rows[p].0 as usize == j {
+                let i = self.rows[p].1 as usize;
+                let target = joint.targets[i][LOCK];
+                let old = joint.impulses[i][LOCK];
+                let delta = -(self.work[p] as f32) * target.mass_scale - old * target.impulse_scale;
+                if delta != 0.0 && delta.is_finite() {
+                    joint.impulses[i][LOCK] = old + delta;
+                    let row = joint.rows[i];
+                    row.apply(joint, delta, &mut v);
+                }
+                p += 1;
+            }
+            joint.store(velocities, v);
+        }
+        // The change reported is each row's velocity change, J·Δv, read back once every
+        // impulse is applied (a row's Δλ·K_pp would count the coupled rows' share twice).
+        let mut largest = 0.0f32;
+        let mut p = 0;
+        while p < n {
+            let j = self.rows[p].0 as usize;
+            let joint = &joints[j];
+            let v = joint.load(velocities);
+            while p < n && self.rows[p].0 as usize == j {
+                let i = self.rows[p].1 as usize;
+                largest = largest.max((joint.rows[i].velocity(&v) - self.velocity[p]).abs());
+                p += 1;
+            }
+        }
+        largest
+    }
+}
+
+/// Entry (p, q) of K = J M⁻¹ Jᵀ: the two rows' coupling through each body they share.
+#[inline]
+fn coupling(sides: &[[SignedSide; 2]], p: usize, q: usize) -> f64 {
+    let mut sum = 0.0f32;
+    for a in &sides[p] {
+        for b in &sides[q] {
+            if a.slot == b.slot && a.slot != u32::MAX {
+                sum += a.linear.dot(b.moved) + a.angular.dot(b.response);
+            }
+        }
+    }
+    f64::from(sum)
+}
+
+/// The joints (of `with_rows`) sharing a movable body with each joint.
+fn neighbours(joints: &[JointConstraint], with_rows: &[usize]) -> Vec<Vec<usize>> {
+    let mut by_slot: std::collections::HashMap<u32, Vec<usize>> = Default::default();
+    for &j in with_rows {
+        for slot in joints[j].movable_slots() {
+            by_slot.entry(slot).or_default().push(j);
+        }
+    }
+    let mut neighbours = vec![Vec::new(); joints.len()];
+    for &j in with_rows {
+        let list: &mut Vec<usize> = &mut neighbours[j];
+        for slot in joints[j].movable_slots() {
+            list.extend(by_slot[&slot].iter().copied().filter(|&k| k != j));
+        }
+        list.sort_unstable();
+        list.dedup();
+    }
+    neighbours
+}
+
+/// The joints of `with_rows` in reverse Cuthill-McKee order over the graph of shared movable
+/// bodies: breadth first from a joint of least degree in each connected part, neighbours by
+/// increasing degree, the whole order reversed.
+fn reverse_cuthill_mckee(joints: &[JointConstraint], with_rows: &[usize]) -> Vec<usize> {
+    let neighbours = neighbours(joints, with_rows);
+    let mut by_degree = with_rows.to_vec();
+    by_degree.sort_by_key(|&j| (neighbours[j].len(), j));
+    let mut visited = vec![false; joints.len()];
+    let mut order = Vec::with_capacity(with_rows.len());
+    for &start in &by_degree {
+        if visited[start] {
+            continue;
+        }
+        visited[start] = true;
+        let mut head = order.len();
+        order.push(start);
+        while head < order.len() {
+            let j = order[head];
+            head += 1;
+            let mut next: Vec<usize> = neighbours[j]
+                .iter()
+                .copied()
+                .filter(|&k| !visited[k])
+                .collect();
+            next.sort_by_key(|&k| (neighbours[k].len(), k));
+            for k in next {
+                visited[k] = true;
+                order.push(k);
+            }
+        }
+    }
+    order.reverse();
+    order
+}
