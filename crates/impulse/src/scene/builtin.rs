@@ -118,6 +118,10 @@ const NAMES: &[(&str, &str)] = &[
         "joints: an 11-body ragdoll (hinges with limits, ball joints) dropped on stairs",
     ),
     (
+        "ragdollpile",
+        "joints: eight ragdolls dropped onto one another on the ground (88 bodies)",
+    ),
+    (
         "bridge",
         "joints: 16 planks on hinges between two abutments, six cubes dropped on it",
     ),
@@ -178,6 +182,7 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
         "chain20" => return Some(super::builtin_joints::chain20()),
         "chain20heavy" => return Some(super::builtin_joints::chain20heavy()),
         "ragdoll" => return Some(super::builtin_joints::ragdoll()),
+        "ragdollpile" => return Some(super::builtin_joints::ragdollpile()),
         "bridge" => return Some(super::builtin_joints::bridge()),
         _ => {}
     }

@@ -1,7 +1,7 @@
 //! The built-in scenes with joints: `chain20` (a chain of 20 links swinging down from a
 //! horizontal start), `chain20heavy` (the same chain with a ball of 100 links' mass at its
-//! end), `ragdoll` (an 11-body ragdoll dropped on stairs) and `bridge` (a plank
-//! bridge on hinges carrying falling boxes).
+//! end), `ragdoll` (an 11-body ragdoll dropped on stairs), `ragdollpile` (eight of them
+//! dropped onto one another) and `bridge` (a plank bridge on hinges carrying falling boxes).
 
 use super::joint_desc::{DofDesc, MotorDesc};
 use super::{BodyDesc, BodyKind, BodyName, JointDesc, Scene, ShapeDesc};
@@ -146,60 +146,74 @@ pub(super) fn ragdoll() -> Scene {
             [0.5 * step as f32, height / 2.0, 0.0],
         ));
     }
-    let y = 3.2f32;
+    add_ragdoll(&mut scene, [0.0, 3.2, 0.0]);
+    scene
+}
+
+/// An 11-body ragdoll (pelvis, torso, head, upper and lower arms and legs) standing with its
+/// pelvis at `origin` (m): spherical neck, shoulders and hips, a spine and knees and elbows on
+/// limited hinges, every joint with friction ([`RAGDOLL_JOINT_FRICTION`]).
+fn add_ragdoll(scene: &mut Scene, origin: [f32; 3]) {
+    let [ox, y, oz] = origin;
     let add = |scene: &mut Scene, name: &str, half: [f32; 3], at: [f32; 3]| {
+        let at = [at[0] + ox, at[1], at[2] + oz];
         let mut b = body(BodyKind::Dynamic, cuboid(half), at);
         b.name = Some(name.to_string());
         scene.bodies.push(b);
         scene.bodies.len() - 1
     };
-    let pelvis = add(&mut scene, "pelvis", [0.15, 0.1, 0.1], [0.0, y, 0.0]);
-    let torso = add(&mut scene, "torso", [0.17, 0.25, 0.1], [0.0, y + 0.37, 0.0]);
-    let head = add(&mut scene, "head", [0.1, 0.1, 0.1], [0.0, y + 0.74, 0.0]);
+    let pelvis = add(scene, "pelvis", [0.15, 0.1, 0.1], [0.0, y, 0.0]);
+    let torso = add(scene, "torso", [0.17, 0.25, 0.1], [0.0, y + 0.37, 0.0]);
+    let head = add(scene, "head", [0.1, 0.1, 0.1], [0.0, y + 0.74, 0.0]);
     let hinge = |scene: &mut Scene, a: usize, b: usize, at: [f32; 3], limits: [f32; 2]| {
+        let at = [at[0] + ox, at[1], at[2] + oz];
         let mut j = joint(JointKind::Revolute, a, b, at);
         j.axis = Some([1.0, 0.0, 0.0]);
         j.limits = Some(limits);
         j.motor = Some(friction_motor());
         scene.joints.push(j);
     };
-    hinge(&mut scene, pelvis, torso, [0.0, y + 0.11, 0.0], [-0.5, 0.8]);
+    hinge(scene, pelvis, torso, [0.0, y + 0.11, 0.0], [-0.5, 0.8]);
     scene
         .joints
-        .push(spherical_with_friction(torso, head, [0.0, y + 0.63, 0.0]));
+        .push(spherical_with_friction(torso, head, [ox, y + 0.63, oz]));
     for side in [-1.0f32, 1.0] {
         let x = 0.25 * side;
-        let upper_arm = add(
-            &mut scene,
-            "upper_arm",
-            [0.05, 0.15, 0.05],
-            [x, y + 0.45, 0.0],
-        );
-        let lower_arm = add(
-            &mut scene,
-            "lower_arm",
-            [0.05, 0.14, 0.05],
-            [x, y + 0.15, 0.0],
-        );
+        let upper_arm = add(scene, "upper_arm", [0.05, 0.15, 0.05], [x, y + 0.45, 0.0]);
+        let lower_arm = add(scene, "lower_arm", [0.05, 0.14, 0.05], [x, y + 0.15, 0.0]);
         scene.joints.push(spherical_with_friction(
             torso,
             upper_arm,
-            [x, y + 0.61, 0.0],
+            [x + ox, y + 0.61, oz],
         ));
-        hinge(
-            &mut scene,
-            upper_arm,
-            lower_arm,
-            [x, y + 0.30, 0.0],
-            [-2.5, 0.0],
-        );
+        hinge(scene, upper_arm, lower_arm, [x, y + 0.30, 0.0], [-2.5, 0.0]);
         let x = 0.09 * side;
-        let thigh = add(&mut scene, "thigh", [0.07, 0.2, 0.07], [x, y - 0.31, 0.0]);
-        let shin = add(&mut scene, "shin", [0.06, 0.2, 0.06], [x, y - 0.72, 0.0]);
-        scene
-            .joints
-            .push(spherical_with_friction(pelvis, thigh, [x, y - 0.1, 0.0]));
-        hinge(&mut scene, thigh, shin, [x, y - 0.515, 0.0], [0.0, 2.5]);
+        let thigh = add(scene, "thigh", [0.07, 0.2, 0.07], [x, y - 0.31, 0.0]);
+        let shin = add(scene, "shin", [0.06, 0.2, 0.06], [x, y - 0.72, 0.0]);
+        scene.joints.push(spherical_with_friction(
+            pelvis,
+            thigh,
+            [x + ox, y - 0.1, oz],
+        ));
+        hinge(scene, thigh, shin, [x, y - 0.515, 0.0], [0.0, 2.5]);
+    }
+}
+
+/// Eight ragdolls ([`add_ragdoll`]) dropped in two columns of four onto the ground, each a
+/// little offset from the one below so that they topple onto one another and come to rest in a
+/// pile: 88 bodies, 80 joints and the contacts between the limbs in one island.
+pub(super) fn ragdollpile() -> Scene {
+    let mut scene = Scene {
+        name: "ragdollpile".into(),
+        ..Scene::default()
+    };
+    ground(&mut scene);
+    for column in 0..2 {
+        for level in 0..4 {
+            let x = 0.6 * column as f32 - 0.3 + 0.12 * level as f32;
+            let z = 0.1 * level as f32 - 0.15;
+            add_ragdoll(&mut scene, [x, 1.0 + 1.9 * level as f32, z]);
+        }
     }
     scene
 }

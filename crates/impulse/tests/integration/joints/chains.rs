@@ -1,5 +1,6 @@
 //! Chains hanging at rest: stretch of a 20-link chain, and of one with a ball 100 times a
-//! link's mass at its end; the heavy-ended chain swinging (`chain20heavy`).
+//! link's mass at its end; the heavy-ended chain swinging (`chain20heavy`); a pile of eight
+//! ragdolls coming to rest (`ragdollpile`).
 
 use impulse::glam::Vec3;
 use impulse::scene::builtin_scene;
@@ -145,4 +146,26 @@ fn a_swinging_heavy_ended_chain_solves_its_locked_rows_together() {
     let largest = w.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     println!("chain20heavy at 1 s: largest |Aλ − b| of the locked rows {largest:.3e} m/s");
     assert!(largest < 1e-3, "{w:?}");
+}
+
+/// `ragdollpile`: eight ragdolls (88 bodies, 80 joints with limits and joint friction) dropped
+/// onto one another come to rest with sleeping off: over the sixth second the kinetic energy
+/// stays at most 1e-4 J per body (the bar for a pile at rest), at the default preset.
+#[test]
+fn a_pile_of_eight_ragdolls_comes_to_rest() {
+    let mut scene = builtin_scene("ragdollpile").unwrap();
+    scene.solver.sleep = false;
+    let mut world = World::from_scene(&scene).unwrap();
+    let moving = world.body_count() - 1;
+    let mut at_rest = 0.0f64;
+    for step in 1..=330 {
+        world.step().unwrap();
+        if step >= 300 {
+            at_rest = at_rest.max(world.energy().kinetic / moving as f64);
+        }
+    }
+    println!(
+        "ragdollpile: largest kinetic energy over 5-5.5 s {at_rest:.3e} J per body ({moving} bodies)"
+    );
+    assert!(at_rest <= 1e-4, "{at_rest} J per body");
 }
