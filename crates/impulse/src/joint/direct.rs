@@ -3,8 +3,8 @@
 //! from it, in place of one locked group after another.
 //!
 //! Gauss-Seidel over the joints of a chain passes a load on by one link a sweep, and a heavy
-//! body at the end of light links needs far more sweeps than a substep has (a 100:1 chain
-//! swinging at the default preset stretched by 1.7 % of its length). The locked rows are
+//! body at the end of light links needs far more sweeps than a substep has: the chain
+//! stretches. The locked rows are
 //! equalities, so their block of the LCP is a linear system: solved directly, a chain or a
 //! ragdoll holds its joints exactly after every sweep, whatever the mass ratio, and the
 //! sweeps are left to the contacts, limits, springs and motors (block Gauss-Seidel with the
@@ -20,7 +20,9 @@
 //! beyond the envelope. The factorization is in f64: a chain with a 100:1 end mass makes K
 //! ill-conditioned for f32's 24 bits.
 //!
-//! Breakable joints keep the per-joint groups: their groups' impulses are bounded by their
+//! The joints solved together are a spanning forest of the island's bodies ([`spanning_forest`]):
+//! a joint closing a loop keeps its own locked groups, swept with the springs and limits.
+//! Breakable joints keep the per-joint groups too: their groups' impulses are bounded by their
 //! strength one group at a time ([`JointConstraint::solve`]).
 
 use std::ops::{Deref, DerefMut};
@@ -28,10 +30,12 @@ use std::ops::{Deref, DerefMut};
 use super::rows::{JointConstraint, LOCK};
 use crate::solver::rows::Velocities;
 
-/// Diagonal regularization relative to each locked row's K_pp: keeps K positive definite when
-/// rows are redundant (a loop of joints, or two joints holding the same degree of freedom),
-/// as the locked groups' blocks do.
-const REGULARIZATION: f64 = 1e-6;
+/// A locked row whose pivot is at most this fraction of its K_pp depends on the rows before it
+/// in the order (to the rounding of f32 Jacobians): it is left out of the factorization, as a
+/// rank-revealing Cholesky drops it, rather than regularized: a regularized redundant row
+/// takes an impulse of the rounding over the regularization, which the f32 velocities cannot
+/// cancel.
+const DEPENDENT: f64 = 1e-6;
 
 /// Most locked rows an island solves directly (its envelope grows with the joint graph's
 /// bandwidth; a larger island keeps the per-joint groups).
@@ -41,8 +45,8 @@ const MAX_DIRECT_ROWS: usize = 4096;
 const MAX_ENVELOPE_PER_ROW: usize = 96;
 
 /// The joints of an island's step: their rows ([`JointConstraint`], the vector this derefs to)
-/// and, when the island has two or more joints with locked rows and none breakable, the
-/// factorization that solves those rows together.
+/// and, when two or more of its joints with locked rows form a forest and none is breakable,
+/// the factorization that solves those rows together.
 #[derive(Debug, Default)]
 pub(crate) struct IslandJoints {
     constraints: Vec<JointConstraint>,
@@ -114,8 +118,9 @@ impl IslandJoints {
 
 /// Sweeps the joints' rows once, first to last (`forward`) or last to first; returns the
 /// largest row velocity change (m/s or rad/s). With the locked rows factorized, each joint's
-/// springs, motors and limits are swept and then every locked row is solved at once;
-/// otherwise each joint takes its rows in turn, its locked groups as blocks.
+/// springs, motors and limits are swept (a joint closing a loop takes its locked groups too)
+/// and then the forest's locked rows are solved at once; otherwise each joint takes its rows in
+/// turn, its locked groups as blocks.
 pub(crate) fn sweep_joints(
     joints: &mut IslandJoints,
     velocities: &mut Velocities<'_>,
@@ -126,15 +131,18 @@ pub(crate) fn sweep_joints(
         direct,
     } = joints;
     let direct = direct.as_mut().filter(|d| d.factorized);
-    let locked_groups = direct.is_none();
+    let in_tree = |k: usize| direct.as_ref().is_some_and(|d| d.in_tree[k]);
     let mut largest = 0.0f32;
+    let mut one = |k: usize, j: &mut JointConstraint| {
+        largest = largest.max(j.solve(velocities, !in_tree(k)));
+    };
     if forward {
-        for j in constraints.iter_mut() {
-            largest = largest.max(j.solve(velocities, locked_groups));
+        for (k, j) in constraints.iter_mut().enumerate() {
+            one(k, j);
         }
     } else {
-        for j in constraints.iter_mut().rev() {
-            largest = largest.max(j.solve(velocities, locked_groups));
+        for (k, j) in constraints.iter_mut().enumerate().rev() {
+            one(k, j);
         }
     }
     if let Some(direct) = direct {
@@ -157,7 +165,10 @@ struct LockedRows {
     offsets: Vec<usize>,
     /// L (K = L·Lᵀ) by rows: row p holds columns first[p]..=p.
     factor: Vec<f64>,
-    /// 1/L_pp.
+    /// Per joint of the island, whether its locked rows are in the factorization (a joint of
+    /// the spanning forest); a joint closing a loop keeps its own locked groups.
+    in_tree: Vec<bool>,
+    /// 1/L_pp; zero for a row left out.
     inverse_diagonal: Vec<f64>,
     /// Whether `factor` holds the factorization of the current K.
     factorized: bool,
@@ -199,11 +210,13 @@ impl LockedRows {
         if joints.iter().any(JointConstraint::is_breakable) {
             return None;
         }
-        let with_rows: Vec<usize> = (0..joints.len())
-            .filter(|&j| joints[j].broke.is_none() && joints[j].locked_dofs().next().is_some())
-            .collect();
+        let with_rows = spanning_forest(joints);
         if with_rows.len() < 2 {
             return None;
+        }
+        let mut in_tree = vec![false; joints.len()];
+        for &j in &with_rows {
+            in_tree[j] = true;
         }
         let order = reverse_cuthill_mckee(joints, &with_rows);
         let mut rows = Vec::new();
@@ -239,6 +252,7 @@ impl LockedRows {
             factor: vec![0.0; offsets[rows.len()]],
             work: vec![0.0; rows.len()],
             velocity: vec![0.0; rows.len()],
+            in_tree,
             inverse_diagonal: vec![0.0; rows.len()],
             sides: vec![[SignedSide::IMMOVABLE; 2]; rows.len()],
             rows,
@@ -269,7 +283,7 @@ impl LockedRows {
     }
 
     /// K at the joints' current rows, factorized in place; leaves `factorized` false (the
-    /// per-joint groups take over) if a pivot is not positive and finite.
+    /// per-joint groups take over) if a pivot is not finite.
     fn factorize(&mut self, joints: &[JointConstraint]) {
         self.factorized = false;
         self.gather_sides(joints);
@@ -293,18 +307,19 @@ impl LockedRows {
                 row_p[q - first_p] = s * self.inverse_diagonal[q];
             }
             let diagonal = coupling(sides, p, p);
-            // A row no body responds to (both sides immovable on it) is left inert.
-            if diagonal <= 1e-12 {
-                row_p.fill(0.0);
-                row_p[p - first_p] = 1.0;
-                self.inverse_diagonal[p] = 1.0;
-                continue;
-            }
             let (off_diagonal, pivot) = row_p.split_at_mut(p - first_p);
-            let s =
-                diagonal * (1.0 + REGULARIZATION) - off_diagonal.iter().map(|l| l * l).sum::<f64>();
-            if !(s.is_finite() && s > diagonal * REGULARIZATION * 0.5) {
+            let s = diagonal - off_diagonal.iter().map(|l| l * l).sum::<f64>();
+            if !s.is_finite() {
                 return;
+            }
+            // A row that the rows before it already determine (a loop of joints, two joints on
+            // one degree of freedom) or that no body responds to is left out: its impulse stays,
+            // and a zero 1/L_pp zeroes its column below and its part of each solve.
+            if diagonal <= 1e-12 || s <= DEPENDENT * diagonal {
+                off_diagonal.fill(0.0);
+                pivot[0] = 1.0;
+                self.inverse_diagonal[p] = 0.0;
+                continue;
             }
             pivot[0] = s.sqrt();
             self.inverse_diagonal[p] = 1.0 / pivot[0];
@@ -386,18 +401,59 @@ impl LockedRows {
     }
 }
 
-/// Entry (p, q) of K = J M⁻¹ Jᵀ: the two rows' coupling through each body they share.
+/// Entry (p, q) of K = J M⁻¹ Jᵀ: the two rows' coupling through each body they share, summed
+/// in f64.
 #[inline]
 fn coupling(sides: &[[SignedSide; 2]], p: usize, q: usize) -> f64 {
-    let mut sum = 0.0f32;
+    let mut sum = 0.0f64;
     for a in &sides[p] {
         for b in &sides[q] {
             if a.slot == b.slot && a.slot != u32::MAX {
-                sum += a.linear.dot(b.moved) + a.angular.dot(b.response);
+                sum += a.linear.as_dvec3().dot(b.moved.as_dvec3())
+                    + a.angular.as_dvec3().dot(b.response.as_dvec3());
             }
         }
     }
-    f64::from(sum)
+    sum
+}
+
+/// The joints with locked rows that form a spanning forest of the graph of bodies (every
+/// immovable body one node, the world): a joint that would close a loop, through movable
+/// bodies or through the world (a bridge held at both ends), is left out. A tree's locked rows
+/// are independent, so its K is positive definite; a loop's rows are redundant (a planar
+/// loop of hinges locks the out-of-plane motion twice), and without pivoting their
+/// near-zero pivots would spoil the rows after them.
+fn spanning_forest(joints: &[JointConstraint]) -> Vec<usize> {
+    const WORLD: u32 = u32::MAX;
+    let mut parent: std::collections::HashMap<u32, u32> = Default::default();
+    fn root(parent: &mut std::collections::HashMap<u32, u32>, mut x: u32) -> u32 {
+        while let Some(&p) = parent.get(&x) {
+            if p == x {
+                break;
+            }
+            let grand = parent.get(&p).copied().unwrap_or(p);
+            parent.insert(x, grand);
+            x = p;
+        }
+        x
+    }
+    let mut forest = Vec::new();
+    for (k, joint) in joints.iter().enumerate() {
+        if joint.locked_dofs().next().is_none() {
+            continue;
+        }
+        let mut nodes = joint.movable_slots().collect::<Vec<_>>();
+        while nodes.len() < 2 {
+            nodes.push(WORLD);
+        }
+        let (a, b) = (root(&mut parent, nodes[0]), root(&mut parent, nodes[1]));
+        if a != b {
+            parent.insert(a, b);
+            parent.entry(b).or_insert(b);
+            forest.push(k);
+        }
+    }
+    forest
 }
 
 /// The joints (of `with_rows`) sharing a movable body with each joint.

@@ -10,6 +10,8 @@
 
 mod builder;
 mod direct;
+#[cfg(test)]
+mod direct_tests;
 mod frames;
 mod handle;
 mod rows;

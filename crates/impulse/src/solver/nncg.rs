@@ -73,7 +73,7 @@ pub fn solve_nncg(
         tolerance,
         velocities,
         workspace,
-        &mut [],
+        &mut IslandJoints::default(),
     )
 }
 

@@ -272,7 +272,7 @@ pub fn solve_pgs(
         velocities,
         true,
         false,
-        &mut [],
+        &mut IslandJoints::default(),
     )
 }
 

@@ -29,6 +29,7 @@ const FILE_SCENES: &[&str] = &[
     "chain20",
     "chain20heavy",
     "ragdoll",
+    "ragdollpile",
     "bridge",
     "arch",
     "overlap_pyramid",

@@ -88,7 +88,7 @@ impl Island {
     ) -> Result<ExactReport, ExactFailure> {
         solve_exact(
             &mut self.constraints,
-            &mut [],
+            &mut crate::joint::IslandJoints::default(),
             &mut Velocities {
                 linear: &mut self.linear,
                 angular: &mut self.angular,
