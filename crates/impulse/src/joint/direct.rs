@@ -105,7 +105,19 @@ impl IslandJoints {
             joint.update_targets(displacement, orientation, with_repair);
         }
         if let Some(direct) = &mut self.direct {
-            direct.factorize(&self.constraints);
+            // K depends on the poses alone (the inverse inertias are the step's start's): a
+            // substep's main solve, at the poses its previous relax solve factorized, reuses
+            // that factorization.
+            let same_poses = direct.factorized
+                && direct.displacement == displacement
+                && direct.orientation == orientation;
+            if !same_poses {
+                direct.displacement.clear();
+                direct.displacement.extend_from_slice(displacement);
+                direct.orientation.clear();
+                direct.orientation.extend_from_slice(orientation);
+                direct.factorize(&self.constraints);
+            }
         }
     }
 
@@ -178,6 +190,9 @@ struct LockedRows {
     velocity: Vec<f32>,
     /// Each row's Jacobian on its (up to two) movable bodies.
     sides: Vec<[SignedSide; 2]>,
+    /// The island's displacements and orientations `factor` was computed at.
+    displacement: Vec<glam::Vec3>,
+    orientation: Vec<glam::Quat>,
 }
 
 /// A row's Jacobian on one movable body, its sign folded in: J = (linear, angular) on (v, ω),
@@ -255,6 +270,8 @@ impl LockedRows {
             in_tree,
             inverse_diagonal: vec![0.0; rows.len()],
             sides: vec![[SignedSide::IMMOVABLE; 2]; rows.len()],
+            displacement: Vec::new(),
+            orientation: Vec::new(),
             rows,
             first,
             offsets,
