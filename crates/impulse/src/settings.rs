@@ -206,6 +206,13 @@ pub struct SolverSettings {
     /// heaviest body is at least 200 times their lightest, where one friction sweep a substep
     /// converges too slowly (docs/solvers.md, "The soft step").
     pub friction_in_main_solve: bool,
+    /// Solve an island's locked joint rows together, by a sparse Cholesky factorization of
+    /// their K at each new pose (default), rather than one joint's locked group after another
+    /// in each sweep. Together, a chain holds whatever its mass ratio (one joint after another
+    /// passes a load on by one link a sweep, and a heavy end stretches the chain); apart costs
+    /// less on joints that Gauss-Seidel already holds (ragdolls, bridges of equal planks).
+    /// docs/method.md "Joints"; its cost in docs/benchmarks.md "chain20heavy".
+    pub direct_joint_solve: bool,
     /// Islands with at least this many contact points are swept colour by colour (greedy graph
     /// colouring: no two points of a colour share a moving body), one colour's points spread
     /// over all worker threads; 0 = never (default). Colour order converges more slowly than
@@ -406,7 +413,8 @@ impl SolverSettings {
     /// `iterations`, `relax_iterations`, `tolerance`, `escalation_tolerance`,
     /// `escalation_iterations`, `mass_ratio_threshold`, `exact_max_contacts`, `repair` (method,
     /// stiffness and its parameters), `overlap_slop`, `max_repair_speed`, `warm_start`,
-    /// `friction_in_main_solve`, `parallel_island_contacts` and `simd_island_contacts`.
+    /// `friction_in_main_solve`, `direct_joint_solve`, `parallel_island_contacts` and
+    /// `simd_island_contacts`.
     /// Kept from `self` (what the scene means to happen): `restitution_threshold`,
     /// `prediction_distance`, sleeping (`sleep`, `sleep_linear_speed`, `sleep_angular_speed`,
     /// `time_to_sleep`), `friction`, `gyroscopic`, `continuous`, and any field not listed
@@ -427,6 +435,7 @@ impl SolverSettings {
             max_repair_speed: preset.max_repair_speed,
             warm_start: preset.warm_start,
             friction_in_main_solve: preset.friction_in_main_solve,
+            direct_joint_solve: preset.direct_joint_solve,
             parallel_island_contacts: preset.parallel_island_contacts,
             simd_island_contacts: preset.simd_island_contacts,
             ..self.clone()
@@ -552,6 +561,7 @@ impl Default for SolverSettings {
             time_to_sleep: 0.5,
             friction: true,
             friction_in_main_solve: false,
+            direct_joint_solve: true,
             parallel_island_contacts: 0,
             simd_island_contacts: 16,
             gyroscopic: true,

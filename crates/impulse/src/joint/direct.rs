@@ -27,6 +27,8 @@
 
 use std::ops::{Deref, DerefMut};
 
+use glam::DVec3;
+
 use super::rows::{JointConstraint, LOCK};
 use crate::solver::rows::Velocities;
 
@@ -83,13 +85,18 @@ impl<'a> IntoIterator for &'a mut IslandJoints {
 }
 
 impl IslandJoints {
-    /// Starts a step of substeps of `h` seconds: every joint's substep length, and the order
-    /// and envelope of the locked rows (the joints were assembled for this step).
-    pub(crate) fn start_step(&mut self, h: f32) {
+    /// Starts a step of substeps of `h` seconds: every joint's substep length, and with
+    /// `direct` ([`crate::SolverSettings::direct_joint_solve`]) the order and envelope of the
+    /// locked rows (the joints were assembled for this step).
+    pub(crate) fn start_step(&mut self, h: f32, direct: bool) {
         for joint in &mut self.constraints {
             joint.start_step(h);
         }
-        self.direct = LockedRows::new(&self.constraints);
+        self.direct = if direct {
+            LockedRows::new(&self.constraints)
+        } else {
+            None
+        };
     }
 
     /// Every joint's targets at the island's current poses (the main solve with repair, the
@@ -195,25 +202,25 @@ struct LockedRows {
     orientation: Vec<glam::Quat>,
 }
 
-/// A row's Jacobian on one movable body, its sign folded in: J = (linear, angular) on (v, ω),
-/// M⁻¹Jᵀ = (moved, response).
+/// A row's Jacobian on one movable body, its sign folded in, in f64: J = (linear, angular) on
+/// (v, ω), M⁻¹Jᵀ = (moved, response).
 #[derive(Clone, Copy, Debug)]
 struct SignedSide {
     /// The body's island slot; `u32::MAX` for no body.
     slot: u32,
-    linear: glam::Vec3,
-    moved: glam::Vec3,
-    angular: glam::Vec3,
-    response: glam::Vec3,
+    linear: DVec3,
+    moved: DVec3,
+    angular: DVec3,
+    response: DVec3,
 }
 
 impl SignedSide {
     const IMMOVABLE: Self = Self {
         slot: u32::MAX,
-        linear: glam::Vec3::ZERO,
-        moved: glam::Vec3::ZERO,
-        angular: glam::Vec3::ZERO,
-        response: glam::Vec3::ZERO,
+        linear: DVec3::ZERO,
+        moved: DVec3::ZERO,
+        angular: DVec3::ZERO,
+        response: DVec3::ZERO,
     };
 }
 
@@ -289,10 +296,10 @@ impl LockedRows {
             {
                 *side = SignedSide {
                     slot: row.slot,
-                    linear: row.sign * row.linear,
-                    moved: row.sign * row.inverse_mass * row.linear,
-                    angular: row.sign * row.angular,
-                    response: row.sign * row.response,
+                    linear: (row.sign * row.linear).as_dvec3(),
+                    moved: (row.sign * row.inverse_mass * row.linear).as_dvec3(),
+                    angular: (row.sign * row.angular).as_dvec3(),
+                    response: (row.sign * row.response).as_dvec3(),
                 };
             }
             self.sides[p] = sides;
@@ -426,8 +433,7 @@ fn coupling(sides: &[[SignedSide; 2]], p: usize, q: usize) -> f64 {
     for a in &sides[p] {
         for b in &sides[q] {
             if a.slot == b.slot && a.slot != u32::MAX {
-                sum += a.linear.as_dvec3().dot(b.moved.as_dvec3())
-                    + a.angular.as_dvec3().dot(b.response.as_dvec3());
+                sum += a.linear.dot(b.moved) + a.angular.dot(b.response);
             }
         }
     }

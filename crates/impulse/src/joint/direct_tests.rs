@@ -109,7 +109,7 @@ fn random_tree(seed: u64, bodies: usize, breakable: bool, loops: bool) -> Island
 fn residual_after_sweeps(joints: &mut IslandJoints, bodies: usize, seed: u64, sweeps: u32) -> f32 {
     let mut random = Seeded(seed);
     let h = 1.0 / 1200.0;
-    joints.start_step(h);
+    joints.start_step(h, true);
     let displacement = vec![Vec3::ZERO; bodies];
     let orientation = vec![Quat::IDENTITY; bodies];
     joints.update_targets(&displacement, &orientation, false);

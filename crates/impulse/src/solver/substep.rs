@@ -212,7 +212,7 @@ pub(crate) fn step_island(
     // The substeps cover the whole step: on the heavy-on-light path, one substep of dt.
     let h = context.dt / settings.substeps as f32;
     w.step_constants(island_bodies, context, h);
-    w.joints.start_step(h);
+    w.joints.start_step(h, settings.direct_joint_solve);
     w.start_solves(constraints, settings, context);
     let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
     for substep in 0..settings.substeps {
