@@ -177,6 +177,9 @@ struct LockedRows {
     /// (joint, degree of freedom) of each row, in elimination order; a joint's rows are
     /// consecutive.
     rows: Vec<(u32, u8)>,
+    /// Each joint (its index in the island) with the range of its rows in `rows`, in
+    /// elimination order: the solve's passes load a joint's bodies once for all its rows.
+    runs: Vec<(usize, std::ops::Range<usize>)>,
     /// The first column of each row's envelope (the first row of the earliest joint sharing a
     /// body with its joint, or of its own joint).
     first: Vec<u32>,
@@ -242,12 +245,15 @@ impl LockedRows {
         }
         let order = reverse_cuthill_mckee(joints, &with_rows);
         let mut rows = Vec::new();
+        let mut runs = Vec::with_capacity(order.len());
         let mut start_row = vec![u32::MAX; joints.len()];
         let mut position = vec![usize::MAX; joints.len()];
         for (p, &j) in order.iter().enumerate() {
             position[j] = p;
             start_row[j] = rows.len() as u32;
+            let start = rows.len();
             rows.extend(joints[j].locked_dofs().map(|i| (j as u32, i as u8)));
+            runs.push((j, start..rows.len()));
         }
         if rows.len() > MAX_DIRECT_ROWS {
             return None;
@@ -280,6 +286,7 @@ impl LockedRows {
             displacement: Vec::new(),
             orientation: Vec::new(),
             rows,
+            runs,
             first,
             offsets,
             factorized: false,
@@ -356,17 +363,14 @@ impl LockedRows {
     /// change.
     fn solve(&mut self, joints: &mut [JointConstraint], velocities: &mut Velocities<'_>) -> f32 {
         let n = self.rows.len();
-        let mut p = 0;
-        while p < n {
-            let j = self.rows[p].0 as usize;
-            let joint = &joints[j];
+        for (j, range) in &self.runs {
+            let joint = &joints[*j];
             let v = joint.load(velocities);
-            while p < n && self.rows[p].0 as usize == j {
+            for p in range.clone() {
                 let i = self.rows[p].1 as usize;
                 let velocity = joint.rows[i].velocity(&v);
                 self.velocity[p] = velocity;
                 self.work[p] = f64::from(velocity + joint.targets[i][LOCK].bias);
-                p += 1;
             }
         }
         // L·y = r, then Lᵀ·x = y, both in the envelope.
@@ -388,12 +392,10 @@ impl LockedRows {
                 self.work[k] -= self.factor[row + k - first] * x;
             }
         }
-        let mut p = 0;
-        while p < n {
-            let j = self.rows[p].0 as usize;
-            let joint = &mut joints[j];
+        for (j, range) in &self.runs {
+            let joint = &mut joints[*j];
             let mut v = joint.load(velocities);
-            while p < n && self.rows[p].0 as usize == j {
+            for p in range.clone() {
                 let i = self.rows[p].1 as usize;
                 let target = joint.targets[i][LOCK];
                 let old = joint.impulses[i][LOCK];
@@ -403,22 +405,18 @@ impl LockedRows {
                     let row = joint.rows[i];
                     row.apply(joint, delta, &mut v);
                 }
-                p += 1;
             }
             joint.store(velocities, v);
         }
         // The change reported is each row's velocity change, J·Δv, read back once every
         // impulse is applied (a row's Δλ·K_pp would count the coupled rows' share twice).
         let mut largest = 0.0f32;
-        let mut p = 0;
-        while p < n {
-            let j = self.rows[p].0 as usize;
-            let joint = &joints[j];
+        for (j, range) in &self.runs {
+            let joint = &joints[*j];
             let v = joint.load(velocities);
-            while p < n && self.rows[p].0 as usize == j {
+            for p in range.clone() {
                 let i = self.rows[p].1 as usize;
                 largest = largest.max((joint.rows[i].velocity(&v) - self.velocity[p]).abs());
-                p += 1;
             }
         }
         largest
