@@ -93,6 +93,13 @@ fn a_heavy_ball_on_a_light_chain_stretches_it_less_than_one_percent() {
     assert!(stretch.abs() < 0.01, "stretch {stretch}");
 }
 
+/// The built-in scene `name` with sleeping off.
+fn awake_builtin(name: &str) -> World {
+    let mut scene = builtin_scene(name).unwrap();
+    scene.solver.sleep = false;
+    World::from_scene(&scene).unwrap()
+}
+
 /// The sum over the joints of the distance between each joint's two anchors (m): how much
 /// longer a chain of spherical joints is than its links.
 fn joint_gap(world: &World) -> f32 {
@@ -111,9 +118,7 @@ fn a_heavy_ended_chain_swinging_through_its_lowest_point_stretches_less_than_a_m
     // of 100 links' mass pulls with about three times its weight. The locked rows of the
     // island are solved together (a load carried by twenty light links to a heavy one),
     // so the chain stays within a millimetre of its length at the default preset.
-    let mut scene = builtin_scene("chain20heavy").unwrap();
-    scene.solver.sleep = false;
-    let mut world = World::from_scene(&scene).unwrap();
+    let mut world = awake_builtin("chain20heavy");
     let length = 5.0;
     let mut largest = 0.0f32;
     for _ in 0..120 {
@@ -133,9 +138,7 @@ fn a_heavy_ended_chain_swinging_through_its_lowest_point_stretches_less_than_a_m
 /// together, not one joint after another.
 #[test]
 fn a_swinging_heavy_ended_chain_solves_its_locked_rows_together() {
-    let mut scene = builtin_scene("chain20heavy").unwrap();
-    scene.solver.sleep = false;
-    let mut world = World::from_scene(&scene).unwrap();
+    let mut world = awake_builtin("chain20heavy");
     for _ in 0..60 {
         world.step().unwrap();
     }
@@ -153,9 +156,7 @@ fn a_swinging_heavy_ended_chain_solves_its_locked_rows_together() {
 /// stays at most 1e-4 J per body (the bar for a pile at rest), at the default preset.
 #[test]
 fn a_pile_of_eight_ragdolls_comes_to_rest() {
-    let mut scene = builtin_scene("ragdollpile").unwrap();
-    scene.solver.sleep = false;
-    let mut world = World::from_scene(&scene).unwrap();
+    let mut world = awake_builtin("ragdollpile");
     let moving = world.body_count() - 1;
     let mut at_rest = 0.0f64;
     for step in 1..=330 {
