@@ -18,7 +18,8 @@ use impulse::{Scene, World};
 use parry3d::math::Pose;
 
 use crate::peer::{
-    PeerRun, PeerWorld, check_carried_over, resolve_material, shape_kind, spherical_joints,
+    PeerJointKind, PeerRun, PeerWorld, check_carried_over, peer_joints, resolve_material,
+    shape_kind,
 };
 use crate::peer_settings::{BOX3D, Box3dSetting};
 use crate::row::BenchRow;
@@ -167,27 +168,58 @@ impl Box3dWorld {
                 }
                 sim.bodies.push(body);
             }
-            // Spherical joints: joint frames at the anchors in the body frames, identity
-            // rotations (a spherical joint without limits does not use them), Box3D's default
-            // joint softness, no contacts between the joined bodies (as impulse).
-            let identity = b3::b3Quat {
-                v: vec3(Vec3::ZERO),
-                s: 1.0,
+            // Joints: frames at the anchors. Box3D's hinge turns about its frames' z axis, so
+            // each of impulse's frame rotations (hinge about x) is followed by the quarter
+            // turn about y taking z to x; both frames turn alike, so the hinge angle (B
+            // relative to A, counter-clockwise about the axis) and its limits carry over
+            // unchanged. Joint friction is Box3D's joint motor of speed 0 bounded by the
+            // friction torque, on the hinge or on all three rotations of a spherical joint.
+            // Box3D's default joint softness; no contacts between the joined bodies (as
+            // impulse).
+            let z_to_x = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+            let frame = |anchor: Vec3, rotation: Quat| b3::b3Transform {
+                p: vec3(anchor),
+                q: b3::b3Quat {
+                    v: vec3(Vec3::new(rotation.x, rotation.y, rotation.z)),
+                    s: rotation.w,
+                },
             };
-            for joint in spherical_joints(world, "Box3D")? {
-                let mut def = b3::b3DefaultSphericalJointDef();
-                def.base.bodyIdA = sim.bodies[joint.body_a];
-                def.base.bodyIdB = sim.bodies[joint.body_b];
-                def.base.localFrameA = b3::b3Transform {
-                    p: vec3(joint.anchor_a),
-                    q: identity,
-                };
-                def.base.localFrameB = b3::b3Transform {
-                    p: vec3(joint.anchor_b),
-                    q: identity,
-                };
-                def.base.collideConnected = false;
-                b3::b3CreateSphericalJoint(id, &def);
+            for joint in peer_joints(world, "Box3D")? {
+                match joint.kind {
+                    PeerJointKind::Spherical => {
+                        let mut def = b3::b3DefaultSphericalJointDef();
+                        def.base.bodyIdA = sim.bodies[joint.body_a];
+                        def.base.bodyIdB = sim.bodies[joint.body_b];
+                        def.base.localFrameA = frame(joint.anchor_a, joint.frame_a);
+                        def.base.localFrameB = frame(joint.anchor_b, joint.frame_b);
+                        def.base.collideConnected = false;
+                        if let Some(torque) = joint.friction_torque {
+                            def.enableMotor = true;
+                            def.maxMotorTorque = torque;
+                            def.motorVelocity = vec3(Vec3::ZERO);
+                        }
+                        b3::b3CreateSphericalJoint(id, &def);
+                    }
+                    PeerJointKind::Revolute => {
+                        let mut def = b3::b3DefaultRevoluteJointDef();
+                        def.base.bodyIdA = sim.bodies[joint.body_a];
+                        def.base.bodyIdB = sim.bodies[joint.body_b];
+                        def.base.localFrameA = frame(joint.anchor_a, joint.frame_a * z_to_x);
+                        def.base.localFrameB = frame(joint.anchor_b, joint.frame_b * z_to_x);
+                        def.base.collideConnected = false;
+                        if let Some((lower, upper)) = joint.limits {
+                            def.enableLimit = true;
+                            def.lowerAngle = lower;
+                            def.upperAngle = upper;
+                        }
+                        if let Some(torque) = joint.friction_torque {
+                            def.enableMotor = true;
+                            def.maxMotorTorque = torque;
+                            def.motorSpeed = 0.0;
+                        }
+                        b3::b3CreateRevoluteJoint(id, &def);
+                    }
+                }
             }
             Ok(sim)
         }

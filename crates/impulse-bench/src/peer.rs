@@ -5,13 +5,14 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use glam::{Quat, Vec3};
 #[cfg(any(feature = "box3d", feature = "jolt"))]
 use impulse::scene::ShapeDesc;
 use impulse::scene::{BodyDesc, Material, MaterialRef};
 use impulse::{Scene, World};
 use parry3d::math::Pose;
 
-use crate::quality::{self, JointAnchors, Quality};
+use crate::quality::{self, Quality};
 use crate::row::BenchRow;
 
 /// A peer engine's world built from a scene, bodies in scene order.
@@ -168,34 +169,117 @@ pub(crate) fn check_carried_over(index: usize, body: &BodyDesc, engine: &str) ->
     Ok(())
 }
 
-/// The joints of `world` a peer builds, each with its bodies' scene indices and its anchors
-/// in their body frames (m, from the body origins): spherical joints only, stiff, without
-/// limits, springs, motors or break thresholds, and with contacts between their two bodies
-/// off (impulse's default). Anything else is refused with an error naming the joint and
-/// `engine`.
-pub(crate) fn spherical_joints(world: &World, engine: &str) -> Result<Vec<JointAnchors>> {
-    use impulse::{AxisMode, JointDof, JointKind, JointStiffness};
-    for (k, joint) in world.joints().enumerate() {
-        let plain_rotation = [JointDof::AngularX, JointDof::AngularY, JointDof::AngularZ]
-            .into_iter()
-            .map(|dof| joint.dof(dof))
-            .all(|axis| {
-                axis.mode == AxisMode::Free && axis.spring.is_none() && axis.motor.is_none()
-            });
-        if joint.kind() != JointKind::Spherical
-            || !plain_rotation
-            || joint.stiffness() != JointStiffness::Stiff
+/// The kind of a joint a peer builds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum PeerJointKind {
+    /// A ball-and-socket joint: the anchors coincide, the three rotations are free.
+    Spherical,
+    /// A hinge: the anchors coincide and the bodies turn only about the hinge axis.
+    Revolute,
+}
+
+/// One joint as a peer builds it, read from impulse's joint.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PeerJoint {
+    /// Spherical or revolute.
+    pub kind: PeerJointKind,
+    /// Scene index of body A.
+    pub body_a: usize,
+    /// Scene index of body B.
+    pub body_b: usize,
+    /// A's anchor in A's frame (m, from the body origin).
+    pub anchor_a: Vec3,
+    /// B's anchor in B's frame (m, from the body origin).
+    pub anchor_b: Vec3,
+    /// The joint frame's rotation in A's body frame: the hinge axis is its x axis, and the
+    /// hinge angle is 0 when both frames agree.
+    pub frame_a: Quat,
+    /// The joint frame's rotation in B's body frame.
+    pub frame_b: Quat,
+    /// A revolute joint's limits (lower, upper) on the angle of B relative to A about A's
+    /// axis (rad, positive counter-clockwise about the axis); `None` for a free hinge or a
+    /// spherical joint.
+    pub limits: Option<(f32, f32)>,
+    /// Joint friction: the bound (N·m) of a velocity motor of target 0 on each free rotation
+    /// (impulse's model of joint friction); `None` without friction.
+    pub friction_torque: Option<f32>,
+}
+
+/// The joints of `world` a peer builds, in the world's order: spherical joints whose three
+/// rotations are free, and revolute joints whose hinge rotation is free or limited; stiff,
+/// without springs, position motors or break thresholds, with contacts between their two
+/// bodies off (impulse's default). A joint may carry joint friction: a velocity motor of
+/// target 0 with the same bound on every free rotation. Anything else is refused with an
+/// error naming the joint and `engine`.
+pub(crate) fn peer_joints(world: &World, engine: &str) -> Result<Vec<PeerJoint>> {
+    use impulse::{AxisMode, JointDof, JointKind, JointStiffness, MotorMode};
+    let anchors = quality::joint_anchors(world);
+    let mut joints = Vec::with_capacity(anchors.len());
+    for ((k, joint), anchor) in world.joints().enumerate().zip(anchors) {
+        let refuse = || -> Result<Vec<PeerJoint>> {
+            bail!(
+                "joint {k}: only spherical joints (free rotations) and revolute joints (free or \
+                 limited hinge), stiff, without springs, position motors, break thresholds or \
+                 contacts between the joined bodies, and with at most joint friction (a velocity \
+                 motor of target 0, the same bound on every free rotation) are carried over to \
+                 the {engine} comparison"
+            )
+        };
+        let (kind, free) = match joint.kind() {
+            JointKind::Spherical => (
+                PeerJointKind::Spherical,
+                &[JointDof::AngularX, JointDof::AngularY, JointDof::AngularZ][..],
+            ),
+            JointKind::Revolute => (PeerJointKind::Revolute, &[JointDof::AngularX][..]),
+            _ => return refuse(),
+        };
+        if joint.stiffness() != JointStiffness::Stiff
             || joint.break_thresholds().is_some()
             || joint.collide_connected()
         {
-            bail!(
-                "joint {k}: only plain spherical joints (no limits, springs, motors, softness, \
-                 break thresholds or contacts between the joined bodies) are carried over to \
-                 the {engine} comparison"
-            );
+            return refuse();
         }
+        let mut limits = None;
+        let mut friction: Option<Option<f32>> = None;
+        for &dof in free {
+            let axis = joint.dof(dof);
+            match axis.mode {
+                AxisMode::Free => {}
+                AxisMode::Limited { lower, upper } if kind == PeerJointKind::Revolute => {
+                    limits = Some((lower, upper));
+                }
+                _ => return refuse(),
+            }
+            if axis.spring.is_some() {
+                return refuse();
+            }
+            let bound = match axis.motor {
+                None => None,
+                Some(motor) => match motor.mode {
+                    MotorMode::Velocity { speed: 0.0 } => Some(motor.max_force),
+                    _ => return refuse(),
+                },
+            };
+            match friction {
+                None => friction = Some(bound),
+                Some(previous) if previous == bound => {}
+                Some(_) => return refuse(),
+            }
+        }
+        let (frame_a, frame_b) = joint.local_frames();
+        joints.push(PeerJoint {
+            kind,
+            body_a: anchor.body_a,
+            body_b: anchor.body_b,
+            anchor_a: anchor.anchor_a,
+            anchor_b: anchor.anchor_b,
+            frame_a,
+            frame_b,
+            limits,
+            friction_torque: friction.flatten(),
+        });
     }
-    Ok(quality::joint_anchors(world))
+    Ok(joints)
 }
 
 /// The scene-format name of a shape's kind, for errors.

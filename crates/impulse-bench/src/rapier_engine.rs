@@ -12,12 +12,19 @@ use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 use rapier3d::prelude::{
     CCDSolver, CoefficientCombineRule, ColliderBuilder, ColliderSet, DefaultBroadPhase,
-    ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet, NarrowPhase,
-    PhysicsPipeline, RigidBodyBuilder, RigidBodyHandle, RigidBodySet, SoftBodySet,
-    SphericalJointBuilder, Vector,
+    GenericJoint, ImpulseJointSet, IntegrationParameters, IslandManager, JointAxis,
+    MultibodyJointSet, NarrowPhase, PhysicsPipeline, RevoluteJointBuilder, RigidBodyBuilder,
+    RigidBodyHandle, RigidBodySet, SoftBodySet, SphericalJointBuilder, Vector,
 };
 
-use crate::peer::{PeerRun, PeerWorld, check_carried_over, resolve_material, spherical_joints};
+use crate::peer::{
+    PeerJointKind, PeerRun, PeerWorld, check_carried_over, peer_joints, resolve_material,
+};
+
+/// The damping factor of the velocity motors that model joint friction in Rapier (its motor's
+/// torque is this factor times the velocity error, clamped to the friction torque): large, so
+/// that the motor acts as a bounded velocity constraint, as impulse's friction motor.
+const FRICTION_MOTOR_FACTOR: f32 = 1.0e4;
 use crate::row::BenchRow;
 
 /// Engine name in [`BenchRow::engine`].
@@ -121,20 +128,37 @@ impl RapierScene {
             colliders.insert_with_parent(collider, handle, &mut bodies);
             handles.push(handle);
         }
-        // Spherical joints as Rapier's impulse joints (its default kind of joint), anchors in
-        // the body frames, no contacts between the joined bodies (as impulse).
+        // Joints as Rapier's impulse joints (its default kind of joint): the joint frames at
+        // the anchors with impulse's frame rotations (Rapier's hinge turns about the frames'
+        // x axis, as impulse's, so the hinge angle and its limits carry over unchanged), no
+        // contacts between the joined bodies (as impulse). Joint friction is a velocity motor
+        // of target 0 on each free rotation, bounded by the friction torque, with a damping
+        // factor large enough that the bound, not the factor, sets the torque.
         let mut impulse_joints = ImpulseJointSet::new();
-        for joint in spherical_joints(world, "Rapier")? {
-            let spherical = SphericalJointBuilder::new()
-                .local_anchor1(joint.anchor_a)
-                .local_anchor2(joint.anchor_b)
-                .contacts_enabled(false);
-            impulse_joints.insert(
-                handles[joint.body_a],
-                handles[joint.body_b],
-                spherical,
-                true,
-            );
+        for joint in peer_joints(world, "Rapier")? {
+            let mut generic: GenericJoint = match joint.kind {
+                PeerJointKind::Spherical => SphericalJointBuilder::new().into(),
+                PeerJointKind::Revolute => RevoluteJointBuilder::new(Vector::X).into(),
+            };
+            generic
+                .set_local_frame1(Pose::from_parts(joint.anchor_a, joint.frame_a))
+                .set_local_frame2(Pose::from_parts(joint.anchor_b, joint.frame_b))
+                .set_contacts_enabled(false);
+            let free: &[JointAxis] = match joint.kind {
+                PeerJointKind::Spherical => &[JointAxis::AngX, JointAxis::AngY, JointAxis::AngZ],
+                PeerJointKind::Revolute => &[JointAxis::AngX],
+            };
+            if let Some((lower, upper)) = joint.limits {
+                generic.set_limits(JointAxis::AngX, [lower, upper]);
+            }
+            if let Some(torque) = joint.friction_torque {
+                for &axis in free {
+                    generic
+                        .set_motor_velocity(axis, 0.0, FRICTION_MOTOR_FACTOR)
+                        .set_motor_max_force(axis, torque);
+                }
+            }
+            impulse_joints.insert(handles[joint.body_a], handles[joint.body_b], generic, true);
         }
         let params = IntegrationParameters {
             dt: scene.dt,
