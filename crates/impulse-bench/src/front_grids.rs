@@ -38,6 +38,38 @@ pub fn impulse_grid() -> Vec<ImpulseSetting> {
     grid
 }
 
+/// impulse's settings for a scene with joints: the presets, and the soft step at substeps
+/// {1, 2, 3, 4, 5, 6, 8 (the preset `fast`), 10, 12, 16, 24, 32} with the island's locked joint rows solved
+/// together (`soft S`, `SolverSettings::direct_joint_solve`, the default) and one joint after
+/// another (`soft S per-joint`), which costs less per sweep and holds chains of similar masses
+/// nearly as well; and `soft S×2` at 4, 8 and 16 substeps. The substeps are what stiffens the
+/// joints (each substep solves them with the positions it starts from), as the peers' joint
+/// grids vary theirs.
+pub fn impulse_joint_grid() -> Vec<ImpulseSetting> {
+    let mut grid = vec![("default".to_string(), None)];
+    for name in ["fast", "precise", "reference"] {
+        grid.push((name.to_string(), SolverSettings::preset(name)));
+    }
+    for substeps in [1, 2, 3, 4, 5, 6, 8, 10, 12, 16, 24, 32] {
+        let (name, settings) = soft_step(substeps, 1);
+        grid.push((
+            format!("{name} per-joint"),
+            settings.clone().map(|settings| SolverSettings {
+                direct_joint_solve: false,
+                ..settings
+            }),
+        ));
+        // `fast` is the soft step at 8 substeps: not measured twice.
+        if settings != Some(SolverSettings::fast()) {
+            grid.push((name, settings));
+        }
+    }
+    for substeps in [4, 8, 16] {
+        grid.push(soft_step(substeps, 2));
+    }
+    grid
+}
+
 /// The small grid of `--quick` (for tests and checks): `default`, `fast` and two more.
 pub fn impulse_quick_grid() -> Vec<ImpulseSetting> {
     vec![

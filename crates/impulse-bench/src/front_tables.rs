@@ -165,24 +165,39 @@ pub fn format_bar_table(front: &SceneFront) -> String {
     out
 }
 
-/// Each engine's whole Pareto front on one scene, fastest first, as a Markdown table.
+/// Each engine's whole Pareto front on one scene, fastest first, as a Markdown table. A scene
+/// with joints shows the joint gap and the overlap that make up its E; any other scene the
+/// sink, overlap and drift.
 pub fn format_front_table(front: &SceneFront) -> String {
-    let mut out = String::from(
+    let joints = front.points.iter().any(|p| p.joint_gap_mm.is_some());
+    let mut out = String::from(if joints {
+        "| engine | setting | ms/step | E (mm) | joint gap (mm) | overlap (mm) |\n\
+         |---|---|---:|---:|---:|---:|\n"
+    } else {
         "| engine | setting | ms/step | E (mm) | sink (mm) | overlap (mm) | drift (mm) |\n\
-         |---|---|---:|---:|---:|---:|---:|\n",
-    );
+         |---|---|---:|---:|---:|---:|---:|\n"
+    });
     for engine in std::iter::once(IMPULSE).chain(PEERS) {
         for p in pareto_front(&front.points, engine) {
-            let _ = writeln!(
+            let _ = write!(
                 out,
-                "| {engine} | {} | {} | {} | {} | {} | {} |",
+                "| {engine} | {} | {} | {} |",
                 cell(&p.setting),
                 format_ms(p.ms_per_step),
                 format_mm(p.e_mm),
-                format_mm_signed(p.sink_mm),
-                format_mm(p.overlap_mm),
-                format_mm(p.drift_mm),
             );
+            let _ = match p.joint_gap_mm {
+                Some(gap) if joints => {
+                    writeln!(out, " {} | {} |", format_mm(gap), format_mm(p.overlap_mm))
+                }
+                _ => writeln!(
+                    out,
+                    " {} | {} | {} |",
+                    format_mm_signed(p.sink_mm),
+                    format_mm(p.overlap_mm),
+                    format_mm(p.drift_mm),
+                ),
+            };
         }
     }
     out
@@ -216,9 +231,10 @@ pub fn format_summary_table(fronts: &[SceneFront]) -> String {
 
 /// What the setting names and columns mean, for the top of the Markdown.
 const LEGEND: &str = "E = max(|top sink|, largest overlap, largest drift) after the run (mm); \
-for a scene with joints (chain20heavy) E is the largest joint gap over the run (the distances \
-between each joint's two anchors, summed: the chain's stretch, mm; 50 mm is 1 % of \
-chain20heavy's 5 m of links). Bars Q50: E ≤ 50 mm, Q5: E ≤ 5 mm, Q1: E ≤ 1 mm. ms/step: median wall-clock time of one step, \
+for a scene with joints (chain20heavy, ragdollpile) E = max(largest joint gap, largest \
+overlap) over the run (the joint gap is the distances between each joint's two anchors, summed: \
+a chain's stretch; the overlap is between bodies not joined; 50 mm is 1 % of chain20heavy's 5 m \
+of links). Bars Q50: E ≤ 50 mm, Q5: E ≤ 5 mm, Q1: E ≤ 1 mm. ms/step: median wall-clock time of one step, \
 one thread, sleeping off, each setting run on its own with the engines interleaved. Time \
 impulse/cheapest peer: impulse's ms/step at its cheapest setting meeting the bar over the \
 lowest ms/step of any peer (Rapier, Box3D, Jolt) meeting it (< 1: impulse is faster); \

@@ -274,6 +274,27 @@ fn grids_have_the_documented_sizes_and_names() {
     assert!(split.split_impulse() && split.method == SolverMethod::Auto);
     assert_eq!((split.substeps, split.iterations), (2, 4));
     assert!(impulse_quick_grid().len() < 5);
+    let joint_grid = impulse_joint_grid();
+    assert_eq!(joint_grid.len(), 4 + 12 * 2 - 1 + 3);
+    let (_, per_joint) = joint_grid
+        .iter()
+        .find(|(n, _)| n == "soft 4 per-joint")
+        .unwrap();
+    assert_eq!(
+        per_joint.as_ref(),
+        Some(&SolverSettings {
+            direct_joint_solve: false,
+            ..SolverSettings::soft_step(4)
+        })
+    );
+    let joint_settings: Vec<&SolverSettings> =
+        joint_grid.iter().filter_map(|(_, s)| s.as_ref()).collect();
+    for (i, setting) in joint_settings.iter().enumerate() {
+        assert!(
+            !joint_settings[..i].contains(setting),
+            "{setting:?} measured twice"
+        );
+    }
     let names = |names: Vec<String>| -> std::collections::HashSet<String> {
         let count = names.len();
         let set: std::collections::HashSet<String> = names.into_iter().collect();
@@ -351,10 +372,10 @@ fn quick_front_on_a_small_stack() {
     assert_eq!(fronts.len(), 1);
     let front = &fronts[0];
     assert_eq!((front.scene.as_str(), front.steps), ("stack3", 20));
-    let peers = config
-        .peer_settings(&scene_by_name("stack3").unwrap())
-        .unwrap();
-    let expected = config.impulse_settings().len() + peers.iter().map(Vec::len).sum::<usize>();
+    let stack3 = scene_by_name("stack3").unwrap();
+    let peers = config.peer_settings(&stack3).unwrap();
+    let expected =
+        config.impulse_settings(&stack3).len() + peers.iter().map(Vec::len).sum::<usize>();
     assert_eq!(front.points.len(), expected);
     assert_eq!(progress.len(), expected);
     assert_eq!(progress.last().unwrap().0, progress.last().unwrap().1);

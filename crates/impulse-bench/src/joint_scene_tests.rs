@@ -79,3 +79,77 @@ fn every_peer_holds_the_heavy_chain_at_its_finest_setting() {
         check(&name, run, bound);
     }
 }
+
+/// A bar of 0.9 m hung by one end from a static block on a hinge with limits (`limits`, rad)
+/// about `axis`, its centre at `centre` (m): gravity turns it about the hinge until one limit
+/// stops it. The limits are lopsided, so an engine that read the hinge angle with the other
+/// sign (or about another axis) would stop the bar at the other angle.
+fn hinge_scene(axis: [f32; 3], centre: [f32; 3], limits: [f32; 2]) -> impulse::Scene {
+    let bar_half = if centre[0] != 0.0 {
+        [0.45, 0.05, 0.05]
+    } else {
+        [0.05, 0.05, 0.45]
+    };
+    let text = format!(
+        r#"{{
+  "name": "hinge-limit",
+  "gravity": [0.0, -9.81, 0.0],
+  "dt": 0.016666668,
+  "bodies": [
+    {{"kind": "static", "shape": {{"type": "cuboid", "half_extents": [0.05, 0.05, 0.05]}}, "position": [0.0, 0.0, 0.0]}},
+    {{"kind": "dynamic", "shape": {{"type": "cuboid", "half_extents": {bar_half:?}}}, "position": {centre:?}}}
+  ],
+  "joints": [
+    {{"type": "revolute", "body_a": 0, "body_b": 1, "anchor": [0.0, 0.0, 0.0], "axis": {axis:?}, "limits": {limits:?}}}
+  ]
+}}"#
+    );
+    impulse::scene::parse_scene_str(&text, "hinge-limit.json").unwrap()
+}
+
+/// Each engine (impulse at its defaults, each peer compiled in at its default) holds a hinge
+/// at the limit gravity drives it to, with the angle's sign and axis as impulse defines them
+/// (B's rotation relative to A about the axis, counter-clockwise positive): a bar out along
+/// +z on a hinge about x falls to the upper limit 0.3 rad (not to 1.0), and a bar out along
+/// +x on a hinge about z falls to the lower limit −0.3 rad (not to −1.0).
+#[test]
+fn every_engine_stops_a_hinge_at_the_limit_of_impulses_sign() {
+    let cases = [
+        ([1.0, 0.0, 0.0], [0.0, 0.0, 0.5], [-1.0, 0.3], 0.3f32),
+        ([0.0, 0.0, 1.0], [0.5, 0.0, 0.0], [-0.3, 1.0], -0.3),
+    ];
+    for (axis, centre, limits, expected) in cases {
+        let scene = hinge_scene(axis, centre, limits);
+        let mut runs: Vec<(String, Box<dyn EngineRun>)> = vec![(
+            "impulse default".to_string(),
+            Box::new(crate::impulse_engine::ImpulseRun::new(&scene, STEPS, 1, None).unwrap()),
+        )];
+        let defaults = [
+            PeerSetting::Rapier(Default::default()),
+            PeerSetting::Box3d(Default::default()),
+            PeerSetting::Jolt(Default::default()),
+        ];
+        for setting in defaults
+            .into_iter()
+            .filter(|setting| crate::peer_settings::peer_compiled(setting.engine()))
+        {
+            let name = setting.engine().to_string();
+            let run = crate::engines::start_peer(&scene, STEPS, &setting, &name).unwrap();
+            runs.push((name, run));
+        }
+        let axis = Vec3::from(axis);
+        for (name, mut run) in runs {
+            run.advance(STEPS).unwrap();
+            let rotation = run.poses()[1].rotation;
+            // The bar turned about the hinge axis only: its rotation's angle about the axis.
+            let along = Vec3::new(rotation.x, rotation.y, rotation.z).dot(axis);
+            let angle = 2.0 * along.atan2(rotation.w);
+            println!("{name}: hinge about {axis} at {angle:.4} rad (limit {expected})");
+            assert!(
+                (angle - expected).abs() < 0.05,
+                "{name}: hinge about {axis} came to {angle} rad, the limit it falls to is \
+                 {expected} rad"
+            );
+        }
+    }
+}

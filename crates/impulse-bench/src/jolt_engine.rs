@@ -21,8 +21,8 @@ use oxijolt_sys as j;
 use parry3d::math::Pose;
 
 use crate::peer::{
-    PeerJointKind, PeerRun, PeerWorld, check_carried_over, peer_joints, resolve_material,
-    shape_kind,
+    PeerJoint, PeerJointKind, PeerRun, PeerWorld, check_carried_over, peer_joints,
+    resolve_material, shape_kind,
 };
 use crate::peer_settings::{JOLT, JoltSetting};
 use crate::row::BenchRow;
@@ -224,16 +224,6 @@ impl JoltWorld {
             bail!("Jolt could not create its physics system");
         };
         let joints = peer_joints(world, "Jolt")?;
-        // Only plain spherical joints are built for Jolt so far (its hinge and swing-twist
-        // constraints with limits and friction torque are not mapped yet).
-        if let Some((k, _)) = joints.iter().enumerate().find(|(_, joint)| {
-            joint.kind != PeerJointKind::Spherical || joint.friction_torque.is_some()
-        }) {
-            bail!(
-                "joint {k}: only plain spherical joints (no friction) are carried over to the \
-                 Jolt comparison so far"
-            );
-        }
         // Jolt's constraints do not keep their bodies from colliding: with joints, every body
         // is in one collision group, its own subgroup, and the table of that group turns off
         // the pairs a joint joins (impulse's default).
@@ -347,35 +337,107 @@ impl JoltWorld {
                 j::JPH_GroupFilter_Destroy(group_filter.cast());
             }
         }
-        // Spherical joints as Jolt's point constraints, both points at the anchor's world
-        // position at the start (Jolt's world-space settings), Jolt's default constraint
-        // settings. The system keeps its own reference to each constraint.
         for (k, joint) in joints.iter().enumerate() {
-            let pose = world.poses()[joint.body_a];
-            let anchor = vec3(pose.rotation * joint.anchor_a + pose.translation);
-            // SAFETY: the bodies are alive in this system; the settings are initialised by
-            // `JPH_PointConstraintSettings_Init`.
-            unsafe {
-                let mut settings = std::mem::zeroed::<j::JPH_PointConstraintSettings>();
-                j::JPH_PointConstraintSettings_Init(&mut settings);
-                settings.space = j::JPH_ConstraintSpace_WorldSpace;
-                settings.point1 = anchor;
-                settings.point2 = anchor;
-                let constraint = j::JPH_PointConstraint_Create(
-                    &settings,
+            // SAFETY: the bodies are alive in this system and belong to it.
+            let constraint = unsafe {
+                add_joint(
+                    world,
+                    joint,
                     body_pointers[joint.body_a],
                     body_pointers[joint.body_b],
-                );
-                if constraint.is_null() {
-                    bail!("joint {k}: Jolt could not create the point constraint");
-                }
-                j::JPH_PhysicsSystem_AddConstraint(sim.system, constraint.cast());
-                j::JPH_Constraint_Destroy(constraint.cast());
+                )
+            };
+            if constraint.is_null() {
+                bail!("joint {k}: Jolt could not create the constraint");
+            }
+            // SAFETY: the system is alive; it keeps its own reference to the constraint.
+            unsafe {
+                j::JPH_PhysicsSystem_AddConstraint(sim.system, constraint);
+                j::JPH_Constraint_Destroy(constraint);
             }
         }
         // SAFETY: the system is alive.
         unsafe { j::JPH_PhysicsSystem_OptimizeBroadPhase(sim.system) };
         Ok(sim)
+    }
+}
+
+/// The Jolt constraint of `joint` between `body_a` and `body_b`, holding one reference for
+/// the caller (null when Jolt refuses it), in Jolt's world-space settings at the scene's
+/// start poses (Jolt reads both bodies' local frames from them), with Jolt's default
+/// constraint settings:
+///
+/// - a spherical joint without friction: a point constraint, both points at the anchors;
+/// - a spherical joint with joint friction: a swing-twist constraint whose cone (half angles
+///   π) and twist (±π) leave the three rotations free, with `maxFrictionTorque` = the bound
+///   (Jolt turns a limit of at least 179.5° into a free axis);
+/// - a revolute joint: a hinge constraint, hinge axis the joint frame's x axis and normal axis
+///   its y axis on each body. Jolt's hinge angle is B's rotation relative to A about A's hinge
+///   axis, 0 where both normal axes agree (Jolt's `HingeConstraintSettings`), so impulse's
+///   limits carry over unchanged; joint friction is `maxFrictionTorque`.
+///
+/// # Safety
+/// Both bodies must be alive in one Jolt physics system.
+unsafe fn add_joint(
+    world: &World,
+    joint: &PeerJoint,
+    body_a: *mut j::JPH_Body,
+    body_b: *mut j::JPH_Body,
+) -> *mut j::JPH_Constraint {
+    let pose_a = world.poses()[joint.body_a];
+    let pose_b = world.poses()[joint.body_b];
+    let point_a = vec3(pose_a.rotation * joint.anchor_a + pose_a.translation);
+    let point_b = vec3(pose_b.rotation * joint.anchor_b + pose_b.translation);
+    let axis_a = |local: Vec3| vec3(pose_a.rotation * (joint.frame_a * local));
+    let axis_b = |local: Vec3| vec3(pose_b.rotation * (joint.frame_b * local));
+    // SAFETY: each settings struct is initialised by its `_Init`; the bodies are alive per the
+    // function's contract.
+    unsafe {
+        match (joint.kind, joint.friction_torque) {
+            (PeerJointKind::Spherical, None) => {
+                let mut settings = std::mem::zeroed::<j::JPH_PointConstraintSettings>();
+                j::JPH_PointConstraintSettings_Init(&mut settings);
+                settings.space = j::JPH_ConstraintSpace_WorldSpace;
+                settings.point1 = point_a;
+                settings.point2 = point_b;
+                j::JPH_PointConstraint_Create(&settings, body_a, body_b).cast()
+            }
+            (PeerJointKind::Spherical, Some(torque)) => {
+                let mut settings = std::mem::zeroed::<j::JPH_SwingTwistConstraintSettings>();
+                j::JPH_SwingTwistConstraintSettings_Init(&mut settings);
+                settings.space = j::JPH_ConstraintSpace_WorldSpace;
+                settings.position1 = point_a;
+                settings.position2 = point_b;
+                settings.twistAxis1 = axis_a(Vec3::X);
+                settings.planeAxis1 = axis_a(Vec3::Y);
+                settings.twistAxis2 = axis_b(Vec3::X);
+                settings.planeAxis2 = axis_b(Vec3::Y);
+                settings.swingType = j::JPH_SwingType_Cone;
+                settings.normalHalfConeAngle = std::f32::consts::PI;
+                settings.planeHalfConeAngle = std::f32::consts::PI;
+                settings.twistMinAngle = -std::f32::consts::PI;
+                settings.twistMaxAngle = std::f32::consts::PI;
+                settings.maxFrictionTorque = torque;
+                j::JPH_SwingTwistConstraint_Create(&settings, body_a, body_b).cast()
+            }
+            (PeerJointKind::Revolute, friction) => {
+                let mut settings = std::mem::zeroed::<j::JPH_HingeConstraintSettings>();
+                j::JPH_HingeConstraintSettings_Init(&mut settings);
+                settings.space = j::JPH_ConstraintSpace_WorldSpace;
+                settings.point1 = point_a;
+                settings.point2 = point_b;
+                settings.hingeAxis1 = axis_a(Vec3::X);
+                settings.normalAxis1 = axis_a(Vec3::Y);
+                settings.hingeAxis2 = axis_b(Vec3::X);
+                settings.normalAxis2 = axis_b(Vec3::Y);
+                if let Some((lower, upper)) = joint.limits {
+                    settings.limitsMin = lower;
+                    settings.limitsMax = upper;
+                }
+                settings.maxFrictionTorque = friction.unwrap_or(0.0);
+                j::JPH_HingeConstraint_Create(&settings, body_a, body_b).cast()
+            }
+        }
     }
 }
 

@@ -82,14 +82,16 @@ enum Command {
     /// compiled in, or `--peers`): each engine over a grid of its settings, one run per setting
     /// (one thread, sleeping off, engines interleaved). Prints Markdown tables of each engine's
     /// cheapest setting meeting E ≤ 50, 5 and 1 mm (E = max(|top sink|, largest overlap,
-    /// largest drift)) with impulse's time over the cheapest peer's, and of each engine's
-    /// front, and writes a plot per scene to DIR/front-<scene>.svg.
+    /// largest drift); with joints max(summed joint gap, largest overlap)) with impulse's time
+    /// over the cheapest peer's, and of each engine's front, and writes a plot per scene to
+    /// DIR/front-<scene>.svg.
     Front(FrontArgs),
 }
 
 #[derive(clap::Args)]
 struct FrontArgs {
-    /// Built-in scene names (default: pyramid20 pyramid3d10 stack30 massratio pyramid100).
+    /// Built-in scene names (default: pyramid20 pyramid3d10 stack30 massratio pyramid100
+    /// chain20heavy ragdollpile).
     scenes: Vec<String>,
     /// Steps per scene.
     #[arg(long, default_value_t = front::FRONT_STEPS)]
