@@ -6,7 +6,7 @@
 //!
 //! let set = InstructionSet::detected();
 //! assert!(set.is_supported());
-//! assert!(["baseline", "x86-64-v4"].contains(&set.name()));
+//! assert!(["baseline", "x86-64-v3", "x86-64-v4"].contains(&set.name()));
 //! assert_eq!(INSTRUCTION_SET_VARIABLE, "IMPULSE_INSTRUCTION_SET");
 //! ```
 //!
@@ -16,6 +16,9 @@
 //! updates, and x86-64's sixteen vector registers spill. AVX-512 gives thirty-two (with its
 //! `avx512vl` encoding of the same 4-lane operations), so the hot kernels are compiled a second
 //! time for x86-64-v4 and chosen at run time when the CPU has it ([`InstructionSet::detected`]).
+//! A CPU with AVX2 but not AVX-512 gets a third build, for x86-64-v3: still sixteen registers,
+//! but the VEX encoding's three-operand instructions leave the two sources in their registers,
+//! where SSE2's two-operand ones overwrite one and make the compiler copy it first.
 //! The operations are the same IEEE operations in the same order (Rust never fuses a multiply
 //! and an add unless asked to, whatever the target features), so both builds of a kernel give
 //! the same bits: the choice changes the time, never a trajectory.
@@ -31,6 +34,9 @@ pub enum InstructionSet {
     /// The build's own target (SSE2 on x86-64 unless built with `-C target-cpu`).
     #[default]
     Baseline,
+    /// x86-64-v3: AVX2, FMA, BMI1, BMI2, LZCNT, MOVBE and F16C with SSE4.2 (sixteen vector
+    /// registers, three-operand instructions).
+    X86_64V3,
     /// x86-64-v4: AVX-512 F, VL, BW, DQ and CD with AVX2 (thirty-two vector registers).
     X86_64V4,
 }
@@ -58,15 +64,19 @@ impl InstructionSet {
     pub fn supported_widest() -> Self {
         if Self::X86_64V4.is_supported() {
             Self::X86_64V4
+        } else if Self::X86_64V3.is_supported() {
+            Self::X86_64V3
         } else {
             Self::Baseline
         }
     }
 
-    /// Its name: `baseline` or `x86-64-v4` (the x86-64 psABI's name of the level).
+    /// Its name: `baseline`, `x86-64-v3` or `x86-64-v4` (the x86-64 psABI's names of the
+    /// levels).
     pub fn name(self) -> &'static str {
         match self {
             Self::Baseline => "baseline",
+            Self::X86_64V3 => "x86-64-v3",
             Self::X86_64V4 => "x86-64-v4",
         }
     }
@@ -75,9 +85,29 @@ impl InstructionSet {
     pub fn is_supported(self) -> bool {
         match self {
             Self::Baseline => true,
+            Self::X86_64V3 => x86_64_v3_supported(),
             Self::X86_64V4 => x86_64_v4_supported(),
         }
     }
+}
+
+#[cfg(target_arch = "x86_64")]
+fn x86_64_v3_supported() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("avx")
+        && std::arch::is_x86_feature_detected!("fma")
+        && std::arch::is_x86_feature_detected!("bmi1")
+        && std::arch::is_x86_feature_detected!("bmi2")
+        && std::arch::is_x86_feature_detected!("lzcnt")
+        && std::arch::is_x86_feature_detected!("movbe")
+        && std::arch::is_x86_feature_detected!("f16c")
+        && std::arch::is_x86_feature_detected!("popcnt")
+        && std::arch::is_x86_feature_detected!("sse4.2")
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn x86_64_v3_supported() -> bool {
+    false
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -100,9 +130,9 @@ fn x86_64_v4_supported() -> bool {
 }
 
 /// Evaluates the expression `$call` (a kernel's loop, whose `#[inline(always)]` updates
-/// inline into it) compiled for `$set`: for [`InstructionSet::X86_64V4`] inside a function
-/// with x86-64-v4's target features, into which the expression inlines; otherwise as the build
-/// compiled it. The caller must have checked that the CPU runs `$set`
+/// inline into it) compiled for `$set`: for [`InstructionSet::X86_64V4`] (or
+/// [`InstructionSet::X86_64V3`]) inside a function with x86-64-v4's (x86-64-v3's) target
+/// features, into which the expression inlines; otherwise as the build compiled it. The caller must have checked that the CPU runs `$set`
 /// ([`InstructionSet::is_supported`]; [`InstructionSet::detected`] always is).
 macro_rules! on_instruction_set {
     ($set:expr, $call:expr) => {{
@@ -119,6 +149,17 @@ macro_rules! on_instruction_set {
                 let kernel = || $call;
                 // SAFETY: the caller checked that the CPU has these features.
                 unsafe { with_x86_64_v4(kernel) }
+            } else if $set == $crate::simd::InstructionSet::X86_64V3 {
+                #[target_feature(
+                    enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,movbe,f16c,popcnt,sse3,ssse3,sse4.1,sse4.2"
+                )]
+                #[inline]
+                unsafe fn with_x86_64_v3<R>(kernel: impl FnOnce() -> R) -> R {
+                    kernel()
+                }
+                let kernel = || $call;
+                // SAFETY: the caller checked that the CPU has these features.
+                unsafe { with_x86_64_v3(kernel) }
             } else {
                 $call
             }
