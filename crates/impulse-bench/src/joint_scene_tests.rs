@@ -168,7 +168,7 @@ const FRICTION_STEPS: u32 = 30;
 /// bound is the friction torque, N·m): a bar held out level by a hinge about x or by a
 /// spherical joint, whose weight pulls with 9 kg · 9.81 m/s² · 0.5 m = 44.1 N·m about the
 /// joint. Under 100 N·m of friction it stays level for 0.5 s (impulse, Box3D, Jolt within
-/// 0.01 rad; Rapier's motor creeps at about 0.17 rad/s whatever its bound, so within 0.1 rad);
+/// 0.01 rad; Rapier's motor lets it creep, 0.085 rad in 0.5 s, so within 0.1 rad);
 /// under 20 N·m it turns as far as impulse's bar does, within 0.1 rad (about 1 rad, where a
 /// frictionless bar turns 1.7): the same torque in every engine.
 #[test]
