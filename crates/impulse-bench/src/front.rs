@@ -9,11 +9,10 @@
 //! the joint gap is the distances between each joint's two anchors, summed (a chain's
 //! stretch; `quality::joint_gap`), the overlap is between bodies not joined (links of a chain
 //! folded onto one another, limbs of a pile). Drift and sink leave it: such a scene moves by
-//! design. An engine's
-//! Pareto front is its points that no other point of the same engine beats on both time and
-//! E ([`pareto_front`]); at each quality bar ([`BARS`]) the engines are compared by their
-//! cheapest setting meeting the bar ([`cheapest_meeting`]), and impulse by its time over the
-//! cheapest peer's.
+//! design. An engine's Pareto front is its points that no other point of the same engine
+//! beats on both time and E ([`pareto_front`]); at each quality bar ([`BARS`]) the engines
+//! are compared by their cheapest setting meeting the bar ([`cheapest_meeting`]), and impulse
+//! by its time over the cheapest peer's.
 //!
 //! Every setting runs on its own from the first step to the last, one world at a time, on one
 //! thread (a one-thread rayon pool; the peers run on the calling thread). The order interleaves

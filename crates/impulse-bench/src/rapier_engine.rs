@@ -20,12 +20,13 @@ use rapier3d::prelude::{
 use crate::peer::{
     PeerJointKind, PeerRun, PeerWorld, check_carried_over, peer_joints, resolve_material,
 };
+use crate::row::BenchRow;
 
 /// The damping factor of the velocity motors that model joint friction in Rapier (its motor's
 /// torque is this factor times the velocity error, clamped to the friction torque): large, so
-/// that the motor acts as a bounded velocity constraint, as impulse's friction motor.
+/// that the bound sets the torque. Rapier's joint then still creeps under a load below its
+/// bound (`every_engine_brakes_a_falling_bar_with_impulses_joint_friction`).
 const FRICTION_MOTOR_FACTOR: f32 = 1.0e4;
-use crate::row::BenchRow;
 
 /// Engine name in [`BenchRow::engine`].
 pub const ENGINE: &str = "rapier";
@@ -132,8 +133,8 @@ impl RapierScene {
         // the anchors with impulse's frame rotations (Rapier's hinge turns about the frames'
         // x axis, as impulse's, so the hinge angle and its limits carry over unchanged), no
         // contacts between the joined bodies (as impulse). Joint friction is a velocity motor
-        // of target 0 on each free rotation, bounded by the friction torque, with a damping
-        // factor large enough that the bound, not the factor, sets the torque.
+        // of target 0 on each free rotation, bounded by the friction torque
+        // ([`FRICTION_MOTOR_FACTOR`]).
         let mut impulse_joints = ImpulseJointSet::new();
         for joint in peer_joints(world, "Rapier")? {
             let mut generic: GenericJoint = match joint.kind {
