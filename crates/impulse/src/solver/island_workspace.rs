@@ -84,7 +84,9 @@ pub(crate) struct IslandWorkspace {
     pub(super) impact: ImpactWorkspace,
     /// Whether this substep's main solve met an impact ([`IMPACT_SWEEPS`]).
     pub(super) impact_met: bool,
-    /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]).
+    /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]): a main solve whose last sweep changed
+    /// a row's velocity by more than this met an impact. Infinite when no row closed faster
+    /// than it at the step's start.
     pub(super) impact_speed: f32,
     /// The rows of the island's joints, written by the assembly stage.
     pub(crate) joints: IslandJoints,
