@@ -85,8 +85,8 @@ pub(crate) struct IslandWorkspace {
     /// Whether this substep's main solve met an impact ([`IMPACT_SWEEPS`]).
     pub(super) impact_met: bool,
     /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]): a main solve whose last sweep changed
-    /// a row's velocity by more than this met an impact. Infinite when no row closed faster
-    /// than it at the step's start.
+    /// a row's velocity by more than this met an impact. Infinite in an island without joints
+    /// where no contact closed faster than it at the step's start.
     pub(super) impact_speed: f32,
     /// The rows of the island's joints, written by the assembly stage.
     pub(crate) joints: IslandJoints,

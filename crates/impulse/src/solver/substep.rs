@@ -419,11 +419,15 @@ impl IslandWorkspace {
         // Only a row closing faster than the impact speed as the step starts makes an impact: in
         // a deep pile at a few substeps the soft rows' repair alone can change a sweep's
         // velocities by more than that, and sweeping such a pile to convergence shakes it
-        // (docs/method.md, "Impacts").
+        // (docs/method.md, "Impacts"). A joint's rows carry no closing speed to test (a limit
+        // reached at speed, a limb its joints whip into another body), so an island with
+        // joints keeps the sweeps' own test: without it a ragdoll pile's limbs sank into one
+        // another.
         let impact_speed = (gravity.length() * dt).max(settings.restitution_threshold);
-        let closing = constraints
-            .iter()
-            .any(|c| c.normal.velocity_before < -impact_speed);
+        let closing = !self.joints.is_empty()
+            || constraints
+                .iter()
+                .any(|c| c.normal.velocity_before < -impact_speed);
         self.impact_speed = if closing { impact_speed } else { f32::INFINITY };
         self.impact_met = false;
     }
