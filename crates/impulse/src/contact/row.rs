@@ -296,6 +296,15 @@ pub(super) fn inverse_block([k11, k12, k22]: [f32; 3]) -> [f32; 3] {
     }
 }
 
+/// Whether some row closed faster than `speed` (m/s) as the step started: its J·v⁻
+/// (`velocity_before`, set at assembly and rewritten only as the island's step ends) below
+/// −`speed`. What makes a step an impact for the solver's extra sweeps and the escalation.
+pub(crate) fn closes_faster_than(constraints: &[ContactConstraint], speed: f32) -> bool {
+    constraints
+        .iter()
+        .any(|c| c.normal.velocity_before < -speed)
+}
+
 /// Projects a friction impulse onto Coulomb's disc of radius `limit` (N·s).
 #[inline(always)]
 pub(crate) fn cap_to_disc(impulse: [f32; 2], limit: f32) -> [f32; 2] {

@@ -85,9 +85,12 @@ pub(crate) struct IslandWorkspace {
     /// Whether this substep's main solve met an impact ([`IMPACT_SWEEPS`]).
     pub(super) impact_met: bool,
     /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]): a main solve whose last sweep changed
-    /// a row's velocity by more than this met an impact. Infinite in an island without joints
-    /// where no contact closed faster than it at the step's start.
+    /// a row's velocity by more than this met an impact, if [`Self::closing`].
     pub(super) impact_speed: f32,
+    /// Whether the step can have an impact: the island has joints, or some contact closed
+    /// faster than `impact_speed` as the step started. `None` until a main solve's last sweep
+    /// asks ([`crate::contact::closes_faster_than`], a pass over the rows).
+    pub(super) closing: Option<bool>,
     /// The rows of the island's joints, written by the assembly stage.
     pub(crate) joints: IslandJoints,
 }

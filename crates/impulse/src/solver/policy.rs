@@ -6,7 +6,7 @@ use super::exact_rows::{breakable_joint, joint_row_count};
 use super::interface::{ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport};
 use super::nncg::Nncg;
 use super::rows::Velocities;
-use crate::contact::ContactConstraint;
+use crate::contact::{self, ContactConstraint};
 use crate::settings::SolverSettings;
 
 /// What the escalation decides on, besides the solve's own outcome: the settings' thresholds
@@ -81,11 +81,7 @@ impl ContactSolver for Auto {
         // column of a pile is the cost of hundreds of exact solves a substep. Asked only when
         // it decides something: a pass over the rows' v⁻ (set at assembly, rewritten only as
         // the island's step ends).
-        let impact = || {
-            constraints
-                .iter()
-                .any(|c| c.normal.velocity_before < -limits.impact_speed)
-        };
+        let impact = || contact::closes_faster_than(constraints, limits.impact_speed);
         let escalate = pass.escalate;
         let persistent = escalate && unconverged && !heavy && small && !impact();
         // The targets are set; the escalated solves keep them.

@@ -122,10 +122,18 @@ impl IslandWorkspace {
         let joints = &mut self.joints;
         let solver = self.solvers.substeps(settings.method, bundled);
         let outcome = solver.solve(constraints, &mut velocities, joints, &pass);
+        // Only a contact closing faster than the impact speed as the step started makes an
+        // impact: in a deep pile at a few substeps the soft rows' repair alone can change a
+        // sweep's velocities by more than that speed, and sweeping such a pile to convergence
+        // shakes it (docs/method.md, "Impacts"). Asked once a step, and only when the last
+        // sweep's change calls for it.
         self.impact_met = if with_repair {
             settings.method == SolverMethod::Pgs
                 && !settings.split_impulse()
                 && outcome.report.last_change > self.impact_speed
+                && *self.closing.get_or_insert_with(|| {
+                    contact::closes_faster_than(constraints, self.impact_speed)
+                })
         } else {
             self.impact_met
         };
@@ -416,19 +424,11 @@ impl IslandWorkspace {
         self.report.substeps = settings.substeps;
         self.solvers.auto.limits =
             EscalationLimits::new(settings, self.report.mass_ratio, gravity.length() * dt);
-        // Only a row closing faster than the impact speed as the step starts makes an impact: in
-        // a deep pile at a few substeps the soft rows' repair alone can change a sweep's
-        // velocities by more than that, and sweeping such a pile to convergence shakes it
-        // (docs/method.md, "Impacts"). A joint's rows carry no closing speed to test (a limit
-        // reached at speed, a limb its joints whip into another body), so an island with
-        // joints keeps the sweeps' own test: without it a ragdoll pile's limbs sank into one
-        // another.
-        let impact_speed = (gravity.length() * dt).max(settings.restitution_threshold);
-        let closing = !self.joints.is_empty()
-            || constraints
-                .iter()
-                .any(|c| c.normal.velocity_before < -impact_speed);
-        self.impact_speed = if closing { impact_speed } else { f32::INFINITY };
+        self.impact_speed = (gravity.length() * dt).max(settings.restitution_threshold);
+        // A joint's rows carry no closing speed to test (a limit reached at speed, a limb its
+        // joints whip into another body), so an island with joints takes the last-sweep test
+        // alone: with the contacts' test too, a ragdoll pile's limbs sank into one another.
+        self.closing = (!self.joints.is_empty()).then_some(true);
         self.impact_met = false;
     }
 
