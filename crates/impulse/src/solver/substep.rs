@@ -446,15 +446,14 @@ impl IslandWorkspace {
         let (parallel, world_inverse_inertia) = (context.parallel, context.world_inverse_inertia);
         let slots = island_bodies.len() + guests.len() + 1;
         let w = self;
-        // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth.
-        // Joints are swept by the scalar path, so an island with joints is not packed into
-        // lanes (docs/solvers.md, "Joints").
-        let bundled = settings.solves_in_lanes(constraints.len()) && w.joints.is_empty();
+        // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth
+        // of contact points; its joints are swept by the scalar path between the lanes' sweeps
+        // (docs/solvers.md, "Joints").
+        let bundled = settings.solves_in_lanes(constraints.len());
         // Assembly leaves the lever-arm products and effective masses of the rows of islands
         // the step's settings would solve in lanes to the lanes (`products_pending`). An island
-        // that does not go to the lanes after all (it has joints, or takes the heavy-on-light
-        // path) computes them here: left pending, its contacts would have no effective mass
-        // and push nothing.
+        // that does not go to the lanes after all (it takes the heavy-on-light path) computes
+        // them here: left pending, its contacts would have no effective mass and push nothing.
         if !bundled && context.settings.solves_in_lanes(constraints.len()) {
             contact::complete_products(constraints, world_inverse_inertia);
         }
@@ -502,7 +501,9 @@ impl IslandWorkspace {
                 && (coloured_threads || (bundled && w.solvers.wide.parallel())),
             // With no restitution solve to follow, the lanes record the rows' J·v* and residual
             // while the bundles are in cache (`lanes::Bundles::record`); `rows` then holds them.
-            record_in_lanes: bundled && !context.restitution,
+            // Not with joints: the lanes' v* (the velocities before the last substep's impulses)
+            // would leave out the joints' impulses too, where the record's v* keeps them.
+            record_in_lanes: bundled && !context.restitution && w.joints.is_empty(),
         }
     }
 

@@ -63,6 +63,11 @@ const CASES: &[Case] = &[
         source: "balls1k",
     },
     Case {
+        name: "ragdollpile",
+        steps: 150,
+        source: "ragdollpile",
+    },
+    Case {
         name: "shapes",
         steps: 300,
         source: "shapes.json",

@@ -9,6 +9,7 @@ use super::schedule::SweepOrder;
 use super::sweep::{VelocityRows, WarmStart};
 use super::targets::{NoTargets, Targets, Turned};
 use crate::contact::ContactConstraint;
+use crate::joint::{IslandJoints, sweep_joints};
 use crate::parallel::SharedItems;
 use crate::solver::interface::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport,
@@ -25,9 +26,14 @@ impl Bundles {
     /// they depend on the bodies' displacements only, which a sweep does not change, so the
     /// result is the same as a separate pass over the bundles first, which would read and
     /// write a third of the bytes of a sweep, twice a substep.
+    ///
+    /// The island's `joints` (scalar rows, few beside the points) are swept in each iteration
+    /// too, as the scalar PGS sweeps them: before the bundles going forward, after them going
+    /// back (block Gauss-Seidel between the joints and the contacts).
     pub(crate) fn solve_pgs(
         &mut self,
         velocities: &mut Velocities<'_>,
+        joints: &mut IslandJoints,
         pass: &SolvePass<'_>,
     ) -> SolveReport {
         let mut report = SolveReport::default();
@@ -46,6 +52,10 @@ impl Bundles {
             // A sweep that may meet stale rows is compiled apart, so that the usual one (no
             // body of the island turned past the limit) carries no test for them.
             let stale = first.is_some_and(|t| !t.turn.is_empty());
+            let mut joint_change = 0.0f32;
+            if forward && !joints.is_empty() {
+                joint_change = sweep_joints(joints, velocities, true);
+            }
             // One relax sweep before another substep adds up that substep's warm start as it
             // goes (`RelaxCarrying`). Not with several sweeps: each would add its impulses to
             // the step totals.
@@ -78,7 +88,10 @@ impl Bundles {
                     }
                 }
             };
-            let largest_change = largest.to_array().into_iter().fold(0.0f32, f32::max);
+            if !forward && !joints.is_empty() {
+                joint_change = sweep_joints(joints, velocities, false);
+            }
+            let largest_change = largest.to_array().into_iter().fold(joint_change, f32::max);
             report.iterations += 1;
             report.last_change = largest_change;
             if largest_change <= pass.tolerance {
@@ -133,12 +146,13 @@ impl ContactSolver for Bundles {
         &mut self,
         _constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
-        joints: &mut crate::joint::IslandJoints,
+        joints: &mut IslandJoints,
         pass: &SolvePass<'_>,
     ) -> SolveOutcome {
-        // Islands with joints are never packed into lanes (`IslandWorkspace::prepare_solver`).
-        debug_assert!(joints.is_empty());
-        SolveOutcome::of(EscalationLevel::Pgs, self.solve_pgs(velocities, pass))
+        SolveOutcome::of(
+            EscalationLevel::Pgs,
+            self.solve_pgs(velocities, joints, pass),
+        )
     }
 
     fn finish(&mut self, constraints: &mut [ContactConstraint]) {

@@ -146,10 +146,25 @@ fn a_motorised_wheel_reaches_its_target_speed_within_its_torque_bound() {
 /// brick in one substep of h = 1/1200 s its three joints would have to pass on several N·s,
 /// far above what each can carry, T·h ≈ 1.05 N·s: in the step of the impact exactly those
 /// three break, and nothing else.
+///
+/// Twice: at the defaults, which solve the island's contacts in SIMD lanes and sweep its
+/// joints between the lanes' sweeps, and with the lanes off (`simd_island_contacts` 0), so
+/// that the scalar PGS sweeps contacts and joints alike.
 #[test]
 fn a_breakable_wall_holds_its_weight_and_breaks_where_the_ball_strikes() {
+    for lanes in [false, true] {
+        breakable_wall(lanes);
+    }
+}
+
+fn breakable_wall(lanes: bool) {
     let mut world = world(SolverSettings {
         sleep: false,
+        simd_island_contacts: if lanes {
+            SolverSettings::default().simd_island_contacts
+        } else {
+            0
+        },
         ..SolverSettings::default()
     });
     let ground = world
@@ -217,8 +232,13 @@ fn a_breakable_wall_holds_its_weight_and_breaks_where_the_ball_strikes() {
         .map(|(name, _)| force(&world, name).length())
         .fold(0.0f32, f32::max);
     let (lowest_cut, top_cut) = (cut(&world, 1), cut(&world, 3));
+    let islands = &world.diagnostics().islands;
+    assert!(
+        islands.len() == 1 && islands[0].simd == lanes,
+        "one island, in the lanes: {lanes}"
+    );
     println!(
-        "wall at rest: the joints above the bottom row carry {lowest_cut:.1} N (9·m·g = {:.1} \
+        "wall at rest (lanes: {lanes}): the joints above the bottom row carry {lowest_cut:.1} N (9·m·g = {:.1} \
          N), the top row's {top_cut:.1} N (3·m·g = {:.1} N); largest joint force {largest:.1} \
          N, strength {strength:.1} N",
         9.0 * weight,
@@ -246,7 +266,7 @@ fn a_breakable_wall_holds_its_weight_and_breaks_where_the_ball_strikes() {
             break;
         }
     }
-    println!("wall struck: joints broken in the impact step {first_breaks:?}");
+    println!("wall struck (lanes: {lanes}): joints broken in the impact step {first_breaks:?}");
     let ball_z = world.body(ball).unwrap().translation().z;
     assert!((-0.35..0.0).contains(&ball_z), "ball at z = {ball_z} m");
     let mut names: Vec<&str> = first_breaks

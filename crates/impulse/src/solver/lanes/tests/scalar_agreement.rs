@@ -3,6 +3,7 @@
 //! sweep each give what the scalar update of the unpacked rows gives.
 
 use super::scenes::{DT, material, sphere};
+use crate::joint::IslandJoints;
 use crate::scene::builtin_scene;
 use crate::{BodyKind, SolverSettings, World};
 use glam::{Mat3, Vec3};
@@ -265,6 +266,7 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
                 linear: &mut linear,
                 angular: &mut angular,
             },
+            &mut IslandJoints::default(),
             &pass,
         );
         let mut lanes = rows.clone();
@@ -436,7 +438,7 @@ fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
             };
             bundles.warm_start(&mut [], &mut velocities, 0);
             let pass = pass_at_rest(&still, &settings, false, carry);
-            bundles.solve_pgs(&mut velocities, &pass);
+            bundles.solve_pgs(&mut velocities, &mut IslandJoints::default(), &pass);
             bundles.warm_start(&mut [], &mut velocities, 1);
             let mut unpacked = rows.clone();
             bundles.unpack(&mut unpacked);
@@ -536,7 +538,7 @@ fn normal_rows_sweep_reads_only_the_normal_part_of_a_bundle() {
             }
         }
         let pass = pass_at_rest(&still, &settings, true, false);
-        bundles.solve_pgs(&mut velocities, &pass);
+        bundles.solve_pgs(&mut velocities, &mut IslandJoints::default(), &pass);
         let impulses: Vec<u32> = bundles
             .bundles
             .iter()
