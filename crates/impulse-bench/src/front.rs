@@ -18,7 +18,9 @@
 //! thread (a one-thread rayon pool; the peers run on the calling thread). The order interleaves
 //! the engines (an impulse setting, a Rapier setting, a Box3D setting, a Jolt setting, an
 //! impulse setting, …) so that a drift of the machine's speed during the run hits every engine
-//! alike, after an untimed warm-up of each engine's first setting ([`WARM_UP_STEPS`]).
+//! alike, after an untimed warm-up of each engine's first setting ([`WARM_UP_STEPS`]). The
+//! settings that decide the bars then run again, by turns, and take their runs' median time
+//! ([`crate::front_retime`], [`FrontConfig::repeats`]).
 
 use std::path::{Path, PathBuf};
 
@@ -26,9 +28,11 @@ use anyhow::{Result, bail};
 use impulse::{Scene, SolverSettings};
 use serde::Serialize;
 
+pub use crate::front_point::{FrontPoint, error_mm};
+use crate::front_retime;
 use crate::peer_settings::{PeerSetting, missing_peer, peer_compiled};
+use crate::scene_by_name;
 use crate::threads::thread_pool;
-use crate::{BenchRow, scene_by_name};
 
 pub use crate::front_grids::{
     ImpulseSetting, box3d_grid, box3d_joint_grid, box3d_quick_grid, impulse_grid,
@@ -64,6 +68,9 @@ pub const WARM_UP_STEPS: u32 = 60;
 /// Scenes with more bodies than this run the large-scene step count.
 pub const LARGE_SCENE_BODIES: usize = 2000;
 
+/// Runs of each bar contender when not told otherwise (`front_retime`).
+pub const DEFAULT_REPEATS: u32 = 3;
+
 /// The quality bars: name and the largest E (mm) that meets it.
 pub const BARS: [(&str, f64); 3] = [("Q50", 50.0), ("Q5", 5.0), ("Q1", 1.0)];
 
@@ -72,99 +79,6 @@ pub const PLOT_E_FLOOR_MM: f64 = 0.01;
 
 /// [`FrontPoint::engine`] of impulse's points (the peers': [`RAPIER`], [`BOX3D`], [`JOLT`]).
 pub const IMPULSE: &str = "impulse";
-
-/// One engine with one setting on one scene.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FrontPoint {
-    /// [`IMPULSE`], [`RAPIER`], [`BOX3D`] or [`JOLT`].
-    pub engine: String,
-    /// The setting's name in its grid, e.g. `soft 8`, `8×120Hz coulomb` or `c1 v10 p2`.
-    pub setting: String,
-    /// Median wall-clock time of one step (ms), over the steps taken.
-    pub ms_per_step: f64,
-    /// The quality error (mm): max(joint gap, overlap) for a scene with joints, max(|sink|,
-    /// overlap, drift) otherwise.
-    pub e_mm: f64,
-    /// Initial y − final y of the moving body that started highest (mm).
-    pub sink_mm: f64,
-    /// Largest penetration depth between two bodies over the samples (mm).
-    pub overlap_mm: f64,
-    /// Largest distance of a moving body from its start over the samples (mm).
-    pub drift_mm: f64,
-    /// Largest joint gap over the samples (mm; `quality::joint_gap`); None for a scene
-    /// without joints.
-    pub joint_gap_mm: Option<f64>,
-    /// Steps taken (fewer than asked when the run failed).
-    pub steps: u32,
-    /// The engine's settings in full, as the engine ran them.
-    pub details: String,
-    /// Why the run failed (an error, a blow-up, a non-finite result); None when it did not. A
-    /// failed point is kept in the JSON and left out of fronts and tables of cheapest settings.
-    pub failed: Option<String>,
-}
-
-impl FrontPoint {
-    /// The point of a run's row; `error` is the error that ended the run early, if any. A
-    /// run whose time or error is not finite counts as failed too.
-    pub fn from_row(engine: &str, setting: &str, row: &BenchRow, error: Option<String>) -> Self {
-        let sink_mm = row.top_sink_m * 1e3;
-        let overlap_mm = row.max_overlap_m * 1e3;
-        let drift_mm = row.max_drift_m * 1e3;
-        let joint_gap_mm = row.max_joint_gap_m.map(|gap| gap * 1e3);
-        let e_mm = match joint_gap_mm {
-            Some(gap) => error_mm(gap, overlap_mm, 0.0),
-            None => error_mm(sink_mm, overlap_mm, drift_mm),
-        };
-        let failed = error.or_else(|| {
-            (!(e_mm.is_finite() && row.ms_per_step_median.is_finite()))
-                .then(|| "non-finite result".to_string())
-        });
-        Self {
-            engine: engine.to_string(),
-            setting: setting.to_string(),
-            ms_per_step: row.ms_per_step_median,
-            e_mm,
-            sink_mm,
-            overlap_mm,
-            drift_mm,
-            joint_gap_mm,
-            steps: row.steps,
-            details: row.settings.clone(),
-            failed,
-        }
-    }
-
-    /// A run that could not start (its world could not be built).
-    fn not_started(engine: &str, setting: &str, error: &anyhow::Error) -> Self {
-        Self {
-            engine: engine.to_string(),
-            setting: setting.to_string(),
-            ms_per_step: f64::NAN,
-            e_mm: f64::NAN,
-            sink_mm: f64::NAN,
-            overlap_mm: f64::NAN,
-            drift_mm: f64::NAN,
-            joint_gap_mm: None,
-            steps: 0,
-            details: String::new(),
-            failed: Some(format!("{error:#}")),
-        }
-    }
-
-    /// True when the point takes part in fronts and bars: not failed, finite time and error.
-    pub fn counts(&self) -> bool {
-        self.failed.is_none() && self.ms_per_step.is_finite() && self.e_mm.is_finite()
-    }
-}
-
-/// E = max(|sink|, overlap, drift), in the units given; NaN when any of them is NaN.
-pub fn error_mm(sink: f64, overlap: f64, drift: f64) -> f64 {
-    let values = [sink.abs(), overlap, drift];
-    if values.iter().any(|v| v.is_nan()) {
-        return f64::NAN;
-    }
-    values.into_iter().fold(0.0, f64::max)
-}
 
 /// All points of one scene.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -175,7 +89,9 @@ pub struct SceneFront {
     pub bodies: usize,
     /// Steps each setting was asked to run.
     pub steps: u32,
-    /// Every setting of every engine, in the order they ran.
+    /// Runs of each bar contender (`front_retime`); 1 when every setting ran once.
+    pub repeats: u32,
+    /// Every setting of every engine, in the order they first ran.
     pub points: Vec<FrontPoint>,
 }
 
@@ -244,6 +160,8 @@ pub struct FrontConfig {
     pub quick: bool,
     /// The peers to measure, by engine name ([`PEERS`]); each needs its feature.
     pub peers: Vec<String>,
+    /// Runs of each bar contender (`front_retime`): 1 runs every setting once.
+    pub repeats: u32,
 }
 
 impl Default for FrontConfig {
@@ -259,6 +177,7 @@ impl Default for FrontConfig {
                 .filter(|peer| peer_compiled(peer))
                 .map(str::to_string)
                 .collect(),
+            repeats: DEFAULT_REPEATS,
         }
     }
 }
@@ -352,8 +271,10 @@ pub struct Progress<'a> {
     pub steps: u32,
     /// Points measured so far over all scenes, this one included (1-based).
     pub done: usize,
-    /// Points to measure over all scenes.
+    /// Points to measure over all scenes (the grid pass; re-timings come on top).
     pub total: usize,
+    /// 0 in the grid pass; k for the k-th re-timing round of the bars' contenders.
+    pub round: u32,
     /// The point just measured.
     pub point: &'a FrontPoint,
 }
@@ -367,6 +288,9 @@ pub fn run_front(
 ) -> Result<Vec<SceneFront>> {
     if config.steps == 0 || config.large_steps == 0 {
         bail!("steps must be at least 1");
+    }
+    if config.repeats == 0 {
+        bail!("repeats must be at least 1");
     }
     let scenes = config
         .scenes
@@ -397,13 +321,17 @@ pub fn run_front(
                 config.steps_for(scene),
                 impulse,
                 peers,
-                &mut |scene, steps, point| {
-                    done += 1;
+                config.repeats,
+                &mut |scene, steps, round, point| {
+                    if round == 0 {
+                        done += 1;
+                    }
                     on_point(&Progress {
                         scene,
                         steps,
                         done,
                         total,
+                        round,
                         point,
                     });
                 },
@@ -415,14 +343,16 @@ pub fn run_front(
 /// Runs `scene` for `steps` steps once per setting, interleaving the engines (impulse's first
 /// setting, then the first of each peer grid in `peers`, impulse's second, …; the longer
 /// grids' rest at the end), each run on its own from start to end inside a one-thread rayon
-/// pool. `on_point` gets the scene name, the steps and each point as it is measured. A peer
-/// setting needs its engine's feature.
+/// pool; then `repeats − 1` rounds re-time the bars' contenders (`front_retime`). `on_point`
+/// gets the scene name, the steps, the round (0 for the grid pass) and each run's point as
+/// it is measured. A peer setting needs its engine's feature.
 pub fn measure_scene(
     scene: &Scene,
     steps: u32,
     impulse: &[ImpulseSetting],
     peers: &[Vec<PeerSetting>],
-    on_point: &mut dyn FnMut(&str, u32, &FrontPoint),
+    repeats: u32,
+    on_point: &mut dyn FnMut(&str, u32, u32, &FrontPoint),
 ) -> Result<SceneFront> {
     for setting in peers.iter().flatten() {
         if !peer_compiled(setting.engine()) {
@@ -431,6 +361,8 @@ pub fn measure_scene(
     }
     let longest = peers.iter().map(Vec::len).fold(impulse.len(), usize::max);
     let mut points = Vec::new();
+    // Where each point's setting is: impulse's k-th, or setting k of peer grid g.
+    let mut sources = Vec::new();
     let pool = thread_pool(1)?;
     // Warm-up, not recorded, so that no measured run is the first on a scene: the first run on
     // a scene pays for cold caches and page faults that its neighbours do not.
@@ -444,19 +376,44 @@ pub fn measure_scene(
     for k in 0..longest {
         if let Some((name, settings)) = impulse.get(k) {
             let point = pool.install(|| run_impulse(scene, steps, name, settings));
-            on_point(&scene.name, steps, &point);
+            on_point(&scene.name, steps, 0, &point);
             points.push(point);
+            sources.push((None, k));
         }
-        for setting in peers.iter().filter_map(|grid| grid.get(k)) {
+        for (g, setting) in peers
+            .iter()
+            .enumerate()
+            .filter_map(|(g, grid)| Some((g, grid.get(k)?)))
+        {
             let point = pool.install(|| run_peer(scene, steps, setting));
-            on_point(&scene.name, steps, &point);
+            on_point(&scene.name, steps, 0, &point);
             points.push(point);
+            sources.push((Some(g), k));
+        }
+    }
+    let contenders = if repeats > 1 {
+        front_retime::contenders(&points, &BARS)
+    } else {
+        Vec::new()
+    };
+    for round in 1..repeats {
+        for &k in &contenders {
+            let again = match sources[k] {
+                (None, i) => {
+                    let (name, settings) = &impulse[i];
+                    pool.install(|| run_impulse(scene, steps, name, settings))
+                }
+                (Some(g), i) => pool.install(|| run_peer(scene, steps, &peers[g][i])),
+            };
+            on_point(&scene.name, steps, round, &again);
+            front_retime::add_run(&mut points[k], &again);
         }
     }
     Ok(SceneFront {
         scene: scene.name.clone(),
         bodies: scene.bodies.len(),
         steps,
+        repeats,
         points,
     })
 }

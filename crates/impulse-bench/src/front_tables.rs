@@ -9,6 +9,7 @@ use crate::MachineInfo;
 use crate::front::{
     BARS, FrontPoint, IMPULSE, SceneFront, cheapest_meeting, pareto_front, plot_path,
 };
+use crate::front_retime::CONTENDER_SPAN;
 use crate::peer_settings::{BOX3D, JOLT, PEERS, RAPIER};
 
 /// An engine's name in table headers: `impulse`, `Rapier`, `Box3D`, `Jolt`.
@@ -278,6 +279,16 @@ pub fn format_tables(fronts: &[SceneFront], plots: Plots<'_>) -> String {
             front.points.len()
         );
         out.push_str(&format_bar_table(front));
+        let retimed = front.points.iter().filter(|p| p.runs_ms.len() > 1).count();
+        if retimed > 0 {
+            let _ = writeln!(
+                out,
+                "\nTimes of the {retimed} settings that could decide a bar (each engine's settings \
+                 meeting one within {CONTENDER_SPAN}× of its cheapest there) are the medians of \
+                 {} runs taken by turns; every other setting ran once.",
+                front.repeats
+            );
+        }
         out.push_str("\nPareto fronts:\n\n");
         out.push_str(&format_front_table(front));
         let failed: Vec<&FrontPoint> = front.points.iter().filter(|p| !p.counts()).collect();

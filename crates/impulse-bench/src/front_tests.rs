@@ -1,6 +1,7 @@
 //! Unit tests of `front.rs`: the front's dominance, bars and tables on hand-made points.
 
 use super::*;
+use crate::BenchRow;
 use crate::MachineInfo;
 use crate::peer_settings::{Box3dSetting, JoltSetting, RapierVariant};
 use impulse::SolverMethod;
@@ -10,6 +11,7 @@ fn point(engine: &str, setting: &str, ms: f64, e_mm: f64) -> FrontPoint {
         engine: engine.into(),
         setting: setting.into(),
         ms_per_step: ms,
+        runs_ms: vec![ms],
         e_mm,
         sink_mm: e_mm,
         overlap_mm: 0.0,
@@ -119,6 +121,7 @@ fn tables_mark_bars_no_setting_meets() {
         scene: "s".into(),
         bodies: 4,
         steps: 20,
+        repeats: 1,
         points: vec![
             point(IMPULSE, "fast", 1.0, 30.0),
             point(IMPULSE, "default", 4.0, 0.5),
@@ -203,6 +206,7 @@ fn tables_compare_impulse_with_the_cheapest_peer() {
         scene: "s".into(),
         bodies: 4,
         steps: 20,
+        repeats: 1,
         points: vec![
             point(IMPULSE, "fast", 1.0, 30.0),
             point(RAPIER, "4×30Hz", 4.0, 40.0),
@@ -365,8 +369,13 @@ fn quick_front_on_a_small_stack() {
         ..FrontConfig::default()
     };
     let mut progress = Vec::new();
+    let mut again = Vec::new();
     let fronts = run_front(&config, &mut |p| {
-        progress.push((p.done, p.total, p.point.engine.clone()))
+        if p.round == 0 {
+            progress.push((p.done, p.total, p.point.engine.clone()))
+        } else {
+            again.push((p.round, p.point.engine.clone(), p.point.setting.clone()))
+        }
     })
     .unwrap();
     assert_eq!(fronts.len(), 1);
@@ -397,6 +406,23 @@ fn quick_front_on_a_small_stack() {
         assert!(p.e_mm < 50.0, "{p:?}");
     }
     assert!(!pareto_front(&front.points, IMPULSE).is_empty());
+    // The bars' contenders ran `repeats` times in all, the others once, and a re-timed
+    // point's time is the median of its runs.
+    let contenders = crate::front_retime::contenders(&front.points, &BARS);
+    assert!(!contenders.is_empty());
+    assert_eq!(
+        again.len(),
+        contenders.len() * (DEFAULT_REPEATS as usize - 1)
+    );
+    for (k, p) in front.points.iter().enumerate() {
+        let runs = if contenders.contains(&k) {
+            DEFAULT_REPEATS as usize
+        } else {
+            1
+        };
+        assert_eq!(p.runs_ms.len(), runs, "{p:?}");
+        assert_eq!(p.ms_per_step, crate::front_retime::median(&p.runs_ms));
+    }
 
     let dir = std::env::temp_dir().join(format!("impulse-front-test-{}", std::process::id()));
     let paths = crate::plot::write_plots(&fronts, &dir).unwrap();
@@ -432,4 +458,53 @@ fn quick_front_on_a_small_stack() {
     );
     assert_eq!(json["scenes"][0]["steps"], 20);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The contenders at a bar are each engine's settings meeting it within the span of its
+/// cheapest there; failed points and settings too slow or too poor are not.
+#[test]
+fn the_contenders_are_each_engines_settings_near_its_cheapest_at_a_bar() {
+    let mut failed = point(IMPULSE, "failed", 0.1, 0.0);
+    failed.failed = Some("blew up".into());
+    let points = vec![
+        point(IMPULSE, "cheapest Q50", 1.0, 40.0),
+        point(IMPULSE, "near Q50", 1.4, 30.0),
+        point(IMPULSE, "too slow for Q50, cheapest Q5", 2.0, 4.0),
+        point(IMPULSE, "too poor", 0.5, 80.0),
+        point(RAPIER, "only Q50", 3.0, 20.0),
+        point(RAPIER, "slow Q5", 9.0, 5.0),
+        failed,
+    ];
+    let names: Vec<&str> = crate::front_retime::contenders(&points, &BARS)
+        .into_iter()
+        .map(|k| points[k].setting.as_str())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "cheapest Q50",
+            "near Q50",
+            "too slow for Q50, cheapest Q5",
+            "only Q50",
+            "slow Q5"
+        ]
+    );
+}
+
+#[test]
+fn a_retimed_point_takes_the_median_of_its_runs() {
+    use crate::front_retime::{add_run, median};
+    assert!(median(&[]).is_nan());
+    assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+    assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+    let mut p = point(IMPULSE, "soft 4", 5.0, 1.0);
+    add_run(&mut p, &point(IMPULSE, "soft 4", 1.0, 1.0));
+    add_run(&mut p, &point(IMPULSE, "soft 4", 2.0, 1.0));
+    let mut failed = point(IMPULSE, "soft 4", 0.1, 1.0);
+    failed.failed = Some("blew up".into());
+    add_run(&mut p, &failed);
+    assert_eq!(
+        (p.runs_ms.as_slice(), p.ms_per_step),
+        ([5.0, 1.0, 2.0].as_slice(), 2.0)
+    );
 }

@@ -24,6 +24,8 @@ mod box3d_engine;
 mod engines;
 pub mod front;
 mod front_grids;
+mod front_point;
+pub mod front_retime;
 mod front_tables;
 mod impulse_engine;
 #[cfg(test)]

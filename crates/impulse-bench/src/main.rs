@@ -115,6 +115,11 @@ struct FrontArgs {
     /// A few settings per engine instead of the full grids (for checks).
     #[arg(long)]
     quick: bool,
+    /// Runs of each setting that could decide a bar (each engine's settings meeting it within
+    /// 1.5× of its cheapest there), by turns across the engines; their time is the median.
+    /// 1 runs every setting once.
+    #[arg(long, default_value_t = front::DEFAULT_REPEATS, value_name = "R")]
+    repeats: u32,
 }
 
 fn main() -> ExitCode {
@@ -255,6 +260,7 @@ fn run_front(args: FrontArgs) -> Result<bool> {
         steps: args.steps,
         large_steps: args.large_steps,
         quick: args.quick,
+        repeats: args.repeats,
         ..FrontConfig::default()
     };
     if let Some(peers) = args.peers {
@@ -278,6 +284,13 @@ fn run_front(args: FrontArgs) -> Result<bool> {
     report_peers(&asked);
     let fronts = front::run_front(&config, &mut |p| {
         let point = p.point;
+        if p.round > 0 {
+            eprintln!(
+                "[again {}] {} {:<7} {:<18} {:>9.3} ms/step",
+                p.round, p.scene, point.engine, point.setting, point.ms_per_step
+            );
+            return;
+        }
         match &point.failed {
             None => eprintln!(
                 "[{}/{}] {} ({} steps) {:<7} {:<18} {:>9.3} ms/step  E {:.2} mm (sink {:.2}, \

@@ -1,0 +1,105 @@
+//! One run of the front: an engine with one setting on one scene ([`FrontPoint`]), and its
+//! quality error ([`error_mm`]).
+
+use serde::Serialize;
+
+use crate::BenchRow;
+
+/// One engine with one setting on one scene.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FrontPoint {
+    /// `impulse`, `rapier`, `box3d` or `jolt`.
+    pub engine: String,
+    /// The setting's name in its grid, e.g. `soft 8`, `8×120Hz coulomb` or `c1 v10 p2`.
+    pub setting: String,
+    /// Median wall-clock time of one step (ms), over the steps taken; for a bar contender
+    /// re-timed by `--repeats`, the median of its runs' ([`Self::runs_ms`]).
+    pub ms_per_step: f64,
+    /// Each run's median ms/step: one entry, or one per run of a re-timed bar contender
+    /// (`front_retime`); empty when the run could not start.
+    pub runs_ms: Vec<f64>,
+    /// The quality error (mm): max(joint gap, overlap) for a scene with joints, max(|sink|,
+    /// overlap, drift) otherwise.
+    pub e_mm: f64,
+    /// Initial y − final y of the moving body that started highest (mm).
+    pub sink_mm: f64,
+    /// Largest penetration depth between two bodies over the samples (mm).
+    pub overlap_mm: f64,
+    /// Largest distance of a moving body from its start over the samples (mm).
+    pub drift_mm: f64,
+    /// Largest joint gap over the samples (mm; `quality::joint_gap`); None for a scene
+    /// without joints.
+    pub joint_gap_mm: Option<f64>,
+    /// Steps taken (fewer than asked when the run failed).
+    pub steps: u32,
+    /// The engine's settings in full, as the engine ran them.
+    pub details: String,
+    /// Why the run failed (an error, a blow-up, a non-finite result); None when it did not. A
+    /// failed point is kept in the JSON and left out of fronts and tables of cheapest settings.
+    pub failed: Option<String>,
+}
+
+impl FrontPoint {
+    /// The point of a run's row; `error` is the error that ended the run early, if any. A
+    /// run whose time or error is not finite counts as failed too.
+    pub fn from_row(engine: &str, setting: &str, row: &BenchRow, error: Option<String>) -> Self {
+        let sink_mm = row.top_sink_m * 1e3;
+        let overlap_mm = row.max_overlap_m * 1e3;
+        let drift_mm = row.max_drift_m * 1e3;
+        let joint_gap_mm = row.max_joint_gap_m.map(|gap| gap * 1e3);
+        let e_mm = match joint_gap_mm {
+            Some(gap) => error_mm(gap, overlap_mm, 0.0),
+            None => error_mm(sink_mm, overlap_mm, drift_mm),
+        };
+        let failed = error.or_else(|| {
+            (!(e_mm.is_finite() && row.ms_per_step_median.is_finite()))
+                .then(|| "non-finite result".to_string())
+        });
+        Self {
+            engine: engine.to_string(),
+            setting: setting.to_string(),
+            ms_per_step: row.ms_per_step_median,
+            runs_ms: vec![row.ms_per_step_median],
+            e_mm,
+            sink_mm,
+            overlap_mm,
+            drift_mm,
+            joint_gap_mm,
+            steps: row.steps,
+            details: row.settings.clone(),
+            failed,
+        }
+    }
+
+    /// A run that could not start (its world could not be built).
+    pub(crate) fn not_started(engine: &str, setting: &str, error: &anyhow::Error) -> Self {
+        Self {
+            engine: engine.to_string(),
+            setting: setting.to_string(),
+            ms_per_step: f64::NAN,
+            runs_ms: Vec::new(),
+            e_mm: f64::NAN,
+            sink_mm: f64::NAN,
+            overlap_mm: f64::NAN,
+            drift_mm: f64::NAN,
+            joint_gap_mm: None,
+            steps: 0,
+            details: String::new(),
+            failed: Some(format!("{error:#}")),
+        }
+    }
+
+    /// True when the point takes part in fronts and bars: not failed, finite time and error.
+    pub fn counts(&self) -> bool {
+        self.failed.is_none() && self.ms_per_step.is_finite() && self.e_mm.is_finite()
+    }
+}
+
+/// E = max(|sink|, overlap, drift), in the units given; NaN when any of them is NaN.
+pub fn error_mm(sink: f64, overlap: f64, drift: f64) -> f64 {
+    let values = [sink.abs(), overlap, drift];
+    if values.iter().any(|v| v.is_nan()) {
+        return f64::NAN;
+    }
+    values.into_iter().fold(0.0, f64::max)
+}
