@@ -32,6 +32,10 @@ pub(crate) const UPPER: usize = 2;
 pub(crate) const SPRING: usize = 3;
 pub(crate) const MOTOR: usize = 4;
 
+/// The rows a sweep updates one by one, in its order: springs and motors, then limits (the
+/// locked groups follow as blocks).
+const SWEPT_ROWS: [usize; 4] = [SPRING, MOTOR, LOWER, UPPER];
+
 /// Impulses of a joint's rows (N·s or N·m·s), per degree of freedom and row.
 pub(crate) type JointImpulses = [[f32; ROWS_PER_DOF]; 6];
 
@@ -234,6 +238,11 @@ pub(crate) struct JointConstraint {
     pub state: FrameState,
     pub rows: [JointRow; 6],
     pub targets: [[RowTarget; ROWS_PER_DOF]; 6],
+    /// (degree of freedom, row) of each spring, motor and limit row whose target is active,
+    /// the first `active_count`, in the order a sweep updates them ([`SWEPT_ROWS`]); set with
+    /// the targets, so that a sweep does not test all twenty-four.
+    active_rows: [(u8, u8); 4 * 6],
+    active_count: u8,
     /// Inverse of each locked group's K (translations, rotations), identity on the unlocked.
     block_inverse: [Mat3; 2],
     /// J·v* of each row with the island's joint impulses taken out (for the exported LCP).
@@ -287,6 +296,8 @@ impl JointConstraint {
             state: FrameState::default(),
             rows: [JointRow::default(); 6],
             targets: [[RowTarget::default(); ROWS_PER_DOF]; 6],
+            active_rows: [(0, 0); 4 * 6],
+            active_count: 0,
             block_inverse: [Mat3::IDENTITY; 2],
             velocity_before: [0.0; 6],
             bounce: [[0.0; ROWS_PER_DOF]; 6],
@@ -467,6 +478,15 @@ impl JointConstraint {
                 targets[MOTOR] = target;
             }
             self.targets[i] = targets;
+        }
+        self.active_count = 0;
+        for kind in SWEPT_ROWS {
+            for i in 0..6 {
+                if self.targets[i][kind].active {
+                    self.active_rows[self.active_count as usize] = (i as u8, kind as u8);
+                    self.active_count += 1;
+                }
+            }
         }
     }
 
@@ -712,28 +732,26 @@ impl JointConstraint {
         }
         let mut v = self.load(velocities);
         let mut largest = 0.0f32;
-        for kind in [SPRING, MOTOR, LOWER, UPPER] {
-            for i in 0..6 {
-                let target = self.targets[i][kind];
-                if !target.active {
-                    continue;
-                }
-                let row = self.rows[i];
-                if row.mass == 0.0 {
-                    continue;
-                }
-                let velocity = target.sign * row.velocity(&v);
-                let old = self.impulses[i][kind];
-                let new = (old
-                    - row.mass * target.mass_scale * (velocity + target.bias)
-                    - target.impulse_scale * old)
-                    .clamp(target.lower, target.upper);
-                let delta = new - old;
-                if delta != 0.0 {
-                    self.impulses[i][kind] = new;
-                    row.apply(self, target.sign * delta, &mut v);
-                    largest = largest.max(delta.abs() * row.inverse_mass);
-                }
+        for k in 0..self.active_count as usize {
+            let (i, kind) = self.active_rows[k];
+            let (i, kind) = (i as usize, kind as usize);
+            let target = &self.targets[i][kind];
+            let row = &self.rows[i];
+            if row.mass == 0.0 {
+                continue;
+            }
+            let velocity = target.sign * row.velocity(&v);
+            let old = self.impulses[i][kind];
+            let new = (old
+                - row.mass * target.mass_scale * (velocity + target.bias)
+                - target.impulse_scale * old)
+                .clamp(target.lower, target.upper);
+            let delta = new - old;
+            if delta != 0.0 {
+                let (sign, inverse_mass) = (target.sign, row.inverse_mass);
+                self.impulses[i][kind] = new;
+                self.rows[i].apply(self, sign * delta, &mut v);
+                largest = largest.max(delta.abs() * inverse_mass);
             }
         }
         for (group, start) in [(1, 3), (0, 0)] {
