@@ -509,6 +509,7 @@ fn a_breakable_wall_on_the_exact_path_carries_its_weight_and_breaks_at_its_stren
         if exact {
             took_the_exact_path(&world);
         }
+        println!("impact step: {:?}", world.diagnostics().islands);
         println!(
             "wall struck, exact path {exact}: joints broken {names:?} (ball at z = {ball_z} m)"
         );
