@@ -32,7 +32,7 @@ pub(crate) struct ExactWorkspace {
     /// Per point: index in `full` of its first tangent row, if it has friction.
     pub(super) tangent_row: Vec<Option<usize>>,
     /// Per row of `full`: the diagonal added for the solve (soft-row term + ε·A_ii) (1/kg).
-    /// Lemke's rows are the first n + p: the normals, then the joint rows.
+    /// Lemke's rows are those of `lemke`: the normals, then the joint rows not held.
     pub(super) extra: Vec<f64>,
     /// Rows of `full` of this round's sticking tangents.
     pub(super) free: Vec<usize>,
