@@ -13,7 +13,9 @@
 //! free variables (bounds ±∞), limits unilateral ([0, ∞)), motors boxed (±max_force·h), so a
 //! step with joints exports a mixed (boxed) LCP. Each group's recorded J·v* has only its own
 //! impulses taken out (the contacts' record and the joints' are taken apart), so b adds the
-//! coupling A_cj·λ_j to each contact row and A_jc·γ_c to each joint row.
+//! coupling A_cj·λ_j to each contact row and A_jc·γ_c to each joint row. A breakable joint's
+//! locked rows are exported free like any other: the ball bound its strength puts on a locked
+//! group's impulse (|λ_g| ≤ threshold·h) is not a box, so it is not part of the exported problem.
 
 use std::collections::BTreeMap;
 

@@ -27,7 +27,7 @@ pub(crate) use direct::{IslandJoints, sweep_joints};
 pub(crate) use frames::{LocalFrames, frame_state};
 pub use handle::JointHandle;
 pub(crate) use handle::JointHandles;
-pub(crate) use rows::{JointBody, JointConstraint, JointImpulses, ROWS_PER_DOF};
+pub(crate) use rows::{JointBody, JointConstraint, JointImpulses, LOCK, ROWS_PER_DOF};
 pub use types::{
     AxisMode, JointAxis, JointDof, JointKind, JointStiffness, Motor, MotorMode, Spring,
 };

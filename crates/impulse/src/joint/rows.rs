@@ -562,7 +562,7 @@ impl JointConstraint {
 
     /// The strength of a locked group over a solve of h seconds (N·s or N·m·s; infinite:
     /// unbreakable): group 0 the translations, group 1 the rotations.
-    fn strength(&self, group: usize) -> f32 {
+    pub(crate) fn strength(&self, group: usize) -> f32 {
         if group == 0 {
             self.break_force * self.h
         } else {

@@ -30,9 +30,17 @@
 //! free, limits λ ≥ 0, motors boxed by ±max_force·h, soft rows with their diagonal term. Lemke
 //! then takes a box LCP ([`impulse_lcp::Bounds::Box`]) and eliminates the free rows itself by
 //! a Schur complement; the sticking tangents are eliminated before, as without joints. An
-//! island without joints takes exactly the arithmetic it took before joints existed. A
-//! breakable joint is refused ([`ExactFailure::BreakableJoint`]): its strength bounds a locked
-//! group's impulse by a ball, not a box.
+//! island without joints takes exactly the arithmetic it took before joints existed.
+//!
+//! A breakable joint's strength bounds each locked group's impulse by a ball, |λ_g| ≤ s, not a
+//! box; the ball is handled as the friction disc is ([`super::exact_ball`]). A group inside it
+//! is free in step 1; a group at its bound is held at λ_g = s·u, u its current direction, and
+//! is no Lemke row that round, its impulse reaching the other rows through the velocities; step
+//! 2 also runs block passes over the groups (each solved given the rest, projected onto its
+//! ball in the metric of its block), which updates u and moves groups between free and held.
+//! Such an island may take [`MAX_ROUNDS_WITH_BALLS`] rounds. The joint rows then hold the
+//! impulses, and the break test after the substep breaks a joint whose group ended at its
+//! bound, as after an iterative solve.
 //!
 //! Everything happens on copies of the impulses and velocities, written back only when the
 //! solve succeeded, so a failure leaves the caller's (iterative) result untouched.
@@ -42,12 +50,13 @@ use impulse_lcp::solvers::lemke;
 use impulse_lcp::{Bounds, DenseMatrix, Lcp, Matrix, SolverSettings, Status};
 
 use super::cholesky::{cholesky, cholesky_solve, cholesky_solve_columns};
+use super::exact_ball::{ball_pass, collect_ball_groups, hold_at_bound, with_ball_residual};
 pub(crate) use super::exact_report::{ExactFailure, ExactReport};
 use super::exact_rows::{
-    ExactJointRow, Side, apply_joint, breakable_joint, collect_joint_rows, contact_is_finite,
-    contact_sides, coupling, joint_row_count, joint_row_is_finite, joint_sides, joint_velocity,
-    residual, velocity,
+    apply_joint, box_bounds, collect_joint_rows, contact_is_finite, contact_sides, coupling,
+    joint_row_count, joint_row_is_finite, joint_sides, joint_velocity, residual, velocity,
 };
+pub(crate) use super::exact_workspace::ExactWorkspace;
 use super::interface::{
     ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport, set_scalar_targets,
 };
@@ -122,6 +131,11 @@ pub(crate) const REGULARISATION: f64 = 1e-6;
 /// it changed a velocity by more than 1 m/s (see [`REGULARISATION`]).
 pub(crate) const MAX_ROUNDS: u32 = 4;
 
+/// Most rounds for an island with a breakable joint's locked group ([`super::exact_ball`]):
+/// the directions of the groups held at their bound settle from round to round, as the sliding
+/// points' do, while every coupled row follows them.
+pub(crate) const MAX_ROUNDS_WITH_BALLS: u32 = 8;
+
 /// Symmetric Gauss-Seidel passes over the friction pairs per round.
 const FRICTION_PASSES: u32 = 4;
 
@@ -143,65 +157,6 @@ const PIVOTS_PER_ROW: usize = 4;
 /// See [`PIVOTS_PER_ROW`].
 const MIN_PIVOTS: usize = 16;
 
-/// Buffers reused between calls: the dense blocks and the trial impulses and velocities.
-#[derive(Default)]
-pub(crate) struct ExactWorkspace {
-    /// A = J M⁻¹ Jᵀ over the island's rows (normals, joint rows, then tangent pairs),
-    /// row-major (1/kg).
-    full: Vec<f64>,
-    /// Per row of `full`: (point, 0 for the normal or 1, 2 for a tangent), or (joint row,
-    /// [`JOINT`]).
-    rows: Vec<(usize, usize)>,
-    /// The island's joint rows in this solve ([`collect_joint_rows`]).
-    joint_rows: Vec<ExactJointRow>,
-    /// Trial impulses of the joint rows (N·s or N·m·s).
-    joint_impulse: Vec<f32>,
-    /// See `best_normal`.
-    best_joint: Vec<f32>,
-    /// Per row of `full`: its movable sides.
-    sides: Vec<[Option<Side>; 2]>,
-    /// Per point: index in `full` of its first tangent row, if it has friction.
-    tangent_row: Vec<Option<usize>>,
-    /// Per row of `full`: the diagonal added for the solve (soft-row term + ε·A_ii) (1/kg).
-    /// Lemke's rows are the first n + p: the normals, then the joint rows.
-    extra: Vec<f64>,
-    /// Rows of `full` of this round's sticking tangents.
-    free: Vec<usize>,
-    /// Per point: μ·u, u the unit direction of its friction, when it slides this round.
-    sliding: Vec<Option<[f64; 2]>>,
-    /// Cholesky factor of the sticking tangent block (row-major, lower triangle).
-    factor: Vec<f64>,
-    /// (A_ff + E_f)⁻¹ C_fn, free rows × normal rows, column-major (column j, of normal row j,
-    /// at j·s..(j + 1)·s for s free rows).
-    coupling: Vec<f64>,
-    /// (A_ff + E_f)⁻¹ b_f, then the solved free impulses (N·s).
-    free_rhs: Vec<f64>,
-    /// Scratch over the free rows: one row A_iF of the reduction.
-    column: Vec<f64>,
-    /// Schur complement buffer handed to Lemke (n × n).
-    matrix: Vec<f64>,
-    /// b of Lemke's problem (m/s).
-    rhs: Vec<f64>,
-    /// Per point: the soft-row term alone (1/kg), part of the problem the residual measures.
-    softness: Vec<f32>,
-    /// Trial normal impulses (N·s).
-    normal: Vec<f32>,
-    /// Trial friction impulses (N·s).
-    tangent: Vec<[f32; 2]>,
-    /// Trial linear velocities (m/s).
-    linear: Vec<Vec3>,
-    /// Trial angular velocities (rad/s).
-    angular: Vec<Vec3>,
-    /// The trial state of the best round so far (normal and tangent impulses, velocities).
-    best_normal: Vec<f32>,
-    /// See `best_normal`.
-    best_tangent: Vec<[f32; 2]>,
-    /// See `best_normal`.
-    best_linear: Vec<Vec3>,
-    /// See `best_normal`.
-    best_angular: Vec<Vec3>,
-}
-
 /// The `rows` tag of a joint row in [`ExactWorkspace`].
 const JOINT: usize = 3;
 
@@ -216,7 +171,9 @@ const JOINT: usize = 3;
 /// friction the pair (γ_t1, γ_t2) lies in the disc |γ_t| ≤ μ·γ_n. Sign convention: positive
 /// w_n separates; the normal points from B towards A. Per active row of an unbroken joint of
 /// `joints` (targets already set, velocities including its impulses), lo ≤ λ ≤ hi with
-/// w = s·J·v + bias + k_soft·λ ≥ 0 at lo, ≤ 0 at hi and = 0 inside ([`super::exact_rows`]).
+/// w = s·J·v + bias + k_soft·λ ≥ 0 at lo, ≤ 0 at hi and = 0 inside ([`super::exact_rows`]);
+/// a breakable joint's locked group g asks |λ_g| ≤ s and w_g = 0 inside, w_g = −β·λ_g (β ≥ 0)
+/// at the bound ([`super::exact_ball`]).
 ///
 /// On success the constraints and joints hold the new impulses (N·s; N·m·s on a joint's
 /// rotation rows), `max_normal_impulse` is raised to the new γ_n where larger, and the velocities were changed by M⁻¹Jᵀ(γ_new − γ_old), so the
@@ -225,12 +182,11 @@ const JOINT: usize = 3;
 /// Lemke pivot.
 ///
 /// Errors (constraints, joints and velocities then bitwise unchanged):
-/// [`ExactFailure::TooManyRows`] when n + p > `max_rows` (p joint rows), and
-/// [`ExactFailure::BreakableJoint`] for an unbroken breakable joint, both checked before any
+/// [`ExactFailure::TooManyRows`] when n + p > `max_rows` (p joint rows), checked before any
 /// work; [`ExactFailure::NonFinite`] for NaN or infinite input; [`ExactFailure::Factorisation`], [`ExactFailure::Lemke`] or
 /// [`ExactFailure::Refused`] when the linear algebra or pivoting does not give a solution;
-/// [`ExactFailure::NotImproved`] when the residual (normal and joint rows) at exit is above both the entry
-/// residual and 1e-6 m/s (friction rounds that did not settle).
+/// [`ExactFailure::NotImproved`] when the residual (normal and joint rows, ball groups) at exit is above both the entry
+/// residual and 1e-6 m/s (friction or ball rounds that did not settle).
 ///
 /// Panics if a local index is outside `velocities`, as the iterative solvers do.
 pub(crate) fn solve_exact(
@@ -247,9 +203,6 @@ pub(crate) fn solve_exact(
             rows: n + p,
             max_rows,
         });
-    }
-    if let Some(joint) = breakable_joint(joints) {
-        return Err(ExactFailure::BreakableJoint { joint });
     }
     if let Some(index) = constraints.iter().position(|c| !contact_is_finite(c)) {
         return Err(ExactFailure::NonFinite {
@@ -278,6 +231,9 @@ pub(crate) fn solve_exact(
             index: r.joint,
         });
     }
+    if let Err(rows) = collect_ball_groups(joints, &mut w.joint_rows, &mut w.groups) {
+        return Err(ExactFailure::Factorisation { rows, round: 0 });
+    }
     w.joint_impulse.clear();
     w.joint_impulse.extend(
         w.joint_rows
@@ -297,6 +253,15 @@ pub(crate) fn solve_exact(
             )
         },
         &w.joint_impulse,
+    );
+    let entry = with_ball_residual(
+        entry,
+        &w.groups,
+        joints,
+        &w.joint_rows,
+        &w.joint_impulse,
+        velocities.linear,
+        velocities.angular,
     );
     if n + p == 0 {
         return Ok(ExactReport {
@@ -327,15 +292,7 @@ pub(crate) fn solve_exact(
     let bounds = if p == 0 {
         Bounds::NonNegative
     } else {
-        let rows = &w.joint_rows;
-        Bounds::Box {
-            lo: (std::iter::repeat_n(0.0, n))
-                .chain(rows.iter().map(|r| r.lower as f64))
-                .collect(),
-            hi: (std::iter::repeat_n(f64::INFINITY, n))
-                .chain(rows.iter().map(|r| r.upper as f64))
-                .collect(),
-        }
+        box_bounds(n, w.joint_rows.iter())
     };
     let mut lcp = Lcp {
         a: Matrix::Dense(DenseMatrix {
@@ -387,15 +344,21 @@ fn rounds(
     w: &mut ExactWorkspace,
 ) -> Result<(u32, u32, f32), ExactFailure> {
     let with_friction = constraints.iter().any(|c| c.friction > 0.0);
+    let with_groups = !w.groups.is_empty();
     let mut pivots = 0u32;
     let mut best = f32::INFINITY;
     let mut best_round = 0;
     let mut round = 0;
-    while round < MAX_ROUNDS {
+    let max_rounds = if with_groups {
+        MAX_ROUNDS_WITH_BALLS
+    } else {
+        MAX_ROUNDS
+    };
+    while round < max_rounds {
         round += 1;
         pivots += normal_solve(constraints, joints, lcp, settings, w, round)?;
-        if with_friction {
-            friction_passes(constraints, w);
+        if with_friction || with_groups {
+            friction_passes(constraints, joints, w);
         }
         let residual = residual(
             constraints,
@@ -405,6 +368,15 @@ fn rounds(
             &w.angular,
             |k| (w.normal[k], w.softness[k]),
             &w.joint_impulse,
+        );
+        let residual = with_ball_residual(
+            residual,
+            &w.groups,
+            joints,
+            &w.joint_rows,
+            &w.joint_impulse,
+            &w.linear,
+            &w.angular,
         );
         // Without friction a round is exact up to the proximal term, ε times the velocity
         // change it made, so a second round is needed only after changes above 1 m/s.
@@ -451,6 +423,8 @@ fn rounds(
 ///
 /// Joint rows join N (Lemke's rows are the normals, then the joint rows, and their columns of
 /// C are A's): the LCP in γ'_N is then a box LCP, whose free rows Lemke eliminates in turn.
+/// The rows of a breakable joint's group at its bound are first held there ([`hold_at_bound`])
+/// and left out of N: with γ' = γ on them, they leave b and C, and act through the velocities.
 fn normal_solve(
     constraints: &[ContactConstraint],
     joints: &[JointConstraint],
@@ -460,8 +434,29 @@ fn normal_solve(
     round: u32,
 ) -> Result<u32, ExactFailure> {
     let n = constraints.len();
-    // Lemke's rows: the normals, then the joint rows.
-    let nk = n + w.joint_rows.len();
+    // Lemke's rows: the normals, then the joint rows, less those held at a ball's bound
+    // (their impulses and the velocities set here, so their effect is in the velocities).
+    hold_at_bound(
+        &w.groups,
+        joints,
+        &w.joint_rows,
+        &mut w.joint_impulse,
+        &mut w.linear,
+        &mut w.angular,
+        &mut w.fixed,
+    );
+    w.lemke.clear();
+    w.lemke.extend(0..n);
+    w.lemke.extend(
+        (0..w.joint_rows.len())
+            .filter(|&q| !w.fixed[q])
+            .map(|q| n + q),
+    );
+    let nk = w.lemke.len();
+    if !w.groups.is_empty() {
+        let rows = &w.joint_rows;
+        lcp.bounds = box_bounds(n, w.lemke[n..].iter().map(|&r| &rows[r - n]));
+    }
     let m = w.rows.len();
     // This round's sticking tangent rows and sliding directions.
     w.free.clear();
@@ -493,8 +488,9 @@ fn normal_solve(
     let full = &w.full;
     let tangent_row = &w.tangent_row;
     let sliding = &w.sliding;
-    // Column j of C at row r: A_rj plus, for a sliding point j, μ_j·u_j along its tangents
-    // (a joint row, j ≥ n, is never sliding).
+    let (lemke, fixed) = (&w.lemke, &w.fixed);
+    // Column j (a row of `full`) of C at row r: A_rj plus, for a sliding point j, μ_j·u_j
+    // along its tangents (a joint row, j ≥ n, is never sliding).
     let c_entry = |r: usize, j: usize| -> f64 {
         let direct = full[r * m + j];
         match (
@@ -506,16 +502,11 @@ fn normal_solve(
         }
     };
 
-    // b over N (rows 0..n of `full`) and F, from the current impulses and velocities.
+    // b over N (Lemke's rows of `full`) and F, from the current impulses and velocities.
     let b_free = &mut w.free_rhs;
     b_free.clear();
     lcp.b.clear();
-    for target in 0..nk + s {
-        let r = if target < nk {
-            target
-        } else {
-            w.free[target - nk]
-        };
+    for (target, &r) in lemke.iter().chain(&w.free).enumerate() {
         let mut a_gamma = 0.0f64;
         for k in 0..n {
             a_gamma += full[r * m + k] * w.normal[k] as f64;
@@ -525,7 +516,9 @@ fn normal_solve(
             }
         }
         for (q, &lambda) in w.joint_impulse.iter().enumerate() {
-            a_gamma += full[r * m + n + q] * lambda as f64;
+            if !fixed[q] {
+                a_gamma += full[r * m + n + q] * lambda as f64;
+            }
         }
         for &q in &w.free {
             let (k, t) = w.rows[q];
@@ -583,7 +576,7 @@ fn normal_solve(
     w.coupling.resize(s * nk, 0.0);
     for (j, column) in w.coupling.chunks_exact_mut(s.max(1)).enumerate().take(nk) {
         for (value, &ri) in column.iter_mut().zip(&w.free) {
-            *value = c_entry(ri, j);
+            *value = c_entry(ri, lemke[j]);
         }
     }
     cholesky_solve_columns(&w.factor, s, &mut w.coupling);
@@ -593,22 +586,23 @@ fn normal_solve(
     let Matrix::Dense(dense) = &mut lcp.a else {
         unreachable!("the exact path hands Lemke a dense matrix")
     };
+    (dense.rows, dense.cols) = (nk, nk);
     dense.data.clear();
     dense.data.resize(nk * nk, 0.0);
     let row = &mut w.column;
-    for i in 0..nk {
+    for (i, &ri) in lemke.iter().enumerate() {
         // A_iF, gathered once per row.
         row.clear();
-        row.extend(w.free.iter().map(|&f| full[i * m + f]));
-        for j in 0..nk {
+        row.extend(w.free.iter().map(|&f| full[ri * m + f]));
+        for (j, &rj) in lemke.iter().enumerate() {
             let reduction: f64 = row
                 .iter()
                 .zip(&w.coupling[j * s..(j + 1) * s])
                 .map(|(a, c)| a * c)
                 .sum();
-            dense.data[i * nk + j] = c_entry(i, j) - reduction;
+            dense.data[i * nk + j] = c_entry(ri, rj) - reduction;
         }
-        dense.data[i * nk + i] += w.extra[i];
+        dense.data[i * nk + i] += w.extra[ri];
         lcp.b[i] -= row
             .iter()
             .zip(b_free.iter())
@@ -616,21 +610,30 @@ fn normal_solve(
             .sum::<f64>();
     }
 
-    let solution = lemke::solve(lcp, None, settings)?;
-    if solution.status != Status::Converged || solution.z.iter().any(|z| !z.is_finite()) {
-        return Err(ExactFailure::Lemke {
-            status: solution.status,
-            pivots: solution.iterations,
-            residual: solution.residual,
-            round,
-        });
-    }
+    // Every joint row held at its bound and no contact: nothing for Lemke.
+    let (z, iterations) = if nk == 0 {
+        (Vec::new(), 0)
+    } else {
+        let solution = lemke::solve(lcp, None, settings)?;
+        if solution.status != Status::Converged || solution.z.iter().any(|z| !z.is_finite()) {
+            return Err(ExactFailure::Lemke {
+                status: solution.status,
+                pivots: solution.iterations,
+                residual: solution.residual,
+                round,
+            });
+        }
+        (solution.z, solution.iterations)
+    };
 
     // γ'_F = (A_FF + E_F)⁻¹ b_F − coupling·γ'_N and γ'_S = D γ'_N; apply every change.
     let joint_rows = &w.joint_rows;
     let gamma = |j: usize| match j.checked_sub(n) {
-        None => solution.z[j].max(0.0),
-        Some(q) => solution.z[j].clamp(joint_rows[q].lower as f64, joint_rows[q].upper as f64),
+        None => z[j].max(0.0),
+        Some(i) => {
+            let r = &joint_rows[lemke[n + i] - n];
+            z[j].clamp(r.lower as f64, r.upper as f64)
+        }
     };
     for (f, value) in b_free.iter_mut().enumerate() {
         *value -= (0..nk)
@@ -649,11 +652,12 @@ fn normal_solve(
         }
         apply(c, delta, &mut w.linear, &mut w.angular);
     }
-    for (q, r) in joint_rows.iter().enumerate() {
-        let new = gamma(n + q) as f32;
+    for (i, &row) in lemke[n..].iter().enumerate() {
+        let q = row - n;
+        let new = gamma(n + i) as f32;
         let delta = new - w.joint_impulse[q];
         w.joint_impulse[q] = new;
-        apply_joint(joints, r, delta, &mut w.linear, &mut w.angular);
+        apply_joint(joints, &joint_rows[q], delta, &mut w.linear, &mut w.angular);
     }
     for (f, &value) in b_free.iter().enumerate() {
         let (k, t) = w.rows[w.free[f]];
@@ -663,7 +667,7 @@ fn normal_solve(
         w.tangent[k][t - 1] = new;
         apply(&constraints[k], delta, &mut w.linear, &mut w.angular);
     }
-    Ok(solution.iterations as u32)
+    Ok(iterations as u32)
 }
 
 /// Applies an impulse change (normal, tangent 1, tangent 2) to the trial velocities.
@@ -729,10 +733,25 @@ fn assemble(constraints: &[ContactConstraint], joints: &[JointConstraint], w: &m
 
 /// Step 2 of a round: symmetric Gauss-Seidel passes over the friction pairs with the normal
 /// impulses fixed. Per point, the 2×2 block solve projected onto the disc |γ_t| ≤ μ·γ_n in
-/// the metric of the tangent block, as [`crate::solver::solve_pgs`] does it.
-fn friction_passes(constraints: &[ContactConstraint], w: &mut ExactWorkspace) {
+/// the metric of the tangent block, as [`crate::solver::solve_pgs`] does it. With breakable
+/// joints each pass starts with one over their locked groups ([`ball_pass`]).
+fn friction_passes(
+    constraints: &[ContactConstraint],
+    joints: &[JointConstraint],
+    w: &mut ExactWorkspace,
+) {
     let n = constraints.len();
     for pass in 0..FRICTION_PASSES {
+        if !w.groups.is_empty() {
+            ball_pass(
+                &w.groups,
+                joints,
+                &w.joint_rows,
+                &mut w.joint_impulse,
+                &mut w.linear,
+                &mut w.angular,
+            );
+        }
         for step in 0..n {
             let k = if pass % 2 == 0 { step } else { n - 1 - step };
             let c = &constraints[k];

@@ -8,7 +8,9 @@ use impulse_lcp::{SolveError, Status};
 pub(crate) struct ExactReport {
     /// Lemke pivots, summed over the rounds.
     pub pivots: u32,
-    /// Rounds run (normal LCP solves), 1 ..= [`MAX_ROUNDS`](super::exact::MAX_ROUNDS); 0 for an island without contacts.
+    /// Rounds run (normal LCP solves), 1 ..= [`MAX_ROUNDS`](super::exact::MAX_ROUNDS) (..=
+    /// [`MAX_ROUNDS_WITH_BALLS`](super::exact::MAX_ROUNDS_WITH_BALLS) with a breakable joint's
+    /// locked group); 0 for an island without rows.
     pub rounds: u32,
     /// Largest natural-map residual of the normal rows and joint rows at exit, in m/s (rad/s
     /// on a joint's rotation rows): max_i |min(w_i, γ_i·k_i)| over the normal rows, where
@@ -42,18 +44,12 @@ pub(crate) enum ExactFailure {
         /// Contact point, joint (in the island's joint order) or velocity slot.
         index: usize,
     },
-    /// A joint of the island is breakable and unbroken: its strength bounds a locked group's
-    /// impulse by a ball (|λ_group| ≤ threshold·h), which is not a box the LCP can take.
-    #[error("joint {joint} of the island is breakable (its strength is not a box bound)")]
-    BreakableJoint {
-        /// The joint, in the island's joint order.
-        joint: usize,
-    },
-    /// The regularised tangent block of the sticking points was not numerically positive
+    /// The regularised tangent block of the sticking points, or in round 0 a breakable
+    /// joint's locked group's block ([`super::exact_ball`]), was not numerically positive
     /// definite (Cholesky met a non-positive pivot).
     #[error("sticking tangent block ({rows} rows) is not positive definite in round {round}")]
     Factorisation {
-        /// Tangent rows in the block.
+        /// Rows in the block.
         rows: usize,
         /// Round, from 1.
         round: u32,

@@ -126,6 +126,9 @@ pub(super) struct ExactJointRow {
     pub upper: f32,
     /// J M⁻¹ Jᵀ of the row: the velocity change per unit impulse on itself.
     pub inverse_mass: f32,
+    /// Whether the row is in a locked group a strength bounds by a ball
+    /// ([`super::exact_ball`]); its conditions are then the group's, not the box's.
+    pub ball: bool,
 }
 
 /// The rows the exact path solves for `joints`: every active row of an unbroken joint on which
@@ -155,10 +158,27 @@ pub(super) fn collect_joint_rows(joints: &[JointConstraint], out: &mut Vec<Exact
                         lower: target.lower,
                         upper: target.upper,
                         inverse_mass: row.inverse_mass,
+                        ball: false,
                     });
                 }
             }
         }
+    }
+}
+
+/// The bounds of Lemke's box LCP over `n` normal rows, [0, ∞), then the joint rows `rows`
+/// with their own (N·s or N·m·s).
+pub(super) fn box_bounds<'a>(
+    n: usize,
+    rows: impl Iterator<Item = &'a ExactJointRow> + Clone,
+) -> impulse_lcp::Bounds {
+    impulse_lcp::Bounds::Box {
+        lo: (std::iter::repeat_n(0.0, n))
+            .chain(rows.clone().map(|r| r.lower as f64))
+            .collect(),
+        hi: (std::iter::repeat_n(f64::INFINITY, n))
+            .chain(rows.map(|r| r.upper as f64))
+            .collect(),
     }
 }
 
@@ -242,7 +262,8 @@ pub(super) fn apply_joint(
 /// velocities, in velocity units (m/s or rad/s): max over rows of
 /// |mid(k·(λ − hi), w, k·(λ − lo))|, k the row's `inverse_mass`, which is k·|λ − mid(lo, λ −
 /// w/k, hi)| and for lo = 0, hi = ∞ the contacts' |min(w, k·λ)|. Zero exactly when every row
-/// meets its box conditions.
+/// meets its box conditions. Rows of a ball group are left out: their conditions are the
+/// group's ([`super::exact_ball`]).
 pub(super) fn joint_residual(
     joints: &[JointConstraint],
     rows: &[ExactJointRow],
@@ -252,6 +273,9 @@ pub(super) fn joint_residual(
 ) -> f32 {
     let mut largest = 0.0f32;
     for (r, &lambda) in rows.iter().zip(impulse) {
+        if r.ball {
+            continue;
+        }
         let w = joint_velocity(joints, r, linear, angular) + r.bias + r.softness * lambda;
         let k = r.inverse_mass;
         // An unbounded side leaves w unclamped there; below ≤ above as lo ≤ hi.
@@ -293,15 +317,6 @@ pub(super) fn joint_row_is_finite(joints: &[JointConstraint], r: &ExactJointRow)
         && j.inverse_mass_b.is_finite()
 }
 
-/// The first of `joints` whose strength bounds its locked groups (a breakable joint that has
-/// not broken): the bound is a ball on the group's impulse, not a box, so the exact path does
-/// not take it.
-pub(crate) fn breakable_joint(joints: &[JointConstraint]) -> Option<usize> {
-    joints
-        .iter()
-        .position(|j| j.broke.is_none() && j.is_breakable())
-}
-
 /// J·v of `row` of contact `c` (m/s).
 #[inline]
 pub(super) fn velocity(
@@ -315,7 +330,8 @@ pub(super) fn velocity(
 }
 
 /// The residual [`ExactReport::residual`](super::exact_report::ExactReport::residual) reports: [`normal_residual`] of the contacts and,
-/// with joint rows, the larger of it and their [`joint_residual`] at `joint_impulse`.
+/// with joint rows, the larger of it and their [`joint_residual`] at `joint_impulse` (the ball
+/// groups' residual is added by the caller, [`super::exact_ball::with_ball_residual`]).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn residual(
     constraints: &[ContactConstraint],

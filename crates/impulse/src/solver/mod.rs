@@ -12,8 +12,9 @@
 //! - [`nncg`]: nonsmooth nonlinear conjugate gradient (PGS sweeps with momentum);
 //! - [`apgd`]: accelerated projected gradient descent;
 //! - [`exact`]: Lemke's pivoting on an island's assembled LCP (its dense factorisation in
-//!   [`cholesky`], its rows (contact and joint) in [`exact_rows`], its report in
-//!   [`exact_report`]);
+//!   [`cholesky`], its rows (contact and joint) in [`exact_rows`], breakable joints' ball
+//!   bounds in [`exact_ball`], its report in [`exact_report`], its buffers in
+//!   [`exact_workspace`]);
 //! - [`lanes`]: PGS in SIMD lanes on packed manifold groups;
 //! - [`policy`]: `method: auto`, the escalation from NNCG to more iterations or the exact path;
 //! - [`position`]: split impulse's position solve;
@@ -29,8 +30,10 @@ pub(crate) use crate::contact::cap_to_disc;
 pub(crate) mod apgd;
 pub(crate) mod cholesky;
 pub(crate) mod exact;
+pub(crate) mod exact_ball;
 pub(crate) mod exact_report;
 pub(crate) mod exact_rows;
+pub(crate) mod exact_workspace;
 pub(crate) mod heavy_on_light;
 pub(crate) mod impact;
 pub(crate) mod interface;

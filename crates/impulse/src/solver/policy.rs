@@ -2,7 +2,7 @@
 //! converge to more NNCG iterations or, for a small island, to the exact path ([`super::exact`]).
 
 use super::exact::Exact;
-use super::exact_rows::{breakable_joint, joint_row_count};
+use super::exact_rows::joint_row_count;
 use super::interface::{ContactSolver, EscalationLevel, SolveOutcome, SolvePass, SolveReport};
 use super::nncg::Nncg;
 use super::rows::Velocities;
@@ -69,13 +69,11 @@ impl ContactSolver for Auto {
         let unconverged = outcome.report.last_change > limits.tolerance;
         let heavy = limits.mass_ratio > limits.mass_ratio_threshold;
         // An island is small when its contact points plus joint rows (the exact path's Lemke
-        // rows) are at most the limit; a breakable joint (a ball bound, not a box) keeps the
-        // island on NNCG.
+        // rows) are at most the limit.
         let small = (joints.is_empty() && constraints.len() <= limits.exact_max_contacts as usize)
             || (!joints.is_empty()
                 && constraints.len() + joint_row_count(joints)
-                    <= limits.exact_max_contacts as usize
-                && breakable_joint(joints).is_none());
+                    <= limits.exact_max_contacts as usize);
         // Unconverged in an impact, the island takes more iterations rather than the exact
         // path: the next steps repair what an impact leaves, while pivoting every landing
         // column of a pile is the cost of hundreds of exact solves a substep. Asked only when

@@ -329,8 +329,9 @@ impl World {
 
     /// The last step's contact LCP, assembled from the rows the solver used, with the engine's
     /// impulses at exit; with joints, their rows follow the contacts' with their bounds (a
-    /// mixed LCP: [`ContactLcp::joint_of_row`]). Errors only when the step produced
-    /// non-finite data.
+    /// mixed LCP: [`ContactLcp::joint_of_row`]). A breakable joint's locked rows are free there:
+    /// the ball bound of its strength is not part of the exported problem. Errors only when the
+    /// step produced non-finite data.
     pub fn contact_lcp(&self) -> Result<ContactLcp, impulse_lcp::ProblemError> {
         let joints: Vec<&crate::joint::JointConstraint> = self
             .workspaces

@@ -5,7 +5,8 @@
 //! Convention (docs/method.md): per normal row γ ≥ 0, w = J·v − target ≥ 0, γ·w = 0, with v the
 //! velocities after the impulses (m/s) and γ the impulses (N·s); friction |γ_t| ≤ μ·γ_n.
 //!
-//! `solutions.rs` checks the results, `failures.rs` the failure contract and the survey.
+//! `solutions.rs` checks the results, `breakable.rs` the ball bounds of breakable joints,
+//! `failures.rs` the failure contract and the survey.
 //!
 //! Timings are not measured here: the ignored `survey` prints, per scene, the outcomes, pivots,
 //! rounds, residuals and single-call times of the exact path on every step's island.
@@ -258,5 +259,6 @@ fn normal_residual(island: &Island) -> f64 {
         .fold(0.0, f64::max)
 }
 
+mod breakable;
 mod failures;
 mod solutions;
