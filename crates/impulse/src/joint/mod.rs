@@ -16,6 +16,7 @@ mod frames;
 mod handle;
 mod rows;
 pub(crate) mod rules;
+mod softness;
 mod types;
 
 use glam::{Quat, Vec3};
