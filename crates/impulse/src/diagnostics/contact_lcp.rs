@@ -15,7 +15,8 @@
 //! impulses taken out (the contacts' record and the joints' are taken apart), so b adds the
 //! coupling A_cj·λ_j to each contact row and A_jc·γ_c to each joint row. A breakable joint's
 //! locked rows are exported free like any other: the ball bound its strength puts on a locked
-//! group's impulse (|λ_g| ≤ threshold·h) is not a box, so it is not part of the exported problem.
+//! group's impulse (|λ_g| ≤ threshold·h) is not a box, so it is not part of the exported problem;
+//! a joint that broke in the step is not passed here at all ([`crate::World::contact_lcp`]).
 
 use std::collections::BTreeMap;
 

@@ -330,8 +330,9 @@ impl World {
     /// The last step's contact LCP, assembled from the rows the solver used, with the engine's
     /// impulses at exit; with joints, their rows follow the contacts' with their bounds (a
     /// mixed LCP: [`ContactLcp::joint_of_row`]). A breakable joint's locked rows are free there:
-    /// the ball bound of its strength is not part of the exported problem. Errors only when the
-    /// step produced non-finite data.
+    /// the ball bound of its strength is not part of the exported problem. A joint that broke
+    /// in the step has no rows: it constrains nothing at the step's end, and what it passed on
+    /// before breaking is in the velocities. Errors only when the step produced non-finite data.
     pub fn contact_lcp(&self) -> Result<ContactLcp, impulse_lcp::ProblemError> {
         let joints: Vec<&crate::joint::JointConstraint> = self
             .workspaces
@@ -339,6 +340,7 @@ impl World {
             .zip(&self.island_awake)
             .filter(|(_, awake)| **awake)
             .flat_map(|(workspace, _)| &workspace.joints)
+            .filter(|joint| joint.broke.is_none())
             .collect();
         assemble_lcp(&self.complete_constraints(), &joints)
     }
