@@ -28,7 +28,8 @@ use anyhow::{Result, bail};
 use impulse::{Scene, SolverSettings};
 use serde::Serialize;
 
-pub use crate::front_point::{FrontPoint, error_mm};
+use crate::front_point::by_time;
+pub use crate::front_point::{FrontPoint, cheapest_meeting, error_mm};
 use crate::front_retime;
 use crate::peer_settings::{PeerSetting, missing_peer, peer_compiled};
 use crate::scene_by_name;
@@ -124,26 +125,6 @@ fn dominates(q: &FrontPoint, p: &FrontPoint) -> bool {
     q.ms_per_step <= p.ms_per_step
         && q.e_mm <= p.e_mm
         && (q.ms_per_step < p.ms_per_step || q.e_mm < p.e_mm)
-}
-
-fn by_time(a: &FrontPoint, b: &FrontPoint) -> std::cmp::Ordering {
-    a.ms_per_step
-        .total_cmp(&b.ms_per_step)
-        .then(a.e_mm.total_cmp(&b.e_mm))
-        .then_with(|| a.setting.cmp(&b.setting))
-}
-
-/// The fastest point of `engine` with E ≤ `bar_mm` (ties: the smaller E, then the name);
-/// None when no setting of it meets the bar. Failed points take no part.
-pub fn cheapest_meeting<'a>(
-    points: &'a [FrontPoint],
-    engine: &str,
-    bar_mm: f64,
-) -> Option<&'a FrontPoint> {
-    points
-        .iter()
-        .filter(|p| p.engine == engine && p.counts() && p.e_mm <= bar_mm)
-        .min_by(|a, b| by_time(a, b))
 }
 
 /// What `front` measures.

@@ -1,5 +1,5 @@
-//! One run of the front: an engine with one setting on one scene ([`FrontPoint`]), and its
-//! quality error ([`error_mm`]).
+//! One run of the front: an engine with one setting on one scene ([`FrontPoint`]), its quality
+//! error ([`error_mm`]), and an engine's cheapest point meeting a bar ([`cheapest_meeting`]).
 
 use serde::Serialize;
 
@@ -93,6 +93,31 @@ impl FrontPoint {
     pub fn counts(&self) -> bool {
         self.failed.is_none() && self.ms_per_step.is_finite() && self.e_mm.is_finite()
     }
+
+    /// True when the point is `engine`'s, counts, and has E ≤ `bar_mm`.
+    pub fn meets(&self, engine: &str, bar_mm: f64) -> bool {
+        self.engine == engine && self.counts() && self.e_mm <= bar_mm
+    }
+}
+
+pub(crate) fn by_time(a: &FrontPoint, b: &FrontPoint) -> std::cmp::Ordering {
+    a.ms_per_step
+        .total_cmp(&b.ms_per_step)
+        .then(a.e_mm.total_cmp(&b.e_mm))
+        .then_with(|| a.setting.cmp(&b.setting))
+}
+
+/// The fastest point of `engine` with E ≤ `bar_mm` (ties: the smaller E, then the name);
+/// None when no setting of it meets the bar. Failed points take no part.
+pub fn cheapest_meeting<'a>(
+    points: &'a [FrontPoint],
+    engine: &str,
+    bar_mm: f64,
+) -> Option<&'a FrontPoint> {
+    points
+        .iter()
+        .filter(|p| p.meets(engine, bar_mm))
+        .min_by(|a, b| by_time(a, b))
 }
 
 /// E = max(|sink|, overlap, drift), in the units given; NaN when any of them is NaN.
