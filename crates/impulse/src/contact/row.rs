@@ -298,11 +298,38 @@ pub(super) fn inverse_block([k11, k12, k22]: [f32; 3]) -> [f32; 3] {
 
 /// Whether some row closed faster than `speed` (m/s) as the step started: its J·v⁻
 /// (`velocity_before`, set at assembly and rewritten only as the island's step ends) below
-/// −`speed`. What makes a step an impact for the solver's extra sweeps and the escalation.
+/// −`speed`. What makes a step an impact for the escalation. Only for rows whose products
+/// assembly computed (not [`ContactConstraint::products_pending`]): a pending row's
+/// `velocity_before` is whatever its slot held; [`closes_faster_than_from_bodies`] serves
+/// those.
 pub(crate) fn closes_faster_than(constraints: &[ContactConstraint], speed: f32) -> bool {
     constraints
         .iter()
         .any(|c| c.normal.velocity_before < -speed)
+}
+
+/// Whether some row closed faster than `speed` (m/s) as the step started, with J·v⁻ computed
+/// from the row's normal and lever arms and the bodies' velocities as the step started
+/// (`linear` in m/s, `angular` in rad/s, indexed by body as `body_a`, `body_b`): the value
+/// assembly gives `velocity_before` (the same operations, so the same bits), for rows whose
+/// products are pending too. What makes a step an impact for the solver's extra sweeps.
+pub(crate) fn closes_faster_than_from_bodies(
+    constraints: &[ContactConstraint],
+    linear: &[Vec3],
+    angular: &[Vec3],
+    speed: f32,
+) -> bool {
+    constraints.iter().any(|c| {
+        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        let d = Vec3A::from(c.normal.direction);
+        let row = JacobianRow {
+            direction: c.normal.direction,
+            angular_a: Vec3A::from(c.lever_a).cross(d).into(),
+            angular_b: Vec3A::from(c.lever_b).cross(d).into(),
+            ..JacobianRow::default()
+        };
+        row.velocity(linear[a], angular[a], linear[b], angular[b]) < -speed
+    })
 }
 
 /// Projects a friction impulse onto Coulomb's disc of radius `limit` (N·s).

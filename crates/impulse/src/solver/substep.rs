@@ -59,9 +59,11 @@ impl IslandWorkspace {
     /// One solve of a substep of `h` seconds: targets from the current separation, then the
     /// main or the relax solve (`which`), in lanes when the island is `bundled` and on the
     /// constraints otherwise.
+    #[allow(clippy::too_many_arguments)]
     fn targets_and_solve(
         &mut self,
         constraints: &mut [ContactConstraint],
+        bodies: &Bodies,
         settings: &SolverSettings,
         h: f32,
         bundled: bool,
@@ -132,7 +134,12 @@ impl IslandWorkspace {
                 && !settings.split_impulse()
                 && outcome.report.last_change > self.impact_speed
                 && *self.closing.get_or_insert_with(|| {
-                    contact::closes_faster_than(constraints, self.impact_speed)
+                    contact::closes_faster_than_from_bodies(
+                        constraints,
+                        &bodies.linear_velocity,
+                        &bodies.angular_velocity,
+                        self.impact_speed,
+                    )
                 })
         } else {
             self.impact_met
@@ -224,7 +231,7 @@ pub(crate) fn step_island(
     w.start_solves(constraints, settings, context);
     let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
     for substep in 0..settings.substeps {
-        w.substep(constraints, settings, context.gravity, &plan, substep);
+        w.substep(constraints, settings, context, &plan, substep);
     }
     w.finish_solves(constraints, settings, &plan);
     w.restitution(
@@ -513,17 +520,17 @@ impl IslandWorkspace {
         &mut self,
         constraints: &mut [ContactConstraint],
         settings: &SolverSettings,
-        gravity: Vec3,
+        context: &StepContext<'_>,
         plan: &SolvePlan,
         substep: u32,
     ) {
-        let (h, bundled) = (plan.h, plan.bundled);
+        let (h, bundled, bodies) = (plan.h, plan.bundled, context.bodies);
         // Every other substep, PGS takes each manifold's points from halfway round (see
         // `lanes::schedule`), so that no corner of a face always goes first. Split
         // impulse keeps one order: its rigid rows are solved to the tolerance, where the order
         // matters little, and its results are compared with exact solutions.
         let half_turn = substep % 2 == 1 && !settings.split_impulse();
-        self.apply_forces(gravity, plan);
+        self.apply_forces(context.gravity, plan);
         // The lanes' record takes v* = v − M⁻¹Jᵀγ, γ the final impulses: the velocities
         // here, before the last substep applies its impulses (see `lanes::Bundles::record`).
         if plan.record_in_lanes && substep + 1 == settings.substeps {
@@ -565,6 +572,7 @@ impl IslandWorkspace {
         self.position_repair = false;
         self.targets_and_solve(
             constraints,
+            bodies,
             settings,
             h,
             bundled,
@@ -576,7 +584,7 @@ impl IslandWorkspace {
             let relax = SubstepSolve::Relax {
                 warm_start_follows: substep + 1 < settings.substeps,
             };
-            self.targets_and_solve(constraints, settings, h, bundled, relax, half_turn);
+            self.targets_and_solve(constraints, bodies, settings, h, bundled, relax, half_turn);
         }
     }
 

@@ -268,3 +268,75 @@ fn the_world_bound_is_configurable() {
     };
     assert!(World::new(Vec3::ZERO, DT, bad).is_err());
 }
+
+/// A cube dropped at 4–12 m/s onto the middle of a row of five resting cubes (one island of
+/// 20 ground points and 16 side points, which the default settings solve in SIMD lanes):
+/// the step its new contact closes in sweeps on as an impact (more sweeps than the budget),
+/// and the restitution-0 impact ends dead, as onto the ground alone. The impact test once read
+/// a lane island's J·v⁻ from whatever its row slot held, so a new contact of such an island
+/// was never an impact.
+#[test]
+fn an_impact_on_an_island_in_lanes_is_an_impact() {
+    for speed in [4.0f32, 7.0, 12.0] {
+        let settings = SolverSettings {
+            sleep: false,
+            ..SolverSettings::default()
+        };
+        let budget = settings.substeps * (settings.iterations + settings.relax_iterations);
+        let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).expect("world");
+        world.set_parallel(false);
+        world
+            .insert(
+                BodyBuilder::fixed(SharedShape::cuboid(50.0, 0.5, 50.0))
+                    .translation(Vec3::new(0.0, -0.5, 0.0))
+                    .friction(0.5),
+            )
+            .expect("ground");
+        for k in 0..5 {
+            world
+                .insert(
+                    BodyBuilder::dynamic(SharedShape::cuboid(HALF, HALF, HALF))
+                        .translation(Vec3::new(k as f32 - 2.0, HALF, 0.0))
+                        .friction(0.5)
+                        .restitution(0.0),
+                )
+                .expect("row cube");
+        }
+        for _ in 0..30 {
+            world.step().expect("settling");
+        }
+        let body = world
+            .insert(
+                BodyBuilder::dynamic(SharedShape::cuboid(HALF, HALF, HALF))
+                    .translation(Vec3::new(0.0, 3.0 * HALF + 0.6, 0.0))
+                    .linear_velocity(Vec3::new(0.0, -speed, 0.0))
+                    .friction(0.5)
+                    .restitution(0.0),
+            )
+            .expect("dropped cube");
+        let (mut impact_steps, mut hit, mut rebound) = (0, false, 0.0f32);
+        for _ in 0..60 {
+            let report = world.step().expect("step");
+            let row = report
+                .islands
+                .iter()
+                .find(|i| i.bodies >= 5)
+                .expect("the row");
+            assert!(row.simd, "the row is solved in lanes");
+            impact_steps += usize::from(row.iterations > budget);
+            let v = world.body(body).expect("the cube").linear_velocity();
+            hit |= v.y > -0.5 * speed;
+            if hit {
+                rebound = rebound.max(v.y);
+            }
+        }
+        assert!(
+            impact_steps > 0,
+            "{speed} m/s: no step swept on as an impact"
+        );
+        assert!(
+            rebound <= 0.01 * speed,
+            "{speed} m/s: rebound {rebound:.3} m/s"
+        );
+    }
+}
