@@ -8,7 +8,7 @@ use super::apgd::Apgd;
 use super::impact::ImpactWorkspace;
 use super::interface::{ContactSolver, RowsReport};
 use super::island_report::IslandReport;
-use super::lanes::Bundles;
+use super::lanes::{Bundles, SolvedPoint};
 use super::nncg::Nncg;
 use super::pgs::Pgs;
 use super::policy::Auto;
@@ -93,9 +93,29 @@ pub(crate) struct IslandWorkspace {
     pub(super) closing: Option<bool>,
     /// The rows of the island's joints, written by the assembly stage.
     pub(crate) joints: IslandJoints,
+    /// Whether the island's step left its rows' impulses, J·v* and targets in its SIMD lanes
+    /// rather than in its rows (an awake island in lanes with no restitution solve and no
+    /// joints after them): the store-impulses stage reads them there
+    /// ([`IslandWorkspace::solved_point`]), and any other reader has them written into a copy
+    /// of the rows ([`IslandWorkspace::unpack_into`]). Cleared when the island sleeps.
+    pub(crate) impulses_in_lanes: bool,
 }
 
 impl IslandWorkspace {
+    /// The impulses of the island's `k`th row as its step ended, from its lanes (only with
+    /// [`IslandWorkspace::impulses_in_lanes`]).
+    #[inline]
+    pub(crate) fn solved_point(&self, k: usize) -> SolvedPoint {
+        self.solvers.wide.solved_point(k)
+    }
+
+    /// Writes what the island's lanes kept (with [`IslandWorkspace::impulses_in_lanes`]) into
+    /// `rows`, a copy of its rows: impulses, step impulses, targets, softness and J·v*, as
+    /// the rows would hold them had the lanes written them back.
+    pub(crate) fn unpack_into(&self, rows: &mut [ContactConstraint]) {
+        self.solvers.wide.unpack_into(rows);
+    }
+
     /// The joints' rows' J·v* for the exported LCP, as the island's step ends: the velocities
     /// with every joint's M⁻¹Jᵀλ taken out (the contacts' record takes the contacts' out, so
     /// the export adds the coupling back: `diagnostics::contact_lcp`).

@@ -721,12 +721,17 @@ impl IslandWorkspace {
         plan: &SolvePlan,
     ) {
         let w = self;
+        // With the lanes' record nothing after the substeps reads the rows' impulses but the
+        // store-impulses stage, which reads them from the lanes: they are not written back.
+        w.impulses_in_lanes = plan.record_in_lanes;
         if plan.record_in_lanes {
             w.solvers.wide.record(&w.linear, &w.angular);
+            w.solvers.wide.report_rows(constraints);
+        } else {
+            w.solvers
+                .substeps(settings.method, plan.bundled)
+                .finish(constraints);
         }
-        w.solvers
-            .substeps(settings.method, plan.bundled)
-            .finish(constraints);
         for joint in &mut w.joints {
             joint.add_step_impulses();
         }

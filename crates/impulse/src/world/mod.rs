@@ -315,16 +315,22 @@ impl World {
             .count()
     }
 
-    /// The last step's constraints with every row's lever-arm products: borrowed when none is
-    /// pending (the SIMD lanes computed theirs in their own bundles), else a completed copy.
+    /// The last step's constraints with every row's lever-arm products and, for islands whose
+    /// step left them in their SIMD lanes (`IslandWorkspace::impulses_in_lanes`), their
+    /// impulses, targets and J·v*: borrowed when the rows hold everything, else a completed
+    /// copy.
     fn complete_constraints(&self) -> std::borrow::Cow<'_, [ContactConstraint]> {
-        if self.constraints.iter().any(|c| c.products_pending) {
-            let mut rows = self.constraints.clone();
-            complete_products(&mut rows, &self.world_inverse_inertia);
-            std::borrow::Cow::Owned(rows)
-        } else {
-            std::borrow::Cow::Borrowed(&self.constraints)
+        let islands = self.islands.len();
+        let in_lanes = |k: usize| self.workspaces.get(k).is_some_and(|w| w.impulses_in_lanes);
+        if !(0..islands).any(in_lanes) && !self.constraints.iter().any(|c| c.products_pending) {
+            return std::borrow::Cow::Borrowed(&self.constraints);
         }
+        let mut rows = self.constraints.clone();
+        for k in (0..islands).filter(|&k| in_lanes(k)) {
+            self.workspaces[k].unpack_into(&mut rows[self.islands.constraint_range(k)]);
+        }
+        complete_products(&mut rows, &self.world_inverse_inertia);
+        std::borrow::Cow::Owned(rows)
     }
 
     /// The last step's contact LCP, assembled from the rows the solver used, with the engine's

@@ -51,6 +51,7 @@ mod sweep;
 mod targets;
 
 pub(crate) use bundles::Bundles;
+pub(crate) use pack::SolvedPoint;
 
 #[cfg(test)]
 mod tests;

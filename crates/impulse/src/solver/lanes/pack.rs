@@ -306,69 +306,139 @@ impl Bundles {
     /// constraint order, in runs of the same length and added in the same order as
     /// `diagnostics::record_velocity_before_and_residual`, so the residual is its to the bit.
     pub(crate) fn unpack(&mut self, constraints: &mut [ContactConstraint]) {
-        let (bundles, totals, records) = (&self.bundles, &self.step_totals, &self.records);
-        let recorded = self.recorded;
-        // Writes one point back; returns its rows' φ² (0 unless recorded).
-        let write = |c: &mut ContactConstraint, slot: u32| -> f64 {
-            let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
-            let b = &bundles[index];
-            let at = |x: &Lane| x.as_array()[lane];
-            c.normal_impulse = at(&b.normal_impulse);
-            c.tangent_impulses = [at(&b.tangent_impulses[0]), at(&b.tangent_impulses[1])];
-            c.max_normal_impulse = at(&b.max_normal_impulse);
-            let total = &totals[index];
-            c.step_impulses = [
-                at(&total[0]) + c.normal_impulse,
-                at(&total[1]) + c.tangent_impulses[0],
-                at(&total[2]) + c.tangent_impulses[1],
-            ];
-            c.target_normal_velocity = at(&b.target);
-            c.softness = (at(&b.mass_scale), at(&b.impulse_scale));
-            if !recorded {
-                return 0.0;
-            }
-            let r = &records[index];
+        self.sum_rows(constraints, true);
+    }
+
+    /// After [`Bundles::record`]: the island's natural-map residual and friction rows
+    /// ([`Bundles::take_rows`]) as [`Bundles::unpack`] sums them, to the bit, without writing
+    /// the rows back: the impulses stay in the bundles, where the store-impulses stage reads
+    /// them ([`Bundles::solved_point`]) and [`Bundles::unpack_into`] writes them into the rows
+    /// for any other reader. Reads each row's friction coefficient only.
+    pub(crate) fn report_rows(&mut self, constraints: &mut [ContactConstraint]) {
+        debug_assert!(self.recorded, "the rows' report follows the record");
+        self.sum_rows(constraints, false);
+    }
+
+    /// [`Bundles::unpack`]'s writes, into `constraints` (a copy of the rows that
+    /// [`Bundles::pack`] read, or those rows), leaving the bundles and their report as they
+    /// are: what [`Bundles::report_rows`] left in the bundles.
+    pub(crate) fn unpack_into(&self, constraints: &mut [ContactConstraint]) {
+        for (c, &slot) in constraints.iter_mut().zip(&self.slots) {
+            self.write_point(c, slot);
+        }
+    }
+
+    /// Point `k`'s (the `k`th row [`Bundles::pack`] read) impulses as the island's step
+    /// ended, as [`Bundles::unpack`] writes them into its row.
+    #[inline]
+    pub(crate) fn solved_point(&self, k: usize) -> SolvedPoint {
+        self.solved_at(self.slots[k])
+    }
+
+    /// The impulses of the point in lane `slot` (bundle × [`LANES`] + lane).
+    #[inline(always)]
+    fn solved_at(&self, slot: u32) -> SolvedPoint {
+        let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
+        let (b, total) = (&self.bundles[index], &self.step_totals[index]);
+        let at = |x: &Lane| x.as_array()[lane];
+        let normal = at(&b.normal_impulse);
+        let tangents = [at(&b.tangent_impulses[0]), at(&b.tangent_impulses[1])];
+        SolvedPoint {
+            normal,
+            tangents,
+            step: [
+                at(&total[0]) + normal,
+                at(&total[1]) + tangents[0],
+                at(&total[2]) + tangents[1],
+            ],
+        }
+    }
+
+    /// Writes the point in lane `slot` back into its row `c`.
+    #[inline(always)]
+    fn write_point(&self, c: &mut ContactConstraint, slot: u32) {
+        let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
+        let b = &self.bundles[index];
+        let at = |x: &Lane| x.as_array()[lane];
+        let solved = self.solved_at(slot);
+        c.normal_impulse = solved.normal;
+        c.tangent_impulses = solved.tangents;
+        c.max_normal_impulse = at(&b.max_normal_impulse);
+        c.step_impulses = solved.step;
+        c.target_normal_velocity = at(&b.target);
+        c.softness = (at(&b.mass_scale), at(&b.impulse_scale));
+        if self.recorded {
+            let r = &self.records[index];
             c.normal.velocity_before = at(&r.velocity_before[0]);
             c.tangents[0].velocity_before = at(&r.velocity_before[1]);
             c.tangents[1].velocity_before = at(&r.velocity_before[2]);
-            let phi = at(&r.phi[0]) as f64;
-            let mut squared = phi * phi;
-            if c.friction > 0.0 {
-                for k in 1..3 {
-                    let phi = at(&r.phi[k]) as f64;
-                    squared += phi * phi;
-                }
+        }
+    }
+
+    /// φ² of the rows of the point in lane `slot` by [`Bundles::record`]: the normal row's,
+    /// and the tangent rows' for a point with friction (`friction` > 0).
+    #[inline(always)]
+    fn residual_at(&self, slot: u32, friction: f32) -> f64 {
+        let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
+        let r = &self.records[index];
+        let at = |x: &Lane| x.as_array()[lane] as f64;
+        let phi = at(&r.phi[0]);
+        let mut squared = phi * phi;
+        if friction > 0.0 {
+            for k in 1..3 {
+                let phi = at(&r.phi[k]);
+                squared += phi * phi;
             }
-            squared
-        };
-        let slots = &self.slots;
+        }
+        squared
+    }
+
+    /// [`Bundles::unpack`] (`write`) or [`Bundles::report_rows`] (not `write`).
+    fn sum_rows(&mut self, constraints: &mut [ContactConstraint], write: bool) {
         let parallel = spread(self.parallel, constraints.len(), PARALLEL_PACK_POINTS - 1);
-        if !recorded {
+        let this = &*self;
+        if !this.recorded {
+            if !write {
+                return;
+            }
             if parallel {
                 use rayon::prelude::*;
                 constraints
                     .par_iter_mut()
-                    .zip(slots.par_iter())
+                    .zip(this.slots.par_iter())
                     .with_min_len(PARALLEL_PACK_POINTS / 4)
-                    .for_each(|(c, &slot)| {
-                        write(c, slot);
-                    });
+                    .for_each(|(c, &slot)| this.write_point(c, slot));
             } else {
-                for (c, &slot) in constraints.iter_mut().zip(slots) {
-                    write(c, slot);
-                }
+                this.unpack_into(constraints);
             }
             return;
         }
         // One run of points from `start`: its φ² sum and its points with friction.
         let run = |start: usize, rows: &mut [ContactConstraint]| {
             let (mut sum, mut friction_rows) = (0.0f64, 0usize);
-            for (c, &slot) in rows.iter_mut().zip(&slots[start..]) {
-                sum += write(c, slot);
+            for (c, &slot) in rows.iter_mut().zip(&this.slots[start..]) {
+                if write {
+                    this.write_point(c, slot);
+                }
+                sum += this.residual_at(slot, c.friction);
                 friction_rows += usize::from(c.friction > 0.0);
             }
             (sum, friction_rows)
         };
-        self.rows = Some(RowsReport::sum_in_runs(constraints, parallel, run));
+        let rows = RowsReport::sum_in_runs(constraints, parallel, run);
+        self.rows = Some(rows);
     }
 }
+
+/// A point's impulses as its island's step ended, from its lanes (N·s): the accumulated
+/// normal and friction impulses of the last substep (what the next step warm-starts from) and
+/// the impulses of the whole step (normal, tangent 1, tangent 2; see
+/// [`ContactConstraint::step_impulses`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SolvedPoint {
+    pub(crate) normal: f32,
+    pub(crate) tangents: [f32; 2],
+    pub(crate) step: [f32; 3],
+}
+
+

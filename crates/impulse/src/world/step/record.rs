@@ -48,6 +48,14 @@ impl World {
     pub(super) fn record_sleeping_rows(&mut self) {
         let islands = self.islands.len();
         if self.island_awake.iter().take(islands).any(|awake| !awake) {
+            // The pass reads every row's impulses, which an awake island in lanes may have
+            // kept in its lanes: they are written back first.
+            for k in 0..islands {
+                let w = &mut self.workspaces[k];
+                if std::mem::take(&mut w.impulses_in_lanes) {
+                    w.unpack_into(&mut self.constraints[self.islands.constraint_range(k)]);
+                }
+            }
             // The pass reads every row's I⁻¹(r × d), which the lanes keep in their bundles.
             constraints::complete_products(&mut self.constraints, &self.world_inverse_inertia);
             constraints::record_velocity_before(

@@ -45,6 +45,9 @@ impl World {
                     let (bodies, guests) = (islands_of.bodies(k), islands_of.guests(k));
                     substep::step_island(bodies, guests, rows, &context, workspace);
                     super::record::end_island(rows, workspace, context.parallel);
+                } else {
+                    // A sleeping island's rows keep what they hold.
+                    workspace.impulses_in_lanes = false;
                 }
             },
         );
