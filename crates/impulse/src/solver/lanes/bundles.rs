@@ -41,7 +41,8 @@ pub(crate) struct Bundles {
     pub(super) keys: Vec<PointKey>,
     pub(super) layout_slots: usize,
     /// What [`Bundles::record`] found per bundle, and the velocities v* it took them from;
-    /// `recorded` until the next pack. `rows` is what [`Bundles::unpack`] summed from them.
+    /// `recorded` until the next pack. `rows` is what [`Bundles::unpack`] or
+    /// [`Bundles::report_rows`] summed from them.
     pub(super) records: Vec<BundleRecord>,
     pub(super) before_linear: Vec<Vec3>,
     pub(super) before_angular: Vec<Vec3>,

@@ -19,8 +19,11 @@
 //!
 //! Rows are packed once per step ([`Bundles::pack`]); the substep loop then warm-starts, sets
 //! targets and sweeps on the packed rows, and [`Bundles::unpack`] writes the impulses back to
-//! the constraints for everything after the substeps (restitution, diagnostics, warm start of
-//! the next step). Results are deterministic: the order of updates depends only on the
+//! the constraints for what reads them after the substeps (restitution, a joint island's
+//! record). An island with neither records its rows in the lanes ([`Bundles::record`],
+//! [`Bundles::report_rows`]) and keeps its impulses there: the store-impulses stage reads them
+//! point by point into the manifolds ([`Bundles::solved_point`]), and [`Bundles::unpack_into`]
+//! writes them into the rows for any other reader. Results are deterministic: the order of updates depends only on the
 //! constraints, never on the thread count.
 //!
 //! Only the velocity rows of rigid (`repair: bias`) and soft (`repair: soft`) contacts are

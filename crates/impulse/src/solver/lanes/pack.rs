@@ -440,5 +440,3 @@ pub(crate) struct SolvedPoint {
     pub(crate) tangents: [f32; 2],
     pub(crate) step: [f32; 3],
 }
-
-

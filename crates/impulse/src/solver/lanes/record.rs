@@ -1,7 +1,7 @@
 //! The v* record: as an island's step ends, each point's J·v* (v* the velocities before the
 //! final impulses) and the natural map of its rows, computed on the bundles while they are in
-//! cache, for the step's diagnostics ([`Bundles::unpack`] writes them back and sums the
-//! residual).
+//! cache, for the step's diagnostics ([`Bundles::report_rows`] sums the residual;
+//! [`Bundles::unpack_into`] writes J·v* into the rows for the exported LCP).
 
 use glam::Vec3;
 
@@ -14,7 +14,7 @@ use crate::solver::interface::RowsReport;
 
 impl Bundles {
     /// The island's natural-map residual and friction rows that the last [`Bundles::unpack`]
-    /// summed after a [`Bundles::record`]; `None` when the step's rows were not recorded in
+    /// or [`Bundles::report_rows`] summed after a [`Bundles::record`]; `None` when the step's rows were not recorded in
     /// the lanes. Taking it leaves `None`.
     pub(crate) fn take_rows(&mut self) -> Option<RowsReport> {
         self.rows.take()
@@ -36,8 +36,9 @@ impl Bundles {
     /// Records, as the island's step ends, what its diagnostics need from each point at the
     /// final velocities `linear`, `angular` (per island slot, as the sweeps had them): the
     /// rows' J·v*, with v* = v − M⁻¹Jᵀγ the velocities before the final impulses γ, and the
-    /// natural map of its rows. [`Bundles::unpack`] then writes J·v* into the constraints and
-    /// sums the residual. Call it after the last solve, before `unpack`, and only when no
+    /// natural map of its rows. [`Bundles::report_rows`] (or [`Bundles::unpack`], which also
+    /// writes J·v* into the constraints) then sums the residual. Call it after the last solve,
+    /// before either, and only when no
     /// solve on the constraints follows (restitution): it reads the bundles' impulses.
     ///
     /// v* is the velocities [`Bundles::keep_velocities_before`] kept in the last substep;

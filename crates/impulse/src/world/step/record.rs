@@ -4,12 +4,13 @@
 //! the count of rows with friction. One home for the three paths that take it:
 //!
 //! - an awake island solved in SIMD lanes took it from its bundles as its last substep ended
-//!   (`IslandWorkspace::rows`, the lanes' `Bundles::record`);
+//!   (`IslandWorkspace::rows`, the lanes' `Bundles::record`), and its rows' J·v* and impulses
+//!   stay there (`IslandWorkspace::impulses_in_lanes`) unless a pass over every row needs them;
 //! - any other awake island takes it in one pass over its rows as its job ends, while they are
 //!   still in cache ([`crate::diagnostics::record_velocity_before_and_residual`]);
 //! - a sleeping island's rows take v* from the bodies' velocities, in one pass over every row
-//!   at the finish ([`record_sleeping_rows`]); rows of awake islands come out of that pass as
-//!   their own record, to the last bits.
+//!   at the finish ([`record_sleeping_rows`]); rows of awake islands (those in lanes have their
+//!   impulses written back first) come out of that pass as their own record, to the last bits.
 //!
 //! The three give the same bits for the same rows on any thread count (tests in
 //! `diagnostics/contact_lcp_tests.rs` and `solver/wide_tests.rs`).
