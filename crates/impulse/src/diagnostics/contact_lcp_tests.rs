@@ -689,3 +689,96 @@ fn pile_of_spheres_satisfies_complementarity_at_exit() {
     }
     assert!(checked_steps > 10);
 }
+
+/// Two stacks of five cubes far apart, each an island the default settings solve in SIMD
+/// lanes; once both sleep, the top cube of one is set sliding at 1 m/s. In its next step the
+/// other stack sleeps, so every row's record is taken again in one pass, for which the awake
+/// island's impulses, kept in its lanes, are written back into its rows first: its exported
+/// rows give w = Aγ − b equal to J·v − target for the velocities the step left, and their
+/// natural-map residual at the exported impulses is the one the island reported (the
+/// impulses the warm start began from, with the sliding contact's friction far from its
+/// disc, would give another).
+#[test]
+fn an_island_in_lanes_beside_a_sleeping_one_exports_its_impulses() {
+    let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, SolverSettings::default()).unwrap();
+    world.set_parallel(false);
+    world
+        .add_body(
+            &static_box(Vec3::new(20.0, 0.5, 20.0), Vec3::new(0.0, -0.5, 0.0)),
+            &material(0.5),
+        )
+        .unwrap();
+    let mut stacks = [Vec::new(), Vec::new()];
+    for (s, x) in [(0, -5.0f32), (1, 5.0)] {
+        for i in 0..5 {
+            let cube = BodyDesc::new(
+                BodyKind::Dynamic,
+                ShapeDesc::Cuboid {
+                    half_extents: [0.5; 3],
+                },
+                [x, 0.5 + i as f32, 0.0],
+            );
+            stacks[s].push(world.add_body(&cube, &material(0.5)).unwrap());
+        }
+    }
+    let asleep = |world: &World, s: usize| stacks[s].iter().all(|&i| world.bodies.asleep[i]);
+    for _ in 0..300 {
+        world.step().unwrap();
+        if asleep(&world, 0) && asleep(&world, 1) {
+            break;
+        }
+    }
+    assert!(asleep(&world, 0) && asleep(&world, 1), "the stacks sleep");
+    let top = stacks[1][4];
+    world.bodies.linear_velocity[top] = Vec3::new(1.0, 0.0, 0.0);
+    world.wake_up(top);
+    world.step().unwrap();
+    assert!(asleep(&world, 0) && !asleep(&world, 1));
+    let islands = &world.diagnostics().islands;
+    assert_eq!(islands.len(), 1, "one island was solved");
+    assert!(islands[0].simd, "in lanes");
+    let reported = islands[0].natural_map_residual as f64;
+
+    let exported = world.contact_lcp().unwrap();
+    let lcp = &exported.problem;
+    let constraints = world.contact_constraints();
+    assert_eq!(lcp.n(), 3 * constraints.len());
+    let (gamma, w) = (&exported.engine_solution, lcp.w(&exported.engine_solution));
+    let (linear, angular) = (
+        &world.bodies.linear_velocity,
+        &world.bodies.angular_velocity,
+    );
+    let (mut squared, mut points) = (0.0f64, 0);
+    for (k, c) in constraints.iter().enumerate() {
+        let (a, b) = (c.body_a as usize, c.body_b as usize);
+        if !stacks[1].contains(&a) && !stacks[1].contains(&b) {
+            continue;
+        }
+        let rows = [
+            (&c.normal, c.target_normal_velocity),
+            (&c.tangents[0], 0.0),
+            (&c.tangents[1], 0.0),
+        ];
+        for (t, (row, target)) in rows.into_iter().enumerate() {
+            let r = 3 * k + t;
+            let velocity = row.velocity(linear[a], angular[a], linear[b], angular[b]);
+            assert!(
+                (w[r] - (velocity - target) as f64).abs() <= VELOCITY_TOLERANCE,
+                "row {r}: w = {}, J·v − target = {}",
+                w[r],
+                velocity - target
+            );
+        }
+        let r = 3 * k;
+        let phi = gamma[r].min(w[r]);
+        let disc = disc_natural_map(&gamma[r..r + 3], &w[r..r + 3], c.friction as f64);
+        squared += phi * phi + disc * disc;
+        points += 1;
+    }
+    assert_eq!(points, 20, "the sliding stack's points");
+    let exported_residual = squared.sqrt();
+    assert!(
+        (reported - exported_residual).abs() <= 1e-3 * reported.max(1e-6) + 1e-6,
+        "reported {reported:.6e}, from the export {exported_residual:.6e}"
+    );
+}
