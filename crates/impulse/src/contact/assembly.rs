@@ -17,7 +17,9 @@ use rayon::prelude::*;
 /// them (within an island, narrow-phase order), with each constraint's local body slots set.
 /// `velocity_before` is read from the current velocities: called before gravity is applied, it
 /// is the approach velocity v⁻ that restitution reflects. Targets are left at zero. The
-/// carried-over impulses are scaled by `settings.warm_start` ([`crate::solver::scale_impulses`]).
+/// carried-over impulses are scaled by `settings.warm_start` ([`warm_start_impulses`]).
+/// Lever arms reach from `world_center_of_mass` (per body, m, the islands stage's); products
+/// come from `world_inverse_inertia` (per body).
 ///
 /// Pairs are read in memory order and written to their islands' rows. With `parallel`, runs of
 /// `PAIRS_PER_TASK` (1024) pairs are assembled on rayon's threads, each pair into its own rows of
@@ -36,6 +38,7 @@ pub(crate) fn assemble(
     islands: &Islands,
     settings: &SolverSettings,
     world_inverse_inertia: &[Mat3],
+    world_center_of_mass: &[Vec3],
     lanes_compute_products: bool,
     parallel: bool,
     out: &mut Vec<ContactConstraint>,
@@ -53,6 +56,7 @@ pub(crate) fn assemble(
         islands,
         settings,
         world_inverse_inertia,
+        world_center_of_mass,
         lanes_compute_products,
     };
     if spread(parallel, pairs.len(), PAIRS_PER_TASK) {
@@ -126,6 +130,7 @@ struct Assembly<'a> {
     islands: &'a Islands,
     settings: &'a SolverSettings,
     world_inverse_inertia: &'a [Mat3],
+    world_center_of_mass: &'a [Vec3],
     lanes_compute_products: bool,
 }
 
@@ -177,8 +182,8 @@ impl Assembly<'_> {
         let (local_a, local_b) = (self.islands.slot(a, island), self.islands.slot(b, island));
         let pose_a = &bodies.pose[a];
         let pose_b = &bodies.pose[b];
-        let com_a = bodies.center_of_mass(a);
-        let com_b = bodies.center_of_mass(b);
+        let com_a = self.world_center_of_mass[a];
+        let com_b = self.world_center_of_mass[b];
         let friction = (bodies.friction[a] * bodies.friction[b]).sqrt();
         let restitution = bodies.restitution[a].max(bodies.restitution[b]);
         let inverse_mass_a = bodies.effective_inverse_mass(a);
@@ -189,8 +194,14 @@ impl Assembly<'_> {
             && is_isotropic(inverse_mass_a)
             && is_isotropic(inverse_mass_b)
             && settings.solves_in_lanes(self.islands.constraint_range(island).len());
-        let inertia_a = &Mat3A::from(self.world_inverse_inertia[a]);
-        let inertia_b = &Mat3A::from(self.world_inverse_inertia[b]);
+        // Only points whose products assembly computes read the tensors.
+        let inertia = (!lanes_compute_products).then(|| {
+            (
+                Mat3A::from(self.world_inverse_inertia[a]),
+                Mat3A::from(self.world_inverse_inertia[b]),
+            )
+        });
+        let friction = if settings.friction { friction } else { 0.0 };
         for (manifold_index, manifold) in pair.manifolds.iter().enumerate() {
             if manifold.points.is_empty() {
                 continue;
@@ -242,11 +253,18 @@ impl Assembly<'_> {
                 c.lever_a = r_a;
                 c.lever_b = r_b;
                 c.restitution = restitution;
-                c.friction = if settings.friction { friction } else { 0.0 };
-                c.normal_impulse = warm.normal;
-                c.tangent_impulses = [warm.friction.dot(t1), warm.friction.dot(t2)];
+                c.friction = friction;
+                // Last step's impulses, scaled for the warm start.
+                let (normal_impulse, tangent_impulses) = warm_start_impulses(
+                    warm.normal,
+                    [warm.friction.dot(t1), warm.friction.dot(t2)],
+                    friction,
+                    settings.warm_start,
+                );
+                c.normal_impulse = normal_impulse;
+                c.tangent_impulses = tangent_impulses;
+                c.max_normal_impulse = normal_impulse;
                 c.depth = -point.dist;
-                c.max_normal_impulse = 0.0;
                 // Last step's totals, which a sleeping island keeps reporting; an awake
                 // island's step starts them from zero.
                 c.step_impulses = [
@@ -256,7 +274,7 @@ impl Assembly<'_> {
                 ];
                 c.source = (pair_index, manifold_index as u16, point_index as u16);
                 c.products_pending = true;
-                if !lanes_compute_products {
+                if let Some((inertia_a, inertia_b)) = &inertia {
                     // Only the normal row's v⁻ is read before the step ends, by restitution,
                     // which a point with pending products never meets; every row's is
                     // rewritten as the step ends ([`record_velocity_before`], or the lanes'
@@ -272,8 +290,6 @@ impl Assembly<'_> {
             }
         }
         debug_assert!(slots.next().is_none(), "more slots than rows");
-        // While the rows are in cache, rather than in a pass of its own over every row.
-        scale_impulses(out, settings.warm_start);
     }
 }
 
@@ -291,14 +307,18 @@ fn tangent_basis(normal: Vec3, previous: Vec3) -> (Vec3, Vec3) {
     }
 }
 
-/// Scales the impulses carried over from the last step by `fraction` (0 = cold start) and
-/// keeps the friction impulse inside its disc.
-pub(crate) fn scale_impulses(constraints: &mut [ContactConstraint], fraction: f32) {
-    for c in constraints.iter_mut() {
-        c.normal_impulse *= fraction;
-        c.tangent_impulses[0] *= fraction;
-        c.tangent_impulses[1] *= fraction;
-        c.tangent_impulses = cap_to_disc(c.tangent_impulses, c.friction * c.normal_impulse);
-        c.max_normal_impulse = c.normal_impulse;
-    }
+/// The warm start of a point whose last step left it the normal impulse `normal` and the
+/// friction impulses `tangents` along its new friction directions (N·s): each scaled by
+/// `fraction` (0 = cold start), the friction then kept inside Coulomb's disc of the scaled
+/// normal impulse for the point's coefficient `friction`.
+#[inline(always)]
+pub(crate) fn warm_start_impulses(
+    normal: f32,
+    tangents: [f32; 2],
+    friction: f32,
+    fraction: f32,
+) -> (f32, [f32; 2]) {
+    let normal = normal * fraction;
+    let tangents = [tangents[0] * fraction, tangents[1] * fraction];
+    (normal, cap_to_disc(tangents, friction * normal))
 }

@@ -10,19 +10,11 @@ use glam::Vec3;
 /// halving, inside the disc of radius 1.0·5 and outside 0.4·5 = 2).
 #[test]
 fn a_warm_start_fraction_scales_every_impulse_then_caps_friction() {
-    let row = |friction| ContactConstraint {
-        friction,
-        normal_impulse: 10.0,
-        tangent_impulses: [3.0, 4.0],
-        ..ContactConstraint::default()
-    };
-    let mut rows = [row(1.0), row(0.4)];
-    scale_impulses(&mut rows, 0.5);
-    assert_eq!(rows[0].normal_impulse, 5.0);
-    assert_eq!(rows[0].tangent_impulses, [1.5, 2.0]);
-    assert_eq!(rows[0].max_normal_impulse, 5.0);
-    assert_eq!(rows[1].normal_impulse, 5.0);
-    let [t1, t2] = rows[1].tangent_impulses;
+    let (normal, tangents) = warm_start_impulses(10.0, [3.0, 4.0], 1.0, 0.5);
+    assert_eq!(normal, 5.0);
+    assert_eq!(tangents, [1.5, 2.0]);
+    let (normal, [t1, t2]) = warm_start_impulses(10.0, [3.0, 4.0], 0.4, 0.5);
+    assert_eq!(normal, 5.0);
     assert!(
         (t1 - 1.2).abs() < 1e-6 && (t2 - 1.6).abs() < 1e-6,
         "{t1}, {t2}"

@@ -54,6 +54,9 @@ pub struct World {
     candidates: Vec<(u32, u32)>,
     constraints: Vec<ContactConstraint>,
     world_inverse_inertia: Vec<Mat3>,
+    /// Every body's centre of mass in the world (m) at the step's start poses, beside
+    /// `world_inverse_inertia`: what assembly measures lever arms from.
+    world_center_of_mass: Vec<Vec3>,
     scratch: Vec<(Vec3, Vec3)>,
     margins: narrow_phase::SpeculativeMargins,
     islands: Islands,
@@ -133,6 +136,7 @@ impl World {
             candidates: Vec::new(),
             constraints: Vec::new(),
             world_inverse_inertia: Vec::new(),
+            world_center_of_mass: Vec::new(),
             scratch: Vec::new(),
             margins: narrow_phase::SpeculativeMargins::default(),
             islands: Islands::default(),

@@ -14,6 +14,7 @@ impl World {
             &self.islands,
             settings,
             &self.world_inverse_inertia,
+            &self.world_center_of_mass,
             !self.any_restitution(),
             self.parallel,
             &mut self.constraints,

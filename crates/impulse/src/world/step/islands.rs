@@ -1,7 +1,7 @@
 //! The islands stage ([`crate::Stage::Islands`]): islands from the pairs (`island.rs`), and
-//! every body's world inverse inertia tensor beside them.
+//! every body's world inverse inertia tensor and centre of mass beside them.
 
-use glam::Mat3;
+use glam::{Mat3, Vec3};
 
 use crate::World;
 use crate::body::Bodies;
@@ -10,18 +10,26 @@ use crate::parallel::{BODIES_PER_TASK, both, map_into, spread};
 impl World {
     /// Islands from the pairs first, so that assembly writes each island's constraints
     /// contiguously and nothing has to be moved afterwards. The union-find is serial; the
-    /// world inertia tensors (from the poses alone) are computed beside it.
+    /// world inertia tensors and centres of mass (from the poses alone) are computed beside
+    /// it, once a body rather than once for each of its pairs.
     pub(super) fn islands_stage(&mut self, parallel: bool) {
         let joints = if self.joints.is_empty() {
             Vec::new()
         } else {
             self.active_joints()
         };
-        let (islands, world_inverse_inertia) = (&mut self.islands, &mut self.world_inverse_inertia);
+        let (islands, world_inverse_inertia, world_center_of_mass) = (
+            &mut self.islands,
+            &mut self.world_inverse_inertia,
+            &mut self.world_center_of_mass,
+        );
         let (bodies, pairs) = (&self.bodies, &self.narrow_phase.pairs);
         both(
             parallel,
-            || world_inverse_inertia_of(bodies, parallel, world_inverse_inertia),
+            || {
+                world_inverse_inertia_of(bodies, parallel, world_inverse_inertia);
+                world_center_of_mass_of(bodies, parallel, world_center_of_mass);
+            },
             || islands.build(bodies, pairs, &joints),
         );
     }
@@ -36,6 +44,18 @@ fn world_inverse_inertia_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Mat3>
         bodies.len(),
         BODIES_PER_TASK,
         |i| bodies.world_inverse_inertia(i),
+        out,
+    );
+}
+
+/// Every body's centre of mass in the world (m) at its current pose
+/// (`Bodies::center_of_mass`).
+fn world_center_of_mass_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Vec3>) {
+    map_into(
+        spread(parallel, 1, 0),
+        bodies.len(),
+        BODIES_PER_TASK,
+        |i| bodies.center_of_mass(i),
         out,
     );
 }
