@@ -5,7 +5,7 @@
 
 use glam::Mat3;
 
-use super::lane::{LANES, Lane, LaneVec, cross, dot, lane_vec};
+use super::lane::{LANES, Lane, LaneVec, cross, dot};
 use super::layout::{Bundle, BundleGeometry, Group, RowLanes};
 use crate::parallel::{GROUPS_PER_TASK, SharedItems};
 use crate::simd::{InstructionSet, on_instruction_set};
@@ -22,23 +22,6 @@ pub(super) fn compute_products(
     parallel: bool,
 ) {
     let set = InstructionSet::detected();
-    let group = |g: &Group, bundles: &mut [Bundle]| {
-        let range = g.start as usize..(g.start + g.len) as usize;
-        let geometry = &geometry[range];
-        if geometry.iter().all(|g| !g.pending.contains(&true)) {
-            return;
-        }
-        let inertia_a = inertia_lanes(&g.local_a, inverse_inertia);
-        let inertia_b = inertia_lanes(&g.local_b, inverse_inertia);
-        let inertia = (&inertia_a, &inertia_b);
-        for (b, where_) in bundles.iter_mut().zip(geometry) {
-            if where_.pending == [true; LANES] {
-                bundle_products::<true>(b, g, where_, inertia);
-            } else if where_.pending.contains(&true) {
-                bundle_products::<false>(b, g, where_, inertia);
-            }
-        }
-    };
     if parallel {
         use rayon::prelude::*;
         let total = bundles.len();
@@ -55,24 +38,69 @@ pub(super) fn compute_products(
                 // SAFETY: lane groups cover disjoint bundle ranges (`lay_out` gives each
                 // its own run of bundles), inside the bundles (checked above).
                 let mine = unsafe { std::slice::from_raw_parts_mut(bundles.0.add(start), len) };
-                on_instruction_set!(set, group(g, mine));
+                on_instruction_set!(set, group_products(g, mine, geometry, inverse_inertia));
             });
     } else {
         on_instruction_set!(set, {
             for g in groups {
                 let range = g.start as usize..(g.start + g.len) as usize;
-                group(g, &mut bundles[range]);
+                group_products(g, &mut bundles[range], geometry, inverse_inertia);
             }
         });
     }
 }
 
+/// The pending products of lane group `g`'s `bundles` (its own, `g.start..g.start + g.len`)
+/// from their `geometry` (all the island's) and the slots' tensors `inverse_inertia`, the
+/// bodies' tensors gathered once for the group. A function, not a closure, and always
+/// inlined: so it is compiled into the instruction set's kernel that calls it
+/// ([`on_instruction_set`]), where a closure would be compiled for the baseline.
+#[inline(always)]
+fn group_products(
+    g: &Group,
+    bundles: &mut [Bundle],
+    geometry: &[BundleGeometry],
+    inverse_inertia: &[Mat3],
+) {
+    let range = g.start as usize..(g.start + g.len) as usize;
+    let geometry = &geometry[range];
+    if geometry.iter().all(|g| !g.pending.contains(&true)) {
+        return;
+    }
+    let inertia_a = inertia_lanes(&g.local_a, inverse_inertia);
+    let inertia_b = inertia_lanes(&g.local_b, inverse_inertia);
+    let inertia = (&inertia_a, &inertia_b);
+    for (b, where_) in bundles.iter_mut().zip(geometry) {
+        if where_.pending == [true; LANES] {
+            bundle_products::<true>(b, g, where_, inertia);
+        } else if where_.pending.contains(&true) {
+            bundle_products::<false>(b, g, where_, inertia);
+        }
+    }
+}
+
 /// The world inverse inertia tensors of the lanes' `slots`, as columns of lanes: `[c][r]` is
-/// entry (r, c) of each lane's tensor.
+/// entry (r, c) of each lane's tensor. Written with loops rather than `array::map`, which the
+/// compiler left as out-of-line calls compiled for the baseline instruction set.
 #[inline(always)]
 pub(super) fn inertia_lanes(slots: &[u32; LANES], inverse_inertia: &[Mat3]) -> [LaneVec; 3] {
-    let tensors = slots.map(|slot| inverse_inertia[slot as usize]);
-    [0, 1, 2].map(|c| lane_vec(tensors.map(|t| t.col(c))))
+    let mut entries = [[[0.0f32; LANES]; 3]; 3];
+    for (lane, &slot) in slots.iter().enumerate() {
+        let tensor = inverse_inertia[slot as usize].to_cols_array_2d();
+        for (c, column) in tensor.iter().enumerate() {
+            for (r, &entry) in column.iter().enumerate() {
+                entries[c][r][lane] = entry;
+            }
+        }
+    }
+    let column = |c: usize| {
+        [
+            Lane::new(entries[c][0]),
+            Lane::new(entries[c][1]),
+            Lane::new(entries[c][2]),
+        ]
+    };
+    [column(0), column(1), column(2)]
 }
 
 /// M·v per lane for tensors `m` from [`inertia_lanes`]: (m₀ᵣ·vₓ + m₁ᵣ·v_y) + m₂ᵣ·v_z per

@@ -63,38 +63,64 @@ impl Bundles {
         let len = self.bundles.len();
         self.records.resize(len, BundleRecord::default());
         let (bundles, records) = (&self.bundles, SharedItems(self.records.as_mut_ptr()));
-        let (before_linear_ref, before_angular_ref) = (&before_linear, &before_angular);
-        let fill = |groups: &[Group]| {
-            // Capture the whole wrapper (Sync), not its raw-pointer field.
-            #[allow(clippy::redundant_locals)]
-            let records = records;
-            for group in groups {
-                let range = group.start as usize..(group.start + group.len) as usize;
-                let (a, b) = (&group.local_a, &group.local_b);
-                let before = BodyLanes::gather(a, b, before_linear_ref, before_angular_ref);
-                let after = BodyLanes::gather(a, b, linear, angular);
-                let end = range.end.min(len);
-                for (index, bundle) in (range.start..end).zip(&bundles[range.start..end]) {
-                    // SAFETY: `index` < the records' length (`len`); the groups' ranges are
-                    // disjoint, so no other task writes this record.
-                    unsafe {
-                        *records.0.add(index) = record_bundle(bundle, group, &before, &after);
-                    }
-                }
-            }
-        };
+        let before = (&before_linear[..], &before_angular[..]);
+        let after = (linear, angular);
         let set = InstructionSet::detected();
         if spread(self.parallel, len * LANES, PARALLEL_PACK_POINTS - 1) {
             use rayon::prelude::*;
             self.groups
                 .par_chunks(PARALLEL_PACK_POINTS / (4 * LANES))
-                .for_each(|groups| on_instruction_set!(set, fill(groups)));
+                .for_each(|groups| {
+                    // Capture the whole wrapper (Sync), not its raw-pointer field.
+                    #[allow(clippy::redundant_locals)]
+                    let records = records;
+                    // SAFETY: the records hold `len` items; the chunks' groups are disjoint.
+                    on_instruction_set!(set, unsafe {
+                        record_groups(groups, bundles, records, before, after)
+                    })
+                });
         } else {
-            on_instruction_set!(set, fill(&self.groups));
+            // SAFETY: as above, with one chunk.
+            on_instruction_set!(set, unsafe {
+                record_groups(&self.groups, bundles, records, before, after)
+            });
         }
         self.before_linear = before_linear;
         self.before_angular = before_angular;
         self.recorded = true;
+    }
+}
+
+/// The records of `groups`' bundles into `records` (one per bundle), each group's bodies
+/// gathered once from the velocities v* (`before`) and v (`after`), each (linear, angular)
+/// per island slot. A function, not a closure, and always inlined: so it is compiled into
+/// the instruction set's kernel that calls it (`on_instruction_set`), where a closure would be
+/// compiled for the baseline.
+///
+/// # Safety
+/// `records` points to one record per bundle, and no other thread writes the records of
+/// these groups' bundles meanwhile.
+#[inline(always)]
+unsafe fn record_groups(
+    groups: &[Group],
+    bundles: &[Bundle],
+    records: SharedItems<BundleRecord>,
+    before: (&[Vec3], &[Vec3]),
+    after: (&[Vec3], &[Vec3]),
+) {
+    for group in groups {
+        let range = group.start as usize..(group.start + group.len) as usize;
+        let (a, b) = (&group.local_a, &group.local_b);
+        let v_before = BodyLanes::gather(a, b, before.0, before.1);
+        let v_after = BodyLanes::gather(a, b, after.0, after.1);
+        let end = range.end.min(bundles.len());
+        for (index, bundle) in (range.start..end).zip(&bundles[range.start..end]) {
+            // SAFETY: `index` < the bundles' length, the records' (the caller's contract);
+            // no other thread writes this record.
+            unsafe {
+                *records.0.add(index) = record_bundle(bundle, group, &v_before, &v_after);
+            }
+        }
     }
 }
 
