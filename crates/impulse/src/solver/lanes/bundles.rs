@@ -27,6 +27,8 @@ pub(crate) struct Bundles {
     pub(super) run_places: Vec<(u32, u32)>,
     /// Whether one colour's bundles may be updated on several threads.
     pub(super) parallel: bool,
+    /// Points with friction (μ > 0) in the last pack: each has two tangent rows.
+    pub(super) friction_points: usize,
     /// Constraint index of each lane of each bundle; `u32::MAX` for padding.
     pub(super) sources: Vec<[u32; LANES]>,
     /// Where each constraint went: bundle index × [`LANES`] + lane.

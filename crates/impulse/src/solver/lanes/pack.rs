@@ -106,23 +106,32 @@ impl Bundles {
         // The step totals start from zero: the packed bundles are this step's alone.
         self.step_totals.clear();
         self.step_totals.resize(total, [Lane::splat(0.0); 3]);
-        if parallel_fill {
+        let any_pending = if parallel_fill {
             self.fill_parallel(constraints, reset.then_some(&empty));
+            constraints.iter().any(|c| c.products_pending)
         } else {
             // The reads stream, and the writes go to one open lane group per colour.
             let (bundles, geometry, slots) = (&mut self.bundles, &mut self.geometry, &self.slots);
             on_instruction_set!(InstructionSet::detected(), {
+                let mut any_pending = false;
                 for (c, &slot) in constraints.iter().zip(slots) {
                     let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
                     set_lane(&mut bundles[index], &mut geometry[index], lane, c);
+                    any_pending |= c.products_pending;
                 }
-            });
-        }
+                any_pending
+            })
+        };
         // What each lane group's points share, lane by lane, from each manifold group's first
         // point; every field of a lane that holds a group (lanes with none keep what
         // `lay_out` gave them: the immovable slot, zero masses and directions).
+        // And the points with friction (each a manifold group's, whose points share it).
+        self.friction_points = 0;
         for (r, &(group, lane)) in self.run_places.iter().enumerate() {
             let c = &constraints[self.runs[r] as usize];
+            if c.friction > 0.0 {
+                self.friction_points += (self.runs[r + 1] - self.runs[r]) as usize;
+            }
             let (g, i) = (&mut self.groups[group as usize], lane as usize);
             g.local_a[i] = c.local_a;
             g.local_b[i] = c.local_b;
@@ -134,7 +143,7 @@ impl Bundles {
             set(&mut g.friction, i, c.friction);
         }
         // Padding alone needs nothing computed: its products are the zeros it was reset to.
-        if constraints.iter().any(|c| c.products_pending) {
+        if any_pending {
             compute_products(
                 &mut self.bundles,
                 &self.geometry,
@@ -313,7 +322,7 @@ impl Bundles {
     /// ([`Bundles::take_rows`]) as [`Bundles::unpack`] sums them, to the bit, without writing
     /// the rows back: the impulses stay in the bundles, where the store-impulses stage reads
     /// them ([`Bundles::solved_point`]) and [`Bundles::unpack_into`] writes them into the rows
-    /// for any other reader. Reads each row's friction coefficient only.
+    /// for any other reader. Reads no row: the points with friction were counted as they were packed.
     pub(crate) fn report_rows(&mut self, constraints: &mut [ContactConstraint]) {
         debug_assert!(self.recorded, "the rows' report follows the record");
         self.sum_rows(constraints, false);
@@ -376,19 +385,19 @@ impl Bundles {
     }
 
     /// φ² of the rows of the point in lane `slot` by [`Bundles::record`]: the normal row's,
-    /// and the tangent rows' for a point with friction (`friction` > 0).
+    /// then the tangent rows'. A point without friction has tangent impulses of zero, which its
+    /// disc of radius zero keeps, so its tangent rows' φ are zero and add nothing: the sum is
+    /// the scalar record's, which leaves them out, to the bit.
     #[inline(always)]
-    fn residual_at(&self, slot: u32, friction: f32) -> f64 {
+    fn residual_at(&self, slot: u32) -> f64 {
         let (index, lane) = (slot as usize / LANES, slot as usize % LANES);
         let r = &self.records[index];
         let at = |x: &Lane| x.as_array()[lane] as f64;
         let phi = at(&r.phi[0]);
         let mut squared = phi * phi;
-        if friction > 0.0 {
-            for k in 1..3 {
-                let phi = at(&r.phi[k]);
-                squared += phi * phi;
-            }
+        for k in 1..3 {
+            let phi = at(&r.phi[k]);
+            squared += phi * phi;
         }
         squared
     }
@@ -413,20 +422,27 @@ impl Bundles {
             }
             return;
         }
-        // One run of points from `start`: its φ² sum and its points with friction.
+        // One run of points from `start`: its φ² sum. Without `write` the rows are not read:
+        // the points with friction were counted as they were packed.
         let run = |start: usize, rows: &mut [ContactConstraint]| {
-            let (mut sum, mut friction_rows) = (0.0f64, 0usize);
-            for (c, &slot) in rows.iter_mut().zip(&this.slots[start..]) {
-                if write {
+            let mut sum = 0.0f64;
+            if write {
+                for (c, &slot) in rows.iter_mut().zip(&this.slots[start..]) {
                     this.write_point(c, slot);
+                    sum += this.residual_at(slot);
                 }
-                sum += this.residual_at(slot, c.friction);
-                friction_rows += usize::from(c.friction > 0.0);
+            } else {
+                for &slot in &this.slots[start..start + rows.len()] {
+                    sum += this.residual_at(slot);
+                }
             }
-            (sum, friction_rows)
+            (sum, 0)
         };
         let rows = RowsReport::sum_in_runs(constraints, parallel, run);
-        self.rows = Some(rows);
+        self.rows = Some(RowsReport {
+            friction_rows: self.friction_points,
+            ..rows
+        });
     }
 }
 

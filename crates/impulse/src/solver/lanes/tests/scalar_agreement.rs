@@ -42,8 +42,10 @@ fn settled_pyramid20_rows() -> (World, Vec<crate::contact::ContactConstraint>) {
 /// (`record_velocity_before_and_residual`): the same natural-map residual to the bit, the same
 /// friction-row count, each row's J·v* equal up to rounding (the lanes take v* as kept before
 /// the impulses were applied, the scalar record takes M⁻¹Jᵀγ off the final velocities), and
-/// the same bits on one and two threads. Rows: a settled pyramid's, repeated with scaled
-/// impulses (every third copy frictionless) to pass the parallel and per-part thresholds.
+/// the same bits on one and two threads; and the report the lanes give without writing the
+/// rows back (`Bundles::report_rows`) is the same. Rows: a settled pyramid's, repeated with
+/// scaled impulses (every third copy frictionless) to pass the parallel and per-part
+/// thresholds.
 #[test]
 fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
     use super::Bundles;
@@ -110,6 +112,13 @@ fn lanes_record_matches_the_scalar_record_of_the_unpacked_rows() {
             let mut lanes = rows.clone();
             bundles.unpack(&mut lanes);
             let report = bundles.take_rows().expect("recorded rows give a report");
+            bundles.report_rows(&mut rows.clone());
+            let kept = bundles.take_rows().expect("recorded rows give a report");
+            assert_eq!(
+                (kept.natural_map_residual.to_bits(), kept.friction_rows),
+                (report.natural_map_residual.to_bits(), report.friction_rows),
+                "the report without the write-back"
+            );
             let mut scalar = lanes.clone();
             let scalar_report = record_velocity_before_and_residual(
                 &mut scalar,
