@@ -326,16 +326,29 @@ fn exported_rows_match_the_constraints() {
         for r in 0..n {
             let c = &constraints[exported.contact_of_row[r]];
             let (row, target, _) = row_data(r);
-            let (a, b) = (c.body_a as usize, c.body_b as usize);
-            let velocity = row.velocity(linear[a], angular[a], linear[b], angular[b]);
-            assert!(
-                (w[r] - (velocity - target) as f64).abs() <= VELOCITY_TOLERANCE,
-                "row {r}: w = {}, J·v − target = {}",
-                w[r],
-                velocity - target
-            );
+            assert_w_is_row_velocity(r, w[r], c, row, target, linear, angular);
         }
     }
+}
+
+/// Exported row `r`'s w = (Aγ − b)_r is the row velocity J·v of contact `c`'s `row` for the
+/// bodies' velocities `linear`, `angular` the step left, minus the row's `target`.
+fn assert_w_is_row_velocity(
+    r: usize,
+    w: f64,
+    c: &ContactConstraint,
+    row: &crate::contact::JacobianRow,
+    target: f32,
+    linear: &[Vec3],
+    angular: &[Vec3],
+) {
+    let (a, b) = (c.body_a as usize, c.body_b as usize);
+    let velocity = row.velocity(linear[a], angular[a], linear[b], angular[b]);
+    assert!(
+        (w - (velocity - target) as f64).abs() <= VELOCITY_TOLERANCE,
+        "row {r}: w = {w}, J·v − target = {}",
+        velocity - target
+    );
 }
 
 /// Per contact (rows k, k + 1, k + 2): the natural map of Coulomb's disc for the tangent pair,
@@ -761,13 +774,7 @@ fn an_island_in_lanes_beside_a_sleeping_one_exports_its_impulses() {
         ];
         for (t, (row, target)) in rows.into_iter().enumerate() {
             let r = 3 * k + t;
-            let velocity = row.velocity(linear[a], angular[a], linear[b], angular[b]);
-            assert!(
-                (w[r] - (velocity - target) as f64).abs() <= VELOCITY_TOLERANCE,
-                "row {r}: w = {}, J·v − target = {}",
-                w[r],
-                velocity - target
-            );
+            assert_w_is_row_velocity(r, w[r], c, row, target, linear, angular);
         }
         let r = 3 * k;
         let phi = gamma[r].min(w[r]);

@@ -1,8 +1,6 @@
 //! The islands stage ([`crate::Stage::Islands`]): islands from the pairs (`island.rs`), and
 //! every body's world inverse inertia tensor and centre of mass beside them.
 
-use glam::{Mat3, Vec3};
-
 use crate::World;
 use crate::body::Bodies;
 use crate::parallel::{BODIES_PER_TASK, both, map_into, spread};
@@ -27,35 +25,34 @@ impl World {
         both(
             parallel,
             || {
-                world_inverse_inertia_of(bodies, parallel, world_inverse_inertia);
-                world_center_of_mass_of(bodies, parallel, world_center_of_mass);
+                // R I_local⁻¹ Rᵀ (1/(kg·m²)), restricted to the free rotations of bodies with
+                // locked rotation axes, zero for bodies that do not rotate; and each centre of
+                // mass in the world (m).
+                per_body(bodies, parallel, world_inverse_inertia, |i| {
+                    bodies.world_inverse_inertia(i)
+                });
+                per_body(bodies, parallel, world_center_of_mass, |i| {
+                    bodies.center_of_mass(i)
+                });
             },
             || islands.build(bodies, pairs, &joints),
         );
     }
 }
 
-/// World-frame inverse inertia tensors I⁻¹ = R I_local⁻¹ Rᵀ (1/(kg·m²)) of every body at its
-/// current pose, restricted to the free rotations of bodies with locked rotation axes
-/// (`Bodies::world_inverse_inertia`); zero for bodies that do not rotate.
-fn world_inverse_inertia_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Mat3>) {
+/// `of(i)` for every body `i` at its current pose, into `out` (in runs of bodies on rayon's
+/// threads with `parallel`).
+fn per_body<T: Send>(
+    bodies: &Bodies,
+    parallel: bool,
+    out: &mut Vec<T>,
+    of: impl Fn(usize) -> T + Sync + Send,
+) {
     map_into(
         spread(parallel, 1, 0),
         bodies.len(),
         BODIES_PER_TASK,
-        |i| bodies.world_inverse_inertia(i),
-        out,
-    );
-}
-
-/// Every body's centre of mass in the world (m) at its current pose
-/// (`Bodies::center_of_mass`).
-fn world_center_of_mass_of(bodies: &Bodies, parallel: bool, out: &mut Vec<Vec3>) {
-    map_into(
-        spread(parallel, 1, 0),
-        bodies.len(),
-        BODIES_PER_TASK,
-        |i| bodies.center_of_mass(i),
+        of,
         out,
     );
 }
