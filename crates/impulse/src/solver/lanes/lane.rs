@@ -65,6 +65,51 @@ pub(super) fn sub(a: LaneVec, b: LaneVec) -> LaneVec {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
+/// max(a, b) per lane for a `b` that is never NaN: `a.max(b)` to the bit in one instruction.
+/// wide's `max` first tests `b` for NaN (to return `a` there), four more instructions; on
+/// x86-64, `maxps` returns `b` wherever either is NaN and on ties, so without a NaN `b` the two
+/// agree (±0 included). Other targets keep `max`.
+#[inline(always)]
+pub(super) fn max_of_number(a: Lane, b: Lane) -> Lane {
+    #[cfg(target_arch = "x86_64")]
+    {
+        a.fast_max(b)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        a.max(b)
+    }
+}
+
+/// min(a, b) per lane for a `b` that is never NaN, as [`max_of_number`].
+#[inline(always)]
+pub(super) fn min_of_number(a: Lane, b: Lane) -> Lane {
+    #[cfg(target_arch = "x86_64")]
+    {
+        a.fast_min(b)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        a.min(b)
+    }
+}
+
+/// The larger of a running largest row velocity change `largest` (never NaN) and a bundle's
+/// `change`, a NaN `change` leaving `largest` as wide's `largest.max(change)` does, in one
+/// instruction on x86-64 (`maxps(change, largest)` returns `largest` wherever either is NaN).
+/// Ties may keep the other zero's sign; the sweeps only compare the result.
+#[inline(always)]
+pub(super) fn fold_largest(largest: Lane, change: Lane) -> Lane {
+    #[cfg(target_arch = "x86_64")]
+    {
+        change.fast_max(largest)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        largest.max(change)
+    }
+}
+
 /// The lanes of a vector as [`LANES`] vectors.
 #[inline(always)]
 pub(super) fn unlane(v: &LaneVec) -> [Vec3; LANES] {

@@ -5,7 +5,7 @@
 
 use glam::Mat3;
 
-use super::lane::{LANES, Lane, LaneVec, cross, dot};
+use super::lane::{LANES, Lane, LaneVec, cross, dot, max_of_number};
 use super::layout::{Bundle, BundleGeometry, Group, RowLanes};
 use crate::parallel::{GROUPS_PER_TASK, SharedItems};
 use crate::simd::{InstructionSet, on_instruction_set};
@@ -183,8 +183,9 @@ pub(super) fn bundle_products<const ALL: bool>(
         + dot(t1.angular_b, t2.inverse_inertia_angular_b);
     // Its inverse, or the pseudo-inverse of a rank-one block, or zero (`inverse_block`).
     let determinant = k11 * k22 - k12 * k12;
-    let regular = determinant
-        .simd_gt(Lane::splat(f32::EPSILON) * (k11 * k22).max(Lane::splat(f32::MIN_POSITIVE)));
+    let regular = determinant.simd_gt(
+        Lane::splat(f32::EPSILON) * max_of_number(k11 * k22, Lane::splat(f32::MIN_POSITIVE)),
+    );
     let inverse = one / determinant;
     let trace = k11 + k22;
     let rank_one = trace.simd_gt(zero) & trace.is_finite();

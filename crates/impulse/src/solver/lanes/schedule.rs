@@ -4,7 +4,7 @@
 //! no moving body), the next bundles asked of the CPU ahead of the update.
 
 use super::bundles::Bundles;
-use super::lane::Lane;
+use super::lane::{Lane, fold_largest};
 use super::layout::{Bundle, Group, SharedLanes};
 use super::sweep::BundleUpdate;
 use super::targets::SetTargets;
@@ -151,7 +151,8 @@ pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
             // SAFETY: the caller's contract.
             let b = unsafe { &mut *bundles.0.add(index) };
             targets.set(b, group, index, &moved);
-            largest = largest.max(update.update_at(b, group, index, &mut v, &mut state));
+            let change = update.update_at(b, group, index, &mut v, &mut state);
+            largest = fold_largest(largest, change);
         }
         // SAFETY: the caller's contract.
         unsafe {

@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use super::bundles::Bundles;
-use super::lane::{LANES, Lane};
+use super::lane::{LANES, Lane, max_of_number, min_of_number};
 use super::layout::{BodyLanes, Bundle, Group, NORMAL_PART, SharedLanes};
 use crate::parallel::{SharedItems, SharedVelocities};
 
@@ -226,12 +226,13 @@ pub(super) fn solve_normal(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> 
     let row = &b.normal;
     let velocity = row.velocity(direction, v);
     let old = b.normal_impulse;
-    let new = (old + row.effective_mass * b.mass_scale * (b.target - velocity)
-        - b.impulse_scale * old)
-        .max(zero);
+    let new = max_of_number(
+        old + row.effective_mass * b.mass_scale * (b.target - velocity) - b.impulse_scale * old,
+        zero,
+    );
     let delta = new - old;
     b.normal_impulse = new;
-    b.max_normal_impulse = b.max_normal_impulse.max(new);
+    b.max_normal_impulse = max_of_number(b.max_normal_impulse, new);
     row.apply(direction, delta, masses, v);
     delta.abs() * row.inverse_effective_mass
 }
@@ -298,7 +299,10 @@ fn cap_to_disc_clamped(impulse: [Lane; 2], limit: Lane) -> [Lane; 2] {
     let zero = Lane::splat(0.0);
     let squared = impulse[0] * impulse[0] + impulse[1] * impulse[1];
     let inside = squared.simd_le(limit * limit);
-    let scale = (limit.max(zero) / squared.sqrt()).min(Lane::splat(1.0));
+    let scale = min_of_number(
+        max_of_number(limit, zero) / squared.sqrt(),
+        Lane::splat(1.0),
+    );
     let scale = squared.simd_gt(zero).select(scale, zero);
     [
         inside.select(impulse[0], impulse[0] * scale),

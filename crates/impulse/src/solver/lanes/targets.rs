@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::lane::{LANES, Lane, add_cross, dot, sub};
+use super::lane::{LANES, Lane, add_cross, dot, max_of_number, min_of_number, sub};
 use super::layout::{BodyLanes, Bundle, BundleGeometry, Group};
 use crate::contact::{SPECULATIVE_TURN, STALE_TARGET, repair_terms};
 use crate::solver::interface::TargetInputs;
@@ -118,7 +118,11 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
         let at_b = add_cross(moved.linear_b, moved.angular_b, g.lever_b);
         let separation = dot(group.directions[0], sub(at_a, at_b)) - g.depth;
         let gap = separation.simd_gt(zero);
-        let repair = (t.repair_rate * (-separation - t.slop).max(zero)).min(t.max_repair);
+        // `max_repair` is a validated setting, never NaN.
+        let repair = min_of_number(
+            t.repair_rate * max_of_number(-separation - t.slop, zero),
+            t.max_repair,
+        );
         let overlap_target = if t.with_repair { repair } else { zero };
         let closing = -separation * t.inverse_h;
         let gap_target = if !STALE {
