@@ -82,10 +82,18 @@ impl Islands {
     /// `body`'s slot in its island's local arrays, where the island is `island`: its local
     /// index if it is dynamic; after the island's bodies, its guest slot if it is kinematic;
     /// the immovable slot after those if it is static.
+    #[inline]
     pub(crate) fn slot(&self, body: usize, island: usize) -> u32 {
         if self.island_of_body[body] != u32::MAX {
             return self.parent[body];
         }
+        self.guest_slot(body, island)
+    }
+
+    /// [`Islands::slot`] of a body outside every island (kinematic or static): assembly calls
+    /// it for every pair with such a body, so [`Islands::slot`] keeps the common case inline.
+    #[inline(never)]
+    fn guest_slot(&self, body: usize, island: usize) -> u32 {
         let bodies = self.body_start[island + 1] - self.body_start[island];
         let guests = self.guests(island);
         match guests.binary_search(&(body as u32)) {
