@@ -117,17 +117,6 @@ pub(super) fn unlane(v: &LaneVec) -> [Vec3; LANES] {
     std::array::from_fn(|i| Vec3::new(x[i], y[i], z[i]))
 }
 
-/// Δx + Δθ × r per lane.
-#[inline(always)]
-pub(super) fn add_cross(linear: LaneVec, angular: LaneVec, lever: LaneVec) -> LaneVec {
-    let turn = cross(angular, lever);
-    [
-        linear[0] + turn[0],
-        linear[1] + turn[1],
-        linear[2] + turn[2],
-    ]
-}
-
 #[inline(always)]
 pub(super) fn set(lane: &mut Lane, i: usize, value: f32) {
     lane.as_mut_array()[i] = value;

@@ -36,6 +36,9 @@ pub(super) struct Bundle {
     pub(super) impulse_scale: Lane,
     pub(super) normal_impulse: Lane,
     pub(super) max_normal_impulse: Lane,
+    /// Penetration depth at assembly (m), > 0 when overlapping: with the normal row and the
+    /// bodies' displacements, the separation a point has reached (see [`super::targets`]).
+    pub(super) depth: Lane,
     pub(super) tangents: [RowLanes; 2],
     pub(super) tangent_inverse_block: [Lane; 3],
     /// Step of a sliding lane's friction update, 1/k₁ with k₁ the tangent block's larger
@@ -44,18 +47,17 @@ pub(super) struct Bundle {
     pub(super) tangent_impulses: [Lane; 2],
 }
 
-/// Bytes at the start of a [`Bundle`] that the normal rows' sweep reads and writes: a third of
-/// the bundle, which a sweep over the normal rows alone asks the CPU for (see
-/// [`sweep_groups`]).
+/// Bytes at the start of a [`Bundle`] that the normal rows' sweep reads and writes, its target
+/// update included: five of its fourteen cache lines (four lanes), which a sweep over the
+/// normal rows alone asks the CPU for (see [`sweep_groups`]).
 pub(super) const NORMAL_PART: usize = std::mem::offset_of!(Bundle, tangents);
 
-/// What the target update of [`Bundles::solve_pgs`] reads: where the points are.
+/// Where the points are: the lever arms, which the pack's lever-arm products and the stale
+/// speculative rows' test of [`Bundles::solve_pgs`] read.
 #[derive(Clone, Copy, Default)]
 pub(super) struct BundleGeometry {
     pub(super) lever_a: LaneVec,
     pub(super) lever_b: LaneVec,
-    /// Penetration depth at assembly (m), > 0 when overlapping.
-    pub(super) depth: Lane,
     /// Per lane, whether the pack computes its lever-arm products: for a point whose products
     /// are pending ([`ContactConstraint::products_pending`]). Padding keeps the zero products
     /// it was reset to (computed from its zero lever arms and its lane's direction, some would
@@ -64,11 +66,10 @@ pub(super) struct BundleGeometry {
 }
 
 impl BundleGeometry {
-    /// The geometry of a lane group's padding: no lever arms, no depth.
+    /// The geometry of a lane group's padding: no lever arms.
     pub(super) const PADDING: Self = Self {
         lever_a: [Lane::ZERO; 3],
         lever_b: [Lane::ZERO; 3],
-        depth: Lane::ZERO,
         pending: [false; LANES],
     };
 }
@@ -78,7 +79,7 @@ impl BundleGeometry {
 /// gathers the lanes' velocities once, updates the `len` bundles in turn on them, and
 /// scatters once. What a manifold group's points share is kept here once, lane by lane,
 /// rather than in each of its bundles: with four lanes a sweep of the normal rows then
-/// streams 304 bytes a bundle instead of 480, and a sweep of all rows 896 instead of 1,152,
+/// streams 320 bytes a bundle instead of 496, and a sweep of all rows 896 instead of 1,152,
 /// while the group stays in the first-level cache as its bundles are updated. Padding points
 /// get their lane's values; their zero lever arms, effective masses and impulses still make
 /// their updates change nothing.
@@ -299,7 +300,7 @@ pub(super) fn set_lane(b: &mut Bundle, g: &mut BundleGeometry, i: usize, c: &Con
     set(&mut b.max_normal_impulse, i, c.max_normal_impulse);
     set_vec(&mut g.lever_a, i, c.lever_a);
     set_vec(&mut g.lever_b, i, c.lever_b);
-    set(&mut g.depth, i, c.depth);
+    set(&mut b.depth, i, c.depth);
 }
 
 /// 1/k₁ for the tangent block (K₁₁, K₁₂, K₂₂) (1/kg), k₁ its larger eigenvalue; 0 for a zero

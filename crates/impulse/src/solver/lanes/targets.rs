@@ -1,10 +1,15 @@
 //! The targets a sweep sets, lane group by lane group, just before it solves them: each
 //! point's target normal velocity and softness from the separation its point has reached
 //! (as `update_targets` does for the scalar rows), stale speculative rows included.
+//!
+//! The separation is the depth at assembly less the normal row's J_n·(Δx, Δθ) of the bodies'
+//! displacements since then, the identity n·(Δθ × r) = (r × n)·Δθ letting the row's angular
+//! parts stand for the lever arms: the sweep reads the bundle's normal part and nothing else
+//! (the scalar update takes Δθ × r, the same to a few roundings).
 
 use glam::Vec3;
 
-use super::lane::{LANES, Lane, add_cross, dot, max_of_number, min_of_number, sub};
+use super::lane::{LANES, Lane, dot, max_of_number, min_of_number};
 use super::layout::{BodyLanes, Bundle, BundleGeometry, Group};
 use crate::contact::{SPECULATIVE_TURN, STALE_TARGET, repair_terms};
 use crate::solver::interface::TargetInputs;
@@ -113,10 +118,9 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
     ) {
         let t = self.0;
         let zero = Lane::splat(0.0);
-        let g = &t.geometry[index];
-        let at_a = add_cross(moved.linear_a, moved.angular_a, g.lever_a);
-        let at_b = add_cross(moved.linear_b, moved.angular_b, g.lever_b);
-        let separation = dot(group.directions[0], sub(at_a, at_b)) - g.depth;
+        // n·((Δx_a + Δθ_a × r_a) − (Δx_b + Δθ_b × r_b)) = J_n·(Δx, Δθ): the normal row's r × n
+        // stand for the lever arms, so the sweep reads no geometry.
+        let separation = b.normal.velocity(&group.directions[0], moved) - b.depth;
         let gap = separation.simd_gt(zero);
         // `max_repair` is a validated setting, never NaN.
         let repair = min_of_number(
@@ -130,6 +134,7 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
         } else {
             let limit = Lane::splat(SPECULATIVE_TURN * SPECULATIVE_TURN);
             let negligible = Lane::splat(1e-6);
+            let g = &t.geometry[index];
             let (arm_a, arm_b) = (b.normal.angular_a, b.normal.angular_b);
             let stale_a = turn_a.simd_gt(limit)
                 & dot(arm_a, arm_a).simd_gt(negligible * dot(g.lever_a, g.lever_a));

@@ -508,11 +508,12 @@ fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
 }
 
 /// The normal rows' sweep (the soft step's main solve) reads and writes nothing past the
-/// bundle's first [`super::NORMAL_PART`] bytes, the part it asks the CPU for: with every byte
-/// after it set to a NaN, the sweep gives the bits it gives on the intact bundles.
+/// bundle's first [`super::NORMAL_PART`] bytes, the part it asks the CPU for, and its target
+/// update no lever arm: with every byte after that part and every lever arm set to a NaN, the
+/// sweep gives the bits it gives on the intact bundles.
 #[test]
 fn normal_rows_sweep_reads_only_the_normal_part_of_a_bundle() {
-    use super::{Bundle, Bundles, NORMAL_PART};
+    use super::{Bundle, Bundles, Lane, NORMAL_PART};
     use crate::solver::{ContactSolver, Velocities};
     // Five cache lines of a bundle's fourteen (four lanes), the normal rows' part past what its
     // lane group keeps for all its bundles (bodies, masses, directions).
@@ -544,6 +545,11 @@ fn normal_rows_sweep_reads_only_the_normal_part_of_a_bundle() {
                         std::mem::size_of::<Bundle>() - NORMAL_PART,
                     )
                 };
+            }
+            // The target update reads no lever arm either (no body turned past the limit).
+            for g in &mut bundles.geometry {
+                g.lever_a = [Lane::splat(f32::NAN); 3];
+                g.lever_b = [Lane::splat(f32::NAN); 3];
             }
         }
         let pass = pass_at_rest(&still, &settings, true, false);
