@@ -6,7 +6,7 @@
 use super::bundles::Bundles;
 use super::lane::{Lane, fold_largest};
 use super::layout::{Bundle, Group, SharedLanes};
-use super::sweep::BundleUpdate;
+use super::sweep::{BundleUpdate, Visits};
 use super::targets::SetTargets;
 use crate::graph::COLOURS;
 use crate::parallel::{
@@ -95,10 +95,10 @@ pub(super) struct SweepOrder {
 /// the torques cancel. Reversing the group instead leaves the first point on the same side.
 ///
 /// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first, the part `update` reads
-/// ([`BundleUpdate::READS`]): a bundle is 18 cache lines, and once an island's bundles outgrow
-/// L2 the sweep waits on L3 for them, which the hardware prefetcher does not hide. The normal
-/// rows' sweep asks for the first 8 lines alone ([`NORMAL_PART`]): asking for the whole bundle
-/// would have it read every line. Groups lie in bundle order, so the
+/// ([`BundleUpdate::READS`]): a bundle is 14 cache lines (four lanes), and once an island's
+/// bundles outgrow L2 the sweep waits on L3 for them, which the hardware prefetcher does not
+/// hide. The normal rows' sweep asks for the first 5 lines alone ([`NORMAL_PART`]): asking for
+/// the whole bundle would have it read every line. Groups lie in bundle order, so the
 /// bundle ahead in memory is the one the sweep visits next.
 ///
 /// # Safety
@@ -123,22 +123,15 @@ pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
         debug_assert!(start + count <= len);
         let (slots_a, slots_b) = (group.local_a, group.local_b);
         let mut v = unsafe { velocities.gather(&slots_a, &slots_b) };
-        // SAFETY: the caller's contract covers what the update reads and writes per body.
-        let mut state = unsafe { update.begin(&slots_a, &slots_b) };
         let moved = targets.moved(&slots_a, &slots_b);
-        let turn = if half_turn { count / 2 } else { 0 };
+        let visits = Visits {
+            start,
+            count,
+            forward,
+            turn: if half_turn { count / 2 } else { 0 },
+        };
         for p in 0..count {
-            // (p + turn) mod count, without a division per bundle.
-            let p = if p + turn < count {
-                p + turn
-            } else {
-                p + turn - count
-            };
-            let index = if forward {
-                start + p
-            } else {
-                start + count - 1 - p
-            };
+            let index = visits.index(p);
             let ahead = if forward {
                 index + PREFETCH_BUNDLES
             } else {
@@ -151,13 +144,13 @@ pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
             // SAFETY: the caller's contract.
             let b = unsafe { &mut *bundles.0.add(index) };
             targets.set(b, group, index, &moved);
-            let change = update.update_at(b, group, index, &mut v, &mut state);
+            let change = update.update_at(b, group, index, &mut v);
             largest = fold_largest(largest, change);
         }
-        // SAFETY: the caller's contract.
+        // SAFETY: the caller's contract (which covers what the update writes per body).
         unsafe {
             velocities.scatter(&slots_a, &slots_b, &v);
-            update.end(&slots_a, &slots_b, &state);
+            update.end(group, visits, bundles);
         }
     }
     largest

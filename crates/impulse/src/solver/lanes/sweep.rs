@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use super::bundles::Bundles;
-use super::lane::{LANES, Lane, max_of_number, min_of_number};
+use super::lane::{Lane, max_of_number, min_of_number};
 use super::layout::{BodyLanes, Bundle, Group, NORMAL_PART, SharedLanes};
 use crate::parallel::{SharedItems, SharedVelocities};
 
@@ -38,31 +38,47 @@ pub(super) trait BundleUpdate: Copy + Sync {
     /// Bytes at the start of each bundle that the update reads (see [`NORMAL_PART`]).
     const READS: usize = std::mem::size_of::<Bundle>();
 
-    /// What an update keeps per lane group besides its bodies' velocities, from
-    /// [`BundleUpdate::begin`] to [`BundleUpdate::end`].
-    type GroupState;
-
-    /// The group state of a lane group between the bodies at `slots_a` and `slots_b`.
-    ///
-    /// # Safety
-    /// As [`SharedLanes::gather`] for whatever the update reads per body.
-    unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::GroupState;
-
     /// Updates bundle `index` of lane group `group` (see the trait).
-    fn update_at(
-        self,
-        b: &mut Bundle,
-        group: &Group,
-        index: usize,
-        v: &mut BodyLanes,
-        state: &mut Self::GroupState,
-    ) -> Lane;
+    fn update_at(self, b: &mut Bundle, group: &Group, index: usize, v: &mut BodyLanes) -> Lane;
 
-    /// Writes back what the group state holds per body.
+    /// What the update does once a lane group's bundles are updated and its velocities
+    /// written back: reads the bundles again, in the order `visits` of the sweep.
     ///
     /// # Safety
-    /// As [`SharedLanes::scatter`].
-    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], state: &Self::GroupState);
+    /// As [`SharedLanes::scatter`] for whatever the update writes per body, and `bundles`
+    /// holds every bundle `visits` names, which no other thread touches meanwhile.
+    #[inline(always)]
+    unsafe fn end(self, _group: &Group, _visits: Visits, _bundles: SharedItems<Bundle>) {}
+}
+
+/// The bundles of one lane group in the order a sweep visits them: from its first or, going
+/// backward, its last, and with a half turn from halfway round (see
+/// [`super::schedule::SweepOrder`]).
+#[derive(Clone, Copy)]
+pub(super) struct Visits {
+    pub(super) start: usize,
+    pub(super) count: usize,
+    pub(super) forward: bool,
+    /// The first visited bundle's place, counted from the group's first (or last).
+    pub(super) turn: usize,
+}
+
+impl Visits {
+    /// The index of the `p`-th bundle visited (`p` < `count`).
+    #[inline(always)]
+    pub(super) fn index(&self, p: usize) -> usize {
+        // (p + turn) mod count, without a division per bundle.
+        let p = if p + self.turn < self.count {
+            p + self.turn
+        } else {
+            p + self.turn - self.count
+        };
+        if self.forward {
+            self.start + p
+        } else {
+            self.start + self.count - 1 - p
+        }
+    }
 }
 
 /// The velocity rows ([`solve_bundle`]).
@@ -76,22 +92,10 @@ impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
     } else {
         NORMAL_PART
     };
-    type GroupState = ();
     #[inline(always)]
-    unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
-    #[inline(always)]
-    fn update_at(
-        self,
-        b: &mut Bundle,
-        group: &Group,
-        _: usize,
-        v: &mut BodyLanes,
-        _: &mut (),
-    ) -> Lane {
+    fn update_at(self, b: &mut Bundle, group: &Group, _: usize, v: &mut BodyLanes) -> Lane {
         solve_bundle::<FRICTION>(b, group, v)
     }
-    #[inline(always)]
-    unsafe fn end(self, _: &[u32; LANES], _: &[u32; LANES], _: &()) {}
 }
 
 /// The accumulated impulses applied to the bodies (warm start); changes no impulse. With
@@ -103,19 +107,8 @@ pub(super) struct WarmStart {
 }
 
 impl BundleUpdate for WarmStart {
-    type GroupState = ();
     #[inline(always)]
-    unsafe fn begin(self, _: &[u32; LANES], _: &[u32; LANES]) {}
-
-    #[inline(always)]
-    fn update_at(
-        self,
-        b: &mut Bundle,
-        group: &Group,
-        index: usize,
-        v: &mut BodyLanes,
-        _: &mut (),
-    ) -> Lane {
+    fn update_at(self, b: &mut Bundle, group: &Group, index: usize, v: &mut BodyLanes) -> Lane {
         if let Some(totals) = self.totals {
             // SAFETY: `totals` has one entry per bundle (`pack` sizes it so) and `index` is
             // the bundle's; no other thread touches this bundle's entry meanwhile.
@@ -124,9 +117,6 @@ impl BundleUpdate for WarmStart {
         apply_impulses(b, group, v);
         Lane::splat(0.0)
     }
-
-    #[inline(always)]
-    unsafe fn end(self, _: &[u32; LANES], _: &[u32; LANES], _: &()) {}
 }
 
 /// Adds a bundle's impulses to its step totals.
@@ -150,7 +140,11 @@ pub(super) fn apply_impulses(b: &Bundle, group: &Group, v: &mut BodyLanes) {
 /// ([`solve_bundle`]), and each bundle's final impulses, added to its step totals and applied
 /// to `carried`, the next substep's warm start per body ([`Bundles::warm_start`] adds it to
 /// the velocities once their gravity and gyroscopic term are in). The warm start's own pass
-/// read every bundle again; this reads each once.
+/// read every bundle again; this reads each once more only while its lane group's bundles are
+/// still in the first-level cache: the impulses are carried once the group's are final
+/// ([`BundleUpdate::end`]), bundle after bundle in the sweep's order, so that `carried`
+/// receives the same additions in the same order as it would bundle by bundle, without
+/// holding its twelve registers of lanes beside the velocities' through the solve.
 #[derive(Clone, Copy)]
 pub(super) struct RelaxCarrying {
     pub(super) totals: SharedItems<[Lane; 3]>,
@@ -158,34 +152,26 @@ pub(super) struct RelaxCarrying {
 }
 
 impl BundleUpdate for RelaxCarrying {
-    type GroupState = BodyLanes;
-
     #[inline(always)]
-    unsafe fn begin(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> BodyLanes {
-        // SAFETY: the caller's contract.
-        unsafe { self.carried.gather(slots_a, slots_b) }
+    fn update_at(self, b: &mut Bundle, group: &Group, _: usize, v: &mut BodyLanes) -> Lane {
+        solve_bundle::<true>(b, group, v)
     }
 
     #[inline(always)]
-    fn update_at(
-        self,
-        b: &mut Bundle,
-        group: &Group,
-        index: usize,
-        v: &mut BodyLanes,
-        carried: &mut BodyLanes,
-    ) -> Lane {
-        let largest = solve_bundle::<true>(b, group, v);
-        // SAFETY: as `WarmStart`'s.
-        add_to_totals(unsafe { &mut *self.totals.0.add(index) }, b);
-        apply_impulses(b, group, carried);
-        largest
-    }
-
-    #[inline(always)]
-    unsafe fn end(self, slots_a: &[u32; LANES], slots_b: &[u32; LANES], carried: &BodyLanes) {
+    unsafe fn end(self, group: &Group, visits: Visits, bundles: SharedItems<Bundle>) {
+        let (slots_a, slots_b) = (&group.local_a, &group.local_b);
         // SAFETY: the caller's contract.
-        unsafe { self.carried.scatter(slots_a, slots_b, carried) }
+        let mut carried = unsafe { self.carried.gather(slots_a, slots_b) };
+        for p in 0..visits.count {
+            let index = visits.index(p);
+            // SAFETY: the caller's contract; `totals` has one entry per bundle, as in
+            // `WarmStart`.
+            let b = unsafe { &*bundles.0.add(index) };
+            add_to_totals(unsafe { &mut *self.totals.0.add(index) }, b);
+            apply_impulses(b, group, &mut carried);
+        }
+        // SAFETY: the caller's contract.
+        unsafe { self.carried.scatter(slots_a, slots_b, &carried) }
     }
 }
 
