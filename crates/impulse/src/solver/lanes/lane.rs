@@ -6,7 +6,7 @@ use glam::Vec3;
 /// Points per bundle: one per lane of a 128-bit register (SSE2 on every x86-64, NEON on
 /// AArch64), so no target feature is needed. The `lanes8` feature makes it 8 (a 256-bit AVX
 /// register when built with `-C target-cpu=x86-64-v3` or `native` on a CPU that has AVX2),
-/// not the default: its sweeps are the slower on the standard scenes (docs/benchmarks.md,
+/// not the default: its sweeps are slower on the standard scenes (docs/benchmarks.md,
 /// "The solver's layout"). The sweep order is the same either way (colour by colour; the
 /// lanes of a bundle hold independent manifold groups of one colour), so results differ only
 /// where padding and the colouring's overflow groups fall differently.
