@@ -232,7 +232,8 @@ impl LockedRows {
     /// solved together (fewer than two joints with locked rows, a breakable joint, or too many
     /// rows).
     fn new(joints: &[JointConstraint]) -> Option<Self> {
-        if joints.iter().any(JointConstraint::is_breakable) {
+        // Fewer than two joints have fewer than two with locked rows (most islands have none).
+        if joints.len() < 2 || joints.iter().any(JointConstraint::is_breakable) {
             return None;
         }
         let with_rows = spanning_forest(joints);
