@@ -5,7 +5,7 @@
 
 use glam::{Quat, Vec3};
 use parry3d::math::Pose;
-use parry3d::query::{ContactManifold, PersistentQueryDispatcher};
+use parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d::shape::{Ball, Shape, SharedShape};
 use parry3d::utils::PoseOpt;
 
@@ -239,4 +239,184 @@ fn a_ball_on_a_compounds_rounded_part_gets_the_face_normal() {
         assert!(close(on_part, on_top, 1e-6), "{on_part} vs {on_top}");
         assert!((dist - GAP).abs() < 1e-6, "dist {dist}");
     }
+}
+
+/// Parry's manifold of `g1` at `pos1` against `g2` at `pos2` within `prediction` (m), with no
+/// fallback: what [`ContactDispatcher`] builds on.
+fn parry_manifold(
+    pos1: &Pose,
+    g1: &dyn Shape,
+    pos2: &Pose,
+    g2: &dyn Shape,
+    prediction: f32,
+) -> ContactManifold<(), f32> {
+    let mut manifold = ContactManifold::new();
+    PersistentQueryDispatcher::<(), f32>::contact_manifold_convex_convex(
+        &DefaultQueryDispatcher,
+        &pos1.inv_mul(pos2),
+        g1,
+        g2,
+        None,
+        None,
+        prediction,
+        &mut manifold,
+    )
+    .unwrap();
+    manifold
+}
+
+/// A tilted box (half-extents 0.2 × 0.1 × 0.15 m, turned 0.3 rad about z and then 0.25 rad
+/// about y) beside the top edge of a box (half-extents 0.5 × 0.2 × 0.3 m): its lowest corner
+/// `dx` m beyond the box's side and `dy` m above its top, at z = 0, in the box's frame. The
+/// tilted box and its pose in the first box's frame.
+fn corner_beside_edge(dx: f32, dy: f32) -> (SharedShape, Pose) {
+    let half_extents = Vec3::new(0.2, 0.1, 0.15);
+    let rotation = Quat::from_rotation_z(0.3) * Quat::from_rotation_y(0.25);
+    let lowest = rotation * half_extents.copysign(rotation.inverse() * -Vec3::Y);
+    let at = Vec3::new(0.5 + dx, 0.2 + dy, 0.0) - lowest;
+    (
+        SharedShape::cuboid(half_extents.x, half_extents.y, half_extents.z),
+        Pose::from_parts(at, rotation),
+    )
+}
+
+/// The tilted box's corner 10 mm beyond the box's side and 20 mm above its top is 22.4 mm
+/// from the box's edge, within a prediction of 0.05 m. Parry's SAT picks an edge axis whose clipped
+/// features give no point; the dispatcher gives one at the nearest points, with the true
+/// normal ((1, 2, 0)/√5 in the box's frame), the true separation and the witness points on
+/// the box's edge and at the tilted box's corner.
+#[test]
+fn a_corner_beside_an_edge_gets_one_point_at_the_nearest_points() {
+    let box_shape = SharedShape::cuboid(0.5, 0.2, 0.3);
+    let (cube, pos12) = corner_beside_edge(0.01, 0.02);
+    let pos1 = Pose::from_parts(Vec3::new(0.2, -0.1, 0.3), Quat::from_rotation_z(0.4));
+    let pos2 = pos1 * pos12;
+    let parry = parry_manifold(&pos1, box_shape.as_ref(), &pos2, cube.as_ref(), 0.05);
+    assert!(parry.points.is_empty(), "Parry alone: {:?}", parry.points);
+    let m = manifold_within(&pos1, box_shape.as_ref(), &pos2, cube.as_ref(), 0.05);
+    let (n, p1, p2, dist) = world_contact(&m, &pos1, &pos2);
+    let expected = pos1.rotation * Vec3::new(1.0, 2.0, 0.0).normalize();
+    assert!(close(n, expected, 1e-4), "normal {n}, expected {expected}");
+    assert!((dist - 0.0005f32.sqrt()).abs() < 1e-5, "dist {dist}");
+    assert!(
+        close(p1, pos1.transform_point(Vec3::new(0.5, 0.2, 0.0)), 1e-4),
+        "{p1}"
+    );
+    let corner = pos1.transform_point(Vec3::new(0.51, 0.22, 0.0));
+    assert!(close(p2, corner, 1e-4), "{p2} vs {corner}");
+    // Beyond the prediction: no point.
+    let far = pos1 * corner_beside_edge(0.05, 0.05).1;
+    let m = manifold_within(&pos1, box_shape.as_ref(), &far, cube.as_ref(), 0.05);
+    assert!(m.points.is_empty(), "{:?}", m.points);
+}
+
+/// The fallback point carries its impulses from step to step like Parry's points do: a
+/// tilted box's corner that stays beside the edge keeps the point's data while it moves.
+#[test]
+fn the_fallback_point_keeps_its_impulse_while_the_pair_stays_apart() {
+    let box_shape = SharedShape::cuboid(0.5, 0.2, 0.3);
+    let mut manifold = ContactManifold::<(), f32>::new();
+    for (step, dy) in [0.024f32, 0.022, 0.02].into_iter().enumerate() {
+        let (cube, pos12) = corner_beside_edge(0.01, dy);
+        let parry = parry_manifold(
+            &Pose::IDENTITY,
+            box_shape.as_ref(),
+            &pos12,
+            cube.as_ref(),
+            0.05,
+        );
+        assert!(parry.points.is_empty(), "step {step}: Parry alone");
+        PersistentQueryDispatcher::<(), f32>::contact_manifold_convex_convex(
+            &ContactDispatcher,
+            &pos12,
+            box_shape.as_ref(),
+            cube.as_ref(),
+            None,
+            None,
+            0.05,
+            &mut manifold,
+        )
+        .unwrap();
+        assert_eq!(manifold.points.len(), 1, "step {step}");
+        let point = &mut manifold.points[0];
+        let distance = (0.01f32 * 0.01 + dy * dy).sqrt();
+        // Parry moves a kept point with the poses rather than recomputing it: within 0.1 mm.
+        assert!(
+            (point.dist - distance).abs() < 1e-4,
+            "step {step}: {}",
+            point.dist
+        );
+        if step > 0 {
+            assert_eq!(point.data, 7.5, "step {step}");
+        }
+        point.data = 7.5;
+    }
+}
+
+/// A seeded sweep of boxes and hulls at random poses: every pair nearer than the prediction
+/// (Parry's exact distance) has at least one point, and no point is nearer than the pair.
+#[test]
+fn every_convex_pair_nearer_than_the_prediction_has_a_point() {
+    let hull = [
+        Vec3::new(-0.4, -0.2, -0.3),
+        Vec3::new(0.5, -0.2, -0.3),
+        Vec3::new(0.0, -0.2, 0.45),
+        Vec3::new(0.1, 0.35, 0.0),
+    ];
+    let shapes = [
+        SharedShape::cuboid(0.5, 0.2, 0.3),
+        SharedShape::cuboid(0.1, 0.4, 0.1),
+        SharedShape::convex_hull(&hull).unwrap(),
+    ];
+    let prediction = 0.1;
+    // A small linear congruential generator: the sweep's cases are the same on every run.
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = move |low: f32, high: f32| {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        low + (high - low) * ((state >> 40) as f32 / (1u64 << 24) as f32)
+    };
+    let (mut near, mut parry_empty) = (0, 0);
+    for case in 0..4000 {
+        let (i, j) = (case % 3, (case / 3) % 3);
+        let mut pose = || {
+            let axis = Vec3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0));
+            let rotation = Quat::from_axis_angle(axis.normalize_or(Vec3::X), uniform(0.0, 3.2));
+            let at = Vec3::new(uniform(-0.6, 0.6), uniform(-0.6, 0.6), uniform(-0.6, 0.6));
+            Pose::from_parts(at, rotation)
+        };
+        let (pos1, pos2) = (pose(), pose());
+        let (g1, g2) = (shapes[i].as_ref(), shapes[j].as_ref());
+        let distance = parry3d::query::distance(&pos1, g1, &pos2, g2)
+            .unwrap()
+            .distance;
+        if distance <= 1e-3 || distance >= prediction {
+            continue;
+        }
+        near += 1;
+        if parry_manifold(&pos1, g1, &pos2, g2, prediction)
+            .points
+            .is_empty()
+        {
+            parry_empty += 1;
+        }
+        let m = manifold_within(&pos1, g1, &pos2, g2, prediction);
+        assert!(
+            !m.points.is_empty(),
+            "case {case}: {distance} m apart, no point"
+        );
+        for p in &m.points {
+            assert!(
+                p.dist >= distance - 1e-4,
+                "case {case}: {} < {distance}",
+                p.dist
+            );
+        }
+    }
+    // The sweep covers what it is for: separated pairs, some of which Parry leaves empty.
+    assert!(
+        near > 300 && parry_empty >= 5,
+        "{near} near, {parry_empty} empty"
+    );
 }
