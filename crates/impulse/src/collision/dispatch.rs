@@ -329,12 +329,12 @@ where
 /// edges that support it. Apart, the nearest features need not be those: a tilted box whose
 /// lowest corner is 10 mm beyond another box's side and 20 mm above its top is 22.4 mm from
 /// that box's edge, yet the clipped features give no point (this module's tests, which also
-/// sweep boxes at seeded random poses for such pairs). A body closing such a gap within one step then has no speculative point
-/// to stop it and ends the step deep inside the other (a limb striking another limb in a pile
-/// of ragdolls overlapped 58 mm at the defaults). The fallback point is Parry's
-/// `query::contact` (GJK's nearest points, with the true normal) when it is within the
-/// prediction; it keeps the impulses of last step's fallback point, so warm starting goes on
-/// while the pair stays apart that way.
+/// sweep boxes at seeded random poses for such pairs). A body closing such a gap within one
+/// step then has no speculative point to stop it and ends the step deep inside the other
+/// (limbs in a pile of ragdolls). The fallback point is Parry's `query::contact` (GJK's
+/// nearest points, with the true normal) when it is within the prediction; it keeps the
+/// impulses of last step's fallback point, so warm starting goes on while the pair stays
+/// apart that way.
 ///
 /// Not used where a ball takes part (Parry's ball generators always give the nearest
 /// point) nor where a mesh triangle's normal constraints apply: the nearest point of a
