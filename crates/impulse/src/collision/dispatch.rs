@@ -332,8 +332,9 @@ where
 /// sweep boxes at seeded random poses for such pairs). A body closing such a gap within one
 /// step then has no speculative point to stop it and ends the step deep inside the other
 /// (limbs in a pile of ragdolls). The fallback point is Parry's `query::contact` (GJK's
-/// nearest points, with the true normal) when it is within the prediction; it keeps the
-/// impulses of last step's fallback point, so warm starting goes on while the pair stays
+/// nearest points, with the true normal) when it is within the prediction, the point Parry's
+/// own generator for convex polyhedra always adds (so hulls are never left empty); it keeps
+/// the impulses of last step's fallback point, so warm starting goes on while the pair stays
 /// apart that way.
 ///
 /// Not used where a ball takes part (Parry's ball generators always give the nearest
@@ -396,8 +397,9 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
     }
 }
 
-/// Whether `point` is a [`NearestPointFallback`] point: the generators name the features of
-/// every point they make.
+/// Whether `point` names no features: a [`NearestPointFallback`] point, or the GJK nearest
+/// point Parry's generator for polyhedra adds to its clipped points. Either is a point at the
+/// nearest points, whose impulse the next fallback point may carry on.
 fn is_fallback_point<ContactData>(point: &TrackedContact<ContactData>) -> bool {
     point.fid1 == PackedFeatureId::UNKNOWN && point.fid2 == PackedFeatureId::UNKNOWN
 }
