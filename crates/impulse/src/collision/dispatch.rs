@@ -27,13 +27,15 @@
 //! generators with this dispatcher, so their parts' pairs (a compound's rounded part against a
 //! ball, a mesh triangle under a cylinder) come back to
 //! [`ContactDispatcher::contact_manifold_convex_convex`]. Voxels go to Parry's dispatcher whole.
-//! Every other pair gets what [`DefaultQueryDispatcher`] gives it, and a pair of convex
-//! shapes that Parry leaves with no point although they are nearer than the prediction gets
-//! one at their nearest points ([`NearestPointFallback`]).
+//! Every other pair gets what [`DefaultQueryDispatcher`] gives it, but where that misses the
+//! nearest points of two convex shapes that are apart ([`NearestPointFallback`]): a box pair
+//! whose cuboid–cuboid manifold is empty or overstates the gap gets the manifold of Parry's
+//! generator for convex polyhedra (built on GJK's nearest points), and any other pair left with
+//! no point although nearer than the prediction gets one at its nearest points.
 
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::query::details::{
-    NormalConstraints, contact_manifold_convex_ball,
+    NormalConstraints, contact_manifold_convex_ball, contact_manifold_pfm_pfm,
     contact_manifolds_composite_shape_composite_shape, contact_manifolds_composite_shape_shape,
     contact_manifolds_heightfield_composite_shape, contact_manifolds_heightfield_shape_shapes,
     contact_manifolds_trimesh_shape_shapes,
@@ -43,7 +45,7 @@ use parry3d::query::{
     NonlinearRigidMotion, PersistentQueryDispatcher, QueryDispatcher, ShapeCastHit,
     ShapeCastOptions, ShapeDistance, ShapeIntersection, TrackedContact, Unsupported,
 };
-use parry3d::shape::{Ball, PackedFeatureId, Shape, ShapeType};
+use parry3d::shape::{Ball, Cuboid, PackedFeatureId, Shape, ShapeType};
 
 use super::caps;
 use crate::body::rules::rounded_parts;
@@ -251,8 +253,8 @@ where
             has_cap_type(this) || (other == ShapeType::Ball && is_rounded_type(this))
         };
         let fallback = NearestPointFallback::before(
-            type1,
-            type2,
+            g1,
+            g2,
             normal_constraints1.is_none() && normal_constraints2.is_none(),
             manifold,
         );
@@ -322,20 +324,52 @@ where
     }
 }
 
-/// One speculative point at the shapes' nearest points, for a pair of convex shapes whose
-/// manifold generator gives no point although the shapes are nearer than the prediction.
+/// Nearest separation (m) of a box pair's manifold from Parry's cuboid–cuboid generator above
+/// which [`NearestPointFallback`] builds the pair's manifold again with Parry's generator for
+/// convex polyhedra. That generator takes the normal from GJK's nearest points, so its
+/// nearest point is the pair's true distance; the cuboid–cuboid generator's can be farther
+/// (see [`NearestPointFallback`]) by at most its own separation when the boxes are apart, so
+/// this bounds by how much a box pair's nearest point may overstate its gap. Resting boxes
+/// (separations about zero) stay with the cuboid–cuboid generator, whose separating axis is
+/// exact for overlapping boxes.
+pub(crate) const SEPARATED_BOXES_GAP: Real = 1e-3;
+
+/// Points of a manifold whose features and solver data [`NearestPointFallback`] keeps while it
+/// rebuilds a box pair's manifold: as many as clipping one box's face against another's gives.
+const KEPT_POINTS: usize = 8;
+
+/// Distance (m) within which two points of a rebuilt box manifold, on both shapes, are one:
+/// clipping a corner's faces against an edge gives the corner once per face edge, and Parry's
+/// generator for convex polyhedra adds the nearest points, often the same point, again.
+const SAME_POINT_DISTANCE: Real = 1e-4;
+
+/// Where Parry's generators miss the nearest point of two convex shapes that are apart: one
+/// speculative point at the shapes' nearest points for a pair whose manifold has no point
+/// although the shapes are nearer than the prediction, and a box pair's manifold built from
+/// its nearest points when the cuboid–cuboid generator's points are farther apart than the
+/// boxes.
 ///
 /// Parry's cuboid–cuboid generator picks a separating axis by SAT and clips the two faces or
-/// edges that support it. Apart, the nearest features need not be those: a tilted box whose
-/// lowest corner is 10 mm beyond another box's side and 20 mm above its top is 22.4 mm from
-/// that box's edge, yet the clipped features give no point (this module's tests, which also
-/// sweep boxes at seeded random poses for such pairs). A body closing such a gap within one
-/// step then has no speculative point to stop it and ends the step deep inside the other
-/// (limbs in a pile of ragdolls). The fallback point is Parry's `query::contact` (GJK's
-/// nearest points, with the true normal) when it is within the prediction, the point Parry's
-/// own generator for convex polyhedra always adds (so hulls are never left empty); it keeps
-/// the impulses of last step's fallback point, so warm starting goes on while the pair stays
-/// apart that way.
+/// edges that support it. Apart, the nearest features need not be those (the nearest points
+/// of a corner and an edge, or of two corners, lie along no face normal and no edge cross
+/// product). The clipped points can then be farther apart along the axis than the boxes are,
+/// or missing altogether: a tilted box whose lowest corner is 10 mm beyond another box's side
+/// and 20 mm above its top is 22.4 mm from that box's edge, yet the clipped features give no
+/// point; among box pairs at seeded random poses within 0.1 m of each other, a few in a
+/// hundred get a nearest point more than 5 mm farther than the boxes are (this module's tests
+/// sweep both). A speculative row lets its point close by its separation within a step, so a
+/// body closing such a gap within one step ends the step inside the other (limbs in a pile of
+/// ragdolls), by as much as the separation is overstated.
+///
+/// So a box pair whose cuboid–cuboid manifold is empty or has its nearest point more than
+/// [`SEPARATED_BOXES_GAP`] away is given the manifold of Parry's generator for convex
+/// polyhedra instead, which takes its normal from GJK's nearest points, clips the features
+/// that support it, and adds the nearest points as a point of their own (as it does for every
+/// pair of hulls); points that coincide are kept once. Any other pair of convex shapes left
+/// with no point gets one at Parry's `query::contact` (GJK's nearest points, with the true
+/// normal) when that is within the prediction. The points keep the solver's data of last
+/// step's points of the same features (a featureless nearest point that of last step's), so
+/// warm starting goes on while the pair stays apart that way.
 ///
 /// Not used where a ball takes part (Parry's ball generators always give the nearest
 /// point) nor where a mesh triangle's normal constraints apply: the nearest point of a
@@ -345,37 +379,76 @@ where
 struct NearestPointFallback<ContactData> {
     /// Whether this pair may get the fallback point.
     applies: bool,
-    /// The solver's data of last step's fallback point, if last step's manifold was one.
+    /// The solver's data of last step's nearest point (a point with no features), if last
+    /// step's manifold had one.
     previous: Option<ContactData>,
+    /// A box pair's points of last step, if last step's manifold was one this fallback may
+    /// have rebuilt (its nearest point beyond [`SEPARATED_BOXES_GAP`]).
+    kept: Option<KeptPoints<ContactData>>,
 }
 
 impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
     /// Reads what the fallback needs of last step's `manifold` before a generator rewrites it.
+    #[inline]
     fn before<ManifoldData>(
-        type1: ShapeType,
-        type2: ShapeType,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
         unconstrained: bool,
         manifold: &ContactManifold<ManifoldData, ContactData>,
     ) -> Self {
+        let (type1, type2) = (g1.shape_type(), g2.shape_type());
         let applies = unconstrained && type1 != ShapeType::Ball && type2 != ShapeType::Ball;
-        let previous = match manifold.points.as_slice() {
-            [point] if applies && is_fallback_point(point) => Some(point.data),
-            _ => None,
+        let boxes = applies && type1 == ShapeType::Cuboid && type2 == ShapeType::Cuboid;
+        // Most box pairs are resting or without points: nothing to keep.
+        let kept = (boxes
+            && !manifold.points.is_empty()
+            && nearest_separation(manifold) > SEPARATED_BOXES_GAP)
+            .then(|| KeptPoints::of(&manifold.points));
+        let previous = if applies && !boxes {
+            manifold
+                .points
+                .iter()
+                .find(|point| is_fallback_point(point))
+                .map(|point| point.data)
+        } else {
+            None
         };
-        Self { applies, previous }
+        Self {
+            applies,
+            previous,
+            kept,
+        }
     }
 
-    /// Adds the fallback point to `manifold` if the generator left it with none and the
-    /// shapes are within `prediction` (m) of each other.
-    fn after<ManifoldData>(
-        self,
+    /// Rebuilds a box pair's `manifold` from its nearest points, or adds the fallback point
+    /// to any other pair's `manifold` that the generator left with none, when the shapes are
+    /// within `prediction` (m) of each other (see [`NearestPointFallback`]).
+    fn after<ManifoldData: Default>(
+        &self,
         pos12: &Pose,
         g1: &dyn Shape,
         g2: &dyn Shape,
         prediction: Real,
         manifold: &mut ContactManifold<ManifoldData, ContactData>,
     ) {
-        if !self.applies || !manifold.points.is_empty() {
+        if !self.applies {
+            return;
+        }
+        if let (Some(box1), Some(box2)) = (g1.as_cuboid(), g2.as_cuboid()) {
+            let nearest = nearest_separation(manifold);
+            // Points on the planes that support the boxes along the manifold's normal are at
+            // the boxes' separation along it, which is no more than their distance: the
+            // manifold is right (two faces apart, say). Only points beyond those planes can
+            // overstate the gap.
+            if manifold.points.is_empty()
+                || (nearest > SEPARATED_BOXES_GAP
+                    && nearest > supporting_gap(pos12, box1, box2, manifold) + SAME_POINT_DISTANCE)
+            {
+                self.rebuild_from_nearest_points(pos12, box1, box2, prediction, manifold);
+            }
+            return;
+        }
+        if !manifold.points.is_empty() {
             return;
         }
         let Ok(Some(contact)) = DefaultQueryDispatcher.contact(pos12, g1, g2, prediction) else {
@@ -395,6 +468,110 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
         manifold.local_n2 = contact.normal2;
         manifold.points.push(point);
     }
+
+    /// Replaces the cuboid–cuboid generator's `manifold` of two boxes with that of Parry's
+    /// generator for convex polyhedra, each point once, whose points keep the solver's data of
+    /// last step's points of the same features: those the fallback kept, or else the replaced
+    /// points (which carry last step's, matched by Parry's generator).
+    fn rebuild_from_nearest_points<ManifoldData: Default>(
+        &self,
+        pos12: &Pose,
+        box1: &Cuboid,
+        box2: &Cuboid,
+        prediction: Real,
+        manifold: &mut ContactManifold<ManifoldData, ContactData>,
+    ) {
+        let kept = self
+            .kept
+            .unwrap_or_else(|| KeptPoints::of(&manifold.points));
+        // With points, the generator would first try to keep them (they fit the pose they were
+        // just computed for).
+        manifold.points.clear();
+        contact_manifold_pfm_pfm(
+            pos12, box1, 0.0, None, box2, 0.0, None, prediction, manifold,
+        );
+        let same = SAME_POINT_DISTANCE * SAME_POINT_DISTANCE;
+        let mut k = 0;
+        while k < manifold.points.len() {
+            let point = &manifold.points[k];
+            let repeated = manifold.points[..k].iter().any(|earlier| {
+                earlier.local_p1.distance_squared(point.local_p1) < same
+                    && earlier.local_p2.distance_squared(point.local_p2) < same
+            });
+            if repeated {
+                manifold.points.remove(k);
+            } else {
+                k += 1;
+            }
+        }
+        for point in &mut manifold.points {
+            if let Some(data) = kept.data(point.fid1, point.fid2) {
+                point.data = data;
+            }
+        }
+    }
+}
+
+/// Up to [`KEPT_POINTS`] points' features and solver data, on the stack (so that keeping them
+/// allocates nothing in a step).
+#[derive(Clone, Copy)]
+struct KeptPoints<ContactData> {
+    points: [(PackedFeatureId, PackedFeatureId, ContactData); KEPT_POINTS],
+    count: usize,
+}
+
+impl<ContactData: Default + Copy> Default for KeptPoints<ContactData> {
+    fn default() -> Self {
+        let unknown = PackedFeatureId::UNKNOWN;
+        Self {
+            points: [(unknown, unknown, ContactData::default()); KEPT_POINTS],
+            count: 0,
+        }
+    }
+}
+
+impl<ContactData: Default + Copy> KeptPoints<ContactData> {
+    /// The features and data of `points` (the first [`KEPT_POINTS`]).
+    fn of(points: &[TrackedContact<ContactData>]) -> Self {
+        let mut kept = Self::default();
+        for (slot, point) in kept.points.iter_mut().zip(points) {
+            *slot = (point.fid1, point.fid2, point.data);
+        }
+        kept.count = points.len().min(KEPT_POINTS);
+        kept
+    }
+
+    /// The data of the kept point of features `fid1`, `fid2`, if there is one.
+    fn data(&self, fid1: PackedFeatureId, fid2: PackedFeatureId) -> Option<ContactData> {
+        self.points[..self.count]
+            .iter()
+            .find(|(kept1, kept2, _)| *kept1 == fid1 && *kept2 == fid2)
+            .map(|&(_, _, data)| data)
+    }
+}
+
+/// The gap (m) between the planes that support two boxes along `manifold`'s normal (box 2's
+/// pose in box 1's frame is `pos12`): the boxes' separation along that axis, which is at most
+/// their distance (projection shortens).
+fn supporting_gap<ManifoldData, ContactData>(
+    pos12: &Pose,
+    box1: &Cuboid,
+    box2: &Cuboid,
+    manifold: &ContactManifold<ManifoldData, ContactData>,
+) -> Real {
+    let (n1, n2) = (manifold.local_n1, manifold.local_n2);
+    pos12.translation.dot(n1) - box1.half_extents.dot(n1.abs()) - box2.half_extents.dot(n2.abs())
+}
+
+/// The least separation (m) of `manifold`'s points; infinite without points.
+fn nearest_separation<ManifoldData, ContactData>(
+    manifold: &ContactManifold<ManifoldData, ContactData>,
+) -> Real {
+    manifold
+        .points
+        .iter()
+        .map(|point| point.dist)
+        .fold(Real::INFINITY, Real::min)
 }
 
 /// Whether `point` names no features: a [`NearestPointFallback`] point, or the GJK nearest

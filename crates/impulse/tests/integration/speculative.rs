@@ -5,6 +5,8 @@
 use crate::common;
 
 use glam::Vec3;
+use impulse::parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
+use impulse::parry3d::shape::Cuboid;
 use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 
 const DT: f32 = 1.0 / 60.0;
@@ -122,86 +124,155 @@ fn bodies_closing_on_each_other_are_caught_by_their_relative_speed() {
 /// 0.5 × 0.2 × 0.3 m), in either order of the bodies. The corner starts 30 mm beyond the
 /// box's side and 60 mm above its top, 67 mm from the edge, and would travel 83 mm in the step.
 /// Parry's cuboid–cuboid manifold gives such a pair no point (its separating axis picks
-/// features that do not face each other); the narrow phase's nearest-point fallback gives one,
-/// so the corner stops at the edge instead of ending the step 11 mm inside the box, and
-/// momentum is kept.
+/// features that do not face each other); the narrow phase gives it the nearest points, so the
+/// corner stops at the edge instead of ending the step 11 mm inside the box, and momentum is
+/// kept.
 #[test]
 fn a_box_corner_flying_at_an_edge_is_caught_though_no_faces_face_each_other() {
-    use impulse::parry3d::query::{
-        ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher,
-    };
-    use impulse::parry3d::shape::Cuboid;
-
     let half_edge = Vec3::new(0.5, 0.2, 0.3);
     let half_corner = Vec3::new(0.2, 0.1, 0.15);
     let rotation = glam::Quat::from_rotation_z(0.3) * glam::Quat::from_rotation_y(0.25);
     let lowest = rotation * half_corner.copysign(rotation.inverse() * -Vec3::Y);
-    let position = Vec3::new(0.53, 0.26, 0.0) - lowest;
-    let direction = Vec3::new(1.0, 2.0, 0.0).normalize();
-    let (mass_edge, mass_corner) = (
-        1000.0 * 8.0 * half_edge.x * half_edge.y * half_edge.z,
-        1000.0 * 8.0 * half_corner.x * half_corner.y * half_corner.z,
-    );
-    for corner_first in [false, true] {
+    let flight = BoxFlight {
+        half_struck: half_edge,
+        half_moving: half_corner,
+        position: Vec3::new(0.53, 0.26, 0.0) - lowest,
+        rotation,
+        direction: Vec3::new(1.0, 2.0, 0.0).normalize(),
+    };
+    for moving_first in [false, true] {
+        let (mut w, struck, moving, parry) = flight.world(moving_first);
+        assert!(parry.points.is_empty(), "Parry alone: {:?}", parry.points);
+        flight.assert_caught(&mut w, struck, moving, moving_first);
+    }
+}
+
+/// A cube standing on a corner (its body diagonal vertical) flies at 5 m/s straight at the top
+/// corner of a box (half-extents 0.5 × 0.2 × 0.3 m), its lowest corner 20 mm beyond the box's
+/// corner along each axis: 32.7 mm from the box, 83 mm of travel in a step. Parry's
+/// cuboid–cuboid manifold gives the pair points 56.6 mm apart along its separating axis, which
+/// would let the cube close 24 mm more than the gap within the step (21.9 mm deep without the
+/// narrow phase's rebuilt manifold); the narrow phase builds the pair's manifold from its
+/// nearest points instead, so the cube stops at the box, and momentum is kept.
+#[test]
+fn a_cube_falling_corner_first_on_a_box_corner_stops_at_its_true_gap() {
+    let half_box = Vec3::new(0.5, 0.2, 0.3);
+    let half_cube = Vec3::splat(0.2);
+    let rotation = glam::Quat::from_rotation_arc(Vec3::ONE.normalize(), Vec3::Y);
+    let flight = BoxFlight {
+        half_struck: half_box,
+        half_moving: half_cube,
+        position: half_box + Vec3::splat(0.02) - rotation * -half_cube,
+        rotation,
+        direction: Vec3::ONE.normalize(),
+    };
+    for moving_first in [false, true] {
+        let (mut w, struck, moving, parry) = flight.world(moving_first);
+        let parry_nearest = parry
+            .points
+            .iter()
+            .map(|p| p.dist)
+            .fold(f32::INFINITY, f32::min);
+        // GJK's distance (Parry's `query::distance` takes a box pair's SAT, which can overstate it).
+        let poses = w.poses();
+        let distance = impulse::parry3d::query::contact(
+            &poses[struck],
+            &Cuboid::new(half_box),
+            &poses[moving],
+            &Cuboid::new(half_cube),
+            0.2,
+        )
+        .unwrap()
+        .expect("the boxes are within 0.2 m")
+        .dist;
+        assert!(
+            (distance - 0.0327).abs() < 2e-4 && parry_nearest > distance + 0.02,
+            "Parry alone: nearest point {parry_nearest} m, the boxes {distance} m apart"
+        );
+        flight.assert_caught(&mut w, struck, moving, moving_first);
+    }
+}
+
+/// A box (`half_moving`, at `position` turned by `rotation`) flying at 5 m/s along −`direction`
+/// at a box (`half_struck`) at rest at the origin, without gravity; both of density 1000 kg/m³.
+struct BoxFlight {
+    half_struck: Vec3,
+    half_moving: Vec3,
+    position: Vec3,
+    rotation: glam::Quat,
+    direction: Vec3,
+}
+
+impl BoxFlight {
+    const SPEED: f32 = 5.0;
+
+    /// The world, the struck and the moving box's indices (the moving one added first with
+    /// `moving_first`), and Parry's own cuboid–cuboid manifold of the pair as the step starts
+    /// (prediction 0.2 m).
+    fn world(&self, moving_first: bool) -> (World, usize, usize, ContactManifold<(), ()>) {
         let mut w = world(Vec3::ZERO);
         let m = common::material(0.3);
-        let edge_body = BodyDesc::new(
+        let struck_body = BodyDesc::new(
             BodyKind::Dynamic,
             ShapeDesc::Cuboid {
-                half_extents: half_edge.to_array(),
+                half_extents: self.half_struck.to_array(),
             },
             [0.0; 3],
         );
-        let mut corner_body = BodyDesc::new(
+        let mut moving_body = BodyDesc::new(
             BodyKind::Dynamic,
             ShapeDesc::Cuboid {
-                half_extents: half_corner.to_array(),
+                half_extents: self.half_moving.to_array(),
             },
-            position.to_array(),
+            self.position.to_array(),
         );
-        corner_body.orientation = rotation.to_array();
-        corner_body.linear_velocity = (-5.0 * direction).to_array();
-        let (edge, corner) = if corner_first {
-            let corner = w.add_body(&corner_body, &m).unwrap();
-            (w.add_body(&edge_body, &m).unwrap(), corner)
+        moving_body.orientation = self.rotation.to_array();
+        moving_body.linear_velocity = (-Self::SPEED * self.direction).to_array();
+        let (struck, moving) = if moving_first {
+            let moving = w.add_body(&moving_body, &m).unwrap();
+            (w.add_body(&struck_body, &m).unwrap(), moving)
         } else {
-            let edge = w.add_body(&edge_body, &m).unwrap();
-            (edge, w.add_body(&corner_body, &m).unwrap())
+            let struck = w.add_body(&struck_body, &m).unwrap();
+            (struck, w.add_body(&moving_body, &m).unwrap())
         };
-        // What Parry alone gives the pair as the step starts: no point.
         let poses = w.poses();
         let mut parry = ContactManifold::<(), ()>::new();
         PersistentQueryDispatcher::<(), ()>::contact_manifold_convex_convex(
             &DefaultQueryDispatcher,
-            &poses[edge].inv_mul(&poses[corner]),
-            &Cuboid::new(half_edge),
-            &Cuboid::new(half_corner),
+            &poses[struck].inv_mul(&poses[moving]),
+            &Cuboid::new(self.half_struck),
+            &Cuboid::new(self.half_moving),
             None,
             None,
             0.2,
             &mut parry,
         )
         .unwrap();
-        assert!(parry.points.is_empty(), "Parry alone: {:?}", parry.points);
+        (w, struck, moving, parry)
+    }
 
+    /// Steps `w` once and asserts the moving box was caught: no overlap over 1 mm, momentum
+    /// kept to 0.1 %, and the struck box pushed off along −`direction`.
+    fn assert_caught(&self, w: &mut World, struck: usize, moving: usize, moving_first: bool) {
+        let mass = |half: Vec3| 1000.0 * 8.0 * half.x * half.y * half.z;
         w.step().unwrap();
-        let overlap = impulse::metrics::max_overlap(&w, w.poses());
+        let overlap = impulse::metrics::max_overlap(w, w.poses());
         assert!(
             overlap < 1e-3,
-            "corner first {corner_first}: overlap {overlap} m"
+            "moving first {moving_first}: overlap {overlap} m"
         );
         let velocities = w.linear_velocities();
-        let momentum = mass_edge * velocities[edge] + mass_corner * velocities[corner];
-        let initial = -5.0 * mass_corner * direction;
+        let momentum = mass(self.half_struck) * velocities[struck]
+            + mass(self.half_moving) * velocities[moving];
+        let initial = -Self::SPEED * mass(self.half_moving) * self.direction;
         assert!(
             (momentum - initial).length() < 1e-3 * initial.length(),
-            "corner first {corner_first}: momentum {momentum}, initial {initial}"
+            "moving first {moving_first}: momentum {momentum}, initial {initial}"
         );
-        // The edge box was struck: it moves off along the contact normal's side.
         assert!(
-            velocities[edge].dot(-direction) > 0.1,
-            "corner first {corner_first}: the struck box moves at {}",
-            velocities[edge]
+            velocities[struck].dot(-self.direction) > 0.1,
+            "moving first {moving_first}: the struck box moves at {}",
+            velocities[struck]
         );
     }
 }
