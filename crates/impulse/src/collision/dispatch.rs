@@ -326,7 +326,7 @@ where
 
 /// Nearest separation (m) of a box pair's manifold from Parry's cuboid–cuboid generator above
 /// which [`NearestPointFallback`] builds the pair's manifold again with Parry's generator for
-/// convex polyhedra. That generator takes the normal from GJK's nearest points, so its
+/// convex polyhedra (when its points also lie beyond the boxes' supporting planes). That generator takes the normal from GJK's nearest points, so its
 /// nearest point is the pair's true distance; the cuboid–cuboid generator's can be farther
 /// (see [`NearestPointFallback`]) by at most its own separation when the boxes are apart, so
 /// this bounds by how much a box pair's nearest point may overstate its gap. Resting boxes
@@ -361,9 +361,11 @@ const SAME_POINT_DISTANCE: Real = 1e-4;
 /// body closing such a gap within one step ends the step inside the other (limbs in a pile of
 /// ragdolls), by as much as the separation is overstated.
 ///
-/// So a box pair whose cuboid–cuboid manifold is empty or has its nearest point more than
-/// [`SEPARATED_BOXES_GAP`] away is given the manifold of Parry's generator for convex
-/// polyhedra instead, which takes its normal from GJK's nearest points, clips the features
+/// So a box pair whose cuboid–cuboid manifold is empty, or has its nearest point more than
+/// [`SEPARATED_BOXES_GAP`] away and beyond the planes that support the boxes along its normal
+/// (points on those planes are at the boxes' separation along the axis, never more than their
+/// distance: two boxes apart face to face keep their manifold), is given the manifold of
+/// Parry's generator for convex polyhedra instead, which takes its normal from GJK's nearest points, clips the features
 /// that support it, and adds the nearest points as a point of their own (as it does for every
 /// pair of hulls); points that coincide are kept once. Any other pair of convex shapes left
 /// with no point gets one at Parry's `query::contact` (GJK's nearest points, with the true
