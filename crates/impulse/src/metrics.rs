@@ -64,8 +64,9 @@ pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u3
         let (i, j) = (i as usize, j as usize);
         let (g1, g2) = (shapes[i].as_ref(), shapes[j].as_ref());
         let manifold = manifold_depth(&poses[i], g1, &poses[j], g2, &mut manifolds);
-        // `deepest` is never negative, and no depth below it (nor NaN) can raise it.
-        if !(manifold > deepest) {
+        // `deepest` is never negative, and no depth at or below it can raise it (neither is
+        // ever NaN: `f32::max` drops NaN).
+        if manifold <= deepest {
             continue;
         }
         let depth = match query::contact(&poses[i], g1, &poses[j], g2, 0.0) {
@@ -82,7 +83,7 @@ pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u3
 
 /// The deepest point (m, positive when overlapping) of a fresh contact manifold of `g1` at
 /// `pose1` and `g2` at `pose2`, `-inf` when the manifold has no point, `+inf` when Parry has no
-/// manifold for the pair; `manifolds` is scratch.
+/// manifold for the pair, never NaN; `manifolds` is scratch.
 fn manifold_depth(
     pose1: &Pose,
     g1: &dyn Shape,
