@@ -28,10 +28,10 @@
 //! ball, a mesh triangle under a cylinder) come back to
 //! [`ContactDispatcher::contact_manifold_convex_convex`]. Voxels go to Parry's dispatcher whole.
 //! Every other pair gets what [`DefaultQueryDispatcher`] gives it, but where that misses the
-//! nearest points of two convex shapes that are apart ([`NearestPointFallback`]): a box pair
-//! whose cuboid–cuboid manifold is empty or overstates the gap gets the manifold of Parry's
-//! generator for convex polyhedra (built on GJK's nearest points), and any other pair left with
-//! no point although nearer than the prediction gets one at its nearest points.
+//! nearest points of two convex shapes that are apart ([`NearestPointFallback`]): a box with a
+//! box or a mesh triangle whose SAT manifold is empty or overstates the gap gets the manifold
+//! of Parry's generator for convex polyhedra (built on GJK's nearest points), and any other
+//! pair left with no point although nearer than the prediction gets one at its nearest points.
 
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::query::details::{
@@ -45,7 +45,7 @@ use parry3d::query::{
     NonlinearRigidMotion, PersistentQueryDispatcher, QueryDispatcher, ShapeCastHit,
     ShapeCastOptions, ShapeDistance, ShapeIntersection, TrackedContact, Unsupported,
 };
-use parry3d::shape::{Ball, Cuboid, PackedFeatureId, Shape, ShapeType};
+use parry3d::shape::{Ball, PackedFeatureId, Shape, ShapeType, SupportMap};
 
 use super::caps;
 use crate::body::rules::rounded_parts;
@@ -252,6 +252,7 @@ where
         let own = |this: ShapeType, other: ShapeType| {
             has_cap_type(this) || (other == ShapeType::Ball && is_rounded_type(this))
         };
+        let constraints = (normal_constraints1, normal_constraints2);
         let fallback = NearestPointFallback::before(
             g1,
             g2,
@@ -268,7 +269,7 @@ where
                 prediction,
                 manifold,
             )?;
-            fallback.after(pos12, g1, g2, prediction, manifold);
+            fallback.after(pos12, g1, g2, constraints, prediction, manifold);
             return Ok(());
         }
         if let Some(ball2) = g2.as_ball()
@@ -319,35 +320,36 @@ where
         if cap_pair {
             caps::refine_cap_contact(pos12, g1, g2, prediction, manifold, &old);
         }
-        fallback.after(pos12, g1, g2, prediction, manifold);
+        fallback.after(pos12, g1, g2, constraints, prediction, manifold);
         Ok(())
     }
 }
 
-/// Nearest separation (m) of a box pair's manifold from Parry's cuboid–cuboid generator above
-/// which [`NearestPointFallback`] builds the pair's manifold again with Parry's generator for
-/// convex polyhedra (when its points also lie beyond the boxes' supporting planes). That generator takes the normal from GJK's nearest points, so its
-/// nearest point is the pair's true distance; the cuboid–cuboid generator's can be farther
-/// (see [`NearestPointFallback`]) by at most its own separation when the boxes are apart, so
-/// this bounds by how much a box pair's nearest point may overstate its gap. Resting boxes
-/// (separations about zero) stay with the cuboid–cuboid generator, whose separating axis is
-/// exact for overlapping boxes.
+/// Nearest separation (m) of the manifold of a box and a box or a triangle from Parry's SAT
+/// generators (cuboid–cuboid, cuboid–triangle) above which [`NearestPointFallback`] builds the
+/// pair's manifold again with Parry's generator for convex polyhedra (when its points also lie
+/// beyond the shapes' supporting planes). That generator takes the normal from GJK's nearest
+/// points, so its nearest point is the pair's true distance; the SAT generators' can be
+/// farther (see [`NearestPointFallback`]) by at most their own separation when the shapes are
+/// apart, so this bounds by how much such a pair's nearest point may overstate its gap.
+/// Resting boxes (separations about zero) stay with the SAT generators, whose separating axis
+/// is exact for overlapping shapes.
 pub(crate) const SEPARATED_BOXES_GAP: Real = 1e-3;
 
 /// Points of a manifold whose features and solver data [`NearestPointFallback`] keeps while it
-/// rebuilds a box pair's manifold: as many as clipping one box's face against another's gives.
+/// rebuilds a manifold: as many as clipping one box's face against another's gives.
 const KEPT_POINTS: usize = 8;
 
-/// Distance (m) within which two points of a rebuilt box manifold, on both shapes, are one:
+/// Distance (m) within which two points of a rebuilt manifold, on both shapes, are one:
 /// clipping a corner's faces against an edge gives the corner once per face edge, and Parry's
 /// generator for convex polyhedra adds the nearest points, often the same point, again.
 const SAME_POINT_DISTANCE: Real = 1e-4;
 
 /// Where Parry's generators miss the nearest point of two convex shapes that are apart: one
 /// speculative point at the shapes' nearest points for a pair whose manifold has no point
-/// although the shapes are nearer than the prediction, and a box pair's manifold built from
-/// its nearest points when the cuboid–cuboid generator's points are farther apart than the
-/// boxes.
+/// although the shapes are nearer than the prediction, and the manifold of a box and a box or
+/// a triangle built from their nearest points when the SAT generator's points are farther
+/// apart than the shapes.
 ///
 /// Parry's cuboid–cuboid generator picks a separating axis by SAT and clips the two faces or
 /// edges that support it. Apart, the nearest features need not be those (the nearest points
@@ -357,35 +359,44 @@ const SAME_POINT_DISTANCE: Real = 1e-4;
 /// and 20 mm above its top is 22.4 mm from that box's edge, yet the clipped features give no
 /// point; among box pairs at seeded random poses within 0.1 m of each other, a few in a
 /// hundred get a nearest point more than 5 mm farther than the boxes are (this module's tests
-/// sweep both). A speculative row lets its point close by its separation within a step, so a
-/// body closing such a gap within one step ends the step inside the other (limbs in a pile of
-/// ragdolls), by as much as the separation is overstated.
+/// sweep both). Parry's cuboid–triangle generator does the same (a few in a hundred box and
+/// triangle pairs too). A speculative row lets its point close by its separation within a
+/// step, so a body closing such a gap within one step ends the step inside the other (limbs in
+/// a pile of ragdolls, a box falling corner-first on a mesh's corner), by as much as the
+/// separation is overstated.
 ///
-/// So a box pair whose cuboid–cuboid manifold is empty, or has its nearest point more than
-/// [`SEPARATED_BOXES_GAP`] away and beyond the planes that support the boxes along its normal
-/// (points on those planes are at the boxes' separation along the axis, never more than their
-/// distance: two boxes apart face to face keep their manifold), is given the manifold of
-/// Parry's generator for convex polyhedra instead, which takes its normal from GJK's nearest points, clips the features
-/// that support it, and adds the nearest points as a point of their own (as it does for every
-/// pair of hulls); points that coincide are kept once. Any other pair of convex shapes left
-/// with no point gets one at Parry's `query::contact` (GJK's nearest points, with the true
-/// normal) when that is within the prediction. The points keep the solver's data of last
-/// step's points of the same features (a featureless nearest point that of last step's), so
-/// warm starting goes on while the pair stays apart that way.
+/// So a box and a box or a triangle whose SAT manifold is empty, or has its nearest point more
+/// than [`SEPARATED_BOXES_GAP`] away and beyond the planes that support the shapes along its
+/// normal (points on those planes are at the shapes' separation along the axis, never more
+/// than their distance: two boxes apart face to face keep their manifold), is given the
+/// manifold of Parry's generator for convex polyhedra instead, which takes its normal from
+/// GJK's nearest points, clips the features that support it, and adds the nearest points as a
+/// point of their own (as it does for every pair of hulls); points that coincide are kept
+/// once. A mesh triangle's normal constraints (which exist against phantom hits beside the
+/// mesh's inner edges) apply to that generator's normal as to the SAT one's; then the normal
+/// need not be GJK's, so the rebuilt manifold is kept only when its nearest point is the
+/// nearer, and an empty manifold (the constraints' verdict) is left empty. Any other pair of
+/// convex shapes left with no point gets one at Parry's `query::contact` (GJK's nearest
+/// points, with the true normal) when that is within the prediction. The points keep the
+/// solver's data of last step's points of the same features (a featureless nearest point that
+/// of last step's), so warm starting goes on while the pair stays apart that way.
 ///
 /// Not used where a ball takes part (Parry's ball generators always give the nearest
-/// point) nor where a mesh triangle's normal constraints apply: the nearest point of a
-/// triangle can lie on an edge inside the mesh, whose normal those constraints exist to
-/// correct (phantom hits beside edges).
+/// point). The single fallback point is not used where a mesh triangle's normal constraints
+/// apply: the nearest point of a triangle can lie on an edge inside the mesh, whose normal
+/// those constraints exist to correct (phantom hits beside edges).
 #[derive(Clone, Copy)]
 struct NearestPointFallback<ContactData> {
     /// Whether this pair may get the fallback point.
     applies: bool,
+    /// Whether this pair is a box with a box or a triangle, whose manifold comes from Parry's
+    /// SAT generators ([`is_sat_pair`]).
+    polyhedra: bool,
     /// The solver's data of last step's nearest point (a point with no features), if last
     /// step's manifold had one.
     previous: Option<ContactData>,
-    /// A box pair's points of last step, if last step's manifold was one this fallback may
-    /// have rebuilt (its nearest point beyond [`SEPARATED_BOXES_GAP`]).
+    /// A box pair's (or box and triangle's) points of last step, if last step's manifold was
+    /// one this fallback may have rebuilt (its nearest point beyond [`SEPARATED_BOXES_GAP`]).
     kept: Option<KeptPoints<ContactData>>,
 }
 
@@ -399,14 +410,17 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
         manifold: &ContactManifold<ManifoldData, ContactData>,
     ) -> Self {
         let (type1, type2) = (g1.shape_type(), g2.shape_type());
-        let applies = unconstrained && type1 != ShapeType::Ball && type2 != ShapeType::Ball;
-        let boxes = applies && type1 == ShapeType::Cuboid && type2 == ShapeType::Cuboid;
+        // A box with a box or a triangle may be rebuilt under a mesh's normal constraints too
+        // (Parry's generator for polyhedra applies them to its normal as the SAT one does).
+        let polyhedra = is_sat_pair(type1, type2);
+        let applies =
+            polyhedra || (unconstrained && type1 != ShapeType::Ball && type2 != ShapeType::Ball);
         // Most box pairs are resting or without points: nothing to keep.
-        let kept = (boxes
+        let kept = (polyhedra
             && !manifold.points.is_empty()
             && nearest_separation(manifold) > SEPARATED_BOXES_GAP)
             .then(|| KeptPoints::of(&manifold.points));
-        let previous = if applies && !boxes {
+        let previous = if applies && !polyhedra {
             manifold
                 .points
                 .iter()
@@ -417,36 +431,45 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
         };
         Self {
             applies,
+            polyhedra,
             previous,
             kept,
         }
     }
 
-    /// Rebuilds a box pair's `manifold` from its nearest points, or adds the fallback point
-    /// to any other pair's `manifold` that the generator left with none, when the shapes are
-    /// within `prediction` (m) of each other (see [`NearestPointFallback`]).
-    fn after<ManifoldData: Default>(
+    /// Rebuilds the `manifold` of a box and a box or a triangle from their nearest points, or
+    /// adds the fallback point to any other pair's `manifold` that the generator left with
+    /// none, when the shapes are within `prediction` (m) of each other (see
+    /// [`NearestPointFallback`]); `constraints` are a mesh triangle's normal constraints.
+    fn after<ManifoldData: Default + Clone>(
         &self,
         pos12: &Pose,
         g1: &dyn Shape,
         g2: &dyn Shape,
+        constraints: NormalConstraintPair<'_>,
         prediction: Real,
         manifold: &mut ContactManifold<ManifoldData, ContactData>,
     ) {
         if !self.applies {
             return;
         }
-        if let (Some(box1), Some(box2)) = (g1.as_cuboid(), g2.as_cuboid()) {
+        if self.polyhedra {
+            let (Some(support1), Some(support2)) = (g1.as_support_map(), g2.as_support_map())
+            else {
+                return;
+            };
             let nearest = nearest_separation(manifold);
-            // Points on the planes that support the boxes along the manifold's normal are at
-            // the boxes' separation along it, which is no more than their distance: the
+            // Points on the planes that support the shapes along the manifold's normal are
+            // at the shapes' separation along it, which is no more than their distance: the
             // manifold is right (two faces apart, say). Only points beyond those planes can
             // overstate the gap.
-            if manifold.points.is_empty()
-                || (nearest > SEPARATED_BOXES_GAP
-                    && nearest > supporting_gap(pos12, box1, box2, manifold) + SAME_POINT_DISTANCE)
-            {
-                self.rebuild_from_nearest_points(pos12, box1, box2, prediction, manifold);
+            let overstated = nearest > SEPARATED_BOXES_GAP
+                && nearest
+                    > supporting_gap(pos12, support1, support2, manifold) + SAME_POINT_DISTANCE;
+            let constrained = constraints.0.is_some() || constraints.1.is_some();
+            // Under normal constraints an empty manifold is the constraints' verdict.
+            if overstated || (manifold.points.is_empty() && !constrained) {
+                self.rebuild_from_nearest_points(pos12, g1, g2, constraints, prediction, manifold);
             }
             return;
         }
@@ -471,18 +494,31 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
         manifold.points.push(point);
     }
 
-    /// Replaces the cuboid–cuboid generator's `manifold` of two boxes with that of Parry's
-    /// generator for convex polyhedra, each point once, whose points keep the solver's data of
-    /// last step's points of the same features: those the fallback kept, or else the replaced
-    /// points (which carry last step's, matched by Parry's generator).
-    fn rebuild_from_nearest_points<ManifoldData: Default>(
+    /// Replaces the SAT generator's `manifold` of a box and a box or a triangle (`g1`, `g2`)
+    /// with that of Parry's generator for convex polyhedra, under the same normal
+    /// `constraints`, each point once, whose points keep the solver's data of last step's
+    /// points of the same features: those the fallback kept, or else the replaced points
+    /// (which carry last step's, matched by Parry's generator). Under normal constraints the
+    /// normal need not be GJK's, so the rebuilt manifold is kept only when its nearest point is
+    /// nearer than the replaced manifold's.
+    fn rebuild_from_nearest_points<ManifoldData: Default + Clone>(
         &self,
         pos12: &Pose,
-        box1: &Cuboid,
-        box2: &Cuboid,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        constraints: NormalConstraintPair<'_>,
         prediction: Real,
         manifold: &mut ContactManifold<ManifoldData, ContactData>,
     ) {
+        let (Some((pfm1, border1)), Some((pfm2, border2))) =
+            (g1.as_polygonal_feature_map(), g2.as_polygonal_feature_map())
+        else {
+            return;
+        };
+        let constrained = constraints.0.is_some() || constraints.1.is_some();
+        // Rare (a pair apart beyond a millimetre whose SAT points overstate its gap), so the
+        // copy to fall back on may allocate.
+        let replaced = constrained.then(|| manifold.clone());
         let kept = self
             .kept
             .unwrap_or_else(|| KeptPoints::of(&manifold.points));
@@ -490,8 +526,22 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
         // just computed for).
         manifold.points.clear();
         contact_manifold_pfm_pfm(
-            pos12, box1, 0.0, None, box2, 0.0, None, prediction, manifold,
+            pos12,
+            pfm1,
+            border1,
+            constraints.0,
+            pfm2,
+            border2,
+            constraints.1,
+            prediction,
+            manifold,
         );
+        if let Some(replaced) = replaced
+            && nearest_separation(manifold) >= nearest_separation(&replaced)
+        {
+            *manifold = replaced;
+            return;
+        }
         let same = SAME_POINT_DISTANCE * SAME_POINT_DISTANCE;
         let mut k = 0;
         while k < manifold.points.len() {
@@ -512,6 +562,23 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
             }
         }
     }
+}
+
+/// A pair's normal constraints (a mesh triangle's), shape 1's then shape 2's.
+type NormalConstraintPair<'a> = (
+    Option<&'a dyn NormalConstraints>,
+    Option<&'a dyn NormalConstraints>,
+);
+
+/// Whether Parry's generator for shapes of these types is a SAT one that can overstate a gap
+/// ([`NearestPointFallback`]): a box with a box or with a triangle.
+fn is_sat_pair(type1: ShapeType, type2: ShapeType) -> bool {
+    matches!(
+        (type1, type2),
+        (ShapeType::Cuboid, ShapeType::Cuboid)
+            | (ShapeType::Cuboid, ShapeType::Triangle)
+            | (ShapeType::Triangle, ShapeType::Cuboid)
+    )
 }
 
 /// Up to [`KEPT_POINTS`] points' features and solver data, on the stack (so that keeping them
@@ -552,17 +619,19 @@ impl<ContactData: Default + Copy> KeptPoints<ContactData> {
     }
 }
 
-/// The gap (m) between the planes that support two boxes along `manifold`'s normal (box 2's
-/// pose in box 1's frame is `pos12`): the boxes' separation along that axis, which is at most
-/// their distance (projection shortens).
+/// The gap (m) between the planes that support two convex shapes along `manifold`'s normal
+/// (shape 2's pose in shape 1's frame is `pos12`): the shapes' separation along that axis,
+/// which is at most their distance (projection shortens).
 fn supporting_gap<ManifoldData, ContactData>(
     pos12: &Pose,
-    box1: &Cuboid,
-    box2: &Cuboid,
+    shape1: &dyn SupportMap,
+    shape2: &dyn SupportMap,
     manifold: &ContactManifold<ManifoldData, ContactData>,
 ) -> Real {
     let (n1, n2) = (manifold.local_n1, manifold.local_n2);
-    pos12.translation.dot(n1) - box1.half_extents.dot(n1.abs()) - box2.half_extents.dot(n2.abs())
+    pos12.translation.dot(n1)
+        - shape1.local_support_point(n1).dot(n1)
+        - shape2.local_support_point(n2).dot(n2)
 }
 
 /// The least separation (m) of `manifold`'s points; infinite without points.
