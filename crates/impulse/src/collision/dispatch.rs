@@ -375,7 +375,8 @@ const SAME_POINT_DISTANCE: Real = 1e-4;
 /// once. A mesh triangle's normal constraints (which exist against phantom hits beside the
 /// mesh's inner edges) apply to that generator's normal as to the SAT one's; then the normal
 /// need not be GJK's, so the rebuilt manifold is kept only when its nearest point is the
-/// nearer, and an empty manifold (the constraints' verdict) is left empty. Any other pair of
+/// nearer; a one-sided triangle rejects GJK's normal from behind it as it rejects the SAT
+/// one's. Any other pair of
 /// convex shapes left with no point gets one at Parry's `query::contact` (GJK's nearest
 /// points, with the true normal) when that is within the prediction. The points keep the
 /// solver's data of last step's points of the same features (a featureless nearest point that
@@ -463,12 +464,13 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
             // at the shapes' separation along it, which is no more than their distance: the
             // manifold is right (two faces apart, say). Only points beyond those planes can
             // overstate the gap.
-            let overstated = nearest > SEPARATED_BOXES_GAP
-                && nearest
-                    > supporting_gap(pos12, support1, support2, manifold) + SAME_POINT_DISTANCE;
-            let constrained = constraints.0.is_some() || constraints.1.is_some();
-            // Under normal constraints an empty manifold is the constraints' verdict.
-            if overstated || (manifold.points.is_empty() && !constrained) {
+            // An empty manifold is rebuilt too: the SAT axis, once a triangle's constraints
+            // turn it, can be one the triangle rejects (pointing behind it) where GJK's is not.
+            if manifold.points.is_empty()
+                || (nearest > SEPARATED_BOXES_GAP
+                    && nearest
+                        > supporting_gap(pos12, support1, support2, manifold) + SAME_POINT_DISTANCE)
+            {
                 self.rebuild_from_nearest_points(pos12, g1, g2, constraints, prediction, manifold);
             }
             return;
