@@ -419,7 +419,7 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
         // Most box pairs are resting or without points: nothing to keep.
         let kept = (polyhedra
             && !manifold.points.is_empty()
-            && nearest_separation(manifold) > SEPARATED_BOXES_GAP)
+            && nearest_separation(&manifold.points) > SEPARATED_BOXES_GAP)
             .then(|| KeptPoints::of(&manifold.points));
         let previous = if applies && !polyhedra {
             manifold
@@ -442,7 +442,7 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
     /// adds the fallback point to any other pair's `manifold` that the generator left with
     /// none, when the shapes are within `prediction` (m) of each other (see
     /// [`NearestPointFallback`]); `constraints` are a mesh triangle's normal constraints.
-    fn after<ManifoldData: Default + Clone>(
+    fn after<ManifoldData: Default>(
         &self,
         pos12: &Pose,
         g1: &dyn Shape,
@@ -459,13 +459,13 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
             else {
                 return;
             };
-            let nearest = nearest_separation(manifold);
+            let nearest = nearest_separation(&manifold.points);
             // Points on the planes that support the shapes along the manifold's normal are
             // at the shapes' separation along it, which is no more than their distance: the
             // manifold is right (two faces apart, say). Only points beyond those planes can
-            // overstate the gap.
-            // An empty manifold is rebuilt too: the SAT axis, once a triangle's constraints
-            // turn it, can be one the triangle rejects (pointing behind it) where GJK's is not.
+            // overstate the gap. An empty manifold is rebuilt too: the SAT axis, once a
+            // triangle's constraints turn it, can be one the triangle rejects (pointing behind
+            // it) where GJK's is not.
             if manifold.points.is_empty()
                 || (nearest > SEPARATED_BOXES_GAP
                     && nearest
@@ -503,7 +503,7 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
     /// (which carry last step's, matched by Parry's generator). Under normal constraints the
     /// normal need not be GJK's, so the rebuilt manifold is kept only when its nearest point is
     /// nearer than the replaced manifold's.
-    fn rebuild_from_nearest_points<ManifoldData: Default + Clone>(
+    fn rebuild_from_nearest_points<ManifoldData: Default>(
         &self,
         pos12: &Pose,
         g1: &dyn Shape,
@@ -518,9 +518,17 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
             return;
         };
         let constrained = constraints.0.is_some() || constraints.1.is_some();
-        // Rare (a pair apart beyond a millimetre whose SAT points overstate its gap), so the
-        // copy to fall back on may allocate.
-        let replaced = constrained.then(|| manifold.clone());
+        // What the generator rewrites (points and normals), to fall back on. It allocates only
+        // when the replaced manifold has points, which is rare (a pair apart beyond a
+        // millimetre whose SAT points overstate its gap); the common rebuild under constraints
+        // is of an empty manifold.
+        let replaced = constrained.then(|| {
+            (
+                manifold.points.clone(),
+                manifold.local_n1,
+                manifold.local_n2,
+            )
+        });
         let kept = self
             .kept
             .unwrap_or_else(|| KeptPoints::of(&manifold.points));
@@ -538,10 +546,12 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
             prediction,
             manifold,
         );
-        if let Some(replaced) = replaced
-            && nearest_separation(manifold) >= nearest_separation(&replaced)
+        if let Some((points, local_n1, local_n2)) = replaced
+            && nearest_separation(&manifold.points) >= nearest_separation(&points)
         {
-            *manifold = replaced;
+            manifold.points = points;
+            manifold.local_n1 = local_n1;
+            manifold.local_n2 = local_n2;
             return;
         }
         let same = SAME_POINT_DISTANCE * SAME_POINT_DISTANCE;
@@ -636,12 +646,9 @@ fn supporting_gap<ManifoldData, ContactData>(
         - shape2.local_support_point(n2).dot(n2)
 }
 
-/// The least separation (m) of `manifold`'s points; infinite without points.
-fn nearest_separation<ManifoldData, ContactData>(
-    manifold: &ContactManifold<ManifoldData, ContactData>,
-) -> Real {
-    manifold
-        .points
+/// The least separation (m) of a manifold's `points`; infinite without points.
+fn nearest_separation<ContactData>(points: &[TrackedContact<ContactData>]) -> Real {
+    points
         .iter()
         .map(|point| point.dist)
         .fold(Real::INFINITY, Real::min)
