@@ -59,6 +59,7 @@ fn margins(world: &World) -> SpeculativeMargins {
         world.settings().prediction_distance,
         world.gravity(),
         world.dt(),
+        false,
     );
     margins
 }

@@ -9,6 +9,7 @@ use parry3d::query::{QueryDispatcher, ShapeCastOptions};
 use super::dispatch::ContactDispatcher;
 use super::manifold::Manifold;
 use crate::body::Bodies;
+use crate::parallel::{BODIES_PER_TASK, spread};
 
 /// Cap on a body's speculative margin (m), so a body thrown at absurd speed does not pair
 /// with the whole scene.
@@ -43,19 +44,28 @@ pub struct SpeculativeMargins {
 
 impl SpeculativeMargins {
     /// Recomputes the margins for a step of `dt` seconds (`prediction_distance` in m,
-    /// `gravity` in m/s²).
-    pub fn update(&mut self, bodies: &Bodies, prediction_distance: f32, gravity: Vec3, dt: f32) {
+    /// `gravity` in m/s²). With `parallel`, in runs of [`BODIES_PER_TASK`] bodies on rayon's
+    /// threads: each body's margin depends on that body alone, so the margins are the same on
+    /// any thread count.
+    pub fn update(
+        &mut self,
+        bodies: &Bodies,
+        prediction_distance: f32,
+        gravity: Vec3,
+        dt: f32,
+        parallel: bool,
+    ) {
         self.prediction_distance = prediction_distance;
         self.dt = dt;
         self.gravity_speed = gravity.length() * dt;
-        self.margins.clear();
-        self.spin_speeds.clear();
-        for i in 0..bodies.len() {
-            let (margin, spin_speed) = if bodies.is_moving(i) {
+        let gravity_speed = self.gravity_speed;
+        // (margin, spin speed) of body i.
+        let of = |i: usize| {
+            if bodies.is_moving(i) {
                 let radius = bodies.shape[i].compute_local_aabb().half_extents().length();
                 let spin_speed = bodies.angular_velocity[i].length() * radius;
                 let gravity_speed = if bodies.is_dynamic(i) {
-                    self.gravity_speed
+                    gravity_speed
                 } else {
                     0.0
                 };
@@ -66,9 +76,23 @@ impl SpeculativeMargins {
                 )
             } else {
                 (0.5 * prediction_distance, 0.0)
-            };
-            self.margins.push(margin);
-            self.spin_speeds.push(spin_speed);
+            }
+        };
+        self.margins.clear();
+        self.spin_speeds.clear();
+        if spread(parallel, bodies.len(), BODIES_PER_TASK) {
+            use rayon::prelude::*;
+            (0..bodies.len())
+                .into_par_iter()
+                .with_min_len(BODIES_PER_TASK)
+                .map(of)
+                .unzip_into_vecs(&mut self.margins, &mut self.spin_speeds);
+        } else {
+            for i in 0..bodies.len() {
+                let (margin, spin_speed) = of(i);
+                self.margins.push(margin);
+                self.spin_speeds.push(spin_speed);
+            }
         }
     }
 
@@ -193,3 +217,7 @@ impl SweptReach {
         true
     }
 }
+
+#[cfg(test)]
+#[path = "margins_tests.rs"]
+mod tests;

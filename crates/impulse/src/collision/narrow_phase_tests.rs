@@ -87,7 +87,7 @@ fn cube_over_ground(gap: f32, turn: f32) -> World {
 /// `narrow` again (as a step keeps it), or a new one when `narrow` is `None`.
 fn update_pair(w: &World, narrow: Option<NarrowPhase>) -> NarrowPhase {
     let mut margins = SpeculativeMargins::default();
-    margins.update(&w.bodies, 0.02, Vec3::ZERO, 1.0 / 60.0);
+    margins.update(&w.bodies, 0.02, Vec3::ZERO, 1.0 / 60.0, false);
     let mut narrow = narrow.unwrap_or_default();
     narrow
         .update(&w.bodies, &[(0, 1)], &margins, false)

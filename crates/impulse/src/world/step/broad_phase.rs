@@ -6,13 +6,14 @@ use crate::settings::SolverSettings;
 
 impl World {
     /// Each body's speculative margin, then the candidate pairs of bodies whose loosened boxes
-    /// overlap.
+    /// overlap (both on rayon's threads with `parallel`).
     pub(super) fn broad_phase_stage(&mut self, settings: &SolverSettings, parallel: bool) {
         self.margins.update(
             &self.bodies,
             settings.prediction_distance,
             self.gravity,
             self.dt,
+            parallel,
         );
         self.broad_phase.candidate_pairs(
             &self.bodies,
