@@ -49,13 +49,7 @@ fn the_deepest_overlap_is_the_definitions_on_random_piles() {
         SharedShape::capsule_y(0.1, 0.08),
         hull,
     ];
-    let mut state = 7u64;
-    let mut uniform = move |low: f32, high: f32| {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        low + (high - low) * ((state >> 40) as f32 / (1u64 << 24) as f32)
-    };
+    let mut uniform = crate::test_support::seeded_uniform(7u64);
     let mut overlapping = 0;
     for pile in 0..40 {
         let n = 12;

@@ -14,6 +14,19 @@ use glam::Vec3;
 use crate::World;
 use crate::contact::constraints::{ContactConstraint, JacobianRow};
 
+/// A seeded generator of uniform numbers in [low, high) (a 64-bit linear congruential
+/// generator, Knuth's MMIX constants, 24 bits of each state): the same sequence on every run,
+/// so every case of a seeded sweep can be rebuilt from its seed.
+pub(crate) fn seeded_uniform(seed: u64) -> impl FnMut(f32, f32) -> f32 {
+    let mut state = seed;
+    move |low: f32, high: f32| {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        low + (high - low) * ((state >> 40) as f32 / (1u64 << 24) as f32)
+    }
+}
+
 /// Checks the engine's own LCP at exit of the last step: for every point γ ≥ 0, w = J·v −
 /// target ≥ −1e-3 m/s and |w·γ| ≤ 1e-3 of the largest γ, and the natural-map residual is
 /// below 1e-2. Returns false (checks nothing) while the pile has fewer than 50 contacts.

@@ -488,13 +488,7 @@ fn random_pairs(
     shapes: &[SharedShape],
     cases: usize,
 ) -> impl Iterator<Item = (usize, &dyn Shape, Pose, &dyn Shape, Pose)> {
-    let mut state = seed;
-    let mut uniform = move |low: f32, high: f32| {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        low + (high - low) * ((state >> 40) as f32 / (1u64 << 24) as f32)
-    };
+    let mut uniform = crate::test_support::seeded_uniform(seed);
     let n = shapes.len();
     (0..cases).map(move |case| {
         let mut pose = || {

@@ -23,13 +23,7 @@ fn margins_on_two_threads_are_those_of_one() {
         &m,
     )
     .unwrap();
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut uniform = move |low: f32, high: f32| {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        low + (high - low) * ((state >> 40) as f32 / (1u64 << 24) as f32)
-    };
+    let mut uniform = crate::test_support::seeded_uniform(0x9e37_79b9_7f4a_7c15u64);
     for k in 0..3000 {
         let shape = if k % 2 == 0 {
             ShapeDesc::Sphere { radius: 0.2 }
