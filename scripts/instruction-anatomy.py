@@ -9,16 +9,20 @@ prints what the extra N steps executed per step inside the machine code of every
 whose demangled name matches REGEX (default: the lanes' sweep kernels), instruction by
 instruction, summed by mnemonic and by kind (multiply, add or subtract, select or sign mask,
 gather and scatter moves, ...). The difference of the two runs leaves out the scene's set-up
-and the first N steps. IMPULSE is the path of an `impulse` binary built with symbols (the
-release profile keeps them); ARGS a `run` or `resume` command without `--steps`.
+and the first N steps. IMPULSE is an `impulse` binary (a path, or a name on PATH) built with
+symbols (the release profile keeps them); ARGS a `run` or `resume` command without `--steps`.
 
 Example (pyramid20 at 3 substeps, the sweep kernels):
 
     python3 scripts/instruction-anatomy.py --steps 60 -- target/release/impulse run pyramid20 \\
         --no-sleep --threads 1 --substeps 3 --soft-hertz 36 --quiet
 
-Needs valgrind, nm and objdump (binutils). Functions are attributed by address, so code inlined
-into a matching function counts as its own; a matching function's calls to others do not count.
+Needs valgrind, nm and objdump (binutils). valgrind 3.19 does not decode every x86-64-v3
+instruction a build may contain (it stops with SIGILL); `IMPULSE_INSTRUCTION_SET=baseline` in
+the environment then runs the baseline kernels, which it decodes. Those are compiled into their
+callers, so match the callers: `--function '^impulse::solver::lanes::(schedule|solve)'`.
+Functions are attributed by address, so code inlined into a matching function counts as its
+own; a matching function's calls to others do not count.
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ import argparse
 import collections
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -181,16 +186,24 @@ def main() -> int:
     command = args.command[1:] if args.command[:1] == ["--"] else args.command
     if not command:
         parser.error("give the impulse command after --")
-    binary = command[0] if os.path.sep in command[0] else subprocess.run(
-        ["which", command[0]], check=True, capture_output=True, text=True).stdout.strip()
+    binary = command[0] if os.path.sep in command[0] else shutil.which(command[0])
+    if not binary:
+        parser.error(f"{command[0]!r} is not on PATH")
     ranges = function_ranges(binary, args.function)
     if not ranges:
         print(f"no function matches {args.function!r} in {binary}", file=sys.stderr)
         return 1
     with tempfile.TemporaryDirectory() as scratch:
         short, long = os.path.join(scratch, "short.out"), os.path.join(scratch, "long.out")
-        run_callgrind(command, args.steps, short)
-        run_callgrind(command, 2 * args.steps, long)
+        try:
+            run_callgrind(command, args.steps, short)
+            run_callgrind(command, 2 * args.steps, long)
+        except subprocess.CalledProcessError as error:
+            print(f"callgrind failed: {error}", file=sys.stderr)
+            if error.returncode == -4:
+                print("valgrind could not decode an instruction of the wider kernels; "
+                      "IMPULSE_INSTRUCTION_SET=baseline runs the baseline ones", file=sys.stderr)
+            return 1
         before, after = costs_by_address(short), costs_by_address(long)
     names = mnemonics(binary, ranges)
     by_mnemonic: collections.Counter = collections.Counter()
@@ -198,8 +211,10 @@ def main() -> int:
         by_mnemonic[mnemonic] += after.get(address, 0) - before.get(address, 0)
     total = sum(by_mnemonic.values()) / args.steps
     if total <= 0:
-        print(f"the functions matching {args.function!r} ran no instructions in the extra steps",
-              file=sys.stderr)
+        print(f"the functions matching {args.function!r} ran no instructions in the extra steps"
+              " (the baseline kernels are inlined into their callers: with"
+              " IMPULSE_INSTRUCTION_SET=baseline, match those, e.g."
+              " --function '^impulse::solver::lanes::(schedule|solve)')", file=sys.stderr)
         return 1
     by_kind: collections.Counter = collections.Counter()
     for mnemonic, count in by_mnemonic.items():
