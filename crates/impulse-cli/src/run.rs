@@ -165,7 +165,7 @@ impl Summary {
 /// (or `baseline`), and how to choose the baseline.
 pub fn instruction_set_line() -> String {
     format!(
-        "SIMD kernels: {} ({}=baseline for the baseline; the results are the same)",
+        "SIMD kernels: {} ({}=baseline for the baseline; the same results unless the solver fuses multiply-adds)",
         impulse::simd::InstructionSet::detected().name(),
         impulse::simd::INSTRUCTION_SET_VARIABLE
     )

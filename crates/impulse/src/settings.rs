@@ -229,6 +229,18 @@ pub struct SolverSettings {
     /// 1024 points, a colour of more than 8 lane groups is spread over the worker threads (the
     /// same result on any thread count).
     pub simd_island_contacts: u32,
+    /// Let the SIMD lanes' sweeps fuse each multiply with the addition that follows it (one
+    /// rounding instead of two: `vfmadd`) in the dot products J·v and the velocity updates
+    /// M⁻¹Jᵀλ, on CPUs whose lanes' kernels have FMA (x86-64-v3 and x86-64-v4; not with the
+    /// `lanes8` feature). About a tenth less solve time on the standard scenes
+    /// (docs/benchmarks.md, "Fused multiply-adds"). Off by default: the kernels then give the
+    /// same bits on every x86-64 CPU (and with `IMPULSE_INSTRUCTION_SET=baseline`); on, a
+    /// trajectory differs in its last bits between a CPU with FMA and one without (which
+    /// rounds twice as before), as Jolt's results do unless built for cross-platform
+    /// determinism (`CROSS_PLATFORM_DETERMINISTIC`). Runs on one machine stay repeatable, on
+    /// any thread count. The scalar solvers, the products and the step's record round twice
+    /// either way.
+    pub fused_multiply_add: bool,
     /// Integrate the gyroscopic term ω × I·ω of rigid bodies, implicitly, once per substep
     /// (`integrate::gyroscopic`), so that a free body keeps its world angular momentum
     /// and a body spun near its intermediate axis tumbles (docs/method.md, "Gyroscopic
@@ -417,7 +429,8 @@ impl SolverSettings {
     /// `simd_island_contacts`.
     /// Kept from `self` (what the scene means to happen): `restitution_threshold`,
     /// `prediction_distance`, sleeping (`sleep`, `sleep_linear_speed`, `sleep_angular_speed`,
-    /// `time_to_sleep`), `friction`, `gyroscopic`, `continuous`, and any field not listed
+    /// `time_to_sleep`), `friction`, `gyroscopic`, `continuous`, `fused_multiply_add` (a
+    /// choice between speed and bits the same on every CPU), and any field not listed
     /// here. The split is tabled in docs/solvers.md, "Presets and scenes".
     pub fn with_effort_of(&self, preset: &SolverSettings) -> SolverSettings {
         SolverSettings {
@@ -564,6 +577,7 @@ impl Default for SolverSettings {
             direct_joint_solve: true,
             parallel_island_contacts: 0,
             simd_island_contacts: 16,
+            fused_multiply_add: false,
             gyroscopic: true,
             continuous: true,
             impact: ImpactModel::Simultaneous,

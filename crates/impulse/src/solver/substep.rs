@@ -483,6 +483,9 @@ impl IslandWorkspace {
                     .map(|&i| world_inverse_inertia[i as usize]),
             );
             w.slot_inverse_inertia.push(Mat3::ZERO);
+            w.solvers
+                .wide
+                .set_fused_multiply_add(settings.fused_multiply_add);
             w.solvers.wide.prepare(
                 constraints,
                 slots,

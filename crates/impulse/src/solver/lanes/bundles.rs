@@ -27,6 +27,10 @@ pub(crate) struct Bundles {
     pub(super) run_places: Vec<(u32, u32)>,
     /// Whether one colour's bundles may be updated on several threads.
     pub(super) parallel: bool,
+    /// Whether the sweeps may fuse multiplies and additions
+    /// ([`crate::SolverSettings::fused_multiply_add`]); they do only in the kernels compiled
+    /// with FMA ([`Bundles::sweep`]).
+    pub(super) fused: bool,
     /// Points with friction (μ > 0) in the last pack: each has two tangent rows.
     pub(super) friction_points: usize,
     /// Constraint index of each lane of each bundle; `u32::MAX` for padding.
@@ -61,6 +65,12 @@ pub(crate) struct Bundles {
 }
 
 impl Bundles {
+    /// Sets whether the sweeps may fuse multiplies and additions
+    /// ([`crate::SolverSettings::fused_multiply_add`]).
+    pub(crate) fn set_fused_multiply_add(&mut self, fused: bool) {
+        self.fused = fused;
+    }
+
     /// Whether [`Bundles::pack`] was asked to spread colours over rayon's threads.
     pub(crate) fn parallel(&self) -> bool {
         self.parallel

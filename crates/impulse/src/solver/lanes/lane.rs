@@ -34,20 +34,114 @@ pub(super) fn lane_vec(vectors: [Vec3; LANES]) -> LaneVec {
     ]
 }
 
-#[inline(always)]
-pub(super) fn dot(a: LaneVec, b: LaneVec) -> Lane {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+/// How a kernel rounds a·b + c: in the sweeps' dot products and velocity updates
+/// ([`crate::SolverSettings::fused_multiply_add`]).
+pub(super) trait Rounding: Copy {
+    /// a·b + c per lane.
+    fn mul_add(a: Lane, b: Lane, c: Lane) -> Lane;
+
+    /// a·b summed over the three components, ((a_x·b_x + a_y·b_y) + a_z·b_z).
+    #[inline(always)]
+    fn dot(a: LaneVec, b: LaneVec) -> Lane {
+        Self::mul_add(a[2], b[2], Self::mul_add(a[1], b[1], a[0] * b[0]))
+    }
+
+    /// a + b·s.
+    #[inline(always)]
+    fn add_scaled(a: LaneVec, b: LaneVec, s: Lane) -> LaneVec {
+        [
+            Self::mul_add(b[0], s, a[0]),
+            Self::mul_add(b[1], s, a[1]),
+            Self::mul_add(b[2], s, a[2]),
+        ]
+    }
+
+    /// a + b·s component by component.
+    #[inline(always)]
+    fn add_scaled_per_axis(a: LaneVec, b: LaneVec, s: LaneVec) -> LaneVec {
+        [
+            Self::mul_add(b[0], s[0], a[0]),
+            Self::mul_add(b[1], s[1], a[1]),
+            Self::mul_add(b[2], s[2], a[2]),
+        ]
+    }
 }
 
-#[inline(always)]
-pub(super) fn add_scaled(a: LaneVec, b: LaneVec, s: Lane) -> LaneVec {
-    [a[0] + b[0] * s, a[1] + b[1] * s, a[2] + b[2] * s]
+/// a·b rounded, then the sum rounded: IEEE operations every instruction set has, so a kernel
+/// gives the same bits on all of them (the default).
+#[derive(Clone, Copy)]
+pub(super) struct Separate;
+
+impl Rounding for Separate {
+    #[inline(always)]
+    fn mul_add(a: Lane, b: Lane, c: Lane) -> Lane {
+        a * b + c
+    }
+
+    // The expressions the kernels have always had, so that their code stays what it was.
+    #[inline(always)]
+    fn dot(a: LaneVec, b: LaneVec) -> Lane {
+        a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    }
+
+    #[inline(always)]
+    fn add_scaled(a: LaneVec, b: LaneVec, s: Lane) -> LaneVec {
+        [a[0] + b[0] * s, a[1] + b[1] * s, a[2] + b[2] * s]
+    }
+
+    #[inline(always)]
+    fn add_scaled_per_axis(a: LaneVec, b: LaneVec, s: LaneVec) -> LaneVec {
+        [a[0] + b[0] * s[0], a[1] + b[1] * s[1], a[2] + b[2] * s[2]]
+    }
 }
 
-/// a + b·s component by component: a scale per axis (a per-axis inverse mass).
+/// One fused multiply-add, rounded once (`vfmadd`). Only for kernels compiled for x86-64-v3
+/// or x86-64-v4 ([`crate::simd::on_instruction_set`]), whose target features include FMA, on a
+/// CPU that has them: [`super::bundles::Bundles::sweep`] chooses it for no other kernel. The
+/// sums of `dot` then take the same terms in the same order as `Separate`'s, each product
+/// but the first added without its own rounding.
+#[derive(Clone, Copy)]
+pub(super) struct Fused;
+
+impl Rounding for Fused {
+    #[inline(always)]
+    fn mul_add(a: Lane, b: Lane, c: Lane) -> Lane {
+        #[cfg(all(target_arch = "x86_64", not(feature = "lanes8")))]
+        {
+            use std::arch::x86_64::{__m128, _mm_fmadd_ps};
+            let (a, b, c): (__m128, __m128, __m128) = (
+                wide::bytemuck::cast(a),
+                wide::bytemuck::cast(b),
+                wide::bytemuck::cast(c),
+            );
+            // SAFETY: only kernels compiled with FMA among their target features call this,
+            // on a CPU that has it (see the type's documentation).
+            wide::bytemuck::cast(unsafe { _mm_fmadd_ps(a, b, c) })
+        }
+        #[cfg(not(all(target_arch = "x86_64", not(feature = "lanes8"))))]
+        {
+            a.mul_add(b, c)
+        }
+    }
+}
+
+/// a·b summed over the three components, rounded as `R` does ([`Rounding::dot`]).
 #[inline(always)]
-pub(super) fn add_scaled_per_axis(a: LaneVec, b: LaneVec, s: LaneVec) -> LaneVec {
-    [a[0] + b[0] * s[0], a[1] + b[1] * s[1], a[2] + b[2] * s[2]]
+pub(super) fn dot<R: Rounding>(a: LaneVec, b: LaneVec) -> Lane {
+    R::dot(a, b)
+}
+
+/// a + b·s, rounded as `R` does.
+#[inline(always)]
+pub(super) fn add_scaled<R: Rounding>(a: LaneVec, b: LaneVec, s: Lane) -> LaneVec {
+    R::add_scaled(a, b, s)
+}
+
+/// a + b·s component by component: a scale per axis (a per-axis inverse mass), rounded as `R`
+/// does.
+#[inline(always)]
+pub(super) fn add_scaled_per_axis<R: Rounding>(a: LaneVec, b: LaneVec, s: LaneVec) -> LaneVec {
+    R::add_scaled_per_axis(a, b, s)
 }
 
 #[inline(always)]

@@ -5,7 +5,8 @@
 use glam::Vec3;
 
 use super::lane::{
-    LANES, Lane, LaneVec, add_scaled, add_scaled_per_axis, dot, lane_vec, set, set_vec, sub, unlane,
+    LANES, Lane, LaneVec, Rounding, add_scaled, add_scaled_per_axis, dot, lane_vec, set, set_vec,
+    sub, unlane,
 };
 use crate::contact::{ContactConstraint, JacobianRow};
 use crate::parallel::SharedVelocities;
@@ -162,14 +163,14 @@ impl RowLanes {
 
     /// J·v per lane (m/s) for the row's `direction`, as [`JacobianRow::velocity`].
     #[inline(always)]
-    pub(super) fn velocity(&self, direction: &LaneVec, v: &BodyLanes) -> Lane {
-        dot(*direction, sub(v.linear_a, v.linear_b)) + dot(self.angular_a, v.angular_a)
-            - dot(self.angular_b, v.angular_b)
+    pub(super) fn velocity<R: Rounding>(&self, direction: &LaneVec, v: &BodyLanes) -> Lane {
+        dot::<R>(*direction, sub(v.linear_a, v.linear_b)) + dot::<R>(self.angular_a, v.angular_a)
+            - dot::<R>(self.angular_b, v.angular_b)
     }
 
     /// Adds M⁻¹J_iᵀ·impulse to the two bodies of each lane, for the row's `direction`.
     #[inline(always)]
-    pub(super) fn apply(
+    pub(super) fn apply<R: Rounding>(
         &self,
         direction: &LaneVec,
         impulse: Lane,
@@ -182,10 +183,10 @@ impl RowLanes {
             direction[2] * impulse,
         ];
         let [bx, by, bz] = inverse_mass.1;
-        v.linear_a = add_scaled_per_axis(v.linear_a, linear, inverse_mass.0);
-        v.linear_b = add_scaled_per_axis(v.linear_b, linear, [-bx, -by, -bz]);
-        v.angular_a = add_scaled(v.angular_a, self.inverse_inertia_angular_a, impulse);
-        v.angular_b = add_scaled(v.angular_b, self.inverse_inertia_angular_b, -impulse);
+        v.linear_a = add_scaled_per_axis::<R>(v.linear_a, linear, inverse_mass.0);
+        v.linear_b = add_scaled_per_axis::<R>(v.linear_b, linear, [-bx, -by, -bz]);
+        v.angular_a = add_scaled::<R>(v.angular_a, self.inverse_inertia_angular_a, impulse);
+        v.angular_b = add_scaled::<R>(v.angular_b, self.inverse_inertia_angular_b, -impulse);
     }
 }
 

@@ -5,7 +5,7 @@
 
 use glam::Mat3;
 
-use super::lane::{LANES, Lane, LaneVec, cross, dot, max_of_number};
+use super::lane::{LANES, Lane, LaneVec, Separate, cross, dot, max_of_number};
 use super::layout::{Bundle, BundleGeometry, Group, RowLanes};
 use crate::parallel::{GROUPS_PER_TASK, SharedItems};
 use crate::simd::{InstructionSet, on_instruction_set};
@@ -135,8 +135,8 @@ pub(super) fn row_products<const ALL: bool>(
     let inverse_inertia_angular_a = mul_tensor(inertia.0, angular_a);
     let inverse_inertia_angular_b = mul_tensor(inertia.1, angular_b);
     let k = linear
-        + dot(angular_a, inverse_inertia_angular_a)
-        + dot(angular_b, inverse_inertia_angular_b);
+        + dot::<Separate>(angular_a, inverse_inertia_angular_a)
+        + dot::<Separate>(angular_b, inverse_inertia_angular_b);
     let zero = Lane::splat(0.0);
     let effective_mass = k.simd_gt(zero).select(Lane::splat(1.0) / k, zero);
     row.angular_a = keep(angular_a, row.angular_a);
@@ -179,8 +179,8 @@ pub(super) fn bundle_products<const ALL: bool>(
     let [t1, t2] = &b.tangents;
     let k11 = t1.inverse_effective_mass;
     let k22 = t2.inverse_effective_mass;
-    let k12 = dot(t1.angular_a, t2.inverse_inertia_angular_a)
-        + dot(t1.angular_b, t2.inverse_inertia_angular_b);
+    let k12 = dot::<Separate>(t1.angular_a, t2.inverse_inertia_angular_a)
+        + dot::<Separate>(t1.angular_b, t2.inverse_inertia_angular_b);
     // Its inverse, or the pseudo-inverse of a rank-one block, or zero (`inverse_block`).
     let determinant = k11 * k22 - k12 * k12;
     let regular = determinant.simd_gt(

@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use super::bundles::Bundles;
-use super::lane::{LANES, cap_to_disc};
+use super::lane::{LANES, Separate, cap_to_disc};
 use super::layout::{BodyLanes, Bundle, BundleRecord, Group};
 use crate::parallel::{PARALLEL_PACK_POINTS, SharedItems, spread};
 use crate::simd::{InstructionSet, on_instruction_set};
@@ -136,18 +136,21 @@ pub(super) fn record_bundle(
 ) -> BundleRecord {
     let [t1, t2] = &b.tangents;
     let [d_n, d_1, d_2] = &group.directions;
-    let normal_velocity = b.normal.velocity(d_n, after) - b.target;
+    let normal_velocity = b.normal.velocity::<Separate>(d_n, after) - b.target;
     let g = b.tangent_impulses;
-    let slip = [t1.velocity(d_1, after), t2.velocity(d_2, after)];
+    let slip = [
+        t1.velocity::<Separate>(d_1, after),
+        t2.velocity::<Separate>(d_2, after),
+    ];
     // The scalar projection's operations per lane (the sweeps' clamped one may round
     // differently).
     let trial = [g[0] - slip[0], g[1] - slip[1]];
     let projected = cap_to_disc(trial, group.friction * b.normal_impulse);
     BundleRecord {
         velocity_before: [
-            b.normal.velocity(d_n, before),
-            t1.velocity(d_1, before),
-            t2.velocity(d_2, before),
+            b.normal.velocity::<Separate>(d_n, before),
+            t1.velocity::<Separate>(d_1, before),
+            t2.velocity::<Separate>(d_2, before),
         ],
         phi: [
             b.normal_impulse.min(normal_velocity),

@@ -4,7 +4,7 @@
 //! no moving body), the next bundles asked of the CPU ahead of the update.
 
 use super::bundles::Bundles;
-use super::lane::{Lane, fold_largest};
+use super::lane::{Fused, Lane, Rounding, Separate, fold_largest};
 use super::layout::{Bundle, Group, SharedLanes};
 use super::sweep::{BundleUpdate, Visits};
 use super::targets::SetTargets;
@@ -39,14 +39,27 @@ impl Bundles {
         };
         let (bundles, len) = (SharedItems(self.bundles.as_mut_ptr()), self.bundles.len());
         let set = InstructionSet::detected();
+        // Fused multiply-adds only in the kernels compiled with FMA (see `Fused`).
+        let fused = self.fused && set != InstructionSet::Baseline;
         if !spread(self.parallel, 1, 0) {
             let groups = &self.groups;
             // SAFETY: `pack` gave every group a range inside the bundles and every lane slots
             // below the island's slot count (the velocities' length); the bundles and the
-            // velocities are borrowed exclusively here. `set` runs on this CPU.
-            return on_instruction_set!(set, unsafe {
-                sweep_groups(groups, bundles, len, order, &shared, update, targets)
-            });
+            // velocities are borrowed exclusively here. `set` runs on this CPU, and `Fused`
+            // only with FMA among its features.
+            return if fused {
+                on_instruction_set!(set, unsafe {
+                    sweep_groups::<F, T, Fused>(
+                        groups, bundles, len, order, &shared, update, targets,
+                    )
+                })
+            } else {
+                on_instruction_set!(set, unsafe {
+                    sweep_groups::<F, T, Separate>(
+                        groups, bundles, len, order, &shared, update, targets,
+                    )
+                })
+            };
         }
         // Runs `update` on a run of lane groups of one colour, in order or in reverse.
         let run = |part: &mut [Group], forward: bool| {
@@ -56,9 +69,17 @@ impl Bundles {
             // SAFETY: as above, and within one colour no other lane group touches this run's
             // bundles or its lanes' moving slots (the immovable slot is only read).
             let order = SweepOrder { forward, ..order };
-            on_instruction_set!(set, unsafe {
-                sweep_groups(part, bundles, len, order, &shared, update, targets)
-            })
+            if fused {
+                on_instruction_set!(set, unsafe {
+                    sweep_groups::<F, T, Fused>(part, bundles, len, order, &shared, update, targets)
+                })
+            } else {
+                on_instruction_set!(set, unsafe {
+                    sweep_groups::<F, T, Separate>(
+                        part, bundles, len, order, &shared, update, targets,
+                    )
+                })
+            }
         };
         let starts = &self.group_colour_starts;
         colour_after_colour(
@@ -106,7 +127,7 @@ pub(super) struct SweepOrder {
 /// are below the velocities' length, and no other thread touches these bundles or their lanes'
 /// moving slots meanwhile.
 #[inline(always)]
-pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
+pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets, R: Rounding>(
     groups: &[Group],
     bundles: SharedItems<Bundle>,
     len: usize,
@@ -143,14 +164,14 @@ pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets>(
             }
             // SAFETY: the caller's contract.
             let b = unsafe { &mut *bundles.0.add(index) };
-            targets.set(b, group, index, &moved);
-            let change = update.update_at(b, group, index, &mut v);
+            targets.set::<R>(b, group, index, &moved);
+            let change = update.update_at::<R>(b, group, index, &mut v);
             largest = fold_largest(largest, change);
         }
         // SAFETY: the caller's contract (which covers what the update writes per body).
         unsafe {
             velocities.scatter(&slots_a, &slots_b, &v);
-            update.end(group, visits, bundles);
+            update.end::<R>(group, visits, bundles);
         }
     }
     largest

@@ -6,7 +6,7 @@
 use glam::Vec3;
 
 use super::bundles::Bundles;
-use super::lane::{Lane, max_of_number, min_of_number};
+use super::lane::{Lane, Rounding, max_of_number, min_of_number};
 use super::layout::{BodyLanes, Bundle, Group, NORMAL_PART, SharedLanes};
 use crate::parallel::{SharedItems, SharedVelocities};
 
@@ -38,8 +38,15 @@ pub(super) trait BundleUpdate: Copy + Sync {
     /// Bytes at the start of each bundle that the update reads (see [`NORMAL_PART`]).
     const READS: usize = std::mem::size_of::<Bundle>();
 
-    /// Updates bundle `index` of lane group `group` (see the trait).
-    fn update_at(self, b: &mut Bundle, group: &Group, index: usize, v: &mut BodyLanes) -> Lane;
+    /// Updates bundle `index` of lane group `group` (see the trait), its dot products and
+    /// velocity updates rounded as `R` does.
+    fn update_at<R: Rounding>(
+        self,
+        b: &mut Bundle,
+        group: &Group,
+        index: usize,
+        v: &mut BodyLanes,
+    ) -> Lane;
 
     /// What the update does once a lane group's bundles are updated and its velocities
     /// written back: reads the bundles again, in the order `visits` of the sweep.
@@ -48,7 +55,13 @@ pub(super) trait BundleUpdate: Copy + Sync {
     /// As [`SharedLanes::scatter`] for whatever the update writes per body, and `bundles`
     /// holds every bundle `visits` names, which no other thread touches meanwhile.
     #[inline(always)]
-    unsafe fn end(self, _group: &Group, _visits: Visits, _bundles: SharedItems<Bundle>) {}
+    unsafe fn end<R: Rounding>(
+        self,
+        _group: &Group,
+        _visits: Visits,
+        _bundles: SharedItems<Bundle>,
+    ) {
+    }
 }
 
 /// The bundles of one lane group in the order a sweep visits them: from its first or, going
@@ -93,8 +106,14 @@ impl<const FRICTION: bool> BundleUpdate for VelocityRows<FRICTION> {
         NORMAL_PART
     };
     #[inline(always)]
-    fn update_at(self, b: &mut Bundle, group: &Group, _: usize, v: &mut BodyLanes) -> Lane {
-        solve_bundle::<FRICTION>(b, group, v)
+    fn update_at<R: Rounding>(
+        self,
+        b: &mut Bundle,
+        group: &Group,
+        _: usize,
+        v: &mut BodyLanes,
+    ) -> Lane {
+        solve_bundle::<R, FRICTION>(b, group, v)
     }
 }
 
@@ -108,13 +127,19 @@ pub(super) struct WarmStart {
 
 impl BundleUpdate for WarmStart {
     #[inline(always)]
-    fn update_at(self, b: &mut Bundle, group: &Group, index: usize, v: &mut BodyLanes) -> Lane {
+    fn update_at<R: Rounding>(
+        self,
+        b: &mut Bundle,
+        group: &Group,
+        index: usize,
+        v: &mut BodyLanes,
+    ) -> Lane {
         if let Some(totals) = self.totals {
             // SAFETY: `totals` has one entry per bundle (`pack` sizes it so) and `index` is
             // the bundle's; no other thread touches this bundle's entry meanwhile.
             add_to_totals(unsafe { &mut *totals.0.add(index) }, b);
         }
-        apply_impulses(b, group, v);
+        apply_impulses::<R>(b, group, v);
         Lane::splat(0.0)
     }
 }
@@ -129,11 +154,11 @@ pub(super) fn add_to_totals(total: &mut [Lane; 3], b: &Bundle) {
 
 /// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v` (its lane group `group`).
 #[inline(always)]
-pub(super) fn apply_impulses(b: &Bundle, group: &Group, v: &mut BodyLanes) {
+pub(super) fn apply_impulses<R: Rounding>(b: &Bundle, group: &Group, v: &mut BodyLanes) {
     let (masses, [n, t1, t2]) = (group.inverse_masses(), &group.directions);
-    b.normal.apply(n, b.normal_impulse, masses, v);
-    b.tangents[0].apply(t1, b.tangent_impulses[0], masses, v);
-    b.tangents[1].apply(t2, b.tangent_impulses[1], masses, v);
+    b.normal.apply::<R>(n, b.normal_impulse, masses, v);
+    b.tangents[0].apply::<R>(t1, b.tangent_impulses[0], masses, v);
+    b.tangents[1].apply::<R>(t2, b.tangent_impulses[1], masses, v);
 }
 
 /// The relax sweep of a substep that another substep follows: the velocity rows with friction
@@ -153,12 +178,18 @@ pub(super) struct RelaxCarrying {
 
 impl BundleUpdate for RelaxCarrying {
     #[inline(always)]
-    fn update_at(self, b: &mut Bundle, group: &Group, _: usize, v: &mut BodyLanes) -> Lane {
-        solve_bundle::<true>(b, group, v)
+    fn update_at<R: Rounding>(
+        self,
+        b: &mut Bundle,
+        group: &Group,
+        _: usize,
+        v: &mut BodyLanes,
+    ) -> Lane {
+        solve_bundle::<R, true>(b, group, v)
     }
 
     #[inline(always)]
-    unsafe fn end(self, group: &Group, visits: Visits, bundles: SharedItems<Bundle>) {
+    unsafe fn end<R: Rounding>(self, group: &Group, visits: Visits, bundles: SharedItems<Bundle>) {
         let (slots_a, slots_b) = (&group.local_a, &group.local_b);
         // SAFETY: the caller's contract.
         let mut carried = unsafe { self.carried.gather(slots_a, slots_b) };
@@ -168,7 +199,7 @@ impl BundleUpdate for RelaxCarrying {
             // `WarmStart`.
             let b = unsafe { &*bundles.0.add(index) };
             add_to_totals(unsafe { &mut *self.totals.0.add(index) }, b);
-            apply_impulses(b, group, &mut carried);
+            apply_impulses::<R>(b, group, &mut carried);
         }
         // SAFETY: the caller's contract.
         unsafe { self.carried.scatter(slots_a, slots_b, &carried) }
@@ -191,14 +222,14 @@ impl BundleUpdate for RelaxCarrying {
 /// the block's quadratic; with the larger 2/(k₁ + k₂), `card_house` with `fast` falls. A Newton iteration on the disc would keep a bundle waiting on its slowest
 /// lane; this step costs the same on every lane.
 #[inline(always)]
-pub(super) fn solve_bundle<const FRICTION: bool>(
+pub(super) fn solve_bundle<R: Rounding, const FRICTION: bool>(
     b: &mut Bundle,
     group: &Group,
     v: &mut BodyLanes,
 ) -> Lane {
-    let normal = solve_normal(b, group, v);
+    let normal = solve_normal::<R>(b, group, v);
     if FRICTION {
-        normal.max(solve_friction(b, group, v))
+        normal.max(solve_friction::<R>(b, group, v))
     } else {
         normal
     }
@@ -206,11 +237,11 @@ pub(super) fn solve_bundle<const FRICTION: bool>(
 
 /// The normal row's part of [`solve_bundle`]: returns each lane's row velocity change (m/s).
 #[inline(always)]
-pub(super) fn solve_normal(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
+pub(super) fn solve_normal<R: Rounding>(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
     let zero = Lane::splat(0.0);
     let (masses, direction) = (group.inverse_masses(), &group.directions[0]);
     let row = &b.normal;
-    let velocity = row.velocity(direction, v);
+    let velocity = row.velocity::<R>(direction, v);
     let old = b.normal_impulse;
     let new = max_of_number(
         old + row.effective_mass * b.mass_scale * (b.target - velocity) - b.impulse_scale * old,
@@ -219,19 +250,23 @@ pub(super) fn solve_normal(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> 
     let delta = new - old;
     b.normal_impulse = new;
     b.max_normal_impulse = max_of_number(b.max_normal_impulse, new);
-    row.apply(direction, delta, masses, v);
+    row.apply::<R>(direction, delta, masses, v);
     delta.abs() * row.inverse_effective_mass
 }
 
 /// The friction pair's part of [`solve_bundle`]: returns each lane's larger tangent row
 /// velocity change (m/s).
 #[inline(always)]
-pub(super) fn solve_friction(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -> Lane {
+pub(super) fn solve_friction<R: Rounding>(
+    b: &mut Bundle,
+    group: &Group,
+    v: &mut BodyLanes,
+) -> Lane {
     let masses = group.inverse_masses();
     let [t1, t2] = &b.tangents;
     let [_, d_1, d_2] = &group.directions;
-    let v1 = t1.velocity(d_1, v);
-    let v2 = t2.velocity(d_2, v);
+    let v1 = t1.velocity::<R>(d_1, v);
+    let v2 = t2.velocity::<R>(d_2, v);
     let old = b.tangent_impulses;
     let new = friction_update(
         old,
@@ -242,8 +277,8 @@ pub(super) fn solve_friction(b: &mut Bundle, group: &Group, v: &mut BodyLanes) -
     );
     let (d1, d2) = (new[0] - old[0], new[1] - old[1]);
     b.tangent_impulses = new;
-    t1.apply(d_1, d1, masses, v);
-    t2.apply(d_2, d2, masses, v);
+    t1.apply::<R>(d_1, d1, masses, v);
+    t2.apply::<R>(d_2, d2, masses, v);
     (d1.abs() * t1.inverse_effective_mass).max(d2.abs() * t2.inverse_effective_mass)
 }
 

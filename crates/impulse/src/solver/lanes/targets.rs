@@ -9,7 +9,7 @@
 
 use glam::Vec3;
 
-use super::lane::{LANES, Lane, dot, max_of_number, min_of_number};
+use super::lane::{LANES, Lane, Rounding, Separate, dot, max_of_number, min_of_number};
 use super::layout::{BodyLanes, Bundle, BundleGeometry, Group};
 use crate::contact::{SPECULATIVE_TURN, STALE_TARGET, repair_terms};
 use crate::solver::interface::TargetInputs;
@@ -19,7 +19,8 @@ use crate::solver::interface::TargetInputs;
 pub(super) trait SetTargets: Copy + Sync {
     type Moved;
     fn moved(&self, slots_a: &[u32; LANES], slots_b: &[u32; LANES]) -> Self::Moved;
-    fn set(&self, b: &mut Bundle, group: &Group, index: usize, moved: &Self::Moved);
+    /// Sets bundle `index`'s targets, its separation's dot products rounded as `R` does.
+    fn set<R: Rounding>(&self, b: &mut Bundle, group: &Group, index: usize, moved: &Self::Moved);
 }
 
 /// A sweep that leaves the targets as they are.
@@ -31,7 +32,7 @@ impl SetTargets for NoTargets {
     #[inline(always)]
     fn moved(&self, _: &[u32; LANES], _: &[u32; LANES]) {}
     #[inline(always)]
-    fn set(&self, _: &mut Bundle, _: &Group, _: usize, _: &()) {}
+    fn set<R: Rounding>(&self, _: &mut Bundle, _: &Group, _: usize, _: &()) {}
 }
 
 /// The target update's constants as lanes, and what it reads.
@@ -109,7 +110,7 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
     /// ([`crate::contact::speculative_row_is_stale`]) gets
     /// [`STALE_TARGET`], as in [`crate::contact::update_targets`].
     #[inline(always)]
-    fn set(
+    fn set<R: Rounding>(
         &self,
         b: &mut Bundle,
         group: &Group,
@@ -120,7 +121,7 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
         let zero = Lane::splat(0.0);
         // n·((Δx_a + Δθ_a × r_a) − (Δx_b + Δθ_b × r_b)) = J_n·(Δx, Δθ): the normal row's r × n
         // stand for the lever arms, so the sweep reads no geometry.
-        let separation = b.normal.velocity(&group.directions[0], moved) - b.depth;
+        let separation = b.normal.velocity::<R>(&group.directions[0], moved) - b.depth;
         let gap = separation.simd_gt(zero);
         // `max_repair` is a validated setting, never NaN.
         let repair = min_of_number(
@@ -137,9 +138,11 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
             let g = &t.geometry[index];
             let (arm_a, arm_b) = (b.normal.angular_a, b.normal.angular_b);
             let stale_a = turn_a.simd_gt(limit)
-                & dot(arm_a, arm_a).simd_gt(negligible * dot(g.lever_a, g.lever_a));
+                & dot::<Separate>(arm_a, arm_a)
+                    .simd_gt(negligible * dot::<Separate>(g.lever_a, g.lever_a));
             let stale_b = turn_b.simd_gt(limit)
-                & dot(arm_b, arm_b).simd_gt(negligible * dot(g.lever_b, g.lever_b));
+                & dot::<Separate>(arm_b, arm_b)
+                    .simd_gt(negligible * dot::<Separate>(g.lever_b, g.lever_b));
             (stale_a | stale_b).select(Lane::splat(STALE_TARGET), closing)
         };
         b.target = gap.select(gap_target, overlap_target);

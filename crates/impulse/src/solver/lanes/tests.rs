@@ -466,5 +466,35 @@ proptest! {
     }
 }
 
+/// `Fused` rounds a·b + c once, `Separate` twice: with a = b = 1 + 2⁻¹² and c = −(1 + 2⁻¹¹),
+/// a·b = 1 + 2⁻¹¹ + 2⁻²⁴ exactly, which single precision (spacing 2⁻²³ above one) rounds to
+/// 1 + 2⁻¹¹ (the tie to even), so the separate sum is 0 and the fused one 2⁻²⁴. On a CPU
+/// whose kernels have no FMA the fused kernel is never chosen, and this checks `Separate` only.
+#[test]
+fn fused_multiply_add_rounds_once() {
+    use crate::simd::{InstructionSet, on_instruction_set};
+    let a = Lane::splat(1.0 + 2f32.powi(-12));
+    let c = Lane::splat(-(1.0 + 2f32.powi(-11)));
+    assert_eq!(Separate::mul_add(a, a, c).to_array(), [0.0; LANES]);
+    let widest = InstructionSet::supported_widest();
+    if widest == InstructionSet::Baseline || cfg!(feature = "lanes8") {
+        eprintln!("no kernel with FMA on this CPU or build: only the separate rounding checked");
+        return;
+    }
+    // SAFETY (of `Fused` inside): `widest` runs on this CPU and has FMA.
+    let fused = on_instruction_set!(widest, Fused::mul_add(a, a, c));
+    assert_eq!(fused.to_array(), [2f32.powi(-24); LANES]);
+    // The dot product and the scaled addition are built from it.
+    let v = [a, Lane::splat(0.0), Lane::splat(0.0)];
+    let fused_dot = on_instruction_set!(widest, dot::<Fused>(v, v));
+    assert_eq!(fused_dot.to_array(), (a * a).to_array());
+    let fused_add = on_instruction_set!(widest, add_scaled::<Fused>([c; 3], v, a));
+    assert_eq!(fused_add[0].to_array(), [2f32.powi(-24); LANES]);
+    assert_eq!(
+        add_scaled::<Separate>([c; 3], v, a)[0].to_array(),
+        [0.0; LANES]
+    );
+}
+
 mod scalar_agreement;
 mod scenes;
