@@ -9,6 +9,17 @@ use impulse::scene::builtin_scene;
 use impulse::scene::load_scene_file;
 use impulse::{Scene, SolverMethod, SolverSettings, World};
 
+/// The world of `scene` (sleeping off) after `steps` steps on rayon's current pool.
+fn stepped(scene: &Scene, steps: u32) -> World {
+    let mut scene = scene.clone();
+    scene.solver.sleep = false;
+    let mut world = World::from_scene(&scene).unwrap();
+    for _ in 0..steps {
+        world.step().unwrap();
+    }
+    world
+}
+
 /// `steps` steps of `scene` (sleeping off) on a pool of `threads` threads; the final state's
 /// hash.
 fn run(scene: &Scene, steps: u32, threads: usize) -> u64 {
@@ -16,15 +27,7 @@ fn run(scene: &Scene, steps: u32, threads: usize) -> u64 {
         .num_threads(threads)
         .build()
         .unwrap();
-    pool.install(|| {
-        let mut scene = scene.clone();
-        scene.solver.sleep = false;
-        let mut world = World::from_scene(&scene).unwrap();
-        for _ in 0..steps {
-            world.step().unwrap();
-        }
-        hash_state(&world)
-    })
+    pool.install(|| hash_state(&stepped(scene, steps)))
 }
 
 fn same_everywhere(scene: &Scene, steps: u32) {
@@ -80,13 +83,7 @@ fn fused_multiply_adds_are_the_same_on_any_thread_count_and_run() {
         impulse::simd::InstructionSet::detected().name()
     );
     let positions = |scene: &Scene| {
-        let mut scene = scene.clone();
-        scene.solver.sleep = false;
-        let mut world = World::from_scene(&scene).unwrap();
-        for _ in 0..steps {
-            world.step().unwrap();
-        }
-        world
+        stepped(scene, steps)
             .iter_bodies()
             .map(|body| body.translation())
             .collect::<Vec<_>>()

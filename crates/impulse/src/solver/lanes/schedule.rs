@@ -38,27 +38,16 @@ impl Bundles {
             immovable: velocities.linear.len() - 1,
         };
         let (bundles, len) = (SharedItems(self.bundles.as_mut_ptr()), self.bundles.len());
-        let set = InstructionSet::detected();
-        // Fused multiply-adds only in the kernels compiled with FMA (see `Fused`).
-        let fused = self.fused && set != InstructionSet::Baseline;
+        let (set, fused) = (InstructionSet::detected(), self.fused);
         if !spread(self.parallel, 1, 0) {
             let groups = &self.groups;
             // SAFETY: `pack` gave every group a range inside the bundles and every lane slots
             // below the island's slot count (the velocities' length); the bundles and the
-            // velocities are borrowed exclusively here. `set` runs on this CPU, and `Fused`
-            // only with FMA among its features.
-            return if fused {
-                on_instruction_set!(set, unsafe {
-                    sweep_groups::<F, T, Fused>(
-                        groups, bundles, len, order, &shared, update, targets,
-                    )
-                })
-            } else {
-                on_instruction_set!(set, unsafe {
-                    sweep_groups::<F, T, Separate>(
-                        groups, bundles, len, order, &shared, update, targets,
-                    )
-                })
+            // velocities are borrowed exclusively here. `set` runs on this CPU.
+            return unsafe {
+                sweep_groups_on(
+                    set, fused, groups, bundles, len, order, &shared, update, targets,
+                )
             };
         }
         // Runs `update` on a run of lane groups of one colour, in order or in reverse.
@@ -69,16 +58,10 @@ impl Bundles {
             // SAFETY: as above, and within one colour no other lane group touches this run's
             // bundles or its lanes' moving slots (the immovable slot is only read).
             let order = SweepOrder { forward, ..order };
-            if fused {
-                on_instruction_set!(set, unsafe {
-                    sweep_groups::<F, T, Fused>(part, bundles, len, order, &shared, update, targets)
-                })
-            } else {
-                on_instruction_set!(set, unsafe {
-                    sweep_groups::<F, T, Separate>(
-                        part, bundles, len, order, &shared, update, targets,
-                    )
-                })
+            unsafe {
+                sweep_groups_on(
+                    set, fused, part, bundles, len, order, &shared, update, targets,
+                )
             }
         };
         let starts = &self.group_colour_starts;
@@ -175,6 +158,36 @@ pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets, R: Rounding>(
         }
     }
     largest
+}
+
+/// [`sweep_groups`] in the kernel compiled for `set`, with fused multiply-adds when `fused`
+/// and `set` has FMA (every set but the baseline; see [`Fused`]).
+///
+/// # Safety
+/// As [`sweep_groups`], and `set` runs on this CPU.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+unsafe fn sweep_groups_on<F: BundleUpdate, T: SetTargets>(
+    set: InstructionSet,
+    fused: bool,
+    groups: &[Group],
+    bundles: SharedItems<Bundle>,
+    len: usize,
+    order: SweepOrder,
+    velocities: &SharedVelocities,
+    update: F,
+    targets: T,
+) -> Lane {
+    // SAFETY (both): the caller's contract; `Fused` only with FMA among the features.
+    if fused && set != InstructionSet::Baseline {
+        on_instruction_set!(set, unsafe {
+            sweep_groups::<F, T, Fused>(groups, bundles, len, order, velocities, update, targets)
+        })
+    } else {
+        on_instruction_set!(set, unsafe {
+            sweep_groups::<F, T, Separate>(groups, bundles, len, order, velocities, update, targets)
+        })
+    }
 }
 
 /// How many bundles ahead a sweep asks for (see [`sweep_groups`]).
