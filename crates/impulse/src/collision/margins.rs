@@ -40,6 +40,10 @@ pub struct SpeculativeMargins {
     dt: f32,
     /// |g|·dt (m/s).
     gravity_speed: f32,
+    /// Gravity (m/s²).
+    gravity: Vec3,
+    /// Substeps per step (0: not set, taken as 1).
+    substeps: u32,
 }
 
 impl SpeculativeMargins {
@@ -58,6 +62,7 @@ impl SpeculativeMargins {
         self.prediction_distance = prediction_distance;
         self.dt = dt;
         self.gravity_speed = gravity.length() * dt;
+        self.gravity = gravity;
         let gravity_speed = self.gravity_speed;
         // (margin, spin speed) of body i.
         let of = |i: usize| {
@@ -96,6 +101,12 @@ impl SpeculativeMargins {
         }
     }
 
+    /// Sets the substeps per step, which the reach of a pair's speculative points depends on
+    /// ([`SweptReach::horizon`]); 1 until set.
+    pub fn set_substeps(&mut self, substeps: u32) {
+        self.substeps = substeps;
+    }
+
     /// Per-body margins (m), indexed like the bodies.
     pub fn margins(&self) -> &[f32] {
         &self.margins
@@ -113,16 +124,24 @@ impl SpeculativeMargins {
         (self.prediction_distance + closing * self.dt).min(self.margins[a] + self.margins[b])
     }
 
-    /// Pair (`a`, `b`)'s straight relative motion over the step and how near along it its
-    /// shapes must come for its speculative points to stand ([`SweptReach`]).
+    /// Pair (`a`, `b`)'s straight relative motion over the step and how far rotation can
+    /// add to it ([`SweptReach`]).
     #[inline]
     pub(crate) fn pair_reach(&self, bodies: &Bodies, a: usize, b: usize) -> SweptReach {
-        let velocity = |i: usize| moving_velocity(bodies, i);
-        let gravity = self.relative_gravity_speed(bodies, a, b);
+        // The step's motion before contacts: the velocity with the step's gravity added
+        // (semi-implicit Euler) for a dynamic body, the prescribed one for a kinematic body.
+        let velocity = |i: usize| {
+            let gravity = if bodies.is_dynamic(i) {
+                self.gravity * self.dt
+            } else {
+                Vec3::ZERO
+            };
+            moving_velocity(bodies, i) + gravity
+        };
         SweptReach {
             displacement: (velocity(b) - velocity(a)) * self.dt,
-            distance: self.prediction_distance
-                + (self.spin_speeds[a] + self.spin_speeds[b] + gravity) * self.dt,
+            turn_reach: (self.spin_speeds[a] + self.spin_speeds[b]) * self.dt,
+            horizon: 1.0 + 1.0 / self.substeps.max(1) as f32,
         }
     }
 
@@ -138,6 +157,15 @@ impl SpeculativeMargins {
     }
 }
 
+/// `manifold`'s normal in shape 1's frame: a compound part's normal turned into its body's.
+#[inline]
+fn body_normal(manifold: &Manifold) -> Vec3 {
+    match manifold.subshape_pos1() {
+        Some(part) => part.rotation * manifold.local_n1,
+        None => manifold.local_n1,
+    }
+}
+
 /// Body `i`'s linear velocity (m/s) if it moves, else zero.
 #[inline]
 fn moving_velocity(bodies: &Bodies, i: usize) -> Vec3 {
@@ -148,23 +176,29 @@ fn moving_velocity(bodies: &Bodies, i: usize) -> Vec3 {
     }
 }
 
-/// What the speculative points of a pair must meet to stand: the pair's shapes, moved apart
-/// by the straight relative motion of the step (body 2 by `displacement` against body 1),
-/// come within `distance` of each other at some time of the step.
+/// What a pair's speculative points must meet to stand: the pair's shapes, moved apart by
+/// the step's straight relative motion (body 2 by `displacement` against body 1), touch
+/// (come within `turn_reach` plus [`TOUCH_TOLERANCE`]) at some time of the step.
 ///
-/// A speculative point holds its pair's closing speed along the manifold's normal to the gap
-/// over the step, v·n ≥ −gap/dt: it acts as a plane through the witness point, unbounded
-/// across the normal. A path that passes beside the feature the point belongs to crosses
-/// that plane outside the feature and is stopped there, on nothing (a 5 cm ball at 150 m/s
-/// whose path passes 0.23 m below a wall's edge stopped on the plane of its face). The pair's own
-/// shape cast tells a real approach from such a passage: where the shapes, moved by the
-/// step's straight motion, never come within `distance`, no point of the pair can be
-/// reached in the step and all its points beyond `distance` are dropped. `distance` is the
-/// part of the pair's prediction ([`SpeculativeMargins::pair_prediction`]) that is not that
-/// straight motion: the base prediction distance, which catches velocity changes within the
-/// step (a body pushed by its neighbours), how far rotation can carry any point of either
-/// body (|ω|·R·dt) and, for a dynamic body against a static or kinematic one, what gravity
-/// adds (|g|·dt²). Points within `distance` (every resting contact) are never dropped.
+/// A speculative point holds its pair's closing speed along the manifold's normal n to the
+/// gap s over the step, v·n ≥ −s/dt: it acts as a plane through the witness point, unbounded
+/// across the normal. For convex shapes that plane separates them, so along a straight
+/// motion d it binds (s + d·n < 0) no later than the shapes touch. A path that passes beside
+/// the point's feature crosses the plane outside the feature and never touches; a point kept
+/// there stops the body on nothing (a 7.3 cm ball at 188 m/s passing 1.9 cm from a wall's
+/// edge was stopped 0.41 m from the wall and sent back). Each point whose plane the step's
+/// motion reaches is therefore checked against the motion itself, whatever its separation:
+/// where the pair's shape cast along d misses, every such point is dropped. Points the
+/// motion does not reach (every resting contact, a body sliding along a face) stay, with
+/// the base prediction distance, for velocity changes within the step (a body pushed by
+/// its neighbours); so do all points of a pair already touching, which the cast would find
+/// at time 0.
+///
+/// `turn_reach` is how far rotation can carry any point of either body in the step
+/// (|ω_a|·R_a·dt + |ω_b|·R_b·dt), which the straight cast does not follow: it widens both the
+/// points checked and the cast's target distance, so a spinning body's real contact is kept.
+/// Gravity is in `displacement` (|g|·dt² for a dynamic body against a static or kinematic
+/// one), as the step integrates it before the contacts.
 ///
 /// Box2D v3 avoids the same phantoms by keeping its speculative distance small (4 linear
 /// slops, `B2_SPECULATIVE_DISTANCE` in `constants.h`, the cut-off of every manifold function
@@ -174,15 +208,26 @@ fn moving_velocity(bodies: &Bodies, i: usize) -> Vec3 {
 pub(crate) struct SweptReach {
     /// Displacement of body 2 relative to body 1 over the step (m, world frame).
     pub displacement: Vec3,
-    /// Distance (m) within which the shapes must come along it.
-    pub distance: f32,
+    /// How far (m) rotation can carry any point of either body in the step.
+    pub turn_reach: f32,
+    /// How many steps ahead a speculative point is checked, 1 + 1/substeps: the relax solve
+    /// that ends the step's last substep holds the velocity to the gap left after it, so a
+    /// plane the motion would cross in the next step's first substep already acts on the
+    /// velocity the step ends with (a 2 cm ball passing 6 mm from a wall's corner, whose
+    /// plane it would have crossed 3 cm after the step, was turned, then bounced back).
+    pub horizon: f32,
 }
+
+/// The distance (m) within which the step's cast counts shapes as touching: half the
+/// smallest miss the sweeps check (0.2 mm), and far above the distance query's rounding
+/// (f32 over a 5 m step).
+pub(crate) const TOUCH_TOLERANCE: f32 = 1.0e-4;
 
 impl SweptReach {
     /// Drops every point of `manifolds` (of a pair whose body 2 sits at `pos12` in body 1's
-    /// frame, body 1 at world rotation `rotation1`) beyond [`SweptReach::distance`] when the
-    /// shapes, moved by the step's straight motion, stay farther apart than that distance;
-    /// whether any point was dropped. Shape pairs Parry cannot cast keep their points.
+    /// frame, body 1 at world rotation `rotation1`) whose plane the step's straight motion
+    /// reaches when the shapes, moved by that motion, do not touch; whether any point was
+    /// dropped. Shape pairs Parry cannot cast keep their points.
     pub(crate) fn drop_unreachable(
         &self,
         pos12: &Pose,
@@ -191,28 +236,53 @@ impl SweptReach {
         shape2: &dyn parry3d::shape::Shape,
         manifolds: &mut [Manifold],
     ) -> bool {
-        let beyond = |manifolds: &[Manifold]| {
-            manifolds
-                .iter()
-                .any(|m| m.points.iter().any(|p| p.dist > self.distance))
+        let turn_reach = self.horizon * self.turn_reach;
+        let target = turn_reach + TOUCH_TOLERANCE;
+        let local_displacement = rotation1.inverse() * self.displacement;
+        // Whether the motion reaches, within the horizon, the plane of a point at separation
+        // `dist` of a manifold whose normal (in shape 1's frame) is `normal`.
+        let reached = |dist: f32, normal: Vec3| {
+            dist + self.horizon * local_displacement.dot(normal) < turn_reach
         };
-        if !beyond(manifolds) {
+        if manifolds
+            .iter()
+            .flat_map(|m| &m.points)
+            .any(|p| p.dist <= target)
+            || !manifolds.iter().any(|m| {
+                let normal = body_normal(m);
+                m.points.iter().any(|p| reached(p.dist, normal))
+            })
+        {
             return false;
         }
         let options = ShapeCastOptions {
-            max_time_of_impact: 1.0,
-            target_distance: self.distance,
+            max_time_of_impact: self.horizon,
+            target_distance: turn_reach,
             stop_at_penetration: true,
             compute_impact_geometry_on_penetration: false,
         };
-        let local_displacement = rotation1.inverse() * self.displacement;
         let cast =
             ContactDispatcher.cast_shapes(pos12, local_displacement, shape1, shape2, options);
-        if !matches!(cast, Ok(None)) {
-            return false;
+        match cast {
+            Ok(None) => {}
+            // Parry's cast can report an impact for shapes that pass within a few tenths of a
+            // millimetre (a ball 0.24 mm past a box's edge, cast 1.9 m with a target distance
+            // of 0.01 mm): an impact stands only where the shapes are within the tolerance.
+            Ok(Some(hit)) => {
+                let at_impact = Pose::from_parts(
+                    pos12.translation + local_displacement * hit.time_of_impact,
+                    pos12.rotation,
+                );
+                match ContactDispatcher.distance(&at_impact, shape1, shape2) {
+                    Ok(apart) if apart.distance > target => {}
+                    _ => return false,
+                }
+            }
+            Err(_) => return false,
         }
         for manifold in manifolds.iter_mut() {
-            manifold.points.retain(|p| p.dist <= self.distance);
+            let normal = body_normal(manifold);
+            manifold.points.retain(|p| !reached(p.dist, normal));
         }
         true
     }

@@ -11,6 +11,7 @@ mod ccd;
 mod common;
 mod dead_impacts;
 mod determinism;
+mod edge_passes;
 mod fuzz_regressions;
 mod golden;
 mod guards;

@@ -134,9 +134,11 @@ fn half_space_case(seed: u64) -> Case {
     let height = rng.range(0.2, 4.0);
     let velocity = speed * direction;
     if miss {
-        // The plane is placed below the free flight's lowest frame.
+        // The plane is placed below the free flight's lowest frame, the two frames after the
+        // last one flown included: a ball whose next frame is in the plane is about to hit it,
+        // and its contact already acts on the velocity the last step ends with.
         let start = Vec3::new(0.0, 0.0, 0.0);
-        let lowest = free_flight(start, velocity, steps)
+        let lowest = free_flight(start, velocity, steps + 2)
             .iter()
             .map(|frame| frame.0.dot(normal))
             .fold(f32::INFINITY, f32::min);

@@ -8,6 +8,7 @@ impl World {
     /// Each body's speculative margin, then the candidate pairs of bodies whose loosened boxes
     /// overlap (both on rayon's threads with `parallel`).
     pub(super) fn broad_phase_stage(&mut self, settings: &SolverSettings, parallel: bool) {
+        self.margins.set_substeps(settings.substeps);
         self.margins.update(
             &self.bodies,
             settings.prediction_distance,
