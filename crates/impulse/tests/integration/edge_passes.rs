@@ -98,7 +98,7 @@ fn line_distance(case: &Case, through: Vec3, direction: Vec3) -> f32 {
     at(0.5 * (lo + hi))
 }
 
-/// A random case from `seed`: a ball or a cube (one in two, in a random orientation) at 1 cm
+/// A random case from `seed`: a ball or a cube (one in two, in a random orientation) at 15 cm
 /// to 3 m from the wall's plane along its path, at up to 75° from the wall's normal. A miss
 /// (with `miss`) is placed so that its shape passes above the top edge at a log-uniform
 /// 0.2 mm–1 m; a hit is aimed 8–30 cm below it.
