@@ -95,7 +95,9 @@ pub use scene::{
     BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
 };
 pub use scene::{Jitter, Override, Variation};
-pub use settings::{ContactRepair, ImpactModel, SettingError, SolverMethod, SolverSettings};
+pub use settings::{
+    CombineRule, ContactRepair, ImpactModel, SettingError, SolverMethod, SolverSettings,
+};
 pub use solver::{EscalationLevel, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, IslandReport};
 pub use world::LeftWorld;
 pub use world::{

@@ -120,6 +120,53 @@ impl ImpactModel {
     }
 }
 
+/// How a contact's friction or restitution coefficient is made from the two bodies' own
+/// (`solver.friction_combine`, `solver.restitution_combine` in scene files). impulse's
+/// defaults are Box2D v3's and Jolt's: the geometric mean √(μa·μb) for friction and the larger
+/// restitution. Blender's rigid bodies (Bullet, `btManifoldResult`) multiply both; Rapier's
+/// `CoefficientCombineRule` offers the average, the minimum, the product and the maximum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CombineRule {
+    /// √(a·b): friction's default. Zero when either is zero.
+    GeometricMean,
+    /// (a + b) / 2.
+    Average,
+    /// The smaller of the two.
+    Min,
+    /// The larger of the two: restitution's default (a bouncy ball bounces on any floor).
+    Max,
+    /// a·b: Blender's (Bullet's) rule for both coefficients.
+    Multiply,
+}
+
+impl CombineRule {
+    /// The pair's coefficient from the two bodies' coefficients `a` and `b` (each ≥ 0 and
+    /// finite, as scenes are validated; restitutions in [0, 1] stay in [0, 1] under every
+    /// rule).
+    #[inline]
+    pub fn combine(self, a: f32, b: f32) -> f32 {
+        match self {
+            CombineRule::GeometricMean => (a * b).sqrt(),
+            CombineRule::Average => 0.5 * (a + b),
+            CombineRule::Min => a.min(b),
+            CombineRule::Max => a.max(b),
+            CombineRule::Multiply => a * b,
+        }
+    }
+
+    /// The name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            CombineRule::GeometricMean => "geometric_mean",
+            CombineRule::Average => "average",
+            CombineRule::Min => "min",
+            CombineRule::Max => "max",
+            CombineRule::Multiply => "multiply",
+        }
+    }
+}
+
 /// Settings of the contact solve (steps 4 and 5 of docs/architecture.md).
 ///
 /// Defaults are chosen for the standard scenes at dt = 1/60 s. Units are SI.
@@ -258,6 +305,12 @@ pub struct SolverSettings {
     /// restitution, the default) or `propagation` (generalized reflections). A physical
     /// choice of the scene, like the restitution coefficients ([`ImpactModel`]).
     pub impact: ImpactModel,
+    /// How a contact's friction coefficient is made from its two bodies' ([`CombineRule`];
+    /// default the geometric mean). A physical choice of the scene, which presets keep.
+    pub friction_combine: CombineRule,
+    /// How a contact's restitution is made from its two bodies' ([`CombineRule`]; default the
+    /// larger). A physical choice of the scene, which presets keep.
+    pub restitution_combine: CombineRule,
     /// World bound (m): a moving body whose centre of mass ends a step farther than this from
     /// the origin leaves the simulation ([`crate::World::left_world`]): it is frozen where it
     /// is and the run goes on. Default 10⁵ m ([`crate::BLOW_UP_DISTANCE`]); must be > 0.
@@ -429,7 +482,8 @@ impl SolverSettings {
     /// `simd_island_contacts`.
     /// Kept from `self` (what the scene means to happen): `restitution_threshold`,
     /// `prediction_distance`, sleeping (`sleep`, `sleep_linear_speed`, `sleep_angular_speed`,
-    /// `time_to_sleep`), `friction`, `gyroscopic`, `continuous`, `fused_multiply_add` (a
+    /// `time_to_sleep`), `friction`, `friction_combine`, `restitution_combine`, `impact`,
+    /// `gyroscopic`, `continuous`, `fused_multiply_add` (a
     /// choice between speed and bits the same on every CPU), and any field not listed
     /// here. The split is tabled in docs/solvers.md, "Presets and scenes".
     pub fn with_effort_of(&self, preset: &SolverSettings) -> SolverSettings {
@@ -581,6 +635,8 @@ impl Default for SolverSettings {
             gyroscopic: true,
             continuous: true,
             impact: ImpactModel::Simultaneous,
+            friction_combine: CombineRule::GeometricMean,
+            restitution_combine: CombineRule::Max,
             max_distance: BLOW_UP_DISTANCE,
         }
     }

@@ -184,8 +184,12 @@ impl Assembly<'_> {
         let pose_b = &bodies.pose[b];
         let com_a = self.world_center_of_mass[a];
         let com_b = self.world_center_of_mass[b];
-        let friction = (bodies.friction[a] * bodies.friction[b]).sqrt();
-        let restitution = bodies.restitution[a].max(bodies.restitution[b]);
+        let friction = settings
+            .friction_combine
+            .combine(bodies.friction[a], bodies.friction[b]);
+        let restitution = settings
+            .restitution_combine
+            .combine(bodies.restitution[a], bodies.restitution[b]);
         let inverse_mass_a = bodies.effective_inverse_mass(a);
         let inverse_mass_b = bodies.effective_inverse_mass(b);
         // The lanes compute the products of points whose bodies have no translation locked

@@ -24,6 +24,7 @@ mod kinematic;
 mod locked_axes;
 mod malformed_meshes;
 mod malformed_scenes;
+mod material_combine;
 mod meshes;
 mod phantom_and_tunnel;
 mod physics;
