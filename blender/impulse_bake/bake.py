@@ -269,7 +269,7 @@ class Baker:
             obj = objects[info.object_name]
             keyed_names.add(obj.name)
             location, rotation = _object_space(info, locations[:, column], quaternions[:, column])
-            keyframes.write_fcurves(obj, frames, location, rotation)
+            keyframes.write_fcurves(obj, frames, location, rotation, info.start)
         for obj in scene_reader.rigid_body_objects(self.scene):
             if obj.name not in keyed_names and keyframes.is_baked(obj):
                 keyframes.free_bake(obj, self.info.frame_start)

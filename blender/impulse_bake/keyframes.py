@@ -87,6 +87,12 @@ def is_baked(obj):
     )
 
 
+def animates_transform(obj):
+    """Whether the animator keyed the object's location or rotation (F-curves not the
+    bake's)."""
+    return _animator_transform_curves(obj)
+
+
 def _animator_transform_curves(obj):
     fcurves = _fcurve_collection(obj, create=False)
     if fcurves is None:
@@ -198,10 +204,33 @@ def _euler_xyz(quaternions):
     return np.unwrap(angles, axis=0)
 
 
-def write_fcurves(obj, frames, locations, quaternions):
+def start_values(obj):
+    """The object's own location and rotation channels (data path → values), for
+    :func:`write_fcurves`'s ``start``."""
+    return {path: tuple(getattr(obj, path)) for path, _ in TRANSFORM_CHANNELS}
+
+
+def _match_start(path, values, start):
+    """``values`` (F, n) of channel ``path`` with the first frame exactly the object's own
+    ``start`` value and the rest continuous with it: quaternions negated together when the
+    start has the other sign, Euler angles shifted together by whole turns."""
+    values = np.array(values, dtype=np.float64, copy=True)
+    first = np.asarray(start, dtype=np.float64)
+    if path == "rotation_quaternion" and np.dot(values[0], first) < 0:
+        values = -values
+    elif path == "rotation_euler":
+        values += 2.0 * np.pi * np.round((first - values[0]) / (2.0 * np.pi))
+    values[0] = first
+    return values
+
+
+def write_fcurves(obj, frames, locations, quaternions, start=None):
     """Key the object's location and rotation at ``frames`` (F,) with ``locations`` (F, 3) and
     ``quaternions`` (F, 4, w x y z; written in the object's rotation mode), replacing an earlier
-    bake's curves and keeping the animator's own (:func:`_keep_the_animation`).
+    bake's curves and keeping the animator's own (:func:`_keep_the_animation`). ``start`` maps
+    the channels' data paths to the object's own values at the first frame, keyed there
+    exactly as they were (:func:`start_values`): a re-bake of an unchanged scene then reads the
+    same start, where the pose's round trip through a matrix would move it by rounding.
 
     Each curve gets its F points in one ``keyframe_points.add`` and its (frame, value) pairs in
     one ``foreach_set("co", ...)``; points are linear so that the pose between two frames is
@@ -223,6 +252,9 @@ def write_fcurves(obj, frames, locations, quaternions):
     co[:, 0] = frames
     linear = None
     rotation_path, rotations = rotation_channel(obj, quaternions)
+    if start is not None and count > 0:
+        locations = _match_start("location", locations, start["location"])
+        rotations = _match_start(rotation_path, rotations, start[rotation_path])
     for path, values in (("location", locations), (rotation_path, rotations)):
         values = np.asarray(values)
         for index in range(values.shape[1]):

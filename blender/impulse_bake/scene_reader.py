@@ -7,9 +7,9 @@ What maps to what (docs/blender.md has the animator's version):
   body settings), its gravity (the scene's, times the world's effector weight for gravity; zero
   when the scene's gravity is off), its frame range (the point cache's start and end frame) and
   the time step dt = time_scale / fps;
-- the scene as it is at the start frame is the initial state: when the scene is at the start
-  frame, its objects' poses are read as they are (unkeyed edits included), else the scene is
-  set to the start frame;
+- the scene as it is at the start frame is the initial state: the scene is set to the start
+  frame and, when it was there already, objects whose transform the animator does not animate
+  keep their unkeyed edits (a baked object moved in the viewport starts where it was put);
 - an object is "animated" at a frame when "Animated" (``kinematic``) is ticked, or when it is
   Active with "Dynamic" (``enabled``) unticked (Blender then moves it with its own transform, as
   an animated one); both flags are read at every frame when they are keyed. An Active object is
@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 import bpy
 import mathutils
 
-from . import axes, constraints, shapes
+from . import axes, constraints, keyframes, shapes
 
 #: The ways two bodies' friction and bounciness combine: Blender's (Bullet's) or impulse's own.
 MATERIAL_RULES = ("blender", "impulse")
@@ -76,7 +76,8 @@ class BodyInfo:
     parent's space (the parent's world matrix times the parent inverse) at every frame for a
     keyed object with a parent, else None. ``active``: the object is Active; ``dynamics`` its
     ``mass`` and damping fields, in ``body`` while the body is dynamic; ``shape_label`` the
-    collision shape's name in the panel.
+    collision shape's name in the panel; ``start`` the object's own location and
+    rotation channels at the start frame (:func:`keyframes.start_values`).
     """
 
     object_name: str
@@ -91,6 +92,7 @@ class BodyInfo:
     active: bool = False
     dynamics: dict = field(default_factory=dict)
     shape_label: str = ""
+    start: dict = None
 
 
 @dataclass
@@ -149,9 +151,7 @@ def _animated(obj):
 
 def _flags_keyed(obj):
     """Whether the object's "Animated" or "Dynamic" flag is keyed (or driven)."""
-    from .keyframes import _fcurve_collection
-
-    fcurves = _fcurve_collection(obj, create=False)
+    fcurves = keyframes._fcurve_collection(obj, create=False)
     if fcurves is not None and any(fc.data_path in FLAG_PATHS for fc in fcurves):
         return True
     animation = obj.animation_data
@@ -239,9 +239,10 @@ def read_scene(scene, depsgraph=None, materials="blender"):
     view_layer = bpy.context.view_layer
     world.enabled = False
     try:
-        if scene.frame_current != frame_start:
-            scene.frame_set(frame_start)
-        else:
+        scene.frame_set(frame_start)
+        if frame_before == frame_start:
+            # Unkeyed edits at the start frame count, except on what the animator animates.
+            _put_back([o for o in objects if not keyframes.animates_transform(o)], saved)
             view_layer.update()
         depsgraph = bpy.context.evaluated_depsgraph_get() if depsgraph is None else depsgraph
         meshes = shapes.Meshes(objects, depsgraph, view_layer)
@@ -283,6 +284,7 @@ def read_scene(scene, depsgraph=None, materials="blender"):
                 "mask": _groups(rigid_body),
             }
             info = BodyInfo(obj.name, kind, body, scale=scale, basis_scale=tuple(obj.scale))
+            info.start = keyframes.start_values(obj)
             info.active = rigid_body.type == "ACTIVE"
             info.shape_label = shapes.SHAPE_NAMES.get(rigid_body.collision_shape, rigid_body.collision_shape)
             if info.active:

