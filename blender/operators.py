@@ -40,6 +40,16 @@ class ImpulseBakeSettings(bpy.types.PropertyGroup):
         ),
         default="blender",
     )
+    mesh_resolution: bpy.props.IntProperty(
+        name="Mesh Detail",
+        description=(
+            "Voxels along the longest side when a moving object's Mesh shape is split into convex parts; "
+            "0 takes impulse's default (64). A hole or wall thinner than about one voxel is closed"
+        ),
+        default=0,
+        min=0,
+        max=512,
+    )
     steps_per_frame: bpy.props.IntProperty(
         name="Steps per Frame",
         description="Simulation steps per frame (contacts are found once a step); 0 keeps a step within 1/60 s",
@@ -79,7 +89,12 @@ class IMPULSE_OT_bake(bpy.types.Operator):
         settings = context.scene.impulse_bake
         try:
             baker = bake.Baker(
-                context.scene, settings.preset, settings.substeps, settings.steps_per_frame, settings.materials
+                context.scene,
+                settings.preset,
+                settings.substeps,
+                settings.steps_per_frame,
+                settings.materials,
+                settings.mesh_resolution,
             )
         except scene_reader.UnsupportedScene as error:
             self.report({"ERROR"}, "impulse: not baked (the earlier bake is kept): " + "; ".join(error.problems))
@@ -177,6 +192,7 @@ def _draw(layout, context):
     column = layout.column()
     column.prop(settings, "preset")
     column.prop(settings, "materials")
+    column.prop(settings, "mesh_resolution")
     column.prop(settings, "substeps")
     column.prop(settings, "steps_per_frame")
     row = column.row()

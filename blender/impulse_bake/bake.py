@@ -120,12 +120,13 @@ class Baker:
 
     Raises :class:`scene_reader.UnsupportedScene` from the constructor, with every problem of
     the scene in the animator's terms, when the scene cannot be represented. ``materials``:
-    one of :data:`scene_reader.MATERIAL_RULES`.
+    one of :data:`scene_reader.MATERIAL_RULES`; ``resolution``: a moving Mesh's decomposition
+    resolution, 0 the engine's default (:func:`shapes.build`).
     """
 
-    def __init__(self, scene, preset="default", substeps=0, frame_steps=0, materials="blender"):
+    def __init__(self, scene, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0):
         self.scene = scene
-        self.info = scene_reader.read_scene(scene, materials=materials)
+        self.info = scene_reader.read_scene(scene, materials=materials, resolution=resolution)
         impulse = import_impulse()
         self.impulse = impulse
         try:
@@ -309,10 +310,10 @@ def _object_space(info, locations, quaternions):
     return out_locations, axes.continuous_quaternions(out_quaternions[:, None])[:, 0]
 
 
-def bake_scene(scene, preset="default", substeps=0, frame_steps=0, materials="blender"):
+def bake_scene(scene, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0):
     """Bake the scene's Rigid Body World with impulse at once; returns the :class:`Baker`
     (its ``simulation_seconds`` and ``write_seconds`` are the two parts' wall times)."""
-    baker = Baker(scene, preset, substeps, frame_steps, materials)
+    baker = Baker(scene, preset, substeps, frame_steps, materials, resolution)
     baker.advance()
     baker.write()
     return baker

@@ -33,8 +33,7 @@ What maps to what (docs/blender.md has the animator's version):
 
 Problems (a shape without geometry, the Compound Parent shape, a zero scale) are collected for
 every object and raised together as :class:`UnsupportedScene`, each message naming the object;
-approximations (a flat shape baked thin, a Mesh on an animated object baked as its hull) are
-``SceneInfo.notes``.
+approximations (a flat shape baked thin) are ``SceneInfo.notes``.
 """
 
 import math
@@ -214,13 +213,14 @@ def _material(rigid_body, materials):
     return {"friction": friction, "restitution": min(max(float(rigid_body.restitution), 0.0), 1.0)}
 
 
-def read_scene(scene, depsgraph=None, materials="blender"):
+def read_scene(scene, depsgraph=None, materials="blender", resolution=0):
     """The scene's Rigid Body World as a :class:`SceneInfo`.
 
     Reads the scene as it is at the world's first frame (see the module's notes) and, when
     objects are animated at some frame or parented, every frame of the range; the current
     frame is put back afterwards, with the objects' unkeyed transforms. Blender's own rigid body
-    simulation is held off while reading. ``materials``: one of :data:`MATERIAL_RULES`. Raises
+    simulation is held off while reading. ``materials``: one of :data:`MATERIAL_RULES`;
+    ``resolution``: a moving Mesh's decomposition resolution (:func:`shapes.build`). Raises
     :class:`UnsupportedScene` listing every problem of every object.
     """
     if materials not in MATERIAL_RULES:
@@ -268,7 +268,7 @@ def read_scene(scene, depsgraph=None, materials="blender"):
                 shape_kind = "kinematic"
             else:
                 shape_kind = "static"
-            shape, shape_notes, shape_problems = shapes.build(obj, shape_kind, scale, meshes)
+            shape, shape_notes, shape_problems = shapes.build(obj, shape_kind, scale, meshes, resolution)
             notes += shape_notes
             problems += shape_problems
             if shape is None:

@@ -6,8 +6,8 @@ docs/scene-format.md "Shapes"), sized and placed as Blender (Bullet) sizes and p
   centred on the body's origin); Sphere's radius is half the largest dimension; Capsule,
   Cylinder and Cone have the radius half the larger of x and y, the height the z dimension.
 - Convex Hull is the hull of the mesh's points; Mesh is a triangle mesh (two-sided on a static
-  body; on a dynamic body the engine decomposes it into convex parts); Mesh on an "Animated"
-  object is its convex hull, reported as a note.
+  body; on a dynamic or kinematic body the engine decomposes it into convex parts, with the
+  ``decomposition`` resolution given, else the engine's default).
 - Flat objects (a plane with the default Convex Hull, a Box of zero thickness) are thin shapes:
   coplanar hull points or a zero half-extent, with ``thickness`` = 2 × the collision margin when
   the object's "Collision Margin" is ticked (the engine's default thickness otherwise), and a note.
@@ -164,10 +164,12 @@ def _primitive(shape_type, dims):
     return {"type": "cone", "half_height": half_height, "radius": radius}
 
 
-def build(obj, kind, scale, meshes):
+def build(obj, kind, scale, meshes, resolution=0):
     """(shape dict or None, notes, problems) of the object's rigid body as a body of ``kind``
     with the world scale ``scale`` (3, signed: a mirrored object has negative components).
-    Notes and problems are messages in the animator's terms, each led by the object's name."""
+    ``resolution`` > 0: the voxels along the longest side of a moving Mesh's decomposition
+    (the engine's default otherwise). Notes and problems are messages in the animator's terms,
+    each led by the object's name."""
     rigid_body = obj.rigid_body
     shape_type = rigid_body.collision_shape
     label = SHAPE_NAMES.get(shape_type, shape_type)
@@ -185,7 +187,7 @@ def build(obj, kind, scale, meshes):
         if rank < 2:
             return None, [], [f"{name}: shape {label}: the mesh is a point or a line, it has no surface to collide with"]
         mirrored = np.prod(np.sign(scale)) < 0
-        if shape_type == "MESH" and kind != "kinematic":
+        if shape_type == "MESH":
             edges = np.cross(points[triangles[:, 1]] - points[triangles[:, 0]], points[triangles[:, 2]] - points[triangles[:, 0]])
             extent = float(np.max(np.ptp(points, axis=0)))
             kept = triangles[np.linalg.norm(edges, axis=1) > 1e-10 * max(extent, 1e-9) ** 2]
@@ -196,10 +198,10 @@ def build(obj, kind, scale, meshes):
             shape = {"type": "trimesh", "vertices": _to_impulse(points), "indices": kept.tolist()}
             if kind == "static":
                 shape["two_sided"] = True
+            elif resolution > 0:
+                shape["decomposition"] = {"resolution": int(resolution)}
             return shape, [], []
         notes = []
-        if shape_type == "MESH":
-            notes.append(f"{name}: a Mesh shape on an Animated object is baked as its convex hull")
         shape = {"type": "convex_hull", "points": _to_impulse(points)}
         if rank == 2:
             notes.append(f"{name}: a flat {label} — baked as a thin shape")

@@ -205,6 +205,21 @@ def test_friction_combines_as_blender_multiplies_it_or_as_impulse_does(materials
         assert moved < 0.01
 
 
+def test_a_moving_mesh_shape_is_a_triangle_mesh_never_its_hull():
+    scene = field.startup(4)
+    ring = field.add("torus", "Ring", location=(0.0, 0.0, 3.0))
+    field.rigid(ring)
+    floor = field.add("plane", "Floor", size=20.0)
+    field.rigid(floor, "PASSIVE")
+    for obj in (ring, floor):
+        obj.rigid_body.collision_shape = "MESH"
+    bodies = {b.object_name: b.body for b in scene_reader.read_scene(scene, resolution=96).bodies}
+    assert bodies["Ring"]["shape"]["type"] == "trimesh"
+    assert bodies["Ring"]["shape"]["decomposition"] == {"resolution": 96}
+    assert len(bodies["Ring"]["shape"]["indices"]) == 2 * len(ring.data.polygons)
+    assert bodies["Floor"]["shape"]["two_sided"] and "decomposition" not in bodies["Floor"]["shape"]
+
+
 def test_a_torus_dropped_over_a_peg_threads_onto_it():
     # Needs the engine's convex decomposition of a Mesh shape on a dynamic body.
     scene = field.startup(72)
