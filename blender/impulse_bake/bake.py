@@ -285,7 +285,9 @@ def _object_space(info, locations, quaternions):
     in its parent's space and divided by its own Scale (a mirrored object's negative scale
     moves into its rotation otherwise). As they are for an object without a parent whose world
     scale is its Scale."""
-    if info.parent_space is None and np.allclose(info.scale, info.basis_scale, rtol=1e-6, atol=1e-9):
+    if info.parent_space is None and all(
+        abs(a - b) <= 1e-9 + 1e-6 * abs(b) for a, b in zip(info.scale, info.basis_scale, strict=True)
+    ):
         return locations, quaternions
     import mathutils
 
