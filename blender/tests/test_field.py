@@ -8,16 +8,18 @@ import bpy
 import mathutils
 import numpy as np
 import pytest
-from impulse_bake import bake, scene_reader
+from impulse_bake import bake, keyframes, scene_reader
 
 import field
 
 FRAMES = 48
 
 
-def test_a_ball_keyed_animated_then_released_keeps_flying_and_reaches_the_wall():
-    # The standard throw: animate the ball with Animated ticked, key Animated off after the
-    # last key of the throw; Blender's simulation takes over with the animation's velocity.
+@pytest.mark.parametrize(("flag", "animated"), [("rigid_body.kinematic", True), ("rigid_body.enabled", False)])
+def test_a_ball_keyed_animated_then_released_keeps_flying_and_reaches_the_wall(flag, animated):
+    # The standard throw: animate the ball with Animated ticked (or Dynamic unticked), key the
+    # flag the other way after the last key of the throw; Blender's simulation takes over with
+    # the animation's velocity.
     scene = field.startup(FRAMES)
     wall = field.add("cube", "Wall", size=1.0, location=(7.25, 0.0, 2.5))
     wall.scale = (0.5, 6.0, 5.0)
@@ -27,9 +29,9 @@ def test_a_ball_keyed_animated_then_released_keeps_flying_and_reaches_the_wall()
     field.rigid(ball)
     field.key(ball, "location", 1, (0.0, 0.0, 2.0))
     field.key(ball, "location", 10, (3.0, 0.0, 2.5))
-    field.key(ball, "rigid_body.kinematic", 1, True, interpolation=None)
-    field.key(ball, "rigid_body.kinematic", 10, True, interpolation=None)
-    field.key(ball, "rigid_body.kinematic", 11, False, interpolation=None)
+    field.key(ball, flag, 1, animated, interpolation=None)
+    field.key(ball, flag, 10, animated, interpolation=None)
+    field.key(ball, flag, 11, not animated, interpolation=None)
 
     bake.bake_scene(scene)
 
@@ -45,6 +47,28 @@ def test_a_ball_keyed_animated_then_released_keeps_flying_and_reaches_the_wall()
     assert max(xs) <= face - 0.5 + 0.01, "and does not pass into it"
     # The ball's own animation is kept: the bake wrote into a copy of its action.
     assert ball.animation_data.action.get("impulse_original_action")
+
+
+def test_a_simulated_ball_keyed_animated_again_snaps_to_its_animation_and_follows_it():
+    scene = field.startup(FRAMES)
+    field.ground()
+    ball = field.add("uv_sphere", "Ball", radius=0.5, location=(0.0, 0.0, 0.5))
+    field.rigid(ball)
+    field.key(ball, "rigid_body.kinematic", 1, False, interpolation=None)
+    field.key(ball, "rigid_body.kinematic", 20, True, interpolation=None)
+    # Held at the start until frame 20 (a constant key), then lifted and carried along x.
+    field.key(ball, "location", 1, (0.0, 0.0, 0.5))
+    field.key(ball, "location", 20, (0.0, 0.0, 3.0))
+    field.key(ball, "location", 40, (4.0, 0.0, 3.0))
+    for fcurve in keyframes._fcurve_collection(ball, create=False):
+        if fcurve.data_path == "location":
+            fcurve.keyframe_points[0].interpolation = "CONSTANT"
+    bake.bake_scene(scene)
+    assert field.world_at(scene, ball, 10).translation.z == pytest.approx(0.5, abs=0.01), "resting, simulated"
+    for frame in (20, 30, 40):
+        expected = (frame - 20) / 20 * 4.0
+        at = field.world_at(scene, ball, frame).translation
+        assert (at.x, at.z) == (pytest.approx(expected, abs=1e-3), pytest.approx(3.0, abs=1e-3)), frame
 
 
 def test_a_ball_released_while_spinning_keeps_its_spin():
