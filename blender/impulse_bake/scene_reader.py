@@ -31,7 +31,7 @@ What maps to what (docs/blender.md has the animator's version):
 - rigid body constraints: the scene's ``joints`` (:mod:`constraints`), read at the first frame;
   settings impulse does not follow are ``SceneInfo.warnings``.
 
-Problems (a shape without geometry, the Compound Parent shape, a zero scale) are collected for
+Problems (a shape without geometry, a Compound Parent without children, a zero scale) are collected for
 every object and raised together as :class:`UnsupportedScene`, each message naming the object;
 approximations (a flat shape baked thin) are ``SceneInfo.notes``.
 """
@@ -247,7 +247,16 @@ def read_scene(scene, depsgraph=None, materials="blender", resolution=0):
         depsgraph = bpy.context.evaluated_depsgraph_get() if depsgraph is None else depsgraph
         meshes = shapes.Meshes(objects, depsgraph, view_layer)
         bodies, tracked = [], []
+        in_world = {o.name for o in objects}
+        children = {
+            o.name: sorted((c for c in o.children if c.name in in_world), key=lambda c: c.name)
+            for o in objects
+            if o.rigid_body.collision_shape == "COMPOUND"
+        }
+        parts = {c.name for group in children.values() for c in group}
         for obj in objects:
+            if obj.name in parts:
+                continue  # a part of its parent's Compound Parent shape
             rigid_body = obj.rigid_body
             keyed_flags = _flags_keyed(obj)
             animated = _animated(obj)
@@ -268,7 +277,10 @@ def read_scene(scene, depsgraph=None, materials="blender", resolution=0):
                 shape_kind = "kinematic"
             else:
                 shape_kind = "static"
-            shape, shape_notes, shape_problems = shapes.build(obj, shape_kind, scale, meshes, resolution)
+            if obj.name in children:
+                shape, shape_notes, shape_problems = shapes.compound(obj, children[obj.name], meshes)
+            else:
+                shape, shape_notes, shape_problems = shapes.build(obj, shape_kind, scale, meshes, resolution)
             notes += shape_notes
             problems += shape_problems
             if shape is None:

@@ -176,7 +176,7 @@ def build(obj, kind, scale, meshes, resolution=0):
     name = obj.name
     scale = np.asarray(scale, dtype=np.float64)
     if shape_type == "COMPOUND":
-        return None, [], [f"{name}: shape {label} is not supported yet: use Convex Hull or Mesh on the joined object"]
+        return None, [], [f"{name}: shape {label} is built by compound()"]
     if shape_type in ("CONVEX_HULL", "MESH"):
         data = meshes.get(name)
         if data is None or len(data[0]) == 0:
@@ -223,6 +223,42 @@ def build(obj, kind, scale, meshes, resolution=0):
     if max(dims[0], dims[1]) < FLAT_EXTENT or dims[2] < FLAT_EXTENT:
         return None, [], [f"{name}: shape {label} is flat (dimensions {_dims(dims)} m): use Box or Convex Hull"]
     return _primitive(shape_type, dims), [], []
+
+
+def compound(obj, children, meshes):
+    """(shape dict or None, notes, problems) of a Compound Parent: the shapes of its children
+    with rigid bodies (``children``), each placed where the child is relative to the parent's
+    unscaled frame, as Blender builds it (the children's own settings but the shape are
+    ignored; they move with the parent)."""
+    import mathutils
+
+    name = obj.name
+    if not children:
+        return None, [], [f"{name}: shape Compound Parent has no children with a rigid body"]
+    location, rotation, _ = obj.matrix_world.decompose()
+    frame = (mathutils.Matrix.Translation(location) @ rotation.to_matrix().to_4x4()).inverted_safe()
+    parts, notes, problems = [], [], []
+    for child in children:
+        child_type = child.rigid_body.collision_shape
+        if child_type in ("MESH", "COMPOUND"):
+            label = SHAPE_NAMES[child_type]
+            problems.append(f"{child.name}: shape {label} cannot be part of {name}'s Compound Parent: use Convex Hull")
+            continue
+        place, turn, scale = (frame @ child.matrix_world).decompose()
+        shape, child_notes, child_problems = build(child, "dynamic", tuple(scale), meshes)
+        notes += child_notes
+        problems += child_problems
+        if shape is not None:
+            parts.append(
+                {
+                    "shape": shape,
+                    "position": axes.vector_to_impulse(place),
+                    "orientation": axes.quaternion_to_impulse(turn),
+                }
+            )
+    if problems:
+        return None, notes, problems
+    return {"type": "compound", "parts": parts}, notes, []
 
 
 def _dims(dims):

@@ -175,6 +175,36 @@ def test_a_mirrored_object_falls_as_the_mirror_image_of_the_original():
     assert tuple(mirrored.scale) == pytest.approx((-1.0, 1.0, 1.0))
 
 
+def test_a_compound_parent_falls_as_one_body_on_its_childrens_shapes():
+    # A table: a top whose shape is Compound Parent, two legs parented to it (default shapes).
+    scene = field.startup(FRAMES)
+    field.ground()
+    top = field.add("cube", "Table", size=1.0, location=(0.0, 0.0, 2.05))
+    top.scale = (2.0, 1.0, 0.1)
+    legs = []
+    for side in (-1.0, 1.0):
+        leg = field.add("cube", f"Leg{'L' if side < 0 else 'R'}", size=1.0, location=(0.9 * side, 0.0, 1.5))
+        leg.scale = (0.1, 0.8, 1.0)
+        legs.append(leg)
+    bpy.context.view_layer.update()
+    for leg in legs:
+        field.select(leg)
+        top.select_set(True)
+        bpy.context.view_layer.objects.active = top
+        bpy.ops.object.parent_set(type="OBJECT", keep_transform=True)
+        field.rigid(leg)
+    field.rigid(top)
+    top.rigid_body.collision_shape = "COMPOUND"
+    info = scene_reader.read_scene(scene)
+    assert [b.object_name for b in info.bodies] == ["Ground", "Table"]
+    assert len(info.bodies[1].body["shape"]["parts"]) == 2
+    bake.bake_scene(scene)
+    for leg in legs:
+        lowest = min(v.z for v in field.world_vertices(scene, leg, FRAMES))
+        assert lowest == pytest.approx(0.0, abs=0.01), leg.name
+    assert field.world_at(scene, top, FRAMES).translation.z == pytest.approx(1.05, abs=0.01)
+
+
 def test_source_deform_is_the_base_mesh_with_the_leading_deform_modifiers():
     scene = field.startup(4)
     cube = field.add("cube", "Bevelled", size=2.0, location=(0.0, 0.0, 3.0))
