@@ -10,6 +10,9 @@ _POSITION = re.compile(r"^[^\s:]*:\d+:\d+: ")
 #: The scene format's path of a body's or joint's field: ``bodies[1] ("Plane").shape.points: ``.
 _PATH = re.compile(r'^(bodies|joints)\[(\d+)\](?: \("(?:[^"\\]|\\.)*"\))?((?:\.\w+|\[\d+\]|\["[^"]*"\])*): ')
 
+#: The world builder's form of a body's field: ``cannot build the world: body 1 ("Plane"): shape.points: ``.
+_BODY = re.compile(r'^(?:[^:]*: )?body (\d+)(?: \("(?:[^"\\]|\\.)*"\))?: ((?:\w+)(?:\.\w+|\[\d+\])*): ')
+
 #: Scene-format fields of a body as the Physics panel names them.
 _FIELDS = {
     "material.friction": "Friction",
@@ -28,6 +31,9 @@ def translate(message, info):
     (:class:`scene_reader.SceneInfo`) led by the object's (or the constraint's) name and the
     setting's name as the panel shows it, without the file position or the field path."""
     message = _POSITION.sub("", message.strip())
+    body_form = _BODY.match(message)
+    if body_form is not None:
+        message = f"bodies[{body_form.group(1)}].{body_form.group(2)}: " + message[body_form.end():]
     found = _PATH.match(message)
     if found is None:
         return f"{info.scene.get('name', 'scene')}: {message}"
@@ -73,5 +79,7 @@ def every_problem(info, error, build):
 
 
 def _renumber(message, index, which="bodies"):
-    """A message about ``which[0]`` of a one-item scene as one about ``which[index]``."""
-    return re.sub(rf"{which}\[0\]", f"{which}[{index}]", message, count=1)
+    """A message about ``which[0]`` (or ``body 0``) of a one-item scene as one about
+    ``which[index]``."""
+    message = re.sub(rf"{which}\[0\]", f"{which}[{index}]", message, count=1)
+    return re.sub(r"\bbody 0\b", f"body {index}", message, count=1) if which == "bodies" else message
