@@ -187,7 +187,7 @@ def build(obj, kind, scale, meshes, resolution=0):
         if rank < 2:
             return None, [], [f"{name}: shape {label}: the mesh is a point or a line, it has no surface to collide with"]
         mirrored = np.prod(np.sign(scale)) < 0
-        if shape_type == "MESH":
+        if shape_type == "MESH" and not (rank == 2 and kind != "static"):
             edges = np.cross(points[triangles[:, 1]] - points[triangles[:, 0]], points[triangles[:, 2]] - points[triangles[:, 0]])
             extent = float(np.max(np.ptp(points, axis=0)))
             kept = triangles[np.linalg.norm(edges, axis=1) > 1e-10 * max(extent, 1e-9) ** 2]
@@ -204,7 +204,9 @@ def build(obj, kind, scale, meshes, resolution=0):
         notes = []
         shape = {"type": "convex_hull", "points": _to_impulse(points)}
         if rank == 2:
-            notes.append(f"{name}: a flat {label} — baked as a thin shape")
+            # A flat mesh bounds no solid to decompose: a moving one is its flat hull.
+            thin = "the thin hull of its outline" if shape_type == "MESH" else "a thin shape"
+            notes.append(f"{name}: a flat {label} — baked as {thin}")
             _thickness(shape, rigid_body)
         return shape, notes, []
     corners = np.array([tuple(c) for c in obj.bound_box], dtype=np.float64)
