@@ -31,6 +31,25 @@ class ImpulseBakeSettings(bpy.types.PropertyGroup):
         min=0,
         soft_max=200,
     )
+    materials: bpy.props.EnumProperty(
+        name="Materials",
+        description="How two objects' Friction and Bounciness combine",
+        items=(
+            ("blender", "Blender", "Friction multiplied as Blender (Bullet) does; Bounciness the larger of the two"),
+            ("impulse", "impulse", "impulse's own rules: the geometric mean of the frictions, the larger Bounciness"),
+        ),
+        default="blender",
+    )
+    mesh_resolution: bpy.props.IntProperty(
+        name="Mesh Detail",
+        description=(
+            "Voxels along the longest side when a moving object's Mesh shape is split into convex parts; "
+            "0 takes impulse's default (64). A hole or wall thinner than about one voxel is closed"
+        ),
+        default=0,
+        min=0,
+        max=512,
+    )
     steps_per_frame: bpy.props.IntProperty(
         name="Steps per Frame",
         description="Simulation steps per frame (contacts are found once a step); 0 keeps a step within 1/60 s",
@@ -51,7 +70,8 @@ def _bake_report(baker, cancelled):
 
 class IMPULSE_OT_bake(bpy.types.Operator):
     """Simulate the Rigid Body World with impulse and write keyframes on its active objects
-    (replacing an earlier bake; Blender's own simulation is then turned off)"""
+    (replacing an earlier bake; Blender's own simulation is then turned off). A refused or
+    cancelled bake leaves the earlier bake as it was"""
 
     bl_idname = "impulse.bake"
     bl_label = "Bake with impulse"
@@ -68,10 +88,16 @@ class IMPULSE_OT_bake(bpy.types.Operator):
     def _start(self, context):
         settings = context.scene.impulse_bake
         try:
-            baker = bake.Baker(context.scene, settings.preset, settings.substeps, settings.steps_per_frame)
+            baker = bake.Baker(
+                context.scene,
+                settings.preset,
+                settings.substeps,
+                settings.steps_per_frame,
+                settings.materials,
+                settings.mesh_resolution,
+            )
         except scene_reader.UnsupportedScene as error:
-            for problem in error.problems:
-                self.report({"ERROR"}, problem)
+            self.report({"ERROR"}, "impulse: not baked (the earlier bake is kept): " + "; ".join(error.problems))
             return None
         except (ValueError, RuntimeError, ImportError) as error:
             # impulse's SceneError / WorldError / StepError, or a missing package.
@@ -79,6 +105,8 @@ class IMPULSE_OT_bake(bpy.types.Operator):
             return None
         for warning in baker.info.warnings:
             self.report({"WARNING"}, f"impulse: {warning}")
+        for note in baker.info.notes:
+            self.report({"INFO"}, f"impulse: {note}")
         return baker
 
     def execute(self, context):
@@ -88,7 +116,8 @@ class IMPULSE_OT_bake(bpy.types.Operator):
         try:
             baker.advance()
         except RuntimeError as error:
-            self.report({"WARNING"}, f"impulse: {error}; keeping the frames done")
+            self.report({"ERROR"}, f"impulse: {error}; not baked (the earlier bake is kept)")
+            return {"CANCELLED"}
         baker.write()
         self.report({"INFO"}, _bake_report(baker, cancelled=not baker.done))
         return {"FINISHED"}
@@ -110,12 +139,14 @@ class IMPULSE_OT_bake(bpy.types.Operator):
         window_manager.event_timer_remove(IMPULSE_OT_bake._timer)
         window_manager.progress_end()
         context.workspace.status_text_set(None)
-        baker.write()
-        if failure is not None:
-            self.report({"WARNING"}, f"impulse: {failure}; keeping the frames done")
-        self.report({"INFO"}, _bake_report(baker, cancelled))
         IMPULSE_OT_bake._baker = None
         IMPULSE_OT_bake._timer = None
+        if failure is not None or cancelled:
+            reason = f"{failure}; " if failure is not None else ""
+            self.report({"WARNING"}, f"impulse: {reason}cancelled at frame {baker.frames_done}: the earlier bake is kept")
+            return {"CANCELLED"}
+        baker.write()
+        self.report({"INFO"}, _bake_report(baker, cancelled))
         return {"FINISHED"}
 
     def modal(self, context, event):
@@ -130,20 +161,43 @@ class IMPULSE_OT_bake(bpy.types.Operator):
             return self._finish(context, cancelled=True, failure=error)
         context.window_manager.progress_update(baker.frames_done)
         context.workspace.status_text_set(
-            f"impulse: frame {baker.frames_done}/{baker.total_frames} (Esc cancels, keeping the frames done)"
+            f"impulse: frame {baker.frames_done}/{baker.total_frames} (Esc cancels, keeping the earlier bake)"
         )
         if baker.done:
             return self._finish(context, cancelled=False)
         return {"RUNNING_MODAL"}
 
 
+class IMPULSE_OT_free_bake(bpy.types.Operator):
+    """Remove impulse's keyframes from the Rigid Body World's objects (each back at its start
+    pose, animated objects' own animation back) and turn Blender's own simulation on again"""
+
+    bl_idname = "impulse.free_bake"
+    bl_label = "Free impulse Bake"
+    bl_options = {"REGISTER", "UNDO"}  # noqa: RUF012  (Blender reads it as a class attribute)
+
+    @classmethod
+    def poll(cls, context):
+        world = context.scene.rigidbody_world if context.scene else None
+        return world is not None and world.collection is not None
+
+    def execute(self, context):
+        freed = bake.free_bake(context.scene)
+        self.report({"INFO"}, f"impulse: freed the bake of {freed} objects; Blender's simulation is on")
+        return {"FINISHED"}
+
+
 def _draw(layout, context):
     settings = context.scene.impulse_bake
     column = layout.column()
     column.prop(settings, "preset")
+    column.prop(settings, "materials")
+    column.prop(settings, "mesh_resolution")
     column.prop(settings, "substeps")
     column.prop(settings, "steps_per_frame")
-    column.operator(IMPULSE_OT_bake.bl_idname, icon="PHYSICS")
+    row = column.row()
+    row.operator(IMPULSE_OT_bake.bl_idname, icon="PHYSICS")
+    row.operator(IMPULSE_OT_free_bake.bl_idname, icon="TRASH")
 
 
 class SCENE_PT_impulse_bake(bpy.types.Panel):
@@ -180,7 +234,7 @@ class PHYSICS_PT_impulse_bake(bpy.types.Panel):
         _draw(self.layout, context)
 
 
-_classes = (ImpulseBakeSettings, IMPULSE_OT_bake, SCENE_PT_impulse_bake, PHYSICS_PT_impulse_bake)
+_classes = (ImpulseBakeSettings, IMPULSE_OT_bake, IMPULSE_OT_free_bake, SCENE_PT_impulse_bake, PHYSICS_PT_impulse_bake)
 
 
 def register():

@@ -12,12 +12,11 @@ or :func:`bake_scene` for all of it at once.
 """
 
 import math
-import re
 import time
 
 import numpy as np
 
-from . import axes, keyframes, scene_reader
+from . import axes, keyframes, messages, scene_reader
 
 #: Quality presets offered in the panel (impulse's ``Settings.preset`` names).
 PRESETS = ("fast", "default", "precise")
@@ -75,43 +74,88 @@ def make_world(scene_dict, preset="default", substeps=0, frame_steps=0):
     return impulse.World.from_scene(scene_dict, settings=settings), count
 
 
-def _name_the_body(message, info):
-    """impulse's scene error (``bodies[3].shape.points: ...``, ``joints[0].limits: ...``) led
-    by the body's or the constraint's object name."""
-    joint = re.search(r"joints\[(\d+)\]", message)
-    joints = info.scene.get("joints", [])
-    if joint is not None and int(joint.group(1)) < len(joints):
-        return f"{joints[int(joint.group(1))]['name']}: {message}"
-    found = re.search(r"bodies\[(\d+)\]", message)
-    if found is None or int(found.group(1)) >= len(info.bodies):
-        return f"{info.scene.get('name', 'scene')}: {message}"
-    return f"{info.bodies[int(found.group(1))].object_name}: {message}"
+def _slerp(q0, q1, s):
+    """Spherical interpolation of unit quaternions (x y z w) the shorter way round."""
+    q0, q1 = np.asarray(q0, dtype=np.float64), np.asarray(q1, dtype=np.float64)
+    if np.dot(q0, q1) < 0:
+        q1 = -q1
+    cos = min(float(np.dot(q0, q1)), 1.0)
+    angle = math.acos(cos)
+    if angle < 1e-9:
+        return q0
+    return (math.sin((1 - s) * angle) * q0 + math.sin(s * angle) * q1) / math.sin(angle)
+
+
+def _rotation_vector(q0, q1):
+    """The rotation vector (axis × angle, rad) of q1 · q0⁻¹, quaternions x y z w."""
+    x0, y0, z0, w0 = -q0[0], -q0[1], -q0[2], q0[3]
+    x1, y1, z1, w1 = q1
+    d = np.array(
+        [
+            w1 * x0 + x1 * w0 + y1 * z0 - z1 * y0,
+            w1 * y0 - x1 * z0 + y1 * w0 + z1 * x0,
+            w1 * z0 + x1 * y0 - y1 * x0 + z1 * w0,
+            w1 * w0 - x1 * x0 - y1 * y0 - z1 * z0,
+        ]
+    )
+    if d[3] < 0:
+        d = -d
+    sine = float(np.linalg.norm(d[:3]))
+    if sine < 1e-12:
+        return np.zeros(3)
+    return d[:3] / sine * 2.0 * math.atan2(sine, d[3])
 
 
 class Baker:
-    """One bake of a scene's Rigid Body World: reads it (undoing an earlier bake first),
-    builds the impulse world, steps it frame by frame on :meth:`advance` (``frame_steps``
-    steps a frame, 0: :func:`steps_per_frame`; ``substeps`` per step, 0: the preset's) and
-    writes keyframes for the dynamic bodies on :meth:`write`.
+    """One bake of a scene's Rigid Body World: reads it as it is at the start frame, builds
+    the impulse world, steps it frame by frame on :meth:`advance` (``frame_steps`` steps a
+    frame, 0: :func:`steps_per_frame`; ``substeps`` per step, 0: the preset's) and writes
+    keyframes for the bodies simulated at some frame on :meth:`write`. Nothing in the file
+    changes before :meth:`write`: a bake refused or dropped leaves the previous one as it was.
 
-    Raises :class:`scene_reader.UnsupportedScene` from the constructor when the scene cannot
-    be represented (before anything is changed but the earlier bake's removal).
+    A body whose "Animated" or "Dynamic" flag switches during the range is swapped between a
+    kinematic and a dynamic body at the frame it switches (removed and inserted again): it
+    leaves its animation with the animation's linear and angular velocity at that frame, and
+    snaps to its animation when it becomes animated again (then driven step by step).
+
+    Raises :class:`scene_reader.UnsupportedScene` from the constructor, with every problem of
+    the scene in the animator's terms, when the scene cannot be represented. ``materials``:
+    one of :data:`scene_reader.MATERIAL_RULES`; ``resolution``: a moving Mesh's decomposition
+    resolution, 0 the engine's default (:func:`shapes.build`).
     """
 
-    def __init__(self, scene, preset="default", substeps=0, frame_steps=0):
+    def __init__(self, scene, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0):
         self.scene = scene
-        objects = scene_reader.rigid_body_objects(scene)
-        scene_reader.restore_rest_poses(objects)
-        self.info = scene_reader.read_scene(scene)
+        self.info = scene_reader.read_scene(scene, materials=materials, resolution=resolution)
+        impulse = import_impulse()
+        self.impulse = impulse
         try:
             self.world, self.frame_steps = make_world(self.info.scene, preset, substeps, frame_steps)
-        except import_impulse().SceneError as error:
-            raise scene_reader.UnsupportedScene([_name_the_body(str(error), self.info)]) from error
-        self.dynamic = [i for i, b in enumerate(self.info.bodies) if b.kind == "dynamic"]
-        self.positions = [self.world.positions[self.dynamic].copy()]
-        self.orientations = [self.world.orientations[self.dynamic].copy()]
+        except impulse.SceneError as error:
+
+            def build(scene_dict):
+                make_world(scene_dict, preset, substeps, frame_steps)
+
+            raise scene_reader.UnsupportedScene(messages.every_problem(self.info, error, build)) from error
+        bodies = self.info.bodies
+        self.handles = [self.world.handle_of(i) for i in range(len(bodies))]
+        self.keyed = [i for i, b in enumerate(bodies) if b.keyed]
+        self.switching = [i for i in self.keyed if bodies[i].animated is not None]
+        self.kinematic_now = {i: bodies[i].kind == "kinematic" for i in self.switching}
+        self.driven = set()
+        self._rows()
+        self.positions = [self.world.positions[self.rows].copy()]
+        self.orientations = [self.world.orientations[self.rows].copy()]
         self.simulation_seconds = 0.0
         self.write_seconds = 0.0
+
+    @property
+    def dynamic(self):
+        """Indices (in ``info.bodies``) of the bodies the bake keys."""
+        return self.keyed
+
+    def _rows(self):
+        self.rows = [self.world.index_of(self.handles[i]) for i in self.keyed]
 
     @property
     def total_frames(self):
@@ -126,6 +170,63 @@ class Baker:
     def done(self):
         return self.frames_done >= self.total_frames
 
+    def _swap(self, index, to_kinematic, frame):
+        """Replace body ``index`` by a kinematic (at its animation's pose at ``frame``) or a
+        dynamic one (at its pose, with its velocities)."""
+        impulse, world = self.impulse, self.world
+        info = self.info.bodies[index]
+        row = world.index_of(self.handles[index])
+        position = world.positions[row].tolist()
+        orientation = world.orientations[row].tolist()
+        linear = world.linear_velocities[row].tolist()
+        angular = world.angular_velocities[row].tolist()
+        world.remove(self.handles[index])
+        shape = impulse.Shape.from_dict(info.body["shape"])
+        props = {
+            "name": info.object_name,
+            "friction": info.body["material"]["friction"],
+            "restitution": info.body["material"]["restitution"],
+        }
+        if to_kinematic:
+            position, orientation = info.poses[frame]
+            builder = impulse.BodyBuilder.kinematic(shape, translation=position, rotation=orientation, **props)
+            self.driven.add(index)
+        else:
+            builder = impulse.BodyBuilder.dynamic(
+                shape,
+                translation=position,
+                rotation=orientation,
+                linear_velocity=linear,
+                angular_velocity=angular,
+                **info.dynamics,
+                **props,
+            )
+            self.driven.discard(index)
+        self.handles[index] = world.insert(builder)
+        self.kinematic_now[index] = to_kinematic
+        self._rows()
+
+    def _drive(self, frame, step):
+        """Put every driven kinematic body at its animation's pose at ``step`` of
+        ``self.frame_steps`` after ``frame`` and give it the velocity that reaches the next."""
+        world, count = self.world, self.frame_steps
+        h = self.info.dt / count
+        positions, orientations = world.positions.copy(), world.orientations.copy()
+        linear, angular = world.linear_velocities.copy(), world.angular_velocities.copy()
+        for index in self.driven:
+            poses = self.info.bodies[index].poses
+            (p0, q0), (p1, q1) = poses[frame], poses[min(frame + 1, len(poses) - 1)]
+            p0, p1 = np.asarray(p0), np.asarray(p1)
+            a, b = step / count, (step + 1) / count
+            row = world.index_of(self.handles[index])
+            qa, qb = _slerp(q0, q1, a), _slerp(q0, q1, b)
+            positions[row] = p0 + (p1 - p0) * a
+            orientations[row] = qa
+            linear[row] = (p1 - p0) / self.info.dt
+            angular[row] = _rotation_vector(qa, qb) / h
+        world.positions, world.orientations = positions, orientations
+        world.linear_velocities, world.angular_velocities = linear, angular
+
     def advance(self, max_frames=None, max_seconds=None):
         """Simulate up to ``max_frames`` more frames, stopping early after ``max_seconds`` of
         wall time (at least one frame). Returns the frames now done."""
@@ -134,43 +235,104 @@ class Baker:
         if max_frames is not None:
             left = min(left, max_frames)
         for _ in range(left):
-            self.world.step(self.frame_steps)
-            self.positions.append(self.world.positions[self.dynamic].copy())
-            self.orientations.append(self.world.orientations[self.dynamic].copy())
+            frame = self.frames_done - 1
+            for index in self.switching:
+                wanted = self.info.bodies[index].animated[frame + 1]
+                if wanted != self.kinematic_now[index]:
+                    self._swap(index, wanted, frame)
+            if self.driven:
+                for step in range(self.frame_steps):
+                    self._drive(frame, step)
+                    self.world.step(1)
+            else:
+                self.world.step(self.frame_steps)
+            self.positions.append(self.world.positions[self.rows].copy())
+            self.orientations.append(self.world.orientations[self.rows].copy())
             if max_seconds is not None and time.perf_counter() - start >= max_seconds:
                 break
         self.simulation_seconds += time.perf_counter() - start
         return self.frames_done
 
     def write(self):
-        """Key every dynamic body's object at the frames done (location and rotation
-        quaternion, whole F-curves), remember each object's pose from before the bake so that
-        the next bake replaces this one, and turn Blender's own rigid body world off so that
-        the keyframes are what plays. Returns the number of keyed objects."""
+        """Key every keyed body's object at the frames done (location and rotation in the
+        object's rotation mode, in its parent's space, whole F-curves in the group
+        :data:`keyframes.GROUP`), replacing an earlier bake, remove an earlier bake from the
+        objects this one does not key, and turn Blender's own rigid body world off so that the
+        keyframes are what plays. Returns the number of keyed objects."""
         start = time.perf_counter()
         frames = np.arange(self.frames_done, dtype=np.float32) + self.info.frame_start
         locations = axes.positions_to_blender(np.stack(self.positions))
         quaternions = axes.continuous_quaternions(axes.orientations_to_blender(np.stack(self.orientations)))
         objects = self.scene.objects
-        for column, index in enumerate(self.dynamic):
-            obj = objects[self.info.bodies[index].object_name]
-            obj[scene_reader.REST_PROPERTY] = {
-                "rotation_mode": obj.rotation_mode,
-                "location": tuple(obj.location),
-                "rotation_quaternion": tuple(obj.rotation_quaternion),
-                "rotation_euler": tuple(obj.rotation_euler),
-                "rotation_axis_angle": tuple(obj.rotation_axis_angle),
-            }
-            keyframes.write_fcurves(obj, frames, locations[:, column], quaternions[:, column])
+        keyed_names = set()
+        for column, index in enumerate(self.keyed):
+            info = self.info.bodies[index]
+            obj = objects[info.object_name]
+            keyed_names.add(obj.name)
+            location, rotation = _object_space(info, locations[:, column], quaternions[:, column])
+            keyframes.write_fcurves(obj, frames, location, rotation, info.start)
+        for obj in scene_reader.rigid_body_objects(self.scene):
+            if obj.name not in keyed_names and keyframes.is_baked(obj):
+                keyframes.free_bake(obj, self.info.frame_start)
         self.scene.rigidbody_world.enabled = False
+        self.scene.frame_set(self.scene.frame_current)
         self.write_seconds = time.perf_counter() - start
-        return len(self.dynamic)
+        return len(self.keyed)
 
 
-def bake_scene(scene, preset="default", substeps=0, frame_steps=0):
+def _object_space(info, locations, quaternions):
+    """World poses (F, 3) and (F, 4, w x y z) of a body as its object's location and rotation:
+    in its parent's space and divided by its own Scale (a mirrored object's negative scale
+    moves into its rotation otherwise). As they are for an object without a parent whose world
+    scale is its Scale."""
+    if info.parent_space is None and all(
+        abs(a - b) <= 1e-9 + 1e-6 * abs(b) for a, b in zip(info.scale, info.basis_scale, strict=True)
+    ):
+        return locations, quaternions
+    import mathutils
+
+    scale = mathutils.Matrix.Diagonal((*info.scale, 1.0))
+    unscale = mathutils.Matrix.Diagonal([1.0 / s for s in info.basis_scale])
+    out_locations = np.empty_like(locations)
+    out_quaternions = np.empty_like(quaternions)
+    identity = mathutils.Matrix.Identity(4)
+    for frame in range(len(locations)):
+        world = (
+            mathutils.Matrix.Translation(locations[frame])
+            @ mathutils.Quaternion(quaternions[frame]).to_matrix().to_4x4()
+            @ scale
+        )
+        if info.parent_space is not None:
+            space = info.parent_space[min(frame, len(info.parent_space) - 1)]
+        else:
+            space = identity
+        basis = space.inverted_safe() @ world
+        out_locations[frame] = basis.translation
+        out_quaternions[frame] = (basis.to_3x3() @ unscale).to_quaternion()
+    return out_locations, axes.continuous_quaternions(out_quaternions[:, None])[:, 0]
+
+
+def bake_scene(scene, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0):
     """Bake the scene's Rigid Body World with impulse at once; returns the :class:`Baker`
     (its ``simulation_seconds`` and ``write_seconds`` are the two parts' wall times)."""
-    baker = Baker(scene, preset, substeps, frame_steps)
+    baker = Baker(scene, preset, substeps, frame_steps, materials, resolution)
     baker.advance()
     baker.write()
     return baker
+
+
+def free_bake(scene):
+    """Remove impulse's bake from every object of the scene's Rigid Body World (each object
+    back at its pose at the start frame, an animated object's own animation back) and tick the
+    Rigid Body World again, so that Blender's own simulation plays. Returns the number of
+    objects freed."""
+    objects = scene_reader.rigid_body_objects(scene)
+    frame = int(scene.rigidbody_world.point_cache.frame_start)
+    freed = 0
+    for obj in objects:
+        if keyframes.is_baked(obj):
+            keyframes.free_bake(obj, frame)
+            freed += 1
+    scene.rigidbody_world.enabled = True
+    scene.frame_set(scene.frame_current)
+    return freed
