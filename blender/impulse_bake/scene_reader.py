@@ -23,8 +23,10 @@ What maps to what (docs/blender.md has the animator's version):
 - a simulated object with a parent is simulated in world space; its keyframes are written in
   its parent's space (:class:`BodyInfo` ``parent_space``);
 - mass (kg), friction, bounciness (restitution); with ``materials="blender"`` (the default)
-  friction is written squared so that impulse's √(μa·μb) is Bullet's μa·μb; restitution is
-  combined as impulse does, max(ea, eb) (Bullet: ea·eb); Blender's damping d (the fraction of
+  a contact's friction and bounciness are the products μa·μb and ea·eb, as Bullet's
+  (``btManifoldResult``), through the scene's ``solver.friction_combine`` and
+  ``solver.restitution_combine`` ("multiply"); with ``"impulse"`` impulse's own √(μa·μb) and
+  max(ea, eb); Blender's damping d (the fraction of
   velocity lost per second) as impulse's rate −ln(1 − d) (1/s), the same decay per second;
 - collision collections: the body's ``groups`` and ``mask`` are both the bit set of its
   collections, so two bodies collide when they share one, as in Blender;
@@ -205,11 +207,8 @@ def _put_back(objects, saved):
         o.rotation_axis_angle, o.scale = axis_angle, scale
 
 
-def _material(rigid_body, materials):
+def _material(rigid_body):
     friction = max(float(rigid_body.friction), 0.0)
-    if materials == "blender":
-        # impulse combines √(μa·μb): with μ² per body that is Bullet's μa·μb.
-        friction = friction * friction
     return {"friction": friction, "restitution": min(max(float(rigid_body.restitution), 0.0), 1.0)}
 
 
@@ -291,7 +290,7 @@ def read_scene(scene, depsgraph=None, materials="blender", resolution=0):
                 "shape": shape,
                 "position": pose[0],
                 "orientation": pose[1],
-                "material": _material(rigid_body, materials),
+                "material": _material(rigid_body),
                 "groups": _groups(rigid_body),
                 "mask": _groups(rigid_body),
             }
@@ -347,6 +346,8 @@ def read_scene(scene, depsgraph=None, materials="blender", resolution=0):
         "steps": frame_end - frame_start,
         "bodies": [b.body for b in bodies],
     }
+    if materials == "blender":
+        impulse_scene["solver"] = {"friction_combine": "multiply", "restitution_combine": "multiply"}
     if joints:
         impulse_scene["joints"] = joints
     return SceneInfo(impulse_scene, bodies, frame_start, frame_end, dt, warnings, notes)

@@ -172,9 +172,11 @@ def test_settings_map_to_the_scene_format():
     bodies = {b.object_name: b for b in info.bodies}
     body = bodies["heavy"].body
     assert body["kind"] == "dynamic" and body["mass"] == 100.0
-    # Blender's rule by default: μ² per body, so that impulse's √(μa·μb) is Bullet's μa·μb.
-    assert body["material"]["friction"] == pytest.approx(0.3 * 0.3)
+    assert body["material"]["friction"] == pytest.approx(0.3)
     assert body["material"]["restitution"] == pytest.approx(0.2)
+    # Blender's rule by default: Bullet's products μa·μb and ea·eb.
+    assert info.scene["solver"] == {"friction_combine": "multiply", "restitution_combine": "multiply"}
+    assert "solver" not in scene_reader.read_scene(scene, materials="impulse").scene
     assert body["linear_damping"] == pytest.approx(math.log(2.0))
     assert body["groups"] == body["mask"] == 1 << 3
     # Blender's x, y, z extents (2, 1, 0.5) are impulse's x, z, y.
