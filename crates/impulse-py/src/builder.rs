@@ -160,6 +160,20 @@ enum Property {
 }
 
 impl Property {
+    /// As Python code, floats in the fewest digits that read back as the same f32.
+    fn source(&self) -> String {
+        match self {
+            Property::Floats(values) => {
+                let items: Vec<String> = values.iter().map(|v| format!("{v:?}")).collect();
+                format!("({})", items.join(", "))
+            }
+            Property::Float(value) => format!("{value:?}"),
+            Property::Text(value) => format!("{value:?}"),
+            Property::Flag(value) => if *value { "True" } else { "False" }.to_string(),
+        }
+    }
+
+    /// As a Python value holding the f32s exactly (for pickling).
     fn to_python<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         Ok(match self {
             Property::Floats(values) => pyo3::types::PyTuple::new(py, values)?.into_any(),
@@ -305,20 +319,20 @@ impl BodyBuilder {
 
     /// The call that made this builder, e.g.
     /// `BodyBuilder.dynamic(Shape({"type":"sphere","radius":0.5}), translation=(0.0, 2.0, 0.0))`.
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+    fn __repr__(&self) -> String {
         let recipe = &self.recipe;
         let mut arguments = vec![match &recipe.shape {
             Ok(desc) => Shape { desc: desc.clone() }.__repr__(),
-            Err(radius) => radius.into_pyobject(py)?.repr()?.to_string(),
+            Err(radius) => format!("{radius:?}"),
         }];
         for (key, value) in &recipe.props {
-            arguments.push(format!("{key}={}", value.to_python(py)?.repr()?));
+            arguments.push(format!("{key}={}", value.source()));
         }
-        Ok(format!(
+        format!(
             "BodyBuilder.{}({})",
             constructor(recipe.kind),
             arguments.join(", ")
-        ))
+        )
     }
 
     /// Pickles as `impulse._body_builder(constructor, shape or radius, properties)`.

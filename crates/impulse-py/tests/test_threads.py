@@ -145,7 +145,7 @@ def test_step_releases_the_gil():
 
     def stepper():
         started.set()
-        world.step(400)
+        world.step(100)
         finished.set()
 
     sys.setswitchinterval(1000.0)
@@ -158,7 +158,7 @@ def test_step_releases_the_gil():
     finally:
         sys.setswitchinterval(interval)
     assert stepping_meanwhile, "no other thread ran while the world stepped"
-    assert world.step_count == 400
+    assert world.step_count == 100
 
 
 def test_python_run_inside_a_call_on_the_world_gets_runtime_error(monkeypatch):
