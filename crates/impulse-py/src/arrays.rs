@@ -8,7 +8,10 @@
 //! Lifetime rule: a view shows the world's current state (it changes as the world steps) and
 //! keeps the world alive. Storage moves only when bodies are inserted or removed, so those
 //! calls refuse, with `WorldError`, while any view of the world is alive; `.copy()` a view to
-//! keep the values of one moment.
+//! keep the values of one moment. Views are made, and inserts and removes checked, with the
+//! world locked (`lock`), so the count of live views cannot change between the check and the
+//! edit. A view read while another thread steps the world may show a half-written state;
+//! `state` copies every array under the lock instead.
 //!
 //! Writing: the setters take any array-like of shape (N, 3) or (N, 4), convert it to float32,
 //! check every value is finite, and apply it through the engine's own edits (which wake the
@@ -20,8 +23,9 @@ use std::sync::Arc;
 use impulse::glam::{Quat, Vec3};
 use impulse::parry3d::math::Pose;
 use numpy::ndarray::{ArrayView2, ShapeBuilder};
-use numpy::{PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::errors::{WorldError, guarded};
 
@@ -124,9 +128,50 @@ pub(crate) fn view<'py>(
     Ok(view)
 }
 
-/// `value` as an (N, columns) float32 array, every element finite. Errors: `WorldError` naming
-/// the field and the expected shape, or the first non-finite element.
-fn rows(value: &Bound<'_, PyAny>, field: Field, n: usize) -> PyResult<Vec<f32>> {
+/// `World.state()`: copies of every body's pose and velocities and the world's step count and
+/// time, as a dict (see `World.state`).
+pub(crate) fn state<'py>(py: Python<'py>, world: &impulse::World) -> PyResult<Bound<'py, PyDict>> {
+    let n = world.body_count();
+    let poses = world.poses();
+    let flat =
+        |values: Vec<f32>, columns: usize| PyArray1::from_vec(py, values).reshape([n, columns]);
+    let positions = poses
+        .iter()
+        .flat_map(|p| p.translation.to_array())
+        .collect();
+    let orientations = poses.iter().flat_map(|p| p.rotation.to_array()).collect();
+    let linear = world
+        .linear_velocities()
+        .iter()
+        .flat_map(|v| v.to_array())
+        .collect();
+    let angular = world
+        .angular_velocities()
+        .iter()
+        .flat_map(|v| v.to_array())
+        .collect();
+    let d = PyDict::new(py);
+    d.set_item("step_count", world.step_count())?;
+    d.set_item("time", world.time())?;
+    d.set_item("positions", flat(positions, 3)?)?;
+    d.set_item("orientations", flat(orientations, 4)?)?;
+    d.set_item("linear_velocities", flat(linear, 3)?)?;
+    d.set_item("angular_velocities", flat(angular, 3)?)?;
+    Ok(d)
+}
+
+/// The rows an assignment to a field sets, read from Python but not yet checked against a
+/// world's body count (`assign` does that).
+pub(crate) struct Rows {
+    field: Field,
+    values: Vec<f32>,
+    shape: Vec<usize>,
+}
+
+/// `value` read as a float32 array for an assignment to `field`. Runs the caller's Python
+/// (`__array__`, sequences), so it is called before the world is locked. Errors: `WorldError`
+/// naming the field for a value that cannot be read as an array of float32.
+pub(crate) fn rows(value: &Bound<'_, PyAny>, field: Field) -> PyResult<Rows> {
     let py = value.py();
     let numpy = py.import("numpy")?;
     let kwargs = pyo3::types::PyDict::new(py);
@@ -139,23 +184,40 @@ fn rows(value: &Bound<'_, PyAny>, field: Field, n: usize) -> PyResult<Vec<f32>> 
                 field.name()
             ))
         })?;
-    let array = array.cast_into::<PyArray2<f32>>().map_err(|_| {
-        WorldError::new_err(format!(
-            "{}: expected shape ({n}, {}), got {}",
-            field.name(),
-            field.columns(),
-            shape_text(value)
-        ))
-    })?;
+    let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+    let values = match array.cast_into::<PyArray2<f32>>() {
+        Ok(array) => array.to_vec()?,
+        Err(_) => Vec::new(),
+    };
+    Ok(Rows {
+        field,
+        values,
+        shape,
+    })
+}
+
+/// The rows' values once their shape is (`n`, columns) and every value is finite. Errors:
+/// `WorldError` naming the field and the expected shape, or the first non-finite element.
+fn checked(rows: Rows, n: usize) -> PyResult<Vec<f32>> {
+    let field = rows.field;
     let columns = field.columns();
-    if array.shape() != [n, columns] {
+    if rows.shape != [n, columns] {
+        let got = match rows.shape.as_slice() {
+            [one] => format!("({one},)"),
+            more => format!(
+                "({})",
+                more.iter()
+                    .map(ToString::to_string)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        };
         return Err(WorldError::new_err(format!(
-            "{}: expected shape ({n}, {columns}), got {:?}",
+            "{}: expected shape ({n}, {columns}), got {got}",
             field.name(),
-            array.shape()
         )));
     }
-    let values = array.to_vec()?;
+    let values = rows.values;
     if let Some(at) = values.iter().position(|v| !v.is_finite()) {
         return Err(WorldError::new_err(format!(
             "{}: row {}, column {}: must be finite, got {}",
@@ -168,25 +230,14 @@ fn rows(value: &Bound<'_, PyAny>, field: Field, n: usize) -> PyResult<Vec<f32>> 
     Ok(values)
 }
 
-fn shape_text(value: &Bound<'_, PyAny>) -> String {
-    value
-        .getattr("shape")
-        .and_then(|s| s.str())
-        .map(|s| s.to_string())
-        .unwrap_or_else(|_| "no array".to_string())
-}
-
-/// Sets `field` of every body from `value` (an array-like of shape (N, 3) or (N, 4)). Bodies
+/// Sets the rows' field of every body (`rows`: shape (N, 3) or (N, 4)). Bodies
 /// whose row equals their current value bit for bit are left alone (not woken), so a static
 /// body's zero velocity may be passed back. On an engine error the bodies already edited get
 /// their old values back and the error is raised.
-pub(crate) fn assign(
-    world: &mut impulse::World,
-    field: Field,
-    value: &Bound<'_, PyAny>,
-) -> PyResult<()> {
+pub(crate) fn assign(world: &mut impulse::World, rows: Rows) -> PyResult<()> {
+    let field = rows.field;
     let n = world.body_count();
-    let values = rows(value, field, n)?;
+    let values = checked(rows, n)?;
     let columns = field.columns();
     let current = |w: &impulse::World, i: usize| -> Vec<f32> {
         match field {

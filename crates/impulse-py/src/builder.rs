@@ -18,7 +18,8 @@ use crate::settings::{from_python, to_python};
 /// ((K, 3) points), `Shape.halfspace(normal)` (the solid below the plane through the origin
 /// with outward `normal`; static bodies only), or `Shape.from_dict(d)` for any shape of the
 /// scene format (`{"type": "trimesh", "file": "mesh.obj"}`, compounds, height fields). Sizes
-/// are checked when a body is made of it (`WorldError` naming the field).
+/// are checked when a body is made of it (`WorldError` naming the field). Compares with `==`;
+/// pickles as its dict.
 #[pyclass(module = "impulse", frozen, eq)]
 #[derive(Clone, PartialEq)]
 pub struct Shape {
@@ -115,6 +116,13 @@ impl Shape {
             serde_json::to_string(&self.desc).unwrap_or_default()
         )
     }
+
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyAny>,))> {
+        let from_dict = slf.get_type().getattr("from_dict")?;
+        Ok((from_dict, (slf.get().to_dict(slf.py())?,)))
+    }
 }
 
 /// A body to insert into a world (`world.insert(builder)`): a kind and a shape, then
@@ -126,46 +134,131 @@ impl Shape {
 /// `restitution` (0–1), `density` (kg/m³), `mass` (kg, overrides density), `name`,
 /// `linear_damping`, `angular_damping` (1/s), `lock_rotation` (bool). Defaults: at rest at the
 /// origin, friction 0.6, restitution 0, density 1000 kg/m³. Values are checked by
-/// `World.insert`.
+/// `World.insert`. Pickles as the call that made it; its repr is that call.
 #[pyclass(module = "impulse", frozen)]
-#[derive(Clone)]
 pub struct BodyBuilder {
     pub(crate) inner: impulse::BodyBuilder,
+    /// The call that made it: kind, shape and properties as read, for pickling and the repr.
+    recipe: Recipe,
 }
 
-/// The builder of `kind` and `shape` with the keyword properties `props` (see `BodyBuilder`).
-/// Raises `WorldError` for an unknown keyword, a value of the wrong type, or a shape that
-/// cannot be built.
+/// A `BodyBuilder` constructor call: which one, its first argument and its keyword properties
+/// in the order given, each as read from Python.
+struct Recipe {
+    kind: BodyKind,
+    /// A particle's radius (m), else the shape.
+    shape: Result<ShapeDesc, f32>,
+    props: Vec<(String, Property)>,
+}
+
+/// A keyword property's value as read (see `BodyBuilder`).
+enum Property {
+    Floats(Vec<f32>),
+    Float(f32),
+    Text(String),
+    Flag(bool),
+}
+
+impl Property {
+    /// As Python code, floats in the fewest digits that read back as the same f32.
+    fn source(&self) -> String {
+        match self {
+            Property::Floats(values) => {
+                let items: Vec<String> = values.iter().map(|v| format!("{v:?}")).collect();
+                format!("({})", items.join(", "))
+            }
+            Property::Float(value) => format!("{value:?}"),
+            Property::Text(value) => format!("{value:?}"),
+            Property::Flag(value) => if *value { "True" } else { "False" }.to_string(),
+        }
+    }
+
+    /// As a Python value holding the f32s exactly (for pickling).
+    fn to_python<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Ok(match self {
+            Property::Floats(values) => pyo3::types::PyTuple::new(py, values)?.into_any(),
+            Property::Float(value) => value.into_pyobject(py)?.into_any(),
+            Property::Text(value) => value.into_pyobject(py)?.into_any(),
+            Property::Flag(value) => value.into_pyobject(py)?.to_owned().into_any(),
+        })
+    }
+}
+
+/// The constructor's name for `kind` (`BodyBuilder.dynamic` …).
+fn constructor(kind: BodyKind) -> &'static str {
+    match kind {
+        BodyKind::Dynamic => "dynamic",
+        BodyKind::Static => "fixed",
+        BodyKind::Kinematic => "kinematic",
+        BodyKind::Particle => "particle",
+    }
+}
+
+/// The builder of `kind` and `shape` (a particle's radius as `Err`) with the keyword
+/// properties `props` (see `BodyBuilder`). Raises `WorldError` for an unknown keyword, a
+/// value of the wrong type, or a shape that cannot be built.
 fn configure(
     kind: BodyKind,
-    shape: &Shape,
+    shape: Result<ShapeDesc, f32>,
     props: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<BodyBuilder> {
+    let desc = match &shape {
+        Ok(desc) => desc.clone(),
+        Err(radius) => ShapeDesc::Sphere { radius: *radius },
+    };
     let shared = crate::errors::guarded(|| {
-        build_shape(kind, &shape.desc).map_err(|e| WorldError::new_err(e.to_string()))
+        build_shape(kind, &desc).map_err(|e| WorldError::new_err(e.to_string()))
     })?;
     let mut b = impulse::BodyBuilder::new(kind, shared);
-    let Some(props) = props else {
-        return Ok(BodyBuilder { inner: b });
+    let mut recipe = Recipe {
+        kind,
+        shape,
+        props: Vec::new(),
     };
-    for (key, value) in props.iter() {
+    for (key, value) in props.iter().flat_map(|props| props.iter()) {
         let key: String = key.extract()?;
         let bad = |e: PyErr| WorldError::new_err(format!("{key}: {e}"));
-        let vec3 = |v: &Bound<'_, PyAny>| v.extract::<[f32; 3]>().map(Vec3::from).map_err(bad);
+        let vec3 = |v: &Bound<'_, PyAny>| v.extract::<[f32; 3]>().map_err(bad);
         let float = |v: &Bound<'_, PyAny>| v.extract::<f32>().map_err(bad);
-        b = match key.as_str() {
-            "translation" => b.translation(vec3(&value)?),
-            "rotation" => b.rotation(Quat::from_array(value.extract::<[f32; 4]>().map_err(bad)?)),
-            "linear_velocity" => b.linear_velocity(vec3(&value)?),
-            "angular_velocity" => b.angular_velocity(vec3(&value)?),
-            "friction" => b.friction(float(&value)?),
-            "restitution" => b.restitution(float(&value)?),
-            "density" => b.density(float(&value)?),
-            "mass" => b.mass(float(&value)?),
-            "name" => b.name(value.extract::<String>().map_err(bad)?),
-            "linear_damping" => b.linear_damping(float(&value)?),
-            "angular_damping" => b.angular_damping(float(&value)?),
-            "lock_rotation" => b.lock_rotation(value.extract::<bool>().map_err(bad)?),
+        let property = match key.as_str() {
+            "translation" | "linear_velocity" | "angular_velocity" => {
+                let v = vec3(&value)?;
+                let v3 = Vec3::from(v);
+                b = match key.as_str() {
+                    "translation" => b.translation(v3),
+                    "linear_velocity" => b.linear_velocity(v3),
+                    _ => b.angular_velocity(v3),
+                };
+                Property::Floats(v.to_vec())
+            }
+            "rotation" => {
+                let q = value.extract::<[f32; 4]>().map_err(bad)?;
+                b = b.rotation(Quat::from_array(q));
+                Property::Floats(q.to_vec())
+            }
+            "friction" | "restitution" | "density" | "mass" | "linear_damping"
+            | "angular_damping" => {
+                let x = float(&value)?;
+                b = match key.as_str() {
+                    "friction" => b.friction(x),
+                    "restitution" => b.restitution(x),
+                    "density" => b.density(x),
+                    "mass" => b.mass(x),
+                    "linear_damping" => b.linear_damping(x),
+                    _ => b.angular_damping(x),
+                };
+                Property::Float(x)
+            }
+            "name" => {
+                let name = value.extract::<String>().map_err(bad)?;
+                b = b.name(name.clone());
+                Property::Text(name)
+            }
+            "lock_rotation" => {
+                let lock = value.extract::<bool>().map_err(bad)?;
+                b = b.lock_rotation(lock);
+                Property::Flag(lock)
+            }
             _ => {
                 return Err(WorldError::new_err(format!(
                     "no body property '{key}'; properties: {}",
@@ -173,8 +266,9 @@ fn configure(
                 )));
             }
         };
+        recipe.props.push((key, property));
     }
-    Ok(BodyBuilder { inner: b })
+    Ok(BodyBuilder { inner: b, recipe })
 }
 
 const PROPERTIES: [&str; 12] = [
@@ -199,27 +293,64 @@ impl BodyBuilder {
     #[staticmethod]
     #[pyo3(signature = (shape, **props))]
     fn dynamic(shape: &Shape, props: Option<&Bound<'_, PyDict>>) -> PyResult<BodyBuilder> {
-        configure(BodyKind::Dynamic, shape, props)
+        configure(BodyKind::Dynamic, Ok(shape.desc.clone()), props)
     }
 
     /// A static body: never moves (ground, walls).
     #[staticmethod]
     #[pyo3(signature = (shape, **props))]
     fn fixed(shape: &Shape, props: Option<&Bound<'_, PyDict>>) -> PyResult<BodyBuilder> {
-        configure(BodyKind::Static, shape, props)
+        configure(BodyKind::Static, Ok(shape.desc.clone()), props)
     }
 
     /// A kinematic body: moves at its velocities, pushes dynamic bodies, is never pushed.
     #[staticmethod]
     #[pyo3(signature = (shape, **props))]
     fn kinematic(shape: &Shape, props: Option<&Bound<'_, PyDict>>) -> PyResult<BodyBuilder> {
-        configure(BodyKind::Kinematic, shape, props)
+        configure(BodyKind::Kinematic, Ok(shape.desc.clone()), props)
     }
 
     /// A particle: a ball of `radius` (m) whose rotation is locked.
     #[staticmethod]
     #[pyo3(signature = (radius, **props))]
     fn particle(radius: f32, props: Option<&Bound<'_, PyDict>>) -> PyResult<BodyBuilder> {
-        configure(BodyKind::Particle, &Shape::ball(radius), props)
+        configure(BodyKind::Particle, Err(radius), props)
+    }
+
+    /// The call that made this builder, e.g.
+    /// `BodyBuilder.dynamic(Shape({"type":"sphere","radius":0.5}), translation=(0.0, 2.0, 0.0))`.
+    fn __repr__(&self) -> String {
+        let recipe = &self.recipe;
+        let mut arguments = vec![match &recipe.shape {
+            Ok(desc) => Shape { desc: desc.clone() }.__repr__(),
+            Err(radius) => format!("{radius:?}"),
+        }];
+        for (key, value) in &recipe.props {
+            arguments.push(format!("{key}={}", value.source()));
+        }
+        format!(
+            "BodyBuilder.{}({})",
+            constructor(recipe.kind),
+            arguments.join(", ")
+        )
+    }
+
+    /// Pickles as `impulse._body_builder(constructor, shape or radius, properties)`.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, pyo3::types::PyTuple>)> {
+        let recipe = &self.recipe;
+        let restore = py.import("impulse")?.getattr("_body_builder")?;
+        let shape = match &recipe.shape {
+            Ok(desc) => Bound::new(py, Shape { desc: desc.clone() })?.into_any(),
+            Err(radius) => radius.into_pyobject(py)?.into_any(),
+        };
+        let props = PyDict::new(py);
+        for (key, value) in &recipe.props {
+            props.set_item(key, value.to_python(py)?)?;
+        }
+        let arguments = (constructor(recipe.kind), shape, props).into_pyobject(py)?;
+        Ok((restore, arguments))
     }
 }

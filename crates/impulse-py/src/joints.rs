@@ -17,7 +17,7 @@ use crate::handle::BodyHandle;
 /// A joint's name in a world: valid while the joint lives, never naming another joint
 /// afterwards (a slot index and the slot's generation). Hashable and ordered (by index, then
 /// generation); compare with `==`. For a world built from a scene and never edited, `index` is
-/// the joint's position in the scene's `joints`.
+/// the joint's position in the scene's `joints`. Pickles as its index and generation.
 #[pyclass(module = "impulse", frozen, eq, ord, hash)]
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct JointHandle {
@@ -26,6 +26,23 @@ pub struct JointHandle {
 
 #[pymethods]
 impl JointHandle {
+    /// The handle of slot `index` at `generation` (as `index` and `generation` read them).
+    /// A world refuses, with `WorldError`, a handle that names no joint of it.
+    #[new]
+    fn new(index: u32, generation: u32) -> PyResult<Self> {
+        Ok(JointHandle {
+            inner: crate::handle::handle_from_parts(index, generation)?,
+        })
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (u32, u32))> {
+        let handle = slf.get().inner;
+        Ok((
+            slf.get_type().into_any(),
+            (handle.index(), handle.generation()),
+        ))
+    }
+
     /// The slot index.
     #[getter]
     fn index(&self) -> u32 {
@@ -299,7 +316,10 @@ impl JointBuilder {
     /// `torque` (N·m) for its locked rotations (either may be `inf`). A substep whose locked
     /// impulse reaches strength × substep breaks the joint there; it then passes no load and
     /// `World.joint_events()` reports it at the end of the step.
-    #[pyo3(signature = (force, torque = f32::INFINITY))]
+    #[pyo3(
+        signature = (force, torque = f32::INFINITY),
+        text_signature = "($self, force, torque=1e999)"
+    )]
     fn breakable(&self, force: f32, torque: f32) -> Self {
         self.with(|b| b.breakable(force, torque))
     }

@@ -3,7 +3,8 @@
 //!
 //! The Python package (`python/impulse/`) re-exports these classes and adds trajectories
 //! (`Trajectory`, `load_trajectory`) on top. Every entry point catches Rust panics and turns
-//! engine errors into the package's exceptions, so no input crashes the interpreter.
+//! engine errors into the package's exceptions, so no input crashes the interpreter; each
+//! world is locked for the length of a call (`lock`), so threads sharing one take turns.
 
 use pyo3::prelude::*;
 
@@ -13,6 +14,8 @@ mod contacts;
 mod errors;
 mod handle;
 mod joints;
+mod lock;
+mod queries;
 mod scene;
 mod settings;
 mod stepping;

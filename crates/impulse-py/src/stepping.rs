@@ -10,6 +10,17 @@ pub(crate) fn step_error(error: impulse::StepError) -> PyErr {
     StepError::new_err(error.to_string())
 }
 
+/// `value` as a count of at least `min` (a number of steps, a frame interval), else
+/// `WorldError` (a `ValueError`) naming the argument `what`.
+pub(crate) fn count(value: i64, what: &str, min: u64) -> PyResult<u64> {
+    match u64::try_from(value) {
+        Ok(count) if count >= min => Ok(count),
+        _ => Err(WorldError::new_err(format!(
+            "{what}: must be a whole number ≥ {min}, got {value}"
+        ))),
+    }
+}
+
 /// Steps `world` `n` times without the GIL, checking for Ctrl-C between chunks of steps.
 pub(crate) fn step_world(py: Python<'_>, world: &mut impulse::World, n: u64) -> PyResult<()> {
     const CHUNK: u64 = 16;
@@ -43,9 +54,7 @@ pub(crate) fn simulate<'py>(
     steps: u64,
     every: u64,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if every == 0 {
-        return Err(WorldError::new_err("every: must be at least 1"));
-    }
+    debug_assert!(every >= 1, "checked by `count`");
     let first = world.step_count();
     let last = first
         .checked_add(steps)

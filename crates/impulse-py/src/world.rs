@@ -4,8 +4,8 @@
 use std::sync::Arc;
 
 use impulse::glam::Vec3;
-use impulse::{StepDiagnostics, WorldSnapshot, metrics};
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use impulse::{StepDiagnostics, WorldSnapshot};
+use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
@@ -15,8 +15,10 @@ use crate::contacts;
 use crate::errors::{SceneError, WorldError, guarded};
 use crate::handle::BodyHandle;
 use crate::joints::{self, JointBuilder, JointHandle};
+use crate::lock::{WorldGuard, WorldLock};
+use crate::queries::{self, vec3};
 use crate::settings::{Settings, to_python};
-use crate::stepping::{self, names_of, step_world};
+use crate::stepping::{self, count, names_of, step_world};
 
 /// A simulation world: bodies, gravity (m/s², y up), time step (s) and solver settings.
 ///
@@ -32,23 +34,34 @@ use crate::stepping::{self, names_of, step_world};
 /// moment. Assigning an (N, 3)/(N, 4) array-like sets every body (validated, see the
 /// properties).
 ///
+/// A world may be shared between threads: its methods take turns (each call waits, without
+/// the GIL, for the one before to finish; `step` runs without the GIL), so no call sees
+/// another half done. Reading a view while another thread steps the world may see a state
+/// half written; `state()` copies one moment's arrays.
+///
 /// A world pickles through the snapshot format and round-trips to the bit.
-#[pyclass(module = "impulse", name = "World")]
+#[pyclass(module = "impulse", name = "World", frozen)]
 pub struct World {
-    pub(crate) inner: impulse::World,
+    inner: WorldLock,
     /// One reference per live array view of the bodies (see `arrays`), plus this one.
-    pub(crate) views: Arc<()>,
+    views: Arc<()>,
 }
 
 impl World {
-    pub(crate) fn wrap(inner: impulse::World) -> Self {
+    fn wrap(inner: impulse::World) -> Self {
         World {
-            inner,
+            inner: WorldLock::new(inner),
             views: Arc::new(()),
         }
     }
 
+    /// The engine world, once no other call uses it (see `lock`).
+    fn world(&self, py: Python<'_>) -> PyResult<WorldGuard<'_>> {
+        self.inner.lock(py)
+    }
+
     /// Refuses an edit that may move the body storage while array views of it are alive.
+    /// Called with the world locked: views are made only under the lock.
     fn refuse_if_viewed(&self, what: &str) -> PyResult<()> {
         let live = Arc::strong_count(&self.views) - 1;
         if live > 0 {
@@ -60,22 +73,41 @@ impl World {
         Ok(())
     }
 
-    fn handle(&self, handle: &BodyHandle) -> PyResult<impulse::BodyHandle> {
-        if self.inner.contains(handle.inner) {
-            Ok(handle.inner)
-        } else {
-            Err(WorldError::new_err(
-                impulse::WorldError::UnknownBody(handle.inner).to_string(),
-            ))
-        }
+    /// A view of `field` of every body (see `arrays::view`).
+    fn view<'py>(slf: &Bound<'py, Self>, field: Field) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let this = slf.get();
+        let world = this.world(slf.py())?;
+        arrays::view(slf.as_any(), &world, &this.views, field)
     }
 
-    fn diagnostics_dict<'py>(
-        py: Python<'py>,
-        diagnostics: &StepDiagnostics,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, diagnostics)
+    /// Sets `field` of every body from `value` (see `arrays::assign`).
+    fn assign(&self, py: Python<'_>, field: Field, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let rows = arrays::rows(value, field)?;
+        arrays::assign(&mut *self.world(py)?, rows)
     }
+}
+
+/// The engine's handle of the body `handle` names in `world`, or `WorldError`.
+fn body(world: &impulse::World, handle: &BodyHandle) -> PyResult<impulse::BodyHandle> {
+    if world.contains(handle.inner) {
+        Ok(handle.inner)
+    } else {
+        Err(WorldError::new_err(
+            impulse::WorldError::UnknownBody(handle.inner).to_string(),
+        ))
+    }
+}
+
+/// `World.diagnostics`: the diagnostics as an `impulse.Diagnostics` (a dict with a short
+/// repr).
+fn diagnostics_object<'py>(
+    py: Python<'py>,
+    diagnostics: &StepDiagnostics,
+) -> PyResult<Bound<'py, PyAny>> {
+    let fields = to_python(py, diagnostics)?;
+    py.import("impulse._diagnostics")?
+        .getattr("Diagnostics")?
+        .call1((fields,))
 }
 
 fn world_error(error: impulse::WorldError) -> PyErr {
@@ -86,24 +118,16 @@ fn unknown_joint(handle: &JointHandle) -> PyErr {
     world_error(impulse::WorldError::UnknownJoint(handle.inner))
 }
 
-fn vec3(value: [f32; 3], what: &str) -> PyResult<Vec3> {
-    let v = Vec3::from(value);
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(WorldError::new_err(format!(
-            "{what}: must be finite, got {value:?}"
-        )))
-    }
-}
-
 #[pymethods]
 impl World {
     /// An empty world. `gravity` (m/s², 3 floats), `dt` (s, > 0), `settings` an
     /// `impulse.Settings` or a preset name (default: the `default` preset). Raises `WorldError`
     /// for a non-finite gravity, a bad dt or settings out of range.
     #[new]
-    #[pyo3(signature = (gravity = [0.0, -9.81, 0.0], dt = 1.0 / 60.0, settings = None))]
+    #[pyo3(
+        signature = (gravity = [0.0, -9.81, 0.0], dt = 1.0 / 60.0, settings = None),
+        text_signature = "(gravity=(0.0, -9.81, 0.0), dt=0.016666666666666666, settings=None)"
+    )]
     fn new(gravity: [f32; 3], dt: f32, settings: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         let settings = match settings {
             Some(s) => Settings::from_argument(s)?,
@@ -169,8 +193,9 @@ impl World {
 
     /// The whole world as bytes of impulse's snapshot format (what pickling uses).
     fn snapshot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let world = self.world(py)?;
         let bytes = guarded(|| {
-            self.inner
+            world
                 .snapshot()
                 .and_then(|s| s.to_bytes())
                 .map_err(|e| WorldError::new_err(e.to_string()))
@@ -195,28 +220,42 @@ impl World {
         self.__copy__(py)
     }
 
-    /// Takes `n` steps (n ≥ 0) with the GIL released, so other Python threads run meanwhile
-    /// (do not read this world's array views from them while it steps). Ctrl-C stops between
-    /// steps. Raises `StepError` when a step fails (a blow-up names the step and the body);
-    /// the world keeps the failed step's state.
+    /// Takes `n` steps (n ≥ 0, else `WorldError`, a `ValueError`) with the GIL released, so
+    /// other Python threads and worlds run meanwhile; calls on this world from other threads
+    /// wait until all `n` steps are done. Ctrl-C stops between steps. Raises `StepError` when
+    /// a step fails (a blow-up names the step and the body); the world keeps the failed
+    /// step's state.
     #[pyo3(signature = (n = 1))]
-    fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
-        step_world(py, &mut self.inner, n)
+    fn step(&self, py: Python<'_>, n: i64) -> PyResult<()> {
+        let n = count(n, "n", 0)?;
+        step_world(py, &mut *self.world(py)?, n)
     }
 
     /// Takes `steps` steps and records a frame at the start and after every step whose number
     /// (`step_count`) is a multiple of `every`, and after the last: an `impulse.Trajectory`
     /// with `positions` (F, N, 3) and `orientations` (F, N, 4) float32, `steps` (F,) int64,
-    /// `times` (F,) float64 seconds and `names`. Raises `StepError` when a step fails; the
-    /// frames recorded before it are the exception's `trajectory` attribute.
+    /// `times` (F,) float64 seconds and `names`. Raises `WorldError` for `steps` < 0 or
+    /// `every` < 1, `StepError` when a step fails; the frames recorded before it are the
+    /// exception's `trajectory` attribute. Holds the world as `step` does.
     #[pyo3(signature = (steps, every = 1))]
     fn simulate<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
-        steps: u64,
-        every: u64,
+        steps: i64,
+        every: i64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        stepping::simulate(py, &mut self.inner, steps, every)
+        let steps = count(steps, "steps", 0)?;
+        let every = count(every, "every", 1)?;
+        stepping::simulate(py, &mut *self.world(py)?, steps, every)
+    }
+
+    /// A copy of every body's state at one moment, as a dict: `step_count`, `time` (s), and
+    /// float32 arrays `positions` (N, 3), `orientations` (N, 4), `linear_velocities` (N, 3),
+    /// `angular_velocities` (N, 3). Unlike the views, consistent while other threads step the
+    /// world: it is taken between two calls.
+    fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let world = self.world(py)?;
+        arrays::state(py, &world)
     }
 
     /// Positions of the body frames (m): read-only view, shape (N, 3), float32. Assign an
@@ -224,13 +263,12 @@ impl World {
     /// unchanged are left alone). Raises `WorldError` for a wrong shape or non-finite values.
     #[getter]
     fn positions<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let world = slf.borrow();
-        arrays::view(slf.as_any(), &world.inner, &world.views, Field::Positions)
+        World::view(slf, Field::Positions)
     }
 
     #[setter]
-    fn set_positions(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        arrays::assign(&mut self.inner, Field::Positions, value)
+    fn set_positions(&self, py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.assign(py, Field::Positions, value)
     }
 
     /// Orientations of the body frames, unit quaternions (x, y, z, w): read-only view, shape
@@ -238,18 +276,12 @@ impl World {
     /// a zero row raises `WorldError`).
     #[getter]
     fn orientations<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let world = slf.borrow();
-        arrays::view(
-            slf.as_any(),
-            &world.inner,
-            &world.views,
-            Field::Orientations,
-        )
+        World::view(slf, Field::Orientations)
     }
 
     #[setter]
-    fn set_orientations(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        arrays::assign(&mut self.inner, Field::Orientations, value)
+    fn set_orientations(&self, py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.assign(py, Field::Orientations, value)
     }
 
     /// Linear velocities of the centres of mass (m/s): read-only view, shape (N, 3), float32.
@@ -257,48 +289,37 @@ impl World {
     /// (zero), else `WorldError` names the body.
     #[getter]
     fn linear_velocities<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let world = slf.borrow();
-        arrays::view(
-            slf.as_any(),
-            &world.inner,
-            &world.views,
-            Field::LinearVelocities,
-        )
+        World::view(slf, Field::LinearVelocities)
     }
 
     #[setter]
-    fn set_linear_velocities(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        arrays::assign(&mut self.inner, Field::LinearVelocities, value)
+    fn set_linear_velocities(&self, py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.assign(py, Field::LinearVelocities, value)
     }
 
     /// Angular velocities, world frame (rad/s): read-only view, shape (N, 3), float32. Assign
     /// an (N, 3) array-like to set them (ignored for particles; locked axes dropped).
     #[getter]
     fn angular_velocities<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let world = slf.borrow();
-        arrays::view(
-            slf.as_any(),
-            &world.inner,
-            &world.views,
-            Field::AngularVelocities,
-        )
+        World::view(slf, Field::AngularVelocities)
     }
 
     #[setter]
-    fn set_angular_velocities(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        arrays::assign(&mut self.inner, Field::AngularVelocities, value)
+    fn set_angular_velocities(&self, py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.assign(py, Field::AngularVelocities, value)
     }
 
     /// The bodies' names in dense order (`""` for a body without one).
     #[getter]
-    fn names(&self) -> Vec<String> {
-        names_of(&self.inner)
+    fn names(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        Ok(names_of(&*self.world(py)?))
     }
 
     /// The bodies' kinds in dense order: `"dynamic"`, `"static"`, `"particle"`, `"kinematic"`.
     #[getter]
-    fn kinds(&self) -> Vec<&'static str> {
-        self.inner
+    fn kinds(&self, py: Python<'_>) -> PyResult<Vec<&'static str>> {
+        Ok(self
+            .world(py)?
             .body_kinds()
             .iter()
             .map(|k| match k {
@@ -307,32 +328,36 @@ impl World {
                 impulse::BodyKind::Particle => "particle",
                 impulse::BodyKind::Kinematic => "kinematic",
             })
-            .collect()
+            .collect())
     }
 
     /// The bodies' masses (kg; `inf` for static and kinematic bodies): shape (N,), float32 (a
     /// copy).
     #[getter]
-    fn masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
-        PyArray1::from_vec(py, self.inner.iter_bodies().map(|b| b.mass()).collect())
+    fn masses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        let masses = self.world(py)?.iter_bodies().map(|b| b.mass()).collect();
+        Ok(PyArray1::from_vec(py, masses))
     }
 
-    /// The last step's diagnostics (`impulse::StepDiagnostics`) as a dict: `step`,
-    /// `contact_pairs`, `contacts`, `rows`, `iterations`, `natural_map_residual` (m/s: how
-    /// well the step's LCP was solved), `islands` (per island: method, iterations, residual…),
-    /// `max_depth` (m), `kinetic_energy` (J), `linear_momentum` (kg·m/s). All zero before the
-    /// first step.
+    /// The last step's diagnostics (`impulse::StepDiagnostics`) as an `impulse.Diagnostics`:
+    /// a dict with `step`, `contact_pairs`, `contacts`, `rows`, `iterations`,
+    /// `natural_map_residual` (how well the step's LCP was solved; N·s and m/s mixed, as in
+    /// the LCP), `islands` (per island: method, iterations, residual…), `max_depth` (m),
+    /// `kinetic_energy` (J), `linear_momentum` (kg·m/s), whose repr is a one-line summary.
+    /// All zero before the first step.
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        World::diagnostics_dict(py, self.inner.diagnostics())
+        let diagnostics = self.world(py)?.diagnostics().clone();
+        diagnostics_object(py, &diagnostics)
     }
 
-    /// Wall-clock seconds of each stage of the last step (`kinematic`, `broad_phase`,
+    /// Wall-clock milliseconds of each stage of the last step (`kinematic`, `broad_phase`,
     /// `narrow_phase`, `islands`, `assembly`, `solve`, `scatter`, `continuous`,
     /// `store_impulses`, `finish`, `total`), as a dict.
     #[getter]
     fn profile<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, self.inner.profile())
+        let profile = *self.world(py)?.profile();
+        to_python(py, &profile)
     }
 
     /// Pose-based quality of the current state, as `impulse run` measures it
@@ -348,96 +373,44 @@ impl World {
         py: Python<'py>,
         initial_positions: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let world = &self.inner;
-        let n = world.body_count();
-        let initial = match initial_positions {
-            Some(value) => {
-                let array = py
-                    .import("numpy")?
-                    .call_method1("asarray", (value, "float32"))?
-                    .cast_into::<PyArray2<f32>>()
-                    .map_err(|_| {
-                        WorldError::new_err(format!("initial_positions: expected shape ({n}, 3)"))
-                    })?;
-                if array.shape() != [n, 3] {
-                    return Err(WorldError::new_err(format!(
-                        "initial_positions: expected shape ({n}, 3), got {:?}",
-                        array.shape()
-                    )));
-                }
-                let values = array.to_vec()?;
-                Some(
-                    values
-                        .chunks_exact(3)
-                        .map(Vec3::from_slice)
-                        .collect::<Vec<_>>(),
-                )
-            }
-            None => None,
-        };
-        let (overlap, top) = py.detach(|| {
-            guarded(|| {
-                Ok((
-                    metrics::max_overlap(world, world.poses()),
-                    metrics::top_body(world, world.poses()),
-                ))
-            })
-        })?;
-        let result = PyDict::new(py);
-        result.set_item("max_overlap_m", overlap)?;
-        result.set_item("top_body", top)?;
-        match &initial {
-            Some(initial) => {
-                result.set_item(
-                    "top_sink_m",
-                    top.map(|i| initial[i].y - world.poses()[i].translation.y),
-                )?;
-                result.set_item(
-                    "max_drift_m",
-                    metrics::max_drift(world, world.poses(), initial),
-                )?;
-            }
-            None => {
-                result.set_item("top_sink_m", py.None())?;
-                result.set_item("max_drift_m", py.None())?;
-            }
-        }
-        result.set_item("kinetic_energy_j", self.inner.diagnostics().kinetic_energy)?;
-        Ok(result)
+        let initial = initial_positions
+            .map(queries::prepare_initial_positions)
+            .transpose()?;
+        queries::quality(py, &*self.world(py)?, initial)
     }
 
     /// Steps taken since the world was made.
     #[getter]
-    fn step_count(&self) -> u64 {
-        self.inner.step_count()
+    fn step_count(&self, py: Python<'_>) -> PyResult<u64> {
+        Ok(self.world(py)?.step_count())
     }
 
     /// Simulated time (s): the sum of the steps' dt.
     #[getter]
-    fn time(&self) -> f64 {
-        self.inner.time()
+    fn time(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.world(py)?.time())
     }
 
     /// The time step (s). Assign a finite value > 0 to change it (else `WorldError`).
     #[getter]
-    fn dt(&self) -> f32 {
-        self.inner.dt()
+    fn dt(&self, py: Python<'_>) -> PyResult<f32> {
+        Ok(self.world(py)?.dt())
     }
 
     #[setter]
-    fn set_dt(&mut self, dt: f32) -> PyResult<()> {
-        self.inner.set_dt(dt).map_err(world_error)
+    fn set_dt(&self, py: Python<'_>, dt: f32) -> PyResult<()> {
+        self.world(py)?.set_dt(dt).map_err(world_error)
     }
 
     /// Gravity (m/s², 3 floats). Assign 3 finite floats to change it (wakes every body).
     #[getter]
-    fn gravity(&self) -> [f32; 3] {
-        self.inner.gravity().to_array()
+    fn gravity(&self, py: Python<'_>) -> PyResult<[f32; 3]> {
+        Ok(self.world(py)?.gravity().to_array())
     }
 
     #[setter]
-    fn set_gravity(&mut self, gravity: [f32; 3]) -> PyResult<()> {
-        self.inner
+    fn set_gravity(&self, py: Python<'_>, gravity: [f32; 3]) -> PyResult<()> {
+        self.world(py)?
             .set_gravity(Vec3::from(gravity))
             .map_err(world_error)
     }
@@ -445,85 +418,95 @@ impl World {
     /// The solver settings (`impulse.Settings`). Assign a `Settings` or a preset name to
     /// replace them from the next step on (`WorldError` when out of range).
     #[getter]
-    fn settings(&self) -> Settings {
-        Settings {
-            inner: self.inner.settings().clone(),
-        }
+    fn settings(&self, py: Python<'_>) -> PyResult<Settings> {
+        Ok(Settings {
+            inner: self.world(py)?.settings().clone(),
+        })
     }
 
     #[setter]
-    fn set_settings(&mut self, settings: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn set_settings(&self, py: Python<'_>, settings: &Bound<'_, PyAny>) -> PyResult<()> {
         let settings = Settings::from_argument(settings)?;
-        self.inner.set_settings(settings).map_err(world_error)
+        self.world(py)?.set_settings(settings).map_err(world_error)
     }
 
     /// Whether the step spreads islands over rayon's worker threads (default True). Results
     /// are the same to the bit either way.
     #[getter]
-    fn parallel(&self) -> bool {
-        self.inner.parallel()
+    fn parallel(&self, py: Python<'_>) -> PyResult<bool> {
+        Ok(self.world(py)?.parallel())
     }
 
     #[setter]
-    fn set_parallel(&mut self, parallel: bool) {
-        self.inner.set_parallel(parallel);
+    fn set_parallel(&self, py: Python<'_>, parallel: bool) -> PyResult<()> {
+        self.world(py)?.set_parallel(parallel);
+        Ok(())
     }
 
     /// Number of bodies (also `len(world)`).
     #[getter]
-    fn body_count(&self) -> usize {
-        self.inner.body_count()
+    fn body_count(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(self.world(py)?.body_count())
     }
 
-    fn __len__(&self) -> usize {
-        self.inner.body_count()
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.body_count(py)
     }
 
-    fn __repr__(&self) -> String {
-        format!(
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let world = self.world(py)?;
+        Ok(format!(
             "World(bodies={}, step_count={}, dt={})",
-            self.inner.body_count(),
-            self.inner.step_count(),
-            self.inner.dt()
-        )
+            world.body_count(),
+            world.step_count(),
+            world.dt()
+        ))
     }
 
     /// Inserts the body `builder` describes (an `impulse.BodyBuilder`) and returns its
     /// `BodyHandle`; its dense index is the old `body_count`. Raises `WorldError` naming the
     /// field for an invalid body, or while array views of the world are alive.
-    fn insert(&mut self, builder: &crate::builder::BodyBuilder) -> PyResult<BodyHandle> {
+    fn insert(
+        &self,
+        py: Python<'_>,
+        builder: &crate::builder::BodyBuilder,
+    ) -> PyResult<BodyHandle> {
+        let mut world = self.world(py)?;
         self.refuse_if_viewed("insert a body")?;
         let builder = builder.inner.clone();
-        let handle = guarded(|| self.inner.insert(builder).map_err(world_error))?;
+        let handle = guarded(|| world.insert(builder).map_err(world_error))?;
         Ok(BodyHandle { inner: handle })
     }
 
     /// Removes the body `handle` names and returns its name (or None). The last body takes
     /// its dense index. Raises `WorldError` for an unknown handle, or while array views of
     /// the world are alive.
-    fn remove(&mut self, handle: &BodyHandle) -> PyResult<Option<String>> {
+    fn remove(&self, py: Python<'_>, handle: &BodyHandle) -> PyResult<Option<String>> {
+        let mut world = self.world(py)?;
         self.refuse_if_viewed("remove a body")?;
-        let handle = self.handle(handle)?;
-        guarded(|| self.inner.remove(handle).map_err(world_error))
+        let handle = body(&world, handle)?;
+        guarded(|| world.remove(handle).map_err(world_error))
     }
 
     /// The handle of the body at dense index `index`. Raises `IndexError` past the end.
-    fn handle_of(&self, index: usize) -> PyResult<BodyHandle> {
-        self.inner
+    fn handle_of(&self, py: Python<'_>, index: usize) -> PyResult<BodyHandle> {
+        let world = self.world(py)?;
+        world
             .handle_of(index)
             .map(|inner| BodyHandle { inner })
             .ok_or_else(|| {
                 pyo3::exceptions::PyIndexError::new_err(format!(
                     "no body at index {index} (the world has {})",
-                    self.inner.body_count()
+                    world.body_count()
                 ))
             })
     }
 
     /// The dense index of the body `handle` names. Raises `WorldError` for an unknown handle.
-    fn index_of(&self, handle: &BodyHandle) -> PyResult<usize> {
-        let handle = self.handle(handle)?;
-        self.inner
+    fn index_of(&self, py: Python<'_>, handle: &BodyHandle) -> PyResult<usize> {
+        let world = self.world(py)?;
+        let handle = body(&world, handle)?;
+        world
             .body(handle)
             .map(|b| b.index())
             .ok_or_else(|| PyRuntimeError::new_err("handle vanished"))
@@ -535,63 +518,76 @@ impl World {
     /// values.
     #[pyo3(signature = (handle, force, point = None))]
     fn apply_force(
-        &mut self,
+        &self,
+        py: Python<'_>,
         handle: &BodyHandle,
         force: [f32; 3],
         point: Option<[f32; 3]>,
     ) -> PyResult<()> {
-        let handle = self.handle(handle)?;
         let force = vec3(force, "force")?;
+        let point = point.map(|p| vec3(p, "point")).transpose()?;
+        let mut world = self.world(py)?;
+        let handle = body(&world, handle)?;
         match point {
-            None => self.inner.apply_force(handle, force),
-            Some(p) => self
-                .inner
-                .apply_force_at_point(handle, force, vec3(p, "point")?),
+            None => world.apply_force(handle, force),
+            Some(p) => world.apply_force_at_point(handle, force, p),
         }
         .map_err(world_error)
     }
 
     /// Adds a torque (N·m, world frame) for the next step only. Errors as `apply_force`.
-    fn apply_torque(&mut self, handle: &BodyHandle, torque: [f32; 3]) -> PyResult<()> {
-        let handle = self.handle(handle)?;
-        self.inner
-            .apply_torque(handle, vec3(torque, "torque")?)
-            .map_err(world_error)
+    fn apply_torque(&self, py: Python<'_>, handle: &BodyHandle, torque: [f32; 3]) -> PyResult<()> {
+        let torque = vec3(torque, "torque")?;
+        let mut world = self.world(py)?;
+        let handle = body(&world, handle)?;
+        world.apply_torque(handle, torque).map_err(world_error)
     }
 
     /// Applies an impulse (N·s, world frame) now, at the centre of mass or at `point` (m,
     /// world): the velocities change at once. Errors as `apply_force`.
     #[pyo3(signature = (handle, impulse, point = None))]
     fn apply_impulse(
-        &mut self,
+        &self,
+        py: Python<'_>,
         handle: &BodyHandle,
         impulse: [f32; 3],
         point: Option<[f32; 3]>,
     ) -> PyResult<()> {
-        let handle = self.handle(handle)?;
         let impulse = vec3(impulse, "impulse")?;
+        let point = point.map(|p| vec3(p, "point")).transpose()?;
+        let mut world = self.world(py)?;
+        let handle = body(&world, handle)?;
         match point {
-            None => self.inner.apply_impulse(handle, impulse),
-            Some(p) => self
-                .inner
-                .apply_impulse_at_point(handle, impulse, vec3(p, "point")?),
+            None => world.apply_impulse(handle, impulse),
+            Some(p) => world.apply_impulse_at_point(handle, impulse, p),
         }
         .map_err(world_error)
     }
 
     /// Applies an angular impulse (N·m·s, world frame) now. Errors as `apply_force`.
-    fn apply_torque_impulse(&mut self, handle: &BodyHandle, impulse: [f32; 3]) -> PyResult<()> {
-        let handle = self.handle(handle)?;
-        self.inner
-            .apply_torque_impulse(handle, vec3(impulse, "impulse")?)
+    fn apply_torque_impulse(
+        &self,
+        py: Python<'_>,
+        handle: &BodyHandle,
+        impulse: [f32; 3],
+    ) -> PyResult<()> {
+        let impulse = vec3(impulse, "impulse")?;
+        let mut world = self.world(py)?;
+        let handle = body(&world, handle)?;
+        world
+            .apply_torque_impulse(handle, impulse)
             .map_err(world_error)
     }
 
     /// The first body along the ray from `origin` (m) in `direction` within `max_distance`
-    /// (in units of the direction's length), or None. With `solid` (default True) a ray
-    /// starting inside a body hits it at distance 0. Returns a dict: `body` (BodyHandle),
-    /// `index` (dense index), `distance`, `point` (m), `normal` (unit, out of the body).
-    #[pyo3(signature = (origin, direction, max_distance = f32::MAX, solid = true))]
+    /// (in units of the direction's length; default: unbounded), or None. With `solid`
+    /// (default True) a ray starting inside a body hits it at distance 0. Returns a dict:
+    /// `body` (BodyHandle), `index` (dense index), `distance`, `point` (m), `normal` (unit,
+    /// out of the body).
+    #[pyo3(
+        signature = (origin, direction, max_distance = f32::MAX, solid = true),
+        text_signature = "($self, origin, direction, max_distance=3.4028234663852886e+38, solid=True)"
+    )]
     fn cast_ray<'py>(
         &self,
         py: Python<'py>,
@@ -600,22 +596,8 @@ impl World {
         max_distance: f32,
         solid: bool,
     ) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let hit = guarded(|| {
-            Ok(self.inner.cast_ray(
-                Vec3::from(origin),
-                Vec3::from(direction),
-                max_distance,
-                solid,
-            ))
-        })?;
-        let Some(hit) = hit else { return Ok(None) };
-        let d = PyDict::new(py);
-        d.set_item("body", BodyHandle { inner: hit.body })?;
-        d.set_item("index", self.inner.body(hit.body).map(|b| b.index()))?;
-        d.set_item("distance", hit.distance)?;
-        d.set_item("point", hit.point.to_array())?;
-        d.set_item("normal", hit.normal.to_array())?;
-        Ok(Some(d))
+        let world = self.world(py)?;
+        queries::cast_ray(py, &world, origin, direction, max_distance, solid)
     }
 
     /// The first body that `shape` (an `impulse.Shape`), starting at `translation` (m) and
@@ -623,7 +605,10 @@ impl World {
     /// `max_time` (s), or None. Returns a dict: `body`, `index`, `time` (s), `witness_shape`,
     /// `witness_body` (m, world), `normal` (unit, out of the moving shape). Raises `WorldError`
     /// for a shape that cannot be built or a non-finite pose.
-    #[pyo3(signature = (shape, translation, velocity, max_time, rotation = [0.0, 0.0, 0.0, 1.0]))]
+    #[pyo3(
+        signature = (shape, translation, velocity, max_time, rotation = [0.0, 0.0, 0.0, 1.0]),
+        text_signature = "($self, shape, translation, velocity, max_time, rotation=(0.0, 0.0, 0.0, 1.0))"
+    )]
     fn cast_shape<'py>(
         &self,
         py: Python<'py>,
@@ -633,33 +618,9 @@ impl World {
         max_time: f32,
         rotation: [f32; 4],
     ) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let shared = guarded(|| {
-            impulse::scene::build_shape(impulse::BodyKind::Dynamic, &shape.desc)
-                .map_err(|e| WorldError::new_err(e.to_string()))
-        })?;
-        let translation = vec3(translation, "translation")?;
-        let rotation = impulse::glam::Quat::from_array(rotation);
-        if !rotation.is_finite() || rotation.length_squared() == 0.0 {
-            return Err(WorldError::new_err(
-                "rotation: must be a finite, non-zero quaternion",
-            ));
-        }
-        let pose = impulse::parry3d::math::Pose::from_parts(translation, rotation.normalize());
-        let velocity = vec3(velocity, "velocity")?;
-        let hit = guarded(|| {
-            Ok(self
-                .inner
-                .cast_shape(&pose, velocity, shared.as_ref(), max_time))
-        })?;
-        let Some(hit) = hit else { return Ok(None) };
-        let d = PyDict::new(py);
-        d.set_item("body", BodyHandle { inner: hit.body })?;
-        d.set_item("index", self.inner.body(hit.body).map(|b| b.index()))?;
-        d.set_item("time", hit.time)?;
-        d.set_item("witness_shape", hit.witness_shape.to_array())?;
-        d.set_item("witness_body", hit.witness_body.to_array())?;
-        d.set_item("normal", hit.normal.to_array())?;
-        Ok(Some(d))
+        let cast = queries::prepare_shape_cast(shape, translation, velocity, rotation)?;
+        let world = self.world(py)?;
+        queries::cast_shape(py, &world, &cast, max_time)
     }
 
     /// Pairs of bodies with contact points after the last step (speculative points too), as
@@ -669,14 +630,14 @@ impl World {
     /// m (negative: overlap), `normal_impulse` (K,) N·s, `friction_impulse` (K, 3) N·s on
     /// body 2; all float32.
     fn contact_pairs<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        contacts::contact_pairs(py, &self.inner)
+        contacts::contact_pairs(py, &*self.world(py)?)
     }
 
     /// The last step's contact events, as a list of dicts: `{"type": "started", "body1",
     /// "body2", "normal_impulse"}` (N·s: how hard they met) or `{"type": "stopped", "body1",
     /// "body2"}`; `body1` is the body with the smaller handle.
     fn contact_events<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        contacts::contact_events(py, &self.inner)
+        contacts::contact_events(py, &*self.world(py)?)
     }
 
     /// The last step's contact LCP (`World::contact_lcp`): find γ within its bounds with
@@ -690,23 +651,25 @@ impl World {
     /// after every contact row.
     /// Raises `StepError` when the last step produced non-finite data.
     fn contact_lcp<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        contacts::contact_lcp(py, &self.inner)
+        contacts::contact_lcp(py, &*self.world(py)?)
     }
 
     /// Inserts the joint `builder` describes (an `impulse.JointBuilder`; world anchors and
     /// axes are placed at the bodies' current poses) and returns its `JointHandle`; wakes both
     /// bodies. Raises `WorldError` naming the joint and field for a removed body, a joint of a
     /// body with itself or of two non-dynamic bodies, or values out of range.
-    fn insert_joint(&mut self, builder: &JointBuilder) -> PyResult<JointHandle> {
+    fn insert_joint(&self, py: Python<'_>, builder: &JointBuilder) -> PyResult<JointHandle> {
         let builder = builder.inner.clone();
-        let inner = guarded(|| self.inner.insert_joint(builder).map_err(world_error))?;
+        let mut world = self.world(py)?;
+        let inner = guarded(|| world.insert_joint(builder).map_err(world_error))?;
         Ok(JointHandle { inner })
     }
 
     /// Removes the joint `handle` names and returns its name (or None); wakes its bodies.
     /// Raises `WorldError` for a removed or foreign handle.
-    fn remove_joint(&mut self, handle: &JointHandle) -> PyResult<Option<String>> {
-        guarded(|| self.inner.remove_joint(handle.inner).map_err(world_error))
+    fn remove_joint(&self, py: Python<'_>, handle: &JointHandle) -> PyResult<Option<String>> {
+        let mut world = self.world(py)?;
+        guarded(|| world.remove_joint(handle.inner).map_err(world_error))
     }
 
     /// A joint's read view as a dict: `handle`, `kind` (str), `name` (str or None), `body_a`,
@@ -716,26 +679,26 @@ impl World {
     /// `coordinates` (as `joint_coordinates`, or None when a body was removed). Raises
     /// `WorldError` for a removed or foreign handle.
     fn joint<'py>(&self, py: Python<'py>, handle: &JointHandle) -> PyResult<Bound<'py, PyDict>> {
-        let joint = self
-            .inner
+        let world = self.world(py)?;
+        let joint = world
             .joint(handle.inner)
             .ok_or_else(|| unknown_joint(handle))?;
-        joints::joint_dict(py, &self.inner, &joint)
+        joints::joint_dict(py, &world, &joint)
     }
 
     /// Every joint's read view (as `joint`), in dense joint order (broken ones included).
     fn joints<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        let inner = &self.inner;
-        inner
+        let world = self.world(py)?;
+        world
             .joints()
-            .map(|j| joints::joint_dict(py, inner, &j))
+            .map(|j| joints::joint_dict(py, &world, &j))
             .collect()
     }
 
     /// Number of joints (broken ones included).
     #[getter]
-    fn joint_count(&self) -> usize {
-        self.inner.joint_count()
+    fn joint_count(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(self.world(py)?.joint_count())
     }
 
     /// The six coordinates of B's joint frame relative to A's at the current poses, (6,)
@@ -747,7 +710,8 @@ impl World {
         py: Python<'py>,
         handle: &JointHandle,
     ) -> PyResult<Bound<'py, PyArray1<f32>>> {
-        let c = guarded(|| Ok(self.inner.joint_coordinates(handle.inner)))?;
+        let world = self.world(py)?;
+        let c = guarded(|| Ok(world.joint_coordinates(handle.inner)))?;
         let c = c.ok_or_else(|| unknown_joint(handle))?;
         Ok(PyArray1::from_vec(py, c.to_vec()))
     }
@@ -757,6 +721,6 @@ impl World {
     /// the substep where the joint broke). Only the last step's: with `step(n)`, n > 1, read
     /// them after each step.
     fn joint_events<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        joints::joint_events(py, &self.inner)
+        joints::joint_events(py, &*self.world(py)?)
     }
 }

@@ -3,7 +3,6 @@
 import json
 import pickle
 import subprocess
-import threading
 
 import numpy as np
 import pytest
@@ -248,7 +247,7 @@ def test_bad_arguments_raise_and_never_crash():
         impulse.World(dt=0.0)
     with pytest.raises(impulse.WorldError):
         impulse.World(gravity=(0, float("nan"), 0))
-    with pytest.raises(OverflowError):
+    with pytest.raises(impulse.WorldError, match="n: must be a whole number"):
         world.step(-1)
     with pytest.raises(impulse.WorldError):
         world.simulate(10, every=0)
@@ -275,36 +274,6 @@ def test_a_blow_up_raises_step_error_with_the_frames_so_far():
     with pytest.raises(impulse.StepError, match="blew up at step") as error:
         world.simulate(100)
     assert error.value.trajectory.frame_count >= 1
-
-
-def test_step_releases_the_gil():
-    # While `step` runs without the GIL, another thread runs Python and finds the world
-    # mutably borrowed (a RuntimeError from pyo3): only possible if the GIL was released
-    # during the step.
-    world = impulse.World.from_scene("pyramid20")
-    world.settings = world.settings.replace(sleep=False)
-    seen_inside = threading.Event()
-    stop = threading.Event()
-
-    def probe():
-        while not stop.is_set():
-            try:
-                world.step_count
-            except RuntimeError:
-                seen_inside.set()
-                return
-
-    thread = threading.Thread(target=probe)
-    thread.start()
-    try:
-        for _ in range(200):
-            world.step(5)
-            if seen_inside.is_set():
-                break
-    finally:
-        stop.set()
-        thread.join()
-    assert seen_inside.is_set(), "no other thread ran while the world stepped"
 
 
 def test_forces_and_impulses_change_momentum_as_newton_says():

@@ -29,6 +29,7 @@ from ._impulse import (
     __version__,
     scenes,
 )
+from ._diagnostics import Diagnostics
 from ._trajectory import Trajectory, load_trajectory
 
 # `impulse.sweep` is the function; the module's other names: `from impulse.sweep import ...`.
@@ -37,6 +38,7 @@ from .sweep import sweep
 __all__ = [
     "BodyBuilder",
     "BodyHandle",
+    "Diagnostics",
     "JointBuilder",
     "JointHandle",
     "SceneError",
@@ -56,3 +58,9 @@ __all__ = [
 def _world_from_snapshot(data: bytes) -> World:
     """Unpickles a world: the inverse of ``World.__reduce__`` (snapshot bytes)."""
     return World.from_snapshot(data)
+
+
+def _body_builder(constructor: str, shape: Shape | float, properties: dict) -> BodyBuilder:
+    """Unpickles a body builder: the inverse of ``BodyBuilder.__reduce__`` (the call that made
+    it: ``BodyBuilder.dynamic(shape, **properties)`` and the like)."""
+    return getattr(BodyBuilder, constructor)(shape, **properties)

@@ -1,5 +1,6 @@
 """Type stubs of the native module ``impulse._impulse`` (re-exported by ``impulse``)."""
 
+import math
 import os
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -7,6 +8,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ._diagnostics import Diagnostics
 from ._trajectory import Trajectory
 
 __version__: str
@@ -41,16 +43,18 @@ class Settings:
     def __getattr__(self, name: str) -> Any: ...
 
 class BodyHandle:
-    """A body's name in a world (slot index and generation); hashable."""
+    """A body's name in a world (slot index and generation); hashable, picklable."""
 
+    def __init__(self, index: int, generation: int) -> None: ...
     @property
     def index(self) -> int: ...
     @property
     def generation(self) -> int: ...
 
 class JointHandle:
-    """A joint's name in a world (slot index and generation); hashable and ordered."""
+    """A joint's name in a world (slot index and generation); hashable, ordered, picklable."""
 
+    def __init__(self, index: int, generation: int) -> None: ...
     @property
     def index(self) -> int: ...
     @property
@@ -108,12 +112,12 @@ class JointBuilder:
         self, hertz: float | None = None, damping_ratio: float | None = None
     ) -> JointBuilder: ...
     def collide_connected(self, collide: bool) -> JointBuilder: ...
-    def breakable(self, force: float, torque: float = ...) -> JointBuilder:
+    def breakable(self, force: float, torque: float = math.inf) -> JointBuilder:
         """Strength ``force`` (N) and ``torque`` (N·m, default inf)."""
     def name(self, name: str) -> JointBuilder: ...
 
 class Shape:
-    """A collision shape in the body frame (m)."""
+    """A collision shape in the body frame (m); compares with ``==``, picklable."""
 
     @staticmethod
     def ball(radius: float) -> Shape: ...
@@ -138,7 +142,7 @@ class BodyBuilder:
 
     Keywords: translation (m), rotation (x y z w), linear_velocity (m/s), angular_velocity
     (rad/s), friction, restitution, density (kg/m³), mass (kg), name, linear_damping,
-    angular_damping (1/s), lock_rotation.
+    angular_damping (1/s), lock_rotation. Picklable; the repr is the call that made it.
     """
 
     @staticmethod
@@ -155,12 +159,13 @@ _ArrayF32 = npt.NDArray[np.float32]
 
 class World:
     """A simulation world. State arrays are read-only float32 views of the engine's storage
-    (see docs/python.md for their lifetime rule); assigning an array sets every body."""
+    (see docs/python.md for their lifetime rule); assigning an array sets every body. Calls
+    from several threads on one world take turns; ``state()`` copies one moment's arrays."""
 
     def __init__(
         self,
         gravity: _Vec3 = (0.0, -9.81, 0.0),
-        dt: float = 1.0 / 60.0,
+        dt: float = 0.016666666666666666,
         settings: Settings | str | None = None,
     ) -> None: ...
     @staticmethod
@@ -175,8 +180,12 @@ class World:
     @staticmethod
     def from_snapshot(data: bytes) -> World: ...
     def snapshot(self) -> bytes: ...
-    def step(self, n: int = 1) -> None: ...
+    def step(self, n: int = 1) -> None:
+        """``n`` ≥ 0 steps without the GIL (else ``WorldError``, a ``ValueError``)."""
     def simulate(self, steps: int, every: int = 1) -> Trajectory: ...
+    def state(self) -> dict[str, Any]:
+        """Copies of one moment: ``step_count``, ``time``, ``positions``, ``orientations``,
+        ``linear_velocities``, ``angular_velocities``."""
     @property
     def positions(self) -> _ArrayF32:
         """(N, 3) float32, metres (read-only view)."""
@@ -204,7 +213,7 @@ class World:
     @property
     def masses(self) -> npt.NDArray[np.float32]: ...
     @property
-    def diagnostics(self) -> dict[str, Any]: ...
+    def diagnostics(self) -> Diagnostics: ...
     @property
     def profile(self) -> dict[str, float]: ...
     def quality(self, initial_positions: npt.ArrayLike | None = None) -> dict[str, Any]: ...
@@ -245,7 +254,7 @@ class World:
         self,
         origin: _Vec3,
         direction: _Vec3,
-        max_distance: float = ...,
+        max_distance: float = 3.4028234663852886e38,
         solid: bool = True,
     ) -> dict[str, Any] | None:
         """First hit: ``body``, ``index``, ``distance``, ``point`` (m), ``normal``; or None."""

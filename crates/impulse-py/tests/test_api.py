@@ -1,0 +1,237 @@
+"""The Python surface: pickling of shapes, builders and handles, real defaults in help() and the
+stubs, errors for negative counts, and a short repr of the diagnostics."""
+
+import ast
+import inspect
+import math
+import pathlib
+import pickle
+import pydoc
+
+import numpy as np
+import pytest
+
+import impulse
+from impulse import _impulse
+
+STUBS = pathlib.Path(impulse.__file__).with_name("_impulse.pyi")
+
+SHAPES = [
+    impulse.Shape.ball(0.5),
+    impulse.Shape.cuboid(0.5, 0.25, 1.0),
+    impulse.Shape.capsule(0.5, 0.2),
+    impulse.Shape.cylinder(0.5, 0.3),
+    impulse.Shape.cone(0.5, 0.3),
+    impulse.Shape.convex_hull([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]),
+    impulse.Shape.halfspace((0, 1, 0)),
+    impulse.Shape.from_dict(
+        {
+            "type": "compound",
+            "parts": [
+                {"shape": {"type": "sphere", "radius": 0.25}, "position": [0.5, 0, 0]},
+                {"shape": {"type": "sphere", "radius": 0.25}, "position": [-0.5, 0, 0]},
+            ],
+        }
+    ),
+]
+
+
+def ground_world():
+    world = impulse.World(gravity=(0, -9.81, 0), dt=1 / 60)
+    world.insert(impulse.BodyBuilder.fixed(impulse.Shape.cuboid(20, 0.5, 20), translation=(0, -0.5, 0)))
+    return world
+
+
+@pytest.mark.parametrize("shape", SHAPES, ids=lambda s: s.to_dict()["type"])
+def test_shapes_pickle(shape):
+    copy = pickle.loads(pickle.dumps(shape))
+    assert copy == shape
+    assert copy.to_dict() == shape.to_dict()
+
+
+def test_body_builders_pickle_to_the_same_body():
+    builders = [
+        impulse.BodyBuilder.dynamic(
+            impulse.Shape.cuboid(0.5, 0.5, 0.5),
+            translation=(0.0, 3.0, 0.0),
+            rotation=(0.0, 0.38268343, 0.0, 0.9238795),
+            linear_velocity=np.array([1.0, 0.0, 0.5]),
+            angular_velocity=[0.0, 2.0, 0.0],
+            friction=0.4,
+            restitution=0.25,
+            density=700.0,
+            name="crate",
+            linear_damping=0.1,
+            angular_damping=0.2,
+        ),
+        impulse.BodyBuilder.particle(0.2, translation=(3.0, 1.0, 0.0), mass=0.5),
+        impulse.BodyBuilder.kinematic(impulse.Shape.ball(0.3), translation=(-3.0, 0.3, 0.0),
+                                      linear_velocity=(0.5, 0, 0)),
+        impulse.BodyBuilder.fixed(impulse.Shape.ball(0.3), translation=(6.0, 0.3, 0.0)),
+        impulse.BodyBuilder.dynamic(impulse.Shape.capsule(0.3, 0.2), translation=(0, 6, 0),
+                                    lock_rotation=True),
+    ]
+    copies = [pickle.loads(pickle.dumps(b)) for b in builders]
+    assert [repr(c) for c in copies] == [repr(b) for b in builders]
+    assert repr(builders[0]).startswith("BodyBuilder.dynamic(Shape(")
+    assert 'friction=0.4, restitution=0.25, density=700.0, name="crate"' in repr(builders[0])
+    worlds = [ground_world(), ground_world()]
+    for world, bodies in zip(worlds, (builders, copies)):
+        for builder in bodies:
+            world.insert(builder)
+        world.step(40)
+    assert worlds[0].names == worlds[1].names
+    assert worlds[0].kinds == worlds[1].kinds == ["static", "dynamic", "particle", "kinematic",
+                                                    "static", "dynamic"]
+    assert worlds[0].masses.tobytes() == worlds[1].masses.tobytes()
+    for name in ("positions", "orientations", "linear_velocities", "angular_velocities"):
+        a, b = getattr(worlds[0], name), getattr(worlds[1], name)
+        assert a.tobytes() == b.tobytes(), name
+    # The bodies moved: the comparison is not of two initial states.
+    assert worlds[0].positions[1, 1] < 3.0
+
+
+def test_handles_pickle_and_name_the_same_body_and_joint():
+    world = ground_world()
+    a = world.insert(impulse.BodyBuilder.dynamic(impulse.Shape.ball(0.5), translation=(0, 2, 0)))
+    b = world.insert(impulse.BodyBuilder.dynamic(impulse.Shape.ball(0.5), translation=(2, 2, 0)))
+    world.remove(a)
+    c = world.insert(impulse.BodyBuilder.dynamic(impulse.Shape.ball(0.5), translation=(0, 2, 0)))
+    assert c.index == a.index and c.generation == a.generation + 1
+    joint = world.insert_joint(impulse.JointBuilder.distance(b, c, 1.0, 3.0))
+    for handle in (b, c, joint):
+        copy = pickle.loads(pickle.dumps(handle))
+        assert copy == handle and hash(copy) == hash(handle)
+        assert (copy.index, copy.generation) == (handle.index, handle.generation)
+    assert world.index_of(pickle.loads(pickle.dumps(c))) == world.index_of(c)
+    assert world.joint(pickle.loads(pickle.dumps(joint)))["handle"] == joint
+    # A handle made from its parts is checked by the world like any other.
+    assert impulse.BodyHandle(b.index, b.generation) == b
+    with pytest.raises(impulse.WorldError):
+        world.index_of(pickle.loads(pickle.dumps(a)))  # the removed body's
+    with pytest.raises(impulse.WorldError):
+        world.joint(impulse.JointHandle(joint.index, joint.generation + 1))
+
+
+def test_negative_counts_raise_value_error():
+    world = impulse.World.from_scene("pyramid20")
+    with pytest.raises(ValueError, match=r"^n: must be a whole number ≥ 0, got -1$") as error:
+        world.step(-1)
+    assert isinstance(error.value, impulse.WorldError)
+    with pytest.raises(impulse.WorldError, match=r"^steps: must be a whole number ≥ 0, got -5$"):
+        world.simulate(-5)
+    with pytest.raises(impulse.WorldError, match=r"^every: must be a whole number ≥ 1, got 0$"):
+        world.simulate(10, every=0)
+    assert world.step_count == 0
+    world.step(0)
+    assert world.step_count == 0
+
+
+def native_callables():
+    """(qualified name, object) of every class, function and method of the native module."""
+    for name, value in vars(_impulse).items():
+        if name.startswith("_"):
+            continue
+        if isinstance(value, type):
+            yield name, value
+            for method, member in vars(value).items():
+                if callable(member) or isinstance(member, (staticmethod, classmethod)):
+                    if method.startswith("__") and method != "__init__":
+                        continue
+                    yield f"{name}.{method}", getattr(value, method)
+        elif callable(value):
+            yield name, value
+
+
+def test_help_shows_the_real_defaults():
+    for name, value in native_callables():
+        if getattr(value, "__text_signature__", None) is None and not isinstance(value, type):
+            continue
+        try:
+            signature = inspect.signature(value)
+        except ValueError:
+            if isinstance(value, type) and value.__text_signature__ is None:
+                continue  # a class made by its static methods only
+            raise
+        for parameter in signature.parameters.values():
+            assert parameter.default is not Ellipsis, f"{name}: {parameter.name}"
+    world = inspect.signature(impulse.World).parameters
+    assert world["gravity"].default == (0.0, -9.81, 0.0)
+    assert world["dt"].default == 1 / 60
+    assert world["settings"].default is None
+    assert inspect.signature(impulse.World.step).parameters["n"].default == 1
+    ray = inspect.signature(impulse.World.cast_ray).parameters
+    assert ray["max_distance"].default == float(np.finfo(np.float32).max)
+    assert ray["solid"].default is True
+    cast = inspect.signature(impulse.World.cast_shape).parameters
+    assert cast["rotation"].default == (0.0, 0.0, 0.0, 1.0)
+    assert inspect.signature(impulse.JointBuilder.breakable).parameters["torque"].default == math.inf
+    text = pydoc.render_doc(impulse.World, renderer=pydoc.plaintext)
+    assert "Ellipsis" not in text
+    assert "gravity=(0.0, -9.81, 0.0), dt=0.016666666666666666, settings=None" in text
+    assert "step(self, /, n=1)" in text
+
+
+def stub_defaults():
+    """{qualified name: {parameter: default}} of every function in the stubs."""
+    tree = ast.parse(STUBS.read_text())
+    found = {}
+
+    def walk(body, prefix):
+        for node in body:
+            if isinstance(node, ast.ClassDef):
+                walk(node.body, f"{prefix}{node.name}.")
+            elif isinstance(node, ast.FunctionDef):
+                if any(isinstance(d, ast.Name) and d.id == "property" or isinstance(d, ast.Attribute)
+                       for d in node.decorator_list):
+                    continue
+                args = node.args
+                positional = args.posonlyargs + args.args
+                pairs = list(zip(positional[len(positional) - len(args.defaults):], args.defaults))
+                pairs += [(a, d) for a, d in zip(args.kwonlyargs, args.kw_defaults) if d is not None]
+                found[prefix + node.name] = {
+                    a.arg: eval(compile(ast.Expression(d), str(STUBS), "eval"), {"math": math})
+                    for a, d in pairs
+                }
+
+    walk(tree.body, "")
+    return found
+
+
+def test_stubs_have_the_runtime_defaults():
+    stubs = stub_defaults()
+    checked = 0
+    for name, defaults in stubs.items():
+        assert Ellipsis not in defaults.values(), name
+        owner, _, method = name.rpartition(".")
+        target = getattr(_impulse, owner) if owner else _impulse
+        if method == "__init__":
+            value = target
+        elif method.startswith("__") or not hasattr(target, method):
+            continue
+        else:
+            value = getattr(target, method)
+        try:
+            runtime = inspect.signature(value).parameters
+        except ValueError:
+            continue
+        for parameter, default in defaults.items():
+            assert runtime[parameter].default == default, f"{name}: {parameter}"
+            checked += 1
+    assert checked >= 15
+
+
+def test_diagnostics_print_a_short_summary():
+    world = ground_world()
+    for i in range(20):
+        world.insert(impulse.BodyBuilder.dynamic(impulse.Shape.ball(0.25), translation=(2.0 * i - 19, 0.2, 0)))
+    world.step(5)
+    diagnostics = world.diagnostics
+    assert isinstance(diagnostics, dict) and isinstance(diagnostics, impulse.Diagnostics)
+    assert len(diagnostics["islands"]) == 20  # each ball on the ground is an island
+    text = repr(diagnostics)
+    assert len(text) < 200, text
+    assert text == str(diagnostics)
+    assert text.startswith("Diagnostics(step=5, contacts=20, ") and "islands=20" in text
+    assert len(repr(dict(diagnostics))) > 5 * len(text)
+    assert pickle.loads(pickle.dumps(diagnostics)) == diagnostics
