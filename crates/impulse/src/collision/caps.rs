@@ -193,7 +193,8 @@ fn face_of(other: &dyn Shape, pose: &Pose, n: Vector) -> Option<Face> {
 /// Replaces the points of `manifold`, Parry's contact of `g1` and `g2` (`g2` at `pos12` in
 /// `g1`'s frame), by the cap's polygon points when one shape's flat cap touches the other's
 /// flat face (see the module's documentation); otherwise leaves it alone. `old` are the
-/// manifold's points before Parry updated it, whose impulses carry over by feature id.
+/// manifold's points before Parry updated it, whose impulses carry over by feature id. True if
+/// it replaced the points.
 pub(crate) fn refine_cap_contact<ManifoldData, ContactData: Default + Copy>(
     pos12: &Pose,
     g1: &dyn Shape,
@@ -201,12 +202,12 @@ pub(crate) fn refine_cap_contact<ManifoldData, ContactData: Default + Copy>(
     prediction: Real,
     manifold: &mut ContactManifold<ManifoldData, ContactData>,
     old: &[TrackedContact<ContactData>],
-) {
+) -> bool {
     if manifold.points.is_empty() {
-        return;
+        return false;
     }
-    let _ = refine(pos12, g1, g2, prediction, manifold, old, false)
-        || refine(&pos12.inverse(), g2, g1, prediction, manifold, old, true);
+    refine(pos12, g1, g2, prediction, manifold, old, false)
+        || refine(&pos12.inverse(), g2, g1, prediction, manifold, old, true)
 }
 
 /// Whether `shape` has a flat cap that [`refine_cap_contact`] may use: a cylinder or cone,
@@ -337,7 +338,7 @@ fn refine<ManifoldData, ContactData: Default + Copy>(
 
 /// Whether `p` lies in the convex polygon `polygon` (either winding; on an edge counts; every
 /// point lies in an empty polygon, a half-space's plane).
-fn inside_convex(polygon: &[[Real; 2]], p: [Real; 2]) -> bool {
+pub(crate) fn inside_convex(polygon: &[[Real; 2]], p: [Real; 2]) -> bool {
     let mut sign = 0.0;
     for i in 0..polygon.len() {
         let a = polygon[i];
