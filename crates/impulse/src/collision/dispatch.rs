@@ -1,6 +1,7 @@
 //! The query dispatcher of the narrow phase: Parry's [`DefaultQueryDispatcher`], except for a
-//! ball against a rounded convex shape (below) and a cylinder's or cone's flat cap on a flat
-//! face ([`super::caps`]).
+//! ball against a rounded convex shape (below), a cylinder's or cone's flat cap on a flat
+//! face ([`super::caps`]) and a convex hull's face of more than four vertices
+//! ([`super::faces`]).
 //!
 //! Parry projects a point on a `RoundShape` with GJK on the rounded shape's support map (the
 //! inner shape's support point moved out by the border radius along the direction asked),
@@ -50,9 +51,9 @@ use parry3d::shape::{Ball, PackedFeatureId, Shape, ShapeType, SupportMap};
 use super::{caps, faces};
 use crate::body::rules::rounded_parts;
 
-/// Parry's default dispatcher, with exact contacts between a ball and a rounded convex shape
-/// and a fine polygon for a cylinder's or cone's flat cap on a flat face (see the module's
-/// documentation).
+/// Parry's default dispatcher, with exact contacts between a ball and a rounded convex shape,
+/// a fine polygon for a cylinder's or cone's flat cap on a flat face and a convex hull's large
+/// faces taken whole (see the module's documentation).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct ContactDispatcher;
 
@@ -324,7 +325,7 @@ where
         let refined =
             cap_pair && caps::refine_cap_contact(pos12, g1, g2, prediction, manifold, &old);
         if hull_pair && !refined {
-            faces::refine_face_contact(pos12, g1, g2, prediction, manifold, &old);
+            faces::refine_face_contact(pos12, g1, g2, prediction, constraints, manifold, &old);
         }
         fallback.after(pos12, g1, g2, constraints, prediction, manifold);
         Ok(())

@@ -28,7 +28,8 @@
 //! is deeper than every clipped point, as where the normal meets the features edge-on.
 
 use parry3d::math::{Pose, Real, Vector};
-use parry3d::query::{ContactManifold, TrackedContact};
+use parry3d::query::details::{NormalConstraints, NormalConstraintsPair};
+use parry3d::query::{ContactManifold, DefaultQueryDispatcher, QueryDispatcher, TrackedContact};
 use parry3d::shape::{ConvexPolyhedron, PackedFeatureId, PolygonalFeature, Shape, TypedShape};
 
 use super::caps::inside_convex;
@@ -365,21 +366,37 @@ pub(crate) fn reduce<ContactData>(
 /// Replaces the points of `manifold`, Parry's contact of `g1` and `g2` (`g2` at `pos12` in
 /// `g1`'s frame), by those of the whole support faces where a hull's support face along the
 /// manifold's normal has more than four vertices (see the module's documentation); otherwise
-/// leaves it alone. `old` are the manifold's points before Parry updated it, whose impulses
+/// leaves it alone. `constraints` are the pair's normal constraints (a mesh triangle's), shape
+/// 1's then shape 2's. `old` are the manifold's points before Parry updated it, whose impulses
 /// carry over by feature id. True if it replaced the points.
 pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
     pos12: &Pose,
     g1: &dyn Shape,
     g2: &dyn Shape,
     prediction: Real,
+    constraints: (
+        Option<&dyn NormalConstraints>,
+        Option<&dyn NormalConstraints>,
+    ),
     manifold: &mut ContactManifold<ManifoldData, ContactData>,
     old: &[TrackedContact<ContactData>],
 ) -> bool {
     let half_space = g1.as_halfspace().is_some() || g2.as_halfspace().is_some();
-    // Without points Parry's generator for two polyhedra found the shapes apart beyond the
-    // prediction, and its normal is only a search direction.
+    // Without points, Parry's generator for two polyhedra either found the shapes apart beyond
+    // the prediction (its normal is then only a search direction) or clipped its four vertices
+    // against a feature they miss (a small mesh triangle under another part of the face, whose
+    // normal constraints also drop GJK's point): the shapes' contact tells which, and gives
+    // the normal.
     if manifold.points.is_empty() && !half_space {
-        return false;
+        let Ok(Some(contact)) = DefaultQueryDispatcher.contact(pos12, g1, g2, prediction) else {
+            return false;
+        };
+        let (mut n1, mut n2) = (contact.normal1, contact.normal2);
+        if !constraints.project_local_normals(pos12, &mut n1, &mut n2) {
+            return false;
+        }
+        manifold.local_n1 = n1;
+        manifold.local_n2 = n2;
     }
     let (n1, n2) = (manifold.local_n1, manifold.local_n2);
     let Some(n) = n1.try_normalize() else {
@@ -404,9 +421,11 @@ pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
     // 1e-4 rad, which tilts every depth across a large face. A normal that near the large
     // face's own is that face's (a vertex, edge or face on a face touches along its normal).
     let face_normal = if large1 {
-        f1.plane_of().map(|(_, normal)| normal * normal.dot(n).signum())
+        f1.plane_of()
+            .map(|(_, normal)| normal * normal.dot(n).signum())
     } else {
-        f2.plane_of().map(|(_, normal)| -normal * normal.dot(-n).signum())
+        f2.plane_of()
+            .map(|(_, normal)| -normal * normal.dot(-n).signum())
     };
     let n = match face_normal {
         Some(normal) if normal.dot(n) >= SNAP_COSINE => {

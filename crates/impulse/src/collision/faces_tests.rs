@@ -132,7 +132,10 @@ fn a_prism_standing_on_its_base_gets_points_spanning_the_whole_base() {
                         points.len()
                     );
                     for &(on_hull, on_ground, dist) in &points {
-                        assert!((on_hull.y - 0.001).abs() < 1e-4, "{case}: hull point {on_hull}");
+                        assert!(
+                            (on_hull.y - 0.001).abs() < 1e-4,
+                            "{case}: hull point {on_hull}"
+                        );
                         assert!(on_ground.y.abs() < 1e-4, "{case}: ground point {on_ground}");
                         assert!((dist - 0.001).abs() < 1e-4, "{case}: separation {dist}");
                     }
@@ -160,7 +163,8 @@ fn a_tilted_prism_keeps_its_deepest_vertex() {
     let lowest = (0..16)
         .map(|k| {
             let angle = k as f32 * std::f32::consts::TAU / 16.0;
-            pose.transform_point(Vec3::new(angle.cos(), -1.0, angle.sin())).y
+            pose.transform_point(Vec3::new(angle.cos(), -1.0, angle.sin()))
+                .y
         })
         .fold(f32::MAX, f32::min);
     assert!((deepest - lowest).abs() < 1e-5, "{deepest} vs {lowest}");
@@ -198,7 +202,11 @@ fn the_reduction_keeps_the_deepest_point_and_a_large_quadrilateral() {
     assert!(ids(&candidates).contains(&PackedFeatureId::vertex(5)));
     // The opposite vertex, and two a quarter turn away: the inscribed square, area 2 m².
     let at: Vec<Vec3> = candidates.iter().map(|c| c.p1).collect();
-    assert!((spread_area(&at) - 2.0).abs() < 1e-4, "{}", spread_area(&at));
+    assert!(
+        (spread_area(&at) - 2.0).abs() < 1e-4,
+        "{}",
+        spread_area(&at)
+    );
 }
 
 #[test]

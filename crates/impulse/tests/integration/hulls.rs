@@ -94,8 +94,11 @@ impl Hull {
         } else {
             // 4–256 points on an ellipsoid, one in four rounded.
             let count = rng.integer(4, 256);
-            let axes = Vec3::new(rng.range(0.5, 1.0), rng.range(0.5, 1.0), rng.range(0.5, 1.0))
-                * rng.range(0.04, 1.0);
+            let axes = Vec3::new(
+                rng.range(0.5, 1.0),
+                rng.range(0.5, 1.0),
+                rng.range(0.5, 1.0),
+            ) * rng.range(0.04, 1.0);
             let points = (0..count)
                 .map(|_| {
                     let z = rng.range(-1.0, 1.0);
@@ -353,7 +356,7 @@ fn hulls_rest_on_every_ground() {
 
 /// The full sweep: docs/testing.md, "Hulls on every ground".
 #[test]
-#[ignore = "the full sweep, a few minutes: docs/testing.md"]
+#[ignore = "the full sweep, about a minute: docs/testing.md"]
 fn hulls_rest_on_every_ground_full_sweep() {
     assert_clean(&sweep(100..300));
 }

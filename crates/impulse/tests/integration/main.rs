@@ -16,6 +16,7 @@ mod golden;
 mod guards;
 mod gyroscopic;
 mod heavy_on_light;
+mod height_fields;
 mod hulls;
 mod impacts;
 mod islands;
