@@ -34,8 +34,9 @@
 //! This applies where Parry uses the cap (|n·axis| ≥ 1/2, n the contact normal in the cap's
 //! frame; for a cone, the base only), against a triangle, a (rounded) cuboid, a (rounded)
 //! convex polyhedron whose face has at most four vertices (Parry gives a face by its first
-//! four), or a half-space. Other pairs (a cap on another cap, on an edge or a vertex, on a
-//! larger hull face) keep Parry's manifold.
+//! four), or a half-space. Other pairs (a cap on another cap, on an edge or a vertex) keep
+//! Parry's manifold; a cap on a larger hull face gets the whole face clipped against Parry's
+//! square ([`super::faces`]).
 
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::query::{ContactManifold, TrackedContact};
