@@ -62,12 +62,12 @@ impl Hull {
     /// A prism (even seeds) or a point cloud (odd seeds), 4–256 points, 4 cm–1 m across.
     fn random(seed: u64) -> Self {
         let mut rng = Rng(seed);
-        if seed % 2 == 0 {
+        if seed.is_multiple_of(2) {
             // 3–128 vertices around (6–256 points), on a circle or at random angles.
             let around = rng.integer(3, 128);
             let radius = rng.range(0.04, 1.0);
             let half_height = radius * rng.range(0.2, 1.0);
-            let regular = rng.next() % 2 == 0;
+            let regular = rng.next().is_multiple_of(2);
             let mut angles: Vec<f32> = (0..around)
                 .map(|k| {
                     let even = k as f32 * std::f32::consts::TAU / around as f32;
@@ -108,7 +108,7 @@ impl Hull {
                     p.to_array()
                 })
                 .collect();
-            let border = if rng.next() % 4 == 0 {
+            let border = if rng.next().is_multiple_of(4) {
                 0.1 * axes.min_element()
             } else {
                 0.0
