@@ -34,8 +34,9 @@
 //! This applies where Parry uses the cap (|n·axis| ≥ 1/2, n the contact normal in the cap's
 //! frame; for a cone, the base only), against a triangle, a (rounded) cuboid, a (rounded)
 //! convex polyhedron whose face has at most four vertices (Parry gives a face by its first
-//! four), or a half-space. Other pairs (a cap on another cap, on an edge or a vertex, on a
-//! larger hull face) keep Parry's manifold.
+//! four), or a half-space. Other pairs (a cap on another cap, on an edge or a vertex) keep
+//! Parry's manifold; a cap on a larger hull face gets the whole face clipped against Parry's
+//! square ([`super::faces`]).
 
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::query::{ContactManifold, TrackedContact};
@@ -193,7 +194,8 @@ fn face_of(other: &dyn Shape, pose: &Pose, n: Vector) -> Option<Face> {
 /// Replaces the points of `manifold`, Parry's contact of `g1` and `g2` (`g2` at `pos12` in
 /// `g1`'s frame), by the cap's polygon points when one shape's flat cap touches the other's
 /// flat face (see the module's documentation); otherwise leaves it alone. `old` are the
-/// manifold's points before Parry updated it, whose impulses carry over by feature id.
+/// manifold's points before Parry updated it, whose impulses carry over by feature id. True if
+/// it replaced the points.
 pub(crate) fn refine_cap_contact<ManifoldData, ContactData: Default + Copy>(
     pos12: &Pose,
     g1: &dyn Shape,
@@ -201,12 +203,12 @@ pub(crate) fn refine_cap_contact<ManifoldData, ContactData: Default + Copy>(
     prediction: Real,
     manifold: &mut ContactManifold<ManifoldData, ContactData>,
     old: &[TrackedContact<ContactData>],
-) {
+) -> bool {
     if manifold.points.is_empty() {
-        return;
+        return false;
     }
-    let _ = refine(pos12, g1, g2, prediction, manifold, old, false)
-        || refine(&pos12.inverse(), g2, g1, prediction, manifold, old, true);
+    refine(pos12, g1, g2, prediction, manifold, old, false)
+        || refine(&pos12.inverse(), g2, g1, prediction, manifold, old, true)
 }
 
 /// Whether `shape` has a flat cap that [`refine_cap_contact`] may use: a cylinder or cone,
@@ -337,7 +339,7 @@ fn refine<ManifoldData, ContactData: Default + Copy>(
 
 /// Whether `p` lies in the convex polygon `polygon` (either winding; on an edge counts; every
 /// point lies in an empty polygon, a half-space's plane).
-fn inside_convex(polygon: &[[Real; 2]], p: [Real; 2]) -> bool {
+pub(crate) fn inside_convex(polygon: &[[Real; 2]], p: [Real; 2]) -> bool {
     let mut sign = 0.0;
     for i in 0..polygon.len() {
         let a = polygon[i];

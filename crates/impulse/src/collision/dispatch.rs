@@ -1,6 +1,7 @@
 //! The query dispatcher of the narrow phase: Parry's [`DefaultQueryDispatcher`], except for a
-//! ball against a rounded convex shape (below) and a cylinder's or cone's flat cap on a flat
-//! face ([`super::caps`]).
+//! ball against a rounded convex shape (below), a cylinder's or cone's flat cap on a flat
+//! face ([`super::caps`]) and a convex hull's face of more than four vertices
+//! ([`super::faces`]).
 //!
 //! Parry projects a point on a `RoundShape` with GJK on the rounded shape's support map (the
 //! inner shape's support point moved out by the border radius along the direction asked),
@@ -47,12 +48,12 @@ use parry3d::query::{
 };
 use parry3d::shape::{Ball, PackedFeatureId, Shape, ShapeType, SupportMap};
 
-use super::caps;
+use super::{caps, faces};
 use crate::body::rules::rounded_parts;
 
-/// Parry's default dispatcher, with exact contacts between a ball and a rounded convex shape
-/// and a fine polygon for a cylinder's or cone's flat cap on a flat face (see the module's
-/// documentation).
+/// Parry's default dispatcher, with exact contacts between a ball and a rounded convex shape,
+/// a fine polygon for a cylinder's or cone's flat cap on a flat face and a convex hull's large
+/// faces taken whole (see the module's documentation).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct ContactDispatcher;
 
@@ -250,7 +251,9 @@ where
         // from the two shape types alone.
         let (type1, type2) = (g1.shape_type(), g2.shape_type());
         let own = |this: ShapeType, other: ShapeType| {
-            has_cap_type(this) || (other == ShapeType::Ball && is_rounded_type(this))
+            has_cap_type(this)
+                || (other == ShapeType::Ball && is_rounded_type(this))
+                || (other != ShapeType::Ball && is_hull_type(this))
         };
         let constraints = (normal_constraints1, normal_constraints2);
         let fallback = NearestPointFallback::before(
@@ -301,9 +304,11 @@ where
             return Ok(());
         }
         // Parry's manifold gives the normal (with a mesh's normal constraints applied); the cap
-        // points replace its points, keeping the impulses of last step's points.
+        // points or a hull's whole-face points replace its points, keeping the impulses of last
+        // step's points.
         let cap_pair = caps::has_cap(g1) || caps::has_cap(g2);
-        let old = if cap_pair {
+        let hull_pair = is_hull_type(type1) || is_hull_type(type2);
+        let old = if cap_pair || hull_pair {
             manifold.points.clone()
         } else {
             Vec::new()
@@ -317,8 +322,10 @@ where
             prediction,
             manifold,
         )?;
-        if cap_pair {
-            caps::refine_cap_contact(pos12, g1, g2, prediction, manifold, &old);
+        let refined =
+            cap_pair && caps::refine_cap_contact(pos12, g1, g2, prediction, manifold, &old);
+        if hull_pair && !refined {
+            faces::refine_face_contact(pos12, g1, g2, prediction, constraints, manifold, &old);
         }
         fallback.after(pos12, g1, g2, constraints, prediction, manifold);
         Ok(())
@@ -666,6 +673,15 @@ fn has_cap_type(shape_type: ShapeType) -> bool {
     matches!(
         shape_type,
         ShapeType::Cylinder | ShapeType::RoundCylinder | ShapeType::Cone | ShapeType::RoundCone
+    )
+}
+
+/// Whether shapes of this type are convex polyhedra, rounded or not, whose faces of more than
+/// four vertices [`faces::refine_face_contact`] takes whole.
+fn is_hull_type(shape_type: ShapeType) -> bool {
+    matches!(
+        shape_type,
+        ShapeType::ConvexPolyhedron | ShapeType::RoundConvexPolyhedron
     )
 }
 

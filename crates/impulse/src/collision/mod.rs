@@ -6,6 +6,7 @@
 pub(crate) mod broad_phase;
 pub(crate) mod caps;
 pub(crate) mod dispatch;
+pub(crate) mod faces;
 pub(crate) mod manifold;
 pub(crate) mod margins;
 pub(crate) mod narrow_phase;

@@ -17,6 +17,8 @@ mod golden;
 mod guards;
 mod gyroscopic;
 mod heavy_on_light;
+mod height_fields;
+mod hulls;
 mod impacts;
 mod islands;
 mod joints;

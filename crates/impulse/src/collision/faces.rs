@@ -1,0 +1,480 @@
+//! Contact points of a convex polyhedron's face of more than four vertices: the whole face
+//! clipped against the other shape's feature, reduced to at most [`MAX_POINTS`] points.
+//!
+//! Parry builds the manifold of a convex polyhedron (a hull) against a half-space, a triangle,
+//! a box or another hull from each shape's support feature, and gives a hull's support face by
+//! its first four vertices only (`ConvexPolyhedron::local_support_feature` keeps four, the
+//! size of a `PolygonalFeature`). On a face of five or more vertices that is an arc of the face
+//! (a 16-gon's four consecutive vertices span a quarter of its rim), so a prism standing on
+//! its base is held only under that arc, sinks on the other side and topples; a hull resting
+//! on two large mesh triangles can lose every point but GJK's nearest one and fall through.
+//!
+//! Here, where a hull's support face along the contact normal has more than four vertices,
+//! the face is taken whole from the hull's topology and clipped against the other shape's
+//! feature along the normal (Parry's for the other shape, the whole face of another hull, or
+//! the plane of a half-space), as Parry clips two features: the vertices of each feature
+//! over the other (every vertex over a plane), and the crossings of their edges. The points
+//! within the speculative distance are then reduced to [`MAX_POINTS`]: the deepest, the one
+//! farthest from it, and the two that make the largest quadrilateral with them, one on each
+//! side of their line. Each point is named by the features that make it (a hull vertex and the
+//! other's face, a face and the other's vertex, two edges), the ids Parry gives the same
+//! points, so impulses carry over by feature from step to step and from Parry's manifold; ties
+//! in the reduction go to last step's points, so a face resting flat keeps the same four.
+//!
+//! The normal is Parry's (GJK's, or the half-space's, with a mesh triangle's normal
+//! constraints applied), or the large face's own where Parry's is within 0.01 rad of it (GJK
+//! leans by its tolerance, a few 1e-4 rad between separated faces, which tilts every depth
+//! across the face). Parry's nearest point (a point with no features) is kept only when it
+//! is deeper than every clipped point, as where the normal meets the features edge-on.
+
+use parry3d::math::{Pose, Real, Vector};
+use parry3d::query::details::{NormalConstraints, NormalConstraintsPair};
+use parry3d::query::{ContactManifold, DefaultQueryDispatcher, QueryDispatcher, TrackedContact};
+use parry3d::shape::{ConvexPolyhedron, PackedFeatureId, PolygonalFeature, Shape, TypedShape};
+
+use super::caps::inside_convex;
+
+/// Most points a refined manifold keeps: a quadrilateral spanning the contact area carries a
+/// resting face and its friction as the whole polygon would.
+pub(crate) const MAX_POINTS: usize = 4;
+
+/// Depth (m) by which a point of last step's manifold may be shallower than the deepest
+/// candidate and still be chosen as the deepest; also the margin by which Parry's nearest point
+/// must be deeper than every clipped point to be kept.
+const DEPTH_TIE: Real = 1.0e-4;
+
+/// Fraction by which a point of last step's manifold may fall short of the best distance or
+/// area in the reduction and still be chosen.
+const SPREAD_TIE: Real = 0.02;
+
+/// |cos| of the angle between the contact normal and a face's plane normal below which the face
+/// is seen edge-on along the normal, and depths measured along the normal to it are not used.
+const EDGE_ON: Real = 0.1;
+
+/// Cosine of the largest angle (0.01 rad) between Parry's normal and the large face's normal
+/// within which the face's is taken (see [`refine_face_contact`]).
+const SNAP_COSINE: Real = 0.99995;
+
+/// The convex polyhedron and border radius of a hull, rounded or not.
+pub(crate) fn hull_parts(shape: &dyn Shape) -> Option<(&ConvexPolyhedron, Real)> {
+    match shape.as_typed_shape() {
+        TypedShape::ConvexPolyhedron(hull) => Some((hull, 0.0)),
+        TypedShape::RoundConvexPolyhedron(hull) => Some((&hull.inner_shape, hull.border_radius)),
+        _ => None,
+    }
+}
+
+/// The index of the face of `hull` whose outward normal is nearest `dir` (the hull's frame):
+/// the face Parry's `local_support_feature` gives (the first of equals).
+pub(crate) fn support_face_index(hull: &ConvexPolyhedron, dir: Vector) -> usize {
+    let mut best = 0;
+    let mut best_dot = Real::NEG_INFINITY;
+    for (index, face) in hull.faces().iter().enumerate() {
+        let dot = face.normal.dot(dir);
+        if dot > best_dot {
+            best = index;
+            best_dot = dot;
+        }
+    }
+    best
+}
+
+/// A flat feature of one shape of a pair, in shape 1's frame: a convex polygon (three or more
+/// vertices in order around it), a segment, a point, or a whole plane (no vertices).
+pub(crate) struct Feature {
+    /// Vertices (m, shape 1's frame), in order around the polygon.
+    pub vertices: Vec<Vector>,
+    /// The vertices' feature ids.
+    pub vids: Vec<PackedFeatureId>,
+    /// `eids[i]`: the id of the edge from vertex i to vertex i + 1 (cyclically).
+    pub eids: Vec<PackedFeatureId>,
+    /// The face's (or the plane's) id.
+    pub fid: PackedFeatureId,
+    /// For a half-space: a point of its plane and its outward unit normal (shape 1's frame).
+    pub plane: Option<(Vector, Vector)>,
+    /// The shape's border radius (m).
+    pub border: Real,
+}
+
+impl Feature {
+    /// The whole face `index` of `hull` (rounded by `border`), its vertices moved by `pose`.
+    pub(crate) fn hull_face(
+        hull: &ConvexPolyhedron,
+        index: usize,
+        border: Real,
+        pose: &Pose,
+    ) -> Self {
+        let face = &hull.faces()[index];
+        let range = face.first_vertex_or_edge as usize
+            ..(face.first_vertex_or_edge + face.num_vertices_or_edges) as usize;
+        let points = hull.points();
+        Self {
+            vertices: hull.vertices_adj_to_face()[range.clone()]
+                .iter()
+                .map(|&vid| pose.transform_point(points[vid as usize]))
+                .collect(),
+            vids: hull.vertices_adj_to_face()[range.clone()]
+                .iter()
+                .map(|&vid| PackedFeatureId::vertex(vid))
+                .collect(),
+            eids: hull.edges_adj_to_face()[range]
+                .iter()
+                .map(|&eid| PackedFeatureId::edge(eid))
+                .collect(),
+            fid: PackedFeatureId::face(index as u32),
+            plane: None,
+            border,
+        }
+    }
+
+    /// The feature of `shape` (at `pose` in shape 1's frame) facing along `dir` (the shape's
+    /// own frame, out of it): a half-space's plane, a hull's whole support face, or Parry's
+    /// support feature for any other shape with one.
+    fn of(shape: &dyn Shape, pose: &Pose, dir: Vector) -> Option<Self> {
+        if let Some(half_space) = shape.as_halfspace() {
+            return Some(Self {
+                vertices: Vec::new(),
+                vids: Vec::new(),
+                eids: Vec::new(),
+                fid: PackedFeatureId::face(0),
+                plane: Some((pose.translation, pose.rotation * half_space.normal)),
+                border: 0.0,
+            });
+        }
+        if let Some((hull, border)) = hull_parts(shape) {
+            return Some(Self::hull_face(
+                hull,
+                support_face_index(hull, dir),
+                border,
+                pose,
+            ));
+        }
+        let (map, border) = shape.as_polygonal_feature_map()?;
+        let mut feature = PolygonalFeature::default();
+        map.local_support_feature(dir, &mut feature);
+        let count = feature.num_vertices;
+        if count == 0 {
+            return None;
+        }
+        Some(Self {
+            vertices: feature.vertices[..count]
+                .iter()
+                .map(|v| pose.transform_point(*v))
+                .collect(),
+            vids: feature.vids[..count].to_vec(),
+            eids: feature.eids[..count].to_vec(),
+            fid: feature.fid,
+            plane: None,
+            border,
+        })
+    }
+
+    /// Edges to clip: none for a point or a plane, one for a segment, one a vertex otherwise.
+    fn edge_count(&self) -> usize {
+        match self.vertices.len() {
+            0 | 1 => 0,
+            2 => 1,
+            n => n,
+        }
+    }
+
+    /// A point of the feature's plane and its unit normal (either side), if the feature is a
+    /// polygon or a plane.
+    fn plane_of(&self) -> Option<(Vector, Vector)> {
+        if let Some(plane) = self.plane {
+            return Some(plane);
+        }
+        if self.vertices.len() < 3 {
+            return None;
+        }
+        // Newell's normal: the polygon's area vector, exact for a planar polygon and well
+        // conditioned whatever its vertices' spacing.
+        let mut normal = Vector::ZERO;
+        let count = self.vertices.len();
+        for i in 0..count {
+            normal += self.vertices[i].cross(self.vertices[(i + 1) % count]);
+        }
+        Some((self.vertices[0], normal.try_normalize()?))
+    }
+}
+
+/// A contact point before the reduction, in shape 1's frame on both shapes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Candidate {
+    /// Point on shape 1's feature (its surface once borders are applied).
+    pub p1: Vector,
+    /// Point on shape 2's feature, shape 1's frame.
+    pub p2: Vector,
+    pub fid1: PackedFeatureId,
+    pub fid2: PackedFeatureId,
+    /// Separation along the normal (m), negative in overlap.
+    pub dist: Real,
+}
+
+/// The points of feature `f1` against feature `f2` along the unit normal `n` (out of shape 1,
+/// shape 1's frame), borders included: vertices of either over the other (within its polygon,
+/// or anywhere over a plane) and crossings of their edges, as seen along `n`. Points whose
+/// depth cannot be measured along `n` (a face seen edge-on) are left out.
+pub(crate) fn clip(f1: &Feature, f2: &Feature, n: Vector, out: &mut Vec<Candidate>) {
+    let (u, w) = n.any_orthonormal_pair();
+    let project = |v: Vector| [v.dot(u), v.dot(w)];
+    let plane1 = f1.plane_of();
+    let plane2 = f2.plane_of();
+    let over = |feature: &Feature, projected: &[[Real; 2]], p: [Real; 2]| {
+        feature.plane.is_some() || (projected.len() >= 3 && inside_convex(projected, p))
+    };
+    let projected1: Vec<[Real; 2]> = f1.vertices.iter().map(|&v| project(v)).collect();
+    let projected2: Vec<[Real; 2]> = f2.vertices.iter().map(|&v| project(v)).collect();
+    let mut push = |p1: Vector, p2: Vector, fid1, fid2| {
+        out.push(Candidate {
+            p1,
+            p2,
+            fid1,
+            fid2,
+            dist: (p2 - p1).dot(n),
+        })
+    };
+    // Vertices of shape 1's feature over shape 2's: p + t·n on shape 2's plane.
+    if let Some((origin, normal)) = plane2
+        && normal.dot(n).abs() >= EDGE_ON
+    {
+        for (i, &p) in f1.vertices.iter().enumerate() {
+            if over(f2, &projected2, projected1[i]) {
+                let t = (origin - p).dot(normal) / n.dot(normal);
+                push(p, p + n * t, f1.vids[i], f2.fid);
+            }
+        }
+    }
+    // Vertices of shape 2's feature over shape 1's: q − t·n on shape 1's plane.
+    if let Some((origin, normal)) = plane1
+        && normal.dot(n).abs() >= EDGE_ON
+    {
+        for (j, &q) in f2.vertices.iter().enumerate() {
+            if over(f1, &projected1, projected2[j]) {
+                let t = (q - origin).dot(normal) / n.dot(normal);
+                push(q - n * t, q, f1.fid, f2.vids[j]);
+            }
+        }
+    }
+    // Crossings of an edge of each, strictly inside both edges (their ends are vertices).
+    for i in 0..f1.edge_count() {
+        let (a, b) = (i, (i + 1) % f1.vertices.len());
+        for j in 0..f2.edge_count() {
+            let (c, d) = (j, (j + 1) % f2.vertices.len());
+            if let Some((s, t)) = crossing(
+                [projected1[a], projected1[b]],
+                [projected2[c], projected2[d]],
+            ) {
+                let p1 = f1.vertices[a].lerp(f1.vertices[b], s);
+                let p2 = f2.vertices[c].lerp(f2.vertices[d], t);
+                push(p1, p2, f1.eids[i], f2.eids[j]);
+            }
+        }
+    }
+    for candidate in out.iter_mut() {
+        candidate.p1 += n * f1.border;
+        candidate.p2 -= n * f2.border;
+        candidate.dist -= f1.border + f2.border;
+    }
+}
+
+/// Where 2-D segments `e1` and `e2` cross, as parameters along each, if they cross strictly
+/// inside both (parallel segments do not cross).
+fn crossing(e1: [[Real; 2]; 2], e2: [[Real; 2]; 2]) -> Option<(Real, Real)> {
+    let d1 = [e1[1][0] - e1[0][0], e1[1][1] - e1[0][1]];
+    let d2 = [e2[1][0] - e2[0][0], e2[1][1] - e2[0][1]];
+    let r = [e2[0][0] - e1[0][0], e2[0][1] - e1[0][1]];
+    let denom = d1[0] * d2[1] - d1[1] * d2[0];
+    let scale = (d1[0] * d1[0] + d1[1] * d1[1]) * (d2[0] * d2[0] + d2[1] * d2[1]);
+    if denom * denom <= 1.0e-12 * scale {
+        return None;
+    }
+    let s = (r[0] * d2[1] - r[1] * d2[0]) / denom;
+    let t = (r[0] * d1[1] - r[1] * d1[0]) / denom;
+    (s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0).then_some((s, t))
+}
+
+/// Whether some point of `old` has the features `fid1`, `fid2`.
+fn was_kept<ContactData>(
+    old: &[TrackedContact<ContactData>],
+    fid1: PackedFeatureId,
+    fid2: PackedFeatureId,
+) -> bool {
+    old.iter()
+        .any(|point| point.fid1 == fid1 && point.fid2 == fid2)
+}
+
+/// Reduces `candidates` to at most [`MAX_POINTS`] (see the module's documentation): the
+/// deepest, the farthest from it across the normal `n`, then the largest triangle with those
+/// two, then the largest on the other side of their line; ties go to points of `old`.
+pub(crate) fn reduce<ContactData>(
+    candidates: &mut Vec<Candidate>,
+    n: Vector,
+    old: &[TrackedContact<ContactData>],
+) {
+    if candidates.len() <= MAX_POINTS {
+        return;
+    }
+    let kept: Vec<bool> = candidates
+        .iter()
+        .map(|c| was_kept(old, c.fid1, c.fid2))
+        .collect();
+    // The index maximising `score` (with last step's points favoured by `tie` in the score's
+    // own units, given as a function of the best score), first of equals.
+    let best = |score: &dyn Fn(usize) -> Real, tie: &dyn Fn(Real) -> Real| {
+        let top = (0..candidates.len())
+            .map(score)
+            .fold(Real::NEG_INFINITY, Real::max);
+        let margin = tie(top);
+        (0..candidates.len())
+            .find(|&i| kept[i] && score(i) >= top - margin)
+            .or_else(|| (0..candidates.len()).find(|&i| score(i) >= top))
+            .unwrap_or(0)
+    };
+    let a = best(&|i| -candidates[i].dist, &|_| DEPTH_TIE);
+    let pa = candidates[a].p1;
+    let across = |v: Vector| v - n * v.dot(n);
+    let b = best(
+        &|i| across(candidates[i].p1 - pa).length_squared(),
+        &|top| top * SPREAD_TIE,
+    );
+    let pb = candidates[b].p1;
+    let signed_area = |i: usize| (pb - pa).cross(candidates[i].p1 - pa).dot(n);
+    let c = best(&|i| signed_area(i).abs(), &|top| top * SPREAD_TIE);
+    let side = signed_area(c).signum();
+    let d = best(&|i| -side * signed_area(i), &|top| top.abs() * SPREAD_TIE);
+    let mut chosen = vec![a];
+    for i in [b, c, d] {
+        if !chosen.contains(&i) {
+            chosen.push(i);
+        }
+    }
+    // `d` is on the far side of ab only if some candidate is; a non-positive best is a
+    // candidate on ab or on c's side, which adds nothing.
+    if side * signed_area(d) >= 0.0 && chosen.len() == 4 {
+        chosen.pop();
+    }
+    chosen.sort_unstable();
+    let mut index = 0;
+    candidates.retain(|_| {
+        let keep = chosen.contains(&index);
+        index += 1;
+        keep
+    });
+}
+
+/// Replaces the points of `manifold`, Parry's contact of `g1` and `g2` (`g2` at `pos12` in
+/// `g1`'s frame), by those of the whole support faces where a hull's support face along the
+/// manifold's normal has more than four vertices (see the module's documentation); otherwise
+/// leaves it alone. `constraints` are the pair's normal constraints (a mesh triangle's), shape
+/// 1's then shape 2's. `old` are the manifold's points before Parry updated it, whose impulses
+/// carry over by feature id. True if it replaced the points.
+pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
+    pos12: &Pose,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    prediction: Real,
+    constraints: (
+        Option<&dyn NormalConstraints>,
+        Option<&dyn NormalConstraints>,
+    ),
+    manifold: &mut ContactManifold<ManifoldData, ContactData>,
+    old: &[TrackedContact<ContactData>],
+) -> bool {
+    let half_space = g1.as_halfspace().is_some() || g2.as_halfspace().is_some();
+    // Without points, Parry's generator for two polyhedra either found the shapes apart beyond
+    // the prediction (its normal is then only a search direction) or clipped its four vertices
+    // against a feature they miss (a small mesh triangle under another part of the face, whose
+    // normal constraints also drop GJK's point): the shapes' contact tells which, and gives
+    // the normal.
+    if manifold.points.is_empty() && !half_space {
+        let Ok(Some(contact)) = DefaultQueryDispatcher.contact(pos12, g1, g2, prediction) else {
+            return false;
+        };
+        let (mut n1, mut n2) = (contact.normal1, contact.normal2);
+        if !constraints.project_local_normals(pos12, &mut n1, &mut n2) {
+            return false;
+        }
+        manifold.local_n1 = n1;
+        manifold.local_n2 = n2;
+    }
+    let (n1, n2) = (manifold.local_n1, manifold.local_n2);
+    let Some(n) = n1.try_normalize() else {
+        return false;
+    };
+    let large = |shape: &dyn Shape, dir: Vector| {
+        hull_parts(shape).is_some_and(|(hull, _)| {
+            hull.faces()[support_face_index(hull, dir)].num_vertices_or_edges as usize > 4
+        })
+    };
+    let (large1, large2) = (large(g1, n1), large(g2, n2));
+    if !large1 && !large2 {
+        return false;
+    }
+    let (Some(f1), Some(f2)) = (
+        Feature::of(g1, &Pose::IDENTITY, n1),
+        Feature::of(g2, pos12, n2),
+    ) else {
+        return false;
+    };
+    // GJK stops within its tolerance: between separated faces its normal leans by up to a few
+    // 1e-4 rad, which tilts every depth across a large face. A normal that near the large
+    // face's own is that face's (a vertex, edge or face on a face touches along its normal).
+    let face_normal = if large1 {
+        f1.plane_of()
+            .map(|(_, normal)| normal * normal.dot(n).signum())
+    } else {
+        f2.plane_of()
+            .map(|(_, normal)| -normal * normal.dot(-n).signum())
+    };
+    let n = match face_normal {
+        Some(normal) if normal.dot(n) >= SNAP_COSINE => {
+            manifold.local_n1 = normal;
+            manifold.local_n2 = -(pos12.rotation.inverse() * normal);
+            normal
+        }
+        _ => n,
+    };
+    let mut candidates = Vec::new();
+    clip(&f1, &f2, n, &mut candidates);
+    candidates.retain(|c| c.dist <= prediction);
+    if candidates.is_empty() {
+        // Nothing within reach: a half-space's manifold is rightly empty; between polyhedra,
+        // Parry's nearest point stands.
+        if half_space {
+            manifold.points.clear();
+        }
+        return half_space;
+    }
+    let deepest_clip = candidates
+        .iter()
+        .map(|c| c.dist)
+        .fold(Real::INFINITY, Real::min);
+    reduce(&mut candidates, n, old);
+    let inverse = pos12.inverse();
+    let nearest = manifold
+        .points
+        .iter()
+        .find(|p| p.fid1 == PackedFeatureId::UNKNOWN && p.fid2 == PackedFeatureId::UNKNOWN)
+        .copied()
+        .filter(|p| p.dist < deepest_clip - DEPTH_TIE);
+    manifold.points.clear();
+    for c in &candidates {
+        manifold.points.push(TrackedContact::new(
+            c.p1,
+            inverse.transform_point(c.p2),
+            c.fid1,
+            c.fid2,
+            c.dist,
+        ));
+    }
+    if let Some(point) = nearest {
+        manifold.points.push(point);
+    }
+    manifold.match_contacts(old);
+    true
+}
+
+#[cfg(test)]
+#[path = "faces_tests.rs"]
+mod tests;

@@ -1,0 +1,236 @@
+//! A hull's large face against the geometry: the points span the whole face (not Parry's arc
+//! of four vertices), lie on both surfaces with the separation along the normal, and the
+//! reduction keeps the deepest point and last step's points among equals.
+
+use glam::{Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::query::{ContactManifold, TrackedContact};
+use parry3d::shape::{PackedFeatureId, Shape, SharedShape, Triangle};
+
+use super::{Candidate, MAX_POINTS, reduce};
+
+const PREDICTION: f32 = 0.02;
+
+/// A prism of `around` vertices on a circle of radius 1 m, 2 m tall (y from −1 to 1).
+fn prism(around: usize) -> Vec<Vec3> {
+    let mut points = Vec::new();
+    for k in 0..around {
+        let angle = k as f32 * std::f32::consts::TAU / around as f32;
+        for y in [-1.0, 1.0] {
+            points.push(Vec3::new(angle.cos(), y, angle.sin()));
+        }
+    }
+    points
+}
+
+fn manifold(pos1: &Pose, g1: &dyn Shape, pos2: &Pose, g2: &dyn Shape) -> ContactManifold<(), ()> {
+    crate::collision::dispatch::tests::manifold_within(pos1, g1, pos2, g2, PREDICTION)
+}
+
+/// The area (m²) of the points' convex quadrilateral across the y axis, points taken in
+/// order of angle about their centroid.
+fn spread_area(points: &[Vec3]) -> f32 {
+    let centre = points.iter().copied().sum::<Vec3>() / points.len() as f32;
+    let mut sorted: Vec<Vec3> = points.to_vec();
+    sorted.sort_by(|a, b| {
+        let angle = |v: &Vec3| (v.z - centre.z).atan2(v.x - centre.x);
+        angle(a).total_cmp(&angle(b))
+    });
+    let mut twice = 0.0;
+    for i in 0..sorted.len() {
+        let (a, b) = (sorted[i], sorted[(i + 1) % sorted.len()]);
+        twice += a.x * b.z - a.z * b.x;
+    }
+    0.5 * twice.abs()
+}
+
+/// The grounds a prism stands on, each with its top at y = 0: a half-space, a box, a large
+/// triangle and a box-shaped hull with a 16-gon top (another hull's large face).
+fn grounds() -> Vec<(&'static str, SharedShape, Pose)> {
+    let disc: Vec<Vec3> = prism(16).into_iter().map(|p| p * 4.0).collect();
+    vec![
+        (
+            "half-space",
+            SharedShape::halfspace(Vec3::Y),
+            Pose::IDENTITY,
+        ),
+        (
+            "box",
+            SharedShape::cuboid(5.0, 0.5, 5.0),
+            Pose::from_translation(Vec3::new(0.0, -0.5, 0.0)),
+        ),
+        (
+            "triangle",
+            SharedShape::new(Triangle::new(
+                Vec3::new(-10.0, 0.0, -10.0),
+                Vec3::new(0.0, 0.0, 10.0),
+                Vec3::new(10.0, 0.0, -10.0),
+            )),
+            Pose::IDENTITY,
+        ),
+        (
+            "16-gon hull",
+            SharedShape::convex_hull(&disc).unwrap(),
+            Pose::from_translation(Vec3::new(0.0, -4.0, 0.0)),
+        ),
+    ]
+}
+
+#[test]
+fn a_prism_standing_on_its_base_gets_points_spanning_the_whole_base() {
+    for around in [6, 16, 32] {
+        for (border, hull) in [
+            (0.0, SharedShape::convex_hull(&prism(around)).unwrap()),
+            (
+                0.05,
+                SharedShape::round_convex_hull(&prism(around), 0.05).unwrap(),
+            ),
+        ] {
+            for (name, ground, ground_pose) in grounds() {
+                // 1 mm above the ground, turned about y so that no vertex sits on an axis.
+                let pose = Pose::from_parts(
+                    Vec3::new(0.1, 1.0 + border + 0.001, -0.2),
+                    Quat::from_rotation_y(0.3),
+                );
+                for flip in [false, true] {
+                    let (points, n) = if flip {
+                        let m = manifold(&ground_pose, ground.as_ref(), &pose, hull.as_ref());
+                        let n = -(ground_pose.rotation * m.local_n1);
+                        let points: Vec<(Vec3, Vec3, f32)> = m
+                            .points
+                            .iter()
+                            .map(|p| {
+                                (
+                                    pose.transform_point(p.local_p2),
+                                    ground_pose.transform_point(p.local_p1),
+                                    p.dist,
+                                )
+                            })
+                            .collect();
+                        (points, n)
+                    } else {
+                        let m = manifold(&pose, hull.as_ref(), &ground_pose, ground.as_ref());
+                        let n = pose.rotation * m.local_n1;
+                        let points: Vec<(Vec3, Vec3, f32)> = m
+                            .points
+                            .iter()
+                            .map(|p| {
+                                (
+                                    pose.transform_point(p.local_p1),
+                                    ground_pose.transform_point(p.local_p2),
+                                    p.dist,
+                                )
+                            })
+                            .collect();
+                        (points, n)
+                    };
+                    let case = format!("{around}-gon (border {border}) on {name}, flip {flip}");
+                    assert!((n + Vec3::Y).length() < 1e-4, "{case}: normal {n}");
+                    assert!(
+                        (1..=MAX_POINTS + 1).contains(&points.len()),
+                        "{case}: {} points",
+                        points.len()
+                    );
+                    for &(on_hull, on_ground, dist) in &points {
+                        assert!(
+                            (on_hull.y - 0.001).abs() < 1e-4,
+                            "{case}: hull point {on_hull}"
+                        );
+                        assert!(on_ground.y.abs() < 1e-4, "{case}: ground point {on_ground}");
+                        assert!((dist - 0.001).abs() < 1e-4, "{case}: separation {dist}");
+                    }
+                    // The largest quadrilateral in the base (a regular n-gon of radius 1 m) has
+                    // an area of at least 1.5 m² (the hexagon's: 2 of its 2.6 m²); Parry's arc
+                    // of four vertices of a 16-gon spans 0.3 m².
+                    let at: Vec<Vec3> = points.iter().map(|p| p.0).collect();
+                    assert!(spread_area(&at) > 1.5, "{case}: area {}", spread_area(&at));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_tilted_prism_keeps_its_deepest_vertex() {
+    let hull = SharedShape::convex_hull(&prism(16)).unwrap();
+    let ground = SharedShape::halfspace(Vec3::Y);
+    // Tilted by 0.2° about x: the base's lowest vertex (at z = +1 m) 3.5 mm deeper than the
+    // centre, the highest 3.5 mm above.
+    let tilt = 0.2f32.to_radians();
+    let pose = Pose::from_parts(Vec3::new(0.0, 1.0, 0.0), Quat::from_rotation_x(tilt));
+    let m = manifold(&pose, hull.as_ref(), &Pose::IDENTITY, ground.as_ref());
+    let deepest = m.points.iter().map(|p| p.dist).fold(f32::MAX, f32::min);
+    let lowest = (0..16)
+        .map(|k| {
+            let angle = k as f32 * std::f32::consts::TAU / 16.0;
+            pose.transform_point(Vec3::new(angle.cos(), -1.0, angle.sin()))
+                .y
+        })
+        .fold(f32::MAX, f32::min);
+    assert!((deepest - lowest).abs() < 1e-5, "{deepest} vs {lowest}");
+    assert_eq!(m.points.len(), MAX_POINTS);
+}
+
+/// Candidates at the vertices of a regular `count`-gon of radius 1 m in the xz plane, all at
+/// separation 0 but for vertex `deep`, 1 mm deep.
+fn ring(count: u32, deep: Option<u32>) -> Vec<Candidate> {
+    (0..count)
+        .map(|k| {
+            let angle = k as f32 * std::f32::consts::TAU / count as f32;
+            let p = Vec3::new(angle.cos(), 0.0, angle.sin());
+            Candidate {
+                p1: p,
+                p2: p,
+                fid1: PackedFeatureId::vertex(k),
+                fid2: PackedFeatureId::face(0),
+                dist: if deep == Some(k) { -1e-3 } else { 0.0 },
+            }
+        })
+        .collect()
+}
+
+fn ids(candidates: &[Candidate]) -> Vec<PackedFeatureId> {
+    candidates.iter().map(|c| c.fid1).collect()
+}
+
+#[test]
+fn the_reduction_keeps_the_deepest_point_and_a_large_quadrilateral() {
+    let none: [TrackedContact<()>; 0] = [];
+    let mut candidates = ring(16, Some(5));
+    reduce(&mut candidates, Vec3::Y, &none);
+    assert_eq!(candidates.len(), 4);
+    assert!(ids(&candidates).contains(&PackedFeatureId::vertex(5)));
+    // The opposite vertex, and two a quarter turn away: the inscribed square, area 2 m².
+    let at: Vec<Vec3> = candidates.iter().map(|c| c.p1).collect();
+    assert!(
+        (spread_area(&at) - 2.0).abs() < 1e-4,
+        "{}",
+        spread_area(&at)
+    );
+}
+
+#[test]
+fn the_reduction_keeps_last_steps_points_among_equals() {
+    // A flat ring: any inscribed square is as good; last step's (vertices 1, 5, 9, 13) stays.
+    let old: Vec<TrackedContact<()>> = [1, 5, 9, 13]
+        .into_iter()
+        .map(|k| {
+            TrackedContact::new(
+                Vec3::ZERO,
+                Vec3::ZERO,
+                PackedFeatureId::vertex(k),
+                PackedFeatureId::face(0),
+                0.0,
+            )
+        })
+        .collect();
+    let mut candidates = ring(16, None);
+    reduce(&mut candidates, Vec3::Y, &old);
+    let mut kept = ids(&candidates);
+    kept.sort_by_key(|id| id.0);
+    let expected: Vec<PackedFeatureId> = [1, 5, 9, 13]
+        .into_iter()
+        .map(PackedFeatureId::vertex)
+        .collect();
+    assert_eq!(kept, expected);
+}

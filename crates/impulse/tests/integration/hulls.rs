@@ -1,0 +1,362 @@
+//! Convex hulls resting on and dropped onto every static ground: a seeded sweep of random
+//! hulls (4–256 points: flat-faced prisms, plain and rounded point clouds) set down touching,
+//! or 5 cm above, a half-space, a box, a flat height field, a 2-triangle mesh (two-sided) and
+//! an 800-triangle mesh, each flat at y = 0. Every ground is flat where the hulls land, so a
+//! hull's depth is how far its lowest vertex (less its border) lies below y = 0. Targets:
+//! at most 1 mm deep at rest (a hull set down touching, over its whole run; a dropped hull,
+//! over its last 0.5 s), at most 5 mm during a drop, and no prism (set down level on its base,
+//! its centre of mass over it) tipped over by more than 5°. The full sweep and its figures:
+//! docs/testing.md, "Hulls on every ground".
+
+use impulse::glam::{Quat, Vec3};
+use impulse::scene::{BodyDesc, BodyKind, Scene, ShapeDesc};
+use impulse::{SolverSettings, World};
+
+/// SplitMix64: a small seeded generator, so every case can be rebuilt from its seed.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [lo, hi).
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        let unit = (self.next() >> 40) as f32 / (1u64 << 24) as f32;
+        lo + (hi - lo) * unit
+    }
+
+    /// Uniform integer in [lo, hi].
+    fn integer(&mut self, lo: usize, hi: usize) -> usize {
+        lo + (self.next() % (hi - lo + 1) as u64) as usize
+    }
+}
+
+/// Height (m) above its resting pose from which a hull is dropped.
+const DROP: f32 = 0.05;
+/// Simulated time (s) of each case.
+const DURATION: f32 = 2.0;
+/// Time (s) at the end of a drop over which the hull must be at rest's depth.
+const SETTLED: f32 = 0.5;
+/// Depth targets (m): at rest, during a drop.
+const REST_DEPTH: f32 = 1.0e-3;
+const DROP_DEPTH: f32 = 5.0e-3;
+/// Largest tilt (rad) of a prism's axis from the vertical.
+const TOPPLED: f32 = 5.0 * std::f32::consts::PI / 180.0;
+
+/// A random hull: its points (m, local frame), border radius (m), and whether it is a prism
+/// standing on its base (the local y axis up, the base at y = −half height).
+#[derive(Clone, Debug)]
+struct Hull {
+    seed: u64,
+    points: Vec<[f32; 3]>,
+    border: f32,
+    prism: bool,
+}
+
+impl Hull {
+    /// A prism (even seeds) or a point cloud (odd seeds), 4–256 points, 4 cm–1 m across.
+    fn random(seed: u64) -> Self {
+        let mut rng = Rng(seed);
+        if seed.is_multiple_of(2) {
+            // 3–128 vertices around (6–256 points), on a circle or at random angles.
+            let around = rng.integer(3, 128);
+            let radius = rng.range(0.04, 1.0);
+            let half_height = radius * rng.range(0.2, 1.0);
+            let regular = rng.next().is_multiple_of(2);
+            let mut angles: Vec<f32> = (0..around)
+                .map(|k| {
+                    let even = k as f32 * std::f32::consts::TAU / around as f32;
+                    if regular {
+                        even
+                    } else {
+                        even + rng.range(0.0, 0.8) * std::f32::consts::TAU / around as f32
+                    }
+                })
+                .collect();
+            angles.sort_by(f32::total_cmp);
+            let mut points = Vec::new();
+            for angle in angles {
+                for y in [-half_height, half_height] {
+                    points.push([radius * angle.cos(), y, radius * angle.sin()]);
+                }
+            }
+            Self {
+                seed,
+                points,
+                border: 0.0,
+                prism: true,
+            }
+        } else {
+            // 4–256 points on an ellipsoid, one in four rounded.
+            let count = rng.integer(4, 256);
+            let axes = Vec3::new(
+                rng.range(0.5, 1.0),
+                rng.range(0.5, 1.0),
+                rng.range(0.5, 1.0),
+            ) * rng.range(0.04, 1.0);
+            let points = (0..count)
+                .map(|_| {
+                    let z = rng.range(-1.0, 1.0);
+                    let phi = rng.range(0.0, std::f32::consts::TAU);
+                    let r = (1.0 - z * z).sqrt();
+                    let p = Vec3::new(r * phi.cos(), z, r * phi.sin()) * axes;
+                    p.to_array()
+                })
+                .collect();
+            let border = if rng.next().is_multiple_of(4) {
+                0.1 * axes.min_element()
+            } else {
+                0.0
+            };
+            Self {
+                seed,
+                points,
+                border,
+                prism: false,
+            }
+        }
+    }
+
+    fn shape(&self) -> ShapeDesc {
+        let hull = ShapeDesc::ConvexHull {
+            points: self.points.clone(),
+        };
+        if self.border > 0.0 {
+            ShapeDesc::Round {
+                shape: Box::new(hull),
+                border_radius: self.border,
+            }
+        } else {
+            hull
+        }
+    }
+}
+
+/// The static grounds, each flat at y = 0 over x, z ∈ [−20, 20] m.
+fn grounds() -> Vec<(&'static str, BodyDesc)> {
+    let at = |shape: ShapeDesc, y: f32| BodyDesc::new(BodyKind::Static, shape, [0.0, y, 0.0]);
+    let grid = |cells: u32| {
+        let size = 40.0 / cells as f32;
+        let mut vertices = Vec::new();
+        for k in 0..=cells {
+            for i in 0..=cells {
+                vertices.push([i as f32 * size - 20.0, 0.0, k as f32 * size - 20.0]);
+            }
+        }
+        let index = |i: u32, k: u32| k * (cells + 1) + i;
+        let mut indices = Vec::new();
+        for k in 0..cells {
+            for i in 0..cells {
+                indices.push([index(i, k), index(i, k + 1), index(i + 1, k + 1)]);
+                indices.push([index(i, k), index(i + 1, k + 1), index(i + 1, k)]);
+            }
+        }
+        (vertices, indices)
+    };
+    let (vertices2, indices2) = grid(1);
+    let two_sided = ShapeDesc::Trimesh {
+        file: None,
+        vertices: Some(vertices2),
+        indices: Some(indices2),
+        two_sided: true,
+        loaded: None,
+    };
+    let (vertices800, indices800) = grid(20);
+    vec![
+        (
+            "half-space",
+            at(
+                ShapeDesc::HalfSpace {
+                    normal: [0.0, 1.0, 0.0],
+                },
+                0.0,
+            ),
+        ),
+        (
+            "box",
+            at(
+                ShapeDesc::Cuboid {
+                    half_extents: [20.0, 0.5, 20.0],
+                },
+                -0.5,
+            ),
+        ),
+        (
+            "flat height field",
+            at(
+                ShapeDesc::HeightField {
+                    heights: vec![vec![0.0; 41]; 41],
+                    scale: [40.0, 1.0, 40.0],
+                },
+                0.0,
+            ),
+        ),
+        ("2-triangle mesh", at(two_sided, 0.0)),
+        (
+            "800-triangle mesh",
+            at(ShapeDesc::trimesh(vertices800, indices800), 0.0),
+        ),
+    ]
+}
+
+/// What one run measured: the largest depth (m) over the run and over its last
+/// [`SETTLED`] s, and the final tilt (rad) of the hull's local y axis from the vertical.
+#[derive(Debug)]
+struct Outcome {
+    deepest: f32,
+    deepest_settled: f32,
+    tilt: f32,
+}
+
+/// Runs `hull` on `ground` for [`DURATION`] s, set down touching the ground (`drop` 0) or
+/// `drop` above it, at a random yaw and a random place within 1 m of the origin.
+fn run(hull: &Hull, ground: &BodyDesc, drop: f32) -> Outcome {
+    let mut rng = Rng(hull.seed ^ 0x5eed);
+    let yaw = Quat::from_rotation_y(rng.range(0.0, std::f32::consts::TAU));
+    let lowest = hull
+        .points
+        .iter()
+        .map(|p| (yaw * Vec3::from_array(*p)).y)
+        .fold(f32::INFINITY, f32::min);
+    let position = [
+        rng.range(-1.0, 1.0),
+        hull.border - lowest + drop,
+        rng.range(-1.0, 1.0),
+    ];
+    let mut body = BodyDesc::new(BodyKind::Dynamic, hull.shape(), position);
+    body.orientation = yaw.to_array();
+    let scene = Scene {
+        solver: SolverSettings::default(),
+        bodies: vec![ground.clone(), body],
+        ..Scene::default()
+    };
+    let mut world = World::from_scene(&scene).unwrap();
+    let steps = (DURATION / world.dt()).round() as usize;
+    let settled_from = steps - (SETTLED / world.dt()).round() as usize;
+    let points: Vec<Vec3> = hull.points.iter().map(|p| Vec3::from_array(*p)).collect();
+    let mut outcome = Outcome {
+        deepest: 0.0,
+        deepest_settled: 0.0,
+        tilt: 0.0,
+    };
+    for step in 0..steps {
+        world.step().unwrap();
+        let pose = world.poses()[1];
+        let low = points
+            .iter()
+            .map(|p| pose.transform_point(*p).y)
+            .fold(f32::INFINITY, f32::min);
+        let depth = (hull.border - low).max(0.0);
+        outcome.deepest = outcome.deepest.max(depth);
+        if step >= settled_from {
+            outcome.deepest_settled = outcome.deepest_settled.max(depth);
+        }
+        outcome.tilt = (pose.rotation * Vec3::Y).angle_between(Vec3::Y);
+    }
+    outcome
+}
+
+/// Runs the hulls of `seeds` on every ground, set down and dropped, and returns the failures,
+/// printing the largest depths found.
+fn sweep(seeds: impl Iterator<Item = u64>) -> Vec<String> {
+    let hulls: Vec<Hull> = seeds.map(Hull::random).collect();
+    let mut failures = Vec::new();
+    for (name, ground) in grounds() {
+        let (mut rest_worst, mut drop_worst, mut settled_worst) = (0.0f32, 0.0f32, 0.0f32);
+        for hull in &hulls {
+            let kind = if hull.prism { "prism" } else { "cloud" };
+            let case = format!(
+                "seed {} ({kind}, {} points, border {}) on {name}",
+                hull.seed,
+                hull.points.len(),
+                hull.border
+            );
+            let rest = run(hull, &ground, 0.0);
+            rest_worst = rest_worst.max(rest.deepest);
+            if rest.deepest > REST_DEPTH {
+                failures.push(format!("{case}, at rest: {rest:?}"));
+            }
+            let dropped = run(hull, &ground, DROP);
+            drop_worst = drop_worst.max(dropped.deepest);
+            settled_worst = settled_worst.max(dropped.deepest_settled);
+            if dropped.deepest > DROP_DEPTH || dropped.deepest_settled > REST_DEPTH {
+                failures.push(format!("{case}, dropped: {dropped:?}"));
+            }
+            if hull.prism && rest.tilt.max(dropped.tilt) > TOPPLED {
+                failures.push(format!(
+                    "{case}: toppled (tilt {:.1}° at rest, {:.1}° dropped)",
+                    rest.tilt.to_degrees(),
+                    dropped.tilt.to_degrees()
+                ));
+            }
+        }
+        eprintln!(
+            "{name}: {} hulls, deepest at rest {:.2} mm, during a drop {:.2} mm, \
+             settled after a drop {:.2} mm",
+            hulls.len(),
+            1e3 * rest_worst,
+            1e3 * drop_worst,
+            1e3 * settled_worst
+        );
+    }
+    failures
+}
+
+fn assert_clean(failures: &[String]) {
+    for failure in failures.iter().take(30) {
+        eprintln!("  {failure}");
+    }
+    assert!(failures.is_empty(), "{} failures", failures.len());
+}
+
+/// The issue's prisms (a 16-gon of radius 1 m and height 2 m, and a 6-gon and a 32-gon alike)
+/// and a 64-gon of radius 5 cm and height 10 cm (a mug's 128 points) on every ground, with
+/// six random hulls.
+#[test]
+fn hulls_rest_on_every_ground() {
+    let mut failures = Vec::new();
+    for (seed, around, radius, half_height) in [
+        (1000, 16, 1.0, 1.0),
+        (1002, 6, 1.0, 1.0),
+        (1004, 32, 1.0, 1.0),
+        (1006, 64, 0.05, 0.05),
+    ] {
+        let mut hull = Hull::random(seed);
+        hull.points.clear();
+        for k in 0..around {
+            let angle = k as f32 * std::f32::consts::TAU / around as f32;
+            for y in [-half_height, half_height] {
+                hull.points
+                    .push([radius * angle.cos(), y, radius * angle.sin()]);
+            }
+        }
+        for (name, ground) in grounds() {
+            for drop in [0.0, DROP] {
+                let outcome = run(&hull, &ground, drop);
+                let limit = if drop > 0.0 { DROP_DEPTH } else { REST_DEPTH };
+                if outcome.deepest > limit
+                    || outcome.deepest_settled > REST_DEPTH
+                    || outcome.tilt > TOPPLED
+                {
+                    failures.push(format!(
+                        "{around}-gon of radius {radius} on {name}, drop {drop}: {outcome:?}"
+                    ));
+                }
+            }
+        }
+    }
+    failures.append(&mut sweep(1..7));
+    assert_clean(&failures);
+}
+
+/// The full sweep: docs/testing.md, "Hulls on every ground".
+#[test]
+#[ignore = "the full sweep, about a minute: docs/testing.md"]
+fn hulls_rest_on_every_ground_full_sweep() {
+    assert_clean(&sweep(100..300));
+}
