@@ -11,6 +11,8 @@ mod ccd;
 mod common;
 mod dead_impacts;
 mod determinism;
+mod extreme_values;
+mod fast_impacts;
 mod fuzz_regressions;
 mod golden;
 mod guards;
