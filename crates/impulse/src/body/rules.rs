@@ -90,9 +90,19 @@ pub(crate) fn derived_mass(
     }
 }
 
-/// Strongest gravity (m/s²): 10⁶ m/s², about a white dwarf's surface gravity. Beyond it a
-/// step of 1/60 s adds more than 10⁴ m/s to every body; 10³⁰ m/s² overflows the energy at once.
-pub(crate) const MAX_GRAVITY: f32 = 1.0e6;
+/// Strongest gravity (m/s²): 10⁴ m/s², about 1,000 g. Beyond it a second of fall reaches the
+/// default `max_linear_speed` within seconds; 10³⁰ m/s² overflows the energy at once.
+pub(crate) const MAX_GRAVITY: f32 = 1.0e4;
+
+/// The time step (s): finite and within [10⁻⁶, 1] s. A step of a second already lets a body
+/// fall 5 m between contact searches; 10¹⁰ s or 10⁻⁴⁵ s overflow or vanish in f32 (NaN energy).
+pub(crate) fn time_step(dt: f32) -> Result<(), String> {
+    if dt.is_finite() && (1.0e-6..=1.0).contains(&dt) {
+        Ok(())
+    } else {
+        Err(format!("must be finite and within [1e-6, 1] s, got {dt}"))
+    }
+}
 
 /// Gravity finite and no stronger than [`MAX_GRAVITY`].
 pub(crate) fn gravity(g: [f32; 3]) -> Result<(), String> {

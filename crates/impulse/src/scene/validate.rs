@@ -73,7 +73,7 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
     if c.finite_array(&root.key("gravity"), &scene.gravity) {
         c.rule(&root.key("gravity"), rules::gravity(scene.gravity));
     }
-    c.positive(&root.key("dt"), scene.dt);
+    c.rule(&root.key("dt"), rules::time_step(scene.dt));
 
     let solver = root.key("solver");
     for problem in scene.solver.problems() {
@@ -250,7 +250,21 @@ impl Checker {
             .errors
             .iter()
             .any(|e| e.body.as_ref().is_some_and(|l| l.index == index));
-        if own_errors || !b.kind.is_moving() {
+        if own_errors {
+            return;
+        }
+        if !b.kind.is_moving() {
+            // A static body's box is clamped to the broad phase's bound of 10⁶ m.
+            let distance = norm(&b.position);
+            if distance > f64::from(rules::MAX_SHAPE_EXTENT) {
+                self.fail(
+                    &path.key("position"),
+                    format!(
+                        "a static body must lie within {} m of the origin, got {distance} m",
+                        rules::MAX_SHAPE_EXTENT
+                    ),
+                );
+            }
             return;
         }
         let (density, density_path) = match &b.material {

@@ -483,11 +483,7 @@ impl World {
 }
 
 fn check_dt(dt: f32) -> Result<(), WorldError> {
-    if dt.is_finite() && dt > 0.0 {
-        Ok(())
-    } else {
-        Err(setting("dt", &format!("must be finite and > 0, got {dt}")))
-    }
+    crate::body::rules::time_step(dt).map_err(|message| setting("dt", &message))
 }
 
 fn setting(field: &str, message: &str) -> WorldError {

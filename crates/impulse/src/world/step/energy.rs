@@ -154,14 +154,15 @@ impl EnergyCheck {
             (settings.max_linear_speed, settings.max_angular_speed);
         let linear_speed = |i: usize| b.linear_velocity[i].length();
         let angular_speed = |i: usize| b.angular_velocity[i].length();
+        // NaN is beyond every bound.
+        let beyond = |value: f32, bound: f32| value.is_nan() || value > bound;
         // A moving body beyond the world bound leaves the world (returned), unless it
         // also blew up; a sleeping one has not moved since it was checked.
         let far = |i: usize| !b.asleep[i] && b.inverse_mass[i] > 0.0 && position(i) > max_distance;
         let bad = |i: usize| {
-            // NaN fails every comparison: `!(x <= bound)` catches it.
             !position(i).is_finite()
-                || !(linear_speed(i) <= max_linear_speed)
-                || !(angular_speed(i) <= max_angular_speed)
+                || beyond(linear_speed(i), max_linear_speed)
+                || beyond(angular_speed(i), max_angular_speed)
         };
         let first = find_first(
             spread(parallel, b.len(), BODIES_PER_TASK),
@@ -193,7 +194,7 @@ impl EnergyCheck {
         let (linear, angular) = (linear_speed(i), angular_speed(i));
         let (quantity, value, unit, setting, bound) = if !position.is_finite() {
             ("position", position, "m", "max_distance", max_distance)
-        } else if !(linear <= max_linear_speed) {
+        } else if beyond(linear, max_linear_speed) {
             (
                 "linear speed",
                 linear,
