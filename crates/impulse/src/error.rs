@@ -36,6 +36,25 @@ pub enum WorldError {
     /// world's).
     #[error("no body {0:?} in this world (removed, or another world's handle)")]
     UnknownBody(crate::body::BodyHandle),
+    /// The bodies start piled into one another: their bounding boxes overlap in more pairs than
+    /// [`crate::MAX_PAIRS_PER_BODY`] per body ([`crate::World::from_scene`]), e.g. 3,000
+    /// coincident spheres. Displayed as `3000 bodies overlap at (0, 0, 0) (around body 0): …`.
+    #[error(
+        "{bodies} bodies overlap at ({}, {}, {}) (around body {body}): their bounding boxes \
+         overlap in more than {limit} pairs ({} per body), a pile no step can take apart; \
+         spread the bodies out",
+        at[0], at[1], at[2], crate::MAX_PAIRS_PER_BODY
+    )]
+    Crowded {
+        /// Bodies whose boxes meet the densest body's box, that body included.
+        bodies: usize,
+        /// The densest body's index.
+        body: usize,
+        /// Its centre of mass `[x, y, z]` (m).
+        at: [f32; 3],
+        /// The most pairs allowed: [`crate::MAX_PAIRS_PER_BODY`] × the bodies.
+        limit: usize,
+    },
     /// The time step or gravity is invalid.
     #[error("{field}: {message}")]
     InvalidSetting {
@@ -56,20 +75,31 @@ pub enum WorldError {
 /// offending state is kept so it can be inspected.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum StepError {
-    /// A body's position or velocity became non-finite or exceeded the blow-up bound.
+    /// A body's position became non-finite, or its linear or angular speed non-finite or
+    /// beyond its bound ([`crate::SolverSettings::max_linear_speed`] in m/s,
+    /// [`crate::SolverSettings::max_angular_speed`] in rad/s). Displayed as, e.g.,
+    /// `simulation blew up at step 3: body 1 has angular speed = 2e7 rad/s, not finite or
+    /// beyond solver.max_angular_speed = 10000000 rad/s`.
     #[error(
-        "simulation blew up at step {step}: body {body} has {quantity} = {value} (bound {bound})"
+        "simulation blew up at step {step}: body {body} has {quantity} = {value} {unit}, not \
+         finite or beyond solver.{setting} = {bound} {unit}"
     )]
     BlowUp {
         /// The step (counted from 1) during which the blow-up happened.
         step: u64,
         /// Index of the first offending body.
         body: usize,
-        /// `position` or `velocity`.
+        /// `position` (its distance from the origin), `linear speed` or `angular speed`.
         quantity: &'static str,
         /// The offending magnitude (may be NaN or infinite).
         value: f32,
-        /// The bound it crossed.
+        /// The quantity's unit: `m`, `m/s` or `rad/s`.
+        unit: &'static str,
+        /// The solver setting that holds the bound: `max_distance` (a position only blows up
+        /// when it is not finite; beyond the bound a body leaves the world),
+        /// `max_linear_speed` or `max_angular_speed`.
+        setting: &'static str,
+        /// The bound (in `unit`).
         bound: f32,
     },
     /// The bodies' mechanical energy (kinetic + gravitational) rose more than

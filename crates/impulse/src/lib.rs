@@ -84,6 +84,7 @@ pub use parry3d;
 pub use parry3d::shape::SharedShape;
 
 pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
+pub use collision::crowding::{Crowd, MAX_PAIRS_PER_BODY};
 pub use diagnostics::contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
@@ -96,13 +97,14 @@ pub use scene::{
 };
 pub use scene::{Jitter, Override, Variation};
 pub use settings::{
-    CombineRule, ContactRepair, ImpactModel, SettingError, SolverMethod, SolverSettings,
+    CombineRule, ContactRepair, DEFAULT_MAX_ANGULAR_SPEED, DEFAULT_MAX_LINEAR_SPEED, ImpactModel,
+    SettingError, SolverMethod, SolverSettings,
 };
 pub use solver::{EscalationLevel, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, IslandReport};
 pub use world::LeftWorld;
 pub use world::{
-    BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, BodyRef, ContactEvent, ContactPairView,
-    ContactPoint, OLDEST_SNAPSHOT_FORMAT_VERSION, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World,
+    BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BodyRef, ContactEvent, ContactPairView, ContactPoint,
+    OLDEST_SNAPSHOT_FORMAT_VERSION, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World,
     WorldSnapshot,
 };
 

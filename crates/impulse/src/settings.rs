@@ -315,12 +315,33 @@ pub struct SolverSettings {
     /// the origin leaves the simulation ([`crate::World::left_world`]): it is frozen where it
     /// is and the run goes on. Default 10⁵ m ([`crate::BLOW_UP_DISTANCE`]); must be > 0.
     pub max_distance: f32,
+    /// Largest speed of a body's centre of mass (m/s): a body faster than this at a step's end
+    /// is a blow-up ([`crate::StepError::BlowUp`]), and a body given a faster initial velocity
+    /// is refused. Default 10⁵ m/s ([`DEFAULT_MAX_LINEAR_SPEED`]); must be finite and > 0.
+    pub max_linear_speed: f32,
+    /// Largest angular speed of a body (rad/s): a body spinning faster than this at a step's
+    /// end is a blow-up ([`crate::StepError::BlowUp`]), and a body given a faster initial spin
+    /// is refused. Default 10⁷ rad/s ([`DEFAULT_MAX_ANGULAR_SPEED`]); must be finite and > 0.
+    pub max_angular_speed: f32,
 }
 
 /// The default world bound (m), [`SolverSettings::max_distance`]: a moving body farther than
 /// this from the origin leaves the world ([`crate::LeftWorld`]); the run goes on. A non-finite
 /// position is a blow-up.
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
+
+/// The default [`SolverSettings::max_linear_speed`] (m/s): 100 km/s, beyond anything that
+/// moves in a contact simulation (a rifle bullet flies at about 1 km/s, a light-gas gun's
+/// projectile at 7 km/s, the fastest meteoroid meets the Earth at 72 km/s). A speed a step
+/// cannot reach by physics is left to the energy check ([`crate::BLOW_UP_ENERGY_PER_KG`]);
+/// this bound only catches a state that is finite but meaningless.
+pub const DEFAULT_MAX_LINEAR_SPEED: f32 = 1.0e5;
+
+/// The default [`SolverSettings::max_angular_speed`] (rad/s): 10⁷ rad/s, the spin of a 1 cm
+/// ball rolling at [`DEFAULT_MAX_LINEAR_SPEED`], and 500 times a rifle bullet's
+/// (18,850 rad/s). A small body that grazes the ground fast spins up to v/r (a 2 cm ball at
+/// 700 m/s: 70,000 rad/s), which is physics, not a blow-up.
+pub const DEFAULT_MAX_ANGULAR_SPEED: f32 = 1.0e7;
 
 /// A solver setting outside its allowed range: which field, and what is allowed.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -421,11 +442,32 @@ impl SolverSettings {
             };
             problems.push(SettingError { field, message });
         }
+        // A soft repair's coefficients overflow f32 far beyond any substep rate (as a joint
+        // spring's do, `joint::rules::MAX_SPRING`).
+        for (field, value) in [(rate_field, rate), ("repair.damping_ratio", damping_ratio)] {
+            if value.is_finite() && value > 1.0e6 {
+                problems.push(SettingError {
+                    field,
+                    message: format!("must be at most 1e6, got {value:e}"),
+                });
+            }
+        }
         if self.max_distance.is_nan() || self.max_distance <= 0.0 {
             problems.push(SettingError {
                 field: "max_distance",
                 message: format!("must be > 0, got {}", self.max_distance),
             });
+        }
+        for (field, value) in [
+            ("max_linear_speed", self.max_linear_speed),
+            ("max_angular_speed", self.max_angular_speed),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                problems.push(SettingError {
+                    field,
+                    message: format!("must be finite and > 0, got {value}"),
+                });
+            }
         }
         let warm_start = self.warm_start;
         if !warm_start.is_finite() {
@@ -638,6 +680,8 @@ impl Default for SolverSettings {
             friction_combine: CombineRule::GeometricMean,
             restitution_combine: CombineRule::Max,
             max_distance: BLOW_UP_DISTANCE,
+            max_linear_speed: DEFAULT_MAX_LINEAR_SPEED,
+            max_angular_speed: DEFAULT_MAX_ANGULAR_SPEED,
         }
     }
 }

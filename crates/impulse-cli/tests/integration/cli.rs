@@ -252,12 +252,13 @@ fn lcp_dump_of_a_chain_has_its_joint_rows_and_lemke_solves_it() {
 #[test]
 fn a_blow_up_stops_with_the_step_and_keeps_the_frames_written() {
     // A runaway body: a sideways "gravity" of 5970 m/s² adds 99.5 m/s per step, so its speed
-    // passes the 10⁴ m/s blow-up bound during step 101 (9950 m/s after step 100). A body
-    // merely far away leaves the world instead (tests/far_bodies in the engine).
+    // passes the scene's bound `solver.max_linear_speed` = 10⁴ m/s during step 101 (9950 m/s
+    // after step 100). A body merely far away leaves the world instead (tests/far_bodies in
+    // the engine).
     let scene = temp("runaway.json");
     std::fs::write(
         &scene,
-        r#"{"gravity": [5970, 0, 0], "bodies": [
+        r#"{"gravity": [5970, 0, 0], "solver": {"max_linear_speed": 10000, "max_distance": 1e9}, "bodies": [
   {"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "position": [0, 0, 0]}
 ]}"#,
     )
@@ -273,6 +274,10 @@ fn a_blow_up_stops_with_the_step_and_keeps_the_frames_written() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("blew up at step 101"), "{err}");
+    assert!(
+        err.contains("linear speed") && err.contains("solver.max_linear_speed = 10000 m/s"),
+        "{err}"
+    );
     let text = std::fs::read_to_string(&csv).unwrap();
     let last = text.lines().last().unwrap();
     assert!(last.starts_with("100,"), "last frame written: {last}");

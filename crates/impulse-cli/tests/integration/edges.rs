@@ -110,6 +110,80 @@ fn a_huge_substep_count_is_a_field_error() {
     }
 }
 
+/// 3,000 coincident spheres: refused with where they pile up and exit 1, before any pair is
+/// listed (they once took 17 GB in the overlap measure and aborted).
+#[test]
+fn a_pile_of_coincident_spheres_is_refused_with_where_it_is() {
+    let path = temp(SUITE, "pile.json");
+    let ball =
+        r#"{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "position": [0, 0, 0]}"#;
+    let bodies = vec![ball; 3_000].join(",\n");
+    std::fs::write(&path, format!("{{\"bodies\": [{bodies}]}}")).unwrap();
+    let out = output_within(impulse().arg("run").arg(&path).arg("--quiet"), 60);
+    assert_refused(
+        &out,
+        &["3000 bodies overlap at (0, 0, 0)", "spread the bodies out"],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+}
+
+/// Values derived from a scene are checked where they come from: a 1e-20 m ball's mass
+/// (named by the shape, with the density it was made from), a 1e25 kg/m³ density, a 1e30 Hz
+/// joint spring and 1e30 m/s² gravity are refused with file, line and field; a scene that is
+/// not an object says what a scene is; a capsule spinning at a rifle bullet's 18,850 rad/s
+/// runs.
+#[test]
+fn derived_and_extreme_values_are_refused_at_the_door() {
+    let cases = [
+        (
+            r#"{"bodies": [{"kind": "dynamic", "shape": {"type": "sphere", "radius": 1e-20}}]}"#,
+            vec![
+                "tiny.json:1:",
+                "bodies[0].shape",
+                "mass must be within",
+                "material.density 1000",
+            ],
+        ),
+        (
+            r#"{"bodies": [{"kind": "dynamic", "shape": {"type": "sphere", "radius": 1},
+                "material": {"friction": 0.5, "restitution": 0, "density": 1e25}}]}"#,
+            vec!["tiny.json:2:", "bodies[0].material.density", "1e12"],
+        ),
+        (
+            r#"{"gravity": [0, -1e30, 0], "bodies": []}"#,
+            vec!["tiny.json:1:", "gravity", "1e4"],
+        ),
+        (
+            "[]",
+            vec!["tiny.json:1:", "a scene is a JSON object", "`bodies`"],
+        ),
+    ];
+    for (scene, parts) in cases {
+        let path = temp(SUITE, "tiny.json");
+        std::fs::write(&path, scene).unwrap();
+        let out = output_within(impulse().arg("run").arg(&path).arg("--quiet"), 60);
+        assert_refused(&out, &parts);
+    }
+    let path = temp(SUITE, "bullet.json");
+    std::fs::write(
+        &path,
+        r#"{"bodies": [
+  {"kind": "static", "shape": {"type": "half_space", "normal": [0, 1, 0]}},
+  {"kind": "dynamic", "shape": {"type": "capsule", "half_height": 0.01, "radius": 0.004},
+   "position": [0, 1, 0], "linear_velocity": [800, -5, 0], "angular_velocity": [18850, 0, 0]}
+]}"#,
+    )
+    .unwrap();
+    let out = output_within(
+        impulse()
+            .arg("run")
+            .arg(&path)
+            .args(["--quiet", "--steps", "30"]),
+        60,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
 #[test]
 fn a_scene_that_is_not_a_regular_file_or_too_large_is_refused_before_reading() {
     let out = output_within(impulse().args(["run", "/dev/zero", "--quiet"]), 30);

@@ -307,16 +307,16 @@ pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
         }
         BodyKind::Dynamic | BodyKind::Particle => {
             check("material.density", rules::positive(b.density))?;
+            if let Some(m) = b.mass {
+                check("mass", rules::positive(m))?;
+            }
+            let particle = b.kind == BodyKind::Particle;
+            rules::derived_mass(&shape, b.density, b.mass, particle)
+                .map_err(|(field, message)| invalid_built(field, message))?;
             let props = shape.mass_properties(b.density);
             let computed_mass = props.mass();
             // Scaling mass and inertia together keeps the shape's mass distribution.
-            let scale = match b.mass {
-                Some(m) => {
-                    check("mass", rules::positive(m))?;
-                    m / computed_mass
-                }
-                None => 1.0,
-            };
+            let scale = b.mass.map_or(1.0, |m| m / computed_mass);
             let inverse_mass = props.inv_mass / scale;
             if !(inverse_mass.is_finite() && inverse_mass > 0.0) {
                 return bad(

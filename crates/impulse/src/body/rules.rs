@@ -15,6 +15,155 @@ pub(crate) const MIN_NORM: f32 = 1e-6;
 /// contact queries (a box 7e37 m long made Parry's EPA index out of bounds).
 pub(crate) const MAX_SHAPE_EXTENT: f32 = 1.0e6;
 
+/// Lightest mass (kg) of a moving body: 10⁻⁹ kg, a grain of sand 0.1 mm across. Lighter
+/// bodies take velocity changes beyond f32 from the smallest contact impulse (a 10⁻²⁰ m ball
+/// has an infinite inverse mass in f32).
+pub(crate) const MIN_MASS: f32 = 1.0e-9;
+
+/// Heaviest mass (kg) of a moving body: 10¹² kg, a cubic kilometre of water. The solver's f32
+/// impulses (mass × speed change) are squared in the friction cone: at 10¹² kg and
+/// 10⁵ m/s they reach 10³⁴ N²s², still within f32 (3·10³⁸); a 10²⁵ kg body overflows at once.
+pub(crate) const MAX_MASS: f32 = 1.0e12;
+
+/// A moving body's principal moments of inertia (kg·m²) lie within [10⁻²⁰, 10²⁴]: 10⁻²⁰ is a
+/// [`MIN_MASS`] body 10 µm across (a smaller moment gives an infinite inverse in f32), 10²⁴ a
+/// [`MAX_MASS`] body [`MAX_SHAPE_EXTENT`] across.
+pub(crate) const INERTIA_RANGE: (f32, f32) = (1.0e-20, 1.0e24);
+
+/// The body's mass and inertia, derived from its shape, density (or given `mass`), must lie
+/// within [`MIN_MASS`]..[`MAX_MASS`] and [`INERTIA_RANGE`]: the checks the step's f32 arithmetic
+/// needs, made where the values come from. Returns the field to blame (`mass` when given,
+/// else `material.density` when the density is outside 10⁻³..10⁶ kg/m³, else `shape`) and
+/// a message naming the fields that produced the value. `particle`: no inertia (a particle
+/// never rotates).
+pub(crate) fn derived_mass(
+    shape: &SharedShape,
+    density: f32,
+    mass: Option<f32>,
+    particle: bool,
+) -> Result<(), (&'static str, String)> {
+    let props = shape.mass_properties(density);
+    let volume = shape.mass_properties(1.0).mass();
+    let derived = props.mass();
+    let (value, field, origin) = match mass {
+        Some(m) => (m, "mass", format!("mass {m} kg")),
+        None => {
+            let field = if (1.0e-3..=1.0e6).contains(&density) {
+                "shape"
+            } else {
+                "material.density"
+            };
+            let origin = format!(
+                "the shape's volume {volume:e} m³ × material.density {density} kg/m³ = {derived:e} kg"
+            );
+            (derived, field, origin)
+        }
+    };
+    if !(value.is_finite() && (MIN_MASS..=MAX_MASS).contains(&value)) {
+        return Err((
+            field,
+            format!(
+                "a moving body's mass must be within [{MIN_MASS:e}, {MAX_MASS:e}] kg (the range \
+                 the solver's f32 impulses hold), got {origin}"
+            ),
+        ));
+    }
+    if particle {
+        return Ok(());
+    }
+    let scale = value / derived;
+    let moments = props.principal_inertia() * scale;
+    let (low, high) = INERTIA_RANGE;
+    let smallest = moments.min_element();
+    let largest = moments.max_element();
+    if moments.is_finite() && smallest >= low && largest <= high {
+        Ok(())
+    } else {
+        Err((
+            if mass.is_some() { "mass" } else { "shape" },
+            format!(
+                "a moving body's principal moments of inertia must be within [{low:e}, \
+                 {high:e}] kg·m², got {smallest:e} to {largest:e} kg·m² from the shape and \
+                 {origin}"
+            ),
+        ))
+    }
+}
+
+/// Strongest gravity (m/s²): 10⁴ m/s², about 1,000 g. Beyond it a second of fall reaches the
+/// default `max_linear_speed` within seconds; 10³⁰ m/s² overflows the energy at once.
+pub(crate) const MAX_GRAVITY: f32 = 1.0e4;
+
+/// The time step (s): finite and within [10⁻⁶, 1] s. A step of a second already lets a body
+/// fall 5 m between contact searches; 10¹⁰ s or 10⁻⁴⁵ s overflow or vanish in f32 (NaN energy).
+pub(crate) fn time_step(dt: f32) -> Result<(), String> {
+    if dt.is_finite() && (1.0e-6..=1.0).contains(&dt) {
+        Ok(())
+    } else {
+        Err(format!("must be finite and within [1e-6, 1] s, got {dt}"))
+    }
+}
+
+/// Gravity finite and no stronger than [`MAX_GRAVITY`].
+pub(crate) fn gravity(g: [f32; 3]) -> Result<(), String> {
+    finite(&g)?;
+    let strength = glam::Vec3::from(g).length();
+    if strength <= MAX_GRAVITY {
+        Ok(())
+    } else {
+        Err(format!(
+            "must be at most {MAX_GRAVITY:e} m/s² in magnitude, got {strength:e} m/s²"
+        ))
+    }
+}
+
+/// A moving body's start within the world's bounds ([`crate::SolverSettings`]): its position
+/// within `max_distance` of the origin (m), its linear speed within `max_linear_speed` (m/s)
+/// and its angular speed within `max_angular_speed` (rad/s); beyond them the first step would
+/// take it out of the world or call it a blow-up. Returns the field and the message.
+pub(crate) fn start_within_bounds(
+    position: [f32; 3],
+    linear_velocity: [f32; 3],
+    angular_velocity: [f32; 3],
+    settings: &crate::SolverSettings,
+) -> Result<(), (&'static str, String)> {
+    let length = |v: [f32; 3]| glam::Vec3::from(v).length();
+    let checks = [
+        (
+            "position",
+            length(position),
+            "m from the origin",
+            "max_distance",
+            settings.max_distance,
+        ),
+        (
+            "linear_velocity",
+            length(linear_velocity),
+            "m/s",
+            "max_linear_speed",
+            settings.max_linear_speed,
+        ),
+        (
+            "angular_velocity",
+            length(angular_velocity),
+            "rad/s",
+            "max_angular_speed",
+            settings.max_angular_speed,
+        ),
+    ];
+    for (field, value, unit, setting, bound) in checks {
+        if value > bound {
+            return Err((
+                field,
+                format!(
+                    "a moving body must start within solver.{setting} = {bound} {unit}, got {value} {unit}"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// A shape's reach from its body's origin: its local bounding box finite and within
 /// [`MAX_SHAPE_EXTENT`] on every axis (a half-space, unbounded, is exempt), and a rounded
 /// shape's border radius finite and ≥ 0 (Parry asserts it when it grows the box).

@@ -5,6 +5,7 @@
 
 pub(crate) mod broad_phase;
 pub(crate) mod caps;
+pub(crate) mod crowding;
 pub(crate) mod dispatch;
 pub(crate) mod faces;
 pub(crate) mod manifold;

@@ -90,7 +90,7 @@ pub(crate) fn update_targets(
 pub(crate) const SPECULATIVE_TURN: f32 = std::f32::consts::FRAC_PI_4;
 
 /// The target (m/s) of a stale speculative row: far below any approach speed (the blow-up guard
-/// stops a body at 10⁴ m/s), so the row's impulse goes to zero, yet small enough that no
+/// stops a body at `max_linear_speed`, 10⁵ m/s by default), so the row's impulse goes to zero, yet small enough that no
 /// solver's products of it overflow.
 pub(crate) const STALE_TARGET: f32 = -1.0e15;
 

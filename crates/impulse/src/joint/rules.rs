@@ -31,6 +31,37 @@ fn positive(field: &str, value: f32) -> Result<(), JointProblem> {
     }
 }
 
+/// Highest spring or motor frequency (Hz) and damping ratio a joint takes: 10⁶. A spring far
+/// stiffer than the substep rate already acts as a rigid row (its soft coefficients reach
+/// their limits); 10³⁰ Hz overflows them (h·ω·(2ζ + h·ω) is infinite in f32) and gives NaN.
+pub(crate) const MAX_SPRING: f32 = 1.0e6;
+
+/// `value` finite, > 0 and at most [`MAX_SPRING`] (a frequency, Hz).
+fn frequency(field: &str, value: f32) -> Result<(), JointProblem> {
+    positive(field, value)?;
+    if value <= MAX_SPRING {
+        Ok(())
+    } else {
+        Err(problem(
+            field,
+            format!("must be at most {MAX_SPRING:e} Hz, got {value:e}"),
+        ))
+    }
+}
+
+/// `value` finite, ≥ 0 and at most [`MAX_SPRING`] (a damping ratio).
+fn damping_ratio(field: &str, value: f32) -> Result<(), JointProblem> {
+    non_negative(field, value)?;
+    if value <= MAX_SPRING {
+        Ok(())
+    } else {
+        Err(problem(
+            field,
+            format!("must be at most {MAX_SPRING:e}, got {value:e}"),
+        ))
+    }
+}
+
 /// `value` finite and ≥ 0.
 fn non_negative(field: &str, value: f32) -> Result<(), JointProblem> {
     if value.is_finite() && value >= 0.0 {
@@ -101,8 +132,8 @@ pub(crate) fn check_dofs(kind: JointKind, dofs: &[JointAxis; 6]) -> Result<(), J
                     "a locked degree of freedom takes no spring",
                 ));
             }
-            positive(&format!("{}.hertz", field("spring")), spring.hertz)?;
-            non_negative(
+            frequency(&format!("{}.hertz", field("spring")), spring.hertz)?;
+            damping_ratio(
                 &format!("{}.damping_ratio", field("spring")),
                 spring.damping_ratio,
             )?;
@@ -126,8 +157,11 @@ pub(crate) fn check_dofs(kind: JointKind, dofs: &[JointAxis; 6]) -> Result<(), J
                     damping_ratio,
                 } => {
                     finite(&format!("{}.position", field("motor")), target)?;
-                    positive(&format!("{}.hertz", field("motor")), hertz)?;
-                    non_negative(&format!("{}.damping_ratio", field("motor")), damping_ratio)?;
+                    frequency(&format!("{}.hertz", field("motor")), hertz)?;
+                    self::damping_ratio(
+                        &format!("{}.damping_ratio", field("motor")),
+                        damping_ratio,
+                    )?;
                 }
             }
         }
@@ -155,8 +189,8 @@ pub(crate) fn check_options(
         damping_ratio,
     } = stiffness
     {
-        positive("stiffness.hertz", hertz)?;
-        non_negative("stiffness.damping_ratio", damping_ratio)?;
+        frequency("stiffness.hertz", hertz)?;
+        self::damping_ratio("stiffness.damping_ratio", damping_ratio)?;
     }
     for (field, value) in [("break_force", break_force), ("break_torque", break_torque)] {
         if let Some(value) = value

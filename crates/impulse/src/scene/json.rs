@@ -174,6 +174,13 @@ fn json_error(text: &str, mut field: FieldPath, inner: &serde_json::Error) -> Sc
         serde_json::error::Category::Data => SceneErrorKind::Structure,
     };
     let mut message = bare_message(inner);
+    // The root as an array or a scalar: serde's `invalid length 6, expected struct Scene with 8
+    // elements` speaks of the Rust type, not of the file.
+    if field.0.is_empty() && message.contains("expected struct Scene") {
+        message = "a scene is a JSON object with a `bodies` array (and optional `gravity`, \
+                   `dt`, `solver`, `materials`, `joints`), e.g. {\"bodies\": []}"
+            .to_string();
+    }
     let mut position =
         (inner.line() > 0).then(|| TextPosition::new(inner.line(), inner.column().max(1)));
     if message.starts_with("data did not match any variant of untagged enum MaterialRef") {

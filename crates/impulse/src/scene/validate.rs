@@ -70,8 +70,10 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
     };
     let root = FieldPath::root();
 
-    c.finite_array(&root.key("gravity"), &scene.gravity);
-    c.positive(&root.key("dt"), scene.dt);
+    if c.finite_array(&root.key("gravity"), &scene.gravity) {
+        c.rule(&root.key("gravity"), rules::gravity(scene.gravity));
+    }
+    c.rule(&root.key("dt"), rules::time_step(scene.dt));
 
     let solver = root.key("solver");
     for problem in scene.solver.problems() {
@@ -92,6 +94,7 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
             name: body.name.clone(),
         });
         c.body(&FieldPath::body(index), body, &scene.materials);
+        c.derived(index, body, scene);
     }
     let kinds: Vec<BodyKind> = scene.bodies.iter().map(|b| b.kind).collect();
     let names: Vec<Option<String>> = scene.bodies.iter().map(|b| b.name.clone()).collect();
@@ -235,6 +238,64 @@ impl Checker {
         }
         if let Some(keyframes) = &b.keyframes {
             self.keyframes(path, b, keyframes);
+        }
+    }
+
+    /// What a valid moving body derives from its fields: its mass and inertia
+    /// ([`rules::derived_mass`]) and its start within the world's bounds
+    /// ([`rules::start_within_bounds`]). Only once its own fields passed.
+    fn derived(&mut self, index: usize, b: &BodyDesc, scene: &Scene) {
+        let path = &FieldPath::body(index);
+        let own_errors = self
+            .errors
+            .iter()
+            .any(|e| e.body.as_ref().is_some_and(|l| l.index == index));
+        if own_errors {
+            return;
+        }
+        if !b.kind.is_moving() {
+            // A static body's box is clamped to the broad phase's bound of 10⁶ m.
+            let distance = norm(&b.position);
+            if distance > f64::from(rules::MAX_SHAPE_EXTENT) {
+                self.fail(
+                    &path.key("position"),
+                    format!(
+                        "a static body must lie within {} m of the origin, got {distance} m",
+                        rules::MAX_SHAPE_EXTENT
+                    ),
+                );
+            }
+            return;
+        }
+        let (density, density_path) = match &b.material {
+            MaterialRef::Inline(m) => (m.density, path.key("material").key("density")),
+            MaterialRef::Named(name) => match scene.materials.get(name) {
+                Some(m) => (
+                    m.density,
+                    FieldPath::root().key("materials").key(name).key("density"),
+                ),
+                None => (Material::default().density, path.key("material")),
+            },
+        };
+        if b.kind.is_dynamic()
+            && let Ok(shape) = shape_of(&b.shape)
+            && let Err((field, message)) =
+                rules::derived_mass(&shape, density, b.mass, b.kind == BodyKind::Particle)
+        {
+            let at = if field == "material.density" {
+                density_path
+            } else {
+                path.key(field)
+            };
+            self.fail(&at, message);
+        }
+        if let Err((field, message)) = rules::start_within_bounds(
+            b.position,
+            b.linear_velocity,
+            b.angular_velocity,
+            &scene.solver,
+        ) {
+            self.fail(&path.key(field), message);
         }
     }
 

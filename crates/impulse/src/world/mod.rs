@@ -36,7 +36,7 @@ pub use query::{RayHit, ShapeHit};
 pub use snapshot::{OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
 
 pub use crate::settings::BLOW_UP_DISTANCE;
-pub use step::{BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED};
+pub use step::BLOW_UP_ENERGY_PER_KG;
 /// Bodies, settings and the persistent contact state of a simulation.
 pub struct World {
     /// The bodies, in scene order while none has been removed (a removal moves the last body
@@ -165,7 +165,9 @@ impl World {
 
     /// Builds the world a scene describes. Bodies keep scene order. Named materials resolve
     /// through `scene.materials` (`"default"` is [`Material::default`] unless redefined).
-    /// Errors name the body and the field ([`WorldError::InvalidBody`]) or the setting.
+    /// Errors name the body and the field ([`WorldError::InvalidBody`]) or the setting; a start
+    /// whose bodies pile into one another by the thousand (more pairs of overlapping bounding
+    /// boxes than [`crate::MAX_PAIRS_PER_BODY`] per body) is refused ([`WorldError::Crowded`]).
     ///
     /// ```
     /// use impulse::{Scene, World, scene::builtin_scene};
@@ -198,6 +200,14 @@ impl World {
                 },
             };
             world.add_body(desc, &material)?;
+        }
+        if let Some(crowd) = crate::collision::crowding::crowded_start(&world.bodies) {
+            return Err(WorldError::Crowded {
+                bodies: crowd.bodies,
+                body: crowd.body,
+                at: crowd.at.to_array(),
+                limit: crowd.limit,
+            });
         }
         let names: Vec<Option<String>> = scene.bodies.iter().map(|b| b.name.clone()).collect();
         for (k, desc) in scene.joints.iter().enumerate() {
@@ -240,6 +250,20 @@ impl World {
             field: error.field,
             message: error.message,
         })?;
+        if builder.kind.is_moving() {
+            crate::body::rules::start_within_bounds(
+                built.pose.translation.to_array(),
+                built.linear_velocity.to_array(),
+                built.angular_velocity.to_array(),
+                &self.settings,
+            )
+            .map_err(|(field, message)| WorldError::InvalidBody {
+                body: index,
+                name: builder.name.clone(),
+                field: field.to_string(),
+                message,
+            })?;
+        }
         let b = &mut self.bodies;
         b.kind.push(builder.kind);
         b.pose.push(built.pose);
@@ -452,19 +476,14 @@ impl World {
 
     fn check_settings(&self) -> Result<(), WorldError> {
         check_dt(self.dt)?;
-        if !self.gravity.is_finite() {
-            return Err(setting("gravity", "must be finite"));
-        }
+        crate::body::rules::gravity(self.gravity.to_array())
+            .map_err(|message| setting("gravity", &message))?;
         Ok(self.settings.validate()?)
     }
 }
 
 fn check_dt(dt: f32) -> Result<(), WorldError> {
-    if dt.is_finite() && dt > 0.0 {
-        Ok(())
-    } else {
-        Err(setting("dt", &format!("must be finite and > 0, got {dt}")))
-    }
+    crate::body::rules::time_step(dt).map_err(|message| setting("dt", &message))
 }
 
 fn setting(field: &str, message: &str) -> WorldError {

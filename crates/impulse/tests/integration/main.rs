@@ -12,6 +12,8 @@ mod common;
 mod dead_impacts;
 mod determinism;
 mod edge_passes;
+mod extreme_values;
+mod fast_impacts;
 mod fuzz_regressions;
 mod golden;
 mod guards;

@@ -334,7 +334,7 @@ fn dt_zero_and_negative() {
         9,
         None,
         "dt",
-        "must be > 0, got 0",
+        "must be finite and within [1e-6, 1] s, got 0",
     );
     let text = Bad {
         dt: "-0.01",
@@ -349,7 +349,7 @@ fn dt_zero_and_negative() {
         9,
         None,
         "dt",
-        "must be > 0, got -0.01",
+        "must be finite and within [1e-6, 1] s, got -0.01",
     );
 }
 

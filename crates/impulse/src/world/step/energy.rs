@@ -1,9 +1,10 @@
 //! The energy and blow-up check, start to end ([`EnergyCheck`]): the reference (the lowest
 //! mechanical energy since the last edit) restarts as a step starts after an edit, is raised by
 //! what the continuous stage's clamps give back and reset by the step's forces and moving
-//! kinematic bodies, and the step's end compares the energy with it and checks every body's
-//! position and speed ([`BLOW_UP_ENERGY_PER_KG`], [`BLOW_UP_SPEED`]); a moving body beyond the
-//! world bound leaves the world instead.
+//! kinematic bodies, and the step's end compares the energy with it ([`BLOW_UP_ENERGY_PER_KG`])
+//! and checks every body's position for a non-finite value and its linear and angular speeds
+//! against their bounds (`SolverSettings::max_linear_speed`, m/s, and `max_angular_speed`,
+//! rad/s); a moving body beyond the world bound leaves the world instead.
 
 use glam::Vec3;
 use parry3d::math::Pose;
@@ -14,15 +15,13 @@ use crate::error::StepError;
 use crate::parallel::{BODIES_PER_TASK, find_first, spread};
 use crate::settings::SolverSettings;
 
-/// A body faster than this (m/s) means the simulation has blown up.
-pub const BLOW_UP_SPEED: f32 = 1.0e4;
 /// Mechanical energy (kinetic + gravitational, [`crate::diagnostics::EnergyTerms`]) more than
 /// this many joules per kilogram of moving mass above the lowest it has been since the last
 /// edit means the simulation has blown up. Contacts only take energy out; what the overlap
 /// repair puts in is lifting bodies out of each other (the `overlap_pyramid` scene, started
 /// 25 % overlapping, gains about 10 J/kg). 50 J/kg is every body lifted 5 m or moving at
 /// 10 m/s. A solve that fails to hold a pile can push it apart far faster than that while no
-/// body comes near [`BLOW_UP_SPEED`] (`impulse run pyramid100 --method pgs --substeps 4
+/// body comes near a speed bound (`impulse run pyramid100 --method pgs --substeps 4
 /// --iterations 1 --position-iterations 1` is such a solve; tests/blow_up.rs). Changing
 /// bodies between steps (velocities, poses, forces, new or removed bodies, gravity: every
 /// edit that wakes a body, [`crate::World::wake_up`]) restarts the reference.
@@ -151,17 +150,19 @@ impl EnergyCheck {
         let b = &bodies;
         let max_distance = settings.max_distance;
         let position = |i: usize| b.pose[i].translation.length();
-        let speed = |i: usize| {
-            b.linear_velocity[i]
-                .length()
-                .max(b.angular_velocity[i].length())
-        };
+        let (max_linear_speed, max_angular_speed) =
+            (settings.max_linear_speed, settings.max_angular_speed);
+        let linear_speed = |i: usize| b.linear_velocity[i].length();
+        let angular_speed = |i: usize| b.angular_velocity[i].length();
+        // NaN is beyond every bound.
+        let beyond = |value: f32, bound: f32| value.is_nan() || value > bound;
         // A moving body beyond the world bound leaves the world (returned), unless it
         // also blew up; a sleeping one has not moved since it was checked.
         let far = |i: usize| !b.asleep[i] && b.inverse_mass[i] > 0.0 && position(i) > max_distance;
         let bad = |i: usize| {
-            let (position, speed) = (position(i), speed(i));
-            position.is_nan() || position.is_infinite() || speed.is_nan() || speed > BLOW_UP_SPEED
+            !position(i).is_finite()
+                || beyond(linear_speed(i), max_linear_speed)
+                || beyond(angular_speed(i), max_angular_speed)
         };
         let first = find_first(
             spread(parallel, b.len(), BODIES_PER_TASK),
@@ -190,21 +191,34 @@ impl EnergyCheck {
             return Ok(leaving);
         };
         let position = position(i);
-        if !position.is_finite() {
-            return Err(StepError::BlowUp {
-                step,
-                body: i,
-                quantity: "position",
-                value: position,
-                bound: max_distance,
-            });
-        }
+        let (linear, angular) = (linear_speed(i), angular_speed(i));
+        let (quantity, value, unit, setting, bound) = if !position.is_finite() {
+            ("position", position, "m", "max_distance", max_distance)
+        } else if beyond(linear, max_linear_speed) {
+            (
+                "linear speed",
+                linear,
+                "m/s",
+                "max_linear_speed",
+                max_linear_speed,
+            )
+        } else {
+            (
+                "angular speed",
+                angular,
+                "rad/s",
+                "max_angular_speed",
+                max_angular_speed,
+            )
+        };
         Err(StepError::BlowUp {
             step,
             body: i,
-            quantity: "velocity",
-            value: speed(i),
-            bound: BLOW_UP_SPEED,
+            quantity,
+            value,
+            unit,
+            setting,
+            bound,
         })
     }
 }

@@ -34,8 +34,8 @@ mod sleep;
 mod solve;
 mod store_impulses;
 
+pub use energy::BLOW_UP_ENERGY_PER_KG;
 pub(super) use energy::EnergyCheck;
-pub use energy::{BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED};
 
 use crate::World;
 use crate::diagnostics::{Stage, StepDiagnostics, StepProfile};
