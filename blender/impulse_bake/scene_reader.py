@@ -15,8 +15,9 @@ What maps to what (docs/blender.md has the animator's version):
   its scale as Blender sizes them (sphere radius: half the largest dimension; capsule, cylinder,
   cone: radius half the larger of x and y, height the z dimension, axis the local z), centred on
   the bounding box's centre (a one-part compound when that is not the object's origin); convex
-  hull: the mesh's vertices; mesh: a two-sided triangle mesh for a static body, the convex hull
-  of the vertices for a dynamic or kinematic one (impulse's triangle meshes are static only);
+  hull: the mesh's vertices; mesh: a two-sided triangle mesh for a static body, and for a
+  dynamic or kinematic one a triangle mesh impulse decomposes into convex parts (with the mass
+  properties of its solid when the mesh is closed);
 - mass (kg), friction, bounciness (restitution) as given (impulse combines two bodies' values
   as √(μa·μb) and max(ea, eb), Bullet as μa·μb and ea·eb); Blender's damping d (the fraction of
   velocity lost per second) as impulse's rate −ln(1 − d) (1/s), the same decay per second;
@@ -185,7 +186,7 @@ def _hull(vertices, scale):
     }
 
 
-def _trimesh(vertices, triangles, scale):
+def _trimesh(vertices, triangles, scale, two_sided=True):
     points = [_scaled(v, scale) for v in vertices]
     kept = []
     for a, b, c in triangles:
@@ -196,7 +197,7 @@ def _trimesh(vertices, triangles, scale):
         "type": "trimesh",
         "vertices": [axes.vector_to_impulse(p) for p in points],
         "indices": kept,
-        "two_sided": True,
+        **({"two_sided": True} if two_sided else {}),
     }
 
 
@@ -213,11 +214,13 @@ def _shape(obj, kind, scale, depsgraph, problems):
             problems.append(f"{name}: a {shape_type.lower()} shape needs a mesh of 4 or more vertices")
             return None
         vertices, triangles = data
-        if shape_type == "MESH" and kind == "static":
+        if shape_type == "MESH":
             if not triangles:
                 problems.append(f"{name}: the mesh shape has no faces")
                 return None
-            return _trimesh(vertices, triangles, scale)
+            # A moving body's mesh is decomposed into convex parts; winding matters only to a
+            # static one's contacts.
+            return _trimesh(vertices, triangles, scale, two_sided=kind == "static")
         return _hull(vertices, scale)
     lo, hi = _bounds(obj)
     dims = _scaled(hi - lo, scale)

@@ -28,6 +28,7 @@ from ._impulse import (
     WorldError,
     __version__,
     scenes,
+    set_decomposition_cache_dir,
 )
 from ._trajectory import Trajectory, load_trajectory
 
@@ -49,6 +50,7 @@ __all__ = [
     "__version__",
     "load_trajectory",
     "scenes",
+    "set_decomposition_cache_dir",
     "sweep",
 ]
 
