@@ -33,7 +33,7 @@ row "negative mass" run "$(case_file mass "$(scene '{"kind": "dynamic", "shape":
 row "friction below zero" run "$(case_file friction "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "material": {"friction": -0.1}}')")" --steps 1 --quiet
 row "restitution above one" run "$(case_file restitution "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "material": {"restitution": 1.5}}')")" --steps 1 --quiet
 row "degenerate hull" run "$(case_file hull "$(scene '{"kind": "dynamic", "shape": {"type": "convex_hull", "points": [[0,0,0],[1,0,0],[0,1,0],[1,1,0]]}}')")" --steps 1 --quiet
-row "trimesh on a moving body" run "$(case_file dynmesh "$(scene '{"kind": "dynamic", "shape": {"type": "trimesh", "vertices": [[0,0,0],[1,0,0],[0,0,1]], "indices": [[0,2,1]]}}')")" --steps 1 --quiet
+row "flat trimesh on a moving body" run "$(case_file dynmesh "$(scene '{"kind": "dynamic", "shape": {"type": "trimesh", "vertices": [[0,0,0],[1,0,0],[0,0,1]], "indices": [[0,2,1]]}}')")" --steps 1 --quiet
 row "missing mesh file" run "$(case_file nomesh "$(scene '{"kind": "static", "shape": {"type": "trimesh", "file": "terrain.obj"}}')")" --steps 1 --quiet
 printf 'v 0 0 0\nv 1 0 x\nf 1 2 3\n' > "$dir/corrupt.obj"
 row "corrupt mesh file" run "$(case_file badmesh "$(scene '{"kind": "static", "shape": {"type": "trimesh", "file": "corrupt.obj"}}')")" --steps 1 --quiet

@@ -29,6 +29,11 @@ use impulse::scene::{load_scene_file, to_json_string};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Directory where the convex decompositions of moving bodies' meshes are kept between
+    /// runs (created when needed; one file per mesh and parameters). Without it they are
+    /// kept in memory for one run.
+    #[arg(long, global = true, value_name = "DIR")]
+    decomposition_cache: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -304,7 +309,11 @@ enum LcpCommand {
 fn resolve_scene(arg: &str) -> Result<Scene> {
     let path = Path::new(arg);
     if path.extension().is_some_and(|e| e == "json") || path.exists() {
-        return Ok(load_scene_file(path)?);
+        let scene = load_scene_file(path)?;
+        for note in impulse::scene::decomposition_notes(&scene) {
+            eprintln!("warning: {note}");
+        }
+        return Ok(scene);
     }
     match builtin_scene(arg) {
         Some(scene) => Ok(scene),
@@ -437,6 +446,7 @@ fn report(summary: run::Summary, profile: bool) -> Result<ExitCode> {
 
 fn real_main() -> Result<ExitCode> {
     let cli = Cli::parse();
+    impulse::scene::set_decomposition_cache_dir(cli.decomposition_cache.clone());
     match cli.command {
         Command::Run {
             scene,

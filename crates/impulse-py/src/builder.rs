@@ -4,8 +4,10 @@
 //! shapes as a scene file, with the same checks (`impulse::scene::build_shape`).
 
 use impulse::glam::{Quat, Vec3};
-use impulse::scene::build_shape;
+use impulse::scene::{DecompositionDesc, body_builder, build_decomposed};
 use impulse::{BodyKind, ShapeDesc};
+use numpy::PyArray2;
+use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -16,7 +18,9 @@ use crate::settings::{from_python, to_python};
 /// (half extents), `Shape.capsule(half_height, radius)`, `Shape.cylinder(half_height,
 /// radius)` and `Shape.cone(half_height, radius)` (along y), `Shape.convex_hull(points)`
 /// ((K, 3) points), `Shape.halfspace(normal)` (the solid below the plane through the origin
-/// with outward `normal`; static bodies only), or `Shape.from_dict(d)` for any shape of the
+/// with outward `normal`; static bodies only), `Shape.trimesh(vertices, indices,
+/// decomposition=None)` (a triangle mesh; on a moving body decomposed into convex parts,
+/// `Shape.convex_parts()`), or `Shape.from_dict(d)` for any shape of the
 /// scene format (`{"type": "trimesh", "file": "mesh.obj"}`, compounds, height fields). Sizes
 /// are checked when a body is made of it (`WorldError` naming the field). Compares with `==`;
 /// pickles as its dict.
@@ -94,6 +98,65 @@ impl Shape {
         Shape {
             desc: ShapeDesc::HalfSpace { normal },
         }
+    }
+
+    /// A triangle mesh: `vertices` (N, 3) in metres and `indices` (T, 3), each triangle
+    /// counter-clockwise seen from outside. On a static body it is used as it is; on a dynamic
+    /// or kinematic body it is decomposed into convex parts (V-HACD) with `decomposition`, a
+    /// dict of `resolution` (voxels along the longest side, 8–512, default 64), `concavity`
+    /// (0–1, default 0.01) and `max_parts` (default 1024), and its mass properties are its
+    /// solid's when the mesh is closed (docs/scene-format.md, "Moving meshes"). Raises
+    /// `WorldError` for a `decomposition` that is not such a dict.
+    #[staticmethod]
+    #[pyo3(signature = (vertices, indices, decomposition=None))]
+    fn trimesh(
+        vertices: Vec<[f32; 3]>,
+        indices: Vec<[u32; 3]>,
+        decomposition: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Shape> {
+        let decomposition: Option<DecompositionDesc> = match decomposition {
+            Some(d) => Some(from_python(d, "decomposition")?),
+            None => None,
+        };
+        let mut desc = ShapeDesc::trimesh(vertices, indices);
+        if let ShapeDesc::Trimesh {
+            decomposition: slot,
+            ..
+        } = &mut desc
+        {
+            *slot = decomposition;
+        }
+        Ok(Shape { desc })
+    }
+
+    /// The convex parts a dynamic body of this trimesh shape moves as: a list of
+    /// `(vertices, indices)` pairs, `vertices` a (K, 3) float32 array (m, body frame) and
+    /// `indices` a (F, 3) uint32 array of the part's triangles. Decomposes the mesh (or takes
+    /// it from the cache). Raises `WorldError` for any other shape or an invalid mesh.
+    #[allow(clippy::type_complexity)]
+    fn convex_parts<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Vec<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<u32>>)>> {
+        let decomposed = crate::errors::guarded(|| {
+            build_decomposed(BodyKind::Dynamic, &self.desc)
+                .map_err(|e| WorldError::new_err(e.to_string()))
+        })?;
+        fn array<T>(rows: usize, flat: Vec<T>) -> PyResult<Array2<T>> {
+            Array2::from_shape_vec((rows, 3), flat).map_err(|e| WorldError::new_err(e.to_string()))
+        }
+        decomposed
+            .parts
+            .iter()
+            .map(|part| {
+                let vertices = part.vertices.iter().flatten().copied().collect();
+                let indices = part.indices.iter().flatten().copied().collect();
+                Ok((
+                    PyArray2::from_owned_array(py, array(part.vertices.len(), vertices)?),
+                    PyArray2::from_owned_array(py, array(part.indices.len(), indices)?),
+                ))
+            })
+            .collect()
     }
 
     /// Any shape of the scene format, as its JSON object (`{"type": "sphere", "radius": 0.5}`).
@@ -206,10 +269,9 @@ fn configure(
         Ok(desc) => desc.clone(),
         Err(radius) => ShapeDesc::Sphere { radius: *radius },
     };
-    let shared = crate::errors::guarded(|| {
-        build_shape(kind, &desc).map_err(|e| WorldError::new_err(e.to_string()))
+    let mut b = crate::errors::guarded(|| {
+        body_builder(kind, &desc).map_err(|e| WorldError::new_err(e.to_string()))
     })?;
-    let mut b = impulse::BodyBuilder::new(kind, shared);
     let mut recipe = Recipe {
         kind,
         shape,

@@ -32,6 +32,15 @@ fn scenes() -> Vec<String> {
         .collect()
 }
 
+/// Sets the directory where the convex decompositions of moving bodies' meshes are kept
+/// between processes (created when needed), or with `None` keeps them in memory only
+/// (docs/scene-format.md, "Moving meshes"). Applies to the whole process.
+#[pyfunction]
+#[pyo3(signature = (directory))]
+fn set_decomposition_cache_dir(directory: Option<std::path::PathBuf>) {
+    impulse::scene::set_decomposition_cache_dir(directory);
+}
+
 #[pymodule]
 fn _impulse(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -46,6 +55,7 @@ fn _impulse(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<joints::JointHandle>()?;
     m.add_class::<joints::JointBuilder>()?;
     m.add_function(wrap_pyfunction!(scenes, m)?)?;
+    m.add_function(wrap_pyfunction!(set_decomposition_cache_dir, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -28,6 +28,7 @@ from ._impulse import (
     WorldError,
     __version__,
     scenes,
+    set_decomposition_cache_dir,
 )
 from ._diagnostics import Diagnostics
 from ._trajectory import Trajectory, load_trajectory
@@ -51,6 +52,7 @@ __all__ = [
     "__version__",
     "load_trajectory",
     "scenes",
+    "set_decomposition_cache_dir",
     "sweep",
 ]
 

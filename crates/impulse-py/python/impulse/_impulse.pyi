@@ -29,6 +29,9 @@ class StepError(RuntimeError):
 def scenes() -> list[str]:
     """The built-in scene names, as ``impulse scenes`` lists them."""
 
+def set_decomposition_cache_dir(directory: str | os.PathLike[str] | None) -> None:
+    """Keep moving meshes' convex decompositions in ``directory`` across processes (None: memory only)."""
+
 class Settings:
     """Solver settings: the scene format's ``solver`` object (same fields and units)."""
 
@@ -133,6 +136,15 @@ class Shape:
     def convex_hull(points: Sequence[Sequence[float]]) -> Shape: ...
     @staticmethod
     def halfspace(normal: Sequence[float]) -> Shape: ...
+    @staticmethod
+    def trimesh(
+        vertices: Sequence[Sequence[float]],
+        indices: Sequence[Sequence[int]],
+        decomposition: Mapping[str, Any] | None = None,
+    ) -> Shape:
+        """A triangle mesh; decomposed into convex parts on a moving body."""
+    def convex_parts(self) -> list[tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32]]]:
+        """The convex parts (vertices (K, 3), triangles (F, 3)) of a moving body of this mesh."""
     @staticmethod
     def from_dict(shape: Mapping[str, Any]) -> Shape: ...
     def to_dict(self) -> dict[str, Any]: ...

@@ -2,6 +2,7 @@
 //! state a world stores.
 
 use glam::{Mat3, Quat, Vec3};
+use parry3d::mass_properties::MassProperties;
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
@@ -46,6 +47,7 @@ pub struct BodyBuilder {
     pub(crate) groups: u32,
     pub(crate) mask: u32,
     pub(crate) keyframes: Vec<Keyframe>,
+    pub(crate) unit_mass_properties: Option<MassProperties>,
 }
 
 impl BodyBuilder {
@@ -71,6 +73,7 @@ impl BodyBuilder {
             groups: u32::MAX,
             mask: u32::MAX,
             keyframes: Vec::new(),
+            unit_mass_properties: None,
         }
     }
 
@@ -142,6 +145,16 @@ impl BodyBuilder {
     /// Mass (kg) > 0, overriding the density; the inertia tensor is scaled to match.
     pub fn mass(mut self, mass: f32) -> Self {
         self.mass = Some(mass);
+        self
+    }
+
+    /// Mass properties at density 1 kg/m³ (mass = volume, m³) to use instead of the shape's
+    /// own, scaled by the density (or to [`Self::mass`]): for a shape that only approximates
+    /// the body's solid, such as the overlapping convex parts of a decomposed mesh
+    /// ([`crate::scene::DecomposedMesh::unit_mass_properties`]). A kinematic body takes its
+    /// centre of mass from them. Checked when inserted: mass > 0, everything finite.
+    pub fn unit_mass_properties(mut self, properties: MassProperties) -> Self {
+        self.unit_mass_properties = Some(properties);
         self
     }
 
@@ -297,7 +310,10 @@ pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
         BodyKind::Kinematic => {
             // No mass; the velocities are those of the shape's centroid, as for a dynamic
             // body of uniform density.
-            let centroid = shape.mass_properties(1.0).local_com;
+            let centroid = b
+                .unit_mass_properties
+                .unwrap_or_else(|| shape.mass_properties(1.0))
+                .local_com;
             let centroid = if centroid.is_finite() {
                 centroid
             } else {
@@ -311,9 +327,19 @@ pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
                 check("mass", rules::positive(m))?;
             }
             let particle = b.kind == BodyKind::Particle;
-            rules::derived_mass(&shape, b.density, b.mass, particle)
+            let unit = b
+                .unit_mass_properties
+                .unwrap_or_else(|| shape.mass_properties(1.0));
+            rules::derived_mass(&unit, b.density, b.mass, particle)
                 .map_err(|(field, message)| invalid_built(field, message))?;
-            let props = shape.mass_properties(b.density);
+            let props = match b.unit_mass_properties {
+                Some(mut unit) => {
+                    // Inertia scales with the mass at a fixed distribution.
+                    unit.set_mass(unit.mass() * b.density, true);
+                    unit
+                }
+                None => shape.mass_properties(b.density),
+            };
             let computed_mass = props.mass();
             // Scaling mass and inertia together keeps the shape's mass distribution.
             let scale = b.mass.map_or(1.0, |m| m / computed_mass);

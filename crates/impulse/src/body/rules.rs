@@ -4,6 +4,7 @@
 //! the one field it checks, so both paths say the same thing in the same words.
 
 use parry3d::shape::{Shape, SharedShape, TypedShape};
+use parry3d::mass_properties::MassProperties;
 
 use super::BodyKind;
 
@@ -34,17 +35,16 @@ pub(crate) const INERTIA_RANGE: (f32, f32) = (1.0e-20, 1.0e24);
 /// within [`MIN_MASS`]..[`MAX_MASS`] and [`INERTIA_RANGE`]: the checks the step's f32 arithmetic
 /// needs, made where the values come from. Returns the field to blame (`mass` when given,
 /// else `material.density` when the density is outside 10⁻³..10⁶ kg/m³, else `shape`) and
-/// a message naming the fields that produced the value. `particle`: no inertia (a particle
-/// never rotates).
+/// a message naming the fields that produced the value. `unit`: the shape's mass properties
+/// at density 1 (its volume as mass). `particle`: no inertia (a particle never rotates).
 pub(crate) fn derived_mass(
-    shape: &SharedShape,
+    unit: &MassProperties,
     density: f32,
     mass: Option<f32>,
     particle: bool,
 ) -> Result<(), (&'static str, String)> {
-    let props = shape.mass_properties(density);
-    let volume = shape.mass_properties(1.0).mass();
-    let derived = props.mass();
+    let volume = unit.mass();
+    let derived = volume * density;
     let (value, field, origin) = match mass {
         Some(m) => (m, "mass", format!("mass {m} kg")),
         None => {
@@ -72,7 +72,7 @@ pub(crate) fn derived_mass(
         return Ok(());
     }
     let scale = value / derived;
-    let moments = props.principal_inertia() * scale;
+    let moments = unit.principal_inertia() * density * scale;
     let (low, high) = INERTIA_RANGE;
     let smallest = moments.min_element();
     let largest = moments.max_element();

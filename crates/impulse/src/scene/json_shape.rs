@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use super::{CompoundPart, ShapeDesc};
+use super::{CompoundPart, DecompositionDesc, ShapeDesc};
 
 fn is_zero(value: &f32) -> bool {
     *value == 0.0
@@ -61,6 +61,8 @@ pub enum ShapeJson {
         indices: Option<Vec<[u32; 3]>>,
         #[serde(default, skip_serializing_if = "is_false")]
         two_sided: bool,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        decomposition: Option<DecompositionDesc>,
     },
     #[serde(rename = "heightfield")]
     HeightField {
@@ -131,11 +133,13 @@ impl From<ShapeJson> for ShapeDesc {
                 vertices,
                 indices,
                 two_sided,
+                decomposition,
             } => ShapeDesc::Trimesh {
                 file,
                 vertices,
                 indices,
                 two_sided,
+                decomposition,
                 loaded: None,
             },
             ShapeJson::HeightField { heights, scale } => ShapeDesc::HeightField { heights, scale },
@@ -188,12 +192,14 @@ impl From<ShapeDesc> for ShapeJson {
                 vertices,
                 indices,
                 two_sided,
+                decomposition,
                 loaded: _,
             } => ShapeJson::Trimesh {
                 file,
                 vertices,
                 indices,
                 two_sided,
+                decomposition,
             },
             ShapeDesc::HeightField { heights, scale } => ShapeJson::HeightField { heights, scale },
             ShapeDesc::Compound { parts } => ShapeJson::Compound { parts },

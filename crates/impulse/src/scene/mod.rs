@@ -111,9 +111,11 @@ pub enum ShapeDesc {
         /// Outward normal (normalised when built; must not be zero).
         normal: [f32; 3],
     },
-    /// A triangle mesh (Parry's `TriMesh` with `FIX_INTERNAL_EDGES`: no bumps at the edges
-    /// between its triangles); static bodies only. The triangles come from `file` or from
-    /// `vertices` and `indices`, never both.
+    /// A triangle mesh. On a static body it is Parry's `TriMesh` with `FIX_INTERNAL_EDGES`
+    /// (no bumps at the edges between its triangles); on a dynamic or kinematic body it is
+    /// decomposed into convex parts (`decomposition`, [`DecomposedMesh`]) and
+    /// moves as their compound, with the mass properties of the mesh's solid when the mesh is
+    /// closed. The triangles come from `file` or from `vertices` and `indices`, never both.
     Trimesh {
         /// An OBJ, glTF or GLB file, relative to the scene file's directory (to the current
         /// directory for scenes not read from a file). Read when the scene file is loaded.
@@ -126,6 +128,9 @@ pub enum ShapeDesc {
         /// Whether bodies may touch the triangles from both sides (for meshes whose winding
         /// is not consistent); by default a contact from behind a triangle is ignored.
         two_sided: bool,
+        /// Parameters of the convex decomposition of a moving body's mesh (defaults when
+        /// `None`); not allowed on a static body, whose mesh is used as it is.
+        decomposition: Option<DecompositionDesc>,
         /// The triangles read from `file` (not part of the JSON form).
         loaded: Option<mesh_file::LoadedMesh>,
     },
@@ -180,6 +185,7 @@ impl ShapeDesc {
             vertices: Some(vertices),
             indices: Some(indices),
             two_sided: false,
+            decomposition: None,
             loaded: None,
         }
     }
@@ -191,6 +197,7 @@ impl ShapeDesc {
             vertices: None,
             indices: None,
             two_sided: false,
+            decomposition: None,
             loaded: None,
         }
     }
@@ -431,6 +438,7 @@ impl BodyDesc {
 
 mod builtin;
 mod builtin_joints;
+mod decomposition;
 mod degeneracy;
 mod error;
 pub(crate) mod joint_desc;
@@ -445,6 +453,10 @@ pub use builtin::{
     MAX_BALLS, MAX_PYRAMID_BASE, MAX_PYRAMID3D_BASE, MAX_STACK, builtin_families, builtin_names,
     builtin_scene,
 };
+pub use decomposition::{
+    ConvexPart, DecomposedMesh, DecompositionDesc, MAX_DECOMPOSITION_RESOLUTION, decompose_mesh,
+    open_edges, open_mesh_note, set_decomposition_cache_dir,
+};
 pub use error::{BodyLocation, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
 pub use joint_desc::{BodyName, DofDesc, DofMode, JointDesc, MotorDesc, StiffnessDesc};
 pub use json::MAX_SCENE_FILE_BYTES;
@@ -454,5 +466,7 @@ pub use json::{
 pub use mesh_file::{
     LoadedMesh, MeshData, MeshFileError, MeshFormat, load_mesh_file, read_mesh_bytes,
 };
-pub use validate::{build_shape, validate, validate_all};
+pub use validate::{
+    body_builder, build_decomposed, build_shape, decomposition_notes, validate, validate_all,
+};
 pub use variation::{Jitter, ORIGIN_PREFIX, Override, Variation};

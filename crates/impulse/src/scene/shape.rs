@@ -5,6 +5,7 @@ use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
 use super::ShapeDesc;
+use super::decomposition::{DecomposedMesh, DecompositionDesc};
 use super::degeneracy::mesh_problem;
 use super::error::FieldPath;
 use super::mesh_file::MeshData;
@@ -74,33 +75,8 @@ pub(crate) fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String
                 ));
             }
         },
-        ShapeDesc::Trimesh {
-            file, two_sided, ..
-        } => {
-            let mesh = match (shape.mesh_data(), file) {
-                (Some(mesh), _) => mesh.into_owned(),
-                (None, Some(file)) => {
-                    let mesh = super::load_mesh_file(std::path::Path::new(file))
-                        .map_err(|e| ("shape.file".to_string(), e.to_string()))?;
-                    let loaded = ShapeDesc::Trimesh {
-                        file: Some(file.clone()),
-                        vertices: None,
-                        indices: None,
-                        two_sided: *two_sided,
-                        loaded: Some(super::LoadedMesh(std::sync::Arc::new(mesh.clone()))),
-                    };
-                    if let Some(problem) = loaded_mesh_problem(&loaded, &mesh) {
-                        return Err(problem);
-                    }
-                    mesh
-                }
-                (None, None) => {
-                    return Err((
-                        "shape.vertices".to_string(),
-                        "a trimesh needs `file`, or `vertices` and `indices`".to_string(),
-                    ));
-                }
-            };
+        ShapeDesc::Trimesh { two_sided, .. } => {
+            let mesh = mesh_of(shape)?;
             let flags = if *two_sided {
                 TriMeshFlags::FIX_INTERNAL_EDGES_TWO_SIDED
             } else {
@@ -142,6 +118,64 @@ pub(crate) fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String
             SharedShape::compound(built)
         }
     })
+}
+
+/// The triangles of a trimesh `shape`: inline, as read with its scene, or read now from its
+/// file relative to the current directory (and checked as validation checks a mesh).
+///
+/// # Errors
+/// (field, message): no triangles given, an unreadable or degenerate file.
+fn mesh_of(shape: &ShapeDesc) -> Result<MeshData, (String, String)> {
+    let ShapeDesc::Trimesh {
+        file, two_sided, ..
+    } = shape
+    else {
+        return Err(("shape.type".to_string(), "not a trimesh".to_string()));
+    };
+    match (shape.mesh_data(), file) {
+        (Some(mesh), _) => Ok(mesh.into_owned()),
+        (None, Some(file)) => {
+            let mesh = super::load_mesh_file(std::path::Path::new(file))
+                .map_err(|e| ("shape.file".to_string(), e.to_string()))?;
+            let loaded = ShapeDesc::Trimesh {
+                file: Some(file.clone()),
+                vertices: None,
+                indices: None,
+                two_sided: *two_sided,
+                decomposition: None,
+                loaded: Some(super::LoadedMesh(std::sync::Arc::new(mesh.clone()))),
+            };
+            if let Some(problem) = loaded_mesh_problem(&loaded, &mesh) {
+                return Err(problem);
+            }
+            Ok(mesh)
+        }
+        (None, None) => Err((
+            "shape.vertices".to_string(),
+            "a trimesh needs `file`, or `vertices` and `indices`".to_string(),
+        )),
+    }
+}
+
+/// The convex decomposition of a trimesh `shape` for a moving body, with its
+/// `decomposition` parameters (defaults when absent), cached by content
+/// ([`super::decompose_mesh`]).
+///
+/// # Errors
+/// (field, message): the mesh cannot be read, the parameters are invalid, or the mesh
+/// bounds no volume.
+pub(crate) fn decomposed_shape(
+    shape: &ShapeDesc,
+) -> Result<std::sync::Arc<DecomposedMesh>, (String, String)> {
+    let mesh = mesh_of(shape)?;
+    let parameters = match shape {
+        ShapeDesc::Trimesh {
+            decomposition: Some(parameters),
+            ..
+        } => parameters.clone(),
+        _ => DecompositionDesc::default(),
+    };
+    super::decompose_mesh(&mesh, &parameters).map_err(|message| ("shape".to_string(), message))
 }
 
 /// The first problem of a triangle mesh read from its file (`loaded` holds `mesh`), as

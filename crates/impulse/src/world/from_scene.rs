@@ -38,6 +38,7 @@ pub(crate) fn builder_of(
     desc: &BodyDesc,
     material: &Material,
 ) -> Result<BodyBuilder, WorldError> {
+    let mut unit_mass_properties = None;
     let shape = match &desc.shape {
         ShapeDesc::Sphere { radius } => {
             positive(index, desc, "shape.radius", *radius)?;
@@ -111,6 +112,15 @@ pub(crate) fn builder_of(
                 }
             }
         }
+        ShapeDesc::Trimesh { .. } if desc.kind != BodyKind::Static => {
+            let decomposed =
+                crate::scene::build_decomposed(desc.kind, &desc.shape).map_err(|e| {
+                    let field = e.field.map(|f| f.to_string()).unwrap_or_default();
+                    invalid(index, desc, &field, e.message)
+                })?;
+            unit_mass_properties = Some(decomposed.unit_mass_properties);
+            decomposed.shape.clone()
+        }
         ShapeDesc::Trimesh { .. }
         | ShapeDesc::HeightField { .. }
         | ShapeDesc::Compound { .. }
@@ -174,5 +184,6 @@ pub(crate) fn builder_of(
                 rotation: Quat::from_array(k.orientation),
             })
             .collect(),
+        unit_mass_properties,
     })
 }

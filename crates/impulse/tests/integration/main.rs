@@ -9,6 +9,7 @@ mod blow_up;
 mod body_options;
 mod ccd;
 mod common;
+mod concave;
 mod dead_impacts;
 mod determinism;
 mod edge_passes;

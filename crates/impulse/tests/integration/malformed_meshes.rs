@@ -44,8 +44,9 @@ fn check(error: &impulse::scene::SceneError, field: &str, message: &str) {
 
 const TRIANGLE: &str = r#""vertices": [[0, 0, 0], [1, 0, 0], [0, 0, 1]], "indices": [[0, 2, 1]]"#;
 
+/// A moving body's mesh is decomposed into convex parts: a flat one (one triangle) has none.
 #[test]
-fn a_trimesh_on_a_moving_body_is_refused() {
+fn a_flat_trimesh_on_a_moving_body_is_refused() {
     let error = load_error(
         "dynamic-mesh",
         &format!(r#""kind": "dynamic", "shape": {{"type": "trimesh", {TRIANGLE}}}"#),
@@ -53,8 +54,22 @@ fn a_trimesh_on_a_moving_body_is_refused() {
     );
     check(
         &error,
+        "bodies[1].shape.vertices",
+        "a moving body's trimesh is decomposed into convex parts and must enclose a volume",
+    );
+}
+
+#[test]
+fn a_trimesh_on_a_particle_is_refused() {
+    let error = load_error(
+        "particle-mesh",
+        &format!(r#""kind": "particle", "shape": {{"type": "trimesh", {TRIANGLE}}}"#),
+        &[],
+    );
+    check(
+        &error,
         "bodies[1].shape.type",
-        "a trimesh shape is only allowed on a static body, this body is dynamic",
+        "a particle must have a sphere shape, got trimesh",
     );
 }
 
