@@ -99,7 +99,7 @@ const NAMES: &[(&str, &str)] = &[
     ),
     (
         "card_house_thin",
-        "three-storey house of 11 playing cards given flat (thin shapes)",
+        "two-storey house of 8 playing cards given flat (thin shapes)",
     ),
     (
         "arch",

@@ -469,10 +469,10 @@ pub use json::MAX_SCENE_FILE_BYTES;
 pub use json::{
     load_scene_file, locate, locate_closest, parse_scene_str, parse_scene_str_in, to_json_string,
 };
-pub use notes::{SceneNote, notes};
-pub use thin::DEFAULT_THICKNESS;
 pub use mesh_file::{
     LoadedMesh, MeshData, MeshFileError, MeshFormat, load_mesh_file, read_mesh_bytes,
 };
+pub use notes::{SceneNote, notes};
+pub use thin::DEFAULT_THICKNESS;
 pub use validate::{build_shape, validate, validate_all};
 pub use variation::{Jitter, ORIGIN_PREFIX, Override, Variation};

@@ -15,16 +15,14 @@ use super::degeneracy::{HULL_FLATNESS_TOLERANCE, hull_plane_normal};
 
 /// Thickness (m) of a flat shape that gives none: 2 mm.
 ///
-/// A real playing card is about 0.3 mm thick, Blender's default collision margin is 4 cm
-/// (which would make a slab 8 cm thick). The slab must be thick enough for the contacts to
-/// hold it: a contact is found up to the prediction distance (2 cm) ahead and a resting
-/// contact sinks by micrometres, so any thickness above about 0.1 mm keeps a card on a card;
-/// but a body is swept against static ones (continuous collision) once it moves a quarter of
-/// its smallest extent in a step, and a contact between two moving thin bodies is only as good
-/// as the step that finds it, and a card tipping over at 1 m/s turns its edge by 17 mm a step
-/// at 60 Hz. 2 mm is the thinnest at which the card house (`card_house`) holds at the
-/// default preset (docs/testing.md, "Thin shapes") and is thin to the eye at the size of a
-/// card (63 × 88 mm).
+/// A real playing card is about 0.3 mm thick; Blender's default collision margin is 4 cm
+/// (a slab of 8 cm), far too thick for a card. The thinner the slab, the sooner a body is
+/// swept against static ones (continuous collision sweeps a body that moves a quarter of its
+/// thickness in a step) and the narrower the ridge a card leans on. Measured on
+/// `card_house_thin` (10 s, largest drift of a card): at the `default` preset it holds at 0.3,
+/// 0.5, 1 and 2 mm (0.07 mm) and falls at 5 mm; at `fast` it holds at 0.5 to 2 mm (0.47 mm)
+/// and falls at 0.3 and 5 mm (docs/testing.md, "Thin shapes"). 2 mm is the thickest that holds
+/// at both and is thin to the eye at card size (88 × 63 mm).
 pub const DEFAULT_THICKNESS: f32 = 0.002;
 
 /// Relative tolerance of flatness: a cuboid is flat when a half extent is at most this
@@ -185,7 +183,10 @@ mod tests {
             // Each corner moved along the normal by ±thickness/2 from the plane.
             let height = (p[0] + p[1] + p[2]) * n - n;
             let side = if k < 3 { -1.0 } else { 1.0 };
-            assert!((height - side * 0.5 * DEFAULT_THICKNESS).abs() < 1e-6, "{p:?}");
+            assert!(
+                (height - side * 0.5 * DEFAULT_THICKNESS).abs() < 1e-6,
+                "{p:?}"
+            );
         }
         let solid = ShapeDesc::ConvexHull {
             points: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],

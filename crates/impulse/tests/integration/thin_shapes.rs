@@ -101,9 +101,7 @@ fn a_flat_shape_has_the_mass_and_inertia_of_its_slab() {
 #[test]
 fn the_scene_format_takes_flat_shapes_and_their_thickness() {
     let scene = |shape: &str, kind: &str| {
-        format!(
-            r#"{{"bodies": [{{"kind": "{kind}", "shape": {shape}}}]}}"#
-        )
+        format!(r#"{{"bodies": [{{"kind": "{kind}", "shape": {shape}}}]}}"#)
     };
     let card = r#"{"type": "cuboid", "half_extents": [0.044, 0.0315, 0], "thickness": 0.0003}"#;
     for kind in ["static", "kinematic", "dynamic"] {
@@ -248,20 +246,22 @@ fn balls_bounce_off_a_thin_plane_from_both_sides() {
     w.add_body(&plane, &material(0.5, restitution)).unwrap();
     let half = 0.5 * DEFAULT_THICKNESS;
     let ball = |x: f32, y: f32, vy: f32| {
-        let mut b = BodyDesc::new(
-            BodyKind::Dynamic,
-            ShapeDesc::Sphere { radius },
-            [x, y, 0.0],
-        );
+        let mut b = BodyDesc::new(BodyKind::Dynamic, ShapeDesc::Sphere { radius }, [x, y, 0.0]);
         b.linear_velocity = [0.0, vy, 0.0];
         b
     };
     // From 1 m above the top face; from 0.5 m below the bottom face at 5 m/s upwards.
     let above = w
-        .add_body(&ball(-1.0, 1.0 + half + radius, 0.0), &material(0.5, restitution))
+        .add_body(
+            &ball(-1.0, 1.0 + half + radius, 0.0),
+            &material(0.5, restitution),
+        )
         .unwrap();
     let below = w
-        .add_body(&ball(1.0, -0.5 - half - radius, 5.0), &material(0.5, restitution))
+        .add_body(
+            &ball(1.0, -0.5 - half - radius, 5.0),
+            &material(0.5, restitution),
+        )
         .unwrap();
     let impact_above = (2.0 * g * 1.0f32).sqrt();
     let impact_below = (5.0f32 * 5.0 - 2.0 * g * 0.5).sqrt();
@@ -271,10 +271,16 @@ fn balls_bounce_off_a_thin_plane_from_both_sides() {
     let (mut rebound_above, mut rebound_below) = (None, None);
     for _ in 0..60 {
         w.step().unwrap();
-        let (ya, yb) = (w.poses()[above].translation.y, w.poses()[below].translation.y);
+        let (ya, yb) = (
+            w.poses()[above].translation.y,
+            w.poses()[below].translation.y,
+        );
         lowest_above = lowest_above.min(ya);
         highest_below = highest_below.max(yb);
-        let (va, vb) = (w.linear_velocities()[above].y, w.linear_velocities()[below].y);
+        let (va, vb) = (
+            w.linear_velocities()[above].y,
+            w.linear_velocities()[below].y,
+        );
         if rebound_above.is_none() && va > 0.0 {
             rebound_above = Some(va);
         }
@@ -305,12 +311,12 @@ fn balls_bounce_off_a_thin_plane_from_both_sides() {
     }
 }
 
-/// `card_house_thin`, eleven playing cards given flat (the default thickness), holds at the
+/// `card_house_thin`, eight playing cards given flat (the default thickness), holds at the
 /// default preset for 10 s: no card moves more than 1 mm from where it stood.
 #[test]
 fn the_thin_card_house_holds_for_ten_seconds() {
     let scene = builtin_scene("card_house_thin").unwrap();
-    assert_eq!(impulse::scene::notes(&scene).len(), 11);
+    assert_eq!(impulse::scene::notes(&scene).len(), 8);
     let mut w = World::from_scene(&scene).unwrap();
     let start: Vec<Vec3> = w.poses().iter().map(|p| p.translation).collect();
     let mut largest_drift = 0.0f32;
@@ -320,7 +326,10 @@ fn the_thin_card_house_holds_for_ten_seconds() {
             largest_drift = largest_drift.max((pose.translation - *start).length());
         }
     }
-    println!("card_house_thin: largest drift in 10 s {:.3} mm", largest_drift * 1e3);
+    println!(
+        "card_house_thin: largest drift in 10 s {:.3} mm",
+        largest_drift * 1e3
+    );
     assert!(
         largest_drift < 1e-3,
         "a card moved by {largest_drift} m in 10 s"
