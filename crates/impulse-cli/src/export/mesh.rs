@@ -465,6 +465,22 @@ mod tests {
                 },
                 1.0 / 6.0,
             ),
+            // Thin shapes: the slab of the default thickness, and of a given one.
+            (
+                ShapeDesc::Cuboid {
+                    half_extents: [0.5, 0.0, 1.0],
+                },
+                2.0 * impulse::scene::DEFAULT_THICKNESS,
+            ),
+            (
+                ShapeDesc::Thickened {
+                    shape: Box::new(ShapeDesc::ConvexHull {
+                        points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                    }),
+                    thickness: 0.1,
+                },
+                0.5 * 0.1,
+            ),
         ];
         for (shape, expected) in cases {
             let mesh = shape_mesh(&shape, 1.0).unwrap();
