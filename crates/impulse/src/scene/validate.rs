@@ -488,7 +488,7 @@ impl Checker {
             && !thin::is_flat(&ShapeDesc::Cuboid {
                 half_extents: *half_extents,
             })
-            && half_extents.iter().any(|&h| h == 0.0)
+            && half_extents.contains(&0.0)
         {
             self.fail(
                 &path.key("half_extents"),

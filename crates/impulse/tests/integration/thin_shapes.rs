@@ -83,12 +83,11 @@ fn a_flat_shape_has_the_mass_and_inertia_of_its_slab() {
             mass * (a * a + t * t) / 12.0,
         ];
         let inverse = body.local_inverse_inertia();
-        for k in 0..3 {
+        for (k, expected) in inertia.into_iter().enumerate() {
             let measured = 1.0 / inverse.col(k)[k];
             assert!(
-                (measured - inertia[k]).abs() < 1e-3 * inertia[k],
-                "{shape:?}: I[{k}] = {measured} kg·m², expected {}",
-                inertia[k]
+                (measured - expected).abs() < 1e-3 * expected,
+                "{shape:?}: I[{k}] = {measured} kg·m², expected {expected}"
             );
         }
         assert!(body.center_of_mass().length() < 1e-6);
