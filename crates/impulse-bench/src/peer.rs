@@ -297,6 +297,7 @@ pub(crate) fn shape_kind(shape: &ShapeDesc) -> &'static str {
         ShapeDesc::HeightField { .. } => "height field",
         ShapeDesc::Compound { .. } => "compound",
         ShapeDesc::Round { .. } => "rounded",
+        ShapeDesc::Thickened { .. } => "thickened",
     }
 }
 

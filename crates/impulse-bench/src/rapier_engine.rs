@@ -216,8 +216,11 @@ impl PeerWorld for RapierScene {
 
 /// The Rapier collider of a scene shape (the same Parry shape impulse builds: triangle meshes,
 /// height fields, compounds and rounded shapes through `impulse::scene::build_shape`, as
-/// Rapier 0.36 uses the same Parry).
+/// Rapier 0.36 uses the same Parry); a thin shape as its slab.
 fn collider_builder(kind: BodyKind, shape: &ShapeDesc) -> Result<ColliderBuilder> {
+    if let Some(slab) = shape.slab() {
+        return collider_builder(kind, &slab);
+    }
     Ok(match shape {
         ShapeDesc::Sphere { radius } => ColliderBuilder::ball(*radius),
         ShapeDesc::Cuboid { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
@@ -246,7 +249,8 @@ fn collider_builder(kind: BodyKind, shape: &ShapeDesc) -> Result<ColliderBuilder
         ShapeDesc::Trimesh { .. }
         | ShapeDesc::HeightField { .. }
         | ShapeDesc::Compound { .. }
-        | ShapeDesc::Round { .. } => {
+        | ShapeDesc::Round { .. }
+        | ShapeDesc::Thickened { .. } => {
             ColliderBuilder::new(impulse::scene::build_shape(kind, shape)?)
         }
     })

@@ -305,18 +305,22 @@ enum LcpCommand {
     },
 }
 
-/// A built-in name or a path to a JSON scene file.
+/// A built-in name or a path to a JSON scene file; its notes printed as `warning:` lines.
 fn resolve_scene(arg: &str) -> Result<Scene> {
     let path = Path::new(arg);
     if path.extension().is_some_and(|e| e == "json") || path.exists() {
         let scene = load_scene_file(path)?;
+        warn_of_notes(&scene);
         for note in impulse::scene::decomposition_notes(&scene) {
             eprintln!("warning: {note}");
         }
         return Ok(scene);
     }
     match builtin_scene(arg) {
-        Some(scene) => Ok(scene),
+        Some(scene) => {
+            warn_of_notes(&scene);
+            Ok(scene)
+        }
         None => {
             let names: Vec<&str> = builtin_names().iter().map(|(n, _)| *n).collect();
             bail!(
@@ -324,6 +328,19 @@ fn resolve_scene(arg: &str) -> Result<Scene> {
                 names.join(", ")
             )
         }
+    }
+}
+
+/// Prints the first notes on `scene` ([`impulse::scene::notes`]) as `warning:` lines on
+/// standard error, and how many more there are.
+fn warn_of_notes(scene: &Scene) {
+    const NAMED: usize = 5;
+    let notes = impulse::scene::notes(scene);
+    for note in notes.iter().take(NAMED) {
+        eprintln!("warning: {note}");
+    }
+    if notes.len() > NAMED {
+        eprintln!("warning: {} more notes on this scene", notes.len() - NAMED);
     }
 }
 

@@ -153,7 +153,9 @@ impl World {
     /// friction, impact model, world bound).
     ///
     /// Raises `SceneError` (message as `impulse run` prints it: file, line, body, field) for a
-    /// scene that cannot be read or built, `WorldError` for bad settings.
+    /// scene that cannot be read or built, `WorldError` for bad settings. Warns
+    /// (`UserWarning`) with each of the scene's notes, as `impulse run` prints them (a flat
+    /// shape without a `thickness` is given the default one).
     #[staticmethod]
     #[pyo3(signature = (scene, *, overrides = None, seed = 0, jitter = None, settings = None))]
     fn from_scene(
@@ -163,6 +165,7 @@ impl World {
         jitter: Option<&Bound<'_, PyAny>>,
         settings: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let scene_argument = scene;
         let (scene, directory) = crate::scene::resolve(scene)?;
         let mut scene = crate::scene::vary(scene, &directory, overrides, seed, jitter)?;
         if let Some(settings) = settings {
@@ -175,6 +178,13 @@ impl World {
                 other => SceneError::new_err(format!("cannot build the world: {other}")),
             })
         })?;
+        // The scene's notes (a flat shape given the default thickness) as warnings.
+        let py = scene_argument.py();
+        for note in impulse::scene::notes(&scene) {
+            let message = std::ffi::CString::new(note.to_string().replace('\0', " "))?;
+            let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+            PyErr::warn(py, category.as_any(), &message, 1)?;
+        }
         Ok(World::wrap(world))
     }
 

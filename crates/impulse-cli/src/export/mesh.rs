@@ -67,9 +67,13 @@ impl TriMesh {
 }
 
 /// The mesh of a shape. A half-space becomes a square of side `2 · ground_half_size` through the
-/// body origin, perpendicular to its normal. A convex hull whose points are degenerate (all in a
-/// plane) is an error.
+/// body origin, perpendicular to its normal. A thin shape (a flat cuboid or convex hull) is
+/// drawn as the slab it is simulated as ([`ShapeDesc::slab`]). A convex hull whose points are
+/// all on a line is an error.
 pub fn shape_mesh(shape: &ShapeDesc, ground_half_size: f32) -> Result<TriMesh> {
+    if let Some(slab) = shape.slab() {
+        return shape_mesh(&slab, ground_half_size);
+    }
     Ok(match shape {
         ShapeDesc::Sphere { radius } => round(*radius, 0.0),
         ShapeDesc::Capsule {
@@ -150,6 +154,8 @@ pub fn shape_mesh(shape: &ShapeDesc, ground_half_size: f32) -> Result<TriMesh> {
             }
             mesh
         }
+        // A thickness on a shape that is not flat (validation rejects it): the shape.
+        ShapeDesc::Thickened { shape: inner, .. } => shape_mesh(inner, ground_half_size)?,
         ShapeDesc::Round {
             shape: inner,
             border_radius,
@@ -458,6 +464,22 @@ mod tests {
                     ],
                 },
                 1.0 / 6.0,
+            ),
+            // Thin shapes: the slab of the default thickness, and of a given one.
+            (
+                ShapeDesc::Cuboid {
+                    half_extents: [0.5, 0.0, 1.0],
+                },
+                2.0 * impulse::scene::DEFAULT_THICKNESS,
+            ),
+            (
+                ShapeDesc::Thickened {
+                    shape: Box::new(ShapeDesc::ConvexHull {
+                        points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                    }),
+                    thickness: 0.1,
+                },
+                0.5 * 0.1,
             ),
         ];
         for (shape, expected) in cases {

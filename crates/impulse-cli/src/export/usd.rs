@@ -139,6 +139,9 @@ pub fn time_codes_per_second(dt: f32) -> f64 {
 /// The `geometry` child prim of a body of `shape`.
 fn geometry(out: &mut Usda, shape: &ShapeDesc, colour: [f32; 3], ground: f32) -> Result<()> {
     let colour_line = format!("color3f[] primvars:displayColor = [{}]", vector(&colour));
+    // A thin shape is drawn as the slab it is simulated as.
+    let slab = shape.slab();
+    let shape = slab.as_ref().unwrap_or(shape);
     match shape {
         ShapeDesc::Sphere { radius } => {
             out.def("Sphere", "geometry");
@@ -214,7 +217,8 @@ fn geometry(out: &mut Usda, shape: &ShapeDesc, colour: [f32; 3], ground: f32) ->
         ShapeDesc::Trimesh { .. }
         | ShapeDesc::HeightField { .. }
         | ShapeDesc::Compound { .. }
-        | ShapeDesc::Round { .. } => {
+        | ShapeDesc::Round { .. }
+        | ShapeDesc::Thickened { .. } => {
             // Triangle meshes as their triangles, height fields as their grid's triangles,
             // compounds as their parts, rounded shapes approximately (export::mesh).
             let mesh = super::mesh::shape_mesh(shape, ground)?;

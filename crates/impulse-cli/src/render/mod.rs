@@ -411,7 +411,9 @@ fn drawn_bodies(
     let mut bodies = Vec::with_capacity(scene.bodies.len());
     for (i, desc) in scene.bodies.iter().enumerate() {
         let pose = world.poses()[i];
-        let top = match (&desc.kind, &desc.shape) {
+        // A thin shape as the slab it is simulated as (a flat ground box's top is its slab's).
+        let slab = desc.shape.slab();
+        let top = match (&desc.kind, slab.as_ref().unwrap_or(&desc.shape)) {
             (BodyKind::Static, ShapeDesc::HalfSpace { normal }) => {
                 let up = pose.rotation * Vec3::from(*normal).normalize_or_zero();
                 (up.y > 0.999).then_some(pose.translation.y)

@@ -98,6 +98,10 @@ const NAMES: &[(&str, &str)] = &[
         "Solver2D: two-level house of 8 thin cards (A-frames + flat cards)",
     ),
     (
+        "card_house_thin",
+        "two-storey house of 8 playing cards given flat (thin shapes)",
+    ),
+    (
         "arch",
         "Solver2D: semicircular arch of 13 convex-hull voussoirs",
     ),
@@ -177,6 +181,7 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
         "mass_ratio_pyramid300" => return Some(mass_ratio_pyramid(name, 300)),
         "plate" => return Some(plate()),
         "card_house" => return Some(card_house()),
+        "card_house_thin" => return Some(super::builtin_thin::card_house_thin()),
         "arch" => return Some(arch()),
         "overlap_pyramid" => return Some(overlap_pyramid(name, 10)),
         "chain20" => return Some(super::builtin_joints::chain20()),

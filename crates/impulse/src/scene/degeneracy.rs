@@ -114,11 +114,40 @@ fn len(a: V) -> f64 {
 /// [`HULL_FLATNESS_TOLERANCE`]·L. If every point lies on that line (plane), they are all
 /// collinear (coplanar), so the test is exact up to the tolerance.
 pub(crate) fn hull_degeneracy(points: &[[f32; 3]]) -> Option<&'static str> {
+    match hull_span(points) {
+        HullSpan::Coincident => Some("convex hull points all coincide: they span no volume"),
+        HullSpan::Collinear => Some("convex hull points are collinear: they span no volume"),
+        HullSpan::Coplanar(_) => Some("convex hull points are coplanar: they span no volume"),
+        HullSpan::Volume => None,
+    }
+}
+
+/// The unit normal of the plane that finite `points` lie in, by the test of
+/// [`hull_degeneracy`], when they are coplanar but not collinear; `None` otherwise.
+pub(crate) fn hull_plane_normal(points: &[[f32; 3]]) -> Option<[f64; 3]> {
+    match hull_span(points) {
+        HullSpan::Coplanar(normal) => Some(normal),
+        _ => None,
+    }
+}
+
+/// What a point set spans, by the test of [`hull_degeneracy`].
+enum HullSpan {
+    Coincident,
+    Collinear,
+    /// Coplanar, with the plane's unit normal.
+    Coplanar([f64; 3]),
+    Volume,
+}
+
+fn hull_span(points: &[[f32; 3]]) -> HullSpan {
     let p: Vec<V> = points
         .iter()
         .map(|q| [f64::from(q[0]), f64::from(q[1]), f64::from(q[2])])
         .collect();
-    let p0 = *p.first()?;
+    let Some(&p0) = p.first() else {
+        return HullSpan::Coincident;
+    };
     let farthest = |f: &dyn Fn(V) -> f64| p.iter().map(|&q| f(q)).fold(0.0_f64, f64::max);
     let (mut extent, mut p1) = (0.0, p0);
     for &q in &p {
@@ -129,7 +158,7 @@ pub(crate) fn hull_degeneracy(points: &[[f32; 3]]) -> Option<&'static str> {
         }
     }
     if extent == 0.0 {
-        return Some("convex hull points all coincide: they span no volume");
+        return HullSpan::Coincident;
     }
     let tol = HULL_FLATNESS_TOLERANCE * extent;
     let axis = sub(p1, p0);
@@ -142,15 +171,15 @@ pub(crate) fn hull_degeneracy(points: &[[f32; 3]]) -> Option<&'static str> {
         }
     }
     if best <= tol {
-        return Some("convex hull points are collinear: they span no volume");
+        return HullSpan::Collinear;
     }
     let normal = cross(axis, sub(p2, p0));
     let normal_len = len(normal);
     let height = farthest(&|q| (dot(normal, sub(q, p0)) / normal_len).abs());
     if height <= tol {
-        return Some("convex hull points are coplanar: they span no volume");
+        return HullSpan::Coplanar(normal.map(|x| x / normal_len));
     }
-    None
+    HullSpan::Volume
 }
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 //! The JSON form of [`ShapeDesc`]: one object per shape with a `"type"`, where a rounded
-//! shape is its inner shape's object with a `"border_radius"` (`docs/scene-format.md`).
+//! shape is its inner shape's object with a `"border_radius"`, a thickened flat one its inner
+//! shape's object with a `"thickness"` (`docs/scene-format.md`).
 //! [`ShapeDesc`] is read and written through [`ShapeJson`], as serde's `from` and `into`
 //! container attributes would do it, written out here so that the description does not
 //! depend on its JSON form.
@@ -27,6 +28,8 @@ pub enum ShapeJson {
         half_extents: [f32; 3],
         #[serde(default, skip_serializing_if = "is_zero")]
         border_radius: f32,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        thickness: Option<f32>,
     },
     Capsule {
         half_height: f32,
@@ -48,6 +51,8 @@ pub enum ShapeJson {
         points: Vec<[f32; 3]>,
         #[serde(default, skip_serializing_if = "is_zero")]
         border_radius: f32,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        thickness: Option<f32>,
     },
     HalfSpace {
         normal: [f32; 3],
@@ -86,6 +91,17 @@ fn rounded(shape: ShapeDesc, border_radius: f32) -> ShapeDesc {
     }
 }
 
+/// `shape` given `thickness`, or `shape` itself when none is given.
+fn thickened(shape: ShapeDesc, thickness: Option<f32>) -> ShapeDesc {
+    match thickness {
+        Some(thickness) => ShapeDesc::Thickened {
+            shape: Box::new(shape),
+            thickness,
+        },
+        None => shape,
+    }
+}
+
 impl From<ShapeJson> for ShapeDesc {
     fn from(json: ShapeJson) -> Self {
         match json {
@@ -93,7 +109,11 @@ impl From<ShapeJson> for ShapeDesc {
             ShapeJson::Cuboid {
                 half_extents,
                 border_radius,
-            } => rounded(ShapeDesc::Cuboid { half_extents }, border_radius),
+                thickness,
+            } => rounded(
+                thickened(ShapeDesc::Cuboid { half_extents }, thickness),
+                border_radius,
+            ),
             ShapeJson::Capsule {
                 half_height,
                 radius,
@@ -126,7 +146,11 @@ impl From<ShapeJson> for ShapeDesc {
             ShapeJson::ConvexHull {
                 points,
                 border_radius,
-            } => rounded(ShapeDesc::ConvexHull { points }, border_radius),
+                thickness,
+            } => rounded(
+                thickened(ShapeDesc::ConvexHull { points }, thickness),
+                border_radius,
+            ),
             ShapeJson::HalfSpace { normal } => ShapeDesc::HalfSpace { normal },
             ShapeJson::Trimesh {
                 file,
@@ -150,14 +174,15 @@ impl From<ShapeJson> for ShapeDesc {
 
 impl From<ShapeDesc> for ShapeJson {
     /// Every shape the scene format can hold is written as it was read. A [`ShapeDesc::Round`]
-    /// of a shape that cannot carry a `border_radius` (validation rejects it) is written as
-    /// its inner shape.
+    /// of a shape that cannot carry a `border_radius`, or a [`ShapeDesc::Thickened`] one that
+    /// cannot carry a `thickness` (validation rejects both), is written as its inner shape.
     fn from(shape: ShapeDesc) -> Self {
         match shape {
             ShapeDesc::Sphere { radius } => ShapeJson::Sphere { radius },
             ShapeDesc::Cuboid { half_extents } => ShapeJson::Cuboid {
                 half_extents,
                 border_radius: 0.0,
+                thickness: None,
             },
             ShapeDesc::Capsule {
                 half_height,
@@ -185,6 +210,7 @@ impl From<ShapeDesc> for ShapeJson {
             ShapeDesc::ConvexHull { points } => ShapeJson::ConvexHull {
                 points,
                 border_radius: 0.0,
+                thickness: None,
             },
             ShapeDesc::HalfSpace { normal } => ShapeJson::HalfSpace { normal },
             ShapeDesc::Trimesh {
@@ -203,13 +229,39 @@ impl From<ShapeDesc> for ShapeJson {
             },
             ShapeDesc::HeightField { heights, scale } => ShapeJson::HeightField { heights, scale },
             ShapeDesc::Compound { parts } => ShapeJson::Compound { parts },
+            ShapeDesc::Thickened { shape, thickness } => match ShapeJson::from(*shape) {
+                ShapeJson::Cuboid {
+                    half_extents,
+                    border_radius,
+                    ..
+                } => ShapeJson::Cuboid {
+                    half_extents,
+                    border_radius,
+                    thickness: Some(thickness),
+                },
+                ShapeJson::ConvexHull {
+                    points,
+                    border_radius,
+                    ..
+                } => ShapeJson::ConvexHull {
+                    points,
+                    border_radius,
+                    thickness: Some(thickness),
+                },
+                other => other,
+            },
             ShapeDesc::Round {
                 shape,
                 border_radius: radius,
             } => match ShapeJson::from(*shape) {
-                ShapeJson::Cuboid { half_extents, .. } => ShapeJson::Cuboid {
+                ShapeJson::Cuboid {
+                    half_extents,
+                    thickness,
+                    ..
+                } => ShapeJson::Cuboid {
                     half_extents,
                     border_radius: radius,
+                    thickness,
                 },
                 ShapeJson::Cylinder {
                     half_height,
@@ -229,9 +281,12 @@ impl From<ShapeDesc> for ShapeJson {
                     radius: r,
                     border_radius: radius,
                 },
-                ShapeJson::ConvexHull { points, .. } => ShapeJson::ConvexHull {
+                ShapeJson::ConvexHull {
+                    points, thickness, ..
+                } => ShapeJson::ConvexHull {
                     points,
                     border_radius: radius,
+                    thickness,
                 },
                 other => other,
             },

@@ -76,7 +76,9 @@ pub enum ShapeDesc {
     },
     /// A box.
     Cuboid {
-        /// Half extents along the local x, y and z axes (m), each > 0.
+        /// Half extents along the local x, y and z axes (m), each ≥ 0. One of them 0 (at
+        /// most [`thin::FLATNESS_TOLERANCE`] of the largest) makes a flat box: a thin shape,
+        /// simulated as a slab of [`DEFAULT_THICKNESS`] ([`ShapeDesc::slab`]).
         half_extents: [f32; 3],
     },
     /// A capsule along the local y axis.
@@ -103,7 +105,9 @@ pub enum ShapeDesc {
     },
     /// The convex hull of points.
     ConvexHull {
-        /// At least 4 non-coplanar points (m, local frame).
+        /// At least 4 points spanning a volume (m, local frame), or at least 3 coplanar
+        /// points (not collinear): a flat polygon, a thin shape simulated as a slab of
+        /// [`DEFAULT_THICKNESS`] ([`ShapeDesc::slab`]).
         points: Vec<[f32; 3]>,
     },
     /// The half-space below the plane through the body origin; static bodies only.
@@ -153,8 +157,17 @@ pub enum ShapeDesc {
         /// or compound).
         parts: Vec<CompoundPart>,
     },
+    /// A flat cuboid or convex hull given a thickness (the JSON shape's `thickness`): the
+    /// slab [`ShapeDesc::slab`] makes of it, `thickness` thick, centred on its plane.
+    Thickened {
+        /// The flat shape: a cuboid with a zero half extent, or a convex hull of coplanar
+        /// points.
+        shape: Box<ShapeDesc>,
+        /// Full thickness of the slab (m) > 0, half on each side of the shape's plane.
+        thickness: f32,
+    },
     /// A shape with rounded edges: every point within `border_radius` of `shape` (Parry's
-    /// `RoundShape`). `shape` is a cuboid, cylinder, cone or convex hull.
+    /// `RoundShape`). `shape` is a cuboid, cylinder, cone or convex hull, flat or thickened.
     Round {
         /// The inner shape.
         shape: Box<ShapeDesc>,
@@ -235,7 +248,9 @@ impl ShapeDesc {
             ShapeDesc::Trimesh { .. } => "trimesh",
             ShapeDesc::HeightField { .. } => "heightfield",
             ShapeDesc::Compound { .. } => "compound",
-            ShapeDesc::Round { shape, .. } => shape.type_name(),
+            ShapeDesc::Round { shape, .. } | ShapeDesc::Thickened { shape, .. } => {
+                shape.type_name()
+            }
         }
     }
 }
@@ -439,13 +454,16 @@ impl BodyDesc {
 mod builtin;
 mod builtin_joints;
 mod decomposition;
+mod builtin_thin;
 mod degeneracy;
 mod error;
 pub(crate) mod joint_desc;
 pub(crate) mod json;
 mod json_shape;
 mod mesh_file;
+mod notes;
 mod shape;
+pub mod thin;
 pub(crate) mod validate;
 mod variation;
 
@@ -466,6 +484,8 @@ pub use json::{
 pub use mesh_file::{
     LoadedMesh, MeshData, MeshFileError, MeshFormat, load_mesh_file, read_mesh_bytes,
 };
+pub use notes::{SceneNote, notes};
+pub use thin::DEFAULT_THICKNESS;
 pub use validate::{
     body_builder, build_decomposed, build_shape, decomposition_notes, validate, validate_all,
 };

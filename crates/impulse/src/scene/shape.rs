@@ -11,7 +11,8 @@ use super::error::FieldPath;
 use super::mesh_file::MeshData;
 use crate::body::rules;
 
-/// The Parry shape of `shape`, which `validate::shape_problem` found valid.
+/// The Parry shape of `shape`, which `validate::shape_problem` found valid; a thin shape's is
+/// its slab's ([`ShapeDesc::slab`]).
 /// A triangle mesh whose file was not read with the scene is read here, relative to the
 /// current directory.
 ///
@@ -20,6 +21,9 @@ use crate::body::rules;
 /// file turns out degenerate, a hull Parry cannot build.
 pub(crate) fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String)> {
     use parry3d::shape::{HeightField, HeightFieldFlags, TriMeshFlags};
+    if let Some(slab) = shape.slab() {
+        return shape_of(&slab);
+    }
     let hull = |points: &[[f32; 3]], border_radius: f32| {
         let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
         let hull = if border_radius > 0.0 {
@@ -52,6 +56,12 @@ pub(crate) fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String
         } => SharedShape::cone(*half_height, *radius),
         ShapeDesc::ConvexHull { points } => hull(points, 0.0)?,
         ShapeDesc::HalfSpace { normal } => SharedShape::halfspace(Vec3::from(*normal).normalize()),
+        ShapeDesc::Thickened { .. } => {
+            return Err((
+                "shape.thickness".to_string(),
+                "thickness is for a flat cuboid or convex hull".to_string(),
+            ));
+        }
         ShapeDesc::Round {
             shape,
             border_radius: r,

@@ -13,9 +13,11 @@
 //! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`;
 //! - a body's `mass`, when given, is > 0; its `linear_damping` and `angular_damping` are ≥ 0;
 //! - shapes: sphere, capsule, cylinder and cone `radius > 0`, capsule `half_height ≥ 0`,
-//!   cylinder and cone `half_height > 0`, every cuboid half
-//!   extent > 0, a convex hull has ≥ 4 points that span a volume (not all coincident,
-//!   collinear or coplanar), a half-space normal is not zero and belongs to a static body;
+//!   cylinder and cone `half_height > 0`, every cuboid half extent ≥ 0 with at most one 0 (a
+//!   flat box), a convex hull has ≥ 4 points that span a volume or ≥ 3 coplanar ones (not all
+//!   coincident or collinear), a `thickness` is > 0 and only on a flat cuboid or convex hull
+//!   (flat shapes are thin shapes, `super::thin`), a half-space normal is not zero and belongs
+//!   to a static body;
 //! - a trimesh belongs to a static, dynamic or kinematic body (a moving body's is decomposed
 //!   into convex parts; only it may have `decomposition`, with `resolution` in [8, 512],
 //!   `concavity` in [0, 1] and `max_parts` ≥ 1) and has `file`, or `vertices` and `indices`,
@@ -46,6 +48,7 @@ use super::degeneracy::{MeshProblem, hull_degeneracy};
 use super::error::{BodyLocation, FieldPath, SceneError, SceneErrorKind};
 use super::mesh_file::MeshData;
 use super::shape::{decomposed_shape, shape_of};
+use super::thin;
 use super::{BodyDesc, BodyKind, KeyframeDesc, Material, MaterialRef, Scene, ShapeDesc};
 use crate::body::BodyBuilder;
 use crate::body::rules::{self, ShapeClass};
@@ -496,11 +499,7 @@ impl Checker {
     fn shape_fields(&mut self, path: &FieldPath, shape: &ShapeDesc) {
         match shape {
             ShapeDesc::Sphere { radius } => self.positive(&path.key("radius"), *radius),
-            ShapeDesc::Cuboid { half_extents } => {
-                for (i, &h) in half_extents.iter().enumerate() {
-                    self.positive(&path.key("half_extents").index(i), h);
-                }
-            }
+            ShapeDesc::Cuboid { half_extents } => self.cuboid(path, half_extents),
             ShapeDesc::Capsule {
                 half_height,
                 radius,
@@ -525,15 +524,18 @@ impl Checker {
                 for (i, p) in points.iter().enumerate() {
                     finite &= self.finite_array(&points_path.index(i), p);
                 }
-                if points.len() < 4 {
+                if points.len() < 3 {
                     self.fail(
                         &points_path,
                         format!(
-                            "a convex hull needs at least 4 points, got {}",
+                            "a convex hull needs at least 4 points (3 for a flat one), got {}",
                             points.len()
                         ),
                     );
-                } else if finite && let Some(problem) = hull_degeneracy(points) {
+                } else if finite
+                    && !thin::is_flat(shape)
+                    && let Some(problem) = hull_degeneracy(points)
+                {
                     self.fail(&points_path, problem.to_string());
                 }
             }
@@ -644,6 +646,7 @@ impl Checker {
                     }
                 }
             }
+            ShapeDesc::Thickened { shape, thickness } => self.thickened(path, shape, *thickness),
             ShapeDesc::Round {
                 shape,
                 border_radius,
@@ -655,6 +658,7 @@ impl Checker {
                         | ShapeDesc::Cylinder { .. }
                         | ShapeDesc::Cone { .. }
                         | ShapeDesc::ConvexHull { .. }
+                        | ShapeDesc::Thickened { .. }
                 ) {
                     self.shape_fields(path, shape);
                 } else {
@@ -668,6 +672,62 @@ impl Checker {
                     );
                 }
             }
+        }
+    }
+
+    /// A cuboid's half extents at `path`: each ≥ 0, at most one of them 0 (a flat box is a
+    /// thin shape; a line or a point is no shape).
+    fn cuboid(&mut self, path: &FieldPath, half_extents: &[f32; 3]) {
+        let before = self.errors.len();
+        for (i, &h) in half_extents.iter().enumerate() {
+            self.non_negative(&path.key("half_extents").index(i), h);
+        }
+        if self.errors.len() == before
+            && !thin::is_flat(&ShapeDesc::Cuboid {
+                half_extents: *half_extents,
+            })
+            && half_extents.contains(&0.0)
+        {
+            self.fail(
+                &path.key("half_extents"),
+                format!(
+                    "a cuboid needs at least two half extents > 0 (one 0 makes a flat box),                      got {half_extents:?}"
+                ),
+            );
+        }
+    }
+
+    /// A flat `shape` given `thickness` at `path`: a cuboid or convex hull, valid and flat,
+    /// and a thickness > 0.
+    fn thickened(&mut self, path: &FieldPath, shape: &ShapeDesc, thickness: f32) {
+        let thickness_path = path.key("thickness");
+        self.positive(&thickness_path, thickness);
+        if !matches!(
+            shape,
+            ShapeDesc::Cuboid { .. } | ShapeDesc::ConvexHull { .. }
+        ) {
+            self.fail(
+                &thickness_path,
+                format!(
+                    "thickness is allowed on a cuboid or convex_hull, not on a {}",
+                    shape.type_name()
+                ),
+            );
+            return;
+        }
+        let before = self.errors.len();
+        self.shape_fields(path, shape);
+        if self.errors.len() == before && !thin::is_flat(shape) {
+            let what = match shape {
+                ShapeDesc::Cuboid { .. } => "this cuboid has no zero half extent",
+                _ => "these convex hull points span a volume",
+            };
+            self.fail(
+                &thickness_path,
+                format!(
+                    "thickness is for a flat shape (a cuboid with a zero half extent, or                      coplanar convex hull points); {what}"
+                ),
+            );
         }
     }
 
@@ -722,7 +782,7 @@ mod tests {
         scene.bodies.push(BodyDesc::new(
             BodyKind::Particle,
             ShapeDesc::Cuboid {
-                half_extents: [1.0, 0.0, 1.0],
+                half_extents: [1.0, -1.0, 1.0],
             },
             [0.0; 3],
         ));
@@ -736,7 +796,7 @@ mod tests {
                 "dt: must be > 0, got -1",
                 "solver.iterations: must be ≥ 1, got 0",
                 "bodies[0].shape.type: a particle must have a sphere shape, got cuboid",
-                "bodies[0].shape.half_extents[1]: must be > 0, got 0",
+                "bodies[0].shape.half_extents[1]: must be ≥ 0, got -1",
             ]
         );
     }

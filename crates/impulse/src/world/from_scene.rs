@@ -39,7 +39,19 @@ pub(crate) fn builder_of(
     material: &Material,
 ) -> Result<BodyBuilder, WorldError> {
     let mut unit_mass_properties = None;
+    let built = || {
+        crate::scene::build_shape(desc.kind, &desc.shape).map_err(|e| {
+            let field = e.field.map(|f| f.to_string()).unwrap_or_default();
+            invalid(index, desc, &field, e.message)
+        })
+    };
     let shape = match &desc.shape {
+        // A thin shape is built as its slab.
+        flat @ (ShapeDesc::Cuboid { .. } | ShapeDesc::ConvexHull { .. })
+            if flat.slab().is_some() =>
+        {
+            built()?
+        }
         ShapeDesc::Sphere { radius } => {
             positive(index, desc, "shape.radius", *radius)?;
             SharedShape::ball(*radius)
@@ -124,12 +136,8 @@ pub(crate) fn builder_of(
         ShapeDesc::Trimesh { .. }
         | ShapeDesc::HeightField { .. }
         | ShapeDesc::Compound { .. }
-        | ShapeDesc::Round { .. } => {
-            crate::scene::build_shape(desc.kind, &desc.shape).map_err(|e| {
-                let field = e.field.map(|f| f.to_string()).unwrap_or_default();
-                invalid(index, desc, &field, e.message)
-            })?
-        }
+        | ShapeDesc::Round { .. }
+        | ShapeDesc::Thickened { .. } => built()?,
         ShapeDesc::HalfSpace { normal } => {
             let n = Vec3::from(*normal);
             if desc.kind != BodyKind::Static {

@@ -164,6 +164,7 @@ fn grounds() -> Vec<(&'static str, BodyDesc)> {
         vertices: Some(vertices2),
         indices: Some(indices2),
         two_sided: true,
+        decomposition: None,
         loaded: None,
     };
     let (vertices800, indices800) = grid(20);

@@ -43,4 +43,5 @@ mod soak;
 mod solver2d_scenes;
 mod speculative;
 mod standard_scenes;
+mod thin_shapes;
 mod variation;

@@ -226,22 +226,23 @@ fn negative_radius() {
     );
 }
 
+/// One zero half extent is a flat box (a thin shape); two make a line.
 #[test]
-fn zero_half_extent() {
+fn two_zero_half_extents() {
     let text = Bad {
-        shape: r#"{"type": "cuboid", "half_extents": [0.5, 0, 0.5]}"#,
+        shape: r#"{"type": "cuboid", "half_extents": [0.5, 0, 0]}"#,
         ..Bad::default()
     }
     .text();
     check(
-        "zero-half-extent",
+        "zero-half-extents",
         &text,
         SceneErrorKind::Invalid,
         11,
-        57,
+        51,
         LID,
-        "bodies[2].shape.half_extents[1]",
-        "must be > 0, got 0",
+        "bodies[2].shape.half_extents",
+        "a cuboid needs at least two half extents > 0",
     );
 }
 
@@ -501,10 +502,11 @@ fn particle_with_a_cuboid() {
     );
 }
 
+/// Three points make a flat hull (a thin shape); two make none.
 #[test]
-fn convex_hull_with_three_points() {
+fn convex_hull_with_two_points() {
     let text = Bad {
-        shape: r#"{"type": "convex_hull", "points": [[0, 0, 0], [1, 0, 0], [0, 1, 0]]}"#,
+        shape: r#"{"type": "convex_hull", "points": [[0, 0, 0], [1, 0, 0]]}"#,
         ..Bad::default()
     }
     .text();
@@ -516,26 +518,27 @@ fn convex_hull_with_three_points() {
         50,
         LID,
         "bodies[2].shape.points",
-        "at least 4 points, got 3",
+        "at least 4 points (3 for a flat one), got 2",
     );
 }
 
+/// Coplanar points make a flat hull (a thin shape); collinear ones make none.
 #[test]
-fn coplanar_convex_hull() {
+fn collinear_convex_hull() {
     let text = Bad {
-        shape: r#"{"type": "convex_hull", "points": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [0.5, 0.5, 0]]}"#,
+        shape: r#"{"type": "convex_hull", "points": [[0, 0, 0], [1, 1, 1], [2, 2, 2], [3, 3, 3]]}"#,
         ..Bad::default()
     }
     .text();
     check(
-        "hull-coplanar",
+        "hull-collinear",
         &text,
         SceneErrorKind::Invalid,
         11,
         50,
         LID,
         "bodies[2].shape.points",
-        "coplanar",
+        "collinear",
     );
 }
 

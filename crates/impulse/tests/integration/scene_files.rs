@@ -26,6 +26,7 @@ const FILE_SCENES: &[&str] = &[
     "mass_ratio_pyramid300",
     "plate",
     "card_house",
+    "card_house_thin",
     "chain20",
     "chain20heavy",
     "ragdoll",
