@@ -6,6 +6,7 @@
 mod chains;
 mod devices;
 mod exact;
+mod limits;
 mod pendulum;
 
 use impulse::glam::Vec3;
