@@ -96,7 +96,10 @@ pub use scene::{
 };
 pub use scene::{Jitter, Override, Variation};
 pub use settings::{ContactRepair, ImpactModel, SettingError, SolverMethod, SolverSettings};
-pub use solver::{EscalationLevel, HEAVY_ON_LIGHT_CONTACTS_FACTOR, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, IslandReport};
+pub use solver::{
+    EscalationLevel, HEAVY_ON_LIGHT_CONTACTS_FACTOR, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight,
+    IslandReport,
+};
 pub use world::LeftWorld;
 pub use world::{
     BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BLOW_UP_SPEED, BodyRef, ContactEvent, ContactPairView,

@@ -595,6 +595,16 @@ impl IslandWorkspace {
                 warm_start_follows: substep + 1 < settings.substeps,
             };
             self.targets_and_solve(constraints, bodies, settings, h, bundled, relax, half_turn);
+        } else if settings.split_impulse() && !self.joints.is_empty() {
+            let mut velocities = Velocities {
+                linear: &mut self.linear,
+                angular: &mut self.angular,
+            };
+            let (sweeps, pose) = (
+                settings.iterations.max(IMPACT_SWEEPS),
+                (&self.displacement[..], &self.orientation[..]),
+            );
+            (self.joints).relax(&mut velocities, pose, sweeps, settings.tolerance);
         }
     }
 

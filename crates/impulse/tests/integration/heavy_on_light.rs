@@ -363,8 +363,11 @@ fn slab_on_grid(settings: SolverSettings) -> (World, usize, f32) {
     (world, slab, 0.6)
 }
 
-/// The slab on the grid holds within the default's bar after 3 s at the default and at
-/// `reference`, and every step's island takes the exact path and is held.
+/// The slab on the grid holds within the default's bar at the default and at `reference`, and
+/// every step's island takes the exact path and is held. At the former limit of 32 points the
+/// default let it sink 9.6 mm within 10 s and `reference` 0.5 m (the boxes squeezed out
+/// sideways); 45 steps keep the test short (an exact solve of 72 points a step, or a substep
+/// at `reference`).
 #[test]
 fn a_heavy_slab_on_a_grid_of_light_boxes_holds() {
     for (name, settings) in [
@@ -375,7 +378,7 @@ fn a_heavy_slab_on_a_grid_of_light_boxes_holds() {
             sleep: false,
             ..settings
         });
-        for _ in 0..180 {
+        for _ in 0..45 {
             world.step().unwrap();
             for island in &world.diagnostics().islands {
                 let found = island.heavy_on_light.expect("a heavy-on-light island");
@@ -396,6 +399,10 @@ fn a_heavy_slab_on_a_grid_of_light_boxes_holds() {
             drift * 1e3
         );
         assert!(sink.abs() <= SINK_BAR, "{name}: sink {:.2} mm", sink * 1e3);
-        assert!(drift <= SINK_BAR, "{name}: a box moved {:.2} mm", drift * 1e3);
+        assert!(
+            drift <= SINK_BAR,
+            "{name}: a box moved {:.2} mm",
+            drift * 1e3
+        );
     }
 }
