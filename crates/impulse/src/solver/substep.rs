@@ -595,7 +595,11 @@ impl IslandWorkspace {
                 warm_start_follows: substep + 1 < settings.substeps,
             };
             self.targets_and_solve(constraints, bodies, settings, h, bundled, relax, half_turn);
-        } else if settings.split_impulse() && !self.joints.is_empty() {
+        } else if settings.split_impulse()
+            && !self.joints.is_empty()
+            // An exact solve's impulses are the exported LCP's solution; it keeps them.
+            && self.report.method < super::interface::EscalationLevel::Exact
+        {
             let mut velocities = Velocities {
                 linear: &mut self.linear,
                 angular: &mut self.angular,
@@ -604,7 +608,8 @@ impl IslandWorkspace {
                 settings.iterations.max(IMPACT_SWEEPS),
                 (&self.displacement[..], &self.orientation[..]),
             );
-            (self.joints).relax(&mut velocities, pose, sweeps, settings.tolerance);
+            self.joints
+                .relax(&mut velocities, pose, sweeps, settings.tolerance);
         }
     }
 
