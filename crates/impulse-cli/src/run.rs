@@ -727,8 +727,9 @@ fn warn_of_heavy_on_light(
     } else {
         format!(
             "its island has {} contact points, more than the exact path takes \
-             (solver.exact_max_contacts)",
-            island.contacts
+             ({} × solver.exact_max_contacts)",
+            island.contacts,
+            impulse::HEAVY_ON_LIGHT_CONTACTS_FACTOR
         )
     };
     eprintln!(

@@ -100,7 +100,10 @@ pub use settings::{
     CombineRule, ContactRepair, DEFAULT_MAX_ANGULAR_SPEED, DEFAULT_MAX_LINEAR_SPEED, ImpactModel,
     SettingError, SolverMethod, SolverSettings,
 };
-pub use solver::{EscalationLevel, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight, IslandReport};
+pub use solver::{
+    EscalationLevel, HEAVY_ON_LIGHT_CONTACTS_FACTOR, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight,
+    IslandReport,
+};
 pub use world::LeftWorld;
 pub use world::{
     BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BodyRef, ContactEvent, ContactPairView, ContactPoint,

@@ -207,7 +207,7 @@ pub struct SolverSettings {
     pub exact_max_contacts: u32,
     /// Methods other than `auto`: an island in which some contact joins two moving bodies
     /// whose masses differ by more than this factor (heavy on light), and which has at most
-    /// `exact_max_contacts` points, is stepped as one LCP per step on rigid rows (velocity bias
+    /// [`crate::HEAVY_ON_LIGHT_CONTACTS_FACTOR`] × `exact_max_contacts` points, is stepped as one LCP per step on rigid rows (velocity bias
     /// at 12/s, relax solve after), solved exactly (Lemke, [`SolverMethod::Auto`]'s exact path),
     /// instead of in substeps. The soft step cannot hold such an island: a soft row's spring is
     /// as stiff as its effective mass, which is the light body's, so under a load R times the

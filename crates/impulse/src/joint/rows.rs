@@ -444,6 +444,19 @@ impl JointConstraint {
         }
     }
 
+    /// Whether a limit of the joint pushes: an active limit row holding a positive impulse (the
+    /// limit reached, or about to be within the substep). Such a row is coupled to the joint's
+    /// locked rows whenever the body's centre of mass is off the joint's axis.
+    pub(crate) fn limit_engaged(&self) -> bool {
+        self.broke.is_none()
+            && self.active_rows[..self.active_count as usize]
+                .iter()
+                .any(|&(i, kind)| {
+                    let kind = kind as usize;
+                    (kind == LOWER || kind == UPPER) && self.impulses[i as usize][kind] > 0.0
+                })
+    }
+
     /// Applies the current impulses to the velocities at the island's current poses (the warm
     /// start of a substep), and from the second substep on adds them to the step totals.
     pub(crate) fn warm_start(

@@ -17,9 +17,10 @@ pub struct HeavyOnLight {
     pub light_body: u32,
     /// Their mass ratio, heavier over lighter (> 1).
     pub mass_ratio: f32,
-    /// Whether the island took the heavy-on-light path: one exact LCP per step on rigid rows
-    /// (it has at most [`SolverSettings::exact_max_contacts`] points). If not, it took the
-    /// ordinary path.
+    /// Whether the island took the exact path: with the soft step or bias repair, the
+    /// heavy-on-light path, one exact LCP per step on rigid rows; with split impulse
+    /// (`reference`), the automatic policy's exact path in every substep. It has at most
+    /// [`heavy_on_light_max_contacts`] points. If not, it took the ordinary path.
     pub exact: bool,
     /// Whether the island looks held: its deepest overlap at the step's start is at most
     /// [`HEAVY_ON_LIGHT_HELD_OVERLAP`]. An island not held is sinking through, or has sunk.
@@ -36,6 +37,21 @@ pub const HEAVY_ON_LIGHT_HELD_OVERLAP: f32 = 0.01;
 /// the relax solve, on rigid rows.
 const HEAVY_ON_LIGHT_REPAIR_RATE: f32 = 12.0;
 
+/// A heavy-on-light island may take the exact path with up to this many times
+/// [`SolverSettings::exact_max_contacts`] contact points (128 at the default). A heavy body on
+/// light ones is held by no iterative budget (docs/method.md, "Heavy on light"), so an exact
+/// solve of a larger island, a few milliseconds a step, is the price of holding it at all: a
+/// 10,000 kg slab on a 3 × 3 grid of 1 kg boxes (72 points) sank through them at 32.
+pub const HEAVY_ON_LIGHT_CONTACTS_FACTOR: u32 = 4;
+
+/// Most contact points of a heavy-on-light island that takes the exact path under `settings`
+/// ([`HEAVY_ON_LIGHT_CONTACTS_FACTOR`] times `exact_max_contacts`; 0 = never).
+pub(crate) fn heavy_on_light_max_contacts(settings: &SolverSettings) -> u32 {
+    settings
+        .exact_max_contacts
+        .saturating_mul(HEAVY_ON_LIGHT_CONTACTS_FACTOR)
+}
+
 /// The settings of the heavy-on-light path ([`SolverSettings::heavy_on_light_mass_ratio`]):
 /// the basic method's one LCP per step (one substep), on rigid rows with a velocity bias
 /// ([`HEAVY_ON_LIGHT_REPAIR_RATE`]) and a relax solve, solved by the automatic policy with every
@@ -47,6 +63,7 @@ pub(crate) fn heavy_on_light_settings(settings: &SolverSettings) -> SolverSettin
         substeps: 1,
         relax_iterations: settings.relax_iterations.max(1),
         mass_ratio_threshold: 0.0,
+        exact_max_contacts: heavy_on_light_max_contacts(settings),
         repair: ContactRepair::Bias {
             rate: HEAVY_ON_LIGHT_REPAIR_RATE,
         },

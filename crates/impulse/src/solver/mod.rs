@@ -48,7 +48,9 @@ pub(crate) mod restitution_solve;
 pub(crate) mod rows;
 pub(crate) mod substep;
 
-pub use heavy_on_light::{HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight};
+pub use heavy_on_light::{
+    HEAVY_ON_LIGHT_CONTACTS_FACTOR, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight,
+};
 pub use interface::*;
 pub use island_report::IslandReport;
 /// The row operations under the solver's path, for the tests and the `internals` feature.

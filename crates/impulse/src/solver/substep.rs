@@ -10,7 +10,9 @@
 use glam::{Mat3, Vec3};
 use parry3d::math::Pose;
 
-use super::heavy_on_light::{HeavyOnLight, heavy_on_light, heavy_on_light_settings, mass_ratio};
+use super::heavy_on_light::{
+    HeavyOnLight, heavy_on_light, heavy_on_light_max_contacts, heavy_on_light_settings, mass_ratio,
+};
 use super::interface::Sweep;
 use super::interface::{ContactSolver, SolveOutcome, SolvePass, TargetInputs};
 use super::island_report::IslandReport;
@@ -389,22 +391,22 @@ impl IslandWorkspace {
         let threshold = settings.heavy_on_light_mass_ratio;
         // Joints keep the soft step: the path's one rigid LCP a step is solved exactly, which
         // an island with joints (a mixed LCP) cannot be yet.
-        if !(threshold > 0.0
-            && self.report.mass_ratio > threshold
-            && !settings.split_impulse()
-            && self.joints.is_empty())
-        {
+        if !(threshold > 0.0 && self.report.mass_ratio > threshold && self.joints.is_empty()) {
             return None;
         }
+        let small = constraints.len() <= heavy_on_light_max_contacts(settings) as usize;
+        // Split impulse (`reference`) keeps its substeps; with `auto` a small heavy island
+        // takes the exact path in each of them (`start_solves` widens its limit), so the
+        // island is reported either way.
+        let split = settings.split_impulse();
+        let exact = small && (!split || settings.method == SolverMethod::Auto);
         self.report.heavy_on_light =
-            heavy_on_light(island_bodies, constraints, context.bodies, threshold).map(
-                |mut heavy| {
-                    heavy.exact = constraints.len() <= settings.exact_max_contacts as usize;
-                    heavy
-                },
-            );
+            heavy_on_light(island_bodies, constraints, context.bodies, threshold)
+                .map(|heavy| HeavyOnLight { exact, ..heavy });
         match self.report.heavy_on_light {
-            Some(HeavyOnLight { exact: true, .. }) => Some(heavy_on_light_settings(settings)),
+            Some(HeavyOnLight { exact: true, .. }) if !split => {
+                Some(heavy_on_light_settings(settings))
+            }
             _ => None,
         }
     }
@@ -431,6 +433,11 @@ impl IslandWorkspace {
         self.report.substeps = settings.substeps;
         self.solvers.auto.limits =
             EscalationLimits::new(settings, self.report.mass_ratio, gravity.length() * dt);
+        if self.report.heavy_on_light.is_some_and(|h| h.exact) {
+            // A heavy-on-light island that keeps its substeps (split impulse) may take the
+            // exact path up to the heavy-on-light path's size.
+            self.solvers.auto.limits.exact_max_contacts = heavy_on_light_max_contacts(settings);
+        }
         self.impact_speed = (gravity.length() * dt).max(settings.restitution_threshold);
         // A joint's rows carry no closing speed to test (a limit reached at speed, a limb its
         // joints whip into another body), so an island with joints takes the last-sweep test
@@ -588,6 +595,21 @@ impl IslandWorkspace {
                 warm_start_follows: substep + 1 < settings.substeps,
             };
             self.targets_and_solve(constraints, bodies, settings, h, bundled, relax, half_turn);
+        } else if settings.split_impulse()
+            && !self.joints.is_empty()
+            // An exact solve's impulses are the exported LCP's solution; it keeps them.
+            && self.report.method < super::interface::EscalationLevel::Exact
+        {
+            let mut velocities = Velocities {
+                linear: &mut self.linear,
+                angular: &mut self.angular,
+            };
+            let (sweeps, pose) = (
+                settings.iterations.max(IMPACT_SWEEPS),
+                (&self.displacement[..], &self.orientation[..]),
+            );
+            self.joints
+                .relax(&mut velocities, pose, sweeps, settings.tolerance);
         }
     }
 
