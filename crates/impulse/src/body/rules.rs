@@ -3,8 +3,8 @@
 //! [`super::BodyBuilder`] (and reports the body and field). Each rule gives the message for
 //! the one field it checks, so both paths say the same thing in the same words.
 
-use parry3d::shape::{Shape, SharedShape, TypedShape};
 use parry3d::mass_properties::MassProperties;
+use parry3d::shape::{Shape, SharedShape, TypedShape};
 
 use super::BodyKind;
 

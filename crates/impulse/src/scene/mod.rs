@@ -453,8 +453,8 @@ impl BodyDesc {
 
 mod builtin;
 mod builtin_joints;
-mod decomposition;
 mod builtin_thin;
+mod decomposition;
 mod degeneracy;
 mod error;
 pub(crate) mod joint_desc;

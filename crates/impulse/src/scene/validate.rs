@@ -375,13 +375,12 @@ impl Checker {
         };
         if b.kind.is_dynamic()
             && let Ok(shape) = shape_of(&b.shape)
-            && let Err((field, message)) =
-                rules::derived_mass(
-                    &shape.mass_properties(1.0),
-                    density,
-                    b.mass,
-                    b.kind == BodyKind::Particle,
-                )
+            && let Err((field, message)) = rules::derived_mass(
+                &shape.mass_properties(1.0),
+                density,
+                b.mass,
+                b.kind == BodyKind::Particle,
+            )
         {
             let at = if field == "material.density" {
                 density_path
