@@ -792,7 +792,7 @@ mod tests {
         assert_eq!(
             errors,
             [
-                "dt: must be > 0, got -1",
+                "dt: must be finite and within [1e-6, 1] s, got -1",
                 "solver.iterations: must be ≥ 1, got 0",
                 "bodies[0].shape.type: a particle must have a sphere shape, got cuboid",
                 "bodies[0].shape.half_extents[1]: must be ≥ 0, got -1",
