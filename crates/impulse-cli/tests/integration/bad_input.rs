@@ -17,7 +17,7 @@ fn a_negative_time_step_is_refused_as_a_time_step() {
     let (ok, err) = stderr_of(&["run", "stack3", "--steps", "1", "--quiet", "--dt", "-0.01"]);
     assert!(!ok);
     assert!(
-        err.contains("dt") && err.contains("> 0") && err.contains("-0.01"),
+        err.contains("dt") && err.contains("within [1e-6, 1] s") && err.contains("-0.01"),
         "{err}"
     );
 }

@@ -266,12 +266,12 @@ fn usda_has_an_xform_per_body_with_the_trajectory_as_time_samples() {
 
 #[test]
 fn a_blow_up_still_exports_the_frames_written() {
-    // As in cli.rs: the body's speed passes the blow-up bound during step 101, so frames
-    // 0..=100 are written.
+    // As in cli.rs: the body's speed passes the scene's bound `solver.max_linear_speed` =
+    // 10⁴ m/s during step 101, so frames 0..=100 are written.
     let scene = temp("runaway.json");
     std::fs::write(
         &scene,
-        r#"{"gravity": [5970, 0, 0], "bodies": [
+        r#"{"gravity": [5970, 0, 0], "solver": {"max_linear_speed": 10000, "max_distance": 1e9}, "bodies": [
   {"name": "runaway", "kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5},
    "position": [0, 0, 0]}
 ]}"#,

@@ -115,7 +115,7 @@ fn a_bad_override_exits_non_zero_naming_the_option_and_the_field() {
         (
             vec!["--set", "bodies[3].shape.half_extents[1]=-1"],
             "--set bodies[3].shape.half_extents[1]=-1: bodies[3].shape.half_extents[1]: \
-             must be > 0",
+             must be ≥ 0",
         ),
         (
             vec!["--set", "solver.substep=12"],
