@@ -27,13 +27,13 @@ use crate::settings::SolverSettings;
 /// edit that wakes a body, [`crate::World::wake_up`]) restarts the reference.
 pub const BLOW_UP_ENERGY_PER_KG: f64 = 50.0;
 
-/// The share of the bodies' kinetic energy a step may add on top of
-/// [`BLOW_UP_ENERGY_PER_KG`] before it is a blow-up. The state is f32 (seven significant
-/// digits) and a fast body's contacts are solved to a tolerance, not exactly: a capsule hitting
-/// the ground at 766 m/s while spinning at 16,205 rad/s (about 10⁵ J/kg of kinetic energy)
-/// rises by 60 J/kg over its impact's steps, a ten-thousandth of its energy. A blow-up
-/// multiplies the energy; a pile pushed apart from rest starts with almost none, so this
-/// share leaves its bound where it was.
+/// The share of the largest kinetic energy the bodies have had since the last edit that a step
+/// may add on top of [`BLOW_UP_ENERGY_PER_KG`] before it is a blow-up. The state is f32 (seven
+/// significant digits) and a fast body's contacts are solved to a tolerance, not exactly: a
+/// capsule hitting the ground at 766 m/s while spinning at 16,205 rad/s (about 3·10⁵ J/kg of
+/// kinetic energy) rises by 60 J/kg in the steps after its impact, a five-thousandth of the
+/// energy it came with. A blow-up multiplies the energy; a pile pushed apart from rest has had
+/// almost none, so this share leaves its bound where it was.
 pub(crate) const BLOW_UP_KINETIC_SHARE: f64 = 1.0e-3;
 
 /// The energy check's state: the lowest mechanical energy since the last edit (J), and
@@ -46,6 +46,10 @@ pub(crate) struct EnergyCheck {
     pub(crate) started: bool,
     /// What f32 rounding may have added since the reference restarted (J/kg).
     rounding: f64,
+    /// The largest kinetic energy per kilogram of moving mass since the reference restarted
+    /// (J/kg), for [`BLOW_UP_KINETIC_SHARE`].
+    #[serde(default)]
+    peak_kinetic: f64,
 }
 
 impl EnergyCheck {
@@ -53,12 +57,13 @@ impl EnergyCheck {
     /// ([`crate::World::wake_up`] clears `started`) or when the body count changed.
     pub(super) fn start(&mut self, bodies: &Bodies, gravity: Vec3) {
         if !self.started || self.bodies != bodies.len() {
-            let start_energy = diagnostics::energy_terms(bodies, gravity).mechanical();
+            let terms = diagnostics::energy_terms(bodies, gravity);
             *self = EnergyCheck {
-                lowest: start_energy,
+                lowest: terms.mechanical(),
                 bodies: bodies.len(),
                 started: true,
                 rounding: 0.0,
+                peak_kinetic: terms.kinetic / terms.mass.max(f64::MIN_POSITIVE),
             };
         }
     }
@@ -135,8 +140,12 @@ impl EnergyCheck {
         self.rounding += f64::from(settings.substeps)
             * (f64::from(gravity.length()) * ulp(terms.largest_distance)
                 + f64::from(terms.largest_speed) * ulp(terms.largest_speed));
-        let kinetic_per_kg = terms.kinetic / terms.mass.max(f64::MIN_POSITIVE);
-        let bound = BLOW_UP_ENERGY_PER_KG + BLOW_UP_KINETIC_SHARE * kinetic_per_kg + self.rounding;
+        let bound =
+            BLOW_UP_ENERGY_PER_KG + BLOW_UP_KINETIC_SHARE * self.peak_kinetic + self.rounding;
+        let kinetic = terms.kinetic / terms.mass.max(f64::MIN_POSITIVE);
+        if kinetic.is_finite() {
+            self.peak_kinetic = self.peak_kinetic.max(kinetic);
+        }
         if gain.is_nan() || gain > bound {
             let speed = |k: usize| bodies.linear_velocity[k].length();
             let fastest = (0..bodies.len())
