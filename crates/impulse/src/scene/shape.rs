@@ -32,6 +32,7 @@ pub(crate) fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String
             SharedShape::convex_hull(&points)
         };
         hull.filter(|h| h.mass_properties(1.0).mass() > 1e-9)
+            .or_else(|| thin_hull(&points, border_radius))
             .ok_or_else(|| {
                 (
                     "shape.points".to_string(),
@@ -201,4 +202,49 @@ fn loaded_mesh_problem(loaded: &ShapeDesc, mesh: &MeshData) -> Option<(String, S
     rules::shape_extent(&built)
         .err()
         .map(|message| (field.to_string(), message))
+}
+
+/// The convex hull of `points` that span a slab far thinner than it is wide (a 20 m plane
+/// 2 mm thick, [`ShapeDesc::slab`]), which Parry's hull, whose tolerance is relative to the
+/// points' extent, reads as flat. An invertible linear map keeps a hull's faces, so the hull is
+/// found with the points stretched across the slab until it is as thick as it is wide, and its
+/// vertices are mapped back. `None` for points that span no plane.
+fn thin_hull(points: &[Vec3], border_radius: f32) -> Option<SharedShape> {
+    let first = *points.first()?;
+    let farthest = |from: &dyn Fn(Vec3) -> f32| {
+        points
+            .iter()
+            .copied()
+            .max_by(|a, b| from(*a).total_cmp(&from(*b)))
+    };
+    let second = farthest(&|p| p.distance_squared(first))?;
+    let axis = (second - first).normalize_or_zero();
+    let third = farthest(&|p| (p - first).reject_from_normalized(axis).length_squared())?;
+    let normal = axis.cross(third - first).normalize_or_zero();
+    if normal == Vec3::ZERO {
+        return None;
+    }
+    let heights = points.iter().map(|p| (*p - first).dot(normal));
+    let (low, high) = heights.fold((f32::MAX, f32::MIN), |(l, h), x| (l.min(x), h.max(x)));
+    let thickness = high - low;
+    let width = second.distance(first);
+    if !(thickness > 0.0 && width > 0.0) {
+        return None;
+    }
+    let stretch = width / thickness;
+    let stretched: Vec<Vec3> = points
+        .iter()
+        .map(|p| *p + normal * ((stretch - 1.0) * (*p - first).dot(normal)))
+        .collect();
+    let (vertices, indices) = parry3d::transformation::convex_hull(&stretched);
+    let vertices: Vec<Vec3> = vertices
+        .iter()
+        .map(|q| *q + normal * ((1.0 / stretch - 1.0) * (*q - first).dot(normal)))
+        .collect();
+    let hull = if border_radius > 0.0 {
+        SharedShape::round_convex_mesh(vertices, &indices, border_radius)
+    } else {
+        SharedShape::convex_mesh(vertices, &indices)
+    };
+    hull.filter(|h| h.mass_properties(1.0).mass() > 0.0)
 }

@@ -334,3 +334,32 @@ fn the_thin_card_house_holds_for_ten_seconds() {
         "a card moved by {largest_drift} m in 10 s"
     );
 }
+
+/// Blender's tutorial plane: a 20 m square given as its four coplanar corners (the default
+/// Convex Hull shape of a plane), 2 mm thick by default, far thinner than wide. A cube dropped
+/// on it from 3 m comes to rest on its top face, 1 mm above the plane, at every thickness.
+#[test]
+fn a_cube_rests_on_a_wide_thin_plane() {
+    for thickness in ["", r#", "thickness": 0.0001"#, r#", "thickness": 0.08"#] {
+        let text = format!(
+            r#"{{"bodies": [
+            {{"kind": "static", "shape": {{"type": "convex_hull", "points":
+              [[-10, 0, 10], [10, 0, 10], [-10, 0, -10], [10, 0, -10]]{thickness}}}}},
+            {{"kind": "dynamic", "shape": {{"type": "cuboid", "half_extents": [1, 1, 1]}},
+              "position": [0, 4, 0]}}]}}"#
+        );
+        let scene = parse_scene_str(&text, "plane.json").unwrap();
+        let half = scene.bodies[0].shape.thin_thickness().unwrap() / 2.0;
+        let mut world = World::from_scene(&scene).unwrap();
+        for _ in 0..180 {
+            world.step().unwrap();
+        }
+        let y = world.poses()[1].translation.y;
+        assert!(
+            (y - (1.0 + half)).abs() < 1e-3,
+            "thickness {thickness:?}: the cube rests at y = {y}, expected {}",
+            1.0 + half
+        );
+        assert!(world.linear_velocities()[1].length() < 1e-3);
+    }
+}
