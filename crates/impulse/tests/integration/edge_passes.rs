@@ -18,30 +18,13 @@ use impulse::parry3d::math::Pose;
 use impulse::parry3d::query;
 use impulse::{BodyBuilder, SharedShape, SolverSettings, World};
 
+use super::common::Rng;
+
 const DT: f32 = 1.0 / 60.0;
 /// The wall's half thickness (m): a 1 cm wall.
 const HALF_THICKNESS: f32 = 0.005;
 /// A miss's largest allowed departure from its free flight (m).
 const DEFLECTION: f32 = 0.001;
-
-/// SplitMix64: a small seeded generator, so every case can be rebuilt from its seed.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [lo, hi).
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        let unit = (self.next() >> 40) as f32 / (1u64 << 24) as f32;
-        lo + (hi - lo) * unit
-    }
-}
 
 #[derive(Clone, Copy, Debug)]
 struct Case {

@@ -12,31 +12,14 @@ use impulse::parry3d::shape::HeightField;
 use impulse::parry3d::utils::Array2;
 use impulse::{BodyBuilder, SharedShape, SolverSettings, World};
 
+use super::common::Rng;
+
 const DT: f32 = 1.0 / 60.0;
 const GRAVITY: Vec3 = Vec3::new(0.0, -9.81, 0.0);
 /// Steps each ball flies: 0.5 s.
 const STEPS: usize = 30;
 /// The target: depth at most this fraction of the radius.
 const MAX_DEPTH_FRACTION: f32 = 0.05;
-
-/// SplitMix64: a small seeded generator, so every case can be rebuilt from its seed.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [lo, hi).
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        let unit = (self.next() >> 40) as f32 / (1u64 << 24) as f32;
-        lo + (hi - lo) * unit
-    }
-}
 
 /// The largest depth (m) of the ball of case `seed` in its terrain over the run, and its
 /// radius (m).

@@ -12,29 +12,7 @@ use impulse::glam::{Quat, Vec3};
 use impulse::scene::{BodyDesc, BodyKind, Scene, ShapeDesc};
 use impulse::{SolverSettings, World};
 
-/// SplitMix64: a small seeded generator, so every case can be rebuilt from its seed.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [lo, hi).
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        let unit = (self.next() >> 40) as f32 / (1u64 << 24) as f32;
-        lo + (hi - lo) * unit
-    }
-
-    /// Uniform integer in [lo, hi].
-    fn integer(&mut self, lo: usize, hi: usize) -> usize {
-        lo + (self.next() % (hi - lo + 1) as u64) as usize
-    }
-}
+use super::common::Rng;
 
 /// Height (m) above its resting pose from which a hull is dropped.
 const DROP: f32 = 0.05;
