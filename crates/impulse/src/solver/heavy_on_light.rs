@@ -20,7 +20,8 @@ pub struct HeavyOnLight {
     /// Whether the island took the exact path: with the soft step or bias repair, the
     /// heavy-on-light path, one exact LCP per step on rigid rows; with split impulse
     /// (`reference`), the automatic policy's exact path in every substep. It has at most
-    /// [`heavy_on_light_max_contacts`] points. If not, it took the ordinary path.
+    /// [`HEAVY_ON_LIGHT_CONTACTS_FACTOR`] × `exact_max_contacts` points. If not, it took the
+    /// ordinary path.
     pub exact: bool,
     /// Whether the island looks held: its deepest overlap at the step's start is at most
     /// [`HEAVY_ON_LIGHT_HELD_OVERLAP`]. An island not held is sinking through, or has sunk.
