@@ -146,3 +146,22 @@ impl Rng {
         lo + (self.next() % (hi - lo + 1) as u64) as usize
     }
 }
+
+/// Whether the segment a–b passes through the box of half extents `extents` centred on the
+/// origin, axes aligned (the slab test): a centre's path through a wall.
+pub(crate) fn segment_crosses_box(a: Vec3, b: Vec3, extents: Vec3) -> bool {
+    let (mut enter, mut leave) = (0.0f32, 1.0f32);
+    for axis in 0..3 {
+        let (start, delta, e) = (a[axis], b[axis] - a[axis], extents[axis]);
+        if delta.abs() < 1e-12 {
+            if start.abs() > e {
+                return false;
+            }
+            continue;
+        }
+        let (t1, t2) = ((-e - start) / delta, (e - start) / delta);
+        enter = enter.max(t1.min(t2));
+        leave = leave.min(t1.max(t2));
+    }
+    enter <= leave
+}

@@ -18,7 +18,7 @@ use impulse::parry3d::math::Pose;
 use impulse::parry3d::query;
 use impulse::{BodyBuilder, SharedShape, SolverSettings, World};
 
-use super::common::Rng;
+use super::common::{Rng, segment_crosses_box};
 
 const DT: f32 = 1.0 / 60.0;
 /// The wall's half thickness (m): a 1 cm wall.
@@ -180,25 +180,6 @@ fn fly(case: &Case, with_wall: bool) -> Vec<(Vec3, Vec3)> {
     frames
 }
 
-/// Whether the segment a–b passes through the wall's box (the slab test).
-fn segment_crosses_wall(a: Vec3, b: Vec3, half: f32) -> bool {
-    let extents = Vec3::new(HALF_THICKNESS, half, half);
-    let (mut enter, mut leave) = (0.0f32, 1.0f32);
-    for axis in 0..3 {
-        let (start, delta, e) = (a[axis], b[axis] - a[axis], extents[axis]);
-        if delta.abs() < 1e-12 {
-            if start.abs() > e {
-                return false;
-            }
-            continue;
-        }
-        let (t1, t2) = ((-e - start) / delta, (e - start) / delta);
-        enter = enter.max(t1.min(t2));
-        leave = leave.min(t1.max(t2));
-    }
-    enter <= leave
-}
-
 /// The failure of `case`, if any: a miss that left its free flight by more than
 /// [`DEFLECTION`], or a centre that moved through the wall.
 fn check(case: &Case) -> Option<String> {
@@ -222,7 +203,13 @@ fn check(case: &Case) -> Option<String> {
     }
     frames
         .windows(2)
-        .position(|w| segment_crosses_wall(w[0].0, w[1].0, case.half))
+        .position(|w| {
+            segment_crosses_box(
+                w[0].0,
+                w[1].0,
+                Vec3::new(HALF_THICKNESS, case.half, case.half),
+            )
+        })
         .map(|step| format!("the centre went through the wall in step {step}"))
 }
 

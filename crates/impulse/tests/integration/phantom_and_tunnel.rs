@@ -19,7 +19,7 @@ use impulse::glam::Vec3;
 use impulse::parry3d::math::Vector;
 use impulse::{BodyBuilder, BodyHandle, SharedShape, SolverSettings, World};
 
-use super::common::Rng;
+use super::common::{Rng, segment_crosses_box};
 
 const DT: f32 = 1.0 / 60.0;
 const GRAVITY: Vec3 = Vec3::new(0.0, -9.81, 0.0);
@@ -239,25 +239,6 @@ fn segment_wall_distance(a: Vec3, b: Vec3, half: f32) -> f32 {
     f(0.5 * (lo + hi)).min(f(0.0)).min(f(1.0))
 }
 
-/// Whether the segment a–b passes through the wall's box (the slab test).
-fn segment_crosses_wall(a: Vec3, b: Vec3, half: f32) -> bool {
-    let extents = Vec3::new(HALF_THICKNESS, half, half);
-    let (mut enter, mut leave) = (0.0f32, 1.0f32);
-    for axis in 0..3 {
-        let (start, delta, e) = (a[axis], b[axis] - a[axis], extents[axis]);
-        if delta.abs() < 1e-12 {
-            if start.abs() > e {
-                return false;
-            }
-            continue;
-        }
-        let (t1, t2) = ((-e - start) / delta, (e - start) / delta);
-        enter = enter.max(t1.min(t2));
-        leave = leave.min(t1.max(t2));
-    }
-    enter <= leave
-}
-
 /// What kind of case the free flight makes.
 fn classify(case: &Case, free: &[(Vec3, Vec3)]) -> Kind {
     match case.target {
@@ -318,7 +299,9 @@ fn check(case: &Case) -> (Kind, Option<String>) {
     let tunnel = match case.target {
         Target::Wall { half } => frames
             .windows(2)
-            .position(|w| segment_crosses_wall(w[0].0, w[1].0, half))
+            .position(|w| {
+                segment_crosses_box(w[0].0, w[1].0, Vec3::new(HALF_THICKNESS, half, half))
+            })
             .map(|step| format!("the centre went through the wall in step {step}")),
         Target::HalfSpace { normal, offset } => frames
             .iter()
