@@ -19,13 +19,14 @@ pub const MAX_PAIRS_PER_BODY: usize = 32;
 /// Half-spaces have unbounded boxes; the broad phase's finite stand-in.
 const WORLD_BOUND: f32 = 1.0e6;
 
-/// Bodies piled into one another: how many boxes meet the densest body's box (itself
-/// included), where that body is, and the pairs counted before the count stopped.
+/// Bodies piled into one another: how many moving bodies' boxes meet the densest moving body's
+/// box (itself included; a static ground under the pile is not counted), where that body is,
+/// and the pairs counted before the count stopped.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Crowd {
-    /// Bodies whose boxes meet the densest body's box, that body included.
+    /// Moving bodies whose boxes meet the densest moving body's box, that body included.
     pub bodies: usize,
-    /// The densest body's index.
+    /// The densest moving body's index.
     pub body: usize,
     /// Its centre of mass (m).
     pub at: Vec3,
@@ -71,13 +72,14 @@ pub(crate) fn crowded_start(bodies: &Bodies) -> Option<Crowd> {
         let met = pairs_of(i).take(room).count();
         let above = pairs_of(i).filter(|&j| j > i).take(room).count();
         pairs += above;
-        if met > densest.1 {
+        // A static ground meets every body of a pile but is not one of them.
+        if bodies.is_dynamic(i) && met > densest.1 {
             densest = (i, met);
         }
         if pairs > limit {
             let (body, _) = densest;
             return Some(Crowd {
-                bodies: pairs_of(body).count() + 1,
+                bodies: pairs_of(body).filter(|&j| bodies.is_dynamic(j)).count() + 1,
                 body,
                 at: bodies.center_of_mass(body),
                 pairs,
@@ -112,6 +114,18 @@ mod tests {
         assert_eq!(crowd.at, Vec3::new(1.0, 2.0, 3.0));
         assert_eq!(crowd.limit, 3_200);
         assert!(crowd.pairs > crowd.limit && crowd.pairs <= 4_950);
+    }
+
+    /// 100 coincident balls on a static ground: the ground is not counted among the crowd.
+    #[test]
+    fn a_crowd_on_the_ground_counts_the_moving_bodies() {
+        let mut world = world_of((0..100).map(|_| Vec3::new(1.0, 0.4, 3.0)));
+        world
+            .insert(BodyBuilder::fixed(SharedShape::cuboid(10.0, 0.5, 10.0)))
+            .unwrap();
+        let crowd = crowded_start(&world.bodies).expect("a crowd");
+        assert_eq!(crowd.bodies, 100);
+        assert_eq!(crowd.at, Vec3::new(1.0, 0.4, 3.0));
     }
 
     /// A 20 × 20 × 20 grid of touching balls (26 neighbours each, 13 pairs per ball) and a
