@@ -5,7 +5,7 @@ from __future__ import annotations
 import concurrent.futures
 import itertools
 import multiprocessing
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
@@ -15,10 +15,12 @@ from impulse.sweep._worker import _run_task, _worker_start
 
 class _LocalBackend:
     """A process pool on this machine (``spawn`` start method, so it is safe with threads and on
-    every platform)."""
+    every platform). ``function(task) -> row`` runs each task (a module-level function, which
+    must never raise): a sweep's run by default, a take for ``impulse.takes``."""
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, function: Callable[[dict[str, Any]], dict[str, Any]] = _run_task):
         self.workers = workers
+        self.function = function
         self.pool = self._new_pool()
 
     def _new_pool(self) -> concurrent.futures.ProcessPoolExecutor:
@@ -35,7 +37,7 @@ class _LocalBackend:
         limit = 4 * self.workers
         while True:
             for task in itertools.islice(tasks, max(0, limit - len(pending))):
-                pending[self.pool.submit(_run_task, task)] = task
+                pending[self.pool.submit(self.function, task)] = task
             if not pending:
                 return
             done, _ = concurrent.futures.wait(
@@ -68,7 +70,7 @@ class _LocalBackend:
             initializer=_worker_start,
         )
         try:
-            return pool.submit(_run_task, task).result()
+            return pool.submit(self.function, task).result()
         except BrokenProcessPool:
             return _failed_row(task, RuntimeError("the worker process running this run died"))
         except Exception as failure:
@@ -83,9 +85,14 @@ class _LocalBackend:
 class _RayBackend:
     """Ray tasks, one per run (``num_cpus=1`` each). Starts a local Ray (``address=None``) or
     joins a cluster (``address="auto"``, ``"ray://head:10001"``) unless Ray is already
-    initialised; shuts down only a Ray it started."""
+    initialised; shuts down only a Ray it started. ``function`` as for the local pool."""
 
-    def __init__(self, workers: int | None, address: str | None):
+    def __init__(
+        self,
+        workers: int | None,
+        address: str | None,
+        function: Callable[[dict[str, Any]], dict[str, Any]] = _run_task,
+    ):
         import ray
 
         self.ray = ray
@@ -102,7 +109,7 @@ class _RayBackend:
             self.started = True
         self.workers = workers or max(1, int(ray.available_resources().get("CPU", 1)))
         # No automatic retry: a run is deterministic, a failure would repeat.
-        self.remote = ray.remote(num_cpus=1, max_retries=0)(_run_task)
+        self.remote = ray.remote(num_cpus=1, max_retries=0)(function)
 
     def run(self, tasks: Iterable[dict[str, Any]]):
         ray = self.ray

@@ -1,0 +1,591 @@
+"""The search for takes: the cross-entropy method over θ, run in batches on the sweep's backends,
+written as it goes, resumable.
+
+Why the cross-entropy method (Rubinstein, "The cross-entropy method for combinatorial and
+continuous optimization", 1999) rather than Chenney & Forsyth's Markov chain (SIGGRAPH 2000):
+each generation is a batch of independent takes, so a process pool or a Ray cluster runs a whole
+generation at once, where a chain runs one take after another; and it needs only the goals'
+costs, no derivative (a pile's outcome is chaotic: derivatives of where a die rests flip sign
+under 1e-6 m/s changes). Each generation draws θ from a normal distribution, keeps the best
+takes so far (lowest total cost, then smallest perturbation), and moves the distribution's mean
+and spread toward them; the first generation draws from the prior N(0, I), the scales' size.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from impulse.takes._goals import MET, Goal, Record, check_names, goal_from_dict
+from impulse.takes._variation import Variation
+
+TAKES_FILE = "takes.parquet"
+MANIFEST_FILE = "manifest.json"
+SCENE_FILE = "scene.json"
+COMPLETED, STOPPED, FAILED = "completed", "stopped", "failed"
+#: Weight of the new elites' mean and spread against the old (the method's smoothing).
+SMOOTHING = 0.7
+#: Smallest spread of θ per component: the search never collapses to one point.
+MIN_SPREAD = 0.02
+_FORMAT = 1
+
+
+def _canonical(value: Any) -> str:
+    return json.dumps(value, sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+
+def take_id(digest: str, theta: np.ndarray) -> str:
+    """A take's id: 16 hex digits of SHA-256 over the search's digest and θ's exact bits."""
+    hasher = hashlib.sha256(digest.encode())
+    hasher.update(np.asarray(theta, dtype="<f8").tobytes())
+    return hasher.hexdigest()[:16]
+
+
+def load_scene(scene: Any) -> dict[str, Any]:
+    """A scene as a dict: a dict as it is, or a JSON file read with its mesh ``file`` paths made
+    absolute (so the varied scene can be written anywhere).
+
+    Raises
+    ------
+    ValueError
+        A name that is not a file (built-in scenes: write one out with ``impulse export``
+        first), or a file that is not a JSON object.
+    """
+    if isinstance(scene, Mapping):
+        return json.loads(json.dumps(scene))
+    path = os.fspath(scene)
+    if not os.path.isfile(path):
+        raise ValueError(
+            f"scene {path!r}: not a file (for a built-in scene, write it out first: "
+            f"impulse export {path} --out {path}.json)"
+        )
+    with open(path, encoding="utf-8") as file:
+        value = json.load(file)
+    if not isinstance(value, dict):
+        raise ValueError(f"scene {path}: a scene is a JSON object")
+    base = os.path.dirname(os.path.abspath(path))
+
+    def absolute(node: Any) -> Any:
+        if isinstance(node, dict):
+            return {
+                key: (
+                    os.path.join(base, item)
+                    if key == "file" and isinstance(item, str) and not os.path.isabs(item)
+                    else absolute(item)
+                )
+                for key, item in node.items()
+            }
+        if isinstance(node, list):
+            return [absolute(item) for item in node]
+        return node
+
+    return absolute(value)
+
+
+def _goal_payload(goals: Sequence[Goal]) -> list[dict[str, Any]]:
+    """Goals as the workers receive them: a JSON goal by its spec, a custom one pickled."""
+    from impulse.sweep import _pickle_observe
+
+    payload = []
+    for goal in goals:
+        if goal.spec is not None:
+            payload.append({"spec": goal.spec})
+        else:
+            payload.append({"pickled": _pickle_observe(goal)})
+    return payload
+
+
+def _goals_from_payload(payload: Sequence[Mapping[str, Any]]) -> list[Goal]:
+    import pickle
+
+    return [
+        goal_from_dict(item["spec"]) if "spec" in item else pickle.loads(item["pickled"])
+        for item in payload
+    ]
+
+
+def simulate_take(
+    scene: Mapping[str, Any], steps: int, goals: Sequence[Goal], preset: str | None = None
+) -> tuple[Record, str, str | None]:
+    """Runs a varied scene ``steps`` steps and records what the goals read.
+
+    Returns the :class:`Record`, the status (``completed``, or ``stopped`` when a step failed:
+    the record then ends at the last good step) and the step's error.
+    """
+    import impulse
+
+    os.environ.setdefault("RAYON_NUM_THREADS", "1")
+    world = impulse.World.from_scene(dict(scene), settings=preset)
+    contacts = any(goal.needs_contacts for goal in goals)
+    frames: dict[str, list] = {key: [] for key in ("t", "p", "q", "v", "w")}
+    touching: list[set] = []
+    current: set = set()
+
+    def record() -> None:
+        state = world.state()
+        frames["t"].append(state["time"])
+        frames["p"].append(state["positions"])
+        frames["q"].append(state["orientations"])
+        frames["v"].append(state["linear_velocities"])
+        frames["w"].append(state["angular_velocities"])
+        touching.append(set(current))
+
+    status, error = COMPLETED, None
+    record()
+    for _ in range(steps):
+        try:
+            world.step()
+        except impulse.StepError as failure:
+            status, error = STOPPED, f"{type(failure).__name__}: {failure}"
+            break
+        if contacts:
+            for event in world.contact_events():
+                a, b = world.index_of(event["body1"]), world.index_of(event["body2"])
+                pair = (min(a, b), max(a, b))
+                if event["type"] == "started":
+                    current.add(pair)
+                else:
+                    current.discard(pair)
+        record()
+    return (
+        Record(
+            times=np.asarray(frames["t"], dtype=np.float64),
+            positions=np.stack(frames["p"]).astype(np.float64),
+            orientations=np.stack(frames["q"]).astype(np.float64),
+            linear_velocities=np.stack(frames["v"]).astype(np.float64),
+            angular_velocities=np.stack(frames["w"]).astype(np.float64),
+            touching=touching,
+            names=list(world.names),
+            gravity=np.asarray(world.gravity, dtype=np.float64),
+            dt=float(world.dt),
+        ),
+        status,
+        error,
+    )
+
+
+def _run_take(task: dict[str, Any]) -> dict[str, Any]:
+    """One take in a worker: its row. Never raises: a failure is the row's status."""
+    start = time.perf_counter()
+    row: dict[str, Any] = {"take_id": task["key"], "status": FAILED, "error": None}
+    try:
+        goals = _goals_from_payload(task["goals"])
+        record, status, error = simulate_take(task["scene"], task["steps"], goals, task["preset"])
+        row["status"], row["error"] = status, error
+        row["costs"] = [goal.cost(record) for goal in goals]
+    except Exception as failure:
+        row["status"] = FAILED
+        row["error"] = f"{type(failure).__name__}: {failure}"
+    row["wall_time_s"] = time.perf_counter() - start
+    return row
+
+
+class _Store:
+    """The search's directory: the manifest, the authored scene and the takes table."""
+
+    def __init__(self, out: str | os.PathLike, manifest: dict[str, Any]):
+        self.root = os.path.abspath(os.fspath(out))
+        self.manifest = manifest
+        os.makedirs(self.root, exist_ok=True)
+        path = os.path.join(self.root, MANIFEST_FILE)
+        if os.path.exists(path):
+            with open(path, encoding="utf-8") as file:
+                old = json.load(file)
+            if old.get("digest") != manifest["digest"]:
+                raise ValueError(
+                    f"{self.root} holds a search of another scene, goals, variation or "
+                    "settings: choose another out directory, or remove it to start again"
+                )
+        self.rows: dict[str, dict[str, Any]] = {}
+        table_path = os.path.join(self.root, TAKES_FILE)
+        if os.path.exists(table_path):
+            import pyarrow.parquet as pq
+
+            for row in pq.read_table(table_path).to_pylist():
+                self.rows[row["take_id"]] = row
+
+    def write(self) -> None:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        rows = sorted(self.rows.values(), key=lambda row: (row["generation"], row["index"]))
+        names = self.manifest["goal_names"]
+        columns: dict[str, Any] = {
+            "take_id": pa.array([r["take_id"] for r in rows], pa.string()),
+            "generation": pa.array([r["generation"] for r in rows], pa.int32()),
+            "index": pa.array([r["index"] for r in rows], pa.int32()),
+            "status": pa.array([r["status"] for r in rows], pa.string()),
+            "error": pa.array([r.get("error") for r in rows], pa.string()),
+            "met": pa.array([r["met"] for r in rows], pa.bool_()),
+            "cost": pa.array([r["cost"] for r in rows], pa.float64()),
+            "perturbation": pa.array([r["perturbation"] for r in rows], pa.float64()),
+        }
+        for name in names:
+            columns[f"cost.{name}"] = pa.array([r.get(f"cost.{name}") for r in rows], pa.float64())
+        columns["theta"] = pa.array([r["theta"] for r in rows], pa.list_(pa.float64()))
+        columns["wall_time_s"] = pa.array([r.get("wall_time_s") for r in rows], pa.float64())
+        temporary = os.path.join(self.root, TAKES_FILE + ".partial")
+        pq.write_table(pa.table(columns), temporary)
+        os.replace(temporary, os.path.join(self.root, TAKES_FILE))
+        with open(os.path.join(self.root, MANIFEST_FILE), "w", encoding="utf-8") as file:
+            json.dump(self.manifest, file, indent=1)
+
+
+def _rank(row: Mapping[str, Any]) -> tuple[float, float]:
+    cost = row["cost"]
+    return (math.inf if cost is None or not math.isfinite(cost) else cost, row["perturbation"])
+
+
+def search(
+    scene: Any,
+    goals: Sequence[Goal | Mapping[str, Any]],
+    variation: Variation | Mapping[str, Any],
+    *,
+    budget: int,
+    steps: int,
+    out: str | os.PathLike = "takes",
+    backend: str = "local",
+    workers: int | None = None,
+    address: str | None = None,
+    seed: int = 0,
+    population: int = 32,
+    elite_fraction: float = 0.2,
+    stop_after: int = 1,
+    preset: str | None = None,
+    progress: bool = True,
+) -> Takes:
+    """Searches for takes of ``scene`` that meet every goal and returns them all (also written
+    to ``out``).
+
+    Parameters
+    ----------
+    scene : str | os.PathLike | dict
+        A scene file or dict (built-in names: write the scene out with ``impulse export``).
+    goals : list of Goal | dict
+        Goals as JSON objects (``impulse.takes`` module documentation) or :class:`Goal` (from
+        :func:`custom`). Must be non-empty.
+    variation : Variation | dict
+        What may vary and by how much (:class:`Variation`).
+    budget : int
+        Most takes to run (>= 1), resumed takes included.
+    steps : int
+        Steps of every take (>= 1).
+    out : str | os.PathLike
+        Directory of the results: ``takes.parquet`` (one row per take), ``manifest.json``,
+        ``scene.json`` (the authored scene). Running again into it resumes: takes already run
+        are read, not run, and the search continues as it would have.
+    backend : "local" | "ray"
+        The sweep's backends: a process pool (call ``search`` under ``if __name__ ==
+        "__main__":`` in a script) or Ray tasks.
+    workers, address
+        As in :func:`impulse.sweep.sweep`.
+    seed : int
+        Seed of the search's draws (NumPy's PCG64, one stream per generation).
+    population : int
+        Takes per generation (>= 2).
+    elite_fraction : float
+        Share of the takes so far that move the distribution, in (0, 1].
+    stop_after : int
+        Stop once this many takes meet every goal (>= 1).
+    preset : str, optional
+        Solver preset of every take, as ``impulse run --preset``.
+    progress : bool
+        A progress bar (tqdm): takes done, goals met, best cost.
+
+    Returns
+    -------
+    Takes
+        Every take run, best first by :meth:`Takes.best`.
+
+    Raises
+    ------
+    ValueError
+        Bad arguments, goals or variation; a scene that does not load; an ``out`` holding
+        another search.
+    TypeError
+        A custom goal that cannot be sent to the workers (define it at module level, or
+        install cloudpickle).
+    """
+    import impulse
+
+    if not isinstance(budget, int) or budget < 1:
+        raise ValueError(f"budget = {budget!r}: must be an integer >= 1")
+    if not isinstance(steps, int) or steps < 1:
+        raise ValueError(f"steps = {steps!r}: must be an integer >= 1")
+    if not isinstance(population, int) or population < 2:
+        raise ValueError(f"population = {population!r}: must be an integer >= 2")
+    if not 0.0 < elite_fraction <= 1.0:
+        raise ValueError(f"elite_fraction = {elite_fraction!r}: must be in (0, 1]")
+    if not isinstance(stop_after, int) or stop_after < 1:
+        raise ValueError(f"stop_after = {stop_after!r}: must be an integer >= 1")
+    if backend not in ("local", "ray"):
+        raise ValueError(f"backend = {backend!r}: use 'local' or 'ray'")
+    base = load_scene(scene)
+    if not isinstance(variation, Variation):
+        variation = Variation.from_dict(variation)
+    goals = [g if isinstance(g, Goal) else goal_from_dict(g) for g in goals]
+    if not goals:
+        raise ValueError("goals: at least one goal is needed")
+    check_names(goals)
+    dimension = variation.dimension(base)
+    impulse.World.from_scene(base, settings=preset)  # a bad scene is one error, here
+    payload = _goal_payload(goals)
+
+    specs = [goal.spec if goal.spec is not None else {"custom": goal.name} for goal in goals]
+    search_spec = {
+        "format": _FORMAT,
+        "scene": base,
+        "goals": specs,
+        "weights": [goal.weight for goal in goals],
+        "variation": variation.to_dict(),
+        "steps": steps,
+        "preset": preset,
+        "seed": seed,
+        "population": population,
+        "elite_fraction": elite_fraction,
+    }
+    digest = hashlib.sha256(_canonical(search_spec).encode()).hexdigest()
+    manifest = {
+        "digest": digest,
+        "goal_names": [goal.name for goal in goals],
+        "impulse": getattr(impulse, "__version__", "unknown"),
+        **{key: value for key, value in search_spec.items() if key != "scene"},
+    }
+    store = _Store(out, manifest)
+    with open(os.path.join(store.root, SCENE_FILE), "w", encoding="utf-8") as file:
+        json.dump(base, file, indent=1)
+
+    runner = _backend(backend, workers, address)
+    bar = _Progress(budget, progress)
+    mean, spread = np.zeros(dimension), np.ones(dimension)
+    elites = max(2, round(elite_fraction * population))
+    done: list[dict[str, Any]] = []
+    generation = 0
+    try:
+        while len(done) < budget:
+            rng = np.random.default_rng([seed, generation])
+            count = min(population, budget - len(done))
+            thetas = mean + spread * rng.standard_normal((population, dimension))
+            batch = []
+            for index, theta in enumerate(thetas[:count]):
+                key = take_id(digest, theta)
+                row = store.rows.get(key)
+                if row is not None and row["status"] != FAILED:
+                    done.append(row)
+                    bar.update(row)
+                    continue
+                batch.append((index, theta, key))
+            tasks = [
+                {
+                    "key": key,
+                    "scene": variation.apply(base, theta),
+                    "steps": steps,
+                    "preset": preset,
+                    "goals": payload,
+                }
+                for _, theta, key in batch
+            ]
+            by_key = {key: (index, theta) for index, theta, key in batch}
+            for result in runner.run(tasks):
+                # A task the pool could not run comes back as the sweep's failed row.
+                result.setdefault("take_id", result.get("run_key"))
+                index, theta = by_key[result["take_id"]]
+                row = _row(result, goals, generation, index, theta)
+                store.rows[row["take_id"]] = row
+                done.append(row)
+                bar.update(row)
+            store.write()
+            if sum(1 for row in done if row["met"]) >= stop_after:
+                break
+            ranked = sorted((row for row in done if row["status"] != FAILED), key=_rank)
+            best = np.array([row["theta"] for row in ranked[:elites]])
+            if len(best) >= 2:
+                mean = SMOOTHING * best.mean(axis=0) + (1.0 - SMOOTHING) * mean
+                spread = SMOOTHING * best.std(axis=0) + (1.0 - SMOOTHING) * spread
+                spread = np.maximum(spread, MIN_SPREAD)
+            generation += 1
+    finally:
+        runner.close()
+        bar.close()
+        store.write()
+    return load(store.root)
+
+
+def _row(
+    result: Mapping[str, Any],
+    goals: Sequence[Goal],
+    generation: int,
+    index: int,
+    theta: np.ndarray,
+) -> dict[str, Any]:
+    row = {
+        "take_id": result["take_id"],
+        "generation": generation,
+        "index": index,
+        "status": result["status"],
+        "error": result.get("error"),
+        "theta": [float(v) for v in theta],
+        "perturbation": Variation.perturbation(theta),
+        "wall_time_s": result.get("wall_time_s"),
+    }
+    costs = result.get("costs")
+    if costs is None or result["status"] != COMPLETED:
+        row.update(met=False, cost=None)
+        for goal in goals:
+            row[f"cost.{goal.name}"] = None
+        return row
+    for goal, cost in zip(goals, costs):
+        row[f"cost.{goal.name}"] = float(cost)
+    row["cost"] = float(sum(goal.weight * cost for goal, cost in zip(goals, costs)))
+    row["met"] = all(cost <= MET for cost in costs)
+    return row
+
+
+def _backend(backend: str, workers: int | None, address: str | None) -> Any:
+    from impulse.sweep._backends import _LocalBackend, _RayBackend
+
+    if backend == "ray":
+        return _RayBackend(workers, address, function=_run_take)
+    return _LocalBackend(workers or os.cpu_count() or 1, function=_run_take)
+
+
+class _Progress:
+    def __init__(self, total: int, enabled: bool):
+        self.bar = None
+        self.met = 0
+        self.best = math.inf
+        if enabled:
+            try:
+                from tqdm.auto import tqdm
+
+                self.bar = tqdm(total=total, unit="take", desc="takes")
+            except ImportError:
+                self.bar = None
+
+    def update(self, row: Mapping[str, Any]) -> None:
+        self.met += bool(row["met"])
+        if row["cost"] is not None:
+            self.best = min(self.best, row["cost"])
+        if self.bar is not None:
+            self.bar.update(1)
+            self.bar.set_postfix(met=self.met, best=f"{self.best:.3g}")
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+class Take:
+    """One take of a search: its θ, costs and the varied scene.
+
+    Attributes: ``take_id`` (str), ``theta`` (ndarray, unit-free), ``met`` (bool: every goal
+    met), ``cost`` (weighted total, None when the take did not complete), ``costs`` (goal name
+    → cost), ``perturbation`` (size of θ; smaller is more plausible), ``status``, ``error``.
+    """
+
+    def __init__(self, row: Mapping[str, Any], takes: Takes):
+        self.take_id = row["take_id"]
+        self.theta = np.asarray(row["theta"], dtype=np.float64)
+        self.met = bool(row["met"])
+        self.cost = row["cost"]
+        self.costs = {name: row.get(f"cost.{name}") for name in takes.goal_names}
+        self.perturbation = row["perturbation"]
+        self.status = row["status"]
+        self.error = row.get("error")
+        self._takes = takes
+
+    def scene(self) -> dict[str, Any]:
+        """The varied scene (a dict as in a scene file): ``impulse run`` of it written to a file
+        reproduces the take's trajectory to the bit."""
+        return self._takes.variation.apply(self._takes.base_scene, self.theta)
+
+    def write_scene(self, path: str | os.PathLike) -> None:
+        """Writes :meth:`scene` as JSON to ``path``."""
+        with open(path, "w", encoding="utf-8") as file:
+            json.dump(self.scene(), file, indent=1)
+
+    def __repr__(self) -> str:
+        return (
+            f"Take({self.take_id!r}, met={self.met}, cost={self.cost}, "
+            f"perturbation={self.perturbation:.3g})"
+        )
+
+
+class Takes(Mapping):
+    """The takes of a search directory, by id (``takes[take_id]`` is a :class:`Take`);
+    ``table`` is the ``pyarrow.Table`` of ``takes.parquet``."""
+
+    def __init__(self, root: str):
+        import pyarrow.parquet as pq
+
+        self.root = root
+        with open(os.path.join(root, MANIFEST_FILE), encoding="utf-8") as file:
+            self.manifest = json.load(file)
+        with open(os.path.join(root, SCENE_FILE), encoding="utf-8") as file:
+            self.base_scene = json.load(file)
+        self.variation = Variation.from_dict(self.manifest["variation"])
+        self.goal_names = list(self.manifest["goal_names"])
+        self.table = pq.read_table(os.path.join(root, TAKES_FILE))
+        self._takes = {row["take_id"]: Take(row, self) for row in self.table.to_pylist()}
+
+    def __getitem__(self, key: str) -> Take:
+        try:
+            return self._takes[key]
+        except KeyError:
+            raise KeyError(f"no take {key!r} in {self.root}") from None
+
+    def __iter__(self):
+        return iter(self._takes)
+
+    def __len__(self) -> int:
+        return len(self._takes)
+
+    def best(self, count: int | None = None) -> list[Take]:
+        """Takes best first: those meeting every goal, then by total cost, then by perturbation
+        (the more plausible first); failed takes last."""
+        order = sorted(
+            self._takes.values(),
+            key=lambda take: (
+                not take.met,
+                math.inf if take.cost is None else take.cost,
+                take.perturbation,
+            ),
+        )
+        return order if count is None else order[:count]
+
+    def met(self) -> list[Take]:
+        """The takes that meet every goal, most plausible first."""
+        return sorted((t for t in self._takes.values() if t.met), key=lambda t: t.perturbation)
+
+
+def load(out: str | os.PathLike) -> Takes:
+    """The takes a search wrote to ``out``.
+
+    Raises
+    ------
+    FileNotFoundError
+        ``out`` holds no search.
+    """
+    root = os.path.abspath(os.fspath(out))
+    if not os.path.exists(os.path.join(root, TAKES_FILE)):
+        raise FileNotFoundError(f"{root}: no {TAKES_FILE} (not a takes search directory)")
+    return Takes(root)
+
+
+def evaluate(
+    scene: Any, goals: Sequence[Goal | Mapping[str, Any]], steps: int, preset: str | None = None
+) -> dict[str, float]:
+    """The goals' costs of one run of ``scene`` in this process (goal name → cost): what a
+    take's row records, for checking goals on a scene by hand."""
+    goals = [g if isinstance(g, Goal) else goal_from_dict(g) for g in goals]
+    record, status, error = simulate_take(load_scene(scene), steps, goals, preset)
+    if status != COMPLETED:
+        raise RuntimeError(f"the run stopped: {error}")
+    return {goal.name: goal.cost(record) for goal in goals}
