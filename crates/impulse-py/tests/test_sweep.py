@@ -383,3 +383,72 @@ def test_local_and_ray_sweeps_are_equal_to_the_bit(tmp_path, local_ray):
         assert final_state(world) == {
             k[len("observe.") :]: v for k, v in row.items() if k.startswith("observe.")
         }
+
+
+# ---------------------------------------------------------------------------------------------
+# Sweeps that fail loudly, before any worker starts
+
+
+def test_the_table_records_each_runs_varied_initial_state(tmp_path):
+    table = sweep(
+        SCENE, seeds=2, steps=2, jitter=JITTER, out=tmp_path / "s", workers=2, progress=False
+    )
+    for row in table.to_pylist():
+        world = impulse.World.from_scene(SCENE, seed=row["seed"], jitter=JITTER)
+        assert row["initial_positions"] == world.positions.ravel().tolist()
+        assert row["initial_orientations"] == world.orientations.ravel().tolist()
+        assert row["initial_linear_velocities"] == world.linear_velocities.ravel().tolist()
+    first, second = table.column("initial_positions").to_pylist()
+    assert first != second  # the seeds' jitters differ
+
+
+def test_seeds_without_jitter_warn_that_every_run_is_the_same(tmp_path):
+    with pytest.warns(UserWarning, match="2 seeds without jitter"):
+        sweep(SCENE, seeds=2, steps=1, out=tmp_path / "s", workers=1, progress=False)
+
+
+def test_a_call_outside_the_main_guard_is_refused_before_any_worker_starts(tmp_path):
+    import subprocess
+    import sys
+
+    script = tmp_path / "unguarded.py"
+    script.write_text(
+        "import impulse\n"
+        f"impulse.sweep({SCENE!r}, seeds=[0], steps=1, out={str(tmp_path / 'o')!r},"
+        " progress=False)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, check=False, timeout=120
+    )
+    assert done.returncode == 1
+    assert 'under if __name__ == "__main__":' in done.stderr
+    assert "unguarded.py (line 2)" in done.stderr
+    assert not (tmp_path / "o" / RESULTS_FILE).exists()
+    guarded = tmp_path / "guarded.py"
+    guarded.write_text(
+        "import impulse\n"
+        "if __name__ == '__main__':\n"
+        f"    t = impulse.sweep({SCENE!r}, seeds=[0], steps=1, out={str(tmp_path / 'g')!r},"
+        " progress=False)\n"
+        "    print(t.column('status').to_pylist())\n"
+    )
+    done = subprocess.run(
+        [sys.executable, str(guarded)], capture_output=True, text=True, check=False, timeout=300
+    )
+    assert done.returncode == 0, done.stderr
+    assert "['completed']" in done.stdout
+
+
+def test_runs_whose_worker_failed_run_again_on_resume(tmp_path):
+    from impulse.sweep._constants import WORKER_FAILURE
+
+    out = tmp_path / "s"
+    first = sweep(SCENE, seeds=[0, 1], steps=2, jitter=JITTER, out=out, workers=2, progress=False)
+    rows = first.to_pylist()
+    rows[0]["status"], rows[0]["error"] = FAILED, f"{WORKER_FAILURE}BrokenProcessPool: died"
+    rows[1]["status"], rows[1]["error"] = FAILED, "observe: ValueError: the run's own failure"
+    pq.write_table(pa.Table.from_pylist(rows, schema=first.schema), out / RESULTS_FILE)
+    again = sweep(SCENE, seeds=[0, 1], steps=2, jitter=JITTER, out=out, workers=2, progress=False)
+    statuses = dict(zip(again.column("seed").to_pylist(), again.column("status").to_pylist()))
+    # The worker's failure is run again; the run's own failure is kept (retry_failed reruns it).
+    assert statuses == {0: COMPLETED, 1: FAILED}

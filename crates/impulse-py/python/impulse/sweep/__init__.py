@@ -30,6 +30,7 @@ import pickle
 import sys
 import time
 import uuid
+import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
@@ -46,6 +47,7 @@ from impulse.sweep._constants import (
     STOPPED,
     TIMING_COLUMNS,
     TRAJECTORY_DIR,
+    WORKER_FAILURE,
 )
 from impulse.sweep._runs import (
     Run,
@@ -226,6 +228,16 @@ def sweep(
         raise TypeError("preset must be a preset name: 'fast', 'default', 'precise' or 'reference'")
     observe_bytes = _pickle_observe(observe) if observe is not None else None
     _check_scene_loads(scene_spec, preset)
+    if backend == "local":
+        _check_workers_can_start("impulse.sweep")
+    if len(seed_list) > 1 and jitter is None:
+        warnings.warn(
+            f"{len(seed_list)} seeds without jitter: a seed varies a run only through jitter, so "
+            "every seed of a grid point gives the same run; pass jitter={'position': m, "
+            "'angle': degrees, 'velocity': m/s} to vary them",
+            UserWarning,
+            stacklevel=2,
+        )
 
     out = os.fspath(out)
     filesystem, root = _filesystem(out)
@@ -246,8 +258,9 @@ def sweep(
             previous.column("status").to_pylist(),
             strict=True,
         ):
-            if not (retry_failed and status == FAILED):
-                done.add(key)
+            if status == FAILED and (retry_failed or _worker_failed(previous, key)):
+                continue
+            done.add(key)
     todo = [run for run in runs if run.key not in done]
     override_types = _override_types(grid)
     manifest = {
@@ -330,6 +343,74 @@ def sweep(
     counts = _status_counts(table, {run.key for run in runs})
     _write_json(filesystem, f"{root}/{MANIFEST_FILE}", {**manifest, "state": "finished", **counts})
     return table
+
+
+def _worker_failed(previous: Any, key: str) -> bool:
+    """Whether the stored row of ``key`` failed because its worker could not run it."""
+    keys = previous.column("run_key").to_pylist()
+    errors = previous.column("error").to_pylist()
+    return any(k == key and (e or "").startswith(WORKER_FAILURE) for k, e in zip(keys, errors))
+
+
+def _check_workers_can_start(caller: str) -> None:
+    """Raises ``RuntimeError`` before any worker starts when the local pool's workers cannot
+    run: the pool starts each worker by ``spawn``, which imports the main script again, so a
+    call at the top level of a script (not under ``if __name__ == "__main__":``) would start the
+    whole sweep again in every worker, and inside a worker it is refused outright."""
+    import ast
+
+    main = sys.modules.get("__main__")
+    spec_name = getattr(getattr(main, "__spec__", None), "name", None) or ""
+    if spec_name == "__main__" or spec_name.endswith(".__main__"):
+        return  # `python -m package`: spawn does not import a package's __main__ again
+    frame = sys._getframe(1)
+    while frame is not None:
+        if frame.f_globals.get("__name__") == "__mp_main__":
+            raise RuntimeError(
+                f"{caller} was started again while a worker process imported the main script: "
+                'put the call under if __name__ == "__main__":'
+            )
+        if (
+            main is not None
+            and frame.f_globals is vars(main)
+            and frame.f_code.co_name == "<module>"
+        ):
+            path = getattr(main, "__file__", None)
+            if path is None or not os.path.isfile(path):
+                return  # a notebook, the REPL or a script read from stdin: not re-imported
+            with open(path, encoding="utf-8") as file:
+                tree = ast.parse(file.read(), path)
+            if not _under_main_guard(tree, frame.f_lineno):
+                raise RuntimeError(
+                    f"{caller} is called at the top level of {path} (line {frame.f_lineno}): "
+                    "the local backend's worker processes start by importing that script "
+                    "again, which would start the sweep again in each. Put the call under "
+                    'if __name__ == "__main__": (or use backend="ray")'
+                )
+            return
+        frame = frame.f_back
+
+
+def _under_main_guard(tree: Any, line: int) -> bool:
+    """Whether ``line`` of a module lies inside an ``if __name__ == "__main__":`` block (or a
+    function or class body, which only runs when called)."""
+    import ast
+
+    for node in tree.body:
+        start, end = node.lineno, getattr(node, "end_lineno", node.lineno)
+        if not start <= line <= end:
+            continue
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            return True
+        test = getattr(node, "test", None)
+        if isinstance(node, ast.If) and isinstance(test, ast.Compare):
+            names = [test.left, *test.comparators]
+            text = {getattr(n, "id", None) for n in names} | {
+                getattr(n, "value", None) for n in names
+            }
+            if "__name__" in text and "__main__" in text:
+                return True
+    return False
 
 
 def _trajectory_every(save_trajectories: bool | int) -> int:

@@ -9,7 +9,7 @@ from collections.abc import Callable, Iterable
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
-from impulse.sweep._constants import FAILED
+from impulse.sweep._constants import FAILED, WORKER_FAILURE
 from impulse.sweep._worker import _run_task, _worker_start
 
 
@@ -18,7 +18,9 @@ class _LocalBackend:
     every platform). ``function(task) -> row`` runs each task (a module-level function, which
     must never raise): a sweep's run by default, a take for ``impulse.takes``."""
 
-    def __init__(self, workers: int, function: Callable[[dict[str, Any]], dict[str, Any]] = _run_task):
+    def __init__(
+        self, workers: int, function: Callable[[dict[str, Any]], dict[str, Any]] = _run_task
+    ):
         self.workers = workers
         self.function = function
         self.pool = self._new_pool()
@@ -138,5 +140,5 @@ def _failed_row(task: dict[str, Any], failure: BaseException) -> dict[str, Any]:
     return {
         "run_key": task["key"],
         "status": FAILED,
-        "error": f"{type(failure).__name__}: {failure}",
+        "error": f"{WORKER_FAILURE}{type(failure).__name__}: {failure}",
     }

@@ -50,6 +50,12 @@ _RUN_COLUMNS = (
     ("mean_iterations", "float64"),
     ("max_natural_map_residual", "float64"),
     ("final_natural_map_residual", "float64"),
+    # The run's initial state after overrides and jitter, every body, flattened row-major:
+    # positions (B·3, m), orientations (B·4, [x, y, z, w]), velocities (B·3, m/s; rad/s).
+    ("initial_positions", "list<float32>"),
+    ("initial_orientations", "list<float32>"),
+    ("initial_linear_velocities", "list<float32>"),
+    ("initial_angular_velocities", "list<float32>"),
 )
 _TAIL_COLUMNS = (
     ("wall_time_s", "float64"),
@@ -70,3 +76,6 @@ COMPLETED = "completed"
 STOPPED = "stopped"
 #: Status of a run that could not be built or measured (bad override, exception in ``observe``).
 FAILED = "failed"
+#: Start of the error of a run that failed because its worker could not run it (the process
+#: died, the task could not be sent): not the run's fault, so a resumed sweep runs it again.
+WORKER_FAILURE = "worker: "

@@ -48,7 +48,7 @@ def _table(rows: list[dict[str, Any]], override_types: Mapping[str, Any]) -> Any
     names += [name for name, _ in _TAIL_COLUMNS]
     fixed = {
         "run_key": pa.string(),
-        **{n: pa.type_for_alias(t) for n, t in (*_RUN_COLUMNS, *_TAIL_COLUMNS)},
+        **{n: _arrow_type(t) for n, t in (*_RUN_COLUMNS, *_TAIL_COLUMNS)},
     }
     columns = {}
     for name in names:
@@ -61,6 +61,15 @@ def _table(rows: list[dict[str, Any]], override_types: Mapping[str, Any]) -> Any
         else:
             columns[name] = pa.array(values, type=fixed.get(name))
     return pa.table(columns)
+
+
+def _arrow_type(alias: str) -> Any:
+    """The Arrow type of a column alias: pyarrow's aliases, and ``list<float32>``."""
+    import pyarrow as pa
+
+    if alias == "list<float32>":
+        return pa.list_(pa.float32())
+    return pa.type_for_alias(alias)
 
 
 def _override_types(grid: Mapping[str, list[Any]]) -> dict[str, tuple[str, Any]]:

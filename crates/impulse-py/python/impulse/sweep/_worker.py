@@ -53,6 +53,16 @@ def _measure(
             frames["times"].append(world.time)
 
     initial = np.array(world.positions, dtype=np.float32, copy=True)
+    initial_state = {
+        "initial_positions": initial.ravel().tolist(),
+        "initial_orientations": np.asarray(world.orientations, dtype=np.float32).ravel().tolist(),
+        "initial_linear_velocities": np.asarray(world.linear_velocities, dtype=np.float32)
+        .ravel()
+        .tolist(),
+        "initial_angular_velocities": np.asarray(world.angular_velocities, dtype=np.float32)
+        .ravel()
+        .tolist(),
+    }
     quality = world.quality(initial)
     top_body = quality.get("top_body")
     max_overlap = float(quality["max_overlap_m"])
@@ -118,6 +128,7 @@ def _measure(
         "mean_contacts": contacts / taken,
         "mean_iterations": iterations / taken,
         "max_natural_map_residual": max_residual,
+        **initial_state,
         "final_natural_map_residual": _finite_or_none(diagnostics.get("natural_map_residual", 0.0)),
     }
 

@@ -312,6 +312,9 @@ def search(
     TypeError
         A custom goal that cannot be sent to the workers (define it at module level, or
         install cloudpickle).
+    RuntimeError
+        The local backend's workers cannot start: the call is at the top level of a script,
+        not under ``if __name__ == "__main__":``.
     """
     import impulse
 
@@ -336,6 +339,10 @@ def search(
     check_names(goals)
     dimension = variation.dimension(base)
     impulse.World.from_scene(base, settings=preset)  # a bad scene is one error, here
+    if backend == "local":
+        from impulse.sweep import _check_workers_can_start
+
+        _check_workers_can_start("impulse.takes.search")
     payload = _goal_payload(goals)
 
     specs = [goal.spec if goal.spec is not None else {"custom": goal.name} for goal in goals]
