@@ -335,6 +335,7 @@ pub(crate) fn peer_zoo() -> Scene {
             friction: 0.2,
             restitution: 0.3,
             density: 300.0,
+            roughness: 0.0,
         },
     );
     scene.bodies.push(BodyDesc::new(

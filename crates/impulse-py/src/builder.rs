@@ -298,12 +298,13 @@ fn configure(
                 b = b.rotation(Quat::from_array(q));
                 Property::Floats(q.to_vec())
             }
-            "friction" | "restitution" | "density" | "mass" | "linear_damping"
+            "friction" | "restitution" | "roughness" | "density" | "mass" | "linear_damping"
             | "angular_damping" => {
                 let x = float(&value)?;
                 b = match key.as_str() {
                     "friction" => b.friction(x),
                     "restitution" => b.restitution(x),
+                    "roughness" => b.roughness(x),
                     "density" => b.density(x),
                     "mass" => b.mass(x),
                     "linear_damping" => b.linear_damping(x),
@@ -333,13 +334,14 @@ fn configure(
     Ok(BodyBuilder { inner: b, recipe })
 }
 
-const PROPERTIES: [&str; 12] = [
+const PROPERTIES: [&str; 13] = [
     "translation",
     "rotation",
     "linear_velocity",
     "angular_velocity",
     "friction",
     "restitution",
+    "roughness",
     "density",
     "mass",
     "name",

@@ -412,6 +412,21 @@ impl World {
         self.world(py)?.set_dt(dt).map_err(world_error)
     }
 
+    /// Seed of the world's seeded variation (int ≥ 0): rough surfaces' contact normals
+    /// (the `roughness` body property, degrees) are tilted by draws keyed by (seed, step,
+    /// pair). The scene's `seed`, or `from_scene`'s non-zero `seed`. Assign to change it:
+    /// contacts that start later draw from the new seed.
+    #[getter]
+    fn seed(&self, py: Python<'_>) -> PyResult<u64> {
+        Ok(self.world(py)?.seed())
+    }
+
+    #[setter]
+    fn set_seed(&self, py: Python<'_>, seed: u64) -> PyResult<()> {
+        self.world(py)?.set_seed(seed);
+        Ok(())
+    }
+
     /// Gravity (m/s², 3 floats). Assign 3 finite floats to change it (wakes every body).
     #[getter]
     fn gravity(&self, py: Python<'_>) -> PyResult<[f32; 3]> {

@@ -153,7 +153,7 @@ class BodyBuilder:
     """A body to insert: ``BodyBuilder.dynamic(Shape.ball(0.5), translation=(0, 2, 0))``.
 
     Keywords: translation (m), rotation (x y z w), linear_velocity (m/s), angular_velocity
-    (rad/s), friction, restitution, density (kg/m³), mass (kg), name, linear_damping,
+    (rad/s), friction, restitution, roughness (degrees), density (kg/m³), mass (kg), name, linear_damping,
     angular_damping (1/s), lock_rotation. Picklable; the repr is the call that made it.
     """
 
@@ -237,6 +237,11 @@ class World:
     def dt(self) -> float: ...
     @dt.setter
     def dt(self, value: float) -> None: ...
+    @property
+    def seed(self) -> int:
+        """Seed of the rough surfaces' draws (the scene's ``seed``)."""
+    @seed.setter
+    def seed(self, value: int) -> None: ...
     @property
     def gravity(self) -> list[float]: ...
     @gravity.setter

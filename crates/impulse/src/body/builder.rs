@@ -37,6 +37,7 @@ pub struct BodyBuilder {
     pub(crate) angular_velocity: Vec3,
     pub(crate) friction: f32,
     pub(crate) restitution: f32,
+    pub(crate) roughness: f32,
     pub(crate) density: f32,
     pub(crate) mass: Option<f32>,
     pub(crate) name: Option<String>,
@@ -63,6 +64,7 @@ impl BodyBuilder {
             angular_velocity: Vec3::ZERO,
             friction: 0.6,
             restitution: 0.0,
+            roughness: 0.0,
             density: 1000.0,
             mass: None,
             name: None,
@@ -133,6 +135,15 @@ impl BodyBuilder {
     /// Restitution coefficient in [0, 1]; a pair uses the larger of its bodies'.
     pub fn restitution(mut self, restitution: f32) -> Self {
         self.restitution = restitution;
+        self
+    }
+
+    /// Surface roughness (degrees) in [0, [`crate::scene::MAX_ROUGHNESS_DEGREES`]]: each new
+    /// contact's normal is tilted by a random angle up to the larger of its two bodies'
+    /// roughness, drawn from the world's [`crate::World::seed`], the step and the pair
+    /// (docs/scene-format.md, "Materials"). 0 (the default): smooth, nothing drawn.
+    pub fn roughness(mut self, degrees: f32) -> Self {
+        self.roughness = degrees;
         self
     }
 
@@ -290,6 +301,7 @@ pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
     )?;
     check("material.friction", rules::non_negative(b.friction))?;
     check("material.restitution", rules::unit_interval(b.restitution))?;
+    check("material.roughness", rules::roughness(b.roughness))?;
     check("linear_damping", rules::non_negative(b.linear_damping))?;
     check("angular_damping", rules::non_negative(b.angular_damping))?;
     let shape = b.shape.clone();

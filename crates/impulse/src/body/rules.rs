@@ -242,6 +242,17 @@ pub(crate) fn non_negative(v: f32) -> Result<(), String> {
     }
 }
 
+/// A surface roughness (degrees): finite and in [0, `MAX_ROUGHNESS_DEGREES`].
+pub(crate) fn roughness(v: f32) -> Result<(), String> {
+    finite(&[v])?;
+    let max = crate::scene::MAX_ROUGHNESS_DEGREES;
+    if (0.0..=max).contains(&v) {
+        Ok(())
+    } else {
+        Err(format!("must be in [0, {max}] degrees, got {v}"))
+    }
+}
+
 /// Finite and in [0, 1] (restitution).
 pub(crate) fn unit_interval(v: f32) -> Result<(), String> {
     finite(&[v])?;

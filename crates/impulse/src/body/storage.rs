@@ -41,6 +41,10 @@ pub struct Bodies {
     pub(crate) friction: Vec<f32>,
     /// Restitution coefficient c_r.
     pub(crate) restitution: Vec<f32>,
+    /// Surface roughness (rad): the largest tilt of a new contact's normal (0: smooth).
+    /// Absent from snapshots written before it existed: read as every body smooth.
+    #[serde(default)]
+    pub(crate) roughness: Vec<f32>,
     /// Asleep: skipped by the step until something awake touches its island. A kinematic
     /// body counts as asleep exactly while it does not move (zero velocities).
     pub(crate) asleep: Vec<bool>,
@@ -81,6 +85,7 @@ impl Bodies {
         self.shape.swap_remove(i);
         self.friction.swap_remove(i);
         self.restitution.swap_remove(i);
+        self.roughness.swap_remove(i);
         self.asleep.swap_remove(i);
         self.sleep_time.swap_remove(i);
         self.force.swap_remove(i);
@@ -108,6 +113,7 @@ impl Bodies {
             ("shape", self.shape.len()),
             ("friction", self.friction.len()),
             ("restitution", self.restitution.len()),
+            ("roughness", self.roughness.len()),
             ("asleep", self.asleep.len()),
             ("sleep_time", self.sleep_time.len()),
             ("force", self.force.len()),

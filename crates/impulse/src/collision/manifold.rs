@@ -1,6 +1,7 @@
 //! A contact manifold as the engine keeps it across steps: Parry's manifold with the solver's
 //! impulses per point ([`ContactImpulse`]) and the friction basis per manifold
-//! ([`ManifoldState`]), and the world poses of its two shapes.
+//! ([`ManifoldState`], with a rough pair's [`RoughnessDraw`]), and the world poses of its two
+//! shapes.
 
 use glam::Vec3;
 use parry3d::math::Pose;
@@ -29,6 +30,31 @@ pub struct ManifoldState {
     /// keeps the friction basis continuous: a basis rebuilt from the normal alone can flip
     /// between steps, and warm-started friction then lands on the wrong axes.
     pub tangent: Vec3,
+    /// The manifold's roughness draw, made when it first had points with a rough body
+    /// (`contact::roughness`); `None` on smooth pairs.
+    #[serde(default)]
+    pub roughness: Option<RoughnessDraw>,
+}
+
+/// One manifold's roughness draw, kept in its state across steps.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RoughnessDraw {
+    /// Where the tilt lies in the cap, in [0, 1): 1 − cos(tilt) = `cap` · (1 − cos(roughness)).
+    pub cap: f32,
+    /// The tilt's direction (rad, in [0, 2π)) about the normal, from `axis`.
+    pub azimuth: f32,
+    /// The axis of body 1's part frame (0 = x, 1 = y, 2 = z) the azimuth is measured from:
+    /// the one least aligned with the normal when the draw was made.
+    pub axis: u8,
+}
+
+impl RoughnessDraw {
+    /// Whether the draw's values are in their ranges (a snapshot's, before it is trusted).
+    pub(crate) fn is_valid(&self) -> bool {
+        (0.0..1.0).contains(&self.cap)
+            && (0.0..=std::f32::consts::TAU).contains(&self.azimuth)
+            && self.axis < 3
+    }
 }
 
 /// Parry's manifold type with our per-manifold and per-point data.

@@ -484,6 +484,7 @@ impl NarrowPhase {
                     m.local_n1.is_finite()
                         && m.local_n2.is_finite()
                         && m.data.tangent.is_finite()
+                        && m.data.roughness.is_none_or(|d| d.is_valid())
                         && m.points.iter().all(|p| {
                             p.local_p1.is_finite()
                                 && p.local_p2.is_finite()

@@ -190,6 +190,7 @@ impl Assembly<'_> {
         let restitution = settings
             .restitution_combine
             .combine(bodies.restitution[a], bodies.restitution[b]);
+        let roughness = super::roughness::pair_roughness(bodies, a, b);
         let inverse_mass_a = bodies.effective_inverse_mass(a);
         let inverse_mass_b = bodies.effective_inverse_mass(b);
         // The lanes compute the products of points whose bodies have no translation locked
@@ -213,7 +214,12 @@ impl Assembly<'_> {
             // Body B is shape 1: its points and normal are in its part's frame.
             let (part_b, part_a) =
                 crate::collision::narrow_phase::manifold_poses(manifold, pose_b, pose_a);
-            let normal = part_b.rotation * manifold.local_n1;
+            let mut normal = part_b.rotation * manifold.local_n1;
+            if let Some(draw) = &manifold.data.roughness {
+                if roughness > 0.0 {
+                    normal = super::roughness::tilted(normal, draw, roughness, &part_b);
+                }
+            }
             let (t1, t2) = tangent_basis(normal, manifold.data.tangent);
             for (point_index, point) in manifold.points.iter().enumerate() {
                 let warm = point.data;

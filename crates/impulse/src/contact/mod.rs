@@ -3,6 +3,7 @@
 //! and warm-started from the impulses of the last step.
 //!
 //! One job per file, each using only the files listed before it:
+//! - [`roughness`]: rough surfaces' seeded tilts of new contacts' normals;
 //! - [`row`]: the row type ([`ContactConstraint`], [`JacobianRow`]) and its lever-arm products;
 //! - [`assembly`]: contact points → rows, island by island, warm-started;
 //! - [`targets`]: the rows' target velocities, per substep, and restitution's;
@@ -10,6 +11,7 @@
 
 pub(crate) mod assembly;
 pub(crate) mod record;
+pub(crate) mod roughness;
 pub(crate) mod row;
 pub(crate) mod targets;
 

@@ -243,6 +243,7 @@ fn cube_material() -> Material {
         friction: 0.6,
         restitution: 0.0,
         density: 1000.0,
+        roughness: 0.0,
     }
 }
 
@@ -426,6 +427,7 @@ fn card_house() -> Scene {
             friction: 0.7,
             restitution: 0.0,
             density: 1000.0,
+            roughness: 0.0,
         },
     );
     scene.bodies.push(ground(GROUND_HALF_WIDTH));
@@ -603,6 +605,7 @@ fn balls(name: &str, n: usize) -> Scene {
             friction: 0.3,
             restitution: 0.0,
             density: 1000.0,
+            roughness: 0.0,
         },
     );
     // Inner half widths of the box and the wall height.

@@ -56,6 +56,7 @@ fn card_house(thickness: Option<f32>) -> Scene {
                 friction: 0.6,
                 restitution: 0.0,
                 density: 1000.0,
+                roughness: 0.0,
             },
         )]
         .into(),

@@ -479,6 +479,7 @@ pub fn to_json_string(scene: &Scene) -> String {
         materials,
         bodies,
         joints,
+        seed,
     } = scene;
     let mut out = String::from("{\n");
     let mut members = vec![
@@ -487,6 +488,9 @@ pub fn to_json_string(scene: &Scene) -> String {
         ("dt", one_line(dt)),
         ("steps", one_line(steps)),
     ];
+    if *seed != 0 {
+        members.push(("seed", one_line(seed)));
+    }
     if *solver != SolverSettings::default() {
         members.push(("solver", one_line(solver)));
     }

@@ -38,6 +38,11 @@ pub struct Scene {
     /// The joints between bodies (docs/scene-format.md, "Joints").
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joints: Vec<JointDesc>,
+    /// Seed of the engine's seeded variation (the contact normals' [`Material::roughness`]
+    /// draws); 0 by default. A [`Variation`] with a non-zero seed replaces it, so run K of a
+    /// sweep draws its own rough surfaces.
+    #[serde(default)]
+    pub seed: u64,
 }
 
 /// Surface and bulk properties of a body.
@@ -50,7 +55,17 @@ pub struct Material {
     pub restitution: f32,
     /// Density (kg/m³) > 0, used for mass and inertia unless the body gives `mass`.
     pub density: f32,
+    /// Surface roughness (degrees) in [0, [`MAX_ROUGHNESS_DEGREES`]]: each new contact's normal
+    /// is tilted by a random angle up to the larger of its two bodies' roughness, drawn from
+    /// the scene's seed, the step and the pair (Chenney & Forsyth, "Sampling plausible
+    /// solutions to multi-body constraint problems", SIGGRAPH 2000). 0 (the default) is a
+    /// smooth surface and draws nothing.
+    pub roughness: f32,
 }
+
+/// The largest [`Material::roughness`] (degrees): a tilt beyond it is no longer a small
+/// perturbation of the contact.
+pub const MAX_ROUGHNESS_DEGREES: f32 = 30.0;
 
 impl Default for Material {
     fn default() -> Self {
@@ -58,6 +73,7 @@ impl Default for Material {
             friction: 0.5,
             restitution: 0.0,
             density: 1000.0,
+            roughness: 0.0,
         }
     }
 }
@@ -423,6 +439,7 @@ impl Default for Scene {
             materials: BTreeMap::new(),
             bodies: Vec::new(),
             joints: Vec::new(),
+            seed: 0,
         }
     }
 }

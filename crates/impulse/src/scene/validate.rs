@@ -295,6 +295,7 @@ impl Checker {
         self.non_negative(&path.key("friction"), m.friction);
         self.unit_interval(&path.key("restitution"), m.restitution);
         self.positive(&path.key("density"), m.density);
+        self.rule(&path.key("roughness"), rules::roughness(m.roughness));
     }
 
     fn body(&mut self, path: &FieldPath, b: &BodyDesc, materials: &BTreeMap<String, Material>) {

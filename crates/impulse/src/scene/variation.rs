@@ -186,7 +186,8 @@ impl Jitter {
 pub struct Variation {
     /// Field changes, applied in order (a later one wins where two set the same field).
     pub overrides: Vec<Override>,
-    /// Seed of the jitter: run K of a sweep uses seed K.
+    /// Seed of the jitter and, when not 0, the scene's [`Scene::seed`] (the rough surfaces'
+    /// draws): run K of a sweep uses seed K.
     pub seed: u64,
     /// The jitter; all zero leaves the bodies where the overrides put them.
     pub jitter: Jitter,
@@ -235,6 +236,10 @@ impl Variation {
             for (index, body) in varied.bodies.iter_mut().enumerate() {
                 jitter_body(self.seed, index, &self.jitter, body);
             }
+        }
+        // The seed also draws the rough surfaces' normals: run K of a sweep gets its own.
+        if self.seed != 0 {
+            varied.seed = self.seed;
         }
         validate(&varied).map_err(|e| self.blame(e))?;
         Ok(varied)

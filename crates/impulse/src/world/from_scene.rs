@@ -169,6 +169,7 @@ pub(crate) fn builder_of(
         angular_velocity: Vec3::from(desc.angular_velocity),
         friction: material.friction,
         restitution: material.restitution,
+        roughness: material.roughness,
         density: material.density,
         mass: desc.mass,
         name: desc.name.clone(),

@@ -49,6 +49,8 @@ pub struct World {
     pub(crate) settings: SolverSettings,
     dt: f32,
     step_count: u64,
+    /// Seed of the seeded variation: the rough surfaces' draws ([`World::seed`]).
+    seed: u64,
     broad_phase: BroadPhase,
     narrow_phase: NarrowPhase,
     candidates: Vec<(u32, u32)>,
@@ -131,6 +133,7 @@ impl World {
             settings,
             dt,
             step_count: 0,
+            seed: 0,
             broad_phase: BroadPhase::default(),
             narrow_phase: NarrowPhase::default(),
             candidates: Vec::new(),
@@ -183,6 +186,7 @@ impl World {
     /// ```
     pub fn from_scene(scene: &Scene) -> Result<Self, WorldError> {
         let mut world = Self::new(Vec3::from(scene.gravity), scene.dt, scene.solver.clone())?;
+        world.seed = scene.seed;
         for (index, desc) in scene.bodies.iter().enumerate() {
             let material = match &desc.material {
                 MaterialRef::Inline(m) => m.clone(),
@@ -275,6 +279,7 @@ impl World {
         b.shape.push(built.shape);
         b.friction.push(builder.friction);
         b.restitution.push(builder.restitution);
+        b.roughness.push(builder.roughness.to_radians());
         b.asleep.push(false);
         b.sleep_time.push(0.0);
         b.force.push(Vec3::ZERO);
@@ -314,6 +319,19 @@ impl World {
     /// Steps taken so far.
     pub fn step_count(&self) -> u64 {
         self.step_count
+    }
+
+    /// Seed of the world's seeded variation: a new contact's normal on a rough surface
+    /// ([`BodyBuilder::roughness`]) is tilted by a draw keyed by (seed, step, pair, manifold),
+    /// the same on every machine and thread count. A scene's `seed` (0 by default).
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Sets [`World::seed`]: the contacts that start from the next step on draw from it;
+    /// contacts already touching keep their tilts.
+    pub fn set_seed(&mut self, seed: u64) {
+        self.seed = seed;
     }
 
     /// Simulated time (s): the sum of the steps' dt, the clock of kinematic keyframes.

@@ -94,6 +94,9 @@ pub struct WorldSnapshot {
     dt: f32,
     settings: SolverSettings,
     step_count: u64,
+    /// The world's seed (absent before it existed: 0).
+    #[serde(default)]
+    seed: u64,
     bodies: Bodies,
     handles: Handles,
     forces_pending: bool,
@@ -283,6 +286,7 @@ impl World {
             dt: self.dt,
             settings: self.settings.clone(),
             step_count: self.step_count,
+            seed: self.seed,
             bodies: self.bodies.clone(),
             handles: self.handles.clone(),
             forces_pending: self.forces_pending,
@@ -316,6 +320,10 @@ impl World {
         let mut world = World::new(snapshot.gravity, snapshot.dt, snapshot.settings)
             .map_err(|e| invalid(e.to_string()))?;
         let mut bodies = snapshot.bodies;
+        if bodies.roughness.is_empty() {
+            // Written before roughness existed: every surface smooth.
+            bodies.roughness = vec![0.0; bodies.len()];
+        }
         bodies.check_lengths().map_err(invalid)?;
         for i in 0..bodies.len() {
             if let Some(shape) = rebuilt_composite(&bodies.shape[i])
@@ -333,6 +341,7 @@ impl World {
         world.bodies = bodies;
         world.handles = snapshot.handles;
         world.step_count = snapshot.step_count;
+        world.seed = snapshot.seed;
         world.forces_pending = snapshot.forces_pending;
         world.energy = snapshot.energy;
         world.contact_events = snapshot.contact_events;
@@ -479,6 +488,9 @@ fn check_bodies(b: &Bodies) -> Result<(), String> {
         }
         if !(0.0..=1.0).contains(&b.restitution[i]) {
             return bad("restitution is outside [0, 1]");
+        }
+        if !(0.0..=crate::scene::MAX_ROUGHNESS_DEGREES.to_radians()).contains(&b.roughness[i]) {
+            return bad("roughness is outside [0, 30] degrees");
         }
         let shape = &b.shape[i];
         if b.kind[i] != BodyKind::Static && shape.as_halfspace().is_some() {

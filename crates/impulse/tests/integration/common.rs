@@ -10,6 +10,7 @@ pub(crate) fn material(friction: f32) -> Material {
         friction,
         restitution: 0.0,
         density: 1000.0,
+        roughness: 0.0,
     }
 }
 

@@ -40,6 +40,7 @@ fn material(density: f32) -> Material {
         friction: 0.6,
         restitution: 0.0,
         density,
+        roughness: 0.0,
     }
 }
 
@@ -285,6 +286,7 @@ fn the_heavy_on_light_path_advances_the_whole_step() {
             friction: 0.0,
             restitution: 0.0,
             density: 1000.0,
+            roughness: 0.0,
         };
         world
             .add_body(

@@ -11,6 +11,7 @@ fn material() -> Material {
         friction: 0.6,
         restitution: 0.0,
         density: 1000.0,
+        roughness: 0.0,
     }
 }
 

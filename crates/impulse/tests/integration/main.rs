@@ -34,6 +34,7 @@ mod meshes;
 mod phantom_and_tunnel;
 mod physics;
 mod profile;
+mod roughness;
 mod scene_files;
 mod seams;
 mod shapes;

@@ -22,6 +22,7 @@ fn material(friction: f32, restitution: f32) -> Material {
         friction,
         restitution,
         density: 1000.0,
+        roughness: 0.0,
     }
 }
 

@@ -13,6 +13,14 @@ impl World {
         let (bodies, candidates, margins) = (&self.bodies, &self.candidates, &self.margins);
         let narrow = || narrow_phase.update(bodies, candidates, margins, parallel);
         both(parallel, || broad_phase.optimize(), narrow).1?;
+        if self.bodies.roughness.iter().any(|&r| r > 0.0) {
+            crate::contact::roughness::draw_new_manifolds(
+                &mut self.narrow_phase.pairs,
+                &self.bodies,
+                self.seed,
+                self.step_count,
+            );
+        }
         Ok(())
     }
 }

@@ -1,0 +1,168 @@
+//! Rough surfaces: each new contact manifold between bodies of which one is rough
+//! ([`crate::BodyBuilder::roughness`]) gets a seeded draw that tilts its normal by a small angle,
+//! kept for as long as the manifold lasts (Chenney & Forsyth, "Sampling plausible solutions to
+//! multi-body constraint problems", SIGGRAPH 2000; Barzel, Hughes & Wood, "Plausible motion
+//! simulation for computer graphics animation", 1996: small random changes at contacts are
+//! physically plausible, and they vary a pile's outcome from one seed to the next).
+//!
+//! The draw is keyed by (world seed, step at which the manifold appeared, the pair's body
+//! indices, the manifold's index in the pair) through the SplitMix64 finaliser (Steele, Lea &
+//! Flood, "Fast splittable pseudorandom number generators", OOPSLA 2014): integer arithmetic, so
+//! it is the same on every machine, thread count and backend. The tilt is uniform over the
+//! spherical cap of half-angle `roughness` around the normal; its direction is measured from an
+//! axis fixed in body 1's part frame, so it turns with the body and does not drift from step to
+//! step.
+
+use crate::body::Bodies;
+use crate::collision::manifold::RoughnessDraw;
+use crate::collision::narrow_phase::ContactPair;
+use glam::Vec3;
+use parry3d::math::Pose;
+
+/// The largest roughness (rad) of a pair's two bodies: the pair's.
+#[inline]
+pub(crate) fn pair_roughness(bodies: &Bodies, a: usize, b: usize) -> f32 {
+    bodies.roughness[a].max(bodies.roughness[b])
+}
+
+/// Gives every manifold with points that has no draw yet, of every pair with a rough body, its
+/// draw for `seed` at `step`. Called once a step, after the narrow phase.
+pub(crate) fn draw_new_manifolds(pairs: &mut [ContactPair], bodies: &Bodies, seed: u64, step: u64) {
+    for pair in pairs.iter_mut() {
+        let (b1, b2) = (pair.body1, pair.body2);
+        if pair_roughness(bodies, b1 as usize, b2 as usize) <= 0.0 {
+            continue;
+        }
+        for (index, manifold) in pair.manifolds.iter_mut().enumerate() {
+            if manifold.points.is_empty() || manifold.data.roughness.is_some() {
+                continue;
+            }
+            let key = [
+                seed,
+                step,
+                u64::from(b1) << 32 | u64::from(b2),
+                index as u64,
+            ];
+            let bits = mix(key);
+            let n = manifold.local_n1.abs();
+            let axis = if n.x <= n.y && n.x <= n.z {
+                0
+            } else if n.y <= n.z {
+                1
+            } else {
+                2
+            };
+            manifold.data.roughness = Some(RoughnessDraw {
+                cap: unit(bits),
+                azimuth: unit(bits >> 32) * std::f32::consts::TAU,
+                axis,
+            });
+        }
+    }
+}
+
+/// `normal` (world, unit) tilted by `draw` for a pair of roughness `roughness` (rad), with
+/// body 1's part pose `part1` (the azimuth's axis turns with it).
+#[inline]
+pub(crate) fn tilted(normal: Vec3, draw: &RoughnessDraw, roughness: f32, part1: &Pose) -> Vec3 {
+    let cos_tilt = 1.0 - draw.cap * (1.0 - roughness.cos());
+    let sin_tilt = (1.0 - cos_tilt * cos_tilt).max(0.0).sqrt();
+    let mut reference = Vec3::ZERO;
+    reference[draw.axis as usize] = 1.0;
+    let reference = part1.rotation * reference;
+    let along = reference - normal * normal.dot(reference);
+    let (d0, d1) = if along.length_squared() > 1e-6 {
+        let d0 = along.normalize();
+        (d0, normal.cross(d0))
+    } else {
+        normal.any_orthonormal_pair()
+    };
+    let (s, c) = draw.azimuth.sin_cos();
+    (normal * cos_tilt + (d0 * c + d1 * s) * sin_tilt).normalize()
+}
+
+/// 64 well-mixed bits of a key: SplitMix64's finaliser over the key's words in turn.
+fn mix(key: [u64; 4]) -> u64 {
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    for word in key {
+        state = state.wrapping_add(word).wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        state = z ^ (z >> 31);
+    }
+    state
+}
+
+/// A number in [0, 1) from the low 24 bits of `bits` (exact in f32).
+fn unit(bits: u64) -> f32 {
+    (bits & 0xFF_FFFF) as f32 / 16_777_216.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Tilts stay within the cap, cover it (the mean of 1 − cos over uniform draws on a cap is
+    /// half the cap's), and are unit vectors.
+    #[test]
+    fn tilts_are_uniform_over_the_cap() {
+        let roughness = 10f32.to_radians();
+        let normal = Vec3::Y;
+        let pose = Pose::IDENTITY;
+        let mut sum = 0.0f64;
+        let mut widest = 0.0f32;
+        let count = 20_000;
+        for k in 0..count {
+            let bits = mix([7, k, 1, 0]);
+            let draw = RoughnessDraw {
+                cap: unit(bits),
+                azimuth: unit(bits >> 32) * std::f32::consts::TAU,
+                axis: 0,
+            };
+            let n = tilted(normal, &draw, roughness, &pose);
+            assert!((n.length() - 1.0).abs() < 1e-5);
+            let angle = n.dot(normal).clamp(-1.0, 1.0).acos();
+            assert!(angle <= roughness + 1e-4, "tilt {angle} beyond {roughness}");
+            widest = widest.max(angle);
+            sum += f64::from(1.0 - n.dot(normal));
+        }
+        let mean = sum / count as f64;
+        let half_cap = 0.5 * f64::from(1.0 - roughness.cos());
+        assert!(
+            (mean - half_cap).abs() < 0.02 * half_cap,
+            "{mean} vs {half_cap}"
+        );
+        assert!(widest > 0.99 * roughness);
+    }
+
+    /// The tilt turns with body 1: the same draw on a turned body gives the turned normal.
+    #[test]
+    fn the_tilt_turns_with_body_one() {
+        let draw = RoughnessDraw {
+            cap: 0.7,
+            azimuth: 1.0,
+            axis: 0,
+        };
+        let roughness = 0.2;
+        let turn = glam::Quat::from_rotation_y(0.9);
+        let still = tilted(Vec3::Y, &draw, roughness, &Pose::IDENTITY);
+        let turned = tilted(
+            turn * Vec3::Y,
+            &draw,
+            roughness,
+            &Pose::from_parts(Vec3::ZERO, turn),
+        );
+        assert!((turned - turn * still).length() < 1e-5);
+    }
+
+    /// Different keys give different draws; the same key the same.
+    #[test]
+    fn draws_depend_on_every_part_of_the_key() {
+        let base = mix([1, 2, 3, 4]);
+        assert_eq!(base, mix([1, 2, 3, 4]));
+        for other in [[0, 2, 3, 4], [1, 0, 3, 4], [1, 2, 0, 4], [1, 2, 3, 0]] {
+            assert_ne!(base, mix(other));
+        }
+    }
+}
