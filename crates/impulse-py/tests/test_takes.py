@@ -422,3 +422,70 @@ def test_the_worked_shots_are_as_documented(shot, repository, tmp_path):
     )
     best = found.met()[0]
     assert (len(found), len(found.met()), round(best.perturbation, 2)) == documented
+
+
+#: A frictionless elastic ball dropped on a rough floor: only the floor's roughness draws (the
+#: scene seed) decide where it bounces.
+ROUGH = {
+    "name": "rough bounce",
+    "materials": {
+        "rough": {"friction": 0.0, "restitution": 1.0, "roughness": 10.0},
+        "ball": {"friction": 0.0, "restitution": 1.0},
+    },
+    "bodies": [
+        {
+            "name": "floor",
+            "kind": "static",
+            "material": "rough",
+            "shape": {"type": "cuboid", "half_extents": [20, 0.5, 20]},
+            "position": [0, -0.5, 0],
+        },
+        {
+            "name": "ball",
+            "kind": "dynamic",
+            "material": "ball",
+            "shape": {"type": "sphere", "radius": 0.1},
+            "position": [0, 1.1, 0],
+        },
+    ],
+}
+
+
+def test_takes_with_their_own_seeds_vary_the_rough_surfaces(tmp_path):
+    # After 1.2 s the ball has bounced once: it must have gone off toward +x.
+    goal = {
+        "type": "ends_inside",
+        "body": "ball",
+        "region": {"box": {"min": [0.15, -1, -1], "max": [5, 5, 1]}},
+    }
+    takes = search(
+        ROUGH,
+        [goal],
+        {"seeds": True},
+        budget=32,
+        steps=72,
+        out=tmp_path / "t",
+        workers=2,
+        population=16,
+        progress=False,
+    )
+    seeds = [take.scene_seed for take in takes.values()]
+    assert all(isinstance(s, int) and s > 0 for s in seeds)
+    assert len(set(seeds)) > 8  # fresh seeds, and the best ones reused
+    ends = {take.take_id: take for take in takes.values()}
+    met = takes.met()
+    assert met, "some rough bounce goes toward +x"
+    scene = met[0].scene()
+    assert scene["seed"] == met[0].scene_seed
+    world = impulse.World.from_scene(scene)
+    assert world.seed == met[0].scene_seed
+    world.step(72)
+    assert world.positions[1][0] >= 0.15
+    # A smooth floor sends the ball straight back up whatever the seed.
+    smooth = json.loads(json.dumps(ROUGH))
+    smooth["materials"]["rough"]["roughness"] = 0.0
+    smooth["seed"] = 12345
+    world = impulse.World.from_scene(smooth)
+    world.step(72)
+    assert abs(world.positions[1][0]) < 1e-6
+    assert len(ends) == len(takes)

@@ -41,10 +41,13 @@ def _canonical(value: Any) -> str:
     return json.dumps(value, sort_keys=True, separators=(",", ":"), allow_nan=False)
 
 
-def take_id(digest: str, theta: np.ndarray) -> str:
-    """A take's id: 16 hex digits of SHA-256 over the search's digest and θ's exact bits."""
+def take_id(digest: str, theta: np.ndarray, scene_seed: int | None = None) -> str:
+    """A take's id: 16 hex digits of SHA-256 over the search's digest, θ's exact bits and the
+    take's scene seed (when the variation gives takes their own)."""
     hasher = hashlib.sha256(digest.encode())
     hasher.update(np.asarray(theta, dtype="<f8").tobytes())
+    if scene_seed is not None:
+        hasher.update(int(scene_seed).to_bytes(8, "little"))
     return hasher.hexdigest()[:16]
 
 
@@ -230,6 +233,7 @@ class _Store:
         for name in names:
             columns[f"cost.{name}"] = pa.array([r.get(f"cost.{name}") for r in rows], pa.float64())
         columns["theta"] = pa.array([r["theta"] for r in rows], pa.list_(pa.float64()))
+        columns["scene_seed"] = pa.array([r.get("scene_seed") for r in rows], pa.uint64())
         columns["wall_time_s"] = pa.array([r.get("wall_time_s") for r in rows], pa.float64())
         temporary = os.path.join(self.root, TAKES_FILE + ".partial")
         pq.write_table(pa.table(columns), temporary)
@@ -374,37 +378,40 @@ def search(
     mean, spread = np.zeros(dimension), np.ones(dimension)
     elites = max(2, round(elite_fraction * population))
     done: list[dict[str, Any]] = []
+    elite_seeds: list[int | None] = []
     generation = 0
     try:
         while len(done) < budget:
             rng = np.random.default_rng([seed, generation])
             count = min(population, budget - len(done))
             thetas = mean + spread * rng.standard_normal((population, dimension))
+            seeds = _scene_seeds(rng, population, variation.seeds, elite_seeds)
             batch = []
-            for index, theta in enumerate(thetas[:count]):
-                key = take_id(digest, theta)
+            for index, (theta, scene_seed) in enumerate(zip(thetas[:count], seeds)):
+                key = take_id(digest, theta, scene_seed)
                 row = store.rows.get(key)
                 if row is not None and row["status"] != FAILED:
                     done.append(row)
                     bar.update(row)
                     continue
-                batch.append((index, theta, key))
+                batch.append((index, theta, scene_seed, key))
             tasks = [
                 {
                     "key": key,
-                    "scene": variation.apply(base, theta),
+                    "scene": variation.apply(base, theta, scene_seed),
                     "steps": steps,
                     "preset": preset,
                     "goals": payload,
                 }
-                for _, theta, key in batch
+                for _, theta, scene_seed, key in batch
             ]
-            by_key = {key: (index, theta) for index, theta, key in batch}
+            by_key = {key: (index, theta, scene_seed) for index, theta, scene_seed, key in batch}
             for result in runner.run(tasks):
                 # A task the pool could not run comes back as the sweep's failed row.
                 result.setdefault("take_id", result.get("run_key"))
-                index, theta = by_key[result["take_id"]]
+                index, theta, scene_seed = by_key[result["take_id"]]
                 row = _row(result, goals, generation, index, theta)
+                row["scene_seed"] = scene_seed
                 store.rows[row["take_id"]] = row
                 done.append(row)
                 bar.update(row)
@@ -413,6 +420,7 @@ def search(
                 break
             ranked = sorted((row for row in done if row["status"] != FAILED), key=_rank)
             best = np.array([row["theta"] for row in ranked[:elites]])
+            elite_seeds = [row.get("scene_seed") for row in ranked[:elites]]
             if len(best) >= 2:
                 mean = SMOOTHING * best.mean(axis=0) + (1.0 - SMOOTHING) * mean
                 spread = SMOOTHING * best.std(axis=0) + (1.0 - SMOOTHING) * spread
@@ -423,6 +431,25 @@ def search(
         bar.close()
         store.write()
     return load(store.root)
+
+
+def _scene_seeds(
+    rng: np.random.Generator, count: int, enabled: bool, elite_seeds: Sequence[int | None]
+) -> list[int | None]:
+    """Each take's scene seed: ``None`` without ``Variation.seeds``; else, drawn in order, one of
+    the best takes' seeds (half the time, once there are some: refining around a good rough
+    world) or a fresh seed in [1, 2⁶³). Drawn whether or not they are used, so the draws of θ
+    never depend on ``seeds``."""
+    reuse = rng.random(count)
+    pick = rng.integers(0, max(1, len(elite_seeds)), count)
+    fresh = rng.integers(1, 2**63, count)
+    if not enabled:
+        return [None] * count
+    known = [s for s in elite_seeds if s is not None]
+    return [
+        int(known[p % len(known)]) if known and r < 0.5 else int(f)
+        for r, p, f in zip(reuse, pick, fresh)
+    ]
 
 
 def _row(
@@ -492,7 +519,8 @@ class _Progress:
 class Take:
     """One take of a search: its θ, costs and the varied scene.
 
-    Attributes: ``take_id`` (str), ``theta`` (ndarray, unit-free), ``met`` (bool: every goal
+    Attributes: ``take_id`` (str), ``theta`` (ndarray, unit-free), ``scene_seed`` (the take's
+    scene seed, or None when the variation keeps the scene's), ``met`` (bool: every goal
     met), ``cost`` (weighted total, None when the take did not complete), ``costs`` (goal name
     → cost), ``perturbation`` (size of θ; smaller is more plausible), ``status``, ``error``.
     """
@@ -500,6 +528,7 @@ class Take:
     def __init__(self, row: Mapping[str, Any], takes: Takes):
         self.take_id = row["take_id"]
         self.theta = np.asarray(row["theta"], dtype=np.float64)
+        self.scene_seed = row.get("scene_seed")
         self.met = bool(row["met"])
         self.cost = row["cost"]
         self.costs = {name: row.get(f"cost.{name}") for name in takes.goal_names}
@@ -511,7 +540,7 @@ class Take:
     def scene(self) -> dict[str, Any]:
         """The varied scene (a dict as in a scene file): ``impulse run`` of it written to a file
         reproduces the take's trajectory to the bit."""
-        return self._takes.variation.apply(self._takes.base_scene, self.theta)
+        return self._takes.variation.apply(self._takes.base_scene, self.theta, self.scene_seed)
 
     def write_scene(self, path: str | os.PathLike) -> None:
         """Writes :meth:`scene` as JSON to ``path``."""

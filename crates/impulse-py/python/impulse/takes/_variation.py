@@ -18,6 +18,10 @@ A field whose scale is 0 is not varied and its components are left out of θ. Th
 are rounded to float32 (the engine's precision) before they are written, so the varied scene
 read from a file gives the same bits as the one simulated in the search.
 
+With ``seeds=True`` a take also has its own scene ``seed``: the seed of the engine's rough
+surfaces (materials with ``roughness``), whose draws tilt each new contact's normal. It is an
+integer, not part of θ: the search draws a fresh one, or reuses one of the best takes' seeds.
+
 Small perturbations of the initial state are the plausible variations of Barzel, Hughes & Wood,
 "Plausible motion simulation for computer graphics animation" (Eurographics CAS 1996).
 """
@@ -52,6 +56,9 @@ class Variation:
         Scale of the linear velocity offsets (m/s).
     angular_velocity : float
         Scale of the angular velocity offsets (rad/s).
+    seeds : bool
+        Give each take its own scene ``seed`` (rough surfaces' draws; materials need a
+        ``roughness`` for it to matter).
 
     Raises
     ------
@@ -66,8 +73,10 @@ class Variation:
         angle: float = 0.0,
         velocity: float = 0.0,
         angular_velocity: float = 0.0,
+        seeds: bool = False,
     ):
         self.bodies = None if bodies is None else list(bodies)
+        self.seeds = bool(seeds)
         self.scales = {
             "position": float(position),
             "angle": float(angle),
@@ -79,20 +88,21 @@ class Variation:
                 raise ValueError(
                     f"variation {name} = {value} {UNITS[name]}: must be finite and >= 0"
                 )
-        if not any(self.scales.values()):
+        if not any(self.scales.values()) and not self.seeds:
             raise ValueError(
                 "a variation with every scale 0 varies nothing: give position (m), angle "
-                "(degrees), velocity (m/s) or angular_velocity (rad/s)"
+                "(degrees), velocity (m/s), angular_velocity (rad/s) or seeds"
             )
 
     @staticmethod
     def from_dict(spec: Mapping[str, Any]) -> Variation:
         """From ``{"bodies": [...], "position": m, "angle": degrees, "velocity": m/s,
         "angular_velocity": rad/s}`` (every key optional but one scale)."""
-        unknown = set(spec) - {"bodies", *FIELDS}
+        unknown = set(spec) - {"bodies", "seeds", *FIELDS}
         if unknown:
             raise ValueError(
-                f"variation has unknown keys {sorted(unknown)}: use bodies, {', '.join(FIELDS)}"
+                f"variation has unknown keys {sorted(unknown)}: use bodies, seeds, "
+                f"{', '.join(FIELDS)}"
             )
         return Variation(**dict(spec))
 
@@ -100,6 +110,8 @@ class Variation:
         """The spec :meth:`from_dict` reads."""
         out: dict[str, Any] = {"bodies": self.bodies}
         out.update(self.scales)
+        if self.seeds:
+            out["seeds"] = True
         return out
 
     def fields(self) -> list[str]:
@@ -143,9 +155,11 @@ class Variation:
         """Length of θ for ``scene``: 3 per varied field per varied body."""
         return 3 * len(self.fields()) * len(self.body_indices(scene))
 
-    def apply(self, scene: Mapping[str, Any], theta: Sequence[float]) -> dict[str, Any]:
+    def apply(
+        self, scene: Mapping[str, Any], theta: Sequence[float], seed: int | None = None
+    ) -> dict[str, Any]:
         """A copy of ``scene`` (a dict as in a scene file) with θ's offsets applied and the
-        changed values rounded to float32.
+        changed values rounded to float32; with ``seed``, also the scene's ``seed``.
 
         Raises
         ------
@@ -163,6 +177,8 @@ class Variation:
         if not np.all(np.isfinite(theta)):
             raise ValueError("theta must be finite")
         out = copy.deepcopy(dict(scene))
+        if seed is not None:
+            out["seed"] = int(seed)
         k = 0
         for index in indices:
             body = out["bodies"][index]

@@ -44,6 +44,11 @@ def _parser() -> argparse.ArgumentParser:
     )
     search.add_argument("--preset", choices=("fast", "default", "precise", "reference"))
     search.add_argument("--vary-bodies", help="comma-separated body names (default: all dynamic)")
+    search.add_argument(
+        "--vary-seed",
+        action="store_true",
+        help="give each take its own scene seed (the rough surfaces' draws)",
+    )
     for field, unit in (
         ("position", "m"),
         ("angle", "degrees"),
@@ -74,6 +79,8 @@ def _variation(arguments: argparse.Namespace, spec: dict[str, Any]) -> dict[str,
     out = dict(spec)
     if arguments.vary_bodies:
         out["bodies"] = [name.strip() for name in arguments.vary_bodies.split(",")]
+    if arguments.vary_seed:
+        out["seeds"] = True
     for field in ("position", "angle", "velocity", "angular_velocity"):
         value = getattr(arguments, f"vary_{field}")
         if value is not None:
