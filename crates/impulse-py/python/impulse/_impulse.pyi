@@ -7,15 +7,30 @@ from typing import Any, Literal, TypeAlias, final
 
 import numpy as np
 import numpy.typing as npt
-from typing_extensions import disjoint_base
 
 from ._diagnostics import Diagnostics
 from ._trajectory import Trajectory
 
-# The native classes are `@final` and `@disjoint_base`: pyo3 classes cannot be subclassed
-# (mypy's stubtest checks these stubs against the module).
+# The native classes are `@final`: pyo3 classes cannot be subclassed (mypy's stubtest checks
+# these stubs against the module).
 
 __version__: str
+
+__all__ = [
+    "SceneError",
+    "WorldError",
+    "StepError",
+    "Settings",
+    "World",
+    "BodyHandle",
+    "Shape",
+    "BodyBuilder",
+    "JointHandle",
+    "JointBuilder",
+    "scenes",
+    "set_decomposition_cache_dir",
+    "__version__",
+]
 
 class SceneError(ValueError):
     """A scene that cannot be read or is invalid: the message names the file, line, body and
@@ -37,7 +52,6 @@ def set_decomposition_cache_dir(directory: str | os.PathLike[str] | None) -> Non
     """Keep moving meshes' convex decompositions in ``directory`` across processes (None: memory only)."""
 
 @final
-@disjoint_base
 class Settings:
     """Solver settings: the scene format's ``solver`` object (same fields and units)."""
 
@@ -153,7 +167,6 @@ class Settings:
         """Largest angular speed of a body (rad/s) before a blow-up."""
 
 @final
-@disjoint_base
 class BodyHandle:
     """A body's name in a world (slot index and generation); hashable, picklable."""
 
@@ -164,7 +177,6 @@ class BodyHandle:
     def generation(self) -> int: ...
 
 @final
-@disjoint_base
 class JointHandle:
     """A joint's name in a world (slot index and generation); hashable, ordered, picklable."""
 
@@ -179,7 +191,6 @@ class JointHandle:
     def __ge__(self, other: JointHandle, /) -> bool: ...
 
 @final
-@disjoint_base
 class JointBuilder:
     """A joint between body A and body B to ``World.insert_joint``; every method returns a new
     builder. Degrees of freedom are B's frame relative to A's: ``"linear_x"`` … ``"angular_z"``
@@ -233,7 +244,6 @@ class JointBuilder:
     def name(self, name: str) -> JointBuilder: ...
 
 @final
-@disjoint_base
 class Shape:
     """A collision shape in the body frame (m); compares with ``==``, picklable."""
 
@@ -265,7 +275,6 @@ class Shape:
     def to_dict(self) -> dict[str, Any]: ...
 
 @final
-@disjoint_base
 class BodyBuilder:
     """A body to insert: ``BodyBuilder.dynamic(Shape.ball(0.5), translation=(0, 2, 0))``.
 
@@ -287,7 +296,6 @@ _Vec3: TypeAlias = Sequence[float]
 _ArrayF32: TypeAlias = npt.NDArray[np.float32]
 
 @final
-@disjoint_base
 class World:
     """A simulation world. State arrays are read-only float32 views of the engine's storage
     (see docs/python.md for their lifetime rule); assigning an array sets every body. Calls
