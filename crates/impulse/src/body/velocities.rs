@@ -5,7 +5,8 @@ use glam::Vec3;
 
 /// Velocities the solver updates in place: an island's local arrays, indexed by the
 /// constraints' `local_a`/`local_b` (static bodies share an immovable slot; their zero inverse
-/// mass and inertia make its updates exact no-ops).
+/// mass and inertia make its updates exact no-ops). Public for the hidden `internals` module.
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 pub struct Velocities<'a> {
     /// Linear velocities (m/s).
     pub linear: &'a mut [Vec3],
