@@ -194,7 +194,11 @@ fn repository_paths() -> Vec<String> {
         for entry in std::fs::read_dir(&folder).unwrap().map(Result::unwrap) {
             let name = entry.file_name().to_string_lossy().into_owned();
             let path = entry.path();
-            let relative = path.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/");
+            let relative = path
+                .strip_prefix(&root)
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
             if entry.file_type().unwrap().is_dir() {
                 if !SKIPPED.contains(&name.as_str()) {
                     paths.push(relative + "/");
@@ -223,9 +227,14 @@ fn paths_named(line: &str) -> Vec<&str> {
     let mut rest = line;
     let mut offset = 0;
     while let Some(start) = rest.find(is_path_char) {
-        let end = rest[start..].find(|c| !is_path_char(c)).map_or(rest.len(), |e| start + e);
+        let end = rest[start..]
+            .find(|c| !is_path_char(c))
+            .map_or(rest.len(), |e| start + e);
         let token = rest[start..end].trim_end_matches(['.', ',', ':']);
-        let (before, after) = (line[..offset + start].chars().last(), line[offset + start + token.len()..].chars().next());
+        let (before, after) = (
+            line[..offset + start].chars().last(),
+            line[offset + start + token.len()..].chars().next(),
+        );
         offset += end;
         rest = &line[offset..];
         if !token.contains('/')
@@ -296,7 +305,11 @@ fn every_path_the_docs_name_exists() {
         }
     }
     assert!(checked >= 200, "only {checked} paths found in the docs");
-    assert!(missing.is_empty(), "the docs name paths that do not exist:\n{}", missing.join("\n"));
+    assert!(
+        missing.is_empty(),
+        "the docs name paths that do not exist:\n{}",
+        missing.join("\n")
+    );
 }
 
 #[test]
@@ -306,6 +319,11 @@ fn paths_named_finds_paths_and_leaves_the_rest() {
                 tests/data/fuzz/ or --set/--seed/ fuzz/TARGET/";
     assert_eq!(
         paths_named(line),
-        ["world/", "crates/impulse/src/lib.rs", "step/kinematic.rs", "tests/data/fuzz/"]
+        [
+            "world/",
+            "crates/impulse/src/lib.rs",
+            "step/kinematic.rs",
+            "tests/data/fuzz/"
+        ]
     );
 }
