@@ -249,7 +249,7 @@ fn paths_named(line: &str) -> Vec<&str> {
         let names: Vec<&str> = token.trim_end_matches('/').split('/').collect();
         if names
             .iter()
-            .any(|n| n.len() > 1 && n.chars().all(|c| c.is_ascii_uppercase()))
+            .any(|n| n.len() > 1 && n.chars().all(|c| c.is_ascii_uppercase() || c == '_'))
         {
             continue; // a placeholder: OUT/manifest.json
         }
@@ -316,7 +316,7 @@ fn every_path_the_docs_name_exists() {
 fn paths_named_finds_paths_and_leaves_the_rest() {
     let line = "see `world/`, crates/impulse/src/lib.rs, step/kinematic.rs: m/s, 1/60, \
                 https://github.com/a/b.rs, OUT/manifest.json, target/blender/x.zip, v/ and \
-                tests/data/fuzz/ or --set/--seed/ fuzz/TARGET/";
+                tests/data/fuzz/ or --set/--seed/ fuzz/TARGET/ OUT_DIR/x.out/";
     assert_eq!(
         paths_named(line),
         [
