@@ -22,7 +22,7 @@ _vendor = os.path.join(os.path.dirname(__file__), "vendor")
 if os.path.isdir(_vendor) and _vendor not in sys.path:
     sys.path.insert(0, _vendor)
 
-from . import operators
+from . import operators  # noqa: E402 (after the vendor path is added)
 
 
 def register():

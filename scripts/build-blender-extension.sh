@@ -24,7 +24,9 @@ out=target/blender
 mkdir -p "$out/wheels"
 if [[ -z "$wheel" ]]; then
   nice python3 -m pip wheel --quiet --no-deps --disable-pip-version-check ./crates/impulse-py -w "$out/wheels"
-  wheel="$(ls -t "$out/wheels"/impulse-"$version"-*.whl | head -n 1)"
+  # The distribution is `impulse-contact` (the wheel impulse_contact-<version>-...); the
+  # package it installs is `impulse`.
+  wheel="$(ls -t "$out/wheels"/impulse_contact-"$version"-*.whl | head -n 1)"
 fi
 [[ -f "$wheel" ]] || { echo "error: no wheel at $wheel" >&2; exit 1; }
 

@@ -14,7 +14,11 @@ module (`use crate::scene;`) counts through the paths that follow it. Comments, 
 test code (`#[cfg(test)]` items and the files they declare) do not count.
 
 A circle is a strongly connected set of files; each is printed with its files and, for every
-dependency inside it, the line that makes it. Exits 1 on a circle.
+dependency inside it, the line that makes it. The same check runs once more on the crate's
+top-level modules (a folder such as `solver/` or a file such as `island.rs` beside `lib.rs`):
+module A depends on module B when a file of A depends on a file of B, so two folders whose
+files import each other one way but in both directions are a circle too. Exits 1 on a circle
+of either kind.
 Usage: scripts/module-cycles.py [--graph] [CRATE_SRC ...]   (default: every crates/*/src)
        scripts/module-cycles.py --self-test                 (checks this script on fixtures)
 """
@@ -451,8 +455,43 @@ def shortest_cycle(graph, component):
     return component
 
 
+def top_level_modules(crate):
+    """Each file's top-level module: `solver` for `solver/rows.rs`, `island` for `island.rs`; a
+    crate root (`lib.rs`, `main.rs`, `bin/x.rs`) is a node of its own, named by its file."""
+    shortest = {}
+    for path, module in crate.modules.items():
+        if module.file is not None and len(path) < len(shortest.get(module.file, path + ("",))):
+            shortest[module.file] = path
+    result = {}
+    for file, path in shortest.items():
+        binary = path[:1] if path[:1] and path[0].startswith("<") else ()
+        below = path[len(binary) :]
+        # The node's name: the top-level module's file, or its folder when it has one.
+        top_file = crate.modules[binary + below[:1]].file
+        folder = os.path.join(crate.src, below[0]) if below else None
+        result[file] = crate.relative(folder) + "/" if folder and os.path.isdir(folder) else crate.relative(top_file)
+    return result
+
+
+def report_circles(src, graph, evidence_edges, name, kind, out):
+    """Prints each circle of `graph` (nodes named by `name`) with the lines that make it."""
+    found = circles(graph)
+    for component in found:
+        cycle = shortest_cycle(graph, component)
+        print(f"{src}: circle of {kind}: {' -> '.join(name(f) for f in cycle)}", file=out)
+        if len(component) > len(cycle) - 1:
+            print(f"  all {kind} of the circle: {', '.join(name(f) for f in component)}", file=out)
+        members = set(component)
+        for (a, b, where, target), evidence in sorted(evidence_edges.items()):
+            if a in members and b in members:
+                for line, text in sorted(set(evidence)):
+                    print(f"  {where}:{line}: {text}  (-> {target})", file=out)
+    return found
+
+
 def check(src, show_graph=False, out=sys.stdout):
-    """Prints `src`'s circles (and its graph if asked); returns the number of circles."""
+    """Prints `src`'s circles between files and between top-level modules (and the file graph
+    if asked); returns the number of circles of both kinds."""
     crate = Crate(src)
     edges = crate.build()
     graph = {}
@@ -462,20 +501,22 @@ def check(src, show_graph=False, out=sys.stdout):
         for file in sorted(crate.texts):
             targets = sorted(crate.relative(b) for b in graph.get(file, ()))
             print(f"  {crate.relative(file)} -> {', '.join(targets) or '(nothing)'}", file=out)
-    found = circles(graph)
-    for component in found:
-        cycle = shortest_cycle(graph, component)
-        print(f"{src}: circle: {' -> '.join(crate.relative(f) for f in cycle)}", file=out)
-        if len(component) > len(cycle) - 1:
-            print(f"  all files of the circle: {', '.join(crate.relative(f) for f in component)}", file=out)
-        members = set(component)
-        for (a, b), evidence in sorted(edges.items()):
-            if a in members and b in members:
-                for line, text in sorted(set(evidence)):
-                    print(f"  {crate.relative(a)}:{line}: {text}  (-> {crate.relative(b)})", file=out)
-    if not found:
-        print(f"{src}: {len(crate.texts)} files, {len(edges)} dependencies, no circles", file=out)
-    return len(found)
+    file_evidence = {(a, b, crate.relative(a), crate.relative(b)): e for (a, b), e in edges.items()}
+    found = report_circles(src, graph, file_evidence, crate.relative, "files", out)
+    top = top_level_modules(crate)
+    module_graph, module_evidence = {}, {}
+    for (a, b), evidence in edges.items():
+        if top[a] != top[b]:
+            module_graph.setdefault(top[a], set()).add(top[b])
+            module_evidence[(top[a], top[b], crate.relative(a), crate.relative(b))] = evidence
+    found_modules = report_circles(src, module_graph, module_evidence, str, "top-level modules", out)
+    if not found and not found_modules:
+        print(
+            f"{src}: {len(crate.texts)} files, {len(edges)} dependencies, "
+            f"{len(set(top.values()))} top-level modules, no circles",
+            file=out,
+        )
+    return len(found) + len(found_modules)
 
 
 FIXTURES = {
@@ -514,8 +555,29 @@ FIXTURES = {
         "solver/sweep.rs": "pub struct Sweep;\n",
         "solver/pgs.rs": "use super::Sweep;\npub fn solve(_: Sweep) {}\n",
     },
+    # Files one way, folders both ways: `a/x.rs` uses `b/p.rs`, `b/q.rs` uses `a/y.rs`.
+    "folders": {
+        "lib.rs": "mod a;\nmod b;\n",
+        "a/mod.rs": "mod x;\npub mod y;\n",
+        "a/x.rs": "use crate::b::p::P;\nfn f(_: P) {}\n",
+        "a/y.rs": "pub struct Y;\n",
+        "b/mod.rs": "pub mod p;\nmod q;\n",
+        "b/p.rs": "pub struct P;\n",
+        "b/q.rs": "use crate::a::y::Y;\nfn g(_: Y) {}\n",
+    },
+    # The same folders with the shared type moved below both (a file beside lib.rs).
+    "folders-one-way": {
+        "lib.rs": "mod a;\nmod b;\nmod shared;\n",
+        "a/mod.rs": "mod x;\n",
+        "a/x.rs": "use crate::b::p::P;\nfn f(_: P) {}\n",
+        "b/mod.rs": "pub mod p;\nmod q;\n",
+        "b/p.rs": "pub struct P;\n",
+        "b/q.rs": "use crate::shared::Y;\nfn g(_: Y) {}\n",
+        "shared.rs": "pub struct Y;\n",
+    },
 }
-EXPECTED = {"circle": 1, "attribute": 1, "acyclic": 0, "nested": 1, "facade": 0}
+# A circle between files of two top-level modules is a circle of both kinds.
+EXPECTED = {"circle": 2, "attribute": 2, "acyclic": 0, "nested": 1, "facade": 0, "folders": 1, "folders-one-way": 0}
 
 
 def self_test():

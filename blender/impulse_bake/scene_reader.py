@@ -324,7 +324,7 @@ def read_scene(scene, depsgraph=None, materials="blender", resolution=0):
                     info.animated.append(_animated(obj))
                     if info.parent_space is not None:
                         info.parent_space.append(_parent_space(obj))
-            for obj, info, keyed_flags in tracked:
+            for _obj, info, _keyed_flags in tracked:
                 _settle_kind(info, dt)
         for info in bodies:
             if info.kind == "dynamic":

@@ -11,8 +11,8 @@ use crate::errors::WorldError;
 /// same field names and units. Immutable; `replace(**fields)` makes a changed copy.
 ///
 /// `Settings()` are the defaults (the `default` preset); `Settings.preset(name)` one of
-/// `"fast"`, `"default"`, `"precise"`, `"reference"`. Fields read as attributes
-/// (`settings.substeps`) or all at once with `to_dict()`.
+/// `"fast"`, `"default"`, `"precise"`, `"reference"`. Fields read as read-only properties
+/// (`settings.substeps`), with the units of the scene format, or all at once with `to_dict()`.
 #[pyclass(module = "impulse", frozen, eq)]
 #[derive(Clone, PartialEq)]
 pub struct Settings {
@@ -54,6 +54,12 @@ impl Settings {
             "settings: expected impulse.Settings or a preset name, not {}",
             value.get_type().name()?
         )))
+    }
+
+    /// One field as the scene format writes it (the value `to_dict()` gives under `name`), so
+    /// a property and the dict agree to the digit.
+    fn field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.inner)?.get_item(name)
     }
 }
 
@@ -108,14 +114,214 @@ impl Settings {
         Self::from_dict(&all)
     }
 
-    fn __getattr__<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        let all = to_python(py, &self.inner)?;
-        match all.get_item(name) {
-            Ok(value) => Ok(value),
-            Err(_) => Err(pyo3::exceptions::PyAttributeError::new_err(format!(
-                "Settings has no field '{name}'"
-            ))),
-        }
+    // One read-only property per field of the scene format's `solver` object, typed in the
+    // stubs; `test_settings_properties_are_the_fields` checks that they are all there.
+
+    /// The method: `"pgs"`, `"nncg"`, `"apgd"` or `"auto"` (the escalation policy).
+    #[getter]
+    fn method<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "method")
+    }
+
+    /// Substeps per step (≥ 1); contacts are found once per step.
+    #[getter]
+    fn substeps<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "substeps")
+    }
+
+    /// Solver iterations per substep, at most (≥ 1).
+    #[getter]
+    fn iterations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "iterations")
+    }
+
+    /// Relax iterations per substep, without the repair bias (≥ 0).
+    #[getter]
+    fn relax_iterations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "relax_iterations")
+    }
+
+    /// Early exit (m/s): no row's velocity changed by more than this in an iteration; 0 disables.
+    #[getter]
+    fn tolerance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "tolerance")
+    }
+
+    /// `auto`: an island still changing a row's velocity by more than this (m/s) escalates.
+    #[getter]
+    fn escalation_tolerance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "escalation_tolerance")
+    }
+
+    /// `auto`: NNCG iterations an unconverged island gets beyond the budget.
+    #[getter]
+    fn escalation_iterations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "escalation_iterations")
+    }
+
+    /// `auto`: islands whose heaviest/lightest moving mass ratio exceeds this go to the exact path.
+    #[getter]
+    fn mass_ratio_threshold<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "mass_ratio_threshold")
+    }
+
+    /// `auto`: islands with at most this many contact points may be solved exactly; 0 = never.
+    #[getter]
+    fn exact_max_contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "exact_max_contacts")
+    }
+
+    /// Mass ratio above which a heavy-on-light island is stepped as one exact LCP; 0 = never.
+    #[getter]
+    fn heavy_on_light_mass_ratio<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "heavy_on_light_mass_ratio")
+    }
+
+    /// Restitution applies only to contacts approaching faster than this (m/s).
+    #[getter]
+    fn restitution_threshold<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "restitution_threshold")
+    }
+
+    /// How overlap is repaired: `{"type": "soft" | "bias" | "split_impulse", ...}` (docs/scene-
+    /// format.md).
+    #[getter]
+    fn repair<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "repair")
+    }
+
+    /// Overlap tolerated without repair (m).
+    #[getter]
+    fn overlap_slop<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "overlap_slop")
+    }
+
+    /// Cap on the repair speed (m/s).
+    #[getter]
+    fn max_repair_speed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "max_repair_speed")
+    }
+
+    /// Fraction of last step's impulses used as the starting guess, in [0, 1].
+    #[getter]
+    fn warm_start<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "warm_start")
+    }
+
+    /// Base speculative margin (m): contacts are generated up to this separation.
+    #[getter]
+    fn prediction_distance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "prediction_distance")
+    }
+
+    /// Whether islands that stay quiet sleep.
+    #[getter]
+    fn sleep<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "sleep")
+    }
+
+    /// A body slower than this (m/s) …
+    #[getter]
+    fn sleep_linear_speed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "sleep_linear_speed")
+    }
+
+    /// … and spinning slower than this (rad/s) counts as quiet.
+    #[getter]
+    fn sleep_angular_speed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "sleep_angular_speed")
+    }
+
+    /// An island sleeps when all its bodies have been quiet this long (s).
+    #[getter]
+    fn time_to_sleep<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "time_to_sleep")
+    }
+
+    /// Whether Coulomb friction rows are applied.
+    #[getter]
+    fn friction<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "friction")
+    }
+
+    /// Whether the friction rows are swept in the main (repairing) solve too.
+    #[getter]
+    fn friction_in_main_solve<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "friction_in_main_solve")
+    }
+
+    /// Whether an island's locked joint rows are solved together (sparse Cholesky).
+    #[getter]
+    fn direct_joint_solve<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "direct_joint_solve")
+    }
+
+    /// Islands with at least this many contact points are swept colour by colour over the threads;
+    /// 0 = never.
+    #[getter]
+    fn parallel_island_contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "parallel_island_contacts")
+    }
+
+    /// Islands with at least this many contact points are solved in SIMD lanes; 0 = never.
+    #[getter]
+    fn simd_island_contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "simd_island_contacts")
+    }
+
+    /// Whether the SIMD lanes' sweeps use fused multiply-adds (one rounding) where the CPU has
+    /// them.
+    #[getter]
+    fn fused_multiply_add<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "fused_multiply_add")
+    }
+
+    /// Whether the gyroscopic term ω × Iω of rigid bodies is integrated.
+    #[getter]
+    fn gyroscopic<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "gyroscopic")
+    }
+
+    /// Whether continuous collision (motion clamping against static and kinematic bodies) is on.
+    #[getter]
+    fn continuous<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "continuous")
+    }
+
+    /// How simultaneous impacts are resolved: `"simultaneous"` or `"propagation"`.
+    #[getter]
+    fn impact<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "impact")
+    }
+
+    /// How a contact's friction is made from its two bodies'.
+    #[getter]
+    fn friction_combine<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "friction_combine")
+    }
+
+    /// How a contact's restitution is made from its two bodies'.
+    #[getter]
+    fn restitution_combine<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "restitution_combine")
+    }
+
+    /// World bound (m): a moving body farther than this from the origin leaves the world.
+    #[getter]
+    fn max_distance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "max_distance")
+    }
+
+    /// Largest speed of a body's centre of mass (m/s) before a blow-up.
+    #[getter]
+    fn max_linear_speed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "max_linear_speed")
+    }
+
+    /// Largest angular speed of a body (rad/s) before a blow-up.
+    #[getter]
+    fn max_angular_speed<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "max_angular_speed")
     }
 
     fn __repr__(&self) -> String {

@@ -76,7 +76,7 @@ def test_body_builders_pickle_to_the_same_body():
     assert repr(builders[0]).startswith("BodyBuilder.dynamic(Shape(")
     assert 'friction=0.4, restitution=0.25, density=700.0, name="crate"' in repr(builders[0])
     worlds = [ground_world(), ground_world()]
-    for world, bodies in zip(worlds, (builders, copies)):
+    for world, bodies in zip(worlds, (builders, copies), strict=True):
         for builder in bodies:
             world.insert(builder)
         world.step(40)
@@ -187,8 +187,8 @@ def stub_defaults():
                     continue
                 args = node.args
                 positional = args.posonlyargs + args.args
-                pairs = list(zip(positional[len(positional) - len(args.defaults):], args.defaults))
-                pairs += [(a, d) for a, d in zip(args.kwonlyargs, args.kw_defaults) if d is not None]
+                pairs = list(zip(positional[len(positional) - len(args.defaults):], args.defaults, strict=True))
+                pairs += [(a, d) for a, d in zip(args.kwonlyargs, args.kw_defaults, strict=True) if d is not None]
                 found[prefix + node.name] = {
                     a.arg: eval(compile(ast.Expression(d), str(STUBS), "eval"), {"math": math})
                     for a, d in pairs
@@ -205,7 +205,7 @@ def test_stubs_have_the_runtime_defaults():
         assert Ellipsis not in defaults.values(), name
         owner, _, method = name.rpartition(".")
         target = getattr(_impulse, owner) if owner else _impulse
-        if method == "__init__":
+        if method in ("__init__", "__new__"):
             value = target
         elif method.startswith("__") or not hasattr(target, method):
             continue
@@ -235,3 +235,39 @@ def test_diagnostics_print_a_short_summary():
     assert text.startswith("Diagnostics(step=5, contacts=20, ") and "islands=20" in text
     assert len(repr(dict(diagnostics))) > 5 * len(text)
     assert pickle.loads(pickle.dumps(diagnostics)) == diagnostics
+
+
+def stub_properties(class_name):
+    """{property: annotation text} of a class in the stubs."""
+    tree = ast.parse(STUBS.read_text())
+    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == class_name)
+    return {
+        node.name: ast.unparse(node.returns)
+        for node in cls.body
+        if isinstance(node, ast.FunctionDef)
+        and any(isinstance(d, ast.Name) and d.id == "property" for d in node.decorator_list)
+    }
+
+
+def test_settings_properties_are_the_fields():
+    # One typed property per field of the scene format's `solver` object, in the runtime and in
+    # the stubs, each reading what to_dict() gives; a field added or renamed fails here.
+    for name in ("fast", "default", "precise", "reference"):
+        settings = impulse.Settings.preset(name)
+        fields = settings.to_dict()
+        runtime = {n for n, v in vars(impulse.Settings).items() if inspect.isdatadescriptor(v)}
+        assert runtime == set(fields)
+        assert set(stub_properties("Settings")) == set(fields)
+        for field, value in fields.items():
+            assert getattr(settings, field) == value, field
+    kinds = {bool: "bool", int: "int", float: "float", dict: "dict[str, Any]"}
+    for field, annotation in stub_properties("Settings").items():
+        value = getattr(impulse.Settings(), field)
+        if isinstance(value, str):
+            assert annotation.startswith("Literal[") and repr(value) in annotation.replace('"', "'"), field
+        else:
+            assert annotation == kinds[type(value)], field
+    with pytest.raises(AttributeError):
+        impulse.Settings().no_such_field  # noqa: B018
+    with pytest.raises(AttributeError):
+        impulse.Settings().substeps = 3

@@ -5,7 +5,6 @@ import sys
 import threading
 
 import numpy as np
-import pytest
 
 import impulse
 
@@ -59,8 +58,8 @@ def test_threads_stepping_and_reading_one_world_equal_sequential_steps():
             seen_steps.append(state["step_count"])
             assert np.isfinite(state["positions"]).all()
             assert world.positions.shape == (len(world), 3)
-            world.orientations, world.linear_velocities, world.angular_velocities
-            world.diagnostics, world.profile, world.step_count, world.time, world.names
+            world.orientations, world.linear_velocities, world.angular_velocities  # noqa: B018 (reads)
+            world.diagnostics, world.profile, world.step_count, world.time, world.names  # noqa: B018
             world.quality()
             world.contact_pairs()
             world.cast_ray((0, 20, 0), (0, -1, 0))
@@ -169,7 +168,7 @@ def test_python_run_inside_a_call_on_the_world_gets_runtime_error(monkeypatch):
 
     def trajectory(*arrays):
         try:
-            world.step_count
+            world.step_count  # noqa: B018 (a read from another thread)
         except RuntimeError as error:
             seen.append(str(error))
         return arrays

@@ -122,7 +122,7 @@ def test_setters_validate_and_apply():
     new[:, 0] += 10.0
     world.positions = new
     assert np.array_equal(world.positions, new)
-    with pytest.raises(impulse.WorldError, match=r"expected shape \(%d, 3\)" % n):
+    with pytest.raises(impulse.WorldError, match=rf"expected shape \({n}, 3\)"):
         world.positions = np.zeros((n, 4))
     with pytest.raises(impulse.WorldError, match="expected shape"):
         world.positions = np.zeros(n * 3)

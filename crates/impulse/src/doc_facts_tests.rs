@@ -166,3 +166,164 @@ fn the_documented_defaults_are_the_code_s() {
     let rows = check_default_table("## Bodies", &read_back::<crate::BodyDesc>(body));
     assert!(rows >= 8, "only {rows} body rows found");
 }
+
+/// The repository's root (this crate is `crates/impulse`).
+fn repository() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// docs/benchmarks.md is a report of current tables, not a history (which git keeps).
+#[test]
+fn the_benchmarks_report_stays_short() {
+    let lines = BENCHMARKS.lines().count();
+    assert!(
+        lines <= 500,
+        "docs/benchmarks.md has {lines} lines, more than 500: keep current tables with their \
+         commands, move what was tried to \"Rejected designs\" (one line each)"
+    );
+}
+
+/// Every file and folder of the repository, relative to its root with `/` separators, folders
+/// ending in `/`; build output, version control and virtual environments left out.
+fn repository_paths() -> Vec<String> {
+    const SKIPPED: [&str; 5] = ["target", ".git", ".venv", "node_modules", "__pycache__"];
+    let root = repository();
+    let mut paths = Vec::new();
+    let mut folders = vec![root.clone()];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap().map(Result::unwrap) {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            let path = entry.path();
+            let relative = path
+                .strip_prefix(&root)
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
+            if entry.file_type().unwrap().is_dir() {
+                if !SKIPPED.contains(&name.as_str()) {
+                    paths.push(relative + "/");
+                    folders.push(path);
+                }
+            } else {
+                paths.push(relative);
+            }
+        }
+    }
+    paths
+}
+
+/// The paths a line of Markdown names: runs of path characters holding a `/` that end in a file
+/// extension of the repository's kinds, or folders (ending in `/`) of two or more names or
+/// alone between back quotes. Web addresses, absolute and `./` paths, build output
+/// (`target/`), command-line options, globs and placeholders in capitals (`OUT/`, `DIR/`) are
+/// not paths of the repository.
+fn paths_named(line: &str) -> Vec<&str> {
+    const EXTENSIONS: [&str; 22] = [
+        "rs", "md", "py", "pyi", "sh", "json", "toml", "svg", "png", "gif", "txt", "csv", "yml",
+        "yaml", "obj", "stl", "glb", "gltf", "usda", "cfg", "lock", "jsonl",
+    ];
+    let is_path_char = |c: char| c.is_ascii_alphanumeric() || "_./*-".contains(c);
+    let mut found = Vec::new();
+    let mut rest = line;
+    let mut offset = 0;
+    while let Some(start) = rest.find(is_path_char) {
+        let end = rest[start..]
+            .find(|c| !is_path_char(c))
+            .map_or(rest.len(), |e| start + e);
+        let token = rest[start..end].trim_end_matches(['.', ',', ':']);
+        let (before, after) = (
+            line[..offset + start].chars().last(),
+            line[offset + start + token.len()..].chars().next(),
+        );
+        offset += end;
+        rest = &line[offset..];
+        if !token.contains('/')
+            || token.starts_with(['/', '-', '~', '*'])
+            || token.starts_with("./")
+            || token.starts_with("target/")
+            || token.contains('*')
+            || before == Some(':')
+        {
+            continue;
+        }
+        let names: Vec<&str> = token.trim_end_matches('/').split('/').collect();
+        if names
+            .iter()
+            .any(|n| n.len() > 1 && n.chars().all(|c| c.is_ascii_uppercase() || c == '_'))
+        {
+            continue; // a placeholder: OUT/manifest.json
+        }
+        let is_path = if token.ends_with('/') {
+            names.len() >= 2 || (before == Some('`') && after == Some('`'))
+        } else {
+            let file = names[names.len() - 1];
+            file.rsplit_once('.').is_some_and(|(stem, extension)| {
+                !stem.is_empty() && EXTENSIONS.contains(&extension)
+            })
+        };
+        if is_path {
+            found.push(token);
+        }
+    }
+    found
+}
+
+/// Every file path docs/*.md and README.md name exists in the repository: as written from the
+/// root, or as the end of a path (`step/kinematic.rs` for `crates/impulse/src/world/step/kinematic.rs`,
+/// `tests/integration/snapshot.rs`), so a moved or renamed file cannot leave a doc pointing at
+/// nothing.
+#[test]
+fn every_path_the_docs_name_exists() {
+    // Paths the docs name that are not the repository's: a user's file in the error examples,
+    // a folder inside the Blender add-on's zip.
+    const NOT_OURS: [&str; 2] = ["scenes/bad.json", "vendor/"];
+    let paths = repository_paths();
+    let root = repository();
+    let mut docs: Vec<std::path::PathBuf> = std::fs::read_dir(root.join("docs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    docs.push(root.join("README.md"));
+    docs.sort();
+    let mut missing = Vec::new();
+    let mut checked = 0;
+    for doc in &docs {
+        let text = std::fs::read_to_string(doc).unwrap();
+        for (number, line) in text.lines().enumerate() {
+            for path in paths_named(line) {
+                if NOT_OURS.contains(&path) {
+                    continue;
+                }
+                checked += 1;
+                let ending = format!("/{path}");
+                if !paths.iter().any(|p| p == path || p.ends_with(&ending)) {
+                    let name = doc.strip_prefix(&root).unwrap().display();
+                    missing.push(format!("{name}:{}: {path}", number + 1));
+                }
+            }
+        }
+    }
+    assert!(checked >= 200, "only {checked} paths found in the docs");
+    assert!(
+        missing.is_empty(),
+        "the docs name paths that do not exist:\n{}",
+        missing.join("\n")
+    );
+}
+
+#[test]
+fn paths_named_finds_paths_and_leaves_the_rest() {
+    let line = "see `world/`, crates/impulse/src/lib.rs, step/kinematic.rs: m/s, 1/60, \
+                https://github.com/a/b.rs, OUT/manifest.json, target/blender/x.zip, v/ and \
+                tests/data/fuzz/ or --set/--seed/ fuzz/TARGET/ OUT_DIR/x.out/";
+    assert_eq!(
+        paths_named(line),
+        [
+            "world/",
+            "crates/impulse/src/lib.rs",
+            "step/kinematic.rs",
+            "tests/data/fuzz/"
+        ]
+    );
+}

@@ -84,7 +84,7 @@ pub use parry3d;
 pub use parry3d::shape::SharedShape;
 
 pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
-pub use collision::crowding::{Crowd, MAX_PAIRS_PER_BODY};
+pub use collision::crowding::Crowd;
 pub use diagnostics::contact_lcp::ContactLcp;
 pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
 pub use error::{SnapshotError, StepError, WorldError};
@@ -98,7 +98,7 @@ pub use scene::{
 pub use scene::{Jitter, Override, Variation};
 pub use settings::{
     CombineRule, ContactRepair, DEFAULT_MAX_ANGULAR_SPEED, DEFAULT_MAX_LINEAR_SPEED, ImpactModel,
-    SettingError, SolverMethod, SolverSettings,
+    MAX_PAIRS_PER_BODY, SettingError, SolverMethod, SolverSettings,
 };
 pub use solver::{
     EscalationLevel, HEAVY_ON_LIGHT_CONTACTS_FACTOR, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight,

@@ -343,6 +343,13 @@ pub const DEFAULT_MAX_LINEAR_SPEED: f32 = 1.0e5;
 /// 700 m/s: 70,000 rad/s), which is physics, not a blow-up.
 pub const DEFAULT_MAX_ANGULAR_SPEED: f32 = 1.0e7;
 
+/// Most pairs of overlapping bounding boxes a start may have, per body: 32. Bodies that do not
+/// overlap meet few boxes each: a box among equal boxes packed face to face touches 26, and a
+/// large body (the ground) under many small ones adds one pair per small body; piles that
+/// overlap by a fraction of a body (`overlap_pyramid`) stay far below it. Coincident bodies
+/// reach it at about 65 (n·(n − 1)/2 pairs).
+pub const MAX_PAIRS_PER_BODY: usize = 32;
+
 /// A solver setting outside its allowed range: which field, and what is allowed.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("solver.{field}: {message}")]

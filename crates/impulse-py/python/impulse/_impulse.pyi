@@ -3,7 +3,7 @@
 import math
 import os
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, Literal, TypeAlias, final
 
 import numpy as np
 import numpy.typing as npt
@@ -11,7 +11,26 @@ import numpy.typing as npt
 from ._diagnostics import Diagnostics
 from ._trajectory import Trajectory
 
+# The native classes are `@final`: pyo3 classes cannot be subclassed (mypy's stubtest checks
+# these stubs against the module).
+
 __version__: str
+
+__all__ = [
+    "SceneError",
+    "WorldError",
+    "StepError",
+    "Settings",
+    "World",
+    "BodyHandle",
+    "Shape",
+    "BodyBuilder",
+    "JointHandle",
+    "JointBuilder",
+    "scenes",
+    "set_decomposition_cache_dir",
+    "__version__",
+]
 
 class SceneError(ValueError):
     """A scene that cannot be read or is invalid: the message names the file, line, body and
@@ -32,10 +51,11 @@ def scenes() -> list[str]:
 def set_decomposition_cache_dir(directory: str | os.PathLike[str] | None) -> None:
     """Keep moving meshes' convex decompositions in ``directory`` across processes (None: memory only)."""
 
+@final
 class Settings:
     """Solver settings: the scene format's ``solver`` object (same fields and units)."""
 
-    def __init__(self) -> None: ...
+    def __new__(cls) -> Settings: ...
     @staticmethod
     def preset(name: str) -> Settings:
         """``"fast"``, ``"default"``, ``"precise"`` or ``"reference"``; else ``WorldError``."""
@@ -43,30 +63,134 @@ class Settings:
     def from_dict(fields: Mapping[str, Any]) -> Settings: ...
     def to_dict(self) -> dict[str, Any]: ...
     def replace(self, **fields: Any) -> Settings: ...
-    def __getattr__(self, name: str) -> Any: ...
+    @property
+    def method(self) -> Literal["pgs", "nncg", "apgd", "auto"]:
+        """The method: ``"pgs"``, ``"nncg"``, ``"apgd"`` or ``"auto"`` (the escalation policy)."""
+    @property
+    def substeps(self) -> int:
+        """Substeps per step (≥ 1); contacts are found once per step."""
+    @property
+    def iterations(self) -> int:
+        """Solver iterations per substep, at most (≥ 1)."""
+    @property
+    def relax_iterations(self) -> int:
+        """Relax iterations per substep, without the repair bias (≥ 0)."""
+    @property
+    def tolerance(self) -> float:
+        """Early exit (m/s): no row's velocity changed by more than this in an iteration; 0 disables."""
+    @property
+    def escalation_tolerance(self) -> float:
+        """``auto``: an island still changing a row's velocity by more than this (m/s) escalates."""
+    @property
+    def escalation_iterations(self) -> int:
+        """``auto``: NNCG iterations an unconverged island gets beyond the budget."""
+    @property
+    def mass_ratio_threshold(self) -> float:
+        """``auto``: islands whose heaviest/lightest moving mass ratio exceeds this go to the exact path."""
+    @property
+    def exact_max_contacts(self) -> int:
+        """``auto``: islands with at most this many contact points may be solved exactly; 0 = never."""
+    @property
+    def heavy_on_light_mass_ratio(self) -> float:
+        """Mass ratio above which a heavy-on-light island is stepped as one exact LCP; 0 = never."""
+    @property
+    def restitution_threshold(self) -> float:
+        """Restitution applies only to contacts approaching faster than this (m/s)."""
+    @property
+    def repair(self) -> dict[str, Any]:
+        """How overlap is repaired: ``{"type": "soft" | "bias" | "split_impulse", ...}`` (docs/scene-format.md)."""
+    @property
+    def overlap_slop(self) -> float:
+        """Overlap tolerated without repair (m)."""
+    @property
+    def max_repair_speed(self) -> float:
+        """Cap on the repair speed (m/s)."""
+    @property
+    def warm_start(self) -> float:
+        """Fraction of last step's impulses used as the starting guess, in [0, 1]."""
+    @property
+    def prediction_distance(self) -> float:
+        """Base speculative margin (m): contacts are generated up to this separation."""
+    @property
+    def sleep(self) -> bool:
+        """Whether islands that stay quiet sleep."""
+    @property
+    def sleep_linear_speed(self) -> float:
+        """A body slower than this (m/s) …"""
+    @property
+    def sleep_angular_speed(self) -> float:
+        """… and spinning slower than this (rad/s) counts as quiet."""
+    @property
+    def time_to_sleep(self) -> float:
+        """An island sleeps when all its bodies have been quiet this long (s)."""
+    @property
+    def friction(self) -> bool:
+        """Whether Coulomb friction rows are applied."""
+    @property
+    def friction_in_main_solve(self) -> bool:
+        """Whether the friction rows are swept in the main (repairing) solve too."""
+    @property
+    def direct_joint_solve(self) -> bool:
+        """Whether an island's locked joint rows are solved together (sparse Cholesky)."""
+    @property
+    def parallel_island_contacts(self) -> int:
+        """Islands with at least this many contact points are swept colour by colour over the threads; 0 = never."""
+    @property
+    def simd_island_contacts(self) -> int:
+        """Islands with at least this many contact points are solved in SIMD lanes; 0 = never."""
+    @property
+    def fused_multiply_add(self) -> bool:
+        """Whether the SIMD lanes' sweeps use fused multiply-adds (one rounding) where the CPU has them."""
+    @property
+    def gyroscopic(self) -> bool:
+        """Whether the gyroscopic term ω × Iω of rigid bodies is integrated."""
+    @property
+    def continuous(self) -> bool:
+        """Whether continuous collision (motion clamping against static and kinematic bodies) is on."""
+    @property
+    def impact(self) -> Literal["simultaneous", "propagation"]:
+        """How simultaneous impacts are resolved: ``"simultaneous"`` or ``"propagation"``."""
+    @property
+    def friction_combine(self) -> Literal["geometric_mean", "average", "min", "max", "multiply"]:
+        """How a contact's friction is made from its two bodies'."""
+    @property
+    def restitution_combine(self) -> Literal["geometric_mean", "average", "min", "max", "multiply"]:
+        """How a contact's restitution is made from its two bodies'."""
+    @property
+    def max_distance(self) -> float:
+        """World bound (m): a moving body farther than this from the origin leaves the world."""
+    @property
+    def max_linear_speed(self) -> float:
+        """Largest speed of a body's centre of mass (m/s) before a blow-up."""
+    @property
+    def max_angular_speed(self) -> float:
+        """Largest angular speed of a body (rad/s) before a blow-up."""
 
+@final
 class BodyHandle:
     """A body's name in a world (slot index and generation); hashable, picklable."""
 
-    def __init__(self, index: int, generation: int) -> None: ...
+    def __new__(cls, index: int, generation: int) -> BodyHandle: ...
     @property
     def index(self) -> int: ...
     @property
     def generation(self) -> int: ...
 
+@final
 class JointHandle:
     """A joint's name in a world (slot index and generation); hashable, ordered, picklable."""
 
-    def __init__(self, index: int, generation: int) -> None: ...
+    def __new__(cls, index: int, generation: int) -> JointHandle: ...
     @property
     def index(self) -> int: ...
     @property
     def generation(self) -> int: ...
-    def __lt__(self, other: JointHandle) -> bool: ...
-    def __le__(self, other: JointHandle) -> bool: ...
-    def __gt__(self, other: JointHandle) -> bool: ...
-    def __ge__(self, other: JointHandle) -> bool: ...
+    def __lt__(self, other: JointHandle, /) -> bool: ...
+    def __le__(self, other: JointHandle, /) -> bool: ...
+    def __gt__(self, other: JointHandle, /) -> bool: ...
+    def __ge__(self, other: JointHandle, /) -> bool: ...
 
+@final
 class JointBuilder:
     """A joint between body A and body B to ``World.insert_joint``; every method returns a new
     builder. Degrees of freedom are B's frame relative to A's: ``"linear_x"`` … ``"angular_z"``
@@ -119,6 +243,7 @@ class JointBuilder:
         """Strength ``force`` (N) and ``torque`` (N·m, default inf)."""
     def name(self, name: str) -> JointBuilder: ...
 
+@final
 class Shape:
     """A collision shape in the body frame (m); compares with ``==``, picklable."""
 
@@ -149,6 +274,7 @@ class Shape:
     def from_dict(shape: Mapping[str, Any]) -> Shape: ...
     def to_dict(self) -> dict[str, Any]: ...
 
+@final
 class BodyBuilder:
     """A body to insert: ``BodyBuilder.dynamic(Shape.ball(0.5), translation=(0, 2, 0))``.
 
@@ -166,20 +292,21 @@ class BodyBuilder:
     @staticmethod
     def particle(radius: float, **props: Any) -> BodyBuilder: ...
 
-_Vec3 = Sequence[float]
-_ArrayF32 = npt.NDArray[np.float32]
+_Vec3: TypeAlias = Sequence[float]
+_ArrayF32: TypeAlias = npt.NDArray[np.float32]
 
+@final
 class World:
     """A simulation world. State arrays are read-only float32 views of the engine's storage
     (see docs/python.md for their lifetime rule); assigning an array sets every body. Calls
     from several threads on one world take turns; ``state()`` copies one moment's arrays."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         gravity: _Vec3 = (0.0, -9.81, 0.0),
         dt: float = 0.016666666666666666,
         settings: Settings | str | None = None,
-    ) -> None: ...
+    ) -> World: ...
     @staticmethod
     def from_scene(
         scene: str | os.PathLike[str] | Mapping[str, Any],

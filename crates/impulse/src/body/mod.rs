@@ -1,6 +1,7 @@
 //! Bodies: what a body is ([`BodyKind`], [`LockedAxes`], [`Keyframe`]), how it is named
 //! ([`BodyHandle`]), described ([`BodyBuilder`]) and
-//! stored ([`Bodies`], one array per quantity).
+//! stored ([`Bodies`], one array per quantity), and the view of velocities a solve updates
+//! ([`Velocities`]).
 
 mod builder;
 mod handle;
@@ -10,6 +11,7 @@ pub(crate) mod rules;
 mod storage;
 #[cfg(test)]
 mod tests;
+mod velocities;
 
 pub use builder::BodyBuilder;
 pub(crate) use builder::build;
@@ -20,3 +22,6 @@ pub use locked_axes::LockedAxes;
 // Public for the hidden `internals` module only.
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 pub use storage::Bodies;
+// Public for the hidden `internals` module only.
+#[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
+pub use velocities::Velocities;

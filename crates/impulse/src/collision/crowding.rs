@@ -8,13 +8,7 @@ use parry3d::bounding_volume::Aabb;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
 
 use crate::body::Bodies;
-
-/// Most pairs of overlapping bounding boxes a start may have, per body: 32. Bodies that do not
-/// overlap meet few boxes each: a box among equal boxes packed face to face touches 26, and a
-/// large body (the ground) under many small ones adds one pair per small body; piles that
-/// overlap by a fraction of a body (`overlap_pyramid`) stay far below it. Coincident bodies
-/// reach it at about 65 (n·(n − 1)/2 pairs).
-pub const MAX_PAIRS_PER_BODY: usize = 32;
+use crate::settings::MAX_PAIRS_PER_BODY;
 
 /// Half-spaces have unbounded boxes; the broad phase's finite stand-in.
 const WORLD_BOUND: f32 = 1.0e6;

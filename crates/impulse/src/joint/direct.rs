@@ -30,7 +30,7 @@ use std::ops::{Deref, DerefMut};
 use glam::DVec3;
 
 use super::rows::{JointConstraint, LOCK};
-use crate::solver::rows::Velocities;
+use crate::body::Velocities;
 
 /// A locked row whose pivot is at most this fraction of its K_pp depends on the rows before it
 /// in the order (to the rounding of f32 Jacobians): it is left out of the factorization, as a

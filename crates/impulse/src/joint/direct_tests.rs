@@ -9,7 +9,7 @@ use super::direct::{IslandJoints, sweep_joints};
 use super::frames::LocalFrames;
 use super::rows::{JointBody, JointConstraint};
 use super::types::{AxisMode, JointAxis, JointStiffness};
-use crate::solver::rows::Velocities;
+use crate::body::Velocities;
 
 /// A small seeded generator (64-bit LCG): the same trees on every machine.
 struct Seeded(u64);

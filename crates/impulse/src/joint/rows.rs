@@ -23,7 +23,7 @@ use glam::{Mat3, Quat, Vec3};
 use super::frames::{FrameState, LocalFrames, frame_state};
 use super::softness::{Softness, joint_softness};
 use super::types::{AxisMode, JointAxis, JointStiffness, MotorMode};
-use crate::solver::rows::Velocities;
+use crate::body::Velocities;
 
 /// Rows per degree of freedom: lock, lower limit, upper limit, spring, motor.
 pub(crate) const ROWS_PER_DOF: usize = 5;

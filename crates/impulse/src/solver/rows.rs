@@ -1,10 +1,11 @@
-//! The scalar row operations every method shares: the velocities a solve updates
-//! ([`Velocities`]), applying a point's impulses M⁻¹Jᵀγ to its bodies (the warm start among
-//! them), the step totals of the impulses, and the projection of a friction impulse onto
+//! The scalar row operations every method shares: applying a point's impulses M⁻¹Jᵀγ to its
+//! bodies (the warm start among them), the step totals of the impulses, and the projection of a friction impulse onto
 //! Coulomb's disc in the tangent block's metric.
 
 use glam::Vec3;
 
+// The solver's files name the velocity view through this module.
+pub use crate::body::Velocities;
 use crate::contact::{ContactConstraint, cap_to_disc};
 use crate::parallel::SharedVelocities;
 
@@ -32,16 +33,6 @@ pub(crate) fn warm_start_substep(
         }
     }
     warm_start(constraints, velocities);
-}
-
-/// Velocities the solver updates in place: an island's local arrays, indexed by the
-/// constraints' `local_a`/`local_b` (static bodies share an immovable slot; their zero inverse
-/// mass and inertia make its updates exact no-ops).
-pub struct Velocities<'a> {
-    /// Linear velocities (m/s).
-    pub linear: &'a mut [Vec3],
-    /// Angular velocities (rad/s).
-    pub angular: &'a mut [Vec3],
 }
 
 /// Applies the accumulated impulses to the velocities, so the sweeps start from the last

@@ -108,7 +108,7 @@ def _impulse_version() -> str:
     try:
         from importlib.metadata import version
 
-        return version("impulse")
+        return version("impulse-contact")
     except Exception:
         return "unknown"
 
