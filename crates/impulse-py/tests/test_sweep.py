@@ -449,6 +449,6 @@ def test_runs_whose_worker_failed_run_again_on_resume(tmp_path):
     rows[1]["status"], rows[1]["error"] = FAILED, "observe: ValueError: the run's own failure"
     pq.write_table(pa.Table.from_pylist(rows, schema=first.schema), out / RESULTS_FILE)
     again = sweep(SCENE, seeds=[0, 1], steps=2, jitter=JITTER, out=out, workers=2, progress=False)
-    statuses = dict(zip(again.column("seed").to_pylist(), again.column("status").to_pylist()))
+    statuses = dict(zip(again.column("seed").to_pylist(), again.column("status").to_pylist(), strict=True))
     # The worker's failure is run again; the run's own failure is kept (retry_failed reruns it).
     assert statuses == {0: COMPLETED, 1: FAILED}

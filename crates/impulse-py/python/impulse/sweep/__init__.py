@@ -349,7 +349,7 @@ def _worker_failed(previous: Any, key: str) -> bool:
     """Whether the stored row of ``key`` failed because its worker could not run it."""
     keys = previous.column("run_key").to_pylist()
     errors = previous.column("error").to_pylist()
-    return any(k == key and (e or "").startswith(WORKER_FAILURE) for k, e in zip(keys, errors))
+    return any(k == key and (e or "").startswith(WORKER_FAILURE) for k, e in zip(keys, errors, strict=True))
 
 
 def _check_workers_can_start(caller: str) -> None:

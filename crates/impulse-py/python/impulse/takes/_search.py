@@ -387,7 +387,7 @@ def search(
             thetas = mean + spread * rng.standard_normal((population, dimension))
             seeds = _scene_seeds(rng, population, variation.seeds, elite_seeds)
             batch = []
-            for index, (theta, scene_seed) in enumerate(zip(thetas[:count], seeds)):
+            for index, (theta, scene_seed) in enumerate(zip(thetas[:count], seeds[:count], strict=True)):
                 key = take_id(digest, theta, scene_seed)
                 row = store.rows.get(key)
                 if row is not None and row["status"] != FAILED:
@@ -448,7 +448,7 @@ def _scene_seeds(
     known = [s for s in elite_seeds if s is not None]
     return [
         int(known[p % len(known)]) if known and r < 0.5 else int(f)
-        for r, p, f in zip(reuse, pick, fresh)
+        for r, p, f in zip(reuse, pick, fresh, strict=True)
     ]
 
 
@@ -475,9 +475,9 @@ def _row(
         for goal in goals:
             row[f"cost.{goal.name}"] = None
         return row
-    for goal, cost in zip(goals, costs):
+    for goal, cost in zip(goals, costs, strict=True):
         row[f"cost.{goal.name}"] = float(cost)
-    row["cost"] = float(sum(goal.weight * cost for goal, cost in zip(goals, costs)))
+    row["cost"] = float(sum(goal.weight * cost for goal, cost in zip(goals, costs, strict=True)))
     row["met"] = all(cost <= MET for cost in costs)
     return row
 
