@@ -138,7 +138,7 @@ impl BodyBuilder {
         self
     }
 
-    /// Surface roughness (degrees) in [0, [`crate::scene::MAX_ROUGHNESS_DEGREES`]]: each new
+    /// Surface roughness (degrees) in [0, [`super::MAX_ROUGHNESS_DEGREES`]]: each new
     /// contact's normal is tilted by a random angle up to the larger of its two bodies'
     /// roughness, drawn from the world's [`crate::World::seed`], the step and the pair
     /// (docs/scene-format.md, "Materials"). 0 (the default): smooth, nothing drawn.

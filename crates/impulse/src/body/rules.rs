@@ -242,10 +242,16 @@ pub(crate) fn non_negative(v: f32) -> Result<(), String> {
     }
 }
 
-/// A surface roughness (degrees): finite and in [0, `MAX_ROUGHNESS_DEGREES`].
+/// The largest surface roughness (degrees, `Material::roughness`, [`BodyBuilder::roughness`]):
+/// a tilt beyond it is no longer a small perturbation of the contact.
+///
+/// [`BodyBuilder::roughness`]: crate::BodyBuilder::roughness
+pub const MAX_ROUGHNESS_DEGREES: f32 = 30.0;
+
+/// A surface roughness (degrees): finite and in [0, [`MAX_ROUGHNESS_DEGREES`]].
 pub(crate) fn roughness(v: f32) -> Result<(), String> {
     finite(&[v])?;
-    let max = crate::scene::MAX_ROUGHNESS_DEGREES;
+    let max = MAX_ROUGHNESS_DEGREES;
     if (0.0..=max).contains(&v) {
         Ok(())
     } else {

@@ -63,9 +63,7 @@ pub struct Material {
     pub roughness: f32,
 }
 
-/// The largest [`Material::roughness`] (degrees): a tilt beyond it is no longer a small
-/// perturbation of the contact.
-pub const MAX_ROUGHNESS_DEGREES: f32 = 30.0;
+pub use crate::body::MAX_ROUGHNESS_DEGREES;
 
 impl Default for Material {
     fn default() -> Self {

@@ -489,7 +489,7 @@ fn check_bodies(b: &Bodies) -> Result<(), String> {
         if !(0.0..=1.0).contains(&b.restitution[i]) {
             return bad("restitution is outside [0, 1]");
         }
-        if !(0.0..=crate::scene::MAX_ROUGHNESS_DEGREES.to_radians()).contains(&b.roughness[i]) {
+        if !(0.0..=crate::body::MAX_ROUGHNESS_DEGREES.to_radians()).contains(&b.roughness[i]) {
             return bad("roughness is outside [0, 30] degrees");
         }
         let shape = &b.shape[i];
