@@ -215,10 +215,10 @@ impl Assembly<'_> {
             let (part_b, part_a) =
                 crate::collision::narrow_phase::manifold_poses(manifold, pose_b, pose_a);
             let mut normal = part_b.rotation * manifold.local_n1;
-            if let Some(draw) = &manifold.data.roughness {
-                if roughness > 0.0 {
-                    normal = super::roughness::tilted(normal, draw, roughness, &part_b);
-                }
+            if let Some(draw) = &manifold.data.roughness
+                && roughness > 0.0
+            {
+                normal = super::roughness::tilted(normal, draw, roughness, &part_b);
             }
             let (t1, t2) = tangent_basis(normal, manifold.data.tangent);
             for (point_index, point) in manifold.points.iter().enumerate() {
