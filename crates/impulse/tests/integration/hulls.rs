@@ -423,3 +423,16 @@ fn clouds_dropped_on_a_box_land_on_it() {
 fn hulls_rest_on_every_ground_full_sweep() {
     assert_clean(&sweep(100..300));
 }
+
+/// Seed 177, a rounded cloud (131 points, border 4.8 cm), set down vertex-down (as the sweep
+/// set clouds down before it chose a stable facet) rolls onto a face and should rest there
+/// within a millimetre; it ends 3.8 mm deep (open: docs/testing.md, "Hulls on every ground").
+#[test]
+#[ignore = "open: a rounded cloud rolled onto a face ends 3.8 mm deep (docs/testing.md)"]
+fn a_rounded_cloud_rolled_onto_a_face_rests_on_it() {
+    let mut hull = Hull::random(177);
+    hull.base = Vec3::NEG_Y;
+    let (_, ground) = grounds().swap_remove(0);
+    let outcome = run(&hull, &ground, 0.0);
+    assert!(outcome.deepest_settled <= REST_DEPTH, "{outcome:?}");
+}
