@@ -16,7 +16,9 @@
 //! over the other (every vertex over a plane), and the crossings of their edges. The points
 //! within the speculative distance are then reduced to [`MAX_POINTS`]: the deepest, the one
 //! farthest from it, and the two that make the largest quadrilateral with them, one on each
-//! side of their line. Each point is named by the features that make it (a hull vertex and the
+//! side of their line; on an uneven face (Parry merges nearly coplanar triangles into one
+//! face, whose vertices then lie off its plane) the deepest of the rest as well, up to
+//! [`UNEVEN_MAX_POINTS`]. Each point is named by the features that make it (a hull vertex and the
 //! other's face, a face and the other's vertex, two edges), the ids Parry gives the same
 //! points, so impulses carry over by feature from step to step and from Parry's manifold; ties
 //! in the reduction go to last step's points, so a face resting flat keeps the same four.
@@ -37,6 +39,10 @@ use super::caps::inside_convex;
 /// Most points a refined manifold keeps: a quadrilateral spanning the contact area carries a
 /// resting face and its friction as the whole polygon would.
 pub(crate) const MAX_POINTS: usize = 4;
+
+/// Most points a refined manifold keeps where a large face is uneven (a vertex more than
+/// [`DEPTH_TIE`] off the face's plane): the quadrilateral and the deepest of the rest.
+pub(crate) const UNEVEN_MAX_POINTS: usize = 8;
 
 /// Depth (m) by which a point of last step's manifold may be shallower than the deepest
 /// candidate and still be chosen as the deepest; also the margin by which Parry's nearest point
@@ -304,15 +310,17 @@ fn was_kept<ContactData>(
         .any(|point| point.fid1 == fid1 && point.fid2 == fid2)
 }
 
-/// Reduces `candidates` to at most [`MAX_POINTS`] (see the module's documentation): the
-/// deepest, the farthest from it across the normal `n`, then the largest triangle with those
-/// two, then the largest on the other side of their line; ties go to points of `old`.
+/// Reduces `candidates` to at most `limit` (see the module's documentation): the deepest,
+/// the farthest from it across the normal `n`, then the largest triangle with those two, then
+/// the largest on the other side of their line; ties go to points of `old`. A `limit` above
+/// [`MAX_POINTS`] (an uneven face, [`UNEVEN_MAX_POINTS`]) keeps the deepest of the rest too.
 pub(crate) fn reduce<ContactData>(
     candidates: &mut Vec<Candidate>,
     n: Vector,
     old: &[TrackedContact<ContactData>],
+    limit: usize,
 ) {
-    if candidates.len() <= MAX_POINTS {
+    if candidates.len() <= MAX_POINTS.max(limit) {
         return;
     }
     let kept: Vec<bool> = candidates
@@ -353,6 +361,17 @@ pub(crate) fn reduce<ContactData>(
     // candidate on ab or on c's side, which adds nothing.
     if side * signed_area(d) >= 0.0 && chosen.len() == 4 {
         chosen.pop();
+    }
+    // A face Parry merged from nearly coplanar triangles is not quite flat (a point cloud's
+    // hexagon, its vertices up to 3.4 mm off its plane over 0.5 m): the body rests on the
+    // triangle its lowest vertices make, and a vertex the quadrilateral leaves out can be one
+    // of them and sink under it. There the deepest of the rest are kept too, up to `limit`.
+    if limit > chosen.len() {
+        let mut rest: Vec<usize> = (0..candidates.len())
+            .filter(|i| !chosen.contains(i))
+            .collect();
+        rest.sort_by(|&i, &j| candidates[i].dist.total_cmp(&candidates[j].dist));
+        chosen.extend(rest.into_iter().take(limit - chosen.len()));
     }
     chosen.sort_unstable();
     let mut index = 0;
@@ -450,7 +469,21 @@ pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
         .iter()
         .map(|c| c.dist)
         .fold(Real::INFINITY, Real::min);
-    reduce(&mut candidates, n, old);
+    let uneven = |large: bool, feature: &Feature| {
+        large
+            && feature.plane_of().is_some_and(|(origin, normal)| {
+                feature
+                    .vertices
+                    .iter()
+                    .any(|&v| (v - origin).dot(normal).abs() > DEPTH_TIE)
+            })
+    };
+    let limit = if uneven(large1, &f1) || uneven(large2, &f2) {
+        UNEVEN_MAX_POINTS
+    } else {
+        MAX_POINTS
+    };
+    reduce(&mut candidates, n, old, limit);
     let inverse = pos12.inverse();
     let nearest = manifold
         .points

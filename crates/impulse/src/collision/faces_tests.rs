@@ -7,7 +7,7 @@ use parry3d::math::Pose;
 use parry3d::query::{ContactManifold, TrackedContact};
 use parry3d::shape::{PackedFeatureId, Shape, SharedShape, Triangle};
 
-use super::{Candidate, MAX_POINTS, reduce};
+use super::{Candidate, MAX_POINTS, UNEVEN_MAX_POINTS, reduce};
 
 const PREDICTION: f32 = 0.02;
 
@@ -197,7 +197,7 @@ fn ids(candidates: &[Candidate]) -> Vec<PackedFeatureId> {
 fn the_reduction_keeps_the_deepest_point_and_a_large_quadrilateral() {
     let none: [TrackedContact<()>; 0] = [];
     let mut candidates = ring(16, Some(5));
-    reduce(&mut candidates, Vec3::Y, &none);
+    reduce(&mut candidates, Vec3::Y, &none, MAX_POINTS);
     assert_eq!(candidates.len(), 4);
     assert!(ids(&candidates).contains(&PackedFeatureId::vertex(5)));
     // The opposite vertex, and two a quarter turn away: the inscribed square, area 2 m².
@@ -225,7 +225,7 @@ fn the_reduction_keeps_last_steps_points_among_equals() {
         })
         .collect();
     let mut candidates = ring(16, None);
-    reduce(&mut candidates, Vec3::Y, &old);
+    reduce(&mut candidates, Vec3::Y, &old, MAX_POINTS);
     let mut kept = ids(&candidates);
     kept.sort_by_key(|id| id.0);
     let expected: Vec<PackedFeatureId> = [1, 5, 9, 13]
@@ -233,4 +233,36 @@ fn the_reduction_keeps_last_steps_points_among_equals() {
         .map(PackedFeatureId::vertex)
         .collect();
     assert_eq!(kept, expected);
+}
+
+/// A point cloud's face that Parry merged from nearly coplanar triangles is uneven: a hexagon
+/// whose deepest vertex (0) and a vertex the quadrilateral leaves out (2) carry the body, 1 mm
+/// and 0.8 mm below the rest. Reduced as a flat face, vertex 2 has no point and sinks; as an
+/// uneven one, the deepest of the rest join the quadrilateral.
+#[test]
+fn an_uneven_face_keeps_its_deepest_points_beyond_the_quadrilateral() {
+    let none: [TrackedContact<()>; 0] = [];
+    let mut hexagon = ring(6, Some(0));
+    hexagon[2].dist = -0.8e-3;
+    let mut flat = hexagon.clone();
+    reduce(&mut flat, Vec3::Y, &none, MAX_POINTS);
+    assert_eq!(flat.len(), MAX_POINTS);
+    assert!(!ids(&flat).contains(&PackedFeatureId::vertex(2)));
+    let mut uneven = hexagon.clone();
+    hexagon.push(Candidate {
+        p1: Vec3::ZERO,
+        p2: Vec3::ZERO,
+        fid1: PackedFeatureId::face(0),
+        fid2: PackedFeatureId::vertex(0),
+        dist: 0.0,
+    });
+    reduce(&mut uneven, Vec3::Y, &none, 5);
+    let kept = ids(&uneven);
+    assert_eq!(kept.len(), 5);
+    for k in [0, 1, 2, 3, 4] {
+        assert!(kept.contains(&PackedFeatureId::vertex(k)), "{k}: {kept:?}");
+    }
+    let mut all = hexagon;
+    reduce(&mut all, Vec3::Y, &none, UNEVEN_MAX_POINTS);
+    assert_eq!(all.len(), 7);
 }

@@ -4,11 +4,14 @@
 //! an 800-triangle mesh, each flat at y = 0. Every ground is flat where the hulls land, so a
 //! hull's depth is how far its lowest vertex (less its border) lies below y = 0. Targets:
 //! at most 1 mm deep at rest (a hull set down touching, over its whole run; a dropped hull,
-//! over its last 0.5 s), at most 5 mm during a drop, and no prism (set down level on its base,
-//! its centre of mass over it) tipped over by more than 5°. The full sweep and its figures:
-//! docs/testing.md, "Hulls on every ground".
+//! over its last 0.5 s), at most 5 mm during a drop, and no hull tipped over by more than 5°
+//! from the face it is set down on (a prism's base; a point cloud's facet over which its centre
+//! of mass lies, [`stable_faces`]). The full sweep and its figures: docs/testing.md, "Hulls on
+//! every ground".
 
 use impulse::glam::{Quat, Vec3};
+use impulse::parry3d::shape::{ConvexPolyhedron, Shape};
+use impulse::parry3d::transformation::convex_hull;
 use impulse::scene::{BodyDesc, BodyKind, Scene, ShapeDesc};
 use impulse::{SolverSettings, World};
 
@@ -23,17 +26,23 @@ const SETTLED: f32 = 0.5;
 /// Depth targets (m): at rest, during a drop.
 const REST_DEPTH: f32 = 1.0e-3;
 const DROP_DEPTH: f32 = 5.0e-3;
-/// Largest tilt (rad) of a prism's axis from the vertical.
+/// Largest tilt (rad) of a hull's base from facing down.
 const TOPPLED: f32 = 5.0 * std::f32::consts::PI / 180.0;
 
-/// A random hull: its points (m, local frame), border radius (m), and whether it is a prism
-/// standing on its base (the local y axis up, the base at y = −half height).
+/// Least angle (rad) by which a point cloud must tip about an edge of the face it is set down
+/// on before its centre of mass passes over that edge.
+const STABLE: f32 = 5.0 * std::f32::consts::PI / 180.0;
+
+/// A random hull: its points (m, local frame), border radius (m), whether it is a prism, and
+/// the outward unit normal (local frame) of the face it is set down on: a prism's base (−y),
+/// a point cloud's face over which its centre of mass lies (see [`stable_faces`]).
 #[derive(Clone, Debug)]
 struct Hull {
     seed: u64,
     points: Vec<[f32; 3]>,
     border: f32,
     prism: bool,
+    base: Vec3,
 }
 
 impl Hull {
@@ -68,34 +77,45 @@ impl Hull {
                 points,
                 border: 0.0,
                 prism: true,
+                base: Vec3::NEG_Y,
             }
         } else {
-            // 4–256 points on an ellipsoid, one in four rounded.
-            let count = rng.integer(4, 256);
-            let axes = Vec3::new(
-                rng.range(0.5, 1.0),
-                rng.range(0.5, 1.0),
-                rng.range(0.5, 1.0),
-            ) * rng.range(0.04, 1.0);
-            let points = (0..count)
-                .map(|_| {
-                    let z = rng.range(-1.0, 1.0);
-                    let phi = rng.range(0.0, std::f32::consts::TAU);
-                    let r = (1.0 - z * z).sqrt();
-                    let p = Vec3::new(r * phi.cos(), z, r * phi.sin()) * axes;
-                    p.to_array()
-                })
-                .collect();
-            let border = if rng.next().is_multiple_of(4) {
-                0.1 * axes.min_element()
-            } else {
-                0.0
-            };
-            Self {
-                seed,
-                points,
-                border,
-                prism: false,
+            // 4–256 points on an ellipsoid, one in four rounded, set down on one of its stable
+            // faces; a cloud with none (it would roll whichever face it is set on) is drawn
+            // again from the same stream.
+            loop {
+                let count = rng.integer(4, 256);
+                let axes = Vec3::new(
+                    rng.range(0.5, 1.0),
+                    rng.range(0.5, 1.0),
+                    rng.range(0.5, 1.0),
+                ) * rng.range(0.04, 1.0);
+                let points: Vec<[f32; 3]> = (0..count)
+                    .map(|_| {
+                        let z = rng.range(-1.0, 1.0);
+                        let phi = rng.range(0.0, std::f32::consts::TAU);
+                        let r = (1.0 - z * z).sqrt();
+                        let p = Vec3::new(r * phi.cos(), z, r * phi.sin()) * axes;
+                        p.to_array()
+                    })
+                    .collect();
+                let border = if rng.next().is_multiple_of(4) {
+                    0.1 * axes.min_element()
+                } else {
+                    0.0
+                };
+                let stable = stable_faces(&points);
+                if stable.is_empty() {
+                    continue;
+                }
+                let base = stable[rng.integer(0, stable.len() - 1)];
+                return Self {
+                    seed,
+                    points,
+                    border,
+                    prism: false,
+                    base,
+                };
             }
         }
     }
@@ -113,6 +133,48 @@ impl Hull {
             hull
         }
     }
+}
+
+/// The outward unit normals (local frame) of the facets of the convex hull of `points` on
+/// which it rests stably: those over which its centre of mass (uniform density) lies at least
+/// [`STABLE`] in from every edge, as seen from the centre of mass (it must tip by that angle
+/// about the nearest edge before it rolls over). The facets are the hull's triangles, not
+/// Parry's faces: Parry merges nearly coplanar triangles into one face whose vertices lie up to
+/// millimetres off its plane, and a body set down along such a face's normal rests on the
+/// triangle its lowest vertices make.
+fn stable_faces(points: &[[f32; 3]]) -> Vec<Vec3> {
+    let points: Vec<Vec3> = points.iter().map(|p| Vec3::from_array(*p)).collect();
+    let Some(hull) = ConvexPolyhedron::from_convex_hull(&points) else {
+        return Vec::new();
+    };
+    let com = hull.mass_properties(1.0).local_com;
+    let (vertices, triangles) = convex_hull(&points);
+    let mut stable = Vec::new();
+    for triangle in triangles {
+        let [a, b, c] = triangle.map(|v| vertices[v as usize]);
+        let Some(mut normal) = (b - a).cross(c - a).try_normalize() else {
+            continue;
+        };
+        if (com - a).dot(normal) > 0.0 {
+            normal = -normal;
+        }
+        // The height of the centre of mass over the facet, and its foot on it.
+        let height = (com - a).dot(-normal);
+        let foot = com + normal * height;
+        // The foot's least distance inside the triangle's edges.
+        let inside = [(a, b, c), (b, c, a), (c, a, b)]
+            .into_iter()
+            .map(|(p, q, opposite)| {
+                let across = normal.cross(q - p).normalize();
+                let inward = across * (opposite - p).dot(across).signum();
+                (foot - p).dot(inward)
+            })
+            .fold(f32::INFINITY, f32::min);
+        if inside.atan2(height) >= STABLE {
+            stable.push(normal);
+        }
+    }
+    stable
 }
 
 /// The static grounds, each flat at y = 0 over x, z ∈ [−20, 20] m.
@@ -184,7 +246,7 @@ fn grounds() -> Vec<(&'static str, BodyDesc)> {
 }
 
 /// What one run measured: the largest depth (m) over the run and over its last
-/// [`SETTLED`] s, and the final tilt (rad) of the hull's local y axis from the vertical.
+/// [`SETTLED`] s, and the final tilt (rad) of the hull's base from facing down.
 #[derive(Debug)]
 struct Outcome {
     deepest: f32,
@@ -196,11 +258,13 @@ struct Outcome {
 /// `drop` above it, at a random yaw and a random place within 1 m of the origin.
 fn run(hull: &Hull, ground: &BodyDesc, drop: f32) -> Outcome {
     let mut rng = Rng(hull.seed ^ 0x5eed);
-    let yaw = Quat::from_rotation_y(rng.range(0.0, std::f32::consts::TAU));
+    // The base face down, at a random yaw.
+    let orientation = Quat::from_rotation_y(rng.range(0.0, std::f32::consts::TAU))
+        * Quat::from_rotation_arc(hull.base, Vec3::NEG_Y);
     let lowest = hull
         .points
         .iter()
-        .map(|p| (yaw * Vec3::from_array(*p)).y)
+        .map(|p| (orientation * Vec3::from_array(*p)).y)
         .fold(f32::INFINITY, f32::min);
     let position = [
         rng.range(-1.0, 1.0),
@@ -208,7 +272,7 @@ fn run(hull: &Hull, ground: &BodyDesc, drop: f32) -> Outcome {
         rng.range(-1.0, 1.0),
     ];
     let mut body = BodyDesc::new(BodyKind::Dynamic, hull.shape(), position);
-    body.orientation = yaw.to_array();
+    body.orientation = orientation.to_array();
     let scene = Scene {
         solver: SolverSettings::default(),
         bodies: vec![ground.clone(), body],
@@ -235,7 +299,7 @@ fn run(hull: &Hull, ground: &BodyDesc, drop: f32) -> Outcome {
         if step >= settled_from {
             outcome.deepest_settled = outcome.deepest_settled.max(depth);
         }
-        outcome.tilt = (pose.rotation * Vec3::Y).angle_between(Vec3::Y);
+        outcome.tilt = (pose.rotation * hull.base).angle_between(Vec3::NEG_Y);
     }
     outcome
 }
@@ -266,7 +330,7 @@ fn sweep(seeds: impl Iterator<Item = u64>) -> Vec<String> {
             if dropped.deepest > DROP_DEPTH || dropped.deepest_settled > REST_DEPTH {
                 failures.push(format!("{case}, dropped: {dropped:?}"));
             }
-            if hull.prism && rest.tilt.max(dropped.tilt) > TOPPLED {
+            if rest.tilt.max(dropped.tilt) > TOPPLED {
                 failures.push(format!(
                     "{case}: toppled (tilt {:.1}° at rest, {:.1}° dropped)",
                     rest.tilt.to_degrees(),
@@ -287,7 +351,7 @@ fn sweep(seeds: impl Iterator<Item = u64>) -> Vec<String> {
 }
 
 fn assert_clean(failures: &[String]) {
-    for failure in failures.iter().take(30) {
+    for failure in failures.iter() {
         eprintln!("  {failure}");
     }
     assert!(failures.is_empty(), "{} failures", failures.len());
@@ -295,8 +359,7 @@ fn assert_clean(failures: &[String]) {
 
 /// The issue's prisms (a 16-gon of radius 1 m and height 2 m, and a 6-gon and a 32-gon alike)
 /// and a 64-gon of radius 5 cm and height 10 cm (a mug's 128 points) on every ground, with
-/// five random hulls. Seed 3 (a point cloud) is left to the full sweep: dropped on the box it
-/// dips 17 mm before settling within 0.01 mm (docs/testing.md, "Hulls on every ground", open).
+/// six random hulls.
 #[test]
 fn hulls_rest_on_every_ground() {
     let mut failures = Vec::new();
@@ -330,7 +393,27 @@ fn hulls_rest_on_every_ground() {
             }
         }
     }
-    failures.append(&mut sweep([1, 2, 4, 5, 6].into_iter()));
+    failures.append(&mut sweep(1..7));
+    assert_clean(&failures);
+}
+
+/// Point clouds dropped face-down on the box land on it, and seed 3 vertex-down (as the sweep
+/// set clouds down before it chose a stable face). The step's speculative points stand only
+/// where the motion reaches the box, and GJK's distance at the cast's impact read such a
+/// face just touching the box as 0.2-1.7 mm apart: the points were dropped and the clouds fell
+/// a whole step (17 mm) into the box (3 of these 41 runs).
+#[test]
+fn clouds_dropped_on_a_box_land_on_it() {
+    let (_, ground) = grounds().swap_remove(1);
+    let mut vertex_down = Hull::random(3);
+    vertex_down.base = Vec3::NEG_Y;
+    let mut failures = Vec::new();
+    for hull in (101..180).step_by(2).map(Hull::random).chain([vertex_down]) {
+        let outcome = run(&hull, &ground, DROP);
+        if outcome.deepest > DROP_DEPTH {
+            failures.push(format!("seed {}: {outcome:?}", hull.seed));
+        }
+    }
     assert_clean(&failures);
 }
 
@@ -339,4 +422,17 @@ fn hulls_rest_on_every_ground() {
 #[ignore = "the full sweep, about a minute: docs/testing.md"]
 fn hulls_rest_on_every_ground_full_sweep() {
     assert_clean(&sweep(100..300));
+}
+
+/// Seed 177, a rounded cloud (131 points, border 4.8 cm), set down vertex-down (as the sweep
+/// set clouds down before it chose a stable facet) rolls onto a face and should rest there
+/// within a millimetre; it ends 3.8 mm deep (open: docs/testing.md, "Hulls on every ground").
+#[test]
+#[ignore = "open: a rounded cloud rolled onto a face ends 3.8 mm deep (docs/testing.md)"]
+fn a_rounded_cloud_rolled_onto_a_face_rests_on_it() {
+    let mut hull = Hull::random(177);
+    hull.base = Vec3::NEG_Y;
+    let (_, ground) = grounds().swap_remove(0);
+    let outcome = run(&hull, &ground, 0.0);
+    assert!(outcome.deepest_settled <= REST_DEPTH, "{outcome:?}");
 }
