@@ -1,0 +1,132 @@
+"""The Takes panel's logic and operators: goals set on objects, a search in a child process, and
+"Bake take" keying exactly the take's trajectory."""
+
+import math
+
+import bpy
+import mathutils
+import numpy as np
+import pytest
+from impulse_bake import axes, bake, keyframes, scene_reader
+from impulse_bake import takes as takes_logic
+from test_operator import addon  # noqa: F401  (the registered add-on, a fixture)
+
+import scenes
+
+FRAMES = 61  # 2.5 s at 24 fps
+
+
+def _die_scene():
+    """A 0.2 m die dropped from 0.6 m onto a passive plane, tipped so it tumbles; the search
+    varies its start angle, velocity and spin."""
+    scene = scenes._reset(FRAMES)
+    scenes._ground(scene, half=5.0)
+    die = scenes._add(
+        scene, "die", scenes._box_mesh("die", (0.2, 0.2, 0.2)), (0.0, 0.0, 0.6), rotation=(0.4, 0.3, 0.0)
+    )
+    die.rotation_mode = "QUATERNION"  # keyed as quaternions, compared component by component
+    die.rotation_quaternion = mathutils.Euler((0.4, 0.3, 0.0)).to_quaternion()
+    settings = scene.impulse_takes
+    settings.position, settings.angle, settings.velocity, settings.angular_velocity = 0.0, 90.0, 1.0, 8.0
+    settings.budget, settings.population, settings.stop_after, settings.workers = 64, 16, 1, 2
+    scene.impulse_bake.preset = "fast"
+    return scene, die
+
+
+def test_goals_are_read_in_impulse_axes(addon, tmp_path):  # noqa: F811
+    scene, die = _die_scene()
+    region = bpy.data.objects.new("target", None)
+    scene.collection.objects.link(region)
+    region.empty_display_type = "CUBE"
+    region.empty_display_size = 0.5
+    region.location = (1.0, 2.0, 0.25)
+    region.scale = (2.0, 1.0, 1.0)
+    bpy.context.view_layer.update()
+    die.impulse_takes.region = region
+    die.impulse_takes.face_up = "NEG_Y"
+    die.impulse_takes.hits = scene.objects["ground"]
+    info = scene_reader.read_scene(scene)
+    goals = {g["type"]: g for g in takes_logic.read_goals(scene, info)}
+    # Blender (x, y, z) is impulse (x, z, -y): the box x 0..2, y 1.5..2.5, z -0.25..0.75.
+    box = goals["ends_inside"]["region"]["box"]
+    assert box["min"] == pytest.approx([0.0, -0.25, -2.5])
+    assert box["max"] == pytest.approx([2.0, 0.75, -1.5])
+    # The die's local -Y is impulse's body-frame +Z; up is Blender's +Z, impulse's +Y.
+    assert goals["rests_with_axis_up"]["axis"] == [0.0, 0.0, 1.0]
+    assert goals["rests_with_axis_up"]["up"] == [0.0, 1.0, 0.0]
+    assert goals["touches"]["other"] == "ground"
+    die.impulse_takes.region = None
+    die.impulse_takes.face_up = "NONE"
+    die.impulse_takes.hits = None
+    with pytest.raises(scene_reader.UnsupportedScene, match="no object has a goal"):
+        takes_logic.read_goals(scene, info)
+
+
+def test_the_searched_scene_steps_as_the_bake(addon):  # noqa: F811
+    """The scene file a search varies gives the bake's bits with no settings besides it."""
+    scene, _ = _die_scene()
+    info = scene_reader.read_scene(scene)
+    searched, count = takes_logic.search_scene(info, "fast")
+    impulse = bake.import_impulse()
+    world = impulse.World.from_scene(searched)
+    baked, baked_count = bake.make_world(info.scene, "fast")
+    assert count == baked_count == 3 and searched["steps"] == (FRAMES - 1) * 3
+    for _ in range(20):
+        world.step(count)
+        baked.step(count)
+    assert np.array_equal(world.positions, baked.positions)
+    assert np.array_equal(world.orientations, baked.orientations)
+
+
+def test_a_die_search_finds_a_take_and_bake_take_keys_it(addon, tmp_path, monkeypatch):  # noqa: F811
+    scene, die = _die_scene()
+    die.impulse_takes.face_up = "POS_Z"
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    settings = scene.impulse_takes
+    assert settings.directory.startswith(str(tmp_path))
+    assert len(settings.takes) > 0 and settings.takes[0].met
+    take_id = settings.takes[0].take_id
+
+    assert bpy.ops.impulse.bake_take() == {"FINISHED"}
+    assert not scene.rigidbody_world.enabled
+    scene.frame_set(FRAMES)
+    up = die.matrix_world.to_3x3().normalized() @ mathutils.Vector((0.0, 0.0, 1.0))
+    assert up.z > math.cos(math.radians(10.0))
+
+    # The keyframes are the take's trajectory: impulse.World.from_scene(take.scene()) stepped
+    # the bake's steps per frame, in Blender's axes, to the bit of the F-curves' float32.
+    from impulse.takes import load
+
+    take = load(settings.directory)[take_id]
+    world = bake.import_impulse().World.from_scene(take.scene())
+    count = bake.steps_per_frame(scene.rigidbody_world.time_scale / scene.render.fps)
+    row = world.index_of(world.handle_of(world.names.index("die")))
+    positions, orientations = [world.positions[row].copy()], [world.orientations[row].copy()]
+    for _ in range(FRAMES - 1):
+        world.step(count)
+        positions.append(world.positions[row].copy())
+        orientations.append(world.orientations[row].copy())
+    locations = axes.positions_to_blender(np.stack(positions))
+    quaternions = axes.continuous_quaternions(axes.orientations_to_blender(np.stack(orientations))[:, None])[:, 0]
+    fcurves = keyframes._fcurve_collection(die, create=False)
+    for index in range(3):
+        keyed = [p.co[1] for p in fcurves.find("location", index=index).keyframe_points]
+        assert np.array_equal(np.float32(keyed), np.float32(locations[:, index]))
+    for index in range(4):
+        keyed = [p.co[1] for p in fcurves.find("rotation_quaternion", index=index).keyframe_points]
+        assert len(keyed) == FRAMES
+        assert np.array_equal(np.float32(keyed), np.float32(quaternions[:, index]))
+
+
+def test_bake_take_refuses_a_scene_changed_since_the_search(addon, tmp_path, monkeypatch):  # noqa: F811
+    scene, die = _die_scene()
+    die.impulse_takes.face_up = "POS_Z"
+    settings = scene.impulse_takes
+    settings.budget, settings.stop_after = 16, 16
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    die.location.z += 0.1
+    with pytest.raises(RuntimeError, match="changed since take"):
+        bpy.ops.impulse.bake_take()
+    assert scene.rigidbody_world.enabled
