@@ -119,7 +119,9 @@ def read_goals(scene, info):
             )
         if settings.hits is not None:
             if settings.hits.name not in bodies or settings.hits == obj:
-                problems.append(f"{obj.name}: the object it should hit, {settings.hits.name}, is not a rigid body of the world")
+                problems.append(
+                    f"{obj.name}: the object it should hit, {settings.hits.name}, is not another rigid body of the world"
+                )
             else:
                 goals.append(
                     {

@@ -130,3 +130,34 @@ def test_bake_take_refuses_a_scene_changed_since_the_search(addon, tmp_path, mon
     with pytest.raises(RuntimeError, match="changed since take"):
         bpy.ops.impulse.bake_take()
     assert scene.rigidbody_world.enabled
+
+
+def test_goals_read_from_objects_score_the_bake(addon):  # noqa: F811
+    """The goals, run on the unvaried scene: the die lands near the origin on the ground, so a
+    box around the origin and the ground are met, a box 2 m away along Blender's y is missed
+    by about its distance, and the face it lands on is up."""
+    scene, die = _die_scene()
+    near, far = (bpy.data.objects.new(name, None) for name in ("near", "far"))
+    for empty, location in ((near, (0.0, 0.0, 0.0)), (far, (0.0, 2.5, 0.0))):
+        scene.collection.objects.link(empty)
+        empty.empty_display_type = "CUBE"
+        empty.empty_display_size = 0.5
+        empty.location = location
+    bpy.context.view_layer.update()
+    die.impulse_takes.region = near
+    die.impulse_takes.hits = scene.objects["ground"]
+    info = scene_reader.read_scene(scene)
+    searched, _ = takes_logic.search_scene(info, "fast")
+    goals = takes_logic.read_goals(scene, info)
+    die.impulse_takes.region = far
+    goals.append(dict(takes_logic.read_goals(scene, info)[0], name="far"))
+    from impulse.takes import evaluate
+
+    costs = evaluate(searched, goals, searched["steps"])
+    assert costs["die ends inside near"] == 0.0
+    assert costs["die hits ground"] == 0.0
+    end = bake.import_impulse().World.from_scene(searched)
+    end.step(searched["steps"])
+    x, y, z = axes.positions_to_blender(end.positions[end.names.index("die")])
+    assert abs(x) < 0.5 and abs(y) < 0.5 and abs(z - 0.1) < 0.01
+    assert costs["far"] == pytest.approx(2.0 - y, abs=1e-6)
