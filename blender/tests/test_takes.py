@@ -161,3 +161,23 @@ def test_goals_read_from_objects_score_the_bake(addon):  # noqa: F811
     x, y, z = axes.positions_to_blender(end.positions[end.names.index("die")])
     assert abs(x) < 0.5 and abs(y) < 0.5 and abs(z - 0.1) < 0.01
     assert costs["far"] == pytest.approx(2.0 - y, abs=1e-6)
+
+
+def test_a_cancelled_search_keeps_its_takes_and_resumes(addon, tmp_path):  # noqa: F811
+    """What Esc does in the panel: the child stopped after a generation; its takes are listed,
+    and the same request run again reads them instead of running them."""
+    import time
+
+    scene, die = _die_scene()
+    die.impulse_takes.face_up = "POS_Z"
+    variation = {"position": 0.0, "angle": 90.0, "velocity": 1.0, "angular_velocity": 8.0}
+    request = takes_logic.build_request(scene, variation, population=8, preset="fast")
+    job = takes_logic.SearchJob(str(tmp_path / "search"), request, budget=10_000, stop_after=10_000, workers=2)
+    deadline = time.monotonic() + 60.0
+    while job.takes_done() < 8 and job.running() and time.monotonic() < deadline:
+        time.sleep(0.2)
+    job.cancel()
+    kept = job.finish()
+    assert len(kept) >= 8
+    again = takes_logic.SearchJob(str(tmp_path / "search"), request, budget=8, workers=2).wait()
+    assert set(again) <= set(kept) and len(again) == len(kept)
