@@ -120,7 +120,8 @@ def read_goals(scene, info):
         if settings.hits is not None:
             if settings.hits.name not in bodies or settings.hits == obj:
                 problems.append(
-                    f"{obj.name}: the object it should hit, {settings.hits.name}, is not another rigid body of the world"
+                    f"{obj.name}: the object it should hit, {settings.hits.name}, "
+                    "is not another rigid body of the world"
                 )
             else:
                 goals.append(
@@ -179,8 +180,10 @@ def search_scene(info, preset="default", substeps=0, frame_steps=0):
     return json.loads(json.dumps(scene)), count
 
 
-def build_request(scene, variation, seed=0, population=16, preset="default", substeps=0, frame_steps=0,
-                  materials="blender", resolution=0):
+def build_request(
+    scene, variation, seed=0, population=16, preset="default", substeps=0, frame_steps=0, materials="blender",
+    resolution=0,
+):
     """A search's request for the scene as it is: ``{"scene", "goals", "variation", "seed",
     "population"}`` (:class:`SearchJob`). ``variation`` holds the scales ``position`` (m),
     ``angle`` (degrees), ``velocity`` (m/s) and ``angular_velocity`` (rad/s); the varied

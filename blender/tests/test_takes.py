@@ -13,6 +13,8 @@ from test_operator import addon  # noqa: F401  (the registered add-on, a fixture
 
 import scenes
 
+pytestmark = pytest.mark.usefixtures("addon")
+
 FRAMES = 61  # 2.5 s at 24 fps
 
 
@@ -33,7 +35,7 @@ def _die_scene():
     return scene, die
 
 
-def test_goals_are_read_in_impulse_axes(addon, tmp_path):  # noqa: F811
+def test_goals_are_read_in_impulse_axes():
     scene, die = _die_scene()
     region = bpy.data.objects.new("target", None)
     scene.collection.objects.link(region)
@@ -62,7 +64,7 @@ def test_goals_are_read_in_impulse_axes(addon, tmp_path):  # noqa: F811
         takes_logic.read_goals(scene, info)
 
 
-def test_the_searched_scene_steps_as_the_bake(addon):  # noqa: F811
+def test_the_searched_scene_steps_as_the_bake():
     """The scene file a search varies gives the bake's bits with no settings besides it."""
     scene, _ = _die_scene()
     info = scene_reader.read_scene(scene)
@@ -78,7 +80,7 @@ def test_the_searched_scene_steps_as_the_bake(addon):  # noqa: F811
     assert np.array_equal(world.orientations, baked.orientations)
 
 
-def test_a_die_search_finds_a_take_and_bake_take_keys_it(addon, tmp_path, monkeypatch):  # noqa: F811
+def test_a_die_search_finds_a_take_and_bake_take_keys_it(tmp_path, monkeypatch):
     scene, die = _die_scene()
     die.impulse_takes.face_up = "POS_Z"
     monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
@@ -119,7 +121,7 @@ def test_a_die_search_finds_a_take_and_bake_take_keys_it(addon, tmp_path, monkey
         assert np.array_equal(np.float32(keyed), np.float32(quaternions[:, index]))
 
 
-def test_bake_take_refuses_a_scene_changed_since_the_search(addon, tmp_path, monkeypatch):  # noqa: F811
+def test_bake_take_refuses_a_scene_changed_since_the_search(tmp_path, monkeypatch):
     scene, die = _die_scene()
     die.impulse_takes.face_up = "POS_Z"
     settings = scene.impulse_takes
@@ -132,7 +134,7 @@ def test_bake_take_refuses_a_scene_changed_since_the_search(addon, tmp_path, mon
     assert scene.rigidbody_world.enabled
 
 
-def test_goals_read_from_objects_score_the_bake(addon):  # noqa: F811
+def test_goals_read_from_objects_score_the_bake():
     """The goals, run on the unvaried scene: the die lands near the origin on the ground, so a
     box around the origin and the ground are met, a box 2 m away along Blender's y is missed
     by about its distance, and the face it lands on is up."""
@@ -163,7 +165,7 @@ def test_goals_read_from_objects_score_the_bake(addon):  # noqa: F811
     assert costs["far"] == pytest.approx(2.0 - y, abs=1e-6)
 
 
-def test_a_cancelled_search_keeps_its_takes_and_resumes(addon, tmp_path):  # noqa: F811
+def test_a_cancelled_search_keeps_its_takes_and_resumes(tmp_path):
     """What Esc does in the panel: the child stopped after a generation; its takes are listed,
     and the same request run again reads them instead of running them."""
     import time
