@@ -1,8 +1,13 @@
 """The Takes panel's logic and operators: goals set on objects, a search in a child process, and
 "Bake take" keying exactly the take's trajectory."""
 
+import importlib
+import importlib.util
 import math
 import os
+import pathlib
+import sys
+import zipfile
 
 import bpy
 import mathutils
@@ -10,11 +15,41 @@ import numpy as np
 import pytest
 from impulse_bake import axes, bake, keyframes, scene_reader
 from impulse_bake import takes as takes_logic
-from test_operator import addon  # noqa: F401  (the registered add-on, a fixture)
-
 import scenes
 
 pytestmark = pytest.mark.usefixtures("addon")
+
+
+@pytest.fixture(scope="module")
+def addon(tmp_path_factory):
+    """The add-on registered, loaded as test_operator.py loads it (from the zip named by
+    ``IMPULSE_BLENDER_ADDON_ZIP``, else the source directory), or the module it already loaded
+    in this session (its fixture checks that the module it imports is its own copy)."""
+    module = sys.modules.get("impulse_blender")
+    loaded_here = module is None
+    if loaded_here:
+        archive = os.environ.get("IMPULSE_BLENDER_ADDON_ZIP")
+        if archive:
+            target = tmp_path_factory.mktemp("addons")
+            with zipfile.ZipFile(archive) as packed:
+                packed.extractall(target)
+            sys.path.insert(0, str(target))
+            module = importlib.import_module("impulse_blender")
+            sys.path.remove(str(target))
+        else:
+            source = pathlib.Path(__file__).resolve().parent.parent
+            spec = importlib.util.spec_from_file_location(
+                "impulse_blender", source / "__init__.py", submodule_search_locations=[str(source)]
+            )
+            module = importlib.util.module_from_spec(spec)
+            sys.modules["impulse_blender"] = module
+            spec.loader.exec_module(module)
+    module.register()
+    yield module
+    module.unregister()
+    if loaded_here:  # test_operator.py loads its own copy afterwards
+        for name in [n for n in sys.modules if n == "impulse_blender" or n.startswith("impulse_blender.")]:
+            del sys.modules[name]
 
 FRAMES = 61  # 2.5 s at 24 fps
 
