@@ -22,12 +22,14 @@ _vendor = os.path.join(os.path.dirname(__file__), "vendor")
 if os.path.isdir(_vendor) and _vendor not in sys.path:
     sys.path.insert(0, _vendor)
 
-from . import operators  # noqa: E402 (after the vendor path is added)
+from . import operators, takes_ui  # noqa: E402 (after the vendor path is added)
 
 
 def register():
     operators.register()
+    takes_ui.register()
 
 
 def unregister():
+    takes_ui.unregister()
     operators.unregister()

@@ -1,0 +1,383 @@
+"""Directable takes in Blender, free of any UI: goals set on objects as ``impulse.takes`` goal
+dicts, the scene a search varies, the search run as ``python -m impulse.takes search`` in a
+child process, and a take baked as keyframes through the same path as "Bake with impulse".
+
+The searched scene is the baked one, written so that the scene file alone gives the bake's bits:
+its ``dt`` is one simulation step (a frame's ``dt`` over the steps per frame), its ``steps``
+the range's steps, and its ``solver`` the bake's settings (the preset's effort at that step,
+the scene's friction and bounciness rules). ``impulse.World.from_scene(take.scene())`` stepped
+``steps`` times is then the take's trajectory, and :class:`TakeBaker` keys exactly it.
+
+Goals use the object's origin as its place (the body's ``position``) and Blender's axes, turned
+into impulse's (y up) as the bake does (:mod:`.axes`).
+"""
+
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+from . import axes, bake, scene_reader
+
+#: The local axes an "ends face up" goal can name, in the object's own (Blender) frame.
+FACE_AXES = {
+    "POS_X": (1.0, 0.0, 0.0),
+    "NEG_X": (-1.0, 0.0, 0.0),
+    "POS_Y": (0.0, 1.0, 0.0),
+    "NEG_Y": (0.0, -1.0, 0.0),
+    "POS_Z": (0.0, 0.0, 1.0),
+    "NEG_Z": (0.0, 0.0, -1.0),
+}
+
+#: Blender's world up (+Z) in impulse's axes.
+UP = (0.0, 1.0, 0.0)
+
+#: Files a search directory holds besides what ``impulse.takes.search`` writes: the request
+#: (the scene and goals handed to the child process) and the child's output.
+REQUEST_SCENE = "request-scene.json"
+REQUEST_GOALS = "request-goals.json"
+LOG_FILE = "search.log"
+
+
+def _impulse_vector(v):
+    """A Blender vector in impulse's axes, without negative zeros (so the JSON reads plainly)."""
+    return [c + 0.0 for c in axes.vector_to_impulse(v)]
+
+
+def empty_box(empty):
+    """The world-space box of an Empty displayed as a Cube (its display size times its world
+    matrix), as an impulse ``box`` region: the axis-aligned bounds in impulse's axes of its 8
+    corners (exact for an Empty that is not rotated; a rotated one gives the box around it)."""
+    size = float(empty.empty_display_size)
+    corners = np.array(
+        [
+            _impulse_vector(empty.matrix_world @ _vector((sx * size, sy * size, sz * size)))
+            for sx in (-1, 1)
+            for sy in (-1, 1)
+            for sz in (-1, 1)
+        ]
+    )
+    return {"box": {"min": corners.min(axis=0).tolist(), "max": corners.max(axis=0).tolist()}}
+
+
+def _vector(values):
+    import mathutils
+
+    return mathutils.Vector(values)
+
+
+def is_region(obj):
+    """Whether ``obj`` can be an "ends inside" region: an Empty displayed as a Cube."""
+    return obj is not None and obj.type == "EMPTY" and obj.empty_display_type == "CUBE"
+
+
+def read_goals(scene, info):
+    """The goals set on the objects of the scene's Rigid Body World (their ``impulse_takes``
+    settings) as ``impulse.takes`` goal dicts, in object-name order, for the bodies of ``info``
+    (a :class:`scene_reader.SceneInfo`). Raises :class:`scene_reader.UnsupportedScene` naming
+    each object whose goal cannot be met as set, or when no object has a goal."""
+    bodies = {b.object_name: b for b in info.bodies}
+    goals, problems = [], []
+    for obj in scene_reader.rigid_body_objects(scene):
+        settings = getattr(obj, "impulse_takes", None)
+        if settings is None or not has_goal(settings):
+            continue
+        body = bodies.get(obj.name)
+        if body is None or not body.keyed:
+            problems.append(f"{obj.name}: has goals but is not a moving body of the bake (an Active rigid body)")
+            continue
+        if body.animated is not None:
+            problems.append(f"{obj.name}: its Animated or Dynamic flag is keyed; takes vary scenes without switches")
+            continue
+        if settings.region is not None:
+            if not is_region(settings.region):
+                problems.append(f"{obj.name}: its region {settings.region.name} is not an Empty displayed as a Cube")
+            else:
+                goals.append(
+                    {
+                        "type": "ends_inside",
+                        "name": f"{obj.name} ends inside {settings.region.name}",
+                        "body": obj.name,
+                        "region": empty_box(settings.region),
+                    }
+                )
+        if settings.face_up != "NONE":
+            goals.append(
+                {
+                    "type": "rests_with_axis_up",
+                    "name": f"{obj.name} ends {settings.face_up} up",
+                    "body": obj.name,
+                    "axis": _impulse_vector(FACE_AXES[settings.face_up]),
+                    "up": list(UP),
+                    "tolerance_degrees": float(settings.face_tolerance),
+                    "rest_speed": float(settings.rest_speed),
+                }
+            )
+        if settings.hits is not None:
+            if settings.hits.name not in bodies or settings.hits == obj:
+                problems.append(
+                    f"{obj.name}: the object it should hit, {settings.hits.name}, "
+                    "is not another rigid body of the world"
+                )
+            else:
+                goals.append(
+                    {
+                        "type": "touches",
+                        "name": f"{obj.name} hits {settings.hits.name}",
+                        "body": obj.name,
+                        "other": settings.hits.name,
+                    }
+                )
+    if problems:
+        raise scene_reader.UnsupportedScene(problems)
+    if not goals:
+        raise scene_reader.UnsupportedScene(
+            [f"{scene.name}: no object has a goal (set one in Physics > impulse Takes: Goals)"]
+        )
+    return goals
+
+
+def has_goal(settings):
+    """Whether an object's ``impulse_takes`` settings state any goal."""
+    return settings.region is not None or settings.face_up != "NONE" or settings.hits is not None
+
+
+def varied_bodies(scene, info):
+    """Names of the moving bodies a search varies: those whose ``impulse_takes.vary`` is on."""
+    names = []
+    for body in info.bodies:
+        if not body.keyed:
+            continue
+        obj = scene.objects.get(body.object_name)
+        if obj is not None and getattr(obj, "impulse_takes", None) is not None and obj.impulse_takes.vary:
+            names.append(body.object_name)
+    return names
+
+
+def search_scene(info, preset="default", substeps=0, frame_steps=0):
+    """The scene dict a search varies, and the steps per frame: ``info.scene`` (a
+    :class:`scene_reader.SceneInfo`'s) with one simulation step as ``dt``, the range's steps as
+    ``steps`` and the bake's solver settings as ``solver``, so that
+    ``impulse.World.from_scene`` of it steps exactly as :func:`bake.make_world` of ``info.scene``
+    does. Raises :class:`scene_reader.UnsupportedScene` for a scene with bodies whose Animated
+    or Dynamic flag switches (the bake swaps them mid-range; a scene file cannot)."""
+    switching = [b.object_name for b in info.bodies if b.animated is not None]
+    if switching:
+        raise scene_reader.UnsupportedScene(
+            [f"{name}: its Animated or Dynamic flag is keyed; takes vary scenes without switches" for name in switching]
+        )
+    count = bake.steps_per_frame(info.dt, frame_steps)
+    dt = info.dt / count
+    solver = bake.solver_settings(preset, substeps, dt).to_dict()
+    # The scene's own solver fields (the combine rules) are not effort fields: the bake keeps
+    # them over the preset's (impulse's Settings.with_effort_of), and so does this.
+    solver.update(info.scene.get("solver", {}))
+    scene = dict(info.scene, dt=dt, steps=info.steps * count, solver=solver)
+    return json.loads(json.dumps(scene)), count
+
+
+def build_request(
+    scene, variation, seed=0, population=16, preset="default", substeps=0, frame_steps=0, materials="blender",
+    resolution=0,
+):
+    """A search's request for the scene as it is: ``{"scene", "goals", "variation", "seed",
+    "population"}`` (:class:`SearchJob`). ``variation`` holds the scales ``position`` (m),
+    ``angle`` (degrees), ``velocity`` (m/s) and ``angular_velocity`` (rad/s); the varied
+    bodies are the objects whose ``impulse_takes.vary`` is on. The bake settings are those of
+    "Bake with impulse". Raises :class:`scene_reader.UnsupportedScene` naming what is missing
+    or wrong."""
+    info = scene_reader.read_scene(scene, materials=materials, resolution=resolution)
+    goals = read_goals(scene, info)
+    searched, _ = search_scene(info, preset, substeps, frame_steps)
+    bodies = varied_bodies(scene, info)
+    if not bodies:
+        raise scene_reader.UnsupportedScene([f"{scene.name}: no moving object has Vary on"])
+    variation = dict(variation, bodies=bodies)
+    if not any(variation[key] > 0.0 for key in ("position", "angle", "velocity", "angular_velocity")):
+        raise scene_reader.UnsupportedScene([f"{scene.name}: every variation scale is 0: nothing would vary"])
+    return {"scene": searched, "goals": goals, "variation": variation, "seed": int(seed), "population": int(population)}
+
+
+def _canonical(value):
+    return json.dumps(value, sort_keys=True, separators=(",", ":"))
+
+
+def search_directory(blend_path, request):
+    """The directory of a search: ``<blend name>_takes/<16 hex digits of the request>`` beside
+    the .blend, or under the system's temporary directory for an unsaved file. One request
+    (scene, goals, variation, seed, population) always maps to one directory, so running it
+    again resumes it."""
+    digest = hashlib.sha256(_canonical(request).encode()).hexdigest()[:16]
+    if blend_path:
+        stem = os.path.splitext(os.path.basename(blend_path))[0]
+        base = os.path.join(os.path.dirname(os.path.abspath(blend_path)), f"{stem}_takes")
+    else:
+        base = os.path.join(tempfile.gettempdir(), "impulse-takes")
+    return os.path.join(base, digest)
+
+
+def python_executable():
+    """The Python interpreter to run the search with: ``sys.executable``, which is Blender's
+    bundled Python in Blender (2.91 and later) and the environment's Python for the ``bpy``
+    module. Raises RuntimeError when it is not a Python interpreter."""
+    executable = sys.executable
+    if not executable or not os.path.basename(executable).lower().startswith("python"):
+        raise RuntimeError(
+            f"impulse takes run the search with a Python interpreter, and sys.executable is "
+            f"{executable!r}: run Blender 2.91 or later, or search from a shell with "
+            "python -m impulse.takes search"
+        )
+    return executable
+
+
+class SearchJob:
+    """One search running in a child process (``python -m impulse.takes search`` on the local
+    process pool), started on construction.
+
+    ``request`` holds the search's inputs: ``scene`` (the :func:`search_scene` dict), ``goals``,
+    ``variation`` (an ``impulse.takes.Variation`` dict), ``seed``, ``population``; ``budget``,
+    ``stop_after`` and ``workers`` (0: every core) only limit the run. The child writes its
+    takes to ``directory`` (:func:`search_directory`) a generation at a time and its messages
+    to ``search.log`` there.
+    """
+
+    def __init__(self, directory, request, budget, stop_after=1, workers=0):
+        self.directory = directory
+        self.budget = int(budget)
+        self.cancelled = False
+        os.makedirs(directory, exist_ok=True)
+        scene_path = os.path.join(directory, REQUEST_SCENE)
+        goals_path = os.path.join(directory, REQUEST_GOALS)
+        with open(scene_path, "w", encoding="utf-8") as file:
+            json.dump(request["scene"], file)
+        with open(goals_path, "w", encoding="utf-8") as file:
+            json.dump(
+                {"goals": request["goals"], "steps": request["scene"]["steps"], "variation": request["variation"]},
+                file,
+                indent=1,
+            )
+        command = [
+            python_executable(),
+            "-m",
+            "impulse.takes",
+            "search",
+            scene_path,
+            "--goals",
+            goals_path,
+            "--budget",
+            str(self.budget),
+            "--out",
+            directory,
+            "--seed",
+            str(int(request["seed"])),
+            "--population",
+            str(int(request["population"])),
+            "--stop-after",
+            str(int(stop_after)),
+            "--no-progress",
+        ]
+        if workers > 0:
+            command += ["--workers", str(int(workers))]
+        impulse = bake.import_impulse()
+        # The child finds impulse where this process did (an installed wheel, or the plain
+        # add-on's vendor/ directory).
+        package_root = os.path.dirname(os.path.dirname(os.path.abspath(impulse.__file__)))
+        environment = dict(os.environ)
+        environment["PYTHONPATH"] = os.pathsep.join(
+            p for p in (package_root, environment.get("PYTHONPATH")) if p
+        )
+        self._log = open(os.path.join(directory, LOG_FILE), "w", encoding="utf-8")  # noqa: SIM115
+        self.process = subprocess.Popen(
+            command, stdout=self._log, stderr=subprocess.STDOUT, env=environment, cwd=directory
+        )
+
+    def takes_done(self):
+        """Takes run so far (the rows the child has written; it writes after each generation)."""
+        path = os.path.join(self.directory, "takes.parquet")
+        if not os.path.exists(path):
+            return 0
+        try:
+            import pyarrow.parquet as pq
+
+            return pq.read_metadata(path).num_rows
+        except (OSError, ValueError):
+            return 0  # being replaced this instant
+
+    def running(self):
+        return self.process.poll() is None
+
+    def wait(self):
+        """Blocks until the child ends; returns :meth:`finish`."""
+        self.process.wait()
+        return self.finish()
+
+    def cancel(self):
+        """Stops the child; the takes of its finished generations stay in the directory (a
+        search run again with the same settings resumes them)."""
+        if self.running():
+            self.cancelled = True
+            self.process.terminate()
+            self.process.wait()
+        self._log.close()
+
+    def finish(self):
+        """The ``impulse.takes.Takes`` of the ended (or cancelled) search. Raises RuntimeError
+        with the child's last message when it failed (exit code 2 or a crash), FileNotFoundError
+        when it was cancelled before any take was written."""
+        self._log.close()
+        code = self.process.returncode
+        if code not in (0, 1) and not self.cancelled:
+            with open(os.path.join(self.directory, LOG_FILE), encoding="utf-8", errors="replace") as file:
+                lines = [line.strip() for line in file if line.strip()]
+            message = lines[-1] if lines else f"exit code {code}"
+            raise RuntimeError(f"the search failed: {message}")
+        from impulse.takes import load
+
+        return load(self.directory)
+
+
+class TakeBaker(bake.Baker):
+    """A :class:`bake.Baker` that simulates take ``take_id`` of ``takes`` (an
+    ``impulse.takes.Takes``) instead of the scene as read: the scene is read and checked as for
+    "Bake with impulse", the search must have been run on this very scene and settings (its
+    ``scene.json``), and the world is ``impulse.World.from_scene(take.scene())``, stepped the
+    same steps per frame. Raises :class:`scene_reader.UnsupportedScene` when the scene or the
+    bake settings changed since the search, KeyError for an unknown take."""
+
+    def __init__(
+        self, scene, takes, take_id, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0
+    ):
+        take = takes[take_id]
+        super().__init__(scene, preset, substeps, frame_steps, materials, resolution)
+        searched, count = search_scene(self.info, preset, substeps, frame_steps)
+        if _canonical(searched) != _canonical(takes.base_scene):
+            raise scene_reader.UnsupportedScene(
+                [
+                    f"{scene.name}: the scene or the bake settings changed since take {take.take_id} was "
+                    "searched; search again"
+                ]
+            )
+        self.take = take
+        self.frame_steps = count
+        # A varied body's first key is its varied start, not the object's own channels
+        # (bake.Baker keys those at the first frame to keep an unchanged re-bake's bits).
+        for index in takes.variation.body_indices(takes.base_scene):
+            self.info.bodies[index].start = None
+        self.world = self.impulse.World.from_scene(take.scene())
+        self.handles = [self.world.handle_of(i) for i in range(len(self.info.bodies))]
+        self._rows()
+        self.positions = [self.world.positions[self.rows].copy()]
+        self.orientations = [self.world.orientations[self.rows].copy()]
+
+
+def bake_take(scene, takes, take_id, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0):
+    """Bake take ``take_id`` of ``takes`` (a search of this scene) as keyframes at once;
+    returns the :class:`TakeBaker`."""
+    baker = TakeBaker(scene, takes, take_id, preset, substeps, frame_steps, materials, resolution)
+    baker.advance()
+    baker.write()
+    return baker
