@@ -23,9 +23,12 @@ first frame, placed on both bodies, as Blender does):
   and ``angular_x`` (``use_motor_lin``, ``use_motor_ang``);
 - ``disable_collisions`` → ``collide_connected`` = not it; ``object1``/``object2`` → body A/B;
 - Breaking: Bullet breaks a constraint when one of its rows' impulse in one Bullet substep reaches
-  ``breaking_threshold`` (N·s). impulse's strength is a force (N) and torque (N·m), so the
-  threshold becomes force = torque = threshold / h with h = time_scale / (fps ·
-  substeps_per_frame), Bullet's substep (s). A motor's "max impulse" converts the same way.
+  ``breaking_threshold`` (N·s). impulse's strength is a force (N) and torque (N·m) measured over
+  a window (s), so the threshold becomes force = torque = threshold / h over a window of h,
+  with h = time_scale / (fps · substeps_per_frame), Bullet's substep (s): a steady load breaks
+  the joint at threshold / h as in Bullet, and a blow when its impulse reaches the threshold,
+  however many of impulse's shorter substeps carry it. A motor's "max impulse" converts to a
+  force the same way.
 
 Settings impulse cannot follow (a disabled constraint, solver-iteration overrides, angular
 springs, a generic frame whose y and z axes impulse cannot reproduce, a constraint on a body
@@ -252,5 +255,6 @@ def read_constraints(scene, bodies, masses):
             strength = float(constraint.breaking_threshold) / substep
             joint["break_force"] = strength
             joint["break_torque"] = strength
+            joint["break_window"] = substep
         joints.append(joint)
     return joints, warnings

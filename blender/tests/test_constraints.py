@@ -121,6 +121,7 @@ def test_constraint_settings_map_and_unsupported_ones_are_warned():
     substep = constraints.bullet_substep(scene)
     assert math.isclose(substep, 1.0 / (24 * scene.rigidbody_world.substeps_per_frame))
     assert math.isclose(joint["break_force"], 2.0 / substep, rel_tol=1e-6)
+    assert math.isclose(joint["break_window"], substep, rel_tol=1e-6)
     assert joint["collide_connected"] is True
     warnings = info.warnings
     assert any(w.startswith("hinge: ") and "iterations" in w for w in warnings), warnings

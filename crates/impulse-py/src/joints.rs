@@ -313,15 +313,25 @@ impl JointBuilder {
     }
 
     /// Makes the joint breakable with strength `force` (N) for its locked translations and
-    /// `torque` (N·m) for its locked rotations (either may be `inf`). A substep whose locked
-    /// impulse reaches strength × substep breaks the joint there; it then passes no load and
-    /// `World.joint_events()` reports it at the end of the step.
+    /// `torque` (N·m) for its locked rotations (either may be `inf`), measured over `window`
+    /// seconds (0: one substep). The joint breaks when its locked impulse over the window
+    /// reaches strength × window (over a substep: strength × substep), so a steady load breaks
+    /// it at `force`, and a blow when its impulse reaches force × window; it then passes no
+    /// load and `World.joint_events()` reports it at the end of the step. Blender's (Bullet's)
+    /// breaking threshold T over its substep h is `breakable(T / h, T / h, window=h)`.
     #[pyo3(
-        signature = (force, torque = f32::INFINITY),
-        text_signature = "($self, force, torque=1e999)"
+        signature = (force, torque = f32::INFINITY, window = 0.0),
+        text_signature = "($self, force, torque=1e999, window=0.0)"
     )]
-    fn breakable(&self, force: f32, torque: f32) -> Self {
-        self.with(|b| b.breakable(force, torque))
+    fn breakable(&self, force: f32, torque: f32, window: f32) -> Self {
+        self.with(|b| {
+            let b = b.breakable(force, torque);
+            if window != 0.0 {
+                b.break_window(window)
+            } else {
+                b
+            }
+        })
     }
 
     /// A name, shown in errors and events.
@@ -362,6 +372,7 @@ pub(crate) fn joint_dict<'py>(
         PyArray1::from_vec(py, joint.torque().to_array().to_vec()),
     )?;
     d.set_item("collide_connected", joint.collide_connected())?;
+    d.set_item("break_window", joint.break_window())?;
     d.set_item("break_thresholds", joint.break_thresholds())?;
     d.set_item(
         "coordinates",

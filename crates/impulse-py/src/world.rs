@@ -700,9 +700,9 @@ impl World {
     /// A joint's read view as a dict: `handle`, `kind` (str), `name` (str or None), `body_a`,
     /// `body_b` (BodyHandle), `broken` (bool), `force` (3,) float32 N and `torque` (3,) N·m
     /// (the reaction on B at the anchor over the last step it was solved, world frame; A's is
-    /// the opposite), `collide_connected`, `break_thresholds` ((N, N·m) or None) and
-    /// `coordinates` (as `joint_coordinates`, or None when a body was removed). Raises
-    /// `WorldError` for a removed or foreign handle.
+    /// the opposite), `collide_connected`, `break_thresholds` ((N, N·m) or None),
+    /// `break_window` (s) and `coordinates` (as `joint_coordinates`, or None when a body was
+    /// removed). Raises `WorldError` for a removed or foreign handle.
     fn joint<'py>(&self, py: Python<'py>, handle: &JointHandle) -> PyResult<Bound<'py, PyDict>> {
         let world = self.world(py)?;
         let joint = world

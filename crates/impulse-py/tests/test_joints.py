@@ -126,10 +126,14 @@ def test_a_door_swinging_through_its_own_post_is_not_stopped():
     assert abs(swing - expected) < 0.01
 
 
-def hang(load: float, strength: float = 100.0) -> tuple:
+#: A break window (s): Bullet's substep at Blender's defaults.
+WINDOW = 1.0 / 240.0
+
+
+def hang(load: float, strength: float = 100.0, window: float = 0.0) -> tuple:
     """A mass of weight `load`·`strength` (N) hung below a static beam by one fixed joint of
-    strength `strength` (N); stepped 2 s one step at a time. Returns the world, the joint and
-    the events of every step."""
+    strength `strength` (N) measured over `window` s; stepped 2 s one step at a time. Returns
+    the world, the joint and the events of every step."""
     world = impulse.World(
         gravity=(0, -G, 0), dt=DT, settings=impulse.Settings.preset("default").replace(sleep=False)
     )
@@ -144,7 +148,7 @@ def hang(load: float, strength: float = 100.0) -> tuple:
     joint = world.insert_joint(
         impulse.JointBuilder.fixed(beam, weight)
         .world_anchor((0, 0.95, 0))
-        .breakable(strength)
+        .breakable(strength, window=window)
         .name("hook")
     )
     events = []
@@ -154,9 +158,11 @@ def hang(load: float, strength: float = 100.0) -> tuple:
     return world, joint, events
 
 
-def test_a_breakable_joint_holds_a_weight_below_its_strength():
-    """Strength 1.05·m·g: by statics the joint carries m·g, holds, and its force is m·g up."""
-    world, joint, events = hang(1 / 1.05)
+@pytest.mark.parametrize("window", [0.0, WINDOW])
+def test_a_breakable_joint_holds_a_weight_below_its_strength(window):
+    """Strength 1.05·m·g: by statics the joint carries m·g, holds, and its force is m·g up,
+    with or without a break window."""
+    world, joint, events = hang(1 / 1.05, window=window)
     view = world.joint(joint)
     weight = 100.0 / 1.05
     print(f"holding: force {view['force']} N, weight {weight:.3f} N")
@@ -166,15 +172,57 @@ def test_a_breakable_joint_holds_a_weight_below_its_strength():
     assert world.joint_events() == []
 
 
-def test_a_breakable_joint_breaks_under_a_weight_above_its_strength():
-    """Strength 0.95·m·g: breaks, with one event naming it and reporting the strength."""
-    world, joint, events = hang(1 / 0.95)
+@pytest.mark.parametrize("window", [0.0, WINDOW])
+def test_a_breakable_joint_breaks_under_a_weight_above_its_strength(window):
+    """Strength 0.95·m·g: breaks, with one event naming it and reporting the strength, with or
+    without a break window."""
+    world, joint, events = hang(1 / 0.95, window=window)
     print(f"breaking: events {events}")
     assert len(events) == 1
     (event,) = events
     assert event["type"] == "broken" and event["joint"] == joint and event["name"] == "hook"
     assert abs(event["force"] - 100.0) < 1e-3 * 100.0
     assert world.joint(joint)["broken"]
+
+
+def kicked(kick: float, window: float) -> list:
+    """A mass of weight 0.3·F hung below a static beam by one fixed joint of strength F = 100 N
+    measured over `window` s, at rest after 0.5 s, then kicked downwards with a momentum of
+    `kick`·F·(1/240 s). Returns the events of the second after the kick."""
+    strength = 100.0
+    world = impulse.World(
+        gravity=(0, -G, 0), dt=DT, settings=impulse.Settings.preset("default").replace(sleep=False)
+    )
+    beam = world.insert(
+        impulse.BodyBuilder.fixed(impulse.Shape.cuboid(0.5, 0.05, 0.5), translation=(0, 1, 0))
+    )
+    mass = 0.3 * strength / G
+    weight = world.insert(
+        impulse.BodyBuilder.dynamic(impulse.Shape.cuboid(0.1, 0.1, 0.1), translation=(0, 0.85, 0), mass=mass)
+    )
+    world.insert_joint(
+        impulse.JointBuilder.fixed(beam, weight).world_anchor((0, 0.95, 0)).breakable(strength, window=window)
+    )
+    world.step(30)
+    velocities = world.linear_velocities.copy()
+    velocities[world.index_of(weight)] = (0.0, -kick * strength * WINDOW / mass, 0.0)
+    world.linear_velocities = velocities
+    events = []
+    for _ in range(60):
+        world.step()
+        events.extend(world.joint_events())
+    return events
+
+
+def test_a_break_window_keeps_the_static_strength_and_measures_a_blow_over_the_window():
+    """Measured over 1/240 s the joint takes a blow of 0.3·F·(1/240 s) on top of its 0.3·F load
+    (0.6 of its window's strength) and breaks under one of 1.5·F·(1/240 s); measured over a
+    substep of the default preset (1/1200 s) the small blow is more than the substep's F·h and
+    breaks it."""
+    assert kicked(0.3, WINDOW) == []
+    assert len(kicked(1.5, WINDOW)) == 1
+    assert len(kicked(0.3, 0.0)) == 1
+    assert kicked(0.0, WINDOW) == []
 
 
 def test_bad_joints_raise_world_error_naming_the_field():

@@ -239,8 +239,9 @@ class JointBuilder:
         self, hertz: float | None = None, damping_ratio: float | None = None
     ) -> JointBuilder: ...
     def collide_connected(self, collide: bool) -> JointBuilder: ...
-    def breakable(self, force: float, torque: float = math.inf) -> JointBuilder:
-        """Strength ``force`` (N) and ``torque`` (N·m, default inf)."""
+    def breakable(self, force: float, torque: float = math.inf, window: float = 0.0) -> JointBuilder:
+        """Strength ``force`` (N) and ``torque`` (N·m, default inf), measured over ``window``
+        seconds (0: one substep)."""
     def name(self, name: str) -> JointBuilder: ...
 
 @final
@@ -425,7 +426,7 @@ class World:
     def joint(self, handle: JointHandle) -> dict[str, Any]:
         """``handle``, ``kind``, ``name``, ``body_a``, ``body_b``, ``broken``, ``force`` (3,) N
         and ``torque`` (3,) N·m on B (world frame), ``collide_connected``,
-        ``break_thresholds``, ``coordinates`` (6,)."""
+        ``break_thresholds``, ``break_window`` (s), ``coordinates`` (6,)."""
     def joints(self) -> list[dict[str, Any]]: ...
     @property
     def joint_count(self) -> int: ...

@@ -73,6 +73,7 @@ pub struct JointBuilder {
     pub(crate) collide_connected: bool,
     pub(crate) break_force: Option<f32>,
     pub(crate) break_torque: Option<f32>,
+    pub(crate) break_window: Option<f32>,
     pub(crate) name: Option<String>,
     /// A builder call that does not fit the kind (field, message), reported at insertion.
     pub(crate) misuse: Option<(String, String)>,
@@ -123,6 +124,7 @@ impl JointBuilder {
             collide_connected: false,
             break_force: None,
             break_torque: None,
+            break_window: None,
             name: None,
             misuse: None,
         }
@@ -318,6 +320,19 @@ impl JointBuilder {
     pub fn breakable(mut self, force: f32, torque: f32) -> Self {
         self.break_force = Some(force);
         self.break_torque = Some(torque);
+        self
+    }
+
+    /// Measures the break thresholds over a window of `seconds` (s, ≥ 0; default 0: one
+    /// substep): the joint breaks when its locked translations passed force × `seconds` of
+    /// impulse over the last `seconds` (an exponential window; torques alike). A steady load
+    /// breaks it at the same force as without a window; a blow breaks it when its impulse
+    /// reaches force × `seconds`, however many substeps carry it, so its impact strength does
+    /// not depend on the substep length. Bullet's (and Blender's) breaking threshold, an
+    /// impulse per Bullet substep, is force = threshold / substep with a window of that
+    /// substep. Only for a [`Self::breakable`] joint.
+    pub fn break_window(mut self, seconds: f32) -> Self {
+        self.break_window = Some(seconds);
         self
     }
 

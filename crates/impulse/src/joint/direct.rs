@@ -281,7 +281,7 @@ impl LockedRows {
     /// rows).
     fn new(joints: &[JointConstraint]) -> Option<Self> {
         // Fewer than two joints have fewer than two with locked rows (most islands have none).
-        if joints.len() < 2 || joints.iter().any(JointConstraint::is_breakable) {
+        if joints.len() < 2 || joints.iter().any(|joint| joint.strength.is_breakable()) {
             return None;
         }
         let with_rows = spanning_forest(joints);

@@ -5,8 +5,8 @@
 //! `types.rs` the public description of the degrees of freedom, `builder.rs` [`JointBuilder`],
 //! `handle.rs` generational [`JointHandle`]s, `rules.rs` the checks shared with the scene
 //! validator, `frames.rs` the frames and coordinates at given poses, `rows.rs` the rows an
-//! island's step solves ([`JointConstraint`]), `direct.rs` an island's locked rows solved
-//! together ([`IslandJoints`]).
+//! island's step solves ([`JointConstraint`]), `strength.rs` a breakable joint's strength in
+//! it, `direct.rs` an island's locked rows solved together ([`IslandJoints`]).
 
 mod builder;
 mod direct;
@@ -17,6 +17,7 @@ mod handle;
 mod rows;
 pub(crate) mod rules;
 mod softness;
+mod strength;
 mod types;
 
 use glam::{Quat, Vec3};
@@ -29,6 +30,7 @@ pub(crate) use frames::{LocalFrames, frame_state};
 pub use handle::JointHandle;
 pub(crate) use handle::JointHandles;
 pub(crate) use rows::{JointBody, JointConstraint, JointImpulses, LOCK, ROWS_PER_DOF};
+pub(crate) use strength::Strength;
 pub use types::{
     AxisMode, JointAxis, JointDof, JointKind, JointStiffness, Motor, MotorMode, Spring,
 };
@@ -53,9 +55,15 @@ pub(crate) struct Joint {
     pub collide_connected: bool,
     pub break_force: Option<f32>,
     pub break_torque: Option<f32>,
+    /// The window (s) over which the break thresholds are measured; 0: one substep.
+    #[serde(default)]
+    pub break_window: f32,
     pub name: Option<String>,
     /// The last substep's impulses, the next step's warm start.
     pub impulses: JointImpulses,
+    /// The locked groups' impulses summed over the break window ([`Strength::sums`]).
+    #[serde(default)]
+    pub break_sums: [Vec3; 2],
     /// Whether it broke (then it is no longer solved and joins nothing).
     pub broken: bool,
     /// The last solved step's reaction on B at the anchor (N, N·m; world frame).
@@ -139,6 +147,12 @@ impl<'a> JointRef<'a> {
         }
     }
 
+    /// The window (s) over which its break thresholds are measured
+    /// ([`JointBuilder::break_window`]); 0: one substep.
+    pub fn break_window(&self) -> f32 {
+        self.joint.break_window
+    }
+
     /// Whether it broke.
     pub fn broken(&self) -> bool {
         self.joint.broken
@@ -172,10 +186,11 @@ pub enum JointEvent {
         joint: JointHandle,
         /// Its name, if it has one.
         name: Option<String>,
-        /// Its reaction force in the substep where it broke (N): the force threshold when the
-        /// translations broke it.
+        /// Its reaction force where it broke (N): the impulse of its break window (the substep
+        /// where it broke, and the earlier ones when the window is longer) over the window's
+        /// length; the force threshold when the translations broke it.
         force: f32,
-        /// Its reaction torque in that substep (N·m).
+        /// Its reaction torque likewise (N·m).
         torque: f32,
     },
 }

@@ -22,6 +22,7 @@ use glam::{Mat3, Quat, Vec3};
 
 use super::frames::{FrameState, LocalFrames, frame_state};
 use super::softness::{Softness, joint_softness};
+use super::strength::Strength;
 use super::types::{AxisMode, JointAxis, JointStiffness, MotorMode};
 use crate::body::Velocities;
 
@@ -204,11 +205,9 @@ pub(crate) struct JointConstraint {
     /// What the restitution solve added to the impulses (zero without a bounce): part of the
     /// step's impulse, not of the next step's warm start.
     pub bounce: JointImpulses,
-    /// Break thresholds (N, N·m; infinite: unbreakable): the strength of the locked
-    /// translations and rotations, which bounds their impulse in a solve of h seconds to
-    /// threshold·h.
-    break_force: f32,
-    break_torque: f32,
+    /// The strength of the locked translations and rotations, which bounds their impulse in
+    /// a substep ([`Strength`]).
+    pub strength: Strength,
     /// The force and torque (N, N·m, world) of the substep in which the joint broke; `None`
     /// while it holds. A broken joint takes no further part in the step.
     pub broke: Option<(Vec3, Vec3)>,
@@ -255,8 +254,7 @@ impl JointConstraint {
             block_inverse: [Mat3::IDENTITY; 2],
             velocity_before: [0.0; 6],
             bounce: [[0.0; ROWS_PER_DOF]; 6],
-            break_force: break_force.unwrap_or(f32::INFINITY),
-            break_torque: break_torque.unwrap_or(f32::INFINITY),
+            strength: Strength::new(break_force, break_torque, 0.0, [Vec3::ZERO; 2]),
             broke: None,
         }
     }
@@ -264,6 +262,7 @@ impl JointConstraint {
     /// The substep length of this step's solves.
     pub(crate) fn start_step(&mut self, h: f32) {
         self.h = h;
+        self.strength.start_step(h);
     }
 
     /// A slot's centre of mass and orientation now: the start plus the island's displacement
@@ -522,31 +521,21 @@ impl JointConstraint {
         (force, torque)
     }
 
-    /// Whether a strength bounds the joint's locked groups (a finite break force or torque).
-    pub(crate) fn is_breakable(&self) -> bool {
-        self.break_force.is_finite() || self.break_torque.is_finite()
-    }
-
-    /// The strength of a locked group over a solve of h seconds (N·s or N·m·s; infinite:
-    /// unbreakable): group 0 the translations, group 1 the rotations.
-    pub(crate) fn strength(&self, group: usize) -> f32 {
-        if group == 0 {
-            self.break_force * self.h
-        } else {
-            self.break_torque * self.h
-        }
+    /// A locked group's current impulse as a world vector (N·s or N·m·s).
+    fn locked_impulse(&self, group: usize) -> Vec3 {
+        let start = 3 * group;
+        let local = Vec3::from_array(std::array::from_fn(|k| self.impulses[start + k][LOCK]));
+        self.group_impulse(group, local)
     }
 
     /// Whether a locked group's current impulse is at its strength (to rounding: the solve
     /// bounds it by the strength itself).
     fn group_at_strength(&self, group: usize) -> bool {
-        let strength = self.strength(group);
+        let strength = self.strength.bound(group);
         if !strength.is_finite() {
             return false;
         }
-        let start = 3 * group;
-        let local = Vec3::from_array(std::array::from_fn(|k| self.impulses[start + k][LOCK]));
-        self.group_impulse(group, local).length() >= strength * (1.0 - 1e-3)
+        self.locked_impulse(group).length() >= strength * (1.0 - 1e-3)
     }
 
     /// After a substep: a breakable joint breaks when the substep ended with one of its locked
@@ -554,11 +543,19 @@ impl JointConstraint {
     /// (`solve`), so a substep converged at that bound is a load the joint could not carry,
     /// where the unbounded force would have exceeded its threshold. The joint breaks there, as
     /// a real one would, and passes no more load for the rest of the step: what its neighbours
-    /// received is the short pulse up to its strength.
+    /// received is the short pulse up to its strength. A joint that holds adds the substep's
+    /// impulses to its strength's window ([`Strength::record`]).
     fn check_break(&mut self) {
-        if self.broke.is_none() && (self.group_at_strength(0) || self.group_at_strength(1)) {
-            self.broke = Some(self.reaction(&self.impulses, self.h));
+        if self.broke.is_some() || !self.strength.is_breakable() {
+            return;
+        }
+        if self.group_at_strength(0) || self.group_at_strength(1) {
+            let (force, torque) = self.reaction(&self.impulses, self.h);
+            self.broke = Some(self.strength.breaking_load(force, torque));
             self.impulses = [[0.0; ROWS_PER_DOF]; 6];
+        } else {
+            let impulses = [self.locked_impulse(0), self.locked_impulse(1)];
+            self.strength.record(impulses);
         }
     }
 
@@ -742,7 +739,7 @@ impl JointConstraint {
             // impulse is projected onto the ball of radius threshold·h (as friction onto its
             // disc); a substep ending there breaks the joint at the end of the step
             // (`check_break`).
-            let strength = self.strength(group);
+            let strength = self.strength.bound(group);
             if strength.is_finite() {
                 let total = self.group_impulse(group, old + delta);
                 let length = total.length();

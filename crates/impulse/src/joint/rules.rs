@@ -178,11 +178,12 @@ pub(crate) fn check_dofs(kind: JointKind, dofs: &[JointAxis; 6]) -> Result<(), J
     Ok(())
 }
 
-/// Checks the repair stiffness and the break thresholds.
+/// Checks the repair stiffness, the break thresholds and their window.
 pub(crate) fn check_options(
     stiffness: JointStiffness,
     break_force: Option<f32>,
     break_torque: Option<f32>,
+    break_window: Option<f32>,
 ) -> Result<(), JointProblem> {
     if let JointStiffness::Soft {
         hertz,
@@ -199,6 +200,20 @@ pub(crate) fn check_options(
             return Err(problem(
                 field,
                 format!("must be > 0 (may be infinite), got {value}"),
+            ));
+        }
+    }
+    if let Some(window) = break_window {
+        if !(window.is_finite() && window >= 0.0) {
+            return Err(problem(
+                "break_window",
+                format!("must be finite and >= 0 s, got {window}"),
+            ));
+        }
+        if break_force.is_none() && break_torque.is_none() {
+            return Err(problem(
+                "break_window",
+                "is for a breakable joint: give break_force or break_torque too".to_string(),
             ));
         }
     }

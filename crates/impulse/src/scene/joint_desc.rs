@@ -156,6 +156,10 @@ pub struct JointDesc {
     /// Break torque (N·m).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub break_torque: Option<f32>,
+    /// The window (s) the break thresholds are measured over; absent: one substep
+    /// ([`crate::JointBuilder::break_window`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub break_window: Option<f32>,
 }
 
 impl JointDesc {
@@ -181,6 +185,7 @@ impl JointDesc {
             collide_connected: false,
             break_force: None,
             break_torque: None,
+            break_window: None,
         }
     }
 
@@ -296,12 +301,18 @@ impl JointDesc {
         builder = builder.collide_connected(self.collide_connected);
         builder.break_force = self.break_force;
         builder.break_torque = self.break_torque;
+        builder.break_window = self.break_window;
         if let Some(name) = &self.name {
             builder = builder.name(name.clone());
         }
         check_dofs(self.kind, &builder.dofs).map_err(|p| (p.field, p.message))?;
-        check_options(builder.stiffness, builder.break_force, builder.break_torque)
-            .map_err(|p| (p.field, p.message))?;
+        check_options(
+            builder.stiffness,
+            builder.break_force,
+            builder.break_torque,
+            builder.break_window,
+        )
+        .map_err(|p| (p.field, p.message))?;
         Ok(builder)
     }
 }

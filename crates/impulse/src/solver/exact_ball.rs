@@ -1,13 +1,13 @@
 //! The exact path's ball bounds. A breakable joint's strength bounds each of its locked groups
-//! (the translations, the rotations) by a ball, |λ_g| ≤ s with s = break_force·h or
-//! break_torque·h ([`JointConstraint::strength`]), not by a box, so the group cannot be a
-//! Lemke variable throughout. It is handled as a sliding friction point is ([`super::exact`]):
-//! a group inside the ball is free, its rows Lemke's like any locked row; a group at its bound
-//! is held at λ_g = s·u for the round, u the direction of its current impulse, and enters
-//! Lemke's problem through the velocities ([`hold_at_bound`]). After each normal solve, block
-//! passes solve each group given the rest and project it onto the ball in the metric of its
-//! block ([`ball_pass`], the friction disc's projection in up to three dimensions), which
-//! updates u and reclassifies the groups for the next round.
+//! (the translations, the rotations) by a ball, |λ_g| ≤ s with s the bound of the substep
+//! ([`crate::joint::Strength::bound`]: break_force·h or break_torque·h without a window), not
+//! by a box, so the group cannot be a Lemke variable throughout. It is handled as a sliding
+//! friction point is ([`super::exact`]): a group inside the ball is free, its rows Lemke's like
+//! any locked row; a group at its bound is held at λ_g = s·u for the round, u the direction of
+//! its current impulse, and enters Lemke's problem through the velocities ([`hold_at_bound`]).
+//! After each normal solve, block passes solve each group given the rest and project it onto
+//! the ball in the metric of its block ([`ball_pass`], the friction disc's projection in up to
+//! three dimensions), which updates u and reclassifies the groups for the next round.
 //!
 //! A group's rows have orthonormal directions (the joint frame's axes), so |λ_g|, the length of
 //! the world impulse the joint's break test measures, is the Euclidean norm of its rows'
@@ -60,7 +60,7 @@ pub(super) fn collect_ball_groups(
     let mut current = None;
     for (q, r) in rows.iter_mut().enumerate() {
         let group = r.dof / 3;
-        let strength = joints[r.joint].strength(group);
+        let strength = joints[r.joint].strength.bound(group);
         if r.kind != LOCK || !strength.is_finite() {
             continue;
         }

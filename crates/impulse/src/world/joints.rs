@@ -11,7 +11,7 @@ use crate::error::WorldError;
 use crate::joint::rules::{check_dofs, check_options};
 use crate::joint::{
     Anchors, Axes, Joint, JointBody, JointBuilder, JointConstraint, JointEvent, JointHandle,
-    JointKind, JointRef, LocalFrames, ROWS_PER_DOF, frame_state,
+    JointKind, JointRef, LocalFrames, ROWS_PER_DOF, Strength, frame_state,
 };
 
 impl World {
@@ -49,8 +49,13 @@ impl World {
             ));
         }
         check_dofs(builder.kind, &builder.dofs).map_err(|p| invalid(&p.field, p.message))?;
-        check_options(builder.stiffness, builder.break_force, builder.break_torque)
-            .map_err(|p| invalid(&p.field, p.message))?;
+        check_options(
+            builder.stiffness,
+            builder.break_force,
+            builder.break_torque,
+            builder.break_window,
+        )
+        .map_err(|p| invalid(&p.field, p.message))?;
         let (pose_a, pose_b) = (self.bodies.pose[a], self.bodies.pose[b]);
         let (anchor_a, anchor_b) = match builder.anchors {
             Anchors::Local { a, b } => (a, b),
@@ -107,8 +112,10 @@ impl World {
             collide_connected: builder.collide_connected,
             break_force: builder.break_force,
             break_torque: builder.break_torque,
+            break_window: builder.break_window.unwrap_or(0.0),
             name: builder.name,
             impulses: [[0.0; ROWS_PER_DOF]; 6],
+            break_sums: [Vec3::ZERO; 2],
             broken: false,
             force: Vec3::ZERO,
             torque: Vec3::ZERO,
@@ -276,7 +283,7 @@ impl World {
             for row in impulses.iter_mut().flatten() {
                 *row *= warm_start;
             }
-            let constraint = JointConstraint::new(
+            let mut constraint = JointConstraint::new(
                 k,
                 body(a),
                 body(b),
@@ -286,6 +293,12 @@ impl World {
                 joint.stiffness,
                 impulses,
                 (joint.break_force, joint.break_torque),
+            );
+            constraint.strength = Strength::new(
+                joint.break_force,
+                joint.break_torque,
+                joint.break_window,
+                joint.break_sums,
             );
             self.workspaces[island].joints.push(constraint);
         }
@@ -306,12 +319,14 @@ impl World {
             for c in &workspace.joints {
                 let joint = &mut self.joints.joints[c.joint as usize];
                 joint.impulses = c.warm_start_impulses();
+                joint.break_sums = c.strength.sums;
                 (joint.force, joint.torque) = c.reaction(&c.step_impulses, dt);
                 if let Some((force, torque)) = c.broke
                     && !joint.broken
                 {
                     joint.broken = true;
                     joint.impulses = [[0.0; ROWS_PER_DOF]; 6];
+                    joint.break_sums = [Vec3::ZERO; 2];
                     self.joint_events.push(JointEvent::Broken {
                         joint: self.joints.handles.of_joint[c.joint as usize],
                         name: joint.name.clone(),

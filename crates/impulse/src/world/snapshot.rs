@@ -423,6 +423,7 @@ fn check_joints(world: &World, joints: &Joints) -> Result<(), String> {
         let finite = joint.anchor_a.is_finite()
             && joint.anchor_b.is_finite()
             && joint.impulses.iter().flatten().all(|x| x.is_finite())
+            && joint.break_sums.iter().all(|s| s.is_finite())
             && joint.force.is_finite()
             && joint.torque.is_finite();
         if !finite {
@@ -445,6 +446,7 @@ fn check_joints(world: &World, joints: &Joints) -> Result<(), String> {
                     joint.stiffness,
                     joint.break_force,
                     joint.break_torque,
+                    (joint.break_window != 0.0).then_some(joint.break_window),
                 )
             })
             .map_err(|p| format!("joint {k}: {}: {}", p.field, p.message))?;

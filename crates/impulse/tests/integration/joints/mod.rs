@@ -1,12 +1,13 @@
 //! Joints against closed forms: pendulum periods (the exact elliptic-integral period), a double
 //! pendulum's energy, chains hanging at rest (stretch, a 1:100 heavy end), a hinge door hit by a
 //! ball (limit, impact closed form), a door slammed onto its limit, a motorised wheel, a ragdoll
-//! at rest on stairs, a breakable wall; and the API's checks, snapshots and the exported mixed
-//! LCP.
+//! at rest on stairs, a breakable wall, a beam broken by a falling ball; and the API's checks,
+//! snapshots and the exported mixed LCP.
 
 mod chains;
 mod devices;
 mod exact;
+mod fracture;
 mod limits;
 mod pendulum;
 
