@@ -389,6 +389,19 @@ fn a_chair_lands_and_rests_on_its_four_legs() {
         }
     }
     assert_eq!(legs_touching, [true; 4], "legs pushing on the ground");
+    // Each point names the part of the chair it is on (the ground is no compound): the named
+    // convex part holds it, to within the contact's millimetre.
+    let compound = world.shapes()[1]
+        .as_compound()
+        .expect("a moving mesh is a compound of its parts");
+    for point in pair.points().filter(|p| p.normal_impulse > 0.0) {
+        assert_eq!(point.part1, None);
+        let k = point.part2.expect("the point names the chair's part") as usize;
+        let (part_pose, part) = &compound.shapes()[k];
+        let local = pose.inverse_transform_point(point.position);
+        let distance = part.distance_to_point(part_pose, local, true);
+        assert!(distance < 2e-3, "part {k} is {distance} m from its point");
+    }
 }
 
 /// A hollow closed box (outer surface wound outward, inner surface inward, walls 1 mm thick)
@@ -571,4 +584,3 @@ fn decomposition_costs() {
         );
     }
 }
-
