@@ -78,16 +78,32 @@ def handle():
         vertices.append((cx + ring * math.cos(u), cy + ring * math.sin(u), 0.0))
         for j in range(m):
             a, b = end * m + j, end * m + (j + 1) % m
-            triangles.append((centre, b, a) if end == 0 else (centre, a, b))
+            triangles.append((centre, a, b) if end == 0 else (centre, b, a))
     return vertices, outward(vertices, triangles)
 
 
-def write_obj(path):
+def mug():
+    """The mug's vertices and triangles: the cup, then the handle."""
     cup_vertices, cup_triangles = cup()
     handle_vertices, handle_triangles = handle()
     offset = len(cup_vertices)
     vertices = cup_vertices + handle_vertices
     triangles = cup_triangles + [(a + offset, b + offset, c + offset) for a, b, c in handle_triangles]
+    return vertices, triangles
+
+
+def open_edges(triangles):
+    """Edges not shared by exactly two triangles of opposite winding: 0 for a closed mesh."""
+    count = {}
+    for a, b, c in triangles:
+        for edge in ((a, b), (b, c), (c, a)):
+            count[edge] = count.get(edge, 0) + 1
+    return sum(1 for (a, b), n in count.items() if n != 1 or count.get((b, a), 0) != 1)
+
+
+def write_obj(path):
+    vertices, triangles = mug()
+    assert open_edges(triangles) == 0, "the mug mesh is not closed"
     with open(path, "w") as f:
         f.write(f"# A mug: {len(triangles)} triangles, closed, wound outward (scripts/make-mug-scenes.py)\n")
         for x, y, z in vertices:
@@ -97,7 +113,24 @@ def write_obj(path):
     return len(triangles)
 
 
-def write_scene(path, count=500):
+def bounding_sphere(vertices):
+    """Centre (the bounding box's) and radius of a sphere holding every vertex."""
+    centre = [0.5 * (min(v[i] for v in vertices) + max(v[i] for v in vertices)) for i in range(3)]
+    radius = max(math.dist(v, centre) for v in vertices)
+    return centre, radius
+
+
+def rotate(q, v):
+    """The vector v turned by the unit quaternion q = [x, y, z, w]."""
+    x, y, z, w = q
+    tx, ty, tz = 2 * (y * v[2] - z * v[1]), 2 * (z * v[0] - x * v[2]), 2 * (x * v[1] - y * v[0])
+    return [v[0] + w * tx + (y * tz - z * ty), v[1] + w * ty + (z * tx - x * tz), v[2] + w * tz + (x * ty - y * tx)]
+
+
+def write_scene(path, count=500, gap=0.01):
+    """Mugs in layers of a 7 x 7 grid above a walled box, each turned at random about its
+    bounding sphere's centre, the spheres `gap` apart: no mug starts touching another, the
+    floor or a wall."""
     rng = random.Random(62)
     half, wall_height = 0.7, 0.6
     bodies = [
@@ -112,13 +145,16 @@ def write_scene(path, count=500):
     ]:
         bodies.append({"name": name, "kind": "static", "shape": {"type": "cuboid", "half_extents": extents},
                        "position": position})
-    spacing, per_row = 0.17, 7
+    centre, radius = bounding_sphere(mug()[0])
+    spacing, per_row = 2 * radius + gap, 7
+    assert (per_row - 1) / 2 * spacing + radius < half, "the grid does not fit inside the walls"
+    spheres = []
     for k in range(count):
         layer, cell = divmod(k, per_row * per_row)
         row, column = divmod(cell, per_row)
-        position = [
+        sphere = [
             (column - (per_row - 1) / 2) * spacing,
-            0.15 + layer * spacing,
+            radius + gap + layer * spacing,
             (row - (per_row - 1) / 2) * spacing,
         ]
         # A uniformly random orientation (Shoemake's method).
@@ -129,8 +165,20 @@ def write_scene(path, count=500):
             math.sqrt(u1) * math.sin(2 * math.pi * u3),
             math.sqrt(u1) * math.cos(2 * math.pi * u3),
         ]
+        q = [round(x, 6) for x in q]
+        # The origin placed so that the turned bounding sphere's centre is the grid point (the
+        # engine normalises the rounded quaternion).
+        norm = math.sqrt(sum(x * x for x in q))
+        turned = rotate([x / norm for x in q], centre)
+        position = [round(sphere[i] - turned[i], 6) for i in range(3)]
+        spheres.append([position[i] + turned[i] for i in range(3)])
         bodies.append({"kind": "dynamic", "shape": {"type": "trimesh", "file": "mug.obj"},
-                       "position": [round(x, 4) for x in position], "orientation": [round(x, 6) for x in q]})
+                       "position": position, "orientation": q})
+    # No mug touches another or the floor at the start: bounding spheres apart.
+    for i, a in enumerate(spheres):
+        assert a[1] - radius > 0, f"mug {i} starts in the floor"
+        for b in spheres[i + 1:i + per_row * per_row + per_row + 2]:
+            assert math.dist(a, b) > 2 * radius, "two mugs start overlapping"
     scene = {"name": f"{count} mugs poured into a box", "steps": 300, "bodies": bodies}
     with open(path, "w") as f:
         json.dump(scene, f, indent=1)

@@ -753,15 +753,25 @@ fn warn_of_overlaps_at_start(world: &World) {
     };
     const NAMED: usize = 5;
     let mut count = 0;
+    // A compound's part (a decomposed mesh's convex part) is named after its body.
+    let part = |part: Option<u32>| part.map_or(String::new(), |k| format!(" part {k}"));
     for pair in world.contact_pairs() {
-        let depth = pair.points().map(|p| -p.separation).fold(0.0f32, f32::max);
+        let Some(deepest) = pair
+            .points()
+            .min_by(|a, b| a.separation.total_cmp(&b.separation))
+        else {
+            continue;
+        };
+        let depth = -deepest.separation;
         if depth > START_OVERLAP_WARNING {
             count += 1;
             if count <= NAMED {
                 eprintln!(
-                    "warning: bodies {} and {} start overlapping by {:.1} mm; the solver pushes them apart",
+                    "warning: bodies {}{} and {}{} start overlapping by {:.1} mm; the solver pushes them apart",
                     name(pair.body1()),
+                    part(deepest.part1),
                     name(pair.body2()),
+                    part(deepest.part2),
                     depth * 1e3
                 );
             }

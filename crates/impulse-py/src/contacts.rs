@@ -35,6 +35,15 @@ pub(crate) fn contact_pairs<'py>(
             PyArray1::from_vec(py, points.iter().map(|p| p.normal_impulse).collect()),
         )?;
         arrays.set_item("friction_impulse", flat3(&|p| p.friction_impulse)?)?;
+        let part = |part: Option<u32>| part.map_or(-1, i64::from);
+        arrays.set_item(
+            "part1",
+            PyArray1::from_vec(py, points.iter().map(|p| part(p.part1)).collect()),
+        )?;
+        arrays.set_item(
+            "part2",
+            PyArray1::from_vec(py, points.iter().map(|p| part(p.part2)).collect()),
+        )?;
         let d = PyDict::new(py);
         d.set_item(
             "body1",

@@ -653,7 +653,8 @@ impl World {
     /// `touching` (bool), `total_normal_impulse` (N·s), and `points`: a dict of arrays with
     /// `position` (K, 3) m, `normal` (K, 3) unit from body 1 towards body 2, `separation` (K,)
     /// m (negative: overlap), `normal_impulse` (K,) N·s, `friction_impulse` (K, 3) N·s on
-    /// body 2; all float32.
+    /// body 2, all float32; and `part1`, `part2` (K,) int64: the part of each body's shape the
+    /// point is on when that shape is a compound (a decomposed mesh), else -1.
     fn contact_pairs<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         contacts::contact_pairs(py, &*self.world(py)?)
     }

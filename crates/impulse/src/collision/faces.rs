@@ -327,27 +327,55 @@ pub(crate) fn reduce<ContactData>(
         .iter()
         .map(|c| was_kept(old, c.fid1, c.fid2))
         .collect();
+    let chosen = choose_four(
+        candidates.len(),
+        &|i| candidates[i].p1,
+        &|i| candidates[i].dist,
+        &kept,
+        n,
+    );
+    let mut index = 0;
+    candidates.retain(|_| {
+        let keep = chosen.contains(&index);
+        index += 1;
+        keep
+    });
+}
+
+/// The indices (ascending, at most [`MAX_POINTS`]) of the points to keep among `count` points
+/// at `position(i)` with separation `dist(i)` along the unit normal `n`: the deepest, the
+/// farthest from it across `n`, then the largest triangle with those two, then the largest on
+/// the other side of their line. Among points within a tie ([`DEPTH_TIE`], [`SPREAD_TIE`]) of
+/// the best, the first with `kept[i]` (a point kept last step) is chosen, so a resting contact
+/// keeps the same points from step to step.
+pub(crate) fn choose_four(
+    count: usize,
+    position: &dyn Fn(usize) -> Vector,
+    dist: &dyn Fn(usize) -> Real,
+    kept: &[bool],
+    n: Vector,
+) -> Vec<usize> {
+    if count <= MAX_POINTS {
+        return (0..count).collect();
+    }
     // The index maximising `score` (with last step's points favoured by `tie` in the score's
     // own units, given as a function of the best score), first of equals.
     let best = |score: &dyn Fn(usize) -> Real, tie: &dyn Fn(Real) -> Real| {
-        let top = (0..candidates.len())
-            .map(score)
-            .fold(Real::NEG_INFINITY, Real::max);
+        let top = (0..count).map(score).fold(Real::NEG_INFINITY, Real::max);
         let margin = tie(top);
-        (0..candidates.len())
+        (0..count)
             .find(|&i| kept[i] && score(i) >= top - margin)
-            .or_else(|| (0..candidates.len()).find(|&i| score(i) >= top))
+            .or_else(|| (0..count).find(|&i| score(i) >= top))
             .unwrap_or(0)
     };
-    let a = best(&|i| -candidates[i].dist, &|_| DEPTH_TIE);
-    let pa = candidates[a].p1;
+    let a = best(&|i| -dist(i), &|_| DEPTH_TIE);
+    let pa = position(a);
     let across = |v: Vector| v - n * v.dot(n);
-    let b = best(
-        &|i| across(candidates[i].p1 - pa).length_squared(),
-        &|top| top * SPREAD_TIE,
-    );
-    let pb = candidates[b].p1;
-    let signed_area = |i: usize| (pb - pa).cross(candidates[i].p1 - pa).dot(n);
+    let b = best(&|i| across(position(i) - pa).length_squared(), &|top| {
+        top * SPREAD_TIE
+    });
+    let pb = position(b);
+    let signed_area = |i: usize| (pb - pa).cross(position(i) - pa).dot(n);
     let c = best(&|i| signed_area(i).abs(), &|top| top * SPREAD_TIE);
     let side = signed_area(c).signum();
     let d = best(&|i| -side * signed_area(i), &|top| top.abs() * SPREAD_TIE);
@@ -374,12 +402,7 @@ pub(crate) fn reduce<ContactData>(
         chosen.extend(rest.into_iter().take(limit - chosen.len()));
     }
     chosen.sort_unstable();
-    let mut index = 0;
-    candidates.retain(|_| {
-        let keep = chosen.contains(&index);
-        index += 1;
-        keep
-    });
+    chosen
 }
 
 /// Replaces the points of `manifold`, Parry's contact of `g1` and `g2` (`g2` at `pos12` in

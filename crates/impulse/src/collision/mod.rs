@@ -11,3 +11,4 @@ pub(crate) mod faces;
 pub(crate) mod manifold;
 pub(crate) mod margins;
 pub(crate) mod narrow_phase;
+pub(crate) mod part_pairs;

@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 use super::dispatch::ContactDispatcher;
 pub(crate) use super::manifold::{ContactImpulse, Manifold, manifold_poses};
 pub use super::margins::SpeculativeMargins;
+use super::part_pairs;
 use crate::body::Bodies;
 use crate::error::StepError;
 use crate::parallel::{MANIFOLD_PAIRS_PER_TASK, prefetch, spread};
@@ -364,6 +365,9 @@ impl NarrowPhase {
                 bodies.shape[b].as_ref(),
                 &mut pair.manifolds,
             );
+            if part_pairs::applies(bodies.shape[a].as_ref(), bodies.shape[b].as_ref()) {
+                part_pairs::reduce(&mut pair.manifolds);
+            }
             pair.summary = PairSummary::of(&pair.manifolds);
             query.reach = recycle_reach(&bodies.shape[a], &bodies.shape[b]);
             pair.last_query = Some(query);

@@ -25,6 +25,12 @@ pub struct ContactPoint {
     /// Friction impulse over the last step on body 2 (N·s, world vector in the contact plane;
     /// body 1 receives its opposite).
     pub friction_impulse: Vec3,
+    /// The part of [`ContactPairView::body1`]'s shape the point is on, when that shape is a
+    /// compound (a decomposed mesh's convex parts, or a `compound` shape's parts, in their
+    /// order): an index into its parts; `None` for any other shape.
+    pub part1: Option<u32>,
+    /// The part of [`ContactPairView::body2`]'s shape the point is on (as `part1`).
+    pub part2: Option<u32>,
 }
 
 /// A pair of bodies with contact points after the last step ([`World::contact_pairs`]).
@@ -52,7 +58,11 @@ impl<'a> ContactPairView<'a> {
             bodies.pose[self.pair.body1 as usize],
             bodies.pose[self.pair.body2 as usize],
         );
+        let compound = |body: u32| bodies.shape[body as usize].as_compound().is_some();
+        let (compound1, compound2) = (compound(self.pair.body1), compound(self.pair.body2));
         self.pair.manifolds.iter().flat_map(move |manifold| {
+            let part1 = compound1.then_some(manifold.subshape1);
+            let part2 = compound2.then_some(manifold.subshape2);
             let (pose1, pose2) = narrow_phase::manifold_poses(manifold, &pose1, &pose2);
             let normal = pose1.rotation * manifold.local_n1;
             manifold.points.iter().map(move |point| ContactPoint {
@@ -65,6 +75,8 @@ impl<'a> ContactPairView<'a> {
                 // its friction vector is the impulse on A.
                 normal_impulse: point.data.step_normal,
                 friction_impulse: point.data.step_friction,
+                part1,
+                part2,
             })
         })
     }

@@ -24,7 +24,7 @@ use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, distance};
-use parry3d::shape::{Ball, Cuboid, HalfSpace, HeightField, Shape, Triangle};
+use parry3d::shape::{Ball, Compound, Cuboid, HalfSpace, HeightField, Shape, Triangle};
 
 use super::kinematic::rotation_vector;
 use crate::World;
@@ -314,20 +314,69 @@ pub(crate) fn clamp_fraction_castable(
         let t = hit.time_of_impact;
         return (t < 1.0).then(|| (t - gap / body.travel).max(0.0));
     }
-    let core = Ball::new(CORE_FRACTION * body.min_half_extent);
-    let com = body.sweep.local_center_of_mass;
-    // The core sphere is centred on the centre of mass: the same motion about the same point.
-    let core_motion = NonlinearRigidMotion::new(
-        Pose::from_parts(
-            body.sweep.start.transform_point(com),
-            body.sweep.start.rotation,
-        ),
-        Vec3::ZERO,
-        motion.linvel,
-        motion.angvel,
-    );
-    let hit = cast_shapes_nonlinear(&core_motion, &core, &target_motion, target, 0.0, 1.0, true)
-        .ok()??;
+    core_spheres(body, &mut |core, center| {
+        clamp_core(body, core, center, &target_motion, target)
+    })
+}
+
+/// Calls `each` with every core sphere of `body` (in contact, [`clamp_fraction_castable`]):
+/// a ball and its centre in the body frame, and returns the earliest fraction any of them
+/// gives. A compound has one core sphere per part, at the mean of the part's vertices (inside
+/// the convex part) with a [`CORE_FRACTION`] of the part's smallest half extent: the centre of
+/// mass of a ring or a mug lies in its hole, where a core sphere of the whole body would meet a
+/// peg through the hole that the ring itself never touches, and hold the ring still. Any other
+/// shape has one, at its centre of mass, with a [`CORE_FRACTION`] of [`FastBody::min_half_extent`].
+fn core_spheres(
+    body: &FastBody<'_>,
+    each: &mut dyn FnMut(Ball, Vec3) -> Option<f32>,
+) -> Option<f32> {
+    let Some(compound) = body.shape.as_shape::<Compound>() else {
+        return each(
+            Ball::new(CORE_FRACTION * body.min_half_extent),
+            body.sweep.local_center_of_mass,
+        );
+    };
+    compound
+        .shapes()
+        .iter()
+        .filter_map(|(pose, part)| {
+            let inside = match part.as_convex_polyhedron() {
+                Some(hull) if !hull.points().is_empty() => {
+                    hull.points().iter().copied().sum::<Vec3>() / hull.points().len() as f32
+                }
+                _ => part.compute_local_aabb().center(),
+            };
+            let half = part.compute_local_aabb().half_extents().min_element();
+            each(
+                Ball::new(CORE_FRACTION * half),
+                pose.transform_point(inside),
+            )
+        })
+        .min_by(f32::total_cmp)
+}
+
+/// The clamp from one core sphere `core` centred at `center` (body frame) of `body`: its first
+/// time of impact with `target`, moved back by the gap along the centre's path; `None` when it
+/// starts touching the target or does not meet it in the step.
+fn clamp_core(
+    body: &FastBody<'_>,
+    core: Ball,
+    center: Vec3,
+    target_motion: &NonlinearRigidMotion,
+    target: &dyn Shape,
+) -> Option<f32> {
+    let gap = CLAMP_GAP.min(0.1 * body.min_half_extent);
+    let core_sweep = body.sweep.of_part(&Pose::from_translation(center));
+    let hit = cast_shapes_nonlinear(
+        &core_sweep.motion(),
+        &core,
+        target_motion,
+        target,
+        0.0,
+        1.0,
+        true,
+    )
+    .ok()??;
     let t = hit.time_of_impact;
     if !(t > 0.0 && t < 1.0) {
         return None;
@@ -335,8 +384,7 @@ pub(crate) fn clamp_fraction_castable(
     // Moved back by the gap along the centre's path, as the whole body is above: a core sphere
     // left touching the target casts a time of impact of 0 the next step, and so would not be
     // clamped again however far the body then went through.
-    let (start, end) = body.sweep.center_path();
-    let center_travel = (end - start).length();
+    let center_travel = (core_sweep.end.translation - core_sweep.start.translation).length();
     Some(if center_travel > gap {
         (t - gap / center_travel).max(0.0)
     } else {

@@ -1,0 +1,141 @@
+//! Contact points between a compound (a decomposed mesh) and another convex or compound shape:
+//! Parry gives one manifold per pair of parts within the speculative distance, up to four
+//! points each, so two mugs of 21 parts side by side get dozens of manifolds, many of them
+//! along the same face. Points whose normals agree within [`NORMAL_COSINE`] are one patch, as
+//! in Jolt's manifold reduction (`PhysicsSettings::mUseManifoldReduction`, which merges the
+//! manifolds of sub-shape pairs with similar normals into one of at most four points). A patch
+//! is cut in layers [`LAYER_DEPTH`] deep from its deepest point, and each layer keeps
+//! [`MAX_POINTS`] points, chosen as a single face's are ([`choose_four`]: the deepest and the
+//! largest quadrilateral across the normal). Kept apart, a part's speculative points cannot
+//! take the place of the touching points that hold the body, nor far points the place of those
+//! about to touch (with the two merged, a bowl
+//! on a 1 cm foot kept four points spread up its curved bottom and rocked 12°).
+//!
+//! The dropped points are removed from their manifolds, which stay in place (Parry's
+//! workspace refers to them by index); the next update recomputes them and the reduction
+//! chooses again, ties going to points that carried impulse in the last step.
+
+use parry3d::math::{Pose, Real, Vector};
+use parry3d::shape::Shape;
+
+use super::faces::{MAX_POINTS, choose_four};
+use super::manifold::Manifold;
+
+/// Cosine of the largest angle (5°) between two points' normals for them to be one patch.
+pub(crate) const NORMAL_COSINE: Real = 0.996_194_7;
+
+/// Depth (m) of a patch's layers: layer k holds the points between k and k + 1 times this
+/// farther off than the patch's deepest point.
+pub(crate) const LAYER_DEPTH: Real = 1.0e-3;
+
+/// Whether a pair of `shape1` and `shape2` gets its manifolds reduced: one of them a compound
+/// and neither a triangle mesh or height field, whose per-triangle manifolds the seam pass
+/// reads.
+pub(crate) fn applies(shape1: &dyn Shape, shape2: &dyn Shape) -> bool {
+    let compound = |s: &dyn Shape| s.as_compound().is_some();
+    let mesh = |s: &dyn Shape| s.as_trimesh().is_some() || s.as_heightfield().is_some();
+    (compound(shape1) || compound(shape2)) && !mesh(shape1) && !mesh(shape2)
+}
+
+/// One contact point of a pair: its manifold and index there, its normal and position on body
+/// 1 (body 1's frame), its separation, and whether it carried impulse in the last step.
+#[derive(Clone, Copy)]
+struct PatchPoint {
+    manifold: usize,
+    point: usize,
+    normal: Vector,
+    position: Vector,
+    dist: Real,
+    kept: bool,
+}
+
+/// Reduces the points of one pair's `manifolds`: each patch (see the module's documentation)
+/// keeps at most [`MAX_POINTS`] points of each of its layers. Points
+/// are removed from their manifolds; no manifold is removed or reordered. Deterministic: the
+/// result depends on the manifolds' order and contents only.
+pub(crate) fn reduce(manifolds: &mut [Manifold]) {
+    if manifolds.len() < 2 {
+        return;
+    }
+    let identity = Pose::IDENTITY;
+    let mut points: Vec<PatchPoint> = Vec::new();
+    for (m, manifold) in manifolds.iter().enumerate() {
+        let pose = manifold.subshape_pos1().unwrap_or(&identity);
+        let normal = pose.rotation * manifold.local_n1;
+        points.extend(
+            manifold
+                .points
+                .iter()
+                .enumerate()
+                .map(|(k, point)| PatchPoint {
+                    manifold: m,
+                    point: k,
+                    normal,
+                    position: pose.transform_point(point.local_p1),
+                    dist: point.dist,
+                    kept: point.data.normal > 0.0 || point.data.step_normal > 0.0,
+                }),
+        );
+    }
+    if points.len() <= MAX_POINTS {
+        return;
+    }
+    // Deepest first (then by manifold and index: a total order), so that each patch's first
+    // point is its deepest and names its normal.
+    points.sort_by(|a, b| {
+        a.dist
+            .total_cmp(&b.dist)
+            .then(a.manifold.cmp(&b.manifold))
+            .then(a.point.cmp(&b.point))
+    });
+    // Each point's group: its patch (the index of the patch's first point) and layer.
+    let mut patches: Vec<usize> = Vec::new();
+    let mut groups: Vec<(usize, u32)> = Vec::with_capacity(points.len());
+    for (i, point) in points.iter().enumerate() {
+        let patch = patches
+            .iter()
+            .copied()
+            .find(|&first| points[first].normal.dot(point.normal) >= NORMAL_COSINE)
+            .unwrap_or_else(|| {
+                patches.push(i);
+                i
+            });
+        let layer = ((point.dist - points[patch].dist) / LAYER_DEPTH) as u32;
+        groups.push((patch, layer));
+    }
+    let mut keep: Vec<Vec<bool>> = manifolds
+        .iter()
+        .map(|m| vec![true; m.points.len()])
+        .collect();
+    // The points grouped (a stable sort keeps each group's points deepest first).
+    let mut by_group: Vec<usize> = (0..points.len()).collect();
+    by_group.sort_by_key(|&i| groups[i]);
+    for members in by_group.chunk_by(|&i, &j| groups[i] == groups[j]) {
+        if members.len() <= MAX_POINTS {
+            continue;
+        }
+        let kept: Vec<bool> = members.iter().map(|&i| points[i].kept).collect();
+        let chosen = choose_four(
+            members.len(),
+            &|k| points[members[k]].position,
+            &|k| points[members[k]].dist,
+            &kept,
+            points[groups[members[0]].0].normal,
+        );
+        for (k, &i) in members.iter().enumerate() {
+            keep[points[i].manifold][points[i].point] = chosen.contains(&k);
+        }
+    }
+    for (manifold, keep) in manifolds.iter_mut().zip(&keep) {
+        let mut k = 0;
+        manifold.points.retain(|_| {
+            let kept = keep[k];
+            k += 1;
+            kept
+        });
+    }
+}
+
+#[cfg(test)]
+#[path = "part_pairs_tests.rs"]
+mod tests;
