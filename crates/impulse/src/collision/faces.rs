@@ -327,13 +327,24 @@ pub(crate) fn reduce<ContactData>(
         .iter()
         .map(|c| was_kept(old, c.fid1, c.fid2))
         .collect();
-    let chosen = choose_four(
+    let mut chosen = choose_four(
         candidates.len(),
         &|i| candidates[i].p1,
         &|i| candidates[i].dist,
         &kept,
         n,
     );
+    // A face Parry merged from nearly coplanar triangles is not quite flat (a point cloud's
+    // hexagon, its vertices up to 3.4 mm off its plane over 0.5 m): the body rests on the
+    // triangle its lowest vertices make, and a vertex the quadrilateral leaves out can be one
+    // of them and sink under it. There the deepest of the rest are kept too, up to `limit`.
+    if limit > chosen.len() {
+        let mut rest: Vec<usize> = (0..candidates.len())
+            .filter(|i| !chosen.contains(i))
+            .collect();
+        rest.sort_by(|&i, &j| candidates[i].dist.total_cmp(&candidates[j].dist));
+        chosen.extend(rest.into_iter().take(limit - chosen.len()));
+    }
     let mut index = 0;
     candidates.retain(|_| {
         let keep = chosen.contains(&index);
@@ -389,17 +400,6 @@ pub(crate) fn choose_four(
     // candidate on ab or on c's side, which adds nothing.
     if side * signed_area(d) >= 0.0 && chosen.len() == 4 {
         chosen.pop();
-    }
-    // A face Parry merged from nearly coplanar triangles is not quite flat (a point cloud's
-    // hexagon, its vertices up to 3.4 mm off its plane over 0.5 m): the body rests on the
-    // triangle its lowest vertices make, and a vertex the quadrilateral leaves out can be one
-    // of them and sink under it. There the deepest of the rest are kept too, up to `limit`.
-    if limit > chosen.len() {
-        let mut rest: Vec<usize> = (0..candidates.len())
-            .filter(|i| !chosen.contains(i))
-            .collect();
-        rest.sort_by(|&i, &j| candidates[i].dist.total_cmp(&candidates[j].dist));
-        chosen.extend(rest.into_iter().take(limit - chosen.len()));
     }
     chosen.sort_unstable();
     chosen
