@@ -136,7 +136,6 @@ fn sweep(values: impl Fn(usize) -> Vec<f64>) -> (usize, Vec<String>) {
 }
 
 #[test]
-#[ignore = "known failures remain: joint anchors far from their bodies, spins above 1e5 rad/s on a contact (docs/testing.md)"]
 fn extreme_numbers_are_refused_with_their_place_or_run() {
     let (count, failures) = sweep(|_| EXTREMES.to_vec());
     assert!(
@@ -148,7 +147,6 @@ fn extreme_numbers_are_refused_with_their_place_or_run() {
 }
 
 #[test]
-#[ignore = "known failures remain: joint anchors far from their bodies, spins above 1e5 rad/s on a contact (docs/testing.md)"]
 fn random_magnitudes_are_refused_with_their_place_or_run() {
     let (count, failures) = sweep(|k| {
         let mut rng = ChaCha20Rng::seed_from_u64(0x7e57 + k as u64);
