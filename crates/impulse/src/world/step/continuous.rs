@@ -292,9 +292,11 @@ const CONFIRM_CASTS: usize = 16;
 /// there, a false impact). A time where the shapes are farther apart than a thousandth of the
 /// body's smallest half extent is no impact: the cast goes on from the earliest time they
 /// could touch, that distance later at the speed its points move at most ([`Sweep::travel`]).
-/// Parry's answer that nothing comes after is trusted for a body that does not turn (its test,
-/// one separating plane at the end of the step, holds for a straight motion); a turning body
-/// keeps the first time found, as does a cast that has not settled in [`CONFIRM_CASTS`].
+/// Only a pair that does not turn is confirmed so: Parry's answer that nothing comes after
+/// (one separating plane at the end of the step) holds for a straight motion only, and a
+/// turning body cast on from a later time could be let through (a plate spinning at 100 rad/s
+/// into a wall was). A turning pair keeps the cast's first time, as does a cast that has not
+/// settled in [`CONFIRM_CASTS`].
 fn confirmed_time_of_impact(
     body: &FastBody<'_>,
     target: &dyn Shape,
@@ -314,7 +316,7 @@ fn confirmed_time_of_impact(
         };
         let t = hit.time_of_impact;
         let first_time = *first.get_or_insert(t);
-        if t >= 1.0 {
+        if t >= 1.0 || turns {
             return Some(t);
         }
         let (at, target_at) = (body.sweep.pose_at(t), target_sweep.pose_at(t));
