@@ -311,11 +311,9 @@ fn confirmed_time_of_impact(
         let cast = |from| {
             cast_shapes_nonlinear(&motion, body.shape, &target_motion, target, from, 1.0, true)
         };
-        let Some(hit) = cast(from).ok()? else {
-            return if turns { first } else { None };
-        };
+        let hit = cast(from).ok()??;
         let t = hit.time_of_impact;
-        let first_time = *first.get_or_insert(t);
+        first.get_or_insert(t);
         if t >= 1.0 || turns {
             return Some(t);
         }
@@ -329,8 +327,8 @@ fn confirmed_time_of_impact(
             + body.radius;
         let closing = body.travel + target_sweep.travel(reach + body.travel);
         from = t + apart / closing;
-        if !(from < 1.0) {
-            return if turns { Some(first_time) } else { None };
+        if from.is_nan() || from >= 1.0 {
+            return None;
         }
     }
     first
