@@ -56,7 +56,9 @@ pub(crate) fn integrate_orientation(q: Quat, omega: Vec3, h: f32) -> Quat {
 /// GDC 2015; Bullet's `btRigidBody::computeGyroscopicImpulseImplicit_Body`). Unlike the explicit
 /// term it is stable at any spin: the exact backward-Euler solution has |I·ω'| ≤ |I·ω| and
 /// ω'·I·ω' ≤ ω·I·ω (take f(ω') = 0 dotted with I·ω' and with ω'), so it never adds angular
-/// momentum or energy, and one Newton step is within O(h²) of it.
+/// momentum or energy. One Newton step is within O(h²) of it; a step that would raise the
+/// energy (a body turning radians a substep) is scaled back to the energy it started with,
+/// so no substep adds any.
 ///
 /// `inertia` holds each body's inertia tensor about its centre of mass in the body frame
 /// (kg·m²), or zero for a body with no gyroscopic term (a particle, a body that does not
@@ -75,10 +77,21 @@ pub(crate) fn gyroscopic(angular: &mut [Vec3], orientation: &[Quat], inertia: &[
         if !determinant.is_finite() || determinant.abs() <= f32::MIN_POSITIVE {
             continue;
         }
+        let mut step = jacobian.inverse() * residual;
+        // The exact backward-Euler solution never gains energy; one Newton step towards it can,
+        // and by far once the body turns radians in a substep (the step's error grows as
+        // (h·|ω|)²: a box spinning at 14,731 rad/s, 61 rad a substep at 240 Hz, gained
+        // 380,000 J/kg in one step of free flight). Such a result keeps its direction and is
+        // scaled back to the energy the body had.
+        let next = local - step;
+        let (before, after) = (local.dot(momentum), next.dot(*tensor * next));
+        if after > before {
+            step = local - next * (before / after).sqrt();
+        }
         // Only the change goes back through the rotation: a round trip of ω itself through
         // a quaternion of norm 1 ± ulp scales it each substep, and in f32 that bias adds up
         // over many substeps (`gyroscopic_substeps_do_not_gain_energy` bounds the drift).
-        let change = q * (jacobian.inverse() * residual);
+        let change = q * step;
         if change.is_finite() {
             *omega -= change;
         }
@@ -206,6 +219,54 @@ mod tests {
                 assert!(e < e0 * (1.0 + 1e-4), "{e} J from {e0} J");
             }
         }
+    }
+
+    /// A body spinning at thousands of rad/s turns tens of radians a substep, where one Newton
+    /// step of backward Euler overshoots: over seeded random spin axes, orientations and three
+    /// boxes' tensors, at 1,000–20,000 rad/s and h = 1/240 s, no substep raises the kinetic
+    /// energy (beyond f32 rounding) over 60 substeps.
+    #[test]
+    fn a_fast_spin_gains_no_energy_in_a_substep() {
+        let tensors = [
+            Mat3::from_diagonal(Vec3::new(0.34, 0.10, 0.26)),
+            Mat3::from_diagonal(Vec3::new(0.0122, 0.0299, 0.0199)),
+            Mat3::from_diagonal(Vec3::new(1.0e-4, 2.6e-2, 2.6e-2)),
+        ];
+        // xorshift32, seeded: uniform in [0, 1].
+        fn uniform(state: &mut u32) -> f32 {
+            *state ^= *state << 13;
+            *state ^= *state >> 17;
+            *state ^= *state << 5;
+            *state as f32 / u32::MAX as f32
+        }
+        fn unit(state: &mut u32) -> Vec3 {
+            Vec3::new(uniform(state), uniform(state), uniform(state)) * 2.0 - 1.0
+        }
+        let mut state = 0x9e37_79b9_u32;
+        let h = 1.0 / 240.0;
+        let mut gained = 0;
+        for tensor in tensors {
+            for _ in 0..50 {
+                let axis = unit(&mut state).normalize_or(Vec3::X);
+                let spin = 1_000.0 + 19_000.0 * uniform(&mut state);
+                let mut q = [Quat::from_scaled_axis(unit(&mut state) * 3.0)];
+                let mut omega = [axis * spin];
+                let energy = |omega: Vec3, q: Quat| {
+                    let local = q.inverse() * omega;
+                    0.5 * local.dot(tensor * local)
+                };
+                let e0 = energy(omega[0], q[0]);
+                for _ in 0..60 {
+                    let e = energy(omega[0], q[0]);
+                    gyroscopic(&mut omega, &q, &[tensor], h);
+                    let after = energy(omega[0], q[0]);
+                    gained += usize::from(after > e * (1.0 + 1e-5));
+                    q[0] = integrate_orientation(q[0], omega[0], h);
+                }
+                assert!(energy(omega[0], q[0]) <= e0 * (1.0 + 1e-5));
+            }
+        }
+        assert_eq!(gained, 0, "substeps that gained energy");
     }
 
     /// The constrained step with one locked world axis, substep after substep with the

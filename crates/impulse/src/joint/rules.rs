@@ -219,3 +219,29 @@ pub(crate) fn check_options(
     }
     Ok(())
 }
+
+/// How far (m) a joint's anchor may lie from its body's origin: the reach a shape may have
+/// ([`crate::body::rules::MAX_SHAPE_EXTENT`], 10⁶ m), since an anchor is a point carried by
+/// the body as its shape's points are. The anchor's lever arm enters the joint's rows as
+/// r × d and its effective mass as |r|²/I: an anchor 10¹⁰ m from a ball 0.25 m across makes
+/// rows whose f32 products lose every digit of the ball's own motion (the joint then pumps
+/// energy in at its first step).
+pub(crate) const MAX_ANCHOR_DISTANCE: f32 = crate::body::rules::MAX_SHAPE_EXTENT;
+
+/// A joint's anchor `anchor` (m, in its body's frame, from the body's origin) within
+/// [`MAX_ANCHOR_DISTANCE`] of the origin. `field` names it as the caller's input does
+/// (`anchor_a`, or `anchor`, `world_anchors[1]` for a world anchor).
+pub(crate) fn anchor_reach(field: &str, anchor: glam::Vec3) -> Result<(), JointProblem> {
+    let distance = anchor.length();
+    if distance.is_finite() && distance <= MAX_ANCHOR_DISTANCE {
+        Ok(())
+    } else {
+        Err(problem(
+            field,
+            format!(
+                "the anchor lies {distance:e} m from its body's origin; at most \
+                 {MAX_ANCHOR_DISTANCE:e} m (the reach of a shape)"
+            ),
+        ))
+    }
+}

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::{FieldPath, SceneError, SceneErrorKind};
 use crate::body::{BodyHandle, BodyKind};
-use crate::joint::rules::{check_dofs, check_options};
+use crate::joint::rules::{JointProblem, anchor_reach, check_dofs, check_options};
 use crate::joint::{
     AxisMode, JointAxis, JointBuilder, JointDof, JointKind, JointStiffness, Motor, MotorMode,
     Spring,
@@ -360,12 +360,14 @@ pub(crate) fn resolve_body(name: &BodyName, names: &[Option<String>]) -> Result<
 }
 
 /// Every problem of the scene's joints, with their paths (`joints[2].limits`): bodies that
-/// exist and differ, at least one of them not static, frames, limits, springs, motors.
-/// `kinds` and `names` are the scene's bodies'.
+/// exist and differ, at least one of them not static, frames (anchors within
+/// [`crate::joint::rules::MAX_ANCHOR_DISTANCE`] of their bodies), limits, springs, motors.
+/// `kinds`, `names` and `positions` (m) are the scene's bodies'.
 pub(crate) fn joint_errors(
     joints: &[JointDesc],
     kinds: &[BodyKind],
     names: &[Option<String>],
+    positions: &[[f32; 3]],
 ) -> Vec<SceneError> {
     let mut errors = Vec::new();
     for (k, joint) in joints.iter().enumerate() {
@@ -400,7 +402,59 @@ pub(crate) fn joint_errors(
         let placeholder = crate::body::Handles::default().insert(0);
         if let Err((field, message)) = joint.builder(placeholder, placeholder) {
             errors.push(fail(&field, message));
+            continue;
+        }
+        if let Some((key, index, problem)) = joint.anchor_problem(positions[a], positions[b]) {
+            let field = match index {
+                Some(i) => path.key(key).index(i),
+                None => path.key(key),
+            };
+            errors.push(SceneError::new(
+                SceneErrorKind::Invalid,
+                Some(field),
+                problem.message,
+            ));
         }
     }
     errors
+}
+
+impl JointDesc {
+    /// The first anchor of a joint whose bodies start at `position_a` and `position_b` that
+    /// lies beyond [`crate::joint::rules::MAX_ANCHOR_DISTANCE`] of its body's origin: its
+    /// field path and the problem. An anchor given in the world is measured from the body's
+    /// position (a rotation keeps the distance).
+    fn anchor_problem(
+        &self,
+        position_a: [f32; 3],
+        position_b: [f32; 3],
+    ) -> Option<(&'static str, Option<usize>, JointProblem)> {
+        let from = |p: [f32; 3], origin: [f32; 3]| Vec3::from(p) - Vec3::from(origin);
+        let anchors = match (
+            self.anchor,
+            self.world_anchors,
+            self.anchor_a,
+            self.anchor_b,
+        ) {
+            (Some(p), None, None, None) => [
+                ("anchor", None, from(p, position_a)),
+                ("anchor", None, from(p, position_b)),
+            ],
+            (None, Some([p, q]), None, None) => [
+                ("world_anchors", Some(0), from(p, position_a)),
+                ("world_anchors", Some(1), from(q, position_b)),
+            ],
+            (None, None, Some(p), Some(q)) => [
+                ("anchor_a", None, Vec3::from(p)),
+                ("anchor_b", None, Vec3::from(q)),
+            ],
+            _ => return None,
+        };
+        anchors.into_iter().find_map(|(key, index, anchor)| {
+            let field = index.map_or(key.to_string(), |i| format!("{key}[{i}]"));
+            anchor_reach(&field, anchor)
+                .err()
+                .map(|problem| (key, index, problem))
+        })
+    }
 }

@@ -107,10 +107,12 @@ pub fn validate_all(scene: &Scene) -> Vec<SceneError> {
     }
     let kinds: Vec<BodyKind> = scene.bodies.iter().map(|b| b.kind).collect();
     let names: Vec<Option<String>> = scene.bodies.iter().map(|b| b.name.clone()).collect();
+    let positions: Vec<[f32; 3]> = scene.bodies.iter().map(|b| b.position).collect();
     c.errors.extend(super::joint_desc::joint_errors(
         &scene.joints,
         &kinds,
         &names,
+        &positions,
     ));
     c.errors
 }

@@ -44,10 +44,10 @@ impl IslandWorkspace {
             use rayon::prelude::*;
             constraints
                 .par_chunks_mut(RESTITUTION_POINTS_PER_TASK)
-                .map(|part| contact::restitution_targets(part, threshold))
+                .map(|part| contact::restitution_targets(part, threshold, &w.rotation))
                 .reduce(|| false, |x, y| x || y)
         } else {
-            contact::restitution_targets(constraints, threshold)
+            contact::restitution_targets(constraints, threshold, &w.rotation)
         };
         if !bounces {
             return;

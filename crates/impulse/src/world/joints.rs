@@ -8,7 +8,7 @@ use glam::Vec3;
 use super::World;
 use crate::body::BodyHandle;
 use crate::error::WorldError;
-use crate::joint::rules::{check_dofs, check_options};
+use crate::joint::rules::{anchor_reach, check_dofs, check_options};
 use crate::joint::{
     Anchors, Axes, Joint, JointBody, JointBuilder, JointConstraint, JointEvent, JointHandle,
     JointKind, JointRef, LocalFrames, ROWS_PER_DOF, Strength, frame_state,
@@ -71,6 +71,7 @@ impl World {
                     format!("must be finite, got {:?}", anchor.to_array()),
                 ));
             }
+            anchor_reach(field, anchor).map_err(|p| invalid(&p.field, p.message))?;
         }
         let (rotation_a, rotation_b) = match builder.axes {
             Axes::Local { a, b } => (a, b),

@@ -156,35 +156,44 @@ fn impact(index: u64) -> Impact {
     Impact { what, world }
 }
 
+/// Runs case `index`: its failure, if any, and the fastest spin it reached (rad/s).
+fn run(index: u64) -> (Option<String>, f32) {
+    let Impact { what, mut world } = impact(index);
+    let start = world.energy().mechanical();
+    let mut stopped = None;
+    let mut fastest_spin = 0.0f32;
+    for step in 1..=STEPS {
+        if let Err(e) = world.step() {
+            stopped = Some(format!("stopped at step {step}: {e}"));
+            break;
+        }
+        let spin = world
+            .angular_velocities()
+            .iter()
+            .map(|w| w.length())
+            .fold(0.0, f32::max);
+        fastest_spin = fastest_spin.max(spin);
+    }
+    let end = world.energy().mechanical();
+    let problem = stopped.or_else(|| {
+        // The body may leave the world's bound; then it is frozen and counts no more.
+        (!end.is_finite() || end > start + 1e-3 * start.abs().max(1.0))
+            .then(|| format!("energy {start:.6e} J at the start, {end:.6e} J at the end"))
+    });
+    (
+        problem.map(|problem| format!("{what}: {problem}")),
+        fastest_spin,
+    )
+}
+
 /// Runs cases `0..count`; returns the failures, one line each.
 fn sweep(count: u64) -> Vec<String> {
     let mut failures = Vec::new();
     let mut fastest_spin = 0.0f32;
     for index in 0..count {
-        let Impact { what, mut world } = impact(index);
-        let start = world.energy().mechanical();
-        let mut stopped = None;
-        for step in 1..=STEPS {
-            if let Err(e) = world.step() {
-                stopped = Some(format!("stopped at step {step}: {e}"));
-                break;
-            }
-            let spin = world
-                .angular_velocities()
-                .iter()
-                .map(|w| w.length())
-                .fold(0.0, f32::max);
-            fastest_spin = fastest_spin.max(spin);
-        }
-        let end = world.energy().mechanical();
-        let problem = stopped.or_else(|| {
-            // The body may leave the world's bound; then it is frozen and counts no more.
-            (!end.is_finite() || end > start + 1e-3 * start.abs().max(1.0))
-                .then(|| format!("energy {start:.6e} J at the start, {end:.6e} J at the end"))
-        });
-        if let Some(problem) = problem {
-            failures.push(format!("{what}: {problem}"));
-        }
+        let (failure, spin) = run(index);
+        failures.extend(failure);
+        fastest_spin = fastest_spin.max(spin);
     }
     println!(
         "{count} fast impacts, {} failed; fastest spin {fastest_spin:.0} rad/s",
@@ -196,6 +205,22 @@ fn sweep(count: u64) -> Vec<String> {
 #[test]
 fn fast_impacts_run_to_their_end() {
     let failures = sweep(24);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Spinning boxes that once gained energy the step could not explain, each for one cause:
+/// case 57 (179 m/s, 14,731 rad/s) in free flight, where one Newton step of the implicit
+/// gyroscopic term overshot at 61 rad a substep (+380,000 J/kg); case 106 (568 m/s, 4,890
+/// rad/s), clamped by the continuous stage, which turned it back but kept its angular velocity
+/// in the world's frame, changing its kinetic energy with the turn (+6,761 J/kg); case 162
+/// (702 m/s, 15,630 rad/s), whose rows bounced at lever arms the body had turned away from
+/// within the step.
+#[test]
+fn spinning_boxes_gain_no_energy() {
+    let failures: Vec<String> = [57, 106, 162]
+        .into_iter()
+        .filter_map(|i| run(i).0)
+        .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
