@@ -357,7 +357,6 @@ pub(crate) fn clamp_fraction_castable(
             .ok()?
             .distance
     };
-    let motion = body.sweep.motion();
     let target_motion = target_sweep.motion();
     if start_distance > gap {
         let t = confirmed_time_of_impact(body, target, target_sweep)?;
