@@ -504,7 +504,7 @@ pub fn to_json_string(scene: &Scene) -> String {
         '}',
         materials
             .iter()
-            .map(|(k, m)| format!("{}: {}", one_line(k), one_line(m))),
+            .map(|(k, m)| format!("{}: {}", one_line(k), one_line(&MaterialOut::from(m)))),
     );
     out.push_str(",\n  \"bodies\": ");
     list(
@@ -550,7 +550,10 @@ struct BodyOut<'a> {
     linear_velocity: [f32; 3],
     #[serde(skip_serializing_if = "is_zero")]
     angular_velocity: [f32; 3],
-    #[serde(skip_serializing_if = "is_default_material")]
+    #[serde(
+        skip_serializing_if = "is_default_material",
+        serialize_with = "material_ref_out"
+    )]
     material: &'a MaterialRef,
     #[serde(skip_serializing_if = "Option::is_none")]
     mass: Option<f32>,
@@ -634,6 +637,41 @@ fn is_all(bits: &u32) -> bool {
 }
 fn is_default_material(m: &&MaterialRef) -> bool {
     **m == MaterialRef::default()
+}
+
+/// A material as written: a smooth surface's `roughness` (0) is left out, as scene files
+/// written before rough surfaces existed read.
+#[derive(Serialize)]
+struct MaterialOut {
+    friction: f32,
+    restitution: f32,
+    density: f32,
+    #[serde(skip_serializing_if = "is_zero_scalar")]
+    roughness: f32,
+}
+
+impl From<&Material> for MaterialOut {
+    fn from(m: &Material) -> Self {
+        let Material {
+            friction,
+            restitution,
+            density,
+            roughness,
+        } = *m;
+        MaterialOut {
+            friction,
+            restitution,
+            density,
+            roughness,
+        }
+    }
+}
+
+fn material_ref_out<S: serde::Serializer>(m: &&MaterialRef, s: S) -> Result<S::Ok, S::Error> {
+    match m {
+        MaterialRef::Named(name) => s.serialize_str(name),
+        MaterialRef::Inline(material) => MaterialOut::from(material).serialize(s),
+    }
 }
 
 /// serde_json formatter for one line with a space after `,` and `:`.

@@ -39,8 +39,8 @@ pub struct Scene {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joints: Vec<JointDesc>,
     /// Seed of the engine's seeded variation (the contact normals' [`Material::roughness`]
-    /// draws); 0 by default. A [`Variation`] with a non-zero seed replaces it, so run K of a
-    /// sweep draws its own rough surfaces.
+    /// draws); 0 by default. A [`Variation`] with a non-zero seed replaces it in a scene with
+    /// rough materials, so run K of a sweep draws its own rough surfaces.
     #[serde(default)]
     pub seed: u64,
 }

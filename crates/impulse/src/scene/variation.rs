@@ -186,8 +186,8 @@ impl Jitter {
 pub struct Variation {
     /// Field changes, applied in order (a later one wins where two set the same field).
     pub overrides: Vec<Override>,
-    /// Seed of the jitter and, when not 0, the scene's [`Scene::seed`] (the rough surfaces'
-    /// draws): run K of a sweep uses seed K.
+    /// Seed of the jitter and, when not 0 and the scene has rough materials, the scene's
+    /// [`Scene::seed`] (the rough surfaces' draws): run K of a sweep uses seed K.
     pub seed: u64,
     /// The jitter; all zero leaves the bodies where the overrides put them.
     pub jitter: Jitter,
@@ -237,8 +237,9 @@ impl Variation {
                 jitter_body(self.seed, index, &self.jitter, body);
             }
         }
-        // The seed also draws the rough surfaces' normals: run K of a sweep gets its own.
-        if self.seed != 0 {
+        // The seed also draws the rough surfaces' normals: run K of a sweep gets its own. A
+        // scene without rough materials draws nothing and is left as it is.
+        if self.seed != 0 && has_roughness(&varied) {
             varied.seed = self.seed;
         }
         validate(&varied).map_err(|e| self.blame(e))?;
@@ -490,6 +491,15 @@ fn load_meshes(varied: &mut Scene, original: &Scene, directory: &Path) -> Result
         };
     }
     Ok(())
+}
+
+/// Whether any material of `scene` (named or inline) has a `roughness` above 0.
+fn has_roughness(scene: &Scene) -> bool {
+    scene.materials.values().any(|m| m.roughness > 0.0)
+        || scene.bodies.iter().any(|b| match &b.material {
+            super::MaterialRef::Inline(m) => m.roughness > 0.0,
+            super::MaterialRef::Named(_) => false,
+        })
 }
 
 /// The generator of body `index` for `seed`: ChaCha20 keyed by the seed (its 8 little-endian
