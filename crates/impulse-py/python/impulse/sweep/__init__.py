@@ -232,9 +232,10 @@ def sweep(
         _check_workers_can_start("impulse.sweep")
     if len(seed_list) > 1 and jitter is None:
         warnings.warn(
-            f"{len(seed_list)} seeds without jitter: a seed varies a run only through jitter, so "
-            "every seed of a grid point gives the same run; pass jitter={'position': m, "
-            "'angle': degrees, 'velocity': m/s} to vary them",
+            f"{len(seed_list)} seeds without jitter: a seed varies a run only through jitter "
+            "(and the draws of rough materials, if the scene has any), so every seed of a grid "
+            "point may give the same run; pass jitter={'position': m, 'angle': degrees, "
+            "'velocity': m/s} to vary them",
             UserWarning,
             stacklevel=2,
         )
