@@ -62,7 +62,7 @@ def first_separations(scene, glue):
     start = relative(1)
     first = [None] * len(pairs)
     for frame in range(2, FRAMES + 1):
-        for k, (before, now) in enumerate(zip(start, relative(frame))):
+        for k, (before, now) in enumerate(zip(start, relative(frame), strict=True)):
             if first[k] is None and (now - before).length > 0.01:
                 first[k] = frame
     return first
