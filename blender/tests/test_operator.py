@@ -5,42 +5,24 @@ script made), the zip is unpacked and its add-on registered (its ``impulse`` pac
 zip's ``vendor/`` when none is installed); otherwise the source directory ``blender/`` is.
 """
 
-import importlib
-import importlib.util
 import os
 import pathlib
 import subprocess
 import sys
-import zipfile
 
 import bpy
 import pytest
 from impulse_bake import keyframes
 
 import scenes
-
-SOURCE = pathlib.Path(__file__).resolve().parent.parent
+from addon import load_addon
 
 
 @pytest.fixture(scope="module")
 def addon(tmp_path_factory):
     # Registered by hand rather than enabled through addon_utils: the scene builders reload
     # factory settings, which would disable an enabled add-on again.
-    archive = os.environ.get("IMPULSE_BLENDER_ADDON_ZIP")
-    if archive:
-        target = tmp_path_factory.mktemp("addons")
-        with zipfile.ZipFile(archive) as packed:
-            packed.extractall(target)
-        sys.path.insert(0, str(target))
-        module = importlib.import_module("impulse_blender")
-        assert pathlib.Path(module.__file__).parent == target / "impulse_blender"
-    else:
-        spec = importlib.util.spec_from_file_location(
-            "impulse_blender", SOURCE / "__init__.py", submodule_search_locations=[str(SOURCE)]
-        )
-        module = importlib.util.module_from_spec(spec)
-        sys.modules["impulse_blender"] = module
-        spec.loader.exec_module(module)
+    module = load_addon(tmp_path_factory)
     module.register()
     yield module
     module.unregister()

@@ -1,13 +1,9 @@
 """The Takes panel's logic and operators: goals set on objects, a search in a child process, and
 "Bake take" keying exactly the take's trajectory."""
 
-import importlib
-import importlib.util
 import math
 import os
-import pathlib
 import sys
-import zipfile
 
 import bpy
 import mathutils
@@ -16,6 +12,7 @@ import pytest
 from impulse_bake import axes, bake, keyframes, scene_reader
 from impulse_bake import takes as takes_logic
 import scenes
+from addon import load_addon
 
 pytestmark = pytest.mark.usefixtures("addon")
 
@@ -28,22 +25,7 @@ def addon(tmp_path_factory):
     module = sys.modules.get("impulse_blender")
     loaded_here = module is None
     if loaded_here:
-        archive = os.environ.get("IMPULSE_BLENDER_ADDON_ZIP")
-        if archive:
-            target = tmp_path_factory.mktemp("addons")
-            with zipfile.ZipFile(archive) as packed:
-                packed.extractall(target)
-            sys.path.insert(0, str(target))
-            module = importlib.import_module("impulse_blender")
-            sys.path.remove(str(target))
-        else:
-            source = pathlib.Path(__file__).resolve().parent.parent
-            spec = importlib.util.spec_from_file_location(
-                "impulse_blender", source / "__init__.py", submodule_search_locations=[str(source)]
-            )
-            module = importlib.util.module_from_spec(spec)
-            sys.modules["impulse_blender"] = module
-            spec.loader.exec_module(module)
+        module = load_addon(tmp_path_factory, keep_path=False)
     module.register()
     yield module
     module.unregister()
