@@ -254,12 +254,14 @@ def sweep(
     previous = _read_all(filesystem, root)
     done = set()
     if previous is not None:
-        for key, status in zip(
+        for key, status, error in zip(
             previous.column("run_key").to_pylist(),
             previous.column("status").to_pylist(),
+            previous.column("error").to_pylist(),
             strict=True,
         ):
-            if status == FAILED and (retry_failed or _worker_failed(previous, key)):
+            # A run whose worker could not run it failed for the worker's sake: run it again.
+            if status == FAILED and (retry_failed or (error or "").startswith(WORKER_FAILURE)):
                 continue
             done.add(key)
     todo = [run for run in runs if run.key not in done]
@@ -344,13 +346,6 @@ def sweep(
     counts = _status_counts(table, {run.key for run in runs})
     _write_json(filesystem, f"{root}/{MANIFEST_FILE}", {**manifest, "state": "finished", **counts})
     return table
-
-
-def _worker_failed(previous: Any, key: str) -> bool:
-    """Whether the stored row of ``key`` failed because its worker could not run it."""
-    keys = previous.column("run_key").to_pylist()
-    errors = previous.column("error").to_pylist()
-    return any(k == key and (e or "").startswith(WORKER_FAILURE) for k, e in zip(keys, errors, strict=True))
 
 
 def _check_workers_can_start(caller: str) -> None:
