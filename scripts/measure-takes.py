@@ -6,7 +6,8 @@
    sampling; the first success is the take's place in the order of the draws (generation ×
    population + index + 1). Prints the median over the seeds, and each count.
 2. Throughput: takes per second of one search of a fixed number of takes with 1 worker and with
-   2, on the local pool and on a local Ray; prints the ratio.
+   2, on the local pool (its start-up included) and on a local Ray (started before the clock);
+   prints the ratio.
 
     python3 scripts/measure-takes.py                       # everything (long: run it once)
     python3 scripts/measure-takes.py --shots hoop --seeds 2 --no-throughput
@@ -62,27 +63,39 @@ def first_success(shot: str, method: str, seed: int, budget: int, workers: int) 
     return min(places) if places else None
 
 
-def takes_per_second(shot: str, backend: str, workers: int, takes: int) -> float:
-    """Takes per second of a random search of ``takes`` takes that never stops early."""
+def takes_per_second(shot: str, backend: str, workers: int, takes: int) -> tuple[float, float]:
+    """Takes per second of a random search of ``takes`` takes that never stops early, and how
+    many workers were busy on average (the takes' summed run times over the wall time)."""
     from impulse.takes import search
 
     scene, spec = _shot(shot)
-    with tempfile.TemporaryDirectory() as out:
-        start = time.perf_counter()
-        search(
-            scene,
-            spec["goals"],
-            spec["variation"],
-            budget=takes,
-            steps=spec["steps"],
-            method="random",
-            stop_after=takes + 1,
-            backend=backend,
-            workers=workers,
-            out=out,
-            progress=False,
-        )
-        return takes / (time.perf_counter() - start)
+    if backend == "ray":
+        import ray
+
+        # A running Ray, as a cluster would be: its start-up is not the search's.
+        ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
+    try:
+        with tempfile.TemporaryDirectory() as out:
+            start = time.perf_counter()
+            found = search(
+                scene,
+                spec["goals"],
+                spec["variation"],
+                budget=takes,
+                steps=spec["steps"],
+                method="random",
+                stop_after=takes + 1,
+                backend=backend,
+                workers=workers,
+                out=out,
+                progress=False,
+            )
+            elapsed = time.perf_counter() - start
+            busy = sum(found.table.column("wall_time_s").to_pylist()) / elapsed
+            return takes / elapsed, busy
+    finally:
+        if backend == "ray":
+            ray.shutdown()
 
 
 def main() -> int:
@@ -95,7 +108,7 @@ def main() -> int:
     parser.add_argument("--no-first-success", action="store_true")
     parser.add_argument("--no-throughput", action="store_true")
     parser.add_argument("--throughput-shot", default="bowling")
-    parser.add_argument("--throughput-takes", type=int, default=192)
+    parser.add_argument("--throughput-takes", type=int, default=256)
     arguments = parser.parse_args()
     shots = arguments.shots.split(",")
 
@@ -129,12 +142,14 @@ def main() -> int:
             print("ray is not installed: no Ray rows", file=sys.stderr)
         count = arguments.throughput_takes
         print(f"\nthroughput ({count} takes of {arguments.throughput_shot}, takes/s)")
-        print("| backend | 1 worker | 2 workers | ratio |")
-        print("|---|---|---|---|")
+        print("| backend | 1 worker | 2 workers | ratio | workers busy (of 2) |")
+        print("|---|---|---|---|---|")
         for backend in backends:
-            one = takes_per_second(arguments.throughput_shot, backend, 1, count)
-            two = takes_per_second(arguments.throughput_shot, backend, 2, count)
-            print(f"| {backend} | {one:.1f} | {two:.1f} | {two / one:.2f} |", flush=True)
+            one, _ = takes_per_second(arguments.throughput_shot, backend, 1, count)
+            two, busy = takes_per_second(arguments.throughput_shot, backend, 2, count)
+            print(
+                f"| {backend} | {one:.1f} | {two:.1f} | {two / one:.2f} | {busy:.2f} |", flush=True
+            )
     return 0
 
 

@@ -37,9 +37,10 @@ COMPLETED, STOPPED, FAILED = "completed", "stopped", "failed"
 SMOOTHING = 0.7
 #: Smallest spread of θ per component: the search never collapses to one point.
 MIN_SPREAD = 0.02
-#: Generations without a lower best cost after which the search starts again from the prior,
-#: ranking only the takes drawn since (a restart, as for CMA-ES: Auger & Hansen 2005). In a
-#: chaotic scene a near miss can sit on a plateau where every nearby take has the same outcome.
+#: Generations without a lower best cost, and no take meeting every goal, after which the search
+#: starts again from the prior, ranking only the takes drawn since (a restart, as for CMA-ES:
+#: Auger & Hansen 2005). In a chaotic scene a near miss can sit on a plateau where every nearby
+#: take has the same outcome.
 STALL_GENERATIONS = 4
 _FORMAT = 1
 #: The search methods: the cross-entropy method, or plain random sampling from the prior.
@@ -441,7 +442,10 @@ def search(
                 continue
             ranked = sorted((row for row in done[since:] if row["status"] != FAILED), key=_rank)
             lowest = _rank(ranked[0])[0] if ranked else math.inf
-            best_cost, stalled = (lowest, 0) if lowest < best_cost else (best_cost, stalled + 1)
+            if lowest < best_cost:
+                best_cost, stalled = lowest, 0
+            elif not any(row["met"] for row in ranked):  # never restart away from a success
+                stalled += 1
             if stalled >= STALL_GENERATIONS:
                 mean, spread = np.zeros(dimension), np.ones(dimension)
                 since, best_cost, stalled, elite_seeds = len(done), math.inf, 0, []
