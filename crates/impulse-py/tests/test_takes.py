@@ -561,3 +561,37 @@ def test_a_met_take_is_the_same_to_the_bit_on_a_ray_worker(tmp_path):
     assert on_worker[1] == here[1] == "completed"
     for field in ("positions", "orientations", "linear_velocities", "angular_velocities"):
         assert getattr(on_worker[0], field).tobytes() == getattr(here[0], field).tobytes()
+
+
+def test_a_met_hoop_take_is_the_same_to_the_bit_through_impulse_run(
+    repository, tmp_path, impulse_cli
+):
+    goals = json.loads((repository / "scenes" / "takes" / "hoop.goals.json").read_text())
+    found = search(
+        repository / "scenes" / "takes" / "hoop.json",
+        goals["goals"],
+        goals["variation"],
+        budget=SHOTS_BUDGET,
+        steps=goals["steps"],
+        workers=2,
+        out=tmp_path / "hoop",
+        progress=False,
+    )
+    take = found.met()[0]
+    path = tmp_path / "take.json"
+    take.write_scene(path)
+    out = tmp_path / "frames.jsonl"
+    subprocess.run(
+        [impulse_cli, "run", str(path), "--steps", str(goals["steps"]), "--out", str(out), "--quiet"],
+        check=True,
+        capture_output=True,
+    )
+    frames = [json.loads(line) for line in out.read_text().splitlines()]
+    # serde_json writes each float32 widened to float64 exactly, so the cast back is exact.
+    poses = np.array([f["bodies"] for f in frames], dtype=np.float64).astype(np.float32)
+    record, status, _ = simulate_take(take.scene(), goals["steps"], [])
+    assert status == "completed" and len(frames) == goals["steps"] + 1
+    positions = record.positions.astype(np.float32)
+    orientations = record.orientations.astype(np.float32)
+    assert positions.view(np.uint32).tolist() == poses[..., :3].view(np.uint32).tolist()
+    assert orientations.view(np.uint32).tolist() == poses[..., 3:].view(np.uint32).tolist()
