@@ -23,9 +23,12 @@ type                    fields                                           cost (0
 ``tilted``              ``body``, ``axis``, ``up``, ``min_degrees``       degrees short of
                         (default 45): the axis ends at least that far    ``min_degrees``, in rad
                         from up (a pin knocked over)
-``touches``             ``body``, ``other``, ``between``                 closest approach (m) of
-                                                                         their positions when
-                                                                         they never touch
+``touches``             ``body``, ``other``, ``between``, ``times``      closest approach (m) of
+                        (optional: the number of separate contacts,      their positions when
+                        e.g. 1 for one bounce)                           they never touch; with
+                                                                         ``times``, |contacts -
+                                                                         times| plus that
+                                                                         approach when none
 ``never_touches``       ``body``, ``other``, ``between``                 time in contact (s)
 ======================  ===============================================  ========================
 
@@ -183,6 +186,12 @@ def _touch_frames(record: Record, a: int, b: int, frames: np.ndarray) -> list[in
     return [f for f in frames if pair in record.touching[f]]
 
 
+def _contact_episodes(frames: Sequence[int]) -> int:
+    """Separate contacts among sorted frame indices: runs of consecutive frames in contact
+    (a bounce is one run; a body resting on another is one long run)."""
+    return sum(1 for k, frame in enumerate(frames) if k == 0 or frame != frames[k - 1] + 1)
+
+
 def goal_from_dict(spec: Mapping[str, Any]) -> Goal:
     """A goal from its JSON object (the table in this module's documentation).
 
@@ -200,7 +209,7 @@ def goal_from_dict(spec: Mapping[str, Any]) -> Goal:
         "stays_inside": {"body", "region", "between"},
         "rests_with_axis_up": {"body", "axis", "up", "tolerance_degrees", "rest_speed"},
         "tilted": {"body", "axis", "up", "min_degrees"},
-        "touches": {"body", "other", "between"},
+        "touches": {"body", "other", "between", "times"},
         "never_touches": {"body", "other", "between"},
     }
     if kind not in allowed:
@@ -255,6 +264,9 @@ def goal_from_dict(spec: Mapping[str, Any]) -> Goal:
     if "other" not in spec:
         raise ValueError(f"goal {kind}: 'other' is required")
     other = spec["other"]
+    times = spec.get("times")
+    if times is not None and (isinstance(times, bool) or not isinstance(times, int) or times < 0):
+        raise ValueError(f"goal {kind}: 'times' must be an integer >= 0, got {times!r}")
 
     def touch_cost(record: Record) -> float:
         a, b = record.body(body), record.body(other)
@@ -262,10 +274,13 @@ def goal_from_dict(spec: Mapping[str, Any]) -> Goal:
         touching = _touch_frames(record, a, b, frames)
         if kind == "never_touches":
             return len(touching) * float(record.dt)
-        if touching:
-            return 0.0
-        gap = record.positions[frames, a] - record.positions[frames, b]
-        return float(np.linalg.norm(gap, axis=-1).min())
+        miss = 0.0
+        if not touching:
+            gap = record.positions[frames, a] - record.positions[frames, b]
+            miss = float(np.linalg.norm(gap, axis=-1).min())
+        if times is None:
+            return miss
+        return float(abs(_contact_episodes(touching) - times)) + (miss if times > 0 else 0.0)
 
     return Goal(name, touch_cost, weight, spec, needs_contacts=True)
 

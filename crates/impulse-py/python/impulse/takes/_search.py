@@ -8,7 +8,10 @@ generation at once, where a chain runs one take after another; and it needs only
 costs, no derivative (a pile's outcome is chaotic: derivatives of where a die rests flip sign
 under 1e-6 m/s changes). Each generation draws θ from a normal distribution, keeps the best
 takes so far (lowest total cost, then smallest perturbation), and moves the distribution's mean
-and spread toward them; the first generation draws from the prior N(0, I), the scales' size.
+and spread toward them; the first generation draws from the prior N(0, I), the scales' size,
+and so does the first after a restart (:data:`STALL_GENERATIONS` without a lower best cost).
+``method="random"`` is the baseline the method is measured against: every take drawn from the
+prior, nothing refined.
 """
 
 from __future__ import annotations
@@ -34,7 +37,14 @@ COMPLETED, STOPPED, FAILED = "completed", "stopped", "failed"
 SMOOTHING = 0.7
 #: Smallest spread of θ per component: the search never collapses to one point.
 MIN_SPREAD = 0.02
+#: Generations without a lower best cost, and no take meeting every goal, after which the search
+#: starts again from the prior, ranking only the takes drawn since (a restart, as for CMA-ES:
+#: Auger & Hansen 2005). In a chaotic scene a near miss can sit on a plateau where every nearby
+#: take has the same outcome.
+STALL_GENERATIONS = 4
 _FORMAT = 1
+#: The search methods: the cross-entropy method, or plain random sampling from the prior.
+METHODS = ("cross-entropy", "random")
 
 
 def _canonical(value: Any) -> str:
@@ -262,6 +272,7 @@ def search(
     population: int = 32,
     elite_fraction: float = 0.2,
     stop_after: int = 1,
+    method: str = "cross-entropy",
     preset: str | None = None,
     progress: bool = True,
 ) -> Takes:
@@ -298,6 +309,10 @@ def search(
         Share of the takes so far that move the distribution, in (0, 1].
     stop_after : int
         Stop once this many takes meet every goal (>= 1).
+    method : "cross-entropy" | "random"
+        The cross-entropy method (this module's documentation), or plain random sampling: every
+        take's θ drawn from the prior N(0, I) and its scene seed fresh, nothing refined (the
+        baseline the method is measured against; the same draws per generation and ``seed``).
     preset : str, optional
         Solver preset of every take, as ``impulse run --preset``.
     progress : bool
@@ -332,6 +347,8 @@ def search(
         raise ValueError(f"elite_fraction = {elite_fraction!r}: must be in (0, 1]")
     if not isinstance(stop_after, int) or stop_after < 1:
         raise ValueError(f"stop_after = {stop_after!r}: must be an integer >= 1")
+    if method not in METHODS:
+        raise ValueError(f"method = {method!r}: use one of {', '.join(METHODS)}")
     if backend not in ("local", "ray"):
         raise ValueError(f"backend = {backend!r}: use 'local' or 'ray'")
     base = load_scene(scene)
@@ -361,6 +378,7 @@ def search(
         "seed": seed,
         "population": population,
         "elite_fraction": elite_fraction,
+        "method": method,
     }
     digest = hashlib.sha256(_canonical(search_spec).encode()).hexdigest()
     manifest = {
@@ -380,6 +398,7 @@ def search(
     done: list[dict[str, Any]] = []
     elite_seeds: list[int | None] = []
     generation = 0
+    since, best_cost, stalled = 0, math.inf, 0  # the current start's first take, its best cost
     try:
         while len(done) < budget:
             rng = np.random.default_rng([seed, generation])
@@ -418,14 +437,25 @@ def search(
             store.write()
             if sum(1 for row in done if row["met"]) >= stop_after:
                 break
-            ranked = sorted((row for row in done if row["status"] != FAILED), key=_rank)
+            generation += 1
+            if method == "random":
+                continue
+            ranked = sorted((row for row in done[since:] if row["status"] != FAILED), key=_rank)
+            lowest = _rank(ranked[0])[0] if ranked else math.inf
+            if lowest < best_cost:
+                best_cost, stalled = lowest, 0
+            elif not any(row["met"] for row in ranked):  # never restart away from a success
+                stalled += 1
+            if stalled >= STALL_GENERATIONS:
+                mean, spread = np.zeros(dimension), np.ones(dimension)
+                since, best_cost, stalled, elite_seeds = len(done), math.inf, 0, []
+                continue
             best = np.array([row["theta"] for row in ranked[:elites]])
             elite_seeds = [row.get("scene_seed") for row in ranked[:elites]]
             if len(best) >= 2:
                 mean = SMOOTHING * best.mean(axis=0) + (1.0 - SMOOTHING) * mean
                 spread = SMOOTHING * best.std(axis=0) + (1.0 - SMOOTHING) * spread
                 spread = np.maximum(spread, MIN_SPREAD)
-            generation += 1
     finally:
         runner.close()
         bar.close()

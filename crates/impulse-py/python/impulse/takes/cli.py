@@ -42,6 +42,12 @@ def _parser() -> argparse.ArgumentParser:
     search.add_argument(
         "--stop-after", type=int, default=1, help="stop once this many takes meet every goal"
     )
+    search.add_argument(
+        "--method",
+        choices=("cross-entropy", "random"),
+        default="cross-entropy",
+        help="the cross-entropy method, or plain random sampling from the prior (a baseline)",
+    )
     search.add_argument("--preset", choices=("fast", "default", "precise", "reference"))
     search.add_argument("--vary-bodies", help="comma-separated body names (default: all dynamic)")
     search.add_argument(
@@ -116,6 +122,7 @@ def _search(arguments: argparse.Namespace) -> int:
         seed=arguments.seed,
         population=arguments.population,
         stop_after=arguments.stop_after,
+        method=arguments.method,
         preset=arguments.preset,
         progress=not arguments.no_progress,
     )
