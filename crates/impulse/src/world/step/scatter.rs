@@ -3,22 +3,33 @@
 
 use crate::World;
 use crate::body::Bodies;
+use crate::island::Islands;
 use crate::parallel::{BODIES_PER_TASK, for_each_of_three, spread};
-use crate::solver::substep;
+use crate::solver::substep::{self, IslandWorkspace};
 
 impl World {
-    /// Island results into the bodies, then kinematic bodies to their step's end poses.
-    pub(super) fn scatter_stage(&mut self) {
-        self.scatter_islands();
-        self.move_kinematic_bodies();
+    /// Island results (the solve's `workspaces` of the islands it woke, `island_awake`) into
+    /// the bodies, then the `moving_kinematic` bodies to their step's end poses.
+    pub(super) fn scatter_stage(
+        &mut self,
+        islands: &Islands,
+        island_awake: &[bool],
+        workspaces: &[IslandWorkspace],
+        moving_kinematic: &[u32],
+    ) {
+        self.scatter_islands(islands, island_awake, workspaces);
+        self.move_kinematic_bodies(moving_kinematic);
     }
 
     /// Writes every awake island's velocities and poses back into the bodies. In parallel,
     /// runs of bodies each look up their island and local index (islands can be many and
     /// small, or one and large; body runs split either evenly).
-    fn scatter_islands(&mut self) {
-        let islands = &self.islands;
-        let (workspaces, awake) = (&self.workspaces, &self.island_awake);
+    fn scatter_islands(
+        &mut self,
+        islands: &Islands,
+        awake: &[bool],
+        workspaces: &[IslandWorkspace],
+    ) {
         if !spread(self.parallel, self.bodies.len(), BODIES_PER_TASK) {
             for k in 0..islands.len() {
                 if awake[k] {
