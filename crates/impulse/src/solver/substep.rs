@@ -8,7 +8,6 @@
 //! mutable.
 
 use glam::{Mat3, Vec3};
-use parry3d::math::Pose;
 
 use super::heavy_on_light::{
     HeavyOnLight, heavy_on_light, heavy_on_light_max_contacts, heavy_on_light_settings, mass_ratio,
@@ -211,7 +210,7 @@ pub(crate) struct IslandContext<'a> {
 
 /// Runs one island's part of the solve stage ([`crate::Stage::Solve`]): per substep of h = dt/substeps, gravity,
 /// warm start, the solve with overlap repair, position integration, and the relax solve; then
-/// the restitution solve. Results stay in `workspace` until [`scatter`]. The rows' J·v*
+/// the restitution solve. Results stay in `workspace` until the scatter stage (`world/step/scatter.rs`). The rows' J·v*
 /// (`velocity_before`) and the residual are recorded here when the SIMD lanes solved the
 /// island and no restitution solve followed (`IslandWorkspace::rows`); otherwise they are
 /// left to the caller, which takes them in one pass
@@ -783,38 +782,4 @@ impl IslandWorkspace {
             None
         };
     }
-}
-
-/// Writes an island's velocities and poses back into the bodies.
-pub(crate) fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut Bodies) {
-    for (k, &i) in island_bodies.iter().enumerate() {
-        let i = i as usize;
-        scatter_body(
-            workspace,
-            k,
-            bodies.local_center_of_mass[i],
-            &mut bodies.pose[i],
-            &mut bodies.linear_velocity[i],
-            &mut bodies.angular_velocity[i],
-        );
-    }
-}
-
-/// Writes the body at local index `k` of `workspace`'s island back: its velocities and its
-/// pose (the centre of mass moved by the island's displacement, at its new orientation).
-#[inline]
-pub(crate) fn scatter_body(
-    workspace: &IslandWorkspace,
-    k: usize,
-    local_center_of_mass: Vec3,
-    pose: &mut Pose,
-    linear: &mut Vec3,
-    angular: &mut Vec3,
-) {
-    let com = pose.transform_point(local_center_of_mass) + workspace.displacement[k];
-    let rotation = workspace.orientation[k];
-    *linear = workspace.linear[k];
-    *angular = workspace.angular[k];
-    pose.rotation = rotation;
-    pose.translation = com - rotation * local_center_of_mass;
 }
