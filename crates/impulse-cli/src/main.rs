@@ -81,7 +81,9 @@ enum Command {
         quiet: bool,
         /// After the summary, print the median wall time of each stage of the step (kinematic,
         /// broad phase, narrow phase, islands, assembly, solve, scatter, continuous, store
-        /// impulses, finish; `impulse::Stage`).
+        /// impulses, finish, end step; `impulse::Stage`) and the median CPU time of each phase
+        /// of the solve stage summed over islands (`impulse::SolvePhase`; timed only with
+        /// `--profile` or `--stats`).
         #[arg(long)]
         profile: bool,
         #[command(flatten)]
@@ -122,7 +124,8 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
-        /// After the summary, print the median wall time of each stage of the step.
+        /// After the summary, print the median wall time of each stage of the step and the
+        /// median CPU time of each phase of the solve stage summed over islands.
         #[arg(long)]
         profile: bool,
         #[command(flatten)]
@@ -452,6 +455,7 @@ fn report(summary: run::Summary, profile: bool) -> Result<ExitCode> {
     println!("{}", summary.line());
     if profile {
         println!("{}", summary.stage_line());
+        println!("{}", summary.phase_line());
         println!("{}", run::instruction_set_line());
     }
     if run::INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
@@ -515,6 +519,7 @@ fn real_main() -> Result<ExitCode> {
                 stats,
                 checkpoint_every: checkpoints.checkpoint_every,
                 checkpoint_dir: checkpoints.checkpoint_dir,
+                profile,
             };
             run::stop_on_ctrl_c()?;
             return report(run::run(scene, &options)?, profile);
@@ -556,6 +561,7 @@ fn real_main() -> Result<ExitCode> {
                 stats,
                 checkpoint_every: checkpoints.checkpoint_every,
                 checkpoint_dir: checkpoints.checkpoint_dir,
+                profile,
             };
             run::stop_on_ctrl_c()?;
             return report(run::resume(&snapshot, &options)?, profile);

@@ -7,8 +7,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use impulse::EscalationLevel;
-use impulse::StepProfile;
 use impulse::{Scene, World, WorldSnapshot, metrics};
+use impulse::{SolvePhase, Stage, StepProfile};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
@@ -37,6 +37,9 @@ pub struct RunOptions {
     /// Directory of the checkpoints: every `checkpoint_every` steps, and at the end of the
     /// run (completed or stopped by Ctrl-C).
     pub checkpoint_dir: Option<PathBuf>,
+    /// `--profile`: time the solve stage's phases too (as `stats` does), for
+    /// [`Summary::phase_line`].
+    pub profile: bool,
 }
 
 /// Island solves of a run by the strongest method each reached (one count per island and
@@ -105,7 +108,8 @@ pub struct Summary {
     pub status: String,
     /// Median wall time (ms) of each stage of the step over the run
     /// ([`impulse::StepProfile`]), each stage's median on its own: they need not
-    /// add up to the median step.
+    /// add up to the median step; with the median CPU time of each phase of the solve stage
+    /// summed over islands (`solve_phases`, zero unless `--profile` or `--stats` timed them).
     pub stage_ms: StepProfile,
 }
 
@@ -158,6 +162,22 @@ impl Summary {
             .map(|(name, ms)| format!("{name} {ms:.3}"))
             .collect();
         format!("stages (median ms): {}", stages.join(", "))
+    }
+
+    /// The solve phases' medians as one line: `solve phases (median CPU ms summed over
+    /// islands): prepare 0.012, …`.
+    pub fn phase_line(&self) -> String {
+        let phases: Vec<String> = self
+            .stage_ms
+            .solve_phases
+            .phases()
+            .iter()
+            .map(|(name, ms)| format!("{name} {ms:.3}"))
+            .collect();
+        format!(
+            "solve phases (median CPU ms summed over islands): {}",
+            phases.join(", ")
+        )
     }
 }
 
@@ -445,6 +465,8 @@ fn simulate(
     parallel: bool,
 ) -> Result<Summary> {
     world.set_parallel(parallel);
+    // The phases' clocks cost time in worlds of many small islands: only when asked for.
+    world.set_profile_solve_phases(options.profile || options.stats.is_some());
     let last = world.step_count() + session.steps;
     let every = session.every;
     if let Some(dir) = &options.checkpoint_dir {
@@ -666,25 +688,25 @@ fn simulate(
     Ok(summary)
 }
 
-/// Each stage's median over `profiles`.
+/// Each stage's and each solve phase's median over `profiles`.
 fn median_profile(profiles: &[StepProfile]) -> StepProfile {
-    let of = |stage: fn(&StepProfile) -> f32| {
-        let mut times: Vec<f64> = profiles.iter().map(|p| stage(p) as f64).collect();
+    let of = |time: &dyn Fn(&StepProfile) -> f32| {
+        let mut times: Vec<f64> = profiles.iter().map(|p| time(p) as f64).collect();
         median(&mut times) as f32
     };
-    StepProfile {
-        kinematic: of(|p| p.kinematic),
-        broad_phase: of(|p| p.broad_phase),
-        narrow_phase: of(|p| p.narrow_phase),
-        islands: of(|p| p.islands),
-        assembly: of(|p| p.assembly),
-        solve: of(|p| p.solve),
-        scatter: of(|p| p.scatter),
-        continuous: of(|p| p.continuous),
-        store_impulses: of(|p| p.store_impulses),
-        finish: of(|p| p.finish),
-        total: of(|p| p.total),
+    let mut profile = StepProfile {
+        total: of(&|p| p.total),
+        ..StepProfile::default()
+    };
+    for stage in Stage::ALL {
+        profile.set(stage, of(&|p| p.get(stage)));
     }
+    for phase in SolvePhase::ALL {
+        profile
+            .solve_phases
+            .set(phase, of(&|p| p.solve_phases.get(phase)));
+    }
+    profile
 }
 
 fn median(values: &mut [f64]) -> f64 {

@@ -4,7 +4,9 @@
 //! `natural_map_residual` (the LCP's mixed units, see [`impulse::StepDiagnostics`]),
 //! `kinetic_energy` (J), `max_depth` (largest overlap among the step's contact points before
 //! the solve, m), then the wall time of each stage of the step in ms
-//! ([`impulse::StepProfile::stages`], `kinematic_ms`, `broad_phase_ms` …) and `total_ms`.
+//! ([`impulse::StepProfile::stages`], `kinematic_ms`, `broad_phase_ms` …) and `total_ms`, then
+//! the CPU time of each phase of the solve stage summed over islands in ms
+//! ([`impulse::SolvePhaseProfile::phases`], `phase_prepare_ms` … `phase_record_ms`).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -36,6 +38,9 @@ impl StatsWriter {
             header.push_str(&format!(",{name}_ms"));
         }
         header.push_str(",total_ms");
+        for (name, _) in StepProfile::default().solve_phases.phases() {
+            header.push_str(&format!(",phase_{name}_ms"));
+        }
         writeln!(writer.out, "{header}").with_context(|| writer.error())?;
         Ok(writer)
     }
@@ -66,6 +71,9 @@ impl StatsWriter {
             row.push_str(&format!(",{ms}"));
         }
         row.push_str(&format!(",{}", profile.total));
+        for (_, ms) in profile.solve_phases.phases() {
+            row.push_str(&format!(",{ms}"));
+        }
         writeln!(self.out, "{row}").with_context(|| self.error())
     }
 

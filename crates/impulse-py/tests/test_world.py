@@ -190,6 +190,31 @@ def test_diagnostics_and_quality():
         world.quality(start[:3])
 
 
+def test_profile_names_the_stages_and_the_solve_phases():
+    stages = [
+        "kinematic", "broad_phase", "narrow_phase", "islands", "assembly", "solve", "scatter",
+        "continuous", "store_impulses", "finish", "end_step",
+    ]
+    phases = [
+        "prepare", "integrate_velocities", "warm_start", "main_solve", "integrate_positions",
+        "relax", "impacts", "record",
+    ]
+    world = impulse.World.from_scene("pyramid20")
+    assert world.profile_solve_phases is False
+    world.step()
+    profile = world.profile
+    assert list(profile) == [*stages, "total", "solve_phases"]
+    assert list(profile["solve_phases"]) == phases
+    assert all(ms == 0.0 for ms in profile["solve_phases"].values())
+    world.profile_solve_phases = True
+    world.parallel = False
+    world.step()
+    profile = world.profile
+    assert sum(profile["solve_phases"].values()) > 0.0
+    # On one thread the islands' phases are parts of the solve stage's time.
+    assert sum(profile["solve_phases"].values()) <= profile["solve"] * 1.001 + 1e-4
+
+
 def test_settings_presets_and_fields():
     fast = impulse.Settings.preset("fast")
     assert fast.substeps == 8

@@ -53,6 +53,7 @@ mod integrate;
 mod island;
 mod joint;
 mod parallel;
+mod profile;
 mod settings;
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 mod solver;
@@ -86,7 +87,9 @@ pub use parry3d::shape::SharedShape;
 pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
 pub use collision::crowding::Crowd;
 pub use diagnostics::contact_lcp::ContactLcp;
-pub use diagnostics::{EnergyTerms, Stage, StepDiagnostics, StepProfile};
+pub use diagnostics::{
+    EnergyTerms, SolvePhase, SolvePhaseProfile, Stage, StepDiagnostics, StepProfile,
+};
 pub use error::{SnapshotError, StepError, WorldError};
 pub use joint::{
     AxisMode, JointAxis, JointBuilder, JointDof, JointEvent, JointHandle, JointKind, JointRef,

@@ -70,10 +70,19 @@ fn run_writes_csv_trajectory_and_summary_json() {
         "scatter",
         "store_impulses",
         "finish",
+        "end_step",
         "total",
     ] {
         let ms = &json["stage_ms"][stage];
         assert!(ms.is_number(), "stage_ms.{stage}: {ms:?}");
+    }
+    for phase in impulse::SolvePhase::ALL {
+        let ms = &json["stage_ms"]["solve_phases"][phase.name()];
+        assert!(
+            ms.is_number(),
+            "stage_ms.solve_phases.{}: {ms:?}",
+            phase.name()
+        );
     }
     assert_eq!(json["bodies"], 31);
     assert_eq!(json["steps"], 20);
@@ -96,8 +105,23 @@ fn profile_prints_the_median_of_every_stage() {
         .split(", ")
         .collect();
     assert_eq!(stages.len(), impulse::Stage::ALL.len(), "{line}");
+    // Then the solve's phases, by their names, timed: some island solved.
+    let line = stdout.lines().nth(2).unwrap_or_default();
+    let phases: Vec<(&str, f64)> = line
+        .strip_prefix("solve phases (median CPU ms summed over islands): ")
+        .unwrap_or_else(|| panic!("no phase line in {stdout}"))
+        .split(", ")
+        .map(|phase| {
+            let (name, ms) = phase.rsplit_once(' ').unwrap();
+            (name, ms.parse::<f64>().unwrap())
+        })
+        .collect();
+    let names: Vec<&str> = impulse::SolvePhase::ALL.iter().map(|p| p.name()).collect();
+    assert_eq!(phases.iter().map(|(n, _)| *n).collect::<Vec<_>>(), names);
+    assert!(phases.iter().all(|(_, ms)| *ms >= 0.0), "{line}");
+    assert!(phases.iter().any(|(_, ms)| *ms > 0.0), "{line}");
     // Then which build of the SIMD kernels ran: the widest this CPU runs.
-    let kernels = stdout.lines().nth(2).unwrap_or_default();
+    let kernels = stdout.lines().nth(3).unwrap_or_default();
     let name = impulse::simd::InstructionSet::supported_widest().name();
     assert!(
         kernels.starts_with(&format!("SIMD kernels: {name} (")),

@@ -227,8 +227,21 @@ fn stats_have_one_finite_row_per_step_and_plot_as_svg_and_png() {
             "max_depth"
         ]
     );
-    for stage in ["broad_phase_ms", "narrow_phase_ms", "solve_ms", "total_ms"] {
+    for stage in [
+        "broad_phase_ms",
+        "narrow_phase_ms",
+        "solve_ms",
+        "end_step_ms",
+        "total_ms",
+    ] {
         assert!(header.contains(&stage), "no {stage} in {header:?}");
+    }
+    for phase in impulse::SolvePhase::ALL {
+        let column = format!("phase_{}_ms", phase.name());
+        assert!(
+            header.contains(&column.as_str()),
+            "no {column} in {header:?}"
+        );
     }
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())

@@ -1,12 +1,13 @@
 //! Bodies: what a body is ([`BodyKind`], [`LockedAxes`], [`Keyframe`]), how it is named
 //! ([`BodyHandle`]), described ([`BodyBuilder`]) and
-//! stored ([`Bodies`], one array per quantity), and the view of velocities a solve updates
-//! ([`Velocities`]).
+//! stored ([`Bodies`], one array per quantity), the view of velocities a solve updates
+//! ([`Velocities`]), and kinematic bodies' prescribed motion (`motion.rs`).
 
 mod builder;
 mod handle;
 mod kind;
 mod locked_axes;
+pub(crate) mod motion;
 pub(crate) mod rules;
 mod storage;
 #[cfg(test)]

@@ -1,10 +1,12 @@
 //! Collision detection, the broad phase and narrow phase stages of the step
 //! ([`crate::Stage::BroadPhase`], [`crate::Stage::NarrowPhase`]): the broad phase turns loosened
 //! bounding boxes into candidate pairs, the narrow phase turns candidates into persistent contact
-//! manifolds (Parry) with the speculative margins that decide how far ahead points are made.
+//! manifolds (Parry) with the speculative margins that decide how far ahead points are made;
+//! and the sweeps of continuous collision (`continuous.rs`, for [`crate::Stage::Continuous`]).
 
 pub(crate) mod broad_phase;
 pub(crate) mod caps;
+pub(crate) mod continuous;
 pub(crate) mod crowding;
 pub(crate) mod dispatch;
 pub(crate) mod faces;

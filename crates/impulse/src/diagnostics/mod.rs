@@ -1,7 +1,10 @@
 //! What a step did and how well its contact LCP was solved ([`StepDiagnostics`], written by
-//! the finish stage), and where its time went, stage by stage ([`Stage`], [`StepProfile`]).
+//! the finish stage), and where its time went, stage by stage and the solve stage phase by
+//! phase ([`Stage`], [`SolvePhase`], [`StepProfile`], defined in `profile.rs`).
 
 pub(crate) mod contact_lcp;
+
+pub use crate::profile::{SolvePhase, SolvePhaseProfile, Stage, StepProfile};
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -40,143 +43,6 @@ pub struct StepDiagnostics {
     pub kinetic_energy: f32,
     /// Total linear momentum of moving bodies after the step (kg·m/s).
     pub linear_momentum: [f32; 3],
-}
-
-/// Wall-clock time (ms) of each stage of one step, in the order [`crate::World::step`] runs
-/// them (as Box2D's `b2Profile` and Rapier's `Counters`); [`crate::World::profile`] gives the
-/// last step's. Kept apart from [`StepDiagnostics`], which is the same bit for bit on any thread
-/// count. Stages that run beside each other on
-/// two threads are timed together. Read from `std::time::Instant`, so it varies from run to run
-/// like any timing: it says where a step's time went, it is not a measure of quality.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct StepProfile {
-    /// Kinematic bodies' velocities for the step (and the start poses for continuous
-    /// collision).
-    pub kinematic: f32,
-    /// Speculative margins and broad phase (with the energy at the step's start beside them).
-    pub broad_phase: f32,
-    /// Narrow phase: contact manifolds of the candidate pairs.
-    pub narrow_phase: f32,
-    /// Islands (union-find over the pairs) and the bodies' world inverse inertia tensors.
-    pub islands: f32,
-    /// Constraint assembly: Jacobian rows, effective masses, warm-start impulses.
-    pub assembly: f32,
-    /// The island jobs: substeps (solve, position integration), restitution, and each island's
-    /// residual.
-    pub solve: f32,
-    /// Island results written back to the bodies, and kinematic bodies moved.
-    pub scatter: f32,
-    /// Continuous collision: fast bodies swept against static and kinematic bodies.
-    pub continuous: f32,
-    /// Impulses written back to the manifolds for the next warm start.
-    pub store_impulses: f32,
-    /// Sleep, energy, momentum and the counts of the diagnostics.
-    pub finish: f32,
-    /// The whole step.
-    pub total: f32,
-}
-
-/// The stages of a step, in order: the one vocabulary of the step. [`crate::World::step`]
-/// calls one method per stage (each in its file of `world/step/`), [`StepProfile`] times them,
-/// and docs/architecture.md describes them by these names.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Stage {
-    /// Kinematic bodies' velocities for the step, from their keyframes or target poses (and
-    /// every body's start pose when continuous collision is on).
-    Kinematic,
-    /// Speculative margins and candidate pairs (with the energy at the step's start).
-    BroadPhase,
-    /// Contact manifolds of the candidate pairs.
-    NarrowPhase,
-    /// Islands from the pairs, and the bodies' world inverse inertia tensors.
-    Islands,
-    /// Constraint assembly: Jacobian rows, effective masses, warm-start impulses.
-    Assembly,
-    /// Each island's substeps (warm start, solve, integrate positions, relax), restitution and
-    /// residual.
-    Solve,
-    /// Island results written back to the bodies, and kinematic bodies moved.
-    Scatter,
-    /// Continuous collision: fast bodies swept against static and kinematic bodies, their
-    /// motion clamped to the first impact.
-    Continuous,
-    /// Impulses written back to the manifolds for the next warm start.
-    StoreImpulses,
-    /// Sleep, energy, momentum and the counts of the diagnostics.
-    Finish,
-}
-
-impl Stage {
-    /// Every stage, in step order.
-    pub const ALL: [Stage; 10] = [
-        Stage::Kinematic,
-        Stage::BroadPhase,
-        Stage::NarrowPhase,
-        Stage::Islands,
-        Stage::Assembly,
-        Stage::Solve,
-        Stage::Scatter,
-        Stage::Continuous,
-        Stage::StoreImpulses,
-        Stage::Finish,
-    ];
-
-    /// Snake-case name, as in JSON and the CLI's profile.
-    pub fn name(self) -> &'static str {
-        match self {
-            Stage::Kinematic => "kinematic",
-            Stage::BroadPhase => "broad_phase",
-            Stage::NarrowPhase => "narrow_phase",
-            Stage::Islands => "islands",
-            Stage::Assembly => "assembly",
-            Stage::Solve => "solve",
-            Stage::Scatter => "scatter",
-            Stage::Continuous => "continuous",
-            Stage::StoreImpulses => "store_impulses",
-            Stage::Finish => "finish",
-        }
-    }
-}
-
-impl StepProfile {
-    /// The time of `stage` (ms).
-    pub fn get(&self, stage: Stage) -> f32 {
-        match stage {
-            Stage::Kinematic => self.kinematic,
-            Stage::BroadPhase => self.broad_phase,
-            Stage::NarrowPhase => self.narrow_phase,
-            Stage::Islands => self.islands,
-            Stage::Assembly => self.assembly,
-            Stage::Solve => self.solve,
-            Stage::Scatter => self.scatter,
-            Stage::Continuous => self.continuous,
-            Stage::StoreImpulses => self.store_impulses,
-            Stage::Finish => self.finish,
-        }
-    }
-
-    /// Sets the time of `stage` (ms).
-    pub fn set(&mut self, stage: Stage, ms: f32) {
-        let field = match stage {
-            Stage::Kinematic => &mut self.kinematic,
-            Stage::BroadPhase => &mut self.broad_phase,
-            Stage::NarrowPhase => &mut self.narrow_phase,
-            Stage::Islands => &mut self.islands,
-            Stage::Assembly => &mut self.assembly,
-            Stage::Solve => &mut self.solve,
-            Stage::Scatter => &mut self.scatter,
-            Stage::Continuous => &mut self.continuous,
-            Stage::StoreImpulses => &mut self.store_impulses,
-            Stage::Finish => &mut self.finish,
-        };
-        *field = ms;
-    }
-
-    /// The stages as (name, ms) pairs, in step order (without `total`).
-    pub fn stages(&self) -> [(&'static str, f32); 10] {
-        Stage::ALL.map(|stage| (stage.name(), self.get(stage)))
-    }
 }
 
 /// The natural-map residual of `constraints` ([`StepDiagnostics::natural_map_residual`]) by

@@ -15,6 +15,7 @@ use super::policy::Auto;
 use super::rows::Velocities;
 use crate::contact::ContactConstraint;
 use crate::joint::IslandJoints;
+use crate::profile::PhaseClock;
 use crate::settings::SolverMethod;
 #[cfg(doc)]
 use crate::{contact, integrate, solver::Sweep};
@@ -99,6 +100,8 @@ pub(crate) struct IslandWorkspace {
     /// ([`IslandWorkspace::solved_point`]), and any other reader has them written into a copy
     /// of the rows ([`IslandWorkspace::unpack_into`]). Cleared when the island sleeps.
     pub(crate) impulses_in_lanes: bool,
+    /// The island's clock of its [`crate::SolvePhase`]s in the step.
+    pub(crate) phases: PhaseClock,
 }
 
 impl IslandWorkspace {

@@ -7,7 +7,7 @@ use super::impact;
 use super::interface::{SolvePass, Sweep};
 use super::island_workspace::IslandWorkspace;
 use super::rows::{self, Velocities};
-use super::substep::{IMPACT_SWEEPS, StepContext};
+use super::substep::{IMPACT_SWEEPS, IslandContext};
 use crate::contact::{self, ContactConstraint};
 use crate::parallel::RESTITUTION_POINTS_PER_TASK;
 use crate::settings::{ImpactModel, SolverSettings};
@@ -22,7 +22,7 @@ impl IslandWorkspace {
         guests: &[u32],
         constraints: &mut [ContactConstraint],
         settings: &SolverSettings,
-        context: &StepContext<'_>,
+        context: &IslandContext<'_>,
         spread: bool,
     ) {
         let w = self;

@@ -8,7 +8,6 @@
 //! mutable.
 
 use glam::{Mat3, Vec3};
-use parry3d::math::Pose;
 
 use super::heavy_on_light::{
     HeavyOnLight, heavy_on_light, heavy_on_light_max_contacts, heavy_on_light_settings, mass_ratio,
@@ -25,6 +24,7 @@ use crate::body::{Bodies, BodyKind, LockedAxes};
 use crate::contact::{self, ContactConstraint};
 use crate::integrate;
 use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS};
+use crate::profile::SolvePhase;
 use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
@@ -126,6 +126,9 @@ impl IslandWorkspace {
         let joints = &mut self.joints;
         let solver = self.solvers.substeps(settings.method, bundled);
         let outcome = solver.solve(constraints, &mut velocities, joints, &pass);
+        if with_repair {
+            self.phases.end(SolvePhase::MainSolve);
+        }
         // Only a contact closing faster than the impact speed as the step started makes an
         // impact: in a deep pile at a few substeps the soft rows' repair alone can change a
         // sweep's velocities by more than that speed, and sweeping such a pile to convergence
@@ -154,7 +157,9 @@ impl IslandWorkspace {
                 targets: None,
                 ..pass
             };
-            solver.solve(constraints, &mut velocities, joints, &more)
+            let outcome = solver.solve(constraints, &mut velocities, joints, &more);
+            self.phases.end(SolvePhase::Impacts);
+            outcome
         });
         self.position_repair = outcome.position_repair;
         self.record(&outcome, with_repair);
@@ -179,7 +184,7 @@ impl IslandWorkspace {
 }
 
 /// Everything an island's step reads besides its own bodies and constraints.
-pub(crate) struct StepContext<'a> {
+pub(crate) struct IslandContext<'a> {
     /// All bodies (read only).
     pub bodies: &'a Bodies,
     /// Gravity (m/s²).
@@ -199,11 +204,13 @@ pub(crate) struct StepContext<'a> {
     /// Whether any body has a force or torque this step ([`Bodies::force`]); without one the
     /// substeps add gravity alone.
     pub forces: bool,
+    /// Whether the island's job times its phases ([`crate::World::set_profile_solve_phases`]).
+    pub time_phases: bool,
 }
 
 /// Runs one island's part of the solve stage ([`crate::Stage::Solve`]): per substep of h = dt/substeps, gravity,
 /// warm start, the solve with overlap repair, position integration, and the relax solve; then
-/// the restitution solve. Results stay in `workspace` until [`scatter`]. The rows' J·v*
+/// the restitution solve. Results stay in `workspace` until the scatter stage (`world/step/scatter.rs`). The rows' J·v*
 /// (`velocity_before`) and the residual are recorded here when the SIMD lanes solved the
 /// island and no restitution solve followed (`IslandWorkspace::rows`); otherwise they are
 /// left to the caller, which takes them in one pass
@@ -218,10 +225,11 @@ pub(crate) fn step_island(
     island_bodies: &[u32],
     guests: &[u32],
     constraints: &mut [ContactConstraint],
-    context: &StepContext<'_>,
+    context: &IslandContext<'_>,
     workspace: &mut IslandWorkspace,
 ) {
     let w = workspace;
+    w.phases.start(context.time_phases);
     w.gather(island_bodies, guests, context);
     w.start_report(island_bodies, constraints, context.bodies);
     let heavy = w.heavy_on_light_path(island_bodies, constraints, context);
@@ -232,10 +240,12 @@ pub(crate) fn step_island(
     w.joints.start_step(h, settings.direct_joint_solve);
     w.start_solves(constraints, settings, context);
     let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
+    w.phases.end(SolvePhase::Prepare);
     for substep in 0..settings.substeps {
         w.substep(constraints, settings, context, &plan, substep);
     }
     w.finish_solves(constraints, settings, &plan);
+    w.phases.end(SolvePhase::Record);
     w.restitution(
         island_bodies,
         guests,
@@ -244,7 +254,9 @@ pub(crate) fn step_island(
         context,
         plan.spread,
     );
+    w.phases.end(SolvePhase::Impacts);
     w.record_joints();
+    w.phases.end(SolvePhase::Record);
 }
 
 /// How an island's solves run in a step, decided before its substeps.
@@ -266,7 +278,7 @@ struct SolvePlan {
 impl IslandWorkspace {
     /// The island's velocities and orientations, its guests' after its bodies', then the
     /// immovable slot's zero velocity.
-    fn gather(&mut self, island_bodies: &[u32], guests: &[u32], context: &StepContext<'_>) {
+    fn gather(&mut self, island_bodies: &[u32], guests: &[u32], context: &IslandContext<'_>) {
         let bodies = context.bodies;
         let w = self;
         w.linear.clear();
@@ -284,8 +296,8 @@ impl IslandWorkspace {
     /// What stays constant over the step's substeps of `h` seconds: the bodies' accelerations
     /// from applied forces, the gyroscopic term's tensors, damping factors and translation
     /// locks; and zero displacements and rotations.
-    fn step_constants(&mut self, island_bodies: &[u32], context: &StepContext<'_>, h: f32) {
-        let StepContext {
+    fn step_constants(&mut self, island_bodies: &[u32], context: &IslandContext<'_>, h: f32) {
+        let IslandContext {
             bodies,
             settings,
             forces,
@@ -385,7 +397,7 @@ impl IslandWorkspace {
         &mut self,
         island_bodies: &[u32],
         constraints: &[ContactConstraint],
-        context: &StepContext<'_>,
+        context: &IslandContext<'_>,
     ) -> Option<SolverSettings> {
         let settings = context.settings;
         let threshold = settings.heavy_on_light_mass_ratio;
@@ -417,7 +429,7 @@ impl IslandWorkspace {
         &mut self,
         constraints: &mut [ContactConstraint],
         settings: &SolverSettings,
-        context: &StepContext<'_>,
+        context: &IslandContext<'_>,
     ) {
         let (gravity, dt) = (context.gravity, context.dt);
         if settings.substeps != context.settings.substeps {
@@ -454,7 +466,7 @@ impl IslandWorkspace {
         guests: &[u32],
         constraints: &mut [ContactConstraint],
         settings: &SolverSettings,
-        context: &StepContext<'_>,
+        context: &IslandContext<'_>,
         h: f32,
     ) -> SolvePlan {
         let (parallel, world_inverse_inertia) = (context.parallel, context.world_inverse_inertia);
@@ -530,7 +542,7 @@ impl IslandWorkspace {
         &mut self,
         constraints: &mut [ContactConstraint],
         settings: &SolverSettings,
-        context: &StepContext<'_>,
+        context: &IslandContext<'_>,
         plan: &SolvePlan,
         substep: u32,
     ) {
@@ -548,6 +560,7 @@ impl IslandWorkspace {
                 .wide
                 .keep_velocities_before(&self.linear, &self.angular);
         }
+        self.phases.end(SolvePhase::IntegrateVelocities);
         let mut velocities = Velocities {
             linear: &mut self.linear,
             angular: &mut self.angular,
@@ -580,6 +593,7 @@ impl IslandWorkspace {
             );
         }
         self.position_repair = false;
+        self.phases.end(SolvePhase::WarmStart);
         self.targets_and_solve(
             constraints,
             bodies,
@@ -590,6 +604,7 @@ impl IslandWorkspace {
             half_turn,
         );
         self.integrate_positions(constraints, settings, plan);
+        self.phases.end(SolvePhase::IntegratePositions);
         if settings.relax_iterations > 0 && !settings.split_impulse() {
             let relax = SubstepSolve::Relax {
                 warm_start_follows: substep + 1 < settings.substeps,
@@ -611,6 +626,7 @@ impl IslandWorkspace {
             self.joints
                 .relax(&mut velocities, pose, sweeps, settings.tolerance);
         }
+        self.phases.end(SolvePhase::Relax);
     }
 
     /// A substep's velocity changes before the contacts are solved: gravity, applied forces,
@@ -766,38 +782,4 @@ impl IslandWorkspace {
             None
         };
     }
-}
-
-/// Writes an island's velocities and poses back into the bodies.
-pub(crate) fn scatter(island_bodies: &[u32], workspace: &IslandWorkspace, bodies: &mut Bodies) {
-    for (k, &i) in island_bodies.iter().enumerate() {
-        let i = i as usize;
-        scatter_body(
-            workspace,
-            k,
-            bodies.local_center_of_mass[i],
-            &mut bodies.pose[i],
-            &mut bodies.linear_velocity[i],
-            &mut bodies.angular_velocity[i],
-        );
-    }
-}
-
-/// Writes the body at local index `k` of `workspace`'s island back: its velocities and its
-/// pose (the centre of mass moved by the island's displacement, at its new orientation).
-#[inline]
-pub(crate) fn scatter_body(
-    workspace: &IslandWorkspace,
-    k: usize,
-    local_center_of_mass: Vec3,
-    pose: &mut Pose,
-    linear: &mut Vec3,
-    angular: &mut Vec3,
-) {
-    let com = pose.transform_point(local_center_of_mass) + workspace.displacement[k];
-    let rotation = workspace.orientation[k];
-    *linear = workspace.linear[k];
-    *angular = workspace.angular[k];
-    pose.rotation = rotation;
-    pose.translation = com - rotation * local_center_of_mass;
 }

@@ -570,6 +570,52 @@ impl World {
         self.wake_up(i);
         self.scratch_bodies = touching;
     }
+
+    /// Sets the pose a kinematic body reaches at the end of the next step (Rapier's
+    /// `set_next_kinematic_position`): that step moves it at the constant velocity that gets
+    /// it there, so the bodies it touches are pushed and carried, and it then stays (velocity
+    /// zero) until given a new target, unless it has keyframes, which resume. Errors for a
+    /// removed or non-kinematic body, a non-finite translation or a zero rotation.
+    pub fn set_kinematic_target(
+        &mut self,
+        handle: BodyHandle,
+        translation: Vec3,
+        rotation: Quat,
+    ) -> Result<(), WorldError> {
+        let i = self
+            .handles
+            .body(handle)
+            .ok_or(WorldError::UnknownBody(handle))?;
+        let refuse = |field: &str, message: String| {
+            Err(WorldError::InvalidBody {
+                body: i,
+                name: self.bodies.name[i].clone(),
+                field: field.to_string(),
+                message,
+            })
+        };
+        if self.bodies.kind[i] != BodyKind::Kinematic {
+            return refuse(
+                "kind",
+                "only a kinematic body has a target pose".to_string(),
+            );
+        }
+        let target = match checked_pose(translation, rotation) {
+            Ok(pose) => pose,
+            Err((field, message)) => return refuse(field, message),
+        };
+        match self.scripts.iter_mut().find(|s| s.handle == handle) {
+            Some(script) => script.target = Some(target),
+            None => self.scripts.push(super::step::kinematic_script::Script {
+                handle,
+                initial: self.bodies.pose[i],
+                keyframes: Vec::new(),
+                target: Some(target),
+                step_target: None,
+            }),
+        }
+        Ok(())
+    }
 }
 
 /// The pose of a body frame at `translation` with `rotation` (normalised), or the field that

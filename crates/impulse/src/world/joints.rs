@@ -3,16 +3,18 @@
 //! the bodies each joint links for the islands, its rows for assembly, its impulses stored and
 //! its break check after the solve).
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 use super::World;
 use crate::body::BodyHandle;
 use crate::error::WorldError;
+use crate::island::Islands;
 use crate::joint::rules::{anchor_reach, check_dofs, check_options};
 use crate::joint::{
     Anchors, Axes, Joint, JointBody, JointBuilder, JointConstraint, JointEvent, JointHandle,
     JointKind, JointRef, LocalFrames, ROWS_PER_DOF, Strength, frame_state,
 };
+use crate::solver::substep::IslandWorkspace;
 
 impl World {
     /// Inserts a joint and returns its handle; wakes both bodies. World anchors and axes
@@ -256,29 +258,35 @@ impl World {
         pairs
     }
 
-    /// The rows of every solved joint, into its island's workspace (the assembly stage).
-    pub(super) fn assemble_joints(&mut self, warm_start: f32) {
-        for workspace in &mut self.workspaces {
+    /// The rows of every solved joint, into its island's workspace (the assembly stage), from
+    /// the islands stage's `islands` and `world_inverse_inertia`.
+    pub(super) fn assemble_joints(
+        &mut self,
+        warm_start: f32,
+        islands: &Islands,
+        world_inverse_inertia: &[Mat3],
+        workspaces: &mut Vec<IslandWorkspace>,
+    ) {
+        for workspace in workspaces.iter_mut() {
             workspace.joints.clear();
         }
         if self.joints.is_empty() {
             return;
         }
-        let islands = self.islands.len();
-        if self.workspaces.len() < islands {
-            self.workspaces.resize_with(islands, Default::default);
+        if workspaces.len() < islands.len() {
+            workspaces.resize_with(islands.len(), Default::default);
         }
         for (a, b, k) in self.active_joints() {
             let joint = &self.joints.joints[k as usize];
             let (a, b) = (a as usize, b as usize);
-            let island = self.islands.island_of_pair(a, b);
+            let island = islands.island_of_pair(a, b);
             let body = |i: usize| JointBody {
                 body: i as u32,
-                slot: self.islands.slot(i, island),
+                slot: islands.slot(i, island),
                 center: self.bodies.center_of_mass(i),
                 orientation: self.bodies.pose[i].rotation,
                 inverse_mass: self.bodies.effective_inverse_mass(i),
-                inverse_inertia: self.world_inverse_inertia[i],
+                inverse_inertia: world_inverse_inertia[i],
             };
             let mut impulses = joint.impulses;
             for row in impulses.iter_mut().flatten() {
@@ -301,20 +309,25 @@ impl World {
                 joint.break_window,
                 joint.break_sums,
             );
-            self.workspaces[island].joints.push(constraint);
+            workspaces[island].joints.push(constraint);
         }
     }
 
     /// After the solve: each solved joint's impulses stored for the next warm start, its
-    /// reaction force and torque, and its break check (the step's joint events).
-    pub(super) fn store_joint_impulses(&mut self) {
+    /// reaction force and torque, and its break check (the step's joint events), from the
+    /// solve's `workspaces` of the islands it woke (`island_awake`).
+    pub(super) fn store_joint_impulses(
+        &mut self,
+        island_awake: &[bool],
+        workspaces: &[IslandWorkspace],
+    ) {
         self.joint_events.clear();
         if self.joints.is_empty() {
             return;
         }
         let dt = self.dt;
-        for (k, workspace) in self.workspaces.iter().enumerate() {
-            if !self.island_awake.get(k).copied().unwrap_or(false) {
+        for (k, workspace) in workspaces.iter().enumerate() {
+            if !island_awake.get(k).copied().unwrap_or(false) {
                 continue;
             }
             for c in &workspace.joints {

@@ -1,21 +1,18 @@
 //! The world and its step. `World::step` reads as the pipeline of docs/architecture.md: each call is one stage,
 //! each stage lives in its own module, and data flows one way through them.
 
-use glam::{Mat3, Vec3};
-use parry3d::math::Pose;
+use glam::Vec3;
 
 use crate::body::{Bodies, BodyBuilder, BodyHandle, Handles};
 use crate::collision::broad_phase::BroadPhase;
-use crate::collision::narrow_phase::{self, NarrowPhase};
+use crate::collision::narrow_phase::NarrowPhase;
 use crate::contact::constraints::{ContactConstraint, complete_products};
 use crate::diagnostics::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms};
 use crate::error::WorldError;
-use crate::island::Islands;
 use crate::joint::{JointEvent, Joints};
 use crate::scene::{BodyDesc, Material, MaterialRef, Scene};
 use crate::settings::SolverSettings;
-use crate::solver::substep::IslandWorkspace;
 
 mod bodies;
 mod contact_events;
@@ -27,6 +24,7 @@ mod snapshot;
 mod step;
 
 use step::EnergyCheck;
+use step::context::StepContext;
 use step::kinematic_script::Script;
 
 pub use bodies::BodyRef;
@@ -53,21 +51,15 @@ pub struct World {
     seed: u64,
     broad_phase: BroadPhase,
     narrow_phase: NarrowPhase,
-    candidates: Vec<(u32, u32)>,
-    constraints: Vec<ContactConstraint>,
-    world_inverse_inertia: Vec<Mat3>,
-    /// Every body's centre of mass in the world (m) at the step's start poses, beside
-    /// `world_inverse_inertia`: what assembly measures lever arms from.
-    world_center_of_mass: Vec<Vec3>,
-    scratch: Vec<(Vec3, Vec3)>,
-    margins: narrow_phase::SpeculativeMargins,
-    islands: Islands,
-    island_awake: Vec<bool>,
-    workspaces: Vec<IslandWorkspace>,
+    /// The step's working data between its stages, kept for its allocations and for the last
+    /// step's rows ([`World::contact_lcp`]); nothing a resumed step needs.
+    context: StepContext,
     energy: EnergyCheck,
     /// Run islands (and the narrow phase) on rayon's thread pool when it has more than one
     /// thread. `false` runs everything on the calling thread.
     pub(crate) parallel: bool,
+    /// Whether the solve stage times its phases ([`World::set_profile_solve_phases`]).
+    profile_solve_phases: bool,
     diagnostics: StepDiagnostics,
     profile: StepProfile,
     /// Whether any body has a force or torque for the next step.
@@ -80,16 +72,6 @@ pub struct World {
     time: f64,
     /// The position-based kinematic bodies' keyframes and targets.
     scripts: Vec<Script>,
-    /// Every body's pose at the start of the step, for continuous collision (empty when it is
-    /// off).
-    start_poses: Vec<Pose>,
-    /// Kinematic bodies moving this step, in index order.
-    moving_kinematic: Vec<u32>,
-    /// The continuous stage's clamps (scratch): body, clamped pose, fraction of the step.
-    clamps: Vec<(usize, Pose, f32)>,
-    /// Every body's pose before the continuous stage (empty when it is off): what the energy
-    /// check credits a clamp with.
-    unclamped_poses: Vec<Pose>,
     /// The bodies that left the world in the last step ([`World::left_world`]).
     left_world: Vec<LeftWorld>,
     /// The joints, with their warm-start impulses.
@@ -136,17 +118,10 @@ impl World {
             seed: 0,
             broad_phase: BroadPhase::default(),
             narrow_phase: NarrowPhase::default(),
-            candidates: Vec::new(),
-            constraints: Vec::new(),
-            world_inverse_inertia: Vec::new(),
-            world_center_of_mass: Vec::new(),
-            scratch: Vec::new(),
-            margins: narrow_phase::SpeculativeMargins::default(),
-            islands: Islands::default(),
-            island_awake: Vec::new(),
-            workspaces: Vec::new(),
+            context: StepContext::default(),
             energy: EnergyCheck::default(),
             parallel: true,
+            profile_solve_phases: false,
             diagnostics: StepDiagnostics::default(),
             profile: StepProfile::default(),
             forces_pending: false,
@@ -154,10 +129,6 @@ impl World {
             contact_events: contact_events::ContactEvents::default(),
             time: 0.0,
             scripts: Vec::new(),
-            start_poses: Vec::new(),
-            moving_kinematic: Vec::new(),
-            clamps: Vec::new(),
-            unclamped_poses: Vec::new(),
             left_world: Vec::new(),
             joints: Joints::default(),
             joint_events: Vec::new(),
@@ -355,7 +326,8 @@ impl World {
     /// the SIMD lanes ([`ContactConstraint::products_pending`]).
     #[cfg(test)]
     pub(crate) fn pending_products(&self) -> usize {
-        self.constraints
+        self.context
+            .constraints
             .iter()
             .filter(|c| c.products_pending)
             .count()
@@ -366,16 +338,22 @@ impl World {
     /// impulses, targets and J·v*: borrowed when the rows hold everything, else a completed
     /// copy.
     fn complete_constraints(&self) -> std::borrow::Cow<'_, [ContactConstraint]> {
-        let islands = self.islands.len();
-        let in_lanes = |k: usize| self.workspaces.get(k).is_some_and(|w| w.impulses_in_lanes);
-        if !(0..islands).any(in_lanes) && !self.constraints.iter().any(|c| c.products_pending) {
-            return std::borrow::Cow::Borrowed(&self.constraints);
+        let context = &self.context;
+        let islands = context.islands.len();
+        let in_lanes = |k: usize| {
+            context
+                .workspaces
+                .get(k)
+                .is_some_and(|w| w.impulses_in_lanes)
+        };
+        if !(0..islands).any(in_lanes) && !context.constraints.iter().any(|c| c.products_pending) {
+            return std::borrow::Cow::Borrowed(&context.constraints);
         }
-        let mut rows = self.constraints.clone();
+        let mut rows = context.constraints.clone();
         for k in (0..islands).filter(|&k| in_lanes(k)) {
-            self.workspaces[k].unpack_into(&mut rows[self.islands.constraint_range(k)]);
+            context.workspaces[k].unpack_into(&mut rows[context.islands.constraint_range(k)]);
         }
-        complete_products(&mut rows, &self.world_inverse_inertia);
+        complete_products(&mut rows, &context.world_inverse_inertia);
         std::borrow::Cow::Owned(rows)
     }
 
@@ -387,9 +365,10 @@ impl World {
     /// before breaking is in the velocities. Errors only when the step produced non-finite data.
     pub fn contact_lcp(&self) -> Result<ContactLcp, impulse_lcp::ProblemError> {
         let joints: Vec<&crate::joint::JointConstraint> = self
+            .context
             .workspaces
             .iter()
-            .zip(&self.island_awake)
+            .zip(&self.context.island_awake)
             .filter(|(_, awake)| **awake)
             .flat_map(|(workspace, _)| &workspace.joints)
             .filter(|joint| joint.broke.is_none())
@@ -397,9 +376,26 @@ impl World {
         assemble_lcp(&self.complete_constraints(), &joints)
     }
 
-    /// Wall-clock time of each stage of the last step (all zero before the first step).
+    /// Wall-clock time of each stage of the last step (all zero before the first step), and
+    /// the CPU time of the solve stage's phases summed over islands when
+    /// [`World::profile_solve_phases`] is on.
     pub fn profile(&self) -> &StepProfile {
         &self.profile
+    }
+
+    /// Whether steps time the solve stage's phases ([`crate::SolvePhaseProfile`]); off by
+    /// default.
+    pub fn profile_solve_phases(&self) -> bool {
+        self.profile_solve_phases
+    }
+
+    /// Times the solve stage's phases in each island from the next step on
+    /// ([`StepProfile::solve_phases`]), or not (`false`, the default: the phases read zero).
+    /// A phase's clock costs about a tenth of a microsecond per island and substep, which a
+    /// world of many small islands feels, so it is off unless asked for, as Rapier's
+    /// `Counters` are. Results are the same to the bit either way.
+    pub fn set_profile_solve_phases(&mut self, on: bool) {
+        self.profile_solve_phases = on;
     }
 
     /// Kinetic and gravitational energy, mass and momentum of the moving bodies now (the

@@ -1,25 +1,44 @@
 //! The assembly stage ([`crate::Stage::Assembly`]): one constraint per contact point, with its
 //! Jacobian rows, effective masses and warm-start impulses (`contact/constraints.rs`).
 
+use glam::{Mat3, Vec3};
+
 use crate::World;
-use crate::contact::constraints;
+use crate::contact::constraints::{self, ContactConstraint};
+use crate::island::Islands;
 use crate::settings::SolverSettings;
+use crate::solver::substep::IslandWorkspace;
 
 impl World {
-    /// The constraints of every island's points, each island's contiguous.
-    pub(super) fn assembly_stage(&mut self, settings: &SolverSettings) {
+    /// The constraints of every island's points, each island's contiguous (writes
+    /// `constraints`), and the joints' rows into their islands' `workspaces`, from the islands
+    /// stage's `islands`, `world_inverse_inertia` and `world_center_of_mass`.
+    pub(super) fn assembly_stage(
+        &mut self,
+        settings: &SolverSettings,
+        islands: &Islands,
+        world_inverse_inertia: &[Mat3],
+        world_center_of_mass: &[Vec3],
+        constraints: &mut Vec<ContactConstraint>,
+        workspaces: &mut Vec<IslandWorkspace>,
+    ) {
         constraints::assemble(
             &self.bodies,
             &self.narrow_phase,
-            &self.islands,
+            islands,
             settings,
-            &self.world_inverse_inertia,
-            &self.world_center_of_mass,
+            world_inverse_inertia,
+            world_center_of_mass,
             !self.any_restitution(),
             self.parallel,
-            &mut self.constraints,
+            constraints,
         );
-        self.assemble_joints(settings.warm_start);
+        self.assemble_joints(
+            settings.warm_start,
+            islands,
+            world_inverse_inertia,
+            workspaces,
+        );
     }
 
     /// Whether any body has a restitution coefficient above zero (then islands end their step

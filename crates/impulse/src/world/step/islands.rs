@@ -1,26 +1,31 @@
 //! The islands stage ([`crate::Stage::Islands`]): islands from the pairs (`island.rs`), and
 //! every body's world inverse inertia tensor and centre of mass beside them.
 
+use glam::{Mat3, Vec3};
+
 use crate::World;
 use crate::body::Bodies;
+use crate::island::Islands;
 use crate::parallel::{BODIES_PER_TASK, both, map_into, spread};
 
 impl World {
     /// Islands from the pairs first, so that assembly writes each island's constraints
     /// contiguously and nothing has to be moved afterwards. The union-find is serial; the
     /// world inertia tensors and centres of mass (from the poses alone) are computed beside
-    /// it, once a body rather than once for each of its pairs.
-    pub(super) fn islands_stage(&mut self, parallel: bool) {
+    /// it, once a body rather than once for each of its pairs. Writes `islands`,
+    /// `world_inverse_inertia` and `world_center_of_mass`.
+    pub(super) fn islands_stage(
+        &mut self,
+        parallel: bool,
+        islands: &mut Islands,
+        world_inverse_inertia: &mut Vec<Mat3>,
+        world_center_of_mass: &mut Vec<Vec3>,
+    ) {
         let joints = if self.joints.is_empty() {
             Vec::new()
         } else {
             self.active_joints()
         };
-        let (islands, world_inverse_inertia, world_center_of_mass) = (
-            &mut self.islands,
-            &mut self.world_inverse_inertia,
-            &mut self.world_center_of_mass,
-        );
         let (bodies, pairs) = (&self.bodies, &self.narrow_phase.pairs);
         both(
             parallel,

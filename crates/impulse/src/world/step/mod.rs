@@ -1,32 +1,45 @@
 //! `World::step`: the step as its stages, named by [`Stage`] and run in its order, one file
-//! each. [`World::step`] only calls them, in order, and times each for [`StepProfile`]:
+//! each. [`World::step`] only calls them, in order, and times each for [`StepProfile`]. The
+//! data one stage hands to the next is the step's [`StepContext`] (`context.rs`); each stage
+//! is given the fields it reads (`&`) and writes (`&mut`), and the world's persistent state
+//! through `self`:
 //!
-//! | stage | file | what it does |
-//! |---|---|---|
-//! | [`Stage::Kinematic`] | `kinematic.rs` | kinematic bodies' velocities for the step; start poses for the continuous stage |
-//! | [`Stage::BroadPhase`] | `broad_phase.rs` | speculative margins, candidate pairs (the energy check's reference, `energy.rs`) |
-//! | [`Stage::NarrowPhase`] | `narrow_phase.rs` | contact manifolds of the candidate pairs |
-//! | [`Stage::Islands`] | `islands.rs` | islands from the pairs; world inverse inertia tensors |
-//! | [`Stage::Assembly`] | `assembly.rs` | one constraint (row) per contact point |
-//! | [`Stage::Solve`] | `solve.rs` | which islands wake (`sleep.rs`); each awake island's substeps and its rows' record (`record.rs`) |
-//! | [`Stage::Scatter`] | `scatter.rs` | island results into the bodies; kinematic bodies moved (`kinematic.rs`) |
-//! | [`Stage::Continuous`] | `continuous.rs` | fast bodies swept and clamped (and the energy credit of the clamps, `energy.rs`) |
-//! | [`Stage::StoreImpulses`] | `store_impulses.rs` | impulses into the manifolds for the next warm start |
-//! | [`Stage::Finish`] | `finish.rs` | sleep (`sleep.rs`), energy, momentum, the diagnostics |
+//! | stage | file | reads from the context | writes into it |
+//! |---|---|---|---|
+//! | [`Stage::Kinematic`] | `kinematic.rs` | | `moving_kinematic`, `start_poses` |
+//! | [`Stage::BroadPhase`] | `broad_phase.rs` | | `margins`, `candidates` |
+//! | [`Stage::NarrowPhase`] | `narrow_phase.rs` | `candidates`, `margins` | (the manifolds) |
+//! | [`Stage::Islands`] | `islands.rs` | | `islands`, `world_inverse_inertia`, `world_center_of_mass` |
+//! | [`Stage::Assembly`] | `assembly.rs` | `islands`, `world_inverse_inertia`, `world_center_of_mass` | `constraints`, `workspaces` (joints) |
+//! | [`Stage::Solve`] | `solve.rs` | `islands`, `world_inverse_inertia` | `island_awake`, `constraints`, `workspaces` |
+//! | [`Stage::Scatter`] | `scatter.rs` | `islands`, `island_awake`, `workspaces`, `moving_kinematic` | (the bodies) |
+//! | [`Stage::Continuous`] | `motion_clamp.rs` | `start_poses`, `moving_kinematic` | `clamps`, `unclamped_poses` |
+//! | [`Stage::StoreImpulses`] | `store_impulses.rs` | `islands`, `island_awake`, `constraints`, `workspaces` | (the manifolds, the joints) |
+//! | [`Stage::Finish`] | `finish.rs` | `islands`, `island_awake`, `world_inverse_inertia` | `constraints`, `workspaces`, `record_scratch` (the rows of sleeping islands) |
+//! | [`Stage::EndStep`] | `end_step.rs` | `moving_kinematic` | |
 //!
-//! After the stages the step ends (`finish.rs`): contact events, the end of the step's forces
-//! and the energy and blow-up check (`energy.rs`). The state the world keeps for the step's
-//! concerns lives in files that do not reach back into the world (`energy.rs`,
-//! `kinematic_script.rs`), so that files import one way. Every thread decision goes through [`crate::parallel`].
+//! What each does: kinematic bodies' velocities (`kinematic.rs`); speculative margins and
+//! candidate pairs, after the energy check's reference (`energy.rs`); contact manifolds;
+//! islands and world inverse inertia tensors; one row per contact point; which islands wake
+//! (`sleep.rs`) and each awake island's substeps and its rows' record (`record.rs`), timed by
+//! [`crate::SolvePhase`]; island results into the bodies and kinematic bodies moved; fast
+//! bodies swept and clamped (the geometry in `collision/continuous.rs`); impulses into the
+//! manifolds for the next warm start; sleep, energy, momentum and the diagnostics; contact
+//! events, the end of the step's forces, the energy and blow-up check and the bodies that left
+//! the world. The state the world keeps for the step's concerns lives in files that do not
+//! reach back into the world (`energy.rs`, `kinematic_script.rs`), so that files import one
+//! way. Every thread decision goes through [`crate::parallel`].
 
 mod assembly;
 mod broad_phase;
-mod continuous;
+pub(super) mod context;
+mod end_step;
 mod energy;
 mod finish;
 mod islands;
 mod kinematic;
 pub(super) mod kinematic_script;
+mod motion_clamp;
 mod narrow_phase;
 mod record;
 mod scatter;
@@ -38,9 +51,11 @@ pub use energy::BLOW_UP_ENERGY_PER_KG;
 pub(super) use energy::EnergyCheck;
 
 use crate::World;
-use crate::diagnostics::{Stage, StepDiagnostics, StepProfile};
+use crate::diagnostics::StepDiagnostics;
 use crate::error::StepError;
 use crate::parallel::{in_pool, spread};
+use crate::profile::{Stage, StepProfile};
+use context::StepContext;
 
 /// Times the stages of one step for [`StepProfile`].
 struct StageClock {
@@ -90,38 +105,90 @@ impl World {
         Ok(&self.diagnostics)
     }
 
-    /// [`World::step`] on the calling thread: the stages in order, each timed.
+    /// [`World::step`] on the calling thread: the step's context taken out of the world for
+    /// the stages and put back after them, whatever they return.
     fn step_here(&mut self) -> Result<&StepDiagnostics, StepError> {
+        let mut context = std::mem::take(&mut self.context);
+        let stepped = self.run_stages(&mut context);
+        self.context = context;
+        stepped?;
+        Ok(&self.diagnostics)
+    }
+
+    /// The stages in order, each timed, each given the context's fields it reads and writes.
+    fn run_stages(&mut self, context: &mut StepContext) -> Result<(), StepError> {
         let settings = self.settings.clone();
         self.step_count += 1;
         self.left_world.clear();
         let parallel = spread(self.parallel, 1, 0);
+        let c = context;
         let mut clock = StageClock::start();
-        self.kinematic_stage(&settings);
+        self.kinematic_stage(&settings, &mut c.moving_kinematic, &mut c.start_poses);
         clock.end(Stage::Kinematic);
         self.energy.start(&self.bodies, self.gravity);
-        self.broad_phase_stage(&settings, parallel);
+        self.broad_phase_stage(&settings, parallel, &mut c.margins, &mut c.candidates);
         clock.end(Stage::BroadPhase);
-        self.narrow_phase_stage(parallel)?;
+        self.narrow_phase_stage(parallel, &c.candidates, &c.margins)?;
         clock.end(Stage::NarrowPhase);
-        self.islands_stage(parallel);
+        self.islands_stage(
+            parallel,
+            &mut c.islands,
+            &mut c.world_inverse_inertia,
+            &mut c.world_center_of_mass,
+        );
         clock.end(Stage::Islands);
-        self.assembly_stage(&settings);
+        self.assembly_stage(
+            &settings,
+            &c.islands,
+            &c.world_inverse_inertia,
+            &c.world_center_of_mass,
+            &mut c.constraints,
+            &mut c.workspaces,
+        );
         clock.end(Stage::Assembly);
-        self.solve_stage(&settings);
+        let phases = self.solve_stage(
+            &settings,
+            &c.islands,
+            &c.world_inverse_inertia,
+            &mut c.island_awake,
+            &mut c.constraints,
+            &mut c.workspaces,
+        );
         clock.end(Stage::Solve);
-        self.scatter_stage();
+        clock.profile.solve_phases = phases;
+        self.scatter_stage(
+            &c.islands,
+            &c.island_awake,
+            &c.workspaces,
+            &c.moving_kinematic,
+        );
         clock.end(Stage::Scatter);
-        self.continuous_stage(&settings);
+        self.continuous_stage(
+            &settings,
+            &c.start_poses,
+            &c.moving_kinematic,
+            &mut c.clamps,
+            &mut c.unclamped_poses,
+        );
         clock.end(Stage::Continuous);
-        self.store_impulses_stage();
+        self.store_impulses_stage(&c.islands, &c.island_awake, &c.constraints, &c.workspaces);
         clock.end(Stage::StoreImpulses);
-        let energy = self.finish_stage(&settings, parallel);
+        let energy = self.finish_stage(
+            &settings,
+            parallel,
+            &c.islands,
+            &c.island_awake,
+            &c.world_inverse_inertia,
+            &mut c.constraints,
+            &mut c.workspaces,
+            &mut c.record_scratch,
+        );
         clock.end(Stage::Finish);
-        self.profile = clock.profile();
         self.time += f64::from(self.dt);
-        self.end_step(&energy)?;
-        Ok(&self.diagnostics)
+        let ended = self.end_step(&energy, &c.moving_kinematic);
+        clock.end(Stage::EndStep);
+        self.profile = clock.profile();
+        ended
     }
 }
 

@@ -2,15 +2,21 @@
 //! pairs (Parry, `collision/narrow_phase.rs`), beside the broad phase tree's upkeep.
 
 use crate::World;
+use crate::collision::margins::SpeculativeMargins;
 use crate::error::StepError;
 use crate::parallel::both;
 
 impl World {
-    /// The manifolds of the candidate pairs, with the broad phase's tree optimised beside them
-    /// (neither reads what the other writes).
-    pub(super) fn narrow_phase_stage(&mut self, parallel: bool) -> Result<(), StepError> {
+    /// The manifolds of the `candidates` (with their `margins`), with the broad phase's tree
+    /// optimised beside them (neither reads what the other writes).
+    pub(super) fn narrow_phase_stage(
+        &mut self,
+        parallel: bool,
+        candidates: &[(u32, u32)],
+        margins: &SpeculativeMargins,
+    ) -> Result<(), StepError> {
         let (broad_phase, narrow_phase) = (&mut self.broad_phase, &mut self.narrow_phase);
-        let (bodies, candidates, margins) = (&self.bodies, &self.candidates, &self.margins);
+        let bodies = &self.bodies;
         let narrow = || narrow_phase.update(bodies, candidates, margins, parallel);
         both(parallel, || broad_phase.optimize(), narrow).1?;
         if self.bodies.roughness.iter().any(|&r| r > 0.0) {

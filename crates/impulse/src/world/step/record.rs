@@ -15,9 +15,12 @@
 //! The three give the same bits for the same rows on any thread count (tests in
 //! `diagnostics/contact_lcp_tests.rs` and `solver/wide_tests.rs`).
 
+use glam::{Mat3, Vec3};
+
 use crate::World;
 use crate::contact::constraints::{self, BodySlots, ContactConstraint};
 use crate::diagnostics;
+use crate::island::Islands;
 use crate::solver::substep::IslandWorkspace;
 
 /// Ends an awake island's job: its rows' record, the lanes' if they took it, else one pass over
@@ -43,29 +46,37 @@ pub(super) fn end_island(
 }
 
 impl World {
-    /// When any island slept through the step, every row's v* from the bodies' velocities
-    /// (one pass over all rows: the sleeping islands' rows get theirs, the awake islands' rows
-    /// their own record again, to the bit).
-    pub(super) fn record_sleeping_rows(&mut self) {
-        let islands = self.islands.len();
-        if self.island_awake.iter().take(islands).any(|awake| !awake) {
+    /// When any island slept through the step (`awake`), every row's v* from the bodies'
+    /// velocities (one pass over all rows: the sleeping islands' rows get theirs, the awake
+    /// islands' rows their own record again, to the bit).
+    pub(super) fn record_sleeping_rows(
+        &self,
+        islands_of: &Islands,
+        awake: &[bool],
+        world_inverse_inertia: &[Mat3],
+        constraints: &mut [ContactConstraint],
+        workspaces: &mut [IslandWorkspace],
+        scratch: &mut Vec<(Vec3, Vec3)>,
+    ) {
+        let islands = islands_of.len();
+        if awake.iter().take(islands).any(|awake| !awake) {
             // The pass reads every row's impulses, which an awake island in lanes may have
             // kept in its lanes: they are written back first.
             for k in 0..islands {
-                let w = &mut self.workspaces[k];
+                let w = &mut workspaces[k];
                 if std::mem::take(&mut w.impulses_in_lanes) {
-                    w.unpack_into(&mut self.constraints[self.islands.constraint_range(k)]);
+                    w.unpack_into(&mut constraints[islands_of.constraint_range(k)]);
                 }
             }
             // The pass reads every row's I⁻¹(r × d), which the lanes keep in their bundles.
-            constraints::complete_products(&mut self.constraints, &self.world_inverse_inertia);
+            constraints::complete_products(constraints, world_inverse_inertia);
             constraints::record_velocity_before(
-                &mut self.constraints,
+                constraints,
                 BodySlots::World,
                 &self.bodies.linear_velocity,
                 &self.bodies.angular_velocity,
                 self.parallel,
-                &mut self.scratch,
+                scratch,
             );
         }
     }
@@ -73,8 +84,14 @@ impl World {
     /// The step's natural-map residual (the islands' added as a 2-norm, in island order), its
     /// rows with friction, and the reports of the awake islands with contacts, from the
     /// islands' records; a sleeping island's rows are counted here.
-    pub(super) fn rows_summary(&mut self) -> (f32, usize) {
-        let islands = self.islands.len();
+    pub(super) fn rows_summary(
+        &mut self,
+        islands_of: &Islands,
+        awake: &[bool],
+        constraints: &[ContactConstraint],
+        workspaces: &[IslandWorkspace],
+    ) -> (f32, usize) {
+        let islands = islands_of.len();
         // Only awake islands were solved this step; sleeping ones keep last step's state.
         let mut squared = 0.0f64;
         let mut friction_rows = 0;
@@ -82,17 +99,17 @@ impl World {
         let mut island_reports = std::mem::take(&mut self.diagnostics.islands);
         island_reports.clear();
         for k in 0..islands {
-            let range = self.islands.constraint_range(k);
-            if self.island_awake[k] {
-                let report = self.workspaces[k].report;
+            let range = islands_of.constraint_range(k);
+            if awake[k] {
+                let report = workspaces[k].report;
                 let part = report.natural_map_residual as f64;
                 squared += part * part;
-                friction_rows += self.workspaces[k].friction_rows;
+                friction_rows += workspaces[k].friction_rows;
                 if !range.is_empty() {
                     island_reports.push(report);
                 }
             } else {
-                friction_rows += self::friction_rows(&self.constraints[range]);
+                friction_rows += self::friction_rows(&constraints[range]);
             }
         }
         self.diagnostics.islands = island_reports;

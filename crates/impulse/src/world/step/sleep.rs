@@ -11,7 +11,7 @@ use crate::parallel::{BODIES_PER_TASK, for_each_indexed, indices_where, spread};
 use crate::settings::SolverSettings;
 
 impl World {
-    /// Marks which islands run this step: an island with any awake body or moving kinematic
+    /// Marks which `islands` run this step (writes `island_awake`): an island with any awake body or moving kinematic
     /// guest runs and wakes all its bodies (a sleeping pile hit by an awake body, or carried
     /// off by a kinematic one, wakes whole); an island whose bodies are all asleep and whose
     /// guests are still is skipped.
@@ -22,20 +22,20 @@ impl World {
     /// islands linked by a contact that comes and goes from step to step (Parry's manifold of
     /// two cones side by side, 0.15 mm apart, flickers so) woke each other for ever, each
     /// falling asleep on a step the link was gone while the other was still counting.
-    pub(super) fn wake_or_skip_islands(&mut self) {
-        self.island_awake.clear();
-        for k in 0..self.islands.len() {
-            let bodies = self.islands.bodies(k);
+    pub(super) fn wake_or_skip_islands(&mut self, islands: &Islands, island_awake: &mut Vec<bool>) {
+        island_awake.clear();
+        for k in 0..islands.len() {
+            let bodies = islands.bodies(k);
             let awake = bodies
                 .iter()
-                .chain(self.islands.guests(k))
+                .chain(islands.guests(k))
                 .any(|&i| !self.bodies.asleep[i as usize]);
             if awake {
                 for &i in bodies {
                     self.bodies.asleep[i as usize] = false;
                 }
             }
-            self.island_awake.push(awake);
+            island_awake.push(awake);
         }
     }
 }

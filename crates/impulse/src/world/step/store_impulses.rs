@@ -6,8 +6,10 @@ use glam::Vec3;
 use crate::World;
 use crate::collision::narrow_phase::{self, ContactImpulse};
 use crate::contact::constraints::ContactConstraint;
+use crate::island::Islands;
 use crate::parallel::{PAIRS_PER_TASK, all_in_chunks, spread};
 use crate::solver::lanes::SolvedPoint;
+use crate::solver::substep::IslandWorkspace;
 
 impl World {
     /// Stores the solved impulses in the manifolds' points for next step's warm start.
@@ -20,12 +22,16 @@ impl World {
     /// directions. An island swept colour by colour has its rows re-sorted by colour; a row
     /// found out of its place (its `source` not the pair, manifold and point where assembly
     /// put it) then sends the whole stage to the serial path, which follows each row's
-    /// `source`.
-    pub(super) fn store_impulses_stage(&mut self) {
-        self.store_joint_impulses();
-        let constraints = &self.constraints;
-        let islands = &self.islands;
-        let workspaces = &self.workspaces;
+    /// `source`. Reads the solve's `constraints` and `workspaces` of the islands it woke
+    /// (`island_awake`).
+    pub(super) fn store_impulses_stage(
+        &mut self,
+        islands: &Islands,
+        island_awake: &[bool],
+        constraints: &[ContactConstraint],
+        workspaces: &[IslandWorkspace],
+    ) {
+        self.store_joint_impulses(island_awake, workspaces);
         // The workspace of a pair's island if its lanes hold the impulses, and the island's
         // first row.
         let in_lanes = |pair: &narrow_phase::ContactPair| {

@@ -1,4 +1,6 @@
-//! The continuous stage ([`crate::Stage::Continuous`]), continuous collision (motion clamping): a dynamic body that moved more than a fraction of
+//! Continuous collision's geometry (motion clamping), for the continuous stage
+//! ([`crate::Stage::Continuous`], `world/step/motion_clamp.rs`, which picks the bodies and the
+//! targets and applies the clamps): a dynamic body that moved more than a fraction of
 //! its own size in a step is swept from its pose at the step's start to its pose at the end
 //! against the static and kinematic bodies in its swept box, with Parry's nonlinear shape
 //! cast (translation and rotation); if it would pass one, its pose is put back to the first
@@ -26,10 +28,7 @@ use parry3d::math::Pose;
 use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, distance};
 use parry3d::shape::{Ball, Compound, Cuboid, HalfSpace, HeightField, Shape, Triangle};
 
-use super::kinematic::rotation_vector;
-use crate::World;
-use crate::body::BodyKind;
-use crate::settings::SolverSettings;
+use crate::body::motion::rotation_vector;
 
 /// A body is swept when it moved more than this fraction of its smallest half extent in a
 /// step (Box2D v3's safety factor: a slower body cannot pass through anything the contacts
@@ -174,6 +173,45 @@ pub(crate) struct FastBody<'a> {
     pub(crate) travel: f32,
     /// The farthest any of its points lies from its centre of mass (m).
     pub(crate) radius: f32,
+}
+
+impl<'a> FastBody<'a> {
+    /// The motion of a body of `shape` from `start` to `end` over the step (its centre of mass
+    /// at `local_center_of_mass` in the body frame, its angular velocity times the step `spin`,
+    /// rad, world frame) as a body to sweep; `None` when it moved no more than
+    /// [`FAST_FRACTION`] of its smallest half extent (or its travel is not finite): such a
+    /// body cannot pass through anything the contacts see.
+    pub(crate) fn moving_fast(
+        shape: &'a dyn Shape,
+        start: Pose,
+        end: Pose,
+        local_center_of_mass: Vec3,
+        spin: Vec3,
+    ) -> Option<Self> {
+        let local = shape.compute_local_aabb();
+        let half = local.half_extents();
+        let min_half_extent = half.min_element();
+        let radius = (local.center() - local_center_of_mass).length() + half.length();
+        // Most bodies are slow: a cheap bound settles them before the sweep's trigonometry.
+        let limit = FAST_FRACTION * min_half_extent;
+        if travel_bound(&start, &end, local_center_of_mass, spin, radius)
+            .is_some_and(|bound| bound <= limit)
+        {
+            return None;
+        }
+        let sweep = Sweep::new(start, end, local_center_of_mass, spin);
+        let travel = sweep.travel(radius);
+        if !travel.is_finite() || travel <= limit {
+            return None;
+        }
+        Some(Self {
+            shape,
+            sweep,
+            min_half_extent,
+            travel,
+            radius,
+        })
+    }
 }
 
 impl FastBody<'_> {
@@ -438,147 +476,6 @@ fn clamp_core(
     } else {
         0.0
     })
-}
-
-impl World {
-    /// Keeps the step's start poses for the sweep (when continuous collision is on).
-    pub(super) fn record_start_poses(&mut self, settings: &SolverSettings) {
-        if settings.continuous {
-            self.start_poses.clone_from(&self.bodies.pose);
-        } else {
-            self.start_poses.clear();
-        }
-    }
-
-    /// The continuous stage: fast bodies swept and clamped, then the energy check credited
-    /// with what the clamps gave back ([`super::EnergyCheck::credit_clamps`]).
-    pub(super) fn continuous_stage(&mut self, settings: &SolverSettings) {
-        self.sweep_and_clamp(settings);
-        let (clamps, unclamped) = (&self.clamps, &self.unclamped_poses);
-        self.energy
-            .credit_clamps(clamps, unclamped, &self.bodies, self.gravity);
-    }
-
-    /// Sweeps every awake dynamic body that moved more than [`FAST_FRACTION`] of its smallest
-    /// half extent this step against the static and kinematic bodies in its swept box (the
-    /// broad phase's tree, and the moving kinematic bodies; not the bodies it is joined to unless
-    /// the joint lets them collide), and puts it back to the earliest
-    /// clamp ([`clamp_fraction`]) with the velocity gravity had given it by then. Each body's clamp reads only its own poses and
-    /// the static and kinematic bodies', which no clamp changes, so the order does not matter.
-    fn sweep_and_clamp(&mut self, settings: &SolverSettings) {
-        if settings.continuous {
-            // The poses before any clamp, for the energy check's credit (`credit_clamps`).
-            self.unclamped_poses.clone_from(&self.bodies.pose);
-        }
-        let n = self.bodies.len();
-        if !settings.continuous || self.start_poses.len() != n {
-            return;
-        }
-        let mut clamps = std::mem::take(&mut self.clamps);
-        clamps.clear();
-        // Bodies joined without `collide_connected` pass through each other, as in the broad
-        // phase: a door sweeping through its own post is not clamped there.
-        let joined = self.joined_pairs();
-        let b = &self.bodies;
-        for i in 0..n {
-            if !b.is_dynamic(i) || b.asleep[i] || b.pose[i] == self.start_poses[i] {
-                continue;
-            }
-            let (start, end) = (self.start_poses[i], b.pose[i]);
-            let (center_of_mass, spin) =
-                (b.local_center_of_mass[i], b.angular_velocity[i] * self.dt);
-            let shape = &*b.shape[i];
-            let local = shape.compute_local_aabb();
-            let half = local.half_extents();
-            let min_half_extent = half.min_element();
-            let radius = (local.center() - center_of_mass).length() + half.length();
-            // Most bodies are slow: a cheap bound settles them before the sweep's trigonometry.
-            let limit = FAST_FRACTION * min_half_extent;
-            if travel_bound(&start, &end, center_of_mass, spin, radius)
-                .is_some_and(|bound| bound <= limit)
-            {
-                continue;
-            }
-            let sweep = Sweep::new(start, end, center_of_mass, spin);
-            let travel = sweep.travel(radius);
-            if !travel.is_finite() || travel <= limit {
-                continue;
-            }
-            let body = FastBody {
-                shape,
-                sweep,
-                min_half_extent,
-                travel,
-                radius,
-            };
-            let swept = shape.compute_swept_aabb(&sweep.start, &sweep.end);
-            let mut earliest = 1.0f32;
-            let mut visit = |j: usize| {
-                if j == i
-                    || !b.groups_interact(i, j)
-                    || joined
-                        .binary_search(&(i.min(j) as u32, i.max(j) as u32))
-                        .is_ok()
-                {
-                    return;
-                }
-                let target = Sweep::new(
-                    self.start_poses[j],
-                    b.pose[j],
-                    b.local_center_of_mass[j],
-                    b.angular_velocity[j] * self.dt,
-                );
-                let in_contact = self.narrow_phase.has_points(i as u32, j as u32);
-                if let Some(t) = clamp_fraction(&body, &*b.shape[j], &target, in_contact) {
-                    earliest = earliest.min(t);
-                }
-            };
-            // Static bodies and resting kinematic ones from the tree (their boxes there are
-            // where they are); moving kinematic bodies from their own swept boxes.
-            for j in self.broad_phase.bodies_in(&swept) {
-                let j = j as usize;
-                if j < n
-                    && (b.kind[j] == BodyKind::Static
-                        || (b.kind[j] == BodyKind::Kinematic && b.asleep[j]))
-                {
-                    visit(j);
-                }
-            }
-            for &j in &self.moving_kinematic {
-                let j = j as usize;
-                if b.shape[j]
-                    .compute_swept_aabb(&self.start_poses[j], &b.pose[j])
-                    .intersects(&swept)
-                {
-                    visit(j);
-                }
-            }
-            if earliest < 1.0 {
-                clamps.push((i, sweep.pose_at(earliest), earliest));
-            }
-        }
-        // A clamped body stands where it was at fraction t of the step, so it takes the
-        // velocity gravity had given it by then: with the whole step's, the potential energy
-        // of the (1 − t)·dt it did not travel would come back as kinetic energy
-        // (|v·g|·(1 − t)·dt per kg, 80 J/kg for a ball falling at 500 m/s at 60 Hz).
-        // It is turned back too, and its spin with it: the angular velocity keeps its
-        // components in the body's frame, and so its kinetic energy ½·ωᵀ·R·I·Rᵀ·ω. Kept in
-        // the world's frame instead, a spinning box's energy would change with the turn (a box
-        // at 4,890 rad/s, turned back by a few radians, gained 6,761 J/kg). A body with a
-        // locked rotation axis turns about its free axes only and keeps its ω as it is.
-        let gravity = self.gravity * self.dt;
-        for &(i, pose, t) in &clamps {
-            let end = self.bodies.pose[i].rotation;
-            self.bodies.pose[i] = pose;
-            let unspent = self.bodies.locked_axes[i].lock_linear_velocity(gravity * (1.0 - t));
-            self.bodies.linear_velocity[i] -= unspent;
-            if !self.bodies.locked_axes[i].locks_rotation() {
-                let back = pose.rotation * end.inverse();
-                self.bodies.angular_velocity[i] = back * self.bodies.angular_velocity[i];
-            }
-        }
-        self.clamps = clamps;
-    }
 }
 
 #[cfg(test)]
