@@ -23,6 +23,7 @@ mod heavy_on_light;
 mod height_fields;
 mod hulls;
 mod impacts;
+mod impact_perturbation;
 mod islands;
 mod joints;
 mod kinematic;
