@@ -300,8 +300,14 @@ fn configure(
                 b = b.rotation(Quat::from_array(q));
                 Property::Floats(q.to_vec())
             }
-            "friction" | "restitution" | "roughness" | "impact_perturbation" | "density"
-            | "mass" | "linear_damping" | "angular_damping" => {
+            "friction"
+            | "restitution"
+            | "roughness"
+            | "impact_perturbation"
+            | "density"
+            | "mass"
+            | "linear_damping"
+            | "angular_damping" => {
                 let x = float(&value)?;
                 b = match key.as_str() {
                     "friction" => b.friction(x),

@@ -94,7 +94,10 @@ mod tests {
         let variance = sum_squares / count as f64;
         let expected = f64::from(perturbation).powi(2) / 3.0;
         assert!((mean - 0.5).abs() < 0.005, "mean {mean}");
-        assert!((variance - expected).abs() < 0.03 * expected, "{variance} vs {expected}");
+        assert!(
+            (variance - expected).abs() < 0.03 * expected,
+            "{variance} vs {expected}"
+        );
         assert!(lowest >= 0.2 - 1e-6 && lowest < 0.201, "lowest {lowest}");
         assert!(highest <= 0.8 && highest > 0.799, "highest {highest}");
         for xi in [-1.0, -0.5, 0.0, 0.5, 0.999_999_9] {

@@ -17,7 +17,8 @@ const GRAVITY: f32 = 9.81;
 /// `perturbation` dropped from 1 m (4.4 m/s at impact) on a floor of restitution 0, in a world
 /// of `seed`: (approach speed, rebound speed), m/s, read across the step of the bounce.
 fn bounce(restitution: f32, perturbation: f32, seed: u64) -> (f32, f32) {
-    let mut world = World::new(Vec3::new(0.0, -GRAVITY, 0.0), DT, SolverSettings::default()).unwrap();
+    let mut world =
+        World::new(Vec3::new(0.0, -GRAVITY, 0.0), DT, SolverSettings::default()).unwrap();
     world.set_seed(seed);
     world
         .insert(
@@ -57,12 +58,17 @@ fn a_ball_rebounds_within_the_perturbed_restitution() {
     let (_, plain) = bounce(restitution, 0.0, 1);
     let mut ratios = Vec::new();
     for seed in 1..=120u64 {
-        assert_eq!(bounce(restitution, 0.0, seed).1, plain, "seed {seed} without perturbation");
+        assert_eq!(
+            bounce(restitution, 0.0, seed).1,
+            plain,
+            "seed {seed} without perturbation"
+        );
         let (approach, rebound) = bounce(restitution, perturbation, seed);
         let slack = GRAVITY * DT / approach;
         let ratio = rebound / approach;
         assert!(
-            ratio >= restitution - perturbation - slack && ratio <= restitution + perturbation + slack,
+            ratio >= restitution - perturbation - slack
+                && ratio <= restitution + perturbation + slack,
             "seed {seed}: rebound ratio {ratio}"
         );
         ratios.push(ratio);
@@ -71,7 +77,10 @@ fn a_ball_rebounds_within_the_perturbed_restitution() {
     let lowest = ratios.iter().copied().fold(f32::MAX, f32::min);
     let highest = ratios.iter().copied().fold(f32::MIN, f32::max);
     let plain_ratio = plain / bounce(restitution, 0.0, 1).0;
-    assert!((mean - plain_ratio).abs() < 0.06, "mean {mean} vs unperturbed {plain_ratio}");
+    assert!(
+        (mean - plain_ratio).abs() < 0.06,
+        "mean {mean} vs unperturbed {plain_ratio}"
+    );
     assert!(lowest < 0.3 && highest > 0.7, "ratios {lowest} … {highest}");
 }
 
@@ -90,17 +99,24 @@ fn no_impact_rebounds_faster_than_a_restitution_of_one() {
         );
         slowest = slowest.min(rebound / approach);
     }
-    assert!(slowest < 0.2, "the slowest rebound kept {slowest} of the speed");
+    assert!(
+        slowest < 0.2,
+        "the slowest rebound kept {slowest} of the speed"
+    );
     let bounced = (1..=120u64)
         .filter(|&seed| bounce(0.0, 1.0, seed).1 > 0.5)
         .count();
-    assert!((40..=80).contains(&bounced), "{bounced} of 120 dead balls bounced");
+    assert!(
+        (40..=80).contains(&bounced),
+        "{bounced} of 120 dead balls bounced"
+    );
 }
 
 /// 64 cubes of impact perturbation `perturbation` thrown into a heap on a floor of the same,
 /// in a world of `seed`.
 fn heap(seed: u64, perturbation: f32) -> World {
-    let mut world = World::new(Vec3::new(0.0, -GRAVITY, 0.0), DT, SolverSettings::default()).unwrap();
+    let mut world =
+        World::new(Vec3::new(0.0, -GRAVITY, 0.0), DT, SolverSettings::default()).unwrap();
     world.set_seed(seed);
     world
         .insert(
@@ -178,7 +194,9 @@ fn a_perturbation_outside_zero_to_one_is_refused() {
                     "material": "rubber"}]}"#;
     let error = impulse::scene::parse_scene_str(scene, "rubber.json").unwrap_err();
     assert!(
-        error.to_string().contains("materials.rubber.impact_perturbation"),
+        error
+            .to_string()
+            .contains("materials.rubber.impact_perturbation"),
         "{error}"
     );
 }
@@ -193,8 +211,12 @@ fn scene_files_carry_the_perturbation_and_its_seed() {
     let scene = impulse::scene::parse_scene_str(text, "rubber.json").unwrap();
     assert_eq!(scene.materials["rubber"].impact_perturbation, 0.25);
     let written = impulse::scene::to_json_string(&scene);
-    assert!(written.contains("\"impact_perturbation\": 0.25"), "{written}");
-    let plain = impulse::scene::to_json_string(&impulse::scene::builtin_scene("pyramid20").unwrap());
+    assert!(
+        written.contains("\"impact_perturbation\": 0.25"),
+        "{written}"
+    );
+    let plain =
+        impulse::scene::to_json_string(&impulse::scene::builtin_scene("pyramid20").unwrap());
     assert!(!plain.contains("impact_perturbation"));
     let variation = impulse::scene::Variation {
         seed: 9,
