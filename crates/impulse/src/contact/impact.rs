@@ -98,8 +98,8 @@ mod tests {
             (variance - expected).abs() < 0.03 * expected,
             "{variance} vs {expected}"
         );
-        assert!(lowest >= 0.2 - 1e-6 && lowest < 0.201, "lowest {lowest}");
-        assert!(highest <= 0.8 && highest > 0.799, "highest {highest}");
+        assert!((0.2 - 1e-6..0.201).contains(&lowest), "lowest {lowest}");
+        assert!((0.799..=0.8).contains(&highest), "highest {highest}");
         for xi in [-1.0, -0.5, 0.0, 0.5, 0.999_999_9] {
             for (e, p) in [(0.0, 1.0), (1.0, 1.0), (0.9, 0.5), (0.1, 0.5)] {
                 assert!((0.0..=1.0).contains(&perturbed_restitution(e, p, xi)));
