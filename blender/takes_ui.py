@@ -1,7 +1,10 @@
 """The "Takes" panels and operators: goals set on objects, a search run in the background, the
-best takes listed, and "Bake take" (docs/blender.md, "Takes")."""
+best takes listed with a still of each one's end, and "Bake take" (docs/blender.md, "Takes")."""
+
+import os
 
 import bpy
+import bpy.utils.previews
 
 from .impulse_bake import scene_reader
 from .impulse_bake import takes as takes_logic
@@ -10,6 +13,14 @@ from .impulse_bake import takes as takes_logic
 POLL_SECONDS = 0.5
 #: How many of the best takes the panel lists.
 LISTED = 20
+#: How large the chosen take's still is drawn under the list (times a UI icon).
+PREVIEW_SCALE = 6.0
+
+#: The stills loaded as icons (``bpy.utils.previews``), keyed by the PNG's path; made in
+#: :func:`register`.
+_previews = None
+#: The stills being drawn for the last search (an ``impulse_bake.takes.PreviewJob``).
+_preview_job = None
 
 _FACES = (
     ("NONE", "None", "No face goal"),
@@ -106,6 +117,9 @@ class ImpulseTakesSettings(bpy.types.PropertyGroup):
         name="Workers", description="Worker processes; 0 uses every core", default=0, min=0, soft_max=64
     )
     directory: bpy.props.StringProperty(name="Results", description="The last search's directory", subtype="DIR_PATH")
+    previews_note: bpy.props.StringProperty(
+        name="Previews", description="Why the listed takes have no stills, when they have none"
+    )
     takes: bpy.props.CollectionProperty(type=ImpulseTake)
     active: bpy.props.IntProperty(name="Take", default=0)
 
@@ -142,6 +156,53 @@ def _list_takes(settings, found):
     settings.active = 0
 
 
+def _draw_previews(settings, found, wait):
+    """Starts drawing the listed takes' stills (``impulse render`` in a background thread);
+    with ``wait``, returns when they are drawn. Without the ``impulse`` command the list has
+    no stills and ``settings.previews_note`` says why. Returns the job, or None."""
+    global _preview_job
+    command = takes_logic.impulse_command()
+    if command is None:
+        settings.previews_note = "No stills: the impulse command is not found (set IMPULSE_CLI or put it on PATH)"
+        return None
+    settings.previews_note = ""
+    _preview_job = takes_logic.PreviewJob(found, [item.take_id for item in settings.takes], command)
+    if wait:
+        _preview_job.wait()
+    elif not bpy.app.timers.is_registered(_redraw_while_drawing):
+        bpy.app.timers.register(_redraw_while_drawing, first_interval=POLL_SECONDS)
+    return _preview_job
+
+
+def _redraw_while_drawing():
+    """Timer: redraws the Properties editors while stills are being drawn, so each appears
+    when it is ready; ends with the job."""
+    for window in getattr(bpy.context.window_manager, "windows", ()):
+        for area in window.screen.areas:
+            if area.type == "PROPERTIES":
+                area.tag_redraw()
+    return POLL_SECONDS if _preview_job is not None and _preview_job.running() else None
+
+
+def preview(directory, take_id):
+    """The ``bpy.types.ImagePreview`` of take ``take_id``'s still (the end of the take) in the
+    search in ``directory``, loaded on first use; None when there is none (yet)."""
+    if _previews is None or not directory:
+        return None
+    path = takes_logic.preview_path(bpy.path.abspath(directory), take_id)
+    found = _previews.get(path)
+    if found is None and os.path.exists(path):
+        found = _previews.load(path, path, "IMAGE")
+    return found
+
+
+def preview_icon(directory, take_id):
+    """The icon id of take ``take_id``'s still for the UI; 0 when there is none (yet), and
+    always without a UI (Blender run in the background makes no icons)."""
+    found = preview(directory, take_id)
+    return 0 if found is None else found.icon_id
+
+
 class IMPULSE_OT_takes_search(bpy.types.Operator):
     """Search for takes that meet the objects' goals: simulate varied starts of the Rigid Body
     World with impulse in a background process (every core), keeping the best takes. Esc stops
@@ -175,7 +236,9 @@ class IMPULSE_OT_takes_search(bpy.types.Operator):
         settings.directory = directory
         return job
 
-    def _done(self, context, job):
+    def _done(self, context, job, wait_for_previews):
+        """Lists the ended search's best takes and starts their stills: drawn before returning
+        when ``wait_for_previews`` (run from a script), else in the background (the panel)."""
         settings = context.scene.impulse_takes
         try:
             found = job.finish()
@@ -183,6 +246,7 @@ class IMPULSE_OT_takes_search(bpy.types.Operator):
             self.report({"ERROR"}, f"impulse: {error}")
             return {"CANCELLED"}
         _list_takes(settings, found)
+        _draw_previews(settings, found, wait=wait_for_previews)
         met = len(found.met())
         self.report({"INFO"}, f"impulse: {len(found)} takes, {met} meet every goal ({settings.directory})")
         return {"FINISHED"}
@@ -192,7 +256,7 @@ class IMPULSE_OT_takes_search(bpy.types.Operator):
         if job is None:
             return {"CANCELLED"}
         job.process.wait()
-        return self._done(context, job)
+        return self._done(context, job, wait_for_previews=True)
 
     def invoke(self, context, event):
         job = self._start(context)
@@ -218,7 +282,7 @@ class IMPULSE_OT_takes_search(bpy.types.Operator):
         if event.type == "ESC":
             job.cancel()
             self._end_modal(context)
-            return self._done(context, job) if job.takes_done() else {"CANCELLED"}
+            return self._done(context, job, wait_for_previews=False) if job.takes_done() else {"CANCELLED"}
         if event.type != "TIMER":
             return {"PASS_THROUGH"}
         done = job.takes_done()
@@ -227,7 +291,7 @@ class IMPULSE_OT_takes_search(bpy.types.Operator):
         if job.running():
             return {"RUNNING_MODAL"}
         self._end_modal(context)
-        return self._done(context, job)
+        return self._done(context, job, wait_for_previews=False)
 
 
 class IMPULSE_OT_bake_take(bpy.types.Operator):
@@ -276,10 +340,13 @@ class IMPULSE_OT_bake_take(bpy.types.Operator):
 
 
 class IMPULSE_UL_takes(bpy.types.UIList):
-    """The listed takes: id, every goal met, cost, perturbation."""
+    """The listed takes: the still of its end, id, every goal met, cost, perturbation."""
 
-    def draw_item(self, _context, layout, _data, item, _icon, _active_data, _active_property, _index=0, _flt_flag=0):
+    def draw_item(self, _context, layout, data, item, _icon, _active_data, _active_property, _index=0, _flt_flag=0):
         row = layout.row(align=True)
+        icon = preview_icon(data.directory, item.take_id)
+        if icon:
+            row.label(text="", icon_value=icon)
         row.label(text=item.take_id, icon="CHECKMARK" if item.met else "X")
         row.label(text="failed" if item.cost < 0 else f"cost {item.cost:.3g}")
         row.label(text=f"pert. {item.perturbation:.2f}")
@@ -312,6 +379,13 @@ class SCENE_PT_impulse_takes(bpy.types.Panel):
         if settings.directory:
             column.label(text=settings.directory)
         layout.template_list("IMPULSE_UL_takes", "", settings, "takes", settings, "active", rows=4)
+        if settings.previews_note:
+            layout.label(text=settings.previews_note, icon="INFO")
+        elif 0 <= settings.active < len(settings.takes):
+            # Blender's UI draws no GIF animation: the chosen take's still is its last frame.
+            icon = preview_icon(settings.directory, settings.takes[settings.active].take_id)
+            if icon:
+                layout.template_icon(icon_value=icon, scale=PREVIEW_SCALE)
         layout.operator(IMPULSE_OT_bake_take.bl_idname, icon="PHYSICS")
 
 
@@ -354,6 +428,8 @@ _classes = (
 
 
 def register():
+    global _previews
+    _previews = bpy.utils.previews.new()
     for cls in _classes:
         bpy.utils.register_class(cls)
     bpy.types.Object.impulse_takes = bpy.props.PointerProperty(type=ImpulseTakeGoals)
@@ -361,6 +437,12 @@ def register():
 
 
 def unregister():
+    global _previews, _preview_job
+    if bpy.app.timers.is_registered(_redraw_while_drawing):
+        bpy.app.timers.unregister(_redraw_while_drawing)
+    if _previews is not None:
+        bpy.utils.previews.remove(_previews)
+    _previews, _preview_job = None, None
     del bpy.types.Scene.impulse_takes
     del bpy.types.Object.impulse_takes
     for cls in reversed(_classes):

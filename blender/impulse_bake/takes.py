@@ -381,3 +381,87 @@ def bake_take(scene, takes, take_id, preset="default", substeps=0, frame_steps=0
     baker.advance()
     baker.write()
     return baker
+
+
+#: Where the still previews go in a search directory: the contact sheet's folder
+#: (``impulse.takes.sheet`` keeps its GIFs there), as ``<take_id>.png``.
+PREVIEWS_DIR = "previews"
+#: The stills' size in pixels (width, height).
+PREVIEW_SIZE = (128, 96)
+
+
+def impulse_command():
+    """The ``impulse`` command that draws previews: ``$IMPULSE_CLI``, else ``impulse`` on
+    ``PATH``; None when neither names one."""
+    import shutil
+
+    named = os.environ.get("IMPULSE_CLI")
+    if named:
+        return named if os.path.exists(named) else shutil.which(named)
+    return shutil.which("impulse")
+
+
+def preview_path(directory, take_id):
+    """The still of take ``take_id`` of the search in ``directory`` (it may not exist yet)."""
+    return os.path.join(directory, PREVIEWS_DIR, f"{take_id}.png")
+
+
+class PreviewJob:
+    """Stills of takes' end states, drawn by ``impulse render`` in a background thread, one take
+    after another (the UI stays usable; Blender's UI cannot animate a GIF, so the panel shows
+    the last frame of what the contact sheet's GIF animates).
+
+    Each still is the take's scene (``take.scene()``, written beside it as
+    ``previews/<take_id>.json``) simulated the search's ``steps`` with ``impulse render --out``
+    and its last frame moved to :func:`preview_path` whole (``os.replace``), so a reader never
+    sees half a file. Takes whose still exists are not drawn again. ``command`` is the
+    ``impulse`` command (:func:`impulse_command`); a failed render is kept in ``errors``
+    (take id → message) and the others go on.
+    """
+
+    def __init__(self, takes, take_ids, command, size=PREVIEW_SIZE):
+        import threading
+
+        self.directory = takes.root
+        self.command = command
+        self.size = size
+        self.steps = int(takes.manifest["steps"])
+        self.preset = takes.manifest.get("preset")
+        self.errors = {}
+        self._todo = [
+            takes[take_id]
+            for take_id in take_ids
+            if takes[take_id].status == "completed" and not os.path.exists(preview_path(self.directory, take_id))
+        ]
+        os.makedirs(os.path.join(self.directory, PREVIEWS_DIR), exist_ok=True)
+        self._thread = threading.Thread(target=self._draw_all, name="impulse take previews", daemon=True)
+        self._thread.start()
+
+    def _draw_all(self):
+        for take in self._todo:
+            try:
+                self._draw(take)
+            except (OSError, RuntimeError, ValueError) as error:
+                self.errors[take.take_id] = str(error)
+
+    def _draw(self, take):
+        folder = os.path.join(self.directory, PREVIEWS_DIR)
+        scene = os.path.join(folder, f"{take.take_id}.json")
+        take.write_scene(scene)
+        with tempfile.TemporaryDirectory(dir=folder) as frames:
+            arguments = [self.command, "render", scene, "--out", frames, "--steps", str(self.steps)]
+            arguments += ["--every", str(max(self.steps, 1)), "--size", "{}x{}".format(*self.size), "--quiet"]
+            if self.preset:
+                arguments += ["--preset", self.preset]
+            done = subprocess.run(arguments, capture_output=True, text=True, check=False)
+            if done.returncode != 0:
+                raise RuntimeError(f"impulse render of take {take.take_id} failed: {done.stderr.strip()}")
+            os.replace(os.path.join(frames, f"frame_{self.steps:05d}.png"), preview_path(self.directory, take.take_id))
+
+    def running(self):
+        return self._thread.is_alive()
+
+    def wait(self):
+        """Blocks until every still is drawn (or failed); returns ``errors``."""
+        self._thread.join()
+        return self.errors

@@ -152,6 +152,91 @@ def test_bake_take_refuses_a_scene_changed_since_the_search(tmp_path, monkeypatc
     assert scene.rigidbody_world.enabled
 
 
+@pytest.fixture(scope="module")
+def impulse_cli():
+    """The ``impulse`` command that draws the stills: ``$IMPULSE_CLI``, else the repository's
+    release build, else ``PATH``. Missing, the tests that need it are skipped, unless
+    ``IMPULSE_REQUIRE_CLI=1`` (as in CI), where they fail."""
+    import shutil
+
+    repository = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    for candidate in (
+        os.environ.get("IMPULSE_CLI"),
+        os.path.join(repository, "target", "release", "impulse"),
+        shutil.which("impulse"),
+    ):
+        if candidate and os.path.isfile(candidate) and os.access(candidate, os.X_OK):
+            return candidate
+    message = "the impulse command is not built (cargo build --release -p impulse-cli)"
+    if os.environ.get("IMPULSE_REQUIRE_CLI") == "1":
+        pytest.fail(message)
+    pytest.skip(message)
+
+
+def _render_frames(cli, scene_path, steps, out):
+    """``impulse render`` of a scene file's first and last frames at the stills' size."""
+    import subprocess
+
+    size = "{}x{}".format(*takes_logic.PREVIEW_SIZE)
+    subprocess.run(
+        [cli, "render", scene_path, "--out", str(out), "--steps", str(steps), "--every", str(steps)]
+        + ["--size", size, "--quiet"],
+        check=True,
+    )
+    with open(out / f"frame_{steps:05d}.png", "rb") as last, open(out / "frame_00000.png", "rb") as first:
+        return first.read(), last.read()
+
+
+def test_listed_takes_show_a_still_of_their_end(tmp_path, monkeypatch, addon, impulse_cli):
+    """After a search, every listed take has a still: the last frame ``impulse render`` draws of
+    the take's own scene (the same bytes; not its first frame), loaded for the list's icons."""
+    scene, die = _die_scene()
+    die.impulse_takes.face_up = "POS_Z"
+    settings = scene.impulse_takes
+    settings.budget, settings.stop_after = 16, 16
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    monkeypatch.setenv("IMPULSE_CLI", impulse_cli)
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    assert settings.previews_note == ""
+    takes_ui = sys.modules[addon.__name__ + ".takes_ui"]
+    from impulse.takes import load
+
+    found = load(settings.directory)
+    steps = int(found.manifest["steps"])
+    stills = {}
+    for item in settings.takes:
+        path = takes_logic.preview_path(settings.directory, item.take_id)
+        with open(path, "rb") as file:
+            stills[item.take_id] = file.read()
+        image = bpy.data.images.load(path)
+        assert tuple(image.size) == takes_logic.PREVIEW_SIZE
+        bpy.data.images.remove(image)
+        # Loaded for the list (Blender in the background makes no icon ids, only the image).
+        assert tuple(takes_ui.preview(settings.directory, item.take_id).image_size) == takes_logic.PREVIEW_SIZE
+    assert len(stills) == len(settings.takes) > 1
+    assert len(set(stills.values())) > 1, "different takes end differently"
+    chosen = settings.takes[0].take_id
+    scene_path = tmp_path / "chosen.json"
+    found[chosen].write_scene(str(scene_path))
+    first, last = _render_frames(impulse_cli, str(scene_path), steps, tmp_path / "frames")
+    assert stills[chosen] == last
+    assert stills[chosen] != first
+
+
+def test_without_the_impulse_command_the_list_says_why_it_has_no_stills(tmp_path, monkeypatch, addon):
+    scene, die = _die_scene()
+    die.impulse_takes.face_up = "POS_Z"
+    settings = scene.impulse_takes
+    settings.budget, settings.stop_after = 16, 16
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    monkeypatch.setenv("IMPULSE_CLI", str(tmp_path / "no-such-impulse"))
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    assert len(settings.takes) > 0
+    assert "impulse command is not found" in settings.previews_note
+    takes_ui = sys.modules[addon.__name__ + ".takes_ui"]
+    assert takes_ui.preview(settings.directory, settings.takes[0].take_id) is None
+
+
 def test_goals_read_from_objects_score_the_bake():
     """The goals, run on the unvaried scene: the die lands near the origin on the ground, so a
     box around the origin and the ground are met, a box 2 m away along Blender's y is missed

@@ -336,6 +336,7 @@ pub(crate) fn peer_zoo() -> Scene {
             restitution: 0.3,
             density: 300.0,
             roughness: 0.0,
+            impact_perturbation: 0.0,
         },
     );
     scene.bodies.push(BodyDesc::new(

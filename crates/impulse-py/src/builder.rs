@@ -194,9 +194,11 @@ impl Shape {
 ///
 /// Keywords (all optional): `translation` (m), `rotation` (quaternion x y z w),
 /// `linear_velocity` (m/s), `angular_velocity` (rad/s, world), `friction` (μ ≥ 0),
-/// `restitution` (0–1), `density` (kg/m³), `mass` (kg, overrides density), `name`,
-/// `linear_damping`, `angular_damping` (1/s), `lock_rotation` (bool). Defaults: at rest at the
-/// origin, friction 0.6, restitution 0, density 1000 kg/m³. Values are checked by
+/// `restitution` (0–1), `roughness` (degrees, 0–30: seeded tilts of new contacts' normals),
+/// `impact_perturbation` (0–1: an impact's restitution moved by a seeded draw in ±this, kept in
+/// 0–1), `density` (kg/m³), `mass` (kg, overrides density), `name`, `linear_damping`,
+/// `angular_damping` (1/s), `lock_rotation` (bool). Defaults: at rest at the origin, friction
+/// 0.6, restitution 0, roughness 0, impact perturbation 0, density 1000 kg/m³. Values are checked by
 /// `World.insert`. Pickles as the call that made it; its repr is that call.
 #[pyclass(module = "impulse", frozen)]
 pub struct BodyBuilder {
@@ -298,13 +300,20 @@ fn configure(
                 b = b.rotation(Quat::from_array(q));
                 Property::Floats(q.to_vec())
             }
-            "friction" | "restitution" | "roughness" | "density" | "mass" | "linear_damping"
+            "friction"
+            | "restitution"
+            | "roughness"
+            | "impact_perturbation"
+            | "density"
+            | "mass"
+            | "linear_damping"
             | "angular_damping" => {
                 let x = float(&value)?;
                 b = match key.as_str() {
                     "friction" => b.friction(x),
                     "restitution" => b.restitution(x),
                     "roughness" => b.roughness(x),
+                    "impact_perturbation" => b.impact_perturbation(x),
                     "density" => b.density(x),
                     "mass" => b.mass(x),
                     "linear_damping" => b.linear_damping(x),
@@ -334,7 +343,7 @@ fn configure(
     Ok(BodyBuilder { inner: b, recipe })
 }
 
-const PROPERTIES: [&str; 13] = [
+const PROPERTIES: [&str; 14] = [
     "translation",
     "rotation",
     "linear_velocity",
@@ -342,6 +351,7 @@ const PROPERTIES: [&str; 13] = [
     "friction",
     "restitution",
     "roughness",
+    "impact_perturbation",
     "density",
     "mass",
     "name",

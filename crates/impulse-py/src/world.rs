@@ -417,8 +417,9 @@ impl World {
     }
 
     /// Seed of the world's seeded variation (int ≥ 0): rough surfaces' contact normals
-    /// (the `roughness` body property, degrees) are tilted by draws keyed by (seed, step,
-    /// pair). The scene's `seed`, or `from_scene`'s non-zero `seed`. Assign to change it:
+    /// (the `roughness` body property, degrees) are tilted, and perturbed impacts'
+    /// restitution (the `impact_perturbation` body property) moved, by draws keyed by (seed,
+    /// step, pair). The scene's `seed`, or `from_scene`'s non-zero `seed`. Assign to change it:
     /// contacts that start later draw from the new seed.
     #[getter]
     fn seed(&self, py: Python<'_>) -> PyResult<u64> {

@@ -595,3 +595,75 @@ def test_a_met_hoop_take_is_the_same_to_the_bit_through_impulse_run(
     orientations = record.orientations.astype(np.float32)
     assert positions.view(np.uint32).tolist() == poses[..., :3].view(np.uint32).tolist()
     assert orientations.view(np.uint32).tolist() == poses[..., 3:].view(np.uint32).tolist()
+
+
+#: A frictionless ball of restitution 0.5 and impact perturbation 0.4 dropped 1 m onto a floor:
+#: the impact draws (the scene seed) decide how high it bounces (c_r' in [0.1, 0.9], apex
+#: c_r'² × 1 m above the floor).
+BOUNCY = {
+    "name": "perturbed bounce",
+    "dt": 1.0 / 60.0,
+    "materials": {
+        "floor": {"friction": 0.0},
+        "ball": {"friction": 0.0, "restitution": 0.5, "impact_perturbation": 0.4},
+    },
+    "bodies": [
+        {
+            "name": "floor",
+            "kind": "static",
+            "material": "floor",
+            "shape": {"type": "cuboid", "half_extents": [20, 0.5, 20]},
+            "position": [0, -0.5, 0],
+        },
+        {
+            "name": "ball",
+            "kind": "dynamic",
+            "material": "ball",
+            "shape": {"type": "sphere", "radius": 0.1},
+            "position": [0, 1.1, 0],
+        },
+    ],
+}
+
+
+def _highest_after_bounce(scene, steps=90):
+    world = impulse.World.from_scene(scene)
+    highest = 0.0
+    for step in range(steps):
+        world.step()
+        if step >= 30:  # after the impact at 0.45 s
+            highest = max(highest, float(world.positions[1][1]))
+    return highest
+
+
+def test_takes_with_their_own_seeds_vary_the_perturbed_impacts(tmp_path):
+    # Up through y >= 0.65 m (an apex 0.55 m above the ball's resting height, c_r' > 0.74)
+    # between 0.5 s and 1.5 s: about one seed in five.
+    goal = {
+        "type": "passes_through",
+        "body": "ball",
+        "region": {"box": {"min": [-1, 0.65, -1], "max": [1, 5, 1]}},
+        "between": [0.5, 1.5],
+    }
+    takes = search(
+        BOUNCY,
+        [goal],
+        {"seeds": True},
+        budget=32,
+        steps=90,
+        out=tmp_path / "t",
+        workers=2,
+        population=16,
+        progress=False,
+    )
+    met = takes.met()
+    assert met, "some perturbed bounce goes high"
+    assert len(met) < len(takes), "some perturbed bounce stays low"
+    scene = met[0].scene()
+    assert scene["seed"] == met[0].scene_seed
+    assert scene["materials"]["ball"]["impact_perturbation"] == 0.4
+    assert _highest_after_bounce(scene) >= 0.65
+    # Unperturbed, the same seed bounces to c_r² × 1 m = 0.25 m above its rest (0.35 m).
+    plain = json.loads(json.dumps(scene))
+    plain["materials"]["ball"]["impact_perturbation"] = 0.0
+    assert _highest_after_bounce(plain) == pytest.approx(0.35, abs=0.03)

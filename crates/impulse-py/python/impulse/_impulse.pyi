@@ -280,8 +280,8 @@ class BodyBuilder:
     """A body to insert: ``BodyBuilder.dynamic(Shape.ball(0.5), translation=(0, 2, 0))``.
 
     Keywords: translation (m), rotation (x y z w), linear_velocity (m/s), angular_velocity
-    (rad/s), friction, restitution, roughness (degrees), density (kg/m³), mass (kg), name, linear_damping,
-    angular_damping (1/s), lock_rotation. Picklable; the repr is the call that made it.
+    (rad/s), friction, restitution, roughness (degrees), impact_perturbation (0-1), density
+    (kg/m³), mass (kg), name, linear_damping, angular_damping (1/s), lock_rotation. Picklable; the repr is the call that made it.
     """
 
     @staticmethod

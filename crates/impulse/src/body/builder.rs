@@ -38,6 +38,7 @@ pub struct BodyBuilder {
     pub(crate) friction: f32,
     pub(crate) restitution: f32,
     pub(crate) roughness: f32,
+    pub(crate) impact_perturbation: f32,
     pub(crate) density: f32,
     pub(crate) mass: Option<f32>,
     pub(crate) name: Option<String>,
@@ -65,6 +66,7 @@ impl BodyBuilder {
             friction: 0.6,
             restitution: 0.0,
             roughness: 0.0,
+            impact_perturbation: 0.0,
             density: 1000.0,
             mass: None,
             name: None,
@@ -144,6 +146,17 @@ impl BodyBuilder {
     /// (docs/scene-format.md, "Materials"). 0 (the default): smooth, nothing drawn.
     pub fn roughness(mut self, degrees: f32) -> Self {
         self.roughness = degrees;
+        self
+    }
+
+    /// Impact perturbation (dimensionless) in [0, [`super::MAX_IMPACT_PERTURBATION`]]: at an
+    /// impact (a contact closing faster than the restitution threshold) the pair's restitution
+    /// is moved by a seeded draw uniform in ±(the larger of its two bodies' perturbation),
+    /// kept in [0, 1], so the rebound speed moves in proportion to the approach speed. Drawn
+    /// from the world's [`crate::World::seed`], the step and the pair (docs/scene-format.md,
+    /// "Materials"). 0 (the default): no perturbation, nothing drawn.
+    pub fn impact_perturbation(mut self, perturbation: f32) -> Self {
+        self.impact_perturbation = perturbation;
         self
     }
 
@@ -302,6 +315,10 @@ pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
     check("material.friction", rules::non_negative(b.friction))?;
     check("material.restitution", rules::unit_interval(b.restitution))?;
     check("material.roughness", rules::roughness(b.roughness))?;
+    check(
+        "material.impact_perturbation",
+        rules::impact_perturbation(b.impact_perturbation),
+    )?;
     check("linear_damping", rules::non_negative(b.linear_damping))?;
     check("angular_damping", rules::non_negative(b.angular_damping))?;
     let shape = b.shape.clone();

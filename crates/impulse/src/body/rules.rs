@@ -259,6 +259,23 @@ pub(crate) fn roughness(v: f32) -> Result<(), String> {
     }
 }
 
+/// The largest impact perturbation (dimensionless, `Material::impact_perturbation`,
+/// [`BodyBuilder::impact_perturbation`]): the whole range of a restitution coefficient.
+///
+/// [`BodyBuilder::impact_perturbation`]: crate::BodyBuilder::impact_perturbation
+pub const MAX_IMPACT_PERTURBATION: f32 = 1.0;
+
+/// An impact perturbation: finite and in [0, [`MAX_IMPACT_PERTURBATION`]].
+pub(crate) fn impact_perturbation(v: f32) -> Result<(), String> {
+    finite(&[v])?;
+    let max = MAX_IMPACT_PERTURBATION;
+    if (0.0..=max).contains(&v) {
+        Ok(())
+    } else {
+        Err(format!("must be in [0, {max}], got {v}"))
+    }
+}
+
 /// Finite and in [0, 1] (restitution).
 pub(crate) fn unit_interval(v: f32) -> Result<(), String> {
     finite(&[v])?;

@@ -45,6 +45,10 @@ pub struct Bodies {
     /// Absent from snapshots written before it existed: read as every body smooth.
     #[serde(default)]
     pub(crate) roughness: Vec<f32>,
+    /// Impact perturbation (dimensionless, in [0, 1]): the largest change of an impact's
+    /// restitution (0: none). Absent from snapshots written before it existed: read as 0.
+    #[serde(default)]
+    pub(crate) impact_perturbation: Vec<f32>,
     /// Asleep: skipped by the step until something awake touches its island. A kinematic
     /// body counts as asleep exactly while it does not move (zero velocities).
     pub(crate) asleep: Vec<bool>,
@@ -86,6 +90,7 @@ impl Bodies {
         self.friction.swap_remove(i);
         self.restitution.swap_remove(i);
         self.roughness.swap_remove(i);
+        self.impact_perturbation.swap_remove(i);
         self.asleep.swap_remove(i);
         self.sleep_time.swap_remove(i);
         self.force.swap_remove(i);
@@ -114,6 +119,7 @@ impl Bodies {
             ("friction", self.friction.len()),
             ("restitution", self.restitution.len()),
             ("roughness", self.roughness.len()),
+            ("impact_perturbation", self.impact_perturbation.len()),
             ("asleep", self.asleep.len()),
             ("sleep_time", self.sleep_time.len()),
             ("force", self.force.len()),

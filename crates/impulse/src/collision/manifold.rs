@@ -1,6 +1,7 @@
 //! A contact manifold as the engine keeps it across steps: Parry's manifold with the solver's
 //! impulses per point ([`ContactImpulse`]) and the friction basis per manifold
-//! ([`ManifoldState`], with a rough pair's [`RoughnessDraw`]), and the world poses of its two
+//! ([`ManifoldState`], with a rough pair's [`RoughnessDraw`] and a perturbed pair's impact
+//! draw), and the world poses of its two
 //! shapes.
 
 use glam::Vec3;
@@ -34,6 +35,10 @@ pub struct ManifoldState {
     /// (`contact::roughness`); `None` on smooth pairs.
     #[serde(default)]
     pub roughness: Option<RoughnessDraw>,
+    /// The manifold's impact draw ξ in [−1, 1) for this step, made afresh every step while a
+    /// body of the pair has an impact perturbation (`contact::impact`); `None` otherwise.
+    #[serde(default)]
+    pub impact: Option<f32>,
 }
 
 /// One manifold's roughness draw, kept in its state across steps.

@@ -489,6 +489,7 @@ impl NarrowPhase {
                         && m.local_n2.is_finite()
                         && m.data.tangent.is_finite()
                         && m.data.roughness.is_none_or(|d| d.is_valid())
+                        && m.data.impact.is_none_or(|x| (-1.0..1.0).contains(&x))
                         && m.points.iter().all(|p| {
                             p.local_p1.is_finite()
                                 && p.local_p2.is_finite()

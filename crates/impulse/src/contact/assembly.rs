@@ -191,6 +191,7 @@ impl Assembly<'_> {
             .restitution_combine
             .combine(bodies.restitution[a], bodies.restitution[b]);
         let roughness = super::roughness::pair_roughness(bodies, a, b);
+        let perturbation = super::impact::pair_perturbation(bodies, a, b);
         let inverse_mass_a = bodies.effective_inverse_mass(a);
         let inverse_mass_b = bodies.effective_inverse_mass(b);
         // The lanes compute the products of points whose bodies have no translation locked
@@ -221,6 +222,13 @@ impl Assembly<'_> {
                 normal = super::roughness::tilted(normal, draw, roughness, &part_b);
             }
             let (t1, t2) = tangent_basis(normal, manifold.data.tangent);
+            // An impact perturbation moves the manifold's restitution by this step's draw.
+            let restitution = match manifold.data.impact {
+                Some(draw) if perturbation > 0.0 => {
+                    super::impact::perturbed_restitution(restitution, perturbation, draw)
+                }
+                _ => restitution,
+            };
             for (point_index, point) in manifold.points.iter().enumerate() {
                 let warm = point.data;
                 // A speculative contact's impulse acts once its gap has closed, where the two

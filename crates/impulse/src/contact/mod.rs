@@ -4,12 +4,14 @@
 //!
 //! One job per file, each using only the files listed before it:
 //! - [`roughness`]: rough surfaces' seeded tilts of new contacts' normals;
+//! - [`impact`]: impacts' seeded perturbations of restitution;
 //! - [`row`]: the row type ([`ContactConstraint`], [`JacobianRow`]) and its lever-arm products;
 //! - [`assembly`]: contact points → rows, island by island, warm-started;
 //! - [`targets`]: the rows' target velocities, per substep, and restitution's;
 //! - [`record`]: J·v* per row for the step's diagnostics.
 
 pub(crate) mod assembly;
+pub(crate) mod impact;
 pub(crate) mod record;
 pub(crate) mod roughness;
 pub(crate) mod row;

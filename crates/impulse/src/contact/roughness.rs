@@ -43,7 +43,7 @@ pub(crate) fn draw_new_manifolds(pairs: &mut [ContactPair], bodies: &Bodies, see
                 u64::from(b1) << 32 | u64::from(b2),
                 index as u64,
             ];
-            let bits = mix(key);
+            let bits = mix(&key);
             let n = manifold.local_n1.abs();
             let axis = if n.x <= n.y && n.x <= n.z {
                 0
@@ -82,9 +82,9 @@ pub(crate) fn tilted(normal: Vec3, draw: &RoughnessDraw, roughness: f32, part1: 
 }
 
 /// 64 well-mixed bits of a key: SplitMix64's finaliser over the key's words in turn.
-fn mix(key: [u64; 4]) -> u64 {
+pub(super) fn mix(key: &[u64]) -> u64 {
     let mut state = 0x9E37_79B9_7F4A_7C15u64;
-    for word in key {
+    for &word in key {
         state = state.wrapping_add(word).wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = state;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -95,7 +95,7 @@ fn mix(key: [u64; 4]) -> u64 {
 }
 
 /// A number in [0, 1) from the low 24 bits of `bits` (exact in f32).
-fn unit(bits: u64) -> f32 {
+pub(super) fn unit(bits: u64) -> f32 {
     (bits & 0xFF_FFFF) as f32 / 16_777_216.0
 }
 
@@ -114,7 +114,7 @@ mod tests {
         let mut widest = 0.0f32;
         let count = 20_000;
         for k in 0..count {
-            let bits = mix([7, k, 1, 0]);
+            let bits = mix(&[7, k, 1, 0]);
             let draw = RoughnessDraw {
                 cap: unit(bits),
                 azimuth: unit(bits >> 32) * std::f32::consts::TAU,
@@ -159,10 +159,10 @@ mod tests {
     /// Different keys give different draws; the same key the same.
     #[test]
     fn draws_depend_on_every_part_of_the_key() {
-        let base = mix([1, 2, 3, 4]);
-        assert_eq!(base, mix([1, 2, 3, 4]));
+        let base = mix(&[1, 2, 3, 4]);
+        assert_eq!(base, mix(&[1, 2, 3, 4]));
         for other in [[0, 2, 3, 4], [1, 0, 3, 4], [1, 2, 0, 4], [1, 2, 3, 0]] {
-            assert_ne!(base, mix(other));
+            assert_ne!(base, mix(&other));
         }
     }
 }

@@ -244,6 +244,7 @@ fn cube_material() -> Material {
         restitution: 0.0,
         density: 1000.0,
         roughness: 0.0,
+        impact_perturbation: 0.0,
     }
 }
 
@@ -428,6 +429,7 @@ fn card_house() -> Scene {
             restitution: 0.0,
             density: 1000.0,
             roughness: 0.0,
+            impact_perturbation: 0.0,
         },
     );
     scene.bodies.push(ground(GROUND_HALF_WIDTH));
@@ -606,6 +608,7 @@ fn balls(name: &str, n: usize) -> Scene {
             restitution: 0.0,
             density: 1000.0,
             roughness: 0.0,
+            impact_perturbation: 0.0,
         },
     );
     // Inner half widths of the box and the wall height.

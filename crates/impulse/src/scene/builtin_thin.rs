@@ -57,6 +57,7 @@ fn card_house(thickness: Option<f32>) -> Scene {
                 restitution: 0.0,
                 density: 1000.0,
                 roughness: 0.0,
+                impact_perturbation: 0.0,
             },
         )]
         .into(),

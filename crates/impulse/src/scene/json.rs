@@ -639,8 +639,8 @@ fn is_default_material(m: &&MaterialRef) -> bool {
     **m == MaterialRef::default()
 }
 
-/// A material as written: a smooth surface's `roughness` (0) is left out, as scene files
-/// written before rough surfaces existed read.
+/// A material as written: a smooth surface's `roughness` (0) and an unperturbed one's
+/// `impact_perturbation` (0) are left out, as scene files written before they existed read.
 #[derive(Serialize)]
 struct MaterialOut {
     friction: f32,
@@ -648,6 +648,8 @@ struct MaterialOut {
     density: f32,
     #[serde(skip_serializing_if = "is_zero_scalar")]
     roughness: f32,
+    #[serde(skip_serializing_if = "is_zero_scalar")]
+    impact_perturbation: f32,
 }
 
 impl From<&Material> for MaterialOut {
@@ -657,12 +659,14 @@ impl From<&Material> for MaterialOut {
             restitution,
             density,
             roughness,
+            impact_perturbation,
         } = *m;
         MaterialOut {
             friction,
             restitution,
             density,
             roughness,
+            impact_perturbation,
         }
     }
 }

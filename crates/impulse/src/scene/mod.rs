@@ -39,8 +39,9 @@ pub struct Scene {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joints: Vec<JointDesc>,
     /// Seed of the engine's seeded variation (the contact normals' [`Material::roughness`]
-    /// draws); 0 by default. A [`Variation`] with a non-zero seed replaces it in a scene with
-    /// rough materials, so run K of a sweep draws its own rough surfaces.
+    /// draws and the impacts' [`Material::impact_perturbation`] draws); 0 by default. A
+    /// [`Variation`] with a non-zero seed replaces it in a scene with rough or perturbed
+    /// materials, so run K of a sweep draws its own.
     #[serde(default)]
     pub seed: u64,
 }
@@ -61,9 +62,17 @@ pub struct Material {
     /// solutions to multi-body constraint problems", SIGGRAPH 2000). 0 (the default) is a
     /// smooth surface and draws nothing.
     pub roughness: f32,
+    /// Impact perturbation (dimensionless) in [0, [`MAX_IMPACT_PERTURBATION`]]: at an impact (a
+    /// contact closing faster than `solver.restitution_threshold`) the pair's restitution c_r is
+    /// replaced by clamp(c_r + p·ξ, 0, 1), p the larger of its two bodies' perturbation and ξ
+    /// uniform in [−1, 1) drawn from the scene's seed, the step and the pair (Barzel, Hughes &
+    /// Wood, "Plausible motion simulation for computer graphics animation", 1996). The rebound
+    /// speed moves by at most p times the approach speed and never exceeds it. 0 (the default)
+    /// draws nothing.
+    pub impact_perturbation: f32,
 }
 
-pub use crate::body::MAX_ROUGHNESS_DEGREES;
+pub use crate::body::{MAX_IMPACT_PERTURBATION, MAX_ROUGHNESS_DEGREES};
 
 impl Default for Material {
     fn default() -> Self {
@@ -72,6 +81,7 @@ impl Default for Material {
             restitution: 0.0,
             density: 1000.0,
             roughness: 0.0,
+            impact_perturbation: 0.0,
         }
     }
 }

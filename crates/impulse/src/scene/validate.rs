@@ -10,7 +10,8 @@
 //!   velocities, shape sizes, hull points, mass);
 //! - `dt > 0`; the solver settings as [`crate::SolverSettings::problems`] checks them (the
 //!   same check the library's `World` makes);
-//! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`;
+//! - materials: `friction ≥ 0`, `restitution` in [0, 1], `density > 0`, `roughness` in [0, 30]
+//!   degrees, `impact_perturbation` in [0, 1];
 //! - a body's `mass`, when given, is > 0; its `linear_damping` and `angular_damping` are ≥ 0;
 //! - shapes: sphere, capsule, cylinder and cone `radius > 0`, capsule `half_height ≥ 0`,
 //!   cylinder and cone `half_height > 0`, every cuboid half extent ≥ 0 with at most one 0 (a
@@ -298,6 +299,10 @@ impl Checker {
         self.unit_interval(&path.key("restitution"), m.restitution);
         self.positive(&path.key("density"), m.density);
         self.rule(&path.key("roughness"), rules::roughness(m.roughness));
+        self.rule(
+            &path.key("impact_perturbation"),
+            rules::impact_perturbation(m.impact_perturbation),
+        );
     }
 
     fn body(&mut self, path: &FieldPath, b: &BodyDesc, materials: &BTreeMap<String, Material>) {

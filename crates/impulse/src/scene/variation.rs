@@ -186,8 +186,8 @@ impl Jitter {
 pub struct Variation {
     /// Field changes, applied in order (a later one wins where two set the same field).
     pub overrides: Vec<Override>,
-    /// Seed of the jitter and, when not 0 and the scene has rough materials, the scene's
-    /// [`Scene::seed`] (the rough surfaces' draws): run K of a sweep uses seed K.
+    /// Seed of the jitter and, when not 0 and the scene has rough or impact-perturbed
+    /// materials, the scene's [`Scene::seed`] (their draws): run K of a sweep uses seed K.
     pub seed: u64,
     /// The jitter; all zero leaves the bodies where the overrides put them.
     pub jitter: Jitter,
@@ -237,9 +237,10 @@ impl Variation {
                 jitter_body(self.seed, index, &self.jitter, body);
             }
         }
-        // The seed also draws the rough surfaces' normals: run K of a sweep gets its own. A
-        // scene without rough materials draws nothing and is left as it is.
-        if self.seed != 0 && has_roughness(&varied) {
+        // The seed also draws the rough surfaces' normals and the perturbed impacts: run K of
+        // a sweep gets its own. A scene without such materials draws nothing and is left as
+        // it is.
+        if self.seed != 0 && draws_from_seed(&varied) {
             varied.seed = self.seed;
         }
         validate(&varied).map_err(|e| self.blame(e))?;
@@ -493,11 +494,13 @@ fn load_meshes(varied: &mut Scene, original: &Scene, directory: &Path) -> Result
     Ok(())
 }
 
-/// Whether any material of `scene` (named or inline) has a `roughness` above 0.
-fn has_roughness(scene: &Scene) -> bool {
-    scene.materials.values().any(|m| m.roughness > 0.0)
+/// Whether any material of `scene` (named or inline) has a `roughness` or an
+/// `impact_perturbation` above 0: the run draws from the scene's seed.
+fn draws_from_seed(scene: &Scene) -> bool {
+    let draws = |m: &super::Material| m.roughness > 0.0 || m.impact_perturbation > 0.0;
+    scene.materials.values().any(draws)
         || scene.bodies.iter().any(|b| match &b.material {
-            super::MaterialRef::Inline(m) => m.roughness > 0.0,
+            super::MaterialRef::Inline(m) => draws(m),
             super::MaterialRef::Named(_) => false,
         })
 }

@@ -170,6 +170,7 @@ pub(crate) fn builder_of(
         friction: material.friction,
         restitution: material.restitution,
         roughness: material.roughness,
+        impact_perturbation: material.impact_perturbation,
         density: material.density,
         mass: desc.mass,
         name: desc.name.clone(),

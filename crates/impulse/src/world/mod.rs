@@ -47,7 +47,8 @@ pub struct World {
     pub(crate) settings: SolverSettings,
     dt: f32,
     step_count: u64,
-    /// Seed of the seeded variation: the rough surfaces' draws ([`World::seed`]).
+    /// Seed of the seeded variation: the rough surfaces' and perturbed impacts' draws
+    /// ([`World::seed`]).
     seed: u64,
     broad_phase: BroadPhase,
     narrow_phase: NarrowPhase,
@@ -251,6 +252,7 @@ impl World {
         b.friction.push(builder.friction);
         b.restitution.push(builder.restitution);
         b.roughness.push(builder.roughness.to_radians());
+        b.impact_perturbation.push(builder.impact_perturbation);
         b.asleep.push(false);
         b.sleep_time.push(0.0);
         b.force.push(Vec3::ZERO);
@@ -294,7 +296,10 @@ impl World {
 
     /// Seed of the world's seeded variation: a new contact's normal on a rough surface
     /// ([`BodyBuilder::roughness`]) is tilted by a draw keyed by (seed, step, pair, manifold),
-    /// the same on every machine and thread count. A scene's `seed` (0 by default).
+    /// and an impact's restitution on a perturbed surface
+    /// ([`BodyBuilder::impact_perturbation`]) moved by a draw keyed by (seed, step of the
+    /// impact, pair, manifold), the same on every machine and thread count. A scene's `seed`
+    /// (0 by default).
     pub fn seed(&self) -> u64 {
         self.seed
     }

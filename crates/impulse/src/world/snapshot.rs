@@ -324,6 +324,10 @@ impl World {
             // Written before roughness existed: every surface smooth.
             bodies.roughness = vec![0.0; bodies.len()];
         }
+        if bodies.impact_perturbation.is_empty() {
+            // Written before impact perturbations existed: none.
+            bodies.impact_perturbation = vec![0.0; bodies.len()];
+        }
         bodies.check_lengths().map_err(invalid)?;
         for i in 0..bodies.len() {
             if let Some(shape) = rebuilt_composite(&bodies.shape[i])
@@ -493,6 +497,9 @@ fn check_bodies(b: &Bodies) -> Result<(), String> {
         }
         if !(0.0..=crate::body::MAX_ROUGHNESS_DEGREES.to_radians()).contains(&b.roughness[i]) {
             return bad("roughness is outside [0, 30] degrees");
+        }
+        if !(0.0..=crate::body::MAX_IMPACT_PERTURBATION).contains(&b.impact_perturbation[i]) {
+            return bad("impact_perturbation is outside [0, 1]");
         }
         let shape = &b.shape[i];
         if b.kind[i] != BodyKind::Static && shape.as_halfspace().is_some() {

@@ -67,6 +67,7 @@ fn a_throw_between_steps_is_not_a_blow_up() {
         restitution: 0.0,
         density: 1000.0,
         roughness: 0.0,
+        impact_perturbation: 0.0,
     };
     let mut world = World::new(
         Vec3::new(0.0, -9.81, 0.0),

@@ -11,6 +11,7 @@ pub(crate) fn material(friction: f32) -> Material {
         restitution: 0.0,
         density: 1000.0,
         roughness: 0.0,
+        impact_perturbation: 0.0,
     }
 }
 

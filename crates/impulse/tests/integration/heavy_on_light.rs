@@ -41,6 +41,7 @@ fn material(density: f32) -> Material {
         restitution: 0.0,
         density,
         roughness: 0.0,
+        impact_perturbation: 0.0,
     }
 }
 
@@ -287,6 +288,7 @@ fn the_heavy_on_light_path_advances_the_whole_step() {
             restitution: 0.0,
             density: 1000.0,
             roughness: 0.0,
+            impact_perturbation: 0.0,
         };
         world
             .add_body(

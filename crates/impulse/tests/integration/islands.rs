@@ -12,6 +12,7 @@ fn material() -> Material {
         restitution: 0.0,
         density: 1000.0,
         roughness: 0.0,
+        impact_perturbation: 0.0,
     }
 }
 

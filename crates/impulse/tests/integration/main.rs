@@ -22,6 +22,7 @@ mod gyroscopic;
 mod heavy_on_light;
 mod height_fields;
 mod hulls;
+mod impact_perturbation;
 mod impacts;
 mod islands;
 mod joints;

@@ -15,6 +15,7 @@ fn material(friction: f32, restitution: f32) -> Material {
         restitution,
         density: 1000.0,
         roughness: 0.0,
+        impact_perturbation: 0.0,
     }
 }
 

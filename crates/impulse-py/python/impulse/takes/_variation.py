@@ -18,9 +18,11 @@ A field whose scale is 0 is not varied and its components are left out of θ. Th
 are rounded to float32 (the engine's precision) before they are written, so the varied scene
 read from a file gives the same bits as the one simulated in the search.
 
-With ``seeds=True`` a take also has its own scene ``seed``: the seed of the engine's rough
-surfaces (materials with ``roughness``), whose draws tilt each new contact's normal. It is an
-integer, not part of θ: the search draws a fresh one, or reuses one of the best takes' seeds.
+With ``seeds=True`` a take also has its own scene ``seed``: the seed of the engine's seeded
+draws, which tilt each new contact's normal on rough surfaces (materials with ``roughness``,
+degrees) and move each impact's restitution by up to ± ``impact_perturbation`` (materials with
+one, in [0, 1]; the rebound never exceeds the approach speed). It is an integer, not part of θ:
+the search draws a fresh one, or reuses one of the best takes' seeds.
 
 Small perturbations of the initial state are the plausible variations of Barzel, Hughes & Wood,
 "Plausible motion simulation for computer graphics animation" (Eurographics CAS 1996).
@@ -57,8 +59,9 @@ class Variation:
     angular_velocity : float
         Scale of the angular velocity offsets (rad/s).
     seeds : bool
-        Give each take its own scene ``seed`` (rough surfaces' draws; materials need a
-        ``roughness`` for it to matter).
+        Give each take its own scene ``seed`` (the draws of rough surfaces and perturbed
+        impacts; materials need a ``roughness`` or an ``impact_perturbation`` for it to
+        matter).
 
     Raises
     ------

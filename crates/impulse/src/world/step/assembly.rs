@@ -41,9 +41,10 @@ impl World {
         );
     }
 
-    /// Whether any body has a restitution coefficient above zero (then islands end their step
-    /// with a restitution solve).
+    /// Whether any body has a restitution coefficient or an impact perturbation above zero
+    /// (then islands end their step with a restitution solve).
     pub(super) fn any_restitution(&self) -> bool {
         self.bodies.restitution.iter().any(|&r| r > 0.0)
+            || self.bodies.impact_perturbation.iter().any(|&p| p > 0.0)
     }
 }

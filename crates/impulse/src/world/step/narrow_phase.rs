@@ -27,6 +27,14 @@ impl World {
                 self.step_count,
             );
         }
+        if self.bodies.impact_perturbation.iter().any(|&p| p > 0.0) {
+            crate::contact::impact::draw_impacts(
+                &mut self.narrow_phase.pairs,
+                &self.bodies,
+                self.seed,
+                self.step_count,
+            );
+        }
         Ok(())
     }
 }
