@@ -84,7 +84,12 @@ impl World {
         for k in 0..islands {
             let range = self.islands.constraint_range(k);
             if self.island_awake[k] {
-                let report = self.workspaces[k].report;
+                let mut report = self.workspaces[k].report;
+                report.deepest_contact = crate::world::contacts::deepest_contact(
+                    &self.constraints[range.clone()],
+                    &self.narrow_phase.pairs,
+                    &self.bodies,
+                );
                 let part = report.natural_map_residual as f64;
                 squared += part * part;
                 friction_rows += self.workspaces[k].friction_rows;
