@@ -105,7 +105,7 @@ pub use settings::{
 };
 pub use solver::{
     EscalationLevel, HEAVY_ON_LIGHT_CONTACTS_FACTOR, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight,
-    IslandReport,
+    IslandContact, IslandReport,
 };
 pub use world::LeftWorld;
 pub use world::{

@@ -3,9 +3,11 @@
 //! along the same face. Points whose normals agree within [`NORMAL_COSINE`] are one patch, as
 //! in Jolt's manifold reduction (`PhysicsSettings::mUseManifoldReduction`, which merges the
 //! manifolds of sub-shape pairs with similar normals into one of at most four points). A patch
-//! is cut in layers [`LAYER_DEPTH`] deep from its deepest point, and each layer keeps
-//! [`MAX_POINTS`] points, chosen as a single face's are ([`choose_four`]: the deepest and the
-//! largest quadrilateral across the normal). Kept apart, a part's speculative points cannot
+//! is cut in [`LAYERS`] layers: the points within [`LAYER_DEPTH`] of its deepest point, and
+//! the rest. Each layer keeps [`MAX_POINTS`] points, chosen as a single face's are
+//! ([`choose_four`]: the deepest and the largest quadrilateral across the normal); the
+//! manifolds' points keep Parry's feature ids, so the kept points warm start. Kept apart, a
+//! part's speculative points cannot
 //! take the place of the touching points that hold the body, nor far points the place of those
 //! about to touch (with the two merged, a bowl
 //! on a 1 cm foot kept four points spread up its curved bottom and rocked 12°).
@@ -20,12 +22,20 @@ use parry3d::shape::Shape;
 use super::faces::{MAX_POINTS, choose_four};
 use super::manifold::Manifold;
 
-/// Cosine of the largest angle (5°) between two points' normals for them to be one patch.
-pub(crate) const NORMAL_COSINE: Real = 0.996_194_7;
+/// Cosine of the largest angle (20°) between two points' normals for them to be one patch.
+/// Two curved bodies (mugs) touch through many part pairs whose normals turn with the
+/// surface: with 5° patches most patches held a single manifold and two mugs kept up to 494
+/// points; with 20° a ring of contact around a mug still keeps 18 patches of its own.
+pub(crate) const NORMAL_COSINE: Real = 0.939_692_6;
 
-/// Depth (m) of a patch's layers: layer k holds the points between k and k + 1 times this
-/// farther off than the patch's deepest point.
+/// Depth (m) of a patch's first layer: it holds the points at most this farther off than the
+/// patch's deepest point (those that hold the bodies); the second holds all the others.
 pub(crate) const LAYER_DEPTH: Real = 1.0e-3;
+
+/// Layers of a patch: the touching points and the speculative points beyond them, each
+/// keeping at most [`MAX_POINTS`], so a pair keeps at most 2 × [`MAX_POINTS`] per patch
+/// however far its speculative distance reaches.
+pub(crate) const LAYERS: u32 = 2;
 
 /// Whether a pair of `shape1` and `shape2` gets its manifolds reduced: both compounds (two
 /// decomposed meshes touching through many parts). A compound against a single convex shape
@@ -101,7 +111,7 @@ pub(crate) fn reduce(manifolds: &mut [Manifold]) {
                 patches.push(i);
                 i
             });
-        let layer = ((point.dist - points[patch].dist) / LAYER_DEPTH) as u32;
+        let layer = (((point.dist - points[patch].dist) / LAYER_DEPTH) as u32).min(LAYERS - 1);
         groups.push((patch, layer));
     }
     let mut keep: Vec<Vec<bool>> = manifolds

@@ -116,3 +116,28 @@ fn other_pairs_are_not_reduced() {
     let single = SharedShape::compound(row(1, 0.05));
     assert_eq!(points(&on_ground(&single, Pose::IDENTITY, true)).len(), 4);
 }
+
+/// A row whose cubes stand 0, 2, 4, 6 and 8 mm above the box: the resting cube keeps its
+/// four points, and the four raised ones, at whatever gap, share the second layer's four (the
+/// nearest raised cube's deepest among them), not four each.
+#[test]
+fn speculative_parts_share_one_layer() {
+    let mut parts = row(5, 0.05);
+    for (k, part) in parts.iter_mut().enumerate() {
+        part.0.translation.y += 0.002 * k as f32;
+    }
+    let compound = SharedShape::compound(parts);
+    assert_eq!(
+        points(&on_ground(&compound, Pose::IDENTITY, false)).len(),
+        20
+    );
+    let kept = points(&on_ground(&compound, Pose::IDENTITY, true));
+    let resting = kept.iter().filter(|(_, d)| d.abs() < 1e-4).count();
+    let nearest_raised = kept
+        .iter()
+        .filter(|(_, d)| (d - 0.002).abs() < 1e-4)
+        .count();
+    assert_eq!(kept.len(), 8, "{kept:?}");
+    assert_eq!(resting, 4, "{kept:?}");
+    assert!(nearest_raised >= 1, "{kept:?}");
+}

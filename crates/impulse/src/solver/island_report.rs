@@ -48,4 +48,28 @@ pub struct IslandReport {
     /// split-impulse repair, which holds such islands on its own).
     #[serde(default)]
     pub heavy_on_light: Option<HeavyOnLight>,
+    /// The island's deepest contact point as the step's contacts were found (see
+    /// [`IslandContact`]); `None` for an island without contact points. Set by the world as the
+    /// step ends.
+    #[serde(default)]
+    pub deepest_contact: Option<IslandContact>,
+}
+
+/// One contact point of an island named by its bodies and, on a compound (a decomposed mesh's
+/// convex parts, or a `compound` shape's parts), the part it is on: where an island's overlap
+/// is, down to the part of a mug's wall.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct IslandContact {
+    /// Index of the first body of the point's pair (the lower index; a static body included).
+    pub body1: u32,
+    /// Index of the pair's second body.
+    pub body2: u32,
+    /// The part of `body1`'s shape the point is on, when that shape is a compound: an index
+    /// into its parts, in their order; `None` for any other shape.
+    pub part1: Option<u32>,
+    /// The part of `body2`'s shape the point is on (as `part1`).
+    pub part2: Option<u32>,
+    /// Penetration depth (m) when the contacts were found: > 0 overlapping, < 0 a speculative
+    /// point's gap.
+    pub depth: f32,
 }

@@ -52,7 +52,7 @@ pub use heavy_on_light::{
     HEAVY_ON_LIGHT_CONTACTS_FACTOR, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight,
 };
 pub use interface::*;
-pub use island_report::IslandReport;
+pub use island_report::{IslandContact, IslandReport};
 /// The row operations under the solver's path, for the tests and the `internals` feature.
 #[cfg(any(test, feature = "internals"))]
 pub use rows::Velocities;

@@ -5,8 +5,10 @@ use glam::Vec3;
 
 use super::World;
 use super::contact_events::ContactEvent;
-use crate::body::BodyHandle;
+use crate::body::{Bodies, BodyHandle};
 use crate::collision::narrow_phase::{self, ContactPair};
+use crate::contact::constraints::ContactConstraint;
+use crate::solver::IslandContact;
 
 /// One contact point of a pair after the last step, in world coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,6 +92,30 @@ impl<'a> ContactPairView<'a> {
     pub fn touching(&self) -> bool {
         touching(self.pair)
     }
+}
+
+/// The deepest of an island's contact points `constraints` (the first of equal depths), named
+/// by its pair's bodies and, on a compound, the parts it is on: `pairs` are the narrow phase's
+/// pairs the rows' `source` indexes this step. `None` without points.
+pub(crate) fn deepest_contact(
+    constraints: &[ContactConstraint],
+    pairs: &[ContactPair],
+    bodies: &Bodies,
+) -> Option<IslandContact> {
+    let deepest = constraints
+        .iter()
+        .reduce(|deepest, c| if c.depth > deepest.depth { c } else { deepest })?;
+    let (pair, manifold, _) = deepest.source;
+    let pair = pairs.get(pair as usize)?;
+    let manifold = pair.manifolds.get(manifold as usize)?;
+    let compound = |body: u32| bodies.shape[body as usize].as_compound().is_some();
+    Some(IslandContact {
+        body1: pair.body1,
+        body2: pair.body2,
+        part1: compound(pair.body1).then_some(manifold.subshape1),
+        part2: compound(pair.body2).then_some(manifold.subshape2),
+        depth: deepest.depth,
+    })
 }
 
 /// Sum of a pair's normal impulses in the last step (N·s), each point once (summed as the

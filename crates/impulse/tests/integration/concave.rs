@@ -404,6 +404,46 @@ fn a_chair_lands_and_rests_on_its_four_legs() {
     }
 }
 
+/// The island report names the part of a compound its deepest contact is on: a chair (one
+/// mesh: a seat and four legs) resting on the ground, whose deepest point is on one of the four
+/// legs (a part reaching down to the ground), never on the seat 40 cm above it.
+#[test]
+fn an_island_report_names_the_part_of_a_compound_its_deepest_contact_is_on() {
+    let (leg, seat_half, leg_length) = (0.02f32, 0.2f32, 0.4f32);
+    let mut parts = vec![([0.0, leg_length + 0.02, 0.0], [seat_half, 0.02, seat_half])];
+    for (x, z) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+        let at = seat_half - leg;
+        parts.push((
+            [x * at, leg_length / 2.0, z * at],
+            [leg, leg_length / 2.0, leg],
+        ));
+    }
+    let chair = BodyDesc::new(BodyKind::Dynamic, trimesh(&boxes(&parts)), [0.0, 0.1, 0.0]);
+    let mut world = World::from_scene(&scene_on_ground(vec![chair])).unwrap();
+    run(&mut world, 0.5);
+    let islands = &world.diagnostics().islands;
+    assert_eq!(islands.len(), 1, "one island: the chair on the ground");
+    let deepest = islands[0]
+        .deepest_contact
+        .expect("the island's report names its deepest contact");
+    assert_eq!((deepest.body1, deepest.body2), (0, 1));
+    assert_eq!(deepest.part1, None, "the ground is no compound");
+    let k = deepest.part2.expect("the report names the chair's part") as usize;
+    let compound = world.shapes()[1]
+        .as_compound()
+        .expect("a moving mesh is a compound of its parts");
+    let lowest = |(part_pose, part): &(_, impulse::parry3d::shape::SharedShape)| {
+        part.compute_aabb(&(world.poses()[1] * *part_pose)).mins.y
+    };
+    // The check can tell parts apart: the seat's parts end 40 cm above the ground.
+    assert!(compound.shapes().iter().any(|part| lowest(part) > 0.3));
+    let lowest = lowest(&compound.shapes()[k]);
+    assert!(
+        lowest.abs() < 5e-3,
+        "part {k}, named by the report, reaches down to y = {lowest} m, not to the ground"
+    );
+}
+
 /// A hollow closed box (outer surface wound outward, inner surface inward, walls 1 mm thick)
 /// gets the mass, centre of mass and inertia of its walls, not of the solid its convex parts
 /// fill: within 1 % of the closed form of a thin-walled box (six plates of surface density

@@ -32,6 +32,7 @@ mod malformed_meshes;
 mod malformed_scenes;
 mod material_combine;
 mod meshes;
+mod mug_pour;
 mod phantom_and_tunnel;
 mod physics;
 mod profile;

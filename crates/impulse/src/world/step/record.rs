@@ -101,7 +101,12 @@ impl World {
         for k in 0..islands {
             let range = islands_of.constraint_range(k);
             if awake[k] {
-                let report = workspaces[k].report;
+                let mut report = workspaces[k].report;
+                report.deepest_contact = crate::world::contacts::deepest_contact(
+                    &constraints[range.clone()],
+                    &self.narrow_phase.pairs,
+                    &self.bodies,
+                );
                 let part = report.natural_map_residual as f64;
                 squared += part * part;
                 friction_rows += workspaces[k].friction_rows;
