@@ -597,8 +597,11 @@ fn better_face_axis<ContactData>(
     // Along a contact normal the deepest point of the manifold is at the shapes' separation
     // along it; only a normal whose points read the shapes far nearer than they are along it is
     // searched (two support points a pair, not one per face).
-    let deepest = points.iter().map(|p| p.dist).fold(Real::INFINITY, Real::min);
-    if !(deepest > given + tolerance) {
+    let deepest = points
+        .iter()
+        .map(|p| p.dist)
+        .fold(Real::INFINITY, Real::min);
+    if points.is_empty() || deepest.is_nan() || deepest <= given + tolerance {
         return None;
     }
     let mut axes: Vec<Vector> = Vec::new();
