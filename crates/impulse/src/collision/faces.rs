@@ -440,17 +440,42 @@ pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
         manifold.local_n1 = n1;
         manifold.local_n2 = n2;
     }
-    let (n1, n2) = (manifold.local_n1, manifold.local_n2);
-    let Some(n) = n1.try_normalize() else {
+    let Some(parry_normal) = manifold.local_n1.try_normalize() else {
         return false;
     };
+    // GJK and EPA can end on a direction that separates nothing where a face lies exactly on
+    // another (a point cloud set down on a box: a normal 45° off the box's top, one point, and
+    // the cloud fell a whole step into the box): such a normal is replaced by the faces' best.
+    // Not under a mesh triangle's normal constraints, which may have turned GJK's normal on
+    // purpose (against phantom hits at the mesh's inner edges).
+    let constrained = constraints.0.is_some() || constraints.1.is_some();
+    let corrected = if half_space || constrained {
+        None
+    } else {
+        better_face_axis(pos12, g1, g2, parry_normal, &manifold.points)
+    };
+    if let Some(normal) = corrected {
+        manifold.local_n1 = normal;
+        manifold.local_n2 = -(pos12.rotation.inverse() * normal);
+    }
+    let (n1, n2) = (manifold.local_n1, manifold.local_n2);
+    let n = n1.normalize();
     let large = |shape: &dyn Shape, dir: Vector| {
         hull_parts(shape).is_some_and(|(hull, _)| {
             hull.faces()[support_face_index(hull, dir)].num_vertices_or_edges as usize > 4
         })
     };
     let (large1, large2) = (large(g1, n1), large(g2, n2));
-    if !large1 && !large2 {
+    // Under a mesh triangle's normal constraints Parry drops every point more than five times
+    // deeper than GJK's depth along its normal (`contact_manifold_pfm_pfm`), which is itself
+    // off by GJK's tolerance where a face lies flat on the triangle: a cloud's facet 0.09 mm
+    // into a height field kept two of its three vertices and tipped 5 mm in about the third.
+    // There a hull's support face is clipped whole whatever its size.
+    let (refine1, refine2) = (
+        large1 || ((constrained || corrected.is_some()) && hull_parts(g1).is_some()),
+        large2 || ((constrained || corrected.is_some()) && hull_parts(g2).is_some()),
+    );
+    if !refine1 && !refine2 {
         return false;
     }
     let (Some(f1), Some(f2)) = (
@@ -462,7 +487,7 @@ pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
     // GJK stops within its tolerance: between separated faces its normal leans by up to a few
     // 1e-4 rad, which tilts every depth across a large face. A normal that near the large
     // face's own is that face's (a vertex, edge or face on a face touches along its normal).
-    let face_normal = if large1 {
+    let face_normal = if refine1 {
         f1.plane_of()
             .map(|(_, normal)| normal * normal.dot(n).signum())
     } else {
@@ -501,7 +526,7 @@ pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
                     .any(|&v| (v - origin).dot(normal).abs() > DEPTH_TIE)
             })
     };
-    let limit = if uneven(large1, &f1) || uneven(large2, &f2) {
+    let limit = if uneven(refine1, &f1) || uneven(refine2, &f2) {
         UNEVEN_MAX_POINTS
     } else {
         MAX_POINTS
@@ -513,7 +538,7 @@ pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
         .iter()
         .find(|p| p.fid1 == PackedFeatureId::UNKNOWN && p.fid2 == PackedFeatureId::UNKNOWN)
         .copied()
-        .filter(|p| p.dist < deepest_clip - DEPTH_TIE);
+        .filter(|p| corrected.is_none() && p.dist < deepest_clip - DEPTH_TIE);
     manifold.points.clear();
     for c in &candidates {
         manifold.points.push(TrackedContact::new(
@@ -529,6 +554,79 @@ pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
     }
     manifold.match_contacts(old);
     true
+}
+
+/// Tolerance (m) of [`better_face_axis`]: this plus [`AXIS_RELATIVE_TOLERANCE`] times the
+/// pair's reach. A normal GJK leaves leaning by its tolerance (a few 1e-4 rad) moves the
+/// separation along it by that angle times the shapes' size (3 mm over a 40 m box).
+const AXIS_TOLERANCE: Real = 1.0e-3;
+
+/// See [`AXIS_TOLERANCE`].
+const AXIS_RELATIVE_TOLERANCE: Real = 1.0e-3;
+
+/// The separation (m) of `g1` and `g2` (at `pos12` in `g1`'s frame) along the unit `axis`
+/// (shape 1's frame, out of it), borders included: the least of shape 2's extent along the
+/// axis less the most of shape 1's. For convex shapes the signed distance is the largest of
+/// these over all axes (the separating axis theorem), reached at the contact normal.
+fn support_separation(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, axis: Vector) -> Option<Real> {
+    let (s1, s2) = (g1.as_support_map()?, g2.as_support_map()?);
+    let far1 = s1.local_support_point(axis).dot(axis);
+    let near2 = pos12
+        .transform_point(s2.local_support_point(pos12.rotation.inverse() * -axis))
+        .dot(axis);
+    Some(near2 - far1)
+}
+
+/// A face normal of either shape (shape 1's frame, out of it: a hull's faces, a box's, a
+/// triangle's two sides) along which the shapes are farther apart, by more than the tolerance
+/// ([`AXIS_TOLERANCE`]), than along `normal` (Parry's), if one is; then `normal` is no contact
+/// normal (the contact normal is the axis of largest separation) and this is a better one.
+/// Searched only where the deepest of `points` (Parry's, along `normal`) lies more than the
+/// tolerance above the separation along `normal`, which a contact normal's points never do.
+/// `None` for shapes without a support map, and where no face beats `normal`.
+fn better_face_axis<ContactData>(
+    pos12: &Pose,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    normal: Vector,
+    points: &[TrackedContact<ContactData>],
+) -> Option<Vector> {
+    let given = support_separation(pos12, g1, g2, normal)?;
+    let reach = |shape: &dyn Shape| shape.compute_local_bounding_sphere().radius();
+    let tolerance = AXIS_TOLERANCE + AXIS_RELATIVE_TOLERANCE * (reach(g1) + reach(g2));
+    // Along a contact normal the deepest point of the manifold is at the shapes' separation
+    // along it; only a normal whose points read the shapes far nearer than they are along it is
+    // searched (two support points a pair, not one per face).
+    let deepest = points
+        .iter()
+        .map(|p| p.dist)
+        .fold(Real::INFINITY, Real::min);
+    if points.is_empty() || deepest.is_nan() || deepest <= given + tolerance {
+        return None;
+    }
+    let mut axes: Vec<Vector> = Vec::new();
+    let mut add = |shape: &dyn Shape, to_frame1: Option<&Pose>| {
+        let out = |v: Vector| match to_frame1 {
+            None => v,
+            Some(pose) => -(pose.rotation * v),
+        };
+        if let Some((hull, _)) = hull_parts(shape) {
+            axes.extend(hull.faces().iter().map(|face| out(face.normal)));
+        } else if shape.as_cuboid().is_some() {
+            for v in [Vector::X, Vector::Y, Vector::Z] {
+                axes.extend([out(v), out(-v)]);
+            }
+        } else if let Some(normal) = shape.as_triangle().and_then(|t| t.normal()) {
+            axes.extend([out(normal), out(-normal)]);
+        }
+    };
+    add(g1, None);
+    add(g2, Some(pos12));
+    let (best, separation) = axes
+        .into_iter()
+        .filter_map(|axis| Some((axis, support_separation(pos12, g1, g2, axis)?)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    (separation > given + tolerance).then_some(best)
 }
 
 #[cfg(test)]

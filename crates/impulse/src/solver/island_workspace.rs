@@ -88,6 +88,10 @@ pub(crate) struct IslandWorkspace {
     /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]): a main solve whose last sweep changed
     /// a row's velocity by more than this met an impact, if [`Self::closing`].
     pub(super) impact_speed: f32,
+    /// How much a main solve's last sweep must change a row's velocity (m/s) for the step to
+    /// meet an impact ([`IMPACT_SWEEPS`]): `impact_speed`, or, for an island without joints
+    /// (whose impacts [`Self::closing`] tells), the speed gravity gives in a step.
+    pub(super) impact_change: f32,
     /// Whether the step can have an impact: the island has joints, or some contact closed
     /// faster than `impact_speed` as the step started. `None` until a main solve's last sweep
     /// asks ([`crate::contact::closes_faster_than`], a pass over the rows).

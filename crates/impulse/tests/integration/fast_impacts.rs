@@ -224,6 +224,15 @@ fn spinning_boxes_gain_no_energy() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// Case 301, a capsule at 263 m/s onto the slab, spun to 454 rad/s by its impact: the impact
+/// sweeps a landing takes, swept on after it had turned past an eighth of a turn in the step,
+/// converged its rows at lever arms turned away and gained 1,518 J/kg.
+#[test]
+fn a_capsule_spun_by_its_impact_gains_no_energy() {
+    let failure = run(301).0;
+    assert!(failure.is_none(), "{failure:?}");
+}
+
 #[test]
 #[ignore = "400 impacts; run on demand (docs/testing.md)"]
 fn four_hundred_fast_impacts_run_to_their_end() {
