@@ -81,7 +81,7 @@ enum Command {
         quiet: bool,
         /// After the summary, print the median wall time of each stage of the step (kinematic,
         /// broad phase, narrow phase, islands, assembly, solve, scatter, continuous, store
-        /// impulses, finish; `impulse::Stage`).
+        /// impulses, finish; `impulse::report::Stage`).
         #[arg(long)]
         profile: bool,
         #[command(flatten)]

@@ -6,8 +6,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use impulse::EscalationLevel;
-use impulse::StepProfile;
+use impulse::report::EscalationLevel;
+use impulse::report::StepProfile;
 use impulse::{Scene, World, WorldSnapshot, metrics};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -40,7 +40,7 @@ pub struct RunOptions {
 }
 
 /// Island solves of a run by the strongest method each reached (one count per island and
-/// step), from [`impulse::IslandReport`].
+/// step), from [`impulse::report::IslandReport`].
 #[derive(Debug, Default, Serialize)]
 pub struct IslandSolves {
     pub pgs: u64,
@@ -104,7 +104,7 @@ pub struct Summary {
     /// `completed`, or the error that stopped the run.
     pub status: String,
     /// Median wall time (ms) of each stage of the step over the run
-    /// ([`impulse::StepProfile`]), each stage's median on its own: they need not
+    /// ([`impulse::report::StepProfile`]), each stage's median on its own: they need not
     /// add up to the median step.
     pub stage_ms: StepProfile,
 }
@@ -708,12 +708,12 @@ const START_OVERLAP_WARNING: f32 = 0.01;
 /// [`START_OVERLAP_WARNING`], naming both and the depth: the first step's contact points are
 /// found on the poses the scene gave.
 /// The one warning of a run that a heavy-on-light island is not held
-/// ([`impulse::HeavyOnLight::held`]), naming the contact's two bodies.
+/// ([`impulse::report::HeavyOnLight::held`]), naming the contact's two bodies.
 fn warn_of_heavy_on_light(
     world: &World,
     step: u64,
-    island: &impulse::IslandReport,
-    heavy: impulse::HeavyOnLight,
+    island: &impulse::report::IslandReport,
+    heavy: impulse::report::HeavyOnLight,
 ) {
     let name = |index: u32| match world.handle_of(index as usize).and_then(|h| world.body(h)) {
         Some(b) => match b.name() {
@@ -729,7 +729,7 @@ fn warn_of_heavy_on_light(
             "its island has {} contact points, more than the exact path takes \
              ({} × solver.exact_max_contacts)",
             island.contacts,
-            impulse::HEAVY_ON_LIGHT_CONTACTS_FACTOR
+            impulse::report::HEAVY_ON_LIGHT_CONTACTS_FACTOR
         )
     };
     eprintln!(
@@ -739,7 +739,7 @@ fn warn_of_heavy_on_light(
         name(heavy.heavy_body),
         name(heavy.light_body),
         heavy.mass_ratio,
-        impulse::HEAVY_ON_LIGHT_HELD_OVERLAP * 1e3,
+        impulse::report::HEAVY_ON_LIGHT_HELD_OVERLAP * 1e3,
     );
 }
 

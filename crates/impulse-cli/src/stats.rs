@@ -4,7 +4,7 @@
 //! `natural_map_residual` (the LCP's mixed units, see [`impulse::StepDiagnostics`]),
 //! `kinetic_energy` (J), `max_depth` (largest overlap among the step's contact points before
 //! the solve, m), then the wall time of each stage of the step in ms
-//! ([`impulse::StepProfile::stages`], `kinematic_ms`, `broad_phase_ms` …) and `total_ms`.
+//! ([`impulse::report::StepProfile::stages`], `kinematic_ms`, `broad_phase_ms` …) and `total_ms`.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use impulse::StepDiagnostics;
-use impulse::StepProfile;
+use impulse::report::StepProfile;
 
 /// Writes one CSV row per step.
 pub struct StatsWriter {

@@ -95,7 +95,7 @@ fn profile_prints_the_median_of_every_stage() {
         .unwrap_or_else(|| panic!("no stage line in {stdout}"))
         .split(", ")
         .collect();
-    assert_eq!(stages.len(), impulse::Stage::ALL.len(), "{line}");
+    assert_eq!(stages.len(), impulse::report::Stage::ALL.len(), "{line}");
     // Then which build of the SIMD kernels ran: the widest this CPU runs.
     let kernels = stdout.lines().nth(2).unwrap_or_default();
     let name = impulse::simd::InstructionSet::supported_widest().name();

@@ -28,7 +28,7 @@ fn stage_times_add_up_to_the_step() {
 /// section lists the stages by their enum names in the same order.
 #[test]
 fn the_stages_have_one_name_everywhere() {
-    use impulse::{Stage, StepProfile};
+    use impulse::report::{Stage, StepProfile};
     let json = serde_json::to_value(StepProfile::default()).unwrap();
     let keys: Vec<&str> = json
         .as_object()

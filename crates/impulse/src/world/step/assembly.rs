@@ -2,13 +2,13 @@
 //! Jacobian rows, effective masses and warm-start impulses (`contact/constraints.rs`).
 
 use crate::World;
-use crate::contact::constraints;
+use crate::contact;
 use crate::settings::SolverSettings;
 
 impl World {
     /// The constraints of every island's points, each island's contiguous.
     pub(super) fn assembly_stage(&mut self, settings: &SolverSettings) {
-        constraints::assemble(
+        contact::assemble(
             &self.bodies,
             &self.narrow_phase,
             &self.islands,

@@ -16,7 +16,7 @@
 //! `diagnostics/contact_lcp_tests.rs` and `solver/wide_tests.rs`).
 
 use crate::World;
-use crate::contact::constraints::{self, BodySlots, ContactConstraint};
+use crate::contact::{self, BodySlots, ContactConstraint};
 use crate::diagnostics;
 use crate::solver::substep::IslandWorkspace;
 
@@ -58,8 +58,8 @@ impl World {
                 }
             }
             // The pass reads every row's I⁻¹(r × d), which the lanes keep in their bundles.
-            constraints::complete_products(&mut self.constraints, &self.world_inverse_inertia);
-            constraints::record_velocity_before(
+            contact::complete_products(&mut self.constraints, &self.world_inverse_inertia);
+            contact::record_velocity_before(
                 &mut self.constraints,
                 BodySlots::World,
                 &self.bodies.linear_velocity,

@@ -3,7 +3,7 @@
 //! record (`record.rs`).
 
 use crate::World;
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::parallel::{ISLANDS_PER_TASK, for_each_with_rows, spread};
 use crate::settings::SolverSettings;
 use crate::solver::substep::{self, IslandWorkspace, StepContext};
