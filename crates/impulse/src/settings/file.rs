@@ -22,7 +22,7 @@ enum MethodName {
 /// (other methods ignore them) and written as the method's, or `auto`'s defaults.
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub(super) struct SettingsFile {
+struct SettingsFile {
     method: MethodName,
     substeps: u32,
     iterations: u32,
@@ -57,6 +57,20 @@ pub(super) struct SettingsFile {
     max_distance: f32,
     max_linear_speed: f32,
     max_angular_speed: f32,
+}
+
+/// As the flat `solver` object.
+impl Serialize for SolverSettings {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        SettingsFile::from(self.clone()).serialize(serializer)
+    }
+}
+
+/// From the flat `solver` object; missing fields take their defaults, unknown ones are errors.
+impl<'de> Deserialize<'de> for SolverSettings {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        SettingsFile::deserialize(deserializer).map(Self::from)
+    }
 }
 
 impl Default for SettingsFile {

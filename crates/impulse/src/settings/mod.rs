@@ -244,9 +244,8 @@ impl CombineRule {
 /// Each term is explained in docs/method.md with its source.
 ///
 /// Scene files and snapshots hold them as the flat `solver` object of docs/scene-format.md
-/// (`file::SettingsFile`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(from = "file::SettingsFile", into = "file::SettingsFile")]
+/// (serialised through `settings/file.rs`).
+#[derive(Clone, Debug, PartialEq)]
 pub struct SolverSettings {
     /// Method: `pgs`, `nncg`, `apgd`, or `auto` (the escalation policy, with its parameters).
     pub method: SolverMethod,

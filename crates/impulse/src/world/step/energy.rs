@@ -119,6 +119,8 @@ impl EnergyCheck {
     /// energy per kilogram against its lowest since the last edit, then every body's position
     /// and speed (bodies named in errors by `handles`, per dense index). Returns the moving bodies beyond `settings.max_distance`, in index order,
     /// which leave the world, or the blow-up.
+    // The step's state this check reads, each part as the step holds it.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn check(
         &mut self,
         terms: &EnergyTerms,
