@@ -48,7 +48,13 @@ pub fn cap_settings(solver: &mut SolverSettings) {
     solver.substeps = solver.substeps.min(MAX_SUBSTEPS);
     solver.iterations = solver.iterations.min(MAX_ITERATIONS);
     solver.relax_iterations = solver.relax_iterations.min(MAX_RELAX_ITERATIONS);
-    solver.escalation_iterations = solver.escalation_iterations.min(MAX_ITERATIONS);
+    if let impulse::SolverMethod::Auto {
+        escalation_iterations,
+        ..
+    } = &mut solver.method
+    {
+        *escalation_iterations = (*escalation_iterations).min(MAX_ITERATIONS);
+    }
     solver.exact_max_contacts = solver.exact_max_contacts.min(MAX_EXACT_CONTACTS);
 }
 
@@ -139,7 +145,8 @@ pub fn mesh_input(data: &[u8]) -> Option<usize> {
 /// and at most [`MAX_STEPS`] capped steps. Returns the steps taken without error, `None` when
 /// the snapshot was refused or has more than [`MAX_BODIES`] bodies.
 pub fn snapshot_input(data: &[u8]) -> Option<usize> {
-    use impulse::{OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION, World, WorldSnapshot};
+    use impulse::report::{OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION};
+    use impulse::{World, WorldSnapshot};
     let (&selector, rest) = data.split_first()?;
     let snapshot = if selector % 2 == 1 {
         WorldSnapshot::from_bytes(rest).ok()?

@@ -178,7 +178,7 @@ pub fn settings_text(s: &SolverSettings, threads: usize) -> String {
         SolverMethod::Pgs => "PGS",
         SolverMethod::Nncg => "NNCG",
         SolverMethod::Apgd => "APGD",
-        SolverMethod::Auto => "auto (NNCG, escalating per island)",
+        SolverMethod::Auto { .. } => "auto (NNCG, escalating per island)",
     };
     // As the step runs them: split impulse leaves no work to the relax pass.
     let repair = match s.repair {

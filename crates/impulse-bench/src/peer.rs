@@ -212,7 +212,8 @@ pub(crate) struct PeerJoint {
 /// target 0 with the same bound on every free rotation. Anything else is refused with an
 /// error naming the joint and `engine`.
 pub(crate) fn peer_joints(world: &World, engine: &str) -> Result<Vec<PeerJoint>> {
-    use impulse::{AxisMode, JointDof, JointKind, JointStiffness, MotorMode};
+    use impulse::JointKind;
+    use impulse::joints::{AxisMode, JointDof, JointStiffness, MotorMode};
     let anchors = quality::joint_anchors(world);
     let mut joints = Vec::with_capacity(anchors.len());
     for ((k, joint), anchor) in world.joints().enumerate().zip(anchors) {

@@ -81,8 +81,8 @@ enum Command {
         quiet: bool,
         /// After the summary, print the median wall time of each stage of the step (kinematic,
         /// broad phase, narrow phase, islands, assembly, solve, scatter, continuous, store
-        /// impulses, finish, end step; `impulse::Stage`) and the median CPU time of each phase
-        /// of the solve stage summed over islands (`impulse::SolvePhase`; timed only with
+        /// impulses, finish, end step; `impulse::report::Stage`) and the median CPU time of each phase
+        /// of the solve stage summed over islands (`impulse::report::SolvePhase`; timed only with
         /// `--profile` or `--stats`).
         #[arg(long)]
         profile: bool,

@@ -6,9 +6,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use impulse::EscalationLevel;
+use impulse::report::EscalationLevel;
+use impulse::report::{SolvePhase, Stage, StepProfile};
 use impulse::{Scene, World, WorldSnapshot, metrics};
-use impulse::{SolvePhase, Stage, StepProfile};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
@@ -43,7 +43,7 @@ pub struct RunOptions {
 }
 
 /// Island solves of a run by the strongest method each reached (one count per island and
-/// step), from [`impulse::IslandReport`].
+/// step), from [`impulse::report::IslandReport`].
 #[derive(Debug, Default, Serialize)]
 pub struct IslandSolves {
     pub pgs: u64,
@@ -107,7 +107,7 @@ pub struct Summary {
     /// `completed`, or the error that stopped the run.
     pub status: String,
     /// Median wall time (ms) of each stage of the step over the run
-    /// ([`impulse::StepProfile`]), each stage's median on its own: they need not
+    /// ([`impulse::report::StepProfile`]), each stage's median on its own: they need not
     /// add up to the median step; with the median CPU time of each phase of the solve stage
     /// summed over islands (`solve_phases`, zero unless `--profile` or `--stats` timed them).
     pub stage_ms: StepProfile,
@@ -730,12 +730,12 @@ const START_OVERLAP_WARNING: f32 = 0.01;
 /// [`START_OVERLAP_WARNING`], naming both and the depth: the first step's contact points are
 /// found on the poses the scene gave.
 /// The one warning of a run that a heavy-on-light island is not held
-/// ([`impulse::HeavyOnLight::held`]), naming the contact's two bodies.
+/// ([`impulse::report::HeavyOnLight::held`]), naming the contact's two bodies.
 fn warn_of_heavy_on_light(
     world: &World,
     step: u64,
-    island: &impulse::IslandReport,
-    heavy: impulse::HeavyOnLight,
+    island: &impulse::report::IslandReport,
+    heavy: impulse::report::HeavyOnLight,
 ) {
     let name = |index: u32| match world.handle_of(index as usize).and_then(|h| world.body(h)) {
         Some(b) => match b.name() {
@@ -751,7 +751,7 @@ fn warn_of_heavy_on_light(
             "its island has {} contact points, more than the exact path takes \
              ({} × solver.exact_max_contacts)",
             island.contacts,
-            impulse::HEAVY_ON_LIGHT_CONTACTS_FACTOR
+            impulse::report::HEAVY_ON_LIGHT_CONTACTS_FACTOR
         )
     };
     eprintln!(
@@ -761,7 +761,7 @@ fn warn_of_heavy_on_light(
         name(heavy.heavy_body),
         name(heavy.light_body),
         heavy.mass_ratio,
-        impulse::HEAVY_ON_LIGHT_HELD_OVERLAP * 1e3,
+        impulse::report::HEAVY_ON_LIGHT_HELD_OVERLAP * 1e3,
     );
 }
 

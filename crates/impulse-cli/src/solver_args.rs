@@ -1,6 +1,7 @@
 //! The solver options of `impulse run`: one clap `Args` group applied on top of a scene's (or a
 //! preset's) `SolverSettings`.
 
+use clap::builder::TypedValueParser;
 use clap::{Args, ValueEnum};
 use impulse::{ContactRepair, SolverMethod, SolverSettings};
 
@@ -31,28 +32,11 @@ impl PresetArg {
     }
 }
 
-/// The solve method of every island.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum MethodArg {
-    /// Projected Gauss-Seidel.
-    Pgs,
-    /// Nonsmooth nonlinear conjugate gradient.
-    Nncg,
-    /// Accelerated projected gradient descent.
-    Apgd,
-    /// NNCG escalating per island to more iterations or the exact path.
-    Auto,
-}
-
-impl From<MethodArg> for SolverMethod {
-    fn from(method: MethodArg) -> Self {
-        match method {
-            MethodArg::Pgs => SolverMethod::Pgs,
-            MethodArg::Nncg => SolverMethod::Nncg,
-            MethodArg::Apgd => SolverMethod::Apgd,
-            MethodArg::Auto => SolverMethod::Auto,
-        }
-    }
+/// `--method`: one of [`SolverMethod::ALL`] by its name, with `auto`'s parameters at their
+/// defaults (the escalation options set them).
+fn method_parser() -> impl TypedValueParser<Value = SolverMethod> {
+    clap::builder::PossibleValuesParser::new(SolverMethod::ALL.map(SolverMethod::name))
+        .try_map(|name| name.parse::<SolverMethod>())
 }
 
 /// How overlap is repaired.
@@ -88,9 +72,11 @@ pub struct SolverArgs {
     /// Relax iterations per substep.
     #[arg(long)]
     pub relax: Option<u32>,
-    /// Method of every island's solve.
-    #[arg(long, value_enum)]
-    pub method: Option<MethodArg>,
+    /// Method of every island's solve: `pgs` (projected Gauss-Seidel), `nncg` (nonsmooth
+    /// nonlinear conjugate gradient), `apgd` (accelerated projected gradient descent) or `auto`
+    /// (NNCG escalating per island to more iterations or the exact path).
+    #[arg(long, value_parser = method_parser())]
+    pub method: Option<SolverMethod>,
     /// Early exit: a solve stops when no row's velocity changed by more than this in a sweep
     /// (m/s).
     #[arg(long)]
@@ -114,8 +100,8 @@ pub struct SolverArgs {
     /// `auto`: NNCG iterations per substep after an island escalates.
     #[arg(long)]
     pub escalation_iterations: Option<u32>,
-    /// `auto`: solve islands of at most this many contact points exactly when NNCG does not
-    /// converge (0 = never).
+    /// Solve islands of at most this many contact points exactly: `auto` when NNCG does not
+    /// converge, and every method's heavy-on-light islands up to 4 times as many (0 = never).
     #[arg(long)]
     pub exact_max_contacts: Option<u32>,
     /// Overlap (m) left unrepaired, so resting rigid contacts do not jitter (the soft-step
@@ -199,15 +185,46 @@ impl SolverArgs {
             self.parallel_island_contacts,
         );
         set(&mut s.simd_island_contacts, self.simd_island_contacts);
-        if let Some(tolerance) = self.escalation_tolerance {
-            s.escalation_tolerance = tolerance;
-        }
-        set(&mut s.escalation_iterations, self.escalation_iterations);
         set(&mut s.exact_max_contacts, self.exact_max_contacts);
         if let Some(method) = self.method {
-            s.method = method.into();
+            // `--method auto` on settings that already solve by `auto` keeps their parameters.
+            if !(method.is_auto() && s.method.is_auto()) {
+                s.method = method;
+            }
         }
+        s.method = self.escalation(s.method)?;
         Ok(s)
+    }
+
+    /// `method` with the escalation options applied. Errors: an escalation option given for
+    /// a method other than `auto`.
+    fn escalation(&self, method: SolverMethod) -> Result<SolverMethod, String> {
+        let SolverMethod::Auto {
+            mut escalation_tolerance,
+            mut escalation_iterations,
+            mass_ratio_threshold,
+        } = method
+        else {
+            return match (self.escalation_tolerance, self.escalation_iterations) {
+                (None, None) => Ok(method),
+                _ => Err(format!(
+                    "--escalation-tolerance and --escalation-iterations are parameters of method \
+                     auto; these settings solve by {} (add --method auto)",
+                    method.name()
+                )),
+            };
+        };
+        if let Some(tolerance) = self.escalation_tolerance {
+            escalation_tolerance = tolerance;
+        }
+        if let Some(iterations) = self.escalation_iterations {
+            escalation_iterations = iterations;
+        }
+        Ok(SolverMethod::Auto {
+            escalation_tolerance,
+            escalation_iterations,
+            mass_ratio_threshold,
+        })
     }
 
     /// `repair` with `--repair`, then the repair parameters, applied.
@@ -290,7 +307,7 @@ mod tests {
             preset: Some(PresetArg::Fast),
             substeps: Some(3),
             repair: Some(RepairArg::Split),
-            method: Some(MethodArg::Nncg),
+            method: Some(SolverMethod::Nncg),
             no_sleep: true,
             ..SolverArgs::default()
         };
@@ -378,5 +395,41 @@ mod tests {
             ..SolverArgs::default()
         };
         assert!(sweeps.apply(&soft).unwrap_err().contains("--repair split"));
+    }
+
+    /// `--method` takes the library's method names, `auto` with the escalation options as its
+    /// parameters; an escalation option for another method is an error naming it.
+    #[test]
+    fn methods_are_the_librarys_and_escalation_options_are_autos() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Command {
+            #[command(flatten)]
+            solver: SolverArgs,
+        }
+        let parse = |args: &[&str]| {
+            Command::try_parse_from(std::iter::once("impulse").chain(args.iter().copied()))
+                .map(|command| command.solver)
+        };
+        for method in SolverMethod::ALL {
+            let args = parse(&["--method", method.name()]).unwrap();
+            let settings = args.apply(&SolverSettings::default()).unwrap();
+            assert_eq!(settings.method, method);
+        }
+        assert!(parse(&["--method", "lemke"]).is_err());
+        let args = parse(&["--method", "auto", "--escalation-iterations", "9"]).unwrap();
+        let SolverMethod::Auto {
+            escalation_iterations,
+            ..
+        } = args.apply(&SolverSettings::default()).unwrap().method
+        else {
+            panic!("not auto");
+        };
+        assert_eq!(escalation_iterations, 9);
+        let error = parse(&["--escalation-tolerance", "0.1"])
+            .unwrap()
+            .apply(&SolverSettings::default())
+            .unwrap_err();
+        assert!(error.contains("--method auto"), "{error}");
     }
 }

@@ -4,9 +4,9 @@
 //! `natural_map_residual` (the LCP's mixed units, see [`impulse::StepDiagnostics`]),
 //! `kinetic_energy` (J), `max_depth` (largest overlap among the step's contact points before
 //! the solve, m), then the wall time of each stage of the step in ms
-//! ([`impulse::StepProfile::stages`], `kinematic_ms`, `broad_phase_ms` …) and `total_ms`, then
+//! ([`impulse::report::StepProfile::stages`], `kinematic_ms`, `broad_phase_ms` …) and `total_ms`, then
 //! the CPU time of each phase of the solve stage summed over islands in ms
-//! ([`impulse::SolvePhaseProfile::phases`], `phase_prepare_ms` … `phase_record_ms`).
+//! ([`impulse::report::SolvePhaseProfile::phases`], `phase_prepare_ms` … `phase_record_ms`).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use impulse::StepDiagnostics;
-use impulse::StepProfile;
+use impulse::report::StepProfile;
 
 /// Writes one CSV row per step.
 pub struct StatsWriter {

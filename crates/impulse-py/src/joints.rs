@@ -6,7 +6,9 @@
 //! raises `WorldError` naming the field.
 
 use impulse::glam::{Quat, Vec3};
-use impulse::{AxisMode, JointDof, JointEvent, JointRef, JointStiffness, Motor, MotorMode, Spring};
+use impulse::joints::{
+    AxisMode, JointDof, JointEvent, JointRef, JointStiffness, Motor, MotorMode, Spring,
+};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

@@ -174,7 +174,11 @@ impl World {
         }
         let world = guarded(|| {
             impulse::World::from_scene(&scene).map_err(|e| match e {
-                impulse::WorldError::InvalidSetting { .. } => world_error(e),
+                impulse::WorldError::InvalidSettings(ref problem)
+                    if impulse::settings::SettingError::WORLD_FIELDS.contains(&problem.field) =>
+                {
+                    world_error(e)
+                }
                 other => SceneError::new_err(format!("cannot build the world: {other}")),
             })
         })?;

@@ -3,7 +3,7 @@
 //! with the constants, `size_of` and the defaults. A doc that states a number differently from
 //! the code, or no longer states it where this test looks, fails here.
 
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::{Scene, SolverSettings};
 
 const ARCHITECTURE: &str = include_str!("../../../docs/architecture.md");

@@ -37,13 +37,13 @@ pub enum WorldError {
     #[error("no body {0:?} in this world (removed, or another world's handle)")]
     UnknownBody(crate::body::BodyHandle),
     /// The bodies start piled into one another: their bounding boxes overlap in more pairs than
-    /// [`crate::MAX_PAIRS_PER_BODY`] per body ([`crate::World::from_scene`]), e.g. 3,000
+    /// [`crate::settings::MAX_PAIRS_PER_BODY`] per body ([`crate::World::from_scene`]), e.g. 3,000
     /// coincident spheres. Displayed as `3000 bodies overlap at (0, 0, 0) (around body 0): …`.
     #[error(
         "{bodies} bodies overlap at ({}, {}, {}) (around body {body}): their bounding boxes \
          overlap in more than {limit} pairs ({} per body), a pile no step can take apart; \
          spread the bodies out",
-        at[0], at[1], at[2], crate::MAX_PAIRS_PER_BODY
+        at[0], at[1], at[2], crate::settings::MAX_PAIRS_PER_BODY
     )]
     Crowded {
         /// Bodies whose boxes meet the densest body's box, that body included.
@@ -52,19 +52,12 @@ pub enum WorldError {
         body: usize,
         /// Its centre of mass `[x, y, z]` (m).
         at: [f32; 3],
-        /// The most pairs allowed: [`crate::MAX_PAIRS_PER_BODY`] × the bodies.
+        /// The most pairs allowed: [`crate::settings::MAX_PAIRS_PER_BODY`] × the bodies.
         limit: usize,
     },
-    /// The time step or gravity is invalid.
-    #[error("{field}: {message}")]
-    InvalidSetting {
-        /// `dt` or `gravity`.
-        field: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// A solver setting is out of range ([`crate::SolverSettings::validate`]; displayed as
-    /// `solver.<field>: <message>`).
+    /// A setting is out of range: the time step or gravity (displayed as `<field>: <message>`,
+    /// e.g. `dt: must be finite and > 0, got 0`), or a solver setting
+    /// ([`crate::SolverSettings::validate`]; displayed as `solver.<field>: <message>`).
     #[error(transparent)]
     InvalidSettings(#[from] crate::settings::SettingError),
 }
@@ -87,8 +80,8 @@ pub enum StepError {
     BlowUp {
         /// The step (counted from 1) during which the blow-up happened.
         step: u64,
-        /// Index of the first offending body.
-        body: usize,
+        /// The first offending body.
+        body: crate::body::BodyHandle,
         /// `position` (its distance from the origin), `linear speed` or `angular speed`.
         quantity: &'static str,
         /// The offending magnitude (may be NaN or infinite).
@@ -107,7 +100,8 @@ pub enum StepError {
     /// since the last edit: the solve created energy, which contacts cannot.
     #[error(
         "simulation blew up at step {step}: mechanical energy rose {gain_per_kg} J per kg of \
-         moving mass above its lowest (bound {bound}); fastest body {fastest_body} at {speed} m/s"
+         moving mass above its lowest (bound {bound}); fastest body {} at {speed} m/s",
+        fastest_body.map_or("none".to_string(), |h| h.to_string())
     )]
     EnergyBlowUp {
         /// The step (counted from 1) during which the bound was crossed.
@@ -116,18 +110,18 @@ pub enum StepError {
         gain_per_kg: f32,
         /// The bound it crossed (J/kg).
         bound: f32,
-        /// Index of the fastest body, where to start looking.
-        fastest_body: usize,
+        /// The fastest body, where to start looking (`None` in a world without bodies).
+        fastest_body: Option<crate::body::BodyHandle>,
         /// Its speed (m/s).
         speed: f32,
     },
     /// Parry cannot generate contacts for this pair of shapes.
     #[error("no contact generator for the shapes of bodies {body1} and {body2}")]
     UnsupportedShapePair {
-        /// First body index.
-        body1: usize,
-        /// Second body index.
-        body2: usize,
+        /// The first body.
+        body1: crate::body::BodyHandle,
+        /// The second body.
+        body2: crate::body::BodyHandle,
     },
 }
 

@@ -27,18 +27,17 @@
 //! [`BodyBuilder`] and [`BodyHandle`], [`SolverSettings`] (presets along the quality/speed
 //! front), [`Scene`] and the [`scene`] module (the JSON scene format and built-in scenes),
 //! [`StepDiagnostics`] (how well each step's LCP was solved) and [`metrics`] (sink, overlap
-//! and drift of a simulation's state). Inside, each stage of [`World::step`] is one private
-//! module: integrate (1, 6) → broad phase (2) → narrow phase (3) → constraints (4) → islands
-//! and the solver (5: one island at a time, each method behind one interface) → kinematic
-//! bodies and continuous collision → diagnostics (7); docs/architecture.md in the repository
-//! maps them.
+//! and drift of a simulation's state). Inside, each stage of [`World::step`] ([`report::Stage`]
+//! lists them in order) is one private module; docs/architecture.md in the repository maps
+//! them.
 
 #![warn(missing_docs)]
 #![warn(unreachable_pub)]
 
-// Every stage is private: the public API is the re-exports below, plus two namespaces,
-// [`scene`] (the JSON scene format and the built-in scenes) and [`metrics`] (quality measures
-// of a simulation's state).
+// Every stage is private: the public API is the re-exports below, plus the namespaces
+// [`scene`] (the JSON scene format and the built-in scenes), [`settings`] (the solver
+// settings' parts), [`metrics`] (quality measures of a simulation's state), [`joints`] and
+// [`report`] (below).
 mod body;
 // The stages the hidden `internals` module re-exports keep those items `pub`: without the
 // feature they are unreachable, which is their point.
@@ -54,7 +53,7 @@ mod island;
 mod joint;
 mod parallel;
 mod profile;
-mod settings;
+pub mod settings;
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 mod solver;
 mod world;
@@ -85,34 +84,46 @@ pub use parry3d;
 pub use parry3d::shape::SharedShape;
 
 pub use body::{BodyBuilder, BodyHandle, BodyKind, Keyframe, LockedAxes};
-pub use collision::crowding::Crowd;
-pub use diagnostics::contact_lcp::ContactLcp;
-pub use diagnostics::{
-    EnergyTerms, SolvePhase, SolvePhaseProfile, Stage, StepDiagnostics, StepProfile,
-};
+pub use diagnostics::StepDiagnostics;
 pub use error::{SnapshotError, StepError, WorldError};
-pub use joint::{
-    AxisMode, JointAxis, JointBuilder, JointDof, JointEvent, JointHandle, JointKind, JointRef,
-    JointStiffness, Motor, MotorMode, Spring,
-};
-pub use scene::{
-    BodyDesc, LockedAxesDesc, Material, MaterialRef, Scene, SceneError, ShapeDesc, WorldAxis,
-};
-pub use scene::{Jitter, Override, Variation};
-pub use settings::{
-    CombineRule, ContactRepair, DEFAULT_MAX_ANGULAR_SPEED, DEFAULT_MAX_LINEAR_SPEED, ImpactModel,
-    MAX_PAIRS_PER_BODY, SettingError, SolverMethod, SolverSettings,
-};
-pub use solver::{
-    EscalationLevel, HEAVY_ON_LIGHT_CONTACTS_FACTOR, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight,
-    IslandContact, IslandReport,
-};
-pub use world::LeftWorld;
+pub use joint::{JointBuilder, JointHandle, JointKind};
+pub use scene::{BodyDesc, Material, Scene, SceneError, ShapeDesc};
+pub use settings::{ContactRepair, SolverMethod, SolverSettings};
 pub use world::{
-    BLOW_UP_DISTANCE, BLOW_UP_ENERGY_PER_KG, BodyRef, ContactEvent, ContactPairView, ContactPoint,
-    OLDEST_SNAPSHOT_FORMAT_VERSION, RayHit, SNAPSHOT_FORMAT_VERSION, ShapeHit, World,
+    BodyRef, ContactEvent, ContactPairView, ContactPoint, LeftWorld, RayHit, ShapeHit, World,
     WorldSnapshot,
 };
+// The engine's own paths to items re-exported only in the modules below (its doc links name
+// `crate::Stage` and the like).
+#[allow(unused_imports)]
+use report::{BLOW_UP_ENERGY_PER_KG, HEAVY_ON_LIGHT_CONTACTS_FACTOR, IslandReport, Stage};
+
+/// Joints beyond their builder and handle: the axes and degrees of freedom a joint constrains,
+/// its motors, springs and stiffness, and the events it reports ([`World::joint_events`]).
+pub mod joints {
+    pub use crate::joint::{
+        AxisMode, JointAxis, JointDof, JointEvent, JointRef, JointStiffness, Motor, MotorMode,
+        Spring,
+    };
+}
+
+/// What a step reports beyond [`StepDiagnostics`]: the stages' timings ([`report::Stage`],
+/// [`report::StepProfile`]), each island's solve ([`report::IslandReport`], with its
+/// escalation level and heavy-on-light finding), the bodies' energy terms, the contact LCP's
+/// export ([`World::contact_lcp`]), a crowded start ([`report::Crowd`]), and the bounds of the
+/// blow-up check and of snapshots.
+pub mod report {
+    pub use crate::collision::crowding::Crowd;
+    pub use crate::diagnostics::contact_lcp::ContactLcp;
+    pub use crate::diagnostics::{EnergyTerms, SolvePhase, SolvePhaseProfile, Stage, StepProfile};
+    pub use crate::solver::{
+        EscalationLevel, HEAVY_ON_LIGHT_CONTACTS_FACTOR, HEAVY_ON_LIGHT_HELD_OVERLAP, HeavyOnLight,
+        IslandContact, IslandReport,
+    };
+    pub use crate::world::{
+        BLOW_UP_ENERGY_PER_KG, OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION,
+    };
+}
 
 /// The engine's stages for benchmarks that time them one by one (`impulse-bench`'s
 /// criterion benches). Not part of the supported API: names and signatures change without
@@ -123,7 +134,7 @@ pub mod internals {
     pub use crate::body::Bodies;
     pub use crate::collision::broad_phase::BroadPhase;
     pub use crate::collision::narrow_phase::{NarrowPhase, SpeculativeMargins};
-    pub use crate::contact::constraints::ContactConstraint;
+    pub use crate::contact::ContactConstraint;
     pub use crate::solver::nncg::{NncgWorkspace, solve_nncg};
     pub use crate::solver::pgs::solve_pgs;
     pub use crate::solver::{Sweep, Velocities, warm_start};

@@ -12,7 +12,7 @@ pub(crate) use common::*;
 use glam::Vec3;
 
 use crate::World;
-use crate::contact::constraints::{ContactConstraint, JacobianRow};
+use crate::contact::{ContactConstraint, JacobianRow};
 
 /// A seeded generator of uniform numbers in [low, high) (a 64-bit linear congruential
 /// generator, Knuth's MMIX constants, 24 bits of each state): the same sequence on every run,

@@ -76,7 +76,7 @@ fn run_writes_csv_trajectory_and_summary_json() {
         let ms = &json["stage_ms"][stage];
         assert!(ms.is_number(), "stage_ms.{stage}: {ms:?}");
     }
-    for phase in impulse::SolvePhase::ALL {
+    for phase in impulse::report::SolvePhase::ALL {
         let ms = &json["stage_ms"]["solve_phases"][phase.name()];
         assert!(
             ms.is_number(),
@@ -104,7 +104,7 @@ fn profile_prints_the_median_of_every_stage() {
         .unwrap_or_else(|| panic!("no stage line in {stdout}"))
         .split(", ")
         .collect();
-    assert_eq!(stages.len(), impulse::Stage::ALL.len(), "{line}");
+    assert_eq!(stages.len(), impulse::report::Stage::ALL.len(), "{line}");
     // Then the solve's phases, by their names, timed: some island solved.
     let line = stdout.lines().nth(2).unwrap_or_default();
     let phases: Vec<(&str, f64)> = line
@@ -116,7 +116,10 @@ fn profile_prints_the_median_of_every_stage() {
             (name, ms.parse::<f64>().unwrap())
         })
         .collect();
-    let names: Vec<&str> = impulse::SolvePhase::ALL.iter().map(|p| p.name()).collect();
+    let names: Vec<&str> = impulse::report::SolvePhase::ALL
+        .iter()
+        .map(|p| p.name())
+        .collect();
     assert_eq!(phases.iter().map(|(n, _)| *n).collect::<Vec<_>>(), names);
     assert!(phases.iter().all(|(_, ms)| *ms >= 0.0), "{line}");
     assert!(phases.iter().any(|(_, ms)| *ms > 0.0), "{line}");

@@ -236,7 +236,7 @@ fn stats_have_one_finite_row_per_step_and_plot_as_svg_and_png() {
     ] {
         assert!(header.contains(&stage), "no {stage} in {header:?}");
     }
-    for phase in impulse::SolvePhase::ALL {
+    for phase in impulse::report::SolvePhase::ALL {
         let column = format!("phase_{}_ms", phase.name());
         assert!(
             header.contains(&column.as_str()),

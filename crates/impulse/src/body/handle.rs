@@ -25,6 +25,17 @@ impl BodyHandle {
     }
 }
 
+/// The slot index, and the generation after a `v` when the slot was reused (`3`, `3v1`): as
+/// errors name a body.
+impl std::fmt::Display for BodyHandle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.generation {
+            0 => write!(f, "{}", self.index),
+            generation => write!(f, "{}v{generation}", self.index),
+        }
+    }
+}
+
 /// Handle slots of a world: which dense body index each handle names, and the free slots.
 #[derive(Clone, Default, Serialize, Deserialize)]
 pub(crate) struct Handles {

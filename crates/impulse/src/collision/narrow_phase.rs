@@ -17,8 +17,12 @@ pub(crate) use super::manifold::{ContactImpulse, Manifold, manifold_poses};
 pub use super::margins::SpeculativeMargins;
 use super::part_pairs;
 use crate::body::Bodies;
-use crate::error::StepError;
 use crate::parallel::{MANIFOLD_PAIRS_PER_TASK, prefetch, spread};
+
+/// Parry has no contact generator for the shapes of bodies `.0` and `.1` (dense indices; the
+/// stage reports them by handle, [`crate::StepError::UnsupportedShapePair`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnsupportedShapePair(pub usize, pub usize);
 
 /// The contact state of one pair of bodies. Shape 1 belongs to `body1`, shape 2 to `body2`,
 /// and `body1 < body2`.
@@ -289,7 +293,7 @@ impl NarrowPhase {
         candidates: &[(u32, u32)],
         margins: &SpeculativeMargins,
         parallel: bool,
-    ) -> Result<(), StepError> {
+    ) -> Result<(), UnsupportedShapePair> {
         // Last step's pairs and this step's candidates are both sorted by (body1, body2): a
         // merge join carries each surviving pair over without hashing.
         debug_assert!(candidates.windows(2).all(|w| w[0] < w[1]));
@@ -312,7 +316,7 @@ impl NarrowPhase {
                 self.pairs.push(pair);
             }
         }
-        let update = |pair: &mut ContactPair| -> Result<(), StepError> {
+        let update = |pair: &mut ContactPair| -> Result<(), UnsupportedShapePair> {
             pair.recomputed = false;
             let (a, b) = (pair.body1 as usize, pair.body2 as usize);
             // A pair with no awake body keeps its manifolds as they were: nothing moved.
@@ -354,7 +358,7 @@ impl NarrowPhase {
                     &mut pair.manifolds,
                     &mut pair.workspace,
                 )
-                .map_err(|_| StepError::UnsupportedShapePair { body1: a, body2: b })?;
+                .map_err(|_| UnsupportedShapePair(a, b))?;
             for manifold in &mut pair.manifolds {
                 drop_duplicate_points(manifold);
             }
@@ -374,7 +378,7 @@ impl NarrowPhase {
             pair.recomputed = true;
             Ok(())
         };
-        let run = |pairs: &mut [ContactPair]| -> Result<(), StepError> {
+        let run = |pairs: &mut [ContactPair]| -> Result<(), UnsupportedShapePair> {
             for i in 0..pairs.len() {
                 prefetch_manifolds(pairs, i);
                 update(&mut pairs[i])?;

@@ -22,9 +22,5 @@ pub(crate) use record::*;
 pub use row::*;
 pub(crate) use targets::*;
 
-/// The same items under the path the step's callers name them by
-/// (`contact::constraints::assemble`).
-pub(crate) use crate::contact as constraints;
-
 #[cfg(test)]
 mod tests;

@@ -10,7 +10,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use crate::body::Bodies;
-use crate::contact::constraints::{BodySlots, ContactConstraint};
+use crate::contact::{BodySlots, ContactConstraint};
 use crate::parallel::{ENERGY_BODIES_PER_PART, parts_in_order, spread};
 use crate::solver::cap_to_disc;
 use crate::solver::{IslandReport, RowsReport};
@@ -110,9 +110,8 @@ fn row_squared_natural_map(
     linear_b: Vec3,
     angular_b: Vec3,
 ) -> f64 {
-    let velocity = |row: &crate::contact::constraints::JacobianRow| {
-        row.velocity(linear_a, angular_a, linear_b, angular_b)
-    };
+    let velocity =
+        |row: &crate::contact::JacobianRow| row.velocity(linear_a, angular_a, linear_b, angular_b);
     let w = velocity(&c.normal) - c.target_normal_velocity;
     let phi = c.normal_impulse.min(w) as f64;
     let mut sum = phi * phi;
@@ -129,7 +128,7 @@ fn row_squared_natural_map(
     sum
 }
 
-/// [`crate::contact::constraints::record_velocity_before`], [`natural_map_residual_in`] and the count of
+/// [`crate::contact::record_velocity_before`], [`natural_map_residual_in`] and the count of
 /// points with friction in one pass over the rows instead of three: how an island's step ends.
 /// The results are those of the three passes to the bit (the residual's partial sums are
 /// taken over the same runs of rows and added in the same order) on any thread count.
@@ -145,7 +144,7 @@ pub(crate) fn record_velocity_before_and_residual(
     scratch: &mut Vec<(Vec3, Vec3)>,
 ) -> RowsReport {
     let parallel = spread(parallel, 1, 0);
-    let Some(changes) = crate::contact::constraints::impulse_velocity_changes(
+    let Some(changes) = crate::contact::impulse_velocity_changes(
         constraints,
         slots,
         linear.len(),
@@ -161,7 +160,7 @@ pub(crate) fn record_velocity_before_and_residual(
             let (a, b) = bodies_of(c);
             sum += row_squared_natural_map(c, linear[a], angular[a], linear[b], angular[b]);
             friction_rows += usize::from(c.friction > 0.0);
-            crate::contact::constraints::record_row(c, a, b, linear, angular, changes);
+            crate::contact::record_row(c, a, b, linear, angular, changes);
         }
         (sum, friction_rows)
     };

@@ -56,14 +56,19 @@ pub(crate) fn heavy_on_light_max_contacts(settings: &SolverSettings) -> u32 {
 /// The settings of the heavy-on-light path ([`SolverSettings::heavy_on_light_mass_ratio`]):
 /// the basic method's one LCP per step (one substep), on rigid rows with a velocity bias
 /// ([`HEAVY_ON_LIGHT_REPAIR_RATE`]) and a relax solve, solved by the automatic policy with every
-/// solve escalating to the exact path (Lemke; NNCG's result stands if pivoting fails). The
+/// solve escalating to the exact path (Lemke; NNCG's result stands if pivoting fails; `auto`'s
+/// other parameters as `settings.method`'s, or their defaults). The
 /// rest, repair cap, friction and warm start included, is `settings`'.
 pub(crate) fn heavy_on_light_settings(settings: &SolverSettings) -> SolverSettings {
+    let (escalation_tolerance, escalation_iterations, _) = settings.method.auto_parameters();
     SolverSettings {
-        method: SolverMethod::Auto,
+        method: SolverMethod::Auto {
+            escalation_tolerance,
+            escalation_iterations,
+            mass_ratio_threshold: 0.0,
+        },
         substeps: 1,
         relax_iterations: settings.relax_iterations.max(1),
-        mass_ratio_threshold: 0.0,
         exact_max_contacts: heavy_on_light_max_contacts(settings),
         repair: ContactRepair::Bias {
             rate: HEAVY_ON_LIGHT_REPAIR_RATE,

@@ -163,7 +163,7 @@ impl Solvers {
             SolverMethod::Pgs => &mut self.pgs,
             SolverMethod::Nncg => &mut self.nncg,
             SolverMethod::Apgd => &mut self.apgd,
-            SolverMethod::Auto => &mut self.auto,
+            SolverMethod::Auto { .. } => &mut self.auto,
         }
     }
 

@@ -425,7 +425,7 @@ impl IslandWorkspace {
         // takes the exact path in each of them (`start_solves` widens its limit), so the
         // island is reported either way.
         let split = settings.split_impulse();
-        let exact = small && (!split || settings.method == SolverMethod::Auto);
+        let exact = small && (!split || settings.method.is_auto());
         self.report.heavy_on_light =
             heavy_on_light(island_bodies, constraints, context.bodies, threshold)
                 .map(|heavy| HeavyOnLight { exact, ..heavy });

@@ -7,7 +7,7 @@ use super::World;
 use super::contact_events::ContactEvent;
 use crate::body::{Bodies, BodyHandle};
 use crate::collision::narrow_phase::{self, ContactPair};
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::solver::IslandContact;
 
 /// One contact point of a pair after the last step, in world coordinates.

@@ -6,7 +6,7 @@ use glam::Vec3;
 use crate::body::{Bodies, BodyBuilder, BodyHandle, Handles};
 use crate::collision::broad_phase::BroadPhase;
 use crate::collision::narrow_phase::NarrowPhase;
-use crate::contact::constraints::{ContactConstraint, complete_products};
+use crate::contact::{ContactConstraint, complete_products};
 use crate::diagnostics::contact_lcp::{ContactLcp, assemble_lcp};
 use crate::diagnostics::{EnergyTerms, StepDiagnostics, StepProfile, energy_terms};
 use crate::error::WorldError;
@@ -33,7 +33,6 @@ pub use contacts::{ContactPairView, ContactPoint};
 pub use query::{RayHit, ShapeHit};
 pub use snapshot::{OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION, WorldSnapshot};
 
-pub use crate::settings::BLOW_UP_DISTANCE;
 pub use step::BLOW_UP_ENERGY_PER_KG;
 /// Bodies, settings and the persistent contact state of a simulation.
 pub struct World {
@@ -142,7 +141,7 @@ impl World {
     /// through `scene.materials` (`"default"` is [`Material::default`] unless redefined).
     /// Errors name the body and the field ([`WorldError::InvalidBody`]) or the setting; a start
     /// whose bodies pile into one another by the thousand (more pairs of overlapping bounding
-    /// boxes than [`crate::MAX_PAIRS_PER_BODY`] per body) is refused ([`WorldError::Crowded`]).
+    /// boxes than [`crate::settings::MAX_PAIRS_PER_BODY`] per body) is refused ([`WorldError::Crowded`]).
     ///
     /// ```
     /// use impulse::{Scene, World, scene::builtin_scene};
@@ -505,9 +504,10 @@ fn check_dt(dt: f32) -> Result<(), WorldError> {
     crate::body::rules::time_step(dt).map_err(|message| setting("dt", &message))
 }
 
-fn setting(field: &str, message: &str) -> WorldError {
-    WorldError::InvalidSetting {
-        field: field.to_string(),
+/// `field` is one of [`crate::settings::SettingError::WORLD_FIELDS`].
+fn setting(field: &'static str, message: &str) -> WorldError {
+    WorldError::InvalidSettings(crate::settings::SettingError {
+        field,
         message: message.to_string(),
-    }
+    })
 }

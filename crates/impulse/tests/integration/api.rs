@@ -425,11 +425,21 @@ fn the_api_and_the_scene_loader_reject_a_bad_setting_alike() {
         ("warm_start", "1.5", |s| s.warm_start = 1.5),
         ("overlap_slop", "-0.001", |s| s.overlap_slop = -0.001),
         ("escalation_iterations", "0", |s| {
-            s.escalation_iterations = 0
+            if let impulse::SolverMethod::Auto {
+                escalation_iterations,
+                ..
+            } = &mut s.method
+            {
+                *escalation_iterations = 0;
+            }
         }),
     ];
     for (field, value, edit) in cases {
-        let mut settings = SolverSettings::default();
+        // `auto`, so that its parameters count.
+        let mut settings = SolverSettings {
+            method: impulse::SolverMethod::AUTO,
+            ..SolverSettings::default()
+        };
         edit(&mut settings);
         let problem = settings.validate().expect_err("invalid");
         assert_eq!(problem.field, field);
@@ -444,7 +454,7 @@ fn the_api_and_the_scene_loader_reject_a_bad_setting_alike() {
                 .starts_with(&format!("solver.{field}: "))
         );
         let text = format!(
-            r#"{{"gravity": [0, 0, 0], "dt": 0.0166, "solver": {{"{field}": {value}}}, "bodies": []}}"#
+            r#"{{"gravity": [0, 0, 0], "dt": 0.0166, "solver": {{"method": "auto", "{field}": {value}}}, "bodies": []}}"#
         );
         let error = impulse::scene::parse_scene_str(&text, "bad.json")
             .expect_err("the scene loader rejects it")

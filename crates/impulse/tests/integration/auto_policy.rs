@@ -4,9 +4,9 @@
 
 use crate::common;
 
-use impulse::EscalationLevel;
 use impulse::SolverMethod;
 use impulse::World;
+use impulse::report::EscalationLevel;
 use impulse::scene::builtin_scene;
 
 /// Steps `name` with the `reference` preset (sleeping off) for `steps`; returns the world and,
@@ -15,7 +15,7 @@ fn run(
     name: &str,
     steps: u32,
     edit: impl Fn(&mut impulse::SolverSettings),
-) -> (World, Vec<Vec<impulse::IslandReport>>) {
+) -> (World, Vec<Vec<impulse::report::IslandReport>>) {
     let mut scene = builtin_scene(name).expect("built-in scene");
     scene.solver = impulse::SolverSettings {
         sleep: false,
@@ -38,7 +38,7 @@ fn run(
 #[test]
 fn heavy_small_island_is_solved_exactly_and_stays_at_rest() {
     let (world, reports) = run("massratio", 300, |_| {});
-    assert_eq!(world.settings().method, SolverMethod::Auto);
+    assert_eq!(world.settings().method, SolverMethod::AUTO);
     for (step, islands) in reports.iter().enumerate() {
         assert_eq!(islands.len(), 1, "step {step}: one island");
         let island = islands[0];
@@ -53,7 +53,7 @@ fn heavy_small_island_is_solved_exactly_and_stays_at_rest() {
         assert!(island.exact_failures < 4, "step {step}: {island:?}");
         assert!(island.exact_pivots > 0);
         assert!(
-            island.last_change <= world.settings().escalation_tolerance,
+            island.last_change <= escalation_tolerance(&world),
             "{island:?}"
         );
     }
@@ -107,7 +107,7 @@ fn fixed_methods_do_not_escalate() {
 #[test]
 fn plate_stands_still_with_the_exact_path() {
     let (world, reports) = run("plate", 300, |_| {});
-    let tolerance = world.settings().escalation_tolerance;
+    let tolerance = escalation_tolerance(&world);
     let mut exact = 0;
     for (step, island) in reports.iter().flatten().enumerate() {
         if island.method == EscalationLevel::Exact {
@@ -141,7 +141,11 @@ fn landing_column(
     let mut settings = impulse::SolverSettings {
         sleep: false,
         iterations: 1,
-        escalation_tolerance: 0.0,
+        method: SolverMethod::Auto {
+            escalation_tolerance: 0.0,
+            escalation_iterations: 4,
+            mass_ratio_threshold: 10.0,
+        },
         ..impulse::SolverSettings::reference()
     };
     edit(&mut settings);
@@ -190,7 +194,7 @@ fn impacts_take_more_iterations_and_rest_or_heavy_islands_the_exact_path() {
 }
 
 /// The island's report after one step of `world`.
-fn first_step_report(mut world: World) -> impulse::IslandReport {
+fn first_step_report(mut world: World) -> impulse::report::IslandReport {
     let islands = world.step().unwrap().islands.clone();
     assert_eq!(islands.len(), 1, "one column, one island: {islands:?}");
     islands[0]
@@ -201,7 +205,15 @@ fn first_step_report(mut world: World) -> impulse::IslandReport {
 /// iterations, not the exact path.
 #[test]
 fn an_island_at_the_mass_ratio_threshold_is_not_heavy() {
-    let island = first_step_report(landing_column(8.0, None, |s| s.mass_ratio_threshold = 1.0));
+    let island = first_step_report(landing_column(8.0, None, |s| {
+        if let SolverMethod::Auto {
+            mass_ratio_threshold,
+            ..
+        } = &mut s.method
+        {
+            *mass_ratio_threshold = 1.0;
+        }
+    }));
     assert_eq!(island.mass_ratio, 1.0, "{island:?}");
     assert_eq!(island.method, EscalationLevel::NncgExtended, "{island:?}");
 }
@@ -231,7 +243,13 @@ fn the_report_counts_the_budget_and_the_extension() {
         first_step_report(landing_column(8.0, None, |s| {
             s.iterations = 2;
             s.tolerance = 0.0;
-            s.escalation_iterations = extra;
+            if let SolverMethod::Auto {
+                escalation_iterations,
+                ..
+            } = &mut s.method
+            {
+                *escalation_iterations = extra;
+            }
         }))
     };
     let (short, long) = (report(4), report(8));
@@ -243,4 +261,9 @@ fn the_report_counts_the_budget_and_the_extension() {
         4 * short.escalations,
         "{short:?} {long:?}"
     );
+}
+
+/// The escalation tolerance of `world`'s `auto` method.
+fn escalation_tolerance(world: &World) -> f32 {
+    world.settings().method.auto_parameters().0
 }

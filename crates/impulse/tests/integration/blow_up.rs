@@ -2,9 +2,9 @@
 //! user puts in between steps is not mistaken for one.
 
 use glam::Vec3;
-use impulse::BLOW_UP_ENERGY_PER_KG;
 use impulse::ContactRepair;
 use impulse::SolverMethod;
+use impulse::report::BLOW_UP_ENERGY_PER_KG;
 use impulse::scene::builtin_scene;
 use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, StepError, World};
 

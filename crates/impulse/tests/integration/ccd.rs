@@ -205,7 +205,7 @@ fn tumbling_thin_box_bullets_never_cross_a_thin_wall() {
 /// 19 and 27 cm read as 16 and 1 mm, and the rows pushed the dart (a "ghost" contact) through
 /// the start orientation's inverse inertia, adding 265 J/kg in one substep (0°) and 1,140 J/kg
 /// in two (60°). A speculative row of a body turned by more than an eighth of a turn since the
-/// step began is stale and no longer pushes (`contact::constraints::SPECULATIVE_TURN`). The
+/// step began is stale and no longer pushes (`contact::SPECULATIVE_TURN`). The
 /// dart's island is small, so its rows take the scalar sweep; with SIMD lanes forced on
 /// (`simd_island_contacts` 1) the lanes' own test of stale rows is checked the same way.
 #[test]

@@ -107,7 +107,7 @@ fn every_solver_method_is_the_same_on_any_thread_count() {
     for (method, preset) in [
         (SolverMethod::Nncg, SolverSettings::default()),
         (SolverMethod::Apgd, SolverSettings::default()),
-        (SolverMethod::Auto, SolverSettings::reference()),
+        (SolverMethod::AUTO, SolverSettings::reference()),
     ] {
         let mut scene = builtin_scene("pyramid20").unwrap();
         scene.solver = SolverSettings { method, ..preset };

@@ -4,7 +4,8 @@
 //! the heavy-on-light path cannot take is reported as not held.
 
 use glam::Vec3;
-use impulse::{BodyDesc, BodyKind, HeavyOnLight, Material, ShapeDesc, SolverSettings, World};
+use impulse::report::HeavyOnLight;
+use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
 
 /// The largest sink (m) a heavy cube may show after 600 steps (10 s): the default preset's
 /// quality bar.
@@ -131,7 +132,7 @@ fn sink_after(
     heavy: usize,
     rest: f32,
     steps: u32,
-) -> (f32, Vec<impulse::IslandReport>) {
+) -> (f32, Vec<impulse::report::IslandReport>) {
     for _ in 0..steps {
         world.step().unwrap();
     }
@@ -182,7 +183,7 @@ fn the_island_report_names_the_path_taken() {
         "{found:?}"
     );
     assert_eq!(island.substeps, 1);
-    assert_eq!(island.method, impulse::EscalationLevel::Exact);
+    assert_eq!(island.method, impulse::report::EscalationLevel::Exact);
 
     for ratio in [1.0, 100.0] {
         let (mut world, heavy, rest) = heavy_on_light(Support::Stack, ratio, 1, settings());
@@ -191,7 +192,11 @@ fn the_island_report_names_the_path_taken() {
         for island in islands {
             assert_eq!(island.heavy_on_light, None, "{ratio}:1");
             assert_eq!(island.substeps, 20, "{ratio}:1");
-            assert_eq!(island.method, impulse::EscalationLevel::Pgs, "{ratio}:1");
+            assert_eq!(
+                island.method,
+                impulse::report::EscalationLevel::Pgs,
+                "{ratio}:1"
+            );
         }
     }
 }

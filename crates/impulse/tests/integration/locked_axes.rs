@@ -3,9 +3,9 @@
 
 use crate::body_options::{DT, G, ground, settings};
 use impulse::glam::{Quat, Vec3};
+use impulse::report::EscalationLevel;
 use impulse::{
-    BodyBuilder, BodyKind, EscalationLevel, LockedAxes, SharedShape, SolverSettings, World,
-    WorldSnapshot,
+    BodyBuilder, BodyKind, LockedAxes, SharedShape, SolverSettings, World, WorldSnapshot,
 };
 
 /// The locks a 2D-style scene gives every body: it moves in the x–y plane and turns about z.

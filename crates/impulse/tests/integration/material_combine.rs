@@ -4,7 +4,8 @@
 
 use glam::Vec3;
 use impulse::scene::parse_scene_str;
-use impulse::{BodyDesc, BodyKind, CombineRule, Material, ShapeDesc, SolverSettings, World};
+use impulse::settings::CombineRule;
+use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
 
 const DT: f32 = 1.0 / 60.0;
 const G: f32 = 9.81;

@@ -72,10 +72,13 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
                 .islands
                 .iter()
                 .filter_map(|i| i.deepest_contact)
-                .fold(None, |x: Option<impulse::IslandContact>, c| match x {
-                    Some(x) if x.depth >= c.depth => Some(x),
-                    _ => Some(c),
-                });
+                .fold(
+                    None,
+                    |x: Option<impulse::report::IslandContact>, c| match x {
+                        Some(x) if x.depth >= c.depth => Some(x),
+                        _ => Some(c),
+                    },
+                );
             println!(
                 "step {step}: overlap {:.2} mm, bodies {} and {} ({:.2} mm); deepest point at \
                  the step's start {deepest:?}",

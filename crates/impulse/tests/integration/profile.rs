@@ -29,7 +29,7 @@ fn stage_times_add_up_to_the_step() {
 /// section lists the stages by their enum names in the same order.
 #[test]
 fn the_stages_have_one_name_everywhere() {
-    use impulse::{Stage, StepProfile};
+    use impulse::report::{Stage, StepProfile};
     let json = serde_json::to_value(StepProfile::default()).unwrap();
     let keys: Vec<&str> = json
         .as_object()
@@ -76,7 +76,7 @@ fn the_stages_have_one_name_everywhere() {
 /// `SolvePhase::ALL` order) and docs/architecture.md's solve stage, which lists them in order.
 #[test]
 fn the_solve_phases_have_one_name_everywhere() {
-    use impulse::{SolvePhase, StepProfile};
+    use impulse::report::{SolvePhase, StepProfile};
     let json = serde_json::to_value(StepProfile::default()).unwrap();
     let keys: Vec<&str> = json["solve_phases"]
         .as_object()

@@ -16,7 +16,8 @@
 
 use impulse::glam::Vec3;
 use impulse::scene::load_scene_file;
-use impulse::{BodyBuilder, BodyHandle, ImpactModel, SharedShape, SolverSettings, World};
+use impulse::settings::ImpactModel;
+use impulse::{BodyBuilder, BodyHandle, SharedShape, SolverSettings, World};
 
 const RADIUS: f32 = 0.1;
 const DT: f32 = 1.0 / 60.0;

@@ -12,11 +12,12 @@
 
 use crate::common::hash_state;
 use impulse::glam::Vec3;
+use impulse::report::{OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION};
 use impulse::scene::builtin_scene;
 use impulse::scene::load_scene_file;
 use impulse::{
-    BodyBuilder, JointBuilder, OLDEST_SNAPSHOT_FORMAT_VERSION, SNAPSHOT_FORMAT_VERSION, Scene,
-    SharedShape, SnapshotError, SolverSettings, World, WorldSnapshot,
+    BodyBuilder, JointBuilder, Scene, SharedShape, SnapshotError, SolverSettings, World,
+    WorldSnapshot,
 };
 
 /// Runs `f` on a pool of `threads` threads (1: everything on the calling thread).
@@ -487,10 +488,13 @@ fn joint_zoo() -> World {
         .insert_joint(
             JointBuilder::generic(post, free)
                 .world_anchor(Vec3::new(0.6, 0.6, 0.0))
-                .dof(impulse::JointDof::LinearY, impulse::AxisMode::Free)
                 .dof(
-                    impulse::JointDof::AngularX,
-                    impulse::AxisMode::Limited {
+                    impulse::joints::JointDof::LinearY,
+                    impulse::joints::AxisMode::Free,
+                )
+                .dof(
+                    impulse::joints::JointDof::AngularX,
+                    impulse::joints::AxisMode::Limited {
                         lower: -0.2,
                         upper: 0.2,
                     },

@@ -5,10 +5,11 @@
 
 use std::path::Path;
 
+use impulse::scene::MaterialRef;
 use impulse::scene::{
     Jitter, Override, SceneErrorKind, Variation, builtin_scene, load_scene_file, parse_scene_str,
 };
-use impulse::{BodyDesc, BodyKind, MaterialRef, Scene, ShapeDesc};
+use impulse::{BodyDesc, BodyKind, Scene, ShapeDesc};
 use serde_json::json;
 
 /// A small scene with a named material, as a file would give it.
@@ -372,7 +373,7 @@ fn a_bodys_jitter_does_not_depend_on_the_bodies_after_it() {
 #[test]
 fn locked_axes_are_not_jittered() {
     let mut scene = crowd(4);
-    scene.bodies[2].locked_axes.translation = vec![impulse::WorldAxis::Z];
+    scene.bodies[2].locked_axes.translation = vec![impulse::scene::WorldAxis::Z];
     scene.bodies[3].lock_rotation = true;
     let out = jittered(&scene, 5, JITTER);
     assert_eq!(out.bodies[2].position[2], 0.0);

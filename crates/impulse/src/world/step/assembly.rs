@@ -4,7 +4,7 @@
 use glam::{Mat3, Vec3};
 
 use crate::World;
-use crate::contact::constraints::{self, ContactConstraint};
+use crate::contact::{self, ContactConstraint};
 use crate::island::Islands;
 use crate::settings::SolverSettings;
 use crate::solver::substep::IslandWorkspace;
@@ -22,7 +22,7 @@ impl World {
         constraints: &mut Vec<ContactConstraint>,
         workspaces: &mut Vec<IslandWorkspace>,
     ) {
-        constraints::assemble(
+        contact::assemble(
             &self.bodies,
             &self.narrow_phase,
             islands,

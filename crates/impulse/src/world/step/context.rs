@@ -15,7 +15,7 @@ use glam::{Mat3, Vec3};
 use parry3d::math::Pose;
 
 use crate::collision::margins::SpeculativeMargins;
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::island::Islands;
 use crate::solver::substep::IslandWorkspace;
 

@@ -28,6 +28,7 @@ impl World {
         let leaving = self.energy.check(
             energy,
             &self.bodies,
+            &self.handles.of_body,
             &self.settings,
             self.gravity,
             self.step_count,

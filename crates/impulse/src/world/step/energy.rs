@@ -9,7 +9,7 @@
 use glam::Vec3;
 use parry3d::math::Pose;
 
-use crate::body::Bodies;
+use crate::body::{Bodies, BodyHandle};
 use crate::diagnostics::{self, EnergyTerms};
 use crate::error::StepError;
 use crate::parallel::{BODIES_PER_TASK, find_first, spread};
@@ -117,12 +117,15 @@ impl EnergyCheck {
 
     /// The blow-up check as step `step` ends, on the bodies' energy `terms`: the mechanical
     /// energy per kilogram against its lowest since the last edit, then every body's position
-    /// and speed. Returns the moving bodies beyond `settings.max_distance`, in index order,
+    /// and speed (bodies named in errors by `handles`, per dense index). Returns the moving bodies beyond `settings.max_distance`, in index order,
     /// which leave the world, or the blow-up.
+    // The step's state this check reads, each part as the step holds it.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn check(
         &mut self,
         terms: &EnergyTerms,
         bodies: &Bodies,
+        handles: &[BodyHandle],
         settings: &SolverSettings,
         gravity: Vec3,
         step: u64,
@@ -155,7 +158,7 @@ impl EnergyCheck {
                 step,
                 gain_per_kg: gain as f32,
                 bound: bound as f32,
-                fastest_body: fastest,
+                fastest_body: handles.get(fastest).copied(),
                 speed: if bodies.is_empty() {
                     0.0
                 } else {
@@ -232,7 +235,7 @@ impl EnergyCheck {
         };
         Err(StepError::BlowUp {
             step,
-            body: i,
+            body: handles[i],
             quantity,
             value,
             unit,

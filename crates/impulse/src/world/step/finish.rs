@@ -4,7 +4,7 @@
 use glam::{Mat3, Vec3};
 
 use crate::World;
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::diagnostics::{self, EnergyTerms, StepDiagnostics};
 use crate::island::Islands;
 use crate::parallel::both;

@@ -18,7 +18,13 @@ impl World {
         let (broad_phase, narrow_phase) = (&mut self.broad_phase, &mut self.narrow_phase);
         let bodies = &self.bodies;
         let narrow = || narrow_phase.update(bodies, candidates, margins, parallel);
-        both(parallel, || broad_phase.optimize(), narrow).1?;
+        let of_body = &self.handles.of_body;
+        both(parallel, || broad_phase.optimize(), narrow)
+            .1
+            .map_err(|pair| StepError::UnsupportedShapePair {
+                body1: of_body[pair.0],
+                body2: of_body[pair.1],
+            })?;
         if self.bodies.roughness.iter().any(|&r| r > 0.0) {
             crate::contact::roughness::draw_new_manifolds(
                 &mut self.narrow_phase.pairs,

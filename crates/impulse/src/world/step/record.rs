@@ -18,7 +18,7 @@
 use glam::{Mat3, Vec3};
 
 use crate::World;
-use crate::contact::constraints::{self, BodySlots, ContactConstraint};
+use crate::contact::{self, BodySlots, ContactConstraint};
 use crate::diagnostics;
 use crate::island::Islands;
 use crate::solver::substep::IslandWorkspace;
@@ -69,8 +69,8 @@ impl World {
                 }
             }
             // The pass reads every row's I⁻¹(r × d), which the lanes keep in their bundles.
-            constraints::complete_products(constraints, world_inverse_inertia);
-            constraints::record_velocity_before(
+            contact::complete_products(constraints, world_inverse_inertia);
+            contact::record_velocity_before(
                 constraints,
                 BodySlots::World,
                 &self.bodies.linear_velocity,

@@ -5,7 +5,7 @@
 use glam::Mat3;
 
 use crate::World;
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::island::Islands;
 use crate::parallel::{ISLANDS_PER_TASK, for_each_with_rows, spread};
 use crate::profile::{SolvePhase, SolvePhaseProfile};

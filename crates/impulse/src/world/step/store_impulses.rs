@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use crate::World;
 use crate::collision::narrow_phase::{self, ContactImpulse};
-use crate::contact::constraints::ContactConstraint;
+use crate::contact::ContactConstraint;
 use crate::island::Islands;
 use crate::parallel::{PAIRS_PER_TASK, all_in_chunks, spread};
 use crate::solver::lanes::SolvedPoint;

@@ -3,10 +3,10 @@
 //! fixed-jointed bricks hit by a ball, a ragdoll at rest on stairs, and the exported mixed LCP.
 
 use impulse::glam::Vec3;
+use impulse::joints::JointEvent;
+use impulse::report::EscalationLevel;
 use impulse::scene::builtin_scene;
-use impulse::{
-    BodyBuilder, EscalationLevel, JointBuilder, JointEvent, SharedShape, SolverSettings, World,
-};
+use impulse::{BodyBuilder, JointBuilder, SharedShape, SolverMethod, SolverSettings, World};
 
 use super::{anchor, world};
 
@@ -404,7 +404,11 @@ fn hung_mass(
 /// so `auto` would keep it iterative) on islands of up to 160 contact points plus joint rows.
 fn reference_exact() -> SolverSettings {
     SolverSettings {
-        mass_ratio_threshold: 0.0,
+        method: SolverMethod::Auto {
+            escalation_tolerance: 3e-4,
+            escalation_iterations: 4,
+            mass_ratio_threshold: 0.0,
+        },
         exact_max_contacts: 160,
         sleep: false,
         ..SolverSettings::reference()

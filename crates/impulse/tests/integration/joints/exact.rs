@@ -5,9 +5,9 @@
 //! exported LCP (`World::contact_lcp()`), and its limit rows against complementarity.
 
 use impulse::glam::Vec3;
+use impulse::report::{ContactLcp, EscalationLevel};
 use impulse::{
-    BodyBuilder, BodyHandle, ContactLcp, EscalationLevel, JointBuilder, SharedShape,
-    SolverSettings, World,
+    BodyBuilder, BodyHandle, JointBuilder, SharedShape, SolverMethod, SolverSettings, World,
 };
 use impulse_lcp::solvers::lemke;
 use impulse_lcp::{SolverSettings as LcpSettings, Status};
@@ -23,7 +23,11 @@ const G: f32 = 9.81;
 fn exact_settings() -> SolverSettings {
     SolverSettings {
         substeps: 1,
-        mass_ratio_threshold: 0.0,
+        method: SolverMethod::Auto {
+            escalation_tolerance: 3e-4,
+            escalation_iterations: 4,
+            mass_ratio_threshold: 0.0,
+        },
         exact_max_contacts: 64,
         sleep: false,
         ..SolverSettings::reference()

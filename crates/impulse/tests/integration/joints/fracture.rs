@@ -3,7 +3,8 @@
 //! cantilevers) carries its own weight for seconds, so nothing breaks after the impact.
 
 use impulse::glam::Vec3;
-use impulse::{BodyBuilder, JointBuilder, JointEvent, SharedShape, SolverSettings, World};
+use impulse::joints::JointEvent;
+use impulse::{BodyBuilder, JointBuilder, SharedShape, SolverSettings, World};
 
 use super::world;
 

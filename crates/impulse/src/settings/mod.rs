@@ -2,9 +2,12 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The iterative method run on the contact rows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
+mod file;
+
+/// The iterative method run on the contact rows. In scene files, `solver.method` names it
+/// (`"pgs"`, `"nncg"`, `"apgd"`, `"auto"`) and `auto`'s parameters sit beside it in the `solver`
+/// object (`escalation_tolerance`, `escalation_iterations`, `mass_ratio_threshold`).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub enum SolverMethod {
     /// Projected Gauss-Seidel, the basic method of docs/method.md (sweeps in alternating direction); the
     /// default, in the soft step ([`SolverSettings::soft_step`]).
@@ -17,7 +20,7 @@ pub enum SolverMethod {
     /// The automatic policy, per island and solve ([`SolverSettings::reference`]): NNCG within the iteration
     /// budget; an island whose last iteration still changed a row's velocity by more than
     /// `escalation_tolerance`, or whose mass ratio exceeds `mass_ratio_threshold`, escalates:
-    /// to the exact path when it has at most `exact_max_contacts` contact points (keeping the
+    /// to the exact path when it has at most [`SolverSettings::exact_max_contacts`] contact points (keeping the
     /// iterative result if pivoting fails), otherwise (only when unconverged) to
     /// `escalation_iterations` more NNCG iterations. An unconverged island that is not heavy
     /// but in an impact (a contact closing at the step's start faster than |g|·dt, the speed
@@ -25,19 +28,87 @@ pub enum SolverMethod {
     /// what an impact leaves. Each island's choice is reported in the
     /// step diagnostics. It starts from NNCG rather than plain PGS because an NNCG iteration
     /// is a symmetric PGS sweep plus a momentum step, and on every standard scene it reached a
-    /// given sink at less cost than PGS first (docs/solvers.md).
-    Auto,
+    /// given sink at less cost than PGS first (docs/solvers.md). [`SolverMethod::AUTO`] has the
+    /// default parameters.
+    Auto {
+        /// An island escalates when the last iteration of its solve still changed some row's
+        /// velocity by more than this (m/s), ≥ 0. Looser than
+        /// [`SolverSettings::tolerance`], which only ends iterations early: a solve that
+        /// stopped at its budget above it is not converged. Default 3·10⁻⁴.
+        escalation_tolerance: f32,
+        /// NNCG iterations an unconverged island gets beyond the budget, ≥ 1. Default 4.
+        escalation_iterations: u32,
+        /// Islands whose heaviest to lightest moving body mass ratio exceeds this escalate to
+        /// the exact path even when the iterations look converged (iterative methods stall on
+        /// heavy-on-light), ≥ 0. Default 10.
+        mass_ratio_threshold: f32,
+    },
 }
 
 impl SolverMethod {
+    /// The automatic policy with its default parameters.
+    pub const AUTO: SolverMethod = SolverMethod::Auto {
+        escalation_tolerance: 3e-4,
+        escalation_iterations: 4,
+        mass_ratio_threshold: 10.0,
+    };
+
+    /// Every method, with default parameters, in the order the docs list them: what a
+    /// command line or a scene file may name ([`Self::name`], [`str::parse`]).
+    pub const ALL: [SolverMethod; 4] = [
+        SolverMethod::Pgs,
+        SolverMethod::Nncg,
+        SolverMethod::Apgd,
+        SolverMethod::AUTO,
+    ];
+
     /// The name used in scene files and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             SolverMethod::Pgs => "pgs",
             SolverMethod::Nncg => "nncg",
             SolverMethod::Apgd => "apgd",
-            SolverMethod::Auto => "auto",
+            SolverMethod::Auto { .. } => "auto",
         }
+    }
+
+    /// Whether this is the automatic policy (with any parameters).
+    pub fn is_auto(self) -> bool {
+        matches!(self, SolverMethod::Auto { .. })
+    }
+
+    /// The automatic policy's parameters (escalation tolerance, escalation iterations, mass
+    /// ratio threshold): this method's if it is `auto`, else [`Self::AUTO`]'s, which the
+    /// heavy-on-light path and the scene writer use.
+    pub fn auto_parameters(self) -> (f32, u32, f32) {
+        match self {
+            SolverMethod::Auto {
+                escalation_tolerance,
+                escalation_iterations,
+                mass_ratio_threshold,
+            } => (
+                escalation_tolerance,
+                escalation_iterations,
+                mass_ratio_threshold,
+            ),
+            _ => SolverMethod::AUTO.auto_parameters(),
+        }
+    }
+}
+
+/// The method named `name` (one of [`SolverMethod::ALL`]'s names), `auto` with its default
+/// parameters.
+impl std::str::FromStr for SolverMethod {
+    type Err = String;
+
+    fn from_str(name: &str) -> Result<Self, String> {
+        SolverMethod::ALL
+            .into_iter()
+            .find(|method| method.name() == name)
+            .ok_or_else(|| {
+                let names: Vec<_> = SolverMethod::ALL.iter().map(|m| m.name()).collect();
+                format!("no method named '{name}'; methods: {}", names.join(", "))
+            })
     }
 }
 
@@ -171,10 +242,12 @@ impl CombineRule {
 ///
 /// Defaults are chosen for the standard scenes at dt = 1/60 s. Units are SI.
 /// Each term is explained in docs/method.md with its source.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+///
+/// Scene files and snapshots hold them as the flat `solver` object of docs/scene-format.md
+/// (serialised through `settings/file.rs`).
+#[derive(Clone, Debug, PartialEq)]
 pub struct SolverSettings {
-    /// Method: `pgs`, `nncg`, `apgd`, or `auto` (the escalation policy).
+    /// Method: `pgs`, `nncg`, `apgd`, or `auto` (the escalation policy, with its parameters).
     pub method: SolverMethod,
     /// Substeps per step. Contacts are found once per step; each substep of h = dt/substeps
     /// applies gravity, solves, and integrates positions, with each contact's separation
@@ -192,17 +265,9 @@ pub struct SolverSettings {
     /// Early exit: stop sweeping once no row's velocity changed by more than this in a sweep
     /// (m/s), i.e. max |Δγ_i|/m_eff,i ≤ tolerance. 0 disables early exit.
     pub tolerance: f32,
-    /// `auto`: an island escalates when the last iteration of its solve still changed some
-    /// row's velocity by more than this (m/s). Looser than `tolerance`, which only ends
-    /// iterations early: a solve that stopped at its budget above it is not converged.
-    pub escalation_tolerance: f32,
-    /// `auto`: NNCG iterations an unconverged island gets beyond the budget.
-    pub escalation_iterations: u32,
-    /// `auto`: islands whose heaviest to lightest moving body mass ratio exceeds this escalate
-    /// to the exact path even when the iterations look converged (iterative methods stall on
-    /// heavy-on-light).
-    pub mass_ratio_threshold: f32,
-    /// `auto`: islands with at most this many contact points may escalate to the exact path
+    /// Islands with at most this many contact points may take the exact path: `auto`'s
+    /// escalation ([`SolverMethod::Auto`]), and, times
+    /// [`crate::HEAVY_ON_LIGHT_CONTACTS_FACTOR`], the heavy-on-light path of every method
     /// (0 = never).
     pub exact_max_contacts: u32,
     /// Methods other than `auto`: an island in which some contact joins two moving bodies
@@ -313,7 +378,7 @@ pub struct SolverSettings {
     pub restitution_combine: CombineRule,
     /// World bound (m): a moving body whose centre of mass ends a step farther than this from
     /// the origin leaves the simulation ([`crate::World::left_world`]): it is frozen where it
-    /// is and the run goes on. Default 10⁵ m ([`crate::BLOW_UP_DISTANCE`]); must be > 0.
+    /// is and the run goes on. Default 10⁵ m ([`crate::settings::BLOW_UP_DISTANCE`]); must be > 0.
     pub max_distance: f32,
     /// Largest speed of a body's centre of mass (m/s): a body faster than this at a step's end
     /// is a blow-up ([`crate::StepError::BlowUp`]), and a body given a faster initial velocity
@@ -350,15 +415,23 @@ pub const DEFAULT_MAX_ANGULAR_SPEED: f32 = 1.0e7;
 /// reach it at about 65 (n·(n − 1)/2 pairs).
 pub const MAX_PAIRS_PER_BODY: usize = 32;
 
-/// A solver setting outside its allowed range: which field, and what is allowed.
+/// A setting outside its allowed range: which field, and what is allowed. Displayed as
+/// `solver.<field>: <message>` for a solver setting, `<field>: <message>` for the world's
+/// `dt` and `gravity`.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("solver.{field}: {message}")]
+#[error("{}{field}: {message}", if Self::WORLD_FIELDS.contains(field) { "" } else { "solver." })]
 pub struct SettingError {
-    /// The field's name in [`SolverSettings`], which is also its key in a scene file's
-    /// `solver` object.
+    /// The field's key in a scene file's `solver` object (its name in [`SolverSettings`]'s
+    /// file format, e.g. `substeps` or `repair.hertz`), or one of [`Self::WORLD_FIELDS`].
     pub field: &'static str,
     /// What is wrong and what is allowed, with the value found (e.g. `must be ≥ 0, got -1`).
     pub message: String,
+}
+
+impl SettingError {
+    /// The world's settings outside the solver's, top-level keys of a scene file: the time
+    /// step `dt` (s) and `gravity` (m/s²).
+    pub const WORLD_FIELDS: [&'static str; 2] = ["dt", "gravity"];
 }
 
 impl SolverSettings {
@@ -376,11 +449,13 @@ impl SolverSettings {
             ContactRepair::SplitImpulse { iterations, .. } => iterations,
             _ => 1,
         };
+        let (escalation_tolerance, escalation_iterations, mass_ratio_threshold) =
+            self.method.auto_parameters();
         let counts = [
             ("iterations", self.iterations),
             ("substeps", self.substeps),
             ("repair.iterations", position_iterations),
-            ("escalation_iterations", self.escalation_iterations),
+            ("escalation_iterations", escalation_iterations),
         ];
         for (field, value) in counts {
             if value == 0 {
@@ -426,8 +501,8 @@ impl SolverSettings {
         };
         let non_negative = [
             ("tolerance", self.tolerance),
-            ("escalation_tolerance", self.escalation_tolerance),
-            ("mass_ratio_threshold", self.mass_ratio_threshold),
+            ("escalation_tolerance", escalation_tolerance),
+            ("mass_ratio_threshold", mass_ratio_threshold),
             ("heavy_on_light_mass_ratio", self.heavy_on_light_mass_ratio),
             (rate_field, rate),
             ("repair.damping_ratio", damping_ratio),
@@ -524,8 +599,8 @@ impl SolverSettings {
     /// for applying a preset to a scene: a preset sets accuracy, the scene sets physics.
     ///
     /// Taken from `preset` (how hard and how the LCP is solved): `method`, `substeps`,
-    /// `iterations`, `relax_iterations`, `tolerance`, `escalation_tolerance`,
-    /// `escalation_iterations`, `mass_ratio_threshold`, `exact_max_contacts`, `repair` (method,
+    /// `iterations`, `relax_iterations`, `tolerance` (`method` with `auto`'s parameters),
+    /// `exact_max_contacts`, `repair` (method,
     /// stiffness and its parameters), `overlap_slop`, `max_repair_speed`, `warm_start`,
     /// `friction_in_main_solve`, `direct_joint_solve`, `parallel_island_contacts` and
     /// `simd_island_contacts`.
@@ -542,9 +617,6 @@ impl SolverSettings {
             iterations: preset.iterations,
             relax_iterations: preset.relax_iterations,
             tolerance: preset.tolerance,
-            escalation_tolerance: preset.escalation_tolerance,
-            escalation_iterations: preset.escalation_iterations,
-            mass_ratio_threshold: preset.mass_ratio_threshold,
             exact_max_contacts: preset.exact_max_contacts,
             repair: preset.repair,
             overlap_slop: preset.overlap_slop,
@@ -632,7 +704,7 @@ impl SolverSettings {
     /// solution; it costs several times the default for the same quality on stacks.
     pub fn reference() -> Self {
         Self {
-            method: SolverMethod::Auto,
+            method: SolverMethod::AUTO,
             substeps: 4,
             iterations: 8,
             repair: ContactRepair::SplitImpulse {
@@ -657,9 +729,6 @@ impl Default for SolverSettings {
             iterations: 1,
             relax_iterations: 1,
             tolerance: 1e-5,
-            escalation_tolerance: 3e-4,
-            escalation_iterations: 4,
-            mass_ratio_threshold: 10.0,
             exact_max_contacts: 32,
             heavy_on_light_mass_ratio: 200.0,
             restitution_threshold: 0.5,
@@ -694,5 +763,4 @@ impl Default for SolverSettings {
 }
 
 #[cfg(test)]
-#[path = "settings_tests.rs"]
 mod tests;

@@ -1,4 +1,4 @@
-//! Unit tests of `settings.rs`.
+//! Unit tests of `settings`.
 
 use super::*;
 
@@ -44,7 +44,11 @@ fn each_rule_names_its_field_and_what_is_allowed() {
         ),
         (
             SolverSettings {
-                escalation_iterations: 0,
+                method: SolverMethod::Auto {
+                    escalation_tolerance: 1e-3,
+                    escalation_iterations: 0,
+                    mass_ratio_threshold: 10.0,
+                },
                 ..base()
             },
             "escalation_iterations: must be ≥ 1, got 0",
@@ -164,7 +168,7 @@ fn friction_leaves_the_main_solve_only_for_pgs_with_a_relax_solve() {
         }
         .main_solve_friction()
     );
-    for method in [SolverMethod::Nncg, SolverMethod::Apgd, SolverMethod::Auto] {
+    for method in [SolverMethod::Nncg, SolverMethod::Apgd, SolverMethod::AUTO] {
         assert!(SolverSettings { method, ..base() }.main_solve_friction());
     }
     assert!(
@@ -231,7 +235,7 @@ fn the_reference_preset_is_as_documented() {
     let r = SolverSettings::reference();
     assert_eq!(
         (r.method, r.substeps, r.iterations),
-        (SolverMethod::Auto, 4, 8)
+        (SolverMethod::AUTO, 4, 8)
     );
     assert_eq!(
         r.repair,
@@ -302,15 +306,21 @@ fn counts_have_a_maximum() {
 /// The names the CLI and reports print are the scene format's.
 #[test]
 fn names_are_the_scene_format_names() {
-    for method in [
-        SolverMethod::Pgs,
-        SolverMethod::Nncg,
-        SolverMethod::Apgd,
-        SolverMethod::Auto,
-    ] {
-        let json = serde_json::to_string(&method).unwrap();
-        assert_eq!(json, format!("\"{}\"", method.name()));
+    for method in SolverMethod::ALL {
+        let settings = SolverSettings {
+            method,
+            ..SolverSettings::default()
+        };
+        let json = serde_json::to_value(&settings).unwrap();
+        assert_eq!(json["method"], method.name());
+        assert_eq!(method.name().parse(), Ok(method));
     }
+    assert!(
+        "lemke"
+            .parse::<SolverMethod>()
+            .unwrap_err()
+            .contains("apgd")
+    );
     for repair in [
         ContactRepair::Bias { rate: 1.0 },
         ContactRepair::SplitImpulse {
@@ -325,4 +335,35 @@ fn names_are_the_scene_format_names() {
         let json = serde_json::to_value(repair).unwrap();
         assert_eq!(json["type"], repair.name());
     }
+}
+
+/// `auto`'s parameters sit beside `method` in the `solver` object: read into
+/// [`SolverMethod::Auto`], written back from it, and ignored by the other methods (which write
+/// `auto`'s defaults), so every file reads as it did when they were fields of the settings.
+#[test]
+fn autos_parameters_read_and_write_beside_the_method() {
+    let json = r#"{"method": "auto", "escalation_tolerance": 0.002, "escalation_iterations": 7,
+        "mass_ratio_threshold": 3.5, "exact_max_contacts": 12}"#;
+    let settings: SolverSettings = serde_json::from_str(json).unwrap();
+    assert_eq!(
+        settings.method,
+        SolverMethod::Auto {
+            escalation_tolerance: 0.002,
+            escalation_iterations: 7,
+            mass_ratio_threshold: 3.5,
+        }
+    );
+    assert_eq!(settings.exact_max_contacts, 12);
+    let written = serde_json::to_value(&settings).unwrap();
+    assert_eq!(written["escalation_iterations"], 7);
+    assert_eq!(
+        serde_json::from_value::<SolverSettings>(written).unwrap(),
+        settings
+    );
+    let pgs: SolverSettings =
+        serde_json::from_str(r#"{"method": "pgs", "escalation_iterations": 7}"#).unwrap();
+    assert_eq!(pgs, SolverSettings::default());
+    let default = serde_json::to_value(SolverSettings::default()).unwrap();
+    assert_eq!(default["escalation_iterations"], 4);
+    assert!(serde_json::from_str::<SolverSettings>(r#"{"substep": 3}"#).is_err());
 }
