@@ -104,7 +104,7 @@ pub(crate) struct IslandWorkspace {
     /// ([`IslandWorkspace::solved_point`]), and any other reader has them written into a copy
     /// of the rows ([`IslandWorkspace::unpack_into`]). Cleared when the island sleeps.
     pub(crate) impulses_in_lanes: bool,
-    /// The island's clock of its [`crate::SolvePhase`]s in the step.
+    /// The island's clock of its [`crate::report::SolvePhase`]s in the step.
     pub(crate) phases: PhaseClock,
 }
 

@@ -387,7 +387,7 @@ impl World {
         &self.profile
     }
 
-    /// Whether steps time the solve stage's phases ([`crate::SolvePhaseProfile`]); off by
+    /// Whether steps time the solve stage's phases ([`crate::report::SolvePhaseProfile`]); off by
     /// default.
     pub fn profile_solve_phases(&self) -> bool {
         self.profile_solve_phases

@@ -22,7 +22,7 @@
 //! candidate pairs, after the energy check's reference (`energy.rs`); contact manifolds;
 //! islands and world inverse inertia tensors; one row per contact point; which islands wake
 //! (`sleep.rs`) and each awake island's substeps and its rows' record (`record.rs`), timed by
-//! [`crate::SolvePhase`]; island results into the bodies and kinematic bodies moved; fast
+//! [`crate::report::SolvePhase`]; island results into the bodies and kinematic bodies moved; fast
 //! bodies swept and clamped (the geometry in `collision/continuous.rs`); impulses into the
 //! manifolds for the next warm start; sleep, energy, momentum and the diagnostics; contact
 //! events, the end of the step's forces, the energy and blow-up check and the bodies that left
