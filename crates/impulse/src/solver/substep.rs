@@ -27,6 +27,8 @@ use crate::parallel::{self, BODIES_PER_TASK, PARALLEL_ISLAND_POINTS};
 use crate::profile::SolvePhase;
 use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 
+mod forces;
+
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
 /// friction rows too, whatever [`SolverSettings::friction_in_main_solve`] says. Friction
 /// between a heavy body and a light one converges slowly under Gauss-Seidel (each sweep moves
@@ -650,53 +652,6 @@ impl IslandWorkspace {
                 .relax(&mut velocities, pose, sweeps, settings.tolerance);
         }
         self.phases.end(SolvePhase::Relax);
-    }
-
-    /// A substep's velocity changes before the contacts are solved: gravity, applied forces,
-    /// damping, locked axes and the gyroscopic term.
-    fn apply_forces(&mut self, gravity: Vec3, plan: &SolvePlan) {
-        let (h, moving) = (plan.h, plan.moving);
-        let w = self;
-        integrate::prospective_velocities(&mut w.linear[..moving], gravity, h);
-        for (k, &(linear, angular)) in w.acceleration.iter().enumerate() {
-            w.linear[k] += linear * h;
-            w.angular[k] += angular * h;
-        }
-        // Damping after gravity and forces, implicit: v ← v/(1 + h·c) (Box2D's damping).
-        for (k, &(linear, angular)) in w.damping.iter().enumerate() {
-            w.linear[k] *= linear;
-            w.angular[k] *= angular;
-        }
-        // Locked components stay zero: gravity is the one velocity change above that does
-        // not go through the inverse mass.
-        for &(k, free) in &w.translation_locks {
-            w.linear[k as usize] *= free;
-        }
-        // The gyroscopic term, per body at its current orientation, with the other velocity
-        // updates before the contacts are solved (as Bullet applies it with the external forces).
-        if !w.inertia.is_empty() {
-            let angular = &mut w.angular[..moving];
-            if plan.spread {
-                use rayon::prelude::*;
-                angular
-                    .par_chunks_mut(BODIES_PER_TASK)
-                    .zip(w.orientation.par_chunks(BODIES_PER_TASK))
-                    .zip(w.inertia.par_chunks(BODIES_PER_TASK))
-                    .for_each(|((a, o), t)| integrate::gyroscopic(a, o, t, h));
-            } else {
-                integrate::gyroscopic(angular, &w.orientation, &w.inertia, h);
-            }
-        }
-        for (k, locked, tensor) in &w.rotation_locks {
-            let k = *k as usize;
-            integrate::gyroscopic_in_plane(
-                &mut w.angular[k],
-                w.orientation[k],
-                tensor,
-                usize::from(*locked),
-                h,
-            );
-        }
     }
 
     /// Moves the island's bodies and guests by a substep's velocities; with split impulse and
