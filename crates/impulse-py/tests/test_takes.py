@@ -471,31 +471,34 @@ def test_the_worked_shots_are_as_documented(shot, repository, tmp_path):
     assert found_row == documented
 
 
+def _ball_over_floor(name, materials, **scene):
+    """A 10 cm ball 1 m above a static floor (its top at y = 0), materials `floor` and `ball`."""
+    floor = {
+        "name": "floor",
+        "kind": "static",
+        "material": "floor",
+        "shape": {"type": "cuboid", "half_extents": [20, 0.5, 20]},
+        "position": [0, -0.5, 0],
+    }
+    ball = {
+        "name": "ball",
+        "kind": "dynamic",
+        "material": "ball",
+        "shape": {"type": "sphere", "radius": 0.1},
+        "position": [0, 1.1, 0],
+    }
+    return {"name": name, **scene, "materials": materials, "bodies": [floor, ball]}
+
+
 #: A frictionless elastic ball dropped on a rough floor: only the floor's roughness draws (the
 #: scene seed) decide where it bounces.
-ROUGH = {
-    "name": "rough bounce",
-    "materials": {
-        "rough": {"friction": 0.0, "restitution": 1.0, "roughness": 10.0},
+ROUGH = _ball_over_floor(
+    "rough bounce",
+    {
+        "floor": {"friction": 0.0, "restitution": 1.0, "roughness": 10.0},
         "ball": {"friction": 0.0, "restitution": 1.0},
     },
-    "bodies": [
-        {
-            "name": "floor",
-            "kind": "static",
-            "material": "rough",
-            "shape": {"type": "cuboid", "half_extents": [20, 0.5, 20]},
-            "position": [0, -0.5, 0],
-        },
-        {
-            "name": "ball",
-            "kind": "dynamic",
-            "material": "ball",
-            "shape": {"type": "sphere", "radius": 0.1},
-            "position": [0, 1.1, 0],
-        },
-    ],
-}
+)
 
 
 def test_takes_with_their_own_seeds_vary_the_rough_surfaces(tmp_path):
@@ -530,7 +533,7 @@ def test_takes_with_their_own_seeds_vary_the_rough_surfaces(tmp_path):
     assert world.positions[1][0] >= 0.15
     # A smooth floor sends the ball straight back up whatever the seed.
     smooth = json.loads(json.dumps(ROUGH))
-    smooth["materials"]["rough"]["roughness"] = 0.0
+    smooth["materials"]["floor"]["roughness"] = 0.0
     smooth["seed"] = 12345
     world = impulse.World.from_scene(smooth)
     world.step(72)
@@ -600,30 +603,14 @@ def test_a_met_hoop_take_is_the_same_to_the_bit_through_impulse_run(
 #: A frictionless ball of restitution 0.5 and impact perturbation 0.4 dropped 1 m onto a floor:
 #: the impact draws (the scene seed) decide how high it bounces (c_r' in [0.1, 0.9], apex
 #: c_r'² × 1 m above the floor).
-BOUNCY = {
-    "name": "perturbed bounce",
-    "dt": 1.0 / 60.0,
-    "materials": {
+BOUNCY = _ball_over_floor(
+    "perturbed bounce",
+    {
         "floor": {"friction": 0.0},
         "ball": {"friction": 0.0, "restitution": 0.5, "impact_perturbation": 0.4},
     },
-    "bodies": [
-        {
-            "name": "floor",
-            "kind": "static",
-            "material": "floor",
-            "shape": {"type": "cuboid", "half_extents": [20, 0.5, 20]},
-            "position": [0, -0.5, 0],
-        },
-        {
-            "name": "ball",
-            "kind": "dynamic",
-            "material": "ball",
-            "shape": {"type": "sphere", "radius": 0.1},
-            "position": [0, 1.1, 0],
-        },
-    ],
-}
+    dt=1.0 / 60.0,
+)
 
 
 def _highest_after_bounce(scene, steps=90):

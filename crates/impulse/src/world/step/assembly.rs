@@ -1,5 +1,5 @@
 //! The assembly stage ([`crate::Stage::Assembly`]): one constraint per contact point, with its
-//! Jacobian rows, effective masses and warm-start impulses (`contact/constraints.rs`).
+//! Jacobian rows, effective masses and warm-start impulses (`contact/assembly.rs`).
 
 use glam::{Mat3, Vec3};
 
