@@ -104,6 +104,23 @@ def test_axis_goals_measure_the_angle_from_up():
     ) == pytest.approx(math.radians(30), abs=1e-6)
 
 
+def test_a_knocked_over_goal_is_graded_by_the_largest_tilt_reached():
+    # A pin that rocks to 30 degrees about z and stands again, against one that never moves and
+    # one that ends at 60 degrees (met: at least 45).
+    def turned(degrees):
+        half = math.radians(degrees) / 2
+        return [0.0, 0.0, math.sin(half), math.cos(half)]
+
+    goal = goal_from_dict({"type": "tilted", "body": 0, "axis": [0, 1, 0], "min_degrees": 45})
+    still = _record([[[0, 0, 0]]] * 3)
+    rocked = _record([[[0, 0, 0]]] * 3, orientations=[[turned(a)] for a in (0, 30, 0)])
+    fallen = _record([[[0, 0, 0]]] * 3, orientations=[[turned(a)] for a in (0, 30, 60)])
+    # Half the final angle short of 45 degrees, half the largest one short of it.
+    assert goal.cost(still) == pytest.approx(math.radians(45))
+    assert goal.cost(rocked) == pytest.approx(0.5 * math.radians(45) + 0.5 * math.radians(15))
+    assert goal.cost(fallen) == 0.0
+
+
 def test_touch_goals_read_the_contacts():
     positions = [[[0, 0, 0], [3, 4, 0]], [[0, 0, 0], [0.6, 0.8, 0]], [[0, 0, 0], [3, 0, 0]]]
     apart = _record(positions)
