@@ -11,6 +11,7 @@
 
     python3 scripts/measure-takes.py                       # everything (long: run it once)
     python3 scripts/measure-takes.py --shots hoop --seeds 2 --no-throughput
+    python3 scripts/measure-takes.py --shots bowling --first-seed 5 --no-throughput
 
 Needs the impulse package (with pyarrow), and ray for the Ray rows (skipped without it). The
 counts are deterministic (the engine is); the throughput depends on the machine and its load.
@@ -102,6 +103,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--shots", default="dice,hoop,pachinko,bowling")
     parser.add_argument("--seeds", type=int, default=5, help="searches per shot and method")
+    parser.add_argument("--first-seed", type=int, default=0, help="seeds first-seed.. on")
     parser.add_argument("--budget", type=int, default=2000)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--methods", default="cross-entropy,random")
@@ -113,7 +115,8 @@ def main() -> int:
     shots = arguments.shots.split(",")
 
     if not arguments.no_first_success:
-        print(f"takes to the first success (budget {arguments.budget}, seeds 0..{arguments.seeds - 1})")
+        first, last = arguments.first_seed, arguments.first_seed + arguments.seeds - 1
+        print(f"takes to the first success (budget {arguments.budget}, seeds {first}..{last})")
         methods = arguments.methods.split(",")
         print("| shot | " + " | ".join(f"{m}: median | each" for m in methods) + " |")
         print("|---|" + "---|---|" * len(methods))
@@ -122,7 +125,7 @@ def main() -> int:
             for method in methods:
                 counts = [
                     first_success(shot, method, seed, arguments.budget, arguments.workers)
-                    for seed in range(arguments.seeds)
+                    for seed in range(first, last + 1)
                 ]
                 # A search that found none counts as more than the budget.
                 ranked = [arguments.budget + 1 if c is None else c for c in counts]

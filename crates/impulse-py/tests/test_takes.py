@@ -104,6 +104,47 @@ def test_axis_goals_measure_the_angle_from_up():
     ) == pytest.approx(math.radians(30), abs=1e-6)
 
 
+def test_a_knocked_over_goal_is_graded_by_the_largest_tilt_reached():
+    # A pin that rocks to 30 degrees about z and stands again, against one that never moves and
+    # one that ends at 60 degrees (met: at least 45).
+    def turned(degrees):
+        half = math.radians(degrees) / 2
+        return [0.0, 0.0, math.sin(half), math.cos(half)]
+
+    goal = goal_from_dict({"type": "tilted", "body": 0, "axis": [0, 1, 0], "min_degrees": 45})
+    still = _record([[[0, 0, 0]]] * 3)
+    rocked = _record([[[0, 0, 0]]] * 3, orientations=[[turned(a)] for a in (0, 30, 0)])
+    fallen = _record([[[0, 0, 0]]] * 3, orientations=[[turned(a)] for a in (0, 30, 60)])
+    # Half the final angle short of 45 degrees, half the largest one short of it.
+    assert goal.cost(still) == pytest.approx(math.radians(45))
+    assert goal.cost(rocked) == pytest.approx(0.5 * math.radians(45) + 0.5 * math.radians(15))
+    assert goal.cost(fallen) == 0.0
+
+
+def test_the_search_ranks_a_take_meeting_the_rare_goal_first():
+    # Goal "rare" is met by 1 take of 4, "common" by 3: (4 + 1) / (1 + 1) = 2.5 against
+    # (4 + 1) / (3 + 1) = 1.25. A take missing only the common goal (by far) ranks above one
+    # missing only the rare goal (by a little), which a plain total cost would rank the other way.
+    from impulse.takes._search import _ranking
+
+    goals = [goal_from_dict({"type": "tilted", "body": 0, "name": name}) for name in ("rare", "common")]
+
+    def row(rare, common, perturbation=1.0):
+        return {"cost.rare": rare, "cost.common": common, "cost": rare + common,
+                "perturbation": perturbation}
+
+    misses_common, misses_rare = row(0.0, 3.0), row(0.1, 0.0)
+    pool = [misses_common, misses_rare, row(0.2, 0.0), row(0.5, 0.0, perturbation=0.5)]
+    assert misses_rare["cost"] < misses_common["cost"]
+    ranked = sorted(pool, key=_ranking(pool, goals))
+    assert ranked[0] is misses_common
+    # Among takes missing the same goals, the lower total cost first.
+    assert ranked[1:] == [misses_rare, pool[2], pool[3]]
+    # A take that did not complete ranks last.
+    failed = {"cost.rare": None, "cost.common": None, "cost": None, "perturbation": 0.0}
+    assert sorted([failed, *pool], key=_ranking(pool, goals))[-1] is failed
+
+
 def test_touch_goals_read_the_contacts():
     positions = [[[0, 0, 0], [3, 4, 0]], [[0, 0, 0], [0.6, 0.8, 0]], [[0, 0, 0], [3, 0, 0]]]
     apart = _record(positions)
@@ -227,6 +268,13 @@ def test_random_sampling_draws_every_take_from_the_prior(tmp_path):
     # The first generation is the same draw for both.
     first = [row["theta"] for row in plain.table.to_pylist()][:8]
     assert first == [row["theta"] for row in refined.table.to_pylist()][:8]
+    # The second generation's last half are local steps (0.15 N(0, I)) around the first
+    # generation's 4 best takes in turn (one goal, missed by all: the lowest costs).
+    rows = refined.table.to_pylist()
+    best = sorted(rows[:8], key=lambda row: (row["cost"], row["perturbation"]))[:4]
+    for k in range(4, 8):
+        step = np.array(rows[8 + k]["theta"]) - np.array(best[k % 4]["theta"])
+        assert np.all(np.abs(step) < 5 * 0.15), (k, step)
     with pytest.raises(ValueError, match="method = 'annealing'"):
         search(SCENE, [TARGET], VARIATION, out=tmp_path / "x", method="annealing", **common)
 

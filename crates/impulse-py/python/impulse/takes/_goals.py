@@ -20,9 +20,11 @@ type                    fields                                           cost (0
                         face normal), ``up`` (default against gravity),  tolerance, plus speed
                         ``tolerance_degrees`` (default 10),              (m/s, rad/s) beyond the
                         ``rest_speed`` (m/s and rad/s, default 0.05)     rest speed, at the end
-``tilted``              ``body``, ``axis``, ``up``, ``min_degrees``       degrees short of
-                        (default 45): the axis ends at least that far    ``min_degrees``, in rad
-                        from up (a pin knocked over)
+``tilted``              ``body``, ``axis``, ``up``, ``min_degrees``       half the angle short of
+                        (default 45): the axis ends at least that far    ``min_degrees`` at the
+                        from up (a pin knocked over)                     end plus half the
+                                                                         largest angle reached
+                                                                         short of it (rad)
 ``touches``             ``body``, ``other``, ``between``, ``times``      closest approach (m) of
                         (optional: the number of separate contacts,      their positions when
                         e.g. 1 for one bounce)                           they never touch; with
@@ -160,14 +162,8 @@ def _region_distance(region: Mapping[str, Any]) -> Callable[[np.ndarray], np.nda
     raise ValueError(f"goal: unknown region {kind!r}: use box or sphere")
 
 
-def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """v turned by the unit quaternion q = [x, y, z, w]."""
-    u, w = q[:3], q[3]
-    return v + 2.0 * np.cross(u, np.cross(u, v) + w * v)
-
-
-def _axis_angle(record: Record, index: int, spec: Mapping[str, Any]) -> float:
-    """Angle (rad) between the body's ``axis`` at the end and ``up``."""
+def _axis_angles(record: Record, index: int, spec: Mapping[str, Any]) -> np.ndarray:
+    """Angle (rad) between the body's ``axis`` and ``up`` at every frame, (F,)."""
     axis = np.asarray(spec.get("axis", [0.0, 1.0, 0.0]), dtype=np.float64)
     if "up" in spec:
         up = np.asarray(spec["up"], dtype=np.float64)
@@ -175,10 +171,13 @@ def _axis_angle(record: Record, index: int, spec: Mapping[str, Any]) -> float:
         up = -np.asarray(record.gravity, dtype=np.float64)
     if np.linalg.norm(axis) == 0.0 or np.linalg.norm(up) == 0.0:
         raise ValueError("goal: axis and up must be non-zero (up defaults to against gravity)")
-    q = np.asarray(record.orientations[-1, index], dtype=np.float64)
-    turned = _rotate(q / np.linalg.norm(q), axis / np.linalg.norm(axis))
-    cosine = float(np.dot(turned, up / np.linalg.norm(up)))
-    return math.acos(max(-1.0, min(1.0, cosine)))
+    q = np.asarray(record.orientations[:, index], dtype=np.float64)
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    u, w = q[:, :3], q[:, 3:]
+    a = axis / np.linalg.norm(axis)
+    turned = a + 2.0 * np.cross(u, np.cross(u, a) + w * a)
+    cosine = turned @ (up / np.linalg.norm(up))
+    return np.arccos(np.clip(cosine, -1.0, 1.0))
 
 
 def _touch_frames(record: Record, a: int, b: int, frames: np.ndarray) -> list[int]:
@@ -246,7 +245,7 @@ def goal_from_dict(spec: Mapping[str, Any]) -> Goal:
 
         def rest_cost(record: Record) -> float:
             index = record.body(body)
-            angle = _axis_angle(record, index, spec)
+            angle = float(_axis_angles(record, index, spec)[-1])
             speed = float(np.linalg.norm(record.linear_velocities[-1, index]))
             spin = float(np.linalg.norm(record.angular_velocities[-1, index]))
             return max(0.0, angle - tolerance) + max(0.0, speed - rest) + max(0.0, spin - rest)
@@ -257,7 +256,13 @@ def goal_from_dict(spec: Mapping[str, Any]) -> Goal:
         least = math.radians(float(spec.get("min_degrees", 45.0)))
 
         def tilt_cost(record: Record) -> float:
-            return max(0.0, least - _axis_angle(record, record.body(body), spec))
+            # Half the final angle short of the least, half the largest angle reached short
+            # of it: a body that rocked and stood again is nearer to falling than one that
+            # never moved. Both halves are 0 when the final angle reaches the least (the
+            # largest is at least the final), so the goal is met exactly as before.
+            angles = _axis_angles(record, record.body(body), spec)
+            final, largest = float(angles[-1]), float(angles.max())
+            return 0.5 * max(0.0, least - final) + 0.5 * max(0.0, least - largest)
 
         return Goal(name, tilt_cost, weight, spec)
 

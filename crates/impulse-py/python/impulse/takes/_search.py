@@ -6,12 +6,14 @@ continuous optimization", 1999) rather than Chenney & Forsyth's Markov chain (SI
 each generation is a batch of independent takes, so a process pool or a Ray cluster runs a whole
 generation at once, where a chain runs one take after another; and it needs only the goals'
 costs, no derivative (a pile's outcome is chaotic: derivatives of where a die rests flip sign
-under 1e-6 m/s changes). Each generation draws θ from a normal distribution, keeps the best
-takes so far (lowest total cost, then smallest perturbation), and moves the distribution's mean
-and spread toward them; the first generation draws from the prior N(0, I), the scales' size,
-and so does the first after a restart (:data:`STALL_GENERATIONS` without a lower best cost).
-``method="random"`` is the baseline the method is measured against: every take drawn from the
-prior, nothing refined.
+under 1e-6 m/s changes). Each generation draws θ from a normal distribution, ranks the takes
+so far (:func:`_ranking`: the goals missed, each weighted by how rarely the takes meet it; then
+the total cost; then the perturbation) and moves the distribution's mean and spread toward the
+best; half of each refined generation are instead local steps around the best few takes, as
+Chenney & Forsyth's chain proposes (:data:`LOCAL_SHARE`). The first generation draws from the
+prior N(0, I), the scales' size, and so does the first after a restart
+(:data:`STALL_GENERATIONS` without a lower best cost). ``method="random"`` is the baseline the
+method is measured against: every take drawn from the prior, nothing refined.
 """
 
 from __future__ import annotations
@@ -34,7 +36,14 @@ MANIFEST_FILE = "manifest.json"
 SCENE_FILE = "scene.json"
 COMPLETED, STOPPED, FAILED = "completed", "stopped", "failed"
 #: Weight of the new elites' mean and spread against the old (the method's smoothing).
-SMOOTHING = 0.7
+SMOOTHING = 0.9
+#: Share of each refined generation drawn as local steps around the best takes instead of from
+#: the normal distribution (Metropolis-like proposals, as Chenney & Forsyth's chain makes).
+LOCAL_SHARE = 0.5
+#: Size of a local step: the spread of θ around a best take (unit-free, as θ).
+LOCAL_STEP = 0.15
+#: How many of the best takes the local steps start from (in turn).
+LOCAL_CENTRES = 4
 #: Smallest spread of θ per component: the search never collapses to one point.
 MIN_SPREAD = 0.02
 #: Generations without a lower best cost, and no take meeting every goal, after which the search
@@ -42,7 +51,7 @@ MIN_SPREAD = 0.02
 #: Auger & Hansen 2005). In a chaotic scene a near miss can sit on a plateau where every nearby
 #: take has the same outcome.
 STALL_GENERATIONS = 4
-_FORMAT = 1
+_FORMAT = 2  # 2: graded tilt costs, goals ranked by rarity, local steps
 #: The search methods: the cross-entropy method, or plain random sampling from the prior.
 METHODS = ("cross-entropy", "random")
 
@@ -257,6 +266,33 @@ def _rank(row: Mapping[str, Any]) -> tuple[float, float]:
     return (math.inf if cost is None or not math.isfinite(cost) else cost, row["perturbation"])
 
 
+def _ranking(pool: Sequence[Mapping[str, Any]], goals: Sequence[Goal]):
+    """The key the search ranks ``pool``'s takes by, best first: the goals each take misses,
+    each weighted by its ``weight`` times how rarely the pool's takes meet it, (n + 1) / (m + 1)
+    for n completed takes of which m meet it; then the total cost; then the perturbation.
+
+    A goal nearly every take meets weighs about 1, one that few meet weighs up to n + 1, so a
+    take that meets the rare goals ranks above one that only lowers the common goals' costs (in
+    the bowling shot: a take leaving the 7 and the 10 standing with two other pins up ranks
+    above a strike that leaves only the 10). Takes that did not complete rank last.
+    """
+    names = [f"cost.{goal.name}" for goal in goals]
+    completed = [row for row in pool if row["cost"] is not None]
+    weights = [
+        goal.weight * (len(completed) + 1) / (sum(row[name] <= MET for row in completed) + 1)
+        for goal, name in zip(goals, names, strict=True)
+    ]
+
+    def key(row: Mapping[str, Any]) -> tuple[float, float, float]:
+        cost = row["cost"]
+        if cost is None or not math.isfinite(cost):
+            return (math.inf, math.inf, row["perturbation"])
+        missed = sum(w for w, name in zip(weights, names, strict=True) if row[name] > MET)
+        return (missed, cost, row["perturbation"])
+
+    return key
+
+
 def search(
     scene: Any,
     goals: Sequence[Goal | Mapping[str, Any]],
@@ -397,13 +433,18 @@ def search(
     elites = max(2, round(elite_fraction * population))
     done: list[dict[str, Any]] = []
     elite_seeds: list[int | None] = []
+    local_centres: list[np.ndarray] = []  # the best takes' θ, which local steps start from
     generation = 0
     since, best_cost, stalled = 0, math.inf, 0  # the current start's first take, its best cost
     try:
         while len(done) < budget:
             rng = np.random.default_rng([seed, generation])
             count = min(population, budget - len(done))
-            thetas = mean + spread * rng.standard_normal((population, dimension))
+            normal = rng.standard_normal((population, dimension))
+            thetas = mean + spread * normal
+            if local_centres:  # the generation's last share: steps around the best takes
+                for k in range(population - round(LOCAL_SHARE * population), population):
+                    thetas[k] = local_centres[k % len(local_centres)] + LOCAL_STEP * normal[k]
             seeds = _scene_seeds(rng, population, variation.seeds, elite_seeds)
             batch = []
             for index, (theta, scene_seed) in enumerate(zip(thetas[:count], seeds[:count], strict=True)):
@@ -440,8 +481,9 @@ def search(
             generation += 1
             if method == "random":
                 continue
-            ranked = sorted((row for row in done[since:] if row["status"] != FAILED), key=_rank)
-            lowest = _rank(ranked[0])[0] if ranked else math.inf
+            pool = [row for row in done[since:] if row["status"] != FAILED]
+            ranked = sorted(pool, key=_ranking(pool, goals))
+            lowest = _rank(ranked[0])[0] if ranked else math.inf  # the best take's total cost
             if lowest < best_cost:
                 best_cost, stalled = lowest, 0
             elif not any(row["met"] for row in ranked):  # never restart away from a success
@@ -449,8 +491,10 @@ def search(
             if stalled >= STALL_GENERATIONS:
                 mean, spread = np.zeros(dimension), np.ones(dimension)
                 since, best_cost, stalled, elite_seeds = len(done), math.inf, 0, []
+                local_centres = []
                 continue
             best = np.array([row["theta"] for row in ranked[:elites]])
+            local_centres = [np.asarray(row["theta"]) for row in ranked[:LOCAL_CENTRES]]
             elite_seeds = [row.get("scene_seed") for row in ranked[:elites]]
             if len(best) >= 2:
                 mean = SMOOTHING * best.mean(axis=0) + (1.0 - SMOOTHING) * mean
