@@ -5,13 +5,13 @@
 //! Per degree of freedom up to five rows share its Jacobian row: a lock (bilateral), a lower
 //! and an upper limit (unilateral, ≥ 0, the upper one with the row negated), a spring (soft,
 //! unbounded) and a motor (bounded by ±max_force·h). The Jacobian of a translation is
-//! (−e, −arm_A × e, e, r_B × e) on (v_A, ω_A, v_B, ω_B), its direction e and A's lever arm as
-//! the joint's form measures them ([`super::forms::JointForm::translation_rows`]: A's axis e and
-//! r_A + d, with d the anchor separation, unless the form says otherwise); of a rotation about
-//! A's axis e, (0, −e, 0, e). Within a
-//! joint, springs and motors go first, then limits, then the locked rotations and last the
-//! locked translations, each locked group solved as one block (its K = J M⁻¹ Jᵀ inverted), the
-//! order of Box2D v3's joint solvers (`revolute_joint.c`: spring, motor, limits, point).
+//! (−e, −arm_A × e, e, r_B × e) on (v_A, ω_A, v_B, ω_B), its direction e and A's lever arm
+//! as the joint's form measures them ([`super::forms::JointForm::translation_rows`]: A's
+//! axis e and r_A + d by default, with d the anchor separation); of a rotation about A's axis
+//! e, (0, −e, 0, e). Within a joint, springs and motors go first, then limits, then the locked
+//! rotations and last the locked translations, each locked group solved as one block (its
+//! K = J M⁻¹ Jᵀ inverted), the order of Box2D v3's joint solvers (`revolute_joint.c`: spring,
+//! motor, limits, point).
 //!
 //! Softness (docs/method.md, "Joints"): every row's update is
 //! Δλ = −m·s_m·(J·v + bias) − s_i·λ, the soft-constraint form of the contacts. Locked rows and
@@ -299,12 +299,12 @@ impl JointConstraint {
         let geometry = &state.geometry;
         let translations = form.translation_rows(geometry);
         for i in 0..6 {
-            let (linear, angular_a, angular_b) = if i < 3 {
-                let (e, arm_a) = translations[i];
-                (e, arm_a.cross(e), geometry.r_b.cross(e))
-            } else {
-                let e = geometry.axes.col(i - 3);
-                (Vec3::ZERO, e, e)
+            let (linear, angular_a, angular_b) = match translations.get(i) {
+                Some(&(e, arm_a)) => (e, arm_a.cross(e), geometry.r_b.cross(e)),
+                None => {
+                    let e = geometry.axes.col(i - 3);
+                    (Vec3::ZERO, e, e)
+                }
             };
             let response_a = self.inverse_inertia_a * angular_a;
             let response_b = self.inverse_inertia_b * angular_b;
