@@ -155,6 +155,27 @@ impl JointBuilder {
         }
     }
 
+    /// A joint of the kind named `kind` (`JointBuilder.kind`'s names: `"fixed"`,
+    /// `"spherical"`, `"revolute"`, `"prismatic"`, `"distance"`, `"generic"`, and any form the
+    /// engine registers besides) with that kind's degrees of freedom; `WorldError` for an
+    /// unknown name. A distance joint made so needs its lengths (`limits`) or a `spring`.
+    #[staticmethod]
+    fn new(kind: &str, body_a: &BodyHandle, body_b: &BodyHandle) -> PyResult<Self> {
+        let kind = impulse::JointKind::from_name(kind).ok_or_else(|| {
+            WorldError::new_err(format!(
+                "kind: no joint kind '{kind}'; one of {}",
+                impulse::JointKind::ALL
+                    .iter()
+                    .map(|k| k.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })?;
+        Ok(JointBuilder {
+            inner: impulse::JointBuilder::new(kind, body_a.inner, body_b.inner),
+        })
+    }
+
     /// All six degrees of freedom locked until `dof` frees or limits them (a six-DOF joint).
     #[staticmethod]
     fn generic(body_a: &BodyHandle, body_b: &BodyHandle) -> Self {

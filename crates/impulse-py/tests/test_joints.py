@@ -225,6 +225,29 @@ def test_a_break_window_keeps_the_static_strength_and_measures_a_blow_over_the_w
     assert kicked(0.0, WINDOW) == []
 
 
+def test_a_joint_built_by_kind_name_is_the_named_constructors_joint():
+    """`JointBuilder.new(kind, a, b)` takes every kind by its name and gives the joint its
+    named constructor gives: a hinge swings the same to the bit; an unknown name raises."""
+    names = ["fixed", "spherical", "revolute", "prismatic", "distance", "generic"]
+    trajectories = []
+    by_name = lambda a, b: impulse.JointBuilder.new("revolute", a, b)  # noqa: E731
+    for make in (impulse.JointBuilder.revolute, by_name):
+        world = impulse.World(gravity=(0, -G, 0), dt=DT)
+        pivot, bob = pivot_and_bob(
+            world, impulse.BodyBuilder.dynamic(impulse.Shape.ball(0.1), translation=(0.5, 1.5, 0))
+        )
+        for name in names:
+            assert impulse.JointBuilder.new(name, pivot, bob).kind == name
+        world.insert_joint(make(pivot, bob).world_anchor((0, 2, 0)).world_axis((0, 0, 1)))
+        for _ in range(30):
+            world.step()
+        trajectories.append(world.positions.copy())
+    assert np.array_equal(trajectories[0], trajectories[1])
+    assert abs(trajectories[0][1, 2]) < 1e-6  # the hinge about z keeps the bob in its plane
+    with pytest.raises(impulse.WorldError, match="no joint kind 'hinge'; one of fixed, spherical"):
+        impulse.JointBuilder.new("hinge", pivot, bob)
+
+
 def test_bad_joints_raise_world_error_naming_the_field():
     world = impulse.World()
     post = world.insert(impulse.BodyBuilder.fixed(impulse.Shape.ball(0.1)))

@@ -3,8 +3,9 @@
 
 use glam::{Quat, Vec3};
 
+use super::forms::JointKind;
 use super::types::Spring;
-use super::types::{AxisMode, JointAxis, JointDof, JointKind, JointStiffness, Motor, MotorMode};
+use super::types::{AxisMode, JointAxis, JointDof, JointStiffness, Motor, MotorMode};
 use crate::body::BodyHandle;
 
 /// Where the joint's anchors are given.
@@ -85,28 +86,7 @@ impl JointBuilder {
     /// distance joint the anchor distance is then free: give it with
     /// [`JointBuilder::distance`] or [`JointBuilder::limits`].
     pub fn new(kind: JointKind, body_a: BodyHandle, body_b: BodyHandle) -> Self {
-        use JointAxis as A;
-        let dofs = match kind {
-            JointKind::Fixed | JointKind::Generic => [A::LOCKED; 6],
-            JointKind::Spherical => [A::LOCKED, A::LOCKED, A::LOCKED, A::FREE, A::FREE, A::FREE],
-            JointKind::Revolute => [
-                A::LOCKED,
-                A::LOCKED,
-                A::LOCKED,
-                A::FREE,
-                A::LOCKED,
-                A::LOCKED,
-            ],
-            JointKind::Prismatic => [
-                A::FREE,
-                A::LOCKED,
-                A::LOCKED,
-                A::LOCKED,
-                A::LOCKED,
-                A::LOCKED,
-            ],
-            JointKind::Distance => [A::FREE; 6],
-        };
+        let dofs = kind.form().dofs();
         Self {
             kind,
             body_a,
@@ -166,11 +146,7 @@ impl JointBuilder {
     /// [`JointBuilder::spring`] and [`JointBuilder::motor`] act on: a hinge's angle, a
     /// slider's or a distance joint's distance; `None` for the other kinds.
     pub fn main_dof(kind: JointKind) -> Option<JointDof> {
-        match kind {
-            JointKind::Revolute => Some(JointDof::AngularX),
-            JointKind::Prismatic | JointKind::Distance => Some(JointDof::LinearX),
-            _ => None,
-        }
+        kind.form().main_dof()
     }
 
     /// Anchors in each body's frame (m, from the body origin, not the centre of mass).

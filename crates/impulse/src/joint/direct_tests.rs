@@ -6,6 +6,7 @@
 use glam::{Mat3, Quat, Vec3};
 
 use super::direct::{IslandJoints, sweep_joints};
+use super::forms::JointKind;
 use super::frames::LocalFrames;
 use super::rows::{JointBody, JointConstraint};
 use super::types::{AxisMode, JointAxis, JointStiffness};
@@ -95,7 +96,7 @@ fn random_tree(seed: u64, bodies: usize, breakable: bool, loops: bool) -> Island
             body_b,
             frames,
             dofs,
-            false,
+            JointKind::Generic,
             JointStiffness::Stiff,
             [[0.0; 5]; 6],
             (strength, strength),

@@ -11,6 +11,7 @@
 
 use glam::{Mat3, Quat, Vec3};
 
+use super::forms::{AnchorGeometry, JointForm};
 use super::types::{AxisMode, JointAxis};
 
 /// The frames of a joint in its bodies, relative to their centres of mass.
@@ -29,25 +30,20 @@ pub(crate) struct LocalFrames {
 /// A joint's geometry at given poses.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct FrameState {
-    /// World lever arm from A's centre of mass to A's anchor (m).
-    pub r_a: Vec3,
-    /// World lever arm from B's centre of mass to B's anchor (m).
-    pub r_b: Vec3,
-    /// B's anchor minus A's (m).
-    pub separation: Vec3,
-    /// A's frame axes in the world, as columns (x, y, z).
-    pub axes: Mat3,
-    /// The six coordinates of B's frame relative to A's (m, rad): linear along A's axes (a
-    /// distance joint's first: the anchor distance), angular as the module says.
+    /// The lever arms, the anchor separation and A's frame axes in the world.
+    pub geometry: AnchorGeometry,
+    /// The six coordinates of B's frame relative to A's (m, rad): linear as the joint's form
+    /// measures them ([`JointForm::translation_coordinates`]; along A's axes but for a
+    /// distance joint's first, the anchor distance), angular as the module says.
     pub coordinates: [f32; 6],
 }
 
-/// The joint's geometry with A's centre of mass at `center_a` and orientation `orientation_a`,
-/// and B's likewise; `distance`: the first coordinate is the anchor distance.
+/// The geometry of a joint of form `form` with A's centre of mass at `center_a` and
+/// orientation `orientation_a`, and B's likewise.
 pub(crate) fn frame_state(
     frames: &LocalFrames,
     dofs: &[JointAxis; 6],
-    distance: bool,
+    form: &dyn JointForm,
     (center_a, orientation_a): (Vec3, Quat),
     (center_b, orientation_b): (Vec3, Quat),
 ) -> FrameState {
@@ -56,22 +52,18 @@ pub(crate) fn frame_state(
     let separation = (center_b + r_b) - (center_a + r_a);
     let frame_a = (orientation_a * frames.rotation_a).normalize();
     let frame_b = (orientation_b * frames.rotation_b).normalize();
-    let axes = Mat3::from_quat(frame_a);
-    let mut coordinates = [0.0f32; 6];
-    if distance {
-        coordinates[0] = separation.length();
-    } else {
-        for (i, c) in coordinates.iter_mut().take(3).enumerate() {
-            *c = axes.col(i).dot(separation);
-        }
-    }
-    let angular = angular_coordinates(frame_a.conjugate() * frame_b, dofs);
-    coordinates[3..].copy_from_slice(&angular);
-    FrameState {
+    let geometry = AnchorGeometry {
         r_a,
         r_b,
         separation,
-        axes,
+        axes: Mat3::from_quat(frame_a),
+    };
+    let mut coordinates = [0.0f32; 6];
+    coordinates[..3].copy_from_slice(&form.translation_coordinates(&geometry));
+    let angular = angular_coordinates(frame_a.conjugate() * frame_b, dofs);
+    coordinates[3..].copy_from_slice(&angular);
+    FrameState {
+        geometry,
         coordinates,
     }
 }

@@ -2,7 +2,8 @@
 //! (boxed rows) between two bodies' frames, solved in the same substeps, sweeps and islands as
 //! the contacts (docs/method.md, "Joints").
 //!
-//! `types.rs` the public description of the degrees of freedom, `builder.rs` [`JointBuilder`],
+//! `forms/` the joint forms, one file each, registered as the [`JointKind`]s, `types.rs` the
+//! public description of the degrees of freedom, `builder.rs` [`JointBuilder`],
 //! `handle.rs` generational [`JointHandle`]s, `rules.rs` the checks shared with the scene
 //! validator, `frames.rs` the frames and coordinates at given poses, `rows.rs` the rows an
 //! island's step solves ([`JointConstraint`]), `strength.rs` a breakable joint's strength in
@@ -12,6 +13,7 @@ mod builder;
 mod direct;
 #[cfg(test)]
 mod direct_tests;
+mod forms;
 mod frames;
 mod handle;
 mod rows;
@@ -26,14 +28,13 @@ use serde::{Deserialize, Serialize};
 pub use builder::JointBuilder;
 pub(crate) use builder::{Anchors, Axes, shortest_arc};
 pub(crate) use direct::{IslandJoints, sweep_joints};
+pub use forms::JointKind;
 pub(crate) use frames::{LocalFrames, frame_state};
 pub use handle::JointHandle;
 pub(crate) use handle::JointHandles;
 pub(crate) use rows::{JointBody, JointConstraint, JointImpulses, LOCK, ROWS_PER_DOF};
 pub(crate) use strength::Strength;
-pub use types::{
-    AxisMode, JointAxis, JointDof, JointKind, JointStiffness, Motor, MotorMode, Spring,
-};
+pub use types::{AxisMode, JointAxis, JointDof, JointStiffness, Motor, MotorMode, Spring};
 
 use crate::body::BodyHandle;
 

@@ -4,13 +4,14 @@
 //!
 //! Per degree of freedom up to five rows share its Jacobian row: a lock (bilateral), a lower
 //! and an upper limit (unilateral, ≥ 0, the upper one with the row negated), a spring (soft,
-//! unbounded) and a motor (bounded by ±max_force·h). The Jacobian of a translation along A's
-//! axis e is (−e, −(r_A + d) × e, e, r_B × e) on (v_A, ω_A, v_B, ω_B), with d the anchor
-//! separation (the derivative of e·d with e turning with A); of a distance joint's length,
-//! e = d/|d| and A's lever arm r_A; of a rotation about A's axis e, (0, −e, 0, e). Within a
-//! joint, springs and motors go first, then limits, then the locked rotations and last the
-//! locked translations, each locked group solved as one block (its K = J M⁻¹ Jᵀ inverted), the
-//! order of Box2D v3's joint solvers (`revolute_joint.c`: spring, motor, limits, point).
+//! unbounded) and a motor (bounded by ±max_force·h). The Jacobian of a translation is
+//! (−e, −arm_A × e, e, r_B × e) on (v_A, ω_A, v_B, ω_B), its direction e and A's lever arm
+//! as the joint's form measures them ([`super::forms::JointForm::translation_rows`]: A's
+//! axis e and r_A + d by default, with d the anchor separation); of a rotation about A's axis
+//! e, (0, −e, 0, e). Within a joint, springs and motors go first, then limits, then the locked
+//! rotations and last the locked translations, each locked group solved as one block (its
+//! K = J M⁻¹ Jᵀ inverted), the order of Box2D v3's joint solvers (`revolute_joint.c`: spring,
+//! motor, limits, point).
 //!
 //! Softness (docs/method.md, "Joints"): every row's update is
 //! Δλ = −m·s_m·(J·v + bias) − s_i·λ, the soft-constraint form of the contacts. Locked rows and
@@ -20,10 +21,11 @@
 
 use glam::{Mat3, Quat, Vec3};
 
+use super::forms::JointKind;
 use super::frames::{FrameState, LocalFrames, frame_state};
 use super::softness::{Softness, joint_softness};
 use super::strength::Strength;
-use super::types::{AxisMode, JointAxis, JointStiffness, MotorMode};
+use super::types::{AxisMode, JointAxis, JointDof, JointStiffness, MotorMode};
 use crate::body::Velocities;
 
 /// Rows per degree of freedom: lock, lower limit, upper limit, spring, motor.
@@ -182,7 +184,11 @@ pub(crate) struct JointConstraint {
     start_b: (Vec3, Quat),
     frames: LocalFrames,
     dofs: [JointAxis; 6],
-    distance: bool,
+    /// The joint's form, which measures its translations.
+    kind: JointKind,
+    /// Whether each degree of freedom is in a locked group: locked, and its form holds it with
+    /// a lock row ([`super::forms::JointForm::lockable`]).
+    locked: [bool; 6],
     stiffness: JointStiffness,
     /// Substep length (s), set by [`JointConstraint::start_step`].
     h: f32,
@@ -222,11 +228,12 @@ impl JointConstraint {
         b: JointBody,
         frames: LocalFrames,
         dofs: [JointAxis; 6],
-        distance: bool,
+        kind: JointKind,
         stiffness: JointStiffness,
         impulses: JointImpulses,
         (break_force, break_torque): (Option<f32>, Option<f32>),
     ) -> Self {
+        let form = kind.form();
         Self {
             joint,
             body_a: a.body,
@@ -241,7 +248,10 @@ impl JointConstraint {
             start_b: (b.center, b.orientation),
             frames,
             dofs,
-            distance,
+            kind,
+            locked: std::array::from_fn(|i| {
+                dofs[i].mode == AxisMode::Locked && form.lockable(JointDof::ALL[i])
+            }),
             stiffness,
             h: 0.0,
             impulses,
@@ -284,28 +294,17 @@ impl JointConstraint {
     fn update_geometry(&mut self, displacement: &[Vec3], orientation: &[Quat]) {
         let pose_a = Self::pose_of(self.slot_a, self.start_a, displacement, orientation);
         let pose_b = Self::pose_of(self.slot_b, self.start_b, displacement, orientation);
-        let state = frame_state(&self.frames, &self.dofs, self.distance, pose_a, pose_b);
+        let form = self.kind.form();
+        let state = frame_state(&self.frames, &self.dofs, form, pose_a, pose_b);
+        let geometry = &state.geometry;
+        let translations = form.translation_rows(geometry);
         for i in 0..6 {
-            let (linear, angular_a, angular_b) = if i < 3 {
-                let e = if self.distance && i == 0 {
-                    let length = state.separation.length();
-                    if length > 1e-6 {
-                        state.separation / length
-                    } else {
-                        state.axes.col(0)
-                    }
-                } else {
-                    state.axes.col(i)
-                };
-                let arm_a = if self.distance {
-                    state.r_a
-                } else {
-                    state.r_a + state.separation
-                };
-                (e, arm_a.cross(e), state.r_b.cross(e))
-            } else {
-                let e = state.axes.col(i - 3);
-                (Vec3::ZERO, e, e)
+            let (linear, angular_a, angular_b) = match translations.get(i) {
+                Some(&(e, arm_a)) => (e, arm_a.cross(e), geometry.r_b.cross(e)),
+                None => {
+                    let e = geometry.axes.col(i - 3);
+                    (Vec3::ZERO, e, e)
+                }
             };
             let response_a = self.inverse_inertia_a * angular_a;
             let response_b = self.inverse_inertia_b * angular_b;
@@ -364,9 +363,9 @@ impl JointConstraint {
         }
     }
 
-    /// Whether degree of freedom `i` is in a locked group (a distance joint's length never is).
+    /// Whether degree of freedom `i` is in a locked group.
     fn locked(&self, i: usize) -> bool {
-        self.dofs[i].mode == AxisMode::Locked && !(self.distance && i < 3)
+        self.locked[i]
     }
 
     #[allow(clippy::needless_range_loop)]

@@ -3,14 +3,9 @@
 
 use std::f32::consts::PI;
 
-use super::types::{AxisMode, JointAxis, JointDof, JointKind, JointStiffness, MotorMode};
-
-/// A broken rule: the field (relative to the joint, e.g. `limits.lower`) and what is wrong.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct JointProblem {
-    pub field: String,
-    pub message: String,
-}
+use super::forms::JointKind;
+pub(crate) use super::forms::JointProblem;
+use super::types::{AxisMode, JointAxis, JointDof, JointStiffness, MotorMode};
 
 fn problem(field: impl Into<String>, message: impl Into<String>) -> JointProblem {
     JointProblem {
@@ -85,7 +80,7 @@ fn finite(field: &str, value: f32) -> Result<(), JointProblem> {
 /// The field name of a degree of freedom's part: the kind's main one is named as its builder
 /// calls name it (`limits`, `spring`, `motor`), the others `dofs.<name>.<part>`.
 pub(crate) fn dof_field(kind: JointKind, dof: JointDof, part: &str) -> String {
-    if super::JointBuilder::main_dof(kind) == Some(dof) && kind != JointKind::Generic {
+    if kind.form().main_dof() == Some(dof) {
         part.to_string()
     } else {
         format!("dofs.{}.{part}", dof.name())
@@ -93,9 +88,11 @@ pub(crate) fn dof_field(kind: JointKind, dof: JointDof, part: &str) -> String {
 }
 
 /// Checks the degrees of freedom of a joint of `kind`: limits ordered and finite (angles within
-/// [−π, π], a distance joint's lengths ≥ 0 and not both 0), springs and motors well formed
-/// and on non-locked degrees of freedom only.
+/// [−π, π]), springs and motors well formed and on non-locked degrees of freedom only, and
+/// what the kind's form checks besides ([`super::forms::JointForm::check_limits`], a distance
+/// joint's lengths ≥ 0 and not both 0; [`super::forms::JointForm::check_dofs`]).
 pub(crate) fn check_dofs(kind: JointKind, dofs: &[JointAxis; 6]) -> Result<(), JointProblem> {
+    let form = kind.form();
     for dof in JointDof::ALL {
         let axis = &dofs[dof.index()];
         let field = |part: &str| dof_field(kind, dof, part);
@@ -114,15 +111,8 @@ pub(crate) fn check_dofs(kind: JointKind, dofs: &[JointAxis; 6]) -> Result<(), J
                     format!("angles must be within [−π, π], got [{lower}, {upper}]"),
                 ));
             }
-            if kind == JointKind::Distance
-                && dof == JointDof::LinearX
-                && (lower < 0.0 || upper <= 0.0)
-            {
-                return Err(problem(
-                    field("limits"),
-                    format!("lengths must be ≥ 0 with max > 0, got [{lower}, {upper}]"),
-                ));
-            }
+            form.check_limits(dof, lower, upper)
+                .map_err(|message| problem(field("limits"), message))?;
         }
         let locked = axis.mode == AxisMode::Locked;
         if let Some(spring) = axis.spring {
@@ -166,16 +156,7 @@ pub(crate) fn check_dofs(kind: JointKind, dofs: &[JointAxis; 6]) -> Result<(), J
             }
         }
     }
-    if kind == JointKind::Distance
-        && !matches!(dofs[0].mode, AxisMode::Limited { .. })
-        && dofs[0].spring.is_none()
-    {
-        return Err(problem(
-            "limits",
-            "a distance joint needs its lengths (min, max) or a spring",
-        ));
-    }
-    Ok(())
+    form.check_dofs(dofs)
 }
 
 /// Checks the repair stiffness, the break thresholds and their window.

@@ -1,47 +1,8 @@
 //! The public description of a joint's degrees of freedom: which are locked, limited or free,
-//! and the spring and motor a free or limited one may carry.
+//! and the spring and motor a free or limited one may carry (the kinds of joint, which set
+//! them, are the forms of `forms/`).
 
 use serde::{Deserialize, Serialize};
-
-/// The kind of a joint: which of its six degrees of freedom (three translations and three
-/// rotations of body B's frame relative to body A's, along and about A's frame axes x, y, z)
-/// it constrains. The joint's axis is its frame's x axis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum JointKind {
-    /// All six degrees of freedom locked: the bodies move as one (Blender's "fixed", Box2D's
-    /// weld joint).
-    Fixed,
-    /// The anchors coincide; rotation is free (a ball-and-socket joint, Blender's "point").
-    Spherical,
-    /// The anchors coincide and the only rotation is about the frame's x axis (a hinge), with
-    /// an optional angle limit, spring and motor on it.
-    Revolute,
-    /// The frames keep their orientation and the only translation is along the frame's x axis
-    /// (a slider), with an optional distance limit, spring and motor on it.
-    Prismatic,
-    /// The distance between the anchors stays within [min, max] (a rod when min = max, a rope
-    /// when min = 0), with an optional spring towards a rest length; rotation is free.
-    Distance,
-    /// Each of the six degrees of freedom locked, limited or free on its own
-    /// ([`JointBuilder::dof`](crate::JointBuilder::dof)), with springs and motors on the
-    /// free ones (PhysX's D6 joint, Jolt's six-DOF constraint, Blender's "generic").
-    Generic,
-}
-
-impl JointKind {
-    /// Lower-case name, as in scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            JointKind::Fixed => "fixed",
-            JointKind::Spherical => "spherical",
-            JointKind::Revolute => "revolute",
-            JointKind::Prismatic => "prismatic",
-            JointKind::Distance => "distance",
-            JointKind::Generic => "generic",
-        }
-    }
-}
 
 /// One of a joint's six degrees of freedom, in body A's joint frame: translations along and
 /// rotations about its x, y and z axes. Index order: `LinearX` = 0 … `AngularZ` = 5.

@@ -12,7 +12,7 @@ use crate::island::Islands;
 use crate::joint::rules::{anchor_reach, check_dofs, check_options};
 use crate::joint::{
     Anchors, Axes, Joint, JointBody, JointBuilder, JointConstraint, JointEvent, JointHandle,
-    JointKind, JointRef, LocalFrames, ROWS_PER_DOF, Strength, frame_state,
+    JointRef, LocalFrames, ROWS_PER_DOF, Strength, frame_state,
 };
 use crate::solver::substep::IslandWorkspace;
 
@@ -196,13 +196,7 @@ impl World {
         );
         let frames = self.local_frames(joint, a, b);
         let pose = |i: usize| (self.bodies.center_of_mass(i), self.bodies.pose[i].rotation);
-        let state = frame_state(
-            &frames,
-            &joint.dofs,
-            joint.kind == JointKind::Distance,
-            pose(a),
-            pose(b),
-        );
+        let state = frame_state(&frames, &joint.dofs, joint.kind.form(), pose(a), pose(b));
         Some(state.coordinates)
     }
 
@@ -298,7 +292,7 @@ impl World {
                 body(b),
                 self.local_frames(joint, a, b),
                 joint.dofs,
-                joint.kind == JointKind::Distance,
+                joint.kind,
                 joint.stiffness,
                 impulses,
                 (joint.break_force, joint.break_torque),

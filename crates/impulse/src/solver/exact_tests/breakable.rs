@@ -3,7 +3,8 @@
 
 use super::*;
 use crate::joint::{
-    AxisMode, IslandJoints, JointAxis, JointBody, JointConstraint, JointStiffness, LocalFrames,
+    AxisMode, IslandJoints, JointAxis, JointBody, JointConstraint, JointKind, JointStiffness,
+    LocalFrames,
 };
 use crate::solver::exact_ball::groups_of;
 use glam::{Mat3, Quat};
@@ -77,7 +78,7 @@ fn hung_boxes(force: f32, torque: f32, force_1: f32) -> IslandJoints {
             b,
             frames(&a, &b, anchor),
             dofs,
-            false,
+            JointKind::Generic,
             JointStiffness::Stiff,
             [[0.0; 5]; 6],
             strength,
