@@ -122,7 +122,9 @@ impl BounceEnergy {
             second += 0.5 * form(dv, dw, dv, dw, after);
         }
         let reference = reference.max(start);
-        if !(start + first + second > reference) {
+        // A non-finite energy is the blow-up check's to report.
+        let end = start + first + second;
+        if !end.is_finite() || !reference.is_finite() || end <= reference {
             return;
         }
         // K(0) ≤ R < K(1), so the larger root lies in [0, 1).
