@@ -7,7 +7,7 @@
 //!
 //! Why the solve can gain energy: Newton's targets v⁺ = −c_r·v⁻ take v⁻ at the step's start,
 //! as if every point that collided in the step were struck at once. With a speculative margin
-//! covering a fast body's whole step, the points are often struck one after the other within
+//! covering a fast body's whole step, the points may be struck one after the other within
 //! the step: a ball at 254 m/s bounces off one height-field triangle and only then reaches the
 //! speculative point of a neighbouring one, at a fraction of the approach the step's start
 //! shows there. The bounce asked at that point (−c_r times an approach that never happened)
