@@ -24,6 +24,7 @@ pub use rules::{MAX_IMPACT_PERTURBATION, MAX_ROUGHNESS_DEGREES};
 // Public for the hidden `internals` module only.
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 pub use storage::Bodies;
+pub(crate) use storage::inertia_form;
 // Public for the hidden `internals` module only.
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 pub use velocities::Velocities;

@@ -222,23 +222,39 @@ impl Bodies {
         let mut energy = 0.5 * v.length_squared() / self.inverse_mass[i];
         let w = self.angular_velocity[i];
         if w != Vec3::ZERO {
-            // ωᵀ·I_world·ω = ω_lᵀ·I_local·ω_l with ω_l = Rᵀω: no world tensor to build, and
-            // I_local = (I⁻¹_local)⁻¹ is a division per axis for the usual diagonal tensor.
-            let local = self.pose[i].rotation.inverse() * w;
-            let inv = &self.local_inverse_inertia[i];
-            let diagonal = Vec3::new(inv.x_axis.x, inv.y_axis.y, inv.z_axis.z);
-            let off_diagonal = inv.x_axis.y != 0.0
-                || inv.x_axis.z != 0.0
-                || inv.y_axis.x != 0.0
-                || inv.y_axis.z != 0.0
-                || inv.z_axis.x != 0.0
-                || inv.z_axis.y != 0.0;
-            if !off_diagonal && diagonal.cmpgt(Vec3::ZERO).all() {
-                energy += 0.5 * local.dot(local / diagonal);
-            } else if inv.determinant().abs() > f32::MIN_POSITIVE {
-                energy += 0.5 * local.dot(inv.inverse() * local);
-            }
+            energy +=
+                0.5 * inertia_form(&self.local_inverse_inertia[i], self.pose[i].rotation, w, w);
         }
         energy
+    }
+}
+
+/// The inertia tensor's bilinear form xᵀ·I_world·y (kg·m²/s² for angular velocities in rad/s)
+/// of a body with local inverse inertia `local_inverse_inertia` (1/(kg·m²)) turned by
+/// `rotation`, computed as x_lᵀ·I_local·y_l with x_l = Rᵀx: no world tensor to build, and
+/// I_local = (I⁻¹_local)⁻¹ is a division per axis for the usual diagonal tensor. Zero when
+/// the inverse is singular (every rotation locked). ½·ωᵀ·I·ω is the rotational kinetic energy.
+pub(crate) fn inertia_form(
+    local_inverse_inertia: &Mat3,
+    rotation: glam::Quat,
+    x: Vec3,
+    y: Vec3,
+) -> f32 {
+    let inverse_rotation = rotation.inverse();
+    let (x, y) = (inverse_rotation * x, inverse_rotation * y);
+    let inv = local_inverse_inertia;
+    let diagonal = Vec3::new(inv.x_axis.x, inv.y_axis.y, inv.z_axis.z);
+    let off_diagonal = inv.x_axis.y != 0.0
+        || inv.x_axis.z != 0.0
+        || inv.y_axis.x != 0.0
+        || inv.y_axis.z != 0.0
+        || inv.z_axis.x != 0.0
+        || inv.z_axis.y != 0.0;
+    if !off_diagonal && diagonal.cmpgt(Vec3::ZERO).all() {
+        x.dot(y / diagonal)
+    } else if inv.determinant().abs() > f32::MIN_POSITIVE {
+        x.dot(inv.inverse() * y)
+    } else {
+        0.0
     }
 }

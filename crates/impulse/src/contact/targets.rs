@@ -18,9 +18,9 @@ use crate::settings::{ContactRepair, SolverSettings};
 ///   come from a damped spring instead ([`soft_contact`]);
 /// - s ≤ 0 without repair (the relax solve): v⁺ ≥ 0, rigid.
 ///
-/// A speculative row of a body that had turned by more than [`SPECULATIVE_TURN`] since the step
-/// began, as the substep started (`turn`: per body, the square of that angle), is stale
-/// ([`speculative_row_is_stale`]) and gets no push: its target is [`STALE_TARGET`], which
+/// A speculative row (a gap now, or at assembly) of a body that had turned by more than
+/// [`SPECULATIVE_TURN`] since the step began, as the substep started (`turn`: per body, the
+/// square of that angle), is stale ([`speculative_row_is_stale`]) and gets no push: its target is [`STALE_TARGET`], which
 /// releases the impulse the warm start gave it. A row whose lever arm lies along its normal (a ball's)
 /// does not depend on the body's rotation and is never stale.
 ///
@@ -45,23 +45,34 @@ pub(crate) fn update_targets(
         let moved = (displacement[a] + rotation[a].cross(c.lever_a))
             - (displacement[b] + rotation[b].cross(c.lever_b));
         let separation = -c.depth + c.normal.direction.dot(moved);
-        let stale = separation > 0.0
+        // Speculative at assembly (depth < 0) counts too: past the turn limit the linearised
+        // separation may read a gap the real motion has opened as closed (see
+        // `SPECULATIVE_TURN`), and the row would act as a touching one.
+        let stale = (separation > 0.0 || c.depth < 0.0)
             && !turn.is_empty()
             && (speculative_row_is_stale(turn[a], c.normal.angular_a, c.lever_a)
                 || speculative_row_is_stale(turn[b], c.normal.angular_b, c.lever_b));
         let gap_target = if stale { STALE_TARGET } else { -separation / h };
-        let repair = (repair_rate * (-separation - settings.overlap_slop).max(0.0))
-            .min(settings.max_repair_speed);
+        let repair = if stale {
+            0.0
+        } else {
+            (repair_rate * (-separation - settings.overlap_slop).max(0.0))
+                .min(settings.max_repair_speed)
+        };
         if settings.split_impulse() {
             // The repair goes to the position solve; the velocity rows stay rigid.
             c.position_target = repair;
             c.position_impulse = 0.0;
             any_repair |= repair > settings.tolerance;
-            c.target_normal_velocity = if separation > 0.0 { gap_target } else { 0.0 };
+            c.target_normal_velocity = if separation > 0.0 || stale {
+                gap_target
+            } else {
+                0.0
+            };
             c.softness = (1.0, 0.0);
             continue;
         }
-        (c.target_normal_velocity, c.softness) = if separation > 0.0 {
+        (c.target_normal_velocity, c.softness) = if separation > 0.0 || stale {
             (gap_target, (1.0, 0.0))
         } else if with_repair {
             (repair, softness)
@@ -84,9 +95,12 @@ pub(crate) fn update_targets(
 /// off by 0.3·|r|. Over the tumbling impacts of tests/ccd.rs (darts and plates at 0, 30 and
 /// 100 rad/s about three axes, four angles), the largest energy rise above the lowest was 28
 /// J/kg with this limit or with 0.5 rad, 36 J/kg with a quarter turn, and 851 J/kg (21 runs
-/// over the blow-up guard) without one. Touching and overlapping rows keep acting: dropping
-/// them too let darts through the wall; they hold a body where it is pressed, and continuous
-/// collision sweeps its true motion as the step ends.
+/// over the blow-up guard) without one. A row with a gap at assembly is stale past the limit
+/// even when its linearised separation reads an overlap: a capsule spun to 800 rad/s by its
+/// impact on a height field turned 8 rad in the next step, where such rows held it at lever
+/// arms turned away and it gained 3,884 J/kg (tests/integration/fast_impacts.rs). Rows touching or overlapping at
+/// assembly keep acting: dropping them too let darts through the wall; they hold a body where
+/// it is pressed, and continuous collision sweeps its true motion as the step ends.
 pub(crate) const SPECULATIVE_TURN: f32 = std::f32::consts::FRAC_PI_4;
 
 /// The target (m/s) of a stale speculative row: far below any approach speed (the blow-up guard

@@ -5,6 +5,7 @@
 use glam::{Mat3, Quat, Vec3};
 
 use super::apgd::Apgd;
+use super::bounce_energy::BounceEnergy;
 use super::impact::ImpactWorkspace;
 use super::interface::{ContactSolver, RowsReport};
 use super::island_report::IslandReport;
@@ -83,6 +84,8 @@ pub(crate) struct IslandWorkspace {
     pub(super) slot_inverse_inertia: Vec<Mat3>,
     /// `impact: propagation`'s work space ([`super::impact`]).
     pub(super) impact: ImpactWorkspace,
+    /// The kinetic-energy bound on the restitution solve's bounce.
+    pub(super) bounce_energy: BounceEnergy,
     /// Whether this substep's main solve met an impact ([`IMPACT_SWEEPS`]).
     pub(super) impact_met: bool,
     /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]): a main solve whose last sweep changed

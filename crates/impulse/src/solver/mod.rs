@@ -28,6 +28,7 @@
 pub(crate) use crate::contact::cap_to_disc;
 
 pub(crate) mod apgd;
+pub(crate) mod bounce_energy;
 pub(crate) mod cholesky;
 pub(crate) mod exact;
 pub(crate) mod exact_ball;

@@ -3,6 +3,7 @@
 //! generalized reflections), then one solve of contacts and joints together when any point
 //! bounces (docs/method.md, "Targets: restitution, gaps and repair").
 
+use super::bounce_energy::BounceIsland;
 use super::impact;
 use super::interface::{SolvePass, Sweep};
 use super::island_workspace::IslandWorkspace;
@@ -52,6 +53,12 @@ impl IslandWorkspace {
         if !bounces {
             return;
         }
+        w.bounce_energy.start(
+            (&w.linear, &w.angular),
+            constraints,
+            island_bodies.len(),
+            (!w.joints.is_empty(), context.forces),
+        );
         // With joints the bounce is a coupled problem: one sweep (the soft step's) takes the
         // joints first and the contacts after them, so the bounce would be that of bodies the
         // joints do not hold (a hinged door struck by a ball spun 37 % faster than the closed
@@ -96,6 +103,16 @@ impl IslandWorkspace {
             &mut w.joints,
             &pass,
         );
+        // An impact of passive bodies gains no kinetic energy (`bounce_energy`).
+        let island = BounceIsland {
+            island_bodies,
+            bodies: context.bodies,
+            gravity: context.gravity,
+            displacement: &w.displacement,
+            orientation: &w.orientation,
+        };
+        let velocities = (&mut w.linear[..], &mut w.angular[..]);
+        w.bounce_energy.bound(&island, velocities, constraints);
         for c in constraints.iter_mut() {
             rows::add_step_impulses(c);
         }

@@ -130,8 +130,10 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
         );
         let overlap_target = if t.with_repair { repair } else { zero };
         let closing = -separation * t.inverse_h;
-        let gap_target = if !STALE {
-            closing
+        // A row speculative at assembly (depth < 0) is stale past the turn limit whatever its
+        // linearised separation reads (as in `update_targets`).
+        let (gap_target, gap) = if !STALE {
+            (closing, gap)
         } else {
             let limit = Lane::splat(SPECULATIVE_TURN * SPECULATIVE_TURN);
             let negligible = Lane::splat(1e-6);
@@ -143,7 +145,11 @@ impl<const STALE: bool> SetTargets for Turned<'_, STALE> {
             let stale_b = turn_b.simd_gt(limit)
                 & dot::<Separate>(arm_b, arm_b)
                     .simd_gt(negligible * dot::<Separate>(g.lever_b, g.lever_b));
-            (stale_a | stale_b).select(Lane::splat(STALE_TARGET), closing)
+            let stale = (stale_a | stale_b) & (gap | zero.simd_gt(b.depth));
+            (
+                stale.select(Lane::splat(STALE_TARGET), closing),
+                gap | stale,
+            )
         };
         b.target = gap.select(gap_target, overlap_target);
         b.mass_scale = gap.select(Lane::splat(1.0), t.soft_mass);
