@@ -39,6 +39,7 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
     let (mut largest, mut largest_step) = (0.0f32, 0);
     let (mut total_s, mut contacts_sum) = (0.0f64, 0usize);
     for step in 1..=steps {
+        let start_poses = world.poses().to_vec();
         let start = Instant::now();
         world.step().unwrap();
         let seconds = start.elapsed().as_secs_f64();
@@ -79,13 +80,33 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
                         _ => Some(c),
                     },
                 );
+            // That pair at the step's start: its overlap from the start poses and the deepest
+            // of its contact points (computed there), with the pair's normal impulse.
+            let (a, b) = (worst.1 as u32, worst.2 as u32);
+            let at_start = metrics::max_overlap_of_pairs(shapes, &start_poses, &[(a, b)]);
+            let pair = world
+                .contact_pairs()
+                .find(|pair| (pair.body1().index(), pair.body2().index()) == (a, b));
+            let (held, impulse, points) = pair.map_or((f32::NAN, 0.0, 0), |pair| {
+                let held = pair
+                    .points()
+                    .map(|p| -p.separation)
+                    .fold(f32::NEG_INFINITY, f32::max);
+                (held, pair.total_normal_impulse(), pair.points().count())
+            });
+            if std::env::var("IMPULSE_MUG_PARTS").is_ok() {
+                explain_parts(&world, &start_poses, a, b);
+            }
             println!(
-                "step {step}: overlap {:.2} mm, bodies {} and {} ({:.2} mm); deepest point at \
-                 the step's start {deepest:?}",
+                "step {step}: overlap {:.2} mm, bodies {} and {} ({:.2} mm; at the step's start \
+                 {:.2} mm, its deepest point there {:.2} mm of {points}, impulse {impulse:.4} N s); \
+                 deepest point at the step's start {deepest:?}",
                 overlap * 1e3,
                 worst.1,
                 worst.2,
-                worst.0 * 1e3
+                worst.0 * 1e3,
+                at_start * 1e3,
+                held * 1e3,
             );
         }
         let diagnostics = world.diagnostics();
@@ -129,4 +150,78 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
         "two bodies overlap by {} mm at step {largest_step}",
         largest * 1e3
     );
+}
+
+/// With `IMPULSE_MUG_PARTS` set: the part pairs of bodies `a` and `b` overlapping by more than
+/// 2 mm at the step's end (Parry's `query::contact` per pair of parts, the four deepest), each
+/// with its depth and normal at the step's `start` poses and the pair's contact points on those
+/// parts, then the pair's 30 deepest points (parts, separation in mm).
+fn explain_parts(world: &World, start: &[impulse::parry3d::math::Pose], a: u32, b: u32) {
+    use impulse::parry3d::query;
+    let shapes = world.shapes();
+    let (ca, cb) = (
+        shapes[a as usize].as_compound().unwrap(),
+        shapes[b as usize].as_compound().unwrap(),
+    );
+    let depth = |poses: &[impulse::parry3d::math::Pose], i: usize, j: usize| {
+        let (pi, si) = &ca.shapes()[i];
+        let (pj, sj) = &cb.shapes()[j];
+        let p1 = poses[a as usize] * *pi;
+        let p2 = poses[b as usize] * *pj;
+        query::contact(&p1, si.as_ref(), &p2, sj.as_ref(), 0.05)
+            .ok()
+            .flatten()
+            .map(|c| (-c.dist, p1.rotation * c.normal1))
+    };
+    let mut list = Vec::new();
+    for i in 0..ca.shapes().len() {
+        for j in 0..cb.shapes().len() {
+            if let Some((d, n)) = depth(world.poses(), i, j)
+                && d > 2e-3
+            {
+                list.push((d, i, j, n));
+            }
+        }
+    }
+    list.sort_by(|x, y| y.0.total_cmp(&x.0));
+    let pos12 = start[a as usize].inv_mul(&start[b as usize]);
+    println!(
+        "   start pos12: rotation {:?} translation {:?}",
+        pos12.rotation.to_array(),
+        pos12.translation.to_array()
+    );
+    let pair = world
+        .contact_pairs()
+        .find(|p| (p.body1().index(), p.body2().index()) == (a, b));
+    for &(d, i, j, n) in list.iter().take(4) {
+        let s = depth(start, i, j);
+        println!(
+            "   parts {i}-{j}: end {:.2} mm normal {n:.3}, start {:?}",
+            d * 1e3,
+            s.map(|(d, n)| (d * 1e3, n))
+        );
+        if let Some(pair) = &pair {
+            for p in pair.points() {
+                if p.part1 == Some(i as u32) && p.part2 == Some(j as u32) {
+                    println!(
+                        "      held: sep {:.2} mm normal {:.3} impulse {:.4}",
+                        p.separation * 1e3,
+                        p.normal,
+                        p.normal_impulse
+                    );
+                }
+            }
+        }
+    }
+    if let Some(pair) = &pair {
+        let mut parts: Vec<_> = pair
+            .points()
+            .map(|p| (p.part1, p.part2, (p.separation * 1e4).round() / 10.0))
+            .collect();
+        parts.sort_by(|x, y| x.2.total_cmp(&y.2));
+        println!(
+            "   held points (parts, sep mm): {:?}",
+            &parts[..parts.len().min(30)]
+        );
+    }
 }
