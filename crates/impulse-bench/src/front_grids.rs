@@ -55,7 +55,10 @@ pub fn impulse_joint_grid() -> Vec<ImpulseSetting> {
         grid.push((
             format!("{name} per-joint"),
             settings.clone().map(|settings| SolverSettings {
-                direct_joint_solve: false,
+                solve: impulse::settings::SolveSettings {
+                    direct_joint_solve: false,
+                    ..settings.solve
+                },
                 ..settings
             }),
         ));
@@ -90,7 +93,10 @@ fn soft_step(substeps: u32, iterations: u32) -> ImpulseSetting {
     (
         name,
         Some(SolverSettings {
-            iterations,
+            solve: impulse::settings::SolveSettings {
+                iterations,
+                ..SolverSettings::soft_step(substeps).solve
+            },
             ..SolverSettings::soft_step(substeps)
         }),
     )
@@ -101,8 +107,11 @@ fn reference(substeps: u32, iterations: u32) -> ImpulseSetting {
     (
         format!("reference {substeps}×{iterations}"),
         Some(SolverSettings {
-            substeps,
-            iterations,
+            solve: impulse::settings::SolveSettings {
+                substeps,
+                iterations,
+                ..SolverSettings::reference().solve
+            },
             ..SolverSettings::reference()
         }),
     )

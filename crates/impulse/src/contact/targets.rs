@@ -39,7 +39,7 @@ pub(crate) fn update_targets(
     with_repair: bool,
 ) -> bool {
     let mut any_repair = false;
-    let (repair_rate, softness) = repair_terms(&settings.repair, h);
+    let (repair_rate, softness) = repair_terms(&settings.contact.repair, h);
     for c in constraints.iter_mut() {
         let (a, b) = (c.local_a as usize, c.local_b as usize);
         let moved = (displacement[a] + rotation[a].cross(c.lever_a))
@@ -50,13 +50,13 @@ pub(crate) fn update_targets(
             && (speculative_row_is_stale(turn[a], c.normal.angular_a, c.lever_a)
                 || speculative_row_is_stale(turn[b], c.normal.angular_b, c.lever_b));
         let gap_target = if stale { STALE_TARGET } else { -separation / h };
-        let repair = (repair_rate * (-separation - settings.overlap_slop).max(0.0))
-            .min(settings.max_repair_speed);
+        let repair = (repair_rate * (-separation - settings.contact.overlap_slop).max(0.0))
+            .min(settings.contact.max_repair_speed);
         if settings.split_impulse() {
             // The repair goes to the position solve; the velocity rows stay rigid.
             c.position_target = repair;
             c.position_impulse = 0.0;
-            any_repair |= repair > settings.tolerance;
+            any_repair |= repair > settings.solve.tolerance;
             c.target_normal_velocity = if separation > 0.0 { gap_target } else { 0.0 };
             c.softness = (1.0, 0.0);
             continue;

@@ -49,6 +49,7 @@ pub const HEAVY_ON_LIGHT_CONTACTS_FACTOR: u32 = 4;
 /// ([`HEAVY_ON_LIGHT_CONTACTS_FACTOR`] times `exact_max_contacts`; 0 = never).
 pub(crate) fn heavy_on_light_max_contacts(settings: &SolverSettings) -> u32 {
     settings
+        .solve
         .exact_max_contacts
         .saturating_mul(HEAVY_ON_LIGHT_CONTACTS_FACTOR)
 }
@@ -57,24 +58,23 @@ pub(crate) fn heavy_on_light_max_contacts(settings: &SolverSettings) -> u32 {
 /// the basic method's one LCP per step (one substep), on rigid rows with a velocity bias
 /// ([`HEAVY_ON_LIGHT_REPAIR_RATE`]) and a relax solve, solved by the automatic policy with every
 /// solve escalating to the exact path (Lemke; NNCG's result stands if pivoting fails; `auto`'s
-/// other parameters as `settings.method`'s, or their defaults). The
+/// other parameters as `settings.solve.method`'s, or their defaults). The
 /// rest, repair cap, friction and warm start included, is `settings`'.
 pub(crate) fn heavy_on_light_settings(settings: &SolverSettings) -> SolverSettings {
-    let (escalation_tolerance, escalation_iterations, _) = settings.method.auto_parameters();
-    SolverSettings {
-        method: SolverMethod::Auto {
-            escalation_tolerance,
-            escalation_iterations,
-            mass_ratio_threshold: 0.0,
-        },
-        substeps: 1,
-        relax_iterations: settings.relax_iterations.max(1),
-        exact_max_contacts: heavy_on_light_max_contacts(settings),
-        repair: ContactRepair::Bias {
-            rate: HEAVY_ON_LIGHT_REPAIR_RATE,
-        },
-        ..settings.clone()
-    }
+    let (escalation_tolerance, escalation_iterations, _) = settings.solve.method.auto_parameters();
+    let mut light = settings.clone();
+    light.solve.method = SolverMethod::Auto {
+        escalation_tolerance,
+        escalation_iterations,
+        mass_ratio_threshold: 0.0,
+    };
+    light.solve.substeps = 1;
+    light.solve.relax_iterations = settings.solve.relax_iterations.max(1);
+    light.solve.exact_max_contacts = heavy_on_light_max_contacts(settings);
+    light.contact.repair = ContactRepair::Bias {
+        rate: HEAVY_ON_LIGHT_REPAIR_RATE,
+    };
+    light
 }
 
 /// The contact of `constraints` of largest mass ratio between two moving bodies, if above

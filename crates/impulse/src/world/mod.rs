@@ -437,12 +437,13 @@ impl World {
     /// use impulse::{SolverSettings, World, WorldError};
     ///
     /// let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 0.01, SolverSettings::default())?;
-    /// let bad = SolverSettings { iterations: 0, ..SolverSettings::default() };
+    /// let mut bad = SolverSettings::default();
+    /// bad.solve.iterations = 0;
     /// let Err(WorldError::InvalidSettings(problem)) = world.set_settings(bad) else {
     ///     panic!("0 iterations accepted");
     /// };
     /// assert_eq!(problem.field, "iterations");
-    /// assert_eq!(world.settings().iterations, SolverSettings::default().iterations);
+    /// assert_eq!(world.settings().solve.iterations, SolverSettings::default().solve.iterations);
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), WorldError> {
