@@ -40,7 +40,7 @@ pub fn impulse_grid() -> Vec<ImpulseSetting> {
 
 /// impulse's settings for a scene with joints: the presets, and the soft step at substeps
 /// {1, 2, 3, 4, 5, 6, 8 (the preset `fast`), 10, 12, 16, 24, 32} with the island's locked
-/// joint rows solved together (`soft S`, `SolverSettings::direct_joint_solve`, the default)
+/// joint rows solved together (`soft S`, `SolveSettings::direct_joint_solve`, the default)
 /// and one joint after another (`soft S per-joint`), which costs less per sweep and holds
 /// chains of similar masses nearly as well; and `soft S×2` at 4, 8 and 16 substeps. The substeps are what stiffens the
 /// joints (each substep solves them with the positions it starts from), as the peers' joint

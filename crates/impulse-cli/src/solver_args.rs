@@ -109,12 +109,12 @@ pub struct SolverArgs {
     #[arg(long)]
     pub overlap_slop: Option<f32>,
     /// Sweep the friction rows in the soft step's main (repairing) solve too, not only in its
-    /// relax solve (see `SolverSettings::friction_in_main_solve`).
+    /// relax solve (see `SolveSettings::friction_in_main_solve`).
     #[arg(long)]
     pub friction_in_main_solve: bool,
     /// Let the SIMD lanes' sweeps fuse multiplies and additions on CPUs that have FMA: about a
     /// tenth less solve time, results that differ in their last bits from a CPU without FMA
-    /// (see `SolverSettings::fused_multiply_add`).
+    /// (see `SolveSettings::fused_multiply_add`).
     #[arg(long)]
     pub fused_multiply_add: bool,
     /// Soft contact frequency in Hz, > 0 (with `--repair soft` or settings that repair with

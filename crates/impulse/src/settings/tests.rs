@@ -451,3 +451,65 @@ fn autos_parameters_read_and_write_beside_the_method() {
     assert_eq!(default["escalation_iterations"], 4);
     assert!(serde_json::from_str::<SolverSettings>(r#"{"substep": 3}"#).is_err());
 }
+
+/// The `solver` object stays flat while the Rust type is grouped: each group's keys read into
+/// their group, the file keeps the 34 keys it has always had, `"sleep":
+/// false` is `sleep: None`, and every preset reads back as it was written.
+#[test]
+fn flat_keys_read_into_their_groups_and_write_back_flat() {
+    let json = r#"{"substeps": 7, "warm_start": 0.5, "prediction_distance": 0.01,
+        "impact": "propagation", "sleep_linear_speed": 0.2, "time_to_sleep": 2,
+        "max_distance": 50, "max_angular_speed": 1000, "gyroscopic": false}"#;
+    let s: SolverSettings = serde_json::from_str(json).unwrap();
+    let default = SolverSettings::default();
+    assert_eq!((s.solve.substeps, s.solve.warm_start), (7, 0.5));
+    assert_eq!(s.contact.prediction_distance, 0.01);
+    assert_eq!(s.contact.impact, ImpactModel::Propagation);
+    assert_eq!(
+        s.sleep,
+        Some(SleepSettings {
+            linear_speed: 0.2,
+            angular_speed: SleepSettings::default().angular_speed,
+            time_to_sleep: 2.0,
+        })
+    );
+    assert_eq!(
+        (s.limits.max_distance, s.limits.max_angular_speed),
+        (50.0, 1000.0)
+    );
+    assert_eq!(s.limits.max_linear_speed, default.limits.max_linear_speed);
+    assert!(!s.gyroscopic && s.continuous);
+    let asleep_off: SolverSettings =
+        serde_json::from_str(r#"{"sleep": false, "time_to_sleep": 2}"#).unwrap();
+    assert_eq!(asleep_off.sleep, None);
+    let written = serde_json::to_value(&asleep_off).unwrap();
+    assert_eq!(
+        (&written["sleep"], &written["time_to_sleep"]),
+        (&false.into(), &0.5.into())
+    );
+    let keys: Vec<String> = match serde_json::to_value(&default).unwrap() {
+        serde_json::Value::Object(map) => map.keys().cloned().collect(),
+        other => panic!("not an object: {other}"),
+    };
+    let expected = "method substeps iterations relax_iterations tolerance escalation_tolerance \
+        escalation_iterations mass_ratio_threshold exact_max_contacts heavy_on_light_mass_ratio \
+        restitution_threshold repair overlap_slop max_repair_speed warm_start prediction_distance \
+        sleep sleep_linear_speed sleep_angular_speed time_to_sleep friction friction_in_main_solve \
+        direct_joint_solve parallel_island_contacts simd_island_contacts fused_multiply_add \
+        gyroscopic continuous impact friction_combine restitution_combine max_distance \
+        max_linear_speed max_angular_speed";
+    let mut sorted_expected: Vec<&str> = expected.split_whitespace().collect();
+    let mut sorted_keys: Vec<&str> = keys.iter().map(String::as_str).collect();
+    sorted_expected.sort_unstable();
+    sorted_keys.sort_unstable();
+    assert_eq!(sorted_keys, sorted_expected);
+    for name in SolverSettings::PRESETS {
+        let preset = SolverSettings::preset(name).unwrap();
+        let text = serde_json::to_string(&preset).unwrap();
+        assert_eq!(
+            serde_json::from_str::<SolverSettings>(&text).unwrap(),
+            preset,
+            "{name}"
+        );
+    }
+}

@@ -30,7 +30,7 @@ use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 mod forces;
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
-/// friction rows too, whatever [`SolverSettings::friction_in_main_solve`] says. Friction
+/// friction rows too, whatever [`crate::settings::SolveSettings::friction_in_main_solve`] says. Friction
 /// between a heavy body and a light one converges slowly under Gauss-Seidel (each sweep moves
 /// the heavy body by the light one's share), and one friction sweep a substep, the relax
 /// solve's, let the 400:1 `plate` rock sideways with growing amplitude, up to 600 J after 10 s

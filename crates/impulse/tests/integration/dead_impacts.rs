@@ -3,7 +3,7 @@
 //! At restitution 0 Newton's hypothesis asks for v⁺ = 0 along the normal: a body dropped flat
 //! onto the ground at any speed stops on it (Stronge, "Impact Mechanics", 2000, ch. 2). The
 //! rebound allowed here is 1 % of the impact speed. A body in free fall keeps falling: one that
-//! passes the world bound ([`SolverSettings::max_distance`]) leaves the world with an event and
+//! passes the world bound ([`impulse::settings::WorldLimits::max_distance`]) leaves the world with an event and
 //! the run goes on. A pile that nothing strikes is not taken for an impact.
 
 use impulse::glam::{Quat, Vec3};

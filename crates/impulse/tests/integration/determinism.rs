@@ -59,7 +59,7 @@ fn a_scene_of_every_shape_is_the_same_on_any_thread_count_and_run() {
     same_everywhere(&scene, 180);
 }
 
-/// With fused multiply-adds (`SolverSettings::fused_multiply_add`) the lanes round
+/// With fused multiply-adds (`SolveSettings::fused_multiply_add`) the lanes round
 /// otherwise, where the CPU's kernels have FMA, and a run is still the same on any thread
 /// count and from one run to the next. Where they have none (or with
 /// `IMPULSE_INSTRUCTION_SET=baseline`) the setting changes nothing, to the bit; where they

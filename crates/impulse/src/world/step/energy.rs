@@ -3,7 +3,7 @@
 //! what the continuous stage's clamps give back and reset by the step's forces and moving
 //! kinematic bodies, and the step's end compares the energy with it ([`BLOW_UP_ENERGY_PER_KG`])
 //! and checks every body's position for a non-finite value and its linear and angular speeds
-//! against their bounds (`SolverSettings::max_linear_speed`, m/s, and `max_angular_speed`,
+//! against their bounds (`WorldLimits::max_linear_speed`, m/s, and `max_angular_speed`,
 //! rad/s); a moving body beyond the world bound leaves the world instead.
 
 use glam::Vec3;
