@@ -163,7 +163,7 @@ impl SolverSettings {
     }
 
     /// Whether an island of `contacts` contact points is solved in SIMD lanes
-    /// ([`SolveSettings::simd_island_contacts`]): PGS without split impulse, at or above the threshold.
+    /// ([`crate::settings::SolveSettings::simd_island_contacts`]): PGS without split impulse, at or above the threshold.
     pub fn solves_in_lanes(&self, contacts: usize) -> bool {
         self.solve.method == SolverMethod::Pgs
             && !self.split_impulse()
