@@ -45,17 +45,17 @@ pub fn capped(mut scene: Scene) -> Option<Scene> {
 
 /// Clamps the solver effort to the caps above.
 pub fn cap_settings(solver: &mut SolverSettings) {
-    solver.substeps = solver.substeps.min(MAX_SUBSTEPS);
-    solver.iterations = solver.iterations.min(MAX_ITERATIONS);
-    solver.relax_iterations = solver.relax_iterations.min(MAX_RELAX_ITERATIONS);
+    solver.solve.substeps = solver.solve.substeps.min(MAX_SUBSTEPS);
+    solver.solve.iterations = solver.solve.iterations.min(MAX_ITERATIONS);
+    solver.solve.relax_iterations = solver.solve.relax_iterations.min(MAX_RELAX_ITERATIONS);
     if let impulse::SolverMethod::Auto {
         escalation_iterations,
         ..
-    } = &mut solver.method
+    } = &mut solver.solve.method
     {
         *escalation_iterations = (*escalation_iterations).min(MAX_ITERATIONS);
     }
-    solver.exact_max_contacts = solver.exact_max_contacts.min(MAX_EXACT_CONTACTS);
+    solver.solve.exact_max_contacts = solver.solve.exact_max_contacts.min(MAX_EXACT_CONTACTS);
 }
 
 /// A scene of `mesh` as a static `trimesh` body and a 0.1 m ball 0.5 m above the middle of

@@ -32,7 +32,7 @@ fn settled_world() -> World {
     // A pyramid at rest would fall asleep and cost nothing.
     world
         .set_settings(impulse::SolverSettings {
-            sleep: false,
+            sleep: None,
             ..world.settings().clone()
         })
         .expect("valid settings");
@@ -56,7 +56,7 @@ fn margins(world: &World) -> SpeculativeMargins {
     let mut margins = SpeculativeMargins::default();
     margins.update(
         bodies(world),
-        world.settings().prediction_distance,
+        world.settings().contact.prediction_distance,
         world.gravity(),
         world.dt(),
         false,

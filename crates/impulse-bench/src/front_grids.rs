@@ -40,7 +40,7 @@ pub fn impulse_grid() -> Vec<ImpulseSetting> {
 
 /// impulse's settings for a scene with joints: the presets, and the soft step at substeps
 /// {1, 2, 3, 4, 5, 6, 8 (the preset `fast`), 10, 12, 16, 24, 32} with the island's locked
-/// joint rows solved together (`soft S`, `SolverSettings::direct_joint_solve`, the default)
+/// joint rows solved together (`soft S`, `SolveSettings::direct_joint_solve`, the default)
 /// and one joint after another (`soft S per-joint`), which costs less per sweep and holds
 /// chains of similar masses nearly as well; and `soft S×2` at 4, 8 and 16 substeps. The substeps are what stiffens the
 /// joints (each substep solves them with the positions it starts from), as the peers' joint
@@ -55,7 +55,10 @@ pub fn impulse_joint_grid() -> Vec<ImpulseSetting> {
         grid.push((
             format!("{name} per-joint"),
             settings.clone().map(|settings| SolverSettings {
-                direct_joint_solve: false,
+                solve: impulse::settings::SolveSettings {
+                    direct_joint_solve: false,
+                    ..settings.solve
+                },
                 ..settings
             }),
         ));
@@ -90,7 +93,10 @@ fn soft_step(substeps: u32, iterations: u32) -> ImpulseSetting {
     (
         name,
         Some(SolverSettings {
-            iterations,
+            solve: impulse::settings::SolveSettings {
+                iterations,
+                ..SolverSettings::soft_step(substeps).solve
+            },
             ..SolverSettings::soft_step(substeps)
         }),
     )
@@ -101,8 +107,11 @@ fn reference(substeps: u32, iterations: u32) -> ImpulseSetting {
     (
         format!("reference {substeps}×{iterations}"),
         Some(SolverSettings {
-            substeps,
-            iterations,
+            solve: impulse::settings::SolveSettings {
+                substeps,
+                iterations,
+                ..SolverSettings::reference().solve
+            },
             ..SolverSettings::reference()
         }),
     )

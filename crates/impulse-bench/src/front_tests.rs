@@ -274,8 +274,8 @@ fn grids_have_the_documented_sizes_and_names() {
     assert_eq!(names.len(), grid.len(), "names are unique");
     let (_, split) = grid.iter().find(|(n, _)| n == "reference 2×4").unwrap();
     let split = split.as_ref().unwrap();
-    assert!(split.split_impulse() && split.method.is_auto());
-    assert_eq!((split.substeps, split.iterations), (2, 4));
+    assert!(split.split_impulse() && split.solve.method.is_auto());
+    assert_eq!((split.solve.substeps, split.solve.iterations), (2, 4));
     assert!(impulse_quick_grid().len() < 5);
     let joint_grid = impulse_joint_grid();
     assert_eq!(joint_grid.len(), 4 + 12 * 2 - 1 + 3);
@@ -286,7 +286,10 @@ fn grids_have_the_documented_sizes_and_names() {
     assert_eq!(
         per_joint.as_ref(),
         Some(&SolverSettings {
-            direct_joint_solve: false,
+            solve: impulse::settings::SolveSettings {
+                direct_joint_solve: false,
+                ..SolverSettings::soft_step(4).solve
+            },
             ..SolverSettings::soft_step(4)
         })
     );

@@ -110,7 +110,7 @@ impl ImpulseRun {
         let mut world = World::from_scene(&scene)
             .with_context(|| format!("building scene {} in {engine}", scene.name))?;
         world.set_settings(SolverSettings {
-            sleep: false,
+            sleep: None,
             ..world.settings().clone()
         })?;
         Ok(Self {
@@ -174,31 +174,34 @@ impl ImpulseRun {
 /// The solver settings as one line: method, substeps, iterations, overlap repair, sleeping,
 /// threads.
 pub fn settings_text(s: &SolverSettings, threads: usize) -> String {
-    let method = match s.method {
+    let method = match s.solve.method {
         SolverMethod::Pgs => "PGS",
         SolverMethod::Nncg => "NNCG",
         SolverMethod::Apgd => "APGD",
         SolverMethod::Auto { .. } => "auto (NNCG, escalating per island)",
     };
     // As the step runs them: split impulse leaves no work to the relax pass.
-    let repair = match s.repair {
+    let repair = match s.contact.repair {
         ContactRepair::SplitImpulse { rate, .. } => format!("split-impulse repair {rate}/s"),
         ContactRepair::Soft { hertz, .. } => {
-            format!("soft contact {hertz} Hz + {} relax", s.relax_iterations)
+            format!(
+                "soft contact {hertz} Hz + {} relax",
+                s.solve.relax_iterations
+            )
         }
         ContactRepair::Bias { rate } => {
-            format!("bias repair {rate}/s + {} relax", s.relax_iterations)
+            format!("bias repair {rate}/s + {} relax", s.solve.relax_iterations)
         }
     };
     format!(
         "{method}, {} substeps × ≤{} iterations, {repair}, slop {} mm, tol {:e}, warm start {}, \
          sleeping {}, {threads} thread{}",
-        s.substeps,
-        s.iterations,
-        s.overlap_slop * 1e3,
-        s.tolerance,
-        s.warm_start,
-        if s.sleep { "on" } else { "off" },
+        s.solve.substeps,
+        s.solve.iterations,
+        s.contact.overlap_slop * 1e3,
+        s.solve.tolerance,
+        s.solve.warm_start,
+        if s.sleep.is_some() { "on" } else { "off" },
         if threads == 1 { "" } else { "s" },
     )
 }

@@ -27,7 +27,7 @@ fn history(
     let mut out = Vec::with_capacity(iterations as usize);
     for k in 1..=iterations {
         let mut scene = scene.clone();
-        scene.solver.sleep = false;
+        scene.solver.sleep = None;
         let mut world = World::from_scene(&scene).context("cannot build the world")?;
         for _ in 1..step {
             world
@@ -36,10 +36,13 @@ fn history(
             bar.inc(1);
         }
         world.set_settings(SolverSettings {
-            substeps: 1,
-            method,
-            iterations: k,
-            tolerance: 0.0,
+            solve: impulse::settings::SolveSettings {
+                substeps: 1,
+                method,
+                iterations: k,
+                tolerance: 0.0,
+                ..world.settings().clone().solve
+            },
             ..world.settings().clone()
         })?;
         let residual = world

@@ -137,11 +137,11 @@ pub fn dump(mut scene: Scene, step: u64, out: &Path, no_friction: bool) -> Resul
         bail!("--step must be at least 1: contacts are found by the first step");
     }
     if no_friction {
-        scene.solver.friction = false;
+        scene.solver.contact.friction = false;
     }
     // A sleeping island is not solved: its rows would hold last step's impulses with zero
     // velocities, a trivial LCP (w = 0) rather than the step's.
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     let name = scene.name.clone();
     let mut world = World::from_scene(&scene).context("cannot build the scene's world")?;
     for _ in 0..step {

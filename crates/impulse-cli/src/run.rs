@@ -338,7 +338,7 @@ fn run_scene(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<S
         scene.dt = dt;
     }
     if let Some(iterations) = options.iterations {
-        scene.solver.iterations = iterations;
+        scene.solver.solve.iterations = iterations;
     }
     let steps = options.steps.unwrap_or(scene.steps) as u64;
     if steps == 0 {
@@ -660,15 +660,15 @@ fn simulate(
         mean_iterations: iterations_sum as f64 / taken,
         max_natural_map_residual: max_residual,
         final_natural_map_residual: world.diagnostics().natural_map_residual,
-        iterations_limit: settings.iterations,
-        method: settings.method.name().to_string(),
+        iterations_limit: settings.solve.iterations,
+        method: settings.solve.method.name().to_string(),
         island_solves,
         threads: if parallel {
             rayon::current_num_threads()
         } else {
             1
         },
-        sleep: settings.sleep,
+        sleep: settings.sleep.is_some(),
         status,
         stage_ms: median_profile(&profiles),
     };

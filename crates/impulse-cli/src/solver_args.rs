@@ -109,12 +109,12 @@ pub struct SolverArgs {
     #[arg(long)]
     pub overlap_slop: Option<f32>,
     /// Sweep the friction rows in the soft step's main (repairing) solve too, not only in its
-    /// relax solve (see `SolverSettings::friction_in_main_solve`).
+    /// relax solve (see `SolveSettings::friction_in_main_solve`).
     #[arg(long)]
     pub friction_in_main_solve: bool,
     /// Let the SIMD lanes' sweeps fuse multiplies and additions on CPUs that have FMA: about a
     /// tenth less solve time, results that differ in their last bits from a CPU without FMA
-    /// (see `SolverSettings::fused_multiply_add`).
+    /// (see `SolveSettings::fused_multiply_add`).
     #[arg(long)]
     pub fused_multiply_add: bool,
     /// Soft contact frequency in Hz, > 0 (with `--repair soft` or settings that repair with
@@ -158,41 +158,41 @@ impl SolverArgs {
                 *field = v;
             }
         };
-        set(&mut s.iterations, self.iterations);
-        set(&mut s.substeps, self.substeps);
-        set(&mut s.relax_iterations, self.relax);
+        set(&mut s.solve.iterations, self.iterations);
+        set(&mut s.solve.substeps, self.substeps);
+        set(&mut s.solve.relax_iterations, self.relax);
         if let Some(fraction) = self.warm_start {
-            s.warm_start = fraction;
+            s.solve.warm_start = fraction;
         }
-        s.repair = self.repair(s.repair)?;
+        s.contact.repair = self.repair(s.contact.repair)?;
         if let Some(slop) = self.overlap_slop {
-            s.overlap_slop = slop;
+            s.contact.overlap_slop = slop;
         }
         if self.friction_in_main_solve {
-            s.friction_in_main_solve = true;
+            s.solve.friction_in_main_solve = true;
         }
         if self.fused_multiply_add {
-            s.fused_multiply_add = true;
+            s.solve.fused_multiply_add = true;
         }
         if self.no_sleep {
-            s.sleep = false;
+            s.sleep = None;
         }
         if let Some(tolerance) = self.tolerance {
-            s.tolerance = tolerance;
+            s.solve.tolerance = tolerance;
         }
         set(
-            &mut s.parallel_island_contacts,
+            &mut s.solve.parallel_island_contacts,
             self.parallel_island_contacts,
         );
-        set(&mut s.simd_island_contacts, self.simd_island_contacts);
-        set(&mut s.exact_max_contacts, self.exact_max_contacts);
+        set(&mut s.solve.simd_island_contacts, self.simd_island_contacts);
+        set(&mut s.solve.exact_max_contacts, self.exact_max_contacts);
         if let Some(method) = self.method {
             // `--method auto` on settings that already solve by `auto` keeps their parameters.
-            if !(method.is_auto() && s.method.is_auto()) {
-                s.method = method;
+            if !(method.is_auto() && s.solve.method.is_auto()) {
+                s.solve.method = method;
             }
         }
-        s.method = self.escalation(s.method)?;
+        s.solve.method = self.escalation(s.solve.method)?;
         Ok(s)
     }
 
@@ -312,21 +312,24 @@ mod tests {
             ..SolverArgs::default()
         };
         let mut scene = SolverSettings::reference();
-        scene.sleep = true;
+        scene.sleep = Some(impulse::settings::SleepSettings::default());
         let s = args.apply(&scene).unwrap();
-        assert_eq!(s.substeps, 3);
+        assert_eq!(s.solve.substeps, 3);
         assert_eq!(
-            s.repair,
+            s.contact.repair,
             ContactRepair::SplitImpulse {
                 rate: 12.0,
                 iterations: 16
             }
         );
-        assert_eq!(s.method, SolverMethod::Nncg);
-        assert!(!s.sleep);
+        assert_eq!(s.solve.method, SolverMethod::Nncg);
+        assert_eq!(s.sleep, None);
         assert_eq!(
-            s.relax_iterations,
-            SolverSettings::preset("fast").unwrap().relax_iterations
+            s.solve.relax_iterations,
+            SolverSettings::preset("fast")
+                .unwrap()
+                .solve
+                .relax_iterations
         );
         // Without options the settings stay as they are.
         assert_eq!(SolverArgs::default().apply(&scene), Ok(scene));
@@ -343,21 +346,26 @@ mod tests {
         assert!(
             on.apply(&SolverSettings::default())
                 .unwrap()
+                .solve
                 .fused_multiply_add
         );
         let scene = SolverSettings {
-            fused_multiply_add: true,
+            solve: impulse::settings::SolveSettings {
+                fused_multiply_add: true,
+                ..SolverSettings::default().solve
+            },
             ..SolverSettings::default()
         };
         let fast = SolverArgs {
             preset: Some(PresetArg::Fast),
             ..SolverArgs::default()
         };
-        assert!(fast.apply(&scene).unwrap().fused_multiply_add);
+        assert!(fast.apply(&scene).unwrap().solve.fused_multiply_add);
         assert!(
             !SolverArgs::default()
                 .apply(&SolverSettings::default())
                 .unwrap()
+                .solve
                 .fused_multiply_add
         );
     }
@@ -370,7 +378,7 @@ mod tests {
             ..SolverArgs::default()
         };
         assert_eq!(
-            args.apply(&soft).unwrap().repair,
+            args.apply(&soft).unwrap().contact.repair,
             ContactRepair::Soft {
                 hertz: 60.0,
                 damping_ratio: 10.0
@@ -387,7 +395,7 @@ mod tests {
             ..SolverArgs::default()
         };
         assert_eq!(
-            bias.apply(&soft).unwrap().repair,
+            bias.apply(&soft).unwrap().contact.repair,
             ContactRepair::Bias { rate: 5.0 }
         );
         let sweeps = SolverArgs {
@@ -414,14 +422,14 @@ mod tests {
         for method in SolverMethod::ALL {
             let args = parse(&["--method", method.name()]).unwrap();
             let settings = args.apply(&SolverSettings::default()).unwrap();
-            assert_eq!(settings.method, method);
+            assert_eq!(settings.solve.method, method);
         }
         assert!(parse(&["--method", "lemke"]).is_err());
         let args = parse(&["--method", "auto", "--escalation-iterations", "9"]).unwrap();
         let SolverMethod::Auto {
             escalation_iterations,
             ..
-        } = args.apply(&SolverSettings::default()).unwrap().method
+        } = args.apply(&SolverSettings::default()).unwrap().solve.method
         else {
             panic!("not auto");
         };

@@ -57,7 +57,7 @@ fn the_constraint_row_size_is_the_code_s() {
 
 #[test]
 fn the_simd_lane_threshold_is_the_default() {
-    let default = f64::from(SolverSettings::default().simd_island_contacts);
+    let default = f64::from(SolverSettings::default().solve.simd_island_contacts);
     assert_stated(BENCHMARKS, "`simd_island_contacts` points, ", default);
 }
 

@@ -69,8 +69,8 @@ pub enum WorldError {
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum StepError {
     /// A body's position became non-finite, or its linear or angular speed non-finite or
-    /// beyond its bound ([`crate::SolverSettings::max_linear_speed`] in m/s,
-    /// [`crate::SolverSettings::max_angular_speed`] in rad/s). Displayed as, e.g.,
+    /// beyond its bound ([`crate::settings::WorldLimits::max_linear_speed`] in m/s,
+    /// [`crate::settings::WorldLimits::max_angular_speed`] in rad/s). Displayed as, e.g.,
     /// `simulation blew up at step 3: body 1 has angular speed = 2e7 rad/s, not finite or
     /// beyond solver.max_angular_speed = 10000000 rad/s`.
     #[error(

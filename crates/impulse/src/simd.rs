@@ -22,7 +22,7 @@
 //! The operations are the same IEEE operations in the same order (Rust never fuses a multiply
 //! and an add unless asked to, whatever the target features), so both builds of a kernel give
 //! the same bits: the choice changes the time, never a trajectory. The one exception is asked
-//! for by the scene: with [`crate::SolverSettings::fused_multiply_add`] the x86-64-v3 and
+//! for by the scene: with [`crate::settings::SolveSettings::fused_multiply_add`] the x86-64-v3 and
 //! x86-64-v4 builds of the sweeps fuse multiplies and additions (one rounding), which the
 //! baseline cannot.
 //!

@@ -80,7 +80,7 @@ fn count(scene: &str, preset: &str, threads: usize) -> (u64, u64, Option<String>
     pool.install(|| {
         let mut scene = builtin_scene(scene).expect("built-in scene");
         scene.solver = SolverSettings::preset(preset).expect("preset");
-        scene.solver.sleep = false;
+        scene.solver.sleep = None;
         let mut world = World::from_scene(&scene).expect("world");
         for _ in 0..120 {
             world.step().expect("step");

@@ -134,21 +134,21 @@ pub(crate) fn start_within_bounds(
             length(position),
             "m from the origin",
             "max_distance",
-            settings.max_distance,
+            settings.limits.max_distance,
         ),
         (
             "linear_velocity",
             length(linear_velocity),
             "m/s",
             "max_linear_speed",
-            settings.max_linear_speed,
+            settings.limits.max_linear_speed,
         ),
         (
             "angular_velocity",
             length(angular_velocity),
             "rad/s",
             "max_angular_speed",
-            settings.max_angular_speed,
+            settings.limits.max_angular_speed,
         ),
     ];
     for (field, value, unit, setting, bound) in checks {

@@ -14,7 +14,7 @@ use parry3d::shape::SharedShape;
 /// gravity, so that nothing moves and every step after the first asks the same query.
 fn ball_on_ground() -> World {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     let mut w = World::new(Vec3::ZERO, 1.0 / 60.0, settings).unwrap();

@@ -185,9 +185,11 @@ impl Assembly<'_> {
         let com_a = self.world_center_of_mass[a];
         let com_b = self.world_center_of_mass[b];
         let friction = settings
+            .contact
             .friction_combine
             .combine(bodies.friction[a], bodies.friction[b]);
         let restitution = settings
+            .contact
             .restitution_combine
             .combine(bodies.restitution[a], bodies.restitution[b]);
         let roughness = super::roughness::pair_roughness(bodies, a, b);
@@ -207,7 +209,11 @@ impl Assembly<'_> {
                 Mat3A::from(self.world_inverse_inertia[b]),
             )
         });
-        let friction = if settings.friction { friction } else { 0.0 };
+        let friction = if settings.contact.friction {
+            friction
+        } else {
+            0.0
+        };
         for (manifold_index, manifold) in pair.manifolds.iter().enumerate() {
             if manifold.points.is_empty() {
                 continue;
@@ -277,7 +283,7 @@ impl Assembly<'_> {
                     warm.normal,
                     [warm.friction.dot(t1), warm.friction.dot(t2)],
                     friction,
-                    settings.warm_start,
+                    settings.solve.warm_start,
                 );
                 c.normal_impulse = normal_impulse;
                 c.tangent_impulses = tangent_impulses;

@@ -39,7 +39,7 @@ pub(crate) fn update_targets(
     with_repair: bool,
 ) -> bool {
     let mut any_repair = false;
-    let (repair_rate, softness) = repair_terms(&settings.repair, h);
+    let (repair_rate, softness) = repair_terms(&settings.contact.repair, h);
     for c in constraints.iter_mut() {
         let (a, b) = (c.local_a as usize, c.local_b as usize);
         let moved = (displacement[a] + rotation[a].cross(c.lever_a))
@@ -56,14 +56,14 @@ pub(crate) fn update_targets(
         let repair = if stale {
             0.0
         } else {
-            (repair_rate * (-separation - settings.overlap_slop).max(0.0))
-                .min(settings.max_repair_speed)
+            (repair_rate * (-separation - settings.contact.overlap_slop).max(0.0))
+                .min(settings.contact.max_repair_speed)
         };
         if settings.split_impulse() {
             // The repair goes to the position solve; the velocity rows stay rigid.
             c.position_target = repair;
             c.position_impulse = 0.0;
-            any_repair |= repair > settings.tolerance;
+            any_repair |= repair > settings.solve.tolerance;
             c.target_normal_velocity = if separation > 0.0 || stale {
                 gap_target
             } else {

@@ -39,11 +39,17 @@ fn pile(friction: bool) -> World {
     const HALF_WIDTH: f32 = 2.0;
     const SPACING: f32 = 1.02;
     let settings = SolverSettings {
-        iterations: 200,
-        relax_iterations: 200,
-        tolerance: 0.0,
-        friction,
-        sleep: false,
+        solve: crate::settings::SolveSettings {
+            iterations: 200,
+            relax_iterations: 200,
+            tolerance: 0.0,
+            ..SolverSettings::reference().solve
+        },
+        contact: crate::settings::ContactSettings {
+            friction,
+            ..SolverSettings::reference().contact
+        },
+        sleep: None,
         ..SolverSettings::reference()
     };
     let mu = if friction { 0.5 } else { 0.0 };
@@ -469,11 +475,11 @@ fn friction_pile_engine_is_in_the_disc_and_pyramid_pgs_converges() {
 #[test]
 fn soft_rows_are_exported_with_their_regularisation() {
     let mut world = pile(false);
-    world.settings.repair = ContactRepair::Soft {
+    world.settings.contact.repair = ContactRepair::Soft {
         hertz: 30.0,
         damping_ratio: 10.0,
     };
-    world.settings.relax_iterations = 0;
+    world.settings.solve.relax_iterations = 0;
     for step in 1..=120 {
         world.step().unwrap();
         if step % 30 != 0 {
@@ -685,10 +691,16 @@ fn pile_of_spheres_satisfies_complementarity_at_exit() {
     // The LCP at exit is that of the last solve of the step (the relax solve), so both are
     // run to convergence.
     let settings = SolverSettings {
-        iterations: 500,
-        relax_iterations: 500,
-        tolerance: 0.0,
-        friction: false,
+        solve: crate::settings::SolveSettings {
+            iterations: 500,
+            relax_iterations: 500,
+            tolerance: 0.0,
+            ..SolverSettings::default().solve
+        },
+        contact: crate::settings::ContactSettings {
+            friction: false,
+            ..SolverSettings::default().contact
+        },
         ..SolverSettings::default()
     };
     let mut w = common::sphere_pile(settings);

@@ -86,7 +86,7 @@ impl<'a> IntoIterator for &'a mut IslandJoints {
 
 impl IslandJoints {
     /// Starts a step of substeps of `h` seconds: every joint's substep length, and with
-    /// `direct` ([`crate::SolverSettings::direct_joint_solve`]) the order and envelope of the
+    /// `direct` ([`crate::settings::SolveSettings::direct_joint_solve`]) the order and envelope of the
     /// locked rows (the joints were assembled for this step).
     pub(crate) fn start_step(&mut self, h: f32, direct: bool) {
         for joint in &mut self.constraints {

@@ -785,7 +785,7 @@ mod tests {
             dt: -1.0,
             ..Scene::default()
         };
-        scene.solver.iterations = 0;
+        scene.solver.solve.iterations = 0;
         scene.bodies.push(BodyDesc::new(
             BodyKind::Particle,
             ShapeDesc::Cuboid {

@@ -1,11 +1,16 @@
 //! The settings as scene files and snapshots hold them: one flat `solver` object
-//! (docs/scene-format.md), `auto`'s parameters beside `method`. [`SolverSettings`] reads and
-//! writes itself through [`SettingsFile`], so the format stays as it was when the Rust type
-//! was given its variant parameters; a field missing from a file takes its default.
+//! (docs/scene-format.md), `auto`'s parameters beside `method`, every group's fields side by
+//! side. [`SolverSettings`] reads and writes itself through [`SettingsFile`], so the format
+//! stays as it was before the Rust type was grouped; a field missing from a file takes its
+//! default. `sleep: false` is [`SolverSettings::sleep`] `None` (its three parameters are then
+//! ignored on reading and written as their defaults).
 
 use serde::{Deserialize, Serialize};
 
-use super::{CombineRule, ContactRepair, ImpactModel, SolverMethod, SolverSettings};
+use super::{
+    CombineRule, ContactRepair, ContactSettings, ImpactModel, SleepSettings, SolveSettings,
+    SolverMethod, SolverSettings, WorldLimits,
+};
 
 /// `solver.method`: the method's name alone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -82,47 +87,48 @@ impl Default for SettingsFile {
 impl From<SolverSettings> for SettingsFile {
     fn from(s: SolverSettings) -> Self {
         let (escalation_tolerance, escalation_iterations, mass_ratio_threshold) =
-            s.method.auto_parameters();
+            s.solve.method.auto_parameters();
+        let sleep = s.sleep.unwrap_or_default();
         SettingsFile {
-            method: match s.method {
+            method: match s.solve.method {
                 SolverMethod::Pgs => MethodName::Pgs,
                 SolverMethod::Nncg => MethodName::Nncg,
                 SolverMethod::Apgd => MethodName::Apgd,
                 SolverMethod::Auto { .. } => MethodName::Auto,
             },
-            substeps: s.substeps,
-            iterations: s.iterations,
-            relax_iterations: s.relax_iterations,
-            tolerance: s.tolerance,
+            substeps: s.solve.substeps,
+            iterations: s.solve.iterations,
+            relax_iterations: s.solve.relax_iterations,
+            tolerance: s.solve.tolerance,
             escalation_tolerance,
             escalation_iterations,
             mass_ratio_threshold,
-            exact_max_contacts: s.exact_max_contacts,
-            heavy_on_light_mass_ratio: s.heavy_on_light_mass_ratio,
-            restitution_threshold: s.restitution_threshold,
-            repair: s.repair,
-            overlap_slop: s.overlap_slop,
-            max_repair_speed: s.max_repair_speed,
-            warm_start: s.warm_start,
-            prediction_distance: s.prediction_distance,
-            sleep: s.sleep,
-            sleep_linear_speed: s.sleep_linear_speed,
-            sleep_angular_speed: s.sleep_angular_speed,
-            time_to_sleep: s.time_to_sleep,
-            friction: s.friction,
-            friction_in_main_solve: s.friction_in_main_solve,
-            direct_joint_solve: s.direct_joint_solve,
-            parallel_island_contacts: s.parallel_island_contacts,
-            simd_island_contacts: s.simd_island_contacts,
-            fused_multiply_add: s.fused_multiply_add,
+            exact_max_contacts: s.solve.exact_max_contacts,
+            heavy_on_light_mass_ratio: s.solve.heavy_on_light_mass_ratio,
+            restitution_threshold: s.contact.restitution_threshold,
+            repair: s.contact.repair,
+            overlap_slop: s.contact.overlap_slop,
+            max_repair_speed: s.contact.max_repair_speed,
+            warm_start: s.solve.warm_start,
+            prediction_distance: s.contact.prediction_distance,
+            sleep: s.sleep.is_some(),
+            sleep_linear_speed: sleep.linear_speed,
+            sleep_angular_speed: sleep.angular_speed,
+            time_to_sleep: sleep.time_to_sleep,
+            friction: s.contact.friction,
+            friction_in_main_solve: s.solve.friction_in_main_solve,
+            direct_joint_solve: s.solve.direct_joint_solve,
+            parallel_island_contacts: s.solve.parallel_island_contacts,
+            simd_island_contacts: s.solve.simd_island_contacts,
+            fused_multiply_add: s.solve.fused_multiply_add,
             gyroscopic: s.gyroscopic,
             continuous: s.continuous,
-            impact: s.impact,
-            friction_combine: s.friction_combine,
-            restitution_combine: s.restitution_combine,
-            max_distance: s.max_distance,
-            max_linear_speed: s.max_linear_speed,
-            max_angular_speed: s.max_angular_speed,
+            impact: s.contact.impact,
+            friction_combine: s.contact.friction_combine,
+            restitution_combine: s.contact.restitution_combine,
+            max_distance: s.limits.max_distance,
+            max_linear_speed: s.limits.max_linear_speed,
+            max_angular_speed: s.limits.max_angular_speed,
         }
     }
 }
@@ -130,46 +136,53 @@ impl From<SolverSettings> for SettingsFile {
 impl From<SettingsFile> for SolverSettings {
     fn from(f: SettingsFile) -> Self {
         SolverSettings {
-            method: match f.method {
-                MethodName::Pgs => SolverMethod::Pgs,
-                MethodName::Nncg => SolverMethod::Nncg,
-                MethodName::Apgd => SolverMethod::Apgd,
-                MethodName::Auto => SolverMethod::Auto {
-                    escalation_tolerance: f.escalation_tolerance,
-                    escalation_iterations: f.escalation_iterations,
-                    mass_ratio_threshold: f.mass_ratio_threshold,
+            solve: SolveSettings {
+                method: match f.method {
+                    MethodName::Pgs => SolverMethod::Pgs,
+                    MethodName::Nncg => SolverMethod::Nncg,
+                    MethodName::Apgd => SolverMethod::Apgd,
+                    MethodName::Auto => SolverMethod::Auto {
+                        escalation_tolerance: f.escalation_tolerance,
+                        escalation_iterations: f.escalation_iterations,
+                        mass_ratio_threshold: f.mass_ratio_threshold,
+                    },
                 },
+                substeps: f.substeps,
+                iterations: f.iterations,
+                relax_iterations: f.relax_iterations,
+                tolerance: f.tolerance,
+                exact_max_contacts: f.exact_max_contacts,
+                heavy_on_light_mass_ratio: f.heavy_on_light_mass_ratio,
+                warm_start: f.warm_start,
+                friction_in_main_solve: f.friction_in_main_solve,
+                direct_joint_solve: f.direct_joint_solve,
+                parallel_island_contacts: f.parallel_island_contacts,
+                simd_island_contacts: f.simd_island_contacts,
+                fused_multiply_add: f.fused_multiply_add,
             },
-            substeps: f.substeps,
-            iterations: f.iterations,
-            relax_iterations: f.relax_iterations,
-            tolerance: f.tolerance,
-            exact_max_contacts: f.exact_max_contacts,
-            heavy_on_light_mass_ratio: f.heavy_on_light_mass_ratio,
-            restitution_threshold: f.restitution_threshold,
-            repair: f.repair,
-            overlap_slop: f.overlap_slop,
-            max_repair_speed: f.max_repair_speed,
-            warm_start: f.warm_start,
-            prediction_distance: f.prediction_distance,
-            sleep: f.sleep,
-            sleep_linear_speed: f.sleep_linear_speed,
-            sleep_angular_speed: f.sleep_angular_speed,
-            time_to_sleep: f.time_to_sleep,
-            friction: f.friction,
-            friction_in_main_solve: f.friction_in_main_solve,
-            direct_joint_solve: f.direct_joint_solve,
-            parallel_island_contacts: f.parallel_island_contacts,
-            simd_island_contacts: f.simd_island_contacts,
-            fused_multiply_add: f.fused_multiply_add,
+            contact: ContactSettings {
+                restitution_threshold: f.restitution_threshold,
+                repair: f.repair,
+                overlap_slop: f.overlap_slop,
+                max_repair_speed: f.max_repair_speed,
+                prediction_distance: f.prediction_distance,
+                friction: f.friction,
+                impact: f.impact,
+                friction_combine: f.friction_combine,
+                restitution_combine: f.restitution_combine,
+            },
+            sleep: f.sleep.then_some(SleepSettings {
+                linear_speed: f.sleep_linear_speed,
+                angular_speed: f.sleep_angular_speed,
+                time_to_sleep: f.time_to_sleep,
+            }),
+            limits: WorldLimits {
+                max_distance: f.max_distance,
+                max_linear_speed: f.max_linear_speed,
+                max_angular_speed: f.max_angular_speed,
+            },
             gyroscopic: f.gyroscopic,
             continuous: f.continuous,
-            impact: f.impact,
-            friction_combine: f.friction_combine,
-            restitution_combine: f.restitution_combine,
-            max_distance: f.max_distance,
-            max_linear_speed: f.max_linear_speed,
-            max_angular_speed: f.max_angular_speed,
         }
     }
 }

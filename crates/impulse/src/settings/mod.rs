@@ -3,6 +3,9 @@
 use serde::{Deserialize, Serialize};
 
 mod file;
+mod validation;
+
+pub use validation::SettingError;
 
 /// The iterative method run on the contact rows. In scene files, `solver.method` names it
 /// (`"pgs"`, `"nncg"`, `"apgd"`, `"auto"`) and `auto`'s parameters sit beside it in the `solver`
@@ -20,7 +23,7 @@ pub enum SolverMethod {
     /// The automatic policy, per island and solve ([`SolverSettings::reference`]): NNCG within the iteration
     /// budget; an island whose last iteration still changed a row's velocity by more than
     /// `escalation_tolerance`, or whose mass ratio exceeds `mass_ratio_threshold`, escalates:
-    /// to the exact path when it has at most [`SolverSettings::exact_max_contacts`] contact points (keeping the
+    /// to the exact path when it has at most [`SolveSettings::exact_max_contacts`] contact points (keeping the
     /// iterative result if pivoting fails), otherwise (only when unconverged) to
     /// `escalation_iterations` more NNCG iterations. An unconverged island that is not heavy
     /// but in an impact (a contact closing at the step's start faster than |g|·dt, the speed
@@ -33,7 +36,7 @@ pub enum SolverMethod {
     Auto {
         /// An island escalates when the last iteration of its solve still changed some row's
         /// velocity by more than this (m/s), ≥ 0. Looser than
-        /// [`SolverSettings::tolerance`], which only ends iterations early: a solve that
+        /// [`SolveSettings::tolerance`], which only ends iterations early: a solve that
         /// stopped at its budget above it is not converged. Default 3·10⁻⁴.
         escalation_tolerance: f32,
         /// NNCG iterations an unconverged island gets beyond the budget, ≥ 1. Default 4.
@@ -238,15 +241,10 @@ impl CombineRule {
     }
 }
 
-/// Settings of the contact solve (steps 4 and 5 of docs/architecture.md).
-///
-/// Defaults are chosen for the standard scenes at dt = 1/60 s. Units are SI.
-/// Each term is explained in docs/method.md with its source.
-///
-/// Scene files and snapshots hold them as the flat `solver` object of docs/scene-format.md
-/// (serialised through `settings/file.rs`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct SolverSettings {
+/// How hard and how the LCP is solved: the method, its budgets, the exact and heavy-on-light
+/// paths, warm starting and how an island's rows are swept ([`SolverSettings::solve`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolveSettings {
     /// Method: `pgs`, `nncg`, `apgd`, or `auto` (the escalation policy, with its parameters).
     pub method: SolverMethod,
     /// Substeps per step. Contacts are found once per step; each substep of h = dt/substeps
@@ -280,32 +278,9 @@ pub struct SolverSettings {
     /// body to the light one at a rate of about 1/R per sweep (docs/solvers.md, "Heavy on
     /// light"). 0 = never; every other island takes the ordinary path unchanged.
     pub heavy_on_light_mass_ratio: f32,
-    /// Restitution hypothesis v⁺ = −c_r·v⁻ is applied only when the contact approaches faster
-    /// than this (m/s), so resting contacts do not bounce (docs/method.md, "Targets: restitution, gaps and repair").
-    pub restitution_threshold: f32,
-    /// How overlap is repaired: soft contact springs (the default), a velocity bias, or
-    /// split impulse ([`ContactRepair`]).
-    pub repair: ContactRepair,
-    /// Overlap (m) tolerated without repair, so resting contacts do not jitter.
-    pub overlap_slop: f32,
-    /// Cap (m/s) on the repair speed, so deep overlaps separate without an explosion.
-    pub max_repair_speed: f32,
     /// Fraction of last step's impulses used as this step's starting guess (0 = cold start).
     /// Impulses are matched by Parry's contact feature ids.
     pub warm_start: f32,
-    /// Contacts are generated up to this separation (m) ahead of touching ("speculative"
-    /// contacts): a row with gap g > 0 only forbids closing faster than g/dt.
-    pub prediction_distance: f32,
-    /// Let quiet islands sleep (the finish stage, docs/architecture.md). Off for benchmarks.
-    pub sleep: bool,
-    /// A body slower than this (m/s) …
-    pub sleep_linear_speed: f32,
-    /// … and spinning slower than this (rad/s) counts as quiet.
-    pub sleep_angular_speed: f32,
-    /// An island sleeps when all its bodies have been quiet this long (s).
-    pub time_to_sleep: f32,
-    /// Apply Coulomb friction rows (two tangents per point, |γ_t| ≤ μ·γ_n).
-    pub friction: bool,
     /// Solve the friction rows in the main (repairing) solve as well as in the relax solve.
     /// When false (the default), `pgs` with a relax solve (soft or bias repair, not split
     /// impulse) sweeps only the normal rows while it repairs overlap, and the friction rows
@@ -314,7 +289,7 @@ pub struct SolverSettings {
     /// lower bodies sideways and spreads the pile (Rapier's `friction_in_bias_pass`, off by
     /// default, makes the same choice). The friction impulses are applied throughout (warm
     /// start). Other methods, split impulse, and solves without a relax solve always sweep
-    /// friction with the normal rows ([`Self::main_solve_friction`]), and so do islands whose
+    /// friction with the normal rows ([`SolverSettings::main_solve_friction`]), and so do islands whose
     /// heaviest body is at least 200 times their lightest, where one friction sweep a substep
     /// converges too slowly (docs/solvers.md, "The soft step").
     pub friction_in_main_solve: bool,
@@ -353,19 +328,28 @@ pub struct SolverSettings {
     /// any thread count. The scalar solvers, the products and the step's record round twice
     /// either way.
     pub fused_multiply_add: bool,
-    /// Integrate the gyroscopic term ω × I·ω of rigid bodies, implicitly, once per substep
-    /// (`integrate::gyroscopic`), so that a free body keeps its world angular momentum
-    /// and a body spun near its intermediate axis tumbles (docs/method.md, "Gyroscopic
-    /// motion"). Off keeps ω constant in the world frame between contacts.
-    pub gyroscopic: bool,
-    /// Continuous collision (motion clamping): a dynamic body that
-    /// moved more than half its smallest half extent in a step is swept from its pose at the
-    /// step's start to its pose at the end against the static and kinematic bodies (Parry's
-    /// nonlinear shape cast), and put back to the first impact, its velocity kept for the
-    /// next step's contacts (Rapier's CCD against fixed colliders, Box2D v3's continuous
-    /// collision). Fast bodies then never pass through a thin wall, whatever their speed. On
-    /// by default; the cost without fast bodies is a pass over the bodies' poses.
-    pub continuous: bool,
+}
+
+/// How contacts are made and what they mean: restitution, overlap repair, speculative
+/// contacts, friction, the impact model and how two bodies' coefficients combine
+/// ([`SolverSettings::contact`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactSettings {
+    /// Restitution hypothesis v⁺ = −c_r·v⁻ is applied only when the contact approaches faster
+    /// than this (m/s), so resting contacts do not bounce (docs/method.md, "Targets: restitution, gaps and repair").
+    pub restitution_threshold: f32,
+    /// How overlap is repaired: soft contact springs (the default), a velocity bias, or
+    /// split impulse ([`ContactRepair`]).
+    pub repair: ContactRepair,
+    /// Overlap (m) tolerated without repair, so resting contacts do not jitter.
+    pub overlap_slop: f32,
+    /// Cap (m/s) on the repair speed, so deep overlaps separate without an explosion.
+    pub max_repair_speed: f32,
+    /// Contacts are generated up to this separation (m) ahead of touching ("speculative"
+    /// contacts): a row with gap g > 0 only forbids closing faster than g/dt.
+    pub prediction_distance: f32,
+    /// Apply Coulomb friction rows (two tangents per point, |γ_t| ≤ μ·γ_n).
+    pub friction: bool,
     /// How simultaneous impacts are resolved: `simultaneous` (one LCP with Newton's
     /// restitution, the default) or `propagation` (generalized reflections). A physical
     /// choice of the scene, like the restitution coefficients ([`ImpactModel`]).
@@ -376,6 +360,23 @@ pub struct SolverSettings {
     /// How a contact's restitution is made from its two bodies' ([`CombineRule`]; default the
     /// larger). A physical choice of the scene, which presets keep.
     pub restitution_combine: CombineRule,
+}
+
+/// When quiet islands sleep ([`SolverSettings::sleep`]; `None` keeps every body awake).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SleepSettings {
+    /// A body slower than this (m/s) …
+    pub linear_speed: f32,
+    /// … and spinning slower than this (rad/s) counts as quiet.
+    pub angular_speed: f32,
+    /// An island sleeps when all its bodies have been quiet this long (s).
+    pub time_to_sleep: f32,
+}
+
+/// The world's bounds: where a moving body leaves the world, and which speeds are a blow-up
+/// ([`SolverSettings::limits`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldLimits {
     /// World bound (m): a moving body whose centre of mass ends a step farther than this from
     /// the origin leaves the simulation ([`crate::World::left_world`]): it is frozen where it
     /// is and the run goes on. Default 10⁵ m ([`crate::settings::BLOW_UP_DISTANCE`]); must be > 0.
@@ -390,19 +391,54 @@ pub struct SolverSettings {
     pub max_angular_speed: f32,
 }
 
-/// The default world bound (m), [`SolverSettings::max_distance`]: a moving body farther than
+/// Settings of the step: the solve, the contacts, sleeping, the world's limits, and two
+/// switches of the bodies' motion.
+///
+/// Defaults are chosen for the standard scenes at dt = 1/60 s. Units are SI.
+/// Each term is explained in docs/method.md with its source.
+///
+/// Scene files and snapshots hold them as one flat `solver` object (docs/scene-format.md),
+/// each group's fields under their own names (the sleep group's as `sleep_linear_speed`,
+/// `sleep_angular_speed`, `time_to_sleep`, with `sleep: false` for `None`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolverSettings {
+    /// How hard and how the LCP is solved ([`SolveSettings`]).
+    pub solve: SolveSettings,
+    /// How contacts are made and resolved ([`ContactSettings`]).
+    pub contact: ContactSettings,
+    /// Let quiet islands sleep (the finish stage, docs/architecture.md), when they have been
+    /// quiet as [`SleepSettings`] says; `None` keeps every body awake, as benchmarks do.
+    pub sleep: Option<SleepSettings>,
+    /// Where a body leaves the world and which speeds are a blow-up ([`WorldLimits`]).
+    pub limits: WorldLimits,
+    /// Integrate the gyroscopic term ω × I·ω of rigid bodies, implicitly, once per substep
+    /// (`integrate::gyroscopic`), so that a free body keeps its world angular momentum
+    /// and a body spun near its intermediate axis tumbles (docs/method.md, "Gyroscopic
+    /// motion"). Off keeps ω constant in the world frame between contacts.
+    pub gyroscopic: bool,
+    /// Continuous collision (motion clamping): a dynamic body that
+    /// moved more than half its smallest half extent in a step is swept from its pose at the
+    /// step's start to its pose at the end against the static and kinematic bodies (Parry's
+    /// nonlinear shape cast), and put back to the first impact, its velocity kept for the
+    /// next step's contacts (Rapier's CCD against fixed colliders, Box2D v3's continuous
+    /// collision). Fast bodies then never pass through a thin wall, whatever their speed. On
+    /// by default; the cost without fast bodies is a pass over the bodies' poses.
+    pub continuous: bool,
+}
+
+/// The default world bound (m), [`WorldLimits::max_distance`]: a moving body farther than
 /// this from the origin leaves the world ([`crate::LeftWorld`]); the run goes on. A non-finite
 /// position is a blow-up.
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
 
-/// The default [`SolverSettings::max_linear_speed`] (m/s): 100 km/s, beyond anything that
+/// The default [`WorldLimits::max_linear_speed`] (m/s): 100 km/s, beyond anything that
 /// moves in a contact simulation (a rifle bullet flies at about 1 km/s, a light-gas gun's
 /// projectile at 7 km/s, the fastest meteoroid meets the Earth at 72 km/s). A speed a step
 /// cannot reach by physics is left to the energy check ([`crate::BLOW_UP_ENERGY_PER_KG`]);
 /// this bound only catches a state that is finite but meaningless.
 pub const DEFAULT_MAX_LINEAR_SPEED: f32 = 1.0e5;
 
-/// The default [`SolverSettings::max_angular_speed`] (rad/s): 10⁷ rad/s, the spin of a 1 cm
+/// The default [`WorldLimits::max_angular_speed`] (rad/s): 10⁷ rad/s, the spin of a 1 cm
 /// ball rolling at [`DEFAULT_MAX_LINEAR_SPEED`], and 500 times a rifle bullet's
 /// (18,850 rad/s). A small body that grazes the ground fast spins up to v/r (a 2 cm ball at
 /// 700 m/s: 70,000 rad/s), which is physics, not a blow-up.
@@ -415,229 +451,56 @@ pub const DEFAULT_MAX_ANGULAR_SPEED: f32 = 1.0e7;
 /// reach it at about 65 (n·(n − 1)/2 pairs).
 pub const MAX_PAIRS_PER_BODY: usize = 32;
 
-/// A setting outside its allowed range: which field, and what is allowed. Displayed as
-/// `solver.<field>: <message>` for a solver setting, `<field>: <message>` for the world's
-/// `dt` and `gravity`.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{}{field}: {message}", if Self::WORLD_FIELDS.contains(field) { "" } else { "solver." })]
-pub struct SettingError {
-    /// The field's key in a scene file's `solver` object (its name in [`SolverSettings`]'s
-    /// file format, e.g. `substeps` or `repair.hertz`), or one of [`Self::WORLD_FIELDS`].
-    pub field: &'static str,
-    /// What is wrong and what is allowed, with the value found (e.g. `must be ≥ 0, got -1`).
-    pub message: String,
-}
-
-impl SettingError {
-    /// The world's settings outside the solver's, top-level keys of a scene file: the time
-    /// step `dt` (s) and `gravity` (m/s²).
-    pub const WORLD_FIELDS: [&'static str; 2] = ["dt", "gravity"];
-}
-
-impl SolverSettings {
-    /// Every setting outside its allowed range, in field order; empty when all are valid.
-    /// The one check of solver settings: the scene loader reports each problem at its place in
-    /// the file; [`crate::World::new`], [`crate::World::set_settings`] and the snapshot loader
-    /// the first one (the step trusts settings that came through them). Counts
-    /// (`iterations`, `substeps`, split impulse's `repair.iterations`, `escalation_iterations`)
-    /// must be ≥ 1 and ≤ [`Self::MAX_COUNT`] (`relax_iterations` ≤ it, 0 allowed); a soft repair's `hertz` > 0;
-    /// tolerances, thresholds, rates, speeds, distances, frequencies and times finite and ≥ 0;
-    /// `warm_start` in [0, 1].
-    pub fn problems(&self) -> Vec<SettingError> {
-        let mut problems = Vec::new();
-        let position_iterations = match self.repair {
-            ContactRepair::SplitImpulse { iterations, .. } => iterations,
-            _ => 1,
-        };
-        let (escalation_tolerance, escalation_iterations, mass_ratio_threshold) =
-            self.method.auto_parameters();
-        let counts = [
-            ("iterations", self.iterations),
-            ("substeps", self.substeps),
-            ("repair.iterations", position_iterations),
-            ("escalation_iterations", escalation_iterations),
-        ];
-        for (field, value) in counts {
-            if value == 0 {
-                problems.push(SettingError {
-                    field,
-                    message: "must be ≥ 1, got 0".to_string(),
-                });
-            } else if value > Self::MAX_COUNT {
-                problems.push(SettingError {
-                    field,
-                    message: format!("must be ≤ {}, got {value}", Self::MAX_COUNT),
-                });
-            }
-        }
-        if self.relax_iterations > Self::MAX_COUNT {
-            problems.push(SettingError {
-                field: "relax_iterations",
-                message: format!(
-                    "must be ≤ {}, got {}",
-                    Self::MAX_COUNT,
-                    self.relax_iterations
-                ),
-            });
-        }
-        let (rate, damping_ratio) = match self.repair {
-            ContactRepair::Bias { rate } | ContactRepair::SplitImpulse { rate, .. } => (rate, 0.0),
-            ContactRepair::Soft {
-                hertz,
-                damping_ratio,
-            } => {
-                if hertz.is_finite() && hertz <= 0.0 {
-                    problems.push(SettingError {
-                        field: "repair.hertz",
-                        message: format!("must be > 0, got {hertz}"),
-                    });
-                }
-                (hertz, damping_ratio)
-            }
-        };
-        let rate_field = match self.repair {
-            ContactRepair::Soft { .. } => "repair.hertz",
-            _ => "repair.rate",
-        };
-        let non_negative = [
-            ("tolerance", self.tolerance),
-            ("escalation_tolerance", escalation_tolerance),
-            ("mass_ratio_threshold", mass_ratio_threshold),
-            ("heavy_on_light_mass_ratio", self.heavy_on_light_mass_ratio),
-            (rate_field, rate),
-            ("repair.damping_ratio", damping_ratio),
-            ("sleep_linear_speed", self.sleep_linear_speed),
-            ("sleep_angular_speed", self.sleep_angular_speed),
-            ("time_to_sleep", self.time_to_sleep),
-            ("restitution_threshold", self.restitution_threshold),
-            ("overlap_slop", self.overlap_slop),
-            ("max_repair_speed", self.max_repair_speed),
-            ("prediction_distance", self.prediction_distance),
-        ];
-        for (field, value) in non_negative {
-            let message = if !value.is_finite() {
-                format!("must be finite, got {value}")
-            } else if value < 0.0 {
-                format!("must be ≥ 0, got {value}")
-            } else {
-                continue;
-            };
-            problems.push(SettingError { field, message });
-        }
-        // A soft repair's coefficients overflow f32 far beyond any substep rate (as a joint
-        // spring's do, `joint::rules::MAX_SPRING`).
-        for (field, value) in [(rate_field, rate), ("repair.damping_ratio", damping_ratio)] {
-            if value.is_finite() && value > 1.0e6 {
-                problems.push(SettingError {
-                    field,
-                    message: format!("must be at most 1e6, got {value:e}"),
-                });
-            }
-        }
-        if self.max_distance.is_nan() || self.max_distance <= 0.0 {
-            problems.push(SettingError {
-                field: "max_distance",
-                message: format!("must be > 0, got {}", self.max_distance),
-            });
-        }
-        for (field, value) in [
-            ("max_linear_speed", self.max_linear_speed),
-            ("max_angular_speed", self.max_angular_speed),
-        ] {
-            if !(value.is_finite() && value > 0.0) {
-                problems.push(SettingError {
-                    field,
-                    message: format!("must be finite and > 0, got {value}"),
-                });
-            }
-        }
-        let warm_start = self.warm_start;
-        if !warm_start.is_finite() {
-            problems.push(SettingError {
-                field: "warm_start",
-                message: format!("must be finite, got {warm_start}"),
-            });
-        } else if !(0.0..=1.0).contains(&warm_start) {
-            problems.push(SettingError {
-                field: "warm_start",
-                message: format!("must be in [0, 1], got {warm_start}"),
-            });
-        }
-        problems
-    }
-
-    /// Whether overlap is repaired by split impulse.
-    pub fn split_impulse(&self) -> bool {
-        matches!(self.repair, ContactRepair::SplitImpulse { .. })
-    }
-
-    /// Whether an island of `contacts` contact points is solved in SIMD lanes
-    /// ([`Self::simd_island_contacts`]): PGS without split impulse, at or above the threshold.
-    pub fn solves_in_lanes(&self, contacts: usize) -> bool {
-        self.method == SolverMethod::Pgs
-            && !self.split_impulse()
-            && self.simd_island_contacts > 0
-            && contacts >= self.simd_island_contacts as usize
-    }
-
-    /// Largest allowed `substeps`, `iterations`, `relax_iterations`, `repair.iterations` and
-    /// `escalation_iterations`: 10,000. The presets use at most 48 substeps and 16 sweeps; a
-    /// count far beyond this is a typo, and 4,294,967,295 substeps would run for days per step.
-    pub const MAX_COUNT: u32 = 10_000;
-
-    /// The first of [`Self::problems`], if any.
-    pub fn validate(&self) -> Result<(), SettingError> {
-        match self.problems().into_iter().next() {
-            Some(problem) => Err(problem),
-            None => Ok(()),
-        }
-    }
-}
-
 impl SolverSettings {
     /// These settings with the solver effort of `preset` (e.g. [`Self::preset`]`("fast")`),
     /// for applying a preset to a scene: a preset sets accuracy, the scene sets physics.
     ///
-    /// Taken from `preset` (how hard and how the LCP is solved): `method`, `substeps`,
-    /// `iterations`, `relax_iterations`, `tolerance` (`method` with `auto`'s parameters),
-    /// `exact_max_contacts`, `repair` (method,
-    /// stiffness and its parameters), `overlap_slop`, `max_repair_speed`, `warm_start`,
-    /// `friction_in_main_solve`, `direct_joint_solve`, `parallel_island_contacts` and
-    /// `simd_island_contacts`.
-    /// Kept from `self` (what the scene means to happen): `restitution_threshold`,
-    /// `prediction_distance`, sleeping (`sleep`, `sleep_linear_speed`, `sleep_angular_speed`,
-    /// `time_to_sleep`), `friction`, `friction_combine`, `restitution_combine`, `impact`,
-    /// `gyroscopic`, `continuous`, `fused_multiply_add` (a
-    /// choice between speed and bits the same on every CPU), and any field not listed
-    /// here. The split is tabled in docs/solvers.md, "Presets and scenes".
+    /// Taken from `preset` (how hard and how the LCP is solved): in [`Self::solve`], `method`
+    /// (with `auto`'s parameters), `substeps`, `iterations`, `relax_iterations`, `tolerance`,
+    /// `exact_max_contacts`, `warm_start`, `friction_in_main_solve`, `direct_joint_solve`,
+    /// `parallel_island_contacts` and `simd_island_contacts`; in [`Self::contact`], `repair`
+    /// (method, stiffness and its parameters), `overlap_slop` and `max_repair_speed`.
+    /// Kept from `self` (what the scene means to happen): the rest of [`Self::contact`]
+    /// (`restitution_threshold`, `prediction_distance`, `friction`, `friction_combine`,
+    /// `restitution_combine`, `impact`), [`Self::sleep`], [`Self::limits`], `gyroscopic`,
+    /// `continuous`, and in [`Self::solve`] `heavy_on_light_mass_ratio` and
+    /// `fused_multiply_add` (a choice between speed and bits the same on every CPU). The split
+    /// is tabled in docs/solvers.md, "Presets and scenes".
     pub fn with_effort_of(&self, preset: &SolverSettings) -> SolverSettings {
+        let (solve, contact) = (&preset.solve, &preset.contact);
         SolverSettings {
-            method: preset.method,
-            substeps: preset.substeps,
-            iterations: preset.iterations,
-            relax_iterations: preset.relax_iterations,
-            tolerance: preset.tolerance,
-            exact_max_contacts: preset.exact_max_contacts,
-            repair: preset.repair,
-            overlap_slop: preset.overlap_slop,
-            max_repair_speed: preset.max_repair_speed,
-            warm_start: preset.warm_start,
-            friction_in_main_solve: preset.friction_in_main_solve,
-            direct_joint_solve: preset.direct_joint_solve,
-            parallel_island_contacts: preset.parallel_island_contacts,
-            simd_island_contacts: preset.simd_island_contacts,
+            solve: SolveSettings {
+                method: solve.method,
+                substeps: solve.substeps,
+                iterations: solve.iterations,
+                relax_iterations: solve.relax_iterations,
+                tolerance: solve.tolerance,
+                exact_max_contacts: solve.exact_max_contacts,
+                warm_start: solve.warm_start,
+                friction_in_main_solve: solve.friction_in_main_solve,
+                direct_joint_solve: solve.direct_joint_solve,
+                parallel_island_contacts: solve.parallel_island_contacts,
+                simd_island_contacts: solve.simd_island_contacts,
+                ..self.solve
+            },
+            contact: ContactSettings {
+                repair: contact.repair,
+                overlap_slop: contact.overlap_slop,
+                max_repair_speed: contact.max_repair_speed,
+                ..self.contact
+            },
             ..self.clone()
         }
     }
 }
 
 impl SolverSettings {
-    /// Whether the main solve sweeps the friction rows: see [`Self::friction_in_main_solve`].
+    /// Whether the main solve sweeps the friction rows: see [`SolveSettings::friction_in_main_solve`].
     pub fn main_solve_friction(&self) -> bool {
-        self.friction_in_main_solve
-            || self.method != SolverMethod::Pgs
+        self.solve.friction_in_main_solve
+            || self.solve.method != SolverMethod::Pgs
             || self.split_impulse()
-            || self.relax_iterations == 0
+            || self.solve.relax_iterations == 0
     }
 
     /// The soft step at `substeps` substeps: one PGS sweep of the normal rows with overlap
@@ -656,13 +519,20 @@ impl SolverSettings {
     /// [`Self::default`], which is this step at 20 substeps.
     pub fn soft_step(substeps: u32) -> Self {
         let substeps = substeps.max(1);
+        let default = Self::default();
         Self {
-            substeps,
-            repair: ContactRepair::Soft {
-                hertz: 12.0 * substeps as f32,
-                damping_ratio: 10.0,
+            solve: SolveSettings {
+                substeps,
+                ..default.solve
             },
-            ..Self::default()
+            contact: ContactSettings {
+                repair: ContactRepair::Soft {
+                    hertz: 12.0 * substeps as f32,
+                    damping_ratio: 10.0,
+                },
+                ..default.contact
+            },
+            ..default
         }
     }
 
@@ -703,17 +573,24 @@ impl SolverSettings {
     /// a 2 mm slop). Its per-step residual is small and its LCP can be compared with an exact
     /// solution; it costs several times the default for the same quality on stacks.
     pub fn reference() -> Self {
+        let default = Self::default();
         Self {
-            method: SolverMethod::AUTO,
-            substeps: 4,
-            iterations: 8,
-            repair: ContactRepair::SplitImpulse {
-                rate: 12.0,
-                iterations: 16,
+            solve: SolveSettings {
+                method: SolverMethod::AUTO,
+                substeps: 4,
+                iterations: 8,
+                ..default.solve
             },
-            overlap_slop: 0.002,
-            max_repair_speed: 1.0,
-            ..Self::default()
+            contact: ContactSettings {
+                repair: ContactRepair::SplitImpulse {
+                    rate: 12.0,
+                    iterations: 16,
+                },
+                overlap_slop: 0.002,
+                max_repair_speed: 1.0,
+                ..default.contact
+            },
+            ..default
         }
     }
 }
@@ -724,6 +601,20 @@ impl SolverSettings {
 impl Default for SolverSettings {
     fn default() -> Self {
         Self {
+            solve: SolveSettings::default(),
+            contact: ContactSettings::default(),
+            sleep: Some(SleepSettings::default()),
+            limits: WorldLimits::default(),
+            gyroscopic: true,
+            continuous: true,
+        }
+    }
+}
+
+/// The default settings' solve: the soft step's PGS at 20 substeps ([`SolverSettings::default`]).
+impl Default for SolveSettings {
+    fn default() -> Self {
+        Self {
             method: SolverMethod::Pgs,
             substeps: 20,
             iterations: 1,
@@ -731,6 +622,20 @@ impl Default for SolverSettings {
             tolerance: 1e-5,
             exact_max_contacts: 32,
             heavy_on_light_mass_ratio: 200.0,
+            warm_start: 1.0,
+            friction_in_main_solve: false,
+            direct_joint_solve: true,
+            parallel_island_contacts: 0,
+            simd_island_contacts: 16,
+            fused_multiply_add: false,
+        }
+    }
+}
+
+/// The default settings' contacts: soft repair at 240 Hz, ζ = 10 ([`SolverSettings::default`]).
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
             restitution_threshold: 0.5,
             repair: ContactRepair::Soft {
                 hertz: 240.0,
@@ -738,23 +643,30 @@ impl Default for SolverSettings {
             },
             overlap_slop: 0.0,
             max_repair_speed: 0.5,
-            warm_start: 1.0,
             prediction_distance: 0.02,
-            sleep: true,
-            sleep_linear_speed: 0.05,
-            sleep_angular_speed: 2.0f32.to_radians(),
-            time_to_sleep: 0.5,
             friction: true,
-            friction_in_main_solve: false,
-            direct_joint_solve: true,
-            parallel_island_contacts: 0,
-            simd_island_contacts: 16,
-            fused_multiply_add: false,
-            gyroscopic: true,
-            continuous: true,
             impact: ImpactModel::Simultaneous,
             friction_combine: CombineRule::GeometricMean,
             restitution_combine: CombineRule::Max,
+        }
+    }
+}
+
+/// Quiet below 0.05 m/s and 2°/s for 0.5 s.
+impl Default for SleepSettings {
+    fn default() -> Self {
+        Self {
+            linear_speed: 0.05,
+            angular_speed: 2.0f32.to_radians(),
+            time_to_sleep: 0.5,
+        }
+    }
+}
+
+/// [`BLOW_UP_DISTANCE`], [`DEFAULT_MAX_LINEAR_SPEED`] and [`DEFAULT_MAX_ANGULAR_SPEED`].
+impl Default for WorldLimits {
+    fn default() -> Self {
+        Self {
             max_distance: BLOW_UP_DISTANCE,
             max_linear_speed: DEFAULT_MAX_LINEAR_SPEED,
             max_angular_speed: DEFAULT_MAX_ANGULAR_SPEED,

@@ -30,24 +30,33 @@ fn each_rule_names_its_field_and_what_is_allowed() {
     let cases = [
         (
             SolverSettings {
-                iterations: 0,
+                solve: SolveSettings {
+                    iterations: 0,
+                    ..base().solve
+                },
                 ..base()
             },
             "iterations: must be ≥ 1, got 0",
         ),
         (
             SolverSettings {
-                substeps: 0,
+                solve: SolveSettings {
+                    substeps: 0,
+                    ..base().solve
+                },
                 ..base()
             },
             "substeps: must be ≥ 1, got 0",
         ),
         (
             SolverSettings {
-                method: SolverMethod::Auto {
-                    escalation_tolerance: 1e-3,
-                    escalation_iterations: 0,
-                    mass_ratio_threshold: 10.0,
+                solve: SolveSettings {
+                    method: SolverMethod::Auto {
+                        escalation_tolerance: 1e-3,
+                        escalation_iterations: 0,
+                        mass_ratio_threshold: 10.0,
+                    },
+                    ..base().solve
                 },
                 ..base()
             },
@@ -55,9 +64,12 @@ fn each_rule_names_its_field_and_what_is_allowed() {
         ),
         (
             SolverSettings {
-                repair: ContactRepair::SplitImpulse {
-                    rate: 10.0,
-                    iterations: 0,
+                contact: ContactSettings {
+                    repair: ContactRepair::SplitImpulse {
+                        rate: 10.0,
+                        iterations: 0,
+                    },
+                    ..base().contact
                 },
                 ..base()
             },
@@ -65,9 +77,12 @@ fn each_rule_names_its_field_and_what_is_allowed() {
         ),
         (
             SolverSettings {
-                repair: ContactRepair::Soft {
-                    hertz: 0.0,
-                    damping_ratio: 1.0,
+                contact: ContactSettings {
+                    repair: ContactRepair::Soft {
+                        hertz: 0.0,
+                        damping_ratio: 1.0,
+                    },
+                    ..base().contact
                 },
                 ..base()
             },
@@ -75,9 +90,12 @@ fn each_rule_names_its_field_and_what_is_allowed() {
         ),
         (
             SolverSettings {
-                repair: ContactRepair::Soft {
-                    hertz: f32::NAN,
-                    damping_ratio: 1.0,
+                contact: ContactSettings {
+                    repair: ContactRepair::Soft {
+                        hertz: f32::NAN,
+                        damping_ratio: 1.0,
+                    },
+                    ..base().contact
                 },
                 ..base()
             },
@@ -85,9 +103,12 @@ fn each_rule_names_its_field_and_what_is_allowed() {
         ),
         (
             SolverSettings {
-                repair: ContactRepair::Soft {
-                    hertz: 30.0,
-                    damping_ratio: -1.0,
+                contact: ContactSettings {
+                    repair: ContactRepair::Soft {
+                        hertz: 30.0,
+                        damping_ratio: -1.0,
+                    },
+                    ..base().contact
                 },
                 ..base()
             },
@@ -95,42 +116,60 @@ fn each_rule_names_its_field_and_what_is_allowed() {
         ),
         (
             SolverSettings {
-                repair: ContactRepair::Bias { rate: f32::NAN },
+                contact: ContactSettings {
+                    repair: ContactRepair::Bias { rate: f32::NAN },
+                    ..base().contact
+                },
                 ..base()
             },
             "repair.rate: must be finite, got NaN",
         ),
         (
             SolverSettings {
-                tolerance: -1.0,
+                solve: SolveSettings {
+                    tolerance: -1.0,
+                    ..base().solve
+                },
                 ..base()
             },
             "tolerance: must be ≥ 0, got -1",
         ),
         (
             SolverSettings {
-                time_to_sleep: f32::INFINITY,
+                sleep: Some(SleepSettings {
+                    time_to_sleep: f32::INFINITY,
+                    ..SleepSettings::default()
+                }),
                 ..base()
             },
             "time_to_sleep: must be finite, got inf",
         ),
         (
             SolverSettings {
-                max_repair_speed: -0.5,
+                contact: ContactSettings {
+                    max_repair_speed: -0.5,
+                    ..base().contact
+                },
                 ..base()
             },
             "max_repair_speed: must be ≥ 0, got -0.5",
         ),
         (
             SolverSettings {
-                warm_start: 1.5,
+                solve: SolveSettings {
+                    warm_start: 1.5,
+                    ..base().solve
+                },
                 ..base()
             },
             "warm_start: must be in [0, 1], got 1.5",
         ),
         (
             SolverSettings {
-                warm_start: f32::NAN,
+                solve: SolveSettings {
+                    warm_start: f32::NAN,
+                    ..base().solve
+                },
                 ..base()
             },
             "warm_start: must be finite, got NaN",
@@ -144,9 +183,12 @@ fn each_rule_names_its_field_and_what_is_allowed() {
 #[test]
 fn every_problem_is_listed_in_field_order() {
     let settings = SolverSettings {
-        iterations: 0,
-        tolerance: -1.0,
-        warm_start: 2.0,
+        solve: SolveSettings {
+            iterations: 0,
+            tolerance: -1.0,
+            warm_start: 2.0,
+            ..SolverSettings::default().solve
+        },
         ..SolverSettings::default()
     };
     let fields: Vec<_> = settings.problems().iter().map(|p| p.field).collect();
@@ -159,23 +201,38 @@ fn every_problem_is_listed_in_field_order() {
 #[test]
 fn friction_leaves_the_main_solve_only_for_pgs_with_a_relax_solve() {
     let base = SolverSettings::default;
-    assert_eq!(base().method, SolverMethod::Pgs);
+    assert_eq!(base().solve.method, SolverMethod::Pgs);
     assert!(!base().main_solve_friction());
     assert!(
         SolverSettings {
-            friction_in_main_solve: true,
+            solve: SolveSettings {
+                friction_in_main_solve: true,
+                ..base().solve
+            },
             ..base()
         }
         .main_solve_friction()
     );
     for method in [SolverMethod::Nncg, SolverMethod::Apgd, SolverMethod::AUTO] {
-        assert!(SolverSettings { method, ..base() }.main_solve_friction());
+        assert!(
+            SolverSettings {
+                solve: SolveSettings {
+                    method,
+                    ..base().solve
+                },
+                ..base()
+            }
+            .main_solve_friction()
+        );
     }
     assert!(
         SolverSettings {
-            repair: ContactRepair::SplitImpulse {
-                rate: 10.0,
-                iterations: 1
+            contact: ContactSettings {
+                repair: ContactRepair::SplitImpulse {
+                    rate: 10.0,
+                    iterations: 1
+                },
+                ..base().contact
             },
             ..base()
         }
@@ -183,7 +240,10 @@ fn friction_leaves_the_main_solve_only_for_pgs_with_a_relax_solve() {
     );
     assert!(
         SolverSettings {
-            relax_iterations: 0,
+            solve: SolveSettings {
+                relax_iterations: 0,
+                ..base().solve
+            },
             ..base()
         }
         .main_solve_friction()
@@ -198,19 +258,27 @@ fn the_presets_are_the_soft_step() {
     for substeps in [1, 8, 20, 48] {
         let s = SolverSettings::soft_step(substeps);
         assert_eq!(
-            (s.method, s.substeps, s.iterations, s.relax_iterations),
+            (
+                s.solve.method,
+                s.solve.substeps,
+                s.solve.iterations,
+                s.solve.relax_iterations
+            ),
             (SolverMethod::Pgs, substeps, 1, 1)
         );
         assert_eq!(
-            s.repair,
+            s.contact.repair,
             ContactRepair::Soft {
                 hertz: 12.0 * substeps as f32,
                 damping_ratio: 10.0
             }
         );
-        assert_eq!((s.overlap_slop, s.max_repair_speed), (0.0, 0.5));
+        assert_eq!(
+            (s.contact.overlap_slop, s.contact.max_repair_speed),
+            (0.0, 0.5)
+        );
     }
-    assert_eq!(SolverSettings::soft_step(0).substeps, 1);
+    assert_eq!(SolverSettings::soft_step(0).solve.substeps, 1);
     assert_eq!(SolverSettings::default(), SolverSettings::soft_step(20));
     assert_eq!(SolverSettings::fast(), SolverSettings::soft_step(8));
     assert_eq!(SolverSettings::precise(), SolverSettings::soft_step(48));
@@ -234,33 +302,40 @@ fn the_presets_are_the_soft_step() {
 fn the_reference_preset_is_as_documented() {
     let r = SolverSettings::reference();
     assert_eq!(
-        (r.method, r.substeps, r.iterations),
+        (r.solve.method, r.solve.substeps, r.solve.iterations),
         (SolverMethod::AUTO, 4, 8)
     );
     assert_eq!(
-        r.repair,
+        r.contact.repair,
         ContactRepair::SplitImpulse {
             rate: 12.0,
             iterations: 16
         }
     );
     assert!(r.split_impulse() && !SolverSettings::default().split_impulse());
-    assert_eq!((r.overlap_slop, r.max_repair_speed), (0.002, 1.0));
+    assert_eq!(
+        (r.contact.overlap_slop, r.contact.max_repair_speed),
+        (0.002, 1.0)
+    );
 }
 
 /// A preset applied to a scene's settings changes the solve and keeps the physics.
 #[test]
 fn a_preset_sets_effort_and_keeps_the_scenes_physics() {
     let scene = SolverSettings {
-        restitution_threshold: 2.0,
-        prediction_distance: 0.05,
-        sleep: false,
-        sleep_linear_speed: 0.1,
-        sleep_angular_speed: 0.2,
-        time_to_sleep: 3.0,
-        friction: false,
+        contact: ContactSettings {
+            restitution_threshold: 2.0,
+            prediction_distance: 0.05,
+            friction: false,
+            ..SolverSettings::default().contact
+        },
         gyroscopic: false,
         continuous: false,
+        sleep: Some(SleepSettings {
+            linear_speed: 0.1,
+            angular_speed: 0.2,
+            time_to_sleep: 3.0,
+        }),
         ..SolverSettings::default()
     };
     for name in SolverSettings::PRESETS {
@@ -268,15 +343,15 @@ fn a_preset_sets_effort_and_keeps_the_scenes_physics() {
         let s = scene.with_effort_of(&preset);
         // Effort from the preset.
         let effort = SolverSettings {
-            restitution_threshold: preset.restitution_threshold,
-            prediction_distance: preset.prediction_distance,
-            sleep: preset.sleep,
-            sleep_linear_speed: preset.sleep_linear_speed,
-            sleep_angular_speed: preset.sleep_angular_speed,
-            time_to_sleep: preset.time_to_sleep,
-            friction: preset.friction,
+            contact: ContactSettings {
+                restitution_threshold: preset.contact.restitution_threshold,
+                prediction_distance: preset.contact.prediction_distance,
+                friction: preset.contact.friction,
+                ..s.clone().contact
+            },
             gyroscopic: preset.gyroscopic,
             continuous: preset.continuous,
+            sleep: preset.sleep,
             ..s.clone()
         };
         assert_eq!(effort, preset, "{name}");
@@ -292,12 +367,18 @@ fn a_preset_sets_effort_and_keeps_the_scenes_physics() {
 #[test]
 fn counts_have_a_maximum() {
     let s = SolverSettings {
-        substeps: u32::MAX,
+        solve: SolveSettings {
+            substeps: u32::MAX,
+            ..SolverSettings::default().solve
+        },
         ..SolverSettings::default()
     };
     assert_eq!(problem(s), "substeps: must be ≤ 10000, got 4294967295");
     let s = SolverSettings {
-        iterations: SolverSettings::MAX_COUNT,
+        solve: SolveSettings {
+            iterations: SolverSettings::MAX_COUNT,
+            ..SolverSettings::default().solve
+        },
         ..SolverSettings::default()
     };
     assert_eq!(s.validate(), Ok(()));
@@ -308,7 +389,10 @@ fn counts_have_a_maximum() {
 fn names_are_the_scene_format_names() {
     for method in SolverMethod::ALL {
         let settings = SolverSettings {
-            method,
+            solve: SolveSettings {
+                method,
+                ..SolverSettings::default().solve
+            },
             ..SolverSettings::default()
         };
         let json = serde_json::to_value(&settings).unwrap();
@@ -346,14 +430,14 @@ fn autos_parameters_read_and_write_beside_the_method() {
         "mass_ratio_threshold": 3.5, "exact_max_contacts": 12}"#;
     let settings: SolverSettings = serde_json::from_str(json).unwrap();
     assert_eq!(
-        settings.method,
+        settings.solve.method,
         SolverMethod::Auto {
             escalation_tolerance: 0.002,
             escalation_iterations: 7,
             mass_ratio_threshold: 3.5,
         }
     );
-    assert_eq!(settings.exact_max_contacts, 12);
+    assert_eq!(settings.solve.exact_max_contacts, 12);
     let written = serde_json::to_value(&settings).unwrap();
     assert_eq!(written["escalation_iterations"], 7);
     assert_eq!(
@@ -366,4 +450,66 @@ fn autos_parameters_read_and_write_beside_the_method() {
     let default = serde_json::to_value(SolverSettings::default()).unwrap();
     assert_eq!(default["escalation_iterations"], 4);
     assert!(serde_json::from_str::<SolverSettings>(r#"{"substep": 3}"#).is_err());
+}
+
+/// The `solver` object stays flat while the Rust type is grouped: each group's keys read into
+/// their group, the file keeps the 34 keys it has always had, `"sleep":
+/// false` is `sleep: None`, and every preset reads back as it was written.
+#[test]
+fn flat_keys_read_into_their_groups_and_write_back_flat() {
+    let json = r#"{"substeps": 7, "warm_start": 0.5, "prediction_distance": 0.01,
+        "impact": "propagation", "sleep_linear_speed": 0.2, "time_to_sleep": 2,
+        "max_distance": 50, "max_angular_speed": 1000, "gyroscopic": false}"#;
+    let s: SolverSettings = serde_json::from_str(json).unwrap();
+    let default = SolverSettings::default();
+    assert_eq!((s.solve.substeps, s.solve.warm_start), (7, 0.5));
+    assert_eq!(s.contact.prediction_distance, 0.01);
+    assert_eq!(s.contact.impact, ImpactModel::Propagation);
+    assert_eq!(
+        s.sleep,
+        Some(SleepSettings {
+            linear_speed: 0.2,
+            angular_speed: SleepSettings::default().angular_speed,
+            time_to_sleep: 2.0,
+        })
+    );
+    assert_eq!(
+        (s.limits.max_distance, s.limits.max_angular_speed),
+        (50.0, 1000.0)
+    );
+    assert_eq!(s.limits.max_linear_speed, default.limits.max_linear_speed);
+    assert!(!s.gyroscopic && s.continuous);
+    let asleep_off: SolverSettings =
+        serde_json::from_str(r#"{"sleep": false, "time_to_sleep": 2}"#).unwrap();
+    assert_eq!(asleep_off.sleep, None);
+    let written = serde_json::to_value(&asleep_off).unwrap();
+    assert_eq!(
+        (&written["sleep"], &written["time_to_sleep"]),
+        (&false.into(), &0.5.into())
+    );
+    let keys: Vec<String> = match serde_json::to_value(&default).unwrap() {
+        serde_json::Value::Object(map) => map.keys().cloned().collect(),
+        other => panic!("not an object: {other}"),
+    };
+    let expected = "method substeps iterations relax_iterations tolerance escalation_tolerance \
+        escalation_iterations mass_ratio_threshold exact_max_contacts heavy_on_light_mass_ratio \
+        restitution_threshold repair overlap_slop max_repair_speed warm_start prediction_distance \
+        sleep sleep_linear_speed sleep_angular_speed time_to_sleep friction friction_in_main_solve \
+        direct_joint_solve parallel_island_contacts simd_island_contacts fused_multiply_add \
+        gyroscopic continuous impact friction_combine restitution_combine max_distance \
+        max_linear_speed max_angular_speed";
+    let mut sorted_expected: Vec<&str> = expected.split_whitespace().collect();
+    let mut sorted_keys: Vec<&str> = keys.iter().map(String::as_str).collect();
+    sorted_expected.sort_unstable();
+    sorted_keys.sort_unstable();
+    assert_eq!(sorted_keys, sorted_expected);
+    for name in SolverSettings::PRESETS {
+        let preset = SolverSettings::preset(name).unwrap();
+        let text = serde_json::to_string(&preset).unwrap();
+        assert_eq!(
+            serde_json::from_str::<SolverSettings>(&text).unwrap(),
+            preset,
+            "{name}"
+        );
+    }
 }

@@ -40,13 +40,14 @@ fn sphere(radius: f32, position: Vec3) -> BodyDesc {
 /// Cheap engine settings: the engine only has to produce a realistic step; the problems below
 /// are solved again by the solvers under test. No sleeping (a sleeping island is not solved).
 fn settings(friction: bool) -> SolverSettings {
-    SolverSettings {
-        iterations: 30,
-        relax_iterations: 30,
-        friction,
-        sleep: false,
+    let mut settings = SolverSettings {
+        sleep: None,
         ..SolverSettings::reference()
-    }
+    };
+    settings.solve.iterations = 30;
+    settings.solve.relax_iterations = 30;
+    settings.contact.friction = friction;
+    settings
 }
 
 /// A sphere resting on two spheres that stand on the ground between two walls (radius 0.5 m,
@@ -350,11 +351,11 @@ fn apgd_frictionless_matches_lemke() {
 #[test]
 fn apgd_soft_rows_match_lemke() {
     let mut world = pile(0.0);
-    world.settings.repair = ContactRepair::Soft {
+    world.settings.contact.repair = ContactRepair::Soft {
         hertz: 30.0,
         damping_ratio: 10.0,
     };
-    world.settings.relax_iterations = 0;
+    world.settings.solve.relax_iterations = 0;
     let p = settled(world, 60);
     assert!(p.constraints.iter().any(|c| c.softness != (1.0, 0.0)));
     let (constraints, _, _, _) = run(&p, Method::Apgd, 0.5, 500, 0.0);
@@ -564,8 +565,8 @@ fn apgd_convergence_comparison() {
                 )
                 .unwrap();
         }
-        world.settings.iterations = 100;
-        world.settings.relax_iterations = 100;
+        world.settings.solve.iterations = 100;
+        world.settings.solve.relax_iterations = 100;
         settled(world, 30)
     };
     let cases = [

@@ -1,5 +1,5 @@
 //! Heavy on light: an island whose mass ratio between two touching moving bodies exceeds
-//! [`SolverSettings::heavy_on_light_mass_ratio`] is reported ([`HeavyOnLight`]) and, when small
+//! [`crate::settings::SolveSettings::heavy_on_light_mass_ratio`] is reported ([`HeavyOnLight`]) and, when small
 //! enough, solved as one exact LCP a step on rigid rows (the path's settings:
 //! [`heavy_on_light_settings`]).
 
@@ -39,7 +39,7 @@ pub const HEAVY_ON_LIGHT_HELD_OVERLAP: f32 = 0.01;
 const HEAVY_ON_LIGHT_REPAIR_RATE: f32 = 12.0;
 
 /// A heavy-on-light island may take the exact path with up to this many times
-/// [`SolverSettings::exact_max_contacts`] contact points (128 at the default). A heavy body on
+/// [`crate::settings::SolveSettings::exact_max_contacts`] contact points (128 at the default). A heavy body on
 /// light ones is held by no iterative budget (docs/method.md, "Heavy on light"), so an exact
 /// solve of a larger island, a few milliseconds a step, is the price of holding it at all: a
 /// 10,000 kg slab on a 3 × 3 grid of 1 kg boxes (72 points) sank through them at 32.
@@ -49,32 +49,32 @@ pub const HEAVY_ON_LIGHT_CONTACTS_FACTOR: u32 = 4;
 /// ([`HEAVY_ON_LIGHT_CONTACTS_FACTOR`] times `exact_max_contacts`; 0 = never).
 pub(crate) fn heavy_on_light_max_contacts(settings: &SolverSettings) -> u32 {
     settings
+        .solve
         .exact_max_contacts
         .saturating_mul(HEAVY_ON_LIGHT_CONTACTS_FACTOR)
 }
 
-/// The settings of the heavy-on-light path ([`SolverSettings::heavy_on_light_mass_ratio`]):
+/// The settings of the heavy-on-light path ([`crate::settings::SolveSettings::heavy_on_light_mass_ratio`]):
 /// the basic method's one LCP per step (one substep), on rigid rows with a velocity bias
 /// ([`HEAVY_ON_LIGHT_REPAIR_RATE`]) and a relax solve, solved by the automatic policy with every
 /// solve escalating to the exact path (Lemke; NNCG's result stands if pivoting fails; `auto`'s
-/// other parameters as `settings.method`'s, or their defaults). The
+/// other parameters as `settings.solve.method`'s, or their defaults). The
 /// rest, repair cap, friction and warm start included, is `settings`'.
 pub(crate) fn heavy_on_light_settings(settings: &SolverSettings) -> SolverSettings {
-    let (escalation_tolerance, escalation_iterations, _) = settings.method.auto_parameters();
-    SolverSettings {
-        method: SolverMethod::Auto {
-            escalation_tolerance,
-            escalation_iterations,
-            mass_ratio_threshold: 0.0,
-        },
-        substeps: 1,
-        relax_iterations: settings.relax_iterations.max(1),
-        exact_max_contacts: heavy_on_light_max_contacts(settings),
-        repair: ContactRepair::Bias {
-            rate: HEAVY_ON_LIGHT_REPAIR_RATE,
-        },
-        ..settings.clone()
-    }
+    let (escalation_tolerance, escalation_iterations, _) = settings.solve.method.auto_parameters();
+    let mut light = settings.clone();
+    light.solve.method = SolverMethod::Auto {
+        escalation_tolerance,
+        escalation_iterations,
+        mass_ratio_threshold: 0.0,
+    };
+    light.solve.substeps = 1;
+    light.solve.relax_iterations = settings.solve.relax_iterations.max(1);
+    light.solve.exact_max_contacts = heavy_on_light_max_contacts(settings);
+    light.contact.repair = ContactRepair::Bias {
+        rate: HEAVY_ON_LIGHT_REPAIR_RATE,
+    };
+    light
 }
 
 /// The contact of `constraints` of largest mass ratio between two moving bodies, if above

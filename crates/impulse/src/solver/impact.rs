@@ -81,8 +81,9 @@ const RELATIVE_TOLERANCE: f32 = 1e-5;
 /// `tolerance`; it runs only in islands where some point bounces).
 pub(crate) fn restitution_iterations(settings: &SolverSettings) -> u32 {
     settings
+        .solve
         .iterations
-        .max(settings.relax_iterations)
+        .max(settings.solve.relax_iterations)
         .max(RESTITUTION_SWEEPS)
 }
 
@@ -155,7 +156,7 @@ impl ImpactWorkspace {
         settings: &SolverSettings,
     ) -> bool {
         self.rounds = 0;
-        let threshold = settings.restitution_threshold;
+        let threshold = settings.contact.restitution_threshold;
         let speed = constraints
             .iter()
             .filter(|c| c.restitution > 0.0 && c.max_normal_impulse > 0.0)
@@ -165,7 +166,7 @@ impl ImpactWorkspace {
         if speed <= 0.0 {
             return false;
         }
-        let tolerance = settings.tolerance.max(RELATIVE_TOLERANCE * speed);
+        let tolerance = settings.solve.tolerance.max(RELATIVE_TOLERANCE * speed);
         self.gather(island_bodies, guests, bodies);
         let moving = island_bodies.len();
         self.index_rows(constraints, moving);

@@ -44,7 +44,7 @@ pub struct IslandReport {
     #[serde(default)]
     pub substeps: u32,
     /// The island's contact of largest mass ratio between two moving bodies, when that ratio
-    /// exceeds [`SolverSettings::heavy_on_light_mass_ratio`]; `None` otherwise (and for
+    /// exceeds [`crate::settings::SolveSettings::heavy_on_light_mass_ratio`]; `None` otherwise (and for
     /// split-impulse repair, which holds such islands on its own).
     #[serde(default)]
     pub heavy_on_light: Option<HeavyOnLight>,

@@ -279,7 +279,7 @@ pub fn solve_pgs(
 /// [`solve_pgs`], with the friction rows left out when `friction` is false: the normal rows
 /// alone are swept and the friction impulses stay as they are (still applied to the bodies).
 /// The soft step's repairing solve runs this way when a relax solve follows that solves the
-/// friction ([`crate::SolverSettings::friction_in_main_solve`]). With `half_turn`, each run of
+/// friction ([`crate::settings::SolveSettings::friction_in_main_solve`]). With `half_turn`, each run of
 /// consecutive points between the same two bodies (a manifold) is taken from halfway round (the
 /// soft step does so every other substep, so that no corner of a face is always updated first;
 /// see [`super::wide`]'s sweep); sweeps colour by colour over threads ignore it. The island's

@@ -31,11 +31,11 @@ impl EscalationLimits {
     /// The thresholds of `settings` for an island of `mass_ratio` in a step whose impact speed
     /// is `impact_speed` (m/s).
     pub(crate) fn new(settings: &SolverSettings, mass_ratio: f32, impact_speed: f32) -> Self {
-        let (tolerance, iterations, mass_ratio_threshold) = settings.method.auto_parameters();
+        let (tolerance, iterations, mass_ratio_threshold) = settings.solve.method.auto_parameters();
         Self {
             tolerance,
             iterations,
-            exact_max_contacts: settings.exact_max_contacts,
+            exact_max_contacts: settings.solve.exact_max_contacts,
             mass_ratio_threshold,
             mass_ratio,
             impact_speed,

@@ -27,12 +27,12 @@ impl IslandWorkspace {
         spread: bool,
     ) {
         let w = self;
-        let threshold = settings.restitution_threshold;
+        let threshold = settings.contact.restitution_threshold;
         let bounces = if !context.restitution {
             // No body bounces, so no pair does (a pair's coefficient is the larger of its
             // bodies').
             false
-        } else if settings.impact == ImpactModel::Propagation {
+        } else if settings.contact.impact == ImpactModel::Propagation {
             let mut velocities = Velocities {
                 linear: &mut w.linear,
                 angular: &mut w.angular,
@@ -71,7 +71,7 @@ impl IslandWorkspace {
             } else {
                 sweeps.max(IMPACT_SWEEPS)
             },
-            tolerance: settings.tolerance,
+            tolerance: settings.solve.tolerance,
             friction: true,
             half_turn: false,
             warm_start_follows: false,
@@ -94,7 +94,7 @@ impl IslandWorkspace {
         for joint in &mut w.joints {
             joint.start_bounce();
         }
-        let outcome = w.solvers.scalar(settings.method).solve(
+        let outcome = w.solvers.scalar(settings.solve.method).solve(
             constraints,
             &mut Velocities {
                 linear: &mut w.linear,

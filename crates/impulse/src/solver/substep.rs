@@ -30,7 +30,7 @@ use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 mod forces;
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
-/// friction rows too, whatever [`SolverSettings::friction_in_main_solve`] says. Friction
+/// friction rows too, whatever [`crate::settings::SolveSettings::friction_in_main_solve`] says. Friction
 /// between a heavy body and a light one converges slowly under Gauss-Seidel (each sweep moves
 /// the heavy body by the light one's share), and one friction sweep a substep, the relax
 /// solve's, let the 400:1 `plate` rock sideways with growing amplitude, up to 600 J after 10 s
@@ -84,11 +84,11 @@ impl IslandWorkspace {
         );
         let pass = SolvePass {
             iterations: if with_repair {
-                settings.iterations
+                settings.solve.iterations
             } else {
-                settings.relax_iterations
+                settings.solve.relax_iterations
             },
-            tolerance: settings.tolerance,
+            tolerance: settings.solve.tolerance,
             friction: !with_repair
                 || settings.main_solve_friction()
                 || self.report.mass_ratio >= HEAVY_ON_LIGHT_MASS_RATIO,
@@ -127,7 +127,7 @@ impl IslandWorkspace {
             angular: &mut self.angular,
         };
         let joints = &mut self.joints;
-        let solver = self.solvers.substeps(settings.method, bundled);
+        let solver = self.solvers.substeps(settings.solve.method, bundled);
         let outcome = solver.solve(constraints, &mut velocities, joints, &pass);
         if with_repair {
             self.phases.end(SolvePhase::MainSolve);
@@ -138,7 +138,7 @@ impl IslandWorkspace {
         // shakes it (docs/method.md, "Impacts"). Asked once a step, and only when the last
         // sweep's change calls for it.
         self.impact_met = if with_repair {
-            settings.method == SolverMethod::Pgs
+            settings.solve.method == SolverMethod::Pgs
                 && !settings.split_impulse()
                 && outcome.report.last_change > impact_change
                 && *self.closing.get_or_insert_with(|| {
@@ -251,13 +251,13 @@ pub(crate) fn step_island(
     let heavy = w.heavy_on_light_path(island_bodies, constraints, context);
     let settings = heavy.as_ref().unwrap_or(context.settings);
     // The substeps cover the whole step: on the heavy-on-light path, one substep of dt.
-    let h = context.dt / settings.substeps as f32;
+    let h = context.dt / settings.solve.substeps as f32;
     w.step_constants(island_bodies, context, h);
-    w.joints.start_step(h, settings.direct_joint_solve);
+    w.joints.start_step(h, settings.solve.direct_joint_solve);
     w.start_solves(constraints, settings, context);
     let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
     w.phases.end(SolvePhase::Prepare);
-    for substep in 0..settings.substeps {
+    for substep in 0..settings.solve.substeps {
         w.substep(constraints, settings, context, &plan, substep);
     }
     w.finish_solves(constraints, settings, &plan);
@@ -416,7 +416,7 @@ impl IslandWorkspace {
         context: &IslandContext<'_>,
     ) -> Option<SolverSettings> {
         let settings = context.settings;
-        let threshold = settings.heavy_on_light_mass_ratio;
+        let threshold = settings.solve.heavy_on_light_mass_ratio;
         // Joints keep the soft step: the path's one rigid LCP a step is solved exactly, which
         // an island with joints (a mixed LCP) cannot be yet.
         if !(threshold > 0.0 && self.report.mass_ratio > threshold && self.joints.is_empty()) {
@@ -427,7 +427,7 @@ impl IslandWorkspace {
         // takes the exact path in each of them (`start_solves` widens its limit), so the
         // island is reported either way.
         let split = settings.split_impulse();
-        let exact = small && (!split || settings.method.is_auto());
+        let exact = small && (!split || settings.solve.method.is_auto());
         self.report.heavy_on_light =
             heavy_on_light(island_bodies, constraints, context.bodies, threshold)
                 .map(|heavy| HeavyOnLight { exact, ..heavy });
@@ -448,7 +448,7 @@ impl IslandWorkspace {
         context: &IslandContext<'_>,
     ) {
         let (gravity, dt) = (context.gravity, context.dt);
-        if settings.substeps != context.settings.substeps {
+        if settings.solve.substeps != context.settings.solve.substeps {
             // The heavy-on-light path starts cold: the carried impulses are the soft step's,
             // per substep of another length, and the exact solve needs no starting guess.
             // Warm started with them, a 10,000:1 cube dropped onto a stack of four or five
@@ -458,7 +458,7 @@ impl IslandWorkspace {
                 c.tangent_impulses = [0.0; 2];
             }
         }
-        self.report.substeps = settings.substeps;
+        self.report.substeps = settings.solve.substeps;
         self.solvers.auto.limits =
             EscalationLimits::new(settings, self.report.mass_ratio, gravity.length() * dt);
         if self.report.heavy_on_light.is_some_and(|h| h.exact) {
@@ -466,7 +466,7 @@ impl IslandWorkspace {
             // exact path up to the heavy-on-light path's size.
             self.solvers.auto.limits.exact_max_contacts = heavy_on_light_max_contacts(settings);
         }
-        self.impact_speed = (gravity.length() * dt).max(settings.restitution_threshold);
+        self.impact_speed = (gravity.length() * dt).max(settings.contact.restitution_threshold);
         // A joint's rows carry no closing speed to test (a limit reached at speed, a limb its
         // joints whip into another body), so an island with joints takes the last-sweep test
         // alone: with the contacts' test too, a ragdoll pile's limbs sank into one another.
@@ -510,7 +510,7 @@ impl IslandWorkspace {
         }
         w.parallel = parallel;
         w.colour_starts.clear();
-        let threshold = settings.parallel_island_contacts as usize;
+        let threshold = settings.solve.parallel_island_contacts as usize;
         w.report.simd = bundled;
         let coloured_threads = threshold > 0 && constraints.len() >= threshold;
         if bundled {
@@ -529,7 +529,7 @@ impl IslandWorkspace {
             w.slot_inverse_inertia.push(Mat3::ZERO);
             w.solvers
                 .wide
-                .set_fused_multiply_add(settings.fused_multiply_add);
+                .set_fused_multiply_add(settings.solve.fused_multiply_add);
             w.solvers.wide.prepare(
                 constraints,
                 slots,
@@ -580,7 +580,7 @@ impl IslandWorkspace {
         self.apply_forces(context.gravity, plan);
         // The lanes' record takes v* = v − M⁻¹Jᵀγ, γ the final impulses: the velocities
         // here, before the last substep applies its impulses (see `lanes::Bundles::record`).
-        if plan.record_in_lanes && substep + 1 == settings.substeps {
+        if plan.record_in_lanes && substep + 1 == settings.solve.substeps {
             self.solvers
                 .wide
                 .keep_velocities_before(&self.linear, &self.angular);
@@ -599,11 +599,9 @@ impl IslandWorkspace {
                 substep,
             );
         }
-        self.solvers.substeps(settings.method, bundled).warm_start(
-            constraints,
-            &mut velocities,
-            substep,
-        );
+        self.solvers
+            .substeps(settings.solve.method, bundled)
+            .warm_start(constraints, &mut velocities, substep);
         // Both solves of the substep take the turn as it started, so that the relax solve
         // does not release what the main solve gave a row before the body turned. Left empty
         // while no body of the island has turned past the limit (every ordinary step), so
@@ -630,9 +628,9 @@ impl IslandWorkspace {
         );
         self.integrate_positions(constraints, settings, plan);
         self.phases.end(SolvePhase::IntegratePositions);
-        if settings.relax_iterations > 0 && !settings.split_impulse() {
+        if settings.solve.relax_iterations > 0 && !settings.split_impulse() {
             let relax = SubstepSolve::Relax {
-                warm_start_follows: substep + 1 < settings.substeps,
+                warm_start_follows: substep + 1 < settings.solve.substeps,
             };
             self.targets_and_solve(constraints, bodies, settings, h, bundled, relax, half_turn);
         } else if settings.split_impulse()
@@ -645,11 +643,11 @@ impl IslandWorkspace {
                 angular: &mut self.angular,
             };
             let (sweeps, pose) = (
-                settings.iterations.max(IMPACT_SWEEPS),
+                settings.solve.iterations.max(IMPACT_SWEEPS),
                 (&self.displacement[..], &self.orientation[..]),
             );
             self.joints
-                .relax(&mut velocities, pose, sweeps, settings.tolerance);
+                .relax(&mut velocities, pose, sweeps, settings.solve.tolerance);
         }
         self.phases.end(SolvePhase::Relax);
     }
@@ -685,11 +683,11 @@ impl IslandWorkspace {
                     starts: &w.colour_starts,
                     parallel: w.parallel,
                 },
-                match settings.repair {
+                match settings.contact.repair {
                     ContactRepair::SplitImpulse { iterations, .. } => iterations,
                     _ => 1,
                 },
-                settings.tolerance,
+                settings.solve.tolerance,
                 &mut pseudo,
             );
             for k in 0..integrated {
@@ -748,7 +746,7 @@ impl IslandWorkspace {
             w.solvers.wide.report_rows(constraints);
         } else {
             w.solvers
-                .substeps(settings.method, plan.bundled)
+                .substeps(settings.solve.method, plan.bundled)
                 .finish(constraints);
         }
         for joint in &mut w.joints {

@@ -81,7 +81,7 @@ pub struct World {
 }
 
 /// A body that left the world: its centre of mass ended a step farther from the origin than
-/// [`SolverSettings::max_distance`] (m). Such a body is taken out of the simulation, not
+/// [`crate::settings::WorldLimits::max_distance`] (m). Such a body is taken out of the simulation, not
 /// treated as a blow-up: its velocities are zeroed, it is put to sleep, its collision groups,
 /// mass and inertia are cleared (it collides with nothing, nothing wakes it, and it no longer
 /// counts in [`World::energy`]), and it stays in the world at its index ([`World::poses`]) with its last
@@ -100,7 +100,7 @@ pub struct LeftWorld {
     pub step: u64,
     /// Its centre of mass then (m, world frame).
     pub position: Vec3,
-    /// The bound it crossed (m), [`SolverSettings::max_distance`].
+    /// The bound it crossed (m), [`crate::settings::WorldLimits::max_distance`].
     pub bound: f32,
 }
 
@@ -437,12 +437,13 @@ impl World {
     /// use impulse::{SolverSettings, World, WorldError};
     ///
     /// let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 0.01, SolverSettings::default())?;
-    /// let bad = SolverSettings { iterations: 0, ..SolverSettings::default() };
+    /// let mut bad = SolverSettings::default();
+    /// bad.solve.iterations = 0;
     /// let Err(WorldError::InvalidSettings(problem)) = world.set_settings(bad) else {
     ///     panic!("0 iterations accepted");
     /// };
     /// assert_eq!(problem.field, "iterations");
-    /// assert_eq!(world.settings().iterations, SolverSettings::default().iterations);
+    /// assert_eq!(world.settings().solve.iterations, SolverSettings::default().solve.iterations);
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), WorldError> {

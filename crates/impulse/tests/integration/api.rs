@@ -124,8 +124,11 @@ fn a_resting_cube_presses_its_weight_into_the_ground() {
 fn each_joint_of_a_resting_column_carries_the_weight_above_it() {
     for relax_iterations in [1, 2] {
         column_carries_the_weight_above_each_joint(SolverSettings {
-            sleep: false,
-            relax_iterations,
+            solve: impulse::settings::SolveSettings {
+                relax_iterations,
+                ..SolverSettings::default().solve
+            },
+            sleep: None,
             ..SolverSettings::default()
         });
     }
@@ -133,7 +136,7 @@ fn each_joint_of_a_resting_column_carries_the_weight_above_it() {
 
 fn column_carries_the_weight_above_each_joint(settings: SolverSettings) {
     use std::f32::consts::FRAC_1_SQRT_2;
-    let relax = settings.relax_iterations;
+    let relax = settings.solve.relax_iterations;
     let mut w = World::new(
         Vec3::new(0.981 * FRAC_1_SQRT_2, -9.81, 0.981 * FRAC_1_SQRT_2),
         DT,
@@ -330,7 +333,7 @@ fn a_body_replaced_by_one_of_another_kind_is_not_solved_as_the_old_one() {
 fn edits_are_checked_and_wake_the_body() {
     let (mut w, ground, cube) = cube_on_ground();
     let mut settings = w.settings().clone();
-    settings.sleep = true;
+    settings.sleep = Some(impulse::settings::SleepSettings::default());
     w.set_settings(settings).unwrap();
     for _ in 0..240 {
         w.step().unwrap();
@@ -421,14 +424,16 @@ fn rays_and_shapes_find_the_bodies_they_meet() {
 fn the_api_and_the_scene_loader_reject_a_bad_setting_alike() {
     type Edit = fn(&mut SolverSettings);
     let cases: [(&str, &str, Edit); 4] = [
-        ("substeps", "0", |s| s.substeps = 0),
-        ("warm_start", "1.5", |s| s.warm_start = 1.5),
-        ("overlap_slop", "-0.001", |s| s.overlap_slop = -0.001),
+        ("substeps", "0", |s| s.solve.substeps = 0),
+        ("warm_start", "1.5", |s| s.solve.warm_start = 1.5),
+        ("overlap_slop", "-0.001", |s| {
+            s.contact.overlap_slop = -0.001
+        }),
         ("escalation_iterations", "0", |s| {
             if let impulse::SolverMethod::Auto {
                 escalation_iterations,
                 ..
-            } = &mut s.method
+            } = &mut s.solve.method
             {
                 *escalation_iterations = 0;
             }
@@ -437,7 +442,10 @@ fn the_api_and_the_scene_loader_reject_a_bad_setting_alike() {
     for (field, value, edit) in cases {
         // `auto`, so that its parameters count.
         let mut settings = SolverSettings {
-            method: impulse::SolverMethod::AUTO,
+            solve: impulse::settings::SolveSettings {
+                method: impulse::SolverMethod::AUTO,
+                ..SolverSettings::default().solve
+            },
             ..SolverSettings::default()
         };
         edit(&mut settings);

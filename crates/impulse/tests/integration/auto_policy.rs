@@ -18,7 +18,7 @@ fn run(
 ) -> (World, Vec<Vec<impulse::report::IslandReport>>) {
     let mut scene = builtin_scene(name).expect("built-in scene");
     scene.solver = impulse::SolverSettings {
-        sleep: false,
+        sleep: None,
         ..impulse::SolverSettings::reference()
     };
     edit(&mut scene.solver);
@@ -38,7 +38,7 @@ fn run(
 #[test]
 fn heavy_small_island_is_solved_exactly_and_stays_at_rest() {
     let (world, reports) = run("massratio", 300, |_| {});
-    assert_eq!(world.settings().method, SolverMethod::AUTO);
+    assert_eq!(world.settings().solve.method, SolverMethod::AUTO);
     for (step, islands) in reports.iter().enumerate() {
         assert_eq!(islands.len(), 1, "step {step}: one island");
         let island = islands[0];
@@ -66,7 +66,7 @@ fn heavy_small_island_is_solved_exactly_and_stays_at_rest() {
 /// budget leaves it unconverged, and the reports say so.
 #[test]
 fn unconverged_islands_get_more_iterations() {
-    let (_, reports) = run("massratio", 120, |s| s.exact_max_contacts = 0);
+    let (_, reports) = run("massratio", 120, |s| s.solve.exact_max_contacts = 0);
     let extended = reports
         .iter()
         .flatten()
@@ -92,7 +92,7 @@ fn fixed_methods_do_not_escalate() {
         (SolverMethod::Nncg, EscalationLevel::Nncg),
         (SolverMethod::Apgd, EscalationLevel::Apgd),
     ] {
-        let (_, reports) = run("massratio", 30, |s| s.method = method);
+        let (_, reports) = run("massratio", 30, |s| s.solve.method = method);
         for island in reports.iter().flatten() {
             assert_eq!(island.method, level);
             assert_eq!(island.escalations, 0);
@@ -139,13 +139,16 @@ fn landing_column(
     use glam::Vec3;
     use impulse::{BodyDesc, BodyKind, ShapeDesc};
     let mut settings = impulse::SolverSettings {
-        sleep: false,
-        iterations: 1,
-        method: SolverMethod::Auto {
-            escalation_tolerance: 0.0,
-            escalation_iterations: 4,
-            mass_ratio_threshold: 10.0,
+        solve: impulse::settings::SolveSettings {
+            iterations: 1,
+            method: SolverMethod::Auto {
+                escalation_tolerance: 0.0,
+                escalation_iterations: 4,
+                mass_ratio_threshold: 10.0,
+            },
+            ..impulse::SolverSettings::reference().solve
         },
+        sleep: None,
         ..impulse::SolverSettings::reference()
     };
     edit(&mut settings);
@@ -209,7 +212,7 @@ fn an_island_at_the_mass_ratio_threshold_is_not_heavy() {
         if let SolverMethod::Auto {
             mass_ratio_threshold,
             ..
-        } = &mut s.method
+        } = &mut s.solve.method
         {
             *mass_ratio_threshold = 1.0;
         }
@@ -225,7 +228,7 @@ fn an_island_at_the_mass_ratio_threshold_is_not_heavy() {
 fn islands_above_the_exact_limit_take_more_iterations_instead() {
     for (speed, top_mass) in [(0.0, None), (8.0, Some(524.0 * 50.0))] {
         let island = first_step_report(landing_column(speed, top_mass, |s| {
-            s.exact_max_contacts = 3
+            s.solve.exact_max_contacts = 3
         }));
         assert!(island.contacts > 3, "{island:?}");
         assert_eq!(island.method, EscalationLevel::NncgExtended, "{island:?}");
@@ -241,12 +244,12 @@ fn islands_above_the_exact_limit_take_more_iterations_instead() {
 fn the_report_counts_the_budget_and_the_extension() {
     let report = |extra: u32| {
         first_step_report(landing_column(8.0, None, |s| {
-            s.iterations = 2;
-            s.tolerance = 0.0;
+            s.solve.iterations = 2;
+            s.solve.tolerance = 0.0;
             if let SolverMethod::Auto {
                 escalation_iterations,
                 ..
-            } = &mut s.method
+            } = &mut s.solve.method
             {
                 *escalation_iterations = extra;
             }
@@ -265,5 +268,5 @@ fn the_report_counts_the_budget_and_the_extension() {
 
 /// The escalation tolerance of `world`'s `auto` method.
 fn escalation_tolerance(world: &World) -> f32 {
-    world.settings().method.auto_parameters().0
+    world.settings().solve.method.auto_parameters().0
 }

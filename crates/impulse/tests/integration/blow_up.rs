@@ -17,14 +17,20 @@ use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, StepError
 fn a_solve_that_creates_energy_stops_with_the_step() {
     let mut scene = builtin_scene("pyramid100").unwrap();
     scene.solver = SolverSettings {
-        method: SolverMethod::Pgs,
-        substeps: 4,
-        iterations: 1,
-        repair: ContactRepair::SplitImpulse {
-            rate: 12.0,
+        solve: impulse::settings::SolveSettings {
+            method: SolverMethod::Pgs,
+            substeps: 4,
             iterations: 1,
+            ..SolverSettings::reference().solve
         },
-        sleep: false,
+        contact: impulse::settings::ContactSettings {
+            repair: ContactRepair::SplitImpulse {
+                rate: 12.0,
+                iterations: 1,
+            },
+            ..SolverSettings::reference().contact
+        },
+        sleep: None,
         ..SolverSettings::reference()
     };
     let mut world = World::from_scene(&scene).unwrap();
@@ -184,7 +190,7 @@ fn edits_between_steps_are_not_blow_ups() {
 /// off.
 fn awake_world() -> World {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap()

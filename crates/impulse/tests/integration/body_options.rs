@@ -10,7 +10,7 @@ pub(crate) const G: f32 = 9.81;
 
 pub(crate) fn settings() -> SolverSettings {
     SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     }
 }
@@ -29,7 +29,7 @@ pub(crate) fn ground(world: &mut World, friction: f32, restitution: f32) {
 #[test]
 fn damping_scales_velocities_by_one_over_one_plus_h_c_per_substep() {
     let settings = settings();
-    let substeps = settings.substeps;
+    let substeps = settings.solve.substeps;
     let mut world = World::new(Vec3::ZERO, DT, settings).unwrap();
     let (v0, w0) = (Vec3::new(3.0, -1.0, 2.0), Vec3::new(0.5, 4.0, -1.0));
     let (linear, angular) = (0.8f32, 2.5f32);

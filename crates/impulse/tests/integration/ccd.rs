@@ -210,9 +210,12 @@ fn tumbling_thin_box_bullets_never_cross_a_thin_wall() {
 /// (`simd_island_contacts` 1) the lanes' own test of stale rows is checked the same way.
 #[test]
 fn tumbling_dart_impacts_gain_no_energy() {
-    for simd_island_contacts in [SolverSettings::default().simd_island_contacts, 1] {
+    for simd_island_contacts in [SolverSettings::default().solve.simd_island_contacts, 1] {
         let settings = SolverSettings {
-            simd_island_contacts,
+            solve: impulse::settings::SolveSettings {
+                simd_island_contacts,
+                ..settings(true).solve
+            },
             ..settings(true)
         };
         for (angle, axis, rate) in [(60.0f32, Vec3::Z, 30.0), (0.0, Vec3::Y, 100.0)] {

@@ -3,7 +3,7 @@
 //! At restitution 0 Newton's hypothesis asks for v⁺ = 0 along the normal: a body dropped flat
 //! onto the ground at any speed stops on it (Stronge, "Impact Mechanics", 2000, ch. 2). The
 //! rebound allowed here is 1 % of the impact speed. A body in free fall keeps falling: one that
-//! passes the world bound ([`SolverSettings::max_distance`]) leaves the world with an event and
+//! passes the world bound ([`impulse::settings::WorldLimits::max_distance`]) leaves the world with an event and
 //! the run goes on. A pile that nothing strikes is not taken for an impact.
 
 use impulse::glam::{Quat, Vec3};
@@ -33,7 +33,7 @@ struct Drop {
 /// `steps` steps.
 fn drop(cube: bool, ground: Ground, speed: f32, gap: f32, yaw: f32, steps: usize) -> Drop {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).expect("valid world");
@@ -154,11 +154,15 @@ fn dead_impacts_on_a_half_space_do_not_rebound() {
 fn a_pile_nothing_strikes_is_not_an_impact() {
     let mut scene = impulse::scene::builtin_scene("pyramid20").expect("built-in scene");
     scene.solver = SolverSettings {
-        sleep: false,
-        substeps: 3,
+        solve: impulse::settings::SolveSettings {
+            substeps: 3,
+            ..scene.solver.solve
+        },
+        sleep: None,
         ..scene.solver
     };
-    let budget = scene.solver.substeps * (scene.solver.iterations + scene.solver.relax_iterations);
+    let budget = scene.solver.solve.substeps
+        * (scene.solver.solve.iterations + scene.solver.solve.relax_iterations);
     let mut world = World::from_scene(&scene).expect("valid scene");
     world.set_parallel(false);
     let mut energy = Vec::new();
@@ -199,7 +203,7 @@ fn a_long_free_fall_leaves_the_world_and_the_run_completes() {
         Vec3::new(0.0, -9.81, 0.0),
         DT,
         SolverSettings {
-            sleep: false,
+            sleep: None,
             ..SolverSettings::default()
         },
     )
@@ -240,8 +244,11 @@ fn the_world_bound_is_configurable() {
         Vec3::new(0.0, -9.81, 0.0),
         DT,
         SolverSettings {
-            sleep: false,
-            max_distance: 100.0,
+            limits: impulse::settings::WorldLimits {
+                max_distance: 100.0,
+                ..SolverSettings::default().limits
+            },
+            sleep: None,
             ..SolverSettings::default()
         },
     )
@@ -263,7 +270,10 @@ fn the_world_bound_is_configurable() {
     assert_eq!(left[1].0, high);
     assert!(left[0].1 < left[1].1);
     let bad = SolverSettings {
-        max_distance: 0.0,
+        limits: impulse::settings::WorldLimits {
+            max_distance: 0.0,
+            ..SolverSettings::default().limits
+        },
         ..SolverSettings::default()
     };
     assert!(World::new(Vec3::ZERO, DT, bad).is_err());
@@ -279,10 +289,11 @@ fn the_world_bound_is_configurable() {
 fn an_impact_on_an_island_in_lanes_is_an_impact() {
     for speed in [4.0f32, 7.0, 12.0] {
         let settings = SolverSettings {
-            sleep: false,
+            sleep: None,
             ..SolverSettings::default()
         };
-        let budget = settings.substeps * (settings.iterations + settings.relax_iterations);
+        let budget =
+            settings.solve.substeps * (settings.solve.iterations + settings.solve.relax_iterations);
         let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).expect("world");
         world.set_parallel(false);
         world

@@ -12,7 +12,7 @@ use impulse::{Scene, SolverMethod, SolverSettings, World};
 /// The world of `scene` (sleeping off) after `steps` steps on rayon's current pool.
 fn stepped(scene: &Scene, steps: u32) -> World {
     let mut scene = scene.clone();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     let mut world = World::from_scene(&scene).unwrap();
     for _ in 0..steps {
         world.step().unwrap();
@@ -59,7 +59,7 @@ fn a_scene_of_every_shape_is_the_same_on_any_thread_count_and_run() {
     same_everywhere(&scene, 180);
 }
 
-/// With fused multiply-adds (`SolverSettings::fused_multiply_add`) the lanes round
+/// With fused multiply-adds (`SolveSettings::fused_multiply_add`) the lanes round
 /// otherwise, where the CPU's kernels have FMA, and a run is still the same on any thread
 /// count and from one run to the next. Where they have none (or with
 /// `IMPULSE_INSTRUCTION_SET=baseline`) the setting changes nothing, to the bit; where they
@@ -70,7 +70,7 @@ fn fused_multiply_adds_are_the_same_on_any_thread_count_and_run() {
     let steps = 120;
     let separate = builtin_scene("pyramid20").unwrap();
     let mut fused = separate.clone();
-    fused.solver.fused_multiply_add = true;
+    fused.solver.solve.fused_multiply_add = true;
     fused.name = "pyramid20 with fused multiply-adds".into();
     same_everywhere(&fused, steps);
     let fuses = impulse::simd::InstructionSet::detected()
@@ -110,7 +110,13 @@ fn every_solver_method_is_the_same_on_any_thread_count() {
         (SolverMethod::AUTO, SolverSettings::reference()),
     ] {
         let mut scene = builtin_scene("pyramid20").unwrap();
-        scene.solver = SolverSettings { method, ..preset };
+        scene.solver = SolverSettings {
+            solve: impulse::settings::SolveSettings {
+                method,
+                ..preset.solve
+            },
+            ..preset
+        };
         scene.name = format!("pyramid20 with {method:?}");
         same_everywhere(&scene, 30);
     }

@@ -152,7 +152,7 @@ fn edge_case(seed: u64, miss: bool, speeds: (f32, f32)) -> Case {
 /// The frames (centre, velocity) of `case`, the start first, with or without the wall.
 fn fly(case: &Case, with_wall: bool) -> Vec<(Vec3, Vec3)> {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     let mut w = World::new(Vec3::ZERO, DT, settings).expect("world");

@@ -124,7 +124,7 @@ fn impact(index: u64) -> Impact {
     let aim = Vec3::new(0.3, 1.0, -0.2);
     let start = aim - 3.0 * direction;
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     let mut world = World::new(GRAVITY, DT, settings).expect("world");

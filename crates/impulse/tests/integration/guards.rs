@@ -40,8 +40,11 @@ fn apex_after_bounce(w: &mut World, ball: BodyHandle, steps: usize) -> f32 {
 #[test]
 fn the_restitution_threshold_decides_whether_a_ball_bounces() {
     let settings = SolverSettings {
-        restitution_threshold: 1.0,
-        sleep: false,
+        contact: impulse::settings::ContactSettings {
+            restitution_threshold: 1.0,
+            ..SolverSettings::default().contact
+        },
+        sleep: None,
         ..SolverSettings::default()
     };
     let e = 0.8f32;
@@ -86,9 +89,15 @@ fn an_overlap_is_pushed_out_no_faster_than_the_repair_cap() {
     // In SIMD lanes (islands of at least one point) and in the scalar sweep (never in lanes).
     for (cap, lanes) in [(0.25f32, 1), (0.5, 1), (0.25, 0), (0.5, 0)] {
         let settings = SolverSettings {
-            max_repair_speed: cap,
-            simd_island_contacts: lanes,
-            sleep: false,
+            contact: impulse::settings::ContactSettings {
+                max_repair_speed: cap,
+                ..SolverSettings::default().contact
+            },
+            solve: impulse::settings::SolveSettings {
+                simd_island_contacts: lanes,
+                ..SolverSettings::default().solve
+            },
+            sleep: None,
             ..SolverSettings::default()
         };
         let mut w = world_with_ground(settings);
@@ -123,12 +132,18 @@ fn a_soft_contact_deflects_as_a_spring_of_its_frequency() {
     // In SIMD lanes (islands of at least one point) and in the scalar sweep.
     for (hertz, radius, lanes) in [(5.0f32, 0.25f32, 1), (8.0, 0.5, 1), (5.0, 0.25, 0)] {
         let settings = SolverSettings {
-            repair: ContactRepair::Soft {
-                hertz,
-                damping_ratio: 10.0,
+            contact: impulse::settings::ContactSettings {
+                repair: ContactRepair::Soft {
+                    hertz,
+                    damping_ratio: 10.0,
+                },
+                ..SolverSettings::default().contact
             },
-            simd_island_contacts: lanes,
-            sleep: false,
+            solve: impulse::settings::SolveSettings {
+                simd_island_contacts: lanes,
+                ..SolverSettings::default().solve
+            },
+            sleep: None,
             ..SolverSettings::default()
         };
         let mut w = world_with_ground(settings);
@@ -158,7 +173,7 @@ fn a_soft_contact_deflects_as_a_spring_of_its_frequency() {
 #[test]
 fn the_reported_residual_is_that_of_the_exported_lcp_friction_included() {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::fast()
     };
     let mut w = world_with_ground(settings);
@@ -223,8 +238,10 @@ fn the_reported_residual_is_that_of_the_exported_lcp_friction_included() {
 #[test]
 fn an_island_sleeps_when_all_its_bodies_were_quiet_long_enough() {
     let settings = SolverSettings {
-        sleep: true,
-        time_to_sleep: 0.5,
+        sleep: Some(impulse::settings::SleepSettings {
+            time_to_sleep: 0.5,
+            ..Default::default()
+        }),
         ..SolverSettings::default()
     };
     let mut w = world_with_ground(settings.clone());

@@ -25,7 +25,7 @@ fn moments() -> DVec3 {
 /// A world without gravity holding one free box at `rotation` spinning at `omega` (world).
 fn free_box(rotation: Quat, omega: Vec3, gyroscopic: bool) -> (World, BodyHandle) {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         gyroscopic,
         ..SolverSettings::default()
     };
@@ -359,12 +359,15 @@ fn a_body_with_one_locked_rotation_follows_eulers_equations_in_the_free_plane() 
     ] {
         let mut deviations = Vec::new();
         for substeps in [
-            SolverSettings::default().substeps,
-            4 * SolverSettings::default().substeps,
+            SolverSettings::default().solve.substeps,
+            4 * SolverSettings::default().solve.substeps,
         ] {
             let settings = SolverSettings {
-                sleep: false,
-                substeps,
+                solve: impulse::settings::SolveSettings {
+                    substeps,
+                    ..SolverSettings::default().solve
+                },
+                sleep: None,
                 ..SolverSettings::default()
             };
             let (mut world, body) = free_box_with(settings, rotation, omega);

@@ -167,7 +167,7 @@ fn heavy_cubes_hold_at_the_default_preset() {
 #[test]
 fn the_island_report_names_the_path_taken() {
     let settings = || SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     let (mut world, heavy, rest) = heavy_on_light(Support::Single, 10_000.0, 0, settings());
@@ -209,15 +209,21 @@ fn the_island_report_names_the_path_taken() {
 fn an_island_the_path_cannot_take_is_reported_not_held() {
     for settings in [
         SolverSettings {
-            exact_max_contacts: 0,
+            solve: impulse::settings::SolveSettings {
+                exact_max_contacts: 0,
+                ..SolverSettings::default().solve
+            },
             ..SolverSettings::default()
         },
         SolverSettings {
-            heavy_on_light_mass_ratio: 0.0,
+            solve: impulse::settings::SolveSettings {
+                heavy_on_light_mass_ratio: 0.0,
+                ..SolverSettings::default().solve
+            },
             ..SolverSettings::default()
         },
     ] {
-        let off = settings.heavy_on_light_mass_ratio == 0.0;
+        let off = settings.solve.heavy_on_light_mass_ratio == 0.0;
         let (mut world, heavy, rest) = heavy_on_light(Support::Single, 10_000.0, 0, settings);
         let mut not_held: Option<HeavyOnLight> = None;
         for _ in 0..600 {
@@ -260,10 +266,16 @@ fn heavy_on_light_table() {
     for support in [Support::Two, Support::Single, Support::Stack] {
         for ratio in [100.0, 1_000.0, 10_000.0] {
             let mut cells = Vec::new();
-            for threshold in [0.0, SolverSettings::default().heavy_on_light_mass_ratio] {
+            for threshold in [
+                0.0,
+                SolverSettings::default().solve.heavy_on_light_mass_ratio,
+            ] {
                 let settings = SolverSettings {
-                    sleep: false,
-                    heavy_on_light_mass_ratio: threshold,
+                    solve: impulse::settings::SolveSettings {
+                        heavy_on_light_mass_ratio: threshold,
+                        ..SolverSettings::default().solve
+                    },
+                    sleep: None,
                     ..SolverSettings::default()
                 };
                 let (mut world, heavy, rest) = heavy_on_light(support, ratio, 0, settings);
@@ -284,7 +296,10 @@ fn heavy_on_light_table() {
 fn the_heavy_on_light_path_advances_the_whole_step() {
     for substeps in [1, 4, 8] {
         let settings = SolverSettings {
-            substeps,
+            solve: impulse::settings::SolveSettings {
+                substeps,
+                ..SolverSettings::default().solve
+            },
             ..SolverSettings::default()
         };
         let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
@@ -384,7 +399,7 @@ fn a_heavy_slab_on_a_grid_of_light_boxes_holds() {
         ("reference", SolverSettings::preset("reference").unwrap()),
     ] {
         let (mut world, slab, rest) = slab_on_grid(SolverSettings {
-            sleep: false,
+            sleep: None,
             ..settings
         });
         for _ in 0..45 {

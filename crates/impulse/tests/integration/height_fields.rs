@@ -50,7 +50,7 @@ fn deepest(seed: u64) -> (f32, f32) {
         GRAVITY,
         DT,
         SolverSettings {
-            sleep: false,
+            sleep: None,
             ..SolverSettings::default()
         },
     )

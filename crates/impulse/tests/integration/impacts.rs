@@ -26,7 +26,7 @@ fn bounce(vx: f32, vy: f32, height: f32, mu: f32, e: f32, settings: SolverSettin
         Vec3::ZERO,
         DT,
         SolverSettings {
-            sleep: false,
+            sleep: None,
             ..settings
         },
     )

@@ -58,7 +58,7 @@ fn stacks(stacks: usize, height: usize, settings: SolverSettings) -> World {
 #[test]
 fn parallel_islands_match_sequential_bit_for_bit() {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     let mut sequential = stacks(6, 5, settings.clone());
@@ -147,11 +147,16 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
         let mut scene = impulse::scene::builtin_scene("pyramid3d10").unwrap();
         let simd = !settings.split_impulse();
         scene.solver = SolverSettings {
-            sleep: false,
             // pyramid3d10 is one island of ~8700 points: colours of over 512 points (or 8 lane
+
             // groups) run in parallel. The scalar sweep needs the setting to go colour by
+
             // colour; SIMD bundles spread their colours in any island of 1024 points or more.
-            parallel_island_contacts: if simd { 0 } else { 1000 },
+            solve: impulse::settings::SolveSettings {
+                parallel_island_contacts: if simd { 0 } else { 1000 },
+                ..settings.solve
+            },
+            sleep: None,
             ..settings
         };
         let (mut one, mut two, pool) = one_and_two_threads(&scene);
@@ -183,7 +188,7 @@ fn coloured_island_on_two_threads_matches_one_thread_bit_for_bit() {
 #[test]
 fn many_bodies_on_two_threads_match_one_thread_bit_for_bit() {
     let mut scene = impulse::scene::builtin_scene("balls4096").unwrap();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     let (mut one, mut two, pool) = one_and_two_threads(&scene);
     let mut contacts = 0;
     for _ in 0..45 {
@@ -223,7 +228,7 @@ fn one_and_two_threads(scene: &impulse::Scene) -> (World, World, rayon::ThreadPo
 #[test]
 fn many_bodies_fall_asleep_alike_on_one_and_two_threads() {
     let scene = impulse::scene::builtin_scene("balls4096").unwrap();
-    assert!(scene.solver.sleep);
+    assert!(scene.solver.sleep.is_some());
     let (mut one, mut two, pool) = one_and_two_threads(&scene);
     let mut first_sleep = None;
     for _ in 0..240 {

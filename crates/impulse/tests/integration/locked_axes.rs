@@ -129,7 +129,7 @@ fn a_heavy_planar_box_on_a_light_one_is_solved_exactly() {
         Vec3::new(0.0, -G, 0.0),
         DT,
         SolverSettings {
-            sleep: false,
+            sleep: None,
             ..SolverSettings::reference()
         },
     )
@@ -205,7 +205,7 @@ fn an_oblique_impact_on_a_body_locked_along_z_takes_the_locked_effective_mass() 
             Vec3::ZERO,
             DT,
             SolverSettings {
-                sleep: false,
+                sleep: None,
                 ..settings
             },
         )

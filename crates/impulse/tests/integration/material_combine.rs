@@ -59,9 +59,12 @@ fn a_dropped_ball_rebounds_at_the_combined_restitution() {
     let (ball_restitution, floor_restitution) = (0.8f32, 0.5f32);
     for rule in RULES {
         let settings = SolverSettings {
-            restitution_combine: rule,
-            restitution_threshold: 0.1,
-            sleep: false,
+            contact: impulse::settings::ContactSettings {
+                restitution_combine: rule,
+                restitution_threshold: 0.1,
+                ..SolverSettings::default().contact
+            },
+            sleep: None,
             ..SolverSettings::default()
         };
         let mut world = world_on_ground(settings, material(0.5, floor_restitution));
@@ -105,8 +108,11 @@ fn a_sliding_box_slows_at_the_combined_friction() {
     let (box_friction, ground_friction) = (0.4f32, 0.9f32);
     for rule in RULES {
         let settings = SolverSettings {
-            friction_combine: rule,
-            sleep: false,
+            contact: impulse::settings::ContactSettings {
+                friction_combine: rule,
+                ..SolverSettings::default().contact
+            },
+            sleep: None,
             ..SolverSettings::default()
         };
         let mut world = world_on_ground(settings, material(ground_friction, 0.0));
@@ -147,16 +153,19 @@ fn scenes_name_the_rules_and_presets_keep_them() {
     let text = r#"{"solver": {"friction_combine": "multiply", "restitution_combine": "min"},
         "bodies": [{"kind": "static", "shape": {"type": "half_space", "normal": [0, 1, 0]}}]}"#;
     let scene = parse_scene_str(text, "combine.json").unwrap();
-    assert_eq!(scene.solver.friction_combine, CombineRule::Multiply);
-    assert_eq!(scene.solver.restitution_combine, CombineRule::Min);
+    assert_eq!(scene.solver.contact.friction_combine, CombineRule::Multiply);
+    assert_eq!(scene.solver.contact.restitution_combine, CombineRule::Min);
     let fast = scene
         .solver
         .with_effort_of(&SolverSettings::preset("fast").unwrap());
-    assert_eq!(fast.friction_combine, CombineRule::Multiply);
-    assert_eq!(fast.restitution_combine, CombineRule::Min);
+    assert_eq!(fast.contact.friction_combine, CombineRule::Multiply);
+    assert_eq!(fast.contact.restitution_combine, CombineRule::Min);
     let defaults = SolverSettings::default();
-    assert_eq!(defaults.friction_combine, CombineRule::GeometricMean);
-    assert_eq!(defaults.restitution_combine, CombineRule::Max);
+    assert_eq!(
+        defaults.contact.friction_combine,
+        CombineRule::GeometricMean
+    );
+    assert_eq!(defaults.contact.restitution_combine, CombineRule::Max);
 
     let bad = r#"{"solver": {"friction_combine": "product"}, "bodies": []}"#;
     let message = parse_scene_str(bad, "combine.json")

@@ -241,7 +241,7 @@ fn obj_gltf_and_glb_give_the_same_triangles() {
 
 fn settings() -> SolverSettings {
     SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     }
 }

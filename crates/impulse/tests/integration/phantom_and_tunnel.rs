@@ -157,7 +157,7 @@ fn half_space_case(seed: u64) -> Case {
 
 fn settings() -> SolverSettings {
     SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     }
 }

@@ -59,7 +59,7 @@ fn free_fall_matches_the_integrator_closed_form() {
     let mut desc = cuboid(BodyKind::Dynamic, Vec3::splat(0.5), x0);
     desc.linear_velocity = v0.to_array();
     w.add_body(&desc, &material(0.5, 0.0)).unwrap();
-    let substeps = w.settings().substeps;
+    let substeps = w.settings().solve.substeps;
     let h = DT / substeps as f32;
     for n in 1..=120u32 {
         w.step().unwrap();
@@ -332,17 +332,26 @@ fn box_on_incline_sticks_or_slides_by_coulomb() {
 fn invalid_settings_are_rejected_before_stepping() {
     let bad = [
         SolverSettings {
-            substeps: 0,
+            solve: impulse::settings::SolveSettings {
+                substeps: 0,
+                ..SolverSettings::default().solve
+            },
             ..SolverSettings::default()
         },
         SolverSettings {
-            time_to_sleep: f32::NAN,
+            sleep: Some(impulse::settings::SleepSettings {
+                time_to_sleep: f32::NAN,
+                ..impulse::settings::SleepSettings::default()
+            }),
             ..SolverSettings::default()
         },
         SolverSettings {
-            repair: ContactRepair::Soft {
-                hertz: -1.0,
-                damping_ratio: 10.0,
+            contact: impulse::settings::ContactSettings {
+                repair: ContactRepair::Soft {
+                    hertz: -1.0,
+                    damping_ratio: 10.0,
+                },
+                ..SolverSettings::default().contact
             },
             ..SolverSettings::default()
         },
@@ -355,7 +364,10 @@ fn invalid_settings_are_rejected_before_stepping() {
     let mut w = world(Vec3::ZERO);
     assert!(w.set_dt(f32::NAN).is_err());
     let bad = SolverSettings {
-        iterations: 0,
+        solve: impulse::settings::SolveSettings {
+            iterations: 0,
+            ..w.settings().clone().solve
+        },
         ..w.settings().clone()
     };
     assert!(
@@ -363,8 +375,8 @@ fn invalid_settings_are_rejected_before_stepping() {
         "a bad setting changed between steps is refused"
     );
     assert_eq!(
-        w.settings().iterations,
-        SolverSettings::default().iterations
+        w.settings().solve.iterations,
+        SolverSettings::default().solve.iterations
     );
     w.step().unwrap();
 }
@@ -378,7 +390,7 @@ fn split_impulse_repairs_an_overlap_down_to_the_slop_and_then_rests() {
     let mut w = world(Vec3::new(0.0, -9.81, 0.0));
     // Awake throughout: a sleeping ball would stop wherever the repair had got to.
     w.set_settings(SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::reference()
     })
     .unwrap();
@@ -394,17 +406,17 @@ fn split_impulse_repairs_an_overlap_down_to_the_slop_and_then_rests() {
             &material(0.5, 0.0),
         )
         .unwrap();
-    let slop = w.settings().overlap_slop;
+    let slop = w.settings().contact.overlap_slop;
     // The 48 mm beyond the slop decay as e^(-12 t); the repair stops once it asks for less
     // than the tolerance (1e-5 m/s at 12/s: 0.8 µm beyond the slop).
     for _ in 0..90 {
         w.step().unwrap();
     }
     let depth = radius - w.poses()[ball].translation.y;
-    let ContactRepair::SplitImpulse { rate, .. } = w.settings().repair else {
+    let ContactRepair::SplitImpulse { rate, .. } = w.settings().contact.repair else {
         panic!("split impulse");
     };
-    let tolerance_depth = w.settings().tolerance / rate;
+    let tolerance_depth = w.settings().solve.tolerance / rate;
     assert!(
         depth > slop - 1e-6 && depth < slop + tolerance_depth + 1e-6,
         "depth {depth} m after 1.5 s, slop {slop} m"

@@ -113,7 +113,7 @@ struct Crossing {
 
 fn cross(mover: Mover, floor: Floor, speed: f32) -> Crossing {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
@@ -239,7 +239,7 @@ fn capsule_rolls_across_height_field_cells() {
 #[test]
 fn cube_pushed_into_a_concave_corner_stays_out_of_both_walls() {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();

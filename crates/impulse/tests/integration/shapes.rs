@@ -11,7 +11,7 @@ const DENSITY: f32 = 1000.0;
 fn world_of(bodies: Vec<BodyDesc>) -> World {
     let scene = Scene {
         solver: SolverSettings {
-            sleep: false,
+            sleep: None,
             ..SolverSettings::default()
         },
         bodies,

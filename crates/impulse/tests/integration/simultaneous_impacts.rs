@@ -24,8 +24,11 @@ const DT: f32 = 1.0 / 60.0;
 
 fn settings(impact: ImpactModel) -> SolverSettings {
     SolverSettings {
-        sleep: false,
-        impact,
+        contact: impulse::settings::ContactSettings {
+            impact,
+            ..SolverSettings::default().contact
+        },
+        sleep: None,
         ..SolverSettings::default()
     }
 }
@@ -141,7 +144,10 @@ fn newtons_cradle_of_two_to_five_balls_gives_one_in_one_out() {
 /// 0.4·v), with the striker's −0.6·v within 1 %; both keep the kinetic energy within 1 %.
 #[test]
 fn the_default_is_the_one_lcp_restitution_and_keeps_the_energy() {
-    assert_eq!(SolverSettings::default().impact, ImpactModel::Simultaneous);
+    assert_eq!(
+        SolverSettings::default().contact.impact,
+        ImpactModel::Simultaneous
+    );
     let masses = [1.0; 5];
     for (name, effort, row_error) in [
         ("default", SolverSettings::default(), 0.05),
@@ -346,7 +352,7 @@ fn the_cradle_scene_file_gives_one_in_one_out() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/newtons_cradle.json");
     let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(scene.solver.impact, ImpactModel::Propagation);
+    assert_eq!(scene.solver.contact.impact, ImpactModel::Propagation);
     let mut world = World::from_scene(&scene).unwrap();
     for _ in 0..60 {
         world.step().unwrap();

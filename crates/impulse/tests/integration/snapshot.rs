@@ -95,14 +95,14 @@ const BOTH_WAYS: [(usize, usize); 2] = [(1, 2), (2, 1)];
 #[test]
 fn pyramid20_resumes_bit_for_bit_on_one_and_two_threads() {
     let mut scene = builtin_scene("pyramid20").unwrap();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     resumes_bit_for_bit("pyramid20", || world_of(&scene), 60, 60, &BOTH_WAYS);
 }
 
 #[test]
 fn balls4096_resumes_bit_for_bit_on_one_and_two_threads() {
     let mut scene = builtin_scene("balls4096").unwrap();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     resumes_bit_for_bit("balls4096", || world_of(&scene), 60, 30, &BOTH_WAYS);
 }
 
@@ -126,7 +126,7 @@ fn kinematic_bodies_resume_bit_for_bit() {
 fn meshes_height_fields_and_compounds_resume_bit_for_bit() {
     for name in ["mesh_terrain", "compound"] {
         let mut scene = file_scene(name);
-        scene.solver.sleep = false;
+        scene.solver.sleep = None;
         resumes_bit_for_bit(name, || world_of(&scene), 60, 40, &BOTH_WAYS);
     }
 }
@@ -403,7 +403,7 @@ fn files_round_trip_and_a_missing_file_is_an_io_error() {
 #[test]
 fn worlds_with_joints_resume_bit_for_bit() {
     let mut scene = builtin_scene("chain20").unwrap();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     resumes_bit_for_bit("chain20", || world_of(&scene), 45, 45, &BOTH_WAYS);
     let mut probe = joint_zoo();
     steps(&mut probe, 30, 1);
@@ -422,7 +422,7 @@ fn joint_zoo() -> World {
         Vec3::new(0.0, -9.81, 0.0),
         1.0 / 60.0,
         SolverSettings {
-            sleep: false,
+            sleep: None,
             ..SolverSettings::default()
         },
     )

@@ -10,7 +10,7 @@ use impulse::{BodyKind, World};
 #[ignore = "a soak of a few minutes; run on demand"]
 fn balls4096_for_20000_steps_stays_finite_boxed_and_dissipative() {
     let mut scene = builtin_scene("balls4096").unwrap();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     // The box's inner faces, from its four walls (bodies 1–4).
     let wall = |name: &str| {
         scene

@@ -23,7 +23,7 @@ fn ball(position: Vec3, velocity: Vec3) -> BodyDesc {
 
 fn world(gravity: Vec3) -> World {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     World::new(gravity, DT, settings).unwrap()

@@ -65,7 +65,7 @@ fn pyramid20_stands_for_ten_seconds() {
 /// at any step).
 fn run_awake(name: &str) -> (f32, f32, f32) {
     let mut scene = builtin_scene(name).expect("built-in scene");
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     let mut world = World::from_scene(&scene).unwrap();
     let top = metrics::top_body(&world, world.poses()).unwrap();
     let top_y = world.poses()[top].translation.y;
@@ -116,7 +116,7 @@ fn overlap_pyramid_recovers_without_explosion() {
     for (preset, speed_bound) in [("default", 5.0), ("reference", 2.0)] {
         let mut scene = builtin_scene("overlap_pyramid").expect("built-in scene");
         scene.solver = SolverSettings {
-            sleep: false,
+            sleep: None,
             ..SolverSettings::preset(preset).unwrap()
         };
         let mut world = World::from_scene(&scene).unwrap();
@@ -157,7 +157,7 @@ fn overlap_pyramid_recovers_without_explosion() {
 fn awake_world(name: &str, preset: &str) -> World {
     let mut scene = builtin_scene(name).expect("built-in scene");
     scene.solver = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::preset(preset).unwrap()
     };
     World::from_scene(&scene).unwrap()
@@ -270,7 +270,7 @@ fn plate_on_two_cubes_comes_to_rest_at_every_preset() {
 #[test]
 fn pyramid20_comes_to_rest_at_the_default() {
     let mut scene = builtin_scene("pyramid20").expect("built-in scene");
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     let mut world = World::from_scene(&scene).unwrap();
     let mut energy = 0.0f32;
     for step in 1..=600 {

@@ -62,9 +62,9 @@ fn an_override_changes_its_field_and_nothing_else() {
     assert_eq!(s, expected);
 
     let s = varied(&["solver.substeps=12", "dt=0.01", "steps=42"]).unwrap();
-    assert_eq!((s.solver.substeps, s.dt, s.steps), (12, 0.01, 42));
+    assert_eq!((s.solver.solve.substeps, s.dt, s.steps), (12, 0.01, 42));
     let mut expected = base.clone();
-    expected.solver.substeps = 12;
+    expected.solver.solve.substeps = 12;
     expected.dt = 0.01;
     expected.steps = 42;
     assert_eq!(s, expected);

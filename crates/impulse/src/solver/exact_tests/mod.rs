@@ -185,11 +185,12 @@ fn stored(c: &ContactConstraint) -> [f32; 3] {
 /// The engine's iterative solve only (its automatic policy may itself call the exact path),
 /// no sleeping.
 fn settings() -> SolverSettings {
-    SolverSettings {
-        method: SolverMethod::Pgs,
-        sleep: false,
+    let mut settings = SolverSettings {
+        sleep: None,
         ..SolverSettings::reference()
-    }
+    };
+    settings.solve.method = SolverMethod::Pgs;
+    settings
 }
 
 /// `count` unit cubes stacked on a static ground, μ = 0.5, under `gravity`, each moving at

@@ -76,7 +76,7 @@ fn sphere_on_two_spheres_matches_statics_and_lemke() {
 
     // (b) The statics: from rest (v* = −g·h·ŷ), rigid rows with target 0, entered from
     // deliberately wrong impulses.
-    let h = DT / world.settings.substeps as f32;
+    let h = DT / world.settings.solve.substeps as f32;
     let mut statics = island.clone();
     let mut prospective = vec![(DVec3::ZERO, DVec3::ZERO); statics.linear.len()];
     prospective[0].0 = DVec3::new(0.0, -(g * h) as f64, 0.0);
@@ -364,12 +364,18 @@ fn out_of_rounds_the_best_round_is_returned_whole() {
 #[test]
 fn soft_rows_solve_the_exported_lcp() {
     let soft = SolverSettings {
-        friction: false,
-        repair: ContactRepair::Soft {
-            hertz: 30.0,
-            damping_ratio: 10.0,
+        contact: crate::settings::ContactSettings {
+            friction: false,
+            repair: ContactRepair::Soft {
+                hertz: 30.0,
+                damping_ratio: 10.0,
+            },
+            ..settings().contact
         },
-        relax_iterations: 0,
+        solve: crate::settings::SolveSettings {
+            relax_iterations: 0,
+            ..settings().solve
+        },
         ..settings()
     };
     let world = box_stack_with(soft, 3, Vec3::new(0.0, -9.81, 0.0), Vec3::ZERO, 30);

@@ -28,7 +28,7 @@ pub(crate) struct Bundles {
     /// Whether one colour's bundles may be updated on several threads.
     pub(super) parallel: bool,
     /// Whether the sweeps may fuse multiplies and additions
-    /// ([`crate::SolverSettings::fused_multiply_add`]); they do only in the kernels compiled
+    /// ([`crate::settings::SolveSettings::fused_multiply_add`]); they do only in the kernels compiled
     /// with FMA ([`Bundles::sweep`]).
     pub(super) fused: bool,
     /// Points with friction (μ > 0) in the last pack: each has two tangent rows.
@@ -66,7 +66,7 @@ pub(crate) struct Bundles {
 
 impl Bundles {
     /// Sets whether the sweeps may fuse multiplies and additions
-    /// ([`crate::SolverSettings::fused_multiply_add`]).
+    /// ([`crate::settings::SolveSettings::fused_multiply_add`]).
     pub(crate) fn set_fused_multiply_add(&mut self, fused: bool) {
         self.fused = fused;
     }

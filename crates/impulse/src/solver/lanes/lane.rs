@@ -35,7 +35,7 @@ pub(super) fn lane_vec(vectors: [Vec3; LANES]) -> LaneVec {
 }
 
 /// How a kernel rounds a·b + c: in the sweeps' dot products and velocity updates
-/// ([`crate::SolverSettings::fused_multiply_add`]).
+/// ([`crate::settings::SolveSettings::fused_multiply_add`]).
 pub(super) trait Rounding: Copy {
     /// a·b + c per lane.
     fn mul_add(a: Lane, b: Lane, c: Lane) -> Lane;

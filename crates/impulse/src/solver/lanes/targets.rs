@@ -54,7 +54,8 @@ pub(super) struct Targets<'a> {
 impl<'a> Targets<'a> {
     pub(super) fn new(inputs: &TargetInputs<'a>, geometry: &'a [BundleGeometry]) -> Self {
         let settings = inputs.settings;
-        let (repair_rate, (mass_scale, impulse_scale)) = repair_terms(&settings.repair, inputs.h);
+        let (repair_rate, (mass_scale, impulse_scale)) =
+            repair_terms(&settings.contact.repair, inputs.h);
         let (soft_mass, soft_impulse) = if inputs.with_repair {
             (Lane::splat(mass_scale), Lane::splat(impulse_scale))
         } else {
@@ -66,8 +67,8 @@ impl<'a> Targets<'a> {
             turn: inputs.turn,
             geometry,
             repair_rate: Lane::splat(repair_rate),
-            slop: Lane::splat(settings.overlap_slop),
-            max_repair: Lane::splat(settings.max_repair_speed),
+            slop: Lane::splat(settings.contact.overlap_slop),
+            max_repair: Lane::splat(settings.contact.max_repair_speed),
             inverse_h: Lane::splat(1.0 / inputs.h),
             soft_mass,
             soft_impulse,

@@ -34,7 +34,7 @@ impl World {
             constraints,
         );
         self.assemble_joints(
-            settings.warm_start,
+            settings.solve.warm_start,
             islands,
             world_inverse_inertia,
             workspaces,

@@ -16,10 +16,10 @@ impl World {
         margins: &mut SpeculativeMargins,
         candidates: &mut Vec<(u32, u32)>,
     ) {
-        margins.set_substeps(settings.substeps);
+        margins.set_substeps(settings.solve.substeps);
         margins.update(
             &self.bodies,
-            settings.prediction_distance,
+            settings.contact.prediction_distance,
             self.gravity,
             self.dt,
             parallel,

@@ -64,7 +64,7 @@ impl World {
             name: self.bodies.name[i].clone(),
             step: self.step_count,
             position,
-            bound: self.settings.max_distance,
+            bound: self.settings.limits.max_distance,
         });
     }
 }

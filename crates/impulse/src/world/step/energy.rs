@@ -3,7 +3,7 @@
 //! what the continuous stage's clamps give back and reset by the step's forces and moving
 //! kinematic bodies, and the step's end compares the energy with it ([`BLOW_UP_ENERGY_PER_KG`])
 //! and checks every body's position for a non-finite value and its linear and angular speeds
-//! against their bounds (`SolverSettings::max_linear_speed`, m/s, and `max_angular_speed`,
+//! against their bounds (`WorldLimits::max_linear_speed`, m/s, and `max_angular_speed`,
 //! rad/s); a moving body beyond the world bound leaves the world instead.
 
 use glam::Vec3;
@@ -140,7 +140,7 @@ impl EnergyCheck {
         // fast (a body 25 km down after 70 s of free fall) that adds up to more than the bound;
         // near the origin it is negligible (1e-5 J/kg a substep at 10 m).
         let ulp = |x: f32| f64::from(x.abs().max(1.0) * f32::EPSILON);
-        self.rounding += f64::from(settings.substeps)
+        self.rounding += f64::from(settings.solve.substeps)
             * (f64::from(gravity.length()) * ulp(terms.largest_distance)
                 + f64::from(terms.largest_speed) * ulp(terms.largest_speed));
         let bound =
@@ -170,10 +170,12 @@ impl EnergyCheck {
         // on rayon's threads for a large world, where a serial pass would be a large share of
         // the step's own work.
         let b = &bodies;
-        let max_distance = settings.max_distance;
+        let max_distance = settings.limits.max_distance;
         let position = |i: usize| b.pose[i].translation.length();
-        let (max_linear_speed, max_angular_speed) =
-            (settings.max_linear_speed, settings.max_angular_speed);
+        let (max_linear_speed, max_angular_speed) = (
+            settings.limits.max_linear_speed,
+            settings.limits.max_angular_speed,
+        );
         let linear_speed = |i: usize| b.linear_velocity[i].length();
         let angular_speed = |i: usize| b.angular_velocity[i].length();
         // NaN is beyond every bound.

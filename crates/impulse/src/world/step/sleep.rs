@@ -51,6 +51,8 @@ pub(super) fn update_sleep(
     dt: f32,
     parallel: bool,
 ) {
+    // Without sleeping the timers still run, at the default thresholds.
+    let thresholds = s.sleep.unwrap_or_default();
     // Per body first (the bodies of awake islands), then per island; both passes are
     // independent per item, so they run on rayon's threads when the world is large.
     let in_awake_island = |i: usize| {
@@ -60,7 +62,7 @@ pub(super) fn update_sleep(
             .is_some_and(|&k| k != u32::MAX && awake.get(k as usize).copied().unwrap_or(false))
     };
     let quiet = |linear: Vec3, angular: Vec3| {
-        linear.length() < s.sleep_linear_speed && angular.length() < s.sleep_angular_speed
+        linear.length() < thresholds.linear_speed && angular.length() < thresholds.angular_speed
     };
     let parallel = spread(parallel, bodies.len(), BODIES_PER_TASK);
     {
@@ -81,7 +83,7 @@ pub(super) fn update_sleep(
             }
         });
     }
-    if !s.sleep {
+    if s.sleep.is_none() {
         return;
     }
     // An island touching a moving kinematic body stays awake: the body may carry it at any
@@ -91,7 +93,7 @@ pub(super) fn update_sleep(
             && islands
                 .bodies(k)
                 .iter()
-                .all(|&i| bodies.sleep_time[i as usize] >= s.time_to_sleep)
+                .all(|&i| bodies.sleep_time[i as usize] >= thresholds.time_to_sleep)
             && islands.guests(k).iter().all(|&i| bodies.asleep[i as usize])
     };
     let sleepers = indices_where(parallel, awake.len(), falls_asleep);

@@ -66,7 +66,7 @@ pub(crate) fn stretch(world: &World, last: BodyHandle) -> f32 {
 
 fn settled(end_mass: Option<f32>) -> f32 {
     let settings = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     };
     let (mut world, last, _) = hanging_chain(settings, end_mass);
@@ -96,7 +96,7 @@ fn a_heavy_ball_on_a_light_chain_stretches_it_less_than_one_percent() {
 /// The built-in scene `name` with sleeping off.
 fn awake_builtin(name: &str) -> World {
     let mut scene = builtin_scene(name).unwrap();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     World::from_scene(&scene).unwrap()
 }
 

@@ -12,7 +12,7 @@ use super::{anchor, world};
 
 fn no_gravity() -> World {
     let mut world = world(SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     });
     world.set_gravity(Vec3::ZERO).unwrap();
@@ -161,12 +161,15 @@ fn a_breakable_wall_holds_its_weight_and_breaks_where_the_ball_strikes() {
 
 fn wall_in_lanes_or_not(lanes: bool) {
     let wall = breakable_wall(SolverSettings {
-        sleep: false,
-        simd_island_contacts: if lanes {
-            SolverSettings::default().simd_island_contacts
-        } else {
-            0
+        solve: impulse::settings::SolveSettings {
+            simd_island_contacts: if lanes {
+                SolverSettings::default().solve.simd_island_contacts
+            } else {
+                0
+            },
+            ..SolverSettings::default().solve
         },
+        sleep: None,
         ..SolverSettings::default()
     });
     let BreakableWall {
@@ -328,7 +331,7 @@ fn a_breakable_joint_holds_below_its_strength_and_breaks_above_it() {
     for (load, breaks) in [(0.95f32, false), (1.05, true)] {
         let (mut world, weight, joint) = hung_mass(
             SolverSettings {
-                sleep: false,
+                sleep: None,
                 ..SolverSettings::default()
             },
             load,
@@ -404,13 +407,16 @@ fn hung_mass(
 /// so `auto` would keep it iterative) on islands of up to 160 contact points plus joint rows.
 fn reference_exact() -> SolverSettings {
     SolverSettings {
-        method: SolverMethod::Auto {
-            escalation_tolerance: 3e-4,
-            escalation_iterations: 4,
-            mass_ratio_threshold: 0.0,
+        solve: impulse::settings::SolveSettings {
+            method: SolverMethod::Auto {
+                escalation_tolerance: 3e-4,
+                escalation_iterations: 4,
+                mass_ratio_threshold: 0.0,
+            },
+            exact_max_contacts: 160,
+            ..SolverSettings::reference().solve
         },
-        exact_max_contacts: 160,
-        sleep: false,
+        sleep: None,
         ..SolverSettings::reference()
     }
 }
@@ -503,8 +509,11 @@ fn a_breakable_wall_on_the_exact_path_carries_its_weight_and_breaks_at_its_stren
             reference_exact()
         } else {
             SolverSettings {
-                exact_max_contacts: 0,
-                sleep: false,
+                solve: impulse::settings::SolveSettings {
+                    exact_max_contacts: 0,
+                    ..SolverSettings::reference().solve
+                },
+                sleep: None,
                 ..SolverSettings::reference()
             }
         };
@@ -565,7 +574,7 @@ fn a_breakable_wall_on_the_exact_path_carries_its_weight_and_breaks_at_its_stren
 #[test]
 fn a_ragdoll_dropped_on_stairs_comes_to_rest() {
     let mut scene = builtin_scene("ragdoll").unwrap();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     let mut world = World::from_scene(&scene).unwrap();
     let start = world.energy().mechanical();
     let moving = world.body_count() - 6;
@@ -599,7 +608,7 @@ fn a_ragdoll_dropped_on_stairs_comes_to_rest() {
 #[test]
 fn a_chain_dropped_on_the_ground_lands_and_rests_on_its_contacts() {
     let mut world = world(SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     });
     world

@@ -22,14 +22,17 @@ const G: f32 = 9.81;
 /// (`mass_ratio_threshold` 0) on islands of up to 64 contact points plus joint rows.
 fn exact_settings() -> SolverSettings {
     SolverSettings {
-        substeps: 1,
-        method: SolverMethod::Auto {
-            escalation_tolerance: 3e-4,
-            escalation_iterations: 4,
-            mass_ratio_threshold: 0.0,
+        solve: impulse::settings::SolveSettings {
+            substeps: 1,
+            method: SolverMethod::Auto {
+                escalation_tolerance: 3e-4,
+                escalation_iterations: 4,
+                mass_ratio_threshold: 0.0,
+            },
+            exact_max_contacts: 64,
+            ..SolverSettings::reference().solve
         },
-        exact_max_contacts: 64,
-        sleep: false,
+        sleep: None,
         ..SolverSettings::reference()
     }
 }
@@ -279,7 +282,10 @@ fn a_chain_of_five_links_resting_on_the_ground_solves_exactly() {
 
     // Above the exact path's limit (contact points plus joint rows), the island keeps NNCG.
     let mut world = chain(SolverSettings {
-        exact_max_contacts: 8,
+        solve: impulse::settings::SolveSettings {
+            exact_max_contacts: 8,
+            ..exact_settings().solve
+        },
         ..exact_settings()
     });
     for _ in 0..10 {

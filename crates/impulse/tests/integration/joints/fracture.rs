@@ -23,7 +23,7 @@ const WINDOW: f32 = 1.0 / 240.0;
 /// x of their anchor in cm. Returns the world and the boxes.
 fn beam(window: f32) -> (World, Vec<impulse::BodyHandle>) {
     let mut world = world(SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     });
     let span = 2.0 * HALF * BOXES as f32;

@@ -14,7 +14,7 @@ use super::{anchor, world};
 /// within 0.01 rad of the limit, never past it by more than that.
 fn door_slam(settings: SolverSettings, preset: &str) {
     let mut world = world(SolverSettings {
-        sleep: false,
+        sleep: None,
         ..settings
     });
     let post = anchor(&mut world, Vec3::new(0.0, 1.0, 0.0));

@@ -80,7 +80,7 @@ fn a_simple_pendulum_keeps_the_exact_period_at_small_and_large_amplitude() {
 #[test]
 fn a_double_pendulum_keeps_its_energy_over_ten_seconds() {
     let mut world = world(SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::default()
     });
     let pivot = anchor(&mut world, Vec3::new(0.0, 3.0, 0.0));

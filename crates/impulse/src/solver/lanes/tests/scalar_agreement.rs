@@ -12,7 +12,7 @@ use glam::{Mat3, Vec3};
 /// immovable body in the last slot, `bodies.len()`.
 fn settled_pyramid20_rows() -> (World, Vec<crate::contact::ContactConstraint>) {
     let mut scene = builtin_scene("pyramid20").unwrap();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     let mut w = World::from_scene(&scene).unwrap();
     for _ in 0..30 {
         w.step().unwrap();
@@ -213,10 +213,13 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
     rotation.push(Vec3::ZERO);
     // A slop (the default has none), so that the repair's subtraction of it counts too.
     let settings = SolverSettings {
-        overlap_slop: 5e-4,
+        contact: crate::settings::ContactSettings {
+            overlap_slop: 5e-4,
+            ..SolverSettings::default().contact
+        },
         ..SolverSettings::default()
     };
-    let h = DT / settings.substeps as f32;
+    let h = DT / settings.solve.substeps as f32;
     // Then with every third body turned past the speculative limit since the step began
     // (`turn`, rad²): its gap rows with a lever arm off the normal are stale on the scalar
     // sweep, and must be in lanes, while its neighbours' gap rows stay live.
@@ -326,7 +329,7 @@ fn lanes_set_the_targets_of_the_scalar_update_from_moved_and_turned_bodies() {
 #[test]
 fn lanes_computing_the_lever_arm_products_change_no_trajectory() {
     let mut scene = builtin_scene("stack30").unwrap();
-    scene.solver.sleep = false;
+    scene.solver.sleep = None;
     let mut deferred = World::from_scene(&scene).unwrap();
     let mut computed = World::from_scene(&scene).unwrap();
     let ball = sphere(0.1, Vec3::new(500.0, 1000.0, 0.0));
@@ -390,7 +393,7 @@ fn pass_at_rest<'a>(
             rotation: still,
             turn: &[],
             settings,
-            h: DT / settings.substeps as f32,
+            h: DT / settings.solve.substeps as f32,
             with_repair: main,
         }),
         sweep: crate::solver::Sweep::default(),

@@ -32,15 +32,16 @@ pub(super) fn sphere(radius: f32, position: Vec3) -> BodyDesc {
 
 /// PGS on rigid rows (`repair: bias`), every island in lanes however small.
 fn bundled(iterations: u32) -> SolverSettings {
-    SolverSettings {
-        method: SolverMethod::Pgs,
-        repair: ContactRepair::Bias { rate: 12.0 },
-        iterations,
-        relax_iterations: iterations,
-        simd_island_contacts: 1,
-        sleep: false,
+    let mut settings = SolverSettings {
+        sleep: None,
         ..SolverSettings::default()
-    }
+    };
+    settings.solve.method = SolverMethod::Pgs;
+    settings.contact.repair = ContactRepair::Bias { rate: 12.0 };
+    settings.solve.iterations = iterations;
+    settings.solve.relax_iterations = iterations;
+    settings.solve.simd_island_contacts = 1;
+    settings
 }
 
 /// One contact in a bundle of four: three padding lanes must change nothing, so momentum is
@@ -83,8 +84,14 @@ fn head_on_spheres_in_lanes_conserve_momentum_and_obey_restitution() {
 #[test]
 fn pile_of_spheres_solved_in_lanes_satisfies_complementarity() {
     let settings = SolverSettings {
-        tolerance: 0.0,
-        friction: false,
+        solve: impulse::settings::SolveSettings {
+            tolerance: 0.0,
+            ..bundled(500).solve
+        },
+        contact: impulse::settings::ContactSettings {
+            friction: false,
+            ..bundled(500).contact
+        },
         ..bundled(500)
     };
     let mut w = common::sphere_pile(settings);
@@ -109,7 +116,7 @@ fn pile_of_spheres_solved_in_lanes_satisfies_complementarity() {
 fn fast_preset_keeps_pyramid20_standing_with_impulses_inside_their_bounds() {
     let mut scene = builtin_scene("pyramid20").unwrap();
     scene.solver = SolverSettings {
-        sleep: false,
+        sleep: None,
         ..SolverSettings::fast()
     };
     let mut w = World::from_scene(&scene).unwrap();
@@ -212,14 +219,14 @@ fn the_lanes_threshold_counts_contact_points_and_zero_is_never() {
     // are found before its solve, so they do not depend on the threshold.
     let sixth_step = |threshold: Option<u32>| {
         let mut scene = builtin_scene("pyramid20").unwrap();
-        scene.solver.sleep = false;
-        scene.solver.method = SolverMethod::Pgs;
+        scene.solver.sleep = None;
+        scene.solver.solve.method = SolverMethod::Pgs;
         let mut w = World::from_scene(&scene).unwrap();
         for _ in 0..5 {
             w.step().unwrap();
         }
         if let Some(threshold) = threshold {
-            w.settings.simd_island_contacts = threshold;
+            w.settings.solve.simd_island_contacts = threshold;
         }
         w.step().unwrap();
         let islands = &w.diagnostics().islands;
@@ -246,10 +253,13 @@ fn the_lanes_threshold_counts_contact_points_and_zero_is_never() {
 fn lanes_report_the_row_velocity_change_of_the_scalar_sweep() {
     let run = |simd_island_contacts: u32| {
         let settings = SolverSettings {
-            simd_island_contacts,
-            substeps: 1,
-            warm_start: 0.0,
-            friction_in_main_solve: true,
+            solve: impulse::settings::SolveSettings {
+                simd_island_contacts,
+                substeps: 1,
+                warm_start: 0.0,
+                friction_in_main_solve: true,
+                ..bundled(1).solve
+            },
             ..bundled(1)
         };
         let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
@@ -294,8 +304,14 @@ fn lanes_report_the_row_velocity_change_of_the_scalar_sweep() {
 #[test]
 fn cubes_on_a_sphere_pile_in_lanes_satisfy_complementarity() {
     let settings = SolverSettings {
-        tolerance: 0.0,
-        friction: false,
+        solve: impulse::settings::SolveSettings {
+            tolerance: 0.0,
+            ..bundled(500).solve
+        },
+        contact: impulse::settings::ContactSettings {
+            friction: false,
+            ..bundled(500).contact
+        },
         ..bundled(500)
     };
     let mut w = common::sphere_pile(settings);
