@@ -38,20 +38,11 @@ fn pile(friction: bool) -> World {
     const COUNT: usize = 36;
     const HALF_WIDTH: f32 = 2.0;
     const SPACING: f32 = 1.02;
-    let settings = SolverSettings {
-        solve: crate::settings::SolveSettings {
-            iterations: 200,
-            relax_iterations: 200,
-            tolerance: 0.0,
-            ..SolverSettings::reference().solve
-        },
-        contact: crate::settings::ContactSettings {
-            friction,
-            ..SolverSettings::reference().contact
-        },
-        sleep: None,
-        ..SolverSettings::reference()
-    };
+    let mut settings = SolverSettings::reference();
+    (settings.solve.iterations, settings.solve.relax_iterations) = (200, 200);
+    settings.solve.tolerance = 0.0;
+    settings.contact.friction = friction;
+    settings.sleep = None;
     let mu = if friction { 0.5 } else { 0.0 };
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
     world
@@ -690,19 +681,10 @@ fn fused_record_and_residual_equals_the_separate_passes_on_any_thread_count() {
 fn pile_of_spheres_satisfies_complementarity_at_exit() {
     // The LCP at exit is that of the last solve of the step (the relax solve), so both are
     // run to convergence.
-    let settings = SolverSettings {
-        solve: crate::settings::SolveSettings {
-            iterations: 500,
-            relax_iterations: 500,
-            tolerance: 0.0,
-            ..SolverSettings::default().solve
-        },
-        contact: crate::settings::ContactSettings {
-            friction: false,
-            ..SolverSettings::default().contact
-        },
-        ..SolverSettings::default()
-    };
+    let mut settings = SolverSettings::default();
+    (settings.solve.iterations, settings.solve.relax_iterations) = (500, 500);
+    settings.solve.tolerance = 0.0;
+    settings.contact.friction = false;
     let mut w = common::sphere_pile(settings);
     assert_eq!(w.body_count(), 5 + 64);
     let mut checked_steps = 0;
