@@ -3,6 +3,7 @@
 mod engine_convergence;
 mod export;
 mod lcp_command;
+mod median_profile;
 mod plot;
 mod plot_output;
 mod render;

@@ -7,12 +7,13 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use impulse::report::EscalationLevel;
-use impulse::report::{SolvePhase, Stage, StepProfile};
+use impulse::report::StepProfile;
 use impulse::{Scene, World, WorldSnapshot, metrics};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
 use crate::export::{self, Recording};
+use crate::median_profile::{median, median_profile};
 use crate::trajectory::TrajectoryWriter;
 
 /// Options of `impulse run` and `impulse resume` beyond the scene or snapshot itself.
@@ -686,40 +687,6 @@ fn simulate(
     }
     exported?;
     Ok(summary)
-}
-
-/// Each stage's and each solve phase's median over `profiles`.
-fn median_profile(profiles: &[StepProfile]) -> StepProfile {
-    let of = |time: &dyn Fn(&StepProfile) -> f32| {
-        let mut times: Vec<f64> = profiles.iter().map(|p| time(p) as f64).collect();
-        median(&mut times) as f32
-    };
-    let mut profile = StepProfile {
-        total: of(&|p| p.total),
-        ..StepProfile::default()
-    };
-    for stage in Stage::ALL {
-        profile.set(stage, of(&|p| p.get(stage)));
-    }
-    for phase in SolvePhase::ALL {
-        profile
-            .solve_phases
-            .set(phase, of(&|p| p.solve_phases.get(phase)));
-    }
-    profile
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
 }
 
 /// Overlap (m) beyond which bodies the scene creates inside each other are worth a warning:
