@@ -83,17 +83,9 @@ fn head_on_spheres_in_lanes_conserve_momentum_and_obey_restitution() {
 /// γ ≥ 0, w ≥ 0 and wᵀγ ≈ 0 for the engine's own LCP.
 #[test]
 fn pile_of_spheres_solved_in_lanes_satisfies_complementarity() {
-    let settings = SolverSettings {
-        solve: impulse::settings::SolveSettings {
-            tolerance: 0.0,
-            ..bundled(500).solve
-        },
-        contact: impulse::settings::ContactSettings {
-            friction: false,
-            ..bundled(500).contact
-        },
-        ..bundled(500)
-    };
+    let mut settings = bundled(500);
+    settings.solve.tolerance = 0.0;
+    settings.contact.friction = false;
     let mut w = common::sphere_pile(settings);
     let mut checked_steps = 0;
     for _ in 0..90 {
@@ -252,16 +244,11 @@ fn the_lanes_threshold_counts_contact_points_and_zero_is_never() {
 #[test]
 fn lanes_report_the_row_velocity_change_of_the_scalar_sweep() {
     let run = |simd_island_contacts: u32| {
-        let settings = SolverSettings {
-            solve: impulse::settings::SolveSettings {
-                simd_island_contacts,
-                substeps: 1,
-                warm_start: 0.0,
-                friction_in_main_solve: true,
-                ..bundled(1).solve
-            },
-            ..bundled(1)
-        };
+        let mut settings = bundled(1);
+        settings.solve.simd_island_contacts = simd_island_contacts;
+        settings.solve.substeps = 1;
+        settings.solve.warm_start = 0.0;
+        settings.solve.friction_in_main_solve = true;
         let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
         let ground = common::static_box(Vec3::new(50.0, 0.5, 50.0), Vec3::new(0.0, -0.5, 0.0));
         w.add_body(&ground, &material(0.6, 0.0)).unwrap();
@@ -303,17 +290,9 @@ fn lanes_report_the_row_velocity_change_of_the_scalar_sweep() {
 /// complementarity as in the scalar test.
 #[test]
 fn cubes_on_a_sphere_pile_in_lanes_satisfy_complementarity() {
-    let settings = SolverSettings {
-        solve: impulse::settings::SolveSettings {
-            tolerance: 0.0,
-            ..bundled(500).solve
-        },
-        contact: impulse::settings::ContactSettings {
-            friction: false,
-            ..bundled(500).contact
-        },
-        ..bundled(500)
-    };
+    let mut settings = bundled(500);
+    settings.solve.tolerance = 0.0;
+    settings.contact.friction = false;
     let mut w = common::sphere_pile(settings);
     let first_cube = w.bodies.len();
     for i in 0..4 {
