@@ -312,6 +312,15 @@ def test_a_search_resumes_where_it_stopped(tmp_path):
     assert all(after[key] == value for key, value in before.items())
     with pytest.raises(ValueError, match="another scene, goals"):
         search(SCENE, [TARGET], VARIATION, budget=4, steps=10, out=out, progress=False)
+    # A directory an older search wrote (another format) is refused, saying so.
+    manifest = json.loads((out / "manifest.json").read_text())
+    manifest["format"] -= 1
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(ValueError, match="another version of impulse.takes"):
+        search(
+            SCENE, [unreachable], VARIATION, budget=24, steps=10, out=out, population=8,
+            progress=False,
+        )
 
 
 def _far(record):

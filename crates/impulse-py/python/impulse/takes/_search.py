@@ -220,6 +220,14 @@ class _Store:
         if os.path.exists(path):
             with open(path, encoding="utf-8") as file:
                 old = json.load(file)
+            if old.get("format") != manifest["format"]:
+                raise ValueError(
+                    f"{self.root} holds a search made by another version of impulse.takes "
+                    f"(search format {old.get('format')}, this version writes "
+                    f"{manifest['format']}), which would continue differently: its takes still "
+                    "load with impulse.takes.load; to search, choose another out directory or "
+                    "remove it"
+                )
             if old.get("digest") != manifest["digest"]:
                 raise ValueError(
                     f"{self.root} holds a search of another scene, goals, variation or "

@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""Measures how rare the bowling shot's 7-10 split is (docs/takes.md, "Why bowling's 7-10 split
+stays rare").
+
+1. ``lines``: straight balls, rolling without slip and without a hop, over the line where they
+   would meet the head pin (x at the head pin's z, m) and their sideways velocity (m/s): which of
+   the 7 and the 10 stand after the shot's steps. One row per sideways velocity, one character
+   per line: ``.`` neither, ``7`` or ``T`` (the 10) alone, ``B`` both, ``M`` the split itself
+   (both, every other pin down).
+2. ``around``: takes drawn around one take of a search directory at several step sizes
+   (θ + size × N(0, I), the search's local steps; the take's scene seed kept): how many leave
+   the 7 and the 10 standing, and how many meet every goal.
+
+    python3 scripts/bowling-split.py lines
+    python3 scripts/bowling-split.py around takes/bowling-random TAKE_ID --sizes 0.003,0.03,0.1
+
+Needs the impulse package; runs on 2 processes. The counts are deterministic (the engine is).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from multiprocessing import Pool
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SHOT = os.path.join(HERE, "..", "scenes", "takes", "bowling")
+CORNERS = ("pin7 standing", "pin10 standing")
+
+
+def _outcome(scene: dict) -> tuple[bool, bool, bool]:
+    """(7 standing, 10 standing, every goal met) of one run of ``scene``."""
+    from impulse.takes import MET, evaluate
+
+    with open(SHOT + ".goals.json", encoding="utf-8") as file:
+        spec = json.load(file)
+    costs = evaluate(scene, spec["goals"], spec["steps"])
+    seven, ten = (costs[name] <= MET for name in CORNERS)
+    return seven, ten, all(cost <= MET for cost in costs.values())
+
+
+def _straight(task: tuple[float, float]) -> tuple[bool, bool, bool]:
+    line, sideways = task
+    with open(SHOT + ".json", encoding="utf-8") as file:
+        scene = json.load(file)
+    ball = next(body for body in scene["bodies"] if body.get("name") == "ball")
+    radius = ball["shape"]["radius"]
+    speed = -ball["linear_velocity"][2]
+    flight = ball["position"][2] / speed  # s to the head pin's z (0)
+    ball["position"] = [line - sideways * flight, radius, ball["position"][2]]
+    ball["linear_velocity"] = [sideways, 0.0, -speed]
+    ball["angular_velocity"] = [-speed / radius, 0.0, -sideways / radius]  # rolling
+    return _outcome(scene)
+
+
+def _varied(task: tuple[dict, dict, list[float], int | None]) -> tuple[bool, bool, bool]:
+    from impulse.takes import Variation
+
+    base, variation, theta, seed = task
+    return _outcome(Variation.from_dict(variation).apply(base, theta, seed))
+
+
+def _mark(seven: bool, ten: bool, met: bool) -> str:
+    if met:
+        return "M"
+    return {(True, True): "B", (True, False): "7", (False, True): "T"}.get((seven, ten), ".")
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    commands = parser.add_subparsers(dest="command", required=True)
+    lines = commands.add_parser("lines")
+    lines.add_argument("--lines", default="-0.2,0.2,0.01", help="first, last, step (m)")
+    lines.add_argument("--sideways", default="-0.6,-0.4,-0.2,0,0.2,0.4,0.6", help="m/s")
+    around = commands.add_parser("around")
+    around.add_argument("directory")
+    around.add_argument("take_id")
+    around.add_argument("--sizes", default="0.003,0.01,0.03,0.1")
+    around.add_argument("--takes", type=int, default=100, help="takes per step size")
+    around.add_argument("--seed", type=int, default=1)
+    arguments = parser.parse_args()
+
+    with Pool(2) as pool:
+        if arguments.command == "lines":
+            first, last, step = (float(v) for v in arguments.lines.split(","))
+            xs = np.arange(first, last + 0.5 * step, step)
+            print(f"lines x = {first} .. {last} m by {step} m, left to right")
+            for sideways in (float(v) for v in arguments.sideways.split(",")):
+                marks = pool.map(_straight, [(float(x), sideways) for x in xs])
+                print(f"{sideways:+5.2f} m/s  " + "".join(_mark(*m) for m in marks), flush=True)
+            return 0
+        from impulse.takes import load
+
+        found = load(arguments.directory)
+        take = found[arguments.take_id]
+        rng = np.random.default_rng(arguments.seed)
+        print("| step size | takes | 7 and 10 standing | every goal met |")
+        print("|---|---|---|---|")
+        for size in (float(v) for v in arguments.sizes.split(",")):
+            thetas = take.theta + size * rng.standard_normal((arguments.takes, take.theta.size))
+            tasks = [
+                (found.base_scene, found.manifest["variation"], list(theta), take.scene_seed)
+                for theta in thetas
+            ]
+            marks = pool.map(_varied, tasks)
+            both = sum(seven and ten for seven, ten, _ in marks)
+            met = sum(m for _, _, m in marks)
+            print(f"| {size:g} | {arguments.takes} | {both} | {met} |", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
