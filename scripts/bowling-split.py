@@ -10,9 +10,12 @@ stays rare").
 2. ``around``: takes drawn around one take of a search directory at several step sizes
    (θ + size × N(0, I), the search's local steps; the take's scene seed kept): how many leave
    the 7 and the 10 standing, and how many meet every goal.
+3. ``reroll``: one take of a search directory with a ``roughness`` (degrees) on the pins'
+   material and scene seeds 1..N: the ball's line kept, the pins' contacts re-rolled.
 
     python3 scripts/bowling-split.py lines
     python3 scripts/bowling-split.py around takes/bowling-random TAKE_ID --sizes 0.003,0.03,0.1
+    python3 scripts/bowling-split.py reroll takes/bowling-random TAKE_ID --roughness 0.3,1
 
 Needs the impulse package; runs on 2 processes. The counts are deterministic (the engine is).
 """
@@ -82,6 +85,12 @@ def main() -> int:
     around.add_argument("--sizes", default="0.003,0.01,0.03,0.1")
     around.add_argument("--takes", type=int, default=100, help="takes per step size")
     around.add_argument("--seed", type=int, default=1)
+    reroll = commands.add_parser("reroll")
+    reroll.add_argument("directory")
+    reroll.add_argument("take_id")
+    reroll.add_argument("--roughness", default="0.3,1", help="degrees, on the pins' material")
+    reroll.add_argument("--material", default="maple")
+    reroll.add_argument("--takes", type=int, default=60, help="scene seeds 1..N")
     arguments = parser.parse_args()
 
     with Pool(2) as pool:
@@ -97,6 +106,21 @@ def main() -> int:
 
         found = load(arguments.directory)
         take = found[arguments.take_id]
+        if arguments.command == "reroll":
+            print("| roughness (degrees) | seeds | 7 and 10 standing | every goal met |")
+            print("|---|---|---|---|")
+            for roughness in (float(v) for v in arguments.roughness.split(",")):
+                base = json.loads(json.dumps(found.base_scene))
+                base["materials"][arguments.material]["roughness"] = roughness
+                tasks = [
+                    (base, found.manifest["variation"], list(take.theta), seed)
+                    for seed in range(1, arguments.takes + 1)
+                ]
+                marks = pool.map(_varied, tasks)
+                both = sum(seven and ten for seven, ten, _ in marks)
+                met = sum(m for _, _, m in marks)
+                print(f"| {roughness:g} | {arguments.takes} | {both} | {met} |", flush=True)
+            return 0
         rng = np.random.default_rng(arguments.seed)
         print("| step size | takes | 7 and 10 standing | every goal met |")
         print("|---|---|---|---|")
