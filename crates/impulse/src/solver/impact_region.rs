@@ -1,4 +1,4 @@
-//! The rows an impact's extra sweeps run on ([`IMPACT_SWEEPS`]): in a large island, the
+//! The rows an impact's extra sweeps run on (`IMPACT_SWEEPS` in [`super::substep`]): in a large island, the
 //! points around the impact rather than the whole island.
 //!
 //! An impact's sweeps make the rows of the bodies that hit converge; in a pile of thousands of
@@ -21,12 +21,10 @@
 use super::interface::SolvePass;
 use glam::Vec3;
 
-use super::interface::{EscalationLevel, SolveOutcome, SolveReport};
-use super::island_workspace::IslandWorkspace;
+use super::interface::SolveReport;
 use super::lanes::Bundles;
 use super::pgs::solve_pgs_rows;
 use super::rows::Velocities;
-use super::substep::IMPACT_SWEEPS;
 use crate::body::Bodies;
 use crate::contact::{ContactConstraint, row_closes_faster_than};
 use crate::joint::IslandJoints;
@@ -148,16 +146,23 @@ impl ImpactRegion {
         self.kind
     }
 
-    /// [`ImpactRegion::find`], and for an island in lanes (`wide`) the lane groups its sweeps
-    /// visit ([`Bundles::select_local`]; [`Self::size`] then counts their points).
+    /// [`ImpactRegion::find`] at the `bodies`' velocities, and for an island in lanes (`wide`)
+    /// the lane groups its sweeps visit ([`Bundles::select_local`]; [`Self::size`] then counts
+    /// their points). An island with `joints`, whose impacts no contact's closing speed tells,
+    /// sweeps whole.
     pub(crate) fn find_in(
         &mut self,
         constraints: &[ContactConstraint],
         bodies: &Bodies,
         speed: f32,
         moving: usize,
+        joints: bool,
         wide: Option<&mut Bundles>,
     ) -> RegionKind {
+        if joints {
+            self.kind = RegionKind::Whole;
+            return self.kind;
+        }
         let (linear, angular) = (&bodies.linear_velocity, &bodies.angular_velocity);
         let kind = self.find(constraints, linear, angular, speed, moving);
         if let (RegionKind::Local, Some(wide)) = (kind, wide) {
@@ -173,7 +178,7 @@ impl ImpactRegion {
     }
 
     /// PGS on the region's points of `constraints` alone (the scalar path), the others' impulses
-    /// held: at most [`IMPACT_SWEEPS`] sweeps, alternating from forward, until no row's velocity
+    /// held: at most `sweeps` sweeps, alternating from forward, until no row's velocity
     /// changes by more than `tolerance` (m/s); `friction` and `half_turn` as
     /// [`solve_pgs_rows`]. The rows are copied out in constraint order, swept on one thread
     /// and copied back.
@@ -181,6 +186,7 @@ impl ImpactRegion {
         &mut self,
         constraints: &mut [ContactConstraint],
         velocities: &mut Velocities<'_>,
+        sweeps: u32,
         tolerance: f32,
         friction: bool,
         half_turn: bool,
@@ -191,7 +197,7 @@ impl ImpactRegion {
         let report = solve_pgs_rows(
             &mut self.rows,
             Sweep::default(),
-            IMPACT_SWEEPS,
+            sweeps,
             tolerance,
             velocities,
             friction,
@@ -202,48 +208,6 @@ impl ImpactRegion {
             constraints[k as usize] = *row;
         }
         report
-    }
-}
-
-impl IslandWorkspace {
-    /// The impact sweeps on the region alone, after a solve of the substep with `(tolerance,
-    /// friction, half_turn)` (m/s, and as [`SolvePass`]), in lanes when `bundled`; counted in
-    /// the island's report.
-    pub(super) fn local_impact_sweeps(
-        &mut self,
-        constraints: &mut [ContactConstraint],
-        bundled: bool,
-        (tolerance, friction, half_turn): (f32, bool, bool),
-    ) -> SolveOutcome {
-        let mut velocities = Velocities {
-            linear: &mut self.linear,
-            angular: &mut self.angular,
-        };
-        let report = if bundled {
-            self.solvers.wide.solve_local(
-                &mut velocities,
-                IMPACT_SWEEPS,
-                tolerance,
-                friction,
-                half_turn,
-            )
-        } else {
-            self.impact_region.solve_scalar(
-                constraints,
-                &mut velocities,
-                tolerance,
-                friction,
-                half_turn,
-            )
-        };
-        self.count_impact_sweeps(report.iterations, self.impact_region.size);
-        SolveOutcome::of(EscalationLevel::Pgs, report)
-    }
-
-    /// Adds `sweeps` impact sweeps of `points` contact points each to the island's report.
-    pub(super) fn count_impact_sweeps(&mut self, sweeps: u32, points: usize) {
-        self.report.impact_sweeps += sweeps;
-        self.report.impact_points += u64::from(sweeps) * points as u64;
     }
 }
 

@@ -29,6 +29,7 @@ use crate::profile::SolvePhase;
 use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 
 mod forces;
+mod impacts;
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
 /// friction rows too, whatever [`crate::settings::SolveSettings::friction_in_main_solve`] says. Friction
@@ -47,7 +48,8 @@ pub(crate) const HEAVY_ON_LIGHT_MASS_RATIO: f32 = 200.0;
 /// the next substeps turn it into a rebound and a sideways drift (a cube dropped flat at
 /// restitution 0 left at 7 % of its impact speed, docs/method.md "Impacts"). Resting contacts,
 /// whose sweeps change velocities by about |g|·h, never take them. Only with soft or bias
-/// repair (the soft step's solves): split impulse's PGS keeps the sweeps it was given.
+/// repair (the soft step's solves): split impulse's PGS keeps the sweeps it was given. A large
+/// island sweeps the points around the impact alone ([`super::impact_region`]).
 pub(crate) const IMPACT_SWEEPS: u32 = 32;
 
 /// Which of a substep's solves [`IslandWorkspace::targets_and_solve`] runs.
@@ -159,16 +161,11 @@ impl IslandWorkspace {
             self.impact_met
         };
         if self.impact_met && self.impact_region.kind == RegionKind::Unknown {
-            let moving = self.report.bodies as usize;
             let wide = bundled.then_some(&mut self.solvers.wide);
-            self.impact_region.kind = if self.joints.is_empty() {
-                let speed = self.impact_speed;
-                self.impact_region
-                    .find_in(constraints, bodies, speed, moving, wide)
-            } else {
-                // An island with joints, whose impacts no contact's closing speed tells.
-                RegionKind::Whole
-            };
+            let (speed, moving) = (self.impact_speed, self.report.bodies as usize);
+            let joints = !self.joints.is_empty();
+            self.impact_region
+                .find_in(constraints, bodies, speed, moving, joints, wide);
         }
         let local = self.impact_region.kind == RegionKind::Local;
         let more = if self.impact_met && local {
