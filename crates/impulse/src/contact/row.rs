@@ -319,17 +319,29 @@ pub(crate) fn closes_faster_than_from_bodies(
     angular: &[Vec3],
     speed: f32,
 ) -> bool {
-    constraints.iter().any(|c| {
-        let (a, b) = (c.body_a as usize, c.body_b as usize);
-        let d = Vec3A::from(c.normal.direction);
-        let row = JacobianRow {
-            direction: c.normal.direction,
-            angular_a: Vec3A::from(c.lever_a).cross(d).into(),
-            angular_b: Vec3A::from(c.lever_b).cross(d).into(),
-            ..JacobianRow::default()
-        };
-        row.velocity(linear[a], angular[a], linear[b], angular[b]) < -speed
-    })
+    constraints
+        .iter()
+        .any(|c| row_closes_faster_than(c, linear, angular, speed))
+}
+
+/// Whether the one row `c` closed faster than `speed` (m/s) as the step started, as
+/// [`closes_faster_than_from_bodies`] tests each row.
+#[inline]
+pub(crate) fn row_closes_faster_than(
+    c: &ContactConstraint,
+    linear: &[Vec3],
+    angular: &[Vec3],
+    speed: f32,
+) -> bool {
+    let (a, b) = (c.body_a as usize, c.body_b as usize);
+    let d = Vec3A::from(c.normal.direction);
+    let row = JacobianRow {
+        direction: c.normal.direction,
+        angular_a: Vec3A::from(c.lever_a).cross(d).into(),
+        angular_b: Vec3A::from(c.lever_b).cross(d).into(),
+        ..JacobianRow::default()
+    };
+    row.velocity(linear[a], angular[a], linear[b], angular[b]) < -speed
 }
 
 /// Projects a friction impulse onto Coulomb's disc of radius `limit` (N·s).

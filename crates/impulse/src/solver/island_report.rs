@@ -33,6 +33,15 @@ pub struct IslandReport {
     /// Largest row velocity change of the last iteration of the last main solve (m/s): how far
     /// from converged the island's final solve stopped.
     pub last_change: f32,
+    /// Sweeps the step's impacts took beyond the solves' budgets (docs/method.md, "Impacts"),
+    /// over the whole island or over the points around the impact; part of `iterations`.
+    #[serde(default)]
+    pub impact_sweeps: u32,
+    /// Contact points those impact sweeps updated, summed over the sweeps: `impact_sweeps` ×
+    /// `contacts` when they swept the whole island, fewer when they swept the points around
+    /// the impact alone (in SIMD lanes: the points of the lane groups they visited).
+    #[serde(default)]
+    pub impact_points: u64,
     /// Whether the substeps' solves ran in SIMD lanes.
     pub simd: bool,
     /// Natural-map residual of the island's rows at the end of the step (see

@@ -7,6 +7,7 @@ use glam::{Mat3, Quat, Vec3};
 use super::apgd::Apgd;
 use super::bounce_energy::BounceEnergy;
 use super::impact::ImpactWorkspace;
+use super::impact_region::ImpactRegion;
 use super::interface::{ContactSolver, RowsReport};
 use super::island_report::IslandReport;
 use super::lanes::{Bundles, SolvedPoint};
@@ -99,6 +100,8 @@ pub(crate) struct IslandWorkspace {
     /// faster than `impact_speed` as the step started. `None` until a main solve's last sweep
     /// asks ([`crate::contact::closes_faster_than`], a pass over the rows).
     pub(super) closing: Option<bool>,
+    /// Where the step's impact sweeps go: the whole island or the points around the impact.
+    pub(super) impact_region: ImpactRegion,
     /// The rows of the island's joints, written by the assembly stage.
     pub(crate) joints: IslandJoints,
     /// Whether the island's step left its rows' impulses, J·v* and targets in its SIMD lanes

@@ -22,6 +22,7 @@
 //! - [`island_workspace`]: an island's local state and solvers during a step;
 //! - [`island_report`]: what the solver did on an island ([`IslandReport`]);
 //! - [`impact`]: `impact: propagation`, simultaneous impacts by generalized reflections;
+//! - [`impact_region`]: the points an impact's extra sweeps go on in a large island;
 //! - [`substep`]: one island's step (substeps, warm start, solves, relax, restitution), which
 //!   picks the method and calls it through the interface.
 
@@ -37,6 +38,7 @@ pub(crate) mod exact_rows;
 pub(crate) mod exact_workspace;
 pub(crate) mod heavy_on_light;
 pub(crate) mod impact;
+pub(crate) mod impact_region;
 pub(crate) mod interface;
 pub(crate) mod island_report;
 pub(crate) mod island_workspace;

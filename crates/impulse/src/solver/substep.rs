@@ -12,6 +12,7 @@ use glam::{Mat3, Vec3};
 use super::heavy_on_light::{
     HeavyOnLight, heavy_on_light, heavy_on_light_max_contacts, heavy_on_light_settings, mass_ratio,
 };
+use super::impact_region::RegionKind;
 use super::interface::Sweep;
 use super::interface::{ContactSolver, SolveOutcome, SolvePass, TargetInputs};
 use super::island_report::IslandReport;
@@ -28,6 +29,7 @@ use crate::profile::SolvePhase;
 use crate::settings::{ContactRepair, SolverMethod, SolverSettings};
 
 mod forces;
+mod impacts;
 
 /// Mass ratio (heaviest over lightest body) from which an island's main solve sweeps the
 /// friction rows too, whatever [`crate::settings::SolveSettings::friction_in_main_solve`] says. Friction
@@ -46,7 +48,8 @@ pub(crate) const HEAVY_ON_LIGHT_MASS_RATIO: f32 = 200.0;
 /// the next substeps turn it into a rebound and a sideways drift (a cube dropped flat at
 /// restitution 0 left at 7 % of its impact speed, docs/method.md "Impacts"). Resting contacts,
 /// whose sweeps change velocities by about |g|·h, never take them. Only with soft or bias
-/// repair (the soft step's solves): split impulse's PGS keeps the sweeps it was given.
+/// repair (the soft step's solves): split impulse's PGS keeps the sweeps it was given. A large
+/// island sweeps the points around the impact alone ([`super::impact_region`]).
 pub(crate) const IMPACT_SWEEPS: u32 = 32;
 
 /// Which of a substep's solves [`IslandWorkspace::targets_and_solve`] runs.
@@ -109,14 +112,19 @@ impl IslandWorkspace {
             },
         };
         // A substep whose main solve found an impact sweeps its relax solve to convergence too
-        // (more than one sweep, so the lanes do not carry the warm start; see `IMPACT_SWEEPS`).
-        let pass = if !with_repair && self.impact_met {
-            SolvePass {
+        // (more than one sweep, so the lanes do not carry the warm start; see `IMPACT_SWEEPS`):
+        // the whole island, or its budget and then the points around the impact.
+        let local = self.impact_region.kind == RegionKind::Local;
+        let pass = match (!with_repair && self.impact_met, local) {
+            (true, false) => SolvePass {
                 iterations: pass.iterations.max(IMPACT_SWEEPS),
                 ..pass
-            }
-        } else {
-            pass
+            },
+            (true, true) => SolvePass {
+                warm_start_follows: false,
+                ..pass
+            },
+            (false, _) => pass,
         };
         if !self.joints.is_empty() && pass.targets.is_some() {
             self.joints
@@ -152,7 +160,21 @@ impl IslandWorkspace {
         } else {
             self.impact_met
         };
-        let more = (with_repair && self.impact_met).then(|| {
+        if self.impact_met && self.impact_region.kind == RegionKind::Unknown {
+            let wide = bundled.then_some(&mut self.solvers.wide);
+            let (speed, moving) = (self.impact_speed, self.report.bodies as usize);
+            let joints = !self.joints.is_empty();
+            self.impact_region
+                .find_in(constraints, bodies, speed, moving, joints, wide);
+        }
+        let local = self.impact_region.kind == RegionKind::Local;
+        let more = if self.impact_met && local {
+            // The targets are set; the region's sweeps go on from where the budget ended.
+            let sweep = (pass.tolerance, pass.friction, pass.half_turn);
+            let more = self.local_impact_sweeps(constraints, bundled, sweep);
+            self.phases.end(SolvePhase::Impacts);
+            Some(more)
+        } else if with_repair && self.impact_met {
             // The targets are set; the sweeps go on from where the budget ended.
             let more = SolvePass {
                 iterations: IMPACT_SWEEPS,
@@ -160,14 +182,28 @@ impl IslandWorkspace {
                 targets: None,
                 ..pass
             };
-            let outcome = solver.solve(constraints, &mut velocities, joints, &more);
+            let mut velocities = Velocities {
+                linear: &mut self.linear,
+                angular: &mut self.angular,
+            };
+            let solver = self.solvers.substeps(settings.solve.method, bundled);
+            let outcome = solver.solve(constraints, &mut velocities, &mut self.joints, &more);
             self.phases.end(SolvePhase::Impacts);
-            outcome
-        });
+            self.count_impact_sweeps(outcome.report.iterations, constraints.len());
+            Some(outcome)
+        } else {
+            if self.impact_met {
+                // The relax solve swept the whole island to convergence.
+                let sweeps = outcome.report.iterations;
+                let beyond = sweeps.saturating_sub(settings.solve.relax_iterations);
+                self.count_impact_sweeps(beyond, constraints.len());
+            }
+            None
+        };
         self.position_repair = outcome.position_repair;
         self.record(&outcome, with_repair);
         if let Some(more) = more {
-            self.record(&more, true);
+            self.record(&more, with_repair);
         }
     }
 
@@ -481,6 +517,7 @@ impl IslandWorkspace {
             self.impact_speed
         };
         self.impact_met = false;
+        self.impact_region.reset();
     }
 
     /// Picks how the island is solved (SIMD lanes, coloured rows on several threads, or one

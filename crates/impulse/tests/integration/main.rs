@@ -27,6 +27,7 @@ mod impacts;
 mod islands;
 mod joints;
 mod kinematic;
+mod local_impacts;
 mod locked_axes;
 mod malformed_meshes;
 mod malformed_scenes;

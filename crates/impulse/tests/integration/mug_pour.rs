@@ -142,6 +142,16 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
                 overlap * 1e3,
                 diagnostics.kinetic_energy,
             );
+            // The impact sweeps of the step (docs/method.md, "Impacts"): how many, and the
+            // points a sweep updated on average against the island's points.
+            for island in diagnostics.islands.iter().filter(|i| i.impact_sweeps > 0) {
+                println!(
+                    "   impact sweeps {} of {:.0} points on average, island of {} points",
+                    island.impact_sweeps,
+                    island.impact_points as f64 / f64::from(island.impact_sweeps),
+                    island.contacts,
+                );
+            }
         }
     }
     println!(

@@ -21,6 +21,9 @@ pub(crate) struct Bundles {
     /// groups the colouring could not place, one per lane group, and always runs on one thread.
     pub(super) groups: Vec<Group>,
     pub(super) group_colour_starts: Vec<usize>,
+    /// The lane groups an impact's local sweeps visit ([`Bundles::select_local`]), in bundle
+    /// order.
+    pub(super) local_groups: Vec<Group>,
     /// Packing scratch: per manifold group (a run of at most [`GROUP_POINTS`] consecutive
     /// points between the same two bodies), its first point, and its lane group and lane.
     pub(super) runs: Vec<u32>,

@@ -40,11 +40,13 @@
 //! - [`sweep`]: one bundle's update (the Gauss-Seidel step, the warm start, the relax carry);
 //! - [`schedule`]: the order and the threads of a sweep (colour by colour);
 //! - [`record`]: the v* record and natural map at the step's end;
-//! - [`solve`]: the solve and the [`ContactSolver`](crate::solver::ContactSolver) interface.
+//! - [`solve`]: the solve and the [`ContactSolver`](crate::solver::ContactSolver) interface;
+//! - [`local`]: an impact's sweeps on the lane groups around it alone.
 
 mod bundles;
 mod lane;
 mod layout;
+mod local;
 mod pack;
 mod products;
 mod record;

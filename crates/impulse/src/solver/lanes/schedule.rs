@@ -167,7 +167,7 @@ pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets, R: Rounding>(
 /// As [`sweep_groups`], and `set` runs on this CPU.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-unsafe fn sweep_groups_on<F: BundleUpdate, T: SetTargets>(
+pub(super) unsafe fn sweep_groups_on<F: BundleUpdate, T: SetTargets>(
     set: InstructionSet,
     fused: bool,
     groups: &[Group],

@@ -1,0 +1,89 @@
+use glam::Vec3;
+
+use super::*;
+use crate::contact::ContactConstraint;
+
+/// A chain of `n` bodies (slots 0..n, body index = slot), each on the ground (the immovable
+/// slot n; normal +y) and touching the next (normal +x): body k's point on the ground and, for
+/// k > 0, one between k and k − 1.
+fn chain(n: u32) -> Vec<ContactConstraint> {
+    let mut rows = Vec::new();
+    for k in 0..n {
+        let mut ground = ContactConstraint::default();
+        (ground.body_a, ground.body_b, ground.local_a, ground.local_b) = (k, n, k, n);
+        ground.normal.direction = Vec3::Y;
+        rows.push(ground);
+        if k > 0 {
+            let mut side = ContactConstraint::default();
+            (side.body_a, side.body_b, side.local_a, side.local_b) = (k, k - 1, k, k - 1);
+            side.normal.direction = Vec3::X;
+            rows.push(side);
+        }
+    }
+    rows
+}
+
+/// Body 500 of a 1,000-body chain (1,999 points) falls at 3 m/s onto the ground (its ground
+/// point closes at 3 m/s, faster than the 1 m/s impact speed; every other body rests): the
+/// region is body 500 and its neighbours 499 and 501 (one ring), and its points are every
+/// point touching those three: three ground points and the four chain points from 498–499 to
+/// 501–502. The ground, which touches every body, does not carry the region on.
+#[test]
+fn the_region_is_the_impacts_bodies_and_one_ring_and_stops_at_the_ground() {
+    let n = 1000;
+    let rows = chain(n);
+    let mut linear = vec![Vec3::ZERO; n as usize + 1];
+    linear[500] = Vec3::new(0.0, -3.0, 0.0);
+    let angular = vec![Vec3::ZERO; n as usize + 1];
+    let mut region = ImpactRegion::default();
+    let kind = region.find(&rows, &linear, &angular, 1.0, n as usize);
+    assert_eq!(kind, RegionKind::Local);
+    let inside: Vec<u32> = (0..=n).filter(|&s| region.contains(s)).collect();
+    assert_eq!(inside, vec![499, 500, 501]);
+    let mut pairs: Vec<(u32, u32)> = region
+        .points
+        .iter()
+        .map(|&k| (rows[k as usize].local_a, rows[k as usize].local_b))
+        .collect();
+    pairs.sort_unstable();
+    let expected = vec![
+        (499, 498),
+        (499, n),
+        (500, 499),
+        (500, n),
+        (501, 500),
+        (501, n),
+        (502, 501),
+    ];
+    assert_eq!(pairs, expected);
+    assert_eq!(region.size, 7);
+}
+
+/// An island below the size for local sweeps, or one whose region is more than half of it,
+/// sweeps whole: the 300-body chain (599 points) whatever its impact, and the 1,000-body
+/// chain with every body falling.
+#[test]
+fn a_small_island_or_a_region_of_most_of_it_sweeps_whole() {
+    let mut region = ImpactRegion::default();
+    let small = chain(300);
+    let mut linear = vec![Vec3::new(0.0, -3.0, 0.0); 1001];
+    linear[1000] = Vec3::ZERO;
+    let angular = vec![Vec3::ZERO; 1001];
+    assert!(small.len() < LOCAL_IMPACT_MIN_POINTS);
+    assert_eq!(
+        region.find(&small, &linear, &angular, 1.0, 300),
+        RegionKind::Whole
+    );
+    let large = chain(1000);
+    assert_eq!(
+        region.find(&large, &linear, &angular, 1.0, 1000),
+        RegionKind::Whole
+    );
+    // At rest, no seed: an empty region (the impact test would not have asked).
+    let rest = vec![Vec3::ZERO; 1001];
+    assert_eq!(
+        region.find(&large, &rest, &angular, 1.0, 1000),
+        RegionKind::Local
+    );
+    assert_eq!(region.size, 0);
+}
