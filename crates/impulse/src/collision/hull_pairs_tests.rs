@@ -423,3 +423,50 @@ fn the_long_sweep_of_the_mugs_parts() {
     let (counts, worst) = sweep(2, 5000);
     check(counts, worst, 5000, 5e-3);
 }
+
+/// Two of the mug's part 8 as bodies 49 and 98 of the 98-mug pour held them at the start of
+/// step 30 (at 1/240 s): 0.90 mm apart along a face normal, where Parry's `query::contact`
+/// (EPA) reads them 26 mm deep along another axis and its manifold has points that deep,
+/// which threw the two mugs apart. The engine's manifold has speculative points at the
+/// separation along the face normal instead, none overlapping.
+#[test]
+fn thin_parts_apart_get_no_deep_points() {
+    let parts = mug_parts();
+    let g = part_shape(&parts[8]);
+    let pos12 = Pose::from_parts(
+        Vec3::new(-0.09006938, 0.105422206, -0.017122347),
+        glam::Quat::from_array([-0.11325252, -0.36620712, -0.9226059, -0.04318267]),
+    );
+    let q = separating_axes::Polytope::of(g.as_ref()).unwrap();
+    let exact = separating_axes::depth_beyond(&q, &q, &pos12, f32::NEG_INFINITY).unwrap();
+    assert!(
+        (exact + 0.9e-3).abs() < 1e-5,
+        "apart by {} mm",
+        -exact * 1e3
+    );
+    let parry = query::contact(&Pose::IDENTITY, g.as_ref(), &pos12, g.as_ref(), 0.0)
+        .unwrap()
+        .unwrap();
+    assert!(
+        parry.dist < -0.02,
+        "Parry's contact reads {} mm",
+        parry.dist * 1e3
+    );
+    for prediction in [0.0, 0.005, 0.05] {
+        let manifold = crate::collision::dispatch::tests::manifold_within(
+            &Pose::IDENTITY,
+            g.as_ref(),
+            &pos12,
+            g.as_ref(),
+            prediction,
+        );
+        for point in &manifold.points {
+            assert!(
+                point.dist >= -exact - 1e-5,
+                "prediction {prediction}: a point {} mm apart",
+                point.dist * 1e3
+            );
+        }
+        assert_eq!(manifold.points.is_empty(), prediction < -exact);
+    }
+}
