@@ -130,7 +130,7 @@ impl Polytope {
 /// (negated) face normals are `c`, `d` cross: then the two edges' cross product is a face
 /// normal of the Minkowski difference. The arcs cross when each arc's endpoints lie on
 /// opposite sides of the other's great circle, and on the same hemisphere.
-fn arcs_cross(a: Vector, b: Vector, c: Vector, d: Vector) -> bool {
+pub(crate) fn arcs_cross(a: Vector, b: Vector, c: Vector, d: Vector) -> bool {
     let bxa = b.cross(a);
     let dxc = d.cross(c);
     let cba = c.dot(bxa);
