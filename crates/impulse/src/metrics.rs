@@ -1,7 +1,10 @@
 //! Quality metrics (docs/benchmarks.md) measured from poses alone, never from the engine's own contact
 //! report, so the same functions can measure any engine's output.
 
+use std::collections::HashMap;
+
 use glam::Vec3;
+use parry3d::bounding_volume::BoundingVolume;
 use parry3d::math::Pose;
 use parry3d::query::{self, ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d::shape::{Shape, SharedShape};
@@ -9,6 +12,7 @@ use parry3d::shape::{Shape, SharedShape};
 use crate::World;
 use crate::body::Bodies;
 use crate::collision::broad_phase::BroadPhase;
+use crate::collision::separating_axes::{self, Polytope};
 
 /// Largest penetration depth (m) between any two bodies of `world` at `poses` (one per body, in
 /// the order of [`World::poses`]; pass `world.poses()` for the world's own state, or another
@@ -45,24 +49,40 @@ pub fn max_overlap(world: &World, poses: &[Pose]) -> f32 {
 
 /// Largest penetration depth (m) among `pairs` of shapes at `poses`.
 ///
-/// Each pair's depth is the smaller of two Parry estimates: the single-point `query::contact`
-/// and a fresh contact manifold (no history, no prediction). Each is a depth along some
-/// direction, so each is an upper bound of the true penetration depth, and each is sometimes
-/// far off: `query::contact` can pick an axis from nearly parallel edges of two aligned boxes
-/// (seen: 2.0 m for a cube resting on the ground) and the manifold of two convex hulls that
-/// share a face can report a full-size depth (seen: 1 m for touching arch blocks). Either one
-/// finding the shapes apart counts as no overlap.
+/// Two convex polyhedra or boxes, or compounds of them (a decomposed mesh), get the exact depth
+/// of the separating axis theorem (`collision::separating_axes`), the deepest of their part
+/// pairs whose bounding boxes overlap. Parry's queries can read such shapes apart while they
+/// overlap by millimetres (thin hulls: the mug's V-HACD parts), so they are not used there.
+///
+/// Any other pair's depth is the smaller of two Parry estimates: the single-point
+/// `query::contact` and a fresh contact manifold (no history, no prediction). Each is a depth
+/// along some direction, so each is an upper bound of the true penetration depth, and each is
+/// sometimes far off: `query::contact` can pick an axis from nearly parallel edges of two
+/// aligned boxes (seen: 2.0 m for a cube resting on the ground) and the manifold of two
+/// convex shapes that share a face can report a full-size depth. Either one finding the
+/// shapes apart counts as no overlap.
 ///
 /// The manifold comes first: a pair whose manifold is no deeper than the deepest pair so far
 /// cannot change the result (its depth is the smaller of the two), so its `query::contact`
-/// (GJK and EPA, most of the cost for overlapping shapes) is skipped. The result is the same
-/// as taking both estimates of every pair.
+/// (GJK and EPA, most of the cost for overlapping shapes) is skipped; likewise the separating
+/// axes of a polyhedral pair stop at the first axis that shows it no deeper. The result is the
+/// same as measuring every pair in full.
 pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u32, u32)]) -> f32 {
     let mut deepest = 0.0f32;
     let mut manifolds: Vec<ContactManifold<(), ()>> = Vec::new();
+    let mut polytopes = PolytopeCache::default();
     for &(i, j) in pairs {
         let (i, j) = (i as usize, j as usize);
         let (g1, g2) = (shapes[i].as_ref(), shapes[j].as_ref());
+        if let Some(depth) = polyhedral_depth(
+            &mut polytopes,
+            (&poses[i], &shapes[i]),
+            (&poses[j], &shapes[j]),
+            deepest,
+        ) {
+            deepest = deepest.max(depth.unwrap_or(0.0));
+            continue;
+        }
         let manifold = manifold_depth(&poses[i], g1, &poses[j], g2, &mut manifolds);
         // `deepest` is never negative, and no depth at or below it can raise it (neither is
         // ever NaN: `f32::max` drops NaN).
@@ -79,6 +99,76 @@ pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u3
         }
     }
     deepest
+}
+
+/// The polytopes of the convex parts met so far, by the address of their shape (the parts of
+/// one mesh's compound are shared by every body of that mesh); `None` for a part that is no
+/// polyhedron.
+#[derive(Default)]
+struct PolytopeCache(HashMap<usize, Option<Polytope>>);
+
+impl PolytopeCache {
+    fn key(shape: &SharedShape) -> usize {
+        std::sync::Arc::as_ptr(&shape.0) as *const () as usize
+    }
+
+    /// Makes `shape`'s polytope; whether it has one.
+    fn insert(&mut self, shape: &SharedShape) -> bool {
+        self.0
+            .entry(Self::key(shape))
+            .or_insert_with(|| Polytope::of(shape.as_ref()))
+            .is_some()
+    }
+
+    /// The polytope made for `shape` by [`Self::insert`].
+    fn get(&self, shape: &SharedShape) -> Option<&Polytope> {
+        self.0.get(&Self::key(shape))?.as_ref()
+    }
+}
+
+/// The convex parts of `shape` with their poses in its frame: a compound's parts, or the shape
+/// itself.
+fn convex_parts(shape: &SharedShape) -> Vec<(Pose, SharedShape)> {
+    match shape.as_compound() {
+        Some(compound) => compound.shapes().to_vec(),
+        None => vec![(Pose::IDENTITY, shape.clone())],
+    }
+}
+
+/// The exact penetration depth (m) of two shapes each a convex polyhedron, a box or a compound
+/// of those, given at `(pose, shape)`: `Some(Some(depth))` when it is more than `floor` (m),
+/// `Some(None)` when it is not; `None` when either shape has another part (Parry's estimates
+/// then measure the pair).
+fn polyhedral_depth(
+    polytopes: &mut PolytopeCache,
+    (pose1, shape1): (&Pose, &SharedShape),
+    (pose2, shape2): (&Pose, &SharedShape),
+    floor: f32,
+) -> Option<Option<f32>> {
+    let (parts1, parts2) = (convex_parts(shape1), convex_parts(shape2));
+    for (_, part) in parts1.iter().chain(&parts2) {
+        if !polytopes.insert(part) {
+            return None;
+        }
+    }
+    let mut deepest = None;
+    let mut floor = floor;
+    for (part_pose1, part1) in &parts1 {
+        let at1 = pose1 * part_pose1;
+        let aabb1 = part1.compute_aabb(&at1);
+        for (part_pose2, part2) in &parts2 {
+            let at2 = pose2 * part_pose2;
+            if !aabb1.intersects(&part2.compute_aabb(&at2)) {
+                continue;
+            }
+            let (p1, p2) = (polytopes.get(part1)?, polytopes.get(part2)?);
+            if let Some(depth) = separating_axes::depth_beyond(p1, p2, &at1.inv_mul(&at2), floor) {
+                deepest = Some(depth);
+                floor = depth;
+            }
+        }
+    }
+    Some(deepest)
 }
 
 /// The deepest point (m, positive when overlapping) of a fresh contact manifold of `g1` at

@@ -5,8 +5,9 @@ use parry3d::shape::SharedShape;
 
 use super::*;
 
-/// The definition of [`max_overlap_of_pairs`] with both of Parry's estimates taken for every
-/// pair: its early skip must not change the result.
+/// The definition of [`max_overlap_of_pairs`] with every pair measured in full (the
+/// separating-axis depth of two polyhedra, both of Parry's estimates of any other pair): its
+/// early skips must not change the result.
 fn max_overlap_taking_every_estimate(
     shapes: &[SharedShape],
     poses: &[Pose],
@@ -17,6 +18,12 @@ fn max_overlap_taking_every_estimate(
     for &(i, j) in pairs {
         let (i, j) = (i as usize, j as usize);
         let (g1, g2) = (shapes[i].as_ref(), shapes[j].as_ref());
+        if let (Some(p1), Some(p2)) = (Polytope::of(g1), Polytope::of(g2)) {
+            let pos12 = poses[i].inv_mul(&poses[j]);
+            let depth = separating_axes::depth_beyond(&p1, &p2, &pos12, f32::NEG_INFINITY);
+            deepest = deepest.max(depth.unwrap());
+            continue;
+        }
         let single = match query::contact(&poses[i], g1, &poses[j], g2, 0.0) {
             Ok(Some(contact)) => -contact.dist,
             Ok(None) => continue,

@@ -324,10 +324,15 @@ where
         )?;
         let refined =
             cap_pair && caps::refine_cap_contact(pos12, g1, g2, prediction, manifold, &old);
-        if hull_pair && !refined {
-            faces::refine_face_contact(pos12, g1, g2, prediction, constraints, manifold, &old);
+        let faces_refined = hull_pair
+            && !refined
+            && faces::refine_face_contact(pos12, g1, g2, prediction, constraints, manifold, &old);
+        // A manifold the faces' refinement emptied is of shapes apart beyond the prediction,
+        // where the fallback's contact query may read them deep in (see
+        // `faces::better_face_axis`).
+        if !(faces_refined && manifold.points.is_empty()) {
+            fallback.after(pos12, g1, g2, constraints, prediction, manifold);
         }
-        fallback.after(pos12, g1, g2, constraints, prediction, manifold);
         Ok(())
     }
 }

@@ -14,3 +14,8 @@ pub(crate) mod manifold;
 pub(crate) mod margins;
 pub(crate) mod narrow_phase;
 pub(crate) mod part_pairs;
+pub(crate) mod separating_axes;
+
+#[cfg(test)]
+#[path = "hull_pairs_tests.rs"]
+mod hull_pairs_tests;

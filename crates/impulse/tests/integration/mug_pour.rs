@@ -52,6 +52,9 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
         let seconds = start.elapsed().as_secs_f64();
         total_s += seconds;
         let overlap = metrics::max_overlap(&world, world.poses());
+        if std::env::var("IMPULSE_MUG_PHANTOM").is_ok() {
+            print_phantom_points(&world, &start_poses, step);
+        }
         if overlap > largest {
             (largest, largest_step) = (overlap, step);
         }
@@ -170,7 +173,7 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
 }
 
 /// With `IMPULSE_MUG_PARTS` set: the part pairs of bodies `a` and `b` overlapping by more than
-/// 2 mm at the step's end (Parry's `query::contact` per pair of parts, the four deepest), each
+/// 2 mm at the step's end (the overlap metric per pair of parts, the four deepest), each
 /// with its depth and normal at the step's `start` poses and the pair's contact points on those
 /// parts, then the pair's 30 deepest points (parts, separation in mm).
 fn explain_parts(world: &World, start: &[impulse::parry3d::math::Pose], a: u32, b: u32) {
@@ -185,10 +188,14 @@ fn explain_parts(world: &World, start: &[impulse::parry3d::math::Pose], a: u32, 
         let (pj, sj) = &cb.shapes()[j];
         let p1 = poses[a as usize] * *pi;
         let p2 = poses[b as usize] * *pj;
-        query::contact(&p1, si.as_ref(), &p2, sj.as_ref(), 0.05)
+        // The exact depth (the metric's separating axes); the normal is Parry's, which can
+        // be off between thin parts.
+        let exact = metrics::max_overlap_of_pairs(&[si.clone(), sj.clone()], &[p1, p2], &[(0, 1)]);
+        let normal = query::contact(&p1, si.as_ref(), &p2, sj.as_ref(), 0.05)
             .ok()
             .flatten()
-            .map(|c| (-c.dist, p1.rotation * c.normal1))
+            .map_or(impulse::glam::Vec3::NAN, |c| p1.rotation * c.normal1);
+        (exact > 0.0).then_some((exact, normal))
     };
     let mut list = Vec::new();
     for i in 0..ca.shapes().len() {
@@ -240,5 +247,43 @@ fn explain_parts(world: &World, start: &[impulse::parry3d::math::Pose], a: u32, 
             "   held points (parts, sep mm): {:?}",
             &parts[..parts.len().min(30)]
         );
+    }
+}
+
+/// With `IMPULSE_MUG_PHANTOM` set: every contact point of the step deeper by more than 1 mm than
+/// the exact overlap (the metric's) of the two parts it is on at the step's `start` poses, where
+/// the narrow phase made it.
+fn print_phantom_points(world: &World, start: &[impulse::parry3d::math::Pose], step: usize) {
+    let shapes = world.shapes();
+    let part = |body: usize, index: Option<u32>| match (shapes[body].as_compound(), index) {
+        (Some(compound), Some(k)) => {
+            let (pose, shape) = &compound.shapes()[k as usize];
+            (start[body] * *pose, shape.clone())
+        }
+        _ => (start[body], shapes[body].clone()),
+    };
+    for pair in world.contact_pairs() {
+        let (a, b) = (pair.body1().index() as usize, pair.body2().index() as usize);
+        for point in pair.points() {
+            let (p1, s1) = part(a, point.part1);
+            let (p2, s2) = part(b, point.part2);
+            let exact = metrics::max_overlap_of_pairs(&[s1, s2], &[p1, p2], &[(0, 1)]);
+            if -point.separation > exact + 1e-3 {
+                println!(
+                    "   step {step}: bodies {a} {b} parts {:?} {:?}: point {:.2} mm deep, exact {:.2} mm, normal {:.3}",
+                    point.part1,
+                    point.part2,
+                    -point.separation * 1e3,
+                    exact * 1e3,
+                    point.normal
+                );
+                let pos12 = p1.inv_mul(&p2);
+                println!(
+                    "      pos12 rotation {:?} translation {:?}",
+                    pos12.rotation.to_array(),
+                    pos12.translation.to_array()
+                );
+            }
+        }
     }
 }

@@ -1,0 +1,76 @@
+//! The separating-axis depth on closed forms: boxes face to face, and two boxes edge to edge,
+//! whose depth lies along the cross product of their edges and along no face normal.
+
+use glam::{Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::shape::SharedShape;
+
+use super::{Polytope, depth_beyond};
+
+/// The depth of `shape2` at `pose2` into `shape1` at `pose1`, or `None` if not above zero.
+fn depth(shape1: &SharedShape, pose1: Pose, shape2: &SharedShape, pose2: Pose) -> Option<f32> {
+    let p1 = Polytope::of(shape1.as_ref()).unwrap();
+    let p2 = Polytope::of(shape2.as_ref()).unwrap();
+    depth_beyond(&p1, &p2, &pose1.inv_mul(&pose2), 0.0)
+}
+
+/// A cube as a convex polyhedron (half-extent 1 m).
+fn hull_cube() -> SharedShape {
+    let points: Vec<Vec3> = (0..8)
+        .map(|k| {
+            Vec3::new(
+                if k & 1 == 0 { -1.0 } else { 1.0 },
+                if k & 2 == 0 { -1.0 } else { 1.0 },
+                if k & 4 == 0 { -1.0 } else { 1.0 },
+            )
+        })
+        .collect();
+    SharedShape::convex_hull(&points).unwrap()
+}
+
+#[test]
+fn boxes_face_to_face_overlap_by_their_offset() {
+    for shape in [SharedShape::cuboid(1.0, 1.0, 1.0), hull_cube()] {
+        for overlap in [0.001f32, 0.02, 0.3] {
+            let pose2 = Pose::from_translation(Vec3::new(0.1, 2.0 - overlap, -0.2));
+            let found = depth(&shape, Pose::IDENTITY, &shape, pose2).unwrap();
+            assert!((found - overlap).abs() < 1e-5, "{found} for {overlap}");
+        }
+        let apart = Pose::from_translation(Vec3::new(0.0, 2.01, 0.0));
+        assert_eq!(depth(&shape, Pose::IDENTITY, &shape, apart), None);
+    }
+}
+
+/// Cube 1 turned 45° about x (a top edge along x at y = √2), cube 2 turned 45° about z (a
+/// bottom edge along z) and set on it `overlap` deep: the depth is the overlap, along y = x × z,
+/// though along every face normal the overlap is larger (0.71 m and more).
+#[test]
+fn crossed_edges_overlap_along_their_cross_product() {
+    let cube = hull_cube();
+    let turn1 = Quat::from_rotation_x(std::f32::consts::FRAC_PI_4);
+    let turn2 = Quat::from_rotation_z(std::f32::consts::FRAC_PI_4);
+    for overlap in [0.002f32, 0.01, 0.05] {
+        let height = 2.0 * std::f32::consts::SQRT_2 - overlap;
+        let pose1 = Pose::from_parts(Vec3::ZERO, turn1);
+        let pose2 = Pose::from_parts(Vec3::new(0.0, height, 0.0), turn2);
+        let found = depth(&cube, pose1, &cube, pose2).unwrap();
+        assert!((found - overlap).abs() < 1e-5, "{found} for {overlap}");
+        // A floor above the depth stops the search.
+        assert_eq!(
+            depth_beyond(
+                &Polytope::of(cube.as_ref()).unwrap(),
+                &Polytope::of(cube.as_ref()).unwrap(),
+                &pose1.inv_mul(&pose2),
+                overlap + 1e-3,
+            ),
+            None
+        );
+    }
+}
+
+#[test]
+fn only_polyhedra_and_boxes_have_polytopes() {
+    assert!(Polytope::of(SharedShape::ball(1.0).as_ref()).is_none());
+    assert!(Polytope::of(SharedShape::cylinder(1.0, 0.5).as_ref()).is_none());
+    assert!(Polytope::of(SharedShape::cuboid(1.0, 2.0, 3.0).as_ref()).is_some());
+}
