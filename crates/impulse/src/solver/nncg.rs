@@ -254,12 +254,7 @@ impl Momentum {
             serial(constraints, previous, direction, velocities);
             return;
         }
-        let slots = velocities.linear.len().min(velocities.angular.len());
-        let shared = SharedVelocities {
-            linear: velocities.linear.as_mut_ptr(),
-            angular: velocities.angular.as_mut_ptr(),
-            immovable: slots - 1,
-        };
+        let shared = SharedVelocities::of(velocities);
         for k in 0..colours {
             let range = sweep.starts[k] as usize..sweep.starts[k + 1] as usize;
             let (part, part_previous, part_direction) = (

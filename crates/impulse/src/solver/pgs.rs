@@ -197,11 +197,7 @@ where
     if !coloured || !spread(sweep.parallel, 1, 0) {
         return sequential(constraints, velocities, order);
     }
-    let shared = SharedVelocities {
-        linear: velocities.linear.as_mut_ptr(),
-        angular: velocities.angular.as_mut_ptr(),
-        immovable: slots - 1,
-    };
+    let shared = SharedVelocities::of(velocities);
     let run = |chunk: &mut [ContactConstraint], forward: bool| {
         // Capture the whole wrapper (Sync), not its raw-pointer fields (not Sync).
         #[allow(clippy::redundant_locals)]

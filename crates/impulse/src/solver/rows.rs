@@ -165,6 +165,16 @@ fn impulse_velocity_changes(c: &ContactConstraint, impulses: [f32; 3]) -> (Vec3,
 }
 
 impl SharedVelocities {
+    /// The shared pointers of an island's velocity arrays, whose last slot is the immovable one.
+    pub(crate) fn of(velocities: &mut Velocities<'_>) -> Self {
+        let slots = velocities.linear.len().min(velocities.angular.len());
+        Self {
+            linear: velocities.linear.as_mut_ptr(),
+            angular: velocities.angular.as_mut_ptr(),
+            immovable: slots - 1,
+        }
+    }
+
     /// [`apply_impulses`] through the shared pointers.
     ///
     /// # Safety

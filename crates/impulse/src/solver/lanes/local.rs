@@ -76,11 +76,7 @@ impl Bundles {
         velocities: &mut Velocities<'_>,
         update: F,
     ) -> Lane {
-        let shared = SharedVelocities {
-            linear: velocities.linear.as_mut_ptr(),
-            angular: velocities.angular.as_mut_ptr(),
-            immovable: velocities.linear.len() - 1,
-        };
+        let shared = SharedVelocities::of(velocities);
         let (bundles, len) = (SharedItems(self.bundles.as_mut_ptr()), self.bundles.len());
         let (set, fused) = (InstructionSet::detected(), self.fused);
         // SAFETY: the picked groups are copies of the pack's, whose ranges lie inside the

@@ -32,11 +32,7 @@ impl Bundles {
         F: BundleUpdate,
         T: SetTargets,
     {
-        let shared = SharedVelocities {
-            linear: velocities.linear.as_mut_ptr(),
-            angular: velocities.angular.as_mut_ptr(),
-            immovable: velocities.linear.len() - 1,
-        };
+        let shared = SharedVelocities::of(velocities);
         let (bundles, len) = (SharedItems(self.bundles.as_mut_ptr()), self.bundles.len());
         let (set, fused) = (InstructionSet::detected(), self.fused);
         if !spread(self.parallel, 1, 0) {
