@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Measures how rare the bowling shot's 7-10 split is (docs/takes.md, "Why bowling's 7-10 split
-stays rare").
+"""Measures how the bowling shot's 7-10 split comes about (docs/takes.md, "The bowling shot's
+step").
 
 1. ``lines``: straight balls, rolling without slip and without a hop, over the line where they
    would meet the head pin (x at the head pin's z, m) and their sideways velocity (m/s): which of
@@ -12,10 +12,17 @@ stays rare").
    the 7 and the 10 standing, and how many meet every goal.
 3. ``reroll``: one take of a search directory with a ``roughness`` (degrees) on the pins'
    material and scene seeds 1..N: the ball's line kept, the pins' contacts re-rolled.
+4. ``steps``: the shot with other steps (``dt`` and ``substeps`` pairs, the shot's 2.5 s each):
+   a random search of N takes for each (search seed 0, so every step size gets the same θ),
+   counting the takes that leave the 7, the 10, both, the split itself, and strikes.
+5. ``hit``: the head pin alone, hit by the shot's ball rolled at offsets from its centre line:
+   the direction the pin moves off in (degrees from straight back) at several steps.
 
     python3 scripts/bowling-split.py lines
     python3 scripts/bowling-split.py around takes/bowling-random TAKE_ID --sizes 0.003,0.03,0.1
     python3 scripts/bowling-split.py reroll takes/bowling-random TAKE_ID --roughness 0.3,1
+    python3 scripts/bowling-split.py steps --steps 1/60:20,1/120:10,1/240:5,1/480:3,1/240:20
+    python3 scripts/bowling-split.py hit --offsets 0.05,0.1,0.14 --steps 1/60:20,1/240:5,1/960:2
 
 Needs the impulse package; runs on 2 processes. The counts are deterministic (the engine is).
 """
@@ -91,7 +98,18 @@ def main() -> int:
     reroll.add_argument("--roughness", default="0.3,1", help="degrees, on the pins' material")
     reroll.add_argument("--material", default="maple")
     reroll.add_argument("--takes", type=int, default=60, help="scene seeds 1..N")
+    steps = commands.add_parser("steps")
+    steps.add_argument("--steps", default="1/60:20,1/240:5", help="dt:substeps pairs (s, -)")
+    steps.add_argument("--takes", type=int, default=2000, help="random takes per step")
+    hit = commands.add_parser("hit")
+    hit.add_argument("--offsets", default="0.05,0.1,0.14", help="m, the ball's x at the pin")
+    hit.add_argument("--steps", default="1/60:20,1/240:5,1/960:2", help="dt:substeps pairs")
     arguments = parser.parse_args()
+
+    if arguments.command == "steps":
+        return _steps(arguments.steps, arguments.takes)
+    if arguments.command == "hit":
+        return _hit(arguments.offsets, arguments.steps)
 
     with Pool(2) as pool:
         if arguments.command == "lines":
@@ -134,6 +152,83 @@ def main() -> int:
             both = sum(seven and ten for seven, ten, _ in marks)
             met = sum(m for _, _, m in marks)
             print(f"| {size:g} | {arguments.takes} | {both} | {met} |", flush=True)
+    return 0
+
+
+def _hit(offsets: str, pairs: str) -> int:
+    import math
+    from fractions import Fraction
+
+    import impulse
+
+    with open(SHOT + ".json", encoding="utf-8") as file:
+        base = json.load(file)
+    keep = [body for body in base["bodies"] if body["name"] in ("ground", "pin1", "ball")]
+    steps = [(text, float(Fraction(text.split(":")[0])), int(text.split(":")[1]))
+             for text in pairs.split(",")]
+    print("| ball offset (m) | | " + " | ".join(f"dt {t.split(':')[0]} s" for t, _, _ in steps)
+          + " |")
+    print("|---|---|" + "---|" * len(steps))
+    for offset in (float(v) for v in offsets.split(",")):
+        angles = []
+        for _, dt, substeps in steps:
+            bodies = json.loads(json.dumps(keep))
+            bodies[-1]["position"][0] = offset
+            world = impulse.World.from_scene(
+                dict(base, bodies=bodies, dt=dt, solver={"substeps": substeps}))
+            pin = list(world.names).index("pin1")
+            for _ in range(round(0.6 / dt)):  # until the pin moves, then 10 ms on
+                world.step()
+                v = world.state()["linear_velocities"][pin]
+                if math.hypot(v[0], v[2]) > 0.5:
+                    break
+            for _ in range(round(0.01 / dt)):
+                world.step()
+            v = world.state()["linear_velocities"][pin]
+            angles.append(math.degrees(math.atan2(-v[0], -v[2])))
+        print(f"| {offset:g} | the pin moves off at | "
+              + " | ".join(f"{a:.1f}°" for a in angles) + " |")
+    return 0
+
+
+def _steps(pairs: str, takes: int) -> int:
+    import tempfile
+    from fractions import Fraction
+
+    import pyarrow.parquet as pq
+    from impulse.takes import MET, search
+
+    with open(SHOT + ".json", encoding="utf-8") as file:
+        base = json.load(file)
+    with open(SHOT + ".goals.json", encoding="utf-8") as file:
+        spec = json.load(file)
+    duration = spec["steps"] * base["dt"]
+    print("| dt (s) | substeps | takes | 7 standing | 10 standing | both | 7-10 split "
+          "(every goal met) | strikes | first split |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for pair in pairs.split(","):
+        dt_text, substeps = pair.split(":")
+        dt = float(Fraction(dt_text))
+        scene = dict(base, dt=dt, solver=dict(base.get("solver", {}), substeps=int(substeps)))
+        with tempfile.TemporaryDirectory() as out:
+            search(scene, spec["goals"], spec["variation"], budget=takes,
+                   steps=round(duration / dt), method="random", seed=0, stop_after=takes + 1,
+                   workers=2, out=out, progress=False)
+            table = pq.read_table(os.path.join(out, "takes.parquet")).to_pydict()
+        order = sorted(range(len(table["take_id"])),
+                       key=lambda k: (table["generation"][k], table["index"][k]))
+        standing = {name[5:]: [table[name][k] <= MET for k in order]
+                    for name in table if name.startswith("cost.")}
+        seven, ten = standing[CORNERS[0]], standing[CORNERS[1]]
+        others = [all(column) for column in zip(
+            *(values for name, values in standing.items() if name not in CORNERS), strict=True)]
+        both = sum(s and t for s, t in zip(seven, ten, strict=True))
+        split = [table["met"][k] for k in order]
+        strikes = sum(o and not s and not t
+                      for o, s, t in zip(others, seven, ten, strict=True))
+        first = next((k + 1 for k, m in enumerate(split) if m), None)
+        print(f"| {dt_text} | {substeps} | {len(order)} | {sum(seven)} | {sum(ten)} | {both} | "
+              f"{sum(split)} | {strikes} | {first or 'none'} |", flush=True)
     return 0
 
 
