@@ -771,12 +771,12 @@ def _bounce_direction(scene):
     raise AssertionError("no bounce")
 
 
-def _closed_form_direction(a, b, roughness=math.radians(10.0)):
+def _closed_form_direction(a, b, roughness_degrees=10.0):
     """Twice the tilt from vertical (cos tilt = 1 − cap·(1 − cos R), cap = 1 − exp(−(a²+b²)/2)),
     towards azimuth atan2(b, a) measured from the floor's x axis about y (towards
     cos φ·x − sin φ·z)."""
     cap = 1.0 - math.exp(-(a * a + b * b) / 2.0)
-    tilt = math.acos(1.0 - cap * (1.0 - math.cos(roughness)))
+    tilt = math.acos(1.0 - cap * (1.0 - math.cos(math.radians(roughness_degrees))))
     azimuth = math.atan2(b, a)
     side = math.sin(2.0 * tilt)
     return np.array([side * math.cos(azimuth), math.cos(2.0 * tilt), -side * math.sin(azimuth)])

@@ -204,6 +204,51 @@ mod tests {
         assert!((turned - turn * still).length() < 1e-5);
     }
 
+    /// Explicit draws of standard normals (Box–Muller pairs) have the seeded draws'
+    /// distribution: cap and azimuth uniform (means 1/2 and π, a quarter of each below a
+    /// quarter of its range); huge coordinates stay in range, and (0, 0) is no tilt.
+    #[test]
+    fn explicit_draws_of_standard_normals_are_uniform() {
+        let count = 20_000u64;
+        let (mut caps, mut azimuths, mut low_caps, mut low_azimuths) = (0.0f64, 0.0f64, 0, 0);
+        for k in 0..count {
+            let bits = mix(&[3, k]);
+            let (u1, u2) = (f64::from(unit(bits)), f64::from(unit(bits >> 32)));
+            let radius = (-2.0 * (1.0 - u1).ln()).sqrt();
+            let angle = std::f64::consts::TAU * u2;
+            let (a, b) = ((radius * angle.cos()) as f32, (radius * angle.sin()) as f32);
+            let (cap, azimuth) = explicit_draw(a, b);
+            assert!((0.0..1.0).contains(&cap) && (0.0..std::f32::consts::TAU).contains(&azimuth));
+            caps += f64::from(cap);
+            azimuths += f64::from(azimuth);
+            low_caps += usize::from(cap < 0.25);
+            low_azimuths += usize::from(azimuth < std::f32::consts::FRAC_PI_2);
+        }
+        let n = count as f64;
+        assert!((caps / n - 0.5).abs() < 0.01, "{}", caps / n);
+        assert!(
+            (azimuths / n - std::f64::consts::PI).abs() < 0.03,
+            "{}",
+            azimuths / n
+        );
+        for low in [low_caps, low_azimuths] {
+            assert!((low as f64 / n - 0.25).abs() < 0.01, "{low}");
+        }
+        for (a, b) in [(1e30, -1e30), (f32::MAX, 0.0), (40.0, -1e-30), (-3.0, -0.0)] {
+            let (cap, azimuth) = explicit_draw(a, b);
+            let draw = RoughnessDraw {
+                cap,
+                azimuth,
+                axis: 0,
+            };
+            assert!(
+                draw.is_valid() && azimuth < std::f32::consts::TAU,
+                "{a}, {b}"
+            );
+        }
+        assert_eq!(explicit_draw(0.0, 0.0).0, 0.0);
+    }
+
     /// Different keys give different draws; the same key the same.
     #[test]
     fn draws_depend_on_every_part_of_the_key() {

@@ -142,8 +142,8 @@ fn the_pairs_first_body_gives_its_draw_first() {
 
 /// A particle bouncing on a rough floor under gravity uses one draw per bounce. A snapshot
 /// taken after the first bounce and restored continues to the bit (the count of draws given
-/// is kept: a restored world that gave the first draw again would differ), and the second
-/// draw decides the second bounce.
+/// is kept: a restored world that gave the first draw again would differ), as does a world
+/// stepped on one thread, and the later draws decide the later bounces.
 #[test]
 fn the_draws_given_survive_a_snapshot() {
     let drop = |draws: &[[f32; 2]]| {
@@ -177,6 +177,10 @@ fn the_draws_given_survive_a_snapshot() {
     let mut restored = World::from_snapshot(WorldSnapshot::from_bytes(&bytes).unwrap()).unwrap();
     let uninterrupted = run(&mut world, 150);
     assert_eq!(run(&mut restored, 150), uninterrupted);
+    // One thread gives the same draws to the same contacts.
+    let mut serial = drop(&draws);
+    serial.set_parallel(false);
+    assert_eq!(run(&mut serial, 180), uninterrupted);
     // The first bounce is the first draw's; the rest is the second and third draws'.
     assert_eq!(run(&mut drop(&draws[..1]), 30), after_first);
     assert_ne!(run(&mut drop(&draws[..1]), 180), uninterrupted);
