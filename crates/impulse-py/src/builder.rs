@@ -197,8 +197,10 @@ impl Shape {
 /// `restitution` (0–1), `roughness` (degrees, 0–30: seeded tilts of new contacts' normals),
 /// `impact_perturbation` (0–1: an impact's restitution moved by a seeded draw in ±this, kept in
 /// 0–1), `density` (kg/m³), `mass` (kg, overrides density), `name`, `linear_damping`,
-/// `angular_damping` (1/s), `lock_rotation` (bool). Defaults: at rest at the origin, friction
-/// 0.6, restitution 0, roughness 0, impact perturbation 0, density 1000 kg/m³. Values are checked by
+/// `angular_damping` (1/s), `lock_rotation` (bool), `roughness_draws` (pairs `(a, b)` of
+/// standard-normal coordinates: the draws of the body's first new rough contacts instead of
+/// seeded ones, docs/scene-format.md "Rough surfaces"). Defaults: at rest at the origin, friction
+/// 0.6, restitution 0, roughness 0, impact perturbation 0, density 1000 kg/m³, no draws. Values are checked by
 /// `World.insert`. Pickles as the call that made it; its repr is that call.
 #[pyclass(module = "impulse", frozen)]
 pub struct BodyBuilder {
@@ -222,6 +224,7 @@ enum Property {
     Float(f32),
     Text(String),
     Flag(bool),
+    Pairs(Vec<[f32; 2]>),
 }
 
 impl Property {
@@ -235,6 +238,13 @@ impl Property {
             Property::Float(value) => format!("{value:?}"),
             Property::Text(value) => format!("{value:?}"),
             Property::Flag(value) => if *value { "True" } else { "False" }.to_string(),
+            Property::Pairs(pairs) => {
+                let items: Vec<String> = pairs
+                    .iter()
+                    .map(|[a, b]| format!("({a:?}, {b:?})"))
+                    .collect();
+                format!("[{}]", items.join(", "))
+            }
         }
     }
 
@@ -245,6 +255,13 @@ impl Property {
             Property::Float(value) => value.into_pyobject(py)?.into_any(),
             Property::Text(value) => value.into_pyobject(py)?.into_any(),
             Property::Flag(value) => value.into_pyobject(py)?.to_owned().into_any(),
+            Property::Pairs(pairs) => {
+                let items = pairs
+                    .iter()
+                    .map(|pair| pyo3::types::PyTuple::new(py, pair))
+                    .collect::<PyResult<Vec<_>>>()?;
+                pyo3::types::PyList::new(py, items)?.into_any()
+            }
         })
     }
 }
@@ -331,6 +348,11 @@ fn configure(
                 b = b.lock_rotation(lock);
                 Property::Flag(lock)
             }
+            "roughness_draws" => {
+                let pairs = value.extract::<Vec<[f32; 2]>>().map_err(bad)?;
+                b = b.roughness_draws(pairs.iter().copied());
+                Property::Pairs(pairs)
+            }
             _ => {
                 return Err(WorldError::new_err(format!(
                     "no body property '{key}'; properties: {}",
@@ -343,7 +365,7 @@ fn configure(
     Ok(BodyBuilder { inner: b, recipe })
 }
 
-const PROPERTIES: [&str; 14] = [
+const PROPERTIES: [&str; 15] = [
     "translation",
     "rotation",
     "linear_velocity",
@@ -358,6 +380,7 @@ const PROPERTIES: [&str; 14] = [
     "linear_damping",
     "angular_damping",
     "lock_rotation",
+    "roughness_draws",
 ];
 
 #[pymethods]

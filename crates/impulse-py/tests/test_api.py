@@ -271,3 +271,41 @@ def test_settings_properties_are_the_fields():
         impulse.Settings().no_such_field  # noqa: B018
     with pytest.raises(AttributeError):
         impulse.Settings().substeps = 3
+
+
+def test_a_builders_roughness_draws_are_the_scene_fields():
+    # A frictionless elastic particle dropped on a rough floor: the builder's draws give the
+    # same bits as the scene field, survive pickling, and show in the repr.
+    def rough_floor():
+        world = impulse.World(gravity=(0, -9.81, 0), dt=1 / 60)
+        world.insert(impulse.BodyBuilder.fixed(
+            impulse.Shape.cuboid(20, 0.5, 20), translation=(0, -0.5, 0), friction=0.0,
+            restitution=1.0, roughness=10.0))
+        return world
+
+    builder = impulse.BodyBuilder.particle(
+        0.1, translation=(0, 1.1, 0), friction=0.0, restitution=1.0,
+        roughness_draws=[(0.7, -0.4), [1.5, 0.25]])
+    assert "roughness_draws=[(0.7, -0.4), (1.5, 0.25)]" in repr(builder)
+    scene = {
+        "bodies": [
+            {"kind": "static", "shape": {"type": "cuboid", "half_extents": [20, 0.5, 20]},
+             "position": [0, -0.5, 0],
+             "material": {"friction": 0.0, "restitution": 1.0, "roughness": 10.0}},
+            {"kind": "particle", "shape": {"type": "sphere", "radius": 0.1}, "position": [0, 1.1, 0],
+             "material": {"friction": 0.0, "restitution": 1.0},
+             "roughness_draws": [[0.7, -0.4], [1.5, 0.25]]},
+        ],
+    }
+    worlds = [rough_floor(), rough_floor(), impulse.World.from_scene(scene)]
+    worlds[0].insert(builder)
+    worlds[1].insert(pickle.loads(pickle.dumps(builder)))
+    for world in worlds:
+        world.step(60)
+    assert worlds[0].positions.tobytes() == worlds[1].positions.tobytes()
+    assert worlds[0].positions.tobytes() == worlds[2].positions.tobytes()
+    assert abs(worlds[0].positions[1, 0]) > 0.01  # the draw tilted the bounce
+    with pytest.raises(impulse.WorldError, match="roughness_draws"):
+        impulse.BodyBuilder.particle(0.1, roughness_draws=[(1.0, 2.0, 3.0)])
+    with pytest.raises(impulse.WorldError, match=r"roughness_draws\[0\]\[1\]"):
+        rough_floor().insert(impulse.BodyBuilder.particle(0.1, roughness_draws=[(1.0, math.nan)]))

@@ -713,3 +713,134 @@ def test_takes_with_their_own_seeds_vary_the_perturbed_impacts(tmp_path):
     plain = json.loads(json.dumps(scene))
     plain["materials"]["ball"]["impact_perturbation"] = 0.0
     assert _highest_after_bounce(plain) == pytest.approx(0.35, abs=0.03)
+
+
+def test_a_variation_with_roughness_draws_puts_them_in_theta():
+    # Per varied body: its field offsets, then 2K roughness draw coordinates.
+    variation = Variation(bodies=["ball"], velocity=0.3, roughness_draws=2)
+    assert variation.dimension(SCENE) == 3 + 4
+    theta = [1.0, 0.0, -1.0, 0.1, -2.0, 1.0 / 3.0, 0.25]
+    scene = variation.apply(SCENE, theta)
+    ball = scene["bodies"][1]
+    point3 = float(np.float32(0.3))
+    assert ball["linear_velocity"] == [point3, 0.0, -point3]
+    third = float(np.float32(1.0 / 3.0))
+    assert ball["roughness_draws"] == [[float(np.float32(0.1)), -2.0], [third, 0.25]]
+    assert "roughness_draws" not in scene["bodies"][0] and "roughness_draws" not in SCENE["bodies"][1]
+    # Through the engine: the scene reads back with the same float32 draws.
+    world = impulse.World.from_scene(scene)
+    world.step(2)
+    with pytest.raises(ValueError, match=r"needs \(7,\)"):
+        variation.apply(SCENE, theta[:6])
+    # Draws alone vary something; the spec round-trips.
+    alone = Variation(roughness_draws=1)
+    assert alone.dimension(SCENE) == 2
+    assert Variation.from_dict(alone.to_dict()).to_dict() == alone.to_dict() == {
+        "bodies": None,
+        "position": 0.0,
+        "angle": 0.0,
+        "velocity": 0.0,
+        "angular_velocity": 0.0,
+        "roughness_draws": 1,
+    }
+    assert "roughness_draws" not in Variation(velocity=1.0).to_dict()
+    for bad in (-1, 1.5, True, 257, "2"):
+        with pytest.raises(ValueError, match="roughness_draws"):
+            Variation(velocity=1.0, roughness_draws=bad)
+    with pytest.raises(ValueError, match="varies nothing"):
+        Variation(roughness_draws=0)
+
+
+def _rough_particle(draws):
+    """A frictionless elastic particle (radius 0.1 m, no rotation, so its velocity reflects
+    exactly about the normal) coming straight down at 3 m/s, without gravity, onto the rough
+    floor of ``ROUGH`` (10°), with ``draws`` as its ``roughness_draws``."""
+    scene = json.loads(json.dumps(ROUGH))
+    scene["gravity"] = [0.0, 0.0, 0.0]
+    ball = scene["bodies"][1]
+    ball.update(kind="particle", position=[0.0, 0.4, 0.0], linear_velocity=[0.0, -3.0, 0.0])
+    ball["roughness_draws"] = draws
+    return scene
+
+
+def _bounce_direction(scene):
+    world = impulse.World.from_scene(scene)
+    for _ in range(60):
+        world.step()
+        v = np.asarray(world.linear_velocities[1], dtype=np.float64)
+        if v[1] > 0.0:
+            return v / np.linalg.norm(v)
+    raise AssertionError("no bounce")
+
+
+def _closed_form_direction(a, b, roughness_degrees=10.0):
+    """Twice the tilt from vertical (cos tilt = 1 − cap·(1 − cos R), cap = 1 − exp(−(a²+b²)/2)),
+    towards azimuth atan2(b, a) measured from the floor's x axis about y (towards
+    cos φ·x − sin φ·z)."""
+    cap = 1.0 - math.exp(-(a * a + b * b) / 2.0)
+    tilt = math.acos(1.0 - cap * (1.0 - math.cos(math.radians(roughness_degrees))))
+    azimuth = math.atan2(b, a)
+    side = math.sin(2.0 * tilt)
+    return np.array([side * math.cos(azimuth), math.cos(2.0 * tilt), -side * math.sin(azimuth)])
+
+
+def test_the_roughness_draws_move_the_bounce_continuously():
+    # A small step of (a, b) moves the bounce a little, as the closed form says.
+    previous = None
+    for k in range(6):
+        a, b = 0.6 + 0.002 * k, -0.9 + 0.001 * k
+        direction = _bounce_direction(_rough_particle([[a, b]]))
+        expected = _closed_form_direction(a, b)
+        assert np.linalg.norm(direction - expected) < 1e-3, (a, b, direction, expected)
+        if previous is not None:
+            assert 0.0 < np.linalg.norm(direction - previous) < 5e-3
+        previous = direction
+    # (0, 0) bounces straight back up.
+    assert np.linalg.norm(_bounce_direction(_rough_particle([[0.0, 0.0]])) - [0, 1, 0]) < 1e-6
+
+
+def test_a_take_with_roughness_draws_is_the_same_to_the_bit_through_impulse_run(
+    tmp_path, impulse_cli
+):
+    # The rough bounce of ROUGH must go toward +x: only the ball's roughness draw (θ) decides.
+    goal = {
+        "type": "ends_inside",
+        "body": "ball",
+        "region": {"box": {"min": [0.15, -1, -1], "max": [5, 5, 1]}},
+    }
+    steps = 72
+    out = tmp_path / "t"
+    scene_path, goals_path = tmp_path / "rough.json", tmp_path / "goals.json"
+    scene_path.write_text(json.dumps(ROUGH))
+    goals_path.write_text(json.dumps({"goals": [goal], "steps": steps, "variation": {"bodies": ["ball"]}}))
+    arguments = ["search", str(scene_path), "--goals", str(goals_path), "--budget", "16"]
+    arguments += ["--out", str(out), "--workers", "2", "--population", "16", "--no-progress"]
+    assert cli_main([*arguments, "--vary-roughness-draws", "1"]) == 0
+    takes = load(out)
+    assert takes.variation.roughness_draws == 1
+    met = takes.met()
+    assert met, "some draw sends the ball toward +x"
+    assert len(met) < len(takes), "some draw does not"
+    take = met[0]
+    assert len(take.theta) == 2 and take.scene_seed is None
+    path = tmp_path / "take.json"
+    assert cli_main(["scene", str(out), take.take_id, "--out", str(path)]) == 0
+    written = json.loads(path.read_text())
+    assert written["bodies"][1]["roughness_draws"] == [
+        [float(np.float32(x)) for x in take.theta]
+    ]
+    frames_path = tmp_path / "frames.jsonl"
+    subprocess.run(
+        [impulse_cli, "run", str(path), "--steps", str(steps), "--out", str(frames_path), "--quiet"],
+        check=True,
+        capture_output=True,
+    )
+    frames = [json.loads(line) for line in frames_path.read_text().splitlines()]
+    poses = np.array([f["bodies"] for f in frames], dtype=np.float64).astype(np.float32)
+    record, status, _ = simulate_take(take.scene(), steps, [])
+    assert status == "completed" and len(frames) == steps + 1
+    positions = record.positions.astype(np.float32)
+    orientations = record.orientations.astype(np.float32)
+    assert positions.view(np.uint32).tolist() == poses[..., :3].view(np.uint32).tolist()
+    assert orientations.view(np.uint32).tolist() == poses[..., 3:].view(np.uint32).tolist()
+    assert positions[-1, 1, 0] >= 0.15

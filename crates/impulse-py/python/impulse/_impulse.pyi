@@ -283,7 +283,8 @@ class BodyBuilder:
 
     Keywords: translation (m), rotation (x y z w), linear_velocity (m/s), angular_velocity
     (rad/s), friction, restitution, roughness (degrees), impact_perturbation (0-1), density
-    (kg/m³), mass (kg), name, linear_damping, angular_damping (1/s), lock_rotation. Picklable; the repr is the call that made it.
+    (kg/m³), mass (kg), name, linear_damping, angular_damping (1/s), lock_rotation,
+    roughness_draws (pairs (a, b), standard-normal). Picklable; the repr is the call that made it.
     """
 
     @staticmethod

@@ -39,6 +39,7 @@ pub struct BodyBuilder {
     pub(crate) restitution: f32,
     pub(crate) roughness: f32,
     pub(crate) impact_perturbation: f32,
+    pub(crate) roughness_draws: Vec<[f32; 2]>,
     pub(crate) density: f32,
     pub(crate) mass: Option<f32>,
     pub(crate) name: Option<String>,
@@ -67,6 +68,7 @@ impl BodyBuilder {
             restitution: 0.0,
             roughness: 0.0,
             impact_perturbation: 0.0,
+            roughness_draws: Vec::new(),
             density: 1000.0,
             mass: None,
             name: None,
@@ -146,6 +148,25 @@ impl BodyBuilder {
     /// (docs/scene-format.md, "Materials"). 0 (the default): smooth, nothing drawn.
     pub fn roughness(mut self, degrees: f32) -> Self {
         self.roughness = degrees;
+        self
+    }
+
+    /// Explicit roughness draws: pairs [a, b] of standard-normal coordinates (unit-free,
+    /// finite, at most [`super::MAX_ROUGHNESS_DRAWS`]) that replace the seeded draws of the
+    /// body's rough contacts, one per new manifold in the order the manifolds appear. Pair k
+    /// gives the k-th new manifold whose draw this body gives the tilt
+    /// 1 − cos(tilt) = cap · (1 − cos(roughness)) with cap = 1 − exp(−(a² + b²)/2), in the
+    /// direction azimuth = atan2(b, a) (in [0, 2π)) about the normal. For (a, b) drawn from
+    /// N(0, I₂) the cap is uniform in [0, 1) and the azimuth uniform in [0, 2π), the
+    /// distribution of the seeded draws, and the map is continuous, so a search can refine a
+    /// take's draws (Chenney & Forsyth, "Sampling plausible solutions to multi-body constraint
+    /// problems", SIGGRAPH 2000, perturb each collision's normal). A new manifold of a pair with
+    /// a rough body takes its draw from the pair's first body (lower index) if that has a draw
+    /// left, else from the second, else from the seed ([`crate::World::seed`]); the tilt's size
+    /// still comes from the pair's roughness ([`Self::roughness`]), so draws on a smooth pair
+    /// are not used. Default none.
+    pub fn roughness_draws(mut self, draws: impl IntoIterator<Item = [f32; 2]>) -> Self {
+        self.roughness_draws = draws.into_iter().collect();
         self
     }
 
@@ -319,6 +340,13 @@ pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
         "material.impact_perturbation",
         rules::impact_perturbation(b.impact_perturbation),
     )?;
+    rules::roughness_draws(&b.roughness_draws).map_err(|(at, message)| {
+        let field = match at {
+            Some((k, j)) => format!("roughness_draws[{k}][{j}]"),
+            None => "roughness_draws".to_string(),
+        };
+        invalid_built(&field, message)
+    })?;
     check("linear_damping", rules::non_negative(b.linear_damping))?;
     check("angular_damping", rules::non_negative(b.angular_damping))?;
     let shape = b.shape.clone();

@@ -20,7 +20,7 @@ pub use handle::BodyHandle;
 pub(crate) use handle::Handles;
 pub use kind::{BodyKind, Keyframe};
 pub use locked_axes::LockedAxes;
-pub use rules::{MAX_IMPACT_PERTURBATION, MAX_ROUGHNESS_DEGREES};
+pub use rules::{MAX_IMPACT_PERTURBATION, MAX_ROUGHNESS_DEGREES, MAX_ROUGHNESS_DRAWS};
 // Public for the hidden `internals` module only.
 #[cfg_attr(not(feature = "internals"), allow(unreachable_pub))]
 pub use storage::Bodies;

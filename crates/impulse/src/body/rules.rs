@@ -259,6 +259,33 @@ pub(crate) fn roughness(v: f32) -> Result<(), String> {
     }
 }
 
+/// The most explicit roughness draws a body may have ([`BodyBuilder::roughness_draws`],
+/// `BodyDesc::roughness_draws`): 256 pairs, more new contacts than one body meets in a take
+/// that is refined draw by draw; its later contacts draw from the seed.
+///
+/// [`BodyBuilder::roughness_draws`]: crate::BodyBuilder::roughness_draws
+pub const MAX_ROUGHNESS_DRAWS: usize = 256;
+
+/// A body's explicit roughness draws: at most [`MAX_ROUGHNESS_DRAWS`] pairs, every coordinate
+/// finite. The error gives the pair and coordinate at fault (`None` for too many pairs).
+pub(crate) fn roughness_draws(draws: &[[f32; 2]]) -> Result<(), (Option<(usize, usize)>, String)> {
+    if draws.len() > MAX_ROUGHNESS_DRAWS {
+        return Err((
+            None,
+            format!(
+                "at most {MAX_ROUGHNESS_DRAWS} pairs [a, b], got {}",
+                draws.len()
+            ),
+        ));
+    }
+    for (k, pair) in draws.iter().enumerate() {
+        for (j, &v) in pair.iter().enumerate() {
+            finite(&[v]).map_err(|message| (Some((k, j)), message))?;
+        }
+    }
+    Ok(())
+}
+
 /// The largest impact perturbation (dimensionless, `Material::impact_perturbation`,
 /// [`BodyBuilder::impact_perturbation`]): the whole range of a restitution coefficient.
 ///

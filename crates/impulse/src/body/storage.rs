@@ -49,6 +49,15 @@ pub struct Bodies {
     /// restitution (0: none). Absent from snapshots written before it existed: read as 0.
     #[serde(default)]
     pub(crate) impact_perturbation: Vec<f32>,
+    /// Explicit roughness draws ([`BodyBuilder::roughness_draws`]): standard-normal pairs
+    /// (a, b), given in turn to the new rough manifolds whose draw the body gives. Absent
+    /// from snapshots written before they existed: none.
+    #[serde(default)]
+    pub(crate) roughness_draws: Vec<Vec<[f32; 2]>>,
+    /// How many of its `roughness_draws` the body has given so far: world state, so a
+    /// restored world gives the next one. Absent from older snapshots: none given.
+    #[serde(default)]
+    pub(crate) roughness_draws_given: Vec<u32>,
     /// Asleep: skipped by the step until something awake touches its island. A kinematic
     /// body counts as asleep exactly while it does not move (zero velocities).
     pub(crate) asleep: Vec<bool>,
@@ -91,6 +100,8 @@ impl Bodies {
         self.restitution.swap_remove(i);
         self.roughness.swap_remove(i);
         self.impact_perturbation.swap_remove(i);
+        self.roughness_draws.swap_remove(i);
+        self.roughness_draws_given.swap_remove(i);
         self.asleep.swap_remove(i);
         self.sleep_time.swap_remove(i);
         self.force.swap_remove(i);
@@ -120,6 +131,8 @@ impl Bodies {
             ("restitution", self.restitution.len()),
             ("roughness", self.roughness.len()),
             ("impact_perturbation", self.impact_perturbation.len()),
+            ("roughness_draws", self.roughness_draws.len()),
+            ("roughness_draws_given", self.roughness_draws_given.len()),
             ("asleep", self.asleep.len()),
             ("sleep_time", self.sleep_time.len()),
             ("force", self.force.len()),

@@ -1,11 +1,13 @@
 //! Rough surfaces: each new contact manifold between bodies of which one is rough
-//! ([`crate::BodyBuilder::roughness`]) gets a seeded draw that tilts its normal by a small angle,
+//! ([`crate::BodyBuilder::roughness`]) gets a draw that tilts its normal by a small angle,
 //! kept for as long as the manifold lasts (Chenney & Forsyth, "Sampling plausible solutions to
 //! multi-body constraint problems", SIGGRAPH 2000; Barzel, Hughes & Wood, "Plausible motion
 //! simulation for computer graphics animation", 1996: small random changes at contacts are
 //! physically plausible, and they vary a pile's outcome from one seed to the next).
 //!
-//! The draw is keyed by (world seed, step at which the manifold appeared, the pair's body
+//! A body's explicit draws ([`crate::BodyBuilder::roughness_draws`]: standard-normal pairs,
+//! mapped by [`explicit_draw`] to the seeded draws' distribution) come first; otherwise the
+//! draw is keyed by (world seed, step at which the manifold appeared, the pair's body
 //! indices, the manifold's index in the pair) through the SplitMix64 finaliser (Steele, Lea &
 //! Flood, "Fast splittable pseudorandom number generators", OOPSLA 2014): integer arithmetic, so
 //! it is the same on every machine, thread count and backend. The tilt is uniform over the
@@ -26,8 +28,17 @@ pub(crate) fn pair_roughness(bodies: &Bodies, a: usize, b: usize) -> f32 {
 }
 
 /// Gives every manifold with points that has no draw yet, of every pair with a rough body, its
-/// draw for `seed` at `step`. Called once a step, after the narrow phase.
-pub(crate) fn draw_new_manifolds(pairs: &mut [ContactPair], bodies: &Bodies, seed: u64, step: u64) {
+/// draw: the next explicit draw of the pair's first body ([`Bodies::roughness_draws`]), else
+/// of its second, else the seeded draw for `seed` at `step`. Called once a step, after the
+/// narrow phase. The pairs are sorted by (body1, body2) and each pair's manifolds are in
+/// Parry's order, and this loop is sequential, so the explicit draws are given in the same
+/// order on any number of threads.
+pub(crate) fn draw_new_manifolds(
+    pairs: &mut [ContactPair],
+    bodies: &mut Bodies,
+    seed: u64,
+    step: u64,
+) {
     for pair in pairs.iter_mut() {
         let (b1, b2) = (pair.body1, pair.body2);
         if pair_roughness(bodies, b1 as usize, b2 as usize) <= 0.0 {
@@ -37,13 +48,6 @@ pub(crate) fn draw_new_manifolds(pairs: &mut [ContactPair], bodies: &Bodies, see
             if manifold.points.is_empty() || manifold.data.roughness.is_some() {
                 continue;
             }
-            let key = [
-                seed,
-                step,
-                u64::from(b1) << 32 | u64::from(b2),
-                index as u64,
-            ];
-            let bits = mix(&key);
             let n = manifold.local_n1.abs();
             let axis = if n.x <= n.y && n.x <= n.z {
                 0
@@ -52,13 +56,57 @@ pub(crate) fn draw_new_manifolds(pairs: &mut [ContactPair], bodies: &Bodies, see
             } else {
                 2
             };
-            manifold.data.roughness = Some(RoughnessDraw {
-                cap: unit(bits),
-                azimuth: unit(bits >> 32) * std::f32::consts::TAU,
-                axis,
-            });
+            let (cap, azimuth) = match next_explicit_draw(bodies, b1 as usize)
+                .or_else(|| next_explicit_draw(bodies, b2 as usize))
+            {
+                Some([a, b]) => explicit_draw(a, b),
+                None => {
+                    let key = [
+                        seed,
+                        step,
+                        u64::from(b1) << 32 | u64::from(b2),
+                        index as u64,
+                    ];
+                    let bits = mix(&key);
+                    (unit(bits), unit(bits >> 32) * std::f32::consts::TAU)
+                }
+            };
+            manifold.data.roughness = Some(RoughnessDraw { cap, azimuth, axis });
         }
     }
+}
+
+/// Body `body`'s next explicit draw, counted as given; `None` once it has given them all.
+fn next_explicit_draw(bodies: &mut Bodies, body: usize) -> Option<[f32; 2]> {
+    let given = &mut bodies.roughness_draws_given[body];
+    let draw = *bodies.roughness_draws[body].get(*given as usize)?;
+    *given += 1;
+    Some(draw)
+}
+
+/// The largest f32 below 1: a cap is in [0, 1).
+const LARGEST_CAP: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// The (cap, azimuth) of an explicit draw (a, b) in standard-normal coordinates:
+/// cap = 1 − exp(−(a² + b²)/2) in [0, 1) and azimuth = atan2(b, a) in [0, 2π) (rad). For
+/// (a, b) ~ N(0, I₂), (a² + b²)/2 is exponential with mean 1, so the cap is uniform, and the
+/// azimuth is uniform and independent of it: the seeded draws' distribution. Continuous in
+/// (a, b) (the azimuth wraps from 2π to 0 along the positive a axis, the same direction).
+/// Computed in f64 and rounded to f32 once.
+pub(crate) fn explicit_draw(a: f32, b: f32) -> (f32, f32) {
+    let (a, b) = (f64::from(a), f64::from(b));
+    let cap = (-(-(a * a + b * b) / 2.0).exp_m1()) as f32;
+    let mut azimuth = b.atan2(a);
+    if azimuth < 0.0 {
+        azimuth += std::f64::consts::TAU;
+    }
+    let azimuth = azimuth as f32;
+    let azimuth = if azimuth < std::f32::consts::TAU {
+        azimuth
+    } else {
+        0.0
+    };
+    (cap.clamp(0.0, LARGEST_CAP), azimuth)
 }
 
 /// `normal` (world, unit) tilted by `draw` for a pair of roughness `roughness` (rad), with
@@ -154,6 +202,51 @@ mod tests {
             &Pose::from_parts(Vec3::ZERO, turn),
         );
         assert!((turned - turn * still).length() < 1e-5);
+    }
+
+    /// Explicit draws of standard normals (Box–Muller pairs) have the seeded draws'
+    /// distribution: cap and azimuth uniform (means 1/2 and π, a quarter of each below a
+    /// quarter of its range); huge coordinates stay in range, and (0, 0) is no tilt.
+    #[test]
+    fn explicit_draws_of_standard_normals_are_uniform() {
+        let count = 20_000u64;
+        let (mut caps, mut azimuths, mut low_caps, mut low_azimuths) = (0.0f64, 0.0f64, 0, 0);
+        for k in 0..count {
+            let bits = mix(&[3, k]);
+            let (u1, u2) = (f64::from(unit(bits)), f64::from(unit(bits >> 32)));
+            let radius = (-2.0 * (1.0 - u1).ln()).sqrt();
+            let angle = std::f64::consts::TAU * u2;
+            let (a, b) = ((radius * angle.cos()) as f32, (radius * angle.sin()) as f32);
+            let (cap, azimuth) = explicit_draw(a, b);
+            assert!((0.0..1.0).contains(&cap) && (0.0..std::f32::consts::TAU).contains(&azimuth));
+            caps += f64::from(cap);
+            azimuths += f64::from(azimuth);
+            low_caps += usize::from(cap < 0.25);
+            low_azimuths += usize::from(azimuth < std::f32::consts::FRAC_PI_2);
+        }
+        let n = count as f64;
+        assert!((caps / n - 0.5).abs() < 0.01, "{}", caps / n);
+        assert!(
+            (azimuths / n - std::f64::consts::PI).abs() < 0.03,
+            "{}",
+            azimuths / n
+        );
+        for low in [low_caps, low_azimuths] {
+            assert!((low as f64 / n - 0.25).abs() < 0.01, "{low}");
+        }
+        for (a, b) in [(1e30, -1e30), (f32::MAX, 0.0), (40.0, -1e-30), (-3.0, -0.0)] {
+            let (cap, azimuth) = explicit_draw(a, b);
+            let draw = RoughnessDraw {
+                cap,
+                azimuth,
+                axis: 0,
+            };
+            assert!(
+                draw.is_valid() && azimuth < std::f32::consts::TAU,
+                "{a}, {b}"
+            );
+        }
+        assert_eq!(explicit_draw(0.0, 0.0).0, 0.0);
     }
 
     /// Different keys give different draws; the same key the same.

@@ -571,6 +571,8 @@ struct BodyOut<'a> {
     mask: u32,
     #[serde(skip_serializing_if = "Option::is_none")]
     keyframes: &'a Option<Vec<KeyframeDesc>>,
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    roughness_draws: &'a [[f32; 2]],
 }
 
 impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
@@ -593,6 +595,7 @@ impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
             groups,
             mask,
             keyframes,
+            roughness_draws,
         } = b;
         Self {
             name,
@@ -611,6 +614,7 @@ impl<'a> From<&'a BodyDesc> for BodyOut<'a> {
             groups: *groups,
             mask: *mask,
             keyframes,
+            roughness_draws,
         }
     }
 }

@@ -72,7 +72,7 @@ pub struct Material {
     pub impact_perturbation: f32,
 }
 
-pub use crate::body::{MAX_IMPACT_PERTURBATION, MAX_ROUGHNESS_DEGREES};
+pub use crate::body::{MAX_IMPACT_PERTURBATION, MAX_ROUGHNESS_DEGREES, MAX_ROUGHNESS_DRAWS};
 
 impl Default for Material {
     fn default() -> Self {
@@ -352,6 +352,12 @@ pub struct BodyDesc {
     /// last pose after the last time. At least one; times finite, > 0 and increasing.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub keyframes: Option<Vec<KeyframeDesc>>,
+    /// Explicit roughness draws: pairs `[a, b]` of standard-normal coordinates (finite, at
+    /// most [`MAX_ROUGHNESS_DRAWS`]) given in turn to the new rough contacts whose draw this
+    /// body gives, instead of seeded draws: cap = 1 − exp(−(a² + b²)/2), azimuth = atan2(b, a)
+    /// ([`crate::BodyBuilder::roughness_draws`]). Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub roughness_draws: Vec<[f32; 2]>,
 }
 
 /// A body's locked axes as a scene gives them ([`BodyDesc::locked_axes`]): the world axes
@@ -472,6 +478,7 @@ impl BodyDesc {
             groups: all_groups(),
             mask: all_groups(),
             keyframes: None,
+            roughness_draws: Vec::new(),
         }
     }
 }

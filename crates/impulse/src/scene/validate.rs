@@ -29,6 +29,7 @@
 //!   > 0 and only on a cuboid, cylinder, cone or convex hull;
 //! - a particle's shape is a sphere;
 //! - `locked_axes` belong to a dynamic body or a particle;
+//! - `roughness_draws` are at most 256 pairs `[a, b]` of finite numbers;
 //! - `keyframes` belong to a kinematic body, are at least one, with times finite, > 0 and
 //!   increasing, finite positions and non-zero orientations;
 //! - the orientation quaternion is not zero (norm ≥ [`MIN_NORM`]); a nonzero non-unit
@@ -342,6 +343,13 @@ impl Checker {
         }
         if let Some(keyframes) = &b.keyframes {
             self.keyframes(path, b, keyframes);
+        }
+        if let Err((at, message)) = rules::roughness_draws(&b.roughness_draws) {
+            let mut at_path = path.key("roughness_draws");
+            if let Some((k, j)) = at {
+                at_path = at_path.index(k).index(j);
+            }
+            self.fail(&at_path, message);
         }
     }
 

@@ -171,6 +171,7 @@ pub(crate) fn builder_of(
         restitution: material.restitution,
         roughness: material.roughness,
         impact_perturbation: material.impact_perturbation,
+        roughness_draws: desc.roughness_draws.clone(),
         density: material.density,
         mass: desc.mass,
         name: desc.name.clone(),

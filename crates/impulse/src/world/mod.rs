@@ -252,6 +252,8 @@ impl World {
         b.restitution.push(builder.restitution);
         b.roughness.push(builder.roughness.to_radians());
         b.impact_perturbation.push(builder.impact_perturbation);
+        b.roughness_draws.push(builder.roughness_draws);
+        b.roughness_draws_given.push(0);
         b.asleep.push(false);
         b.sleep_time.push(0.0);
         b.force.push(Vec3::ZERO);

@@ -328,6 +328,11 @@ impl World {
             // Written before impact perturbations existed: none.
             bodies.impact_perturbation = vec![0.0; bodies.len()];
         }
+        if bodies.roughness_draws.is_empty() && bodies.roughness_draws_given.is_empty() {
+            // Written before explicit roughness draws existed: none.
+            bodies.roughness_draws = vec![Vec::new(); bodies.len()];
+            bodies.roughness_draws_given = vec![0; bodies.len()];
+        }
         bodies.check_lengths().map_err(invalid)?;
         for i in 0..bodies.len() {
             if let Some(shape) = rebuilt_composite(&bodies.shape[i])
@@ -500,6 +505,12 @@ fn check_bodies(b: &Bodies) -> Result<(), String> {
         }
         if !(0.0..=crate::body::MAX_IMPACT_PERTURBATION).contains(&b.impact_perturbation[i]) {
             return bad("impact_perturbation is outside [0, 1]");
+        }
+        if crate::body::rules::roughness_draws(&b.roughness_draws[i]).is_err() {
+            return bad("roughness_draws are too many or not finite");
+        }
+        if b.roughness_draws_given[i] as usize > b.roughness_draws[i].len() {
+            return bad("roughness_draws_given exceeds the roughness draws");
         }
         let shape = &b.shape[i];
         if b.kind[i] != BodyKind::Static && shape.as_halfspace().is_some() {

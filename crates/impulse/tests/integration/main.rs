@@ -38,6 +38,7 @@ mod phantom_and_tunnel;
 mod physics;
 mod profile;
 mod roughness;
+mod roughness_draws;
 mod scene_files;
 mod seams;
 mod shapes;

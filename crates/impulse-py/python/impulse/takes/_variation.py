@@ -12,11 +12,20 @@ components            unit    field changed
                               (world frame, about the body's origin)
 6-8 (x, y, z)         m/s     ``linear_velocity`` += θ × ``velocity``
 9-11 (x, y, z)        rad/s   ``angular_velocity`` += θ × ``angular_velocity``
+12 … 12+2K-1 (a, b)   none    ``roughness_draws`` = the K pairs [a, b] of θ as they are
 ====================  ======  ==========================================================
 
-A field whose scale is 0 is not varied and its components are left out of θ. The varied values
-are rounded to float32 (the engine's precision) before they are written, so the varied scene
-read from a file gives the same bits as the one simulated in the search.
+A field whose scale is 0 is not varied and its components are left out of θ (so the draws
+follow directly after the last varied field). The varied values are rounded to float32 (the
+engine's precision) before they are written, so the varied scene read from a file gives the
+same bits as the one simulated in the search.
+
+With ``roughness_draws=K`` each varied body's first K new rough contacts take their tilts from
+θ instead of the seed: pair k (a, b), standard-normal coordinates with no scale, gives the
+contact's normal a tilt with cap 1 − exp(−(a² + b²)/2) and azimuth atan2(b, a) (the body field
+``roughness_draws``, docs/scene-format.md). A standard normal (a, b) gives the seeded draws'
+distribution and the map is continuous, so the search refines rough bounces as it refines the
+initial state. Only contacts with a rough body (a material ``roughness``) draw at all.
 
 With ``seeds=True`` a take also has its own scene ``seed``: the seed of the engine's seeded
 draws, which tilt each new contact's normal on rough surfaces (materials with ``roughness``,
@@ -40,6 +49,8 @@ import numpy as np
 #: The fields a variation may change, with their unit, in θ's order per body.
 FIELDS = ("position", "angle", "velocity", "angular_velocity")
 UNITS = {"position": "m", "angle": "degrees", "velocity": "m/s", "angular_velocity": "rad/s"}
+#: The most roughness draws a body may have (the engine's bound on ``roughness_draws``).
+MAX_ROUGHNESS_DRAWS = 256
 _MOVING = ("dynamic", "particle")
 
 
@@ -62,11 +73,15 @@ class Variation:
         Give each take its own scene ``seed`` (the draws of rough surfaces and perturbed
         impacts; materials need a ``roughness`` or an ``impact_perturbation`` for it to
         matter).
+    roughness_draws : int
+        K ≥ 0: each varied body's first K rough contacts take their draws from θ (2K
+        components per body, after its other ones); 0 (the default) leaves them to the seed.
 
     Raises
     ------
     ValueError
-        A scale negative or not finite, every scale 0, or an unknown key in :meth:`from_dict`.
+        A scale negative or not finite, ``roughness_draws`` not an integer in [0, 256], nothing
+        varied, or an unknown key in :meth:`from_dict`.
     """
 
     def __init__(
@@ -77,9 +92,20 @@ class Variation:
         velocity: float = 0.0,
         angular_velocity: float = 0.0,
         seeds: bool = False,
+        roughness_draws: int = 0,
     ):
         self.bodies = None if bodies is None else list(bodies)
         self.seeds = bool(seeds)
+        if (
+            isinstance(roughness_draws, bool)
+            or not isinstance(roughness_draws, (int, np.integer))
+            or not 0 <= roughness_draws <= MAX_ROUGHNESS_DRAWS
+        ):
+            raise ValueError(
+                f"variation roughness_draws = {roughness_draws!r}: must be an integer in "
+                f"[0, {MAX_ROUGHNESS_DRAWS}] (pairs per varied body)"
+            )
+        self.roughness_draws = int(roughness_draws)
         self.scales = {
             "position": float(position),
             "angle": float(angle),
@@ -91,21 +117,22 @@ class Variation:
                 raise ValueError(
                     f"variation {name} = {value} {UNITS[name]}: must be finite and >= 0"
                 )
-        if not any(self.scales.values()) and not self.seeds:
+        if not any(self.scales.values()) and not self.seeds and not self.roughness_draws:
             raise ValueError(
                 "a variation with every scale 0 varies nothing: give position (m), angle "
-                "(degrees), velocity (m/s), angular_velocity (rad/s) or seeds"
+                "(degrees), velocity (m/s), angular_velocity (rad/s), seeds or roughness_draws"
             )
 
     @staticmethod
     def from_dict(spec: Mapping[str, Any]) -> Variation:
         """From ``{"bodies": [...], "position": m, "angle": degrees, "velocity": m/s,
-        "angular_velocity": rad/s}`` (every key optional but one scale)."""
-        unknown = set(spec) - {"bodies", "seeds", *FIELDS}
+        "angular_velocity": rad/s, "seeds": bool, "roughness_draws": K}`` (every key optional
+        but one that varies something)."""
+        unknown = set(spec) - {"bodies", "seeds", "roughness_draws", *FIELDS}
         if unknown:
             raise ValueError(
                 f"variation has unknown keys {sorted(unknown)}: use bodies, seeds, "
-                f"{', '.join(FIELDS)}"
+                f"roughness_draws, {', '.join(FIELDS)}"
             )
         return Variation(**dict(spec))
 
@@ -115,6 +142,8 @@ class Variation:
         out.update(self.scales)
         if self.seeds:
             out["seeds"] = True
+        if self.roughness_draws:
+            out["roughness_draws"] = self.roughness_draws
         return out
 
     def fields(self) -> list[str]:
@@ -154,15 +183,20 @@ class Variation:
             indices.append(index)
         return indices
 
+    def per_body(self) -> int:
+        """θ's components per varied body: 3 per varied field, then 2 per roughness draw."""
+        return 3 * len(self.fields()) + 2 * self.roughness_draws
+
     def dimension(self, scene: Mapping[str, Any]) -> int:
-        """Length of θ for ``scene``: 3 per varied field per varied body."""
-        return 3 * len(self.fields()) * len(self.body_indices(scene))
+        """Length of θ for ``scene``: :meth:`per_body` per varied body."""
+        return self.per_body() * len(self.body_indices(scene))
 
     def apply(
         self, scene: Mapping[str, Any], theta: Sequence[float], seed: int | None = None
     ) -> dict[str, Any]:
-        """A copy of ``scene`` (a dict as in a scene file) with θ's offsets applied and the
-        changed values rounded to float32; with ``seed``, also the scene's ``seed``.
+        """A copy of ``scene`` (a dict as in a scene file) with θ's offsets applied (and its
+        roughness draws written as the varied bodies' ``roughness_draws``) and the changed
+        values rounded to float32; with ``seed``, also the scene's ``seed``.
 
         Raises
         ------
@@ -172,10 +206,10 @@ class Variation:
         theta = np.asarray(theta, dtype=np.float64)
         indices = self.body_indices(scene)
         fields = self.fields()
-        if theta.shape != (3 * len(fields) * len(indices),):
+        if theta.shape != (self.per_body() * len(indices),):
             raise ValueError(
                 f"theta has shape {theta.shape}, the variation needs "
-                f"({3 * len(fields) * len(indices)},)"
+                f"({self.per_body() * len(indices)},)"
             )
         if not np.all(np.isfinite(theta)):
             raise ValueError("theta must be finite")
@@ -196,6 +230,10 @@ class Variation:
                     key = {"velocity": "linear_velocity"}.get(name, name)
                     value = np.asarray(body.get(key, [0.0, 0.0, 0.0]), dtype=np.float64)
                     body[key] = _float32_list(value + offset)
+            if self.roughness_draws:
+                draws = theta[k : k + 2 * self.roughness_draws]
+                k += 2 * self.roughness_draws
+                body["roughness_draws"] = [_float32_list(pair) for pair in draws.reshape(-1, 2)]
         return out
 
     @staticmethod

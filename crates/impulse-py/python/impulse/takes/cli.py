@@ -55,6 +55,13 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="give each take its own scene seed (the rough surfaces' draws)",
     )
+    search.add_argument(
+        "--vary-roughness-draws",
+        type=int,
+        metavar="K",
+        help="give each varied body's first K rough contacts draws from the take's θ "
+        "(2K components per body) instead of the seed",
+    )
     for field, unit in (
         ("position", "m"),
         ("angle", "degrees"),
@@ -87,6 +94,8 @@ def _variation(arguments: argparse.Namespace, spec: dict[str, Any]) -> dict[str,
         out["bodies"] = [name.strip() for name in arguments.vary_bodies.split(",")]
     if arguments.vary_seed:
         out["seeds"] = True
+    if arguments.vary_roughness_draws is not None:
+        out["roughness_draws"] = arguments.vary_roughness_draws
     for field in ("position", "angle", "velocity", "angular_velocity"):
         value = getattr(arguments, f"vary_{field}")
         if value is not None:

@@ -28,7 +28,7 @@ impl World {
         if self.bodies.roughness.iter().any(|&r| r > 0.0) {
             crate::contact::roughness::draw_new_manifolds(
                 &mut self.narrow_phase.pairs,
-                &self.bodies,
+                &mut self.bodies,
                 self.seed,
                 self.step_count,
             );
