@@ -65,12 +65,15 @@ pub(crate) fn spread(allowed: bool, items: usize, more_than: usize) -> bool {
     allowed && items > more_than && rayon::current_num_threads() > 1
 }
 
-/// Runs `run` on a thread of rayon's pool when threads are `allowed` and the caller is outside
-/// any pool (a program's main thread), else on the calling thread. Work spread from outside a
-/// pool waits for each piece to be handed over and back, and a step spreads hundreds of pieces
-/// (each colour of each substep), so a step is better run inside the pool as a whole.
+/// Runs `run` on a thread of rayon's pool when threads are `allowed`, the caller is outside
+/// any pool (a program's main thread) and the pool has more than one thread, else on the
+/// calling thread. Work spread from outside a pool waits for each piece to be handed over and
+/// back, and a step spreads hundreds of pieces (each colour of each substep), so a step is
+/// better run inside the pool as a whole. A pool of one thread spreads nothing, and handing
+/// the step to it and back would cost two thread wake-ups a step for nothing (a sweep's workers
+/// run on one thread each).
 pub(crate) fn in_pool<R: Send>(allowed: bool, run: impl FnOnce() -> R + Send) -> R {
-    if allowed && rayon::current_thread_index().is_none() {
+    if allowed && rayon::current_thread_index().is_none() && rayon::current_num_threads() > 1 {
         rayon::scope(|_| run())
     } else {
         run()
