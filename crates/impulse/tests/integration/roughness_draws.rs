@@ -28,21 +28,23 @@ fn floor(gravity: f32, roughness: f32) -> World {
     world
 }
 
+/// A frictionless elastic particle (radius 0.1 m) 0.4 m up, coming straight down at 3 m/s,
+/// with `draws`.
+fn falling_particle(draws: &[[f32; 2]]) -> BodyBuilder {
+    BodyBuilder::particle(0.1)
+        .translation(Vec3::new(0.0, 0.4, 0.0))
+        .linear_velocity(Vec3::new(0.0, -3.0, 0.0))
+        .friction(0.0)
+        .restitution(1.0)
+        .roughness_draws(draws.iter().copied())
+}
+
 /// The velocity just after a frictionless elastic particle (radius 0.1 m, rotation locked, so
 /// the impulse along the tilted normal reflects its velocity exactly) with `draws` meets the
 /// floor of `roughness` degrees, coming straight down at 3 m/s without gravity.
 fn bounce(roughness: f32, draws: &[[f32; 2]]) -> Vec3 {
     let mut world = floor(0.0, roughness);
-    let ball = world
-        .insert(
-            BodyBuilder::particle(0.1)
-                .translation(Vec3::new(0.0, 0.4, 0.0))
-                .linear_velocity(Vec3::new(0.0, -3.0, 0.0))
-                .friction(0.0)
-                .restitution(1.0)
-                .roughness_draws(draws.iter().copied()),
-        )
-        .unwrap();
+    let ball = world.insert(falling_particle(draws)).unwrap();
     let index = world.body(ball).unwrap().index();
     for _ in 0..60 {
         world.step().unwrap();
@@ -118,16 +120,7 @@ fn the_pairs_first_body_gives_its_draw_first() {
                 .roughness_draws([a]),
         )
         .unwrap();
-    let ball = world
-        .insert(
-            BodyBuilder::particle(0.1)
-                .translation(Vec3::new(0.0, 0.4, 0.0))
-                .linear_velocity(Vec3::new(0.0, -3.0, 0.0))
-                .friction(0.0)
-                .restitution(1.0)
-                .roughness_draws([b]),
-        )
-        .unwrap();
+    let ball = world.insert(falling_particle(&[b])).unwrap();
     let index = world.body(ball).unwrap().index();
     let v = (0..60)
         .find_map(|_| {
