@@ -19,8 +19,8 @@ step").
    the direction the pin moves off in (degrees from straight back) at several steps.
 
     python3 scripts/bowling-split.py lines
-    python3 scripts/bowling-split.py around takes/bowling-random TAKE_ID --sizes 0.003,0.03,0.1
-    python3 scripts/bowling-split.py reroll takes/bowling-random TAKE_ID --roughness 0.3,1
+    python3 scripts/bowling-split.py around takes/bowling TAKE_ID --sizes 0.003,0.03,0.1
+    python3 scripts/bowling-split.py reroll takes/bowling TAKE_ID --roughness 0.3,1
     python3 scripts/bowling-split.py steps --steps 1/60:20,1/120:10,1/240:5,1/480:3,1/240:20
     python3 scripts/bowling-split.py hit --offsets 0.05,0.1,0.14 --steps 1/60:20,1/240:5,1/960:2
 
