@@ -167,3 +167,14 @@ pub(crate) fn segment_crosses_box(a: Vec3, b: Vec3, extents: Vec3) -> bool {
     }
     enter <= leave
 }
+
+/// Steps `world` `steps` times (each step must succeed) and returns its bodies' poses then.
+pub(crate) fn poses_after(
+    world: &mut impulse::World,
+    steps: usize,
+) -> Vec<impulse::parry3d::math::Pose> {
+    for _ in 0..steps {
+        world.step().unwrap();
+    }
+    world.poses().to_vec()
+}

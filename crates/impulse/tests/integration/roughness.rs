@@ -5,6 +5,7 @@
 //! above the tilt stays put; the same seed gives the same bits (also through a snapshot), and a
 //! smooth world draws nothing.
 
+use crate::common::poses_after;
 use glam::Vec3;
 use impulse::{BodyBuilder, SharedShape, SolverSettings, World, WorldSnapshot};
 
@@ -129,23 +130,20 @@ fn the_draws_are_the_seeds_and_survive_a_snapshot() {
         }
         world
     };
-    let run = |world: &mut World, steps: usize| {
-        for _ in 0..steps {
-            world.step().unwrap();
-        }
-        world.poses().to_vec()
-    };
-    let first = run(&mut throw(8.0, 11), 150);
-    assert_eq!(first, run(&mut throw(8.0, 11), 150));
-    assert_ne!(first, run(&mut throw(8.0, 12), 150));
-    assert_eq!(run(&mut throw(0.0, 11), 150), run(&mut throw(0.0, 12), 150));
+    let first = poses_after(&mut throw(8.0, 11), 150);
+    assert_eq!(first, poses_after(&mut throw(8.0, 11), 150));
+    assert_ne!(first, poses_after(&mut throw(8.0, 12), 150));
+    assert_eq!(
+        poses_after(&mut throw(0.0, 11), 150),
+        poses_after(&mut throw(0.0, 12), 150)
+    );
 
     let mut world = throw(8.0, 11);
-    run(&mut world, 40);
+    poses_after(&mut world, 40);
     let bytes = world.snapshot().unwrap().to_bytes().unwrap();
     let mut restored = World::from_snapshot(WorldSnapshot::from_bytes(&bytes).unwrap()).unwrap();
     assert_eq!(restored.seed(), 11);
-    assert_eq!(run(&mut restored, 110), first);
+    assert_eq!(poses_after(&mut restored, 110), first);
 }
 
 /// Roughness beyond 30° is refused, naming the field.

@@ -6,6 +6,7 @@
 //! particle leaves at twice the tilt from vertical; the draws given are world state (kept
 //! through a snapshot); bad draws are refused naming the body and field.
 
+use crate::common::poses_after;
 use glam::Vec3;
 use impulse::{BodyBuilder, SharedShape, SolverSettings, World, WorldSnapshot};
 
@@ -153,32 +154,26 @@ fn the_draws_given_survive_a_snapshot() {
             .unwrap();
         world
     };
-    let run = |world: &mut World, steps: usize| {
-        for _ in 0..steps {
-            world.step().unwrap();
-        }
-        world.poses().to_vec()
-    };
     let draws = [[0.8f32, -0.3], [1.2, 0.4], [-0.5, 0.9]];
     let mut world = drop(&draws);
-    let after_first = run(&mut world, 30);
+    let after_first = poses_after(&mut world, 30);
     assert!(
         world.linear_velocities()[1].y > 0.0,
         "bounced once by step 30"
     );
     let bytes = world.snapshot().unwrap().to_bytes().unwrap();
     let mut restored = World::from_snapshot(WorldSnapshot::from_bytes(&bytes).unwrap()).unwrap();
-    let uninterrupted = run(&mut world, 150);
-    assert_eq!(run(&mut restored, 150), uninterrupted);
+    let uninterrupted = poses_after(&mut world, 150);
+    assert_eq!(poses_after(&mut restored, 150), uninterrupted);
     // One thread gives the same draws to the same contacts.
     let mut serial = drop(&draws);
     serial.set_parallel(false);
-    assert_eq!(run(&mut serial, 180), uninterrupted);
+    assert_eq!(poses_after(&mut serial, 180), uninterrupted);
     // The first bounce is the first draw's; the rest is the second and third draws'.
-    assert_eq!(run(&mut drop(&draws[..1]), 30), after_first);
-    assert_ne!(run(&mut drop(&draws[..1]), 180), uninterrupted);
+    assert_eq!(poses_after(&mut drop(&draws[..1]), 30), after_first);
+    assert_ne!(poses_after(&mut drop(&draws[..1]), 180), uninterrupted);
     assert_ne!(
-        run(&mut drop(&[draws[0], draws[0], draws[0]]), 180),
+        poses_after(&mut drop(&[draws[0], draws[0], draws[0]]), 180),
         uninterrupted
     );
 }
