@@ -3,15 +3,17 @@
 //!
 //! An impact's sweeps make the rows of the bodies that hit converge; in a pile of thousands of
 //! points every other row is at rest and its sweeps change nothing the impact needs, yet in a
-//! pour some body is always landing somewhere, so sweeping the whole island made every substep
-//! of a 55,000-point pile take 65 sweeps. Here the sweeps go on a region instead: the bodies
-//! of the contacts closing faster than the impact speed as the step started (the impact's
-//! seeds), the bodies sharing a contact with them, out to [`IMPACT_RINGS`] rings of the
-//! contact graph, and every point touching one of those bodies. The other points keep their
-//! impulses through those sweeps: block Gauss-Seidel, the region's block solved on to the
-//! tolerance with the rest held, which the next substep's sweeps over the whole island take up.
-//! Static bodies and guests (kinematic bodies) carry no impulse on, so the region never grows
-//! through them.
+//! pour some body is always landing somewhere. Here the sweeps go on a region instead, found
+//! anew at every substep's main solve: the bodies of the contacts that closed faster than the
+//! impact speed as the step started *and* whose normal velocity that main solve changed by more
+//! than the impact change (the rows the substep struck: the impact's seeds), and every point
+//! touching one of those bodies. The other points keep their impulses through those sweeps:
+//! block Gauss-Seidel, the region's block solved on with the rest held, which the next
+//! substep's sweeps over the whole island take up. A region taken once a step from the closing
+//! contacts alone covered a settling pour (every tumbling cube closes faster than |g|·dt on
+//! some contact), so the whole pile swept 32 more times a solve; taken per substep from the
+//! struck rows, it holds the landings of that substep. Static bodies and guests (kinematic
+//! bodies) are never in it.
 //!
 //! An island below [`LOCAL_IMPACT_MIN_POINTS`], or one whose region holds more than half its
 //! points, takes the whole-island sweeps as before: there the region saves little, and the
@@ -19,30 +21,38 @@
 
 #[cfg(doc)]
 use super::interface::SolvePass;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use super::interface::SolveReport;
 use super::lanes::Bundles;
 use super::pgs::solve_pgs_rows;
 use super::rows::Velocities;
 use crate::body::Bodies;
-use crate::contact::{ContactConstraint, row_closes_faster_than};
+use crate::contact::{ContactConstraint, JacobianRow, row_closes_faster_than};
 use crate::joint::IslandJoints;
 use crate::solver::interface::Sweep;
 
-/// Rings of the contact graph the region takes beyond the impact's bodies. With none, the
-/// impact's sweeps would take the struck body's contacts with its supports but not theirs with
-/// what holds them, and the support (its impulses held) would give way under the blow for the
-/// substep. One ring takes the supports' supports: the blow's impulse goes through the struck
-/// body into what holds it within the substep, as the whole island's sweeps carried it
-/// (`a_cube_dropped_onto_a_resting_grid_stops_dead_and_sweeps_only_around_the_impact`).
-pub(crate) const IMPACT_RINGS: u8 = 1;
+/// The region's sweeps stop once no row's velocity changes by more than this fraction of the
+/// impact change (or the solve's tolerance, if larger): a tenth of the change that made the
+/// impact is enough for the struck face's corners to share the blow evenly (a cube dropped
+/// flat onto a pile or a slab stops dead, `tests/integration/local_impacts.rs` and
+/// `dead_impacts.rs`), and the region's points need not converge further than the rest of the
+/// island, which one sweep a solve leaves far coarser.
+pub(crate) const LOCAL_IMPACT_TOLERANCE: f32 = 0.1;
 
 /// Contact points from which an island's impact sweeps are local.
 pub(crate) const LOCAL_IMPACT_MIN_POINTS: usize = 1024;
 
-/// A slot outside the region.
-const OUTSIDE: u8 = u8::MAX;
+/// The island's velocities (by slot: m/s and rad/s) before and after a substep's main solve,
+/// and the change of a row's normal velocity (m/s) beyond which the solve struck the row
+/// ([`ImpactRegion::find_in`]).
+pub(crate) struct SubstepChange<'a> {
+    pub linear_before: &'a [Vec3],
+    pub angular_before: &'a [Vec3],
+    pub linear_after: &'a [Vec3],
+    pub angular_after: &'a [Vec3],
+    pub limit: f32,
+}
 
 /// Where this step's impact sweeps go, once asked.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -60,9 +70,8 @@ pub(crate) enum RegionKind {
 /// scratch of their scalar sweeps.
 #[derive(Default)]
 pub(crate) struct ImpactRegion {
-    /// Per island slot, the ring at which its body joined the region (0: a body of a contact
-    /// closing faster than the impact speed), or [`OUTSIDE`].
-    ring: Vec<u8>,
+    /// Per island slot, whether its body is a seed of the region.
+    seed: Vec<bool>,
     /// Constraint indices of the region's points, ascending (the sweep's order).
     points: Vec<u32>,
     /// The region's rows, copied for the scalar sweeps.
@@ -83,15 +92,17 @@ impl ImpactRegion {
     /// Whether the island's slot `slot` is in the region.
     #[inline]
     pub(crate) fn contains(&self, slot: u32) -> bool {
-        self.ring.get(slot as usize).is_some_and(|&r| r != OUTSIDE)
+        self.seed.get(slot as usize).copied().unwrap_or(false)
     }
 
     /// Finds the region of an island whose `moving` first slots are its own bodies (the rest
     /// its guests and the immovable slot): the seeds are the bodies of every contact closing
     /// faster than `speed` (m/s) at the bodies' velocities as the step started (`linear` in
-    /// m/s, `angular` in rad/s, indexed by body as the impact test reads them), then [`IMPACT_RINGS`] rings. Sets [`Self::kind`]: local
-    /// when the island has at least [`LOCAL_IMPACT_MIN_POINTS`] points and the region at most
-    /// half of them, whole otherwise.
+    /// m/s, `angular` in rad/s, indexed by body as the impact test reads them) that is
+    /// `struck` (the substep's main solve changed its normal velocity by more than the impact
+    /// change: [`ImpactRegion::find_in`]), and every point touching one of them. Sets [`Self::kind`]:
+    /// local when the island has at least [`LOCAL_IMPACT_MIN_POINTS`] points and the region at
+    /// most half of them, whole otherwise.
     pub(crate) fn find(
         &mut self,
         constraints: &[ContactConstraint],
@@ -99,39 +110,26 @@ impl ImpactRegion {
         angular: &[Vec3],
         speed: f32,
         moving: usize,
+        struck: impl Fn(&ContactConstraint) -> bool,
     ) -> RegionKind {
         self.points.clear();
         self.kind = RegionKind::Whole;
         if constraints.len() < LOCAL_IMPACT_MIN_POINTS {
             return self.kind;
         }
-        self.ring.clear();
-        self.ring.resize(moving, OUTSIDE);
+        self.seed.clear();
+        self.seed.resize(moving, false);
         for c in constraints {
-            if row_closes_faster_than(c, linear, angular, speed) {
+            if row_closes_faster_than(c, linear, angular, speed) && struck(c) {
                 for slot in [c.local_a, c.local_b] {
-                    if let Some(r) = self.ring.get_mut(slot as usize) {
-                        *r = 0;
+                    if let Some(seed) = self.seed.get_mut(slot as usize) {
+                        *seed = true;
                     }
                 }
             }
         }
-        for ring in 0..IMPACT_RINGS {
-            // Only from bodies of earlier rings, so the pass's order does not matter.
-            let inner = |r: u8| r <= ring;
-            for c in constraints {
-                let (a, b) = (c.local_a as usize, c.local_b as usize);
-                let (ra, rb) = (self.ring_of(a), self.ring_of(b));
-                if inner(ra) && rb == OUTSIDE && b < moving {
-                    self.ring[b] = ring + 1;
-                }
-                if inner(rb) && ra == OUTSIDE && a < moving {
-                    self.ring[a] = ring + 1;
-                }
-            }
-        }
-        let ring = &self.ring;
-        let inside = |slot: u32| ring.get(slot as usize).is_some_and(|&r| r != OUTSIDE);
+        let seed = &self.seed;
+        let inside = |slot: u32| seed.get(slot as usize).copied().unwrap_or(false);
         self.points.extend(
             constraints
                 .iter()
@@ -150,6 +148,7 @@ impl ImpactRegion {
     /// the lane groups its sweeps visit ([`Bundles::select_local`]; [`Self::size`] then counts
     /// their points). An island with `joints`, whose impacts no contact's closing speed tells,
     /// sweeps whole.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn find_in(
         &mut self,
         constraints: &[ContactConstraint],
@@ -157,6 +156,7 @@ impl ImpactRegion {
         speed: f32,
         moving: usize,
         joints: bool,
+        change: SubstepChange<'_>,
         wide: Option<&mut Bundles>,
     ) -> RegionKind {
         if joints {
@@ -164,17 +164,29 @@ impl ImpactRegion {
             return self.kind;
         }
         let (linear, angular) = (&bodies.linear_velocity, &bodies.angular_velocity);
-        let kind = self.find(constraints, linear, angular, speed, moving);
+        let struck = |c: &ContactConstraint| {
+            let (a, b) = (c.local_a as usize, c.local_b as usize);
+            let d = Vec3A::from(c.normal.direction);
+            let row = JacobianRow {
+                direction: c.normal.direction,
+                angular_a: Vec3A::from(c.lever_a).cross(d).into(),
+                angular_b: Vec3A::from(c.lever_b).cross(d).into(),
+                ..JacobianRow::default()
+            };
+            let delta = |slot: usize| {
+                (
+                    change.linear_after[slot] - change.linear_before[slot],
+                    change.angular_after[slot] - change.angular_before[slot],
+                )
+            };
+            let ((va, wa), (vb, wb)) = (delta(a), delta(b));
+            row.velocity(va, wa, vb, wb).abs() > change.limit
+        };
+        let kind = self.find(constraints, linear, angular, speed, moving, struck);
         if let (RegionKind::Local, Some(wide)) = (kind, wide) {
             self.size = wide.select_local(|slot| self.contains(slot));
         }
         kind
-    }
-
-    /// The ring of slot `slot` ([`OUTSIDE`] for a guest or the immovable slot).
-    #[inline]
-    fn ring_of(&self, slot: usize) -> u8 {
-        self.ring.get(slot).copied().unwrap_or(OUTSIDE)
     }
 
     /// PGS on the region's points of `constraints` alone (the scalar path), the others' impulses

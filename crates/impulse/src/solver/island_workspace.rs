@@ -100,8 +100,12 @@ pub(crate) struct IslandWorkspace {
     /// faster than `impact_speed` as the step started. `None` until a main solve's last sweep
     /// asks ([`crate::contact::closes_faster_than`], a pass over the rows).
     pub(super) closing: Option<bool>,
-    /// Where the step's impact sweeps go: the whole island or the points around the impact.
+    /// Where the substep's impact sweeps go: the whole island or the points around the impact.
     pub(super) impact_region: ImpactRegion,
+    /// The island's velocities by slot (m/s, rad/s) as the substep's main solve started, after
+    /// the warm start; kept for islands whose impact sweeps can be local
+    /// ([`super::impact_region::LOCAL_IMPACT_MIN_POINTS`]).
+    pub(super) velocities_before_main: (Vec<Vec3>, Vec<Vec3>),
     /// The rows of the island's joints, written by the assembly stage.
     pub(crate) joints: IslandJoints,
     /// Whether the island's step left its rows' impulses, J·v* and targets in its SIMD lanes

@@ -12,7 +12,7 @@ use glam::{Mat3, Vec3};
 use super::heavy_on_light::{
     HeavyOnLight, heavy_on_light, heavy_on_light_max_contacts, heavy_on_light_settings, mass_ratio,
 };
-use super::impact_region::RegionKind;
+use super::impact_region::{LOCAL_IMPACT_MIN_POINTS, RegionKind, SubstepChange};
 use super::interface::Sweep;
 use super::interface::{ContactSolver, SolveOutcome, SolvePass, TargetInputs};
 use super::island_report::IslandReport;
@@ -130,6 +130,18 @@ impl IslandWorkspace {
             self.joints
                 .update_targets(&self.displacement, &self.orientation, with_repair);
         }
+        // A large island's impact region is found anew at every main solve, from the rows the
+        // solve struck: the velocities before it are kept to tell them.
+        let may_be_local =
+            with_repair && constraints.len() >= LOCAL_IMPACT_MIN_POINTS && self.joints.is_empty();
+        if with_repair {
+            self.impact_region.reset();
+        }
+        if may_be_local {
+            let (linear, angular) = &mut self.velocities_before_main;
+            linear.clone_from(&self.linear);
+            angular.clone_from(&self.angular);
+        }
         let mut velocities = Velocities {
             linear: &mut self.linear,
             angular: &mut self.angular,
@@ -164,8 +176,15 @@ impl IslandWorkspace {
             let wide = bundled.then_some(&mut self.solvers.wide);
             let (speed, moving) = (self.impact_speed, self.report.bodies as usize);
             let joints = !self.joints.is_empty();
+            let change = SubstepChange {
+                linear_before: &self.velocities_before_main.0,
+                angular_before: &self.velocities_before_main.1,
+                linear_after: &self.linear,
+                angular_after: &self.angular,
+                limit: impact_change,
+            };
             self.impact_region
-                .find_in(constraints, bodies, speed, moving, joints, wide);
+                .find_in(constraints, bodies, speed, moving, joints, change, wide);
         }
         let local = self.impact_region.kind == RegionKind::Local;
         let more = if self.impact_met && local {

@@ -3,6 +3,7 @@
 
 use super::{IMPACT_SWEEPS, IslandWorkspace};
 use crate::contact::ContactConstraint;
+use crate::solver::impact_region::LOCAL_IMPACT_TOLERANCE;
 #[cfg(doc)]
 use crate::solver::interface::SolvePass;
 use crate::solver::interface::{EscalationLevel, SolveOutcome};
@@ -18,6 +19,7 @@ impl IslandWorkspace {
         bundled: bool,
         (tolerance, friction, half_turn): (f32, bool, bool),
     ) -> SolveOutcome {
+        let tolerance = tolerance.max(LOCAL_IMPACT_TOLERANCE * self.impact_change);
         let mut velocities = Velocities {
             linear: &mut self.linear,
             angular: &mut self.angular,
