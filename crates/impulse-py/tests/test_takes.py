@@ -515,11 +515,12 @@ def test_the_contact_sheet_draws_previews_and_sorts_in_a_browser(
         SCENE,
         [TARGET],
         VARIATION,
-        budget=8,
-        steps=20,
+        budget=32,
+        steps=STEPS,
         out=out,
         workers=2,
         population=8,
+        stop_after=2,
         progress=False,
     )
     monkeypatch.setenv("IMPULSE_CLI", impulse_cli)
@@ -577,6 +578,17 @@ def test_the_contact_sheet_draws_previews_and_sorts_in_a_browser(
             for c in driver.find_elements(By.CSS_SELECTOR, "figure.take")
         ]
         assert order == [t.take_id for t in sorted(shown, key=lambda t: t.perturbation)]
+        # "Only takes that meet every goal" shows exactly those.
+        assert 0 < sum(t.met for t in shown) < len(shown)
+        driver.find_element(By.ID, "only-met").click()
+        visible = [
+            c.get_attribute("data-take-id")
+            for c in driver.find_elements(By.CSS_SELECTOR, "figure.take")
+            if c.is_displayed()
+        ]
+        assert visible == [t.take_id for t in shown if t.met]
+        driver.find_element(By.ID, "only-met").click()
+        assert all(c.is_displayed() for c in driver.find_elements(By.CSS_SELECTOR, "figure.take"))
     finally:
         driver.quit()
 
