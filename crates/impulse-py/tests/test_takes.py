@@ -1351,3 +1351,127 @@ def test_refine_searches_around_a_take_keeping_the_goals(tmp_path, capsys):
     assert len(again) == 8
     with pytest.raises(KeyError, match="no take 'ffff'"):
         refine(custom_out, "ffff", budget=8, goals=[custom(_within_reach, "reach")])
+
+
+def _read_png(path):
+    """The pixels of an 8-bit RGB or RGBA PNG (what `impulse render --out` writes), (H, W, C)
+    uint8: the chunks' zlib stream unfiltered row by row (the PNG specification's five
+    filters)."""
+    import struct
+    import zlib
+
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    position, compressed = 8, b""
+    while position < len(data):
+        length, kind = struct.unpack(">I4s", data[position : position + 8])
+        body = data[position + 8 : position + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour = struct.unpack(">IIBB", body[:10])
+        elif kind == b"IDAT":
+            compressed += body
+        position += 12 + length
+    assert depth == 8 and colour in (2, 6)
+    channels = 3 if colour == 2 else 4
+    raw = zlib.decompress(compressed)
+    stride = width * channels
+    previous = np.zeros(stride, dtype=np.int64)
+    rows = []
+    for y in range(height):
+        kind = raw[y * (stride + 1)]
+        row = np.frombuffer(raw, np.uint8, stride, y * (stride + 1) + 1).astype(np.int64)
+        if kind == 0:
+            current = row
+        elif kind == 2:
+            current = (row + previous) & 255
+        else:
+            current = np.zeros(stride, dtype=np.int64)
+            for x in range(stride):
+                a = current[x - channels] if x >= channels else 0
+                b = previous[x]
+                c = previous[x - channels] if x >= channels else 0
+                if kind == 1:
+                    predicted = a
+                elif kind == 3:
+                    predicted = (a + b) // 2
+                else:  # Paeth
+                    pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                    predicted = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                current[x] = (row[x] + predicted) & 255
+        rows.append(current)
+        previous = current
+    return np.array(rows, dtype=np.uint8).reshape(height, width, channels)
+
+
+def _drawn_box(impulse_cli, scene, body, camera_arguments, tmp_path, size="192x144"):
+    """The pixel box (width, height) ``body`` covers in ``scene``'s first frame: the frame
+    drawn as it is and with the body shrunk to a 1 mm sphere, the same camera; the box of the
+    pixels that differ."""
+    frames = []
+    for shrunk in (False, True):
+        drawn = json.loads(json.dumps(scene))
+        if shrunk:
+            drawn["bodies"][body].update(shape={"type": "sphere", "radius": 1e-3}, mass=1.0)
+        folder = tmp_path / f"frames-{shrunk}"
+        path = tmp_path / f"scene-{shrunk}.json"
+        path.write_text(json.dumps(drawn))
+        subprocess.run(
+            [impulse_cli, "render", str(path), "--out", str(folder), "--steps", "0", "--size",
+             size, "--quiet", *camera_arguments],
+            check=True,
+            capture_output=True,
+        )
+        frames.append(_read_png(folder / "frame_00000.png"))
+    ys, xs = np.nonzero(np.any(frames[0] != frames[1], axis=-1))
+    return (int(np.ptp(xs)) + 1, int(np.ptp(ys)) + 1) if xs.size else (0, 0)
+
+
+#: A coin 25 mm wide dropped 1 cm onto a 1 m table, and a ball rolling 2 m away: framed with
+#: the ball, the coin is a few pixels.
+COIN = {
+    "name": "coin on a table",
+    "bodies": [
+        {"name": "ground", "kind": "static", "shape": {"type": "half_space", "normal": [0, 1, 0]}},
+        {"name": "table", "kind": "static", "position": [0, 0.375, 0],
+         "shape": {"type": "cuboid", "half_extents": [0.5, 0.375, 0.5]}},
+        {"name": "coin", "kind": "dynamic", "position": [0.2, 0.761, 0.1],
+         "shape": {"type": "cylinder", "half_height": 0.001, "radius": 0.0125}},
+        {"name": "ball", "kind": "dynamic", "position": [-2.0, 0.1, -1.0],
+         "linear_velocity": [0.5, 0, 0], "shape": {"type": "sphere", "radius": 0.1}},
+    ],
+}
+
+
+def test_a_preview_frames_the_goal_bodies(tmp_path, impulse_cli):
+    from impulse.takes._sheet import _camera_arguments
+
+    goal = {"type": "rests_with_axis_up", "body": "coin", "axis": [0, 1, 0]}
+    out = tmp_path / "t"
+    search(COIN, [goal], {"bodies": ["coin"], "velocity": 0.01}, budget=2, steps=60, out=out,
+           workers=2, population=2, progress=False)
+    takes = load(out)
+    take = takes.best(1)[0]
+    # The coin where the take ends, drawn with the sheet's cameras.
+    record, _, _ = simulate_take(take.scene(), 60, [])
+    posed = take.scene()
+    coin = posed["bodies"][2]
+    coin.update(position=record.positions[-1, 2].tolist(),
+                orientation=record.orientations[-1, 2].tolist(), linear_velocity=[0, 0, 0])
+    framed = _drawn_box(
+        impulse_cli, posed, 2, _camera_arguments("goals", take, takes, (192, 144)), tmp_path
+    )
+    assert framed[0] >= 20 and framed[1] >= 20, framed
+    # impulse render's own view (the sheet's camera="scene"), as it reports it.
+    path = tmp_path / "posed.json"
+    path.write_text(json.dumps(posed))
+    done = subprocess.run(
+        [impulse_cli, "render", str(path), "--out", str(tmp_path / "own"), "--steps", "0",
+         "--size", "192x144"],
+        check=True, capture_output=True, text=True,
+    )
+    import re
+
+    eye, target = re.search(r"camera eye (\S+) target (\S+)", done.stdout + done.stderr).groups()
+    own = ["--camera-eye", eye, "--camera-target", target]
+    scene_view = _drawn_box(impulse_cli, posed, 2, own, tmp_path)
+    assert scene_view[0] < 20 and scene_view[1] < 20, scene_view

@@ -76,43 +76,71 @@ def _extent(shape: Any) -> float:
     return 0.0
 
 
-def _goal_bodies(specs: Any) -> list[Any]:
-    """The bodies the search's JSON goals name (``body`` and ``other``), in order, once."""
-    bodies: list[Any] = []
+#: The goals that read a body's pose at one time (``at``, default the end); the others read it
+#: over a window (``between``, default the whole take).
+_AT_ONE_TIME = ("ends_inside", "rests_with_axis_up", "tilted")
+
+
+def goal_views(specs: Any) -> list[tuple[Any, str, Any]]:
+    """What the search's JSON goals look at: ``(body, "at", seconds or None)`` for a goal read
+    at one time (None: the end) and ``(body, "between", [t0, t1] or None)`` for one read over
+    a window (None: the whole take), for ``body`` and ``other``."""
+    views: list[tuple[Any, str, Any]] = []
     for spec in specs or []:
-        if isinstance(spec, dict) and "type" in spec:
-            for field in ("body", "other"):
-                if field in spec and spec[field] not in bodies:
-                    bodies.append(spec[field])
-    return bodies
+        if not isinstance(spec, dict) or "type" not in spec:
+            continue
+        if spec["type"] in _AT_ONE_TIME:
+            when: tuple[str, Any] = ("at", spec.get("at"))
+        else:
+            when = ("between", spec.get("between"))
+        for field in ("body", "other"):
+            if field in spec:
+                views.append((spec[field], *when))
+    return views
 
 
 def goal_camera(
     scene: dict[str, Any],
     steps: int,
-    bodies: list[Any],
+    views: list[tuple[Any, str, Any]],
     size: tuple[int, int],
     preset: str | None = None,
 ) -> tuple[list[float], list[float]] | None:
     """The camera (eye, target; m) of a ``goals`` preview: ``impulse render``'s three-quarter
-    view and field of view, aimed at the centre of the box that holds the goal ``bodies`` on
-    their whole paths (each grown by its shape's extent), and far enough that the box's
-    bounding sphere, times :data:`MARGIN`, fits the ``size`` (W, H) image. ``None`` when no
-    goal names a body (custom goals only)."""
+    view and field of view, aimed at the centre of the box that holds the moving bodies the
+    goals look at (:func:`goal_views`) when they look (at the end for a body that must rest,
+    over its window for one that must pass through or touch), each grown by its shape's
+    extent, and far enough that the box's bounding sphere, times :data:`MARGIN`, fits the
+    ``size`` (W, H) image. Static bodies (the ground a ball must touch) are left out. ``None``
+    when the goals look at no moving body (custom goals only, say)."""
     from impulse.takes._search import simulate_take
 
-    if not bodies:
+    shapes = scene.get("bodies", [])
+    moving = [
+        view
+        for view in views
+        if not isinstance(view[0], int) or view[0] >= len(shapes) or view[0] < 0
+        or shapes[view[0]].get("kind", "static") != "static"
+    ]
+    if not moving:
         return None
     record, _, _ = simulate_take(scene, steps, [], preset)
-    indices = [record.body(body) for body in bodies]
-    shapes = scene.get("bodies", [])
     low = np.full(3, np.inf)
     high = np.full(3, -np.inf)
-    for index in indices:
-        path = record.positions[:, index]
+    for body, kind, when in moving:
+        index = record.body(body)
+        if index < len(shapes) and shapes[index].get("kind", "static") == "static":
+            continue
+        if kind == "at":
+            frames = [len(record.times) - 1] if when is None else record.window([when, when])[:1]
+        else:
+            frames = record.window(when)
+        path = record.positions[frames, index]
         extent = _extent(shapes[index].get("shape")) if index < len(shapes) else 0.0
         low = np.minimum(low, path.min(axis=0) - extent)
         high = np.maximum(high, path.max(axis=0) + extent)
+    if not np.all(np.isfinite(low)):
+        return None
     centre = 0.5 * (low + high)
     radius = max(MARGIN * 0.5 * float(np.linalg.norm(high - low)), 1e-3)
     width, height = size
@@ -143,7 +171,7 @@ def _camera_arguments(
         framed = goal_camera(
             take.scene(),
             int(takes.manifest["steps"]),
-            _goal_bodies(takes.manifest.get("goals")),
+            goal_views(takes.manifest.get("goals")),
             size,
             takes.manifest.get("preset"),
         )
