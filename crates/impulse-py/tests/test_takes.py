@@ -689,6 +689,10 @@ def test_takes_with_their_own_seeds_vary_the_rough_surfaces(tmp_path):
     seeds = [take.scene_seed for take in takes.values()]
     assert all(isinstance(s, int) and s > 0 for s in seeds)
     assert len(set(seeds)) > 8  # fresh seeds, and the best ones reused
+    # θ is empty: a reused seed is the same take, read back however often it is drawn and
+    # counted each time, so the budget of 32 is two generations.
+    assert len(takes) < 32
+    assert takes.table.column("generation").to_pylist()[-1] == 1
     ends = {take.take_id: take for take in takes.values()}
     met = takes.met()
     assert met, "some rough bounce goes toward +x"
@@ -706,6 +710,14 @@ def test_takes_with_their_own_seeds_vary_the_rough_surfaces(tmp_path):
     world.step(72)
     assert abs(world.positions[1][0]) < 1e-6
     assert len(ends) == len(takes)
+    # Refined around a take, its seed is drawn again about half the time in the first
+    # generation, before it is in the refinement's table: one run, counted in every slot.
+    from impulse.takes import refine
+
+    refined = refine(tmp_path / "t", met[0].take_id, budget=16, workers=2, progress=False)
+    assert met[0].scene_seed in {take.scene_seed for take in refined.values()}
+    assert len(refined) < 16
+    assert set(refined.table.column("generation").to_pylist()) == {0}
 
 
 def test_a_met_take_is_the_same_to_the_bit_on_a_ray_worker(tmp_path):

@@ -619,7 +619,10 @@ def search(
                     if row is not None and row["status"] != FAILED:
                         slots[index] = row
                         continue
-                    by_key[key] = (index, theta, scene_seed)
+                    if key in by_key:  # the same θ and seed drawn twice: one run, two slots
+                        by_key[key][3].append(index)
+                        continue
+                    by_key[key] = (index, theta, scene_seed, [index])
                     tasks.append(
                         {
                             "key": key,
@@ -636,12 +639,13 @@ def search(
                     for result in runner.run(tasks):
                         # A task the pool could not run comes back as the sweep's failed row.
                         result.setdefault("take_id", result.get("run_key"))
-                        index, theta, scene_seed = by_key[result["take_id"]]
+                        index, theta, scene_seed, indices = by_key[result["take_id"]]
                         row = _row(result, goals, generation, index, theta)
                         row["scene_seed"] = scene_seed
                         store.rows[row["take_id"]] = row
                         ran.append(row["take_id"])
-                        slots[index] = row
+                        for place in indices:
+                            slots[place] = row
                         cursor, met, stop = _advance(slots, cursor, done, bar, met, stop_after)
                         if stop:
                             break
