@@ -143,8 +143,17 @@ def test_the_search_ranks_a_take_meeting_the_rare_goal_first():
     # Among takes missing the same goals, the lower total cost first.
     assert ranked[1:] == [misses_rare, pool[2], pool[3]]
     # A take that did not complete ranks last.
-    failed = {"cost.rare": None, "cost.common": None, "cost": None, "perturbation": 0.0}
+    failed = {"cost.rare": None, "cost.common": None, "cost": None, "perturbation": 0.0,
+              "theta": [0.0]}
     assert sorted([failed, *pool], key=_ranking(pool, goals))[-1] is failed
+    # Around a take (a refinement), ties on the goals rank by the distance from its θ, not
+    # by the perturbation: θ = 0.9 is nearer 1 than θ = 0.5 is.
+    near = dict(row(0.0, 0.0, perturbation=0.9), theta=[0.9])
+    plausible = dict(row(0.0, 0.0, perturbation=0.5), theta=[0.5])
+    assert sorted([near, plausible], key=_ranking(pool, goals)) == [plausible, near]
+    assert sorted([near, plausible], key=_ranking(pool, goals, np.array([1.0]))) == [
+        near, plausible,
+    ]
 
 
 def test_touch_goals_read_the_contacts():

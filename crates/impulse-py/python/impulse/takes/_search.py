@@ -407,10 +407,15 @@ def _rank(row: Mapping[str, Any]) -> tuple[float, float]:
     return (math.inf if cost is None or not math.isfinite(cost) else cost, row["perturbation"])
 
 
-def _ranking(pool: Sequence[Mapping[str, Any]], goals: Sequence[Goal]):
+def _ranking(
+    pool: Sequence[Mapping[str, Any]],
+    goals: Sequence[Goal],
+    origin: np.ndarray | None = None,
+):
     """The key the search ranks ``pool``'s takes by, best first: the goals each take misses,
     each weighted by its ``weight`` times how rarely the pool's takes meet it, (n + 1) / (m + 1)
-    for n completed takes of which m meet it; then the total cost; then the perturbation.
+    for n completed takes of which m meet it; then the total cost; then the perturbation, or
+    with ``origin`` (a refinement's θ) the root mean square of θ − ``origin``.
 
     A goal nearly every take meets weighs about 1, one that few meet weighs up to n + 1, so a
     take that meets the rare goals ranks above one that only lowers the common goals' costs (in
@@ -424,12 +429,17 @@ def _ranking(pool: Sequence[Mapping[str, Any]], goals: Sequence[Goal]):
         for goal, name in zip(goals, names, strict=True)
     ]
 
+    def distance(row: Mapping[str, Any]) -> float:
+        if origin is None:
+            return row["perturbation"]
+        return Variation.perturbation(np.asarray(row["theta"]) - origin)
+
     def key(row: Mapping[str, Any]) -> tuple[float, float, float]:
         cost = row["cost"]
         if cost is None or not math.isfinite(cost):
-            return (math.inf, math.inf, row["perturbation"])
+            return (math.inf, math.inf, distance(row))
         missed = sum(w for w, name in zip(weights, names, strict=True) if row[name] > MET)
-        return (missed, cost, row["perturbation"])
+        return (missed, cost, distance(row))
 
     return key
 
@@ -499,7 +509,8 @@ def search(
         ``{"theta": θ, "spread": s, "scene_seed": seed or None}``: search around one take
         (:func:`refine`): the first generation, and the first after a restart, draw θ from
         N(θ, s² I) instead of the prior N(0, I), local steps and the least spread are s (not
-        ``LOCAL_STEP`` and ``MIN_SPREAD``) when s is smaller, and with ``Variation.seeds`` the
+        ``LOCAL_STEP`` and ``MIN_SPREAD``) when s is smaller, takes tied on the goals rank by
+        their distance from θ (not their perturbation), and with ``Variation.seeds`` the
         take's seed is the first one reused.
 
     Returns
@@ -541,12 +552,14 @@ def search(
     dimension = variation.dimension(base)
     start_mean, start_spread, start_seeds = np.zeros(dimension), np.ones(dimension), []
     local_step, min_spread = LOCAL_STEP, MIN_SPREAD
+    origin = None  # what the ranking's last key measures the distance from (None: θ = 0)
     if around is not None:
         start_mean, spread_value, around_seed = _around(around, dimension)
         start_spread = np.full(dimension, spread_value)
         local_step = min(LOCAL_STEP, spread_value)
         min_spread = min(MIN_SPREAD, spread_value)
         start_seeds = [around_seed] if around_seed is not None else []
+        origin = start_mean
     world = impulse.World.from_scene(base, settings=preset)  # a bad scene is one error, here
     check_goals(goals, Shot(world.names, world.dt, steps, world.gravity))
     if backend == "local":
@@ -663,7 +676,7 @@ def search(
                 if method == "random":
                     continue
                 pool = [row for row in done[since:] if row["status"] != FAILED]
-                ranked = sorted(pool, key=_ranking(pool, goals))
+                ranked = sorted(pool, key=_ranking(pool, goals, origin))
                 lowest = _rank(ranked[0])[0] if ranked else math.inf  # the best take's cost
                 if lowest < best_cost:
                     best_cost, stalled = lowest, 0
