@@ -36,6 +36,10 @@ type                    fields                                           cost (0
 
 Every goal may carry ``"name"`` (the column of its cost; default ``<type>:<body>``) and
 ``"weight"`` (default 1; multiplies the cost in the total the search ranks by).
+
+A goal's fields are checked when it is read (:func:`goal_from_dict`) and against the scene and
+the takes' length before any take runs (:func:`check_goals`): a wrong one is a
+:class:`GoalError` naming the field, reported as ``goals[k].field: what is wrong``.
 """
 
 from __future__ import annotations
