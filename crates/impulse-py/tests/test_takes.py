@@ -988,6 +988,21 @@ def _within_wider_reach(record):
     return max(0.0, 0.2 - x, x - 0.7)
 
 
+def _broken(record):
+    """A goal that cannot be computed."""
+    raise ValueError("this goal is broken")
+
+
+def test_a_search_whose_first_generation_all_fails_says_why(tmp_path):
+    with pytest.raises(RuntimeError, match="every take of the first generation failed .* broken"):
+        search(SCENE, [custom(_broken, "broken")], VARIATION, budget=64, steps=5,
+               out=tmp_path / "t", workers=2, population=8, progress=False)
+    # The failed takes are written, with their error.
+    takes = load(tmp_path / "t")
+    assert len(takes) == 8
+    assert all("this goal is broken" in take.error for take in takes.values())
+
+
 def _constant(record):
     """The same cost for every take: no take is ever better than another."""
     return 1.0

@@ -528,7 +528,9 @@ def search(
         install cloudpickle).
     RuntimeError
         The local backend's workers cannot start: the call is at the top level of a script,
-        not under ``if __name__ == "__main__":``.
+        not under ``if __name__ == "__main__":``, or of a script read from standard input;
+        another search holds ``out``'s lock; every take of the first generation failed (a
+        custom goal that raises, say: the first error is named, the takes are written).
     """
     import impulse
 
@@ -672,6 +674,15 @@ def search(
                 store.write()
                 if stop:
                     break
+                if generation == 0 and all(row is not None and row["status"] == FAILED
+                                           for row in slots):
+                    # Nothing ran: a goal that raises, a worker that cannot import what it
+                    # needs. The rest of the budget would fail the same way.
+                    raise RuntimeError(
+                        f"every take of the first generation failed ({count} of {count}), the "
+                        f"first with: {slots[0]['error'] if slots else None}; the takes are in "
+                        f"{os.path.join(store.root, TAKES_FILE)}"
+                    )
                 generation += 1
                 if method == "random":
                     continue
