@@ -143,8 +143,17 @@ def test_the_search_ranks_a_take_meeting_the_rare_goal_first():
     # Among takes missing the same goals, the lower total cost first.
     assert ranked[1:] == [misses_rare, pool[2], pool[3]]
     # A take that did not complete ranks last.
-    failed = {"cost.rare": None, "cost.common": None, "cost": None, "perturbation": 0.0}
+    failed = {"cost.rare": None, "cost.common": None, "cost": None, "perturbation": 0.0,
+              "theta": [0.0]}
     assert sorted([failed, *pool], key=_ranking(pool, goals))[-1] is failed
+    # Around a take (a refinement), ties on the goals rank by the distance from its θ, not
+    # by the perturbation: θ = 0.9 is nearer 1 than θ = 0.5 is.
+    near = dict(row(0.0, 0.0, perturbation=0.9), theta=[0.9])
+    plausible = dict(row(0.0, 0.0, perturbation=0.5), theta=[0.5])
+    assert sorted([near, plausible], key=_ranking(pool, goals)) == [plausible, near]
+    assert sorted([near, plausible], key=_ranking(pool, goals, np.array([1.0]))) == [
+        near, plausible,
+    ]
 
 
 def test_touch_goals_read_the_contacts():
@@ -180,19 +189,108 @@ def test_touches_with_times_counts_separate_contacts():
 @pytest.mark.parametrize(
     "spec, message",
     [
-        ({"type": "lands", "body": 0}, "goal type 'lands'"),
-        ({"type": "ends_inside", "body": 0}, "'region' is required"),
-        ({"type": "touches", "body": 0}, "'other' is required"),
-        ({"type": "ends_inside", "body": 0, "region": {"cube": {}}}, "unknown region"),
-        ({"type": "tilted", "body": 0, "colour": 1}, "unknown fields"),
-        ({"type": "touches", "body": 0, "other": 1, "times": -1}, "'times' must be"),
-        ({"type": "touches", "body": 0, "other": 1, "times": 1.5}, "'times' must be"),
-        ({"type": "never_touches", "body": 0, "other": 1, "times": 1}, "unknown fields"),
+        ({"type": "lands", "body": 0}, "type: goal type 'lands'"),
+        ({"type": "ends_inside", "body": 0}, "region: is required"),
+        ({"type": "touches", "body": 0}, "other: is required"),
+        ({"type": "ends_inside", "body": 0, "region": {"cube": {}}}, "region: unknown region"),
+        ({"type": "tilted", "body": 0, "colour": 1}, "colour: unknown fields"),
+        ({"type": "touches", "body": 0, "other": 1, "times": -1}, "times: 'times' must be"),
+        ({"type": "touches", "body": 0, "other": 1, "times": 1.5}, "times: 'times' must be"),
+        ({"type": "never_touches", "body": 0, "other": 1, "times": 1}, "times: unknown fields"),
+        ({"type": "tilted", "body": True}, "body: True is not a body"),
+        ({"type": "tilted", "body": -1}, "body: -1 is not a body"),
+        ({"type": "tilted", "body": 0, "min_degrees": 500}, r"min_degrees: 500 degrees is out"),
+        ({"type": "rests_with_axis_up", "body": 0, "tolerance_degrees": -1}, "tolerance_degrees"),
+        ({"type": "rests_with_axis_up", "body": 0, "rest_speed": -0.1}, "rest_speed: -0.1"),
+        ({"type": "tilted", "body": 0, "axis": [0, 0, 0]}, r"axis: \[0, 0, 0\] has no direction"),
+        ({"type": "tilted", "body": 0, "up": [0, 1]}, "up: .* is not three finite numbers"),
+        ({"type": "touches", "body": "a", "other": "a"}, "other: 'a' is the goal's own body"),
+        ({"type": "never_touches", "body": 0, "between": [2, 1], "other": 1}, "between: .* reversed"),
+        ({"type": "stays_inside", "body": 0, "between": [-1, 1], "region": {
+            "sphere": {"center": [0, 0, 0], "radius": 1}}}, "between: .* before the take"),
+        ({"type": "ends_inside", "body": 0, "at": -0.5, "region": {
+            "sphere": {"center": [0, 0, 0], "radius": 1}}}, "at: -0.5 s is out of range"),
+        ({"type": "ends_inside", "body": 0, "region": {
+            "sphere": {"center": [0, 0, 0], "radius": 0}}}, "region.sphere.radius"),
+        ({"type": "ends_inside", "body": 0, "region": {
+            "box": {"min": [0, 0, 0], "max": [1, -1, 1]}}}, "region.box.max"),
+        ({"type": "tilted", "body": 0, "weight": -2}, "weight: -2 must be"),
     ],
 )
 def test_bad_goals_are_refused_with_the_field(spec, message):
     with pytest.raises(ValueError, match=message):
         goal_from_dict(spec)
+
+
+#: A sphere around the ball's start, for goals whose region does not matter.
+HERE = {"sphere": {"center": [0.0, 0.1, 0.0], "radius": 0.5}}
+
+
+@pytest.mark.parametrize(
+    "goal, message",
+    [
+        ({"type": "ends_inside", "body": "Ball", "region": HERE},
+         "goals[1].body: no body named 'Ball' in the scene: did you mean 'ball'?"),
+        ({"type": "touches", "body": "ball", "other": "floor"},
+         "goals[1].other: no body named 'floor' in the scene"),
+        ({"type": "touches", "body": "ball", "other": 1},
+         "goals[1].other: 1 is the goal's body 'ball': a body cannot touch itself"),
+        ({"type": "ends_inside", "body": 5, "region": HERE},
+         "goals[1].body: body index 5 is not in the scene (2 bodies)"),
+        ({"type": "passes_through", "body": "ball", "region": HERE, "between": [0.5, 3]},
+         "goals[1].between: 3 s is after the take's end, 1 s (60 steps of 0.0166667 s)"),
+        ({"type": "passes_through", "body": "ball", "region": HERE, "between": [0.9, 0.5]},
+         "goals[1].between: [0.9, 0.5] is reversed"),
+        ({"type": "ends_inside", "body": "ball", "region": HERE, "at": 2},
+         "goals[1].at: 2 s is after the take's end"),
+        ({"type": "tilted", "body": "ball", "axis": [0, 0, 0]},
+         "goals[1].axis: [0, 0, 0] has no direction"),
+        ({"type": "rests_with_axis_up", "body": "ball", "tolerance_degrees": -5},
+         "goals[1].tolerance_degrees: -5 degrees is out of range"),
+        ({"type": "tilted", "body": "ball", "min_degrees": 500},
+         "goals[1].min_degrees: 500 degrees is out of range: must be in [0, 180]"),
+        ({"type": "touches", "body": "ball", "other": "ball"},
+         "goals[1].other: 'ball' is the goal's own body"),
+        ({"type": "tilted", "body": True}, "goals[1].body: True is not a body"),
+    ],
+)
+def test_goals_the_scene_cannot_hold_are_refused_before_any_take_runs(
+    goal, message, tmp_path, capsys
+):
+    # The command line: exit 2, the goals file and the goal's place and field named, and
+    # nothing written to the search's directory.
+    goal = dict(goal, name="checked")
+    scene = tmp_path / "roll.json"
+    scene.write_text(json.dumps(SCENE))
+    goals = tmp_path / "goals.json"
+    goals.write_text(json.dumps({"steps": STEPS, "variation": VARIATION, "goals": [TARGET, goal]}))
+    out = tmp_path / "t"
+    arguments = ["search", str(scene), "--goals", str(goals), "--budget", "8", "--out", str(out)]
+    assert cli_main([*arguments, "--no-progress"]) == 2
+    assert f"error: {goals}: {message}" in capsys.readouterr().err
+    assert not out.exists()
+    # In Python: the same message.
+    with pytest.raises(ValueError) as refused:
+        search(SCENE, [TARGET, goal], VARIATION, budget=8, steps=STEPS, out=out, progress=False)
+    assert message in str(refused.value)
+    assert not out.exists()
+
+
+def test_a_goals_file_with_an_unknown_key_is_refused(tmp_path, capsys):
+    scene = tmp_path / "roll.json"
+    scene.write_text(json.dumps(SCENE))
+    goals = tmp_path / "goals.json"
+    goals.write_text(json.dumps({"steps": STEPS, "varation": VARIATION, "goals": [TARGET]}))
+    out = tmp_path / "t"
+    arguments = ["search", str(scene), "--goals", str(goals), "--budget", "8", "--out", str(out)]
+    assert cli_main(arguments) == 2
+    error = capsys.readouterr().err
+    assert f"{goals}: unknown keys ['varation']" in error and "goals, steps, variation" in error
+    assert not out.exists()
+    goals.write_text(json.dumps({"steps": 0, "variation": VARIATION, "goals": [TARGET]}))
+    assert cli_main(arguments) == 2
+    assert f"{goals}: steps: 0 must be an integer >= 1" in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_a_variation_moves_each_field_by_theta_times_its_scale():
@@ -208,6 +306,12 @@ def test_a_variation_moves_each_field_by_theta_times_its_scale():
     # Values are float32, so a file and the search build the same bits.
     assert all(float(np.float32(v)) == v for v in ball["position"])
     assert SCENE["bodies"][1]["position"] == [0.0, 0.1, 0.0]  # the scene is not changed
+    # Every field: θ's last three components move the angular velocity (rad/s).
+    every = Variation(bodies=["ball"], position=0.1, angle=90.0, velocity=2.0, angular_velocity=3.0)
+    assert every.dimension(SCENE) == 12
+    spun = every.apply(SCENE, np.concatenate([theta, [0.5, -1.0, 2.0]]))["bodies"][1]
+    assert spun["angular_velocity"] == [1.5, -3.0, 6.0]
+    assert spun["linear_velocity"] == ball["linear_velocity"]
     with pytest.raises(ValueError, match="no body named 'cue'"):
         Variation(bodies=["cue"], velocity=1.0).dimension(SCENE)
     with pytest.raises(ValueError, match="only dynamic bodies"):
@@ -420,11 +524,12 @@ def test_the_contact_sheet_draws_previews_and_sorts_in_a_browser(
         SCENE,
         [TARGET],
         VARIATION,
-        budget=8,
-        steps=20,
+        budget=32,
+        steps=STEPS,
         out=out,
         workers=2,
         population=8,
+        stop_after=2,
         progress=False,
     )
     monkeypatch.setenv("IMPULSE_CLI", impulse_cli)
@@ -432,7 +537,7 @@ def test_the_contact_sheet_draws_previews_and_sorts_in_a_browser(
     takes = load(out)
     shown = takes.best(6)
     for take in shown:
-        gif = out / "previews" / f"{take.take_id}.gif"
+        (gif,) = (out / "previews").glob(f"{take.take_id}-*.gif")
         assert gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
     chromium = shutil.which("chromium")
     missing = None
@@ -482,6 +587,17 @@ def test_the_contact_sheet_draws_previews_and_sorts_in_a_browser(
             for c in driver.find_elements(By.CSS_SELECTOR, "figure.take")
         ]
         assert order == [t.take_id for t in sorted(shown, key=lambda t: t.perturbation)]
+        # "Only takes that meet every goal" shows exactly those.
+        assert 0 < sum(t.met for t in shown) < len(shown)
+        driver.find_element(By.ID, "only-met").click()
+        visible = [
+            c.get_attribute("data-take-id")
+            for c in driver.find_elements(By.CSS_SELECTOR, "figure.take")
+            if c.is_displayed()
+        ]
+        assert visible == [t.take_id for t in shown if t.met]
+        driver.find_element(By.ID, "only-met").click()
+        assert all(c.is_displayed() for c in driver.find_elements(By.CSS_SELECTOR, "figure.take"))
     finally:
         driver.quit()
 
@@ -576,11 +692,16 @@ def test_takes_with_their_own_seeds_vary_the_rough_surfaces(tmp_path):
         out=tmp_path / "t",
         workers=2,
         population=16,
+        stop_after=33,
         progress=False,
     )
     seeds = [take.scene_seed for take in takes.values()]
     assert all(isinstance(s, int) and s > 0 for s in seeds)
     assert len(set(seeds)) > 8  # fresh seeds, and the best ones reused
+    # θ is empty: a reused seed is the same take, read back however often it is drawn and
+    # counted each time, so the budget of 32 is two generations.
+    assert len(takes) < 32
+    assert takes.table.column("generation").to_pylist()[-1] == 1
     ends = {take.take_id: take for take in takes.values()}
     met = takes.met()
     assert met, "some rough bounce goes toward +x"
@@ -598,6 +719,14 @@ def test_takes_with_their_own_seeds_vary_the_rough_surfaces(tmp_path):
     world.step(72)
     assert abs(world.positions[1][0]) < 1e-6
     assert len(ends) == len(takes)
+    # Refined around a take, its seed is drawn again about half the time in the first
+    # generation, before it is in the refinement's table: one run, counted in every slot.
+    from impulse.takes import refine
+
+    refined = refine(tmp_path / "t", met[0].take_id, budget=16, workers=2, progress=False)
+    assert met[0].scene_seed in {take.scene_seed for take in refined.values()}
+    assert len(refined) < 16
+    assert set(refined.table.column("generation").to_pylist()) == {0}
 
 
 def test_a_met_take_is_the_same_to_the_bit_on_a_ray_worker(tmp_path):
@@ -644,7 +773,8 @@ def test_a_met_hoop_take_is_the_same_to_the_bit_through_impulse_run(
     take.write_scene(path)
     out = tmp_path / "frames.jsonl"
     subprocess.run(
-        [impulse_cli, "run", str(path), "--steps", str(goals["steps"]), "--out", str(out), "--quiet"],
+        # The take's scene carries the search's steps: no --steps.
+        [impulse_cli, "run", str(path), "--out", str(out), "--quiet"],
         check=True,
         capture_output=True,
     )
@@ -831,7 +961,7 @@ def test_a_take_with_roughness_draws_is_the_same_to_the_bit_through_impulse_run(
     ]
     frames_path = tmp_path / "frames.jsonl"
     subprocess.run(
-        [impulse_cli, "run", str(path), "--steps", str(steps), "--out", str(frames_path), "--quiet"],
+        [impulse_cli, "run", str(path), "--out", str(frames_path), "--quiet"],
         check=True,
         capture_output=True,
     )
@@ -844,3 +974,540 @@ def test_a_take_with_roughness_draws_is_the_same_to_the_bit_through_impulse_run(
     assert positions.view(np.uint32).tolist() == poses[..., :3].view(np.uint32).tolist()
     assert orientations.view(np.uint32).tolist() == poses[..., 3:].view(np.uint32).tolist()
     assert positions[-1, 1, 0] >= 0.15
+
+
+def _within_reach(record):
+    """0 when the ball ends 0.3-0.6 m along x, else its distance (m) from that range."""
+    x = float(record.positions[-1, 1, 0])
+    return max(0.0, 0.3 - x, x - 0.6)
+
+
+def _within_wider_reach(record):
+    """0 when the ball ends 0.2-0.7 m along x, else its distance (m) from that range."""
+    x = float(record.positions[-1, 1, 0])
+    return max(0.0, 0.2 - x, x - 0.7)
+
+
+def _broken(record):
+    """A goal that cannot be computed."""
+    raise ValueError("this goal is broken")
+
+
+def test_a_search_whose_first_generation_all_fails_says_why(tmp_path):
+    with pytest.raises(RuntimeError, match="every take of the first generation failed .* broken"):
+        search(SCENE, [custom(_broken, "broken")], VARIATION, budget=64, steps=5,
+               out=tmp_path / "t", workers=2, population=8, progress=False)
+    # The failed takes are written, with their error.
+    takes = load(tmp_path / "t")
+    assert len(takes) == 8
+    assert all("this goal is broken" in take.error for take in takes.values())
+
+
+def _constant(record):
+    """The same cost for every take: no take is ever better than another."""
+    return 1.0
+
+
+@pytest.mark.parametrize("backend", ["local", "ray"])
+def test_custom_goals_search_on_both_backends(backend, tmp_path):
+    if backend == "ray":
+        ray = pytest.importorskip("ray")
+        ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        goal = custom(_within_reach, "within reach")
+        takes = search(
+            SCENE,
+            [goal],
+            VARIATION,
+            budget=64,
+            steps=STEPS,
+            out=tmp_path / "t",
+            backend=backend,
+            workers=2,
+            population=16,
+            progress=False,
+        )
+    finally:
+        if backend == "ray":
+            ray.shutdown()
+    assert all(take.status == "completed" for take in takes.values())
+    met = takes.met()
+    assert met, f"no take met the goal in 64: best {takes.best(1)}"
+    # Each take's cost is the function's value for its scene, run here.
+    for take in [met[0], *takes.best()[-3:]]:
+        assert evaluate(take.scene(), [goal], STEPS) == {"within reach": take.costs["within reach"]}
+    x = impulse.World.from_scene(met[0].scene())
+    x.step(STEPS)
+    assert 0.3 <= float(x.positions[1][0]) <= 0.6
+
+
+def test_a_custom_goal_with_changed_code_is_another_search(tmp_path):
+    out = tmp_path / "t"
+    common = dict(budget=8, steps=10, workers=2, population=8, stop_after=9, progress=False)
+    first = search(SCENE, [custom(_within_reach, "reach")], VARIATION, out=out, **common)
+    # The same function resumes: every take read back, none run again.
+    again = search(SCENE, [custom(_within_reach, "reach")], VARIATION, out=out, **common)
+    assert again.table.column("wall_time_s").to_pylist() == first.table.column(
+        "wall_time_s"
+    ).to_pylist()
+    with pytest.raises(ValueError, match="custom goal 'reach': its function's code is not the"):
+        search(SCENE, [custom(_within_wider_reach, "reach")], VARIATION, out=out, **common)
+
+
+def test_a_custom_goals_identity_is_its_code_and_the_values_it_holds():
+    from impulse.takes._goals import code_identity
+
+    def reach(low):
+        return lambda record: max(0.0, low - float(record.positions[-1, 1, 0]))
+
+    assert code_identity(reach(0.3)) == code_identity(reach(0.3))
+    assert code_identity(reach(0.3)) != code_identity(reach(0.4))
+    assert code_identity(_within_reach) != code_identity(_within_wider_reach)
+    with pytest.raises(TypeError, match="not callable"):
+        custom("x", "reach")
+
+
+def test_a_take_scene_runs_the_searchs_steps(tmp_path):
+    # The authored scene runs 600 steps; the search's takes 60.
+    authored = dict(SCENE, steps=600)
+    takes = search(
+        authored, [TARGET], VARIATION, budget=16, steps=STEPS, out=tmp_path / "t", workers=2,
+        population=16, progress=False,
+    )
+    scene = takes.best(1)[0].scene()
+    assert scene["steps"] == STEPS
+    assert scene["dt"] == float(np.float32(1.0 / 60.0))
+
+
+def test_a_take_is_reproduced_by_impulse_run_without_steps(tmp_path, impulse_cli):
+    # `impulse run take.json`, with no --steps, ends where the search's take ended, to the bit.
+    authored = dict(SCENE, steps=600)
+    takes = search(
+        authored, [TARGET], VARIATION, budget=16, steps=STEPS, out=tmp_path / "t", workers=2,
+        population=16, progress=False,
+    )
+    take = takes.best(1)[0]
+    path = tmp_path / "take.json"
+    take.write_scene(path)
+    out = tmp_path / "frames.jsonl"
+    subprocess.run(
+        [impulse_cli, "run", str(path), "--out", str(out), "--quiet"],
+        check=True,
+        capture_output=True,
+    )
+    frames = [json.loads(line) for line in out.read_text().splitlines()]
+    assert len(frames) == STEPS + 1
+    final = np.array(frames[-1]["bodies"], dtype=np.float64).astype(np.float32)
+    record, status, _ = simulate_take(take.scene(), STEPS, [])
+    assert status == "completed"
+    assert record.positions[-1].astype(np.float32).tobytes() == final[:, :3].tobytes()
+    assert record.orientations[-1].astype(np.float32).tobytes() == final[:, 3:].tobytes()
+
+
+def test_a_script_piped_into_python_is_refused_before_any_worker_starts(tmp_path):
+    out = tmp_path / "t"
+    script = (
+        "import impulse.takes as takes\n"
+        f"takes.search({SCENE!r}, [{TARGET!r}], {VARIATION!r}, budget=8, steps=10,\n"
+        f"             out={str(out)!r}, workers=2, progress=False)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-"], input=script, capture_output=True, text=True, check=False
+    )
+    assert done.returncode == 1
+    assert "runs from a script read from standard input (<stdin>)" in done.stderr
+    assert done.stderr.count("Traceback") == 1  # the refusal's alone: no worker ran
+    assert not out.exists()
+
+
+def _children(pid):
+    """The ids of the processes whose parent is ``pid`` (Linux /proc)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as file:
+                    fields = file.read().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) == pid:
+                found.append(int(entry))
+    return found
+
+
+def _running(pid):
+    """Whether process ``pid`` exists and has not exited (a zombie has)."""
+    try:
+        with open(f"/proc/{pid}/stat") as file:
+            state = file.read().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state not in ("Z", "X")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_sigterm_keeps_the_finished_takes_and_ends_the_workers(tmp_path):
+    import signal
+    import time
+
+    scene, goals, out = tmp_path / "roll.json", tmp_path / "far.json", tmp_path / "t"
+    scene.write_text(json.dumps(SCENE))
+    far = dict(TARGET, region={"box": {"min": [50, 0, -1], "max": [51, 1, 1]}})
+    goals.write_text(json.dumps({"steps": STEPS, "variation": VARIATION, "goals": [far]}))
+    command = [sys.executable, "-m", "impulse.takes", "search", str(scene), "--goals", str(goals)]
+    command += ["--budget", "100000", "--population", "8", "--workers", "2", "--out", str(out)]
+    process = subprocess.Popen(
+        [*command, "--no-progress"], stderr=subprocess.PIPE, text=True
+    )
+    try:
+        # Wait (not a timing check) for the first generation to be written.
+        deadline = time.monotonic() + 300
+        while not (out / "takes.parquet").exists():
+            assert process.poll() is None, process.stderr.read()
+            assert time.monotonic() < deadline, "no generation written in 300 s"
+            time.sleep(0.05)
+        workers = _children(process.pid)
+        assert workers, "the search runs worker processes"
+        process.send_signal(signal.SIGTERM)
+        _, error = process.communicate(timeout=300)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 143, error
+    assert "interrupted: the takes run so far are kept" in error
+    kept = load(out)
+    assert len(kept) >= 8  # the first generation, at least
+    assert all(take.status == "completed" for take in kept.values())
+    deadline = time.monotonic() + 60
+    while any(_running(pid) for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not [pid for pid in workers if _running(pid)], "worker processes left running"
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fcntl locks")
+def test_a_search_directory_is_locked_against_a_second_search(tmp_path, capsys):
+    import fcntl
+
+    scene, goals, out = tmp_path / "roll.json", tmp_path / "goals.json", tmp_path / "t"
+    scene.write_text(json.dumps(SCENE))
+    goals.write_text(json.dumps({"steps": 10, "variation": VARIATION, "goals": [TARGET]}))
+    arguments = ["search", str(scene), "--goals", str(goals), "--budget", "8", "--out", str(out)]
+    arguments += ["--workers", "2", "--population", "8", "--no-progress"]
+    out.mkdir()
+    with open(out / "search.lock", "a+") as held:
+        fcntl.flock(held.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)  # another search's lock
+        assert cli_main(arguments) == 2
+        assert "is in use by another search" in capsys.readouterr().err
+        assert not (out / "takes.parquet").exists()
+    assert cli_main(arguments) in (0, 1)  # released: the search runs
+    assert len(load(out)) >= 1
+
+
+@pytest.mark.parametrize(
+    "flag, value, message",
+    [
+        ("--steps", "0", "argument --steps: 0 must be an integer >= 1"),
+        ("--workers", "0", "argument --workers: 0 must be an integer >= 1"),
+        ("--workers", "-1", "argument --workers: -1 must be an integer >= 1"),
+        ("--budget", "0", "argument --budget: 0 must be an integer >= 1"),
+        ("--budget", "ten", "argument --budget: 'ten' is not an integer"),
+        ("--stop-after", "0", "argument --stop-after: 0 must be an integer >= 1"),
+        ("--population", "1", "argument --population: 1 must be an integer >= 2"),
+        ("--seed", "-3", "argument --seed: -3 must be an integer >= 0"),
+        ("--vary-velocity", "-1", "argument --vary-velocity: -1 must be a finite number >= 0"),
+        ("--vary-angle", "nan", "argument --vary-angle: nan must be a finite number >= 0"),
+        ("--vary-roughness-draws", "-2", "argument --vary-roughness-draws: -2 must be"),
+    ],
+)
+def test_every_search_flag_is_checked_with_its_name(flag, value, message, tmp_path, capsys):
+    scene, goals, out = tmp_path / "roll.json", tmp_path / "goals.json", tmp_path / "t"
+    scene.write_text(json.dumps(SCENE))
+    goals.write_text(json.dumps({"steps": 10, "variation": VARIATION, "goals": [TARGET]}))
+    arguments = ["search", str(scene), "--goals", str(goals), "--budget", "8", "--out", str(out)]
+    with pytest.raises(SystemExit) as exited:
+        cli_main([*arguments, flag, value])
+    assert exited.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+def _in_draw_order(rows, population):
+    return [(row["generation"], row["index"]) for row in rows] == [
+        (k // population, k % population) for k in range(len(rows))
+    ]
+
+
+def test_stop_after_ends_the_search_at_that_take(tmp_path):
+    takes = search(
+        SCENE, [TARGET], VARIATION, budget=96, steps=STEPS, out=tmp_path / "t", workers=2,
+        population=16, stop_after=3, progress=False,
+    )
+    rows = takes.table.to_pylist()
+    # Exactly 3 meet every goal, the last take drawn is the third, and every take drawn
+    # before it is in the table.
+    assert sum(row["met"] for row in rows) == 3
+    assert rows[-1]["met"]
+    assert _in_draw_order(rows, 16)
+
+
+def test_a_take_is_met_only_when_it_meets_every_goal(tmp_path):
+    from impulse.takes._search import _row
+
+    goals = [goal_from_dict({"type": "tilted", "body": 0, "name": n}) for n in ("a", "b")]
+    result = {"take_id": "x", "status": "completed", "costs": [0.0, 0.25]}
+    assert not _row(result, goals, 0, 0, np.zeros(3))["met"]
+    assert not _row(dict(result, costs=[0.5, 0.0]), goals, 0, 0, np.zeros(3))["met"]
+    assert _row(dict(result, costs=[0.0, 0.0]), goals, 0, 0, np.zeros(3))["met"]
+    # In a search: takes meeting the reachable goal, none meeting both.
+    far = dict(TARGET, name="far", region={"box": {"min": [50, 0, -1], "max": [51, 1, 1]}})
+    takes = search(
+        SCENE, [TARGET, far], VARIATION, budget=32, steps=STEPS, out=tmp_path / "t", workers=2,
+        population=16, progress=False,
+    )
+    assert any(take.costs["ends_inside:ball"] == 0.0 for take in takes.values())
+    assert not takes.met()
+
+
+def test_a_resumed_search_runs_its_failed_takes_again(tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = tmp_path / "t"
+    far = dict(TARGET, region={"box": {"min": [50, 0, -1], "max": [51, 1, 1]}})
+    common = dict(budget=8, steps=10, workers=2, population=8, progress=False)
+    search(SCENE, [far], VARIATION, out=out, **common)
+    # Take 3 is recorded as failed (as when its worker died).
+    path = out / "takes.parquet"
+    table = pq.read_table(path)
+    rows = table.to_pylist()
+    failed = rows[3]["take_id"]
+    rows[3].update(status="failed", error="WorkerFailure: killed", met=False, cost=None,
+                   wall_time_s=-1.0)
+    rows[3]["cost.ends_inside:ball"] = None
+    pq.write_table(pa.Table.from_pylist(rows, schema=table.schema), path)
+    again = search(SCENE, [far], VARIATION, out=out, **common)
+    assert again[failed].status == "completed" and again[failed].cost is not None
+    times = dict(zip(again.table.column("take_id").to_pylist(),
+                     again.table.column("wall_time_s").to_pylist(), strict=True))
+    assert times[failed] >= 0.0  # run again
+    assert all(times[row["take_id"]] == row["wall_time_s"] for row in rows if row["take_id"] != failed)
+
+
+def test_under_seeds_the_best_takes_seeds_are_reused(tmp_path):
+    from impulse.takes._search import _ranking
+
+    far = {"type": "ends_inside", "body": "ball",
+           "region": {"box": {"min": [5, -1, -1], "max": [6, 5, 1]}}}
+    # θ varies too, so a take reusing a seed is a new take (with θ empty it would be the same
+    # take, read back rather than run again).
+    variation = {"bodies": ["ball"], "velocity": 0.05, "seeds": True}
+    takes = search(
+        ROUGH, [far], variation, budget=32, steps=72, out=tmp_path / "t", workers=2,
+        population=16, progress=False,
+    )
+    rows = takes.table.to_pylist()
+    assert _in_draw_order(rows, 16)
+    first, second = rows[:16], rows[16:]
+    best = sorted(first, key=_ranking(first, [goal_from_dict(far)]))[:3]  # the 3 elites of 16
+    reused = [row for row in second if row["scene_seed"] in {row["scene_seed"] for row in best}]
+    # Half the second generation's seeds are drawn from the elites' (8 of 16 on average).
+    assert 4 <= len(reused) <= 12
+    fresh = {row["scene_seed"] for row in first}
+    assert all(row["scene_seed"] not in fresh for row in second if row not in reused)
+
+
+def test_a_search_restarts_when_its_best_cost_stalls(tmp_path):
+    # Every take costs the same: the best cost never falls, so after 4 generations without a
+    # lower one (STALL_GENERATIONS) the search draws its 6th generation from the prior N(0, I)
+    # again, with no local steps: exactly the standard normal draw of that generation.
+    takes = search(
+        SCENE, [custom(_constant, "constant")], VARIATION, budget=48, steps=5,
+        out=tmp_path / "t", workers=2, population=8, progress=False,
+    )
+    rows = takes.table.to_pylist()
+    theta = np.array([row["theta"] for row in rows]).reshape(6, 8, 3)
+    prior = np.random.default_rng([0, 5]).standard_normal((8, 3))
+    assert np.array_equal(theta[5], prior)
+    # Before it, the search had narrowed around the smallest perturbations.
+    assert theta[4].std() < 0.5 * theta[0].std()
+
+
+def test_the_sheet_lists_the_takes_best_first_with_tied_costs(tmp_path):
+    import re
+
+    out = tmp_path / "t"
+    search(
+        SCENE, [TARGET], VARIATION, budget=96, steps=STEPS, out=out, workers=2, population=16,
+        stop_after=4, progress=False,
+    )
+    takes = load(out)
+    page = (tmp_path / "sheet.html")
+    sheet(out, page, count=10, previews=False)
+    cards = re.findall(r'data-take-id="([0-9a-f]+)" data-rank="(\d+)"', page.read_text())
+    best = takes.best(10)
+    met = [take for take in best if take.met]
+    assert len(met) == 4 and {take.cost for take in met} == {0.0}  # tied at cost 0
+    assert best[:4] == sorted(met, key=lambda take: take.perturbation)
+    assert [take_id for take_id, _ in cards] == [take.take_id for take in best]
+    assert [int(rank) for _, rank in cards] == list(range(len(best)))
+
+
+def test_refine_searches_around_a_take_keeping_the_goals(tmp_path, capsys):
+    out = tmp_path / "t"
+    found = search(
+        SCENE, [TARGET], VARIATION, budget=64, steps=STEPS, out=out, workers=2, population=16,
+        progress=False,
+    )
+    take = found.met()[0]
+    assert cli_main(["refine", str(out), take.take_id, "--budget", "32", "--workers", "2",
+                     "--no-progress"]) == 0
+    refined = load(out / "refine" / take.take_id)
+    assert refined.goal_names == found.goal_names and refined.manifest["steps"] == STEPS
+    rows = refined.table.to_pylist()
+    assert len(rows) == 32 and _in_draw_order(rows, 16)  # the whole budget: stop_after = 32
+    # The first generation is θ of the take plus 0.002 N(0, I): within 5 standard deviations.
+    first = np.array([row["theta"] for row in rows[:16]])
+    assert np.all(np.abs(first - take.theta) < 5 * 0.002)
+    # The goal is a 0.3 m range of the ball's x; a step of 0.002 moves it by about 0.6 mm:
+    # nearly every refined take meets it.
+    assert len(refined.met()) >= 28
+    # A search with custom goals is refined from Python, giving them again.
+    custom_out = tmp_path / "c"
+    customs = search(
+        SCENE, [custom(_within_reach, "reach")], VARIATION, budget=16, steps=STEPS,
+        out=custom_out, workers=2, population=16, stop_after=17, progress=False,
+    )
+    best = customs.best(1)[0].take_id
+    assert cli_main(["refine", str(custom_out), best, "--budget", "8", "--no-progress"]) == 2
+    assert "custom goals ['reach']" in capsys.readouterr().err
+    from impulse.takes import refine
+
+    again = refine(custom_out, best, budget=8, goals=[custom(_within_reach, "reach")],
+                   workers=2, progress=False)
+    assert len(again) == 8
+    with pytest.raises(KeyError, match="no take 'ffff'"):
+        refine(custom_out, "ffff", budget=8, goals=[custom(_within_reach, "reach")])
+
+
+def _read_png(path):
+    """The pixels of an 8-bit RGB or RGBA PNG (what `impulse render --out` writes), (H, W, C)
+    uint8: the chunks' zlib stream unfiltered row by row (the PNG specification's five
+    filters)."""
+    import struct
+    import zlib
+
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    position, compressed = 8, b""
+    while position < len(data):
+        length, kind = struct.unpack(">I4s", data[position : position + 8])
+        body = data[position + 8 : position + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour = struct.unpack(">IIBB", body[:10])
+        elif kind == b"IDAT":
+            compressed += body
+        position += 12 + length
+    assert depth == 8 and colour in (2, 6)
+    channels = 3 if colour == 2 else 4
+    raw = zlib.decompress(compressed)
+    stride = width * channels
+    previous = np.zeros(stride, dtype=np.int64)
+    rows = []
+    for y in range(height):
+        kind = raw[y * (stride + 1)]
+        row = np.frombuffer(raw, np.uint8, stride, y * (stride + 1) + 1).astype(np.int64)
+        if kind == 0:
+            current = row
+        elif kind == 2:
+            current = (row + previous) & 255
+        else:
+            current = np.zeros(stride, dtype=np.int64)
+            for x in range(stride):
+                a = current[x - channels] if x >= channels else 0
+                b = previous[x]
+                c = previous[x - channels] if x >= channels else 0
+                if kind == 1:
+                    predicted = a
+                elif kind == 3:
+                    predicted = (a + b) // 2
+                else:  # Paeth
+                    pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                    predicted = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                current[x] = (row[x] + predicted) & 255
+        rows.append(current)
+        previous = current
+    return np.array(rows, dtype=np.uint8).reshape(height, width, channels)
+
+
+def _drawn_box(impulse_cli, scene, body, camera_arguments, tmp_path, size="192x144"):
+    """The pixel box (width, height) ``body`` covers in ``scene``'s first frame: the frame
+    drawn as it is and with the body shrunk to a 1 mm sphere, the same camera; the box of the
+    pixels that differ."""
+    frames = []
+    for shrunk in (False, True):
+        drawn = json.loads(json.dumps(scene))
+        if shrunk:
+            drawn["bodies"][body].update(shape={"type": "sphere", "radius": 1e-3}, mass=1.0)
+        folder = tmp_path / f"frames-{shrunk}"
+        path = tmp_path / f"scene-{shrunk}.json"
+        path.write_text(json.dumps(drawn))
+        subprocess.run(
+            [impulse_cli, "render", str(path), "--out", str(folder), "--steps", "0", "--size",
+             size, "--quiet", *camera_arguments],
+            check=True,
+            capture_output=True,
+        )
+        frames.append(_read_png(folder / "frame_00000.png"))
+    ys, xs = np.nonzero(np.any(frames[0] != frames[1], axis=-1))
+    return (int(np.ptp(xs)) + 1, int(np.ptp(ys)) + 1) if xs.size else (0, 0)
+
+
+#: A coin 25 mm wide dropped 1 cm onto a 1 m table, and a ball rolling 2 m away: framed with
+#: the ball, the coin is a few pixels.
+COIN = {
+    "name": "coin on a table",
+    "bodies": [
+        {"name": "ground", "kind": "static", "shape": {"type": "half_space", "normal": [0, 1, 0]}},
+        {"name": "table", "kind": "static", "position": [0, 0.375, 0],
+         "shape": {"type": "cuboid", "half_extents": [0.5, 0.375, 0.5]}},
+        {"name": "coin", "kind": "dynamic", "position": [0.2, 0.761, 0.1],
+         "shape": {"type": "cylinder", "half_height": 0.001, "radius": 0.0125}},
+        {"name": "ball", "kind": "dynamic", "position": [-2.0, 0.1, -1.0],
+         "linear_velocity": [0.5, 0, 0], "shape": {"type": "sphere", "radius": 0.1}},
+    ],
+}
+
+
+def test_a_preview_frames_the_goal_bodies(tmp_path, impulse_cli):
+    from impulse.takes._sheet import _camera_arguments
+
+    goal = {"type": "rests_with_axis_up", "body": "coin", "axis": [0, 1, 0]}
+    out = tmp_path / "t"
+    search(COIN, [goal], {"bodies": ["coin"], "velocity": 0.01}, budget=2, steps=60, out=out,
+           workers=2, population=2, progress=False)
+    takes = load(out)
+    take = takes.best(1)[0]
+    # The coin where the take ends, drawn with the sheet's cameras.
+    record, _, _ = simulate_take(take.scene(), 60, [])
+    posed = take.scene()
+    coin = posed["bodies"][2]
+    coin.update(position=record.positions[-1, 2].tolist(),
+                orientation=record.orientations[-1, 2].tolist(), linear_velocity=[0, 0, 0])
+    framed = _drawn_box(
+        impulse_cli, posed, 2, _camera_arguments("goals", take, takes, (192, 144)), tmp_path
+    )
+    assert framed[0] >= 20 and framed[1] >= 20, framed
+    # impulse render's own view (the sheet's camera="scene"), as it reports it.
+    path = tmp_path / "posed.json"
+    path.write_text(json.dumps(posed))
+    done = subprocess.run(
+        [impulse_cli, "render", str(path), "--out", str(tmp_path / "own"), "--steps", "0",
+         "--size", "192x144"],
+        check=True, capture_output=True, text=True,
+    )
+    import re
+
+    eye, target = re.search(r"camera eye (\S+) target (\S+)", done.stdout + done.stderr).groups()
+    own = ["--camera-eye", eye, "--camera-target", target]
+    scene_view = _drawn_box(impulse_cli, posed, 2, own, tmp_path)
+    assert scene_view[0] < 20 and scene_view[1] < 20, scene_view

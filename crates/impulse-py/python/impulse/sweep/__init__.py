@@ -372,8 +372,18 @@ def _check_workers_can_start(caller: str) -> None:
             and frame.f_code.co_name == "<module>"
         ):
             path = getattr(main, "__file__", None)
-            if path is None or not os.path.isfile(path):
-                return  # a notebook, the REPL or a script read from stdin: not re-imported
+            if path is None:
+                return  # a notebook, the REPL, python -c: spawn does not import them again
+            if not os.path.isfile(path):
+                # `python - <<EOF`, `cat script.py | python`: spawn would import the main
+                # script again from `path` (<stdin>), which no worker can read: every run
+                # would fail in its worker.
+                raise RuntimeError(
+                    f"{caller} runs from a script read from standard input ({path}): the local "
+                    "backend's worker processes start by importing the main script again, and "
+                    "a piped script cannot be read twice. Save it to a file and run that (with "
+                    f'{caller} under if __name__ == "__main__":), or use backend="ray"'
+                )
             with open(path, encoding="utf-8") as file:
                 tree = ast.parse(file.read(), path)
             if not _under_main_guard(tree, frame.f_lineno):
@@ -421,13 +431,18 @@ def _trajectory_every(save_trajectories: bool | int) -> int:
     )
 
 
-def _pickle_observe(observe: Callable[[Any], Any]) -> bytes:
+def _pickle_observe(
+    observe: Callable[[Any], Any],
+    what: str = "observe",
+    usage: str = "a callable taking the world and returning a dict",
+) -> bytes:
     """``observe`` as bytes for the workers. A function of an installed package goes by
     reference (the workers import it); any other (a script's, a test's, a lambda, a closure)
     by value with cloudpickle (standalone or Ray's), since a worker process, above all one on
-    another machine, may not find its module."""
+    another machine, may not find its module. ``what`` and ``usage`` name the callable in
+    errors (a sweep's ``observe``, a custom goal's function)."""
     if not callable(observe):
-        raise TypeError("observe must be a callable taking the world and returning a dict")
+        raise TypeError(f"{what} must be {usage}")
     module_name = getattr(observe, "__module__", None) or ""
     package = sys.modules.get(module_name.partition(".")[0])
     if package is not None and _is_installed(package):
@@ -441,7 +456,7 @@ def _pickle_observe(observe: Callable[[Any], Any]) -> bytes:
             return pickle.dumps(observe)
         except Exception as error:
             raise TypeError(
-                f"observe cannot be sent to the workers ({error}): define it at the top of a "
+                f"{what} cannot be sent to the workers ({error}): define it at the top of a "
                 "module, or install cloudpickle"
             ) from None
     if package is None or package.__name__ in ("__main__", "__mp_main__"):

@@ -24,6 +24,7 @@ class _LocalBackend:
         self.workers = workers
         self.function = function
         self.pool = self._new_pool()
+        self.pending: dict[concurrent.futures.Future, dict[str, Any]] = {}
 
     def _new_pool(self) -> concurrent.futures.ProcessPoolExecutor:
         return concurrent.futures.ProcessPoolExecutor(
@@ -35,7 +36,7 @@ class _LocalBackend:
     def run(self, tasks: Iterable[dict[str, Any]]):
         """Yields each task's row as it finishes, at most ``4 × workers`` tasks in flight."""
         tasks = iter(tasks)
-        pending: dict[concurrent.futures.Future, dict[str, Any]] = {}
+        pending = self.pending = {}
         limit = 4 * self.workers
         while True:
             for task in itertools.islice(tasks, max(0, limit - len(pending))):
@@ -81,6 +82,16 @@ class _LocalBackend:
             pool.shutdown(wait=True)
 
     def close(self, cancel: bool = False) -> None:
+        """Shuts the pool down: after the tasks in flight finish, or with ``cancel`` (an
+        interrupt, a search that has its takes) at once, the queued tasks cancelled and the
+        running ones ended with their worker processes."""
+        if cancel:
+            for future in self.pending:
+                future.cancel()
+            # The pool has no public way to end a running task: its worker processes are
+            # terminated (the pool then breaks, which shutdown handles).
+            for process in list((getattr(self.pool, "_processes", None) or {}).values()):
+                process.terminate()
         self.pool.shutdown(wait=True, cancel_futures=cancel)
 
 
@@ -112,11 +123,12 @@ class _RayBackend:
         self.workers = workers or max(1, int(ray.available_resources().get("CPU", 1)))
         # No automatic retry: a run is deterministic, a failure would repeat.
         self.remote = ray.remote(num_cpus=1, max_retries=0)(function)
+        self.pending: dict[Any, dict[str, Any]] = {}
 
     def run(self, tasks: Iterable[dict[str, Any]]):
         ray = self.ray
         tasks = iter(tasks)
-        pending: dict[Any, dict[str, Any]] = {}
+        pending = self.pending = {}
         limit = 4 * self.workers
         while True:
             for task in itertools.islice(tasks, max(0, limit - len(pending))):
@@ -132,6 +144,14 @@ class _RayBackend:
                     yield _failed_row(task, failure)
 
     def close(self, cancel: bool = False) -> None:
+        """Shuts down a Ray this backend started; with ``cancel``, first cancels the tasks in
+        flight (forcing their workers to exit)."""
+        if cancel:
+            for ref in self.pending:
+                try:
+                    self.ray.cancel(ref, force=True)
+                except Exception:  # already finished, or the cluster is gone
+                    pass
         if self.started:
             self.ray.shutdown()
 

@@ -9,13 +9,14 @@ is 0 when met. :func:`search` samples takes with the cross-entropy method on the
 backends (a local process pool or Ray), writes one Parquet row per take to ``out`` and stops
 once enough takes meet every goal; :func:`load` reads them back, ``load(out)[take_id].scene()``
 is the take's exact scene (``impulse run`` of it reproduces the take to the bit), and
-:func:`sheet` draws a contact sheet to browse them.
+:func:`sheet` draws a contact sheet to browse them, and :func:`refine` searches around a
+chosen take.
 
 Command line: ``python -m impulse.takes --help``. Docs: docs/takes.md.
 """
 
 from impulse.takes._goals import MET, Goal, Record, custom, goal_from_dict, goals_from_json
-from impulse.takes._search import Take, Takes, evaluate, load, search, simulate_take
+from impulse.takes._search import Take, Takes, evaluate, load, refine, search, simulate_take
 from impulse.takes._sheet import sheet
 from impulse.takes._variation import Variation
 
@@ -31,6 +32,7 @@ __all__ = [
     "goal_from_dict",
     "goals_from_json",
     "load",
+    "refine",
     "search",
     "sheet",
     "simulate_take",

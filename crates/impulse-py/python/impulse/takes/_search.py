@@ -18,22 +18,35 @@ method is measured against: every take drawn from the prior, nothing refined.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
 import os
+import signal
+import threading
 import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from impulse.takes._goals import MET, Goal, Record, check_names, goal_from_dict
+from impulse.takes._goals import (
+    MET,
+    Goal,
+    GoalError,
+    Record,
+    Shot,
+    check_goals,
+    check_names,
+    goal_from_dict,
+)
 from impulse.takes._variation import Variation
 
 TAKES_FILE = "takes.parquet"
 MANIFEST_FILE = "manifest.json"
 SCENE_FILE = "scene.json"
+LOCK_FILE = "search.lock"
 COMPLETED, STOPPED, FAILED = "completed", "stopped", "failed"
 #: Weight of the new elites' mean and spread against the old (the method's smoothing).
 SMOOTHING = 0.9
@@ -112,7 +125,8 @@ def load_scene(scene: Any) -> dict[str, Any]:
 
 
 def _goal_payload(goals: Sequence[Goal]) -> list[dict[str, Any]]:
-    """Goals as the workers receive them: a JSON goal by its spec, a custom one pickled."""
+    """Goals as the workers receive them: a JSON goal by its spec, a custom one as its name,
+    weight and pickled function."""
     from impulse.sweep import _pickle_observe
 
     payload = []
@@ -120,7 +134,10 @@ def _goal_payload(goals: Sequence[Goal]) -> list[dict[str, Any]]:
         if goal.spec is not None:
             payload.append({"spec": goal.spec})
         else:
-            payload.append({"pickled": _pickle_observe(goal)})
+            function = _pickle_observe(
+                goal._cost, f"custom goal {goal.name!r}", "a callable taking a Record"
+            )
+            payload.append({"name": goal.name, "weight": goal.weight, "function": function})
     return payload
 
 
@@ -128,9 +145,44 @@ def _goals_from_payload(payload: Sequence[Mapping[str, Any]]) -> list[Goal]:
     import pickle
 
     return [
-        goal_from_dict(item["spec"]) if "spec" in item else pickle.loads(item["pickled"])
+        goal_from_dict(item["spec"])
+        if "spec" in item
+        else Goal(item["name"], pickle.loads(item["function"]), item["weight"], needs_contacts=True)
         for item in payload
     ]
+
+
+def as_goals(goals: Sequence[Goal | Mapping[str, Any]]) -> list[Goal]:
+    """Goals given as :class:`Goal` or JSON objects, as :class:`Goal`.
+
+    Raises
+    ------
+    ValueError
+        No goals, two with one name, or a bad JSON goal: ``goals[k].field: what is wrong``.
+    """
+    if isinstance(goals, (str, bytes, Mapping)) or not isinstance(goals, Sequence):
+        raise ValueError("goals: expected a list of goals (JSON objects or impulse.takes.custom)")
+    out = []
+    for k, goal in enumerate(goals):
+        if isinstance(goal, Goal):
+            out.append(goal)
+            continue
+        try:
+            out.append(goal_from_dict(goal))
+        except GoalError as error:
+            raise ValueError(f"goals[{k}].{error.field}: {error.message}") from None
+    if not out:
+        raise ValueError("goals: at least one goal is needed")
+    check_names(out)
+    return out
+
+
+def _goal_identity(goal: Goal) -> dict[str, Any]:
+    """A goal as the search's digest and manifest hold it: a JSON goal's spec, a custom goal's
+    name and the identity of its function's code."""
+    if goal.spec is not None:
+        return goal.spec
+    return {"custom": goal.name, "code": goal.code}
 
 
 def simulate_take(
@@ -210,12 +262,27 @@ def _run_take(task: dict[str, Any]) -> dict[str, Any]:
 
 
 class _Store:
-    """The search's directory: the manifest, the authored scene and the takes table."""
+    """The search's directory: the manifest, the authored scene and the takes table, held
+    under an exclusive lock (``search.lock``, ``fcntl.flock``) from opening to :meth:`close`,
+    so a second search into the same directory is refused instead of losing takes."""
 
-    def __init__(self, out: str | os.PathLike, manifest: dict[str, Any]):
+    def __init__(self, out: str | os.PathLike, manifest: dict[str, Any], scene: dict[str, Any]):
         self.root = os.path.abspath(os.fspath(out))
         self.manifest = manifest
+        self.scene = scene
+        self.created = not os.path.exists(self.root)
+        if not self.created and not os.path.isdir(self.root):
+            raise ValueError(f"out {self.root}: not a directory")
         os.makedirs(self.root, exist_ok=True)
+        self.lock = _lock(self.root)
+        try:
+            self._read()
+        except BaseException:
+            self.close(written=False)
+            raise
+
+    def _read(self) -> None:
+        manifest = self.manifest
         path = os.path.join(self.root, MANIFEST_FILE)
         if os.path.exists(path):
             with open(path, encoding="utf-8") as file:
@@ -231,7 +298,8 @@ class _Store:
             if old.get("digest") != manifest["digest"]:
                 raise ValueError(
                     f"{self.root} holds a search of another scene, goals, variation or "
-                    "settings: choose another out directory, or remove it to start again"
+                    f"settings{_changed_code(old.get('goals'), manifest['goals'])}: choose "
+                    "another out directory, or remove it to start again"
                 )
         self.rows: dict[str, dict[str, Any]] = {}
         table_path = os.path.join(self.root, TAKES_FILE)
@@ -242,9 +310,12 @@ class _Store:
                 self.rows[row["take_id"]] = row
 
     def write(self) -> None:
+        """Writes the scene, the table and the manifest, each whole (a temporary file replaced
+        in one rename), the manifest last: a directory with a manifest has a table."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
+        _write_json(os.path.join(self.root, SCENE_FILE), self.scene)
         rows = sorted(self.rows.values(), key=lambda row: (row["generation"], row["index"]))
         names = self.manifest["goal_names"]
         columns: dict[str, Any] = {
@@ -265,8 +336,70 @@ class _Store:
         temporary = os.path.join(self.root, TAKES_FILE + ".partial")
         pq.write_table(pa.table(columns), temporary)
         os.replace(temporary, os.path.join(self.root, TAKES_FILE))
-        with open(os.path.join(self.root, MANIFEST_FILE), "w", encoding="utf-8") as file:
-            json.dump(self.manifest, file, indent=1)
+        _write_json(os.path.join(self.root, MANIFEST_FILE), self.manifest)
+
+    def close(self, written: bool = True) -> None:
+        """Releases the lock. ``written=False`` (the search ended before writing anything):
+        a directory this search created is removed again."""
+        if self.lock is not None:
+            self.lock.close()  # closing the file releases its flock
+            self.lock = None
+        if not written and self.created:
+            try:
+                os.remove(os.path.join(self.root, LOCK_FILE))
+                os.rmdir(self.root)
+            except OSError:
+                pass
+
+
+def _write_json(path: str, value: Any) -> None:
+    temporary = path + ".partial"
+    with open(temporary, "w", encoding="utf-8") as file:
+        json.dump(value, file, indent=1)
+    os.replace(temporary, path)
+
+
+def _lock(root: str) -> Any:
+    """An exclusive, non-blocking lock on ``root/search.lock``: the open file holding it (the
+    lock lasts until the file is closed or the process ends, however it ends). Where
+    ``fcntl`` does not exist (Windows), no lock: ``None``.
+
+    Raises
+    ------
+    RuntimeError
+        Another search holds the lock.
+    """
+    try:
+        import fcntl
+    except ImportError:
+        return None
+    path = os.path.join(root, LOCK_FILE)
+    file = open(path, "a+", encoding="utf-8")  # noqa: SIM115 - held open: it is the lock
+    try:
+        fcntl.flock(file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        file.close()
+        raise RuntimeError(
+            f"{root} is in use by another search (it holds {path}): wait for that search to "
+            "end, or choose another out directory"
+        ) from None
+    return file
+
+
+def _changed_code(old: Any, new: Sequence[Mapping[str, Any]]) -> str:
+    """`` (custom goal 'x' ...)`` when the only difference a message can name is a custom
+    goal's function, else ``""``."""
+    if not isinstance(old, list):
+        return ""
+    old_code = {g.get("custom"): g.get("code") for g in old if isinstance(g, dict) and "custom" in g}
+    for goal in new:
+        name = goal.get("custom")
+        if name in old_code and old_code[name] != goal.get("code"):
+            return (
+                f" (custom goal {name!r}: its function's code is not the one this directory "
+                "was searched with)"
+            )
+    return ""
 
 
 def _rank(row: Mapping[str, Any]) -> tuple[float, float]:
@@ -274,10 +407,15 @@ def _rank(row: Mapping[str, Any]) -> tuple[float, float]:
     return (math.inf if cost is None or not math.isfinite(cost) else cost, row["perturbation"])
 
 
-def _ranking(pool: Sequence[Mapping[str, Any]], goals: Sequence[Goal]):
+def _ranking(
+    pool: Sequence[Mapping[str, Any]],
+    goals: Sequence[Goal],
+    origin: np.ndarray | None = None,
+):
     """The key the search ranks ``pool``'s takes by, best first: the goals each take misses,
     each weighted by its ``weight`` times how rarely the pool's takes meet it, (n + 1) / (m + 1)
-    for n completed takes of which m meet it; then the total cost; then the perturbation.
+    for n completed takes of which m meet it; then the total cost; then the perturbation, or
+    with ``origin`` (a refinement's θ) the root mean square of θ − ``origin``.
 
     A goal nearly every take meets weighs about 1, one that few meet weighs up to n + 1, so a
     take that meets the rare goals ranks above one that only lowers the common goals' costs (in
@@ -291,12 +429,17 @@ def _ranking(pool: Sequence[Mapping[str, Any]], goals: Sequence[Goal]):
         for goal, name in zip(goals, names, strict=True)
     ]
 
+    def distance(row: Mapping[str, Any]) -> float:
+        if origin is None:
+            return row["perturbation"]
+        return Variation.perturbation(np.asarray(row["theta"]) - origin)
+
     def key(row: Mapping[str, Any]) -> tuple[float, float, float]:
         cost = row["cost"]
         if cost is None or not math.isfinite(cost):
-            return (math.inf, math.inf, row["perturbation"])
+            return (math.inf, math.inf, distance(row))
         missed = sum(w for w, name in zip(weights, names, strict=True) if row[name] > MET)
-        return (missed, cost, row["perturbation"])
+        return (missed, cost, distance(row))
 
     return key
 
@@ -319,6 +462,7 @@ def search(
     method: str = "cross-entropy",
     preset: str | None = None,
     progress: bool = True,
+    around: Mapping[str, Any] | None = None,
 ) -> Takes:
     """Searches for takes of ``scene`` that meet every goal and returns them all (also written
     to ``out``).
@@ -361,6 +505,13 @@ def search(
         Solver preset of every take, as ``impulse run --preset``.
     progress : bool
         A progress bar (tqdm): takes done, goals met, best cost.
+    around : dict, optional
+        ``{"theta": θ, "spread": s, "scene_seed": seed or None}``: search around one take
+        (:func:`refine`): the first generation, and the first after a restart, draw θ from
+        N(θ, s² I) instead of the prior N(0, I), local steps and the least spread are s (not
+        ``LOCAL_STEP`` and ``MIN_SPREAD``) when s is smaller, takes tied on the goals rank by
+        their distance from θ (not their perturbation), and with ``Variation.seeds`` the
+        take's seed is the first one reused.
 
     Returns
     -------
@@ -377,20 +528,21 @@ def search(
         install cloudpickle).
     RuntimeError
         The local backend's workers cannot start: the call is at the top level of a script,
-        not under ``if __name__ == "__main__":``.
+        not under ``if __name__ == "__main__":``, or of a script read from standard input;
+        another search holds ``out``'s lock; every take of the first generation failed (a
+        custom goal that raises, say: the first error is named, the takes are written).
     """
     import impulse
 
-    if not isinstance(budget, int) or budget < 1:
-        raise ValueError(f"budget = {budget!r}: must be an integer >= 1")
-    if not isinstance(steps, int) or steps < 1:
-        raise ValueError(f"steps = {steps!r}: must be an integer >= 1")
-    if not isinstance(population, int) or population < 2:
-        raise ValueError(f"population = {population!r}: must be an integer >= 2")
-    if not 0.0 < elite_fraction <= 1.0:
+    _check_integer("budget", budget, 1)
+    _check_integer("steps", steps, 1)
+    _check_integer("population", population, 2)
+    _check_integer("stop_after", stop_after, 1)
+    _check_integer("seed", seed, 0)
+    if workers is not None:
+        _check_integer("workers", workers, 1)
+    if isinstance(elite_fraction, bool) or not 0.0 < elite_fraction <= 1.0:
         raise ValueError(f"elite_fraction = {elite_fraction!r}: must be in (0, 1]")
-    if not isinstance(stop_after, int) or stop_after < 1:
-        raise ValueError(f"stop_after = {stop_after!r}: must be an integer >= 1")
     if method not in METHODS:
         raise ValueError(f"method = {method!r}: use one of {', '.join(METHODS)}")
     if backend not in ("local", "ray"):
@@ -398,23 +550,30 @@ def search(
     base = load_scene(scene)
     if not isinstance(variation, Variation):
         variation = Variation.from_dict(variation)
-    goals = [g if isinstance(g, Goal) else goal_from_dict(g) for g in goals]
-    if not goals:
-        raise ValueError("goals: at least one goal is needed")
-    check_names(goals)
+    goals = as_goals(goals)
     dimension = variation.dimension(base)
-    impulse.World.from_scene(base, settings=preset)  # a bad scene is one error, here
+    start_mean, start_spread, start_seeds = np.zeros(dimension), np.ones(dimension), []
+    local_step, min_spread = LOCAL_STEP, MIN_SPREAD
+    origin = None  # what the ranking's last key measures the distance from (None: θ = 0)
+    if around is not None:
+        start_mean, spread_value, around_seed = _around(around, dimension)
+        start_spread = np.full(dimension, spread_value)
+        local_step = min(LOCAL_STEP, spread_value)
+        min_spread = min(MIN_SPREAD, spread_value)
+        start_seeds = [around_seed] if around_seed is not None else []
+        origin = start_mean
+    world = impulse.World.from_scene(base, settings=preset)  # a bad scene is one error, here
+    check_goals(goals, Shot(world.names, world.dt, steps, world.gravity))
     if backend == "local":
         from impulse.sweep import _check_workers_can_start
 
         _check_workers_can_start("impulse.takes.search")
     payload = _goal_payload(goals)
 
-    specs = [goal.spec if goal.spec is not None else {"custom": goal.name} for goal in goals]
     search_spec = {
         "format": _FORMAT,
         "scene": base,
-        "goals": specs,
+        "goals": [_goal_identity(goal) for goal in goals],
         "weights": [goal.weight for goal in goals],
         "variation": variation.to_dict(),
         "steps": steps,
@@ -424,95 +583,217 @@ def search(
         "elite_fraction": elite_fraction,
         "method": method,
     }
+    if around is not None:  # only then: the digests of searches from the prior are unchanged
+        search_spec["around"] = {
+            "theta": start_mean.tolist(),
+            "spread": float(start_spread[0]) if dimension else 0.0,
+            "scene_seed": start_seeds[0] if start_seeds else None,
+        }
     digest = hashlib.sha256(_canonical(search_spec).encode()).hexdigest()
     manifest = {
         "digest": digest,
         "goal_names": [goal.name for goal in goals],
         "impulse": getattr(impulse, "__version__", "unknown"),
+        "dt": float(world.dt),
         **{key: value for key, value in search_spec.items() if key != "scene"},
     }
-    store = _Store(out, manifest)
-    with open(os.path.join(store.root, SCENE_FILE), "w", encoding="utf-8") as file:
-        json.dump(base, file, indent=1)
-
-    runner = _backend(backend, workers, address)
+    store = _Store(out, manifest, base)  # locked until closed
+    try:
+        runner = _backend(backend, workers, address)
+    except BaseException:
+        store.close(written=False)
+        raise
     bar = _Progress(budget, progress)
-    mean, spread = np.zeros(dimension), np.ones(dimension)
+    mean, spread = start_mean.copy(), start_spread.copy()
     elites = max(2, round(elite_fraction * population))
     done: list[dict[str, Any]] = []
-    elite_seeds: list[int | None] = []
+    elite_seeds: list[int | None] = list(start_seeds)
     local_centres: list[np.ndarray] = []  # the best takes' θ, which local steps start from
     generation = 0
     since, best_cost, stalled = 0, math.inf, 0  # the current start's first take, its best cost
+    met = 0
+    stop = interrupted = False
     try:
-        while len(done) < budget:
-            rng = np.random.default_rng([seed, generation])
-            count = min(population, budget - len(done))
-            normal = rng.standard_normal((population, dimension))
-            thetas = mean + spread * normal
-            if local_centres:  # the generation's last share: steps around the best takes
-                for k in range(population - round(LOCAL_SHARE * population), population):
-                    thetas[k] = local_centres[k % len(local_centres)] + LOCAL_STEP * normal[k]
-            seeds = _scene_seeds(rng, population, variation.seeds, elite_seeds)
-            batch = []
-            for index, (theta, scene_seed) in enumerate(zip(thetas[:count], seeds[:count], strict=True)):
-                key = take_id(digest, theta, scene_seed)
-                row = store.rows.get(key)
-                if row is not None and row["status"] != FAILED:
-                    done.append(row)
-                    bar.update(row)
+        with _terminate_as_interrupt():
+            while len(done) < budget and met < stop_after:
+                rng = np.random.default_rng([seed, generation])
+                count = min(population, budget - len(done))
+                normal = rng.standard_normal((population, dimension))
+                thetas = mean + spread * normal
+                if local_centres:  # the generation's last share: steps around the best takes
+                    for k in range(population - round(LOCAL_SHARE * population), population):
+                        thetas[k] = local_centres[k % len(local_centres)] + local_step * normal[k]
+                seeds = _scene_seeds(rng, population, variation.seeds, elite_seeds)
+                # The generation's rows in draw order: stored ones read, the others run.
+                slots: list[dict[str, Any] | None] = [None] * count
+                tasks, by_key = [], {}
+                for index in range(count):
+                    theta, scene_seed = thetas[index], seeds[index]
+                    key = take_id(digest, theta, scene_seed)
+                    row = store.rows.get(key)
+                    if row is not None and row["status"] != FAILED:
+                        slots[index] = row
+                        continue
+                    if key in by_key:  # the same θ and seed drawn twice: one run, two slots
+                        by_key[key][3].append(index)
+                        continue
+                    by_key[key] = (index, theta, scene_seed, [index])
+                    tasks.append(
+                        {
+                            "key": key,
+                            "scene": variation.apply(base, theta, scene_seed, steps, world.dt),
+                            "steps": steps,
+                            "preset": preset,
+                            "goals": payload,
+                        }
+                    )
+                cursor = 0  # slots[:cursor] are counted in `done`
+                ran: list[str] = []
+                cursor, met, stop = _advance(slots, cursor, done, bar, met, stop_after)
+                if not stop:
+                    for result in runner.run(tasks):
+                        # A task the pool could not run comes back as the sweep's failed row.
+                        result.setdefault("take_id", result.get("run_key"))
+                        index, theta, scene_seed, indices = by_key[result["take_id"]]
+                        row = _row(result, goals, generation, index, theta)
+                        row["scene_seed"] = scene_seed
+                        store.rows[row["take_id"]] = row
+                        ran.append(row["take_id"])
+                        for place in indices:
+                            slots[place] = row
+                        cursor, met, stop = _advance(slots, cursor, done, bar, met, stop_after)
+                        if stop:
+                            break
+                if stop:
+                    # Takes drawn after the one that met the goals `stop_after` times are not
+                    # part of the search: those run anyway (in flight) are dropped, so the
+                    # table does not depend on which worker finished first.
+                    for key in ran:
+                        if store.rows[key]["index"] >= cursor:
+                            del store.rows[key]
+                store.write()
+                if stop:
+                    break
+                if generation == 0 and all(row is not None and row["status"] == FAILED
+                                           for row in slots):
+                    # Nothing ran: a goal that raises, a worker that cannot import what it
+                    # needs. The rest of the budget would fail the same way.
+                    raise RuntimeError(
+                        f"every take of the first generation failed ({count} of {count}), the "
+                        f"first with: {slots[0]['error'] if slots else None}; the takes are in "
+                        f"{os.path.join(store.root, TAKES_FILE)}"
+                    )
+                generation += 1
+                if method == "random":
                     continue
-                batch.append((index, theta, scene_seed, key))
-            tasks = [
-                {
-                    "key": key,
-                    "scene": variation.apply(base, theta, scene_seed),
-                    "steps": steps,
-                    "preset": preset,
-                    "goals": payload,
-                }
-                for _, theta, scene_seed, key in batch
-            ]
-            by_key = {key: (index, theta, scene_seed) for index, theta, scene_seed, key in batch}
-            for result in runner.run(tasks):
-                # A task the pool could not run comes back as the sweep's failed row.
-                result.setdefault("take_id", result.get("run_key"))
-                index, theta, scene_seed = by_key[result["take_id"]]
-                row = _row(result, goals, generation, index, theta)
-                row["scene_seed"] = scene_seed
-                store.rows[row["take_id"]] = row
-                done.append(row)
-                bar.update(row)
-            store.write()
-            if sum(1 for row in done if row["met"]) >= stop_after:
-                break
-            generation += 1
-            if method == "random":
-                continue
-            pool = [row for row in done[since:] if row["status"] != FAILED]
-            ranked = sorted(pool, key=_ranking(pool, goals))
-            lowest = _rank(ranked[0])[0] if ranked else math.inf  # the best take's total cost
-            if lowest < best_cost:
-                best_cost, stalled = lowest, 0
-            elif not any(row["met"] for row in ranked):  # never restart away from a success
-                stalled += 1
-            if stalled >= STALL_GENERATIONS:
-                mean, spread = np.zeros(dimension), np.ones(dimension)
-                since, best_cost, stalled, elite_seeds = len(done), math.inf, 0, []
-                local_centres = []
-                continue
-            best = np.array([row["theta"] for row in ranked[:elites]])
-            local_centres = [np.asarray(row["theta"]) for row in ranked[:LOCAL_CENTRES]]
-            elite_seeds = [row.get("scene_seed") for row in ranked[:elites]]
-            if len(best) >= 2:
-                mean = SMOOTHING * best.mean(axis=0) + (1.0 - SMOOTHING) * mean
-                spread = SMOOTHING * best.std(axis=0) + (1.0 - SMOOTHING) * spread
-                spread = np.maximum(spread, MIN_SPREAD)
+                pool = [row for row in done[since:] if row["status"] != FAILED]
+                ranked = sorted(pool, key=_ranking(pool, goals, origin))
+                lowest = _rank(ranked[0])[0] if ranked else math.inf  # the best take's cost
+                if lowest < best_cost:
+                    best_cost, stalled = lowest, 0
+                elif not any(row["met"] for row in ranked):  # never restart away from a success
+                    stalled += 1
+                if stalled >= STALL_GENERATIONS:
+                    mean, spread = start_mean.copy(), start_spread.copy()
+                    since, best_cost, stalled = len(done), math.inf, 0
+                    elite_seeds = list(start_seeds)
+                    local_centres = []
+                    continue
+                best = np.array([row["theta"] for row in ranked[:elites]])
+                local_centres = [np.asarray(row["theta"]) for row in ranked[:LOCAL_CENTRES]]
+                elite_seeds = [row.get("scene_seed") for row in ranked[:elites]]
+                if len(best) >= 2:
+                    mean = SMOOTHING * best.mean(axis=0) + (1.0 - SMOOTHING) * mean
+                    spread = SMOOTHING * best.std(axis=0) + (1.0 - SMOOTHING) * spread
+                    spread = np.maximum(spread, min_spread)
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
     finally:
-        runner.close()
+        # Interrupted (Ctrl-C, SIGTERM) or done (stop_after met): the takes in flight are
+        # abandoned and their workers ended; the takes finished so far are written.
+        runner.close(cancel=stop or interrupted)
         bar.close()
         store.write()
+        store.close()
     return load(store.root)
+
+
+def _around(around: Mapping[str, Any], dimension: int) -> tuple[np.ndarray, float, int | None]:
+    """``search``'s ``around``, checked: θ (its dimension), the spread and the scene seed."""
+    unknown = set(around) - {"theta", "spread", "scene_seed"}
+    if unknown:
+        raise ValueError(f"around has unknown keys {sorted(unknown)}: use theta, spread, scene_seed")
+    theta = np.asarray(around.get("theta", []), dtype=np.float64)
+    if theta.shape != (dimension,) or not np.all(np.isfinite(theta)):
+        raise ValueError(
+            f"around theta: {dimension} finite values needed (the variation's θ), got shape "
+            f"{theta.shape}"
+        )
+    spread = around.get("spread")
+    if isinstance(spread, bool) or not isinstance(spread, (int, float)) or not spread > 0.0:
+        raise ValueError(f"around spread = {spread!r}: must be a number > 0 (unit-free, as θ)")
+    if not math.isfinite(spread):
+        raise ValueError(f"around spread = {spread!r}: must be finite")
+    scene_seed = around.get("scene_seed")
+    if scene_seed is not None:
+        _check_integer("around scene_seed", scene_seed, 0)
+        scene_seed = int(scene_seed)
+    return theta, float(spread), scene_seed
+
+
+def _advance(
+    slots: list[dict[str, Any] | None],
+    cursor: int,
+    done: list[dict[str, Any]],
+    bar: _Progress,
+    met: int,
+    stop_after: int,
+) -> tuple[int, int, bool]:
+    """Counts a generation's rows in draw order however they finish: from ``slots[cursor]``,
+    each row known (not None) is appended to ``done``; stops at the first gap, or at the row
+    that makes ``stop_after`` takes meeting every goal (the search ends there, exactly).
+    Returns the new cursor, the count of met takes and whether to stop."""
+    while cursor < len(slots) and slots[cursor] is not None:
+        row = slots[cursor]
+        cursor += 1
+        done.append(row)
+        bar.update(row)
+        met += bool(row["met"])
+        if met >= stop_after:
+            return cursor, met, True
+    return cursor, met, False
+
+
+def _check_integer(name: str, value: Any, least: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+        raise ValueError(f"{name} = {value!r}: must be an integer >= {least}")
+
+
+class Terminated(KeyboardInterrupt):
+    """The search was ended by SIGTERM (a render farm's or a scheduler's kill), handled as
+    Ctrl-C is: the takes finished so far are written, the workers ended."""
+
+
+@contextlib.contextmanager
+def _terminate_as_interrupt():
+    """Within it, SIGTERM raises :class:`Terminated` in the main thread (when SIGTERM has its
+    default action there: a handler the program set is kept)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    if signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+        yield
+        return
+
+    def terminated(signum: int, frame: Any) -> None:
+        raise Terminated(f"signal {signum} (SIGTERM)")
+
+    signal.signal(signal.SIGTERM, terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _scene_seeds(
@@ -620,9 +901,17 @@ class Take:
         self._takes = takes
 
     def scene(self) -> dict[str, Any]:
-        """The varied scene (a dict as in a scene file): ``impulse run`` of it written to a file
-        reproduces the take's trajectory to the bit."""
-        return self._takes.variation.apply(self._takes.base_scene, self.theta, self.scene_seed)
+        """The varied scene (a dict as in a scene file) with the search's ``steps`` and ``dt``:
+        ``impulse run`` of it written to a file reproduces the take's trajectory to the bit,
+        and ``impulse render`` and the exports draw the take's length."""
+        manifest = self._takes.manifest
+        return self._takes.variation.apply(
+            self._takes.base_scene,
+            self.theta,
+            self.scene_seed,
+            manifest.get("steps"),
+            manifest.get("dt"),
+        )
 
     def write_scene(self, path: str | os.PathLike) -> None:
         """Writes :meth:`scene` as JSON to ``path``."""
@@ -695,6 +984,107 @@ def load(out: str | os.PathLike) -> Takes:
     if not os.path.exists(os.path.join(root, TAKES_FILE)):
         raise FileNotFoundError(f"{root}: no {TAKES_FILE} (not a takes search directory)")
     return Takes(root)
+
+
+#: Spread of θ around the take a refinement starts from (unit-free, as θ): in the bowling
+#: shot, takes drawn this close to a split are splits about half the time (docs/takes.md).
+REFINE_STEP = 0.002
+
+
+def refine(
+    directory: str | os.PathLike,
+    take_id: str,
+    *,
+    budget: int,
+    out: str | os.PathLike | None = None,
+    step: float = REFINE_STEP,
+    goals: Sequence[Goal | Mapping[str, Any]] | None = None,
+    backend: str = "local",
+    workers: int | None = None,
+    address: str | None = None,
+    seed: int = 0,
+    population: int | None = None,
+    stop_after: int | None = None,
+    progress: bool = True,
+) -> Takes:
+    """Searches around one take of a search (Twigg & James's browse-and-refine): the same
+    scene, goals, variation, steps, preset and elite fraction, the first generation drawn
+    from N(θ, step² I) around the take's θ (its scene seed reused first under
+    ``Variation.seeds``), then refined as :func:`search` refines.
+
+    Parameters
+    ----------
+    directory : str | os.PathLike
+        A search directory (:func:`search`'s ``out``).
+    take_id : str
+        The take to refine around.
+    budget : int
+        Takes to run (>= 1).
+    out : str | os.PathLike, optional
+        Where the refinement is written; default ``directory/refine/<take_id>``. Resumed as a
+        search is.
+    step : float
+        Spread of θ around the take (> 0, unit-free).
+    goals : list, optional
+        The search's goals again: needed when it has :func:`custom` goals (a directory holds
+        only their names and code identity); they must have the same names.
+    backend, workers, address, seed, progress
+        As for :func:`search`.
+    population : int, optional
+        Takes per generation; default the search's.
+    stop_after : int, optional
+        Stop once this many takes meet every goal; default ``budget`` (run every take: a
+        refinement gives alternatives to choose from).
+
+    Raises
+    ------
+    KeyError
+        No such take.
+    ValueError
+        Custom goals not given again, or given with other names; bad arguments as for
+        :func:`search`.
+    """
+    takes = load(directory)
+    take = takes[take_id]
+    manifest = takes.manifest
+    if goals is None:
+        specs = manifest["goals"]
+        customs = [spec["custom"] for spec in specs if "custom" in spec]
+        if customs:
+            raise ValueError(
+                f"the search has custom goals {customs}: refine it from Python with "
+                "impulse.takes.refine(..., goals=[...]) giving its goals again"
+            )
+        goals = [dict(spec) for spec in specs]
+    goals = as_goals(goals)
+    if [goal.name for goal in goals] != list(manifest["goal_names"]):
+        raise ValueError(
+            f"goals {[goal.name for goal in goals]}: a refinement keeps the search's goals, "
+            f"{manifest['goal_names']}"
+        )
+    _check_integer("budget", budget, 1)
+    return search(
+        takes.base_scene,
+        goals,
+        takes.variation,
+        budget=budget,
+        steps=int(manifest["steps"]),
+        out=os.path.join(takes.root, "refine", take_id) if out is None else out,
+        backend=backend,
+        workers=workers,
+        address=address,
+        seed=seed,
+        population=int(manifest["population"]) if population is None else population,
+        elite_fraction=float(manifest["elite_fraction"]),
+        stop_after=budget if stop_after is None else stop_after,
+        preset=manifest.get("preset"),
+        progress=progress,
+        around={
+            "theta": take.theta.tolist(),
+            "spread": step,
+            "scene_seed": None if take.scene_seed is None else int(take.scene_seed),
+        },
+    )
 
 
 def evaluate(

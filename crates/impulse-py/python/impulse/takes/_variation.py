@@ -192,11 +192,18 @@ class Variation:
         return self.per_body() * len(self.body_indices(scene))
 
     def apply(
-        self, scene: Mapping[str, Any], theta: Sequence[float], seed: int | None = None
+        self,
+        scene: Mapping[str, Any],
+        theta: Sequence[float],
+        seed: int | None = None,
+        steps: int | None = None,
+        dt: float | None = None,
     ) -> dict[str, Any]:
         """A copy of ``scene`` (a dict as in a scene file) with θ's offsets applied (and its
         roughness draws written as the varied bodies' ``roughness_draws``) and the changed
-        values rounded to float32; with ``seed``, also the scene's ``seed``.
+        values rounded to float32; with ``seed``, also the scene's ``seed``; with ``steps`` and
+        ``dt`` (s), the scene's ``steps`` and ``dt``, so ``impulse run``, ``render`` and the
+        exports of the written scene run the take's length.
 
         Raises
         ------
@@ -216,6 +223,10 @@ class Variation:
         out = copy.deepcopy(dict(scene))
         if seed is not None:
             out["seed"] = int(seed)
+        if steps is not None:
+            out["steps"] = int(steps)
+        if dt is not None:
+            out["dt"] = float(np.float32(dt))  # the engine's dt is float32: exact both ways
         k = 0
         for index in indices:
             body = out["bodies"][index]
