@@ -1,0 +1,215 @@
+"""A stage's simulation written back as a layer of time samples over it."""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
+
+from . import _frames as frames
+from ._read import open_stage, stage_to_scene
+from ._report import Report
+
+#: The names of the baked transform ops: their own suffix, so they never clash in type with
+#: a prim's authored ops (a ``float3`` translate against a ``double3`` one).
+TRANSLATE_OP = "xformOp:translate:impulse"
+ORIENT_OP = "xformOp:orient:impulse"
+SCALE_OP = "xformOp:scale:impulse"
+TRANSFORM_OP = "xformOp:transform:impulse"
+
+
+def bake(
+    source: str | os.PathLike | Usd.Stage,
+    out: str | os.PathLike,
+    *,
+    steps: int | None = None,
+    every: int | None = None,
+    settings=None,
+) -> Report:
+    """Simulates a UsdPhysics stage with impulse and writes the motion as a layer over it.
+
+    The layer at ``out`` (``.usda`` or ``.usdc``) has the input stage's root layer as its
+    sublayer, the same ``upAxis``, ``metersPerUnit``, ``kilogramsPerUnit``,
+    ``timeCodesPerSecond`` and ``framesPerSecond``, and on every prim of a moving body an
+    ``over`` with time-sampled ``xformOp:translate:impulse`` (stage units),
+    ``xformOp:orient:impulse`` (a ``quatf``) and, for a scaled prim,
+    ``xformOp:scale:impulse``, with an ``xformOpOrder`` of just those, so the prim's own ops
+    are replaced and not composed with; a prim whose local transform would shear is given one
+    ``xformOp:transform:impulse`` matrix instead. Opening ``out`` plays the simulation.
+
+    Samples sit on the stage's time codes: step k at ``startTimeCode + k·dt·timeCodesPerSecond``,
+    every ``every``-th step (default: one sample per time code when the time step divides
+    the frame, else every step) and the last. ``steps`` as in ``stage_to_scene``;
+    ``settings`` replaces the solver settings (a preset name or ``impulse.Settings``, as
+    ``World.from_scene``). Returns the reader's report.
+
+    Raises what ``stage_to_scene`` and ``impulse.World.from_scene`` raise (``SceneError`` for
+    a stage whose scene impulse refuses, naming the body's prim path), and ``StepError`` for
+    a failed step.
+    """
+    import impulse
+
+    stage = open_stage(source)
+    scene, report = stage_to_scene(stage, steps=steps)
+    world = (
+        impulse.World.from_scene(scene)
+        if settings is None
+        else impulse.World.from_scene(scene, settings=settings)
+    )
+    dt = float(world.dt)
+    count = int(scene.get("steps", 600))
+    if every is None:
+        per_code = 1.0 / (dt * report.time_codes_per_second)
+        every = round(per_code) if abs(per_code - round(per_code)) < 1e-4 and per_code >= 1 else 1
+    trajectory = world.simulate(count, every=max(1, int(every)))
+    write_layer(stage, out, report, trajectory.steps, trajectory.positions, trajectory.orientations, dt)
+    return report
+
+
+def write_layer(stage, out, report: Report, step_numbers, positions, orientations, dt) -> None:
+    """Writes the baked layer: ``positions`` (F, N, 3) m and ``orientations`` (F, N, 4) x y z w
+    of the scene's bodies at ``step_numbers`` (F,), each step ``dt`` seconds."""
+    out = os.fspath(out)
+    layer = Sdf.Layer.CreateNew(out)
+    if layer is None:
+        raise ValueError(f"{out}: cannot create a layer there")
+    root = stage.GetRootLayer()
+    layer.subLayerPaths.append(_relative_path(root, out))
+    baked = Usd.Stage.Open(layer)
+    UsdGeom.SetStageUpAxis(baked, report.up_axis)
+    UsdGeom.SetStageMetersPerUnit(baked, report.meters_per_unit)
+    if UsdPhysics.StageHasAuthoredKilogramsPerUnit(stage):
+        UsdPhysics.SetStageKilogramsPerUnit(baked, report.kilograms_per_unit)
+    tcps = report.time_codes_per_second
+    baked.SetTimeCodesPerSecond(tcps)
+    baked.SetFramesPerSecond(stage.GetFramesPerSecond())
+    codes = [report.start_time_code + float(k) * dt * tcps for k in step_numbers]
+    baked.SetStartTimeCode(report.start_time_code)
+    baked.SetEndTimeCode(codes[-1] if codes else report.start_time_code)
+    if root.defaultPrim:
+        layer.defaultPrim = root.defaultPrim
+
+    L = report.meters_per_unit
+    inverse_up = frames.up_rotation(report.up_axis).GetInverse()
+    start_cache = UsdGeom.XformCache(
+        Usd.TimeCode(report.start_time_code) if stage.HasAuthoredTimeCodeRange() else Usd.TimeCode.Default()
+    )
+    moving = [b for b in report.bodies if b.moves and b.path]
+    moving_paths = {b.path: b for b in moving}
+
+    def world_matrix(body, frame: int) -> Gf.Matrix4d:
+        """The body prim's world matrix (stage units and axes) at a written frame."""
+        prim = baked.GetPrimAtPath(body.path)
+        scale = frames.rigid_from_matrix(start_cache.GetLocalToWorldTransform(prim))[2]
+        body_rotation = frames.from_xyzw(orientations[frame, body.index])
+        offset_rotation = frames.from_xyzw(body.offset_orientation)
+        prim_rotation = body_rotation * offset_rotation.GetInverse()
+        prim_position = Gf.Vec3d(*(float(c) for c in positions[frame, body.index])) - frames.rotate(
+            prim_rotation, body.offset_position
+        )
+        stage_rotation = inverse_up * prim_rotation
+        stage_position = frames.rotate(inverse_up, prim_position) / L
+        return frames.matrix_from_rigid(stage_position, stage_rotation, scale)
+
+    def moving_ancestor(prim):
+        parent = prim.GetParent()
+        while parent and not parent.IsPseudoRoot():
+            if str(parent.GetPath()) in moving_paths:
+                return parent
+            parent = parent.GetParent()
+        return None
+
+    samples: dict[str, list[Gf.Matrix4d]] = {}
+    world_cache: dict[tuple[str, int], Gf.Matrix4d] = {}
+
+    def world_at(body, frame):
+        key = (body.path, frame)
+        if key not in world_cache:
+            world_cache[key] = world_matrix(body, frame)
+        return world_cache[key]
+
+    for body in moving:
+        prim = baked.GetPrimAtPath(body.path)
+        xformable = UsdGeom.Xformable(prim)
+        resets = bool(xformable) and xformable.GetResetXformStack()
+        parent = prim.GetParent()
+        ancestor = None if resets else moving_ancestor(prim)
+        static_parent = (
+            Gf.Matrix4d(1.0) if resets or parent.IsPseudoRoot() else start_cache.GetLocalToWorldTransform(parent)
+        )
+        if ancestor is not None:
+            ancestor_body = moving_paths[str(ancestor.GetPath())]
+            between = static_parent * start_cache.GetLocalToWorldTransform(ancestor).GetInverse()
+        local = []
+        for frame in range(len(codes)):
+            parent_world = (
+                static_parent if ancestor is None else between * world_at(ancestor_body, frame)
+            )
+            local.append(world_at(body, frame) * parent_world.GetInverse())
+        samples[body.path] = local
+        _author(prim, local, codes, resets)
+    layer.Save()
+
+
+def _author(prim, local, codes, resets) -> None:
+    """Authors one prim's baked ops: translate/orient(/scale) when every sample is a rigid
+    motion with a scale along the prim's axes, else a matrix."""
+    decomposed = [frames.rigid_from_matrix(matrix) for matrix in local]
+    shear = any(item[3] for item in decomposed)
+    xformable = UsdGeom.Xformable(prim)
+    order = ["!resetXformStack!"] if resets else []
+    if shear:
+        attribute = prim.CreateAttribute(TRANSFORM_OP, Sdf.ValueTypeNames.Matrix4d)
+        for code, matrix in zip(codes, local, strict=False):
+            attribute.Set(matrix, Usd.TimeCode(code))
+        order.append(TRANSFORM_OP)
+    else:
+        translate = prim.CreateAttribute(TRANSLATE_OP, Sdf.ValueTypeNames.Double3)
+        orient = prim.CreateAttribute(ORIENT_OP, Sdf.ValueTypeNames.Quatf)
+        previous = None
+        for code, (position, rotation, _, _) in zip(codes, decomposed, strict=False):
+            if previous is not None and _dot(previous, rotation) < 0.0:
+                rotation = -rotation
+            previous = rotation
+            translate.Set(Gf.Vec3d(position), Usd.TimeCode(code))
+            orient.Set(Gf.Quatf(rotation.GetNormalized()), Usd.TimeCode(code))
+        order += [TRANSLATE_OP, ORIENT_OP]
+        scale = decomposed[0][2]
+        if max(abs(c - 1.0) for c in scale) > 1e-9:
+            prim.CreateAttribute(SCALE_OP, Sdf.ValueTypeNames.Float3).Set(Gf.Vec3f(scale))
+            order.append(SCALE_OP)
+    xformable.GetXformOpOrderAttr().Set(order)
+
+
+def _dot(a: Gf.Quatd, b: Gf.Quatd) -> float:
+    ia, ib = a.GetImaginary(), b.GetImaginary()
+    return a.GetReal() * b.GetReal() + ia[0] * ib[0] + ia[1] * ib[1] + ia[2] * ib[2]
+
+
+def _relative_path(root: Sdf.Layer, out: str) -> str:
+    """The input's root layer as the baked layer's sublayer path: relative to the baked file
+    when both are files, else the layer's identifier."""
+    source = root.realPath
+    if not source:
+        return root.identifier
+    relative = os.path.relpath(source, os.path.dirname(os.path.abspath(out)) or ".")
+    return relative.replace(os.sep, "/")
+
+
+def positions_of(path: str | os.PathLike, prim_path: str, time_codes) -> np.ndarray:
+    """The world positions (stage units) of a prim of a stage file at the given time codes: a
+    check of a baked stage, as a player would see it."""
+    stage = Usd.Stage.Open(os.fspath(path))
+    prim = stage.GetPrimAtPath(prim_path)
+    result = []
+    for code in time_codes:
+        matrix = UsdGeom.XformCache(Usd.TimeCode(code)).GetLocalToWorldTransform(prim)
+        result.append(list(matrix.ExtractTranslation()))
+    return np.array(result)
+
+
+__all__ = ["bake", "positions_of", "write_layer"]
+
+_ = math  # (math is used by callers' doc examples only)
