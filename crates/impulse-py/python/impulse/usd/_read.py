@@ -55,6 +55,7 @@ _JOINT_TYPES = (
 # Authored attributes in these namespaces are physics: each is either mapped (marked so by the
 # reader) or reported.
 _PHYSICS_NAMESPACES = ("physics:", "physx", "drive:", "limit:", "impulse:")
+_DOF_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 _DOF_NAMES = {
     "TransX": "linear_x",
     "TransY": "linear_y",
@@ -1294,6 +1295,8 @@ class _Reader:
         axis_b = frames.rotate(world_b[1], Gf.Vec3d(1.0, 0.0, 0.0))
         # The stage's joint coordinates at the start: the angle of frame B about frame A's x
         # (a scene's coordinates start at zero).
+        self.joint_world = (world_a[0], frames.rotate(world_a[1], Gf.Vec3d(1.0, 0.0, 0.0)))
+        self.joint_frame = world_a[1]
         relative = world_a[1].GetInverse() * world_b[1]
         start_angle = frames.twist_angle(relative, (1.0, 0.0, 0.0))
         if kind in ("revolute", "prismatic", "generic", "spherical"):
@@ -1417,10 +1420,31 @@ class _Reader:
         return None
 
     def effective_mass(self, joint, angular: bool):
-        """An estimate of the joint's effective mass (kg) or inertia about its axis (kg·m²) for
-        force drives: the moving bodies' masses in series, their shapes as boxes of their
-        extent about the axis through the anchor."""
-        return None
+        """An estimate of the joint's effective mass (kg) or inertia about its axis (kg·m²),
+        to turn a force drive's gains into a frequency: the moving bodies' in series, each
+        body a box of its shape's extent at its mass, turning about the axis through the
+        anchor. None when neither body moves."""
+        anchor, axis = self.joint_world
+        inverses = 0.0
+        for index in (joint["body_a"], joint["body_b"]):
+            body = self.bodies[index]
+            if body["kind"] not in ("dynamic", "particle"):
+                continue
+            half = _half_extents(body["shape"])
+            mass = body.get("mass")
+            if mass is None:
+                material = self.material_of(body)
+                mass = material.get("density", DEFAULT_DENSITY) * 8.0 * half[0] * half[1] * half[2]
+            if not angular:
+                inverses += 1.0 / mass
+                continue
+            rotation = frames.from_xyzw(body.get("orientation", [0.0, 0.0, 0.0, 1.0]))
+            local_axis = frames.rotate(rotation.GetInverse(), axis)
+            gyration = sum(half[k] ** 2 * (1.0 - local_axis[k] ** 2) for k in range(3)) / 3.0
+            lever = Gf.Vec3d(*body["position"]) - anchor
+            distance2 = (lever - axis * Gf.Dot(lever, axis)).GetLength() ** 2
+            inverses += 1.0 / (mass * (gyration + distance2))
+        return 1.0 / inverses if inverses > 0.0 else None
 
     def revolute(self, path, prim, desc, joint, start_angle) -> None:
         self.mark(path, "physics:lowerLimit", "physics:upperLimit")
@@ -1493,7 +1517,9 @@ class _Reader:
                 self.report.add(path, "dropped", f"its {token} drive")
                 continue
             name = _DOF_NAMES[token]
-            motor = self.drive(path, prim, drive, token.startswith("Rot"), 0.0, None)
+            angular = token.startswith("Rot")
+            self.joint_world = (self.joint_world[0], frames.rotate(self.joint_frame, _DOF_AXES[token[-1]]))
+            motor = self.drive(path, prim, drive, angular, 0.0, self.effective_mass(joint, angular))
             if motor is None:
                 continue
             if dofs[name] == "locked":
@@ -1562,3 +1588,27 @@ def _single_precision(value):
             return value
         return float(str(np.float32(value)))
     return value
+
+
+def _half_extents(shape: dict) -> list[float]:
+    """The half extents (m) of a shape's bounding box in its body's frame (a mass estimate's)."""
+    kind = shape["type"]
+    if kind == "sphere":
+        return [shape["radius"]] * 3
+    if kind == "cuboid":
+        return list(shape["half_extents"])
+    if kind in ("capsule", "cylinder", "cone"):
+        radius = shape["radius"]
+        extra = radius if kind == "capsule" else 0.0
+        return [radius, shape["half_height"] + extra, radius]
+    points = shape.get("points") or shape.get("vertices")
+    if points:
+        array = np.abs(np.asarray(points, dtype=np.float64))
+        return [float(c) for c in array.max(axis=0)]
+    if kind == "compound":
+        reach = max(
+            max(_half_extents(part["shape"])) + max(abs(c) for c in part.get("position", [0, 0, 0]))
+            for part in shape["parts"]
+        )
+        return [reach] * 3
+    return [0.5, 0.5, 0.5]
