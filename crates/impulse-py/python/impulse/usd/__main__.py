@@ -1,7 +1,7 @@
 """``python -m impulse.usd``: bake a UsdPhysics stage, or turn stages and scenes into each other.
 
     python -m impulse.usd run stage.usda --out baked.usda [--steps N] [--every K] [--preset P]
-    python -m impulse.usd export stage.usda --out scene.json     # a stage's scene (JSON)
+    python -m impulse.usd export stage.usda --out scene.json     # a stage's scene (JSON; - for stdout)
     python -m impulse.usd import scene.json --out stage.usda     # a scene as a UsdPhysics stage
 
 Each prints the report of what the stage has that the scene does not simulate as authored,
@@ -31,7 +31,7 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--preset", help="solver preset (fast, default, precise, reference)")
     export = commands.add_parser("export", help="write a stage's scene as JSON")
     export.add_argument("stage")
-    export.add_argument("--out", required=True, help="the scene file to write (.json)")
+    export.add_argument("--out", required=True, help="the scene file to write (.json; - for standard output)")
     export.add_argument("--steps", type=int, help="the scene's steps (default: the stage's time range)")
     importing = commands.add_parser("import", help="write a scene (JSON) as a UsdPhysics stage")
     importing.add_argument("scene", help="a scene file (.json)")
@@ -48,9 +48,13 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         if args.command == "export":
             scene, report = stage_to_scene(args.stage, steps=args.steps)
-            with open(args.out, "w", encoding="utf-8") as file:
-                json.dump(scene, file, indent=1)
-                file.write("\n")
+            if args.out == "-":
+                json.dump(scene, sys.stdout)
+                sys.stdout.write("\n")
+            else:
+                with open(args.out, "w", encoding="utf-8") as file:
+                    json.dump(scene, file, indent=1)
+                    file.write("\n")
         else:
             report = bake(args.stage, args.out, steps=args.steps, every=args.every, settings=args.preset)
     except (OSError, ValueError, RuntimeError, ImportError) as error:

@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-import math
 import os
 
-import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
 from . import _frames as frames
@@ -52,6 +50,7 @@ def bake(
     import impulse
 
     stage = open_stage(source)
+    _check_source(stage)
     scene, report = stage_to_scene(stage, steps=steps)
     world = (
         impulse.World.from_scene(scene)
@@ -72,10 +71,11 @@ def write_layer(stage, out, report: Report, step_numbers, positions, orientation
     """Writes the baked layer: ``positions`` (F, N, 3) m and ``orientations`` (F, N, 4) x y z w
     of the scene's bodies at ``step_numbers`` (F,), each step ``dt`` seconds."""
     out = os.fspath(out)
+    _check_source(stage)
+    root = stage.GetRootLayer()
     layer = Sdf.Layer.CreateNew(out)
     if layer is None:
         raise ValueError(f"{out}: cannot create a layer there")
-    root = stage.GetRootLayer()
     layer.subLayerPaths.append(_relative_path(root, out))
     baked = Usd.Stage.Open(layer)
     UsdGeom.SetStageUpAxis(baked, report.up_axis)
@@ -153,6 +153,15 @@ def write_layer(stage, out, report: Report, step_numbers, positions, orientation
     layer.Save()
 
 
+def _check_source(stage) -> None:
+    """The baked layer sublayers the stage's file: it must have one, saved."""
+    root = stage.GetRootLayer()
+    if root.anonymous or not root.realPath:
+        raise ValueError("the stage has no file to sublayer: save it (stage.Export(path)) and bake the file")
+    if root.dirty:
+        raise ValueError(f"{root.realPath}: the stage has unsaved changes, which the baked layer would not see: save it first")
+
+
 def _author(prim, local, codes, resets) -> None:
     """Authors one prim's baked ops: translate/orient(/scale) when every sample is a rigid
     motion with a scale along the prim's axes, else a matrix."""
@@ -161,13 +170,13 @@ def _author(prim, local, codes, resets) -> None:
     xformable = UsdGeom.Xformable(prim)
     order = ["!resetXformStack!"] if resets else []
     if shear:
-        attribute = prim.CreateAttribute(TRANSFORM_OP, Sdf.ValueTypeNames.Matrix4d)
+        attribute = prim.CreateAttribute(TRANSFORM_OP, Sdf.ValueTypeNames.Matrix4d, custom=False)
         for code, matrix in zip(codes, local, strict=False):
             attribute.Set(matrix, Usd.TimeCode(code))
         order.append(TRANSFORM_OP)
     else:
-        translate = prim.CreateAttribute(TRANSLATE_OP, Sdf.ValueTypeNames.Double3)
-        orient = prim.CreateAttribute(ORIENT_OP, Sdf.ValueTypeNames.Quatf)
+        translate = prim.CreateAttribute(TRANSLATE_OP, Sdf.ValueTypeNames.Double3, custom=False)
+        orient = prim.CreateAttribute(ORIENT_OP, Sdf.ValueTypeNames.Quatf, custom=False)
         previous = None
         for code, (position, rotation, _, _) in zip(codes, decomposed, strict=False):
             if previous is not None and _dot(previous, rotation) < 0.0:
@@ -178,7 +187,7 @@ def _author(prim, local, codes, resets) -> None:
         order += [TRANSLATE_OP, ORIENT_OP]
         scale = decomposed[0][2]
         if max(abs(c - 1.0) for c in scale) > 1e-9:
-            prim.CreateAttribute(SCALE_OP, Sdf.ValueTypeNames.Float3).Set(Gf.Vec3f(scale))
+            prim.CreateAttribute(SCALE_OP, Sdf.ValueTypeNames.Float3, custom=False).Set(Gf.Vec3f(scale))
             order.append(SCALE_OP)
     xformable.GetXformOpOrderAttr().Set(order)
 
@@ -196,20 +205,3 @@ def _relative_path(root: Sdf.Layer, out: str) -> str:
         return root.identifier
     relative = os.path.relpath(source, os.path.dirname(os.path.abspath(out)) or ".")
     return relative.replace(os.sep, "/")
-
-
-def positions_of(path: str | os.PathLike, prim_path: str, time_codes) -> np.ndarray:
-    """The world positions (stage units) of a prim of a stage file at the given time codes: a
-    check of a baked stage, as a player would see it."""
-    stage = Usd.Stage.Open(os.fspath(path))
-    prim = stage.GetPrimAtPath(prim_path)
-    result = []
-    for code in time_codes:
-        matrix = UsdGeom.XformCache(Usd.TimeCode(code)).GetLocalToWorldTransform(prim)
-        result.append(list(matrix.ExtractTranslation()))
-    return np.array(result)
-
-
-__all__ = ["bake", "positions_of", "write_layer"]
-
-_ = math  # (math is used by callers' doc examples only)

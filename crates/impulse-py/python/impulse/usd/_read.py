@@ -1383,7 +1383,7 @@ class _Reader:
         damping = float(drive.damping) / unit
         max_force = float(drive.forceLimit)
         max_force = UNLIMITED_FORCE if not math.isfinite(max_force) or max_force > 1e37 else max_force * force_unit
-        if not drive.acceleration:
+        if not drive.acceleration and stiffness > 0.0:
             if effective_mass is None:
                 effective_mass = 1.0
                 self.report.add(path, "approximated", "a force drive without a moving body's mass: gains taken per unit mass")
@@ -1493,7 +1493,8 @@ class _Reader:
 
     def generic(self, path, prim, desc, joint) -> None:
         dofs = {name: "free" for name in _DOF_NAMES.values()}
-        for dof, limit in desc.jointLimits:
+        for pair in desc.jointLimits:
+            dof, limit = pair.first, pair.second
             token = str(dof).rsplit(".", 1)[-1]
             usd_name = token[0].lower() + token[1:]
             self.mark(path, f"limit:{usd_name}:physics:low", f"limit:{usd_name}:physics:high")
@@ -1508,7 +1509,8 @@ class _Reader:
                 dofs[_DOF_NAMES[token]] = "locked"
             elif limits is not None:
                 dofs[_DOF_NAMES[token]] = {"limits": limits}
-        for dof, drive in desc.jointDrives:
+        for pair in desc.jointDrives:
+            dof, drive = pair.first, pair.second
             token = str(dof).rsplit(".", 1)[-1]
             usd_name = token[0].lower() + token[1:]
             for name in ("type", "maxForce", "targetPosition", "targetVelocity", "damping", "stiffness"):
@@ -1543,7 +1545,12 @@ class _Reader:
                 if (path, name) in self.handled:
                     continue
                 if name.startswith("physics:") and not self.is_physics_prim(prim):
-                    self.report.add(path, "dropped", f"{name}: on a prim no physics schema reads")
+                    self.report.add(
+                        path,
+                        "dropped",
+                        f"{name}: on a prim of type {prim.GetTypeName() or 'none'} without a physics "
+                        "schema (a misspelt type or a missing API schema?)",
+                    )
                     continue
                 self.report.add(path, "dropped", f"{name} is not simulated")
             for schema in prim.GetAppliedSchemas():

@@ -260,7 +260,8 @@ class _Writer:
             _set(scope.GetPrim(), "impulse:shape", Sdf.ValueTypeNames.String, json.dumps(shape))
             return scope.GetPrim()
         inner = shape
-        if "border_radius" in shape or "thickness" in shape:
+        flat = kind == "cuboid" and 0.0 in [float(c) for c in shape["half_extents"]]
+        if "border_radius" in shape or "thickness" in shape or flat:
             exact = shape
             inner = {k: v for k, v in shape.items() if k not in ("border_radius", "thickness")}
             kind = inner["type"]
