@@ -42,6 +42,15 @@ def new_stage(path, up_axis="Y", meters_per_unit=1.0, rate=60.0, end=120.0):
     return stage
 
 
+def memory_stage():
+    """An in-memory stage in metres, y up (an unauthored metersPerUnit means centimetres)."""
+    stage = Usd.Stage.CreateInMemory()
+    UsdGeom.SetStageUpAxis(stage, "Y")
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    UsdPhysics.Scene.Define(stage, "/physicsScene")
+    return stage
+
+
 def up(stage, height):
     """A point at ``height`` (stage units) above the origin, along the stage's up axis."""
     return (0.0, 0.0, height) if UsdGeom.GetStageUpAxis(stage) == "Z" else (0.0, height, 0.0)
@@ -225,8 +234,7 @@ def test_mass_api_precedence_mass_over_density_over_material(tmp_path):
 
 
 def test_colliders_of_different_densities_weigh_their_sum():
-    stage = Usd.Stage.CreateInMemory()
-    UsdPhysics.Scene.Define(stage, "/physicsScene")
+    stage = memory_stage()
     body = UsdGeom.Xform.Define(stage, "/dumbbell")
     UsdPhysics.RigidBodyAPI.Apply(body.GetPrim())
     for name, x, density in (("left", -1.0, 1000.0), ("right", 1.0, 3000.0)):
@@ -407,8 +415,7 @@ def test_a_prismatic_joint_with_limits_stops_the_slider(tmp_path):
 
 
 def test_fixed_spherical_distance_and_d6_joints_map_to_their_kinds():
-    stage = Usd.Stage.CreateInMemory()
-    UsdPhysics.Scene.Define(stage, "/physicsScene")
+    stage = memory_stage()
     cubes = [rigid_cube(stage, f"/c{i}", 1.0, (2.0 * i, 5.0, 0.0)) for i in range(5)]
     kinds = [UsdPhysics.FixedJoint, UsdPhysics.SphericalJoint, UsdPhysics.DistanceJoint, UsdPhysics.Joint]
     for i, kind in enumerate(kinds):
@@ -491,7 +498,7 @@ def test_a_hundred_convex_decomposition_meshes_bake_as_their_json_equivalent(tmp
 
 
 def test_mesh_approximations_become_hulls_boxes_and_spheres():
-    stage = Usd.Stage.CreateInMemory()
+    stage = memory_stage()
     shapes = {}
     for name, approximation in (("hull", "convexHull"), ("box", "boundingCube"), ("ball", "boundingSphere")):
         mesh = concave_mesh(stage, f"/{name}", (0.0, 0.0, 0.0))
@@ -505,8 +512,7 @@ def test_mesh_approximations_become_hulls_boxes_and_spheres():
 
 
 def test_everything_not_simulated_is_reported_by_prim_path():
-    stage = Usd.Stage.CreateInMemory()
-    UsdPhysics.Scene.Define(stage, "/physicsScene")
+    stage = memory_stage()
     UsdPhysics.Scene.Define(stage, "/secondScene")
     lonely = UsdGeom.Xform.Define(stage, "/lonely")
     UsdPhysics.RigidBodyAPI.Apply(lonely.GetPrim())
@@ -624,10 +630,8 @@ def test_a_scene_goes_to_a_stage_and_back_unchanged(tmp_path, repository, name):
             else:
                 assert_same(mine[key], given[key], key)
     assert not report.dropped()
-    steps = 60
-    np.testing.assert_allclose(
-        simulate(scene, steps).positions, simulate(original | {"bodies": scene["bodies"]}, steps).positions, atol=1e-4
-    )
+    # The two scenes run alike: the same bodies, and joints whose frames differ in f32 rounding.
+    np.testing.assert_allclose(simulate(scene, 60).positions, simulate(original, 60).positions, atol=1e-4)
 
 
 def test_python_m_impulse_usd_runs_exports_and_imports(tmp_path):

@@ -2,7 +2,7 @@
 
     python -m impulse.usd run stage.usda --out baked.usda [--steps N] [--every K] [--preset P]
     python -m impulse.usd export stage.usda --out scene.json     # a stage's scene (JSON; - for stdout)
-    python -m impulse.usd import scene.json --out stage.usda     # a scene as a UsdPhysics stage
+    python -m impulse.usd import scene.json --out stage.usda     # a scene as a UsdPhysics stage (- for stdin)
 
 Each prints the report of what the stage has that the scene does not simulate as authored,
 one line per prim (``PATH: dropped|approximated|note: …``), on standard error; ``--strict``
@@ -34,7 +34,10 @@ def main(argv: list[str] | None = None) -> int:
     export.add_argument("--out", required=True, help="the scene file to write (.json; - for standard output)")
     export.add_argument("--steps", type=int, help="the scene's steps (default: the stage's time range)")
     importing = commands.add_parser("import", help="write a scene (JSON) as a UsdPhysics stage")
-    importing.add_argument("scene", help="a scene file (.json)")
+    importing.add_argument("scene", help="a scene file (.json; - for standard input)")
+    importing.add_argument(
+        "--directory", help="the directory mesh files are relative to (default: the scene file's; for -, the current one)"
+    )
     importing.add_argument("--out", required=True, help="the stage to write (.usda or .usdc)")
     for sub in (run, export):
         sub.add_argument("--strict", action="store_true", help="fail when anything is dropped")
@@ -44,7 +47,21 @@ def main(argv: list[str] | None = None) -> int:
         from . import bake, scene_to_stage, stage_to_scene
 
         if args.command == "import":
-            scene_to_stage(args.scene, args.out)
+            if args.scene == "-":
+                from ._write import absolute_files
+
+                scene = json.load(sys.stdin)
+                absolute_files(scene, args.directory or ".")
+                scene_to_stage(scene, args.out)
+            elif args.directory:
+                from ._write import absolute_files
+
+                with open(args.scene, encoding="utf-8") as file:
+                    scene = json.load(file)
+                absolute_files(scene, args.directory)
+                scene_to_stage(scene, args.out)
+            else:
+                scene_to_stage(args.scene, args.out)
             return 0
         if args.command == "export":
             scene, report = stage_to_scene(args.stage, steps=args.steps)

@@ -85,7 +85,8 @@ def write_layer(stage, out, report: Report, step_numbers, positions, orientation
     tcps = report.time_codes_per_second
     baked.SetTimeCodesPerSecond(tcps)
     baked.SetFramesPerSecond(stage.GetFramesPerSecond())
-    codes = [report.start_time_code + float(k) * dt * tcps for k in step_numbers]
+    # Rounded so that whole frames are whole time codes despite the step's binary fraction.
+    codes = [round(report.start_time_code + float(k) * dt * tcps, 9) for k in step_numbers]
     baked.SetStartTimeCode(report.start_time_code)
     baked.SetEndTimeCode(codes[-1] if codes else report.start_time_code)
     if root.defaultPrim:

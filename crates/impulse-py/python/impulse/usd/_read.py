@@ -214,14 +214,13 @@ class _Reader:
             chain.append(current)
             current = current.GetParent()
         placed = None
-        for level, item in enumerate(chain):
+        for item in chain:
             xformable = UsdGeom.Xformable(item)
             if not xformable:
                 if item.GetAttribute("xformOpOrder"):
                     return None
                 continue
-            if xformable.GetResetXformStack() and level < len(chain) - 1:
-                return None
+            resets = xformable.GetResetXformStack()
             ops = xformable.GetOrderedXformOps()
             kinds = [op.GetOpType() for op in ops]
             if any(op.IsInverseOp() for op in ops):
@@ -229,6 +228,8 @@ class _Reader:
             if kinds in ([], [UsdGeom.XformOp.TypeScale]):
                 if kinds and placed is not None:
                     return None  # a scale above the translate would scale its translation
+                if resets:
+                    break  # the ancestors' transforms do not apply
                 continue
             if placed is not None or kinds not in (
                 [UsdGeom.XformOp.TypeTranslate, UsdGeom.XformOp.TypeOrient],
@@ -238,6 +239,8 @@ class _Reader:
             ):
                 return None
             placed = ops
+            if resets:
+                break
         if placed is None:
             return Gf.Vec3d(0.0), Gf.Quatd(frames.IDENTITY), Gf.Vec3d(1.0, 1.0, 1.0)
         position = Gf.Vec3d(*placed[0].Get(time))
@@ -1558,7 +1561,7 @@ class _Reader:
                     if schema in ("PhysxConvexDecompositionCollisionAPI",):
                         continue
                     if not any((path, a.GetName()) in self.handled for a in prim.GetAuthoredAttributes()):
-                        self.report.add(path, "note", f"{schema} applied: its defaults are PhysX's, not read")
+                        self.report.add(path, "note", f"{schema} applied: PhysX's own settings, not read")
 
     def is_physics_prim(self, prim) -> bool:
         return bool(

@@ -65,10 +65,14 @@ def _load(scene):
     with open(path, encoding="utf-8") as file:
         loaded = json.load(file)
     # Mesh files are relative to the scene file's directory.
-    base = os.path.dirname(os.path.abspath(path))
-    for body in loaded.get("bodies", []):
-        _absolute_files(body.get("shape", {}), base)
+    absolute_files(loaded, os.path.dirname(os.path.abspath(path)))
     return loaded
+
+
+def absolute_files(scene: dict, directory: str) -> None:
+    """Makes the mesh files of a scene's ``trimesh`` shapes absolute, from ``directory``."""
+    for body in scene.get("bodies", []):
+        _absolute_files(body.get("shape", {}), os.path.abspath(directory))
 
 
 def _absolute_files(shape: dict, base: str) -> None:
