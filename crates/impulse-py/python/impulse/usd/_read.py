@@ -638,7 +638,7 @@ class _Reader:
                     compound.append(
                         self.part(
                             inner["shape"],
-                            local_position + frames.rotate(local_rotation, inner_position) ,
+                            local_position + frames.rotate(local_rotation, inner_position),
                             local_rotation * inner_rotation,
                         )
                     )
@@ -650,16 +650,16 @@ class _Reader:
         if not compound:
             return None, None, None
         body = {"shape": {"type": "compound", "parts": compound}}
-        own = self.compound_shape([path for path, _, _, _ in parts], len(compound))
+        own = self.compound_shape([path for path, _, _, _ in parts], compound)
         if own is not None:
             body["shape"] = own
         if material is not None:
             body["material"] = material
         return body, Gf.Vec3d(0.0), Gf.Quatd(frames.IDENTITY)
 
-    def compound_shape(self, paths, count):
+    def compound_shape(self, paths, derived):
         """A compound impulse wrote (``impulse:shape`` on the colliders' common parent), used
-        while it has as many parts as the stage has colliders."""
+        while its parts sit where the stage's colliders do."""
         common = Sdf.Path(paths[0])
         for path in paths[1:]:
             common = common.GetCommonPrefix(Sdf.Path(path))
@@ -668,9 +668,13 @@ class _Reader:
         if not own:
             return None
         own = json.loads(own)
-        if own.get("type") == "compound" and len(own.get("parts", [])) == count:
-            return own
-        return None
+        parts = own.get("parts", [])
+        if own.get("type") != "compound" or len(parts) != len(derived):
+            return None
+        for mine, theirs in zip(parts, derived, strict=True):
+            if not _close(mine.get("position", [0.0, 0.0, 0.0]), theirs["position"]):
+                return None
+        return own
 
     def part(self, shape, local_position, local_rotation) -> dict:
         part = {"shape": shape, "position": [float(c) * self.L for c in local_position]}
