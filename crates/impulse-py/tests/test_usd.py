@@ -293,10 +293,12 @@ def test_materials_bound_for_physics_slide_as_their_json_equivalent(tmp_path):
     assert any("static friction 0.9 and dynamic friction 0.7" in i.message for i in report.approximated())
     ours, theirs = simulate(scene, 90), simulate(equivalent, 90)
     np.testing.assert_allclose(ours.positions, theirs.positions, atol=1e-6)
-    # Friction μ between ice and ice, √(0.1·0.1): the box slides v²/(2μg) = 8.15 m; on rubber
-    # against ice, μ = √(0.1·0.9) = 0.3: 2.72 m.
+    # Friction μ between ice and ice, √(0.1·0.1): after 1.5 s the box has slid v t − μ g t²/2;
+    # on rubber against ice, μ = √(0.1·0.9) = 0.3 (the static friction): it stops after
+    # v²/(2μg) = 2.72 m.
     slid = ours.positions[-1, 1:, 0]
-    assert slid[0] > 5.0 and slid[1] == pytest.approx(16.0 / (2.0 * 0.3 * 9.81), rel=0.05)
+    assert slid[0] == pytest.approx(4.0 * 1.5 - 0.1 * 9.81 * 1.5**2 / 2.0, rel=0.01)  # still sliding at 1.5 s
+    assert slid[1] == pytest.approx(16.0 / (2.0 * 0.3 * 9.81), rel=0.01)  # stopped at 1.36 s
 
 
 def test_a_filtered_pair_and_collision_groups_let_bodies_pass_through(tmp_path):
@@ -345,7 +347,9 @@ def hinge_stage(path, joint_type, **attributes):
 
 def test_a_revolute_joint_with_limits_stops_the_pendulum_as_its_json_equivalent(tmp_path):
     stage, bar, joint = hinge_stage(tmp_path / "hinge.usda", UsdPhysics.RevoluteJoint, Axis="Z", LowerLimit=-30.0, UpperLimit=30.0)
+    # Turning at 2π rad/s about the hinge: the centre, 0.5 m below it, moves at π m/s.
     UsdPhysics.RigidBodyAPI(bar.GetPrim()).CreateAngularVelocityAttr(Gf.Vec3f(0.0, 0.0, 360.0))
+    UsdPhysics.RigidBodyAPI(bar.GetPrim()).CreateVelocityAttr(Gf.Vec3f(math.pi, 0.0, 0.0))
     scene, report = usd.stage_to_scene(stage)
     (hinge,) = scene["joints"]
     assert hinge["type"] == "revolute" and hinge["body_b"] == 0
@@ -356,7 +360,7 @@ def test_a_revolute_joint_with_limits_stops_the_pendulum_as_its_json_equivalent(
         "dt": 1.0 / 60.0,
         "bodies": [
             {"kind": "dynamic", "shape": {"type": "cuboid", "half_extents": [0.05, 0.5, 0.05]},
-             "position": [0.0, 2.0, 0.0], "angular_velocity": [0.0, 0.0, 2.0 * math.pi],
+             "position": [0.0, 2.0, 0.0], "linear_velocity": [math.pi, 0.0, 0.0], "angular_velocity": [0.0, 0.0, 2.0 * math.pi],
              "mass": 1.0},
             {"kind": "static", "shape": {"type": "sphere", "radius": 0.001}, "position": [0.0, 0.0, 0.0],
              "groups": 0, "mask": 0},
@@ -439,7 +443,7 @@ def test_fixed_spherical_distance_and_d6_joints_map_to_their_kinds():
     joints = scene["joints"]
     assert [j["type"] for j in joints] == ["fixed", "spherical", "distance", "generic"]
     assert joints[2]["limits"] == [0.0, 0.5]
-    assert joints[2]["world_anchors"] == [[3.0, 5.0, 0.0], [3.0, 5.0, 0.0]]
+    assert joints[2]["world_anchors"] == [[5.0, 5.0, 0.0], [5.0, 5.0, 0.0]]  # cube 2 at x = 4, cube 3 at 6
     assert joints[3]["dofs"] == {
         "linear_x": "locked",
         "linear_y": "locked",

@@ -85,8 +85,11 @@ def write_layer(stage, out, report: Report, step_numbers, positions, orientation
     tcps = report.time_codes_per_second
     baked.SetTimeCodesPerSecond(tcps)
     baked.SetFramesPerSecond(stage.GetFramesPerSecond())
-    # Rounded so that whole frames are whole time codes despite the step's binary fraction.
-    codes = [round(report.start_time_code + float(k) * dt * tcps, 9) for k in step_numbers]
+    # A step of a whole fraction of a frame (1/60 s at 60 per second, stored as the f32
+    # 0.016666668) puts whole frames on whole time codes, not on 120.0000096.
+    per_code = 1.0 / (dt * tcps)
+    step_code = 1.0 / round(per_code) if abs(per_code - round(per_code)) < 1e-4 * per_code else dt * tcps
+    codes = [round(report.start_time_code + float(k) * step_code, 9) for k in step_numbers]
     baked.SetStartTimeCode(report.start_time_code)
     baked.SetEndTimeCode(codes[-1] if codes else report.start_time_code)
     if root.defaultPrim:

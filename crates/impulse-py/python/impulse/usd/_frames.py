@@ -39,16 +39,10 @@ def from_xyzw(values) -> Gf.Quatd:
 
 
 def xyzw(q: Gf.Quatd) -> list[float]:
-    """A scene's ``[x, y, z, w]`` of a quaternion, normalised, with w ≥ 0."""
-    q = Gf.Quatd(q)
-    length = q.GetLength()
-    if length > 0.0 and abs(length - 1.0) > 1e-12:
-        q = q / length
+    """A scene's ``[x, y, z, w]`` of a quaternion, as it is (a scene's numbers come back to
+    the bit; impulse normalises when it builds the world)."""
     imaginary = q.GetImaginary()
-    values = [imaginary[0], imaginary[1], imaginary[2], q.GetReal()]
-    if values[3] < 0.0:
-        values = [-value for value in values]
-    return [float(value) for value in values]
+    return [float(imaginary[0]), float(imaginary[1]), float(imaginary[2]), float(q.GetReal())]
 
 
 def rotate(q: Gf.Quatd, v) -> Gf.Vec3d:
@@ -112,8 +106,10 @@ def rigid_from_matrix(matrix: Gf.Matrix4d) -> tuple[Gf.Vec3d, Gf.Quatd, Gf.Vec3d
     pivot = transform.GetPivotOrientation().GetQuat()
     uniform = max(abs(scale[i] - scale[0]) for i in range(3)) <= 1e-9 * max(1.0, abs(scale[0]))
     shear = not uniform and not is_identity(pivot, 1e-9)
-    rotation = transform.GetRotation().GetQuat()
-    return Gf.Vec3d(transform.GetTranslation()), Gf.Quatd(rotation), scale, shear
+    rotation = Gf.Quatd(transform.GetRotation().GetQuat())
+    if rotation.GetReal() < 0.0:
+        rotation = Gf.Quatd(-rotation.GetReal(), -rotation.GetImaginary())
+    return Gf.Vec3d(transform.GetTranslation()), rotation, scale, shear
 
 
 def matrix_from_rigid(position, rotation: Gf.Quatd, scale=(1.0, 1.0, 1.0)) -> Gf.Matrix4d:

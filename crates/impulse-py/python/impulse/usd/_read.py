@@ -1483,17 +1483,19 @@ class _Reader:
 
     def spherical(self, path, prim, desc) -> None:
         self.mark(path, "physics:coneAngle0Limit", "physics:coneAngle1Limit")
-        if desc.limit.enabled and (desc.limit.angle0 < 179.9 or desc.limit.angle1 < 179.9):
+        # The parser's cone limit: its two angles (degrees) are the limit's lower and upper.
+        cone = (float(desc.limit.lower), float(desc.limit.upper))
+        if desc.limit.enabled and 0.0 <= min(cone) < 179.9:
             self.report.add(
                 path,
                 "dropped",
-                f"its cone limit ({desc.limit.angle0:g}°, {desc.limit.angle1:g}°): impulse's spherical joints have no cone limit",
+                f"its cone limit ({cone[0]:g}°, {cone[1]:g}°): impulse's spherical joints have no cone limit",
             )
 
     def distance(self, path, prim, desc, joint) -> None:
         self.mark(path, "physics:minDistance", "physics:maxDistance")
-        low = float(desc.limit.minDist) * self.L if desc.minEnabled else 0.0
-        high = float(desc.limit.maxDist) * self.L if desc.maxEnabled else UNLIMITED_DISTANCE
+        low = float(desc.limit.lower) * self.L if desc.minEnabled else 0.0
+        high = float(desc.limit.upper) * self.L if desc.maxEnabled else UNLIMITED_DISTANCE
         if not desc.maxEnabled:
             self.report.add(path, "note", f"no maximum distance: {UNLIMITED_DISTANCE:g} m")
         joint["limits"] = [max(low, 0.0), max(high, low, 0.0)]
