@@ -169,8 +169,8 @@ def _check_source(stage) -> None:
 def _author(prim, local, codes, resets) -> None:
     """Authors one prim's baked ops: translate/orient(/scale) when every sample is a rigid
     motion with a scale along the prim's axes, else a matrix."""
-    decomposed = [frames.rigid_from_matrix(matrix) for matrix in local]
-    shear = any(item[3] for item in decomposed)
+    decomposed = [frames.trs_from_matrix(matrix) for matrix in local]
+    shear = any(item is None for item in decomposed)
     xformable = UsdGeom.Xformable(prim)
     order = ["!resetXformStack!"] if resets else []
     if shear:
@@ -182,7 +182,7 @@ def _author(prim, local, codes, resets) -> None:
         translate = prim.CreateAttribute(TRANSLATE_OP, Sdf.ValueTypeNames.Double3, custom=False)
         orient = prim.CreateAttribute(ORIENT_OP, Sdf.ValueTypeNames.Quatf, custom=False)
         previous = None
-        for code, (position, rotation, _, _) in zip(codes, decomposed, strict=False):
+        for code, (position, rotation, _) in zip(codes, decomposed, strict=True):
             if previous is not None and _dot(previous, rotation) < 0.0:
                 rotation = -rotation
             previous = rotation

@@ -118,3 +118,35 @@ def matrix_from_rigid(position, rotation: Gf.Quatd, scale=(1.0, 1.0, 1.0)) -> Gf
     rigid = Gf.Matrix4d(1.0).SetRotateOnly(Gf.Rotation(rotation))
     rigid.SetTranslateOnly(Gf.Vec3d(*position))
     return scale_matrix * rigid
+
+
+def trs_from_matrix(matrix: Gf.Matrix4d, tolerance: float = 1e-6):
+    """A local matrix (row vectors) as translate, orient and scale ops, scale first: its rows
+    are the scaled rows of a rotation. None when it is no such product (a shear, a
+    reflection) to ``tolerance`` (relative)."""
+    rows = [Gf.Vec3d(matrix[i][0], matrix[i][1], matrix[i][2]) for i in range(3)]
+    scale = [row.GetLength() for row in rows]
+    if min(scale) <= 0.0:
+        return None
+    rotation = Gf.Matrix3d(*(c / scale[i] for i in range(3) for c in rows[i]))
+    product = rotation * rotation.GetTranspose()
+    identity = Gf.Matrix3d(1.0)
+    error = max(abs(product[i][j] - identity[i][j]) for i in range(3) for j in range(3))
+    if error > tolerance or rotation.GetDeterminant() <= 0.0:
+        return None
+    quaternion = Gf.Quatd(rotation.ExtractRotation().GetQuat())
+    translation = Gf.Vec3d(matrix[3][0], matrix[3][1], matrix[3][2])
+    return translation, quaternion, Gf.Vec3d(*scale)
+
+
+def shortest_arc(axis) -> Gf.Quatd:
+    """The rotation taking x to the unit ``axis`` as impulse builds a joint frame from an axis
+    (glam's ``Quat::from_rotation_arc``: for −x, half a turn about y)."""
+    axis = Gf.Vec3d(*axis)
+    dot = axis[0]
+    if dot > 1.0 - 1e-6:
+        return Gf.Quatd(IDENTITY)
+    if dot < -1.0 + 1e-6:
+        return Gf.Quatd(0.0, 0.0, 1.0, 0.0)
+    cross = Gf.Cross(Gf.Vec3d(1.0, 0.0, 0.0), axis)
+    return Gf.Quatd(1.0 + dot, cross).GetNormalized()

@@ -1304,6 +1304,12 @@ class _Reader:
         # (a scene's coordinates start at zero).
         self.joint_world = (world_a[0], frames.rotate(world_a[1], Gf.Vec3d(1.0, 0.0, 0.0)))
         self.joint_frame = world_a[1]
+        # The scene's joint frame is the shortest turn from x to the axis; the stage's may be
+        # rolled about the axis against it (a z-up stage's by −90°). Rolls of quarter turns
+        # relabel the frame's y and z degrees of freedom.
+        roll = frames.twist_angle(frames.shortest_arc(self.joint_world[1]).GetInverse() * world_a[1], (1.0, 0.0, 0.0))
+        quarter = round(roll / (math.pi / 2.0))
+        self.joint_roll = quarter % 4 if abs(roll - quarter * math.pi / 2.0) < 1e-4 else None
         relative = world_a[1].GetInverse() * world_b[1]
         start_angle = frames.twist_angle(relative, (1.0, 0.0, 0.0))
         if kind in ("revolute", "prismatic", "generic", "spherical"):
@@ -1500,6 +1506,27 @@ class _Reader:
             self.report.add(path, "note", f"no maximum distance: {UNLIMITED_DISTANCE:g} m")
         joint["limits"] = [max(low, 0.0), max(high, low, 0.0)]
 
+    def scene_dof(self, path, token: str) -> tuple[str, float]:
+        """The scene's degree of freedom of a stage's (``TransY``, ``RotZ``, …) and the sign
+        between their coordinates, through the roll of the stage's joint frame."""
+        axis = token[-1]
+        if axis == "X" or self.joint_roll in (0, None):
+            if axis != "X" and self.joint_roll is None:
+                self.report.add(
+                    path,
+                    "approximated",
+                    f"its frame is rolled about its axis by other than quarter turns: {token} is "
+                    "taken about the scene frame's own axis",
+                )
+            return _DOF_NAMES[token], 1.0
+        mapping = {
+            1: {"Y": ("Z", 1.0), "Z": ("Y", -1.0)},
+            2: {"Y": ("Y", -1.0), "Z": ("Z", -1.0)},
+            3: {"Y": ("Z", -1.0), "Z": ("Y", 1.0)},
+        }[self.joint_roll]
+        letter, sign = mapping[axis]
+        return _DOF_NAMES[token[:-1] + letter], sign
+
     def generic(self, path, prim, desc, joint) -> None:
         dofs = {name: "free" for name in _DOF_NAMES.values()}
         for pair in desc.jointLimits:
@@ -1513,11 +1540,12 @@ class _Reader:
             if not limit.enabled:
                 continue
             angular = token.startswith("Rot")
+            name, sign = self.scene_dof(path, token)
             limits = self.limits(path, limit.lower, limit.upper, angular)
             if limits == "locked":
-                dofs[_DOF_NAMES[token]] = "locked"
+                dofs[name] = "locked"
             elif limits is not None:
-                dofs[_DOF_NAMES[token]] = {"limits": limits}
+                dofs[name] = {"limits": sorted(sign * value for value in limits)}
         for pair in desc.jointDrives:
             dof, drive = pair.first, pair.second
             token = str(dof).rsplit(".", 1)[-1]
@@ -1527,12 +1555,15 @@ class _Reader:
             if token not in _DOF_NAMES:
                 self.report.add(path, "dropped", f"its {token} drive")
                 continue
-            name = _DOF_NAMES[token]
+            name, sign = self.scene_dof(path, token)
             angular = token.startswith("Rot")
             self.joint_world = (self.joint_world[0], frames.rotate(self.joint_frame, _DOF_AXES[token[-1]]))
             motor = self.drive(path, prim, drive, angular, 0.0, self.effective_mass(joint, angular))
             if motor is None:
                 continue
+            for field in ("velocity", "position"):
+                if field in motor:
+                    motor[field] = sign * motor[field]
             if dofs[name] == "locked":
                 self.report.add(path, "dropped", f"a drive on its locked {token}")
                 continue
