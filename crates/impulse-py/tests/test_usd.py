@@ -456,6 +456,43 @@ def test_fixed_spherical_distance_and_d6_joints_map_to_their_kinds():
     impulse.World.from_scene(scene).step(10)
 
 
+def test_a_d6_drive_in_a_z_up_stage_turns_the_body_about_the_up_axis(tmp_path):
+    """A D6 joint with its translations and x, y rotations locked and a velocity drive on
+    rotZ (OpenUSD's joint example, authored here): its frames, identity in a z-up stage, are
+    rolled against the scene's, so the stage's rotZ is the scene's angular_y."""
+    stage = new_stage(tmp_path / "d6.usda", "Z", 0.01, rate=24.0, end=24.0)
+    post = UsdGeom.Cube.Define(stage, "/World/post")
+    post.CreateSizeAttr(100.0)
+    post.AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, 1000.0))
+    UsdPhysics.CollisionAPI.Apply(post.GetPrim())
+    arm = rigid_cube(stage, "/World/arm", 100.0, (0.0, 120.0, 1000.0))
+    joint = UsdPhysics.Joint.Define(stage, "/World/d6")
+    joint.CreateBody0Rel().SetTargets([post.GetPath()])
+    joint.CreateBody1Rel().SetTargets([arm.GetPath()])
+    joint.CreateLocalPos0Attr(Gf.Vec3f(0.0, 60.0, 0.0))
+    joint.CreateLocalPos1Attr(Gf.Vec3f(0.0, -60.0, 0.0))
+    for dof in ("transX", "transY", "transZ", "rotX", "rotY"):
+        limit = UsdPhysics.LimitAPI.Apply(joint.GetPrim(), dof)
+        limit.CreateLowAttr(1.0)
+        limit.CreateHighAttr(-1.0)
+    drive = UsdPhysics.DriveAPI.Apply(joint.GetPrim(), "rotZ")
+    drive.CreateTargetVelocityAttr(10.0)  # degrees/s
+    drive.CreateDampingAttr(1.0e4)
+    stage.GetRootLayer().Save()
+    scene, _ = usd.stage_to_scene(stage)
+    dofs = scene["joints"][0]["dofs"]
+    assert dofs["angular_y"]["motor"]["velocity"] == pytest.approx(math.radians(10.0))
+    assert [dofs[n] for n in ("linear_x", "linear_y", "linear_z", "angular_x", "angular_z")] == ["locked"] * 5
+    out = tmp_path / "d6_baked.usda"
+    usd.bake(tmp_path / "d6.usda", out)
+    baked = Usd.Stage.Open(str(out))
+    q = baked.GetPrimAtPath("/World/arm").GetAttribute("xformOp:orient:impulse").Get(24.0)
+    imaginary = q.GetImaginary()
+    # One second at 10°/s about the stage's z (up), about the post.
+    assert 2.0 * math.degrees(math.atan2(imaginary[2], q.GetReal())) == pytest.approx(10.0, rel=1e-3)
+    assert abs(imaginary[0]) < 1e-3 and abs(imaginary[1]) < 1e-3
+
+
 def concave_mesh(stage, path, position):
     """An L-shaped prism (a closed, concave mesh of 8 faces), 1 m tall."""
     mesh = UsdGeom.Mesh.Define(stage, path)
