@@ -136,6 +136,14 @@ def write_layer(stage, out, report: Report, step_numbers, positions, orientation
 
     for body in moving:
         prim = baked.GetPrimAtPath(body.path)
+        if prim.IsInstanceProxy():
+            report.add(
+                body.path,
+                "dropped",
+                "the bake cannot write over a prim inside an instance: its motion is not written "
+                "(make its instanceable ancestor not instanceable)",
+            )
+            continue
         xformable = UsdGeom.Xformable(prim)
         resets = bool(xformable) and xformable.GetResetXformStack()
         parent = prim.GetParent()
