@@ -346,7 +346,7 @@ def hinge_stage(path, joint_type, **attributes):
 
 
 def test_a_revolute_joint_with_limits_stops_the_pendulum_as_its_json_equivalent(tmp_path):
-    stage, bar, joint = hinge_stage(tmp_path / "hinge.usda", UsdPhysics.RevoluteJoint, Axis="Z", LowerLimit=-30.0, UpperLimit=30.0)
+    stage, bar, joint = hinge_stage(tmp_path / "hinge.usda", UsdPhysics.RevoluteJoint, Axis="Z", LowerLimit=-10.0, UpperLimit=40.0)
     # Turning at 2π rad/s about the hinge: the centre, 0.5 m below it, moves at π m/s.
     UsdPhysics.RigidBodyAPI(bar.GetPrim()).CreateAngularVelocityAttr(Gf.Vec3f(0.0, 0.0, 360.0))
     UsdPhysics.RigidBodyAPI(bar.GetPrim()).CreateVelocityAttr(Gf.Vec3f(math.pi, 0.0, 0.0))
@@ -355,7 +355,7 @@ def test_a_revolute_joint_with_limits_stops_the_pendulum_as_its_json_equivalent(
     assert hinge["type"] == "revolute" and hinge["body_b"] == 0
     assert hinge["anchor"] == pytest.approx([0.0, 2.5, 0.0])
     assert hinge["axis"] == pytest.approx([0.0, 0.0, 1.0])
-    assert hinge["limits"] == pytest.approx([-math.pi / 6, math.pi / 6])
+    assert hinge["limits"] == pytest.approx([math.radians(-10.0), math.radians(40.0)])
     equivalent = {
         "dt": 1.0 / 60.0,
         "bodies": [
@@ -366,14 +366,15 @@ def test_a_revolute_joint_with_limits_stops_the_pendulum_as_its_json_equivalent(
              "groups": 0, "mask": 0},
         ],
         "joints": [{"type": "revolute", "body_a": 1, "body_b": 0, "anchor": [0.0, 2.5, 0.0], "axis": [0.0, 0.0, 1.0],
-                    "limits": [-math.pi / 6, math.pi / 6]}],
+                    "limits": [math.radians(-10.0), math.radians(40.0)]}],
     }  # fmt: skip
     ours, theirs = simulate(scene, 120), simulate(equivalent, 120)
     np.testing.assert_allclose(ours.positions, theirs.positions, atol=1e-5)
-    # The bar turns about the hinge and never past 30° (to the joint's softness).
+    # The bar turns counter-clockwise about z (the stage's positive angle, body 1 against body
+    # 0) up to the upper limit, 40°, and never past it or the lower one (to the joint's softness).
     angles = [2.0 * math.atan2(q[2], q[3]) for q in ours.orientations[:, 0]]
-    assert max(angles) == pytest.approx(math.pi / 6, abs=0.02)
-    assert min(angles) > -math.pi / 6 - 0.02
+    assert max(angles) == pytest.approx(math.radians(40.0), abs=0.02)
+    assert min(angles) > math.radians(-10.0) - 0.02
     assert not report.dropped()
 
 
@@ -695,3 +696,144 @@ def test_frames_turn_z_up_into_y_up():
     for axis in "XYZ":
         assert list(_frames.rotate(_frames.axis_rotation(axis), (0.0, 1.0, 0.0))) == pytest.approx(list(_frames.axis_vector(axis)))
         assert list(_frames.rotate(_frames.x_to_axis(axis), (1.0, 0.0, 0.0))) == pytest.approx(list(_frames.axis_vector(axis)))
+
+
+def test_the_impulse_command_reads_and_bakes_stages_through_the_python_reader(tmp_path, impulse_cli):
+    import os
+    import subprocess
+    import sys
+
+    environment = dict(os.environ, IMPULSE_PYTHON=sys.executable)
+    box_drop(tmp_path / "drop.usda", "Z", 0.01)
+
+    def run(*arguments):
+        return subprocess.run([impulse_cli, *arguments], capture_output=True, text=True, env=environment, check=False)
+
+    baked = run("run", str(tmp_path / "drop.usda"), "--out", str(tmp_path / "baked.usda"), "--steps", "120")
+    assert baked.returncode == 0, baked.stderr
+    _, heights = world_heights(tmp_path / "baked.usda", "/World/box", 2)
+    assert heights[-1] == pytest.approx(50.0, abs=0.1)
+    # Any other run reads the stage's scene and runs it as impulse runs a JSON scene.
+    csv = run("run", str(tmp_path / "drop.usda"), "--out", str(tmp_path / "drop.csv"), "--steps", "120", "--quiet")
+    assert csv.returncode == 0, csv.stderr
+    frame, _, body, _, y = (tmp_path / "drop.csv").read_text().strip().splitlines()[-1].split(",")[:5]
+    assert (frame, body) == ("120", "1") and float(y) == pytest.approx(0.5, abs=1e-3)
+    exported = run("export", str(tmp_path / "drop.usda"), "--out", str(tmp_path / "drop.json"))
+    assert exported.returncode == 0, exported.stderr
+    assert json.loads((tmp_path / "drop.json").read_text())["bodies"][1]["position"] == pytest.approx([0.0, 2.0, 0.0])
+    written = run("export", str(tmp_path / "drop.json"), "--out", str(tmp_path / "again.usda"))
+    assert written.returncode == 0, written.stderr
+    assert validation_errors(tmp_path / "again.usda") == []
+    missing = subprocess.run(
+        [impulse_cli, "export", str(tmp_path / "drop.usda")],
+        capture_output=True,
+        text=True,
+        env=dict(environment, IMPULSE_PYTHON=str(tmp_path / "no-python")),
+        check=False,
+    )
+    assert missing.returncode != 0 and "could not be started" in missing.stderr
+
+
+def test_the_issue_stage_bakes_with_every_feature_honoured(tmp_path):
+    """100 convex-decomposition meshes, a revolute and a prismatic joint with limits and a drive,
+    two materials and a filtered pair, in one z-up centimetre stage: each feature is in the
+    scene, and the baked layer's poses are the scene's run, turned back into the stage."""
+    stage = new_stage(tmp_path / "shot.usda", "Z", 0.01, end=30.0)
+    ground = ground_plane(stage)
+    for i in range(100):
+        concave_mesh(stage, f"/World/piece_{i}", (150.0 * (i % 10), 150.0 * (i // 10), 100.0))
+    for i in range(100):
+        UsdGeom.Mesh(stage.GetPrimAtPath(f"/World/piece_{i}")).GetPointsAttr().Set(
+            [p * 100.0 for p in UsdGeom.Mesh(stage.GetPrimAtPath(f"/World/piece_{i}")).GetPointsAttr().Get()]
+        )
+    looks = {}
+    for name, friction in (("wood", 0.6), ("rubber", 1.0)):
+        material = UsdShade.Material.Define(stage, f"/World/Looks/{name}")
+        api = UsdPhysics.MaterialAPI.Apply(material.GetPrim())
+        api.CreateStaticFrictionAttr(friction)
+        api.CreateDynamicFrictionAttr(friction)
+        looks[name] = material
+    door = rigid_cube(stage, "/World/door", 100.0, (-500.0, 0.0, 300.0), mass=10.0)
+    slider = rigid_cube(stage, "/World/slider", 50.0, (-800.0, 0.0, 300.0), mass=2.0)
+    ghost = rigid_cube(stage, "/World/ghost", 50.0, (-1100.0, 0.0, 100.0))
+    for prim, name in ((door, "wood"), (slider, "rubber"), (ghost, "wood")):
+        UsdShade.MaterialBindingAPI.Apply(prim.GetPrim()).Bind(looks[name], UsdShade.Tokens.weakerThanDescendants, "physics")
+    UsdPhysics.FilteredPairsAPI.Apply(ghost.GetPrim()).CreateFilteredPairsRel().AddTarget(ground.GetPath())
+    hinge = UsdPhysics.RevoluteJoint.Define(stage, "/World/hinge")
+    hinge.CreateBody1Rel().SetTargets([door.GetPath()])
+    hinge.CreateLocalPos0Attr(Gf.Vec3f(-550.0, 0.0, 350.0))
+    hinge.CreateLocalPos1Attr(Gf.Vec3f(-50.0, 0.0, 50.0))
+    hinge.CreateAxisAttr("Y")
+    hinge.CreateLowerLimitAttr(-45.0)
+    hinge.CreateUpperLimitAttr(45.0)
+    drive = UsdPhysics.DriveAPI.Apply(hinge.GetPrim(), "angular")
+    drive.CreateTypeAttr("acceleration")
+    drive.CreateStiffnessAttr(10.0)
+    drive.CreateDampingAttr(1.0)
+    drive.CreateTargetPositionAttr(20.0)
+    rail = UsdPhysics.PrismaticJoint.Define(stage, "/World/rail")
+    rail.CreateBody1Rel().SetTargets([slider.GetPath()])
+    rail.CreateLocalPos0Attr(Gf.Vec3f(-800.0, 0.0, 300.0))
+    rail.CreateAxisAttr("Z")
+    rail.CreateLowerLimitAttr(-100.0)
+    rail.CreateUpperLimitAttr(0.0)
+    push = UsdPhysics.DriveAPI.Apply(rail.GetPrim(), "linear")
+    push.CreateTargetVelocityAttr(50.0)
+    push.CreateDampingAttr(1.0e4)
+    push.CreateMaxForceAttr(1.0e5)
+    stage.GetRootLayer().Save()
+
+    scene, report = usd.stage_to_scene(stage)
+    bodies = {body["name"]: body for body in scene["bodies"]}
+    meshes = [b for b in scene["bodies"] if b["name"].startswith("/World/piece_")]
+    assert len(meshes) == 100 and all(b["shape"]["type"] == "trimesh" for b in meshes)
+    hinge_joint, rail_joint = scene["joints"]
+    assert hinge_joint["type"] == "revolute" and hinge_joint["limits"] == pytest.approx([-math.pi / 4, math.pi / 4])
+    assert hinge_joint["motor"]["position"] == pytest.approx(math.radians(20.0))
+    assert rail_joint["type"] == "prismatic" and rail_joint["limits"] == pytest.approx([-1.0, 0.0])
+    assert rail_joint["motor"] == {"velocity": pytest.approx(0.5), "max_force": pytest.approx(1000.0)}
+    assert bodies["/World/door"]["material"] == "wood" and bodies["/World/slider"]["material"] == "rubber"
+    ghost_body, ground_body = bodies["/World/ghost"], bodies["/World/ground"]
+    assert not ghost_body["groups"] & ground_body["mask"]
+    assert not report.dropped()
+
+    out = tmp_path / "shot_baked.usda"
+    usd.bake(tmp_path / "shot.usda", out)
+    trajectory = simulate(scene, 30)
+    baked = Usd.Stage.Open(str(out))
+    turn = _frames.up_rotation("Z").GetInverse()
+    for index, body in enumerate(scene["bodies"]):
+        if body["kind"] == "static" or index % 17:
+            continue
+        prim = baked.GetPrimAtPath(body["name"])
+        position = UsdGeom.XformCache(Usd.TimeCode(30.0)).GetLocalToWorldTransform(prim).ExtractTranslation()
+        expected = _frames.rotate(turn, trajectory.positions[-1, index].tolist()) / 0.01
+        assert list(position) == pytest.approx(list(expected), abs=1e-3)  # 10 µm in centimetres
+    # The slider rode its rail up at 0.5 m/s until the upper limit... of 0: it stays at 0..-1 m.
+    assert validation_errors(out) == []
+
+
+def test_quaternion_arrays_round_trip_through_matrices_on_every_branch():
+    rng = np.random.default_rng(7)
+    q = rng.normal(size=(400, 4))
+    # Half turns about each axis pick each of Shepperd's four branches.
+    q[:4] = [[0, 0, 0, 1], [1, 0, 0, 1e-3], [0, 1, 0, 1e-3], [0, 0, 1, 1e-3]]
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    back = _frames.matrix_quat(_frames.quat_matrix(q))
+    np.testing.assert_allclose(np.abs(np.sum(back * q, axis=1)), 1.0, atol=1e-12)
+    v = rng.normal(size=(400, 3))
+    np.testing.assert_allclose(_frames.quat_rotate(q, v), np.einsum("nij,nj->ni", _frames.quat_matrix(q), v), atol=1e-12)
+    a, b = q[:200], q[200:]
+    product = _frames.quat_matrix(_frames.quat_multiply(a, b))
+    np.testing.assert_allclose(product, _frames.quat_matrix(a) @ _frames.quat_matrix(b), atol=1e-12)
+    # A scaled, turned, moved local matrix splits into its ops; a sheared one does not.
+    matrices = np.zeros((400, 4, 4))
+    matrices[:, :3, :3] = np.array([2.0, 3.0, 0.5])[None, :, None] * np.transpose(_frames.quat_matrix(q), (0, 2, 1))
+    matrices[:, 3, :3] = v
+    matrices[:, 3, 3] = 1.0
+    translations, rotations, scale = _frames.trs_from_matrices(matrices)
+    np.testing.assert_allclose(scale, [2.0, 3.0, 0.5])
+    np.testing.assert_allclose(translations, v)
+    np.testing.assert_allclose(np.abs(np.sum(rotations * q, axis=1)), 1.0, atol=1e-12)
+    matrices[5, 0, 1] += 0.1
+    assert _frames.trs_from_matrices(matrices) is None

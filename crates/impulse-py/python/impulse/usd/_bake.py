@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 
+import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
 from . import _frames as frames
@@ -96,26 +97,38 @@ def write_layer(stage, out, report: Report, step_numbers, positions, orientation
         layer.defaultPrim = root.defaultPrim
 
     L = report.meters_per_unit
-    inverse_up = frames.up_rotation(report.up_axis).GetInverse()
+    inverse_up = np.array(frames.xyzw(frames.up_rotation(report.up_axis).GetInverse()))
     start_cache = UsdGeom.XformCache(
         Usd.TimeCode(report.start_time_code) if stage.HasAuthoredTimeCodeRange() else Usd.TimeCode.Default()
     )
     moving = [b for b in report.bodies if b.moves and b.path]
     moving_paths = {b.path: b for b in moving}
+    positions = np.asarray(positions, dtype=np.float64)
+    orientations = np.asarray(orientations, dtype=np.float64)
+    worlds: dict[str, np.ndarray] = {}
 
-    def world_matrix(body, frame: int) -> Gf.Matrix4d:
-        """The body prim's world matrix (stage units and axes) at a written frame."""
-        prim = baked.GetPrimAtPath(body.path)
-        scale = frames.rigid_from_matrix(start_cache.GetLocalToWorldTransform(prim))[2]
-        body_rotation = frames.from_xyzw(orientations[frame, body.index])
-        offset_rotation = frames.from_xyzw(body.offset_orientation)
-        prim_rotation = body_rotation * offset_rotation.GetInverse()
-        prim_position = Gf.Vec3d(*(float(c) for c in positions[frame, body.index])) - frames.rotate(
-            prim_rotation, body.offset_position
-        )
-        stage_rotation = inverse_up * prim_rotation
-        stage_position = frames.rotate(inverse_up, prim_position) / L
-        return frames.matrix_from_rigid(stage_position, stage_rotation, scale)
+    def world_matrices(body) -> np.ndarray:
+        """The body prim's world matrices (F, 4, 4; row vectors, stage units and axes) at the
+        written frames: the body's poses less its offset, turned back into the stage's frame,
+        times the prim's scale."""
+        if body.path not in worlds:
+            prim = baked.GetPrimAtPath(body.path)
+            scale = np.array(frames.rigid_from_matrix(start_cache.GetLocalToWorldTransform(prim))[2])
+            offset = np.array(body.offset_orientation, dtype=np.float64)
+            offset_inverse = offset * np.array([-1.0, -1.0, -1.0, 1.0])
+            prim_rotation = frames.quat_multiply(orientations[:, body.index], offset_inverse)
+            prim_position = positions[:, body.index] - frames.quat_rotate(
+                prim_rotation, np.array(body.offset_position, dtype=np.float64)
+            )
+            stage_rotation = frames.quat_multiply(inverse_up, prim_rotation)
+            stage_position = frames.quat_rotate(inverse_up, prim_position) / L
+            matrices = np.zeros((len(stage_rotation), 4, 4))
+            # Row vectors: a point p maps to p·S·R + t, so the rows are the scaled rows of Rᵀ.
+            matrices[:, :3, :3] = scale[None, :, None] * np.transpose(frames.quat_matrix(stage_rotation), (0, 2, 1))
+            matrices[:, 3, :3] = stage_position
+            matrices[:, 3, 3] = 1.0
+            worlds[body.path] = matrices
+        return worlds[body.path]
 
     def moving_ancestor(prim):
         parent = prim.GetParent()
@@ -124,15 +137,6 @@ def write_layer(stage, out, report: Report, step_numbers, positions, orientation
                 return parent
             parent = parent.GetParent()
         return None
-
-    samples: dict[str, list[Gf.Matrix4d]] = {}
-    world_cache: dict[tuple[str, int], Gf.Matrix4d] = {}
-
-    def world_at(body, frame):
-        key = (body.path, frame)
-        if key not in world_cache:
-            world_cache[key] = world_matrix(body, frame)
-        return world_cache[key]
 
     for body in moving:
         prim = baked.GetPrimAtPath(body.path)
@@ -148,20 +152,20 @@ def write_layer(stage, out, report: Report, step_numbers, positions, orientation
         resets = bool(xformable) and xformable.GetResetXformStack()
         parent = prim.GetParent()
         ancestor = None if resets else moving_ancestor(prim)
-        static_parent = (
+        static_parent = np.array(
             Gf.Matrix4d(1.0) if resets or parent.IsPseudoRoot() else start_cache.GetLocalToWorldTransform(parent)
         )
-        if ancestor is not None:
-            ancestor_body = moving_paths[str(ancestor.GetPath())]
-            between = static_parent * start_cache.GetLocalToWorldTransform(ancestor).GetInverse()
-        local = []
-        for frame in range(len(codes)):
-            parent_world = (
-                static_parent if ancestor is None else between * world_at(ancestor_body, frame)
-            )
-            local.append(world_at(body, frame) * parent_world.GetInverse())
-        samples[body.path] = local
-        _author(prim, local, codes, resets)
+        if ancestor is None:
+            parent_worlds = static_parent[None]
+        else:
+            # What lies between the moving ancestor and the parent moves with the ancestor.
+            ancestor_start = np.array(start_cache.GetLocalToWorldTransform(ancestor))
+            between = static_parent @ np.linalg.inv(ancestor_start)
+            parent_worlds = between[None] @ world_matrices(moving_paths[str(ancestor.GetPath())])
+        local = world_matrices(body) @ np.linalg.inv(parent_worlds)
+        # One change notice for all of a prim's samples, not one per sample.
+        with Sdf.ChangeBlock():
+            _author(prim, local, codes, resets)
     layer.Save()
 
 
@@ -174,39 +178,35 @@ def _check_source(stage) -> None:
         raise ValueError(f"{root.realPath}: the stage has unsaved changes, which the baked layer would not see: save it first")
 
 
-def _author(prim, local, codes, resets) -> None:
-    """Authors one prim's baked ops: translate/orient(/scale) when every sample is a rigid
-    motion with a scale along the prim's axes, else a matrix."""
-    decomposed = [frames.trs_from_matrix(matrix) for matrix in local]
-    shear = any(item is None for item in decomposed)
+def _author(prim, local: np.ndarray, codes, resets) -> None:
+    """Authors one prim's baked ops from its local matrices (F, 4, 4): translate, orient and
+    scale when every sample's rows are the scaled rows of a rotation, else a matrix."""
     xformable = UsdGeom.Xformable(prim)
     order = ["!resetXformStack!"] if resets else []
-    if shear:
+    decomposed = frames.trs_from_matrices(local)
+    if decomposed is None:
         attribute = prim.CreateAttribute(TRANSFORM_OP, Sdf.ValueTypeNames.Matrix4d, custom=False)
-        for code, matrix in zip(codes, local, strict=False):
-            attribute.Set(matrix, Usd.TimeCode(code))
+        for code, matrix in zip(codes, local, strict=True):
+            attribute.Set(Gf.Matrix4d(matrix.tolist()), Usd.TimeCode(code))
         order.append(TRANSFORM_OP)
     else:
+        translations, rotations, scale = decomposed
+        # Each sample in the hemisphere of the one before, so that tools interpolating
+        # quaternions component by component turn the short way.
+        for k in range(1, len(rotations)):
+            if np.dot(rotations[k], rotations[k - 1]) < 0.0:
+                rotations[k] = -rotations[k]
         translate = prim.CreateAttribute(TRANSLATE_OP, Sdf.ValueTypeNames.Double3, custom=False)
         orient = prim.CreateAttribute(ORIENT_OP, Sdf.ValueTypeNames.Quatf, custom=False)
-        previous = None
-        for code, (position, rotation, _) in zip(codes, decomposed, strict=True):
-            if previous is not None and _dot(previous, rotation) < 0.0:
-                rotation = -rotation
-            previous = rotation
-            translate.Set(Gf.Vec3d(position), Usd.TimeCode(code))
-            orient.Set(Gf.Quatf(rotation.GetNormalized()), Usd.TimeCode(code))
+        for code, position, (x, y, z, w) in zip(codes, translations.tolist(), rotations.tolist(), strict=True):
+            time = Usd.TimeCode(code)
+            translate.Set(Gf.Vec3d(*position), time)
+            orient.Set(Gf.Quatf(w, x, y, z), time)
         order += [TRANSLATE_OP, ORIENT_OP]
-        scale = decomposed[0][2]
-        if max(abs(c - 1.0) for c in scale) > 1e-9:
-            prim.CreateAttribute(SCALE_OP, Sdf.ValueTypeNames.Float3, custom=False).Set(Gf.Vec3f(scale))
+        if np.max(np.abs(scale - 1.0)) > 1e-9:
+            prim.CreateAttribute(SCALE_OP, Sdf.ValueTypeNames.Float3, custom=False).Set(Gf.Vec3f(*scale.tolist()))
             order.append(SCALE_OP)
     xformable.GetXformOpOrderAttr().Set(order)
-
-
-def _dot(a: Gf.Quatd, b: Gf.Quatd) -> float:
-    ia, ib = a.GetImaginary(), b.GetImaginary()
-    return a.GetReal() * b.GetReal() + ia[0] * ib[0] + ia[1] * ib[1] + ia[2] * ib[2]
 
 
 def _relative_path(root: Sdf.Layer, out: str) -> str:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from pxr import Gf
 
 IDENTITY = Gf.Quatd(1.0, 0.0, 0.0, 0.0)
@@ -112,33 +113,6 @@ def rigid_from_matrix(matrix: Gf.Matrix4d) -> tuple[Gf.Vec3d, Gf.Quatd, Gf.Vec3d
     return Gf.Vec3d(transform.GetTranslation()), rotation, scale, shear
 
 
-def matrix_from_rigid(position, rotation: Gf.Quatd, scale=(1.0, 1.0, 1.0)) -> Gf.Matrix4d:
-    """The matrix (row vectors) of scale, then rotation, then translation."""
-    scale_matrix = Gf.Matrix4d(1.0).SetScale(Gf.Vec3d(*scale))
-    rigid = Gf.Matrix4d(1.0).SetRotateOnly(Gf.Rotation(rotation))
-    rigid.SetTranslateOnly(Gf.Vec3d(*position))
-    return scale_matrix * rigid
-
-
-def trs_from_matrix(matrix: Gf.Matrix4d, tolerance: float = 1e-6):
-    """A local matrix (row vectors) as translate, orient and scale ops, scale first: its rows
-    are the scaled rows of a rotation. None when it is no such product (a shear, a
-    reflection) to ``tolerance`` (relative)."""
-    rows = [Gf.Vec3d(matrix[i][0], matrix[i][1], matrix[i][2]) for i in range(3)]
-    scale = [row.GetLength() for row in rows]
-    if min(scale) <= 0.0:
-        return None
-    rotation = Gf.Matrix3d(*(c / scale[i] for i in range(3) for c in rows[i]))
-    product = rotation * rotation.GetTranspose()
-    identity = Gf.Matrix3d(1.0)
-    error = max(abs(product[i][j] - identity[i][j]) for i in range(3) for j in range(3))
-    if error > tolerance or rotation.GetDeterminant() <= 0.0:
-        return None
-    quaternion = Gf.Quatd(rotation.ExtractRotation().GetQuat())
-    translation = Gf.Vec3d(matrix[3][0], matrix[3][1], matrix[3][2])
-    return translation, quaternion, Gf.Vec3d(*scale)
-
-
 def shortest_arc(axis) -> Gf.Quatd:
     """The rotation taking x to the unit ``axis`` as impulse builds a joint frame from an axis
     (glam's ``Quat::from_rotation_arc``: for −x, half a turn about y)."""
@@ -150,3 +124,85 @@ def shortest_arc(axis) -> Gf.Quatd:
         return Gf.Quatd(0.0, 0.0, 1.0, 0.0)
     cross = Gf.Cross(Gf.Vec3d(1.0, 0.0, 0.0), axis)
     return Gf.Quatd(1.0 + dot, cross).GetNormalized()
+
+
+# Arrays of quaternions (…, 4) as x y z w, for whole trajectories at once.
+
+
+def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The products a·b of quaternions (…, 4), x y z w."""
+    a, b = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
+    av, aw = a[..., :3], a[..., 3:]
+    bv, bw = b[..., :3], b[..., 3:]
+    vector = aw * bv + bw * av + np.cross(av, bv)
+    scalar = aw * bw - np.sum(av * bv, axis=-1, keepdims=True)
+    return np.concatenate([vector, scalar], axis=-1)
+
+
+def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Vectors (…, 3) turned by unit quaternions (…, 4), x y z w."""
+    q = np.asarray(q, dtype=np.float64)
+    u, w = q[..., :3], q[..., 3:]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
+
+
+def quat_matrix(q: np.ndarray) -> np.ndarray:
+    """The rotation matrices (…, 3, 3) of quaternions (…, 4), x y z w, normalised first
+    (column vectors: R·v)."""
+    q = np.asarray(q, dtype=np.float64)
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=-1),
+            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=-1),
+            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1),
+        ],
+        axis=-2,
+    )
+
+
+def matrix_quat(r: np.ndarray) -> np.ndarray:
+    """Unit quaternions (…, 4), x y z w, of rotation matrices (…, 3, 3) (column vectors), by
+    the largest of the four diagonal combinations (Shepperd's method)."""
+    r = np.asarray(r, dtype=np.float64)
+    trace = r[..., 0, 0] + r[..., 1, 1] + r[..., 2, 2]
+    candidates = np.stack([trace, r[..., 0, 0], r[..., 1, 1], r[..., 2, 2]], axis=-1)
+    pick = np.argmax(candidates, axis=-1)
+    q = np.empty(r.shape[:-2] + (4,))
+    for case in range(4):
+        mask = pick == case
+        m = r[mask]
+        if case == 0:
+            s = np.sqrt(1.0 + m[:, 0, 0] + m[:, 1, 1] + m[:, 2, 2]) * 2.0
+            values = [(m[:, 2, 1] - m[:, 1, 2]) / s, (m[:, 0, 2] - m[:, 2, 0]) / s, (m[:, 1, 0] - m[:, 0, 1]) / s, 0.25 * s]
+        elif case == 1:
+            s = np.sqrt(1.0 + m[:, 0, 0] - m[:, 1, 1] - m[:, 2, 2]) * 2.0
+            values = [0.25 * s, (m[:, 0, 1] + m[:, 1, 0]) / s, (m[:, 0, 2] + m[:, 2, 0]) / s, (m[:, 2, 1] - m[:, 1, 2]) / s]
+        elif case == 2:
+            s = np.sqrt(1.0 + m[:, 1, 1] - m[:, 0, 0] - m[:, 2, 2]) * 2.0
+            values = [(m[:, 0, 1] + m[:, 1, 0]) / s, 0.25 * s, (m[:, 1, 2] + m[:, 2, 1]) / s, (m[:, 0, 2] - m[:, 2, 0]) / s]
+        else:
+            s = np.sqrt(1.0 + m[:, 2, 2] - m[:, 0, 0] - m[:, 1, 1]) * 2.0
+            values = [(m[:, 0, 2] + m[:, 2, 0]) / s, (m[:, 1, 2] + m[:, 2, 1]) / s, 0.25 * s, (m[:, 1, 0] - m[:, 0, 1]) / s]
+        q[mask] = np.stack(values, axis=-1)
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def trs_from_matrices(matrices: np.ndarray, tolerance: float = 1e-6):
+    """Local matrices (F, 4, 4; row vectors) as translate (F, 3), orient (F, 4, x y z w) and one
+    scale (3,), scale first: when every matrix's rows are the scaled rows of a rotation, by the
+    same scale. None when any is no such product (a shear, a reflection, a changing scale) to
+    ``tolerance`` (relative)."""
+    linear = matrices[:, :3, :3]
+    scale = np.linalg.norm(linear, axis=-1)  # (F, 3): the rows' lengths
+    if np.min(scale) <= 0.0 or np.max(np.abs(scale - scale[0])) > tolerance * np.max(scale):
+        return None
+    rows = linear / scale[:, :, None]
+    error = np.abs(rows @ np.transpose(rows, (0, 2, 1)) - np.eye(3)).max()
+    if error > tolerance or np.min(np.linalg.det(rows)) <= 0.0:
+        return None
+    # Row vectors: p·Rᵀ is R·p, so the rows form Rᵀ.
+    rotations = matrix_quat(np.transpose(rows, (0, 2, 1)))
+    return matrices[:, 3, :3].copy(), rotations, scale[0]
