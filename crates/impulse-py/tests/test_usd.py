@@ -687,6 +687,14 @@ def test_python_m_impulse_usd_runs_exports_and_imports(tmp_path):
     assert scene["bodies"][1]["position"] == pytest.approx([0.0, 2.0, 0.0])
     assert main(["import", str(tmp_path / "drop.json"), "--out", str(tmp_path / "again.usda")]) == 0
     assert main(["run", str(tmp_path / "missing.usda"), "--out", str(tmp_path / "x.usda")]) == 2
+    # --strict refuses a stage with anything dropped, before writing.
+    stage = Usd.Stage.Open(str(tmp_path / "drop.usda"))
+    UsdPhysics.Scene.Define(stage, "/World/secondScene")
+    stage.GetRootLayer().Save()
+    for command in ("run", "export"):
+        out = tmp_path / f"strict_{command}.out"
+        assert main([command, str(tmp_path / "drop.usda"), "--out", str(out), "--strict", "--quiet"]) == 3
+        assert not out.exists()
 
 
 def test_frames_turn_z_up_into_y_up():

@@ -6,7 +6,8 @@
 
 Each prints the report of what the stage has that the scene does not simulate as authored,
 one line per prim (``PATH: dropped|approximated|note: …``), on standard error; ``--strict``
-makes anything dropped an error (exit status 3). Errors print one line and exit with status 2.
+makes anything dropped an error (exit status 3, nothing written). Errors print one line and exit
+with status 2.
 """
 
 from __future__ import annotations
@@ -65,6 +66,8 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         if args.command == "export":
             scene, report = stage_to_scene(args.stage, steps=args.steps)
+            if args.strict and report.dropped():
+                return _refuse(report, args.quiet)
             if args.out == "-":
                 json.dump(scene, sys.stdout)
                 sys.stdout.write("\n")
@@ -73,16 +76,27 @@ def main(argv: list[str] | None = None) -> int:
                     json.dump(scene, file, indent=1)
                     file.write("\n")
         else:
+            if args.strict:
+                # Refused before anything is simulated or written.
+                _, report = stage_to_scene(args.stage, steps=args.steps)
+                if report.dropped():
+                    return _refuse(report, args.quiet)
             report = bake(args.stage, args.out, steps=args.steps, every=args.every, settings=args.preset)
     except (OSError, ValueError, RuntimeError, ImportError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
+    if args.strict and report.dropped():
+        return _refuse(report, args.quiet)
     if not args.quiet:
         print(report, file=sys.stderr)
-    if args.strict and report.dropped():
-        print(f"error: {len(report.dropped())} things dropped (--strict)", file=sys.stderr)
-        return 3
     return 0
+
+
+def _refuse(report, quiet: bool) -> int:
+    if not quiet:
+        print(report, file=sys.stderr)
+    print(f"error: {len(report.dropped())} things dropped (--strict): nothing written", file=sys.stderr)
+    return 3
 
 
 if __name__ == "__main__":
