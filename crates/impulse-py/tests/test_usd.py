@@ -845,3 +845,25 @@ def test_quaternion_arrays_round_trip_through_matrices_on_every_branch():
     np.testing.assert_allclose(np.abs(np.sum(rotations * q, axis=1)), 1.0, atol=1e-12)
     matrices[5, 0, 1] += 0.1
     assert _frames.trs_from_matrices(matrices) is None
+
+
+def test_a_static_compound_is_one_disabled_rigid_body_and_comes_back_whole(tmp_path):
+    rack = {
+        "name": "rack",
+        "kind": "static",
+        "shape": {
+            "type": "compound",
+            "parts": [
+                {"shape": {"type": "cuboid", "half_extents": [1.0, 0.1, 1.0]}, "position": [0.0, 0.0, 0.0]},
+                {"shape": {"type": "sphere", "radius": 0.3}, "position": [0.0, 1.0, 0.0]},
+            ],
+        },
+        "position": [0.0, 0.5, 0.0],
+        "orientation": [0.0, 0.38268343, 0.0, 0.9238795],
+    }
+    ball = {"name": "ball", "kind": "dynamic", "shape": {"type": "sphere", "radius": 0.2}, "position": [0.0, 3.0, 0.0]}
+    stage = usd.scene_to_stage({"bodies": [rack, ball]}, tmp_path / "rack.usda")
+    assert not UsdPhysics.RigidBodyAPI(stage.GetPrimAtPath("/World/rack")).GetRigidBodyEnabledAttr().Get()
+    scene, report = usd.stage_to_scene(tmp_path / "rack.usda")
+    assert scene["bodies"] == [rack, ball]
+    assert not report.issues

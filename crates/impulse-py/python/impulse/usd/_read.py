@@ -400,6 +400,23 @@ class _Reader:
                     shapes.setdefault(body, []).append((path, type_name, desc))
                 else:
                     statics.append((path, type_name, desc))
+        # The parser leaves the colliders of a disabled rigid body without a body; they are
+        # that static body's, at their poses relative to it.
+        disabled = {path: desc for path, desc in descriptors.get("RigidBody", []) if not desc.rigidBodyEnabled}
+        if disabled:
+            kept = []
+            for path, type_name, desc in statics:
+                owner = Sdf.Path(path)
+                while owner != Sdf.Path.absoluteRootPath and str(owner) not in disabled:
+                    owner = owner.GetParentPath()
+                if str(owner) in disabled:
+                    relative = _RelativeCollider(desc, self.world_pose(self.stage.GetPrimAtPath(owner)))
+                    shapes.setdefault(str(owner), []).append((path, type_name, relative))
+                else:
+                    kept.append((path, type_name, desc))
+            statics = kept
+        for colliders in shapes.values():
+            colliders.sort(key=lambda item: self.order.get(item[0], len(self.order)))
         # Bodies in the stage's order (a scene written as a stage comes back in its order).
         items = [(path, "body", desc) for path, desc in descriptors.get("RigidBody", [])]
         items += [(path, type_name, desc) for path, type_name, desc in statics]
@@ -1659,3 +1676,18 @@ def _half_extents(shape: dict) -> list[float]:
         )
         return [reach] * 3
     return [0.5, 0.5, 0.5]
+
+
+class _RelativeCollider:
+    """A collider descriptor whose world pose (the parser's for a collider without a body) is
+    made relative to a static body's frame, as the parser gives a body's colliders'."""
+
+    def __init__(self, desc, body_pose):
+        self._desc = desc
+        position, rotation, _ = body_pose
+        inverse = rotation.GetInverse()
+        self.localPos = frames.rotate(inverse, Gf.Vec3d(*desc.localPos) - position)
+        self.localRot = inverse * frames.quat(desc.localRot)
+
+    def __getattr__(self, name):
+        return getattr(self._desc, name)

@@ -180,7 +180,7 @@ class _Writer:
         shape = body["shape"]
         position = body.get("position", [0.0, 0.0, 0.0])
         orientation = body.get("orientation", [0.0, 0.0, 0.0, 1.0])
-        if kind == "static":
+        if kind == "static" and shape["type"] != "compound":
             # A static body is its collider: a collider without a rigid body.
             xform = UsdGeom.Xform.Define(self.stage, path)
             body_prim = xform.GetPrim()
@@ -192,6 +192,9 @@ class _Writer:
             body_prim = xform.GetPrim()
             _place(xform, position, orientation)
             rigid = UsdPhysics.RigidBodyAPI.Apply(body_prim)
+            if kind == "static":
+                # A static compound: one body of several colliders, a disabled rigid body.
+                rigid.CreateRigidBodyEnabledAttr(False)
             if kind == "kinematic":
                 rigid.CreateKinematicEnabledAttr(True)
             if any(body.get("linear_velocity", [0, 0, 0])):
@@ -203,7 +206,7 @@ class _Writer:
                 UsdPhysics.MassAPI.Apply(body_prim).CreateMassAttr(float(body["mass"]))
             if kind == "particle":
                 _set(body_prim, "impulse:kind", Sdf.ValueTypeNames.Token, "particle")
-            self.write_shape(f"{path}/collider", shape, static=False)
+            self.write_shape(f"{path}/collider", shape, static=kind == "static")
             owner = body_prim
             if body.get("keyframes"):
                 self.write_keyframes(xform, body)
