@@ -94,8 +94,8 @@ def load_descriptors(stage: Usd.Stage) -> dict[str, list[tuple[str, object]]]:
         load = getattr(UsdPhysics, "LoadUsdPhysicsFromRange", None)
     if load is None:
         raise RuntimeError(
-            "this usd-core has no UsdPhysics.LoadUsdPhysicsFromRange (OpenUSD 25.02 or later "
-            "is needed: pip install -U usd-core)"
+            "this usd-core has no UsdPhysics.LoadUsdPhysicsFromRange, OpenUSD's physics parser "
+            "(a newer release has it: pip install -U usd-core)"
         )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
