@@ -408,6 +408,21 @@ def test_an_acceleration_drive_is_a_position_motor_of_the_same_frequency(tmp_pat
     assert motor["position"] == pytest.approx(math.radians(20.0))
 
 
+def test_a_force_drive_is_a_position_motor_at_the_body_inertia_about_the_hinge(tmp_path):
+    stage, bar, joint = hinge_stage(tmp_path / "force.usda", UsdPhysics.RevoluteJoint, Axis="Z")
+    # The 1 kg bar, 0.1 × 1 × 0.1 m, about z through its top end: m(0.1² + 1²)/12 + m·0.5².
+    inertia = (0.01 + 1.0) / 12.0 + 0.25
+    omega = 2.0 * math.pi * 2.0
+    drive = UsdPhysics.DriveAPI.Apply(joint.GetPrim(), "angular")
+    drive.CreateTypeAttr("force")
+    drive.CreateStiffnessAttr(inertia * omega * omega * math.pi / 180.0)  # N·m per degree
+    drive.CreateDampingAttr(2.0 * 0.7 * inertia * omega * math.pi / 180.0)
+    scene, report = usd.stage_to_scene(stage)
+    motor = scene["joints"][0]["motor"]
+    assert motor["hertz"] == pytest.approx(2.0, rel=1e-5) and motor["damping_ratio"] == pytest.approx(0.7, rel=1e-5)
+    assert any(f"{inertia:.6g} kg·m²" in issue.message for issue in report.approximated())
+
+
 def test_a_prismatic_joint_with_limits_stops_the_slider(tmp_path):
     stage, bar, joint = hinge_stage(tmp_path / "slider.usda", UsdPhysics.PrismaticJoint, Axis="Y", LowerLimit=-1.0, UpperLimit=0.0)
     scene, _ = usd.stage_to_scene(stage)
