@@ -49,7 +49,8 @@ pub(crate) fn load_stage(path: &Path) -> Result<Scene> {
         })?;
     let stderr = String::from_utf8_lossy(&output.stderr);
     if !output.status.success() {
-        let message = stderr.trim();
+        // The reader's one-line error, or a traceback's last line (an import failing).
+        let message = stderr.trim().lines().last().unwrap_or("no message");
         if message.contains("No module named impulse")
             || message.contains("No module named 'impulse'")
         {
