@@ -12,6 +12,7 @@ mod run;
 mod solver_args;
 mod stats;
 mod trajectory;
+mod usd_stage;
 mod variation_args;
 
 use std::path::{Path, PathBuf};
@@ -43,7 +44,9 @@ struct Cli {
 enum Command {
     /// Step a scene (a JSON file or a built-in name) and print a summary.
     Run {
-        /// JSON scene file, or the name of a built-in scene (see `impulse scenes`).
+        /// JSON scene file, the name of a built-in scene (see `impulse scenes`), or a
+        /// UsdPhysics stage (.usd, .usda, .usdc, .usdz: read by `python3 -m impulse.usd`; with
+        /// `--out` a .usda or .usdc layer, the bake written over the stage, docs/usd.md).
         scene: String,
         /// Steps to take, ≥ 1 (default: the scene's, 600 for built-ins).
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
@@ -194,9 +197,10 @@ enum Command {
     Scenes,
     /// Write a scene (built-in name or file) as JSON.
     Export {
-        /// Built-in name or JSON file.
+        /// Built-in name, JSON file or UsdPhysics stage.
         scene: String,
-        /// Output file (default: standard output).
+        /// Output file (default: standard output): JSON, or a UsdPhysics stage for a .usd,
+        /// .usda or .usdc name (written by `python3 -m impulse.usd import`, docs/usd.md).
         #[arg(long)]
         out: Option<PathBuf>,
         #[command(flatten)]
@@ -309,9 +313,13 @@ enum LcpCommand {
     },
 }
 
-/// A built-in name or a path to a JSON scene file; its notes printed as `warning:` lines.
+/// A built-in name, a path to a JSON scene file, or a UsdPhysics stage (`.usd`, `.usda`,
+/// `.usdc`, `.usdz`: [`usd_stage`]); its notes printed as `warning:` lines.
 fn resolve_scene(arg: &str) -> Result<Scene> {
     let path = Path::new(arg);
+    if usd_stage::is_stage(path) {
+        return usd_stage::load_stage(path);
+    }
     if path.extension().is_some_and(|e| e == "json") || path.exists() {
         let scene = load_scene_file(path)?;
         warn_of_notes(&scene);
@@ -486,6 +494,9 @@ fn real_main() -> Result<ExitCode> {
             checkpoints,
             variation,
         } => {
+            if let Some(baked) = usd_stage::bake(&scene, out.as_deref(), steps, every) {
+                return baked.map(|()| ExitCode::SUCCESS);
+            }
             let scene_arg = scene.clone();
             let threads = worker_threads(threads)?;
             let scene_path = Path::new(&scene).is_file().then(|| PathBuf::from(&scene));
@@ -640,9 +651,16 @@ fn real_main() -> Result<ExitCode> {
             out,
             variation,
         } => {
+            let directory = Path::new(&scene)
+                .parent()
+                .unwrap_or(Path::new("."))
+                .to_path_buf();
             let scene = variation.apply(resolve_scene(&scene)?, &scene)?;
             let text = to_json_string(&scene);
             match out {
+                Some(path) if usd_stage::is_stage(&path) => {
+                    usd_stage::write_stage(&text, &directory, &path)?
+                }
                 Some(path) => std::fs::write(&path, text)
                     .with_context(|| format!("cannot write {}", path.display()))?,
                 None => print!("{text}"),
