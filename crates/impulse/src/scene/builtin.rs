@@ -110,6 +110,18 @@ const NAMES: &[(&str, &str)] = &[
         "Solver2D: pyramid of base 10 (55 cubes) started 25% overlapping",
     ),
     (
+        "pour500",
+        "500 cubes turned at random poured in 8 layers into an 8x8-cell bin (300 steps)",
+    ),
+    (
+        "pour2000",
+        "2000 cubes turned at random poured in 8 layers into a 16x16-cell bin (300 steps)",
+    ),
+    (
+        "pour8000",
+        "8000 cubes turned at random poured in 8 layers into a 32x32-cell bin (300 steps)",
+    ),
+    (
         "chain20",
         "joints: 20 links on ball joints swinging down from a horizontal start",
     ),
@@ -191,6 +203,9 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
         "bridge" => return Some(super::builtin_joints::bridge()),
         _ => {}
     }
+    if let Some(pour) = super::builtin_pours::builtin_pour(name) {
+        return Some(pour);
+    }
     // Longest prefix first: "pyramid3d" before "pyramid".
     if let Some(n) = name.strip_prefix("pyramid3d").and_then(parse_count) {
         return (1..=MAX_PYRAMID3D_BASE)
@@ -225,12 +240,12 @@ fn parse_count(text: &str) -> Option<usize> {
 
 /// Rounds an f64 coordinate to f32 (the engine's precision).
 #[allow(clippy::cast_possible_truncation)]
-fn f(x: f64) -> f32 {
+pub(super) fn f(x: f64) -> f32 {
     x as f32
 }
 
 /// A scene with the standard settings, a `"default"` material and no bodies.
-fn base(name: &str, default_material: Material) -> Scene {
+pub(super) fn base(name: &str, default_material: Material) -> Scene {
     Scene {
         name: name.to_string(),
         materials: BTreeMap::from([("default".to_string(), default_material)]),
@@ -238,7 +253,7 @@ fn base(name: &str, default_material: Material) -> Scene {
     }
 }
 
-fn cube_material() -> Material {
+pub(super) fn cube_material() -> Material {
     Material {
         friction: 0.6,
         restitution: 0.0,
@@ -248,7 +263,7 @@ fn cube_material() -> Material {
     }
 }
 
-fn ground(half_width: f64) -> BodyDesc {
+pub(super) fn ground(half_width: f64) -> BodyDesc {
     let mut ground = BodyDesc::new(
         BodyKind::Static,
         ShapeDesc::Cuboid {
