@@ -5,7 +5,8 @@
 //! Body 0 is the common ground (top face y = 0), bodies 1–4 the bin's static walls (−x, +x,
 //! −z, +z), then the cubes. The cubes' material is the standard cube's (friction 0.6,
 //! restitution 0, density 1000); dt = 1/60 s; 300 steps (5 s: the top layer, 15.5 m up, lands
-//! after 1.8 s and the pile settles). Positions are integers and halves, exact in f32.
+//! on the pile within 1.8 s and the pile settles). Positions are integers and halves, exact in
+//! f32.
 
 use rand::RngExt;
 
