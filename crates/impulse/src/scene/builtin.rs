@@ -240,12 +240,12 @@ fn parse_count(text: &str) -> Option<usize> {
 
 /// Rounds an f64 coordinate to f32 (the engine's precision).
 #[allow(clippy::cast_possible_truncation)]
-pub(super) fn f(x: f64) -> f32 {
+fn f(x: f64) -> f32 {
     x as f32
 }
 
 /// A scene with the standard settings, a `"default"` material and no bodies.
-pub(super) fn base(name: &str, default_material: Material) -> Scene {
+fn base(name: &str, default_material: Material) -> Scene {
     Scene {
         name: name.to_string(),
         materials: BTreeMap::from([("default".to_string(), default_material)]),
@@ -253,7 +253,7 @@ pub(super) fn base(name: &str, default_material: Material) -> Scene {
     }
 }
 
-pub(super) fn cube_material() -> Material {
+fn cube_material() -> Material {
     Material {
         friction: 0.6,
         restitution: 0.0,
@@ -263,7 +263,7 @@ pub(super) fn cube_material() -> Material {
     }
 }
 
-pub(super) fn ground(half_width: f64) -> BodyDesc {
+fn ground(half_width: f64) -> BodyDesc {
     let mut ground = BodyDesc::new(
         BodyKind::Static,
         ShapeDesc::Cuboid {

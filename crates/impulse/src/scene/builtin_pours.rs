@@ -10,10 +10,15 @@
 
 use rand::RngExt;
 
-use super::builtin::ground;
-use super::builtin::{CUBE_HALF_EXTENT, GROUND_HALF_WIDTH, WALL_THICKNESS, base, cube_material, f};
 use super::variation::body_generator;
-use super::{BodyDesc, BodyKind, Scene, ShapeDesc};
+use super::{BodyDesc, BodyKind, Material, Scene, ShapeDesc};
+
+/// Half extent (m) of a cube (side 1 m), as the standard scenes' cube.
+const CUBE_HALF_EXTENT: f32 = 0.5;
+/// Half extent (m) of the ground in x and z, as the standard scenes' ground.
+const GROUND_HALF_WIDTH: f32 = 150.0;
+/// Thickness (m) of the walls.
+const WALL_THICKNESS: f64 = 1.0;
 
 /// The pours as (name, cubes, columns c of the c × c grid of each layer).
 pub(super) const POURS: [(&str, usize, usize); 3] = [
@@ -66,9 +71,31 @@ pub(super) fn pour_layers(cubes: usize, columns: usize) -> usize {
 /// centres are 2 m apart), none touches a wall (the outer centres are 1 m from the walls) and
 /// the lowest are 0.63 m above the floor.
 pub(super) fn pour(name: &str, cubes: usize, columns: usize, seed: u64) -> Scene {
-    let mut scene = base(name, cube_material());
-    scene.steps = POUR_STEPS;
-    scene.bodies.push(ground(GROUND_HALF_WIDTH));
+    let mut scene = Scene {
+        name: name.to_string(),
+        steps: POUR_STEPS,
+        materials: [(
+            "default".to_string(),
+            Material {
+                friction: 0.6,
+                restitution: 0.0,
+                density: 1000.0,
+                roughness: 0.0,
+                impact_perturbation: 0.0,
+            },
+        )]
+        .into(),
+        ..Scene::default()
+    };
+    let mut ground = BodyDesc::new(
+        BodyKind::Static,
+        ShapeDesc::Cuboid {
+            half_extents: [GROUND_HALF_WIDTH, 0.5, GROUND_HALF_WIDTH],
+        },
+        [0.0, -0.5, 0.0],
+    );
+    ground.name = Some("ground".to_string());
+    scene.bodies.push(ground);
     let layers = pour_layers(cubes, columns);
     let inside = columns as f64 * POUR_SPACING / 2.0;
     let height = POUR_START_Y + (layers as f64 - 1.0) * POUR_SPACING + POUR_SPACING / 2.0;
@@ -115,6 +142,12 @@ pub(super) fn pour(name: &str, cubes: usize, columns: usize, seed: u64) -> Scene
         }
     }
     scene
+}
+
+/// Rounds an f64 coordinate to f32 (the engine's precision).
+#[allow(clippy::cast_possible_truncation)]
+fn f(x: f64) -> f32 {
+    x as f32
 }
 
 /// The uniformly random unit quaternion `[x, y, z, w]` of body `index` for `seed` (see
