@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes scenes/mug.obj (a closed mug mesh as a modelling tool exports it: a revolved cup of
-about 2,000 triangles and a half-torus handle) and scenes/mugs500.json (500 of them poured into
-a walled box, their orientations from a fixed seed). Rerun after changing the shapes here.
+about 2,000 triangles and a half-torus handle), scenes/mugs500.json (500 of them poured into
+a walled box, their orientations from a fixed seed) and scenes/mugs98.json (its first 98 mugs,
+two layers, for 120 steps: the benchmarks' mug pour). Rerun after changing the shapes here.
 
 Usage: scripts/make-mug-scenes.py
 """
@@ -127,10 +128,11 @@ def rotate(q, v):
     return [v[0] + w * tx + (y * tz - z * ty), v[1] + w * ty + (z * tx - x * tz), v[2] + w * tz + (x * ty - y * tx)]
 
 
-def write_scene(path, count=500, gap=0.01):
+def write_scene(path, count=500, steps=480, gap=0.01):
     """Mugs in layers of a 7 x 7 grid above a walled box, each turned at random about its
     bounding sphere's centre, the spheres `gap` apart: no mug starts touching another, the
-    floor or a wall."""
+    floor or a wall. The draws go mug by mug, so the first k mugs are the same for any
+    count >= k."""
     rng = random.Random(62)
     half, wall_height = 0.7, 0.6
     bodies = [
@@ -183,7 +185,7 @@ def write_scene(path, count=500, gap=0.01):
     # the 6 mm walls' parts turn into each other within a step of 1/60 s (docs/testing.md,
     # "The 500-mug pour"), as Blender's substeps per frame and Jolt's collision steps run the
     # collision detection more than once a frame.
-    scene = {"name": f"{count} mugs poured into a box", "dt": 1 / 240, "steps": 480, "bodies": bodies}
+    scene = {"name": f"{count} mugs poured into a box", "dt": 1 / 240, "steps": steps, "bodies": bodies}
     with open(path, "w") as f:
         json.dump(scene, f, indent=1)
         f.write("\n")
@@ -192,4 +194,5 @@ def write_scene(path, count=500, gap=0.01):
 if __name__ == "__main__":
     triangles = write_obj(os.path.join(ROOT, "mug.obj"))
     write_scene(os.path.join(ROOT, "mugs500.json"))
-    print(f"wrote scenes/mug.obj ({triangles} triangles) and scenes/mugs500.json")
+    write_scene(os.path.join(ROOT, "mugs98.json"), count=98, steps=120)
+    print(f"wrote scenes/mug.obj ({triangles} triangles), scenes/mugs500.json and scenes/mugs98.json")

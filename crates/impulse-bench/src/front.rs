@@ -9,8 +9,12 @@
 //! the joint gap is the distances between each joint's two anchors, summed (a chain's
 //! stretch; `quality::joint_gap`), the overlap is between bodies not joined (links of a chain
 //! folded onto one another, limbs of a pile). Drift and sink leave it: such a scene moves by
-//! design. An engine's Pareto front is its points that no other point of the same engine
-//! beats on both time and E ([`pareto_front`]); at each quality bar ([`BARS`]) the engines
+//! design. For a pour (`quality::is_pour`: `pour500`, `pour2000`, `pour8000`, `mugs98`)
+//! E = max(end overlap, largest overlap during the run / [`POUR_TRANSIENT_FACTOR`])
+//! ([`pour_error_mm`]): it meets a bar of b mm when the overlap at the end is at most b and the
+//! largest overlap during the run (poses every 10 steps) at most 30·b; sink and drift leave it
+//! too. An engine's Pareto front is its points that no other point of the same engine beats on
+//! both time and E ([`pareto_front`]); at each quality bar ([`BARS`]) the engines
 //! are compared by their cheapest setting meeting the bar ([`cheapest_meeting`]), and impulse
 //! by its time over the cheapest peer's.
 //!
@@ -29,9 +33,12 @@ use impulse::{Scene, SolverSettings};
 use serde::Serialize;
 
 use crate::front_point::by_time;
-pub use crate::front_point::{FrontPoint, cheapest_meeting, error_mm};
+pub use crate::front_point::{
+    FrontPoint, POUR_TRANSIENT_FACTOR, cheapest_meeting, error_mm, pour_error_mm,
+};
 use crate::front_retime;
 use crate::peer_settings::{PeerSetting, missing_peer, peer_compiled};
+use crate::quality::is_pour;
 use crate::scene_by_name;
 use crate::threads::thread_pool;
 
@@ -136,6 +143,9 @@ pub struct FrontConfig {
     pub steps: u32,
     /// Steps per scene with more than [`LARGE_SCENE_BODIES`] bodies.
     pub large_steps: u32,
+    /// Steps per pour (`quality::is_pour`); None: each pour's own `steps` (300 for the cube
+    /// pours, 120 for `mugs98`), whatever its size: a shorter pour ends before the pile lands.
+    pub pour_steps: Option<u32>,
     /// The small grids ([`impulse_quick_grid`], [`rapier_quick_grid`], …) instead of the full
     /// ones.
     pub quick: bool,
@@ -152,6 +162,7 @@ impl Default for FrontConfig {
             scenes: FRONT_SCENES.iter().map(|s| s.to_string()).collect(),
             steps: FRONT_STEPS,
             large_steps: FRONT_LARGE_STEPS,
+            pour_steps: None,
             quick: false,
             peers: PEERS
                 .into_iter()
@@ -164,10 +175,12 @@ impl Default for FrontConfig {
 }
 
 impl FrontConfig {
-    /// The steps `scene` runs: `large_steps` for a scene of more than [`LARGE_SCENE_BODIES`]
-    /// bodies, `steps` otherwise.
+    /// The steps `scene` runs: for a pour `pour_steps` or its own; otherwise `large_steps` for
+    /// a scene of more than [`LARGE_SCENE_BODIES`] bodies, `steps` for the rest.
     pub fn steps_for(&self, scene: &Scene) -> u32 {
-        if scene.bodies.len() > LARGE_SCENE_BODIES {
+        if is_pour(&scene.name) {
+            self.pour_steps.unwrap_or(scene.steps)
+        } else if scene.bodies.len() > LARGE_SCENE_BODIES {
             self.large_steps
         } else {
             self.steps
@@ -267,7 +280,7 @@ pub fn run_front(
     config: &FrontConfig,
     on_point: &mut dyn FnMut(&Progress<'_>),
 ) -> Result<Vec<SceneFront>> {
-    if config.steps == 0 || config.large_steps == 0 {
+    if config.steps == 0 || config.large_steps == 0 || config.pour_steps == Some(0) {
         bail!("steps must be at least 1");
     }
     if config.repeats == 0 {

@@ -166,12 +166,16 @@ pub fn format_bar_table(front: &SceneFront) -> String {
     out
 }
 
-/// Each engine's whole Pareto front on one scene, fastest first, as a Markdown table. A scene
-/// with joints shows the joint gap and the overlap that make up its E; any other scene the
-/// sink, overlap and drift.
+/// Each engine's whole Pareto front on one scene, fastest first, as a Markdown table. A pour
+/// shows the end overlap and the largest overlap during the run that make up its E; a scene
+/// with joints the joint gap and the overlap; any other scene the sink, overlap and drift.
 pub fn format_front_table(front: &SceneFront) -> String {
+    let pour = front.points.iter().any(|p| p.end_overlap_mm.is_some());
     let joints = front.points.iter().any(|p| p.joint_gap_mm.is_some());
-    let mut out = String::from(if joints {
+    let mut out = String::from(if pour {
+        "| engine | setting | ms/step | E (mm) | end overlap (mm) | overlap during the run (mm) |\n\
+         |---|---|---:|---:|---:|---:|\n"
+    } else if joints {
         "| engine | setting | ms/step | E (mm) | joint gap (mm) | overlap (mm) |\n\
          |---|---|---:|---:|---:|---:|\n"
     } else {
@@ -187,8 +191,11 @@ pub fn format_front_table(front: &SceneFront) -> String {
                 format_ms(p.ms_per_step),
                 format_mm(p.e_mm),
             );
-            let _ = match p.joint_gap_mm {
-                Some(gap) if joints => {
+            let _ = match (p.end_overlap_mm, p.joint_gap_mm) {
+                (Some(end), _) if pour => {
+                    writeln!(out, " {} | {} |", format_mm(end), format_mm(p.overlap_mm))
+                }
+                (_, Some(gap)) if joints => {
                     writeln!(out, " {} | {} |", format_mm(gap), format_mm(p.overlap_mm))
                 }
                 _ => writeln!(
@@ -235,7 +242,10 @@ const LEGEND: &str = "E = max(|top sink|, largest overlap, largest drift) after 
 for a scene with joints (chain20heavy, ragdollpile) E = max(largest joint gap, largest \
 overlap) over the run (the joint gap is the distances between each joint's two anchors, summed: \
 a chain's stretch; the overlap is between bodies not joined; 50 mm is 1 % of chain20heavy's 5 m \
-of links). Bars Q50: E ≤ 50 mm, Q5: E ≤ 5 mm, Q1: E ≤ 1 mm. ms/step: median wall-clock time of one step, \
+of links); for a pour (pour500, pour2000, pour8000, mugs98) E = max(overlap at the end, largest \
+overlap during the run / 30): a pour meets a bar of b mm when its end overlap is at most b and its \
+overlap during the run at most 30·b (sink and drift say nothing where every body moves). Bars \
+Q50: E ≤ 50 mm, Q5: E ≤ 5 mm, Q1: E ≤ 1 mm. ms/step: median wall-clock time of one step, \
 one thread, sleeping off, each setting run on its own with the engines interleaved. Time \
 impulse/cheapest peer: impulse's ms/step at its cheapest setting meeting the bar over the \
 lowest ms/step of any peer (Rapier, Box3D, Jolt) meeting it (< 1: impulse is faster); \

@@ -14,6 +14,7 @@ fn point(engine: &str, setting: &str, ms: f64, e_mm: f64) -> FrontPoint {
         e_mm,
         sink_mm: e_mm,
         overlap_mm: 0.0,
+        end_overlap_mm: None,
         drift_mm: 0.0,
         joint_gap_mm: None,
         steps: 10,
@@ -357,6 +358,79 @@ fn large_scenes_run_fewer_steps() {
     let large = scene_by_name("pyramid100").unwrap();
     assert_eq!(config.steps_for(&small), 600);
     assert_eq!(config.steps_for(&large), 120);
+    // A pour runs its own steps whatever its size (pour2000 has more than 2000 bodies), or
+    // `pour_steps`.
+    let pour = scene_by_name("pour2000").unwrap();
+    assert!(pour.bodies.len() > LARGE_SCENE_BODIES);
+    assert_eq!(config.steps_for(&pour), 300);
+    let config = FrontConfig {
+        pour_steps: Some(40),
+        ..config
+    };
+    assert_eq!(config.steps_for(&pour), 40);
+    assert_eq!(config.steps_for(&large), 120);
+}
+
+/// A pour's E is its end overlap or a thirtieth of its overlap during the run, whichever is
+/// larger, whatever its sink and drift: it meets a bar of b mm exactly when the end overlap is
+/// at most b and the overlap during the run at most 30·b.
+#[test]
+fn a_pours_error_is_made_of_its_two_overlaps() {
+    let row = |scene: &str, end_m: f64, during_m: f64| {
+        let mut row = BenchRow::new(
+            scene,
+            "impulse",
+            505,
+            300,
+            &mut [1.0; 300],
+            crate::QualityReport::default(),
+            "settings".into(),
+        );
+        (row.top_sink_m, row.max_drift_m) = (12.0, 30.0);
+        (row.end_overlap_m, row.max_overlap_m) = (end_m, during_m);
+        row
+    };
+    // Q1 met: 0.25 mm at the end, 11 mm during the run.
+    let good = FrontPoint::from_row(IMPULSE, "default", &row("pour500", 0.00025, 0.011), None);
+    assert!(
+        (good.end_overlap_mm.unwrap() - 0.25).abs() < 1e-9,
+        "{good:?}"
+    );
+    assert!((good.e_mm - 11.0 / 30.0).abs() < 1e-9, "{good:?}");
+    // 13.1 mm at the end and 181 mm during the run: Q50 only.
+    let rapier = FrontPoint::from_row(RAPIER, "4×30Hz", &row("pour500", 0.0131, 0.181), None);
+    assert!((rapier.e_mm - 13.1).abs() < 1e-9);
+    // 0.5 mm at the end but 45 mm during the run: not Q1 (45 > 30), Q5 (45 ≤ 150).
+    let transient = FrontPoint::from_row(IMPULSE, "fast", &row("mugs98", 0.0005, 0.045), None);
+    assert!((transient.e_mm - 1.5).abs() < 1e-9);
+    let points = [good, rapier, transient];
+    let at = |engine, bar| cheapest_meeting(&points, engine, bar).map(|p| p.setting.as_str());
+    assert_eq!(at(IMPULSE, 1.0), Some("default"));
+    assert_eq!(at(IMPULSE, 5.0), Some("default"));
+    assert_eq!((at(RAPIER, 5.0), at(RAPIER, 50.0)), (None, Some("4×30Hz")));
+    // The same row under another scene's name is measured by sink, overlap and drift.
+    let standard =
+        FrontPoint::from_row(IMPULSE, "default", &row("pyramid20", 0.00025, 0.011), None);
+    assert_eq!((standard.end_overlap_mm, standard.e_mm), (None, 30_000.0));
+    assert!(pour_error_mm(f64::NAN, 1.0).is_nan());
+    assert_eq!(pour_error_mm(2.0, 30.0), 2.0);
+    // The front table shows the two overlaps of a pour.
+    let front = SceneFront {
+        scene: "pour500".into(),
+        bodies: 505,
+        steps: 300,
+        repeats: 1,
+        points: points.to_vec(),
+    };
+    let table = format_front_table(&front);
+    assert!(
+        table.contains("| end overlap (mm) | overlap during the run (mm) |"),
+        "{table}"
+    );
+    assert!(
+        table.contains("| impulse | default | 1.00 | 0.367 | 0.250 | 11.0 |"),
+        "{table}"
+    );
 }
 
 /// `front --quick` on a small scene, end to end: points of every engine compiled in, a table

@@ -88,9 +88,6 @@ pub const DEFAULT_SCENES: &[&str] = &[
     "balls4096",
 ];
 
-/// Steps per scene when not told otherwise (10 s at dt = 1/60 s).
-pub const DEFAULT_STEPS: u32 = 600;
-
 /// True for the rows of impulse (its settings, `impulse fast`, `… on N threads`).
 fn is_impulse_row(row: &BenchRow) -> bool {
     row.engine == impulse_engine::ENGINE || row.engine.starts_with("impulse ")
@@ -111,8 +108,11 @@ pub fn format_table(rows: &[BenchRow]) -> String {
         let _ = write!(out, " time impulse/{peer} |");
         rule.push_str("---:|");
     }
-    out.push_str(" top sink (mm) | largest overlap (mm) | largest drift (mm) | settings |\n");
-    rule.push_str("---:|---:|---:|---|\n");
+    out.push_str(
+        " top sink (mm) | largest overlap (mm) | end overlap (mm) | largest drift (mm) | \
+         settings |\n",
+    );
+    rule.push_str("---:|---:|---:|---:|---|\n");
     out.push_str(&rule);
     for row in rows {
         let ratios: String = peers
@@ -129,7 +129,7 @@ pub fn format_table(rows: &[BenchRow]) -> String {
             .collect();
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {:.0} |{ratios} {:.1} | {:.1} | {:.1} | {} |",
+            "| {} | {} | {} | {} | {} | {:.0} |{ratios} {:.1} | {:.1} | {:.2} | {:.1} | {} |",
             row.scene,
             row.engine,
             row.bodies,
@@ -138,6 +138,7 @@ pub fn format_table(rows: &[BenchRow]) -> String {
             row.steps_per_second,
             row.top_sink_m * 1e3,
             row.max_overlap_m * 1e3,
+            row.end_overlap_m * 1e3,
             row.max_drift_m * 1e3,
             row.settings.replace('|', "\\|"),
         );
@@ -225,10 +226,11 @@ pub(crate) fn format_ms(ms: f64) -> String {
 /// What [`run_benchmarks`] measures.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BenchConfig {
-    /// Built-in scene names (`impulse::scene::builtin_scene`).
+    /// Built-in scene names (`impulse::scene::builtin_scene`) or scene files ([`scene_by_name`]).
     pub scenes: Vec<String>,
-    /// Steps per scene.
-    pub steps: u32,
+    /// Steps per scene; None: each scene's own `steps` (600 for the standard scenes, 300 for
+    /// the cube pours, 120 for `scenes/mugs98.json`).
+    pub steps: Option<u32>,
     /// Threads of impulse's rayon pool (the peers always run on one).
     pub threads: usize,
     /// Also measure Rapier at its defaults (needs the `rapier` feature).
@@ -253,7 +255,7 @@ impl Default for BenchConfig {
     fn default() -> Self {
         Self {
             scenes: DEFAULT_SCENES.iter().map(|s| s.to_string()).collect(),
-            steps: DEFAULT_STEPS,
+            steps: None,
             threads: 1,
             rapier: cfg!(feature = "rapier"),
             rapier_variants: Vec::new(),
@@ -266,10 +268,24 @@ impl Default for BenchConfig {
     }
 }
 
-/// The built-in scene `name`, or an error naming it.
+/// The built-in scene `name`; or, for a name ending in `.json`, the scene file at that path
+/// (its meshes read relative to it), named by the file's stem (`scenes/mugs98.json` is
+/// `mugs98`), so that its rows and plots carry a short name. An error names the scene or the
+/// file's problem.
 pub fn scene_by_name(name: &str) -> Result<Scene> {
-    impulse::scene::builtin_scene(name)
-        .with_context(|| format!("no built-in scene named \"{name}\""))
+    if let Some(scene) = impulse::scene::builtin_scene(name) {
+        return Ok(scene);
+    }
+    let path = std::path::Path::new(name);
+    if path.extension().is_some_and(|e| e == "json") {
+        let mut scene = impulse::scene::load_scene_file(path)
+            .with_context(|| format!("reading the scene file {name}"))?;
+        if let Some(stem) = path.file_stem().and_then(|s| s.to_str()) {
+            scene.name = stem.to_string();
+        }
+        return Ok(scene);
+    }
+    bail!("no built-in scene named \"{name}\" (a scene file's name ends in .json)")
 }
 
 impl BenchConfig {
@@ -317,7 +333,10 @@ impl BenchConfig {
 /// engine that fails (a blow-up, say) is dropped from the turns and the others go on.
 pub fn bench_scene(scene: &Scene, config: &BenchConfig) -> Result<Vec<Result<BenchRow>>> {
     config.check_peers_compiled()?;
-    let steps = config.steps;
+    let steps = config.steps.unwrap_or(scene.steps);
+    if steps == 0 {
+        bail!("steps must be at least 1 (scene {})", scene.name);
+    }
     thread_pool(config.threads)?.install(|| {
         // The impulse configurations: the scene's settings (None) and `fast`, as asked.
         let defaults = config.impulse_defaults.then_some(None);
@@ -372,7 +391,7 @@ pub fn run_benchmarks(
     on_error: &mut dyn FnMut(&anyhow::Error),
 ) -> Result<Vec<BenchRow>> {
     config.check_peers_compiled()?;
-    if config.steps == 0 {
+    if config.steps == Some(0) {
         bail!("steps must be at least 1");
     }
     if config.threads == 0 || config.also_threads == Some(0) {
@@ -413,6 +432,7 @@ mod tests {
             steps_per_second: 1e3 / ms,
             top_sink_m: 0.0012,
             max_overlap_m: 0.0,
+            end_overlap_m: 0.0,
             max_drift_m: 0.5,
             max_joint_gap_m: None,
             settings: "a | b".into(),
@@ -429,7 +449,7 @@ mod tests {
         let table = format_table(&rows);
         let lines: Vec<&str> = table.lines().collect();
         assert_eq!(lines.len(), 5);
-        assert!(lines[2].contains("| 2.00 | 500 | 0.50 | 1.2 | 0.0 | 500.0 | a \\| b |"));
+        assert!(lines[2].contains("| 2.00 | 500 | 0.50 | 1.2 | 0.0 | 0.00 | 500.0 | a \\| b |"));
         assert!(lines[3].contains("| rapier |"));
         assert!(lines[3].contains("| 250 |  | 1.2 |"));
         assert!(lines[4].contains("| 1000 |  |"));
@@ -443,7 +463,7 @@ mod tests {
         let scene = scene_by_name("pyramid20").unwrap();
         let config = BenchConfig {
             scenes: vec!["pyramid20".into()],
-            steps: 25,
+            steps: Some(25),
             threads: 1,
             rapier: false,
             rapier_variants: Vec::new(),
@@ -568,7 +588,7 @@ mod tests {
         let scene = scene_by_name("stack3").unwrap();
         let config = BenchConfig {
             scenes: vec!["stack3".into()],
-            steps: 25,
+            steps: Some(25),
             threads: 1,
             rapier: cfg!(feature = "rapier"),
             rapier_variants: if cfg!(feature = "rapier") {
@@ -626,6 +646,46 @@ mod tests {
             assert_eq!(row("jolt").max_drift_m, alone.max_drift_m);
         }
         let _ = row;
+    }
+
+    /// A scene file is named by its stem; a missing file and an unknown name say which.
+    #[test]
+    fn scene_files_are_read_and_named_by_their_stem() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/stack30.json");
+        let scene = scene_by_name(path).unwrap();
+        assert_eq!(scene.name, "stack30");
+        assert_eq!(scene.bodies, scene_by_name("stack30").unwrap().bodies);
+        let error = format!("{:#}", scene_by_name("no/such/pour500.json").unwrap_err());
+        assert!(error.contains("no/such/pour500.json"), "{error}");
+        let error = scene_by_name("pour5").unwrap_err().to_string();
+        assert!(error.contains("\"pour5\""), "{error}");
+    }
+
+    /// The first steps of a pour in the harness: the scene's own 300 steps unless told, the
+    /// cubes falling apart from each other (nothing overlaps, at the end or before).
+    #[test]
+    fn a_short_pour_runs_in_the_harness() {
+        let scene = scene_by_name("pour500").unwrap();
+        let config = BenchConfig {
+            steps: Some(12),
+            rapier: cfg!(feature = "rapier"),
+            box3d: false,
+            jolt: false,
+            ..BenchConfig::default()
+        };
+        for row in bench_scene(&scene, &config).unwrap() {
+            let row = row.unwrap();
+            assert_eq!((row.bodies, row.steps), (505, 12), "{}", row.engine);
+            assert_eq!(
+                (row.max_overlap_m, row.end_overlap_m),
+                (0.0, 0.0),
+                "{}",
+                row.engine
+            );
+            // The top cube fell freely for 0.2 s: g·t²/2 = 0.196 m, up to the integrators'
+            // O(dt) error.
+            assert!((row.top_sink_m - 0.196).abs() < 0.025, "{row:?}");
+        }
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! cargo run --release -p impulse-bench --features rapier,box3d,jolt -- [SCENE...] [--steps N] [--threads N] [--no-rapier] [--no-box3d] [--no-jolt] [--impulse-fast] [--also-threads N] [--markdown FILE]
-//! cargo run --release -p impulse-bench --features rapier,box3d,jolt -- front [SCENE...] [--steps N] [--large-steps M] [--peers rapier,box3d,jolt] [--out-dir DIR] [--markdown FILE] [--json FILE] [--quick]
+//! cargo run --release -p impulse-bench --features rapier,box3d,jolt -- front [SCENE...] [--steps N] [--large-steps M] [--pour-steps P] [--peers rapier,box3d,jolt] [--out-dir DIR] [--markdown FILE] [--json FILE] [--quick]
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -14,8 +14,7 @@ use clap::{Parser, Subcommand};
 use impulse_bench::front::{self, FrontConfig};
 use impulse_bench::peer_settings::{BOX3D, JOLT, PEERS, RAPIER, peer_compiled};
 use impulse_bench::{
-    BenchConfig, DEFAULT_SCENES, DEFAULT_STEPS, MachineInfo, RapierVariant, format_table,
-    format_thread_table,
+    BenchConfig, DEFAULT_SCENES, MachineInfo, RapierVariant, format_table, format_thread_table,
 };
 
 /// Times impulse and its peers (Rapier, Box3D and Jolt, those compiled in) on the same built-in
@@ -32,11 +31,13 @@ struct Args {
     #[command(subcommand)]
     command: Option<Command>,
     /// Built-in scene names (default: pyramid20 pyramid100 pyramid3d10 stack30 massratio
-    /// balls4096).
+    /// balls4096; the pours pour500 pour2000 pour8000 are built in too) or scene files
+    /// (`scenes/mugs98.json`, named by the file's stem).
     scenes: Vec<String>,
-    /// Steps per scene.
-    #[arg(long, default_value_t = DEFAULT_STEPS)]
-    steps: u32,
+    /// Steps per scene (default: each scene's own: 600 for the standard scenes, 300 for the
+    /// cube pours, 120 for scenes/mugs98.json).
+    #[arg(long)]
+    steps: Option<u32>,
     /// Threads of impulse's rayon pool (the peers run on one thread).
     #[arg(long, default_value_t = 1)]
     threads: usize,
@@ -91,14 +92,20 @@ enum Command {
 #[derive(clap::Args)]
 struct FrontArgs {
     /// Built-in scene names (default: pyramid20 pyramid3d10 stack30 massratio pyramid100
-    /// chain20heavy ragdollpile).
+    /// chain20heavy ragdollpile) or scene files (`scenes/mugs98.json`). The pours (pour500,
+    /// pour2000, pour8000, scenes/mugs98.json) are measured by their overlaps at the end and
+    /// during the run.
     scenes: Vec<String>,
     /// Steps per scene.
     #[arg(long, default_value_t = front::FRONT_STEPS)]
     steps: u32,
-    /// Steps per scene of more than 2000 bodies (pyramid100).
+    /// Steps per scene of more than 2000 bodies (pyramid100), pours aside.
     #[arg(long, default_value_t = front::FRONT_LARGE_STEPS)]
     large_steps: u32,
+    /// Steps per pour (default: each pour's own, 300 for the cube pours and 120 for
+    /// scenes/mugs98.json).
+    #[arg(long, value_name = "N")]
+    pour_steps: Option<u32>,
     /// The peers to measure, comma-separated (default: every peer compiled in; each needs its
     /// feature).
     #[arg(long, value_delimiter = ',', value_name = "PEER,...")]
@@ -175,12 +182,14 @@ fn run(args: Args) -> Result<bool> {
         &config,
         &mut |row| {
             eprintln!(
-                "{:<12} {:<8} {:>9.3} ms/step  sink {:.1} mm  overlap {:.1} mm  drift {:.1} mm",
+                "{:<12} {:<8} {:>9.3} ms/step  sink {:.1} mm  overlap {:.1} mm (end {:.2} mm)  \
+                 drift {:.1} mm",
                 row.scene,
                 row.engine,
                 row.ms_per_step_median,
                 row.top_sink_m * 1e3,
                 row.max_overlap_m * 1e3,
+                row.end_overlap_m * 1e3,
                 row.max_drift_m * 1e3,
             );
         },
@@ -259,6 +268,7 @@ fn run_front(args: FrontArgs) -> Result<bool> {
         },
         steps: args.steps,
         large_steps: args.large_steps,
+        pour_steps: args.pour_steps,
         quick: args.quick,
         repeats: args.repeats,
         ..FrontConfig::default()
@@ -294,7 +304,7 @@ fn run_front(args: FrontArgs) -> Result<bool> {
         match &point.failed {
             None => eprintln!(
                 "[{}/{}] {} ({} steps) {:<7} {:<18} {:>9.3} ms/step  E {:.2} mm (sink {:.2}, \
-                 overlap {:.2}, drift {:.2})",
+                 overlap {:.2}{}, drift {:.2})",
                 p.done,
                 p.total,
                 p.scene,
@@ -305,6 +315,9 @@ fn run_front(args: FrontArgs) -> Result<bool> {
                 point.e_mm,
                 point.sink_mm,
                 point.overlap_mm,
+                point
+                    .end_overlap_mm
+                    .map_or(String::new(), |end| format!(", end overlap {end:.2}")),
                 point.drift_mm,
             ),
             Some(error) => eprintln!(
@@ -389,7 +402,7 @@ mod tests {
             .unwrap();
         assert!(args.command.is_none());
         assert_eq!(args.scenes, ["stack30", "pyramid20"]);
-        assert_eq!(args.steps, 5);
+        assert_eq!(args.steps, Some(5));
         let args = Args::try_parse_from(["impulse-bench"]).unwrap();
         assert!(args.command.is_none() && args.scenes.is_empty());
     }

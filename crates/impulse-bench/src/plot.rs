@@ -168,7 +168,12 @@ fn draw(front: &SceneFront, path: &Path) -> Result<(), Box<dyn std::error::Error
     chart
         .configure_mesh()
         .x_desc("time per step (ms, log scale)")
-        .y_desc("E = max(|sink|, overlap, drift) in mm (log scale; below 0.01 at 0.01)")
+        .y_desc(if front.points.iter().any(|p| p.end_overlap_mm.is_some()) {
+            "E = max(end overlap, overlap during the run / 30) in mm (log scale; below 0.01 at \
+             0.01)"
+        } else {
+            "E = max(|sink|, overlap, drift) in mm (log scale; below 0.01 at 0.01)"
+        })
         .x_label_formatter(&|v| tick(*v))
         .y_label_formatter(&|v| tick(*v))
         .label_style((FONT, 15))

@@ -3,6 +3,8 @@
 //! `impulse::metrics` measure them with the shapes, kinds and collision groups of the impulse
 //! world built from the same scene. A scene with joints is also measured by its joint gap
 //! ([`joint_gap`]): how far apart the two anchors of each joint are, summed over the joints.
+//! A pour ([`is_pour`]) is measured by its overlaps alone: the largest at the end and the
+//! largest over the run (bodies move by design, so sink and drift say nothing there).
 
 use glam::Vec3;
 use impulse::{BodyHandle, JointKind};
@@ -15,6 +17,19 @@ pub const SAMPLE_EVERY: u32 = 10;
 /// True when the poses after step `step` (1-based) of `steps` are sampled.
 pub fn is_sample_step(step: u32, steps: u32) -> bool {
     step.is_multiple_of(SAMPLE_EVERY) || step == steps
+}
+
+/// The built-in pours and the mug pour file's name (`scenes/mugs98.json`, named by its stem).
+pub const POUR_SCENES: &[&str] = &["pour500", "pour2000", "pour8000", "mugs98"];
+
+/// True for a pour: a scene named `pour<N>` or `mugs<N>` (N in digits), e.g. the scenes of
+/// [`POUR_SCENES`] and `mugs500`.
+pub fn is_pour(scene: &str) -> bool {
+    ["pour", "mugs"].iter().any(|prefix| {
+        scene
+            .strip_prefix(prefix)
+            .is_some_and(|count| !count.is_empty() && count.bytes().all(|b| b.is_ascii_digit()))
+    })
 }
 
 /// One joint as the metrics read it: its kind, the scene indices of its two bodies and each
@@ -73,6 +88,7 @@ pub struct Quality {
     initial: Vec<Vec3>,
     top: Option<usize>,
     max_overlap: f32,
+    last_overlap: f32,
     max_drift: f32,
     joints: Vec<JointAnchors>,
     max_joint_gap: f32,
@@ -85,6 +101,9 @@ pub struct QualityReport {
     pub top_sink: f32,
     /// Largest penetration depth between any two bodies over the samples.
     pub max_overlap: f32,
+    /// Largest penetration depth between any two bodies at the last sample (the end of a run
+    /// that finished; 0 before any sample).
+    pub end_overlap: f32,
     /// Largest distance any moving body was from its start over the samples.
     pub max_drift: f32,
     /// Largest joint gap over the samples ([`joint_gap`]); None for a scene without joints.
@@ -98,6 +117,7 @@ impl Quality {
             initial: poses.iter().map(|p| p.translation).collect(),
             top: metrics::top_body(world, poses),
             max_overlap: 0.0,
+            last_overlap: 0.0,
             max_drift: 0.0,
             joints: joint_anchors(world),
             max_joint_gap: 0.0,
@@ -106,7 +126,8 @@ impl Quality {
 
     /// Measures one sample: the bodies of `world` at the current `poses`.
     pub fn sample(&mut self, world: &World, poses: &[Pose]) {
-        self.max_overlap = self.max_overlap.max(metrics::max_overlap(world, poses));
+        self.last_overlap = metrics::max_overlap(world, poses);
+        self.max_overlap = self.max_overlap.max(self.last_overlap);
         self.max_drift = self
             .max_drift
             .max(metrics::max_drift(world, poses, &self.initial));
@@ -122,6 +143,7 @@ impl Quality {
         QualityReport {
             top_sink,
             max_overlap: self.max_overlap,
+            end_overlap: self.last_overlap,
             max_drift: self.max_drift,
             max_joint_gap: (!self.joints.is_empty()).then_some(self.max_joint_gap),
         }
@@ -151,6 +173,72 @@ mod tests {
         assert_eq!(median(&mut []), 0.0);
         assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
+    }
+
+    /// Two unit cubes side by side whose centres are `gap` apart along x: they overlap by
+    /// 1 − `gap` when `gap` < 1.
+    fn two_cubes_poses(gap: f32) -> Vec<Pose> {
+        vec![
+            Pose::from_parts(Vec3::new(0.0, 0.5, 0.0), glam::Quat::IDENTITY),
+            Pose::from_parts(Vec3::new(gap, 0.5, 0.0), glam::Quat::IDENTITY),
+        ]
+    }
+
+    /// The pour measures on a hand-made case: two cubes overlapping by 0.3 m at one sample
+    /// and by 0.004 m at the last give a largest overlap of 0.3 m and an end overlap of
+    /// 0.004 m; turning both about their common axis leaves the depths as they are.
+    #[test]
+    fn end_and_largest_overlap_are_the_known_depths() {
+        use impulse::scene::{BodyDesc, BodyKind, ShapeDesc};
+        let cube = || {
+            BodyDesc::new(
+                BodyKind::Dynamic,
+                ShapeDesc::Cuboid {
+                    half_extents: [0.5; 3],
+                },
+                [0.0, 0.0, 0.0],
+            )
+        };
+        let scene = impulse::Scene {
+            bodies: vec![cube(), cube()],
+            ..impulse::Scene::default()
+        };
+        let world = World::from_scene(&scene).unwrap();
+        let mut quality = Quality::new(&world, &two_cubes_poses(5.0));
+        for gap in [5.0, 0.7, 0.996] {
+            quality.sample(&world, &two_cubes_poses(gap));
+        }
+        let turned: Vec<Pose> = two_cubes_poses(0.996)
+            .into_iter()
+            .map(|pose| Pose::from_parts(pose.translation, glam::Quat::from_rotation_x(0.6)))
+            .collect();
+        let report = quality.finish(&turned);
+        assert!((report.max_overlap - 0.3).abs() < 1e-5, "{report:?}");
+        assert!((report.end_overlap - 0.004).abs() < 1e-5, "{report:?}");
+        quality.sample(&world, &turned);
+        let report = quality.finish(&turned);
+        assert!((report.end_overlap - 0.004).abs() < 1e-5, "{report:?}");
+        quality.sample(&world, &two_cubes_poses(1.5));
+        let report = quality.finish(&two_cubes_poses(1.5));
+        assert_eq!(report.end_overlap, 0.0);
+        assert!((report.max_overlap - 0.3).abs() < 1e-5);
+    }
+
+    #[test]
+    fn pours_are_named_pour_or_mugs_and_a_count() {
+        for name in POUR_SCENES.iter().chain(&["mugs500", "pour3"]) {
+            assert!(is_pour(name), "{name}");
+        }
+        for name in [
+            "pour",
+            "pours",
+            "mugs",
+            "pyramid20",
+            "balls4096",
+            "pour500x",
+        ] {
+            assert!(!is_pour(name), "{name}");
+        }
     }
 
     #[test]

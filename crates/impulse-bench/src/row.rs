@@ -30,6 +30,9 @@ pub struct BenchRow {
     /// Largest penetration depth between two bodies, sampled every 10 steps and after the
     /// last (m).
     pub max_overlap_m: f64,
+    /// Largest penetration depth between two bodies at the last sample, after the last step
+    /// taken (m).
+    pub end_overlap_m: f64,
     /// Largest distance of a moving body from its start, at the same samples (m).
     pub max_drift_m: f64,
     /// Largest joint gap (the distances between each joint's two anchors, summed over the
@@ -65,6 +68,7 @@ impl BenchRow {
             steps_per_second: if median > 0.0 { 1e3 / median } else { 0.0 },
             top_sink_m: quality.top_sink.into(),
             max_overlap_m: quality.max_overlap.into(),
+            end_overlap_m: quality.end_overlap.into(),
             max_drift_m: quality.max_drift.into(),
             max_joint_gap_m: quality.max_joint_gap.map(f64::from),
             settings,

@@ -213,9 +213,10 @@ enum Command {
         /// Built-in scene names (default: pyramid20 pyramid100 pyramid3d10 stack30 massratio
         /// balls4096).
         scenes: Vec<String>,
-        /// Steps per scene.
-        #[arg(long, default_value_t = impulse_bench::DEFAULT_STEPS)]
-        steps: u32,
+        /// Steps per scene (default: each scene's own, 600 for the standard scenes and 300 for
+        /// the pours).
+        #[arg(long)]
+        steps: Option<u32>,
         /// Worker threads, at most 4 × the machine's logical CPUs (0: all CPUs).
         #[arg(long, default_value_t = 1)]
         threads: usize,

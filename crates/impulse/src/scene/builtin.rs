@@ -110,6 +110,18 @@ const NAMES: &[(&str, &str)] = &[
         "Solver2D: pyramid of base 10 (55 cubes) started 25% overlapping",
     ),
     (
+        "pour500",
+        "500 cubes turned at random poured in 8 layers into an 8x8-cell bin (300 steps)",
+    ),
+    (
+        "pour2000",
+        "2000 cubes turned at random poured in 8 layers into a 16x16-cell bin (300 steps)",
+    ),
+    (
+        "pour8000",
+        "8000 cubes turned at random poured in 8 layers into a 32x32-cell bin (300 steps)",
+    ),
+    (
         "chain20",
         "joints: 20 links on ball joints swinging down from a horizontal start",
     ),
@@ -190,6 +202,9 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
         "ragdollpile" => return Some(super::builtin_joints::ragdollpile()),
         "bridge" => return Some(super::builtin_joints::bridge()),
         _ => {}
+    }
+    if let Some(pour) = super::builtin_pours::builtin_pour(name) {
+        return Some(pour);
     }
     // Longest prefix first: "pyramid3d" before "pyramid".
     if let Some(n) = name.strip_prefix("pyramid3d").and_then(parse_count) {

@@ -485,6 +485,7 @@ impl BodyDesc {
 
 mod builtin;
 mod builtin_joints;
+mod builtin_pours;
 mod builtin_thin;
 mod decomposition;
 mod degeneracy;
@@ -503,6 +504,7 @@ pub use builtin::{
     MAX_BALLS, MAX_PYRAMID_BASE, MAX_PYRAMID3D_BASE, MAX_STACK, builtin_families, builtin_names,
     builtin_scene,
 };
+pub use builtin_pours::POUR_SEED;
 pub use decomposition::{
     ConvexPart, DecomposedMesh, DecompositionDesc, MAX_DECOMPOSITION_RESOLUTION, decompose_mesh,
     open_edges, open_mesh_note, set_decomposition_cache_dir,

@@ -507,7 +507,7 @@ fn draws_from_seed(scene: &Scene) -> bool {
 
 /// The generator of body `index` for `seed`: ChaCha20 keyed by the seed (its 8 little-endian
 /// bytes, then zeros), on stream `index`, from word 0.
-fn body_generator(seed: u64, index: usize) -> ChaCha20Rng {
+pub(super) fn body_generator(seed: u64, index: usize) -> ChaCha20Rng {
     let mut key = [0u8; 32];
     key[..8].copy_from_slice(&seed.to_le_bytes());
     let mut generator = ChaCha20Rng::from_seed(key);

@@ -11,7 +11,8 @@ use impulse::scene::{
     to_json_string, validate,
 };
 
-/// The built-in scenes that are stored as files (the larger ballsN are generated only).
+/// The built-in scenes that are stored as files (the larger ballsN and pour8000 are generated
+/// only: docs/scenes.md).
 const FILE_SCENES: &[&str] = &[
     "pyramid20",
     "pyramid3d10",
@@ -34,6 +35,8 @@ const FILE_SCENES: &[&str] = &[
     "bridge",
     "arch",
     "overlap_pyramid",
+    "pour500",
+    "pour2000",
 ];
 
 fn scenes_dir() -> PathBuf {
