@@ -154,10 +154,21 @@ fn a_part_pairs_memory_goes_when_the_parts_part() {
     assert!(manifolds.is_empty(), "{} manifolds apart", manifolds.len());
     let back = Pose::from_translation(Vec3::new(0.0, 0.0, 1.0e-4)) * near;
     update(&back, &mut manifolds);
-    for memory in memories(&manifolds) {
-        assert_eq!(
-            memory.pose, back,
-            "a memory of before the parting: {memory:?}"
-        );
+    // A memory's pose is its parts' (part 2 in part 1's frame, which Parry composes from the
+    // compounds' pose, rounding in the last bits): the new one's within a micrometre, 0.1 mm
+    // from the old one's.
+    let mut remembered = 0;
+    for manifold in &manifolds {
+        let Some(memory) = manifold.data.face_axes else {
+            continue;
+        };
+        let identity = Pose::IDENTITY;
+        let part1 = manifold.subshape_pos1().unwrap_or(&identity);
+        let part2 = manifold.subshape_pos2().unwrap_or(&identity);
+        let parts_now = part1.inv_mul(&(back * *part2));
+        let moved = (memory.pose.translation - parts_now.translation).length();
+        assert!(moved < 1.0e-6, "a memory of before the parting: {memory:?}");
+        remembered += 1;
     }
+    assert!(remembered > 0);
 }
