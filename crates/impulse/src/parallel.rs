@@ -21,6 +21,11 @@ pub(crate) const PAIRS_PER_TASK: usize = 1024;
 /// Pairs per task of the narrow phase's manifold update.
 pub(crate) const MANIFOLD_PAIRS_PER_TASK: usize = 256;
 
+/// Pairs per task of the narrow phase's manifold update when a pair has a composite shape
+/// (compound, mesh): such a pair is a convex pair per pair of parts within reach, so a few
+/// make a task.
+pub(crate) const COMPOSITE_PAIRS_PER_TASK: usize = 4;
+
 /// Bodies per task of the per-body passes (inertia, sleep, scatter, checks, integration).
 pub(crate) const BODIES_PER_TASK: usize = 1024;
 

@@ -48,6 +48,7 @@ use parry3d::query::{
 };
 use parry3d::shape::{Ball, PackedFeatureId, Shape, ShapeType, SupportMap};
 
+use super::axis_memory::AxisMemory;
 use super::{caps, faces};
 use crate::body::rules::rounded_parts;
 
@@ -132,7 +133,7 @@ impl QueryDispatcher for ContactDispatcher {
 impl<ManifoldData, ContactData> PersistentQueryDispatcher<ManifoldData, ContactData>
     for ContactDispatcher
 where
-    ManifoldData: Default + Clone + Send + Sync,
+    ManifoldData: Default + Clone + Send + Sync + AxisMemory,
     ContactData: Default + Copy + Send + Sync,
 {
     /// The same routing as [`DefaultQueryDispatcher`]'s (two composite shapes first, then

@@ -29,13 +29,15 @@
 //! across the face). Parry's nearest point (a point with no features) is kept only when it
 //! is deeper than every clipped point, as where the normal meets the features edge-on.
 
+use parry3d::bounding_volume::BoundingSphere;
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::query::details::{NormalConstraints, NormalConstraintsPair};
 use parry3d::query::{ContactManifold, DefaultQueryDispatcher, QueryDispatcher, TrackedContact};
 use parry3d::shape::{ConvexPolyhedron, PackedFeatureId, PolygonalFeature, Shape, TypedShape};
 
+use super::axis_memory::{AxisMemory, FaceAxisMemory, float_slack};
 use super::caps::inside_convex;
-use super::separating_axes;
+use super::separating_axes::GaussArc;
 
 /// Most points a refined manifold keeps: a quadrilateral spanning the contact area carries a
 /// resting face and its friction as the whole polygon would.
@@ -412,7 +414,7 @@ pub(crate) fn choose_four(
 /// leaves it alone. `constraints` are the pair's normal constraints (a mesh triangle's), shape
 /// 1's then shape 2's. `old` are the manifold's points before Parry updated it, whose impulses
 /// carry over by feature id. True if it replaced the points.
-pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
+pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default + Copy>(
     pos12: &Pose,
     g1: &dyn Shape,
     g2: &dyn Shape,
@@ -453,7 +455,14 @@ pub(crate) fn refine_face_contact<ManifoldData, ContactData: Default + Copy>(
     let corrected = if half_space || constrained {
         None
     } else {
-        better_face_axis(pos12, g1, g2, parry_normal, &manifold.points)
+        better_face_axis(
+            pos12,
+            g1,
+            g2,
+            parry_normal,
+            &manifold.points,
+            manifold.data.face_axes(),
+        )
     };
     let corrected_separation = corrected.map(|(_, separation)| separation);
     let corrected = corrected.map(|(normal, _)| normal);
@@ -602,26 +611,36 @@ fn support_separation(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, axis: Vector
 
 /// A face normal of either shape (shape 1's frame, out of it: a hull's faces, a box's, a
 /// triangle's two sides), or between two hulls an edge pair's cross product that is a face of
-/// their Minkowski difference (`separating_axes`), along which the shapes are farther apart, by more than the tolerance
-/// ([`AXIS_TOLERANCE`]), than along `normal` (Parry's), if one is; then `normal` is no contact
-/// normal (the contact normal is the axis of largest separation) and this is a better one.
-/// Searched where the deepest of `points` (Parry's, along `normal`) lies more than the
-/// tolerance above the separation along `normal`, which a contact normal's points never do,
-/// and where that point is deeper than the tolerance: EPA can end on an axis of deep overlap
-/// between thin hulls that are apart (two of the mug's V-HACD parts 0.9 mm apart by a face
-/// normal read 26 mm deep, whose points threw the bodies apart), and only a deep point can be
-/// that far off. `None` for shapes without a support map, and where no face beats `normal`;
-/// otherwise the face's normal and the separation (m) along it.
+/// their Minkowski difference (`separating_axes`), along which the shapes are farther apart,
+/// by more than the tolerance ([`AXIS_TOLERANCE`]), than along `normal` (Parry's), if one is;
+/// then `normal` is no contact normal (the contact normal is the axis of largest separation)
+/// and this is a better one. Searched where the deepest of `points` (Parry's, along `normal`)
+/// lies more than the tolerance above the separation along `normal`, which a contact normal's
+/// points never do, and where that point is deeper than the tolerance: EPA can end on an axis
+/// of deep overlap between thin hulls that are apart (two of the mug's V-HACD parts 0.9 mm
+/// apart by a face normal read 26 mm deep, whose points threw the bodies apart), and only a
+/// deep point can be that far off. `None` for shapes without a support map, and where no face
+/// beats `normal`; otherwise the face's normal and the separation (m) along it.
+///
+/// The face axes are the largest separation over the faces, the last of equals; if it does not
+/// beat `normal`, the edge axes are the largest over the edge pairs, in the order of the
+/// loops. `memory` (the manifold's, if it keeps one) lets the face axes be re-checked from the
+/// last full search ([`FaceAxisMemory`]); an edge axis is taken only where its pair's edges
+/// can be that far apart (a point of each edge bounds the separation along it). Both give
+/// what the full search gives, to the bit.
 fn better_face_axis<ContactData>(
     pos12: &Pose,
     g1: &dyn Shape,
     g2: &dyn Shape,
     normal: Vector,
     points: &[TrackedContact<ContactData>],
+    memory: Option<&mut Option<FaceAxisMemory>>,
 ) -> Option<(Vector, Real)> {
     let given = support_separation(pos12, g1, g2, normal)?;
-    let reach = |shape: &dyn Shape| shape.compute_local_bounding_sphere().radius();
-    let tolerance = AXIS_TOLERANCE + AXIS_RELATIVE_TOLERANCE * (reach(g1) + reach(g2));
+    let sphere1 = g1.compute_local_bounding_sphere();
+    let sphere2 = g2.compute_local_bounding_sphere();
+    let tolerance =
+        AXIS_TOLERANCE + AXIS_RELATIVE_TOLERANCE * (sphere1.radius() + sphere2.radius());
     // Along a contact normal the deepest point of the manifold is at the shapes' separation
     // along it; only a normal whose points read the shapes far nearer than they are along it is
     // searched (two support points a pair, not one per face).
@@ -635,6 +654,8 @@ fn better_face_axis<ContactData>(
     {
         return None;
     }
+    let threshold = given + tolerance;
+    let slack = float_slack(pos12, &sphere1, &sphere2);
     let mut axes: Vec<Vector> = Vec::new();
     let mut add = |shape: &dyn Shape, to_frame1: Option<&Pose>| {
         let out = |v: Vector| match to_frame1 {
@@ -653,41 +674,131 @@ fn better_face_axis<ContactData>(
     };
     add(g1, None);
     add(g2, Some(pos12));
-    let best_of = |axes: Vec<Vector>| {
-        axes.into_iter()
-            .filter_map(|axis| Some((axis, support_separation(pos12, g1, g2, axis)?)))
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-    };
-    let faces_best = best_of(std::mem::take(&mut axes));
-    if let Some((best, separation)) = faces_best
-        && separation > given + tolerance
-    {
-        return Some((best, separation));
+    let spheres = (&sphere1, &sphere2);
+    if let Some(found) = face_axes_above(pos12, g1, g2, &axes, threshold, slack, spheres, memory) {
+        return Some(found);
     }
     // Two hulls can be apart along an edge pair's cross product only (thin parts crossed
     // edge to edge): the pairs whose Gauss-map arcs cross, each axis either way, searched when
     // no face axis did better.
-    if let (Some((hull1, _)), Some((hull2, _))) = (hull_parts(g1), hull_parts(g2)) {
-        let (faces1, faces2) = (hull1.faces(), hull2.faces());
-        for e1 in hull1.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
-            let (a, b) = (
-                faces1[e1.faces[0] as usize].normal,
-                faces1[e1.faces[1] as usize].normal,
-            );
-            for e2 in hull2.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
-                let c = pos12.rotation * faces2[e2.faces[0] as usize].normal;
-                let d = pos12.rotation * faces2[e2.faces[1] as usize].normal;
-                if !separating_axes::arcs_cross(a, b, -c, -d) {
+    let (Some((hull1, _)), Some((hull2, _))) = (hull_parts(g1), hull_parts(g2)) else {
+        return None;
+    };
+    let (faces1, faces2) = (hull1.faces(), hull2.faces());
+    let (points1, points2) = (hull1.points(), hull2.points());
+    // Shape 2's edges in shape 1's frame, once: each edge's arc between its faces' normals
+    // (negated, as the Minkowski difference sees them), its direction and one of its points.
+    let edges2: Vec<(GaussArc, Vector, Vector)> = hull2
+        .edges()
+        .iter()
+        .filter(|e| e.faces[0] != e.faces[1])
+        .map(|e2| {
+            let c = pos12.rotation * faces2[e2.faces[0] as usize].normal;
+            let d = pos12.rotation * faces2[e2.faces[1] as usize].normal;
+            (
+                GaussArc::new(-c, -d),
+                pos12.rotation * e2.dir,
+                pos12.transform_point(points2[e2.vertices[0] as usize]),
+            )
+        })
+        .collect();
+    let mut best: Option<(Vector, Real)> = None;
+    for e1 in hull1.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
+        let arc1 = GaussArc::new(
+            faces1[e1.faces[0] as usize].normal,
+            faces1[e1.faces[1] as usize].normal,
+        );
+        let p = points1[e1.vertices[0] as usize];
+        for (arc2, dir2, q) in &edges2 {
+            if !arc1.crosses(arc2) {
+                continue;
+            }
+            let Some(axis) = e1.dir.cross(*dir2).try_normalize() else {
+                continue;
+            };
+            for axis in [axis, -axis] {
+                // p is a point of shape 1 and q one of shape 2, so the separation along the
+                // axis is at most (q − p)·axis: an axis that cannot beat the threshold can
+                // neither be returned nor change what is (the largest is returned only above
+                // it), and costs no support points.
+                if (*q - p).dot(axis) + slack <= threshold {
                     continue;
                 }
-                if let Some(axis) = e1.dir.cross(pos12.rotation * e2.dir).try_normalize() {
-                    axes.extend([axis, -axis]);
+                let Some(separation) = support_separation(pos12, g1, g2, axis) else {
+                    continue;
+                };
+                // The last of equals, as `Iterator::max_by`.
+                if best.is_none_or(|(_, top)| separation.total_cmp(&top).is_ge()) {
+                    best = Some((axis, separation));
                 }
             }
         }
     }
-    let (best, separation) = best_of(axes)?;
-    (separation > given + tolerance).then_some((best, separation))
+    best.filter(|&(_, separation)| separation > threshold)
+}
+
+/// The face axis of largest separation among `axes` (shape 1's frame), the last of equals,
+/// and that separation, if it is above `threshold` (m); `None` otherwise. With a `memory`
+/// slot, first re-checks the last full search's outcome (see [`FaceAxisMemory`]): all axes
+/// within the drift of the last largest, below the threshold (nothing to find), or the
+/// remembered axis still above all the others; else searches all axes and remembers.
+/// `slack` (m) covers the separations' rounding twice over (then and now).
+#[allow(clippy::too_many_arguments)]
+fn face_axes_above(
+    pos12: &Pose,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    axes: &[Vector],
+    threshold: Real,
+    slack: Real,
+    (sphere1, sphere2): (&BoundingSphere, &BoundingSphere),
+    memory: Option<&mut Option<FaceAxisMemory>>,
+) -> Option<(Vector, Real)> {
+    let separation = |axis: Vector| support_separation(pos12, g1, g2, axis);
+    if let Some(Some(last)) = memory.as_deref()
+        && last.axes as usize == axes.len()
+        && (last.best as usize) < axes.len()
+    {
+        let drift = last.drift(pos12, sphere1, sphere2) + 2.0 * slack;
+        // Every axis is at most its last separation plus the drift.
+        if last.best_separation + drift <= threshold {
+            return None;
+        }
+        let axis = axes[last.best as usize];
+        if let Some(now) = separation(axis)
+            && now > last.runner_up + drift
+        {
+            return (now > threshold).then_some((axis, now));
+        }
+    }
+    let mut best: Option<(usize, Real)> = None;
+    let mut runner_up = Real::MIN;
+    for (index, &axis) in axes.iter().enumerate() {
+        let Some(value) = separation(axis) else {
+            continue;
+        };
+        match best {
+            // The last of equals, as `Iterator::max_by`.
+            Some((_, top)) if value.total_cmp(&top).is_lt() => runner_up = runner_up.max(value),
+            Some((_, top)) => {
+                runner_up = runner_up.max(top);
+                best = Some((index, value));
+            }
+            None => best = Some((index, value)),
+        }
+    }
+    let (index, top) = best?;
+    if let Some(slot) = memory {
+        let remembered = FaceAxisMemory {
+            pose: *pos12,
+            axes: axes.len() as u32,
+            best: index as u32,
+            best_separation: top,
+            runner_up,
+        };
+        *slot = remembered.is_valid().then_some(remembered);
+    }
+    (top > threshold).then_some((axes[index], top))
 }
 
 #[cfg(test)]

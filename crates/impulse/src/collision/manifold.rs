@@ -1,14 +1,15 @@
 //! A contact manifold as the engine keeps it across steps: Parry's manifold with the solver's
 //! impulses per point ([`ContactImpulse`]) and the friction basis per manifold
-//! ([`ManifoldState`], with a rough pair's [`RoughnessDraw`] and a perturbed pair's impact
-//! draw), and the world poses of its two
-//! shapes.
+//! ([`ManifoldState`], with a rough pair's [`RoughnessDraw`], a perturbed pair's impact draw
+//! and the last face-axis search's [`FaceAxisMemory`]), and the world poses of its two shapes.
 
 use glam::Vec3;
 use parry3d::math::Pose;
 use parry3d::query::ContactManifold;
 use parry3d::utils::PoseOpt;
 use serde::{Deserialize, Serialize};
+
+use super::axis_memory::FaceAxisMemory;
 
 /// Impulses a contact point received in the last solve, kept with the point across steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -39,6 +40,11 @@ pub struct ManifoldState {
     /// body of the pair has an impact perturbation (`contact::impact`); `None` otherwise.
     #[serde(default)]
     pub impact: Option<f32>,
+    /// What the face-axis search of this manifold's two convex shapes found last time
+    /// ([`FaceAxisMemory`]), re-checked first at the next update; `None` before any search and
+    /// for shapes without face axes. Derived state: contacts are the same without it.
+    #[serde(default)]
+    pub(crate) face_axes: Option<FaceAxisMemory>,
 }
 
 /// One manifold's roughness draw, kept in its state across steps.

@@ -4,6 +4,7 @@
 //! manifolds (Parry) with the speculative margins that decide how far ahead points are made;
 //! and the sweeps of continuous collision (`continuous.rs`, for [`crate::Stage::Continuous`]).
 
+pub(crate) mod axis_memory;
 pub(crate) mod broad_phase;
 pub(crate) mod caps;
 pub(crate) mod continuous;

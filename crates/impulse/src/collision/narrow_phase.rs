@@ -17,7 +17,7 @@ pub(crate) use super::manifold::{ContactImpulse, Manifold, manifold_poses};
 pub use super::margins::SpeculativeMargins;
 use super::part_pairs;
 use crate::body::Bodies;
-use crate::parallel::{MANIFOLD_PAIRS_PER_TASK, prefetch, spread};
+use crate::parallel::{COMPOSITE_PAIRS_PER_TASK, MANIFOLD_PAIRS_PER_TASK, prefetch, spread};
 
 /// Parry has no contact generator for the shapes of bodies `.0` and `.1` (dense indices; the
 /// stage reports them by handle, [`crate::StepError::UnsupportedShapePair`]).
@@ -344,6 +344,15 @@ impl NarrowPhase {
                     return Ok(());
                 }
             }
+            // A face-axis memory belongs to the shapes it was found for.
+            if pair
+                .last_query
+                .is_some_and(|last| last.shapes != query.shapes)
+            {
+                for manifold in &mut pair.manifolds {
+                    manifold.data.face_axes = None;
+                }
+            }
             if has_curved_surface(&bodies.shape[a]) || has_curved_surface(&bodies.shape[b]) {
                 for manifold in &mut pair.manifolds {
                     manifold.mark_shapes_deformed();
@@ -386,9 +395,20 @@ impl NarrowPhase {
             Ok(())
         };
         if spread(parallel, 1, 0) {
-            self.pairs
-                .par_chunks_mut(MANIFOLD_PAIRS_PER_TASK)
-                .try_for_each(run)?;
+            // A pair with a composite shape (a compound, a mesh) is a pair per pair of parts
+            // within reach, hundreds of convex pairs' work: tasks of a fixed number of pairs
+            // would leave one thread with most of it.
+            let composite = |i: u32| bodies.shape[i as usize].as_composite_shape().is_some();
+            let per_task = if self
+                .pairs
+                .iter()
+                .any(|p| composite(p.body1) || composite(p.body2))
+            {
+                COMPOSITE_PAIRS_PER_TASK
+            } else {
+                MANIFOLD_PAIRS_PER_TASK
+            };
+            self.pairs.par_chunks_mut(per_task).try_for_each(run)?;
         } else {
             run(&mut self.pairs)?;
         }
@@ -494,6 +514,7 @@ impl NarrowPhase {
                         && m.data.tangent.is_finite()
                         && m.data.roughness.is_none_or(|d| d.is_valid())
                         && m.data.impact.is_none_or(|x| (-1.0..1.0).contains(&x))
+                        && m.data.face_axes.is_none_or(|f| f.is_valid())
                         && m.points.iter().all(|p| {
                             p.local_p1.is_finite()
                                 && p.local_p2.is_finite()

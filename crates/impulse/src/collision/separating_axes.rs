@@ -131,13 +131,45 @@ impl Polytope {
 /// normal of the Minkowski difference. The arcs cross when each arc's endpoints lie on
 /// opposite sides of the other's great circle, and on the same hemisphere.
 pub(crate) fn arcs_cross(a: Vector, b: Vector, c: Vector, d: Vector) -> bool {
-    let bxa = b.cross(a);
-    let dxc = d.cross(c);
-    let cba = c.dot(bxa);
-    let dba = d.dot(bxa);
-    let adc = a.dot(dxc);
-    let bdc = b.dot(dxc);
-    cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0
+    GaussArc::new(a, b).crosses(&GaussArc::new(c, d))
+}
+
+/// A Gauss-map arc between unit normals `a` and `b`, with the normal of its great circle
+/// (b × a) computed once, for tests of one arc against many ([`GaussArc::crosses`] gives what
+/// [`arcs_cross`] gives, to the bit).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct GaussArc {
+    a: Vector,
+    b: Vector,
+    bxa: Vector,
+}
+
+impl GaussArc {
+    pub(crate) fn new(a: Vector, b: Vector) -> Self {
+        Self {
+            a,
+            b,
+            bxa: b.cross(a),
+        }
+    }
+
+    /// Whether this arc (a, b) and `other` (c, d) cross (see [`arcs_cross`]). Most arcs of two
+    /// hulls do not straddle each other's great circle, so that test comes first.
+    #[inline]
+    pub(crate) fn crosses(&self, other: &Self) -> bool {
+        let (c, d) = (other.a, other.b);
+        let cba = c.dot(self.bxa);
+        let dba = d.dot(self.bxa);
+        let straddles = cba * dba < 0.0;
+        if !straddles {
+            return false;
+        }
+        // d × c, the other arc's b × a.
+        let dxc = other.bxa;
+        let adc = self.a.dot(dxc);
+        let bdc = self.b.dot(dxc);
+        adc * bdc < 0.0 && cba * bdc > 0.0
+    }
 }
 
 /// The penetration depth (m) of `p1` and `p2` (`p2` at `pos12` in `p1`'s frame), if it is
