@@ -7,7 +7,7 @@ use glam::Vec3;
 use parry3d::bounding_volume::BoundingVolume;
 use parry3d::math::Pose;
 use parry3d::query::{self, ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
-use parry3d::shape::{Shape, SharedShape, SupportMap};
+use parry3d::shape::{Shape, SharedShape};
 
 use crate::World;
 use crate::body::Bodies;
