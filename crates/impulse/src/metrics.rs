@@ -54,6 +54,12 @@ pub fn max_overlap(world: &World, poses: &[Pose]) -> f32 {
 /// pairs whose bounding boxes overlap. Parry's queries can read such shapes apart while they
 /// overlap by millimetres (thin hulls: the mug's V-HACD parts), so they are not used there.
 ///
+/// A half-space and a convex shape, or a compound of convex shapes, get the exact depth of the
+/// deepest point of any part (its support point along the half-space's inward normal). Parry's
+/// manifold of a convex polyhedron and a half-space holds only the vertices of one face (a UV
+/// sphere resting with its pole 9.6 mm under the surface read 0), and `query::contact` can stop
+/// on a vertex that is not the deepest.
+///
 /// Any other pair's depth is the smaller of two Parry estimates: the single-point
 /// `query::contact` and a fresh contact manifold (no history, no prediction). Each is a depth
 /// along some direction, so each is an upper bound of the true penetration depth, and each is
@@ -81,6 +87,10 @@ pub fn max_overlap_of_pairs(shapes: &[SharedShape], poses: &[Pose], pairs: &[(u3
             deepest,
         ) {
             deepest = deepest.max(depth.unwrap_or(0.0));
+            continue;
+        }
+        if let Some(depth) = half_space_depth(&poses[i], g1, &poses[j], g2) {
+            deepest = deepest.max(depth);
             continue;
         }
         let manifold = manifold_depth(&poses[i], g1, &poses[j], g2, &mut manifolds);
@@ -167,6 +177,35 @@ fn polyhedral_depth(
                 floor = depth;
             }
         }
+    }
+    Some(deepest)
+}
+
+/// The exact penetration depth (m, 0 when apart) of a half-space and a convex shape or a
+/// compound of convex shapes, given as `g1` at `pose1` and `g2` at `pose2` either way round:
+/// how far the deepest point of any part lies under the surface. `None` when neither is a
+/// half-space, or a part of the other has no support map (a mesh, a height field).
+fn half_space_depth(pose1: &Pose, g1: &dyn Shape, pose2: &Pose, g2: &dyn Shape) -> Option<f32> {
+    let (half_space, plane_pose, other, other_pose) = match (g1.as_halfspace(), g2.as_halfspace()) {
+        (Some(h), _) => (h, pose1, g2, pose2),
+        (None, Some(h)) => (h, pose2, g1, pose1),
+        (None, None) => return None,
+    };
+    let normal = plane_pose.rotation * half_space.normal;
+    let mut deepest = 0.0f32;
+    let mut part_depth = |pose: &Pose, part: &dyn Shape| -> Option<()> {
+        let support = part.as_support_map()?;
+        let lowest = pose * support.local_support_point(pose.rotation.inverse() * -normal);
+        deepest = deepest.max((plane_pose.translation - lowest).dot(normal));
+        Some(())
+    };
+    match other.as_compound() {
+        Some(compound) => {
+            for (part_pose, part) in compound.shapes() {
+                part_depth(&(other_pose * part_pose), part.as_ref())?;
+            }
+        }
+        None => part_depth(other_pose, other)?,
     }
     Some(deepest)
 }

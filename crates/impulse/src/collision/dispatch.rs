@@ -1,7 +1,8 @@
 //! The query dispatcher of the narrow phase: Parry's [`DefaultQueryDispatcher`], except for a
 //! ball against a rounded convex shape (below), a cylinder's or cone's flat cap on a flat
-//! face ([`super::caps`]) and a convex hull's face of more than four vertices
-//! ([`super::faces`]).
+//! face ([`super::caps`]), a convex hull's face of more than four vertices
+//! ([`super::faces`]) and a convex hull's deepest vertex against a half-space or a triangle
+//! ([`super::deepest_vertex`]).
 //!
 //! Parry projects a point on a `RoundShape` with GJK on the rounded shape's support map (the
 //! inner shape's support point moved out by the border radius along the direction asked),
@@ -49,7 +50,7 @@ use parry3d::query::{
 use parry3d::shape::{Ball, PackedFeatureId, Shape, ShapeType, SupportMap};
 
 use super::axis_memory::AxisMemory;
-use super::{caps, faces};
+use super::{caps, deepest_vertex, faces};
 use crate::body::rules::rounded_parts;
 
 /// Parry's default dispatcher, with exact contacts between a ball and a rounded convex shape,
@@ -333,6 +334,9 @@ where
         // `faces::better_face_axis`).
         if !(faces_refined && manifold.points.is_empty()) {
             fallback.after(pos12, g1, g2, constraints, prediction, manifold);
+        }
+        if hull_pair && (is_flat_type(type1) || is_flat_type(type2)) {
+            deepest_vertex::add_deepest_vertex(pos12, g1, g2, prediction, manifold, &old);
         }
         Ok(())
     }
@@ -680,6 +684,13 @@ fn has_cap_type(shape_type: ShapeType) -> bool {
         shape_type,
         ShapeType::Cylinder | ShapeType::RoundCylinder | ShapeType::Cone | ShapeType::RoundCone
     )
+}
+
+/// Whether shapes of this type are flat where a hull meets them: a half-space, a triangle (of a
+/// mesh or height field), whose manifold with a hull gets its deepest vertex
+/// ([`deepest_vertex`]).
+fn is_flat_type(shape_type: ShapeType) -> bool {
+    matches!(shape_type, ShapeType::HalfSpace | ShapeType::Triangle)
 }
 
 /// Whether shapes of this type are convex polyhedra, rounded or not, whose faces of more than

@@ -9,6 +9,7 @@ pub(crate) mod broad_phase;
 pub(crate) mod caps;
 pub(crate) mod continuous;
 pub(crate) mod crowding;
+pub(crate) mod deepest_vertex;
 pub(crate) mod dispatch;
 pub(crate) mod faces;
 pub(crate) mod manifold;

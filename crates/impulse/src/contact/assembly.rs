@@ -221,11 +221,18 @@ impl Assembly<'_> {
             // Body B is shape 1: its points and normal are in its part's frame.
             let (part_b, part_a) =
                 crate::collision::narrow_phase::manifold_poses(manifold, pose_b, pose_a);
-            let mut normal = part_b.rotation * manifold.local_n1;
+            let untilted = part_b.rotation * manifold.local_n1;
+            let mut normal = untilted;
+            // A rough contact's parts, whose points move with its tilt where they are round.
+            let mut rough_parts = None;
             if let Some(draw) = &manifold.data.roughness
                 && roughness > 0.0
             {
-                normal = super::roughness::tilted(normal, draw, roughness, &part_b);
+                normal = super::roughness::tilted(untilted, draw, roughness, &part_b);
+                rough_parts = Some((
+                    super::roughness::part_shape(bodies.shape[a].as_ref(), manifold.subshape2),
+                    super::roughness::part_shape(bodies.shape[b].as_ref(), manifold.subshape1),
+                ));
             }
             let (t1, t2) = tangent_basis(normal, manifold.data.tangent);
             // An impact perturbation moves the manifold's restitution by this step's draw.
@@ -246,12 +253,32 @@ impl Assembly<'_> {
                 // the two witness points.
                 let p_b = part_b.transform_point(point.local_p1);
                 let p_a = part_a.transform_point(point.local_p2);
-                let (at_a, at_b) = if point.dist > WITNESS_LEVER_GAP {
+                let (mut at_a, mut at_b) = if point.dist > WITNESS_LEVER_GAP {
                     (p_a, p_b)
                 } else {
                     let middle = 0.5 * (p_a + p_b);
                     (middle, middle)
                 };
+                // A rough contact's impulse acts where the tilted surfaces touch: through the
+                // centre of curvature of a round part (`roughness::tilted_points`).
+                if let Some((shape_a, shape_b)) = rough_parts {
+                    use super::roughness::{Side, tilted_points};
+                    (at_a, at_b) = tilted_points(
+                        Side {
+                            part: shape_a,
+                            pose: &part_a,
+                            at: at_a,
+                        },
+                        Side {
+                            part: shape_b,
+                            pose: &part_b,
+                            at: at_b,
+                        },
+                        untilted,
+                        normal,
+                        roughness,
+                    );
+                }
                 let r_a = at_a - com_a;
                 let r_b = at_b - com_b;
                 let Some(c) = slots.next() else {

@@ -20,6 +20,7 @@ use crate::collision::manifold::RoughnessDraw;
 use crate::collision::narrow_phase::ContactPair;
 use glam::Vec3;
 use parry3d::math::Pose;
+use parry3d::shape::{Shape, TypedShape};
 
 /// The largest roughness (rad) of a pair's two bodies: the pair's.
 #[inline]
@@ -127,6 +128,142 @@ pub(crate) fn tilted(normal: Vec3, draw: &RoughnessDraw, roughness: f32, part1: 
     };
     let (s, c) = draw.azimuth.sin_cos();
     (normal * cos_tilt + (d0 * c + d1 * s) * sin_tilt).normalize()
+}
+
+/// How a part's surface is round where a contact touches it: the tilted normal of a rough
+/// contact passes through its centre of curvature, so the contact point moves with the tilt.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Roundness {
+    /// Round in every direction about a centre (world, m): a ball, a capsule's end.
+    Centre(Vec3),
+    /// Round about an axis through a point (world, m) along a unit direction (world): a
+    /// capsule's side, a cylinder's side and rim, a cone's side and rim. Along the axis the
+    /// surface is straight (a side) or sharp (a rim), so only the tilt about the axis moves
+    /// the point.
+    Axis(Vec3, Vec3),
+}
+
+/// Relative position along a capsule's segment within which a point counts as at its end.
+const CAPSULE_END: f32 = 1e-3;
+
+/// Shortest projection of a unit normal across a revolution axis below which the normal is
+/// taken as along the axis (no turn about the axis is defined there).
+const ACROSS_AXIS: f32 = 1e-3;
+
+/// The part of `shape` that sub-shape index `subshape` names: a compound's part, or `shape`
+/// itself (a convex shape; a triangle mesh's or height field's triangles are flat).
+#[inline]
+pub(crate) fn part_shape(shape: &dyn Shape, subshape: u32) -> &dyn Shape {
+    match shape.as_compound() {
+        Some(compound) => compound
+            .shapes()
+            .get(subshape as usize)
+            .map_or(shape, |(_, part)| part.as_ref()),
+        None => shape,
+    }
+}
+
+/// How `part` (at world pose `pose`) is round at the contact point `at` (world), where its
+/// outward normal tilted by the roughness is `outward` (world, unit) and the untilted contact
+/// normal is `normal` (world, unit, either sign); `None` where it is flat or sharp in every
+/// direction (a box, a hull, a triangle, a half-space, a cylinder's or cone's flat cap: the
+/// normal of a cap contact is within `roughness` (rad) of the axis).
+fn roundness(
+    part: &dyn Shape,
+    pose: &Pose,
+    at: Vec3,
+    normal: Vec3,
+    outward: Vec3,
+    roughness: f32,
+) -> Option<Roundness> {
+    match part.as_typed_shape() {
+        TypedShape::Ball(_) => Some(Roundness::Centre(pose.translation)),
+        TypedShape::Capsule(capsule) => {
+            let (a, b) = (
+                pose.transform_point(capsule.segment.a),
+                pose.transform_point(capsule.segment.b),
+            );
+            let along = b - a;
+            let length_squared = along.length_squared();
+            if length_squared <= f32::EPSILON * f32::EPSILON {
+                return Some(Roundness::Centre(a));
+            }
+            let t = (at - a).dot(along) / length_squared;
+            // An end's hemisphere holds the normals that lean out past that end; a tilt that
+            // leans in stays on the straight side.
+            if t <= CAPSULE_END && outward.dot(along) < 0.0 {
+                Some(Roundness::Centre(a))
+            } else if t >= 1.0 - CAPSULE_END && outward.dot(along) > 0.0 {
+                Some(Roundness::Centre(b))
+            } else {
+                Some(Roundness::Axis(a, along / length_squared.sqrt()))
+            }
+        }
+        TypedShape::Cylinder(_) | TypedShape::Cone(_) => {
+            let axis = pose.rotation * Vec3::Y;
+            (normal.dot(axis).abs() < roughness.cos())
+                .then_some(Roundness::Axis(pose.translation, axis))
+        }
+        _ => None,
+    }
+}
+
+/// `point` (world) moved with the tilt to where the part's outward normal is `outward` (the
+/// tilted normal, world, unit), at the same distance from the centre of curvature of
+/// `roundness`: from the centre along `outward`, or from the axis along `outward`'s part
+/// across it (the point's place along the axis stays). The impulse's line along `outward`
+/// then passes through the centre, or meets the axis, to rounding.
+fn moved(roundness: Roundness, point: Vec3, outward: Vec3) -> Vec3 {
+    match roundness {
+        Roundness::Centre(centre) => centre + outward * (point - centre).length(),
+        Roundness::Axis(origin, axis) => {
+            let foot = origin + axis * (point - origin).dot(axis);
+            let across = outward - axis * outward.dot(axis);
+            let length = across.length();
+            if length < ACROSS_AXIS {
+                return point;
+            }
+            foot + across * ((point - foot).length() / length)
+        }
+    }
+}
+
+/// One side of a rough contact for [`tilted_points`]: a body's part shape, its world pose and
+/// the body's point of the contact (world, m).
+pub(crate) struct Side<'a> {
+    pub(crate) part: &'a dyn Shape,
+    pub(crate) pose: &'a Pose,
+    pub(crate) at: Vec3,
+}
+
+/// The points (world, m) at which a rough contact's impulse along `tilted` acts on bodies A
+/// and B, for an untilted contact `normal` (world, unit, from B towards A) and `roughness`
+/// (rad). A body round at the contact ([`Roundness`]) touches the tilted surface where its own
+/// outward normal is the tilted one: its point turns about its centre of curvature with the
+/// tilt, so the impulse's line passes through that centre (a ball's through its centre: no
+/// torque, whatever the tilt). A flat body (a face, an edge, a vertex, a flat cap) against a
+/// round one takes the round body's point, where the two touch; two flat bodies keep their
+/// points (the tilt is a facet of the surface under the point); two round bodies each take
+/// their own point (no point has both surfaces' normals at the tilt: the impulses pass through
+/// both centres, so neither spins, and the couple of the two parallel lines is the tilt's).
+pub(crate) fn tilted_points(
+    a: Side<'_>,
+    b: Side<'_>,
+    normal: Vec3,
+    tilted: Vec3,
+    roughness: f32,
+) -> (Vec3, Vec3) {
+    // Body A's outward normal at the contact is −n, body B's +n.
+    let round_a = roundness(a.part, a.pose, a.at, normal, -tilted, roughness);
+    let round_b = roundness(b.part, b.pose, b.at, normal, tilted, roughness);
+    let at_a = round_a.map(|r| moved(r, a.at, -tilted));
+    let at_b = round_b.map(|r| moved(r, b.at, tilted));
+    match (at_a, at_b) {
+        (Some(at_a), Some(at_b)) => (at_a, at_b),
+        (Some(at_a), None) => (at_a, b.at + (at_a - a.at)),
+        (None, Some(at_b)) => (a.at + (at_b - b.at), at_b),
+        (None, None) => (a.at, b.at),
+    }
 }
 
 /// 64 well-mixed bits of a key: SplitMix64's finaliser over the key's words in turn.

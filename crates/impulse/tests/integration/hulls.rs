@@ -178,7 +178,7 @@ fn stable_faces(points: &[[f32; 3]]) -> Vec<Vec3> {
 }
 
 /// The static grounds, each flat at y = 0 over x, z ∈ [−20, 20] m.
-fn grounds() -> Vec<(&'static str, BodyDesc)> {
+pub(super) fn grounds() -> Vec<(&'static str, BodyDesc)> {
     let at = |shape: ShapeDesc, y: f32| BodyDesc::new(BodyKind::Static, shape, [0.0, y, 0.0]);
     let grid = |cells: u32| {
         let size = 40.0 / cells as f32;

@@ -39,6 +39,7 @@ mod physics;
 mod profile;
 mod roughness;
 mod roughness_draws;
+mod round_hulls;
 mod scene_files;
 mod seams;
 mod shapes;

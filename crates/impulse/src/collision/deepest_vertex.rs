@@ -1,0 +1,170 @@
+//! The deepest vertex of a convex hull against a flat surface (a half-space, or a triangle of a
+//! mesh or height field seen face-on): added to the pair's manifold where the manifold's points
+//! miss it.
+//!
+//! Parry builds a polyhedron's manifold against a half-space from the polyhedron's support
+//! face (`local_support_feature`: the face whose outward normal is nearest the half-space's
+//! inward normal, its first four vertices), and against a triangle by clipping such support
+//! features. The support face need not hold the support vertex: on a round hull (a UV sphere,
+//! a dense point cloud) many small faces meet at each vertex, and the face whose normal is
+//! nearest the surface's can lie beside the lowest vertex, which then gets no point. A 32×16 UV
+//! sphere rested on a half-space with its pole 9.6 mm under the surface (held up by the points
+//! of a face of its first ring), and a 24-point cloud landed 19 mm deep.
+//!
+//! Here the hull's support vertex along the manifold's normal (the deepest vertex, a scan of the
+//! hull's vertices) becomes a point of its own when it is deeper than every point of the
+//! manifold by more than [`DEPTH_TIE`] and within the prediction: against a half-space always,
+//! against a triangle when the manifold's normal is the triangle's face normal (within
+//! [`FACE_ON`]) and the vertex lies over the triangle (a vertex beside it is another triangle's).
+//! The point is named by the vertex and the flat shape's face, so its impulse carries over from
+//! step to step while it stays the deepest.
+
+use parry3d::math::{Pose, Real, Vector};
+use parry3d::query::{ContactManifold, TrackedContact};
+use parry3d::shape::{PackedFeatureId, Shape, TypedShape};
+
+use super::faces::hull_parts;
+
+/// Depth (m) by which the deepest vertex must be deeper than every point of the manifold to be
+/// added: a vertex at a point's depth is held as well as that point holds it.
+const DEPTH_TIE: Real = 1.0e-4;
+
+/// Cosine of the largest angle between a manifold's normal and a triangle's face normal at
+/// which the triangle is seen face-on (0.01 rad).
+const FACE_ON: Real = 0.99995;
+
+/// Distance (m) within which a manifold point on the hull is at the deepest vertex already.
+const SAME_POINT: Real = 1.0e-5;
+
+/// Adds the deepest vertex of a convex hull (`g1` or `g2`, rounded or not) against a half-space
+/// or a face-on triangle (the other shape) to `manifold` (of `g1` and `g2`, `g2`'s pose in
+/// `g1`'s frame being `pos12`) when the manifold misses it, as the module's documentation says;
+/// the point takes the solver's data of the point of the same features in `old` (last step's
+/// points), if any. Other pairs are left alone.
+pub(crate) fn add_deepest_vertex<ManifoldData, ContactData: Default + Copy>(
+    pos12: &Pose,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    prediction: Real,
+    manifold: &mut ContactManifold<ManifoldData, ContactData>,
+    old: &[TrackedContact<ContactData>],
+) {
+    if let Some(hull) = hull_parts(g2) {
+        add(pos12, g1, hull, prediction, manifold, old, false);
+    } else if let Some(hull) = hull_parts(g1) {
+        add(&pos12.inverse(), g2, hull, prediction, manifold, old, true);
+    }
+}
+
+/// [`add_deepest_vertex`] with the hull `hull` (its polyhedron and border radius) as shape 2
+/// and `flat` as shape 1 in the frame of `pos12` (the hull's pose in `flat`'s frame);
+/// `flipped` says the manifold has them the other way round.
+fn add<ManifoldData, ContactData: Default + Copy>(
+    pos12: &Pose,
+    flat: &dyn Shape,
+    (hull, border): (&parry3d::shape::ConvexPolyhedron, Real),
+    prediction: Real,
+    manifold: &mut ContactManifold<ManifoldData, ContactData>,
+    old: &[TrackedContact<ContactData>],
+    flipped: bool,
+) {
+    // The flat shape's outward unit normal (its frame), a point of its plane, and its face id.
+    let (normal, origin, face, triangle) = match flat.as_typed_shape() {
+        TypedShape::HalfSpace(half_space) => (
+            half_space.normal,
+            Vector::ZERO,
+            PackedFeatureId::face(0),
+            None,
+        ),
+        TypedShape::Triangle(triangle) => {
+            if manifold.points.is_empty() {
+                return;
+            }
+            // The manifold's normal, outward from the flat shape, in its frame.
+            let along = if flipped {
+                manifold.local_n2
+            } else {
+                manifold.local_n1
+            };
+            let Some(face_normal) = triangle.normal() else {
+                return;
+            };
+            let (face_normal, face) = if face_normal.dot(along) >= 0.0 {
+                (face_normal, PackedFeatureId::face(0))
+            } else {
+                (-face_normal, PackedFeatureId::face(1))
+            };
+            if face_normal.dot(along) < FACE_ON {
+                return;
+            }
+            (face_normal, triangle.a, face, Some(triangle))
+        }
+        _ => return,
+    };
+    // The deepest vertex: the hull's support point along the flat shape's inward normal.
+    let inward = pos12.rotation.inverse() * -normal;
+    let points = hull.points();
+    let vertex = parry3d::utils::point_cloud_support_point_id(inward, points);
+    let on_hull = points[vertex] + inward * border;
+    let at = pos12 * points[vertex];
+    let dist = (at - origin).dot(normal) - border;
+    if dist > prediction {
+        return;
+    }
+    let nearest = manifold
+        .points
+        .iter()
+        .map(|point| point.dist)
+        .fold(Real::INFINITY, Real::min);
+    if dist >= nearest - DEPTH_TIE {
+        return;
+    }
+    let on_flat = at - normal * (dist + border);
+    if let Some(triangle) = triangle
+        && !over_triangle(triangle, normal, on_flat)
+    {
+        return;
+    }
+    let vertex_id = PackedFeatureId::vertex(vertex as u32);
+    let same = SAME_POINT * SAME_POINT;
+    let has_it = manifold.points.iter().any(|point| {
+        let (fid, local) = if flipped {
+            (point.fid1, point.local_p1)
+        } else {
+            (point.fid2, point.local_p2)
+        };
+        fid == vertex_id || local.distance_squared(on_hull) < same
+    });
+    if has_it {
+        return;
+    }
+    let mut point = TrackedContact::flipped(on_flat, on_hull, face, vertex_id, dist, flipped);
+    if let Some(previous) = old
+        .iter()
+        .find(|p| p.fid1 == point.fid1 && p.fid2 == point.fid2)
+    {
+        point.data = previous.data;
+    }
+    if manifold.points.is_empty() {
+        // A half-space's manifold with no point yet: its normal is the half-space's.
+        let n2 = pos12.rotation.inverse() * -normal;
+        (manifold.local_n1, manifold.local_n2) = if flipped { (n2, normal) } else { (normal, n2) };
+    }
+    manifold.points.push(point);
+}
+
+/// Whether `point` (on the plane of `triangle`, whose unit normal is `normal`) lies over the
+/// triangle, edges included.
+fn over_triangle(triangle: &parry3d::shape::Triangle, normal: Vector, point: Vector) -> bool {
+    let [a, b, c] = [triangle.a, triangle.b, triangle.c];
+    let sign = |p: Vector, q: Vector| (q - p).cross(point - p).dot(normal);
+    let (s1, s2, s3) = (sign(a, b), sign(b, c), sign(c, a));
+    // A triangle wound either way around `normal`.
+    let tolerance = -1.0e-7 * (b - a).cross(c - a).length().max(Real::MIN_POSITIVE);
+    (s1 >= tolerance && s2 >= tolerance && s3 >= tolerance)
+        || (s1 <= -tolerance && s2 <= -tolerance && s3 <= -tolerance)
+}
+
+#[cfg(test)]
+#[path = "deepest_vertex_tests.rs"]
+mod tests;
