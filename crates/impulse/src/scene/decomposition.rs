@@ -521,8 +521,8 @@ fn disk_lookup(directory: &Path, hash: u64, key: &CacheKey) -> Option<Vec<Convex
 
 /// The parts a cache file's `bytes` hold for `key`, trusted only after every check: the
 /// magic, the version, the payload's length and CRC-32, the CBOR, the key (compared in
-/// full) and the parts themselves (finite vertices, at least four per part, indices in
-/// range: what Parry's convex polyhedron assumes). Never panics, whatever the bytes.
+/// full) and the parts themselves (finite vertices, indices in range: what Parry's convex
+/// polyhedron assumes). Never panics, whatever the bytes.
 fn read_cache_file(bytes: &[u8], key: &CacheKey) -> Result<Vec<ConvexPart>, String> {
     if bytes.len() < CACHE_HEADER_LEN || &bytes[..16] != CACHE_MAGIC {
         return Err("not a decomposition cache file (no header)".to_string());
@@ -570,16 +570,10 @@ fn read_cache_file(bytes: &[u8], key: &CacheKey) -> Result<Vec<ConvexPart>, Stri
     Ok(file.parts)
 }
 
-/// What makes `part` unusable as a convex polyhedron, if anything: fewer than four vertices
-/// or triangles, a non-finite vertex, or an index out of range.
+/// What makes `part` unsafe to build a convex polyhedron from, if anything: a non-finite
+/// vertex or an index out of range. (A part without volume, which V-HACD itself may give, is
+/// left out when the compound is assembled.)
 fn part_problem(part: &ConvexPart) -> Option<String> {
-    if part.vertices.len() < 4 || part.indices.len() < 4 {
-        return Some(format!(
-            "{} vertices and {} triangles, a solid needs at least 4 of each",
-            part.vertices.len(),
-            part.indices.len()
-        ));
-    }
     if let Some(v) = part
         .vertices
         .iter()
