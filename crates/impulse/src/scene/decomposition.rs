@@ -851,7 +851,7 @@ mod tests {
                     bytes[at] = generator.random();
                 }
             }
-            if seed % 2 == 1 && bytes.len() >= CACHE_HEADER_LEN {
+            if !seed.is_multiple_of(2) && bytes.len() >= CACHE_HEADER_LEN {
                 let checksum = crc32fast::hash(&bytes[CACHE_HEADER_LEN..]);
                 bytes[28..32].copy_from_slice(&checksum.to_le_bytes());
             }

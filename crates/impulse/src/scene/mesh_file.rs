@@ -200,7 +200,6 @@ fn read_obj(bytes: &[u8], name: &str) -> Result<MeshData, MeshFileError> {
         single_index: true,
         ignore_lines: true,
         ignore_points: true,
-        ..Default::default()
     };
     // Materials are not needed: a missing .mtl file must not fail the load.
     let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &options, |_| Ok(Default::default()))

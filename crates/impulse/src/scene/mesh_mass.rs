@@ -226,7 +226,7 @@ pub fn mesh_solid(mesh: &MeshData) -> MeshSolid {
     let nesting = Nesting::of(&points, &triangles, &shells);
     let mut total = Sums::default();
     for (k, shell_sums) in sums.iter().enumerate() {
-        if nesting.depth[k] % 2 == 0 {
+        if nesting.depth[k].is_multiple_of(2) {
             total = total.plus(shell_sums);
         } else {
             total = total.plus(&shell_sums.negated());
@@ -235,7 +235,11 @@ pub fn mesh_solid(mesh: &MeshData) -> MeshSolid {
     MeshSolid::Closed {
         moments: total.moments(origin),
         shells: shells.len(),
-        cavities: nesting.depth.iter().filter(|&&d| d % 2 == 1).count(),
+        cavities: nesting
+            .depth
+            .iter()
+            .filter(|&&d| !d.is_multiple_of(2))
+            .count(),
         reversed_triangles,
         overlapping: nesting.overlapping,
     }

@@ -190,7 +190,7 @@ fn random_pose(generator: &mut ChaCha20Rng) -> (DQuat, DVec3) {
     )
     .try_normalize()
     .unwrap_or(DVec3::Y);
-    let rotation = DQuat::from_axis_angle(axis, generator.random::<f64>() * 6.28);
+    let rotation = DQuat::from_axis_angle(axis, generator.random::<f64>() * std::f64::consts::TAU);
     let offset = DVec3::new(
         generator.random::<f64>() * 4.0 - 2.0,
         generator.random::<f64>() * 4.0 - 2.0,
@@ -248,7 +248,7 @@ fn hollow_boxes_wound_any_way_subtract_their_cavity() {
             ],
             rotation,
             offset,
-            if seed % 2 == 0 { 0.0 } else { 0.25 },
+            if seed.is_multiple_of(2) { 0.0 } else { 0.25 },
             &mut generator,
         );
         let expected = Expected::cuboid(DVec3::ZERO, outer_h)
