@@ -199,7 +199,7 @@ pub struct DecomposedMesh {
     pub open_edges: usize,
     /// What a user should know about the mass properties, if anything: an open mesh's (the
     /// parts' volume used, the convex hull's as the closed alternative) or overlapping shells'
-    /// (their sum used, the parts' volume as an estimate of the union).
+    /// (their sum used, the parts' volume beside it: the union, and what the parts fill).
     pub mass_note: Option<String>,
 }
 
@@ -341,8 +341,9 @@ fn assemble(mesh: &MeshData, parts: Vec<ConvexPart>) -> Result<DecomposedMesh, S
                     format!(
                         "shells {a} and {b} of the mesh overlap ({} overlapping pairs): its \
                          mass properties are the sum of its shells', volume {:.4e} m³, which \
-                         counts the overlap twice; the union is about {parts_volume:.4e} m³ \
-                         (its convex parts)",
+                         counts the overlap twice; its convex parts, which hold the union \
+                         but also fill what the voxels cannot resolve, have \
+                         {parts_volume:.4e} m³",
                         overlapping.len(),
                         moments.volume
                     )
