@@ -39,6 +39,15 @@ printf 'v 0 0 0\nv 1 0 x\nf 1 2 3\n' > "$dir/corrupt.obj"
 row "corrupt mesh file" run "$(case_file badmesh "$(scene '{"kind": "static", "shape": {"type": "trimesh", "file": "corrupt.obj"}}')")" --steps 1 --quiet
 printf 'v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n' > "$dir/line.obj"
 row "degenerate mesh triangle" run "$(case_file flatmesh "$(scene '{"kind": "static", "shape": {"type": "trimesh", "file": "line.obj"}}')")" --steps 1 --quiet
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n' > "$dir/lines.obj"
+row "an OBJ of only lines" run "$(case_file linesobj "$(scene '{"kind": "dynamic", "shape": {"type": "trimesh", "file": "lines.obj"}}')")" --steps 1 --quiet
+ln -s /dev/zero "$dir/zero.obj"
+row "a mesh file linked to /dev/zero" run "$(case_file zeroobj "$(scene '{"kind": "dynamic", "shape": {"type": "trimesh", "file": "zero.obj"}}')")" --steps 1 --quiet
+cube='"vertices": [[0,0,0],[1,0,0],[0,1,0],[1,1,0],[0,0,1],[1,0,1],[0,1,1],[1,1,1]], "indices": [[0,2,3],[0,3,1],[4,5,7],[4,7,6],[0,1,5],[0,5,4],[2,6,7],[2,7,3],[0,4,6],[0,6,2],[1,3,7],[1,7,5]]'
+row "decomposition max_parts 2147483649" run "$(case_file maxparts "$(scene "{\"kind\": \"dynamic\", \"shape\": {\"type\": \"trimesh\", $cube, \"decomposition\": {\"max_parts\": 2147483649}}}")")" --steps 1 --quiet
+row "decomposition resolution 512 on a cube" run "$(case_file resolution "$(scene "{\"kind\": \"dynamic\", \"shape\": {\"type\": \"trimesh\", $cube, \"decomposition\": {\"resolution\": 512}}}")")" --steps 1 --quiet
+row "a roughness draw of three numbers" run "$(case_file draws "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "roughness_draws": [[1, 2, 3]]}')")" --steps 1 --quiet
+row "an open mesh on a moving body (a warning)" run "$(case_file openmesh "$(scene "{\"kind\": \"dynamic\", \"position\": [0, 2, 0], \"shape\": {\"type\": \"trimesh\", \"vertices\": [[0,0,0],[1,0,0],[0,1,0],[1,1,0],[0,0,1],[1,0,1],[0,1,1],[1,1,1]], \"indices\": [[0,2,3],[0,3,1],[4,5,7],[4,7,6],[0,1,5],[0,5,4],[2,6,7],[2,7,3],[0,4,6],[0,6,2]]}}")")" --steps 1 --quiet
 row "half-space on a moving body" run "$(case_file halfspace "$(scene '{"kind": "dynamic", "shape": {"type": "half_space", "normal": [0, 1, 0]}}')")" --steps 1 --quiet
 row "keyframes out of order" run "$(case_file keyframes "$(scene '{"kind": "kinematic", "shape": {"type": "cuboid", "half_extents": [1, 0.1, 1]}, "keyframes": [{"t": 2, "position": [0, 1, 0]}, {"t": 1, "position": [0, 2, 0]}]}')")" --steps 1 --quiet
 row "keyframes on a dynamic body" run "$(case_file keyed "$(scene '{"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.5}, "keyframes": [{"t": 1, "position": [0, 1, 0]}]}')")" --steps 1 --quiet

@@ -324,8 +324,17 @@ fn resolve_scene(arg: &str) -> Result<Scene> {
     if path.extension().is_some_and(|e| e == "json") || path.exists() {
         let scene = load_scene_file(path)?;
         warn_of_notes(&scene);
-        for note in impulse::scene::decomposition_notes(&scene) {
+        // Bodies of one mesh share its note: the first few, then the count.
+        const NAMED: usize = 5;
+        let notes = impulse::scene::decomposition_notes(&scene);
+        for note in notes.iter().take(NAMED) {
             eprintln!("warning: {note}");
+        }
+        if notes.len() > NAMED {
+            eprintln!(
+                "warning: {} more notes on this scene's meshes",
+                notes.len() - NAMED
+            );
         }
         return Ok(scene);
     }
@@ -477,6 +486,7 @@ fn report(summary: run::Summary, profile: bool) -> Result<ExitCode> {
 
 fn real_main() -> Result<ExitCode> {
     let cli = Cli::parse();
+    run::install_signal_handler()?;
     impulse::scene::set_decomposition_cache_dir(cli.decomposition_cache.clone());
     match cli.command {
         Command::Run {
@@ -534,7 +544,6 @@ fn real_main() -> Result<ExitCode> {
                 checkpoint_dir: checkpoints.checkpoint_dir,
                 profile,
             };
-            run::stop_on_ctrl_c()?;
             return report(run::run(scene, &options)?, profile);
         }
         Command::Resume {
@@ -576,7 +585,6 @@ fn real_main() -> Result<ExitCode> {
                 checkpoint_dir: checkpoints.checkpoint_dir,
                 profile,
             };
-            run::stop_on_ctrl_c()?;
             return report(run::resume(&snapshot, &options)?, profile);
         }
         Command::Render {
@@ -610,7 +618,7 @@ fn real_main() -> Result<ExitCode> {
             };
             let (name, summary) = if scene.ends_with(".glb") {
                 if !variation.is_empty() {
-                    bail!("--set and --jitter-* apply to scenes, not to a .glb animation");
+                    bail!("--set, --seed and --jitter-* apply to scenes, not to a .glb animation");
                 }
                 let summary = render::glb::render_glb(Path::new(&scene), &options)?;
                 (scene, summary)

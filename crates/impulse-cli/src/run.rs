@@ -234,20 +234,33 @@ impl FrameOutput {
     }
 }
 
-/// Set by Ctrl-C (SIGINT), SIGTERM or SIGHUP: the run stops after the step under way, writes
-/// that step's frame, its checkpoint and every file as a finished run would, and `impulse`
-/// exits with status 130.
+/// Set by Ctrl-C (SIGINT), SIGTERM or SIGHUP while a run steps: the run stops after the step
+/// under way, writes that step's frame, its checkpoint and every file as a finished run would,
+/// and `impulse` exits with status 130.
 pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
-/// Makes Ctrl-C, SIGTERM and SIGHUP (the `ctrlc` crate's `termination` feature) set
-/// [`INTERRUPTED`]; a second one ends the process at once.
-pub fn stop_on_ctrl_c() -> Result<()> {
+/// Whether a run is stepping ([`stop_after_the_step_on_ctrl_c`]): a signal then stops it after
+/// the step under way; before (reading the scene, decomposing its meshes, building the world)
+/// and in every other command it ends the process at once, since nothing is written yet.
+static STEPPING: AtomicBool = AtomicBool::new(false);
+
+/// Makes Ctrl-C, SIGTERM and SIGHUP (the `ctrlc` crate's `termination` feature) end the
+/// process at once with status 130 (a convex decomposition under way is not waited for:
+/// V-HACD cannot be stopped from inside, so the handler's thread exits the process), or set
+/// [`INTERRUPTED`] once a run steps; a second signal then ends the process at once.
+pub fn install_signal_handler() -> Result<()> {
     ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+        if !STEPPING.load(Ordering::SeqCst) || INTERRUPTED.swap(true, Ordering::SeqCst) {
+            eprintln!("impulse: interrupted");
             std::process::exit(130);
         }
     })
     .context("cannot install the Ctrl-C handler")
+}
+
+/// From now on a signal stops the run after the step under way ([`INTERRUPTED`]).
+fn stop_after_the_step_on_ctrl_c() {
+    STEPPING.store(true, Ordering::SeqCst);
 }
 
 /// The progress bar of a command taking `steps` steps of the scene `name` (on standard error;
@@ -350,6 +363,10 @@ fn run_scene(mut scene: Scene, options: &RunOptions, parallel: bool) -> Result<S
     }
     let every = options.every.unwrap_or(1).max(1) as u64;
     let world = World::from_scene(&scene).context("cannot build the world")?;
+    // Decomposition cache files found damaged while the world was built.
+    for warning in impulse::scene::take_decomposition_warnings() {
+        eprintln!("warning: {warning}");
+    }
     if !world
         .body_kinds()
         .iter()
@@ -466,6 +483,7 @@ fn simulate(
     parallel: bool,
 ) -> Result<Summary> {
     world.set_parallel(parallel);
+    stop_after_the_step_on_ctrl_c();
     // The phases' clocks cost time in worlds of many small islands: only when asked for.
     world.set_profile_solve_phases(options.profile || options.stats.is_some());
     let last = world.step_count() + session.steps;

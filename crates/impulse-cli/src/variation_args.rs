@@ -18,7 +18,9 @@ pub struct VariationArgs {
     /// order, after `--preset` and the solver options, so it wins over them.
     #[arg(long = "set", value_name = "PATH=VALUE", allow_hyphen_values = true)]
     pub set: Vec<String>,
-    /// Seed of the jitter: the same seed gives the same scene to the bit on any machine.
+    /// Seed of the jitter and, when not 0, the scene's `seed` (the draws of rough and
+    /// impact-perturbed materials), as `--set seed=K` sets it: the same seed gives the same
+    /// scene to the bit on any machine.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Move each dynamic body by an offset uniform in a ball of this radius (m).
@@ -51,7 +53,7 @@ pub struct VariationArgs {
 impl VariationArgs {
     /// Whether no option was given (the scene is used as it is).
     pub fn is_empty(&self) -> bool {
-        self.set.is_empty() && Jitter::is_none(&self.jitter())
+        self.set.is_empty() && self.seed == 0 && Jitter::is_none(&self.jitter())
     }
 
     fn jitter(&self) -> Jitter {

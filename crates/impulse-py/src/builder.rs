@@ -9,6 +9,7 @@ use impulse::{BodyKind, ShapeDesc};
 use numpy::PyArray2;
 use numpy::ndarray::Array2;
 use pyo3::prelude::*;
+use pyo3::pyclass::CompareOp;
 use pyo3::types::PyDict;
 
 use crate::errors::WorldError;
@@ -106,14 +107,19 @@ impl Shape {
     /// dict of `resolution` (voxels along the longest side, 8–512, default 64), `concavity`
     /// (0–1, default 0.01) and `max_parts` (default 1024), and its mass properties are its
     /// solid's when the mesh is closed (docs/scene-format.md, "Moving meshes"). Raises
-    /// `WorldError` for a `decomposition` that is not such a dict.
+    /// `WorldError` (a `ValueError`) naming the argument for `vertices` that are not real
+    /// numbers of shape (N, 3) (complex numbers are refused), `indices` that are not integers
+    /// in [0, 2³²) of shape (T, 3) (naming the first bad element), or a `decomposition` that
+    /// is not such a dict.
     #[staticmethod]
     #[pyo3(signature = (vertices, indices, decomposition=None))]
     fn trimesh(
-        vertices: Vec<[f32; 3]>,
-        indices: Vec<[u32; 3]>,
+        vertices: &Bound<'_, PyAny>,
+        indices: &Bound<'_, PyAny>,
         decomposition: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Shape> {
+        let vertices = mesh_vertices(vertices)?;
+        let indices = mesh_indices(indices)?;
         let decomposition: Option<DecompositionDesc> = match decomposition {
             Some(d) => Some(from_python(d, "decomposition")?),
             None => None,
@@ -186,6 +192,79 @@ impl Shape {
         let from_dict = slf.get_type().getattr("from_dict")?;
         Ok((from_dict, (slf.get().to_dict(slf.py())?,)))
     }
+}
+
+/// `value` as a NumPy array of shape (rows, 3) whose dtype kind is one of `kinds` (NumPy's
+/// letters: `f` float, `i` signed, `u` unsigned integer); `None` for an empty sequence.
+/// Errors: `WorldError` naming `argument`, its dtype or its shape.
+fn three_columns<'py>(
+    value: &Bound<'py, PyAny>,
+    argument: &str,
+    kinds: &str,
+    what: &str,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let numpy = value.py().import("numpy")?;
+    let array = numpy
+        .call_method1("asarray", (value,))
+        .map_err(|e| WorldError::new_err(format!("{argument}: not an array of {what}: {e}")))?;
+    if array.getattr("size")?.extract::<usize>()? == 0 {
+        return Ok(None);
+    }
+    let dtype = array.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    if !kinds.contains(kind.as_str()) {
+        return Err(WorldError::new_err(format!(
+            "{argument}: must be {what}, got dtype {}",
+            dtype.str()?
+        )));
+    }
+    let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+    if shape.len() != 2 || shape[1] != 3 {
+        return Err(WorldError::new_err(format!(
+            "{argument}: must have shape (N, 3), got {shape:?}"
+        )));
+    }
+    Ok(Some(array))
+}
+
+/// `Shape.trimesh`'s `vertices`: real numbers (m), shape (N, 3), as float32.
+fn mesh_vertices(value: &Bound<'_, PyAny>) -> PyResult<Vec<[f32; 3]>> {
+    let Some(array) = three_columns(value, "vertices", "fiu", "real numbers")? else {
+        return Ok(Vec::new());
+    };
+    array
+        .call_method1("astype", ("float32",))?
+        .call_method0("tolist")?
+        .extract()
+}
+
+/// `Shape.trimesh`'s `indices`: integers in [0, 2³²), shape (T, 3). Errors name the first
+/// element out of range as `indices[t][k]`.
+fn mesh_indices(value: &Bound<'_, PyAny>) -> PyResult<Vec<[u32; 3]>> {
+    let Some(array) = three_columns(value, "indices", "iu", "integers (vertex indices)")? else {
+        return Ok(Vec::new());
+    };
+    for (outside, rule) in [
+        (array.rich_compare(0, CompareOp::Lt)?, "must be ≥ 0"),
+        (
+            array.rich_compare(u32::MAX, CompareOp::Gt)?,
+            "must be < 2³²",
+        ),
+    ] {
+        if outside.call_method0("any")?.is_truthy()? {
+            let flat: usize = outside.call_method0("argmax")?.extract()?;
+            let value = array.call_method0("ravel")?.get_item(flat)?;
+            return Err(WorldError::new_err(format!(
+                "indices[{}][{}]: {rule} (a vertex index), got {value}",
+                flat / 3,
+                flat % 3
+            )));
+        }
+    }
+    array
+        .call_method1("astype", ("uint32",))?
+        .call_method0("tolist")?
+        .extract()
 }
 
 /// A body to insert into a world (`world.insert(builder)`): a kind and a shape, then

@@ -309,3 +309,37 @@ def test_a_builders_roughness_draws_are_the_scene_fields():
         impulse.BodyBuilder.particle(0.1, roughness_draws=[(1.0, 2.0, 3.0)])
     with pytest.raises(impulse.WorldError, match=r"roughness_draws\[0\]\[1\]"):
         rough_floor().insert(impulse.BodyBuilder.particle(0.1, roughness_draws=[(1.0, math.nan)]))
+
+
+CUBE_VERTICES = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+CUBE_INDICES = [
+    (0, 2, 3),
+    (0, 3, 1),
+    (4, 5, 7),
+    (4, 7, 6),
+    (0, 1, 5),
+    (0, 5, 4),
+    (2, 6, 7),
+    (2, 7, 3),
+    (0, 4, 6),
+    (0, 6, 2),
+    (1, 3, 7),
+    (1, 7, 5),
+]
+
+
+def test_trimesh_argument_errors_name_the_argument():
+    indices = [list(t) for t in CUBE_INDICES]
+    indices[4][2] = -1
+    with pytest.raises(ValueError, match=r"indices\[4\]\[2\]: must be ≥ 0 .* got -1"):
+        impulse.Shape.trimesh(CUBE_VERTICES, indices)
+    with pytest.raises(ValueError, match=r"indices\[0\]\[1\]: must be < 2³²"):
+        impulse.Shape.trimesh(CUBE_VERTICES, [(0, 2**32, 3)] + CUBE_INDICES[1:])
+    with pytest.raises(ValueError, match=r"vertices: must be real numbers, got dtype complex128"):
+        impulse.Shape.trimesh(np.array(CUBE_VERTICES, dtype=complex), CUBE_INDICES)
+    with pytest.raises(ValueError, match=r"indices: must be integers"):
+        impulse.Shape.trimesh(CUBE_VERTICES, np.array(CUBE_INDICES, dtype=float))
+    with pytest.raises(ValueError, match=r"vertices: must have shape \(N, 3\), got \[8, 2\]"):
+        impulse.Shape.trimesh([v[:2] for v in CUBE_VERTICES], CUBE_INDICES)
+    shape = impulse.Shape.trimesh(np.array(CUBE_VERTICES, dtype=np.float64), np.array(CUBE_INDICES))
+    assert shape.to_dict()["indices"][0] == [0, 2, 3]

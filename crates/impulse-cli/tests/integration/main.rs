@@ -11,5 +11,6 @@ mod edges;
 mod export;
 mod interrupt;
 mod lcp_box;
+mod mesh_files;
 mod render;
 mod variation;

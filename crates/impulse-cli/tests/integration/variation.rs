@@ -140,3 +140,72 @@ fn a_bad_override_exits_non_zero_naming_the_option_and_the_field() {
         assert!(stderr.contains(expected), "{args:?}: {stderr}");
     }
 }
+
+/// A ball dropped with some spin onto a rough floor (roughness 10°): its bounce depends on the
+/// scene's `seed`, 0 in the file.
+const ROUGH_SCENE: &str = r#"{
+  "name": "rough",
+  "materials": {"rough": {"roughness": 10, "restitution": 0.8}},
+  "bodies": [
+    {"kind": "static", "material": "rough", "shape": {"type": "half_space", "normal": [0, 1, 0]}},
+    {"kind": "dynamic", "material": "rough", "position": [0, 0.3, 0],
+     "linear_velocity": [0, -3, 0], "shape": {"type": "sphere", "radius": 0.1}}
+  ]
+}"#;
+
+/// `--seed K` alone replaces the scene's seed as `--set seed=K` does (the docs' rule), on `run`
+/// and `export`; the exported scene is the library's `Variation { seed: K }` of the scene, and
+/// running it is the run with `--seed K`.
+#[test]
+fn seed_alone_replaces_the_scenes_seed_as_set_seed_and_the_library_do() {
+    let scene_path = temp("rough.json");
+    std::fs::write(&scene_path, ROUGH_SCENE).unwrap();
+    let scene = scene_path.to_str().unwrap();
+    let run20 = |args: &[&str], name: &str| {
+        let out = temp(name);
+        let output = impulse()
+            .args(["run", scene, "--steps", "20", "--threads", "1", "--quiet"])
+            .args(args)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_success(&output, &format!("run {args:?}: "));
+        std::fs::read_to_string(out).unwrap()
+    };
+    let plain = run20(&[], "rough-plain.csv");
+    let seeded = run20(&["--seed", "5"], "rough-seed5.csv");
+    let set = run20(&["--set", "seed=5"], "rough-set5.csv");
+    assert_ne!(seeded, plain, "--seed 5 left the run as it was");
+    assert_eq!(seeded, set, "--seed 5 and --set seed=5 differ");
+
+    let exported = temp("rough-seed5.json");
+    assert_success(&export(scene, &["--seed", "5"], &exported), "export: ");
+    let text = std::fs::read_to_string(&exported).unwrap();
+    let library = impulse::scene::Variation {
+        seed: 5,
+        ..Default::default()
+    }
+    .apply(&impulse::scene::parse_scene_str(ROUGH_SCENE, "rough.json").unwrap())
+    .unwrap();
+    assert_eq!(library.seed, 5);
+    assert_eq!(
+        impulse::scene::parse_scene_str(&text, "exported").unwrap(),
+        library
+    );
+    let from_file = run20_file(exported.to_str().unwrap());
+    assert_eq!(from_file, seeded);
+}
+
+/// `impulse run FILE --steps 20` on one thread: the trajectory's text.
+fn run20_file(scene: &str) -> String {
+    let out = temp("rough-from-file.csv");
+    let output = impulse()
+        .args(["run", scene, "--steps", "20", "--threads", "1", "--quiet"])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_success(&output, "run exported: ");
+    std::fs::read_to_string(out).unwrap()
+}

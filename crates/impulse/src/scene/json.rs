@@ -8,7 +8,7 @@
 use std::io;
 use std::path::Path;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::error::{
     BodyLocation, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition,
@@ -455,6 +455,50 @@ impl<'a> Scanner<'a> {
     }
 }
 
+/// Reads `roughness_draws`: a list of pairs `[a, b]`, each refused with "each draw is a pair
+/// [a, b]" and the count it has when it is not two numbers (serde's fixed-size array reader
+/// says only "trailing characters").
+pub(super) fn draw_pairs<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Vec<[f32; 2]>, D::Error> {
+    /// One draw `[a, b]`.
+    struct Pair([f32; 2]);
+    impl<'de> Deserialize<'de> for Pair {
+        fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+            struct PairVisitor;
+            impl<'de> serde::de::Visitor<'de> for PairVisitor {
+                type Value = Pair;
+                fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                    f.write_str("a draw: a pair [a, b] of numbers")
+                }
+                fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                    self,
+                    mut seq: A,
+                ) -> Result<Pair, A::Error> {
+                    let mut numbers = Vec::with_capacity(2);
+                    while let Some(x) = seq.next_element::<f32>()? {
+                        numbers.push(x);
+                        if numbers.len() > 16 {
+                            break;
+                        }
+                    }
+                    match numbers[..] {
+                        [a, b] => Ok(Pair([a, b])),
+                        _ => Err(serde::de::Error::custom(format!(
+                            "each draw is a pair [a, b] of numbers, got {}{} numbers",
+                            numbers.len(),
+                            if numbers.len() > 16 { " or more" } else { "" }
+                        ))),
+                    }
+                }
+            }
+            deserializer.deserialize_seq(PairVisitor)
+        }
+    }
+    let pairs = Vec::<Pair>::deserialize(deserializer)?;
+    Ok(pairs.into_iter().map(|Pair(pair)| pair).collect())
+}
+
 // ---------------------------------------------------------------------------------------------
 // Writer.
 
@@ -775,5 +819,22 @@ mod tests {
                 "{text}"
             );
         }
+    }
+
+    /// A scene's `solver` keys for options that are off (`auto`'s under `pgs`, sleep's with
+    /// `sleep: false`) are written back as read.
+    #[test]
+    fn a_scenes_solver_keys_survive_read_and_write_whatever_the_method() {
+        let text = r#"{"bodies": [], "solver": {"method": "pgs", "escalation_iterations": 9,
+            "mass_ratio_threshold": 2.5, "escalation_tolerance": 0.001, "sleep": false,
+            "time_to_sleep": 3}}"#;
+        let scene = parse_scene_str(text, "t.json").unwrap();
+        let written = to_json_string(&scene);
+        let solver = &serde_json::from_str::<serde_json::Value>(&written).unwrap()["solver"];
+        assert_eq!(solver["escalation_iterations"], 9, "{written}");
+        assert_eq!(solver["mass_ratio_threshold"], 2.5, "{written}");
+        assert_eq!(solver["escalation_tolerance"], 0.001, "{written}");
+        assert_eq!(solver["time_to_sleep"], 3.0, "{written}");
+        assert_eq!(parse_scene_str(&written, "t.json").unwrap(), scene);
     }
 }

@@ -66,8 +66,8 @@ pub enum MeshFileError {
         /// What is wrong.
         message: String,
     },
-    /// The file has no triangle.
-    #[error("{path}: the file has no triangles")]
+    /// The file has no triangle (an OBJ file of only `l` lines or points has none).
+    #[error("{path}: the file has no faces (triangles or polygons; lines and points have no area)")]
     Empty {
         /// The file.
         path: String,
@@ -96,11 +96,20 @@ impl MeshFormat {
     }
 }
 
+/// Largest mesh file (or glTF buffer file) [`load_mesh_file`] reads: 256 MiB (268,435,456
+/// bytes), as [`super::MAX_SCENE_FILE_BYTES`] for scenes. A 5-million-triangle OBJ is about
+/// 200 MB; anything larger would exhaust memory in the decomposition first.
+pub const MAX_MESH_FILE_BYTES: u64 = 256 << 20;
+
 /// Reads the triangles of the OBJ, glTF or GLB file at `path` (by extension, any case). A glTF
-/// file's buffers may be in its GLB chunk, in data URIs or in files beside it.
+/// file's buffers may be in its GLB chunk, in data URIs or in files beside it. A UTF-8 byte
+/// order mark at the start of an OBJ or `.gltf` file is skipped.
 ///
 /// # Errors
-/// [`MeshFileError`]: unreadable file, unknown extension, a malformed file, or no triangle.
+/// [`MeshFileError`]: unreadable file, not a regular file (a directory, a pipe, a device such
+/// as `/dev/zero`) or larger than [`MAX_MESH_FILE_BYTES`] (both found from the file's
+/// metadata, before reading), unknown extension, a malformed file (an OBJ error with the
+/// file's line), or no triangle.
 pub fn load_mesh_file(path: &Path) -> Result<MeshData, MeshFileError> {
     let name = path.display().to_string();
     let format =
@@ -124,8 +133,8 @@ pub fn read_mesh_bytes(
     directory: Option<&Path>,
 ) -> Result<MeshData, MeshFileError> {
     let mesh = match format {
-        MeshFormat::Obj => read_obj(bytes, name)?,
-        MeshFormat::Gltf => read_gltf(bytes, name, directory)?,
+        MeshFormat::Obj => read_obj(without_bom(bytes), name)?,
+        MeshFormat::Gltf => read_gltf(without_bom(bytes), name, directory)?,
     };
     if mesh.indices.is_empty() {
         return Err(MeshFileError::Empty {
@@ -135,11 +144,46 @@ pub fn read_mesh_bytes(
     Ok(mesh)
 }
 
+/// The bytes of the regular file at `path`, refused before reading when it is not a regular
+/// file or is larger than [`MAX_MESH_FILE_BYTES`] (and read at most that far, should it grow).
 fn read(path: &Path, name: &str) -> Result<Vec<u8>, MeshFileError> {
-    std::fs::read(path).map_err(|source| MeshFileError::Io {
+    use std::io::Read as _;
+    let io = |source| MeshFileError::Io {
         path: name.to_string(),
         source,
-    })
+    };
+    let metadata = std::fs::metadata(path).map_err(io)?;
+    if !metadata.is_file() {
+        return Err(format_error(
+            name,
+            "not a regular file (a mesh is read from a file, not a directory, pipe or device)",
+        ));
+    }
+    let too_large = |bytes: u64| {
+        format_error(
+            name,
+            format!(
+                "the file has {bytes} bytes, more than the {MAX_MESH_FILE_BYTES} bytes \
+                 (256 MiB) a mesh file may have"
+            ),
+        )
+    };
+    if metadata.len() > MAX_MESH_FILE_BYTES {
+        return Err(too_large(metadata.len()));
+    }
+    let mut bytes = Vec::with_capacity(metadata.len() as usize);
+    std::fs::File::open(path)
+        .and_then(|file| file.take(MAX_MESH_FILE_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_MESH_FILE_BYTES {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// `bytes` without a leading UTF-8 byte order mark.
+fn without_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes)
 }
 
 fn format_error(name: &str, message: impl Into<String>) -> MeshFileError {
@@ -150,14 +194,22 @@ fn format_error(name: &str, message: impl Into<String>) -> MeshFileError {
 }
 
 fn read_obj(bytes: &[u8], name: &str) -> Result<MeshData, MeshFileError> {
+    // Lines and points have no area: a file of only `l` lines has no faces.
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
-        ..Default::default()
+        ignore_lines: true,
+        ignore_points: true,
     };
     // Materials are not needed: a missing .mtl file must not fail the load.
     let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &options, |_| Ok(Default::default()))
-        .map_err(|e| format_error(name, format!("not a valid OBJ file: {e}")))?;
+        .map_err(|e| {
+            let at = match obj_error_line(bytes, e) {
+                Some((line, text)) => format!(" at line {line} ({text:?})"),
+                None => String::new(),
+            };
+            format_error(name, format!("not a valid OBJ file: {e}{at}"))
+        })?;
     let mut mesh = MeshData::default();
     for model in models {
         let m = &model.mesh;
@@ -180,6 +232,88 @@ fn read_obj(bytes: &[u8], name: &str) -> Result<MeshData, MeshFileError> {
         }
     }
     Ok(mesh)
+}
+
+/// The first line of the OBJ text `bytes` (1-based, with its text, at most 80 characters)
+/// that gives `error`, found by a scan that follows tobj's reading of each statement: tobj's
+/// errors name no line. `None` when the error is not about one line.
+fn obj_error_line(bytes: &[u8], error: tobj::LoadError) -> Option<(usize, String)> {
+    use tobj::LoadError as E;
+    let text = String::from_utf8_lossy(bytes);
+    let floats = |words: &[&str], n: usize| {
+        words.len() >= n && words[..n].iter().all(|w| w.parse::<f32>().is_ok())
+    };
+    // Totals of positions, texture coordinates and normals: faces may refer forward.
+    let mut totals = [0usize; 3];
+    for line in text.lines() {
+        match line.split_whitespace().next() {
+            Some("v") => totals[0] += 1,
+            Some("vt") => totals[1] += 1,
+            Some("vn") => totals[2] += 1,
+            _ => {}
+        }
+    }
+    let mut seen = [0usize; 3];
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let keyword = words.next();
+        let words: Vec<&str> = words.collect();
+        let bad = match keyword {
+            Some("v") => {
+                seen[0] += 1;
+                let rest = words.get(3..).unwrap_or(&[]);
+                match error {
+                    E::PositionParseError => {
+                        !floats(&words, 3) || (rest.len() == 1 && rest[0].parse::<f32>().is_err())
+                    }
+                    E::ScalingByZeroError => rest.len() == 1 && rest[0].parse() == Ok(0.0f32),
+                    E::ColorParseError => rest.len() == 2 || rest.len() > 3,
+                    _ => false,
+                }
+            }
+            Some("vt") => {
+                seen[1] += 1;
+                error == E::TexcoordParseError && !floats(&words, 2)
+            }
+            Some("vn") => {
+                seen[2] += 1;
+                error == E::NormalParseError && !floats(&words, 3)
+            }
+            Some(keyword @ ("f" | "l")) => words.iter().any(|word| {
+                word.split('/').enumerate().any(|(k, part)| {
+                    if part.is_empty() {
+                        return false;
+                    }
+                    let Ok(index) = part.parse::<isize>() else {
+                        return error == E::FaceParseError;
+                    };
+                    if k > 2 {
+                        return error == E::FaceParseError;
+                    }
+                    let kind = [
+                        E::FaceVertexOutOfBounds,
+                        E::FaceTexCoordOutOfBounds,
+                        E::FaceNormalOutOfBounds,
+                    ][k];
+                    // As tobj resolves them: relative (negative) indices count back from
+                    // what has been read so far; 0 is no element.
+                    let resolved = if index < 0 {
+                        seen[k] as isize + index
+                    } else {
+                        index - 1
+                    };
+                    keyword == "f"
+                        && error == kind
+                        && (resolved < 0 || resolved as usize >= totals[k])
+                })
+            }),
+            _ => false,
+        };
+        if bad {
+            return Some((number + 1, line.trim().chars().take(80).collect()));
+        }
+    }
+    None
 }
 
 fn read_gltf(
@@ -384,12 +518,22 @@ fn add_node(
             let base = u32::try_from(mesh.vertices.len())
                 .map_err(|_| format_error(name, "more than 2³² vertices"))?;
             for t in &triangles {
-                if t.iter().any(|&i| i as usize >= count) {
+                if let Some(&index) = t.iter().find(|&&i| i as usize >= count) {
+                    let accessor = match primitive.indices() {
+                        Some(indices) => format!("accessor {}", indices.index()),
+                        None => "the implicit indices".to_string(),
+                    };
                     return Err(format_error(
                         name,
                         format!(
-                            "mesh {:?}: an index is beyond its {count} vertices",
-                            node_mesh.name().unwrap_or("")
+                            "mesh {} ({:?}) primitive {}: {accessor} has index {index}, beyond \
+                             the {count} vertices of POSITION accessor {}",
+                            node_mesh.index(),
+                            node_mesh.name().unwrap_or(""),
+                            primitive.index(),
+                            primitive
+                                .get(&gltf::Semantic::Positions)
+                                .map_or(0, |a| a.index())
                         ),
                     ));
                 }

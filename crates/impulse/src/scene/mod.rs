@@ -356,7 +356,11 @@ pub struct BodyDesc {
     /// most [`MAX_ROUGHNESS_DRAWS`]) given in turn to the new rough contacts whose draw this
     /// body gives, instead of seeded draws: cap = 1 − exp(−(a² + b²)/2), azimuth = atan2(b, a)
     /// ([`crate::BodyBuilder::roughness_draws`]). Default none.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    #[serde(
+        default,
+        skip_serializing_if = "Vec::is_empty",
+        deserialize_with = "json::draw_pairs"
+    )]
     pub roughness_draws: Vec<[f32; 2]>,
 }
 
@@ -494,6 +498,7 @@ pub(crate) mod joint_desc;
 pub(crate) mod json;
 mod json_shape;
 mod mesh_file;
+pub mod mesh_mass;
 mod notes;
 mod shape;
 pub mod thin;
@@ -506,8 +511,9 @@ pub use builtin::{
 };
 pub use builtin_pours::POUR_SEED;
 pub use decomposition::{
-    ConvexPart, DecomposedMesh, DecompositionDesc, MAX_DECOMPOSITION_RESOLUTION, decompose_mesh,
-    open_edges, open_mesh_note, set_decomposition_cache_dir,
+    ConvexPart, DecomposedMesh, DecompositionDesc, MAX_DECOMPOSITION_BYTES,
+    MAX_DECOMPOSITION_PARTS, MAX_DECOMPOSITION_RESOLUTION, decompose_mesh, decomposition_memory,
+    open_edges, open_mesh_note, set_decomposition_cache_dir, take_decomposition_warnings,
 };
 pub use error::{BodyLocation, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
 pub use joint_desc::{BodyName, DofDesc, DofMode, JointDesc, MotorDesc, StiffnessDesc};
@@ -516,7 +522,8 @@ pub use json::{
     load_scene_file, locate, locate_closest, parse_scene_str, parse_scene_str_in, to_json_string,
 };
 pub use mesh_file::{
-    LoadedMesh, MeshData, MeshFileError, MeshFormat, load_mesh_file, read_mesh_bytes,
+    LoadedMesh, MAX_MESH_FILE_BYTES, MeshData, MeshFileError, MeshFormat, load_mesh_file,
+    read_mesh_bytes,
 };
 pub use notes::{SceneNote, notes};
 pub use thin::DEFAULT_THICKNESS;

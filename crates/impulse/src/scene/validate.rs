@@ -44,7 +44,7 @@ use std::sync::Arc;
 
 use parry3d::shape::SharedShape;
 
-use super::decomposition::{DecomposedMesh, DecompositionDesc, open_edges, open_mesh_note};
+use super::decomposition::{DecomposedMesh, DecompositionDesc};
 pub(crate) use super::degeneracy::mesh_problem;
 use super::degeneracy::{MeshProblem, hull_degeneracy};
 use super::error::{BodyLocation, FieldPath, SceneError, SceneErrorKind};
@@ -186,29 +186,26 @@ pub fn body_builder(kind: BodyKind, shape: &ShapeDesc) -> Result<BodyBuilder, Sc
 
 /// What a valid scene's author should know before running it, one line each naming the body
 /// (`bodies[3] ("mug").shape: the mesh is not closed ...`): every dynamic or kinematic body
-/// whose trimesh is not closed, so that its mass properties are its convex parts' rather than
-/// its solid's ([`super::decomposition::open_mesh_note`]). A mesh file not read yet is
+/// whose trimesh's mass properties are not simply its solid's ([`DecomposedMesh::note`]: an
+/// open mesh, overlapping shells), after the decomposition cache's warnings
+/// ([`super::decomposition::take_decomposition_warnings`]). A mesh file not read yet is
 /// skipped.
 pub fn decomposition_notes(scene: &Scene) -> Vec<String> {
-    let mut notes = Vec::new();
+    let mut notes = super::decomposition::take_decomposition_warnings();
     for (index, body) in scene.bodies.iter().enumerate() {
-        if !is_decomposed(body.kind, &body.shape) {
+        if !is_decomposed(body.kind, &body.shape) || body.shape.mesh_data().is_none() {
             continue;
         }
-        let Some(mesh) = body.shape.mesh_data() else {
+        let Ok(decomposed) = build_decomposed(body.kind, &body.shape) else {
             continue;
         };
-        let open = open_edges(&mesh);
-        if open > 0 {
+        if let Some(note) = decomposed.note() {
             let name = body
                 .name
                 .as_ref()
                 .map(|name| format!(" ({name:?})"))
                 .unwrap_or_default();
-            notes.push(format!(
-                "bodies[{index}]{name}.shape: {}",
-                open_mesh_note(open)
-            ));
+            notes.push(format!("bodies[{index}]{name}.shape: {note}"));
         }
     }
     notes

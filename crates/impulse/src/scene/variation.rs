@@ -186,8 +186,8 @@ impl Jitter {
 pub struct Variation {
     /// Field changes, applied in order (a later one wins where two set the same field).
     pub overrides: Vec<Override>,
-    /// Seed of the jitter and, when not 0 and the scene has rough or impact-perturbed
-    /// materials, the scene's [`Scene::seed`] (their draws): run K of a sweep uses seed K.
+    /// Seed of the jitter and, when not 0, the scene's [`Scene::seed`] (the draws of rough
+    /// and impact-perturbed materials): run K of a sweep uses seed K.
     pub seed: u64,
     /// The jitter; all zero leaves the bodies where the overrides put them.
     pub jitter: Jitter,
@@ -238,9 +238,9 @@ impl Variation {
             }
         }
         // The seed also draws the rough surfaces' normals and the perturbed impacts: run K of
-        // a sweep gets its own. A scene without such materials draws nothing and is left as
-        // it is.
-        if self.seed != 0 && draws_from_seed(&varied) {
+        // a sweep gets its own. A non-zero seed replaces the scene's whatever it draws, so
+        // `--seed K`, `--set seed=K` and Python's `from_scene(seed=K)` give the same scene.
+        if self.seed != 0 {
             varied.seed = self.seed;
         }
         validate(&varied).map_err(|e| self.blame(e))?;
@@ -492,17 +492,6 @@ fn load_meshes(varied: &mut Scene, original: &Scene, directory: &Path) -> Result
         };
     }
     Ok(())
-}
-
-/// Whether any material of `scene` (named or inline) has a `roughness` or an
-/// `impact_perturbation` above 0: the run draws from the scene's seed.
-fn draws_from_seed(scene: &Scene) -> bool {
-    let draws = |m: &super::Material| m.roughness > 0.0 || m.impact_perturbation > 0.0;
-    scene.materials.values().any(draws)
-        || scene.bodies.iter().any(|b| match &b.material {
-            super::MaterialRef::Inline(m) => draws(m),
-            super::MaterialRef::Named(_) => false,
-        })
 }
 
 /// The generator of body `index` for `seed`: ChaCha20 keyed by the seed (its 8 little-endian

@@ -3,13 +3,13 @@
 //! side. [`SolverSettings`] reads and writes itself through [`SettingsFile`], so the format
 //! stays as it was before the Rust type was grouped; a field missing from a file takes its
 //! default. `sleep: false` is [`SolverSettings::sleep`] `None` (its three parameters are then
-//! ignored on reading and written as their defaults).
+//! kept in [`SolverSettings::off`] and written back as read).
 
 use serde::{Deserialize, Serialize};
 
 use super::{
-    CombineRule, ContactRepair, ContactSettings, ImpactModel, SleepSettings, SolveSettings,
-    SolverMethod, SolverSettings, WorldLimits,
+    CombineRule, ContactRepair, ContactSettings, ImpactModel, OffParameters, SleepSettings,
+    SolveSettings, SolverMethod, SolverSettings, WorldLimits,
 };
 
 /// `solver.method`: the method's name alone.
@@ -23,8 +23,10 @@ enum MethodName {
 }
 
 /// The `solver` object, field for field in the order files are written; each field as
-/// [`SolverSettings`] documents it. `auto`'s three parameters are read whatever the method
-/// (other methods ignore them) and written as the method's, or `auto`'s defaults.
+/// [`SolverSettings`] documents it. `auto`'s three parameters and the sleep parameters are
+/// read whatever the method and `sleep` say, and written back as read: into the method or
+/// [`SolverSettings::sleep`] while the option is on, into [`super::OffParameters`] while it
+/// is off.
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 struct SettingsFile {
@@ -87,8 +89,8 @@ impl Default for SettingsFile {
 impl From<SolverSettings> for SettingsFile {
     fn from(s: SolverSettings) -> Self {
         let (escalation_tolerance, escalation_iterations, mass_ratio_threshold) =
-            s.solve.method.auto_parameters();
-        let sleep = s.sleep.unwrap_or_default();
+            s.auto_parameters();
+        let sleep = s.sleep_parameters();
         SettingsFile {
             method: match s.solve.method {
                 SolverMethod::Pgs => MethodName::Pgs,
@@ -135,6 +137,17 @@ impl From<SolverSettings> for SettingsFile {
 
 impl From<SettingsFile> for SolverSettings {
     fn from(f: SettingsFile) -> Self {
+        let auto = (
+            f.escalation_tolerance,
+            f.escalation_iterations,
+            f.mass_ratio_threshold,
+        );
+        let sleep = SleepSettings {
+            linear_speed: f.sleep_linear_speed,
+            angular_speed: f.sleep_angular_speed,
+            time_to_sleep: f.time_to_sleep,
+        };
+        let defaults = OffParameters::default();
         SolverSettings {
             solve: SolveSettings {
                 method: match f.method {
@@ -142,9 +155,9 @@ impl From<SettingsFile> for SolverSettings {
                     MethodName::Nncg => SolverMethod::Nncg,
                     MethodName::Apgd => SolverMethod::Apgd,
                     MethodName::Auto => SolverMethod::Auto {
-                        escalation_tolerance: f.escalation_tolerance,
-                        escalation_iterations: f.escalation_iterations,
-                        mass_ratio_threshold: f.mass_ratio_threshold,
+                        escalation_tolerance: auto.0,
+                        escalation_iterations: auto.1,
+                        mass_ratio_threshold: auto.2,
                     },
                 },
                 substeps: f.substeps,
@@ -171,11 +184,7 @@ impl From<SettingsFile> for SolverSettings {
                 friction_combine: f.friction_combine,
                 restitution_combine: f.restitution_combine,
             },
-            sleep: f.sleep.then_some(SleepSettings {
-                linear_speed: f.sleep_linear_speed,
-                angular_speed: f.sleep_angular_speed,
-                time_to_sleep: f.time_to_sleep,
-            }),
+            sleep: f.sleep.then_some(sleep),
             limits: WorldLimits {
                 max_distance: f.max_distance,
                 max_linear_speed: f.max_linear_speed,
@@ -183,6 +192,13 @@ impl From<SettingsFile> for SolverSettings {
             },
             gyroscopic: f.gyroscopic,
             continuous: f.continuous,
+            off: OffParameters {
+                auto: match f.method {
+                    MethodName::Auto => defaults.auto,
+                    _ => auto,
+                },
+                sleep: if f.sleep { defaults.sleep } else { sleep },
+            },
         }
     }
 }

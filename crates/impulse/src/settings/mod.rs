@@ -424,6 +424,35 @@ pub struct SolverSettings {
     /// collision). Fast bodies then never pass through a thin wall, whatever their speed. On
     /// by default; the cost without fast bodies is a pass over the bodies' poses.
     pub continuous: bool,
+    /// The parameters of options that are off ([`OffParameters`]), kept so that every key of
+    /// a file's `solver` object reads and writes back whatever the method; the step never
+    /// reads them.
+    pub off: OffParameters,
+}
+
+/// Parameters a file gave for options that are off, kept only so that a scene or snapshot
+/// read and written keeps them (docs/scene-format.md): `auto`'s when
+/// [`SolveSettings::method`] is another method, the sleep group's when
+/// [`SolverSettings::sleep`] is `None`. Each is the default while its option is on, so two
+/// settings that run the same and came from the same file compare equal. Validated as if the
+/// option were on ([`SolverSettings::problems`]), since switching it on in the file uses them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OffParameters {
+    /// `auto`'s (escalation tolerance, escalation iterations, mass ratio threshold) as
+    /// [`SolverMethod::Auto`] documents them, while the method is not `auto`.
+    pub auto: (f32, u32, f32),
+    /// The sleep parameters while [`SolverSettings::sleep`] is `None`.
+    pub sleep: SleepSettings,
+}
+
+/// `auto`'s defaults ([`SolverMethod::AUTO`]) and [`SleepSettings::default`].
+impl Default for OffParameters {
+    fn default() -> Self {
+        Self {
+            auto: SolverMethod::AUTO.auto_parameters(),
+            sleep: SleepSettings::default(),
+        }
+    }
 }
 
 /// The default world bound (m), [`WorldLimits::max_distance`]: a moving body farther than
@@ -495,6 +524,22 @@ impl SolverSettings {
 }
 
 impl SolverSettings {
+    /// `auto`'s parameters as a file holds them: the method's when it is `auto`, else
+    /// [`OffParameters::auto`].
+    pub fn auto_parameters(&self) -> (f32, u32, f32) {
+        if self.solve.method.is_auto() {
+            self.solve.method.auto_parameters()
+        } else {
+            self.off.auto
+        }
+    }
+
+    /// The sleep parameters as a file holds them: [`Self::sleep`]'s when sleep is on, else
+    /// [`OffParameters::sleep`].
+    pub fn sleep_parameters(&self) -> SleepSettings {
+        self.sleep.unwrap_or(self.off.sleep)
+    }
+
     /// Whether the main solve sweeps the friction rows: see [`SolveSettings::friction_in_main_solve`].
     pub fn main_solve_friction(&self) -> bool {
         self.solve.friction_in_main_solve
@@ -607,6 +652,7 @@ impl Default for SolverSettings {
             limits: WorldLimits::default(),
             gyroscopic: true,
             continuous: true,
+            off: OffParameters::default(),
         }
     }
 }

@@ -422,8 +422,8 @@ fn names_are_the_scene_format_names() {
 }
 
 /// `auto`'s parameters sit beside `method` in the `solver` object: read into
-/// [`SolverMethod::Auto`], written back from it, and ignored by the other methods (which write
-/// `auto`'s defaults), so every file reads as it did when they were fields of the settings.
+/// [`SolverMethod::Auto`] and written back from it; under another method they are kept in
+/// [`SolverSettings::off`] (the step ignores them) and written back as read.
 #[test]
 fn autos_parameters_read_and_write_beside_the_method() {
     let json = r#"{"method": "auto", "escalation_tolerance": 0.002, "escalation_iterations": 7,
@@ -446,7 +446,14 @@ fn autos_parameters_read_and_write_beside_the_method() {
     );
     let pgs: SolverSettings =
         serde_json::from_str(r#"{"method": "pgs", "escalation_iterations": 7}"#).unwrap();
-    assert_eq!(pgs, SolverSettings::default());
+    assert_eq!(pgs.solve.method, SolverMethod::Pgs);
+    assert_eq!(pgs.off.auto.1, 7);
+    assert_eq!(
+        serde_json::to_value(&pgs).unwrap()["escalation_iterations"],
+        7
+    );
+    let pgs_default: SolverSettings = serde_json::from_str(r#"{"method": "pgs"}"#).unwrap();
+    assert_eq!(pgs_default, SolverSettings::default());
     let default = serde_json::to_value(SolverSettings::default()).unwrap();
     assert_eq!(default["escalation_iterations"], 4);
     assert!(serde_json::from_str::<SolverSettings>(r#"{"substep": 3}"#).is_err());
@@ -485,7 +492,7 @@ fn flat_keys_read_into_their_groups_and_write_back_flat() {
     let written = serde_json::to_value(&asleep_off).unwrap();
     assert_eq!(
         (&written["sleep"], &written["time_to_sleep"]),
-        (&false.into(), &0.5.into())
+        (&false.into(), &2.0.into())
     );
     let keys: Vec<String> = match serde_json::to_value(&default).unwrap() {
         serde_json::Value::Object(map) => map.keys().cloned().collect(),
@@ -511,5 +518,58 @@ fn flat_keys_read_into_their_groups_and_write_back_flat() {
             preset,
             "{name}"
         );
+    }
+}
+
+/// Every key of the `solver` object survives read → write under every method and with sleep
+/// on and off: each key set to a valid value other than its default reads and writes back to
+/// the same value, and the settings read back equal.
+#[test]
+fn every_key_round_trips_whatever_the_method() {
+    use serde_json::Value;
+    let default = match serde_json::to_value(SolverSettings::default()).unwrap() {
+        Value::Object(map) => map,
+        other => panic!("not an object: {other}"),
+    };
+    for method in SolverMethod::ALL {
+        for sleep in [true, false] {
+            let mut file = serde_json::Map::new();
+            for (key, value) in &default {
+                let changed: Value = match (key.as_str(), value) {
+                    ("method", _) => method.name().into(),
+                    ("sleep", _) => sleep.into(),
+                    ("repair", _) => serde_json::json!({"type": "bias", "rate": 3.5}),
+                    ("impact", _) => "propagation".into(),
+                    ("friction_combine" | "restitution_combine", _) => "min".into(),
+                    ("warm_start", _) => 0.25.into(),
+                    (_, Value::Bool(b)) => (!b).into(),
+                    (_, Value::Number(n)) if n.is_u64() => (n.as_u64().unwrap() + 3).into(),
+                    (_, Value::Number(n)) => (n.as_f64().unwrap() as f32 * 1.5 + 0.25).into(),
+                    (key, other) => panic!("{key}: no changed value for {other}"),
+                };
+                if !matches!(key.as_str(), "method" | "sleep") {
+                    assert_ne!(&changed, value, "{key} is not changed");
+                }
+                file.insert(key.clone(), changed);
+            }
+            let read: SolverSettings = serde_json::from_value(Value::Object(file.clone()))
+                .unwrap_or_else(|e| panic!("{} sleep {sleep}: {e}", method.name()));
+            assert_eq!(read.validate(), Ok(()));
+            let written = match serde_json::to_value(&read).unwrap() {
+                Value::Object(map) => map,
+                other => panic!("not an object: {other}"),
+            };
+            for (key, value) in &file {
+                assert_eq!(
+                    written.get(key),
+                    Some(value),
+                    "{key} under {} with sleep {sleep}",
+                    method.name()
+                );
+            }
+            assert_eq!(written.len(), file.len());
+            let again: SolverSettings = serde_json::from_value(Value::Object(written)).unwrap();
+            assert_eq!(again, read);
+        }
     }
 }

@@ -37,7 +37,7 @@ impl SolverSettings {
             _ => 1,
         };
         let (escalation_tolerance, escalation_iterations, mass_ratio_threshold) =
-            self.solve.method.auto_parameters();
+            self.auto_parameters();
         let counts = [
             ("iterations", self.solve.iterations),
             ("substeps", self.solve.substeps),
@@ -86,7 +86,7 @@ impl SolverSettings {
             ContactRepair::Soft { .. } => "repair.hertz",
             _ => "repair.rate",
         };
-        let sleep = self.sleep.unwrap_or_default();
+        let sleep = self.sleep_parameters();
         let non_negative = [
             ("tolerance", self.solve.tolerance),
             ("escalation_tolerance", escalation_tolerance),
