@@ -28,10 +28,8 @@ use parry3d::bounding_volume::BoundingSphere;
 use parry3d::math::{Pose, Real};
 use serde::{Deserialize, Serialize};
 
-use super::manifold::ManifoldState;
-
 /// The outcome of a pair's last full face-axis search ([`super::faces`]), kept in its manifold
-/// ([`ManifoldState`]) and dropped with it: Parry drops a compound pair's part manifold when
+/// (the engine's manifold data) and dropped with it: Parry drops a compound pair's part manifold when
 /// the parts' bounding boxes part, and the narrow phase drops the pair's manifolds when the
 /// bodies leave the broad phase (or clears the memory when a body's shape is replaced).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -101,7 +99,7 @@ pub(crate) fn float_slack(
     1.0e-6 + 1.0e-5 * span
 }
 
-/// Manifold data that can keep a [`FaceAxisMemory`]: the engine's ([`ManifoldState`]); `()`
+/// Manifold data that can keep a [`FaceAxisMemory`]: the engine's (its manifold state); `()`
 /// (Parry's manifolds without data, in queries and tests) keeps none, and every search runs in
 /// full.
 pub(crate) trait AxisMemory {
@@ -112,12 +110,6 @@ pub(crate) trait AxisMemory {
 }
 
 impl AxisMemory for () {}
-
-impl AxisMemory for ManifoldState {
-    fn face_axes(&mut self) -> Option<&mut Option<FaceAxisMemory>> {
-        Some(&mut self.face_axes)
-    }
-}
 
 #[cfg(test)]
 #[path = "axis_memory_tests.rs"]

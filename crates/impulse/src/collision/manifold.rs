@@ -9,7 +9,7 @@ use parry3d::query::ContactManifold;
 use parry3d::utils::PoseOpt;
 use serde::{Deserialize, Serialize};
 
-use super::axis_memory::FaceAxisMemory;
+use super::axis_memory::{AxisMemory, FaceAxisMemory};
 
 /// Impulses a contact point received in the last solve, kept with the point across steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -82,4 +82,10 @@ pub(crate) fn manifold_poses(manifold: &Manifold, pose1: &Pose, pose2: &Pose) ->
         manifold.subshape_pos1().prepend_to(pose1),
         manifold.subshape_pos2().prepend_to(pose2),
     )
+}
+
+impl AxisMemory for ManifoldState {
+    fn face_axes(&mut self) -> Option<&mut Option<FaceAxisMemory>> {
+        Some(&mut self.face_axes)
+    }
 }

@@ -359,7 +359,7 @@ pub struct BodyDesc {
     #[serde(
         default,
         skip_serializing_if = "Vec::is_empty",
-        deserialize_with = "json::draw_pairs"
+        deserialize_with = "roughness_draws::draw_pairs"
     )]
     pub roughness_draws: Vec<[f32; 2]>,
 }
@@ -500,6 +500,7 @@ mod json_shape;
 mod mesh_file;
 pub mod mesh_mass;
 mod notes;
+mod roughness_draws;
 mod shape;
 pub mod thin;
 pub(crate) mod validate;

@@ -72,9 +72,11 @@ fn only_the_rows_the_substep_struck_seed_the_region() {
         angular_after: &angular,
         limit: 0.5,
     };
-    let mut bodies = crate::body::Bodies::default();
-    bodies.linear_velocity = linear.clone();
-    bodies.angular_velocity = angular.clone();
+    let bodies = crate::body::Bodies {
+        linear_velocity: linear.clone(),
+        angular_velocity: angular.clone(),
+        ..Default::default()
+    };
     let mut region = ImpactRegion::default();
     let kind = region.find_in(&rows, &bodies, 1.0, n as usize, false, change, None);
     assert_eq!(kind, RegionKind::Local);
