@@ -194,7 +194,8 @@ fn round_hulls_rest_on_their_lowest_vertex_on_meshes() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// The long sweep: docs/testing.md, "Round hulls on every ground".
+/// The long sweep: docs/testing.md, "Round hulls on every ground" (fails on the height field:
+/// seeds 17 and 103).
 #[test]
 #[ignore = "the long sweep, docs/testing.md"]
 fn round_hulls_rest_on_their_lowest_vertex_long_sweep() {
