@@ -135,7 +135,7 @@ fn an_obj_file_without_triangles_is_refused() {
         r#""kind": "static", "shape": {"type": "trimesh", "file": "points.obj"}"#,
         &[("points.obj", b"v 0 0 0\nv 1 0 0\n")],
     );
-    check(&error, "bodies[1].shape.file", "no triangles");
+    check(&error, "bodies[1].shape.file", "the file has no faces");
 }
 
 #[test]
