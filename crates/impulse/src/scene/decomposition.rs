@@ -91,7 +91,7 @@ fn memory_problem(mesh: &MeshData, resolution: u32) -> Option<String> {
         .unwrap_or(8);
     Some(format!(
         "decomposition.resolution: {resolution} gives this mesh a grid of {} × {} × {} voxels, \
-         which would need about {:.1} GB, more than the {:.1} GB (2 GiB) a decomposition may \
+         which would need about {:.1} GB, over the {:.1} GB (2 GiB) a decomposition may \
          use; at most {fits} for this mesh",
         cells[0],
         cells[1],
