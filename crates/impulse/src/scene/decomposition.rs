@@ -53,7 +53,7 @@ const BYTES_PER_VOXEL: u64 = 36;
 
 /// The grid V-HACD voxelises `mesh` into at `resolution` (Parry's voxelisation: `resolution`
 /// cells along the longest side of the bounding box, 2 + resolution·side/longest along the
-/// others) and an upper bound of the memory it needs (bytes): [`BYTES_PER_VOXEL`] per cell.
+/// others) and an upper bound of the memory it needs (bytes): `BYTES_PER_VOXEL` per cell.
 pub fn decomposition_memory(mesh: &MeshData, resolution: u32) -> ([u64; 3], u64) {
     let mut low = [f64::INFINITY; 3];
     let mut high = [f64::NEG_INFINITY; 3];

@@ -11,7 +11,7 @@
 //! the bounding box's centre, so that meshes hundreds of kilometres across do not overflow f32.
 //!
 //! Shells that overlap without nesting (two interpenetrating cubes) bound the union of their
-//! solids, which the sums count twice where they overlap: [`MeshSolid::overlapping`] names
+//! solids, which the sums count twice where they overlap: `MeshSolid`'s overlapping figures name
 //! them so that the caller can warn.
 
 use std::collections::HashMap;
