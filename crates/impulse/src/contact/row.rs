@@ -334,14 +334,20 @@ pub(crate) fn row_closes_faster_than(
     speed: f32,
 ) -> bool {
     let (a, b) = (c.body_a as usize, c.body_b as usize);
+    normal_jacobian(c).velocity(linear[a], angular[a], linear[b], angular[b]) < -speed
+}
+
+/// The normal row's Jacobian of `c` from its normal and lever arms (r × n per body), for the
+/// tests that read a row's normal velocity from body velocities.
+#[inline]
+pub(crate) fn normal_jacobian(c: &ContactConstraint) -> JacobianRow {
     let d = Vec3A::from(c.normal.direction);
-    let row = JacobianRow {
+    JacobianRow {
         direction: c.normal.direction,
         angular_a: Vec3A::from(c.lever_a).cross(d).into(),
         angular_b: Vec3A::from(c.lever_b).cross(d).into(),
         ..JacobianRow::default()
-    };
-    row.velocity(linear[a], angular[a], linear[b], angular[b]) < -speed
+    }
 }
 
 /// Projects a friction impulse onto Coulomb's disc of radius `limit` (N·s).

@@ -21,14 +21,14 @@
 
 #[cfg(doc)]
 use super::interface::SolvePass;
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 
 use super::interface::SolveReport;
 use super::lanes::Bundles;
 use super::pgs::solve_pgs_rows;
 use super::rows::Velocities;
 use crate::body::Bodies;
-use crate::contact::{ContactConstraint, JacobianRow, row_closes_faster_than};
+use crate::contact::{ContactConstraint, normal_jacobian, row_closes_faster_than};
 use crate::joint::IslandJoints;
 use crate::solver::interface::Sweep;
 
@@ -166,13 +166,7 @@ impl ImpactRegion {
         let (linear, angular) = (&bodies.linear_velocity, &bodies.angular_velocity);
         let struck = |c: &ContactConstraint| {
             let (a, b) = (c.local_a as usize, c.local_b as usize);
-            let d = Vec3A::from(c.normal.direction);
-            let row = JacobianRow {
-                direction: c.normal.direction,
-                angular_a: Vec3A::from(c.lever_a).cross(d).into(),
-                angular_b: Vec3A::from(c.lever_b).cross(d).into(),
-                ..JacobianRow::default()
-            };
+            let row = normal_jacobian(c);
             let delta = |slot: usize| {
                 (
                     change.linear_after[slot] - change.linear_before[slot],
