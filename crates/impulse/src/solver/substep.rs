@@ -634,6 +634,15 @@ impl IslandWorkspace {
         // matters little, and its results are compared with exact solutions.
         let half_turn = substep % 2 == 1 && !settings.split_impulse();
         self.apply_forces(context.gravity, plan);
+        if constraints.is_empty() && self.joints.is_empty() {
+            // Free flight (a body of a pour still falling): no row to warm start or solve, so
+            // the substep is its velocity and position updates alone, the same arithmetic as
+            // below without the solves' fixed costs, and no sweep is counted.
+            self.phases.end(SolvePhase::IntegrateVelocities);
+            self.integrate_positions(constraints, settings, plan);
+            self.phases.end(SolvePhase::IntegratePositions);
+            return;
+        }
         // The lanes' record takes v* = v − M⁻¹Jᵀγ, γ the final impulses: the velocities
         // here, before the last substep applies its impulses (see `lanes::Bundles::record`).
         if plan.record_in_lanes && substep + 1 == settings.solve.substeps {
