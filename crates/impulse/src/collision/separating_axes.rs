@@ -17,7 +17,8 @@
 //!
 //! The faces come from Parry's convex hull of the shape's vertices (triangles, not the merged
 //! faces of a `ConvexPolyhedron`, which join triangles up to about 1.5° apart and would drop
-//! their edges from the axes).
+//! their edges from the axes); a box's are its own six faces
+//! and twelve edges.
 
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::shape::{Shape, TypedShape};
@@ -42,9 +43,50 @@ impl Polytope {
     pub(crate) fn of(shape: &dyn Shape) -> Option<Self> {
         match shape.as_typed_shape() {
             TypedShape::ConvexPolyhedron(hull) => Self::hull_of(hull.points()),
-            TypedShape::Cuboid(cuboid) => Self::hull_of(&cuboid.to_trimesh().0),
+            TypedShape::Cuboid(cuboid) => Self::of_box(cuboid.half_extents),
             _ => None,
         }
+    }
+
+    /// The polytope of a box of `half_extents` (m), centred on its frame's origin: its eight
+    /// corners, six face normals, and twelve edges, each along one axis between the faces of
+    /// the other two (the hull of its corners has these, and costs a convex hull per box).
+    /// `None` when a half extent is not positive and finite (the box is flat or not a box).
+    fn of_box(half_extents: Vector) -> Option<Self> {
+        if !half_extents.is_finite() || half_extents.min_element() <= 0.0 {
+            return None;
+        }
+        let axes = [Vector::X, Vector::Y, Vector::Z];
+        let signs = [1.0, -1.0];
+        let vertices = (0..8)
+            .map(|k| {
+                let sign = |bit: usize| if k & (1 << bit) == 0 { 1.0 } else { -1.0 };
+                Vector::new(
+                    sign(0) * half_extents.x,
+                    sign(1) * half_extents.y,
+                    sign(2) * half_extents.z,
+                )
+            })
+            .collect();
+        let normals = axes
+            .iter()
+            .flat_map(|&axis| signs.map(|sign| axis * sign))
+            .collect();
+        // The edges along axis i join a face of axis j and one of axis k, each either way.
+        let mut edges = Vec::with_capacity(12);
+        for i in 0..3 {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            for sj in signs {
+                for sk in signs {
+                    edges.push([axes[i], axes[j] * sj, axes[k] * sk]);
+                }
+            }
+        }
+        Some(Self {
+            vertices,
+            normals,
+            edges,
+        })
     }
 
     /// The convex hull of `points`, `None` when it is flat or empty.

@@ -74,3 +74,54 @@ fn only_polyhedra_and_boxes_have_polytopes() {
     assert!(Polytope::of(SharedShape::cylinder(1.0, 0.5).as_ref()).is_none());
     assert!(Polytope::of(SharedShape::cuboid(1.0, 2.0, 3.0).as_ref()).is_some());
 }
+
+/// A box's polytope, built from its half extents, gives the depth of the convex hull of its
+/// corners (the polytope a hull has) to within rounding, at seeded random poses of two boxes
+/// of different sizes, and the same pairs apart.
+#[test]
+fn a_box_reads_as_the_hull_of_its_corners() {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand::rngs::ChaCha20Rng::seed_from_u64(7);
+    let sizes = [Vec3::new(0.5, 0.5, 0.5), Vec3::new(0.3, 0.1, 0.8)];
+    let hull_of = |h: Vec3| {
+        let corners: Vec<Vec3> = (0..8)
+            .map(|k| {
+                h * Vec3::new(
+                    if k & 1 == 0 { -1.0 } else { 1.0 },
+                    if k & 2 == 0 { -1.0 } else { 1.0 },
+                    if k & 4 == 0 { -1.0 } else { 1.0 },
+                )
+            })
+            .collect();
+        Polytope::of(SharedShape::convex_hull(&corners).unwrap().as_ref()).unwrap()
+    };
+    let (box1, box2) = (
+        Polytope::of(SharedShape::cuboid(sizes[0].x, sizes[0].y, sizes[0].z).as_ref()).unwrap(),
+        Polytope::of(SharedShape::cuboid(sizes[1].x, sizes[1].y, sizes[1].z).as_ref()).unwrap(),
+    );
+    let (hull1, hull2) = (hull_of(sizes[0]), hull_of(sizes[1]));
+    let mut overlapping = 0;
+    for _ in 0..2000 {
+        let mut unit = || {
+            Vec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            )
+        };
+        let turn = Quat::from_scaled_axis(unit() * 3.0);
+        let pose12 = Pose::from_parts(unit() * 1.1, turn);
+        let from_boxes = depth_beyond(&box1, &box2, &pose12, 0.0);
+        let from_hulls = depth_beyond(&hull1, &hull2, &pose12, 0.0);
+        match (from_boxes, from_hulls) {
+            (Some(a), Some(b)) => {
+                overlapping += 1;
+                assert!((a - b).abs() < 1e-5, "{a} against {b} at {pose12:?}");
+            }
+            (None, None) => {}
+            // Touching within rounding either way.
+            (Some(d), None) | (None, Some(d)) => assert!(d < 1e-5, "{d} at {pose12:?}"),
+        }
+    }
+    assert!(overlapping > 200, "{overlapping} overlapping poses");
+}
