@@ -9,6 +9,7 @@ mod kind;
 mod locked_axes;
 pub(crate) mod motion;
 pub(crate) mod rules;
+mod shape_table;
 mod storage;
 #[cfg(test)]
 mod tests;

@@ -35,7 +35,9 @@ pub struct Bodies {
     /// Inverse inertia tensor about the centre of mass, body frame (1/(kg·m²)); zero for
     /// static and kinematic bodies and particles (rotation locked).
     pub(crate) local_inverse_inertia: Vec<Mat3>,
-    /// Collision shape in the body frame.
+    /// Collision shape in the body frame. Stored as a table of distinct shapes
+    /// (`shape_table.rs`), so bodies of one mesh store its parts once.
+    #[serde(with = "super::shape_table")]
     pub(crate) shape: Vec<SharedShape>,
     /// Coulomb friction coefficient μ.
     pub(crate) friction: Vec<f32>,

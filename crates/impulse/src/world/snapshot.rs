@@ -38,9 +38,10 @@ use crate::settings::SolverSettings;
 
 /// The snapshot format this build writes. Raised whenever the stored state changes shape; a
 /// snapshot of a version this build cannot read is refused ([`SnapshotError::VersionMismatch`]).
-/// Version 3 added the joints; it reads version 2 ([`OLDEST_SNAPSHOT_FORMAT_VERSION`]) as a
-/// world without joints.
-pub const SNAPSHOT_FORMAT_VERSION: u32 = 3;
+/// Version 3 added the joints; version 4 stores each distinct shape once, with each body's
+/// index into them (a shape per body before). It reads versions 2
+/// ([`OLDEST_SNAPSHOT_FORMAT_VERSION`], as a world without joints) and 3.
+pub const SNAPSHOT_FORMAT_VERSION: u32 = 4;
 
 /// The oldest snapshot format this build reads: version 2, the format before joints, whose
 /// payload is version 3's without the `joints` field.
@@ -334,11 +335,20 @@ impl World {
             bodies.roughness_draws_given = vec![0; bodies.len()];
         }
         bodies.check_lengths().map_err(invalid)?;
+        // Bodies that share a shape (the table's) share its rebuilt one too.
+        let mut rebuilt = std::collections::HashMap::new();
         for i in 0..bodies.len() {
-            if let Some(shape) = rebuilt_composite(&bodies.shape[i])
-                .map_err(|e| invalid(format!("body {i}: shape: {e}")))?
-            {
-                bodies.shape[i] = shape;
+            let address = std::sync::Arc::as_ptr(&bodies.shape[i].0) as *const () as usize;
+            let shape = match rebuilt.get(&address) {
+                Some(shape) => shape,
+                None => {
+                    let shape = rebuilt_composite(&bodies.shape[i])
+                        .map_err(|e| invalid(format!("body {i}: shape: {e}")))?;
+                    rebuilt.entry(address).or_insert(shape)
+                }
+            };
+            if let Some(shape) = shape {
+                bodies.shape[i] = shape.clone();
             }
         }
         check_bodies(&bodies).map_err(invalid)?;

@@ -280,7 +280,7 @@ fn damaged_files_give_typed_errors() {
     newer[16] += 1;
     let message = read(&newer).to_string();
     assert!(
-        message.contains("format version 4") && message.contains("reads versions 2 to 3"),
+        message.contains("format version 5") && message.contains("reads versions 2 to 4"),
         "{message}"
     );
     let mut longer = bytes.clone();
@@ -353,9 +353,25 @@ fn an_inconsistent_snapshot_is_invalid() {
     assert!(message.contains("bodies.friction"), "{message}");
     let message = refused(&|v| v["bodies"]["restitution"][3] = 2.0.into());
     assert!(message.contains("body 3"), "{message}");
-    let message =
-        refused(&|v| v["bodies"]["shape"][1]["Cuboid"]["half_extents"][0] = (-1.0).into());
+    // Body 1 given a shape of its own in the table, a box with a negative half extent.
+    let message = refused(&|v| {
+        let table = &mut v["bodies"]["shape"];
+        let own = table["shapes"].as_array().unwrap().len();
+        let index = table["of_body"][1].as_u64().unwrap() as usize;
+        let mut shape = table["shapes"][index].clone();
+        shape["Cuboid"]["half_extents"][0] = (-1.0).into();
+        table["shapes"].as_array_mut().unwrap().push(shape);
+        table["of_body"][1] = own.into();
+    });
     assert!(message.contains("body 1: shape"), "{message}");
+    // An index past the table does not decode.
+    let mut past = value.clone();
+    past["bodies"]["shape"]["of_body"][2] = 1000.into();
+    let message = serde_json::from_value::<WorldSnapshot>(past)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(message.contains("body 2: shape index 1000"), "{message}");
     let message = refused(&|v| v["handles"]["free"] = serde_json::json!([]));
     assert!(message.contains("handle"), "{message}");
     let message = refused(&|v| v["broad_phase"]["pairs"][0] = serde_json::json!([7, 3]));
@@ -538,7 +554,7 @@ fn a_snapshot_of_the_format_before_joints_reads_as_a_world_without_joints() {
     older[16..20].copy_from_slice(&(OLDEST_SNAPSHOT_FORMAT_VERSION - 1).to_le_bytes());
     let message = WorldSnapshot::from_bytes(&older).err().unwrap().to_string();
     assert!(
-        message.contains("format version 1") && message.contains("reads versions 2 to 3"),
+        message.contains("format version 1") && message.contains("reads versions 2 to 4"),
         "{message}"
     );
 }
@@ -584,4 +600,93 @@ fn a_snapshot_with_inconsistent_joints_is_invalid() {
     assert!(message.contains("joint 0: limits"), "{message}");
     let message = refused(&|v| v["joints"]["handles"]["free"] = serde_json::json!([7]));
     assert!(message.contains("free joint handle slot 7"), "{message}");
+}
+
+/// Bodies of one shape store it once: 40 bodies of one compound (a mesh's convex parts) make a
+/// snapshot hardly larger than one body does, and 40 equal boxes built apart are stored once.
+/// The restored world steps on to the bit.
+#[test]
+fn bodies_of_one_shape_store_it_once() {
+    use impulse::parry3d::math::Pose;
+    let parts: Vec<(Pose, SharedShape)> = (0..12)
+        .map(|k| {
+            let points: Vec<Vec3> = (0..24)
+                .map(|j| {
+                    let a = (j as f32 * 0.7 + k as f32).sin();
+                    let b = (j as f32 * 1.3 - k as f32).cos();
+                    Vec3::new(a, b, (a * b + j as f32 * 0.1).sin()) * 0.1
+                })
+                .collect();
+            let at = Pose::from_translation(Vec3::new(k as f32 * 0.2, 0.0, 0.0));
+            (at, SharedShape::convex_hull(&points).unwrap())
+        })
+        .collect();
+    let compound = SharedShape::compound(parts);
+    let world_of = |bodies: usize| {
+        let mut world = World::new(
+            Vec3::new(0.0, -9.81, 0.0),
+            1.0 / 60.0,
+            SolverSettings::default(),
+        )
+        .unwrap();
+        world
+            .insert(BodyBuilder::fixed(SharedShape::cuboid(20.0, 0.5, 20.0)))
+            .unwrap();
+        for i in 0..bodies {
+            let at = Vec3::new((i % 5) as f32 * 3.0, 1.0 + (i / 5) as f32 * 1.5, 0.0);
+            world
+                .insert(BodyBuilder::dynamic(compound.clone()).translation(at))
+                .unwrap();
+            world
+                .insert(
+                    BodyBuilder::dynamic(SharedShape::cuboid(0.2, 0.2, 0.2))
+                        .translation(at + Vec3::new(0.0, 0.0, 4.0)),
+                )
+                .unwrap();
+        }
+        world
+    };
+    let size = |world: &World| world.snapshot().unwrap().to_bytes().unwrap().len();
+    let (one, many) = (size(&world_of(1)), size(&world_of(40)));
+    let compound_bytes = {
+        let mut bytes = Vec::new();
+        ciborium::into_writer(&compound, &mut bytes).unwrap();
+        bytes.len()
+    };
+    assert!(
+        many - one < compound_bytes,
+        "39 more bodies of a {compound_bytes}-byte compound added {} bytes",
+        many - one
+    );
+    let mut world = world_of(40);
+    steps(&mut world, 30, 1);
+    let mut restored = World::from_snapshot(
+        WorldSnapshot::from_bytes(&world.snapshot().unwrap().to_bytes().unwrap()).unwrap(),
+    )
+    .unwrap();
+    steps(&mut world, 30, 1);
+    steps(&mut restored, 30, 1);
+    assert_eq!(world.poses(), restored.poses());
+}
+
+/// A snapshot that stores a shape per body, as format versions 2 and 3 did, reads as the
+/// table does: the restored world steps on to the bit.
+#[test]
+fn a_snapshot_with_a_shape_per_body_reads_as_before() {
+    let mut world = small_world();
+    steps(&mut world, 20, 1);
+    let mut value = serde_json::to_value(world.snapshot().unwrap()).unwrap();
+    let table = value["bodies"]["shape"].clone();
+    let per_body: Vec<serde_json::Value> = table["of_body"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|index| table["shapes"][index.as_u64().unwrap() as usize].clone())
+        .collect();
+    value["bodies"]["shape"] = per_body.into();
+    let snapshot: WorldSnapshot = serde_json::from_value(value).unwrap();
+    let mut restored = World::from_snapshot(snapshot).unwrap();
+    steps(&mut world, 20, 1);
+    steps(&mut restored, 20, 1);
+    assert_eq!(world.poses(), restored.poses());
 }
