@@ -156,6 +156,31 @@ fn a_pair_without_points_is_computed_again() {
     assert_eq!(narrow.pairs[0].point_count(), 4);
 }
 
+/// A pair found farther apart than the speculative distance (20 mm) keeps its empty manifold
+/// without a query while its distance then, less the farthest its points have moved since,
+/// stays beyond the distance: 100 mm apart, 50 mm closer and turned 20 mrad (17 mm more at the
+/// cube's corners) it is not computed again; another 20 mm closer it is, and 10 mm apart it
+/// gets its four points.
+#[test]
+fn a_pair_far_apart_is_not_computed_again_until_it_may_be_near() {
+    let mut w = cube_over_ground(0.1, 0.0);
+    let narrow = update_pair(&w, None);
+    assert!(narrow.pairs[0].recomputed);
+    assert_eq!(narrow.pairs[0].point_count(), 0);
+    w.bodies.pose[1].translation.y -= 0.05;
+    w.bodies.pose[1].rotation = glam::Quat::from_rotation_y(0.02);
+    let narrow = update_pair(&w, Some(narrow));
+    assert!(!narrow.pairs[0].recomputed, "computed while 50 mm apart");
+    assert_eq!(narrow.pairs[0].point_count(), 0);
+    w.bodies.pose[1].translation.y -= 0.02;
+    let narrow = update_pair(&w, Some(narrow));
+    assert!(narrow.pairs[0].recomputed, "not computed at 30 mm");
+    assert_eq!(narrow.pairs[0].point_count(), 0);
+    w.bodies.pose[1].translation.y -= 0.02;
+    let narrow = update_pair(&w, Some(narrow));
+    assert_eq!(narrow.pairs[0].point_count(), 4);
+}
+
 /// A turn moves shape 2's farthest points by about its angle times their distance from the
 /// centre (0.87 m for a unit cube): 1 mrad more than the cube's turn when the pair was
 /// computed (2 rad about the vertical) moves them 0.87 mm and the pair is recycled, 1.2 mrad
