@@ -163,12 +163,19 @@ fn polyhedral_depth(
     }
     let mut deepest = None;
     let mut floor = floor;
+    // Each part's pose and box once, not once per part of the other shape.
+    let placed2: Vec<_> = parts2
+        .iter()
+        .map(|(part_pose2, part2)| {
+            let at2 = pose2 * part_pose2;
+            (at2, part2.compute_aabb(&at2), part2)
+        })
+        .collect();
     for (part_pose1, part1) in &parts1 {
         let at1 = pose1 * part_pose1;
         let aabb1 = part1.compute_aabb(&at1);
-        for (part_pose2, part2) in &parts2 {
-            let at2 = pose2 * part_pose2;
-            if !aabb1.intersects(&part2.compute_aabb(&at2)) {
+        for (at2, aabb2, part2) in &placed2 {
+            if !aabb1.intersects(aabb2) {
                 continue;
             }
             let (p1, p2) = (polytopes.get(part1)?, polytopes.get(part2)?);
