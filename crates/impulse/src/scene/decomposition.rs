@@ -28,7 +28,7 @@ use parry3d::shape::SharedShape;
 use parry3d::transformation::vhacd::{VHACD, VHACDParameters};
 use serde::{Deserialize, Serialize};
 
-use super::mesh_file::MeshData;
+use super::mesh_data::MeshData;
 use super::mesh_mass::{MeshSolid, convex_hull_volume, mesh_solid};
 
 /// Largest voxel resolution accepted: the work and memory grow with its cube.

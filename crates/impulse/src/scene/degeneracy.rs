@@ -1,7 +1,7 @@
 //! Whether a point set spans a volume and a triangle mesh has area: the geometric checks of
 //! convex hulls and meshes, shared by scene validation, shape building and snapshots.
 
-use super::mesh_file::MeshData;
+use super::mesh_data::MeshData;
 
 /// Relative tolerance of the convex-hull volume test: the points count as coincident,
 /// collinear or coplanar when they deviate from a point, line or plane by at most

@@ -13,15 +13,8 @@ use std::sync::Arc;
 use glam::{Mat4, Vec3};
 use thiserror::Error;
 
-/// A triangle mesh as plain data: vertex positions (m, the body's frame) and triangles as
-/// three indices into `vertices`, counter-clockwise seen from the side bodies touch.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct MeshData {
-    /// Vertex positions (m).
-    pub vertices: Vec<[f32; 3]>,
-    /// Triangles: indices into `vertices`.
-    pub indices: Vec<[u32; 3]>,
-}
+use super::degeneracy::{MeshProblem, mesh_problem};
+pub use super::mesh_data::MeshData;
 
 /// A mesh read from a `trimesh` shape's `file`, kept with the scene description so that
 /// the world is built from what was read (not serialised: the scene keeps the file's name).
@@ -372,16 +365,81 @@ fn read_gltf(
         buffers.push(data);
     }
     let mut mesh = MeshData::default();
+    let mut origins = Vec::new();
     let scenes: Vec<gltf::Scene> = match document.default_scene() {
         Some(scene) => vec![scene],
         None => document.scenes().collect(),
     };
     for scene in scenes {
         for node in scene.nodes() {
-            add_node(&node, Mat4::IDENTITY, &buffers, &mut mesh, name, 0)?;
+            let mut into = (&mut mesh, &mut origins);
+            add_node(&node, Mat4::IDENTITY, &buffers, &mut into, name, 0)?;
         }
     }
-    Ok(mesh)
+    // A vertex or triangle that the scene format refuses is named by the accessor and element
+    // it came from, which is what a modelling tool's export can be searched for.
+    match mesh_problem(&mesh) {
+        Some(MeshProblem::Vertex(vertex, message)) => {
+            let origin = PrimitiveOrigin::of(&origins, |o| o.first_vertex <= vertex);
+            Err(format_error(
+                name,
+                format!(
+                    "{}, POSITION accessor {} element {} (after the nodes' transforms): {message}",
+                    origin.primitive_name(),
+                    origin.positions,
+                    vertex - origin.first_vertex
+                ),
+            ))
+        }
+        Some(MeshProblem::Triangle(triangle, message)) => {
+            let origin = PrimitiveOrigin::of(&origins, |o| o.first_triangle <= triangle);
+            let within = triangle - origin.first_triangle;
+            let indices = match origin.indices {
+                Some(accessor) => format!("indices accessor {accessor}"),
+                None => "the implicit indices".to_string(),
+            };
+            Err(format_error(
+                name,
+                format!(
+                    "{}, triangle {within} of the primitive ({indices}, POSITION accessor {}): \
+                     {message}",
+                    origin.primitive_name(),
+                    origin.positions
+                ),
+            ))
+        }
+        _ => Ok(mesh),
+    }
+}
+
+/// Where a glTF primitive's vertices and triangles went in the mesh read: the mesh and
+/// primitive, their accessors, and the first vertex and triangle of the primitive in
+/// [`MeshData`].
+struct PrimitiveOrigin {
+    mesh: usize,
+    mesh_name: String,
+    primitive: usize,
+    positions: usize,
+    indices: Option<usize>,
+    first_vertex: usize,
+    first_triangle: usize,
+}
+
+impl PrimitiveOrigin {
+    /// The last of `origins` (in the order read) that `starts_at_or_before` the element, the
+    /// one holding it. `origins` is not empty when the mesh has a vertex or triangle.
+    fn of(origins: &[Self], starts_at_or_before: impl Fn(&Self) -> bool) -> &Self {
+        let after = origins.partition_point(starts_at_or_before);
+        &origins[after.saturating_sub(1)]
+    }
+
+    /// `mesh 2 ("Handle") primitive 0`.
+    fn primitive_name(&self) -> String {
+        format!(
+            "mesh {} ({:?}) primitive {}",
+            self.mesh, self.mesh_name, self.primitive
+        )
+    }
 }
 
 /// The glTF crate's own validation of a parsed document (what `Gltf::from_slice` runs), after
@@ -460,12 +518,13 @@ fn check_accessor_types(primitive: &gltf::Primitive, name: &str) -> Result<(), M
     Ok(())
 }
 
-/// Adds the triangles of `node` and its children, with `parent` the transform above it.
+/// Adds the triangles of `node` and its children, with `parent` the transform above it, to
+/// `into`'s mesh, and where each primitive's went to its origins.
 fn add_node(
     node: &gltf::Node,
     parent: Mat4,
     buffers: &[Vec<u8>],
-    mesh: &mut MeshData,
+    into: &mut (&mut MeshData, &mut Vec<PrimitiveOrigin>),
     name: &str,
     depth: usize,
 ) -> Result<(), MeshFileError> {
@@ -515,6 +574,7 @@ fn add_node(
                 // Points and lines have no area to touch.
                 _ => continue,
             };
+            let (mesh, origins) = (&mut *into.0, &mut *into.1);
             let base = u32::try_from(mesh.vertices.len())
                 .map_err(|_| format_error(name, "more than 2³² vertices"))?;
             for t in &triangles {
@@ -538,13 +598,24 @@ fn add_node(
                     ));
                 }
             }
+            origins.push(PrimitiveOrigin {
+                mesh: node_mesh.index(),
+                mesh_name: node_mesh.name().unwrap_or("").to_string(),
+                primitive: primitive.index(),
+                positions: primitive
+                    .get(&gltf::Semantic::Positions)
+                    .map_or(0, |a| a.index()),
+                indices: primitive.indices().map(|a| a.index()),
+                first_vertex: mesh.vertices.len(),
+                first_triangle: mesh.indices.len(),
+            });
             mesh.vertices.extend(positions.iter().map(|p| p.to_array()));
             mesh.indices
                 .extend(triangles.iter().map(|t| t.map(|i| base + i)));
         }
     }
     for child in node.children() {
-        add_node(&child, transform, buffers, mesh, name, depth + 1)?;
+        add_node(&child, transform, buffers, into, name, depth + 1)?;
     }
     Ok(())
 }

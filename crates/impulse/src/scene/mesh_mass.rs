@@ -19,7 +19,7 @@ use std::collections::HashMap;
 use glam::{DMat3, DVec3, Mat3, Vec3};
 use parry3d::mass_properties::MassProperties;
 
-use super::mesh_file::MeshData;
+use super::mesh_data::MeshData;
 
 /// Volume, centre of mass and inertia of a solid at density 1 kg/m³, in f64.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -241,7 +241,7 @@ impl ShapeDesc {
 
     /// The triangles of a [`ShapeDesc::Trimesh`]: inline, or as read from its file; `None`
     /// for other shapes and for a file not read yet.
-    pub fn mesh_data(&self) -> Option<std::borrow::Cow<'_, mesh_file::MeshData>> {
+    pub fn mesh_data(&self) -> Option<std::borrow::Cow<'_, mesh_data::MeshData>> {
         use std::borrow::Cow;
         match self {
             ShapeDesc::Trimesh {
@@ -251,7 +251,7 @@ impl ShapeDesc {
                 vertices: Some(vertices),
                 indices: Some(indices),
                 ..
-            } => Some(Cow::Owned(mesh_file::MeshData {
+            } => Some(Cow::Owned(mesh_data::MeshData {
                 vertices: vertices.clone(),
                 indices: indices.clone(),
             })),
@@ -497,6 +497,7 @@ mod error;
 pub(crate) mod joint_desc;
 pub(crate) mod json;
 mod json_shape;
+mod mesh_data;
 mod mesh_file;
 pub mod mesh_mass;
 mod notes;

@@ -8,7 +8,7 @@ use super::ShapeDesc;
 use super::decomposition::{DecomposedMesh, DecompositionDesc};
 use super::degeneracy::mesh_problem;
 use super::error::FieldPath;
-use super::mesh_file::MeshData;
+use super::mesh_data::MeshData;
 use crate::body::rules;
 
 /// The Parry shape of `shape`, which `validate::shape_problem` found valid; a thin shape's is

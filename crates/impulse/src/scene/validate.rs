@@ -48,7 +48,7 @@ use super::decomposition::{DecomposedMesh, DecompositionDesc};
 pub(crate) use super::degeneracy::mesh_problem;
 use super::degeneracy::{MeshProblem, hull_degeneracy};
 use super::error::{BodyLocation, FieldPath, SceneError, SceneErrorKind};
-use super::mesh_file::MeshData;
+use super::mesh_data::MeshData;
 use super::shape::{decomposed_shape, shape_of};
 use super::thin;
 use super::{BodyDesc, BodyKind, KeyframeDesc, Material, MaterialRef, Scene, ShapeDesc};

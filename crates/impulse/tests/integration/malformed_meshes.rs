@@ -272,3 +272,108 @@ fn world_from_an_unvalidated_scene_refuses_bad_meshes() {
     let error = World::from_scene(&scene).err().expect("an empty compound");
     assert!(error.to_string().contains("at least one part"), "{error}");
 }
+
+/// A glTF file (JSON, one data-URI buffer) of one mesh per entry of `meshes`: its name, its
+/// positions and its triangles (indices as 32-bit integers).
+fn gltf_of(meshes: &[(&str, Vec<[f32; 3]>, Vec<[u32; 3]>)]) -> String {
+    use base64::Engine as _;
+    let (mut bin, mut views, mut accessors, mut json_meshes, mut nodes) =
+        (Vec::<u8>::new(), vec![], vec![], vec![], vec![]);
+    for (m, (name, positions, triangles)) in meshes.iter().enumerate() {
+        let start = bin.len();
+        for p in positions {
+            for x in p {
+                bin.extend(x.to_le_bytes());
+            }
+        }
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start}),
+        );
+        // glTF asks for the bounds of positions; a NaN coordinate is left out of them.
+        let bound = |pick: fn(f32, f32) -> f32, from: f32| {
+            (0..3)
+                .map(|k| {
+                    positions
+                        .iter()
+                        .map(|p| p[k])
+                        .filter(|x| x.is_finite())
+                        .fold(from, pick)
+                })
+                .collect::<Vec<f32>>()
+        };
+        accessors.push(serde_json::json!({"bufferView": views.len() - 1, "componentType": 5126, "count": positions.len(), "type": "VEC3", "min": bound(f32::min, f32::MAX), "max": bound(f32::max, f32::MIN)}));
+        let start = bin.len();
+        for t in triangles {
+            for i in t {
+                bin.extend(i.to_le_bytes());
+            }
+        }
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start}),
+        );
+        accessors.push(serde_json::json!({"bufferView": views.len() - 1, "componentType": 5125, "count": 3 * triangles.len(), "type": "SCALAR"}));
+        json_meshes.push(serde_json::json!({"name": name, "primitives": [{"attributes": {"POSITION": accessors.len() - 2}, "indices": accessors.len() - 1}]}));
+        nodes.push(serde_json::json!({"mesh": m}));
+    }
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bin)
+    );
+    serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": (0..meshes.len()).collect::<Vec<_>>()}],
+        "nodes": nodes,
+        "meshes": json_meshes,
+        "buffers": [{"byteLength": bin.len(), "uri": uri}],
+        "bufferViews": views,
+        "accessors": accessors,
+    })
+    .to_string()
+}
+
+/// A glTF vertex that is not finite, or a triangle without area, is refused naming the mesh,
+/// the primitive, the accessor and the element a modelling tool wrote, not only its place in
+/// the merged mesh.
+#[test]
+fn gltf_geometry_errors_name_the_accessor_and_element() {
+    let square = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 0.0, 1.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let good = ("Floor", square.clone(), vec![[0, 1, 2], [0, 2, 3]]);
+    let mut nan = square.clone();
+    nan[2][1] = f32::NAN;
+    let cases = [
+        (
+            ("Lid", nan, vec![[0, 1, 2]]),
+            "mesh 1 (\"Lid\") primitive 0, POSITION accessor 2 element 2",
+        ),
+        (
+            ("Handle", square, vec![[0, 1, 2], [1, 1, 3]]),
+            "mesh 1 (\"Handle\") primitive 0, triangle 1 of the primitive (indices accessor 3, POSITION accessor 2)",
+        ),
+    ];
+    for (bad, expected) in cases {
+        let text = gltf_of(&[good.clone(), bad]);
+        let error = load_error(
+            "gltf-geometry",
+            r#""kind": "static", "shape": {"type": "trimesh", "file": "part.gltf"}"#,
+            &[("part.gltf", text.as_bytes())],
+        );
+        check(&error, "bodies[1].shape.file", expected);
+        assert!(error.message.contains("part.gltf"), "{}", error.message);
+    }
+    // The same meshes without the fault are read.
+    let text = gltf_of(&[good.clone(), good]);
+    let mesh = impulse::scene::read_mesh_bytes(
+        text.as_bytes(),
+        impulse::scene::MeshFormat::Gltf,
+        "part.gltf",
+        None,
+    )
+    .unwrap();
+    assert_eq!(mesh.indices.len(), 4);
+}
