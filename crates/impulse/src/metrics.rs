@@ -179,7 +179,7 @@ fn polyhedral_depth(
                 continue;
             }
             let (p1, p2) = (polytopes.get(part1)?, polytopes.get(part2)?);
-            if let Some(depth) = separating_axes::depth_beyond(p1, p2, &at1.inv_mul(&at2), floor) {
+            if let Some(depth) = separating_axes::depth_beyond(p1, p2, &at1.inv_mul(at2), floor) {
                 deepest = Some(depth);
                 floor = depth;
             }

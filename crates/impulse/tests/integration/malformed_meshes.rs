@@ -273,9 +273,12 @@ fn world_from_an_unvalidated_scene_refuses_bad_meshes() {
     assert!(error.to_string().contains("at least one part"), "{error}");
 }
 
-/// A glTF file (JSON, one data-URI buffer) of one mesh per entry of `meshes`: its name, its
-/// positions and its triangles (indices as 32-bit integers).
-fn gltf_of(meshes: &[(&str, Vec<[f32; 3]>, Vec<[u32; 3]>)]) -> String {
+/// A named mesh: its name, positions and triangles.
+type NamedMesh<'a> = (&'a str, Vec<[f32; 3]>, Vec<[u32; 3]>);
+
+/// A glTF file (JSON, one data-URI buffer) of one mesh per entry of `meshes` (indices as
+/// 32-bit integers).
+fn gltf_of(meshes: &[NamedMesh<'_>]) -> String {
     use base64::Engine as _;
     let (mut bin, mut views, mut accessors, mut json_meshes, mut nodes) =
         (Vec::<u8>::new(), vec![], vec![], vec![], vec![]);
