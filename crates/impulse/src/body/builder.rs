@@ -369,7 +369,7 @@ pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
             // body of uniform density.
             let centroid = b
                 .unit_mass_properties
-                .unwrap_or_else(|| shape.mass_properties(1.0))
+                .unwrap_or_else(|| rules::mass_properties(shape.as_ref(), 1.0))
                 .local_com;
             let centroid = if centroid.is_finite() {
                 centroid
@@ -386,7 +386,7 @@ pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
             let particle = b.kind == BodyKind::Particle;
             let unit = b
                 .unit_mass_properties
-                .unwrap_or_else(|| shape.mass_properties(1.0));
+                .unwrap_or_else(|| rules::mass_properties(shape.as_ref(), 1.0));
             rules::derived_mass(&unit, b.density, b.mass, particle)
                 .map_err(|(field, message)| invalid_built(field, message))?;
             let props = match b.unit_mass_properties {
@@ -395,7 +395,7 @@ pub(crate) fn build(b: &BodyBuilder) -> Result<BuiltBody, InvalidField> {
                     unit.set_mass(unit.mass() * b.density, true);
                     unit
                 }
-                None => shape.mass_properties(b.density),
+                None => rules::mass_properties(shape.as_ref(), b.density),
             };
             let computed_mass = props.mass();
             // Scaling mass and inertia together keeps the shape's mass distribution.

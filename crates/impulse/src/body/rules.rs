@@ -90,6 +90,27 @@ pub(crate) fn derived_mass(
     }
 }
 
+/// Bounding radius (m) above which [`mass_properties`] works at a scaled density.
+const LARGE_SHAPE_RADIUS: f32 = 1.0e3;
+
+/// The mass properties of `shape` at `density` (kg/m³), as Parry's `Shape::mass_properties`
+/// gives them for a shape up to [`LARGE_SHAPE_RADIUS`] across. Parry finds a convex
+/// polyhedron's principal axes from its inertia tensor in f32, whose squared entries overflow
+/// once they pass about 10¹⁹ kg·m² (a hull some 10 km across at density 1 kg/m³ read as
+/// infinite moments, reported as 0): a larger shape's properties are found at the density
+/// ρ' = r⁻⁵ (r its bounding radius), which brings the tensor near 1, and scaled to `density`
+/// (inertia scales with the mass at a fixed distribution).
+pub(crate) fn mass_properties(shape: &dyn Shape, density: f32) -> MassProperties {
+    let radius = shape.compute_local_bounding_sphere().radius();
+    if !(radius.is_finite() && radius > LARGE_SHAPE_RADIUS) {
+        return shape.mass_properties(density);
+    }
+    let scaled = radius.recip().powi(5);
+    let mut properties = shape.mass_properties(scaled);
+    properties.set_mass(properties.mass() * (density / scaled), true);
+    properties
+}
+
 /// Strongest gravity (m/s²): 10⁴ m/s², about 1,000 g. Beyond it a second of fall reaches the
 /// default `max_linear_speed` within seconds; 10³⁰ m/s² overflows the energy at once.
 pub(crate) const MAX_GRAVITY: f32 = 1.0e4;

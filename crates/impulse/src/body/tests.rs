@@ -174,3 +174,44 @@ fn locked_inverse_inertia_in_the_cases_with_a_known_answer() {
         }
     }
 }
+
+/// A convex hull of a box's corners from 1 m to 600 km across, given a mass of 1 kg, gets the
+/// box's moments m·(b² + c²)/3 (half extents a, b, c): Parry's f32 principal axes would
+/// overflow for the large ones, which `rules::mass_properties` scales out.
+#[test]
+fn large_hulls_get_their_moments() {
+    for half in [0.5f32, 5.0e3, 3.0e5] {
+        let h = Vec3::new(half, 0.5 * half, 0.25 * half);
+        let corners: Vec<Vec3> = (0..8)
+            .map(|k| {
+                h * Vec3::new(
+                    if k & 1 == 0 { -1.0 } else { 1.0 },
+                    if k & 2 == 0 { -1.0 } else { 1.0 },
+                    if k & 4 == 0 { -1.0 } else { 1.0 },
+                )
+            })
+            .collect();
+        let hull = SharedShape::convex_hull(&corners).unwrap();
+        let properties = super::rules::mass_properties(hull.as_ref(), 1.0);
+        let mut found = properties.principal_inertia().to_array();
+        found.sort_by(f32::total_cmp);
+        let volume = 8.0 * h.x * h.y * h.z;
+        let mut expected = [
+            volume * (h.y * h.y + h.z * h.z) / 3.0,
+            volume * (h.x * h.x + h.z * h.z) / 3.0,
+            volume * (h.x * h.x + h.y * h.y) / 3.0,
+        ];
+        expected.sort_by(f32::total_cmp);
+        for (f, e) in found.iter().zip(expected) {
+            assert!(
+                (f - e).abs() <= 1e-3 * e,
+                "half extent {half}: {found:?} against {expected:?}"
+            );
+        }
+        let mut world =
+            crate::World::new(Vec3::ZERO, 1.0 / 60.0, crate::SolverSettings::default()).unwrap();
+        world
+            .insert(super::BodyBuilder::dynamic(hull).mass(1.0))
+            .expect("a large hull of 1 kg is a body");
+    }
+}

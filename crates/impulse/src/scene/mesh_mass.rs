@@ -34,7 +34,10 @@ pub struct SolidMoments {
 
 impl SolidMoments {
     /// As Parry's f32 mass properties at density 1; `None` when a value is not finite in f32
-    /// or the volume is not positive.
+    /// or the volume is not positive. Parry finds the principal axes in f32, whose squared
+    /// tensor entries overflow past about 10¹⁹ kg·m² (a mesh some 10 km across): the tensor and
+    /// volume are divided by the tensor's largest entry for that, and the mass set back after
+    /// (inertia scales with the mass at a fixed distribution).
     pub fn to_mass_properties(&self) -> Option<MassProperties> {
         let mass = self.volume as f32;
         let center = self.center.as_vec3();
@@ -43,7 +46,22 @@ impl SolidMoments {
             && mass > 0.0
             && center.is_finite()
             && inertia.to_cols_array().iter().all(|x| x.is_finite());
-        finite.then(|| MassProperties::with_inertia_matrix(center, mass, inertia))
+        if !finite {
+            return None;
+        }
+        let largest = self
+            .inertia
+            .to_cols_array()
+            .iter()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        if largest <= 1.0e15 {
+            return Some(MassProperties::with_inertia_matrix(center, mass, inertia));
+        }
+        let (volume, tensor) = (self.volume / largest, self.inertia / largest);
+        let mut properties =
+            MassProperties::with_inertia_matrix(center, volume as f32, tensor.as_mat3());
+        properties.set_mass(mass, true);
+        Some(properties)
     }
 }
 

@@ -388,3 +388,42 @@ fn meshes_hundreds_of_kilometres_across_have_finite_mass_properties() {
         );
     }
 }
+
+/// A closed box mesh from 1 m to 600 km across keeps its closed-form principal moments in
+/// Parry's f32 mass properties (the tensor of the 600 km box at density 1, about 10²⁶ kg·m²,
+/// has squares beyond f32's range), turned so that its tensor has off-diagonal entries.
+#[test]
+fn large_meshes_keep_their_moments_in_f32() {
+    let mut generator = ChaCha20Rng::seed_from_u64(7);
+    for half in [0.5, 5.0e3, 3.0e5] {
+        let h = DVec3::new(half, 0.5 * half, 0.25 * half);
+        let (rotation, _) = random_pose(&mut generator);
+        let mesh = assemble(
+            &[box_shell(DVec3::ZERO, h)],
+            rotation,
+            DVec3::ZERO,
+            0.0,
+            &mut generator,
+        );
+        let MeshSolid::Closed { moments, .. } = mesh_solid(&mesh) else {
+            panic!("the box is closed");
+        };
+        let properties = moments.to_mass_properties().expect("finite properties");
+        let volume = 8.0 * h.x * h.y * h.z;
+        let mut found = properties.principal_inertia().as_dvec3().to_array();
+        found.sort_by(f64::total_cmp);
+        let mut expected = [
+            volume * (h.y * h.y + h.z * h.z) / 3.0,
+            volume * (h.x * h.x + h.z * h.z) / 3.0,
+            volume * (h.x * h.x + h.y * h.y) / 3.0,
+        ];
+        expected.sort_by(f64::total_cmp);
+        for (f, e) in found.iter().zip(expected) {
+            assert!(
+                (f - e).abs() <= 1e-3 * e,
+                "half extent {half}: {found:?} against {expected:?}"
+            );
+        }
+        assert!((f64::from(properties.mass()) - volume).abs() <= 1e-4 * volume);
+    }
+}

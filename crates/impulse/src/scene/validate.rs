@@ -389,7 +389,7 @@ impl Checker {
         if b.kind.is_dynamic()
             && let Ok(shape) = shape_of(&b.shape)
             && let Err((field, message)) = rules::derived_mass(
-                &shape.mass_properties(1.0),
+                &crate::body::rules::mass_properties(shape.as_ref(), 1.0),
                 density,
                 b.mass,
                 b.kind == BodyKind::Particle,
