@@ -224,7 +224,74 @@ fn read_obj(bytes: &[u8], name: &str) -> Result<MeshData, MeshFileError> {
             mesh.indices.push([base + t[0], base + t[1], base + t[2]]);
         }
     }
-    Ok(mesh)
+    // A vertex or triangle the scene format refuses is named by the file's line too.
+    let (at, message) = match mesh_problem(&mesh) {
+        Some(MeshProblem::Vertex(_, message)) => (obj_line(bytes, ObjFault::Vertex), message),
+        Some(MeshProblem::Triangle(triangle, message)) => {
+            let corners = mesh.indices[triangle].map(|i| mesh.vertices[i as usize]);
+            (obj_line(bytes, ObjFault::Face(corners)), message)
+        }
+        _ => return Ok(mesh),
+    };
+    let at = match at {
+        Some((line, text)) => format!("line {line} ({text:?}): "),
+        None => String::new(),
+    };
+    Err(format_error(name, format!("{at}{message}")))
+}
+
+/// What [`obj_line`] looks for.
+enum ObjFault {
+    /// A `v` line whose position is not finite.
+    Vertex,
+    /// An `f` line one of whose triangles (a fan from its first vertex, as the reader splits
+    /// polygons) has these corners: the face a triangle of the mesh as read came from, found
+    /// by its corners because the reader renumbers vertices and regroups faces by object.
+    Face([[f32; 3]; 3]),
+}
+
+/// The first line of the OBJ text `bytes` with `fault` (1-based, with its text, at most 80
+/// characters); `None` when no line has it.
+fn obj_line(bytes: &[u8], fault: ObjFault) -> Option<(usize, String)> {
+    let text = String::from_utf8_lossy(bytes);
+    let mut positions: Vec<[f32; 3]> = Vec::new();
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let found = match (words.next(), &fault) {
+            (Some("v"), _) => {
+                let mut position = [0.0f32; 3];
+                for x in &mut position {
+                    *x = words.next().and_then(|w| w.parse().ok()).unwrap_or(0.0);
+                }
+                positions.push(position);
+                matches!(fault, ObjFault::Vertex) && !position.iter().all(|x| x.is_finite())
+            }
+            (Some("f"), ObjFault::Face(corners)) => {
+                // A face's vertex is the first number of each word, 1-based or negative
+                // (counted back from the vertices read so far).
+                let face: Option<Vec<[f32; 3]>> = words
+                    .map(|word| {
+                        let index: i64 = word.split('/').next()?.parse().ok()?;
+                        let at = if index < 0 {
+                            positions.len() as i64 + index
+                        } else {
+                            index - 1
+                        };
+                        positions.get(usize::try_from(at).ok()?).copied()
+                    })
+                    .collect();
+                face.is_some_and(|face| {
+                    (1..face.len().saturating_sub(1))
+                        .any(|k| [face[0], face[k], face[k + 1]] == *corners)
+                })
+            }
+            _ => false,
+        };
+        if found {
+            return Some((number + 1, line.trim().chars().take(80).collect()));
+        }
+    }
+    None
 }
 
 /// The first line of the OBJ text `bytes` (1-based, with its text, at most 80 characters)

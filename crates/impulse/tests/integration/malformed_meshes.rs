@@ -380,3 +380,27 @@ fn gltf_geometry_errors_name_the_accessor_and_element() {
     .unwrap();
     assert_eq!(mesh.indices.len(), 4);
 }
+
+/// An OBJ face without area, or a vertex that is not finite, is refused naming the file's line
+/// it is on, although the reader renumbers vertices and regroups faces by object.
+#[test]
+fn obj_geometry_errors_name_the_line() {
+    let degenerate = b"o floor\nv 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 3\nf 1 3 4\no lid\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf -3 -2 -1\n";
+    let error = load_error(
+        "obj-degenerate",
+        r#""kind": "static", "shape": {"type": "trimesh", "file": "part.obj"}"#,
+        &[("part.obj", degenerate)],
+    );
+    check(
+        &error,
+        "bodies[1].shape.file",
+        "line 12 (\"f -3 -2 -1\"): triangle 2",
+    );
+    let not_finite = b"v 0 0 0\nv 1 0 0\nv 1 inf 1\nf 1 2 3\n";
+    let error = load_error(
+        "obj-not-finite",
+        r#""kind": "static", "shape": {"type": "trimesh", "file": "part.obj"}"#,
+        &[("part.obj", not_finite)],
+    );
+    check(&error, "bodies[1].shape.file", "line 3");
+}
