@@ -14,6 +14,21 @@ use glam::Vec3;
 use crate::World;
 use crate::contact::{ContactConstraint, JacobianRow};
 
+/// The eight corners of a box of `half_extents` (m) centred on the origin, corner k at
+/// (±x, ±y, ±z) with bit 0, 1, 2 of k choosing the sign of x, y, z (clear: negative).
+pub(crate) fn box_corners(half_extents: Vec3) -> Vec<Vec3> {
+    (0..8)
+        .map(|k| {
+            half_extents
+                * Vec3::new(
+                    if k & 1 == 0 { -1.0 } else { 1.0 },
+                    if k & 2 == 0 { -1.0 } else { 1.0 },
+                    if k & 4 == 0 { -1.0 } else { 1.0 },
+                )
+        })
+        .collect()
+}
+
 /// A seeded generator of uniform numbers in [low, high) (a 64-bit linear congruential
 /// generator, Knuth's MMIX constants, 24 bits of each state): the same sequence on every run,
 /// so every case of a seeded sweep can be rebuilt from its seed.

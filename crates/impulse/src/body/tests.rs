@@ -182,16 +182,7 @@ fn locked_inverse_inertia_in_the_cases_with_a_known_answer() {
 fn large_hulls_get_their_moments() {
     for half in [0.5f32, 5.0e3, 3.0e5] {
         let h = Vec3::new(half, 0.5 * half, 0.25 * half);
-        let corners: Vec<Vec3> = (0..8)
-            .map(|k| {
-                h * Vec3::new(
-                    if k & 1 == 0 { -1.0 } else { 1.0 },
-                    if k & 2 == 0 { -1.0 } else { 1.0 },
-                    if k & 4 == 0 { -1.0 } else { 1.0 },
-                )
-            })
-            .collect();
-        let hull = SharedShape::convex_hull(&corners).unwrap();
+        let hull = SharedShape::convex_hull(&crate::test_support::box_corners(h)).unwrap();
         let properties = super::rules::mass_properties(hull.as_ref(), 1.0);
         let mut found = properties.principal_inertia().to_array();
         found.sort_by(f32::total_cmp);

@@ -6,6 +6,7 @@ use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
 use super::{Polytope, depth_beyond};
+use crate::test_support::box_corners;
 
 /// The depth of `shape2` at `pose2` into `shape1` at `pose1`, or `None` if not above zero.
 fn depth(shape1: &SharedShape, pose1: Pose, shape2: &SharedShape, pose2: Pose) -> Option<f32> {
@@ -16,16 +17,7 @@ fn depth(shape1: &SharedShape, pose1: Pose, shape2: &SharedShape, pose2: Pose) -
 
 /// A cube as a convex polyhedron (half-extent 1 m).
 fn hull_cube() -> SharedShape {
-    let points: Vec<Vec3> = (0..8)
-        .map(|k| {
-            Vec3::new(
-                if k & 1 == 0 { -1.0 } else { 1.0 },
-                if k & 2 == 0 { -1.0 } else { 1.0 },
-                if k & 4 == 0 { -1.0 } else { 1.0 },
-            )
-        })
-        .collect();
-    SharedShape::convex_hull(&points).unwrap()
+    SharedShape::convex_hull(&box_corners(Vec3::ONE)).unwrap()
 }
 
 #[test]
@@ -84,16 +76,7 @@ fn a_box_reads_as_the_hull_of_its_corners() {
     let mut rng = rand::rngs::ChaCha20Rng::seed_from_u64(7);
     let sizes = [Vec3::new(0.5, 0.5, 0.5), Vec3::new(0.3, 0.1, 0.8)];
     let hull_of = |h: Vec3| {
-        let corners: Vec<Vec3> = (0..8)
-            .map(|k| {
-                h * Vec3::new(
-                    if k & 1 == 0 { -1.0 } else { 1.0 },
-                    if k & 2 == 0 { -1.0 } else { 1.0 },
-                    if k & 4 == 0 { -1.0 } else { 1.0 },
-                )
-            })
-            .collect();
-        Polytope::of(SharedShape::convex_hull(&corners).unwrap().as_ref()).unwrap()
+        Polytope::of(SharedShape::convex_hull(&box_corners(h)).unwrap().as_ref()).unwrap()
     };
     let (box1, box2) = (
         Polytope::of(SharedShape::cuboid(sizes[0].x, sizes[0].y, sizes[0].z).as_ref()).unwrap(),
