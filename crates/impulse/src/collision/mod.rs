@@ -13,6 +13,7 @@ pub(crate) mod deepest_vertex;
 pub(crate) mod dispatch;
 pub(crate) mod faces;
 pub(crate) mod manifold;
+pub(crate) mod manifold_record;
 pub(crate) mod margins;
 pub(crate) mod narrow_phase;
 pub(crate) mod part_pairs;

@@ -478,6 +478,8 @@ impl NarrowPhase {
 pub(crate) struct PairState {
     body1: u32,
     body2: u32,
+    /// In the snapshot's compact form ([`super::manifold_record`]).
+    #[serde(with = "super::manifold_record")]
     manifolds: Vec<Manifold>,
     /// Parry's per-pair work space (composite shapes only), which it serialises itself.
     workspace: Option<ContactManifoldsWorkspace>,

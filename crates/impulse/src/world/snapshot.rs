@@ -39,9 +39,12 @@ use crate::settings::SolverSettings;
 /// The snapshot format this build writes. Raised whenever the stored state changes shape; a
 /// snapshot of a version this build cannot read is refused ([`SnapshotError::VersionMismatch`]).
 /// Version 3 added the joints; version 4 stores each distinct shape once, with each body's
-/// index into them (a shape per body before). It reads versions 2
-/// ([`OLDEST_SNAPSHOT_FORMAT_VERSION`], as a world without joints) and 3.
-pub const SNAPSHOT_FORMAT_VERSION: u32 = 4;
+/// index into them (a shape per body before); version 5 compresses the payload (DEFLATE).
+/// It reads versions 2 ([`OLDEST_SNAPSHOT_FORMAT_VERSION`], as a world without joints) to 4.
+pub const SNAPSHOT_FORMAT_VERSION: u32 = 5;
+
+/// The first format version whose payload is compressed.
+const FIRST_COMPRESSED_VERSION: u32 = 5;
 
 /// The oldest snapshot format this build reads: version 2, the format before joints, whose
 /// payload is version 3's without the `joints` field.
@@ -61,8 +64,8 @@ const HEADER_LEN: usize = 16 + 4 + 8 + 4;
 /// takes and [`World::from_snapshot`] restores. It implements serde's `Serialize` and
 /// `Deserialize`, so any serde format can hold it; [`WorldSnapshot::to_bytes`] and
 /// [`WorldSnapshot::write_file`] use impulse's own file format (a 32-byte header with the
-/// format version and a CRC-32, then the snapshot in CBOR, RFC 8949), which stores every
-/// `f32` with its exact bits.
+/// format version and a CRC-32, then the snapshot in CBOR, RFC 8949, compressed by DEFLATE,
+/// RFC 1951), which stores every `f32` with its exact bits.
 ///
 /// A restored world steps on to the bit as the original would have, with the same build of
 /// impulse on the same kind of CPU, on any number of threads (docs/snapshots.md says what is
@@ -150,12 +153,17 @@ impl WorldSnapshot {
 
     /// The snapshot in impulse's file format: the 16-byte magic `IMPULSE-WORLD\0\0\0`, the
     /// format version (u32), the payload's length in bytes (u64) and its CRC-32 (u32, the
-    /// IEEE polynomial), all little-endian, then the payload: the snapshot in CBOR.
+    /// IEEE polynomial), all little-endian, then the payload: the snapshot in CBOR, compressed
+    /// by DEFLATE (RFC 1951, `flate2`'s default level). The checksum is of the compressed
+    /// bytes, so a damaged file is caught before anything is inflated.
     pub fn to_bytes(&self) -> Result<Vec<u8>, SnapshotError> {
         let mut bytes = Vec::with_capacity(HEADER_LEN + 64 * self.bodies.len());
         bytes.extend_from_slice(&[0; HEADER_LEN]);
-        ciborium::into_writer(self, &mut bytes)
-            .map_err(|e| SnapshotError::Decode(format!("cannot encode: {e}")))?;
+        let cannot =
+            |e: &dyn std::fmt::Display| SnapshotError::Decode(format!("cannot encode: {e}"));
+        let mut encoder = flate2::write::DeflateEncoder::new(bytes, flate2::Compression::default());
+        ciborium::into_writer(self, &mut encoder).map_err(|e| cannot(&e))?;
+        let mut bytes = encoder.finish().map_err(|e| cannot(&e))?;
         let payload = &bytes[HEADER_LEN..];
         let (length, checksum) = (payload.len() as u64, crc32fast::hash(payload));
         let mut header = Vec::with_capacity(HEADER_LEN);
@@ -218,8 +226,13 @@ impl WorldSnapshot {
                 found: checksum,
             });
         }
+        let decoded = if found >= FIRST_COMPRESSED_VERSION {
+            ciborium::from_reader(flate2::read::DeflateDecoder::new(payload))
+        } else {
+            ciborium::from_reader(payload)
+        };
         let mut snapshot: WorldSnapshot =
-            ciborium::from_reader(payload).map_err(|e| SnapshotError::Decode(e.to_string()))?;
+            decoded.map_err(|e| SnapshotError::Decode(e.to_string()))?;
         // The header's version is outside the checksum: a payload of another version than the
         // header's is a damaged header (versions 2 and 3 differ in one bit).
         if snapshot.format_version != found {

@@ -280,7 +280,7 @@ fn damaged_files_give_typed_errors() {
     newer[16] += 1;
     let message = read(&newer).to_string();
     assert!(
-        message.contains("format version 5") && message.contains("reads versions 2 to 4"),
+        message.contains("format version 6") && message.contains("reads versions 2 to 5"),
         "{message}"
     );
     let mut longer = bytes.clone();
@@ -554,7 +554,7 @@ fn a_snapshot_of_the_format_before_joints_reads_as_a_world_without_joints() {
     older[16..20].copy_from_slice(&(OLDEST_SNAPSHOT_FORMAT_VERSION - 1).to_le_bytes());
     let message = WorldSnapshot::from_bytes(&older).err().unwrap().to_string();
     assert!(
-        message.contains("format version 1") && message.contains("reads versions 2 to 4"),
+        message.contains("format version 1") && message.contains("reads versions 2 to 5"),
         "{message}"
     );
 }

@@ -1,0 +1,191 @@
+//! A pair's manifolds as a snapshot stores them: each manifold and point as a list of its
+//! values in a fixed order, without the field names that Parry's own serde form repeats for
+//! every manifold and point, and without the face-axis memory, which is derived state (the
+//! contacts do not depend on it: `axis_memory`). A mid-pour snapshot holds tens of thousands of
+//! part-pair manifolds, most of them without a point, so the names were most of its bytes.
+//!
+//! Reading takes either form, so snapshots written before this one (Parry's form, format
+//! versions 2 to 4) still read.
+
+use glam::{Quat, Vec3};
+use parry3d::math::{Pose, Real, Vector};
+use parry3d::query::TrackedContact;
+use parry3d::shape::PackedFeatureId;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use super::manifold::{ContactImpulse, Manifold, ManifoldState, RoughnessDraw};
+
+/// A pose as (rotation, translation).
+#[derive(Serialize, Deserialize)]
+struct PoseRecord(Quat, Vector);
+
+impl From<&Pose> for PoseRecord {
+    fn from(pose: &Pose) -> Self {
+        PoseRecord(pose.rotation, pose.translation)
+    }
+}
+
+impl From<PoseRecord> for Pose {
+    fn from(PoseRecord(rotation, translation): PoseRecord) -> Self {
+        Pose::from_parts(translation, rotation)
+    }
+}
+
+/// A point: `local_p1`, `local_p2`, `dist`, `fid1`, `fid2`, then its [`ContactImpulse`]
+/// (`normal`, `friction`, `step_normal`, `step_friction`).
+#[derive(Serialize, Deserialize)]
+struct PointRecord(Vector, Vector, Real, u32, u32, Real, Vec3, Real, Vec3);
+
+/// A manifold: its points, `local_n1`, `local_n2`, `subshape1`, `subshape2`, the subshapes'
+/// poses, then its [`ManifoldState`] without the face-axis memory (`tangent`, `roughness`,
+/// `impact`).
+#[derive(Serialize, Deserialize)]
+struct ManifoldRecord(
+    Vec<PointRecord>,
+    Vector,
+    Vector,
+    u32,
+    u32,
+    Option<(Option<PoseRecord>, Option<PoseRecord>)>,
+    Vec3,
+    Option<RoughnessDraw>,
+    Option<f32>,
+);
+
+impl From<&Manifold> for ManifoldRecord {
+    fn from(m: &Manifold) -> Self {
+        let points = m
+            .points
+            .iter()
+            .map(|p| {
+                let d = p.data;
+                PointRecord(
+                    p.local_p1,
+                    p.local_p2,
+                    p.dist,
+                    p.fid1.0,
+                    p.fid2.0,
+                    d.normal,
+                    d.friction,
+                    d.step_normal,
+                    d.step_friction,
+                )
+            })
+            .collect();
+        let poses = m.subshape_poses.as_ref().map(|poses| {
+            (
+                poses.pos1.as_ref().map(PoseRecord::from),
+                poses.pos2.as_ref().map(PoseRecord::from),
+            )
+        });
+        ManifoldRecord(
+            points,
+            m.local_n1,
+            m.local_n2,
+            m.subshape1,
+            m.subshape2,
+            poses,
+            m.data.tangent,
+            m.data.roughness,
+            m.data.impact,
+        )
+    }
+}
+
+impl From<ManifoldRecord> for Manifold {
+    fn from(record: ManifoldRecord) -> Self {
+        let ManifoldRecord(
+            points,
+            local_n1,
+            local_n2,
+            subshape1,
+            subshape2,
+            poses,
+            tangent,
+            roughness,
+            impact,
+        ) = record;
+        let points = points
+            .into_iter()
+            .map(
+                |PointRecord(
+                    local_p1,
+                    local_p2,
+                    dist,
+                    fid1,
+                    fid2,
+                    normal,
+                    friction,
+                    step_normal,
+                    step_friction,
+                )| {
+                    TrackedContact {
+                        local_p1,
+                        local_p2,
+                        dist,
+                        fid1: PackedFeatureId(fid1),
+                        fid2: PackedFeatureId(fid2),
+                        data: ContactImpulse {
+                            normal,
+                            friction,
+                            step_normal,
+                            step_friction,
+                        },
+                    }
+                },
+            )
+            .collect();
+        let mut manifold = Manifold {
+            points,
+            local_n1,
+            local_n2,
+            subshape1,
+            subshape2,
+            subshape_poses: None,
+            data: ManifoldState {
+                tangent,
+                roughness,
+                impact,
+                face_axes: None,
+            },
+        };
+        // Parry's `SubshapePoses` is not public: its setters build it. The first call makes
+        // the box whatever `pos1` is, so a box of two absent poses comes back as one.
+        if let Some((pos1, pos2)) = poses {
+            manifold.set_subshape_pos1(Some(Pose::IDENTITY));
+            manifold.set_subshape_pos1(pos1.map(Pose::from));
+            manifold.set_subshape_pos2(pos2.map(Pose::from));
+        }
+        manifold
+    }
+}
+
+/// A manifold in either form: this module's list, or Parry's map (format versions 2 to 4).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum EitherForm {
+    Record(ManifoldRecord),
+    Parry(Manifold),
+}
+
+/// Writes `manifolds` as [`ManifoldRecord`]s (`#[serde(with)]` of a pair's manifolds).
+pub(crate) fn serialize<S: Serializer>(
+    manifolds: &[Manifold],
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    serializer.collect_seq(manifolds.iter().map(ManifoldRecord::from))
+}
+
+/// Reads manifolds written by [`serialize`], or in Parry's form.
+pub(crate) fn deserialize<'de, D: Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Vec<Manifold>, D::Error> {
+    let manifolds = Vec::<EitherForm>::deserialize(deserializer)?;
+    Ok(manifolds
+        .into_iter()
+        .map(|m| match m {
+            EitherForm::Record(record) => record.into(),
+            EitherForm::Parry(manifold) => manifold,
+        })
+        .collect())
+}
