@@ -189,3 +189,96 @@ pub(crate) fn deserialize<'de, D: Deserializer<'de>>(
         })
         .collect())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parry3d::query::ContactManifold;
+
+    /// A pair's manifolds as `PairState` holds them.
+    #[derive(Serialize, Deserialize)]
+    struct Held(#[serde(with = "super")] Vec<Manifold>);
+
+    /// A part-pair manifold with two points, both subshape poses, a roughness draw and an impact
+    /// draw; and an empty one whose poses box holds two absent poses.
+    fn manifolds() -> Vec<Manifold> {
+        let mut full: Manifold = ContactManifold::new();
+        full.local_n1 = Vector::new(0.0, 1.0, 0.0);
+        full.local_n2 = Vector::new(0.6, -0.8, 0.0);
+        (full.subshape1, full.subshape2) = (3, 17);
+        full.set_subshape_pos1(Some(Pose::from_parts(
+            Vector::new(0.1, 0.2, 0.3),
+            Quat::from_rotation_y(0.7),
+        )));
+        full.set_subshape_pos2(Some(Pose::from_translation(Vector::new(-1.0, 0.0, 2.5))));
+        for k in 0..2 {
+            let mut point = TrackedContact::new(
+                Vector::new(k as f32, 0.5, -0.25),
+                Vector::new(0.125, k as f32 * 1e-7, 3.0),
+                PackedFeatureId::face(k),
+                PackedFeatureId::vertex(40 + k),
+                -1.5e-3 * k as f32,
+            );
+            point.data = ContactImpulse {
+                normal: 0.25 + k as f32,
+                friction: Vec3::new(1e-9, -2.0, 0.5),
+                step_normal: 3.0,
+                step_friction: Vec3::new(-0.0, 7.0, f32::MIN_POSITIVE),
+            };
+            full.points.push(point);
+        }
+        full.data = ManifoldState {
+            tangent: Vec3::new(0.0, 0.0, 1.0),
+            roughness: Some(RoughnessDraw {
+                cap: 0.3,
+                azimuth: 2.0,
+                axis: 1,
+            }),
+            impact: Some(-0.5),
+            face_axes: None,
+        };
+        let mut empty: Manifold = ContactManifold::new();
+        empty.set_subshape_pos1(Some(Pose::IDENTITY));
+        empty.set_subshape_pos1(None);
+        vec![full, empty]
+    }
+
+    /// Every value comes back with its bits, through CBOR and JSON.
+    #[test]
+    fn manifolds_come_back_to_the_bit() {
+        let original = manifolds();
+        let mut cbor = Vec::new();
+        ciborium::into_writer(&Held(original.clone()), &mut cbor).unwrap();
+        let json = serde_json::to_string(&Held(original.clone())).unwrap();
+        for Held(back) in [
+            ciborium::from_reader::<Held, _>(&cbor[..]).unwrap(),
+            serde_json::from_str::<Held>(&json).unwrap(),
+        ] {
+            assert_eq!(back.len(), original.len());
+            for (a, b) in original.iter().zip(&back) {
+                assert_eq!(format!("{a:?}"), format!("{b:?}"));
+            }
+        }
+    }
+
+    /// Parry's own form (snapshot format versions 2 to 4) still reads, and the compact form is
+    /// less than half its size.
+    #[test]
+    fn parrys_form_still_reads() {
+        let original = manifolds();
+        let mut parry = Vec::new();
+        ciborium::into_writer(&original, &mut parry).unwrap();
+        let Held(back) = ciborium::from_reader::<Held, _>(&parry[..]).unwrap();
+        for (a, b) in original.iter().zip(&back) {
+            assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        }
+        let mut compact = Vec::new();
+        ciborium::into_writer(&Held(original), &mut compact).unwrap();
+        assert!(
+            2 * compact.len() < parry.len(),
+            "{} of {}",
+            compact.len(),
+            parry.len()
+        );
+    }
+}
