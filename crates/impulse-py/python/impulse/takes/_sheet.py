@@ -11,6 +11,7 @@ import math
 import os
 import shutil
 import subprocess
+import sys
 from typing import Any
 
 import numpy as np
@@ -18,22 +19,35 @@ import numpy as np
 PREVIEWS_DIR = "previews"
 
 
-def _cli() -> str:
-    """The ``impulse`` command: ``$IMPULSE_CLI``, else on ``PATH``.
+def _cli() -> list[str]:
+    """The ``impulse`` command, as the start of an argument list: ``$IMPULSE_CLI``, else the
+    package's own (``python -m impulse._cli`` in a process of its own, so that a crash in it
+    cannot take the caller down), else ``impulse`` on ``PATH`` (an interpreter without
+    ``sys.executable``, embedded).
 
     Raises
     ------
     FileNotFoundError
-        Neither names a command.
+        ``$IMPULSE_CLI`` names no command, or none is found.
     """
-    found = os.environ.get("IMPULSE_CLI") or shutil.which("impulse")
-    if not found or not os.path.exists(found) and shutil.which(found) is None:
+    named = os.environ.get("IMPULSE_CLI")
+    if named:
+        if not os.path.exists(named) and shutil.which(named) is None:
+            raise FileNotFoundError(
+                f"IMPULSE_CLI = {named!r} names no command: unset it to draw the previews with "
+                "the package's own impulse command, or pass previews=False (--no-previews)"
+            )
+        return [named]
+    if sys.executable:
+        return [sys.executable, "-m", "impulse._cli"]
+    found = shutil.which("impulse")
+    if found is None:
         raise FileNotFoundError(
-            "the previews are drawn by the impulse command: install it (cargo install --path "
-            "crates/impulse-cli), or set IMPULSE_CLI to its path, or pass previews=False "
-            "(--no-previews)"
+            "the previews are drawn by the impulse command: this interpreter has no "
+            "sys.executable to run the package's, and none is on PATH; set IMPULSE_CLI to its "
+            "path, or pass previews=False (--no-previews)"
         )
-    return found
+    return [found]
 
 
 #: The preview cameras: ``goals`` frames the goal bodies' paths (the default), ``scene``
@@ -280,7 +294,7 @@ def sheet(
                 take.write_scene(scene)
                 preset = takes.manifest.get("preset")
                 partial = gif[: -len(".gif")] + ".partial.gif"  # renamed when whole
-                arguments = [command, "render", scene, "--gif", partial, "--steps", str(steps)]
+                arguments = [*command, "render", scene, "--gif", partial, "--steps", str(steps)]
                 arguments += ["--every", str(every), "--size", size, "--quiet"]
                 arguments += _camera_arguments(camera, take, takes, pixels)
                 if preset:
