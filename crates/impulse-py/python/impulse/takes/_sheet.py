@@ -19,11 +19,13 @@ import numpy as np
 PREVIEWS_DIR = "previews"
 
 
-def _cli() -> list[str]:
-    """The ``impulse`` command, as the start of an argument list: ``$IMPULSE_CLI``, else the
-    package's own (``python -m impulse._cli`` in a process of its own, so that a crash in it
-    cannot take the caller down), else ``impulse`` on ``PATH`` (an interpreter without
-    ``sys.executable``, embedded).
+def _cli() -> tuple[list[str], dict[str, str] | None]:
+    """The ``impulse`` command, as the start of an argument list, and the environment to run it
+    in (None: this process's): ``$IMPULSE_CLI``, else the package's own (``python -m
+    impulse._cli`` in a process of its own, so that a crash in it cannot take the caller down,
+    with the folder this package was imported from first on ``PYTHONPATH``: the child runs the
+    same package even when the caller found it by ``sys.path`` alone), else ``impulse`` on
+    ``PATH`` (an embedded interpreter without ``sys.executable``).
 
     Raises
     ------
@@ -37,9 +39,17 @@ def _cli() -> list[str]:
                 f"IMPULSE_CLI = {named!r} names no command: unset it to draw the previews with "
                 "the package's own impulse command, or pass previews=False (--no-previews)"
             )
-        return [named]
+        return [named], None
     if sys.executable:
-        return [sys.executable, "-m", "impulse._cli"]
+        import impulse
+
+        package_parent = os.path.dirname(os.path.dirname(os.path.abspath(impulse.__file__)))
+        environment = dict(os.environ)
+        search_path = environment.get("PYTHONPATH")
+        environment["PYTHONPATH"] = (
+            package_parent if not search_path else package_parent + os.pathsep + search_path
+        )
+        return [sys.executable, "-m", "impulse._cli"], environment
     found = shutil.which("impulse")
     if found is None:
         raise FileNotFoundError(
@@ -47,7 +57,7 @@ def _cli() -> list[str]:
             "sys.executable to run the package's, and none is on PATH; set IMPULSE_CLI to its "
             "path, or pass previews=False (--no-previews)"
         )
-    return [found]
+    return [found], None
 
 
 #: The preview cameras: ``goals`` frames the goal bodies' paths (the default), ``scene``
@@ -283,7 +293,7 @@ def sheet(
     steps = int(takes.manifest["steps"])
     images: dict[str, str] = {}
     if previews and chosen:
-        command = _cli()
+        command, environment = _cli()
         folder = os.path.join(root, PREVIEWS_DIR)
         os.makedirs(folder, exist_ok=True)
         key = camera if camera != "goals" else f"goals {MARGIN} {FOV_DEGREES} {VIEW_DIRECTION}"
@@ -299,7 +309,9 @@ def sheet(
                 arguments += _camera_arguments(camera, take, takes, pixels)
                 if preset:
                     arguments += ["--preset", preset]
-                done = subprocess.run(arguments, capture_output=True, text=True, check=False)
+                done = subprocess.run(
+                    arguments, capture_output=True, text=True, check=False, env=environment
+                )
                 if done.returncode != 0:
                     raise RuntimeError(
                         f"impulse render of take {take.take_id} failed: {done.stderr.strip()}"
