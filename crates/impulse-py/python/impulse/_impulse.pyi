@@ -29,6 +29,7 @@ __all__ = [
     "JointBuilder",
     "scenes",
     "set_decomposition_cache_dir",
+    "_cli_main",
     "__version__",
 ]
 
