@@ -477,7 +477,8 @@ const STOPPED_BY_SIGNAL: u8 = 130;
 /// process's life (installed once; later calls keep that handler): before a run steps, and in
 /// every other command, a signal ends the process at once with status 130; while it steps, the
 /// run stops after the step under way and writes its files, and a second signal ends the
-/// process. Without it the caller's signal handling is left alone and a run cannot be stopped.
+/// process. Without it the caller's signal handling is left alone: no run is stopped after its
+/// step.
 ///
 /// Never exits the process except through that handler. Not reentrant across threads: the
 /// settings it sets (the decomposition cache, the interrupted flag) are the process's.
@@ -520,6 +521,7 @@ fn report(summary: run::Summary, profile: bool) -> Result<u8> {
     Ok(0)
 }
 
+/// Runs the parsed command: its exit status, or the error `run_from_args` prints.
 fn run_cli(cli: Cli, handle_signals: bool) -> Result<u8> {
     run::reset_interruption();
     if handle_signals {
