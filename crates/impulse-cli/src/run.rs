@@ -248,14 +248,26 @@ static STEPPING: AtomicBool = AtomicBool::new(false);
 /// process at once with status 130 (a convex decomposition under way is not waited for:
 /// V-HACD cannot be stopped from inside, so the handler's thread exits the process), or set
 /// [`INTERRUPTED`] once a run steps; a second signal then ends the process at once.
+/// Installed once per process: a second call (the command run again in the same process, from
+/// Python) keeps the handler in place.
 pub fn install_signal_handler() -> Result<()> {
-    ctrlc::set_handler(|| {
+    let installed = ctrlc::set_handler(|| {
         if !STEPPING.load(Ordering::SeqCst) || INTERRUPTED.swap(true, Ordering::SeqCst) {
             eprintln!("impulse: interrupted");
             std::process::exit(130);
         }
-    })
-    .context("cannot install the Ctrl-C handler")
+    });
+    match installed {
+        Err(ctrlc::Error::MultipleHandlers) => Ok(()),
+        other => other.context("cannot install the Ctrl-C handler"),
+    }
+}
+
+/// Clears [`INTERRUPTED`] and the stepping flag before a command: one stopped run does not
+/// stop the next one run in the same process.
+pub fn reset_interruption() {
+    STEPPING.store(false, Ordering::SeqCst);
+    INTERRUPTED.store(false, Ordering::SeqCst);
 }
 
 /// From now on a signal stops the run after the step under way ([`INTERRUPTED`]).

@@ -2,14 +2,17 @@
 //! shapes, body builders, joints and the exceptions, with the state of every body as NumPy arrays.
 //!
 //! The Python package (`python/impulse/`) re-exports these classes and adds trajectories
-//! (`Trajectory`, `load_trajectory`) on top. Every entry point catches Rust panics and turns
-//! engine errors into the package's exceptions, so no input crashes the interpreter; each
-//! world is locked for the length of a call (`lock`), so threads sharing one take turns.
+//! (`Trajectory`, `load_trajectory`) on top; `cli` runs the `impulse` command for the
+//! package's console script. Every entry point catches Rust panics and turns engine errors into
+//! the package's exceptions (the command: its exit status), so no input crashes the
+//! interpreter; each world is locked for the length of a call (`lock`), so threads sharing one
+//! take turns.
 
 use pyo3::prelude::*;
 
 mod arrays;
 mod builder;
+mod cli;
 mod contacts;
 mod errors;
 mod handle;
@@ -56,6 +59,7 @@ fn _impulse(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<joints::JointBuilder>()?;
     m.add_function(wrap_pyfunction!(scenes, m)?)?;
     m.add_function(wrap_pyfunction!(set_decomposition_cache_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(cli::_cli_main, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

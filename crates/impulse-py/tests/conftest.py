@@ -3,6 +3,7 @@
 import os
 import pathlib
 import shutil
+import sysconfig
 
 import pytest
 
@@ -16,7 +17,8 @@ def repository() -> pathlib.Path:
 
 @pytest.fixture(scope="session")
 def impulse_cli() -> str:
-    """The `impulse` command: $IMPULSE_CLI, else the repository's release build, else PATH.
+    """The `impulse` command: $IMPULSE_CLI, else the repository's release build, else PATH,
+    else the package's console script (installed by pip beside the interpreter).
 
     Missing, the tests that need it are skipped, unless IMPULSE_REQUIRE_CLI=1 (as in CI),
     where they fail.
@@ -25,6 +27,7 @@ def impulse_cli() -> str:
         os.environ.get("IMPULSE_CLI"),
         str(REPOSITORY / "target" / "release" / "impulse"),
         shutil.which("impulse"),
+        os.path.join(sysconfig.get_path("scripts"), "impulse"),
     ]
     for candidate in candidates:
         if candidate and os.path.isfile(candidate) and os.access(candidate, os.X_OK):

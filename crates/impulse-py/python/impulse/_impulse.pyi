@@ -29,6 +29,7 @@ __all__ = [
     "JointBuilder",
     "scenes",
     "set_decomposition_cache_dir",
+    "_cli_main",
     "__version__",
 ]
 
@@ -50,6 +51,11 @@ def scenes() -> list[str]:
 
 def set_decomposition_cache_dir(directory: str | os.PathLike[str] | None) -> None:
     """Keep moving meshes' convex decompositions in ``directory`` across processes (None: memory only)."""
+
+def _cli_main(argv: list[str], *, signals: bool = False) -> int:
+    """Run the ``impulse`` command on ``argv`` (program name first) without the GIL; its exit
+    status (101: a panic, caught). ``signals=True`` hands Ctrl-C, SIGTERM and SIGHUP to the
+    command for the rest of the process (the console script ``impulse._cli``)."""
 
 @final
 class Settings:

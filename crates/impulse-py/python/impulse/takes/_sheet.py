@@ -11,6 +11,7 @@ import math
 import os
 import shutil
 import subprocess
+import sys
 from typing import Any
 
 import numpy as np
@@ -18,22 +19,45 @@ import numpy as np
 PREVIEWS_DIR = "previews"
 
 
-def _cli() -> str:
-    """The ``impulse`` command: ``$IMPULSE_CLI``, else on ``PATH``.
+def _cli() -> tuple[list[str], dict[str, str] | None]:
+    """The ``impulse`` command, as the start of an argument list, and the environment to run it
+    in (None: this process's): ``$IMPULSE_CLI``, else the package's own (``python -m
+    impulse._cli`` in a process of its own, so that a crash in it cannot take the caller down,
+    with the folder this package was imported from first on ``PYTHONPATH``: the child runs the
+    same package even when the caller found it by ``sys.path`` alone), else ``impulse`` on
+    ``PATH`` (an embedded interpreter without ``sys.executable``).
 
     Raises
     ------
     FileNotFoundError
-        Neither names a command.
+        ``$IMPULSE_CLI`` names no command, or none is found.
     """
-    found = os.environ.get("IMPULSE_CLI") or shutil.which("impulse")
-    if not found or not os.path.exists(found) and shutil.which(found) is None:
-        raise FileNotFoundError(
-            "the previews are drawn by the impulse command: install it (cargo install --path "
-            "crates/impulse-cli), or set IMPULSE_CLI to its path, or pass previews=False "
-            "(--no-previews)"
+    named = os.environ.get("IMPULSE_CLI")
+    if named:
+        if not os.path.exists(named) and shutil.which(named) is None:
+            raise FileNotFoundError(
+                f"IMPULSE_CLI = {named!r} names no command: unset it to draw the previews with "
+                "the package's own impulse command, or pass previews=False (--no-previews)"
+            )
+        return [named], None
+    if sys.executable:
+        import impulse
+
+        package_parent = os.path.dirname(os.path.dirname(os.path.abspath(impulse.__file__)))
+        environment = dict(os.environ)
+        search_path = environment.get("PYTHONPATH")
+        environment["PYTHONPATH"] = (
+            package_parent if not search_path else package_parent + os.pathsep + search_path
         )
-    return found
+        return [sys.executable, "-m", "impulse._cli"], environment
+    found = shutil.which("impulse")
+    if found is None:
+        raise FileNotFoundError(
+            "the previews are drawn by the impulse command: this interpreter has no "
+            "sys.executable to run the package's, and none is on PATH; set IMPULSE_CLI to its "
+            "path, or pass previews=False (--no-previews)"
+        )
+    return [found], None
 
 
 #: The preview cameras: ``goals`` frames the goal bodies' paths (the default), ``scene``
@@ -269,7 +293,7 @@ def sheet(
     steps = int(takes.manifest["steps"])
     images: dict[str, str] = {}
     if previews and chosen:
-        command = _cli()
+        command, environment = _cli()
         folder = os.path.join(root, PREVIEWS_DIR)
         os.makedirs(folder, exist_ok=True)
         key = camera if camera != "goals" else f"goals {MARGIN} {FOV_DEGREES} {VIEW_DIRECTION}"
@@ -280,12 +304,14 @@ def sheet(
                 take.write_scene(scene)
                 preset = takes.manifest.get("preset")
                 partial = gif[: -len(".gif")] + ".partial.gif"  # renamed when whole
-                arguments = [command, "render", scene, "--gif", partial, "--steps", str(steps)]
+                arguments = [*command, "render", scene, "--gif", partial, "--steps", str(steps)]
                 arguments += ["--every", str(every), "--size", size, "--quiet"]
                 arguments += _camera_arguments(camera, take, takes, pixels)
                 if preset:
                     arguments += ["--preset", preset]
-                done = subprocess.run(arguments, capture_output=True, text=True, check=False)
+                done = subprocess.run(
+                    arguments, capture_output=True, text=True, check=False, env=environment
+                )
                 if done.returncode != 0:
                     raise RuntimeError(
                         f"impulse render of take {take.take_id} failed: {done.stderr.strip()}"
