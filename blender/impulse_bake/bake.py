@@ -143,6 +143,9 @@ class Baker:
         self.switching = [i for i in self.keyed if bodies[i].animated is not None]
         self.kinematic_now = {i: bodies[i].kind == "kinematic" for i in self.switching}
         self.driven = set()
+        # The channels as the animator set them, recorded on the keyed objects by write(): a
+        # subclass may key another start (a take's), and Free puts these back.
+        self.authored = {i: bodies[i].start for i in self.keyed}
         self._rows()
         self.positions = [self.world.positions[self.rows].copy()]
         self.orientations = [self.world.orientations[self.rows].copy()]
@@ -258,7 +261,9 @@ class Baker:
         object's rotation mode, in its parent's space, whole F-curves in the group
         :data:`keyframes.GROUP`), replacing an earlier bake, remove an earlier bake from the
         objects this one does not key, and turn Blender's own rigid body world off so that the
-        keyframes are what plays. Returns the number of keyed objects."""
+        keyframes are what plays. Each keyed object records its own start channels as the
+        animator set them (:func:`keyframes.remember_start`), which Free puts back. Returns
+        the number of keyed objects."""
         start = time.perf_counter()
         frames = np.arange(self.frames_done, dtype=np.float32) + self.info.frame_start
         locations = axes.positions_to_blender(np.stack(self.positions))
@@ -271,6 +276,7 @@ class Baker:
             keyed_names.add(obj.name)
             location, rotation = _object_space(info, locations[:, column], quaternions[:, column])
             keyframes.write_fcurves(obj, frames, location, rotation, info.start)
+            keyframes.remember_start(obj, self.authored[index])
         for obj in scene_reader.rigid_body_objects(self.scene):
             if obj.name not in keyed_names and keyframes.is_baked(obj):
                 keyframes.free_bake(obj, self.info.frame_start)
@@ -323,7 +329,8 @@ def bake_scene(scene, preset="default", substeps=0, frame_steps=0, materials="bl
 
 def free_bake(scene):
     """Remove impulse's bake from every object of the scene's Rigid Body World (each object
-    back at its pose at the start frame, an animated object's own animation back) and tick the
+    back at the start pose the animator set, also after a take's bake, which starts elsewhere;
+    an animated object's own animation back) and tick the
     Rigid Body World again, so that Blender's own simulation plays. Returns the number of
     objects freed."""
     objects = scene_reader.rigid_body_objects(scene)

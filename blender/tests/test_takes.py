@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from impulse_bake import axes, bake, keyframes, scene_reader
 from impulse_bake import takes as takes_logic
+import field
 import scenes
 from addon import load_addon
 
@@ -306,3 +307,81 @@ def test_die_searches_over_seeds(tmp_path):
         assert met, f"seed {seed}: no take met the goal in {len(rows)} takes"
         firsts.append(min(met))
     print(f"takes to the first +Z-up die, seeds 0-4: {firsts}, median {sorted(firsts)[2]}")
+
+
+def _animator_die_scene(ground="plane"):
+    """The die shot as an animator makes it: the factory startup file, the default cube
+    deleted, a 0.2 m cube added tipped 0.6 m up and a ground added from the Add menu (a Plane,
+    or a cube slab), each given Physics › Rigid Body with its default shape (Convex Hull); the
+    die's +Z face up as the goal, the search's settings on the panel."""
+    scene = field.startup(FRAMES)
+    die = field.add("cube", "Die", size=0.2, location=(0.0, 0.0, 0.6), rotation=(0.4, 0.3, 0.0))
+    field.rigid(die)
+    if ground == "plane":
+        field.rigid(field.add("plane", "Ground", size=10.0), "PASSIVE")
+    else:
+        field.ground()
+    die.impulse_takes.face_up = "POS_Z"
+    settings = scene.impulse_takes
+    settings.position, settings.angle, settings.velocity, settings.angular_velocity = 0.0, 90.0, 1.0, 8.0
+    settings.budget, settings.population, settings.stop_after, settings.workers = 16, 16, 16, 2
+    scene.impulse_bake.preset = "fast"
+    return scene, die
+
+
+def _shown(obj):
+    """What the viewport shows of ``obj``: its location and rotation channels, and its world
+    matrix rounded to 1e-6 (the operator that added it set the matrix, Blender's evaluation
+    of the channels may differ in the last bit)."""
+    return (
+        tuple(obj.location),
+        tuple(obj.rotation_euler),
+        tuple(obj.rotation_quaternion),
+        [tuple(round(v, 6) + 0.0 for v in row) for row in obj.matrix_world],
+    )
+
+
+def test_free_after_bake_take_puts_back_the_pose_the_animator_set(tmp_path, monkeypatch):
+    scene, die = _animator_die_scene()
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    authored = _shown(die)
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    settings = scene.impulse_takes
+    first, second = settings.takes[0].take_id, settings.takes[1].take_id
+
+    assert bpy.ops.impulse.bake_take(take_id=first) == {"FINISHED"}
+    scene.frame_set(1)
+    varied = _shown(die)
+    assert varied[1] != authored[1], "the take starts tipped otherwise than the animator set"
+    # Another take baked over it is still a take of the same scene (not refused as changed).
+    assert bpy.ops.impulse.bake_take(take_id=second) == {"FINISHED"}
+    scene.frame_set(1)
+    assert _shown(die) != varied
+
+    scene.frame_set(30)
+    assert bpy.ops.impulse.free_bake() == {"FINISHED"}
+    assert _shown(die) == authored
+    scene.frame_set(1)
+    assert _shown(die) == authored
+    assert scene.rigidbody_world.enabled
+    assert not keyframes.is_baked(die) and keyframes.AUTHORED not in die
+
+
+def test_bake_with_impulse_after_a_take_starts_from_the_pose_the_animator_set(tmp_path, monkeypatch):
+    scene, die = _animator_die_scene()
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    authored = _shown(die)
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    assert bpy.ops.impulse.bake_take() == {"FINISHED"}
+    scene.frame_set(1)
+    assert _shown(die) != authored
+    assert bpy.ops.impulse.bake() == {"FINISHED"}
+    scene.frame_set(1)
+    assert _shown(die) == authored
+    # A baked die moved in the viewport at the start frame starts where it was put.
+    die.location.x += 0.5
+    bpy.context.view_layer.update()
+    info = scene_reader.read_scene(scene)
+    assert info.scene["bodies"][[b.object_name for b in info.bodies].index("Die")]["position"][0] == pytest.approx(
+        authored[0][0] + 0.5
+    )
