@@ -13,6 +13,7 @@ or :func:`bake_scene` for all of it at once.
 
 import math
 import time
+import warnings
 
 import numpy as np
 
@@ -130,7 +131,11 @@ class Baker:
         impulse = import_impulse()
         self.impulse = impulse
         try:
-            self.world, self.frame_steps = make_world(self.info.scene, preset, substeps, frame_steps)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", UserWarning)
+                self.world, self.frame_steps = make_world(self.info.scene, preset, substeps, frame_steps)
+            # The engine's notes (none for what the reader writes today) in the panel's terms.
+            self.info.notes += [messages.translate(str(w.message), self.info) for w in caught]
         except impulse.SceneError as error:
 
             def build(scene_dict):

@@ -133,31 +133,36 @@ def remove_baked_fcurves(obj):
 
 
 def remember_start(obj, start):
-    """Record ``start`` (:func:`start_values`: the object's own channels at the start frame,
-    read before the bake) on the baked object as :data:`AUTHORED`."""
-    obj[AUTHORED] = {path: [float(v) for v in values] for path, values in start.items()}
+    """Record on the object its bake has just keyed: ``start`` (:func:`start_values`: its own
+    channels at the start frame as read before the bake) and the bake's first keys, as
+    :data:`AUTHORED`."""
+    keyed = {}
+    for fcurve in baked_fcurves(obj):
+        keyed.setdefault(fcurve.data_path, {})[fcurve.array_index] = float(fcurve.keyframe_points[0].co[1])
+    obj[AUTHORED] = {
+        "channels": {path: [float(v) for v in values] for path, values in start.items()},
+        "keyed": {path: [values[i] for i in sorted(values)] for path, values in keyed.items()},
+    }
 
 
 def _authored(obj):
     stored = obj.get(AUTHORED)
-    if stored is None:
+    if stored is None or "channels" not in stored:
         return None
-    return {path: tuple(stored[path]) for path, _ in TRANSFORM_CHANNELS if path in stored}
+    return {path: tuple(stored["channels"][path]) for path, _ in TRANSFORM_CHANNELS if path in stored["channels"]}
 
 
-def authored_start(obj, frame):
+def authored_start(obj):
     """The object's channels as the animator set them (data path → values) when it carries a
-    bake recorded by :func:`remember_start` and shows that bake's pose at ``frame`` unchanged
-    (every baked curve's value there equals its channel); None otherwise, so that a baked
-    object moved in the viewport keeps where it was put."""
+    bake recorded by :func:`remember_start` and shows that bake's first keys unchanged; None
+    otherwise, so that an edit (moved in the viewport, or keyed into the bake's curves) counts."""
     authored = _authored(obj)
-    curves = baked_fcurves(obj)
-    if authored is None or not curves:
+    if authored is None or not baked_fcurves(obj):
         return None
-    for fcurve in curves:
-        shown = float(getattr(obj, fcurve.data_path)[fcurve.array_index])
+    for path, values in obj[AUTHORED].get("keyed", {}).items():
+        shown = getattr(obj, path)
         # Channels are float32, as the keys: the same value to float32 rounding.
-        if abs(shown - fcurve.evaluate(frame)) > 1e-6 * max(1.0, abs(shown)):
+        if any(abs(float(shown[i]) - v) > 1e-6 * max(1.0, abs(v)) for i, v in enumerate(values)):
             return None
     return authored
 

@@ -247,7 +247,7 @@ def read_scene(scene, depsgraph=None, materials="blender", resolution=0):
         # A baked object showing its bake's start unchanged starts where the animator set it:
         # a take's bake keys the take's varied start, which is not the scene's.
         for obj in objects:
-            authored = keyframes.authored_start(obj, frame_start)
+            authored = keyframes.authored_start(obj)
             if authored is not None:
                 for path, values in authored.items():
                     setattr(obj, path, values)

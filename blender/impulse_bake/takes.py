@@ -18,6 +18,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import warnings
 
 import numpy as np
 
@@ -367,7 +368,10 @@ class TakeBaker(bake.Baker):
         # (bake.Baker keys those at the first frame to keep an unchanged re-bake's bits).
         for index in takes.variation.body_indices(takes.base_scene):
             self.info.bodies[index].start = None
-        self.world = self.impulse.World.from_scene(take.scene())
+        with warnings.catch_warnings():
+            # The engine's notes on the scene were the bake's own (bake.Baker), said once.
+            warnings.simplefilter("ignore", UserWarning)
+            self.world = self.impulse.World.from_scene(take.scene())
         self.handles = [self.world.handle_of(i) for i in range(len(self.info.bodies))]
         self._rows()
         self.positions = [self.world.positions[self.rows].copy()]
