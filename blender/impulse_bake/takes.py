@@ -307,6 +307,8 @@ class SearchJob:
             return pq.read_metadata(path).num_rows
         except (OSError, ValueError):
             return 0  # being replaced this instant
+        except ImportError:
+            return 0  # no working pyarrow here: the child fails the same way, and says so
 
     def running(self):
         return self.process.poll() is None
@@ -325,20 +327,58 @@ class SearchJob:
             self.process.wait()
         self._log.close()
 
+    def failure(self):
+        """Why the ended child failed, in one line, or None when it ran its search: exit code
+        0 (a take meets every goal) or 1 (none does) with its table written and no Python
+        traceback in ``search.log`` (an uncaught exception also exits 1). The line is the
+        child's last message (``error: …`` or the exception), with what to install when it is
+        pyarrow failing with Blender's NumPy."""
+        code = self.process.returncode
+        if code is None or self.cancelled:
+            return None
+        try:
+            with open(os.path.join(self.directory, LOG_FILE), encoding="utf-8", errors="replace") as file:
+                log = file.read()
+        except OSError:
+            log = ""
+        crashed = "Traceback (most recent call last)" in log
+        if code in (0, 1) and not crashed and os.path.exists(os.path.join(self.directory, "takes.parquet")):
+            return None
+        lines = [line.strip() for line in log.splitlines() if line.strip()]
+        errors = [line for line in lines if line.startswith("error: ")]
+        message = errors[-1][len("error: "):] if errors and not crashed else (lines[-1] if lines else "no message")
+        message = f"the search failed (exit code {code}): {message}"
+        if "numpy" in message.lower():
+            message += "; " + pyarrow_advice()
+        return f"{message} (search.log in {self.directory})"
+
     def finish(self):
         """The ``impulse.takes.Takes`` of the ended (or cancelled) search. Raises RuntimeError
-        with the child's last message when it failed (exit code 2 or a crash), FileNotFoundError
-        when it was cancelled before any take was written."""
+        with :meth:`failure` when the child failed (an error, an exception, a crash) or when
+        pyarrow cannot be imported here to read the table, FileNotFoundError when it was
+        cancelled before any take was written."""
         self._log.close()
-        code = self.process.returncode
-        if code not in (0, 1) and not self.cancelled:
-            with open(os.path.join(self.directory, LOG_FILE), encoding="utf-8", errors="replace") as file:
-                lines = [line.strip() for line in file if line.strip()]
-            message = lines[-1] if lines else f"exit code {code}"
-            raise RuntimeError(f"the search failed: {message}")
+        failure = self.failure()
+        if failure is not None:
+            raise RuntimeError(failure)
         from impulse.takes import load
 
-        return load(self.directory)
+        try:
+            return load(self.directory)
+        except ImportError as error:  # pyarrow missing or failing here, though the child ran
+            raise RuntimeError(f"cannot read the takes in {self.directory}: {error}; {pyarrow_advice()}") from error
+
+
+def pyarrow_advice():
+    """What to install for the search's table in this Python: pyarrow 19 and later need NumPy
+    2, and Blender 5.0 ships NumPy 1.26, with which pyarrow 18 works."""
+    import numpy
+
+    wanted = "'pyarrow<19'" if int(numpy.__version__.split(".")[0]) < 2 else "--upgrade pyarrow"
+    return (
+        f"install a pyarrow for this Python's NumPy {numpy.__version__}: "
+        f"{python_executable()} -m pip install {wanted}"
+    )
 
 
 class TakeBaker(bake.Baker):

@@ -385,3 +385,47 @@ def test_bake_with_impulse_after_a_take_starts_from_the_pose_the_animator_set(tm
     assert info.scene["bodies"][[b.object_name for b in info.bodies].index("Die")]["position"][0] == pytest.approx(
         authored[0][0] + 0.5
     )
+
+
+def test_a_search_whose_pyarrow_needs_another_numpy_says_so_in_the_panel(tmp_path, monkeypatch):
+    """Blender's Python with a pyarrow built for NumPy 2 (``pip install pyarrow`` into Blender
+    5.0, whose NumPy is 1.26): the search child fails importing it. The panel says that, and
+    what to install, not that the directory holds no takes."""
+    scene, _ = _animator_die_scene()
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    # pyarrow 26's own refusal, from a package that shadows the installed one in the child only.
+    broken = tmp_path / "site" / "pyarrow"
+    broken.mkdir(parents=True)
+    (broken / "__init__.py").write_text('raise ImportError("pyarrow requires NumPy 2.0 or newer, found 1.26.4")\n')
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path / "site"))
+    settings = scene.impulse_takes
+    with pytest.raises(RuntimeError, match="pyarrow requires NumPy 2.0 or newer"):
+        bpy.ops.impulse.takes_search()
+    note = settings.search_note
+    assert note.startswith("the search failed (exit code 1): ImportError: pyarrow requires NumPy 2.0 or newer")
+    assert "-m pip install 'pyarrow<19'" in note and sys.executable in note
+    assert "not a takes search directory" not in note
+    assert len(settings.takes) == 0
+
+    monkeypatch.delenv("PYTHONPATH")
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    assert settings.search_note == "" and len(settings.takes) > 0
+    # The child ran, but this process cannot import pyarrow to read its table.
+    monkeypatch.setitem(sys.modules, "pyarrow.parquet", None)
+    with pytest.raises(RuntimeError, match="cannot read the takes in .*pip install 'pyarrow<19'"):
+        bpy.ops.impulse.takes_search()
+    assert settings.search_note.startswith("cannot read the takes in ")
+
+
+def test_a_search_that_fails_says_the_childs_error_in_the_panel(tmp_path, monkeypatch):
+    """A child that stops with its own error (exit code 2) is shown by that error."""
+    scene, _ = _animator_die_scene()
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    scene.impulse_takes.population = 2
+    request = takes_logic.build_request(scene, {"position": 0.0, "angle": 90.0, "velocity": 1.0, "angular_velocity": 8.0})
+    request["goals"][0]["body"] = "Dice"
+    job = takes_logic.SearchJob(str(tmp_path / "search"), request, budget=4, workers=1)
+    with pytest.raises(RuntimeError) as failed:
+        job.wait()
+    assert str(failed.value).startswith("the search failed (exit code 2): ")
+    assert "Dice" in str(failed.value)
