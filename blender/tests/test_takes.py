@@ -393,10 +393,13 @@ def test_a_search_whose_pyarrow_needs_another_numpy_says_so_in_the_panel(tmp_pat
     what to install, not that the directory holds no takes."""
     scene, _ = _animator_die_scene()
     monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
-    # pyarrow 26's own refusal, from a package that shadows the installed one in the child only.
-    broken = tmp_path / "site" / "pyarrow"
+    # pyarrow 26's own refusal, from a package that shadows the installed one in the child
+    # only: its sitecustomize puts the shadow first, before the directory impulse came from.
+    broken = tmp_path / "shadow" / "pyarrow"
     broken.mkdir(parents=True)
     (broken / "__init__.py").write_text('raise ImportError("pyarrow requires NumPy 2.0 or newer, found 1.26.4")\n')
+    (tmp_path / "site").mkdir()
+    (tmp_path / "site" / "sitecustomize.py").write_text(f"import sys\nsys.path.insert(0, {str(broken.parent)!r})\n")
     monkeypatch.setenv("PYTHONPATH", str(tmp_path / "site"))
     settings = scene.impulse_takes
     with pytest.raises(RuntimeError, match="pyarrow requires NumPy 2.0 or newer"):
