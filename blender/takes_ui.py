@@ -172,6 +172,7 @@ def _draw_previews(settings, found, wait):
     _preview_job = takes_logic.PreviewJob(found, [item.take_id for item in settings.takes], command)
     if wait:
         _preview_job.wait()
+        settings.previews_note = _preview_job.problem()
     elif not bpy.app.timers.is_registered(_redraw_while_drawing):
         bpy.app.timers.register(_redraw_while_drawing, first_interval=POLL_SECONDS)
     return _preview_job
@@ -179,12 +180,24 @@ def _draw_previews(settings, found, wait):
 
 def _redraw_while_drawing():
     """Timer: redraws the Properties editors while stills are being drawn, so each appears
-    when it is ready; ends with the job."""
+    when it is ready; ends with the job, noting on the scenes listing its takes why stills
+    are missing, if any are."""
+    job = _preview_job
+    running = job is not None and job.running()
+    if job is not None and not running:
+        for scene in bpy.data.scenes:
+            settings = getattr(scene, "impulse_takes", None)
+            if settings is not None and _same_path(settings.directory, job.directory):
+                settings.previews_note = job.problem()
     for window in getattr(bpy.context.window_manager, "windows", ()):
         for area in window.screen.areas:
             if area.type == "PROPERTIES":
                 area.tag_redraw()
-    return POLL_SECONDS if _preview_job is not None and _preview_job.running() else None
+    return POLL_SECONDS if running else None
+
+
+def _same_path(a, b):
+    return bool(a) and os.path.realpath(bpy.path.abspath(a)) == os.path.realpath(b)
 
 
 def preview(directory, take_id):
@@ -405,7 +418,7 @@ class SCENE_PT_impulse_takes(bpy.types.Panel):
         layout.template_list("IMPULSE_UL_takes", "", settings, "takes", settings, "active", rows=4)
         if settings.previews_note:
             _wrapped(layout.column(align=True), settings.previews_note, "INFO")
-        elif 0 <= settings.active < len(settings.takes):
+        if 0 <= settings.active < len(settings.takes):
             # Blender's UI draws no GIF animation: the chosen take's still is its last frame.
             icon = preview_icon(settings.directory, settings.takes[settings.active].take_id)
             if icon:

@@ -25,10 +25,42 @@ PRESETS = ("fast", "default", "precise")
 
 def import_impulse():
     """The ``impulse`` package: the extension's bundled wheel (Blender installs it), or the
-    copy a plain add-on unpacked beside itself."""
+    copy a plain add-on unpacked beside itself. The first call in a session points impulse's
+    decomposition cache at :func:`decomposition_cache_directory`, so that a moving Mesh shape
+    split into convex parts once is read back in later sessions."""
     import impulse
 
+    global _cache_set
+    if not _cache_set:
+        _cache_set = True
+        try:
+            impulse.set_decomposition_cache_dir(decomposition_cache_directory())
+        except (OSError, ValueError, RuntimeError, ImportError):
+            pass  # without a cache the split is only redone: time, not correctness
     return impulse
+
+
+#: Whether :func:`import_impulse` has set the decomposition cache of this session.
+_cache_set = False
+
+#: The cache's folder in the add-on's user directory.
+CACHE_FOLDER = "decompositions"
+
+
+def decomposition_cache_directory():
+    """The directory where impulse keeps the convex parts of moving Mesh shapes between
+    sessions (one file per mesh and Mesh Detail; made when the first is written): the
+    extension's user directory (``bpy.utils.extension_path_user``, kept when the extension is
+    updated), or for the plain add-on Blender's user data files (``impulse/decompositions``
+    under ``bpy.utils.user_resource("DATAFILES")``)."""
+    import os
+
+    import bpy
+
+    package = __package__.rpartition(".")[0]  # the add-on's package, this one's parent
+    if package.startswith("bl_ext."):
+        return bpy.utils.extension_path_user(package, path=CACHE_FOLDER)
+    return bpy.utils.user_resource("DATAFILES", path=os.path.join("impulse", CACHE_FOLDER))
 
 
 #: The step the presets were tuned at (s): 60 steps a second (docs/solvers.md).

@@ -460,7 +460,8 @@ class PreviewJob:
     and its last frame moved to :func:`preview_path` whole (``os.replace``), so a reader never
     sees half a file. Takes whose still exists are not drawn again. ``command`` is the
     ``impulse`` command (:func:`impulse_command`); a failed render is kept in ``errors``
-    (take id → message) and the others go on.
+    (take id → message, bodies named as in Blender) and the others go on; ``count`` is the
+    number of stills it draws.
     """
 
     def __init__(self, takes, take_ids, command, size=PREVIEW_SIZE):
@@ -477,6 +478,7 @@ class PreviewJob:
             for take_id in take_ids
             if takes[take_id].status == "completed" and not os.path.exists(preview_path(self.directory, take_id))
         ]
+        self.count = len(self._todo)
         os.makedirs(os.path.join(self.directory, PREVIEWS_DIR), exist_ok=True)
         self._thread = threading.Thread(target=self._draw_all, name="impulse take previews", daemon=True)
         self._thread.start()
@@ -492,6 +494,7 @@ class PreviewJob:
         folder = os.path.join(self.directory, PREVIEWS_DIR)
         scene = os.path.join(folder, f"{take.take_id}.json")
         take.write_scene(scene)
+        names = [body.get("name") for body in take.scene()["bodies"]]
         with tempfile.TemporaryDirectory(dir=folder) as frames:
             arguments = [self.command, "render", scene, "--out", frames, "--steps", str(self.steps)]
             arguments += ["--every", str(max(self.steps, 1)), "--size", "{}x{}".format(*self.size), "--quiet"]
@@ -499,13 +502,33 @@ class PreviewJob:
                 arguments += ["--preset", self.preset]
             done = subprocess.run(arguments, capture_output=True, text=True, check=False)
             if done.returncode != 0:
-                raise RuntimeError(f"impulse render of take {take.take_id} failed: {done.stderr.strip()}")
+                said = done.stderr.strip().removeprefix("error: ") or f"exit code {done.returncode}"
+                raise RuntimeError(f"impulse render of take {take.take_id} failed: {_named_bodies(said, names)}")
             os.replace(os.path.join(frames, f"frame_{self.steps:05d}.png"), preview_path(self.directory, take.take_id))
 
     def running(self):
         return self._thread.is_alive()
 
+    def problem(self):
+        """Why stills are missing, for the panel: the number not drawn and the first reason;
+        empty when every still was drawn (or while none failed yet)."""
+        errors = dict(self.errors)
+        if not errors:
+            return ""
+        return f"No still for {len(errors)} of {self.count} takes: {next(iter(errors.values()))}"
+
     def wait(self):
         """Blocks until every still is drawn (or failed); returns ``errors``."""
         self._thread.join()
         return self.errors
+
+
+def _named_bodies(message, names):
+    """``message`` with the engine's ``body N`` named by the body's object name, where it has one."""
+    import re
+
+    def name(found):
+        index = int(found.group(1))
+        return f'body "{names[index]}"' if index < len(names) and names[index] else found.group(0)
+
+    return re.sub(r"\bbody (\d+)", name, message)

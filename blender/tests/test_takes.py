@@ -432,3 +432,20 @@ def test_a_search_that_fails_says_the_childs_error_in_the_panel(tmp_path, monkey
         job.wait()
     assert str(failed.value).startswith("the search failed (exit code 2): ")
     assert "Dice" in str(failed.value)
+
+
+def test_a_still_that_cannot_be_drawn_is_explained_in_the_panel(tmp_path, monkeypatch):
+    """``impulse render`` refusing a take's scene: the panel says how many stills are missing
+    and why, the engine's body index as the object's name."""
+    scene, _ = _animator_die_scene()
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    refusing = tmp_path / "impulse"
+    refusing.write_text("#!/bin/sh\necho 'error: cannot draw body 1: the convex hull of 8 points has no volume' >&2\nexit 2\n")
+    refusing.chmod(0o755)
+    monkeypatch.setenv("IMPULSE_CLI", str(refusing))
+    settings = scene.impulse_takes
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    listed = len(settings.takes)
+    assert listed > 1
+    assert settings.previews_note.startswith(f"No still for {listed} of {listed} takes: impulse render of take ")
+    assert settings.previews_note.endswith(' failed: cannot draw body "Ground": the convex hull of 8 points has no volume')
