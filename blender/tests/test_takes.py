@@ -434,6 +434,34 @@ def test_a_search_that_fails_says_the_childs_error_in_the_panel(tmp_path, monkey
     assert "Dice" in str(failed.value)
 
 
+def test_a_plane_grounds_takes_have_stills_with_the_plane_drawn(tmp_path, monkeypatch, impulse_cli):
+    """The die on a Plane ground (the tutorial's ground): every listed take has its still, and
+    the Plane is in it (the take's first frame differs from the same frame without it)."""
+    scene, _ = _animator_die_scene()
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+    monkeypatch.setenv("IMPULSE_CLI", impulse_cli)
+    settings = scene.impulse_takes
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    assert settings.previews_note == ""
+    assert len(settings.takes) > 1
+    for item in settings.takes:
+        assert os.path.getsize(takes_logic.preview_path(settings.directory, item.take_id)) > 0
+    import json
+
+    from impulse.takes import load
+
+    take = load(settings.directory)[settings.takes[0].take_id]
+    with_plane = tmp_path / "with.json"
+    take.write_scene(str(with_plane))
+    written = json.loads(with_plane.read_text())
+    written["bodies"] = [body for body in written["bodies"] if body.get("name") != "Ground"]
+    without_plane = tmp_path / "without.json"
+    without_plane.write_text(json.dumps(written))
+    first_with, _ = _render_frames(impulse_cli, str(with_plane), 1, tmp_path / "with")
+    first_without, _ = _render_frames(impulse_cli, str(without_plane), 1, tmp_path / "without")
+    assert first_with != first_without
+
+
 def test_a_still_that_cannot_be_drawn_is_explained_in_the_panel(tmp_path, monkeypatch):
     """``impulse render`` refusing a take's scene: the panel says how many stills are missing
     and why, the engine's body index as the object's name."""
