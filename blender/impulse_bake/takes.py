@@ -6,7 +6,9 @@ The searched scene is the baked one, written so that the scene file alone gives 
 its ``dt`` is one simulation step (a frame's ``dt`` over the steps per frame), its ``steps``
 the range's steps, and its ``solver`` the bake's settings (the preset's effort at that step,
 the scene's friction and bounciness rules). ``impulse.World.from_scene(take.scene())`` stepped
-``steps`` times is then the take's trajectory, and :class:`TakeBaker` keys exactly it.
+``steps`` times is then the take's trajectory, and :class:`TakeBaker` keys exactly it. A
+keyed throw's take starts at its release (:func:`release_frame`), with the animation's last
+velocity as the thrown body's start.
 
 Goals use the object's origin as its place (the body's ``position``) and Blender's axes, turned
 into impulse's (y up) as the bake does (:mod:`.axes`).
@@ -91,9 +93,6 @@ def read_goals(scene, info):
         if body is None or not body.keyed:
             problems.append(f"{obj.name}: has goals but is not a moving body of the bake (an Active rigid body)")
             continue
-        if body.animated is not None:
-            problems.append(f"{obj.name}: its Animated or Dynamic flag is keyed; takes vary scenes without switches")
-            continue
         if settings.region is not None:
             if not is_region(settings.region):
                 problems.append(f"{obj.name}: its region {settings.region.name} is not an Empty displayed as a Cube")
@@ -159,18 +158,76 @@ def varied_bodies(scene, info):
     return names
 
 
+def release_frame(info):
+    """The index (frames from the range's start) of the last animated frame of the keyed
+    throws of ``info`` (a :class:`scene_reader.SceneInfo`): the bodies whose Animated or
+    Dynamic flag is keyed, animated from the start frame and simulated after it to the end.
+    None when no flag is keyed. Raises :class:`scene_reader.UnsupportedScene` naming each
+    object that is not such a throw, throws released at different frames, and any other
+    object animated in a scene with a throw (a take starts at the release, and a scene file
+    keeps no animation from before it)."""
+    switching = [b for b in info.bodies if b.animated is not None]
+    if not switching:
+        return None
+    problems, releases = [], {}
+    for body in switching:
+        flags = body.animated
+        last = 0
+        while last + 1 < len(flags) and flags[last + 1]:
+            last += 1
+        if not flags[0] or any(flags[last + 1:]):
+            problems.append(
+                f"{body.object_name}: its Animated or Dynamic flag switches otherwise than a throw (animated from "
+                "the start frame, then simulated to the end); takes vary scenes without other switches"
+            )
+        else:
+            releases[body.object_name] = last
+    if len(set(releases.values())) > 1:
+        problems.append(
+            "the keyed throws are released at different frames ("
+            + ", ".join(f"{name} after frame {info.frame_start + last}" for name, last in sorted(releases.items()))
+            + "); a take starts at one release"
+        )
+    for body in info.bodies:
+        if body.animated is None and body.body.get("keyframes"):
+            problems.append(
+                f"{body.object_name}: animated in a scene with a keyed throw; a take starts at the release and "
+                "keeps no other animation"
+            )
+    if problems:
+        raise scene_reader.UnsupportedScene(problems)
+    return next(iter(releases.values()))
+
+
+def _released(info, index, last):
+    """Body ``index`` of ``info`` as the dynamic body it is from the release after frame index
+    ``last``: at its animation's pose there, with the velocity and spin of its animation's
+    last frame (m/s, rad/s, impulse's axes)."""
+    body = dict(info.bodies[index].body, kind="dynamic")
+    body.pop("keyframes", None)
+    poses = info.bodies[index].poses
+    (p0, q0), (p1, q1) = poses[max(last - 1, 0)], poses[last]
+    body["position"], body["orientation"] = list(p1), list(q1)
+    if last > 0:
+        body["linear_velocity"] = [(b - a) / info.dt for a, b in zip(p0, p1, strict=True)]
+        body["angular_velocity"] = (bake._rotation_vector(q0, q1) / info.dt).tolist()
+    body.update(info.bodies[index].dynamics)
+    return body
+
+
 def search_scene(info, preset="default", substeps=0, frame_steps=0):
     """The scene dict a search varies, and the steps per frame: ``info.scene`` (a
     :class:`scene_reader.SceneInfo`'s) with one simulation step as ``dt``, the range's steps as
     ``steps`` and the bake's solver settings as ``solver``, so that
     ``impulse.World.from_scene`` of it steps exactly as :func:`bake.make_world` of ``info.scene``
-    does. Raises :class:`scene_reader.UnsupportedScene` for a scene with bodies whose Animated
-    or Dynamic flag switches (the bake swaps them mid-range; a scene file cannot)."""
-    switching = [b.object_name for b in info.bodies if b.animated is not None]
-    if switching:
-        raise scene_reader.UnsupportedScene(
-            [f"{name}: its Animated or Dynamic flag is keyed; takes vary scenes without switches" for name in switching]
-        )
+    does.
+
+    A scene with keyed throws (:func:`release_frame`) starts at the release instead: each
+    thrown body dynamic at its animation's last pose with the animation's last velocity and
+    spin (what a search varies like any start), the other bodies at their start, and
+    ``steps`` those from the release to the end. Raises :class:`scene_reader.UnsupportedScene`
+    for switches that are not such throws."""
+    last = release_frame(info)
     count = bake.steps_per_frame(info.dt, frame_steps)
     dt = info.dt / count
     solver = bake.solver_settings(preset, substeps, dt).to_dict()
@@ -178,6 +235,11 @@ def search_scene(info, preset="default", substeps=0, frame_steps=0):
     # them over the preset's (impulse's Settings.with_effort_of), and so does this.
     solver.update(info.scene.get("solver", {}))
     scene = dict(info.scene, dt=dt, steps=info.steps * count, solver=solver)
+    if last is not None:
+        scene["bodies"] = [
+            _released(info, i, last) if b.animated is not None else b.body for i, b in enumerate(info.bodies)
+        ]
+        scene["steps"] = (info.steps - last) * count
     return json.loads(json.dumps(scene)), count
 
 
@@ -386,7 +448,9 @@ class TakeBaker(bake.Baker):
     ``impulse.takes.Takes``) instead of the scene as read: the scene is read and checked as for
     "Bake with impulse", the search must have been run on this very scene and settings (its
     ``scene.json``), and the world is ``impulse.World.from_scene(take.scene())``, stepped the
-    same steps per frame. Raises :class:`scene_reader.UnsupportedScene` when the scene or the
+    same steps per frame. With keyed throws the take starts at their release
+    (:func:`search_scene`): the frames before it key the throws' animation and the other
+    bodies at their start. Raises :class:`scene_reader.UnsupportedScene` when the scene or the
     bake settings changed since the search, KeyError for an unknown take."""
 
     def __init__(
@@ -404,18 +468,34 @@ class TakeBaker(bake.Baker):
             )
         self.take = take
         self.frame_steps = count
+        bodies = self.info.bodies
         # A varied body's first key is its varied start, not the object's own channels
-        # (bake.Baker keys those at the first frame to keep an unchanged re-bake's bits).
+        # (bake.Baker keys those at the first frame to keep an unchanged re-bake's bits); a
+        # throw's first key is its animation's, as the object's channels are.
         for index in takes.variation.body_indices(takes.base_scene):
-            self.info.bodies[index].start = None
+            if bodies[index].animated is None:
+                bodies[index].start = None
         with warnings.catch_warnings():
             # The engine's notes on the scene were the bake's own (bake.Baker), said once.
             warnings.simplefilter("ignore", UserWarning)
             self.world = self.impulse.World.from_scene(take.scene())
-        self.handles = [self.world.handle_of(i) for i in range(len(self.info.bodies))]
+        self.handles = [self.world.handle_of(i) for i in range(len(bodies))]
         self._rows()
-        self.positions = [self.world.positions[self.rows].copy()]
-        self.orientations = [self.world.orientations[self.rows].copy()]
+        # The take's world has no switches: a throw is dynamic in it from its release on.
+        self.switching, self.driven = [], set()
+        # Until the release (none without a throw), the throws follow their animation and the
+        # other bodies wait at their start; the take's world is the frame of the release.
+        self.positions, self.orientations = [], []
+        for frame in range(release_frame(self.info) or 0):
+            poses = [bodies[i].poses[frame] if bodies[i].animated is not None else None for i in self.keyed]
+            self.positions.append(
+                np.array([p[0] if p else bodies[i].body["position"] for i, p in zip(self.keyed, poses, strict=True)])
+            )
+            self.orientations.append(
+                np.array([p[1] if p else bodies[i].body["orientation"] for i, p in zip(self.keyed, poses, strict=True)])
+            )
+        self.positions.append(self.world.positions[self.rows].copy())
+        self.orientations.append(self.world.orientations[self.rows].copy())
 
 
 def bake_take(scene, takes, take_id, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0):

@@ -477,3 +477,62 @@ def test_a_still_that_cannot_be_drawn_is_explained_in_the_panel(tmp_path, monkey
     assert listed > 1
     assert settings.previews_note.startswith(f"No still for {listed} of {listed} takes: impulse render of take ")
     assert settings.previews_note.endswith(' failed: cannot draw body "Ground": the convex hull of 8 points has no volume')
+
+
+def test_a_keyed_throw_is_searched_from_its_release_and_baked(tmp_path, monkeypatch):
+    """The bowling shot as an animator keys it: a ball animated with Animated ticked to frame
+    10, Animated keyed off at 11, toward a pin it should hit. The take starts at the release
+    with the keys' velocity (varied like any start); Bake Take keys the animation until the
+    release and the take's world from it, to the bit of the F-curves' float32."""
+    scene = field.startup(FRAMES)
+    field.ground()
+    pin = field.add("cube", "Pin", size=0.2, location=(4.0, 0.0, 0.3))
+    pin.scale = (1.0, 1.0, 3.0)
+    field.rigid(pin)
+    pin.impulse_takes.vary = False
+    ball = field.add("uv_sphere", "Ball", radius=0.2, location=(0.0, 0.0, 0.2))
+    field.rigid(ball)
+    field.key(ball, "location", 1, (0.0, 0.0, 0.2))
+    field.key(ball, "location", 10, (1.5, 0.0, 0.2))
+    field.key(ball, "rigid_body.kinematic", 1, True, interpolation=None)
+    field.key(ball, "rigid_body.kinematic", 10, True, interpolation=None)
+    field.key(ball, "rigid_body.kinematic", 11, False, interpolation=None)
+    ball.impulse_takes.hits = pin
+    settings = scene.impulse_takes
+    settings.position, settings.angle, settings.velocity, settings.angular_velocity = 0.0, 0.0, 0.5, 0.0
+    settings.budget, settings.population, settings.stop_after, settings.workers = 16, 8, 1, 2
+    scene.impulse_bake.preset = "fast"
+    monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
+
+    assert bpy.ops.impulse.takes_search() == {"FINISHED"}
+    assert settings.takes[0].met
+    from impulse.takes import load
+
+    found = load(settings.directory)
+    names = [b["name"] for b in found.base_scene["bodies"]]
+    thrown = found.base_scene["bodies"][names.index("Ball")]
+    # Released after frame 10 at the keys' last velocity: 1.5 m in 9 frames at 24 fps, along x.
+    assert thrown["kind"] == "dynamic"
+    assert thrown["linear_velocity"] == pytest.approx([4.0, 0.0, 0.0], abs=1e-4)
+    count = bake.steps_per_frame(1.0 / scene.render.fps)
+    assert found.base_scene["steps"] == (FRAMES - 10) * count
+    take = found[settings.takes[0].take_id]
+    varied = take.scene()["bodies"][names.index("Ball")]["linear_velocity"]
+    assert varied != thrown["linear_velocity"]
+
+    assert bpy.ops.impulse.bake_take() == {"FINISHED"}
+    fcurves = keyframes._fcurve_collection(ball, create=False)
+    keyed = np.float32([[p.co[1] for p in fcurves.find("location", index=k).keyframe_points] for k in range(3)]).T
+    assert len(keyed) == FRAMES
+    # Until the release, the animation (linear keys: frame 5 is 4/9 of the way).
+    assert keyed[4] == pytest.approx([1.5 * 4 / 9, 0.0, 0.2], abs=1e-5)
+    # From the release, the take's world.
+    world = bake.import_impulse().World.from_scene(take.scene())
+    row = world.index_of(world.handle_of(names.index("Ball")))
+    positions = [world.positions[row].copy()]
+    for _ in range(FRAMES - 10):
+        world.step(count)
+        positions.append(world.positions[row].copy())
+    assert np.array_equal(keyed[9:], np.float32(axes.positions_to_blender(np.stack(positions))))
+    pin_end = field.world_at(scene, pin, FRAMES).translation
+    assert pin_end.x > 4.05 or pin_end.z < 0.25, "the pin was hit"
