@@ -500,7 +500,7 @@ def test_a_keyed_throw_is_searched_from_its_release_and_baked(tmp_path, monkeypa
     ball.impulse_takes.hits = pin
     settings = scene.impulse_takes
     settings.position, settings.angle, settings.velocity, settings.angular_velocity = 0.0, 0.0, 0.5, 0.0
-    settings.budget, settings.population, settings.stop_after, settings.workers = 16, 8, 1, 2
+    settings.budget, settings.population, settings.stop_after, settings.workers = 8, 8, 8, 2
     scene.impulse_bake.preset = "fast"
     monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
 
@@ -536,3 +536,9 @@ def test_a_keyed_throw_is_searched_from_its_release_and_baked(tmp_path, monkeypa
     assert np.array_equal(keyed[9:], np.float32(axes.positions_to_blender(np.stack(positions))))
     pin_end = field.world_at(scene, pin, FRAMES).translation
     assert pin_end.x > 4.05 or pin_end.z < 0.25, "the pin was hit"
+
+    # Another take over it, then Free: the throw's own animation back, the pin at its start.
+    assert bpy.ops.impulse.bake_take(take_id=settings.takes[1].take_id) == {"FINISHED"}
+    assert bpy.ops.impulse.free_bake() == {"FINISHED"}
+    assert field.world_at(scene, ball, 5).translation.x == pytest.approx(1.5 * 4 / 9, abs=1e-5)
+    assert tuple(field.world_at(scene, pin, 1).translation) == pytest.approx((4.0, 0.0, 0.3), abs=1e-6)
