@@ -533,7 +533,9 @@ def preview_path(directory, take_id):
 class PreviewJob:
     """Stills of takes' end states, drawn by ``impulse render`` in a background thread, one take
     after another (the UI stays usable; Blender's UI cannot animate a GIF, so the panel shows
-    the last frame of what the contact sheet's GIF animates).
+    the last frame of what the contact sheet's GIF animates), framed as the contact sheet's
+    ``goals`` camera frames its previews: on the moving bodies the goals name, where the goals
+    read them (:func:`camera_arguments`).
 
     Each still is the take's scene (``take.scene()``, written beside it as
     ``previews/<take_id>.json``) simulated the search's ``steps`` with ``impulse render --out``
@@ -552,6 +554,9 @@ class PreviewJob:
         self.size = size
         self.steps = int(takes.manifest["steps"])
         self.preset = takes.manifest.get("preset")
+        from impulse.takes._sheet import goal_views
+
+        self.views = goal_views(takes.manifest.get("goals"))
         self.errors = {}
         self._todo = [
             takes[take_id]
@@ -580,6 +585,7 @@ class PreviewJob:
             arguments += ["--every", str(max(self.steps, 1)), "--size", "{}x{}".format(*self.size), "--quiet"]
             if self.preset:
                 arguments += ["--preset", self.preset]
+            arguments += camera_arguments(take.scene(), self.steps, self.views, self.size, self.preset)
             done = subprocess.run(arguments, capture_output=True, text=True, check=False)
             if done.returncode != 0:
                 said = done.stderr.strip().removeprefix("error: ") or f"exit code {done.returncode}"
@@ -601,6 +607,26 @@ class PreviewJob:
         """Blocks until every still is drawn (or failed); returns ``errors``."""
         self._thread.join()
         return self.errors
+
+
+def camera_arguments(scene, steps, views, size, preset=None):
+    """``impulse render``'s ``--camera-eye`` and ``--camera-target`` (m, impulse's axes) that
+    frame the moving bodies the goals look at in ``scene`` stepped ``steps`` times
+    (``impulse.takes``' ``goals`` camera, the contact sheet's; ``views`` from its
+    ``goal_views``), for a ``size`` (W, H) image; no flags (``impulse render``'s own view of
+    the moving bodies at the start) when the goals look at no moving body."""
+    from impulse.takes._sheet import goal_camera
+
+    framed = goal_camera(scene, steps, views, size, preset)
+    if framed is None:
+        return []
+    eye, target = framed
+    return [
+        "--camera-eye",
+        ",".join(f"{v:.9g}" for v in eye),
+        "--camera-target",
+        ",".join(f"{v:.9g}" for v in target),
+    ]
 
 
 def _named_bodies(message, names):

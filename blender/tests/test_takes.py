@@ -174,14 +174,15 @@ def impulse_cli():
     pytest.skip(message)
 
 
-def _render_frames(cli, scene_path, steps, out):
-    """``impulse render`` of a scene file's first and last frames at the stills' size."""
+def _render_frames(cli, scene_path, steps, out, camera=()):
+    """``impulse render`` of a scene file's first and last frames at the stills' size, with the
+    ``camera`` flags given."""
     import subprocess
 
     size = "{}x{}".format(*takes_logic.PREVIEW_SIZE)
     subprocess.run(
         [cli, "render", scene_path, "--out", str(out), "--steps", str(steps), "--every", str(steps)]
-        + ["--size", size, "--quiet"],
+        + ["--size", size, "--quiet", *camera],
         check=True,
     )
     with open(out / f"frame_{steps:05d}.png", "rb") as last, open(out / "frame_00000.png", "rb") as first:
@@ -219,7 +220,12 @@ def test_listed_takes_show_a_still_of_their_end(tmp_path, monkeypatch, addon, im
     chosen = settings.takes[0].take_id
     scene_path = tmp_path / "chosen.json"
     found[chosen].write_scene(str(scene_path))
-    first, last = _render_frames(impulse_cli, str(scene_path), steps, tmp_path / "frames")
+    # Framed as the contact sheet's "goals" camera frames the take's preview.
+    from impulse.takes._sheet import _camera_arguments
+
+    camera = _camera_arguments("goals", found[chosen], found, takes_logic.PREVIEW_SIZE)
+    assert camera
+    first, last = _render_frames(impulse_cli, str(scene_path), steps, tmp_path / "frames", camera)
     assert stills[chosen] == last
     assert stills[chosen] != first
 
@@ -434,8 +440,20 @@ def test_a_search_that_fails_says_the_childs_error_in_the_panel(tmp_path, monkey
     assert "Dice" in str(failed.value)
 
 
+def _die_pixels(path):
+    """Pixels of a still that show the die: ``impulse render`` draws moving bodies blue, the
+    ground grey and the sky pale."""
+    image = bpy.data.images.load(path)
+    pixels = np.array(image.pixels[:]).reshape(-1, 4)
+    bpy.data.images.remove(image)
+    red, green, blue = pixels[:, 0], pixels[:, 1], pixels[:, 2]
+    return int(np.sum((blue > red + 0.15) & (blue > green + 0.1)))
+
+
 def test_a_plane_grounds_takes_have_stills_with_the_plane_drawn(tmp_path, monkeypatch, impulse_cli):
-    """The die on a Plane ground (the tutorial's ground): every listed take has its still, and
+    """The die on a Plane ground (the tutorial's ground): every listed take has its still,
+    framed on the die where it rests (at least 20 × 20 of its pixels, where ``impulse
+    render``'s own view of the start showed it about 18 × 18 and let it roll out of frame), and
     the Plane is in it (the take's first frame differs from the same frame without it)."""
     scene, _ = _animator_die_scene()
     monkeypatch.setattr(takes_logic.tempfile, "gettempdir", lambda: str(tmp_path))
@@ -445,7 +463,7 @@ def test_a_plane_grounds_takes_have_stills_with_the_plane_drawn(tmp_path, monkey
     assert settings.previews_note == ""
     assert len(settings.takes) > 1
     for item in settings.takes:
-        assert os.path.getsize(takes_logic.preview_path(settings.directory, item.take_id)) > 0
+        assert _die_pixels(takes_logic.preview_path(settings.directory, item.take_id)) >= 20 * 20, item.take_id
     import json
 
     from impulse.takes import load
