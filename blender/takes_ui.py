@@ -370,7 +370,7 @@ def _wrapped(column, text, icon):
     """``text`` as labels of :data:`NOTE_WIDTH` characters at most, the first with ``icon``."""
     import textwrap
 
-    for index, line in enumerate(textwrap.wrap(text, NOTE_WIDTH, break_long_words=True) or [""]):
+    for index, line in enumerate(textwrap.wrap(text, NOTE_WIDTH, break_on_hyphens=False) or [""]):
         column.label(text=line, icon=icon if index == 0 else "BLANK1")
 
 

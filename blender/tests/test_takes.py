@@ -393,7 +393,49 @@ def test_bake_with_impulse_after_a_take_starts_from_the_pose_the_animator_set(tm
     )
 
 
-def test_a_search_whose_pyarrow_needs_another_numpy_says_so_in_the_panel(tmp_path, monkeypatch):
+class _Layout:
+    """A stand-in for a panel's layout that keeps the labels drawn: (text, icon)."""
+
+    def __init__(self, labels):
+        self.labels = labels
+
+    def column(self, **_options):
+        return self
+
+    row = column
+
+    def label(self, text="", icon="NONE", **_options):
+        self.labels.append((text, icon))
+
+    def prop(self, *_arguments, **_options):
+        pass
+
+    operator = template_list = template_icon = prop
+
+
+def _takes_panel_labels(addon):
+    """The labels the scene's impulse Takes panel draws now, as (text, icon)."""
+    import types
+
+    labels = []
+    panel = sys.modules[addon.__name__ + ".takes_ui"].SCENE_PT_impulse_takes
+    panel.draw(types.SimpleNamespace(layout=_Layout(labels)), bpy.context)
+    return labels
+
+
+def _said(labels, icon):
+    """The text of the note whose first line has ``icon``, its lines joined, without spaces
+    (a long word, a path, is cut across lines)."""
+    start = next(i for i, (_, shown) in enumerate(labels) if shown == icon)
+    lines = [labels[start][0]]
+    for text, shown in labels[start + 1 :]:
+        if shown != "BLANK1":
+            break
+        lines.append(text)
+    return "".join("".join(lines).split())
+
+
+def test_a_search_whose_pyarrow_needs_another_numpy_says_so_in_the_panel(tmp_path, monkeypatch, addon):
     """Blender's Python with a pyarrow built for NumPy 2 (``pip install pyarrow`` into Blender
     5.0, whose NumPy is 1.26): the search child fails importing it. The panel says that, and
     what to install, not that the directory holds no takes."""
@@ -415,6 +457,7 @@ def test_a_search_whose_pyarrow_needs_another_numpy_says_so_in_the_panel(tmp_pat
     assert "-m pip install 'pyarrow<19'" in note and sys.executable in note
     assert "not a takes search directory" not in note
     assert len(settings.takes) == 0
+    assert _said(_takes_panel_labels(addon), "ERROR") == "".join(note.split())
 
     monkeypatch.delenv("PYTHONPATH")
     assert bpy.ops.impulse.takes_search() == {"FINISHED"}
@@ -480,7 +523,7 @@ def test_a_plane_grounds_takes_have_stills_with_the_plane_drawn(tmp_path, monkey
     assert first_with != first_without
 
 
-def test_a_still_that_cannot_be_drawn_is_explained_in_the_panel(tmp_path, monkeypatch):
+def test_a_still_that_cannot_be_drawn_is_explained_in_the_panel(tmp_path, monkeypatch, addon):
     """``impulse render`` refusing a take's scene: the panel says how many stills are missing
     and why, the engine's body index as the object's name."""
     scene, _ = _animator_die_scene()
@@ -495,6 +538,7 @@ def test_a_still_that_cannot_be_drawn_is_explained_in_the_panel(tmp_path, monkey
     assert listed > 1
     assert settings.previews_note.startswith(f"No still for {listed} of {listed} takes: impulse render of take ")
     assert settings.previews_note.endswith(' failed: cannot draw body "Ground": the convex hull of 8 points has no volume')
+    assert _said(_takes_panel_labels(addon), "INFO") == "".join(settings.previews_note.split())
 
 
 def test_a_keyed_throw_is_searched_from_its_release_and_baked(tmp_path, monkeypatch):
