@@ -391,10 +391,10 @@ class SearchJob:
 
     def failure(self):
         """Why the ended child failed, in one line, or None when it ran its search: exit code
-        0 (a take meets every goal) or 1 (none does) with its table written and no Python
-        traceback in ``search.log`` (an uncaught exception also exits 1). The line is the
-        child's last message (``error: …`` or the exception), with what to install when it is
-        pyarrow failing with Blender's NumPy."""
+        0 (a take meets every goal), or 1 with its closing summary (``N takes, M meet every
+        goal``) in ``search.log`` (none does; an uncaught exception also exits 1, without it).
+        The line is the child's last message (``error: …`` or the exception), with what to
+        install when it is pyarrow failing with this Python's NumPy."""
         code = self.process.returncode
         if code is None or self.cancelled:
             return None
@@ -403,12 +403,14 @@ class SearchJob:
                 log = file.read()
         except OSError:
             log = ""
-        crashed = "Traceback (most recent call last)" in log
-        if code in (0, 1) and not crashed and os.path.exists(os.path.join(self.directory, "takes.parquet")):
-            return None
         lines = [line.strip() for line in log.splitlines() if line.strip()]
+        if code == 0 or (code == 1 and any(line.endswith(" meet every goal") for line in lines)):
+            return None
         errors = [line for line in lines if line.startswith("error: ")]
-        message = errors[-1][len("error: "):] if errors and not crashed else (lines[-1] if lines else "no message")
+        if errors and "Traceback (most recent call last)" not in log:
+            message = errors[-1][len("error: "):]
+        else:
+            message = lines[-1] if lines else "no message"
         message = f"the search failed (exit code {code}): {message}"
         if "numpy" in message.lower():
             message += "; " + pyarrow_advice()

@@ -604,3 +604,22 @@ def test_a_keyed_throw_is_searched_from_its_release_and_baked(tmp_path, monkeypa
     assert bpy.ops.impulse.free_bake() == {"FINISHED"}
     assert field.world_at(scene, ball, 5).translation.x == pytest.approx(1.5 * 4 / 9, abs=1e-5)
     assert tuple(field.world_at(scene, pin, 1).translation) == pytest.approx((4.0, 0.0, 0.3), abs=1e-6)
+
+
+def test_a_search_where_no_take_meets_the_goals_lists_its_takes(tmp_path):
+    """Exit code 1 with the child's summary is a search that ran (no take met every goal),
+    not a failure: its takes are read."""
+    scene, die = _animator_die_scene()
+    far = bpy.data.objects.new("Far", None)
+    scene.collection.objects.link(far)
+    far.empty_display_type = "CUBE"
+    far.empty_display_size = 0.1
+    far.location = (50.0, 0.0, 0.0)
+    bpy.context.view_layer.update()
+    die.impulse_takes.face_up = "NONE"
+    die.impulse_takes.region = far
+    request = takes_logic.build_request(scene, {"position": 0.0, "angle": 90.0, "velocity": 1.0, "angular_velocity": 8.0})
+    job = takes_logic.SearchJob(str(tmp_path / "search"), request, budget=8, workers=1)
+    found = job.wait()
+    assert job.process.returncode == 1
+    assert len(found) == 8 and not found.met()
