@@ -305,7 +305,8 @@ class SearchJob:
     ``variation`` (an ``impulse.takes.Variation`` dict), ``seed``, ``population``; ``budget``,
     ``stop_after`` and ``workers`` (0: every core) only limit the run. The child writes its
     takes to ``directory`` (:func:`search_directory`) a generation at a time and its messages
-    to ``search.log`` there.
+    to ``search.log`` there; it and its workers share the bake's decomposition cache
+    (:func:`bake.decomposition_cache_directory`, through ``IMPULSE_DECOMPOSITION_CACHE``).
     """
 
     def __init__(self, directory, request, budget, stop_after=1, workers=0):
@@ -353,6 +354,11 @@ class SearchJob:
         environment["PYTHONPATH"] = os.pathsep.join(
             p for p in (package_root, environment.get("PYTHONPATH")) if p
         )
+        # The child and its workers read and keep the bake's convex parts of moving meshes.
+        try:
+            environment["IMPULSE_DECOMPOSITION_CACHE"] = bake.decomposition_cache_directory()
+        except (OSError, ValueError, RuntimeError):
+            pass  # without a cache the split is only redone: time, not correctness
         self._log = open(os.path.join(directory, LOG_FILE), "w", encoding="utf-8")  # noqa: SIM115
         self.process = subprocess.Popen(
             command, stdout=self._log, stderr=subprocess.STDOUT, env=environment, cwd=directory

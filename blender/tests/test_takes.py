@@ -623,3 +623,22 @@ def test_a_search_where_no_take_meets_the_goals_lists_its_takes(tmp_path):
     found = job.wait()
     assert job.process.returncode == 1
     assert len(found) == 8 and not found.met()
+
+
+def test_a_search_keeps_the_mesh_split_for_the_next_session(tmp_path):
+    """A ring (a torus with shape Mesh) searched: the search's own processes split it and keep
+    the parts in the add-on's user directory, where the bake and later sessions read them."""
+    import shutil
+
+    cache = bake.decomposition_cache_directory()
+    shutil.rmtree(cache, ignore_errors=True)
+    scene = field.startup(24)
+    field.ground()
+    ring = field.add("torus", "Ring", location=(0.0, 0.0, 1.0))
+    field.rigid(ring)
+    ring.rigid_body.collision_shape = "MESH"
+    ring.impulse_takes.hits = scene.objects["Ground"]
+    request = takes_logic.build_request(scene, {"position": 0.0, "angle": 30.0, "velocity": 0.0, "angular_velocity": 0.0})
+    takes_logic.SearchJob(str(tmp_path / "search"), request, budget=2, workers=1).wait()
+    kept = os.listdir(cache)
+    assert len(kept) == 1 and kept[0].endswith(".vhacd")
