@@ -642,3 +642,26 @@ def test_a_search_keeps_the_mesh_split_for_the_next_session(tmp_path):
     takes_logic.SearchJob(str(tmp_path / "search"), request, budget=2, workers=1).wait()
     kept = os.listdir(cache)
     assert len(kept) == 1 and kept[0].endswith(".vhacd")
+
+
+def test_throws_released_at_different_frames_are_refused_naming_them():
+    """Two balls keyed Animated until frames 10 and 15: a take starts at one release, so the
+    search is refused before it runs, naming both and their frames."""
+    scene = field.startup(FRAMES)
+    field.ground()
+    for name, last, y in (("Ball", 10, 0.0), ("Ball2", 15, 2.0)):
+        ball = field.add("uv_sphere", name, radius=0.2, location=(0.0, y, 0.2))
+        field.rigid(ball)
+        field.key(ball, "location", 1, (0.0, y, 0.2))
+        field.key(ball, "location", last, (1.5, y, 0.2))
+        field.key(ball, "rigid_body.kinematic", 1, True, interpolation=None)
+        field.key(ball, "rigid_body.kinematic", last, True, interpolation=None)
+        field.key(ball, "rigid_body.kinematic", last + 1, False, interpolation=None)
+        ball.impulse_takes.hits = scene.objects["Ground"]
+    variation = {"position": 0.0, "angle": 0.0, "velocity": 0.5, "angular_velocity": 0.0}
+    with pytest.raises(scene_reader.UnsupportedScene) as refused:
+        takes_logic.build_request(scene, variation)
+    assert refused.value.problems == [
+        "the keyed throws are released at different frames (Ball after frame 10, Ball2 after frame 15); "
+        "a take starts at one release"
+    ]
