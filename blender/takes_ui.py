@@ -255,7 +255,6 @@ class IMPULSE_OT_takes_search(bpy.types.Operator):
         except (ValueError, RuntimeError, ImportError, OSError) as error:
             self._fail(settings, str(error))
             return None
-        settings.directory = directory
         return job
 
     def _done(self, context, job, wait_for_previews):
@@ -265,9 +264,10 @@ class IMPULSE_OT_takes_search(bpy.types.Operator):
         try:
             found = job.finish()
         except (RuntimeError, OSError, ValueError, ImportError) as error:
-            # The takes listed before stay; they are the earlier search's.
+            # The takes listed before stay, with the directory they are read from.
             self._fail(settings, str(error))
             return {"CANCELLED"}
+        settings.directory = job.directory
         _list_takes(settings, found)
         _draw_previews(settings, found, wait=wait_for_previews)
         met = len(found.met())

@@ -462,11 +462,15 @@ def test_a_search_whose_pyarrow_needs_another_numpy_says_so_in_the_panel(tmp_pat
     monkeypatch.delenv("PYTHONPATH")
     assert bpy.ops.impulse.takes_search() == {"FINISHED"}
     assert settings.search_note == "" and len(settings.takes) > 0
-    # The child ran, but this process cannot import pyarrow to read its table.
+    listed = (settings.directory, [item.take_id for item in settings.takes])
+    # The child ran, but this process cannot import pyarrow to read its table; a search of
+    # another seed fails so, and the takes listed stay with their directory (Bake Take reads it).
+    settings.seed = 1
     monkeypatch.setitem(sys.modules, "pyarrow.parquet", None)
     with pytest.raises(RuntimeError, match="cannot read the takes in .*pip install 'pyarrow<19'"):
         bpy.ops.impulse.takes_search()
     assert settings.search_note.startswith("cannot read the takes in ")
+    assert (settings.directory, [item.take_id for item in settings.takes]) == listed
 
 
 def test_a_search_that_fails_says_the_childs_error_in_the_panel(tmp_path, monkeypatch):
