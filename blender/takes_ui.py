@@ -120,6 +120,9 @@ class ImpulseTakesSettings(bpy.types.PropertyGroup):
     previews_note: bpy.props.StringProperty(
         name="Previews", description="Why the listed takes have no stills, when they have none"
     )
+    search_note: bpy.props.StringProperty(
+        name="Search", description="Why the last search failed (its child process's error), when it failed"
+    )
     takes: bpy.props.CollectionProperty(type=ImpulseTake)
     active: bpy.props.IntProperty(name="Take", default=0)
 
@@ -169,6 +172,7 @@ def _draw_previews(settings, found, wait):
     _preview_job = takes_logic.PreviewJob(found, [item.take_id for item in settings.takes], command)
     if wait:
         _preview_job.wait()
+        settings.previews_note = _preview_job.problem()
     elif not bpy.app.timers.is_registered(_redraw_while_drawing):
         bpy.app.timers.register(_redraw_while_drawing, first_interval=POLL_SECONDS)
     return _preview_job
@@ -176,12 +180,24 @@ def _draw_previews(settings, found, wait):
 
 def _redraw_while_drawing():
     """Timer: redraws the Properties editors while stills are being drawn, so each appears
-    when it is ready; ends with the job."""
+    when it is ready; ends with the job, noting on the scenes listing its takes why stills
+    are missing, if any are."""
+    job = _preview_job
+    running = job is not None and job.running()
+    if job is not None and not running:
+        for scene in bpy.data.scenes:
+            settings = getattr(scene, "impulse_takes", None)
+            if settings is not None and _same_path(settings.directory, job.directory):
+                settings.previews_note = job.problem()
     for window in getattr(bpy.context.window_manager, "windows", ()):
         for area in window.screen.areas:
             if area.type == "PROPERTIES":
                 area.tag_redraw()
-    return POLL_SECONDS if _preview_job is not None and _preview_job.running() else None
+    return POLL_SECONDS if running else None
+
+
+def _same_path(a, b):
+    return bool(a) and os.path.realpath(bpy.path.abspath(a)) == os.path.realpath(b)
 
 
 def preview(directory, take_id):
@@ -220,20 +236,25 @@ class IMPULSE_OT_takes_search(bpy.types.Operator):
         world = context.scene.rigidbody_world if context.scene else None
         return world is not None and world.collection is not None and IMPULSE_OT_takes_search._job is None
 
+    def _fail(self, settings, message):
+        """Reports ``message`` and keeps it in the panel (``search_note``) until the next search."""
+        settings.search_note = message
+        self.report({"ERROR"}, f"impulse: {message}")
+
     def _start(self, context):
         scene = context.scene
         settings = scene.impulse_takes
+        settings.search_note = ""
         try:
             request = _request(scene)
             directory = takes_logic.search_directory(bpy.data.filepath, request)
             job = takes_logic.SearchJob(directory, request, settings.budget, settings.stop_after, settings.workers)
         except scene_reader.UnsupportedScene as error:
-            self.report({"ERROR"}, "impulse: no search: " + "; ".join(error.problems))
+            self._fail(settings, "no search: " + "; ".join(error.problems))
             return None
         except (ValueError, RuntimeError, ImportError, OSError) as error:
-            self.report({"ERROR"}, f"impulse: {error}")
+            self._fail(settings, str(error))
             return None
-        settings.directory = directory
         return job
 
     def _done(self, context, job, wait_for_previews):
@@ -242,9 +263,11 @@ class IMPULSE_OT_takes_search(bpy.types.Operator):
         settings = context.scene.impulse_takes
         try:
             found = job.finish()
-        except (RuntimeError, OSError, ValueError) as error:
-            self.report({"ERROR"}, f"impulse: {error}")
+        except (RuntimeError, OSError, ValueError, ImportError) as error:
+            # The takes listed before stay, with the directory they are read from.
+            self._fail(settings, str(error))
             return {"CANCELLED"}
+        settings.directory = job.directory
         _list_takes(settings, found)
         _draw_previews(settings, found, wait=wait_for_previews)
         met = len(found.met())
@@ -339,6 +362,18 @@ class IMPULSE_OT_bake_take(bpy.types.Operator):
         return {"FINISHED"}
 
 
+#: Characters a line of a note in the panel holds (a label does not wrap; it is cut).
+NOTE_WIDTH = 60
+
+
+def _wrapped(column, text, icon):
+    """``text`` as labels of :data:`NOTE_WIDTH` characters at most, the first with ``icon``."""
+    import textwrap
+
+    for index, line in enumerate(textwrap.wrap(text, NOTE_WIDTH, break_on_hyphens=False) or [""]):
+        column.label(text=line, icon=icon if index == 0 else "BLANK1")
+
+
 class IMPULSE_UL_takes(bpy.types.UIList):
     """The listed takes: the still of its end, id, every goal met, cost, perturbation."""
 
@@ -376,12 +411,14 @@ class SCENE_PT_impulse_takes(bpy.types.Panel):
         for name in ("budget", "population", "stop_after", "seed", "workers"):
             column.prop(settings, name)
         column.operator(IMPULSE_OT_takes_search.bl_idname, icon="VIEWZOOM")
+        if settings.search_note:
+            _wrapped(layout.column(align=True), settings.search_note, "ERROR")
         if settings.directory:
             column.label(text=settings.directory)
         layout.template_list("IMPULSE_UL_takes", "", settings, "takes", settings, "active", rows=4)
         if settings.previews_note:
-            layout.label(text=settings.previews_note, icon="INFO")
-        elif 0 <= settings.active < len(settings.takes):
+            _wrapped(layout.column(align=True), settings.previews_note, "INFO")
+        if 0 <= settings.active < len(settings.takes):
             # Blender's UI draws no GIF animation: the chosen take's still is its last frame.
             icon = preview_icon(settings.directory, settings.takes[settings.active].take_id)
             if icon:

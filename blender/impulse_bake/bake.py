@@ -13,6 +13,7 @@ or :func:`bake_scene` for all of it at once.
 
 import math
 import time
+import warnings
 
 import numpy as np
 
@@ -24,10 +25,42 @@ PRESETS = ("fast", "default", "precise")
 
 def import_impulse():
     """The ``impulse`` package: the extension's bundled wheel (Blender installs it), or the
-    copy a plain add-on unpacked beside itself."""
+    copy a plain add-on unpacked beside itself. The first call in a session points impulse's
+    decomposition cache at :func:`decomposition_cache_directory`, so that a moving Mesh shape
+    split into convex parts once is read back in later sessions."""
     import impulse
 
+    global _cache_set
+    if not _cache_set:
+        _cache_set = True
+        try:
+            impulse.set_decomposition_cache_dir(decomposition_cache_directory())
+        except (OSError, ValueError, RuntimeError, ImportError):
+            pass  # without a cache the split is only redone: time, not correctness
     return impulse
+
+
+#: Whether :func:`import_impulse` has set the decomposition cache of this session.
+_cache_set = False
+
+#: The cache's folder in the add-on's user directory.
+CACHE_FOLDER = "decompositions"
+
+
+def decomposition_cache_directory():
+    """The directory where impulse keeps the convex parts of moving Mesh shapes between
+    sessions (one file per mesh and Mesh Detail; made when the first is written): the
+    extension's user directory (``bpy.utils.extension_path_user``, kept when the extension is
+    updated), or for the plain add-on Blender's user data files (``impulse/decompositions``
+    under ``bpy.utils.user_resource("DATAFILES")``)."""
+    import os
+
+    import bpy
+
+    package = __package__.rpartition(".")[0]  # the add-on's package, this one's parent
+    if package.startswith("bl_ext."):
+        return bpy.utils.extension_path_user(package, path=CACHE_FOLDER)
+    return bpy.utils.user_resource("DATAFILES", path=os.path.join("impulse", CACHE_FOLDER))
 
 
 #: The step the presets were tuned at (s): 60 steps a second (docs/solvers.md).
@@ -130,7 +163,11 @@ class Baker:
         impulse = import_impulse()
         self.impulse = impulse
         try:
-            self.world, self.frame_steps = make_world(self.info.scene, preset, substeps, frame_steps)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", UserWarning)
+                self.world, self.frame_steps = make_world(self.info.scene, preset, substeps, frame_steps)
+            # The engine's notes (none for what the reader writes today) in the panel's terms.
+            self.info.notes += [messages.translate(str(w.message), self.info) for w in caught]
         except impulse.SceneError as error:
 
             def build(scene_dict):
@@ -143,6 +180,9 @@ class Baker:
         self.switching = [i for i in self.keyed if bodies[i].animated is not None]
         self.kinematic_now = {i: bodies[i].kind == "kinematic" for i in self.switching}
         self.driven = set()
+        # The channels as the animator set them, recorded on the keyed objects by write(): a
+        # subclass may key another start (a take's), and Free puts these back.
+        self.authored = {i: bodies[i].start for i in self.keyed}
         self._rows()
         self.positions = [self.world.positions[self.rows].copy()]
         self.orientations = [self.world.orientations[self.rows].copy()]
@@ -258,7 +298,9 @@ class Baker:
         object's rotation mode, in its parent's space, whole F-curves in the group
         :data:`keyframes.GROUP`), replacing an earlier bake, remove an earlier bake from the
         objects this one does not key, and turn Blender's own rigid body world off so that the
-        keyframes are what plays. Returns the number of keyed objects."""
+        keyframes are what plays. Each keyed object records its own start channels as the
+        animator set them (:func:`keyframes.remember_start`), which Free puts back. Returns
+        the number of keyed objects."""
         start = time.perf_counter()
         frames = np.arange(self.frames_done, dtype=np.float32) + self.info.frame_start
         locations = axes.positions_to_blender(np.stack(self.positions))
@@ -271,6 +313,7 @@ class Baker:
             keyed_names.add(obj.name)
             location, rotation = _object_space(info, locations[:, column], quaternions[:, column])
             keyframes.write_fcurves(obj, frames, location, rotation, info.start)
+            keyframes.remember_start(obj, self.authored[index])
         for obj in scene_reader.rigid_body_objects(self.scene):
             if obj.name not in keyed_names and keyframes.is_baked(obj):
                 keyframes.free_bake(obj, self.info.frame_start)
@@ -323,7 +366,8 @@ def bake_scene(scene, preset="default", substeps=0, frame_steps=0, materials="bl
 
 def free_bake(scene):
     """Remove impulse's bake from every object of the scene's Rigid Body World (each object
-    back at its pose at the start frame, an animated object's own animation back) and tick the
+    back at the start pose the animator set, also after a take's bake, which starts elsewhere;
+    an animated object's own animation back) and tick the
     Rigid Body World again, so that Blender's own simulation plays. Returns the number of
     objects freed."""
     objects = scene_reader.rigid_body_objects(scene)

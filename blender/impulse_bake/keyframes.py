@@ -24,6 +24,12 @@ ORIGINAL = "impulse_original_action"
 #: Custom property of an action a bake made.
 MADE = "impulse_bake"
 
+#: Custom property of a baked object: its own location and rotation channels at the start
+#: frame as the animator set them (data path → values), put back when the bake is freed and
+#: read as its start while it shows the bake's start unchanged. A take's bake keys a varied
+#: start, so the bake's first key is not the animator's pose.
+AUTHORED = "impulse_authored_start"
+
 #: The channels a bake may write: (data path, number of components).
 TRANSFORM_CHANNELS = (
     ("location", 3),
@@ -126,13 +132,54 @@ def remove_baked_fcurves(obj):
         fcurves.remove(fcurve)
 
 
+def remember_start(obj, start):
+    """Record on the object its bake has just keyed: ``start`` (:func:`start_values`: its own
+    channels at the start frame as read before the bake) and the bake's first keys, as
+    :data:`AUTHORED`."""
+    keyed = {}
+    for fcurve in baked_fcurves(obj):
+        keyed.setdefault(fcurve.data_path, {})[fcurve.array_index] = float(fcurve.keyframe_points[0].co[1])
+    obj[AUTHORED] = {
+        "channels": {path: [float(v) for v in values] for path, values in start.items()},
+        "keyed": {path: [values[i] for i in sorted(values)] for path, values in keyed.items()},
+    }
+
+
+def _authored(obj):
+    stored = obj.get(AUTHORED)
+    if stored is None or "channels" not in stored:
+        return None
+    return {path: tuple(stored["channels"][path]) for path, _ in TRANSFORM_CHANNELS if path in stored["channels"]}
+
+
+def authored_start(obj):
+    """The object's channels as the animator set them (data path → values) when it carries a
+    bake recorded by :func:`remember_start` and shows that bake's first keys unchanged; None
+    otherwise, so that an edit (moved in the viewport, or keyed into the bake's curves) counts."""
+    authored = _authored(obj)
+    if authored is None or not baked_fcurves(obj):
+        return None
+    for path, values in obj[AUTHORED].get("keyed", {}).items():
+        shown = getattr(obj, path)
+        # Channels are float32, as the keys: the same value to float32 rounding.
+        if any(abs(float(shown[i]) - v) > 1e-6 * max(1.0, abs(v)) for i, v in enumerate(values)):
+            return None
+    return authored
+
+
 def free_bake(obj, frame):
-    """Remove the object's bake: its curves (the object left at their pose at ``frame``),
-    the action copy (the animator's original back) or the action the bake made."""
+    """Remove the object's bake: its curves (the object put back at its pose as the animator
+    set it, :data:`AUTHORED`, else left at the curves' pose at ``frame``), the action copy (the
+    animator's original back) or the action the bake made."""
     import bpy
 
     curves = baked_fcurves(obj)
-    values = [(fc.data_path, fc.array_index, fc.evaluate(frame)) for fc in curves]
+    authored = _authored(obj)
+    if authored is not None:
+        del obj[AUTHORED]
+        values = [(path, index, value) for path, channel in authored.items() for index, value in enumerate(channel)]
+    else:
+        values = [(fc.data_path, fc.array_index, fc.evaluate(frame)) for fc in curves]
     remove_baked_fcurves(obj)
     animation = obj.animation_data
     action = animation.action if animation is not None else None

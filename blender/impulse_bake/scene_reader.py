@@ -9,7 +9,9 @@ What maps to what (docs/blender.md has the animator's version):
   the time step dt = time_scale / fps;
 - the scene as it is at the start frame is the initial state: the scene is set to the start
   frame and, when it was there already, objects whose transform the animator does not animate
-  keep their unkeyed edits (a baked object moved in the viewport starts where it was put);
+  keep their unkeyed edits (a baked object moved in the viewport starts where it was put); a
+  baked object showing its bake's start unchanged starts at the pose the animator set before
+  the bake (:data:`keyframes.AUTHORED`: a take's bake starts from the take's varied start);
 - an object is "animated" at a frame when "Animated" (``kinematic``) is ticked, or when it is
   Active with "Dynamic" (``enabled``) unticked (Blender then moves it with its own transform, as
   an animated one); both flags are read at every frame when they are keyed. An Active object is
@@ -242,7 +244,14 @@ def read_scene(scene, depsgraph=None, materials="blender", resolution=0):
         if frame_before == frame_start:
             # Unkeyed edits at the start frame count, except on what the animator animates.
             _put_back([o for o in objects if not keyframes.animates_transform(o)], saved)
-            view_layer.update()
+        # A baked object showing its bake's start unchanged starts where the animator set it:
+        # a take's bake keys the take's varied start, which is not the scene's.
+        for obj in objects:
+            authored = keyframes.authored_start(obj)
+            if authored is not None:
+                for path, values in authored.items():
+                    setattr(obj, path, values)
+        view_layer.update()
         depsgraph = bpy.context.evaluated_depsgraph_get() if depsgraph is None else depsgraph
         meshes = shapes.Meshes(objects, depsgraph, view_layer)
         bodies, tracked = [], []

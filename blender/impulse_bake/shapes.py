@@ -10,7 +10,9 @@ docs/scene-format.md "Shapes"), sized and placed as Blender (Bullet) sizes and p
   ``decomposition`` resolution given, else the engine's default).
 - Flat objects (a plane with the default Convex Hull, a Box of zero thickness) are thin shapes:
   coplanar hull points or a zero half-extent, with ``thickness`` = 2 × the collision margin when
-  the object's "Collision Margin" is ticked (the engine's default thickness otherwise), and a note.
+  the object's "Collision Margin" is ticked, else :data:`DEFAULT_THICKNESS` (given explicitly,
+  so that the engine has nothing to note in the scene format's words), and a note naming the
+  object, the thickness and the setting that chooses it.
 - A negative scale (a mirrored object) mirrors the mesh points (the triangles' winding kept
   outward).
 - Source: Base is the mesh itself, Deform the mesh with the leading deform-only modifiers and
@@ -35,6 +37,10 @@ SHAPE_NAMES = {
 
 #: A shape thinner than this along an axis (m) counts as flat.
 FLAT_EXTENT = 1e-6
+
+#: The thickness (m) of a flat shape whose "Collision Margin" is not ticked: the engine's own
+#: default for a thin shape (a slab centred on the shape's plane).
+DEFAULT_THICKNESS = 0.002
 
 #: Modifier types that only move vertices (Blender's ``ModifierTypeType::OnlyDeform``): Source
 #: "Deform" applies the leading run of these, as Blender's rigid body reads the evaluated
@@ -142,10 +148,20 @@ def _rank(points):
     return int(np.sum(singular > 1e-6 * singular[0]))
 
 
-def _thickness(shape, rigid_body):
+def _thin(name, label, shape, rigid_body, what="a thin shape"):
+    """(shape with its ``thickness``, the note) of a flat shape of object ``name``: 2 × its
+    collision margin when "Collision Margin" is ticked, else :data:`DEFAULT_THICKNESS`."""
     if rigid_body.use_margin:
         shape["thickness"] = 2.0 * float(rigid_body.collision_margin)
-    return shape
+        why = "twice its Collision Margin"
+    else:
+        shape["thickness"] = DEFAULT_THICKNESS
+        why = (
+            "tick Collision Margin to choose it: twice the Margin; or give the mesh thickness, "
+            "a Solidify modifier with Source Final"
+        )
+    millimetres = f"{shape['thickness'] * 1e3:.3g}"
+    return shape, f"{name}: a flat {label} — baked as {what} {millimetres} mm thick ({why})"
 
 
 def _primitive(shape_type, dims):
@@ -206,8 +222,8 @@ def build(obj, kind, scale, meshes, resolution=0):
         if rank == 2:
             # A flat mesh bounds no solid to decompose: a moving one is its flat hull.
             thin = "the thin hull of its outline" if shape_type == "MESH" else "a thin shape"
-            notes.append(f"{name}: a flat {label} — baked as {thin}")
-            _thickness(shape, rigid_body)
+            shape, note = _thin(name, label, shape, rigid_body, thin)
+            notes.append(note)
         return shape, notes, []
     corners = np.array([tuple(c) for c in obj.bound_box], dtype=np.float64)
     dims = (corners.max(axis=0) - corners.min(axis=0)) * np.abs(scale)
@@ -216,7 +232,8 @@ def build(obj, kind, scale, meshes, resolution=0):
             return None, [], [f"{name}: shape {label} has no area (dimensions {_dims(dims)} m)"]
         shape = _primitive(shape_type, dims)
         if np.min(dims) < FLAT_EXTENT:
-            return _thickness(shape, rigid_body), [f"{name}: a flat {label} — baked as a thin shape"], []
+            shape, note = _thin(name, label, shape, rigid_body)
+            return shape, [note], []
         return shape, [], []
     if shape_type == "SPHERE":
         if max(dims) < FLAT_EXTENT:

@@ -155,3 +155,60 @@ def test_the_engines_refusals_are_translated_for_every_body():
     for problem in problems:
         assert problem.startswith(problem.split(":")[0] + ": shape Box: ")
         assert "bodies[" not in problem and not re.search(r":\d+:\d+", problem), problem
+
+
+#: One Blender session (a fresh Python process with ``bpy``): a ring (a torus, Physics › Rigid
+#: Body, shape Mesh: split into convex parts) and, with the argument ``two``, a second, larger
+#: ring, read for a bake; prints the cache directory and the seconds the world took to build.
+SESSION = """
+import json, sys, time
+sys.path[:0] = sys.argv[1:3]
+import field
+from impulse_bake import bake
+scene = field.startup(4)
+for name, radius in [("Ring", 1.0), ("Ring2", 1.5)][: 2 if sys.argv[3] == "two" else 1]:
+    ring = field.add("torus", name, major_radius=radius, location=(3.0 * radius, 0.0, 3.0))
+    field.rigid(ring)
+    ring.rigid_body.collision_shape = "MESH"
+start = time.perf_counter()
+bake.Baker(scene)
+print(json.dumps({"directory": bake.decomposition_cache_directory(), "seconds": time.perf_counter() - start}))
+"""
+
+
+def _session(user, rings):
+    import json
+    import os
+    import pathlib
+    import subprocess
+    import sys
+
+    tests = pathlib.Path(__file__).resolve().parent
+    done = subprocess.run(
+        [sys.executable, "-c", SESSION, str(tests), str(tests.parent), rings],
+        env=dict(os.environ, BLENDER_USER_DATAFILES=str(user)),
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def test_a_mesh_split_in_one_session_is_read_in_the_next(tmp_path):
+    """The convex parts of a moving Mesh shape are kept in the add-on's user directory: a new
+    session reads them (the file is not written again) and adds the parts of a new mesh."""
+    import os
+
+    first = _session(tmp_path / "user", "one")
+    directory = first["directory"]
+    assert directory.startswith(str(tmp_path / "user"))
+    kept = os.listdir(directory)
+    assert len(kept) == 1 and kept[0].endswith(".vhacd")
+    path = os.path.join(directory, kept[0])
+    long_ago = 946_684_800  # 2000-01-01: a file written again would have a new time
+    os.utime(path, (long_ago, long_ago))
+
+    second = _session(tmp_path / "user", "two")
+    assert second["directory"] == directory
+    assert len(os.listdir(directory)) == 2, "the new ring's parts are kept too"
+    assert os.stat(path).st_mtime == long_ago, "the first ring's parts were read, not split again"

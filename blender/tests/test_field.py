@@ -14,6 +14,12 @@ import field
 
 FRAMES = 48
 
+#: What a flat shape's note says to choose its thickness when Collision Margin is not ticked.
+UNTICKED_MARGIN = (
+    "tick Collision Margin to choose it: twice the Margin; or give the mesh thickness, "
+    "a Solidify modifier with Source Final"
+)
+
 
 @pytest.mark.parametrize(("flag", "animated"), [("rigid_body.kinematic", True), ("rigid_body.enabled", False)])
 def test_a_ball_keyed_animated_then_released_keeps_flying_and_reaches_the_wall(flag, animated):
@@ -100,11 +106,44 @@ def test_a_cube_dropped_on_the_tutorial_plane_rests_on_it(shape):
     plane.rigid_body.collision_shape = shape
     info = scene_reader.read_scene(scene)
     if shape != "MESH":
-        assert "Plane: a flat " + ("Convex Hull" if shape == "CONVEX_HULL" else "Box") + " — baked as a thin shape" in info.notes
+        label = "Convex Hull" if shape == "CONVEX_HULL" else "Box"
+        assert f"Plane: a flat {label} — baked as a thin shape 2 mm thick ({UNTICKED_MARGIN})" in info.notes
     bake.bake_scene(scene)
     rest = field.world_at(scene, cube, FRAMES).translation
     assert rest.z == pytest.approx(1.0, abs=0.06)
     assert abs(rest.x) < 0.05 and abs(rest.y) < 0.05  # where it fell (a flat landing shifts it by a few cm)
+
+
+def test_a_plane_grounds_bake_says_in_blenders_words_how_thick_it_is():
+    """The tutorial's plane ground: the bake's only word on it is the note naming the Plane,
+    its thickness and the setting that chooses it (no Python warning in the scene file's
+    words); ticking Collision Margin or giving it a Solidify read with Source Final does what
+    the note says. (test_operator.py: the operator reports the note.)"""
+    import warnings
+
+    scene = field.startup(FRAMES, keep_cube=True)
+    cube = scene.objects["Cube"]
+    cube.location = (0.0, 0.0, 4.0)
+    field.rigid(cube)
+    plane = field.add("plane", "Plane", size=20.0)
+    field.rigid(plane, "PASSIVE")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert bake.Baker(scene).info.notes == [
+            f"Plane: a flat Convex Hull — baked as a thin shape 2 mm thick ({UNTICKED_MARGIN})"
+        ]
+    plane.rigid_body.use_margin = True
+    plane.rigid_body.collision_margin = 0.01
+    assert bake.Baker(scene).info.notes == [
+        "Plane: a flat Convex Hull — baked as a thin shape 20 mm thick (twice its Collision Margin)"
+    ]
+    plane.rigid_body.use_margin = False
+    plane.modifiers.new("Solidify", "SOLIDIFY").thickness = 0.1
+    plane.rigid_body.mesh_source = "FINAL"
+    baker = bake.Baker(scene)
+    assert baker.info.notes == []
+    bodies = [b.object_name for b in baker.info.bodies]
+    assert "thickness" not in baker.info.scene["bodies"][bodies.index("Plane")]["shape"]
 
 
 def test_an_active_card_falls_flat_onto_the_ground():

@@ -52,6 +52,23 @@ def test_free_bake_returns_the_scene_to_blenders_simulation(addon):
     assert (heavy.matrix_world.translation - start.translation).length < 1e-6
 
 
+def test_the_operator_reports_a_plane_ground_in_the_panels_words(addon, capfd):
+    """The tutorial's cube on a Plane, baked from the panel: the report names the Plane and
+    the settings that choose its thickness, and nothing says the scene file's "thickness"."""
+    import field
+
+    scene = field.startup(24, keep_cube=True)
+    cube = scene.objects["Cube"]
+    cube.location = (0.0, 0.0, 4.0)
+    field.rigid(cube)
+    field.rigid(field.add("plane", "Plane", size=20.0), "PASSIVE")
+    capfd.readouterr()
+    assert bpy.ops.impulse.bake() == {"FINISHED"}
+    said = capfd.readouterr()
+    assert "impulse: Plane: a flat Convex Hull — baked as a thin shape 2 mm thick (tick Collision Margin" in said.out
+    assert '"thickness"' not in said.out + said.err
+
+
 def test_the_operator_reports_an_unsupported_scene(addon):
     scene = scenes.stack30(4)
     scene.objects["cube05"].rigid_body.collision_shape = "COMPOUND"

@@ -72,6 +72,15 @@ impl TriMesh {
 /// all on a line is an error.
 pub fn shape_mesh(shape: &ShapeDesc, ground_half_size: f32) -> Result<TriMesh> {
     if let Some(slab) = shape.slab() {
+        let flat = match shape {
+            ShapeDesc::Thickened { shape: inner, .. } => inner.as_ref(),
+            other => other,
+        };
+        if let (ShapeDesc::ConvexHull { points }, Some(thickness)) = (flat, shape.thin_thickness())
+            && let Some(mesh) = flat_slab(points, thickness)
+        {
+            return Ok(mesh);
+        }
         return shape_mesh(&slab, ground_half_size);
     }
     Ok(match shape {
@@ -261,6 +270,129 @@ pub fn convex_hull(points: &[[f32; 3]]) -> Result<Hull> {
         vertices,
         triangles,
     })
+}
+
+/// The slab of a flat convex hull (coplanar `points`), `thickness` thick and centred on their
+/// plane, as the engine simulates it ([`ShapeDesc::slab`]): the points' outline (their 2-D
+/// hull in the plane) as a top and a bottom face and the sides between them. Drawn without a
+/// 3-D hull, whose tolerance is relative to the points' extent: a 10 m Plane 2 mm thick is
+/// flat to it. `None` when the points span no area.
+fn flat_slab(points: &[[f32; 3]], thickness: f32) -> Option<TriMesh> {
+    let points: Vec<[f64; 3]> = points.iter().map(|p| p.map(f64::from)).collect();
+    let count = points.len() as f64;
+    let mean: [f64; 3] = std::array::from_fn(|k| points.iter().map(|p| p[k]).sum::<f64>() / count);
+    let far = |from: [f64; 3]| {
+        points
+            .iter()
+            .copied()
+            .max_by(|a, b| dist2(*a, from).total_cmp(&dist2(*b, from)))
+    };
+    // Two far-apart points give an in-plane axis, the point farthest off their line the plane.
+    let a = far(mean)?;
+    let b = far(a)?;
+    let u = sub64(b, a);
+    let c = points.iter().copied().max_by(|p, q| {
+        norm2(cross64(u, sub64(*p, a))).total_cmp(&norm2(cross64(u, sub64(*q, a))))
+    })?;
+    let n = cross64(u, sub64(c, a));
+    if norm2(u) == 0.0 || norm2(n) <= 1e-24 * norm2(u) * norm2(u) {
+        return None;
+    }
+    let u = unit64(u);
+    let n = unit64(n);
+    let v = cross64(n, u);
+    let flat: Vec<[f64; 2]> = points
+        .iter()
+        .map(|&p| {
+            let d = sub64(p, mean);
+            [dot64(d, u), dot64(d, v)]
+        })
+        .collect();
+    let outline = hull_2d(flat);
+    if outline.len() < 3 {
+        return None;
+    }
+    // (u, v, n) is right-handed: the outline, counter-clockwise in (u, v), is so seen from +n.
+    let half = 0.5 * f64::from(thickness);
+    let corner = |q: [f64; 2], side: f64| -> [f32; 3] {
+        std::array::from_fn(|k| (mean[k] + q[0] * u[k] + q[1] * v[k] + side * half * n[k]) as f32)
+    };
+    let normal = n.map(|x| x as f32);
+    let top: Vec<[f32; 3]> = outline.iter().map(|&q| corner(q, 1.0)).collect();
+    let bottom: Vec<[f32; 3]> = outline.iter().rev().map(|&q| corner(q, -1.0)).collect();
+    let mut mesh = TriMesh::default();
+    mesh.push_flat_polygon(&top, normal);
+    mesh.push_flat_polygon(&bottom, scale(normal, -1.0));
+    for (i, &q) in outline.iter().enumerate() {
+        let r = outline[(i + 1) % outline.len()];
+        let edge = sub(corner(r, 0.0), corner(q, 0.0));
+        let side = [
+            corner(q, -1.0),
+            corner(r, -1.0),
+            corner(r, 1.0),
+            corner(q, 1.0),
+        ];
+        mesh.push_flat_polygon(&side, cross(edge, normal));
+    }
+    Some(mesh)
+}
+
+/// The convex hull of 2-D points, counter-clockwise, without collinear points (Andrew's
+/// monotone chain).
+fn hull_2d(mut points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
+    points.sort_by(|p, q| p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1])));
+    points.dedup();
+    if points.len() < 3 {
+        return points;
+    }
+    let turn = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut hull: Vec<[f64; 2]> = Vec::with_capacity(2 * points.len());
+    // The lower chain left to right, then the upper one right to left.
+    let reversed: Vec<[f64; 2]> = points.iter().rev().copied().collect();
+    for ordered in [&points, &reversed] {
+        let start = hull.len();
+        for &p in ordered {
+            while hull.len() >= start + 2
+                && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop(); // the next pass starts at this point
+    }
+    hull
+}
+
+fn sub64(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot64(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn norm2(a: [f64; 3]) -> f64 {
+    dot64(a, a)
+}
+
+fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
+    norm2(sub64(a, b))
+}
+
+fn cross64(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn unit64(a: [f64; 3]) -> [f64; 3] {
+    let length = norm2(a).sqrt();
+    a.map(|x| x / length)
 }
 
 /// Corners of the ground square (counter-clockwise seen from the side `normal` points to).
@@ -480,6 +612,36 @@ mod tests {
                     thickness: 0.1,
                 },
                 0.5 * 0.1,
+            ),
+            // Blender's 10 m Plane as the extension writes it (the xz plane, 4 corners), at
+            // the default thickness and at a given one: flat to parry's 3-D hull.
+            (
+                ShapeDesc::ConvexHull {
+                    points: vec![
+                        [-5.0, 0.0, 5.0],
+                        [5.0, 0.0, 5.0],
+                        [-5.0, 0.0, -5.0],
+                        [5.0, 0.0, -5.0],
+                    ],
+                },
+                100.0 * impulse::scene::DEFAULT_THICKNESS,
+            ),
+            (
+                ShapeDesc::Thickened {
+                    shape: Box::new(ShapeDesc::ConvexHull {
+                        // Tilted, off the origin, with a point inside the outline (kept
+                        // small: the volume sum in f32 loses digits far from the origin).
+                        points: vec![
+                            [0.0, 1.0, 0.0],
+                            [2.0, 1.0, 2.0],
+                            [2.0, 3.0, 2.0],
+                            [0.0, 3.0, 0.0],
+                            [1.0, 2.0, 1.0],
+                        ],
+                    }),
+                    thickness: 0.1,
+                },
+                2.0 * 8.0f32.sqrt() * 0.1,
             ),
         ];
         for (shape, expected) in cases {

@@ -15,6 +15,8 @@ See docs/python.md in the repository for the API, the arrays' lifetime rule, pic
 errors.
 """
 
+import os as _os
+
 from ._impulse import (
     BodyBuilder,
     BodyHandle,
@@ -35,6 +37,14 @@ from ._trajectory import Trajectory, load_trajectory
 
 # `impulse.sweep` is the function; the module's other names: `from impulse.sweep import ...`.
 from .sweep import sweep
+
+#: The environment variable naming a decomposition cache directory for every process that
+#: imports impulse, as :func:`set_decomposition_cache_dir` does for one: a sweep's or a takes
+#: search's workers are new processes, which inherit the environment.
+DECOMPOSITION_CACHE_VARIABLE = "IMPULSE_DECOMPOSITION_CACHE"
+
+if _os.environ.get(DECOMPOSITION_CACHE_VARIABLE):
+    set_decomposition_cache_dir(_os.environ[DECOMPOSITION_CACHE_VARIABLE])
 
 __all__ = [
     "BodyBuilder",
