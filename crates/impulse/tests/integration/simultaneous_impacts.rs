@@ -134,6 +134,35 @@ fn newtons_cradle_of_two_to_five_balls_gives_one_in_one_out() {
     }
 }
 
+/// Several balls in: a row of five touching equal balls whose first `k` move together at
+/// 1 m/s. Propagation's sequence of two-body impacts at e = 1 sends `k` balls out at 1 m/s and
+/// stops the rest, keeping momentum and kinetic energy (Smith et al. 2012, §6: the cradle is
+/// the case their model was built to get right).
+#[test]
+fn newtons_cradle_with_several_balls_in_sends_as_many_out() {
+    for k in 1..=4 {
+        for gap in [0.0, 0.001] {
+            let (mut world, handles) = chain(&[1.0; 5], 1.0, gap, 1.0, ImpactModel::Propagation);
+            for &h in &handles[1..k] {
+                world
+                    .set_linear_velocity(h, Vec3::new(1.0, 0.0, 0.0))
+                    .unwrap();
+            }
+            let v = run(&mut world, &handles, 30);
+            let mut want = vec![0.0; 5];
+            want[5 - k..].fill(1.0);
+            println!("{k} in, gap {gap}: {v:?}");
+            assert_close(&v, &want, 1.0, &format!("{k} in, gap {gap} m"));
+            let energy = kinetic_energy(&[1.0; 5], &v);
+            assert!(
+                (energy - 0.5 * k as f32).abs() <= 1e-3 * k as f32,
+                "{k} in, gap {gap} m: kinetic energy {energy} J of {} J",
+                0.5 * k as f32
+            );
+        }
+    }
+}
+
 /// The default model is the method's one LCP: Newton's targets on the points that collided,
 /// the rest at 0. For a row of five touching equal balls struck at one end at v, the struck
 /// contact leaves at +v and the others together: A·λ = b on the chain's four rows gives the
@@ -359,6 +388,57 @@ fn the_cradle_scene_file_gives_one_in_one_out() {
     }
     let v: Vec<Vec3> = (1..=5).map(|i| world.linear_velocities()[i]).collect();
     assert_close(&v, &[0.0, 0.0, 0.0, 0.0, 1.0], 1.0, "scene file");
+}
+
+/// `scenes/newtons_cradle.json` with `k` balls in: the striker and the `k − 1` balls after it
+/// move together at 1 m/s, touching, towards the `5 − k` at rest 0.1 m on. Returns the balls'
+/// velocities after 1 s.
+fn cradle_scene_with_balls_in(k: usize) -> Vec<Vec3> {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/newtons_cradle.json");
+    let mut scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    for (j, body) in scene.bodies[1..].iter_mut().enumerate() {
+        if j < k {
+            body.position[0] = -0.3 - 0.2 * (k - 1 - j) as f32;
+            body.linear_velocity = [1.0, 0.0, 0.0];
+        } else {
+            body.position[0] = 0.2 * (j - k) as f32;
+        }
+    }
+    let mut world = World::from_scene(&scene).unwrap();
+    for _ in 0..60 {
+        world.step().unwrap();
+    }
+    (1..=5).map(|i| world.linear_velocities()[i]).collect()
+}
+
+/// The scene file with 1 to 3 balls in, under gravity on its frictionless table: as many
+/// leave at 1 m/s and the rest stop, the kinetic energy kept.
+#[test]
+fn the_cradle_scene_file_with_several_balls_in_sends_as_many_out() {
+    for k in 1..=3 {
+        let v = cradle_scene_with_balls_in(k);
+        let mut want = vec![0.0; 5];
+        want[5 - k..].fill(1.0);
+        assert_close(&v, &want, 1.0, &format!("scene file, {k} in"));
+        let energy = kinetic_energy(&[1.0; 5], &v);
+        assert!(
+            (energy - 0.5 * k as f32).abs() <= 1e-3 * k as f32,
+            "{k} in: {energy} J per kg of {} J",
+            0.5 * k as f32
+        );
+    }
+}
+
+/// Four balls in: the reflections of the impact step leave (0, 1, 1, 1, 1) m/s, but the next
+/// step pushes the second ball back and the front three on (0, 0.875, 1.042, 1.042, 1.042):
+/// the row between the second and third balls takes 1/8 of the step's impulse again, the
+/// last substep's share (docs/testing.md, "Simultaneous impacts").
+#[test]
+#[ignore = "fails: the step after a four-ball impact pushes the row apart again (docs/testing.md)"]
+fn the_cradle_scene_file_with_four_balls_in_sends_four_out() {
+    let v = cradle_scene_with_balls_in(4);
+    assert_close(&v, &[0.0, 1.0, 1.0, 1.0, 1.0], 1.0, "scene file, 4 in");
 }
 
 /// An oblique bounce on the ground with propagation keeps Coulomb's friction impulse: a solid
