@@ -114,7 +114,10 @@ pub struct DecompositionDesc {
     /// Largest concavity a part may keep, as a fraction of the mesh's bounding-box diagonal,
     /// in [0, 1]: smaller gives more, tighter parts. Default 0.01.
     pub concavity: f32,
-    /// Most convex parts, 1 to [`MAX_DECOMPOSITION_PARTS`]. Default 1024.
+    /// V-HACD's limit on convex parts, 1 to [`MAX_DECOMPOSITION_PARTS`]. Default 1024. Parry's
+    /// V-HACD turns it into a depth of halving splits and does not merge parts back, so a mesh
+    /// gets at most [`most_parts`]`(max_parts)` parts: twice the power of two at or above it
+    /// (4 for 1, 2,048 for 1,024).
     pub max_parts: u32,
 }
 
@@ -247,6 +250,13 @@ pub fn open_edges(mesh: &MeshData) -> usize {
 /// The convex decomposition of `mesh` with `parameters`, from the cache when this mesh was
 /// decomposed with these parameters before (in this process, or in the cache directory).
 ///
+/// The most convex parts a decomposition with `max_parts` gives ([`DecompositionDesc::max_parts`]):
+/// Parry's V-HACD splits to the depth d with 2^(d−1) the power of two at or above
+/// max(`max_parts`, 2), and does not merge parts back, so up to 2^d.
+pub fn most_parts(max_parts: u32) -> u64 {
+    2 * u64::from(max_parts.max(2)).next_power_of_two()
+}
+
 /// # Errors
 /// A message when the parameters are invalid ([`DecompositionDesc::problems`]), the
 /// resolution would need more memory than [`MAX_DECOMPOSITION_BYTES`] for this mesh (the
@@ -894,6 +904,101 @@ mod tests {
         assert!(
             problem.contains("part 0: vertex 0 is not finite"),
             "{problem}"
+        );
+    }
+
+    /// A seeded draw of decomposition parameters as a user might write them: one in ten of
+    /// each field out of range (0, past the limit, `u32::MAX`, NaN, ±∞, negative), the rest
+    /// log-uniform (resolution 8 to 128 voxels, concavity 10⁻⁶ to 1 or uniform in [0, 1],
+    /// max_parts 1 to 65,536).
+    fn drawn_parameters(generator: &mut rand::rngs::ChaCha20Rng) -> DecompositionDesc {
+        use rand::RngExt;
+        let mut log_uniform =
+            |low: f64, high: f64| (low.ln() + generator.random::<f64>() * (high / low).ln()).exp();
+        let resolution = log_uniform(8.0, 129.0) as u32;
+        let concavity = log_uniform(1e-6, 1.0) as f32;
+        let max_parts = log_uniform(1.0, 65_537.0) as u32;
+        let mut parameters = DecompositionDesc {
+            resolution,
+            concavity: if generator.random() {
+                concavity
+            } else {
+                generator.random()
+            },
+            max_parts,
+        };
+        if generator.random_range(0..10) == 0 {
+            parameters.resolution = [0, 7, 513, u32::MAX][generator.random_range(0..4)];
+        }
+        if generator.random_range(0..10) == 0 {
+            parameters.concavity = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -0.01, 1.5]
+                [generator.random_range(0..5)];
+        }
+        if generator.random_range(0..10) == 0 {
+            parameters.max_parts =
+                [0, 65_537, 2_147_483_649, u32::MAX][generator.random_range(0..4)];
+        }
+        parameters
+    }
+
+    /// `count` seeded parameter sets on the L-shaped prism: each is refused naming its field
+    /// (or the memory it would need), or decomposes into 1 to [`most_parts`] convex parts
+    /// with a positive volume. Returns (refused, decomposed, most parts).
+    fn parameter_sweep(count: u64) -> (usize, usize, usize) {
+        use rand::SeedableRng;
+        let mesh = l_prism();
+        let (mut refused, mut decomposed, mut most) = (0, 0, 0);
+        for seed in 0..count {
+            let mut generator = rand::rngs::ChaCha20Rng::seed_from_u64(0xDEC0 ^ seed);
+            let parameters = drawn_parameters(&mut generator);
+            match decompose_mesh(&mesh, &parameters) {
+                Err(message) => {
+                    assert!(
+                        message.starts_with("decomposition."),
+                        "seed {seed}, {parameters:?}: {message}"
+                    );
+                    assert!(
+                        !parameters.problems().is_empty(),
+                        "seed {seed}, {parameters:?} refused: {message}"
+                    );
+                    refused += 1;
+                }
+                Ok(found) => {
+                    assert!(
+                        parameters.problems().is_empty(),
+                        "seed {seed}: {parameters:?}"
+                    );
+                    let parts = found.parts.len();
+                    assert!(
+                        (1..=most_parts(parameters.max_parts)).contains(&(parts as u64)),
+                        "seed {seed}, {parameters:?}: {parts} parts"
+                    );
+                    assert!(found.unit_mass_properties.mass() > 0.0);
+                    decomposed += 1;
+                    most = most.max(parts);
+                }
+            }
+        }
+        (refused, decomposed, most)
+    }
+
+    #[test]
+    fn drawn_parameters_are_refused_by_name_or_decompose() {
+        let (refused, decomposed, _) = parameter_sweep(24);
+        assert_eq!(refused + decomposed, 24);
+        assert!(refused > 0 && decomposed > 0);
+    }
+
+    /// The long sweep of docs/testing.md: 1,000 parameter sets, none hangs or panics.
+    #[test]
+    #[ignore]
+    fn drawn_parameters_sweep() {
+        let start = std::time::Instant::now();
+        let (refused, decomposed, most) = parameter_sweep(1000);
+        println!(
+            "1000 parameter sets: {refused} refused, {decomposed} decomposed (at most {most} \
+             parts), 0 panics, {:.1} s",
+            start.elapsed().as_secs_f64()
         );
     }
 }

@@ -515,7 +515,8 @@ pub use builtin_pours::POUR_SEED;
 pub use decomposition::{
     ConvexPart, DecomposedMesh, DecompositionDesc, MAX_DECOMPOSITION_BYTES,
     MAX_DECOMPOSITION_PARTS, MAX_DECOMPOSITION_RESOLUTION, decompose_mesh, decomposition_memory,
-    open_edges, open_mesh_note, set_decomposition_cache_dir, take_decomposition_warnings,
+    most_parts, open_edges, open_mesh_note, set_decomposition_cache_dir,
+    take_decomposition_warnings,
 };
 pub use error::{BodyLocation, FieldPath, PathSegment, SceneError, SceneErrorKind, TextPosition};
 pub use joint_desc::{BodyName, DofDesc, DofMode, JointDesc, MotorDesc, StiffnessDesc};
