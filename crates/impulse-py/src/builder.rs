@@ -370,6 +370,7 @@ fn configure(
     let mut b = crate::errors::guarded(|| {
         body_builder(kind, &desc).map_err(|e| WorldError::new_err(e.to_string()))
     })?;
+    mesh_warnings(kind, &desc)?;
     let mut recipe = Recipe {
         kind,
         shape,
@@ -442,6 +443,35 @@ fn configure(
         recipe.props.push((key, property));
     }
     Ok(BodyBuilder { inner: b, recipe })
+}
+
+/// A moving mesh's mass note (open, or overlapping shells: the mass used and the
+/// alternative) and the decomposition cache's warnings, as Python `UserWarning`s: the same
+/// rule as a scene's (`World.from_scene`). The decomposition is the one `body_builder` just
+/// made, taken from the in-memory cache.
+fn mesh_warnings(kind: BodyKind, desc: &ShapeDesc) -> PyResult<()> {
+    let decomposed = matches!(desc, ShapeDesc::Trimesh { .. })
+        && matches!(kind, BodyKind::Dynamic | BodyKind::Kinematic);
+    let note = if decomposed {
+        build_decomposed(kind, desc)
+            .ok()
+            .and_then(|mesh| mesh.note())
+    } else {
+        None
+    };
+    let cache = impulse::scene::take_decomposition_warnings();
+    if note.is_none() && cache.is_empty() {
+        return Ok(());
+    }
+    Python::attach(|py| {
+        for warning in cache {
+            crate::errors::warn(py, &warning)?;
+        }
+        match note {
+            Some(note) => crate::errors::warn(py, &format!("Shape.trimesh: {note}")),
+            None => Ok(()),
+        }
+    })
 }
 
 const PROPERTIES: [&str; 15] = [

@@ -155,7 +155,8 @@ impl World {
     /// Raises `SceneError` (message as `impulse run` prints it: file, line, body, field) for a
     /// scene that cannot be read or built, `WorldError` for bad settings. Warns
     /// (`UserWarning`) with each of the scene's notes, as `impulse run` prints them (a flat
-    /// shape without a `thickness` is given the default one).
+    /// shape without a `thickness` is given the default one; a moving mesh that is open, or
+    /// whose shells overlap, with the mass used and the alternative).
     #[staticmethod]
     #[pyo3(signature = (scene, *, overrides = None, seed = 0, jitter = None, settings = None))]
     fn from_scene(
@@ -182,12 +183,14 @@ impl World {
                 other => SceneError::new_err(format!("cannot build the world: {other}")),
             })
         })?;
-        // The scene's notes (a flat shape given the default thickness) as warnings.
+        // The scene's notes (a flat shape given the default thickness) and its meshes' (an
+        // open mesh's or overlapping shells' mass, a damaged cache file) as warnings.
         let py = scene_argument.py();
-        for note in impulse::scene::notes(&scene) {
-            let message = std::ffi::CString::new(note.to_string().replace('\0', " "))?;
-            let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
-            PyErr::warn(py, category.as_any(), &message, 1)?;
+        let notes = impulse::scene::notes(&scene)
+            .into_iter()
+            .map(|n| n.to_string());
+        for note in notes.chain(impulse::scene::decomposition_notes(&scene)) {
+            crate::errors::warn(py, &note)?;
         }
         Ok(World::wrap(world))
     }

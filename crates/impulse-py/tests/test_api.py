@@ -343,3 +343,32 @@ def test_trimesh_argument_errors_name_the_argument():
         impulse.Shape.trimesh([v[:2] for v in CUBE_VERTICES], CUBE_INDICES)
     shape = impulse.Shape.trimesh(np.array(CUBE_VERTICES, dtype=np.float64), np.array(CUBE_INDICES))
     assert shape.to_dict()["indices"][0] == [0, 2, 3]
+
+
+def test_a_moving_open_mesh_warns_with_its_mass_in_the_library_and_the_scene():
+    """One rule for the library and scene files: a dynamic body's open mesh (the unit cube
+    without its x = 1 face) is weighed by its convex parts, and both paths say so with the
+    parts' volume and the closed hull's; the closed cube weighs its solid (1,000 kg at the
+    default density) without a warning."""
+    import warnings
+
+    open_cube = [t for t in CUBE_INDICES if t not in ((1, 3, 7), (1, 7, 5))]
+    for indices, closed in ((CUBE_INDICES, True), (open_cube, False)):
+        with warnings.catch_warnings(record=True) as library:
+            warnings.simplefilter("always")
+            world = impulse.World()
+            world.insert(impulse.BodyBuilder.dynamic(impulse.Shape.trimesh(CUBE_VERTICES, indices)))
+        shape = {"type": "trimesh", "vertices": CUBE_VERTICES, "indices": indices}
+        with warnings.catch_warnings(record=True) as scene:
+            warnings.simplefilter("always")
+            from_scene = impulse.World.from_scene({"bodies": [{"kind": "dynamic", "shape": shape}]})
+        assert world.masses[0] == from_scene.masses[0]
+        if closed:
+            assert world.masses[0] == pytest.approx(1000.0, rel=1e-4)
+            assert [str(w.message) for w in library + scene] == []
+            continue
+        for caught, where in ((library, "Shape.trimesh: "), (scene, "bodies[0].shape: ")):
+            messages = [str(w.message) for w in caught if issubclass(w.category, UserWarning)]
+            assert len(messages) == 1, messages
+            assert messages[0].startswith(where + "the mesh is not closed (4 edges"), messages[0]
+            assert "its convex hull, closed, has 1.0000e0 m³" in messages[0], messages[0]
