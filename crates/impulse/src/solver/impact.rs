@@ -40,8 +40,13 @@
 //! the one-LCP restitution adds its bounce, so the friction disc allows μ times it. The solve
 //! thus starts at the reflected velocities and only adds what the rest of the step asks
 //! (support against gravity, friction, contacts the impact did not reach).
-//! [`ImpactWorkspace::finish`] then takes the addition back out of the accumulated impulses,
-//! which are the next step's warm start, so that the impact is not given a second time.
+//! [`ImpactWorkspace::finish`] then takes each pushed row's accumulated impulse as the
+//! reflections left it back out, keeping only what the restitution solve added beyond it: the
+//! accumulated impulses are the next step's warm start, and an impact must not be given a
+//! second time. That includes the substeps' own impulse on the row, which is the impact's
+//! too: when the collision falls in a step's last substep, that substep's soft contact holds
+//! half of it, and warm-started it pushed a row of four balls in apart again in the next step
+//! (0.875 and 1.042 m/s instead of 1).
 
 use glam::Vec3;
 
@@ -112,7 +117,8 @@ pub(crate) struct ImpactWorkspace {
     slot_rows: Vec<u32>,
     /// Per moving slot, the next free place of its rows while they are listed.
     cursor: Vec<u32>,
-    /// Per row, what [`Self::propagate`] added to its accumulated normal impulse (N·s).
+    /// Per row the reflections pushed, its accumulated normal impulse as [`Self::propagate`]
+    /// left it (N·s), which [`Self::finish`] takes out again.
     added: Vec<f32>,
     /// Whether `added` is waiting for [`Self::finish`].
     pending: bool,
@@ -220,7 +226,9 @@ impl ImpactWorkspace {
             let change = total - c.step_impulses[0];
             push(c, change, velocities.linear, velocities.angular);
             let accumulated = (c.normal_impulse + change).max(0.0);
-            *added = accumulated - c.normal_impulse;
+            // The whole accumulated impulse is taken out again by `finish`: the substeps'
+            // impulse on a row the reflections pushed is the impact's too.
+            *added = accumulated;
             c.normal_impulse = accumulated;
             // The restitution solve's bookkeeping subtracts the accumulated impulse before it
             // and adds it after: the step total becomes the reflections' plus its change.
@@ -231,11 +239,12 @@ impl ImpactWorkspace {
         any
     }
 
-    /// After the restitution solve that followed [`Self::propagate`]: takes what it added
-    /// back out of each pushed row's accumulated impulse (at least zero) and keeps the friction
-    /// impulse inside the disc of what remains. The accumulated impulses are the next step's
-    /// warm start, which must not give the impact a second time (a struck row of balls left at
-    /// rest would be pushed apart again). The step totals keep the impact.
+    /// After the restitution solve that followed [`Self::propagate`]: takes each pushed row's
+    /// accumulated impulse as the propagation left it (the substeps' and the reflections')
+    /// back out (at least zero), leaving what the restitution solve added, and keeps the
+    /// friction impulse inside the disc of what remains. The accumulated impulses are the next
+    /// step's warm start, which must not give the impact a second time (a struck row of balls
+    /// left at rest would be pushed apart again). The step totals keep the impact.
     pub(crate) fn finish(&mut self, constraints: &mut [ContactConstraint]) {
         if !std::mem::take(&mut self.pending) {
             return;

@@ -412,11 +412,13 @@ fn cradle_scene_with_balls_in(k: usize) -> Vec<Vec3> {
     (1..=5).map(|i| world.linear_velocities()[i]).collect()
 }
 
-/// The scene file with 1 to 3 balls in, under gravity on its frictionless table: as many
-/// leave at 1 m/s and the rest stop, the kinetic energy kept.
+/// The scene file with 1 to 4 balls in, under gravity on its frictionless table: as many
+/// leave at 1 m/s and the rest stop, the kinetic energy kept. (With four in, the collision
+/// falls in the impact step's last substep: warm-starting that substep's impulse pushed the
+/// row apart again in the next step, to 0.875 and 1.042 m/s.)
 #[test]
 fn the_cradle_scene_file_with_several_balls_in_sends_as_many_out() {
-    for k in 1..=3 {
+    for k in 1..=4 {
         let v = cradle_scene_with_balls_in(k);
         let mut want = vec![0.0; 5];
         want[5 - k..].fill(1.0);
@@ -428,17 +430,6 @@ fn the_cradle_scene_file_with_several_balls_in_sends_as_many_out() {
             0.5 * k as f32
         );
     }
-}
-
-/// Four balls in: the reflections of the impact step leave (0, 1, 1, 1, 1) m/s, but the next
-/// step pushes the second ball back and the front three on (0, 0.875, 1.042, 1.042, 1.042):
-/// the row between the second and third balls takes 1/8 of the step's impulse again, the
-/// last substep's share (docs/testing.md, "Simultaneous impacts").
-#[test]
-#[ignore = "fails: the step after a four-ball impact pushes the row apart again (docs/testing.md)"]
-fn the_cradle_scene_file_with_four_balls_in_sends_four_out() {
-    let v = cradle_scene_with_balls_in(4);
-    assert_close(&v, &[0.0, 1.0, 1.0, 1.0, 1.0], 1.0, "scene file, 4 in");
 }
 
 /// An oblique bounce on the ground with propagation keeps Coulomb's friction impulse: a solid
