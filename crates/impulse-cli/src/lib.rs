@@ -46,9 +46,16 @@ struct Cli {
 #[allow(clippy::large_enum_variant)]
 enum Command {
     /// Step a scene (a JSON file or a built-in name) and print a summary.
+    ///
+    /// The summary gives ms/step, the largest overlap, the top body's sink and the drift
+    /// (quality measures when every body starts at rest, within 1 cm/s and 0.01 rad/s; for a
+    /// moving scene they are labelled "moving scene, not errors"), the kinetic energy and the
+    /// LCP's natural-map residual. Two outputs naming one file are refused before the run; a
+    /// write error names the file and exits 1; Ctrl-C, SIGTERM and SIGHUP stop the run after
+    /// the step under way, write its files and exit 130 (docs/cli.md, docs/errors.md).
     Run {
-        /// JSON scene file, the name of a built-in scene (see `impulse scenes`), or a
-        /// UsdPhysics stage (.usd, .usda, .usdc, .usdz: read by `python3 -m impulse.usd`; with
+        /// JSON scene file (at most 256 MiB, docs/scene-format.md), the name of a built-in
+        /// scene (see `impulse scenes`), or a UsdPhysics stage (.usd, .usda, .usdc, .usdz: read by `python3 -m impulse.usd`; with
         /// `--out` a .usda or .usdc layer, the bake written over the stage, docs/usd.md).
         scene: String,
         /// Steps to take, ≥ 1 (default: the scene's, 600 for built-ins).
@@ -60,7 +67,9 @@ enum Command {
         #[command(flatten)]
         solver: solver_args::SolverArgs,
         /// Write what the solver did on each island at each step, and the step's wall-clock
-        /// time in ms (JSON Lines).
+        /// time in ms (JSON Lines): per step its time (`ms`), each stage's time (`stages`) and,
+        /// per island, the method used, escalations, iterations, the residual reached and the
+        /// deepest contact (its bodies, depth, and the part of a compound it is on).
         #[arg(long)]
         island_report: Option<PathBuf>,
         /// Write per-step diagnostics as CSV, one row per step: step, time, contacts, rows,
@@ -80,7 +89,7 @@ enum Command {
         /// Write every K-th frame, K ≥ 1 (frame 0 and the last are always written).
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
         every: u32,
-        /// Write the summary as JSON to this file.
+        /// Write the summary as JSON to this file, with each stage's median time as `stage_ms`.
         #[arg(long)]
         summary_json: Option<PathBuf>,
         /// No progress bar.
@@ -88,9 +97,13 @@ enum Command {
         quiet: bool,
         /// After the summary, print the median wall time of each stage of the step (kinematic,
         /// broad phase, narrow phase, islands, assembly, solve, scatter, continuous, store
-        /// impulses, finish, end step; `impulse::report::Stage`) and the median CPU time of each phase
-        /// of the solve stage summed over islands (`impulse::report::SolvePhase`; timed only with
-        /// `--profile` or `--stats`).
+        /// impulses, finish, end step; `impulse::report::Stage`), the median CPU time of each
+        /// phase of the solve stage summed over islands (prepare, integrate velocities, warm
+        /// start, main solve, integrate positions, relax, impacts, record;
+        /// `impulse::report::SolvePhase`; timed only with `--profile` or `--stats`), and which
+        /// build of the SIMD kernels ran (x86-64-v4 where the CPU has AVX-512, x86-64-v3 where
+        /// it has AVX2, the same results unless `--fused-multiply-add`;
+        /// `IMPULSE_INSTRUCTION_SET=baseline` keeps the baseline).
         #[arg(long)]
         profile: bool,
         #[command(flatten)]
@@ -183,7 +196,7 @@ enum Command {
         quiet: bool,
     },
     /// Plot the columns of an `impulse run --stats` CSV over the run (SVG or PNG, one
-    /// panel per column).
+    /// panel per column; the font is built in).
     Plot {
         /// CSV file written by `impulse run --stats`.
         stats: PathBuf,
@@ -198,7 +211,8 @@ enum Command {
     /// List the built-in scenes and the parametrised families (pyramidN, pyramid3dN, stackN,
     /// ballsN).
     Scenes,
-    /// Write a scene (built-in name or file) as JSON.
+    /// Write a scene (built-in name or file) as JSON, with the overrides and jitter applied
+    /// (the files in `scenes/` were made this way).
     Export {
         /// Built-in name, JSON file or UsdPhysics stage.
         scene: String,
@@ -237,7 +251,7 @@ enum Command {
 /// World snapshots written while stepping (docs/snapshots.md).
 #[derive(clap::Args)]
 struct CheckpointArgs {
-    /// Write a world snapshot every K steps (K ≥ 1) into --checkpoint-dir.
+    /// Write a world snapshot every K steps (K ≥ 1) into --checkpoint-dir, each atomically.
     #[arg(long, requires = "checkpoint_dir", value_parser = clap::value_parser!(u64).range(1..))]
     checkpoint_every: Option<u64>,
     /// Directory (created if missing) for the snapshots, `step-000120.snapshot`: every
@@ -250,6 +264,9 @@ struct CheckpointArgs {
 #[derive(Subcommand)]
 enum LcpCommand {
     /// Solve an LCP file: Siconos `.dat` (w = Mz + q) or impulse `.json` (w = Aγ − b).
+    ///
+    /// Exits non-zero when the solver fails; Lemke refuses n > 8,000 rows, naming the memory it
+    /// would need (docs/lcp.md).
     Solve {
         file: PathBuf,
         /// pgs, jacobi or lemke.

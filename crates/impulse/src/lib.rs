@@ -150,7 +150,7 @@ pub mod internals {
     }
 }
 
-/// The README's code, compiled and run as a doc-test.
-#[doc = include_str!("../../../README.md")]
+/// The library tour's code (docs/library.md), compiled and run as a doc-test.
+#[doc = include_str!("../../../docs/library.md")]
 #[cfg(doctest)]
-pub struct ReadmeDoctests;
+pub struct LibraryDocDoctests;

@@ -598,11 +598,11 @@ fn a_preset_keeps_the_scenes_restitution_threshold() {
     assert!(rebound > 0.05, "bounced only {rebound:.3} m");
 }
 
-/// The README's commands write only files outside the repository's tracked tree: absolute
-/// paths under /tmp, or bare names in the working directory that `.gitignore` ignores.
+/// The commands of the README and of docs/cli.md write only files outside the repository's
+/// tracked tree: absolute paths under /tmp, or bare names in the working directory that
+/// `.gitignore` ignores.
 #[test]
-fn the_readme_examples_write_outside_tracked_files() {
-    let readme = std::fs::read_to_string(repo("README.md")).unwrap();
+fn the_documented_examples_write_outside_tracked_files() {
     let gitignore = std::fs::read_to_string(repo(".gitignore")).unwrap();
     let ignored = |name: &str| {
         gitignore.lines().any(|pattern| {
@@ -613,9 +613,19 @@ fn the_readme_examples_write_outside_tracked_files() {
                 || pattern.trim_end_matches('/') == name
         })
     };
+    for doc in ["README.md", "docs/cli.md"] {
+        let text = std::fs::read_to_string(repo(doc)).unwrap();
+        let checked = outputs_outside_tracked_files(doc, &text, &ignored);
+        assert!(checked >= 3, "only {checked} outputs found in {doc}");
+    }
+}
+
+/// How many outputs the commands of `doc` (text `text`) write, each checked to be under /tmp
+/// or a bare name that `ignored` says `.gitignore` ignores.
+fn outputs_outside_tracked_files(doc: &str, text: &str, ignored: &dyn Fn(&str) -> bool) -> usize {
     let mut checked = 0;
     // Commands continued over lines with a trailing backslash, joined.
-    let joined = readme.replace("\\\n", " ");
+    let joined = text.replace("\\\n", " ");
     for line in joined.lines() {
         let line = line.trim();
         if !(line.starts_with("impulse ") || line.starts_with("cargo run")) {
@@ -638,12 +648,12 @@ fn the_readme_examples_write_outside_tracked_files() {
                 let bare_and_ignored = !path.contains('/') && ignored(path);
                 assert!(
                     outside || bare_and_ignored,
-                    "README example writes {path} inside the repository: {line}"
+                    "{doc} example writes {path} inside the repository: {line}"
                 );
             }
         }
     }
-    assert!(checked >= 3, "only {checked} outputs found in the README");
+    checked
 }
 
 /// `lcp engine-convergence` replays a run once per iteration count: it takes --quiet too.
