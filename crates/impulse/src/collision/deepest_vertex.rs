@@ -14,8 +14,12 @@
 //! Here the hull's support vertex along the manifold's normal (the deepest vertex, a scan of the
 //! hull's vertices) becomes a point of its own when it is deeper than every point of the
 //! manifold by more than [`DEPTH_TIE`] and within the prediction: against a half-space always,
-//! against a triangle when the manifold's normal is the triangle's face normal (within
-//! [`FACE_ON`]) and the vertex lies over the triangle (a vertex beside it is another triangle's).
+//! against a triangle when the vertex lies over the triangle (a vertex beside it is another
+//! triangle's) and the manifold's normal is within 45° of the triangle's face normal
+//! ([`TILTED`]). A normal off the face normal by more than [`FACE_ON`] (taken from a face of
+//! the hull by Parry's clipping, as a round hull rolls from one facet to the next) is then
+//! replaced by the face normal, the manifold's points re-expressed along it: the hull rests on
+//! the triangle's plane.
 //! The point is named by the vertex and the flat shape's face, so its impulse carries over from
 //! step to step while it stays the deepest.
 
@@ -32,6 +36,13 @@ const DEPTH_TIE: Real = 1.0e-4;
 /// Cosine of the largest angle between a manifold's normal and a triangle's face normal at
 /// which the triangle is seen face-on (0.01 rad).
 const FACE_ON: Real = 0.99995;
+
+/// Cosine of the largest angle between a manifold's normal and a triangle's face normal at
+/// which a hull whose lowest vertex lies over the triangle is taken to rest on the triangle's
+/// plane (45°): Parry's clipping may take the normal from the hull's face (a round hull
+/// rolling from one facet to the next tilted it by up to 7° and let its lowest vertex sink
+/// 25 mm into a mesh), and the manifold is then re-expressed along the triangle's normal.
+const TILTED: Real = std::f32::consts::FRAC_1_SQRT_2;
 
 /// Distance (m) within which a manifold point on the hull is at the deepest vertex already.
 const SAME_POINT: Real = 1.0e-5;
@@ -94,7 +105,7 @@ fn add<ManifoldData, ContactData: Default + Copy>(
             } else {
                 (-face_normal, PackedFeatureId::face(1))
             };
-            if face_normal.dot(along) < FACE_ON {
+            if face_normal.dot(along) < TILTED {
                 return;
             }
             (face_normal, triangle.a, face, Some(triangle))
@@ -111,18 +122,28 @@ fn add<ManifoldData, ContactData: Default + Copy>(
     if dist > prediction {
         return;
     }
+    let on_flat = at - normal * (dist + border);
+    if let Some(triangle) = triangle {
+        if !over_triangle(triangle, normal, on_flat) {
+            return;
+        }
+        let along = if flipped {
+            manifold.local_n2
+        } else {
+            manifold.local_n1
+        };
+        if normal.dot(along) < FACE_ON {
+            // The hull's lowest vertex is over the triangle: its plane is what the hull rests
+            // on, whatever face of the hull Parry's clipping took the normal from.
+            to_face_normal(pos12, normal, origin, manifold, flipped);
+        }
+    }
     let nearest = manifold
         .points
         .iter()
         .map(|point| point.dist)
         .fold(Real::INFINITY, Real::min);
     if dist >= nearest - DEPTH_TIE {
-        return;
-    }
-    let on_flat = at - normal * (dist + border);
-    if let Some(triangle) = triangle
-        && !over_triangle(triangle, normal, on_flat)
-    {
         return;
     }
     let vertex_id = PackedFeatureId::vertex(vertex as u32);
@@ -151,6 +172,40 @@ fn add<ManifoldData, ContactData: Default + Copy>(
         (manifold.local_n1, manifold.local_n2) = if flipped { (n2, normal) } else { (normal, n2) };
     }
     manifold.points.push(point);
+}
+
+/// Re-expresses `manifold` (of a flat shape and a hull, the hull's pose in the flat shape's
+/// frame being `pos12`; `flipped` when the hull is the manifold's first shape) along the flat
+/// shape's outward unit normal `normal` through `origin`: each point keeps its features and its
+/// point on the hull, and takes its distance along `normal` and its point on the plane.
+fn to_face_normal<ManifoldData, ContactData>(
+    pos12: &Pose,
+    normal: Vector,
+    origin: Vector,
+    manifold: &mut ContactManifold<ManifoldData, ContactData>,
+    flipped: bool,
+) {
+    let on_hull_normal = pos12.rotation.inverse() * -normal;
+    (manifold.local_n1, manifold.local_n2) = if flipped {
+        (on_hull_normal, normal)
+    } else {
+        (normal, on_hull_normal)
+    };
+    for point in &mut manifold.points {
+        let on_hull = if flipped {
+            point.local_p1
+        } else {
+            point.local_p2
+        };
+        let at = pos12 * on_hull;
+        point.dist = (at - origin).dot(normal);
+        let on_flat = at - normal * point.dist;
+        if flipped {
+            point.local_p2 = on_flat;
+        } else {
+            point.local_p1 = on_flat;
+        }
+    }
 }
 
 /// Whether `point` (on the plane of `triangle`, whose unit normal is `normal`) lies over the
