@@ -367,10 +367,17 @@ fn configure(
         Ok(desc) => desc.clone(),
         Err(radius) => ShapeDesc::Sphere { radius: *radius },
     };
-    let mut b = crate::errors::guarded(|| {
-        body_builder(kind, &desc).map_err(|e| WorldError::new_err(e.to_string()))
-    })?;
-    mesh_warnings(kind, &desc)?;
+    // A moving mesh is decomposed here: on a thread of its own, so that Ctrl-C interrupts it.
+    let decomposed = matches!(desc, ShapeDesc::Trimesh { .. })
+        && matches!(kind, BodyKind::Dynamic | BodyKind::Kinematic);
+    let built = desc.clone();
+    let build = move || body_builder(kind, &built).map_err(|e| WorldError::new_err(e.to_string()));
+    let mut b = if decomposed {
+        Python::attach(|py| crate::errors::interruptible(py, build))?
+    } else {
+        crate::errors::guarded(build)?
+    };
+    mesh_warnings(kind, &desc, decomposed)?;
     let mut recipe = Recipe {
         kind,
         shape,
@@ -448,10 +455,8 @@ fn configure(
 /// A moving mesh's mass note (open, or overlapping shells: the mass used and the
 /// alternative) and the decomposition cache's warnings, as Python `UserWarning`s: the same
 /// rule as a scene's (`World.from_scene`). The decomposition is the one `body_builder` just
-/// made, taken from the in-memory cache.
-fn mesh_warnings(kind: BodyKind, desc: &ShapeDesc) -> PyResult<()> {
-    let decomposed = matches!(desc, ShapeDesc::Trimesh { .. })
-        && matches!(kind, BodyKind::Dynamic | BodyKind::Kinematic);
+/// made (`decomposed`: a trimesh on a moving body), taken from the in-memory cache.
+fn mesh_warnings(kind: BodyKind, desc: &ShapeDesc, decomposed: bool) -> PyResult<()> {
     let note = if decomposed {
         build_decomposed(kind, desc)
             .ok()

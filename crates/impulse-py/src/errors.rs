@@ -53,3 +53,41 @@ pub(crate) fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
     let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
     PyErr::warn(py, category.as_any(), &message, 1)
 }
+
+/// Runs `work` (under [`guarded`]) on a thread of its own while the calling thread waits
+/// without the GIL and checks for Ctrl-C every 50 ms, so that a long convex decomposition
+/// (seconds to minutes for a fine mesh at a high resolution) can be interrupted as a run of
+/// steps can: a `KeyboardInterrupt` is raised at once and the work is abandoned (its thread
+/// finishes in the background; a decomposition it completes stays in the in-memory cache).
+pub(crate) fn interruptible<T: Send + 'static>(
+    py: Python<'_>,
+    work: impl FnOnce() -> PyResult<T> + Send + 'static,
+) -> PyResult<T> {
+    use std::sync::mpsc::{RecvTimeoutError, channel};
+    let (sender, receiver) = channel();
+    std::thread::Builder::new()
+        .name("impulse-build".to_string())
+        .spawn(move || {
+            // The receiver is gone when the caller was interrupted: the result is dropped.
+            let _ = sender.send(guarded(work));
+        })
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
+    let mut receiver = receiver;
+    loop {
+        // The receiver goes into the GIL-free wait and back (`&Receiver` is not `Send`).
+        let (received, back) = py.detach(move || {
+            let received = receiver.recv_timeout(std::time::Duration::from_millis(50));
+            (received, receiver)
+        });
+        receiver = back;
+        match received {
+            Ok(result) => return result,
+            Err(RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(PyRuntimeError::new_err(
+                    "the thread building the world ended without a result",
+                ));
+            }
+        }
+    }
+}

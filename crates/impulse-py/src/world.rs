@@ -173,8 +173,10 @@ impl World {
             let preset = Settings::from_argument(settings)?;
             scene.solver = scene.solver.with_effort_of(&preset);
         }
-        let world = guarded(|| {
-            impulse::World::from_scene(&scene).map_err(|e| match e {
+        // On a thread of its own, so that Ctrl-C interrupts the meshes' decompositions.
+        let built = scene.clone();
+        let world = crate::errors::interruptible(scene_argument.py(), move || {
+            impulse::World::from_scene(&built).map_err(|e| match e {
                 impulse::WorldError::InvalidSettings(ref problem)
                     if impulse::settings::SettingError::WORLD_FIELDS.contains(&problem.field) =>
                 {

@@ -372,3 +372,50 @@ def test_a_moving_open_mesh_warns_with_its_mass_in_the_library_and_the_scene():
             assert len(messages) == 1, messages
             assert messages[0].startswith(where + "the mesh is not closed (4 edges"), messages[0]
             assert "its convex hull, closed, has 1.0000e0 m³" in messages[0], messages[0]
+
+
+def _torus(n, m, ring=1.0, tube=0.3):
+    """A closed torus of n × m quads (two triangles each), wound outward."""
+    u = np.repeat(np.arange(n) * 2 * np.pi / n, m)
+    v = np.tile(np.arange(m) * 2 * np.pi / m, n)
+    vertices = np.stack(
+        [(ring + tube * np.cos(v)) * np.cos(u), tube * np.sin(v), (ring + tube * np.cos(v)) * np.sin(u)],
+        axis=1,
+    )
+    indices = []
+    for i in range(n):
+        for j in range(m):
+            a, b = i * m + j, ((i + 1) % n) * m + j
+            c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
+            indices += [(a, d, c), (a, c, b)]
+    return vertices, np.array(indices)
+
+
+@pytest.mark.parametrize("path", ["builder", "scene"])
+def test_ctrl_c_interrupts_a_long_decomposition(path):
+    """Ctrl-C during a moving mesh's convex decomposition (a 4,608-quad torus at resolution
+    300, seconds of V-HACD) raises KeyboardInterrupt from the call that decomposes, as it does
+    between a run's steps, from `BodyBuilder.dynamic` and from `World.from_scene` alike."""
+    import _thread
+    import threading
+    import time
+
+    vertices, indices = _torus(96, 48)
+    parameters = {"resolution": 300 if path == "builder" else 299}
+    fired = []
+
+    def interrupt():
+        fired.append(time.monotonic())
+        _thread.interrupt_main()
+
+    timer = threading.Timer(0.5, interrupt)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        if path == "builder":
+            impulse.BodyBuilder.dynamic(impulse.Shape.trimesh(vertices, indices, decomposition=parameters))
+        else:
+            shape = {"type": "trimesh", "vertices": vertices.tolist(), "indices": indices.tolist(), "decomposition": parameters}
+            impulse.World.from_scene({"bodies": [{"kind": "dynamic", "shape": shape}]})
+    timer.cancel()
+    assert fired, "the call ended before Ctrl-C"
+    print(f"{path}: interrupted {time.monotonic() - fired[0]:.3f} s after Ctrl-C")
