@@ -64,8 +64,8 @@ def _cli() -> tuple[list[str], dict[str, str] | None]:
 #: default, :func:`goal_camera`), ``scene``
 #: is ``impulse render``'s own view of the moving bodies at step 0.
 CAMERAS = ("goals", "scene")
-#: Room around the goal bodies' paths in a ``goals`` preview: the framed sphere's radius is
-#: this times the paths' bounding sphere's.
+#: Room around what a ``goals`` preview frames: the framed box fits the image's field of view
+#: divided by this.
 MARGIN = 1.15
 #: ``impulse render``'s default field of view (degrees, vertical) and three-quarter view
 #: direction, which a ``goals`` camera keeps.
@@ -109,8 +109,8 @@ _CONTACTS = ("touches", "never_touches")
 #: A goal body's judged place farther than this many times the median distance of them all
 #: from their median (a bowling pin knocked into the pit) is left out of a ``goals`` frame.
 OUTLIER = 3.0
-#: A ``goals`` frame is at least this many times the largest goal body's extent in radius, so
-#: that a lone body is seen with what is around it.
+#: A ``goals`` frame's narrower side is at least this many times the largest goal body's
+#: extent (half of it from the centre), so that a lone body is seen with what is around it.
 CONTEXT = 3.0
 #: A ``goals`` frame takes in the goals' regions too when each goal body stays at least this
 #: many pixels across (its extent sphere's diameter).
@@ -241,12 +241,37 @@ def _without_outliers(
     return [box for box, distance in zip(boxes, distances, strict=True) if distance <= limit]
 
 
-def _framed_radius(boxes: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, float]:
-    """The centre and :data:`MARGIN` times the bounding sphere's radius of the box holding
-    ``boxes`` (m)."""
+def _framed(
+    boxes: list[tuple[np.ndarray, np.ndarray]], size: tuple[int, int]
+) -> tuple[np.ndarray, float]:
+    """The target (the centre of the box holding ``boxes``; m) and the least distance (m) from
+    it along :data:`VIEW_DIRECTION` at which every corner of that box is inside the ``size``
+    (W, H) image shrunk by :data:`MARGIN`."""
     low = np.min([box[0] for box in boxes], axis=0)
     high = np.max([box[1] for box in boxes], axis=0)
-    return 0.5 * (low + high), MARGIN * 0.5 * float(np.linalg.norm(high - low))
+    centre = 0.5 * (low + high)
+    back = np.asarray(VIEW_DIRECTION, dtype=float)
+    back /= np.linalg.norm(back)
+    right = np.cross([0.0, 1.0, 0.0], back)
+    right /= np.linalg.norm(right)
+    up = np.cross(back, right)
+    tan_y, tan_x = _half_tangents(size)
+    distance = 1e-3
+    for corner in np.array(np.meshgrid(*zip(low, high, strict=True))).reshape(3, -1).T:
+        offset = corner - centre
+        # A corner at depth d beyond the target (along the view) is in the image when its
+        # sideways offsets are within (distance + d) times the half field's tangents.
+        depth = -float(offset @ back)
+        for side, tangent in ((float(offset @ right), tan_x), (float(offset @ up), tan_y)):
+            distance = max(distance, MARGIN * abs(side) / tangent - depth)
+    return centre, distance
+
+
+def _half_tangents(size: tuple[int, int]) -> tuple[float, float]:
+    """The tangents of half the vertical and horizontal fields of view of a ``size`` image."""
+    width, height = size
+    tan_y = math.tan(0.5 * math.radians(FOV_DEGREES))
+    return tan_y, tan_y * width / height
 
 
 def goal_camera(
@@ -262,12 +287,13 @@ def goal_camera(
     (or ``at``), a body that must pass through a region where it comes closest to it; the
     paths of the bodies of contact goals (``touches``, ``never_touches``) only when no goal
     judges a body at a place. Bodies are grown by their shapes' extents; a place far from all
-    the others (:data:`OUTLIER`; a pin knocked into the pit) is left out. The box holding the
-    rest is framed so that its bounding sphere, times :data:`MARGIN`, fits the ``size`` (W, H)
-    image, and at least :data:`CONTEXT` times the largest goal body's extent (room around a
-    lone body). The goals' regions are framed too when every goal body stays at least
-    :data:`SMALLEST` pixels across. Static bodies (the ground a ball must touch) are left out.
-    ``None`` when the goals look at no moving body (custom goals only, say)."""
+    the others (:data:`OUTLIER`; a pin knocked into the pit) is left out. The camera is as
+    close as keeps the box holding the rest inside the ``size`` (W, H) image shrunk by
+    :data:`MARGIN`, and no closer than a frame :data:`CONTEXT` times the largest goal body's
+    extent across (room around a lone body). The goals' regions are framed too when every goal
+    body then stays at least :data:`SMALLEST` pixels across. Static bodies (the ground a ball
+    must touch) are left out. ``None`` when the goals look at no moving body (custom goals
+    only, say)."""
     from impulse.takes._search import simulate_take
 
     shapes = scene.get("bodies", [])
@@ -277,24 +303,23 @@ def goal_camera(
     boxes, regions = _judged_boxes(record, shapes, views)
     if not boxes:
         return None
-    centre, radius = _framed_radius([box[:2] for box in boxes])
-    radius = max(radius, CONTEXT * max(box[2] for box in boxes), 1e-3)
-    width, height = size
-    half_y = 0.5 * math.radians(FOV_DEGREES)
-    half_x = math.atan(math.tan(half_y) * width / height)
-    half = min(half_x, half_y)
+    tan_y, tan_x = _half_tangents(size)
+    narrow = min(tan_x, tan_y)
+    centre, distance = _framed([box[:2] for box in boxes], size)
+    distance = max(distance, CONTEXT * max(box[2] for box in boxes) / narrow)
     if regions:
-        # A body of extent e in a frame of radius R is e * N * cos(half) / R pixels across, N
+        # A body of extent e at distance D is e * N / (D * tan(half field)) pixels across, N
         # the pixels of the narrower side.
-        pixels = min(width, height) * math.cos(half)
+        pixels = min(size) / narrow
         smallest = min(box[2] for box in boxes)
-        with_regions, wider = _framed_radius([box[:2] for box in boxes] + regions)
-        if smallest > 0.0 and smallest * pixels / max(wider, radius) >= SMALLEST:
-            centre, radius = with_regions, max(wider, radius)
-    if not (np.all(np.isfinite(centre)) and math.isfinite(radius)):
+        with_regions, farther = _framed([box[:2] for box in boxes] + regions, size)
+        farther = max(farther, distance)
+        if smallest * pixels / farther >= SMALLEST:
+            centre, distance = with_regions, farther
+    if not (np.all(np.isfinite(centre)) and math.isfinite(distance)):
         return None
     direction = np.asarray(VIEW_DIRECTION) / np.linalg.norm(VIEW_DIRECTION)
-    eye = centre + direction * (radius / math.sin(half))
+    eye = centre + direction * distance
     return [float(v) for v in eye], [float(v) for v in centre]
 
 
