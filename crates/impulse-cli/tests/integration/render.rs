@@ -197,6 +197,55 @@ fn a_region_is_outlined_over_the_bodies_and_a_bad_one_is_refused_by_name() {
 }
 
 #[test]
+fn a_thin_ground_is_drawn_where_it_is() {
+    // A flat box 0.6 m square (a Blender Plane: no thickness) under one die of two 2 m apart:
+    // narrower than the dice's spread, so it is drawn as itself, not taken as the grid.
+    let dir = temp_dir("thin_ground");
+    let die = |x: f32| {
+        format!(
+            r#"{{"kind": "dynamic", "position": [{x}, 0.3, 0.0], "shape": {{"type": "cuboid", "half_extents": [0.05, 0.05, 0.05]}}}}"#
+        )
+    };
+    let plane = r#"{"name": "plane", "kind": "static", "shape": {"type": "cuboid", "half_extents": [0.3, 0.0, 0.3]}}"#;
+    // Without the plane, a 1 mm static ball as low as the plane's 2 mm slab keeps the grid at
+    // the same height, so that only the plane can change the image.
+    let speck =
+        r#"{"name": "speck", "kind": "static", "shape": {"type": "sphere", "radius": 0.001}}"#;
+    let draw = |name: &str, with_plane: bool| {
+        let mut bodies = vec![die(0.0), die(2.0)];
+        bodies.insert(0, if with_plane { plane } else { speck }.to_string());
+        let path = dir.join(format!("{name}.json"));
+        std::fs::write(
+            &path,
+            format!(r#"{{"name": "{name}", "bodies": [{}]}}"#, bodies.join(", ")),
+        )
+        .unwrap();
+        let frames = dir.join(name);
+        let out = impulse()
+            .args(["render", path.to_str().unwrap(), "--steps", "0"])
+            .args(["--size", "160x100", "--out", frames.to_str().unwrap()])
+            .args(["--camera-eye", "0,2,2", "--camera-target", "0,0,0"])
+            .output()
+            .unwrap();
+        assert_success(&out, "render: ");
+        read_png(&frames.join("frame_00000.png"))
+    };
+    let (with, without) = (draw("with", true), draw("without", false));
+    let changed = with
+        .pixels()
+        .zip(without.pixels())
+        .filter(|(p, q)| {
+            (0..3)
+                .map(|c| (p.0[c] as i32 - q.0[c] as i32).abs())
+                .sum::<i32>()
+                > 30
+        })
+        .count();
+    // The plane spans about 30 × 20 pixels from there, less the die on it.
+    assert!(changed > 300, "the plane changed only {changed} pixels");
+}
+
+#[test]
 fn the_gif_has_one_frame_per_drawn_step() {
     let dir = temp_dir("gif");
     let scene = scene(&dir, true);
