@@ -103,8 +103,8 @@ def _extent(shape: Any) -> float:
 
 #: The goals that read a body's pose at one time (``at``, default the end).
 _AT_ONE_TIME = ("ends_inside", "rests_with_axis_up", "tilted")
-#: The goals read over a window (``between``, default the whole take) with no place of their
-#: own: a ``goals`` camera frames their bodies' paths only when no other goal gives a place.
+#: The contact goals, read over a window (``between``, default the whole take) with no place
+#: of their own: a ``goals`` camera frames their bodies' paths only when no goal gives a place.
 _CONTACTS = ("touches", "never_touches")
 #: A goal body's judged place farther than this many times the median distance of them all
 #: from their median (a bowling pin knocked into the pit) is left out of a ``goals`` frame.
@@ -121,10 +121,10 @@ def goal_views(specs: Any) -> list[tuple[Any, str, Any, Any]]:
     """Where the search's JSON goals are judged, as ``(body, how, when, region)``: ``how`` is
     ``"at"`` (the body at ``when`` s, None: the end; ``ends_inside``, ``rests_with_axis_up``,
     ``tilted``), ``"closest"`` (the body where it comes closest to ``region`` in the window
-    ``when``, [t0, t1] s or None for the whole take; ``passes_through``), ``"region"`` (the
-    region alone; ``stays_inside``) or ``"path"`` (the body over the window; ``body`` and
-    ``other`` of ``touches`` and ``never_touches``). ``region`` is the goal's region (a
-    ``box`` or ``sphere`` mapping) or None."""
+    ``when``, [t0, t1] s or None for the whole take; ``passes_through``) or ``"path"`` (the
+    body over the window ``when``; ``stays_inside``, and ``body`` and ``other`` of ``touches``
+    and ``never_touches``). ``region`` is the goal's region (a ``box`` or ``sphere`` mapping)
+    or None."""
     views: list[tuple[Any, str, Any, Any]] = []
     for spec in specs or []:
         if not isinstance(spec, dict) or "type" not in spec:
@@ -136,8 +136,8 @@ def goal_views(specs: Any) -> list[tuple[Any, str, Any, Any]]:
         elif kind == "passes_through":
             views.append((spec.get("body"), "closest", spec.get("between"), region))
         elif kind == "stays_inside":
-            views.append((spec.get("body"), "region", spec.get("between"), region))
-        else:
+            views.append((spec.get("body"), "path", spec.get("between"), region))
+        elif kind in _CONTACTS:
             for field in ("body", "other"):
                 if field in spec:
                     views.append((spec[field], "path", spec.get("between"), None))
@@ -188,11 +188,12 @@ def region_arguments(views: list[tuple[Any, ...]]) -> list[str]:
 def _judged_boxes(
     record: Any, shapes: list[Any], views: list[tuple[Any, ...]]
 ) -> tuple[list[tuple[np.ndarray, np.ndarray, float]], list[tuple[np.ndarray, np.ndarray]]]:
-    """What a ``goals`` camera frames: the boxes (low, high; m) of the goal bodies where their
-    goals are judged, each with the body's extent (m; a body at its time, a body where it comes
-    closest to its region, or, for contact goals, over its window, extent 0 when some goal
-    judges a body at a place), and the boxes of the goals' regions. Static bodies are left out
-    (the ground a ball must touch is everywhere)."""
+    """What a ``goals`` camera frames: the boxes (low, high; m) of the moving goal bodies where
+    their goals are judged, each with the body's extent (m): a body at its time, a body where
+    it comes closest to its region, less those far from the rest (:func:`_without_outliers`);
+    or, when no goal judges a body at a place, the bodies over their windows. And the boxes of
+    the goals' regions. Static bodies are left out (the ground a ball must touch is
+    everywhere)."""
 
     def moving(index: int) -> bool:
         return index < len(shapes) and shapes[index].get("kind", "static") != "static"
@@ -206,7 +207,7 @@ def _judged_boxes(
         region = region_box(view[3]) if len(view) > 3 else None
         if region is not None:
             regions.append(region)
-        if how == "region" or body is None:
+        if body is None:
             continue
         index = record.body(body)
         if not moving(index):
