@@ -1513,6 +1513,22 @@ def test_a_preview_frames_the_goal_bodies(tmp_path, impulse_cli):
     assert scene_view[0] < 20 and scene_view[1] < 20, scene_view
 
 
+def test_a_goals_frame_is_where_the_goals_are_judged_less_a_body_far_from_the_rest(repository):
+    from impulse.takes._sheet import _without_outliers, goal_views
+
+    hoop = json.loads((repository / "scenes" / "takes" / "hoop.goals.json").read_text())
+    assert [view[:2] for view in goal_views(hoop["goals"])] == [
+        ("ball", "path"), ("wall", "path"), ("ball", "path"), ("ground", "path"),
+        ("ball", "closest"),
+    ]
+    # Five pins where they rest, one knocked 8 m away: that one is left out.
+    boxes = [(np.array([x, 0.0, 0.0]) - 0.1, np.array([x, 0.0, 0.0]) + 0.1, 0.1)
+             for x in (0.0, 0.3, 0.6, 0.9, 8.0)]
+    kept = _without_outliers(boxes)
+    assert [float(box[0][0]) for box in kept] == pytest.approx([-0.1, 0.2, 0.5, 0.8])
+    # Two dice apart are both kept, however far.
+    assert len(_without_outliers(boxes[::4])) == 2
+
 #: The outline colour of ``impulse render --region`` (sRGB).
 MAGENTA = (255, 0, 255)
 
