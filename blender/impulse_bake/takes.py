@@ -594,6 +594,7 @@ class PreviewJob:
             if self.preset:
                 arguments += ["--preset", self.preset]
             arguments += camera_arguments(take.scene(), self.steps, self.views, self.size, self.preset)
+            arguments += region_arguments(self.views)
             done = subprocess.run(arguments, capture_output=True, text=True, check=False)
             if done.returncode != 0:
                 said = done.stderr.strip().removeprefix("error: ") or f"exit code {done.returncode}"
@@ -615,6 +616,14 @@ class PreviewJob:
         """Blocks until every still is drawn (or failed); returns ``errors``."""
         self._thread.join()
         return self.errors
+
+
+def region_arguments(views):
+    """``impulse render``'s ``--region`` flags outlining the goals' regions in magenta, as the
+    contact sheet's previews do (``views`` from ``impulse.takes``' ``goal_views``)."""
+    from impulse.takes._sheet import region_arguments as sheet_regions
+
+    return sheet_regions(views)
 
 
 def camera_arguments(scene, steps, views, size, preset=None):

@@ -189,6 +189,10 @@ enum Command {
         /// Speed drawn in the hottest colour with `--color speed` (m/s).
         #[arg(long, default_value_t = 5.0)]
         speed_max: f32,
+        /// Outline a region over every frame, in magenta: `box:X0,Y0,Z0,X1,Y1,Z1` (lowest
+        /// corner first) or `sphere:X,Y,Z,R` (m, world frame; a goal's target). Repeatable.
+        #[arg(long = "region", value_parser = render::parse_region, allow_hyphen_values = true)]
+        regions: Vec<render::Region>,
         #[command(flatten)]
         variation: variation_args::VariationArgs,
         /// No progress bar.
@@ -656,6 +660,7 @@ fn run_cli(cli: Cli, handle_signals: bool) -> Result<u8> {
             fov,
             color,
             speed_max,
+            regions,
             variation,
             quiet,
         } => {
@@ -671,6 +676,7 @@ fn run_cli(cli: Cli, handle_signals: bool) -> Result<u8> {
                 fov_deg: fov,
                 colour: color,
                 speed_max,
+                regions,
                 quiet,
             };
             let (name, summary) = if scene.ends_with(".glb") {

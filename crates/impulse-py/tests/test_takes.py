@@ -1511,3 +1511,124 @@ def test_a_preview_frames_the_goal_bodies(tmp_path, impulse_cli):
     own = ["--camera-eye", eye, "--camera-target", target]
     scene_view = _drawn_box(impulse_cli, posed, 2, own, tmp_path)
     assert scene_view[0] < 20 and scene_view[1] < 20, scene_view
+
+
+def test_a_goals_frame_is_where_the_goals_are_judged_less_a_body_far_from_the_rest(repository):
+    from impulse.takes._sheet import _without_outliers, goal_views
+
+    hoop = json.loads((repository / "scenes" / "takes" / "hoop.goals.json").read_text())
+    assert [view[:2] for view in goal_views(hoop["goals"])] == [
+        ("ball", "path"), ("wall", "path"), ("ball", "path"), ("ground", "path"),
+        ("ball", "closest"),
+    ]
+    # Five pins where they rest, one knocked 8 m away: that one is left out.
+    boxes = [(np.array([x, 0.0, 0.0]) - 0.1, np.array([x, 0.0, 0.0]) + 0.1, 0.1)
+             for x in (0.0, 0.3, 0.6, 0.9, 8.0)]
+    kept = _without_outliers(boxes)
+    assert [float(box[0][0]) for box in kept] == pytest.approx([-0.1, 0.2, 0.5, 0.8])
+    # Two dice apart are both kept, however far.
+    assert len(_without_outliers(boxes[::4])) == 2
+
+#: The outline colour of ``impulse render --region`` (sRGB).
+MAGENTA = (255, 0, 255)
+
+
+def _drawn_pixels(impulse_cli, scene, bodies, arguments, tmp_path, size="192x144"):
+    """What ``bodies`` (indices) cover in ``scene``'s first frame drawn with ``arguments``:
+    the number of pixels and their box (width, height), found as in :func:`_drawn_box` with
+    all of them shrunk to 1 mm spheres at once; and the frame as drawn."""
+    frames = []
+    for shrunk in (False, True):
+        drawn = json.loads(json.dumps(scene))
+        if shrunk:
+            for body in bodies:
+                drawn["bodies"][body].update(shape={"type": "sphere", "radius": 1e-3}, mass=1.0)
+        folder = tmp_path / f"pixels-{shrunk}"
+        path = tmp_path / f"pixels-{shrunk}.json"
+        path.write_text(json.dumps(drawn))
+        subprocess.run(
+            [impulse_cli, "render", str(path), "--out", str(folder), "--steps", "0", "--size",
+             size, "--quiet", *arguments],
+            check=True,
+            capture_output=True,
+        )
+        frames.append(_read_png(folder / "frame_00000.png")[..., :3])
+    ys, xs = np.nonzero(np.any(frames[0] != frames[1], axis=-1))
+    box = (int(np.ptp(xs)) + 1, int(np.ptp(ys)) + 1) if xs.size else (0, 0)
+    return int(xs.size), box, frames[0]
+
+
+def _judged_pose(scene, goals):
+    """The worked shot's authored take posed where its goals are judged (the frame where the
+    ball comes closest to the hoop for ``passes_through``, else the end), at rest; and the
+    indices of the moving bodies its goals name."""
+    record, _, _ = simulate_take(scene, goals["steps"], [])
+    frame = len(record.times) - 1
+    for goal in goals["goals"]:
+        if goal["type"] == "passes_through":
+            low, high = (np.asarray(goal["region"]["box"][k]) for k in ("min", "max"))
+            centres = record.positions[:, record.body(goal["body"])]
+            gap = np.maximum(np.maximum(low - centres, 0.0), centres - high)
+            frame = int(np.argmin(np.linalg.norm(gap, axis=1)))
+    posed = json.loads(json.dumps(scene))
+    for index, body in enumerate(posed["bodies"]):
+        if body.get("kind") != "static":
+            body.update(position=record.positions[frame, index].tolist(),
+                        orientation=record.orientations[frame, index].tolist(),
+                        linear_velocity=[0, 0, 0], angular_velocity=[0, 0, 0])
+    named = {record.body(goal["body"]) for goal in goals["goals"]}
+    return posed, sorted(i for i in named if scene["bodies"][i].get("kind") != "static")
+
+
+@pytest.mark.parametrize("shot", ["dice", "hoop", "pachinko", "bowling"])
+def test_a_worked_shots_preview_shows_its_goal_bodies_over_20_by_20_pixels(
+    shot, repository, impulse_cli, tmp_path
+):
+    from impulse.takes._sheet import goal_camera, goal_views, region_arguments
+
+    scene = json.loads((repository / "scenes" / "takes" / f"{shot}.json").read_text())
+    goals = json.loads((repository / "scenes" / "takes" / f"{shot}.goals.json").read_text())
+    views = goal_views(goals["goals"])
+    eye, target = goal_camera(scene, goals["steps"], views, (192, 144))
+    # The sheet's preview flags: its camera and the goals' regions.
+    arguments = ["--camera-eye", ",".join(map(str, eye)), "--camera-target",
+                 ",".join(map(str, target)), *region_arguments(views)]
+    posed, bodies = _judged_pose(scene, goals)
+    count, box, _ = _drawn_pixels(impulse_cli, posed, bodies, arguments, tmp_path)
+    assert count >= 400 and box[0] >= 20 and box[1] >= 20, (count, box)
+
+
+def test_a_preview_outlines_the_goals_region(repository, impulse_cli, tmp_path):
+    from impulse.takes._sheet import goal_camera, goal_views, region_arguments
+
+    scene = json.loads((repository / "scenes" / "takes" / "hoop.json").read_text())
+    goals = json.loads((repository / "scenes" / "takes" / "hoop.goals.json").read_text())
+    views = goal_views(goals["goals"])
+    assert region_arguments(views) == [
+        "--region", "box:-1.72,0.8,0.23,-1.48,0.95,0.47"
+    ]
+    eye, target = goal_camera(scene, goals["steps"], views, (192, 144))
+    camera = ["--camera-eye", ",".join(map(str, eye)), "--camera-target",
+              ",".join(map(str, target))]
+    posed, bodies = _judged_pose(scene, goals)
+    for regions, least in (([], 0), (region_arguments(views), 1)):
+        _, _, frame = _drawn_pixels(impulse_cli, posed, bodies, camera + regions, tmp_path)
+        ys, xs = np.nonzero(np.all(frame == MAGENTA, axis=-1))
+        if not least:
+            assert xs.size == 0
+            continue
+        # The hoop's box, 24 cm wide, is drawn as its outline around the ball going through.
+        assert xs.size >= 100 and np.ptp(xs) >= 20 and np.ptp(ys) >= 20, (xs.size, xs, ys)
+
+
+def test_the_sheet_passes_the_goals_regions_to_impulse_render(tmp_path, impulse_cli, monkeypatch):
+    log = tmp_path / "arguments.txt"
+    wrapper = tmp_path / "impulse"
+    wrapper.write_text(f'#!/bin/sh\necho "$@" >> "{log}"\nexec "{impulse_cli}" "$@"\n')
+    wrapper.chmod(0o755)
+    monkeypatch.setenv("IMPULSE_CLI", str(wrapper))
+    out = tmp_path / "t"
+    search(SCENE, [TARGET], VARIATION, budget=2, steps=STEPS, out=out, workers=2,
+           population=2, progress=False)
+    sheet(out, count=1)
+    assert "--region box:0.3,0,-0.2,0.6,0.3,0.2" in log.read_text()

@@ -58,8 +58,95 @@ pub struct RenderOptions {
     pub colour: ColourBy,
     /// Speed drawn in the hottest colour with `ColourBy::Speed` (m/s).
     pub speed_max: f32,
+    /// Regions outlined over every frame (a goal's target box or sphere).
+    pub regions: Vec<Region>,
     /// No progress bar.
     pub quiet: bool,
+}
+
+/// A region drawn as an outline over the bodies (not hidden by them), in [`REGION_COLOUR`]:
+/// a box's twelve edges, a sphere's three great circles about its axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Region {
+    /// An axis-aligned box between two corners (m, world frame).
+    Box { min: Vec3, max: Vec3 },
+    /// A sphere (m, world frame).
+    Sphere { centre: Vec3, radius: f32 },
+}
+
+/// The colour regions are outlined in (linear RGB): a magenta no body is drawn in.
+pub const REGION_COLOUR: Vec3 = Vec3::new(1.0, 0.0, 1.0);
+
+/// Parses a region: `box:X0,Y0,Z0,X1,Y1,Z1` (two opposite corners, m; each coordinate of the
+/// first at most the second's) or `sphere:X,Y,Z,R` (centre and radius > 0, m).
+pub fn parse_region(text: &str) -> Result<Region, String> {
+    let usage = || format!("'{text}' is not a region: box:X0,Y0,Z0,X1,Y1,Z1 or sphere:X,Y,Z,R (m)");
+    let (kind, values) = text.split_once(':').ok_or_else(usage)?;
+    let values: Vec<f32> = values
+        .split(',')
+        .map(|v| v.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| usage())?;
+    if !values.iter().all(|v| v.is_finite()) {
+        return Err(usage());
+    }
+    match (kind.trim(), &values[..]) {
+        ("box", &[x0, y0, z0, x1, y1, z1]) => {
+            let (min, max) = (Vec3::new(x0, y0, z0), Vec3::new(x1, y1, z1));
+            if min.cmpgt(max).any() {
+                return Err(format!(
+                    "'{text}': the box's first corner must be its lowest (min before max)"
+                ));
+            }
+            Ok(Region::Box { min, max })
+        }
+        ("sphere", &[x, y, z, radius]) if radius > 0.0 => Ok(Region::Sphere {
+            centre: Vec3::new(x, y, z),
+            radius,
+        }),
+        _ => Err(usage()),
+    }
+}
+
+impl Region {
+    /// The outline's segments (pairs of world points, m).
+    fn segments(&self) -> Vec<(Vec3, Vec3)> {
+        match *self {
+            Region::Box { min, max } => {
+                let corner = |k: usize| {
+                    Vec3::new(
+                        if k & 1 == 0 { min.x } else { max.x },
+                        if k & 2 == 0 { min.y } else { max.y },
+                        if k & 4 == 0 { min.z } else { max.z },
+                    )
+                };
+                // The corners k and k | bit differ along one axis: an edge.
+                (0..8)
+                    .flat_map(|k| [1, 2, 4].map(move |bit| (k, k | bit)))
+                    .filter(|(a, b)| a != b)
+                    .map(|(a, b)| (corner(a), corner(b)))
+                    .collect()
+            }
+            Region::Sphere { centre, radius } => {
+                const SIDES: usize = 48;
+                let point = |axis: usize, k: usize| {
+                    let angle = std::f32::consts::TAU * k as f32 / SIDES as f32;
+                    let (s, c) = angle.sin_cos();
+                    let offset = match axis {
+                        0 => Vec3::new(0.0, c, s),
+                        1 => Vec3::new(c, 0.0, s),
+                        _ => Vec3::new(c, s, 0.0),
+                    };
+                    centre + radius * offset
+                };
+                (0..3)
+                    .flat_map(|axis| {
+                        (0..SIDES).map(move |k| (point(axis, k), point(axis, (k + 1) % SIDES)))
+                    })
+                    .collect()
+            }
+        }
+    }
 }
 
 /// What a render wrote.
@@ -457,7 +544,7 @@ fn drawn_bodies(
 }
 
 /// One frame: each body drawn at its pose (rotation, translation) in its colour (linear RGB),
-/// all but the ground, over the ground grid.
+/// all but the ground, over the ground grid; then the regions' outlines over everything.
 fn draw(
     bodies: &[DrawnBody],
     poses: &[(Quat, Vec3)],
@@ -490,6 +577,11 @@ fn draw(
                 &vertices[t[1] as usize],
                 &vertices[t[2] as usize],
             );
+        }
+    }
+    for region in &options.regions {
+        for (a, b) in region.segments() {
+            canvas.draw_line(a, b, REGION_COLOUR);
         }
     }
     canvas
@@ -585,6 +677,43 @@ mod tests {
         assert!(parse_vec3("1,2,nan").is_err());
         assert_eq!(parse_fov("40"), Ok(40.0));
         assert!(parse_fov("180").is_err());
+    }
+
+    #[test]
+    fn regions_parse_or_name_the_bad_value() {
+        assert_eq!(
+            parse_region("box:-1,0,-1,1,0.5,1"),
+            Ok(Region::Box {
+                min: Vec3::new(-1.0, 0.0, -1.0),
+                max: Vec3::new(1.0, 0.5, 1.0)
+            })
+        );
+        assert_eq!(
+            parse_region("sphere:0,1,0,0.25"),
+            Ok(Region::Sphere {
+                centre: Vec3::Y,
+                radius: 0.25
+            })
+        );
+        assert!(
+            parse_region("box:1,0,0,0,1,1")
+                .unwrap_err()
+                .contains("lowest")
+        );
+        assert!(parse_region("sphere:0,1,0,-1").is_err());
+        assert!(
+            parse_region("cone:0,0,0,1")
+                .unwrap_err()
+                .contains("'cone:0,0,0,1'")
+        );
+        // A box is its twelve edges.
+        let edges = parse_region("box:0,0,0,1,1,1").unwrap().segments();
+        assert_eq!(edges.len(), 12);
+        assert!(
+            edges
+                .iter()
+                .all(|(a, b)| (a.distance(*b) - 1.0).abs() < 1e-6)
+        );
     }
 
     #[test]

@@ -231,6 +231,48 @@ impl Canvas {
         }
     }
 
+    /// Draws the segment `a`–`b` (world, m) one pixel wide in `colour` (linear RGB, unlit) over
+    /// whatever is drawn (no depth test: an outline stays seen behind a body); the part behind
+    /// the near plane is cut off.
+    pub fn draw_line(&mut self, a: Vec3, b: Vec3, colour: Vec3) {
+        let (mut p, mut q) = (
+            self.view_projection * a.extend(1.0),
+            self.view_projection * b.extend(1.0),
+        );
+        if p.z < 0.0 && q.z < 0.0 {
+            return;
+        }
+        if p.z < 0.0 || q.z < 0.0 {
+            let s = p.z / (p.z - q.z);
+            let cut = p.lerp(q, s);
+            if p.z < 0.0 { p = cut } else { q = cut }
+        }
+        if p.w <= 0.0 || q.w <= 0.0 {
+            return;
+        }
+        let (w, h) = (self.width as f32, self.height as f32);
+        let screen = |v: Vec4| {
+            let ndc = v.xyz() / v.w;
+            ((ndc.x + 1.0) * 0.5 * w, (1.0 - ndc.y) * 0.5 * h)
+        };
+        let ((x0, y0), (x1, y1)) = (screen(p), screen(q));
+        // One sample per pixel along the longer screen axis (capped: a segment reaching far
+        // off screen is not walked pixel by pixel).
+        let samples = (x1 - x0)
+            .abs()
+            .max((y1 - y0).abs())
+            .ceil()
+            .clamp(1.0, 16_384.0) as u32;
+        for k in 0..=samples {
+            let t = k as f32 / samples as f32;
+            let (x, y) = (x0 + t * (x1 - x0), y0 + t * (y1 - y0));
+            if x >= 0.0 && y >= 0.0 && x < w && y < h {
+                let index = (y as u32 * self.width + x as u32) as usize;
+                self.colour[index] = colour;
+            }
+        }
+    }
+
     /// The image as 8-bit sRGB, row by row from the top left.
     pub fn to_rgb8(&self) -> Vec<u8> {
         let encode = |c: f32| {

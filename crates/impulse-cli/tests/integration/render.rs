@@ -130,6 +130,121 @@ fn the_ground_grid_lies_below_the_horizon() {
     );
 }
 
+/// The pixels drawn in the region outline's magenta (255, 0, 255): their count and box
+/// (min x, min y, max x, max y).
+fn magenta(image: &image::RgbImage) -> (usize, [u32; 4]) {
+    let mut box_ = [u32::MAX, u32::MAX, 0, 0];
+    let mut count = 0;
+    for (x, y, p) in image.enumerate_pixels() {
+        if p.0 == [255, 0, 255] {
+            count += 1;
+            box_ = [
+                box_[0].min(x),
+                box_[1].min(y),
+                box_[2].max(x),
+                box_[3].max(y),
+            ];
+        }
+    }
+    (count, box_)
+}
+
+#[test]
+fn a_region_is_outlined_over_the_bodies_and_a_bad_one_is_refused_by_name() {
+    let dir = temp_dir("region");
+    let scene = scene(&dir, true);
+    let draw = |name: &str, regions: &[&str]| {
+        let frames = dir.join(name);
+        let mut command = impulse();
+        command
+            .args(["render", scene.to_str().unwrap(), "--steps", "0"])
+            .args(["--size", "160x100", "--out", frames.to_str().unwrap()])
+            .args(["--camera-eye", "0,3,10", "--camera-target", "0,3,0"]);
+        for region in regions {
+            command.args(["--region", region]);
+        }
+        let out = command.output().unwrap();
+        assert_success(&out, "render: ");
+        read_png(&frames.join("frame_00000.png"))
+    };
+    assert_eq!(magenta(&draw("plain", &[])).0, 0, "magenta with no region");
+    // A 2 m box about the ball (3 m up, in front of it too): its outline surrounds the image's
+    // centre, where the ball is, and is drawn over the ball.
+    let (count, [x0, y0, x1, y1]) = magenta(&draw("box", &["box:-1,2,-1,1,4,1"]));
+    assert!(count > 100, "{count} outline pixels");
+    assert!(
+        x0 < 70 && x1 > 90 && y0 < 40 && y1 > 60,
+        "outline box {x0},{y0} to {x1},{y1}"
+    );
+    let (count, [x0, _, x1, _]) = magenta(&draw("sphere", &["sphere:0,3,0,0.8"]));
+    assert!(
+        count > 50 && x0 < 75 && x1 > 85,
+        "{count} pixels from x = {x0} to {x1}"
+    );
+    for bad in ["box:1,0,0,0,1,1", "sphere:0,0,0,0", "cone:0,0,0,1"] {
+        let out = impulse()
+            .args(["render", scene.to_str().unwrap(), "--steps", "0"])
+            .args(["--out", dir.to_str().unwrap(), "--region", bad])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.contains("--region") && stderr.contains(bad),
+            "{stderr}"
+        );
+    }
+}
+
+#[test]
+fn a_thin_ground_is_drawn_where_it_is() {
+    // A flat box 0.6 m square (a Blender Plane: no thickness) under one die of two 2 m apart:
+    // narrower than the dice's spread, so it is drawn as itself, not taken as the grid.
+    let dir = temp_dir("thin_ground");
+    let die = |x: f32| {
+        format!(
+            r#"{{"kind": "dynamic", "position": [{x}, 0.3, 0.0], "shape": {{"type": "cuboid", "half_extents": [0.05, 0.05, 0.05]}}}}"#
+        )
+    };
+    let plane = r#"{"name": "plane", "kind": "static", "shape": {"type": "cuboid", "half_extents": [0.3, 0.0, 0.3]}}"#;
+    // Without the plane, a 1 mm static ball as low as the plane's 2 mm slab keeps the grid at
+    // the same height, so that only the plane can change the image.
+    let speck =
+        r#"{"name": "speck", "kind": "static", "shape": {"type": "sphere", "radius": 0.001}}"#;
+    let draw = |name: &str, with_plane: bool| {
+        let mut bodies = vec![die(0.0), die(2.0)];
+        bodies.insert(0, if with_plane { plane } else { speck }.to_string());
+        let path = dir.join(format!("{name}.json"));
+        std::fs::write(
+            &path,
+            format!(r#"{{"name": "{name}", "bodies": [{}]}}"#, bodies.join(", ")),
+        )
+        .unwrap();
+        let frames = dir.join(name);
+        let out = impulse()
+            .args(["render", path.to_str().unwrap(), "--steps", "0"])
+            .args(["--size", "160x100", "--out", frames.to_str().unwrap()])
+            .args(["--camera-eye", "0,2,2", "--camera-target", "0,0,0"])
+            .output()
+            .unwrap();
+        assert_success(&out, "render: ");
+        read_png(&frames.join("frame_00000.png"))
+    };
+    let (with, without) = (draw("with", true), draw("without", false));
+    let changed = with
+        .pixels()
+        .zip(without.pixels())
+        .filter(|(p, q)| {
+            (0..3)
+                .map(|c| (p.0[c] as i32 - q.0[c] as i32).abs())
+                .sum::<i32>()
+                > 30
+        })
+        .count();
+    // The plane spans about 30 × 20 pixels from there, less the die on it.
+    assert!(changed > 300, "the plane changed only {changed} pixels");
+}
+
 #[test]
 fn the_gif_has_one_frame_per_drawn_step() {
     let dir = temp_dir("gif");

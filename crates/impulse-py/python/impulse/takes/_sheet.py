@@ -60,11 +60,12 @@ def _cli() -> tuple[list[str], dict[str, str] | None]:
     return [found], None
 
 
-#: The preview cameras: ``goals`` frames the goal bodies' paths (the default), ``scene``
+#: The preview cameras: ``goals`` frames the goal bodies where the goals are judged (the
+#: default, :func:`goal_camera`), ``scene``
 #: is ``impulse render``'s own view of the moving bodies at step 0.
 CAMERAS = ("goals", "scene")
-#: Room around the goal bodies' paths in a ``goals`` preview: the framed sphere's radius is
-#: this times the paths' bounding sphere's.
+#: Room around what a ``goals`` preview frames: the framed box fits the image's field of view
+#: divided by this.
 MARGIN = 1.15
 #: ``impulse render``'s default field of view (degrees, vertical) and three-quarter view
 #: direction, which a ``goals`` camera keeps.
@@ -100,78 +101,226 @@ def _extent(shape: Any) -> float:
     return 0.0
 
 
-#: The goals that read a body's pose at one time (``at``, default the end); the others read it
-#: over a window (``between``, default the whole take).
+#: The goals that read a body's pose at one time (``at``, default the end).
 _AT_ONE_TIME = ("ends_inside", "rests_with_axis_up", "tilted")
+#: The contact goals, read over a window (``between``, default the whole take) with no place
+#: of their own: a ``goals`` camera frames their bodies' paths only when no goal gives a place.
+_CONTACTS = ("touches", "never_touches")
+#: A goal body's judged place farther than this many times the median distance of them all
+#: from their median (a bowling pin knocked into the pit) is left out of a ``goals`` frame.
+OUTLIER = 3.0
+#: A ``goals`` frame's narrower side is at least this many times the largest goal body's
+#: extent (half of it from the centre), so that a lone body is seen with what is around it.
+CONTEXT = 3.0
+#: A ``goals`` frame takes in the goals' regions too when each goal body stays at least this
+#: many pixels across (its extent sphere's diameter).
+SMALLEST = 24.0
 
 
-def goal_views(specs: Any) -> list[tuple[Any, str, Any]]:
-    """What the search's JSON goals look at: ``(body, "at", seconds or None)`` for a goal read
-    at one time (None: the end) and ``(body, "between", [t0, t1] or None)`` for one read over
-    a window (None: the whole take), for ``body`` and ``other``."""
-    views: list[tuple[Any, str, Any]] = []
+def goal_views(specs: Any) -> list[tuple[Any, str, Any, Any]]:
+    """Where the search's JSON goals are judged, as ``(body, how, when, region)``: ``how`` is
+    ``"at"`` (the body at ``when`` s, None: the end; ``ends_inside``, ``rests_with_axis_up``,
+    ``tilted``), ``"closest"`` (the body where it comes closest to ``region`` in the window
+    ``when``, [t0, t1] s or None for the whole take; ``passes_through``) or ``"path"`` (the
+    body over the window ``when``; ``stays_inside``, and ``body`` and ``other`` of ``touches``
+    and ``never_touches``). ``region`` is the goal's region (a ``box`` or ``sphere`` mapping)
+    or None."""
+    views: list[tuple[Any, str, Any, Any]] = []
     for spec in specs or []:
         if not isinstance(spec, dict) or "type" not in spec:
             continue
-        if spec["type"] in _AT_ONE_TIME:
-            when: tuple[str, Any] = ("at", spec.get("at"))
-        else:
-            when = ("between", spec.get("between"))
-        for field in ("body", "other"):
-            if field in spec:
-                views.append((spec[field], *when))
+        kind = spec["type"]
+        region = spec.get("region")
+        if kind in _AT_ONE_TIME:
+            views.append((spec.get("body"), "at", spec.get("at"), region))
+        elif kind == "passes_through":
+            views.append((spec.get("body"), "closest", spec.get("between"), region))
+        elif kind == "stays_inside":
+            views.append((spec.get("body"), "path", spec.get("between"), region))
+        elif kind in _CONTACTS:
+            for field in ("body", "other"):
+                if field in spec:
+                    views.append((spec[field], "path", spec.get("between"), None))
     return views
+
+
+def region_box(region: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """The box (low, high; m) holding a goal's region, None when it is not one."""
+    if not isinstance(region, dict):
+        return None
+    try:
+        if "box" in region:
+            return (
+                np.asarray(region["box"]["min"], dtype=float),
+                np.asarray(region["box"]["max"], dtype=float),
+            )
+        if "sphere" in region:
+            centre = np.asarray(region["sphere"]["center"], dtype=float)
+            radius = float(region["sphere"]["radius"])
+            return centre - radius, centre + radius
+    except (KeyError, TypeError, ValueError):
+        return None
+    return None
+
+
+def region_arguments(views: list[tuple[Any, ...]]) -> list[str]:
+    """``impulse render``'s ``--region`` flags outlining the goals' regions (:func:`goal_views`),
+    each once."""
+    arguments: list[str] = []
+    for view in views:
+        region = view[3] if len(view) > 3 else None
+        flag: str | None = None
+        try:
+            if isinstance(region, dict) and "box" in region:
+                low, high = region["box"]["min"], region["box"]["max"]
+                flag = "box:" + ",".join(f"{float(v):.9g}" for v in [*low, *high])
+            elif isinstance(region, dict) and "sphere" in region:
+                sphere = region["sphere"]
+                values = [*sphere["center"], sphere["radius"]]
+                flag = "sphere:" + ",".join(f"{float(v):.9g}" for v in values)
+        except (KeyError, TypeError, ValueError):
+            flag = None
+        if flag is not None and flag not in arguments[1::2]:
+            arguments += ["--region", flag]
+    return arguments
+
+
+def _judged_boxes(
+    record: Any, shapes: list[Any], views: list[tuple[Any, ...]]
+) -> tuple[list[tuple[np.ndarray, np.ndarray, float]], list[tuple[np.ndarray, np.ndarray]]]:
+    """What a ``goals`` camera frames: the boxes (low, high; m) of the moving goal bodies where
+    their goals are judged, each with the body's extent (m): a body at its time, a body where
+    it comes closest to its region, less those far from the rest (:func:`_without_outliers`);
+    or, when no goal judges a body at a place, the bodies over their windows. And the boxes of
+    the goals' regions. Static bodies are left out (the ground a ball must touch is
+    everywhere)."""
+
+    def moving(index: int) -> bool:
+        return index < len(shapes) and shapes[index].get("kind", "static") != "static"
+
+    placed: list[tuple[np.ndarray, np.ndarray, float]] = []
+    paths: list[tuple[np.ndarray, np.ndarray, float]] = []
+    regions: list[tuple[np.ndarray, np.ndarray]] = []
+    last = len(record.times) - 1
+    for view in views:
+        body, how, when = view[:3]
+        region = region_box(view[3]) if len(view) > 3 else None
+        if region is not None:
+            regions.append(region)
+        if body is None:
+            continue
+        index = record.body(body)
+        if not moving(index):
+            continue
+        extent = _extent(shapes[index].get("shape"))
+        if how == "at":
+            frames = np.array([last]) if when is None else record.window([when, when])[:1]
+        elif how == "closest" and region is not None:
+            frames = record.window(when)
+            centres = record.positions[frames, index]
+            gap = np.maximum(np.maximum(region[0] - centres, 0.0), centres - region[1])
+            frames = frames[[int(np.argmin(np.linalg.norm(gap, axis=1)))]]
+        else:
+            frames = record.window(when)
+        path = record.positions[frames, index]
+        box = (path.min(axis=0) - extent, path.max(axis=0) + extent, extent)
+        (paths if how == "path" else placed).append(box)
+    return (_without_outliers(placed) or paths), regions
+
+
+def _without_outliers(
+    boxes: list[tuple[np.ndarray, np.ndarray, float]],
+) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """``boxes`` less those whose centre is more than :data:`OUTLIER` times the median distance
+    of the centres from their median (and farther than the largest box is wide)."""
+    if len(boxes) < 3:
+        return boxes
+    centres = np.array([0.5 * (box[0] + box[1]) for box in boxes])
+    distances = np.linalg.norm(centres - np.median(centres, axis=0), axis=1)
+    largest = max(float(np.linalg.norm(box[1] - box[0])) for box in boxes)
+    limit = max(OUTLIER * float(np.median(distances)), largest)
+    return [box for box, distance in zip(boxes, distances, strict=True) if distance <= limit]
+
+
+def _framed(
+    boxes: list[tuple[np.ndarray, np.ndarray]], size: tuple[int, int]
+) -> tuple[np.ndarray, float]:
+    """The target (the centre of the box holding ``boxes``; m) and the least distance (m) from
+    it along :data:`VIEW_DIRECTION` at which every corner of that box is inside the ``size``
+    (W, H) image shrunk by :data:`MARGIN`."""
+    low = np.min([box[0] for box in boxes], axis=0)
+    high = np.max([box[1] for box in boxes], axis=0)
+    centre = 0.5 * (low + high)
+    back = np.asarray(VIEW_DIRECTION, dtype=float)
+    back /= np.linalg.norm(back)
+    right = np.cross([0.0, 1.0, 0.0], back)
+    right /= np.linalg.norm(right)
+    up = np.cross(back, right)
+    tan_y, tan_x = _half_tangents(size)
+    distance = 1e-3
+    for corner in np.array(np.meshgrid(*zip(low, high, strict=True))).reshape(3, -1).T:
+        offset = corner - centre
+        # A corner at depth d beyond the target (along the view) is in the image when its
+        # sideways offsets are within (distance + d) times the half field's tangents.
+        depth = -float(offset @ back)
+        for side, tangent in ((float(offset @ right), tan_x), (float(offset @ up), tan_y)):
+            distance = max(distance, MARGIN * abs(side) / tangent - depth)
+    return centre, distance
+
+
+def _half_tangents(size: tuple[int, int]) -> tuple[float, float]:
+    """The tangents of half the vertical and horizontal fields of view of a ``size`` image."""
+    width, height = size
+    tan_y = math.tan(0.5 * math.radians(FOV_DEGREES))
+    return tan_y, tan_y * width / height
 
 
 def goal_camera(
     scene: dict[str, Any],
     steps: int,
-    views: list[tuple[Any, str, Any]],
+    views: list[tuple[Any, ...]],
     size: tuple[int, int],
     preset: str | None = None,
 ) -> tuple[list[float], list[float]] | None:
     """The camera (eye, target; m) of a ``goals`` preview: ``impulse render``'s three-quarter
-    view and field of view, aimed at the centre of the box that holds the moving bodies the
-    goals look at (:func:`goal_views`) when they look (at the end for a body that must rest,
-    over its window for one that must pass through or touch), each grown by its shape's
-    extent, and far enough that the box's bounding sphere, times :data:`MARGIN`, fits the
-    ``size`` (W, H) image. Static bodies (the ground a ball must touch) are left out. ``None``
-    when the goals look at no moving body (custom goals only, say)."""
+    view and field of view, aimed at the goal bodies where their goals are judged
+    (:func:`goal_views`): a body that must end somewhere, rest or tilt where it is at the end
+    (or ``at``), a body that must pass through a region where it comes closest to it; the
+    paths of the bodies of contact goals (``touches``, ``never_touches``) only when no goal
+    judges a body at a place. Bodies are grown by their shapes' extents; a place far from all
+    the others (:data:`OUTLIER`; a pin knocked into the pit) is left out. The camera is as
+    close as keeps the box holding the rest inside the ``size`` (W, H) image shrunk by
+    :data:`MARGIN`, and no closer than a frame :data:`CONTEXT` times the largest goal body's
+    extent across (room around a lone body). The goals' regions are framed too when every goal
+    body then stays at least :data:`SMALLEST` pixels across. Static bodies (the ground a ball
+    must touch) are left out. ``None`` when the goals look at no moving body (custom goals
+    only, say)."""
     from impulse.takes._search import simulate_take
 
     shapes = scene.get("bodies", [])
-    moving = [
-        view
-        for view in views
-        if not isinstance(view[0], int) or view[0] >= len(shapes) or view[0] < 0
-        or shapes[view[0]].get("kind", "static") != "static"
-    ]
-    if not moving:
+    if not views:
         return None
     record, _, _ = simulate_take(scene, steps, [], preset)
-    low = np.full(3, np.inf)
-    high = np.full(3, -np.inf)
-    for body, kind, when in moving:
-        index = record.body(body)
-        if index < len(shapes) and shapes[index].get("kind", "static") == "static":
-            continue
-        if kind == "at":
-            frames = [len(record.times) - 1] if when is None else record.window([when, when])[:1]
-        else:
-            frames = record.window(when)
-        path = record.positions[frames, index]
-        extent = _extent(shapes[index].get("shape")) if index < len(shapes) else 0.0
-        low = np.minimum(low, path.min(axis=0) - extent)
-        high = np.maximum(high, path.max(axis=0) + extent)
-    if not np.all(np.isfinite(low)):
+    boxes, regions = _judged_boxes(record, shapes, views)
+    if not boxes:
         return None
-    centre = 0.5 * (low + high)
-    radius = max(MARGIN * 0.5 * float(np.linalg.norm(high - low)), 1e-3)
-    width, height = size
-    half_y = 0.5 * math.radians(FOV_DEGREES)
-    half_x = math.atan(math.tan(half_y) * width / height)
+    tan_y, tan_x = _half_tangents(size)
+    narrow = min(tan_x, tan_y)
+    centre, distance = _framed([box[:2] for box in boxes], size)
+    distance = max(distance, CONTEXT * max(box[2] for box in boxes) / narrow)
+    if regions:
+        # A body of extent e at distance D is e * N / (D * tan(half field)) pixels across, N
+        # the pixels of the narrower side.
+        pixels = min(size) / narrow
+        smallest = min(box[2] for box in boxes)
+        with_regions, farther = _framed([box[:2] for box in boxes] + regions, size)
+        farther = max(farther, distance)
+        if smallest * pixels / farther >= SMALLEST:
+            centre, distance = with_regions, farther
+    if not (np.all(np.isfinite(centre)) and math.isfinite(distance)):
+        return None
     direction = np.asarray(VIEW_DIRECTION) / np.linalg.norm(VIEW_DIRECTION)
-    eye = centre + direction * (radius / math.sin(min(half_x, half_y)))
+    eye = centre + direction * distance
     return [float(v) for v in eye], [float(v) for v in centre]
 
 
@@ -261,9 +410,10 @@ def sheet(
     size : str
         Preview size, ``WxH`` pixels.
     previews : bool
-        Draw previews with ``impulse render`` (``False``: the page without pictures).
+        Draw previews with ``impulse render`` (``False``: the page without pictures). The goals'
+        regions are outlined in magenta (``impulse render --region``) with any camera.
     camera : str
-        ``"goals"`` (frame the bodies the goals name on their whole paths, :func:`goal_camera`;
+        ``"goals"`` (frame the goal bodies where their goals are judged, :func:`goal_camera`;
         ``impulse render``'s own view when only custom goals name none), ``"scene"``
         (``impulse render``'s view of the moving bodies at step 0) or ``"EX,EY,EZ:TX,TY,TZ"``
         (eye and target, m). A preview is kept under a name that holds the camera, ``size`` and
@@ -296,7 +446,10 @@ def sheet(
         command, environment = _cli()
         folder = os.path.join(root, PREVIEWS_DIR)
         os.makedirs(folder, exist_ok=True)
-        key = camera if camera != "goals" else f"goals {MARGIN} {FOV_DEGREES} {VIEW_DIRECTION}"
+        framing = f"{MARGIN} {FOV_DEGREES} {VIEW_DIRECTION} {OUTLIER} {CONTEXT} {SMALLEST}"
+        # The regions are outlined whatever the camera: part of every key.
+        key = (camera if camera != "goals" else f"goals {framing}") + " regions"
+        regions = region_arguments(goal_views(takes.manifest.get("goals")))
         for take in chosen:
             gif = os.path.join(folder, _preview_name(take.take_id, key, size, every))
             if not os.path.exists(gif):
@@ -307,6 +460,7 @@ def sheet(
                 arguments = [*command, "render", scene, "--gif", partial, "--steps", str(steps)]
                 arguments += ["--every", str(every), "--size", size, "--quiet"]
                 arguments += _camera_arguments(camera, take, takes, pixels)
+                arguments += regions
                 if preset:
                     arguments += ["--preset", preset]
                 done = subprocess.run(

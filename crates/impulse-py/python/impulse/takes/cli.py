@@ -157,8 +157,9 @@ def _parser() -> argparse.ArgumentParser:
     sheet.add_argument(
         "--camera",
         default="goals",
-        help="goals (frame the goal bodies' paths, the default), scene (impulse render's view "
-        "of the moving bodies at step 0), or EX,EY,EZ:TX,TY,TZ (eye and target, m)",
+        help="goals (frame the goal bodies where their goals are judged, the default), scene "
+        "(impulse render's view of the moving bodies at step 0), or EX,EY,EZ:TX,TY,TZ (eye and "
+        "target, m); with any camera the goals' regions are outlined in magenta",
     )
     sheet.add_argument("--no-previews", action="store_true", help="a page without previews")
     return parser
