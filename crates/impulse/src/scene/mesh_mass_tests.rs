@@ -1,5 +1,5 @@
 //! Unit tests of `mesh_mass`: seeded families of closed meshes (boxes, hollow boxes, L-shaped
-//! prisms), each shell and each triangle wound either way, turned and moved, against their
+//! prisms, tori), each shell and each triangle wound either way, turned and moved, against their
 //! closed-form volume, centre of mass and inertia within 0.5 %.
 
 use glam::{DMat3, DQuat, DVec3};
@@ -322,6 +322,69 @@ fn l_shapes_and_separate_boxes_wound_any_way_have_their_closed_form() {
             .combined(Expected::cuboid(box_center, box_h), 1.0)
             .moved(rotation, offset);
         assert_close(&mesh, expected, 6.0, &format!("L shape seed {seed}"));
+    }
+}
+
+/// A torus about the y axis, ring radius `ring`, tube radius `tube`, of `around` × `tube_steps`
+/// quads (two triangles each), wound outward.
+fn torus_shell(ring: f64, tube: f64, around: u32, tube_steps: u32) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let mut vertices = Vec::new();
+    for i in 0..around {
+        let u = i as f64 * std::f64::consts::TAU / around as f64;
+        for j in 0..tube_steps {
+            let v = j as f64 * std::f64::consts::TAU / tube_steps as f64;
+            let radial = ring + tube * v.cos();
+            vertices.push(DVec3::new(
+                radial * u.cos(),
+                tube * v.sin(),
+                radial * u.sin(),
+            ));
+        }
+    }
+    let index = |i: u32, j: u32| (i % around) * tube_steps + j % tube_steps;
+    let mut triangles = Vec::new();
+    for i in 0..around {
+        for j in 0..tube_steps {
+            let (a, b) = (index(i, j), index(i + 1, j));
+            let (c, d) = (index(i + 1, j + 1), index(i, j + 1));
+            triangles.push([a, d, c]);
+            triangles.push([a, c, b]);
+        }
+    }
+    (vertices, triangles)
+}
+
+/// Tori (a shell of genus one) of ring radius 0.2-1.5 m and tube up to 0.9 of it, turned and
+/// moved, wound either way, against the smooth torus's closed form (V = 2π²Rr², about its
+/// axis I = V(R² + ¾r²), across it V(R²/2 + ⅝r²)): at 192 × 96 quads the facets cost 0.1 %.
+#[test]
+fn tori_wound_any_way_have_their_closed_form() {
+    for seed in 0..CASES / 3 {
+        let mut generator = ChaCha20Rng::seed_from_u64(3000 + seed);
+        let ring = 0.2 + 1.3 * generator.random::<f64>();
+        let tube = ring * (0.05 + 0.85 * generator.random::<f64>());
+        let (rotation, offset) = random_pose(&mut generator);
+        let flip = [0.0, 0.25, 1.0][seed as usize % 3];
+        let mesh = assemble(
+            &[torus_shell(ring, tube, 192, 96)],
+            rotation,
+            offset,
+            flip,
+            &mut generator,
+        );
+        let volume = 2.0 * std::f64::consts::PI.powi(2) * ring * tube * tube;
+        let across = volume * (ring * ring / 2.0 + 0.625 * tube * tube);
+        let expected = Expected {
+            volume,
+            center: DVec3::ZERO,
+            inertia: DMat3::from_diagonal(DVec3::new(
+                across,
+                volume * (ring * ring + 0.75 * tube * tube),
+                across,
+            )),
+        }
+        .moved(rotation, offset);
+        assert_close(&mesh, expected, ring + tube, &format!("torus seed {seed}"));
     }
 }
 
