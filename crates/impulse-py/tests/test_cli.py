@@ -16,27 +16,9 @@ import pytest
 from impulse._impulse import _cli_main
 from impulse.takes import load, search, sheet
 from impulse.takes._sheet import _cli
+from test_takes import SCENE  # a ball on a frictionless floor
 
-#: A ball rolling on a frictionless floor; its takes must end 0.3-0.6 m along x.
-SCENE = {
-    "name": "roll",
-    "materials": {"ice": {"friction": 0.0, "restitution": 0.0}},
-    "bodies": [
-        {
-            "name": "ground",
-            "kind": "static",
-            "material": "ice",
-            "shape": {"type": "half_space", "normal": [0, 1, 0]},
-        },
-        {
-            "name": "ball",
-            "kind": "dynamic",
-            "material": "ice",
-            "shape": {"type": "sphere", "radius": 0.1},
-            "position": [0.0, 0.1, 0.0],
-        },
-    ],
-}
+#: Its takes must end 0.3-0.6 m along x.
 TARGET = {
     "type": "ends_inside",
     "body": "ball",
