@@ -161,8 +161,11 @@ impl WorldSnapshot {
         bytes.extend_from_slice(&[0; HEADER_LEN]);
         let cannot =
             |e: &dyn std::fmt::Display| SnapshotError::Decode(format!("cannot encode: {e}"));
-        let mut encoder = flate2::write::DeflateEncoder::new(bytes, flate2::Compression::default());
-        ciborium::into_writer(self, &mut encoder).map_err(|e| cannot(&e))?;
+        // CBOR comes in writes of a few bytes: buffered, the compressor sees large blocks.
+        let encoder = flate2::write::DeflateEncoder::new(bytes, flate2::Compression::default());
+        let mut writer = std::io::BufWriter::with_capacity(1 << 16, encoder);
+        ciborium::into_writer(self, &mut writer).map_err(|e| cannot(&e))?;
+        let encoder = writer.into_inner().map_err(|e| cannot(e.error()))?;
         let mut bytes = encoder.finish().map_err(|e| cannot(&e))?;
         let payload = &bytes[HEADER_LEN..];
         let (length, checksum) = (payload.len() as u64, crc32fast::hash(payload));
@@ -227,7 +230,10 @@ impl WorldSnapshot {
             });
         }
         let decoded = if found >= FIRST_COMPRESSED_VERSION {
-            ciborium::from_reader(flate2::read::DeflateDecoder::new(payload))
+            ciborium::from_reader(std::io::BufReader::with_capacity(
+                1 << 16,
+                flate2::read::DeflateDecoder::new(payload),
+            ))
         } else {
             ciborium::from_reader(payload)
         };
