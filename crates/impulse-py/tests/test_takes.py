@@ -1595,6 +1595,12 @@ def test_a_worked_shots_preview_shows_its_goal_bodies_over_20_by_20_pixels(
                  ",".join(map(str, target)), *region_arguments(views)]
     posed, bodies = _judged_pose(scene, goals)
     count, box, _ = _drawn_pixels(impulse_cli, posed, bodies, arguments, tmp_path)
+    # The figures of docs/takes.md's table (`pytest -k worked_shots -s`): together, then each.
+    each = []
+    for body in bodies:
+        (tmp_path / str(body)).mkdir()
+        each.append(_drawn_pixels(impulse_cli, posed, [body], arguments, tmp_path / str(body))[:2])
+    print(f"{shot}: goal bodies together {count} px, {box[0]} × {box[1]}; each {each}")
     assert count >= 400 and box[0] >= 20 and box[1] >= 20, (count, box)
 
 
