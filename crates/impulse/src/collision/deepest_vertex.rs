@@ -79,7 +79,8 @@ fn add<ManifoldData, ContactData: Default + Copy>(
     old: &[TrackedContact<ContactData>],
     flipped: bool,
 ) {
-    // The flat shape's outward unit normal (its frame), a point of its plane, and its face id.
+    // The flat shape's outward unit normal (its frame), a point of its plane, its face id, and
+    // for a triangle whether the manifold's normal is off the face normal by more than FACE_ON.
     let (normal, origin, face, triangle) = match flat.as_typed_shape() {
         TypedShape::HalfSpace(half_space) => (
             half_space.normal,
@@ -105,10 +106,16 @@ fn add<ManifoldData, ContactData: Default + Copy>(
             } else {
                 (-face_normal, PackedFeatureId::face(1))
             };
-            if face_normal.dot(along) < TILTED {
+            let cosine = face_normal.dot(along);
+            if cosine < TILTED {
                 return;
             }
-            (face_normal, triangle.a, face, Some(triangle))
+            (
+                face_normal,
+                triangle.a,
+                face,
+                Some((triangle, cosine < FACE_ON)),
+            )
         }
         _ => return,
     };
@@ -123,19 +130,14 @@ fn add<ManifoldData, ContactData: Default + Copy>(
         return;
     }
     let on_flat = at - normal * (dist + border);
-    if let Some(triangle) = triangle {
+    if let Some((triangle, tilted)) = triangle {
         if !over_triangle(triangle, normal, on_flat) {
             return;
         }
-        let along = if flipped {
-            manifold.local_n2
-        } else {
-            manifold.local_n1
-        };
-        if normal.dot(along) < FACE_ON {
+        if tilted {
             // The hull's lowest vertex is over the triangle: its plane is what the hull rests
             // on, whatever face of the hull Parry's clipping took the normal from.
-            to_face_normal(pos12, normal, origin, manifold, flipped);
+            to_face_normal(pos12, (normal, inward), origin, manifold, flipped);
         }
     }
     let nearest = manifold
@@ -168,28 +170,31 @@ fn add<ManifoldData, ContactData: Default + Copy>(
     }
     if manifold.points.is_empty() {
         // A half-space's manifold with no point yet: its normal is the half-space's.
-        let n2 = pos12.rotation.inverse() * -normal;
-        (manifold.local_n1, manifold.local_n2) = if flipped { (n2, normal) } else { (normal, n2) };
+        (manifold.local_n1, manifold.local_n2) = if flipped {
+            (inward, normal)
+        } else {
+            (normal, inward)
+        };
     }
     manifold.points.push(point);
 }
 
 /// Re-expresses `manifold` (of a flat shape and a hull, the hull's pose in the flat shape's
 /// frame being `pos12`; `flipped` when the hull is the manifold's first shape) along the flat
-/// shape's outward unit normal `normal` through `origin`: each point keeps its features and its
-/// point on the hull, and takes its distance along `normal` and its point on the plane.
+/// shape's outward unit normal `normal` through `origin` (`inward`: −`normal` in the hull's
+/// frame): each point keeps its features and its point on the hull, and takes its distance
+/// along `normal` and its point on the plane.
 fn to_face_normal<ManifoldData, ContactData>(
     pos12: &Pose,
-    normal: Vector,
+    (normal, inward): (Vector, Vector),
     origin: Vector,
     manifold: &mut ContactManifold<ManifoldData, ContactData>,
     flipped: bool,
 ) {
-    let on_hull_normal = pos12.rotation.inverse() * -normal;
     (manifold.local_n1, manifold.local_n2) = if flipped {
-        (on_hull_normal, normal)
+        (inward, normal)
     } else {
-        (normal, on_hull_normal)
+        (normal, inward)
     };
     for point in &mut manifold.points {
         let on_hull = if flipped {
