@@ -1440,26 +1440,9 @@ def _read_png(path):
 
 
 def _drawn_box(impulse_cli, scene, body, camera_arguments, tmp_path, size="192x144"):
-    """The pixel box (width, height) ``body`` covers in ``scene``'s first frame: the frame
-    drawn as it is and with the body shrunk to a 1 mm sphere, the same camera; the box of the
-    pixels that differ."""
-    frames = []
-    for shrunk in (False, True):
-        drawn = json.loads(json.dumps(scene))
-        if shrunk:
-            drawn["bodies"][body].update(shape={"type": "sphere", "radius": 1e-3}, mass=1.0)
-        folder = tmp_path / f"frames-{shrunk}"
-        path = tmp_path / f"scene-{shrunk}.json"
-        path.write_text(json.dumps(drawn))
-        subprocess.run(
-            [impulse_cli, "render", str(path), "--out", str(folder), "--steps", "0", "--size",
-             size, "--quiet", *camera_arguments],
-            check=True,
-            capture_output=True,
-        )
-        frames.append(_read_png(folder / "frame_00000.png"))
-    ys, xs = np.nonzero(np.any(frames[0] != frames[1], axis=-1))
-    return (int(np.ptp(xs)) + 1, int(np.ptp(ys)) + 1) if xs.size else (0, 0)
+    """The pixel box (width, height) ``body`` covers in ``scene``'s first frame
+    (:func:`_drawn_pixels` of that body alone)."""
+    return _drawn_pixels(impulse_cli, scene, [body], camera_arguments, tmp_path, size)[1]
 
 
 #: A coin 25 mm wide dropped 1 cm onto a 1 m table, and a ball rolling 2 m away: framed with
@@ -1535,8 +1518,8 @@ MAGENTA = (255, 0, 255)
 
 def _drawn_pixels(impulse_cli, scene, bodies, arguments, tmp_path, size="192x144"):
     """What ``bodies`` (indices) cover in ``scene``'s first frame drawn with ``arguments``:
-    the number of pixels and their box (width, height), found as in :func:`_drawn_box` with
-    all of them shrunk to 1 mm spheres at once; and the frame as drawn."""
+    the number of pixels and their box (width, height) of the pixels that differ when all of
+    them are shrunk to 1 mm spheres at once, the same camera; and the frame as drawn."""
     frames = []
     for shrunk in (False, True):
         drawn = json.loads(json.dumps(scene))
