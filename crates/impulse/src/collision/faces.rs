@@ -702,7 +702,21 @@ fn better_face_axis<ContactData>(
             )
         })
         .collect();
-    let mut best: Option<(Vector, Real)> = None;
+    // Each axis's separation is at most q·axis − p·axis for any point p of shape 1 and q of
+    // shape 2 (support separation takes the extremes). The points taken: an end of each edge,
+    // and each hull's vertex mean (inside it, the hull being convex). Along the axis where
+    // the arcs cross (a face of the Minkowski difference) the edges are the shapes' supports
+    // and the bound is the separation; along the other way the means keep it near the
+    // shapes' widths below. The separations themselves (two support points each) are taken
+    // from the highest bound down, until no bound left can reach the largest found: the same
+    // largest, and among equals the same axis (the last in the loops' order), as taking
+    // every one, for a few support points where every pair took two.
+    let mean =
+        |points: &[Vector]| points.iter().copied().sum::<Vector>() / points.len().max(1) as Real;
+    let (mean1, mean2) = (mean(points1), pos12.transform_point(mean(points2)));
+    // (bound, place in the loops' order, axis)
+    let mut candidates: Vec<(Real, u32, Vector)> = Vec::new();
+    let mut order = 0_u32;
     for e1 in hull1.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
         let arc1 = GaussArc::new(
             faces1[e1.faces[0] as usize].normal,
@@ -717,24 +731,38 @@ fn better_face_axis<ContactData>(
                 continue;
             };
             for axis in [axis, -axis] {
-                // p is a point of shape 1 and q one of shape 2, so the separation along the
-                // axis is at most (q − p)·axis: an axis that cannot beat the threshold can
-                // neither be returned nor change what is (the largest is returned only above
-                // it), and costs no support points.
-                if (*q - p).dot(axis) + slack <= threshold {
-                    continue;
-                }
-                let Some(separation) = support_separation(pos12, g1, g2, axis) else {
-                    continue;
-                };
-                // The last of equals, as `Iterator::max_by`.
-                if best.is_none_or(|(_, top)| separation.total_cmp(&top).is_ge()) {
-                    best = Some((axis, separation));
+                order += 1;
+                let near = q.dot(axis).min(mean2.dot(axis));
+                let far = p.dot(axis).max(mean1.dot(axis));
+                // An axis that cannot beat the threshold can neither be returned nor change
+                // what is (the largest is returned only above it).
+                let bound = near - far;
+                if bound + slack > threshold {
+                    candidates.push((bound, order, axis));
                 }
             }
         }
     }
-    best.filter(|&(_, separation)| separation > threshold)
+    candidates.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(b.1.cmp(&a.1)));
+    let mut best: Option<(Vector, Real, u32)> = None;
+    for (bound, order, axis) in candidates {
+        // Every separation left is at most its bound plus the rounding, below the best.
+        if best.is_some_and(|(_, top, _)| bound + slack < top) {
+            break;
+        }
+        let Some(separation) = support_separation(pos12, g1, g2, axis) else {
+            continue;
+        };
+        // The last of equals in the loops' order, as `Iterator::max_by`.
+        let wins = best.is_none_or(|(_, top, place)| {
+            separation.total_cmp(&top).then(order.cmp(&place)).is_gt()
+        });
+        if wins {
+            best = Some((axis, separation, order));
+        }
+    }
+    best.map(|(axis, separation, _)| (axis, separation))
+        .filter(|&(_, separation)| separation > threshold)
 }
 
 /// The face axis of largest separation among `axes` (shape 1's frame), the last of equals,
