@@ -37,7 +37,7 @@ use parry3d::shape::{ConvexPolyhedron, PackedFeatureId, PolygonalFeature, Shape,
 
 use super::axis_memory::{AxisMemory, FaceAxisMemory, float_slack};
 use super::caps::inside_convex;
-use super::separating_axes::GaussArc;
+use super::separating_axes::{GaussArc, GaussArcs};
 
 /// Most points a refined manifold keeps: a quadrilateral spanning the contact area carries a
 /// resting face and its friction as the whole polygon would.
@@ -623,11 +623,12 @@ fn support_separation(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, axis: Vector
 /// beats `normal`; otherwise the face's normal and the separation (m) along it.
 ///
 /// The face axes are the largest separation over the faces, the last of equals; if it does not
-/// beat `normal`, the edge axes are the largest over the edge pairs, in the order of the
-/// loops. `memory` (the manifold's, if it keeps one) lets the face axes be re-checked from the
-/// last full search ([`FaceAxisMemory`]); an edge axis is taken only where its pair's edges
-/// can be that far apart (a point of each edge bounds the separation along it). Both give
-/// what the full search gives, to the bit.
+/// beat `normal`, the edge axes are the largest over the edge pairs whose Gauss arcs cross,
+/// each along the direction where they cross, in the order of the loops. `memory` (the
+/// manifold's, if it keeps one) lets the face axes be re-checked from the last full search
+/// ([`FaceAxisMemory`]), to the bit; the edge axes' separations are taken from the highest
+/// bound down until none left can reach the largest (a point of each edge bounds the
+/// separation along it), which gives what taking every one gives, to the bit.
 fn better_face_axis<ContactData>(
     pos12: &Pose,
     g1: &dyn Shape,
@@ -702,46 +703,55 @@ fn better_face_axis<ContactData>(
             )
         })
         .collect();
-    // Each axis's separation is at most q·axis − p·axis for any point p of shape 1 and q of
-    // shape 2 (support separation takes the extremes). The points taken: an end of each edge,
-    // and each hull's vertex mean (inside it, the hull being convex). Along the axis where
-    // the arcs cross (a face of the Minkowski difference) the edges are the shapes' supports
-    // and the bound is the separation; along the other way the means keep it near the
-    // shapes' widths below. The separations themselves (two support points each) are taken
-    // from the highest bound down, until no bound left can reach the largest found: the same
-    // largest, and among equals the same axis (the last in the loops' order), as taking
-    // every one, for a few support points where every pair took two.
-    let mean =
-        |points: &[Vector]| points.iter().copied().sum::<Vector>() / points.len().max(1) as Real;
-    let (mean1, mean2) = (mean(points1), pos12.transform_point(mean(points2)));
+    let mut arcs2 = GaussArcs::new(edges2.iter().map(|(arc, _, _)| *arc));
+    // An edge pair's axis is a face of the Minkowski difference in one direction only: the
+    // one where the two arcs cross, inside arc 1 (so along its faces' normals' sum). Only
+    // that direction is taken (both where the arc leaves it undecided, faces almost
+    // opposite): between exact polyhedra the largest separation is on such a face. Parry's
+    // hulls join triangles up to about 1.5° apart into one face, so the other direction
+    // sometimes reads more (between the mug's V-HACD parts, by up to millimetres); the search
+    // then keeps a smaller separation along its own axis, or none above the
+    // threshold and Parry's normal stands. Taking both cost a support point pair for most
+    // crossings: the other direction's bound is loose by the shapes' widths.
+    // Along the crossing direction the two edges are the shapes' supports, and q·axis − p·axis
+    // (p, q an end of each edge) is the separation; whatever the direction it bounds the
+    // separation from above (support separation takes the extremes). The separations
+    // themselves (two support points each) are taken from the highest bound down, until no
+    // bound left can reach the largest found: the same largest, and among equals the same
+    // axis (the last in the loops' order), as taking every one.
     // (bound, place in the loops' order, axis)
     let mut candidates: Vec<(Real, u32, Vector)> = Vec::new();
     let mut order = 0_u32;
     for e1 in hull1.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
-        let arc1 = GaussArc::new(
+        let (normal_a, normal_b) = (
             faces1[e1.faces[0] as usize].normal,
             faces1[e1.faces[1] as usize].normal,
         );
+        let arc1 = GaussArc::new(normal_a, normal_b);
+        let inside1 = normal_a + normal_b;
         let p = points1[e1.vertices[0] as usize];
-        for (arc2, dir2, q) in &edges2 {
-            if !arc1.crosses(arc2) {
-                continue;
-            }
+        arcs2.crossing(&arc1, |j| {
+            let (_, dir2, q) = &edges2[j];
             let Some(axis) = e1.dir.cross(*dir2).try_normalize() else {
-                continue;
+                return;
             };
-            for axis in [axis, -axis] {
+            let side = axis.dot(inside1);
+            let both = [axis, -axis];
+            let directions = match side.partial_cmp(&0.0) {
+                Some(std::cmp::Ordering::Greater) => &both[..1],
+                Some(std::cmp::Ordering::Less) => &both[1..],
+                _ => &both[..],
+            };
+            for &axis in directions {
                 order += 1;
-                let near = q.dot(axis).min(mean2.dot(axis));
-                let far = p.dot(axis).max(mean1.dot(axis));
                 // An axis that cannot beat the threshold can neither be returned nor change
                 // what is (the largest is returned only above it).
-                let bound = near - far;
+                let bound = (*q - p).dot(axis);
                 if bound + slack > threshold {
                     candidates.push((bound, order, axis));
                 }
             }
-        }
+        });
     }
     candidates.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(b.1.cmp(&a.1)));
     let mut best: Option<(Vector, Real, u32)> = None;

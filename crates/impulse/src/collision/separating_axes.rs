@@ -203,14 +203,75 @@ impl GaussArc {
         let cba = c.dot(self.bxa);
         let dba = d.dot(self.bxa);
         let straddles = cba * dba < 0.0;
-        if !straddles {
-            return false;
-        }
+        straddles && self.crosses_straddling(other, cba)
+    }
+
+    /// The rest of [`Self::crosses`] for an `other` arc whose ends straddle this arc's great
+    /// circle, `cba` = c·(b × a).
+    #[inline]
+    fn crosses_straddling(&self, other: &Self, cba: Real) -> bool {
         // d × c, the other arc's b × a.
         let dxc = other.bxa;
         let adc = self.a.dot(dxc);
         let bdc = self.b.dot(dxc);
         adc * bdc < 0.0 && cba * bdc > 0.0
+    }
+}
+
+/// Many arcs, their ends in columns, to be tested against one arc at a time: the first test
+/// of [`GaussArc::crosses`] (whether an arc's ends straddle the other's great circle, which
+/// most do not) runs over the columns in a loop the compiler vectorises. The same arithmetic,
+/// in the same order, as [`GaussArc::crosses`]: the same answers to the bit.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct GaussArcs {
+    arcs: Vec<GaussArc>,
+    /// The arcs' first ends, then their second ends, by coordinate.
+    ends: [Vec<Real>; 6],
+    /// c·(b × a) of each arc's first end against the arc last tested.
+    first: Vec<Real>,
+    /// Whether each arc straddles the great circle of the arc last tested.
+    straddles: Vec<bool>,
+}
+
+impl GaussArcs {
+    /// The columns of `arcs`.
+    pub(crate) fn new(arcs: impl IntoIterator<Item = GaussArc>) -> Self {
+        let mut columns = Self::default();
+        for arc in arcs {
+            for (column, value) in columns
+                .ends
+                .iter_mut()
+                .zip([arc.a.x, arc.a.y, arc.a.z, arc.b.x, arc.b.y, arc.b.z])
+            {
+                column.push(value);
+            }
+            columns.arcs.push(arc);
+        }
+        let count = columns.arcs.len();
+        columns.first.resize(count, 0.0);
+        columns.straddles.resize(count, false);
+        columns
+    }
+
+    /// Calls `found(j)` for every arc j that crosses `arc`, in order.
+    #[inline]
+    pub(crate) fn crossing(&mut self, arc: &GaussArc, mut found: impl FnMut(usize)) {
+        let n = arc.bxa;
+        let [cx, cy, cz, dx, dy, dz] = &self.ends;
+        let count = self.arcs.len();
+        let (first, straddles) = (&mut self.first[..count], &mut self.straddles[..count]);
+        for j in 0..count {
+            // Vec3::dot's order: (x·x' + y·y') + z·z'.
+            let cba = cx[j] * n.x + cy[j] * n.y + cz[j] * n.z;
+            let dba = dx[j] * n.x + dy[j] * n.y + dz[j] * n.z;
+            first[j] = cba;
+            straddles[j] = cba * dba < 0.0;
+        }
+        for j in 0..count {
+            if straddles[j] && arc.crosses_straddling(&self.arcs[j], first[j]) {
+                found(j);
+            }
+        }
     }
 }
 

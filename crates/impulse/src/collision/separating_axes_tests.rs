@@ -108,3 +108,38 @@ fn a_box_reads_as_the_hull_of_its_corners() {
     }
     assert!(overlapping > 200, "{overlapping} overlapping poses");
 }
+
+/// Arcs in columns answer as one arc at a time, to the bit: 40 of 200 seeded random arcs,
+/// short as a hull's edges make them and long, against all 200.
+#[test]
+fn arcs_in_columns_cross_as_one_at_a_time() {
+    use super::{GaussArc, GaussArcs};
+    use rand::rngs::ChaCha20Rng;
+    use rand::{RngExt, SeedableRng};
+    use rand_distr::{Distribution, UnitSphere};
+    let mut rng = ChaCha20Rng::seed_from_u64(17);
+    let unit = |rng: &mut ChaCha20Rng| Vec3::from(UnitSphere.sample(rng) as [f32; 3]);
+    let arcs: Vec<GaussArc> = (0..200)
+        .map(|_| {
+            let a = unit(&mut rng);
+            // Short arcs, as a hull's edges make, and some long ones.
+            let b = (a + unit(&mut rng) * rng.random_range(0.05..1.5)).normalize();
+            GaussArc::new(a, b)
+        })
+        .collect();
+    let mut columns = GaussArcs::new(arcs.iter().copied());
+    let mut crossings = 0;
+    for k in 0..40 {
+        let arc = arcs[k * 5];
+        let mut found = Vec::new();
+        columns.crossing(&arc, |j| found.push(j));
+        let one_at_a_time: Vec<usize> =
+            (0..arcs.len()).filter(|&j| arc.crosses(&arcs[j])).collect();
+        assert_eq!(found, one_at_a_time, "arc {k}");
+        crossings += found.len();
+    }
+    assert!(
+        crossings > 100,
+        "{crossings} crossings: the sample tests too little"
+    );
+}
