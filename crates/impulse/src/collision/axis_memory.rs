@@ -9,13 +9,13 @@
 //! centre moves in shape 1's frame plus the turn's chord (2 sin(θ/2)) times that sphere's
 //! radius; an axis fixed in shape 2's frame likewise with shape 1's sphere in shape 2's frame
 //! ([`FaceAxisMemory::drift`]). So from the separations of the last full search (its largest,
-//! which axis gave it, and the largest of the others), a later pose knows, before any support
-//! point is taken:
+//! which axis gave it, and at least the largest of the others), a later pose knows, before
+//! any support point is taken:
 //!
 //! - every axis's separation is at most the last largest plus the drift: when that cannot beat
 //!   the search's threshold, the search would find nothing, and is skipped;
-//! - the remembered axis's separation now (two support points): when it beats the last
-//!   largest of the others plus the drift, it is still the largest of all, and it is what the
+//! - the remembered axis's separation now (two support points): when it beats what was kept
+//!   for the others plus the drift, it is still the largest of all, and it is what the
 //!   full search would return, to the bit (the same axis, computed the same way).
 //!
 //! Otherwise the search runs in full and its result is remembered. The slack
@@ -42,7 +42,9 @@ pub struct FaceAxisMemory {
     pub(crate) best: u32,
     /// That largest separation (m).
     pub(crate) best_separation: Real,
-    /// The largest separation among the other axes (m; `Real::MIN` when there is none).
+    /// At least the largest separation among the other axes (m; `Real::MIN` when there is
+    /// none): the search leaves axes whose bound shows them below the best untaken, and keeps
+    /// the first such bound (plus its slack) here.
     pub(crate) runner_up: Real,
 }
 

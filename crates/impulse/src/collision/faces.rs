@@ -657,34 +657,45 @@ fn better_face_axis<ContactData>(
     }
     let threshold = given + tolerance;
     let slack = float_slack(pos12, &sphere1, &sphere2);
-    let mut axes: Vec<Vector> = Vec::new();
-    let mut add = |shape: &dyn Shape, to_frame1: Option<&Pose>| {
-        let out = |v: Vector| match to_frame1 {
-            None => v,
-            Some(pose) => -(pose.rotation * v),
-        };
-        if let Some((hull, _)) = hull_parts(shape) {
-            axes.extend(hull.faces().iter().map(|face| out(face.normal)));
-        } else if shape.as_cuboid().is_some() {
-            for v in [Vector::X, Vector::Y, Vector::Z] {
-                axes.extend([out(v), out(-v)]);
-            }
-        } else if let Some(normal) = shape.as_triangle().and_then(|t| t.normal()) {
-            axes.extend([out(normal), out(-normal)]);
-        }
-    };
-    add(g1, None);
-    add(g2, Some(pos12));
+    let axes = face_axes(pos12, g1, g2);
     let spheres = (&sphere1, &sphere2);
-    if let Some(found) = face_axes_above(pos12, g1, g2, &axes, threshold, slack, spheres, memory) {
+    // Points of each shape (shape 1's frame): Parry's, on their surfaces.
+    let on1: Vec<Vector> = points.iter().map(|p| p.local_p1).collect();
+    let on2: Vec<Vector> = points
+        .iter()
+        .map(|p| pos12.transform_point(p.local_p2))
+        .collect();
+    let known = (&on1[..], &on2[..]);
+    let search = FaceSearch {
+        threshold,
+        slack,
+        spheres,
+        known,
+    };
+    if let Some(found) = face_axes_above(pos12, g1, g2, &axes, &search, memory) {
         return Some(found);
     }
     // Two hulls can be apart along an edge pair's cross product only (thin parts crossed
-    // edge to edge): the pairs whose Gauss-map arcs cross, each axis either way, searched when
-    // no face axis did better.
+    // edge to edge): searched when no face axis did better.
     let (Some((hull1, _)), Some((hull2, _))) = (hull_parts(g1), hull_parts(g2)) else {
         return None;
     };
+    edge_axis_above(pos12, (g1, hull1), (g2, hull2), threshold, slack)
+}
+
+/// The edge axis of largest separation between hulls `hull1` and `hull2` (the cores of shapes
+/// `g1` and `g2`, shape 2 at `pos12` in shape 1's frame), the last of equals in the loops'
+/// order, and that separation (m, borders included), if it is above `threshold` (m); `None`
+/// otherwise. The axes are the cross products of the edge pairs whose Gauss-map arcs cross,
+/// each along the direction where they cross (see the body); `slack` (m) covers the
+/// separations' rounding.
+fn edge_axis_above(
+    pos12: &Pose,
+    (g1, hull1): (&dyn Shape, &ConvexPolyhedron),
+    (g2, hull2): (&dyn Shape, &ConvexPolyhedron),
+    threshold: Real,
+    slack: Real,
+) -> Option<(Vector, Real)> {
     let (faces1, faces2) = (hull1.faces(), hull2.faces());
     let (points1, points2) = (hull1.points(), hull2.points());
     // Shape 2's edges in shape 1's frame, once: each edge's arc between its faces' normals
@@ -775,23 +786,107 @@ fn better_face_axis<ContactData>(
         .filter(|&(_, separation)| separation > threshold)
 }
 
-/// The face axis of largest separation among `axes` (shape 1's frame), the last of equals,
-/// and that separation, if it is above `threshold` (m); `None` otherwise. With a `memory`
-/// slot, first re-checks the last full search's outcome (see [`FaceAxisMemory`]): all axes
-/// within the drift of the last largest, below the threshold (nothing to find), or the
-/// remembered axis still above all the others; else searches all axes and remembers.
-/// `slack` (m) covers the separations' rounding twice over (then and now).
-#[allow(clippy::too_many_arguments)]
+/// The face axes of a pair (shape 2 at `pos12` in shape 1's frame), each out of shape 1 with
+/// a point of its face, shape 1's frame: every face of a hull, a box's six, a triangle's two
+/// sides; shape 1's first. Other shapes have none.
+fn face_axes(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape) -> Vec<FaceAxis> {
+    let mut axes: Vec<FaceAxis> = Vec::new();
+    let mut add = |shape: &dyn Shape, to_frame1: Option<&Pose>| {
+        // A face normal out of shape 1 (a face of shape 2 faces the other way) and a point of
+        // the face, in shape 1's frame.
+        let mut push = |normal: Vector, point: Vector| {
+            axes.push(match to_frame1 {
+                None => FaceAxis {
+                    axis: normal,
+                    point,
+                    of_first: true,
+                },
+                Some(pose) => FaceAxis {
+                    axis: -(pose.rotation * normal),
+                    point: pose.transform_point(point),
+                    of_first: false,
+                },
+            })
+        };
+        if let Some((hull, _)) = hull_parts(shape) {
+            let (points, loops) = (hull.points(), hull.vertices_adj_to_face());
+            for face in hull.faces() {
+                let vertex = loops[face.first_vertex_or_edge as usize];
+                push(face.normal, points[vertex as usize]);
+            }
+        } else if let Some(cuboid) = shape.as_cuboid() {
+            for v in [Vector::X, Vector::Y, Vector::Z] {
+                push(v, v * cuboid.half_extents);
+                push(-v, -v * cuboid.half_extents);
+            }
+        } else if let Some(triangle) = shape.as_triangle()
+            && let Some(normal) = triangle.normal()
+        {
+            push(normal, triangle.a);
+            push(-normal, triangle.a);
+        }
+    };
+    add(g1, None);
+    add(g2, Some(pos12));
+    axes
+}
+
+/// A face axis of a pair (shape 1's frame, out of shape 1) and a point of its face, of shape 1
+/// or shape 2 (`of_first`), in shape 1's frame: the face's shape reaches at least that far
+/// along the axis (shape 1) or that near (shape 2).
+struct FaceAxis {
+    axis: Vector,
+    point: Vector,
+    of_first: bool,
+}
+
+impl FaceAxis {
+    /// An upper bound (m) of the separation along the axis: the nearest of shape 2's `known`
+    /// points less the farthest of shape 1's (each shape's extremes are at least that far
+    /// out), the face's point among its shape's. Along the axis where the shapes touch,
+    /// Parry's points lie on the supports and the bound is about the separation.
+    fn bound(&self, (on1, on2): (&[Vector], &[Vector])) -> Real {
+        let along = |v: &Vector| v.dot(self.axis);
+        let own = along(&self.point);
+        if self.of_first {
+            on2.iter().map(along).fold(Real::INFINITY, Real::min) - own
+        } else {
+            own - on1.iter().map(along).fold(Real::NEG_INFINITY, Real::max)
+        }
+    }
+}
+
+/// What [`face_axes_above`] searches with: the `threshold` (m) to beat, the `slack` (m) that
+/// covers the separations' rounding twice over (then and now), the shapes' local bounding
+/// spheres, and points known to be on each shape (shape 1's frame).
+struct FaceSearch<'a> {
+    threshold: Real,
+    slack: Real,
+    spheres: (&'a BoundingSphere, &'a BoundingSphere),
+    known: (&'a [Vector], &'a [Vector]),
+}
+
+/// The face axis of largest separation among `axes`, the last of equals, and that separation,
+/// if it is above the threshold; `None` otherwise. With a `memory` slot, first re-checks the
+/// last full search's outcome (see [`FaceAxisMemory`]): all axes within the drift of the last
+/// largest, below the threshold (nothing to find), or the remembered axis still above all the
+/// others; else searches all axes and remembers.
+///
+/// The search takes the separations (two support points each) from the highest bound
+/// ([`FaceAxis::bound`]) down, until no bound left, plus the slack, reaches the largest found:
+/// the largest of all and the same axis among equals as taking every one. What it remembers
+/// as the others' largest is then at most that: the largest of those taken, or the first
+/// bound left plus the slack, which a re-check may rely on all the same.
 fn face_axes_above(
     pos12: &Pose,
     g1: &dyn Shape,
     g2: &dyn Shape,
-    axes: &[Vector],
-    threshold: Real,
-    slack: Real,
-    (sphere1, sphere2): (&BoundingSphere, &BoundingSphere),
+    axes: &[FaceAxis],
+    search: &FaceSearch<'_>,
     memory: Option<&mut Option<FaceAxisMemory>>,
 ) -> Option<(Vector, Real)> {
+    let (threshold, slack) = (search.threshold, search.slack);
+    let (sphere1, sphere2) = search.spheres;
     let separation = |axis: Vector| support_separation(pos12, g1, g2, axis);
     if let Some(Some(last)) = memory.as_deref()
         && last.axes as usize == axes.len()
@@ -802,22 +897,35 @@ fn face_axes_above(
         if last.best_separation + drift <= threshold {
             return None;
         }
-        let axis = axes[last.best as usize];
+        let axis = axes[last.best as usize].axis;
         if let Some(now) = separation(axis)
             && now > last.runner_up + drift
         {
             return (now > threshold).then_some((axis, now));
         }
     }
+    let mut order: Vec<(Real, usize)> = axes
+        .iter()
+        .enumerate()
+        .map(|(index, face)| (face.bound(search.known), index))
+        .collect();
+    order.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(b.1.cmp(&a.1)));
     let mut best: Option<(usize, Real)> = None;
     let mut runner_up = Real::MIN;
-    for (index, &axis) in axes.iter().enumerate() {
-        let Some(value) = separation(axis) else {
+    for &(bound, index) in &order {
+        if best.is_some_and(|(_, top)| bound + slack < top) {
+            // Every axis left is below the best, and at most this bound plus the slack.
+            runner_up = runner_up.max(bound + slack);
+            break;
+        }
+        let Some(value) = separation(axes[index].axis) else {
             continue;
         };
         match best {
             // The last of equals, as `Iterator::max_by`.
-            Some((_, top)) if value.total_cmp(&top).is_lt() => runner_up = runner_up.max(value),
+            Some((place, top)) if value.total_cmp(&top).then(index.cmp(&place)).is_lt() => {
+                runner_up = runner_up.max(value)
+            }
             Some((_, top)) => {
                 runner_up = runner_up.max(top);
                 best = Some((index, value));
@@ -836,7 +944,7 @@ fn face_axes_above(
         };
         *slot = remembered.is_valid().then_some(remembered);
     }
-    (top > threshold).then_some((axes[index], top))
+    (top > threshold).then_some((axes[index].axis, top))
 }
 
 #[cfg(test)]
