@@ -601,12 +601,21 @@ const AXIS_RELATIVE_TOLERANCE: Real = 1.0e-3;
 /// axis less the most of shape 1's. For convex shapes the signed distance is the largest of
 /// these over all axes (the separating axis theorem), reached at the contact normal.
 fn support_separation(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, axis: Vector) -> Option<Real> {
+    supports(pos12, g1, g2, axis).map(|(_, _, separation)| separation)
+}
+
+/// The support points (shape 1's frame) of `g1` along `axis` and of `g2` against it, and the
+/// separation along it ([`support_separation`]).
+fn supports(
+    pos12: &Pose,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    axis: Vector,
+) -> Option<(Vector, Vector, Real)> {
     let (s1, s2) = (g1.as_support_map()?, g2.as_support_map()?);
-    let far1 = s1.local_support_point(axis).dot(axis);
-    let near2 = pos12
-        .transform_point(s2.local_support_point(pos12.rotation.inverse() * -axis))
-        .dot(axis);
-    Some(near2 - far1)
+    let far1 = s1.local_support_point(axis);
+    let near2 = pos12.transform_point(s2.local_support_point(pos12.rotation.inverse() * -axis));
+    Some((far1, near2, near2.dot(axis) - far1.dot(axis)))
 }
 
 /// A face normal of either shape (shape 1's frame, out of it: a hull's faces, a box's, a
@@ -637,7 +646,7 @@ fn better_face_axis<ContactData>(
     points: &[TrackedContact<ContactData>],
     memory: Option<&mut Option<FaceAxisMemory>>,
 ) -> Option<(Vector, Real)> {
-    let given = support_separation(pos12, g1, g2, normal)?;
+    let (support1, support2, given) = supports(pos12, g1, g2, normal)?;
     let sphere1 = g1.compute_local_bounding_sphere();
     let sphere2 = g2.compute_local_bounding_sphere();
     let tolerance =
@@ -659,13 +668,10 @@ fn better_face_axis<ContactData>(
     let slack = float_slack(pos12, &sphere1, &sphere2);
     let axes = face_axes(pos12, g1, g2);
     let spheres = (&sphere1, &sphere2);
-    // Points of each shape (shape 1's frame): Parry's, on their surfaces.
-    let on1: Vec<Vector> = points.iter().map(|p| p.local_p1).collect();
-    let on2: Vec<Vector> = points
-        .iter()
-        .map(|p| pos12.transform_point(p.local_p2))
-        .collect();
-    let known = (&on1[..], &on2[..]);
+    // A point of each shape (shape 1's frame) for the bounds: its support along Parry's
+    // normal, a vertex where the contact is. (Parry's points would bound as well where they
+    // lie on the shapes, but a point clipped onto a merged face's plane can lie just off it.)
+    let known = (&[support1][..], &[support2][..]);
     let search = FaceSearch {
         threshold,
         slack,
@@ -680,45 +686,58 @@ fn better_face_axis<ContactData>(
     let (Some((hull1, _)), Some((hull2, _))) = (hull_parts(g1), hull_parts(g2)) else {
         return None;
     };
-    edge_axis_above(pos12, (g1, hull1), (g2, hull2), threshold, slack)
+    edge_axis_above(pos12, (g1, hull1), (g2, hull2), &search)
 }
 
 /// The edge axis of largest separation between hulls `hull1` and `hull2` (the cores of shapes
 /// `g1` and `g2`, shape 2 at `pos12` in shape 1's frame), the last of equals in the loops'
 /// order, and that separation (m, borders included), if it is above `threshold` (m); `None`
 /// otherwise. The axes are the cross products of the edge pairs whose Gauss-map arcs cross,
-/// each along the direction where they cross (see the body); `slack` (m) covers the
-/// separations' rounding.
+/// each along the direction where they cross (see the body); the search's slack (m) covers
+/// the separations' rounding, and its known points bound them.
 fn edge_axis_above(
     pos12: &Pose,
     (g1, hull1): (&dyn Shape, &ConvexPolyhedron),
     (g2, hull2): (&dyn Shape, &ConvexPolyhedron),
-    threshold: Real,
-    slack: Real,
+    search: &FaceSearch<'_>,
 ) -> Option<(Vector, Real)> {
+    let (threshold, slack) = (search.threshold, search.slack);
+    let (on1, on2) = search.known;
     let (faces1, faces2) = (hull1.faces(), hull2.faces());
     let (points1, points2) = (hull1.points(), hull2.points());
     // Shape 2's edges in shape 1's frame, once: each edge's arc between its faces' normals
-    // (negated, as the Minkowski difference sees them), its direction and one of its points.
-    let edges2: Vec<(GaussArc, Vector, Vector)> = hull2
+    // (negated, as the Minkowski difference sees them) and one of its points.
+    // An edge's axes lie on its arc, so each edge is bounded over its arc before its pairs
+    // are: along an axis x of shape 2's edge (x on its arc), with q a point of the edge and p
+    // any point of shape 1, the separation is at most (q − p)·x, so at most the least over
+    // Parry's points p of the most (q − p)·x reaches on the arc
+    // ([`GaussArc::reach_along`]); likewise a shape 1 edge with Parry's points on shape 2. An
+    // edge whose bound (plus the slack) cannot beat the threshold has no axis that could be
+    // returned or change what is, and its pairs are not tested (edges far from the contact,
+    // whose faces look away from the other shape: most of them).
+    let reach = |arc: &GaussArc, from: &dyn Fn(Vector) -> Vector, known: &[Vector]| {
+        known
+            .iter()
+            .map(|&k| arc.reach_along(from(k)))
+            .fold(Real::INFINITY, Real::min)
+    };
+    let edges2: Vec<(GaussArc, Vector)> = hull2
         .edges()
         .iter()
         .filter(|e| e.faces[0] != e.faces[1])
-        .map(|e2| {
+        .filter_map(|e2| {
             let c = pos12.rotation * faces2[e2.faces[0] as usize].normal;
             let d = pos12.rotation * faces2[e2.faces[1] as usize].normal;
-            (
-                GaussArc::new(-c, -d),
-                pos12.rotation * e2.dir,
-                pos12.transform_point(points2[e2.vertices[0] as usize]),
-            )
+            let arc = GaussArc::new(-c, -d);
+            let q = pos12.transform_point(points2[e2.vertices[0] as usize]);
+            (reach(&arc, &|p| q - p, on1) + slack > threshold).then_some((arc, q))
         })
         .collect();
-    let mut arcs2 = GaussArcs::new(edges2.iter().map(|(arc, _, _)| *arc));
+    let mut arcs2 = GaussArcs::new(edges2.iter().map(|(arc, _)| *arc));
     // An edge pair's axis is a face of the Minkowski difference in one direction only: the
-    // one where the two arcs cross, inside arc 1 (so along its faces' normals' sum). Only
-    // that direction is taken (both where the arc leaves it undecided, faces almost
-    // opposite): between exact polyhedra the largest separation is on such a face. Parry's
+    // one where the two arcs cross, inside arc 1 (so along its faces' normals' sum, or
+    // square to it). Only that direction is taken: between exact polyhedra the largest
+    // separation is on such a face. Parry's
     // hulls join triangles up to about 1.5° apart into one face, so the other direction
     // sometimes reads more (between the mug's V-HACD parts, by up to millimetres); the search
     // then keeps a smaller separation along its own axis, or none above the
@@ -741,26 +760,30 @@ fn edge_axis_above(
         let arc1 = GaussArc::new(normal_a, normal_b);
         let inside1 = normal_a + normal_b;
         let p = points1[e1.vertices[0] as usize];
+        if reach(&arc1, &|q| q - p, on2) + slack <= threshold {
+            continue;
+        }
         arcs2.crossing(&arc1, |j| {
-            let (_, dir2, q) = &edges2[j];
-            let Some(axis) = e1.dir.cross(*dir2).try_normalize() else {
+            let (arc2, q) = &edges2[j];
+            // Where the arcs' great circles cross: on both arcs, so both edges are their
+            // shapes' supports along it. (The edges' own cross product is the same axis
+            // between exact polyhedra; a Parry hull's merged faces leave its edges off
+            // square to their faces' normals by up to a degree or so, and the cross product
+            // off both arcs.)
+            let Some(axis) = arc1
+                .plane_normal()
+                .cross(arc2.plane_normal())
+                .try_normalize()
+            else {
                 return;
             };
-            let side = axis.dot(inside1);
-            let both = [axis, -axis];
-            let directions = match side.partial_cmp(&0.0) {
-                Some(std::cmp::Ordering::Greater) => &both[..1],
-                Some(std::cmp::Ordering::Less) => &both[1..],
-                _ => &both[..],
-            };
-            for &axis in directions {
-                order += 1;
-                // An axis that cannot beat the threshold can neither be returned nor change
-                // what is (the largest is returned only above it).
-                let bound = (*q - p).dot(axis);
-                if bound + slack > threshold {
-                    candidates.push((bound, order, axis));
-                }
+            let axis = if axis.dot(inside1) < 0.0 { -axis } else { axis };
+            order += 1;
+            // An axis that cannot beat the threshold can neither be returned nor change what
+            // is (the largest is returned only above it).
+            let bound = (*q - p).dot(axis);
+            if bound + slack > threshold {
+                candidates.push((bound, order, axis));
             }
         });
     }
