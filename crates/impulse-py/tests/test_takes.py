@@ -723,7 +723,8 @@ def test_takes_with_their_own_seeds_vary_the_rough_surfaces(tmp_path):
     # generation, before it is in the refinement's table: one run, counted in every slot.
     from impulse.takes import refine
 
-    refined = refine(tmp_path / "t", met[0].take_id, budget=16, workers=2, progress=False)
+    refined = refine(tmp_path / "t", met[0].take_id, budget=16, workers=2, population=16,
+                     progress=False)
     assert met[0].scene_seed in {take.scene_seed for take in refined.values()}
     assert len(refined) < 16
     assert set(refined.table.column("generation").to_pylist()) == {0}
@@ -1364,9 +1365,10 @@ def test_refine_searches_around_a_take_keeping_the_goals(tmp_path, capsys):
     refined = load(out / "refine" / take.take_id)
     assert refined.goal_names == found.goal_names and refined.manifest["steps"] == STEPS
     rows = refined.table.to_pylist()
-    assert len(rows) == 32 and _in_draw_order(rows, 16)  # the whole budget: stop_after = 32
+    # The whole budget (stop_after = 32), in generations of 8 (a refinement's default).
+    assert len(rows) == 32 and _in_draw_order(rows, 8)
     # The first generation is θ of the take plus 0.002 N(0, I): within 5 standard deviations.
-    first = np.array([row["theta"] for row in rows[:16]])
+    first = np.array([row["theta"] for row in rows[:8]])
     assert np.all(np.abs(first - take.theta) < 5 * 0.002)
     # The goal is a 0.3 m range of the ball's x; a step of 0.002 moves it by about 0.6 mm:
     # nearly every refined take meets it.
@@ -1387,6 +1389,64 @@ def test_refine_searches_around_a_take_keeping_the_goals(tmp_path, capsys):
     assert len(again) == 8
     with pytest.raises(KeyError, match="no take 'ffff'"):
         refine(custom_out, "ffff", budget=8, goals=[custom(_within_reach, "reach")])
+
+
+def test_a_refinement_around_a_met_take_shrinks_its_step_until_most_takes_meet_the_goals(
+    tmp_path,
+):
+    from impulse.takes import refine
+
+    out = tmp_path / "t"
+    found = search(
+        SCENE, [TARGET], VARIATION, budget=64, steps=STEPS, out=out, workers=2, population=16,
+        progress=False,
+    )
+    take = found.met()[0]
+    # A step of 2 (0.6 m/s of the ball's speed) misses the 0.3 m range most of the time: the
+    # trust region halves it until most takes end in the range.
+    refined = refine(out, take.take_id, budget=48, step=2.0, workers=2, progress=False)
+    rows = refined.table.to_pylist()
+    assert len(rows) == 48 and _in_draw_order(rows, 8)
+    generations = [rows[k : k + 8] for k in range(0, 48, 8)]
+    met = [sum(row["met"] for row in generation) for generation in generations]
+    spread = [
+        float(np.sqrt(np.mean((np.array([row["theta"] for row in generation]) - take.theta) ** 2)))
+        for generation in generations
+    ]
+    assert met[0] < 4, met  # the first generation at the full step: most miss
+    assert spread[-1] < 0.5 * spread[0], spread  # the step shrank
+    # After a generation with fewer than half meeting the goal, the next is drawn with half
+    # the step (the root mean square of 24 draws is within 30 % of the step).
+    for k in range(5):
+        if met[k] < 4:
+            assert spread[k + 1] < 0.8 * spread[k], (k, met, spread)
+    assert sum(met[3:]) >= 12, met  # the last three generations: most meet the goal
+    # Every refined take is still drawn around the take, not from a moving mean.
+    assert all(np.all(np.abs(np.array(row["theta"]) - take.theta) < 5 * 2.0) for row in rows)
+    # Run again, the refinement resumes to the same takes (the step follows from the table).
+    again = refine(out, take.take_id, budget=48, step=2.0, workers=2, progress=False)
+    assert again.table.to_pylist() == rows
+
+
+def test_a_trust_regions_step_halves_below_half_met_and_grows_back_when_most_meet():
+    from impulse.takes._search import REFINE_LEAST_STEP, _adapted_step
+
+    def rows(met, missed, failed=0):
+        return ([{"status": "completed", "met": True}] * met
+                + [{"status": "completed", "met": False}] * missed
+                + [{"status": "failed", "met": False}] * failed)
+
+    assert _adapted_step(0.002, rows(3, 5), 0.002) == 0.001  # fewer than half: halved
+    assert _adapted_step(0.001, rows(4, 4), 0.002) == 0.001  # half: kept
+    assert _adapted_step(0.001, rows(5, 3), 0.002) == 0.001  # more than half, not most: kept
+    grown = _adapted_step(0.0005, rows(6, 2), 0.002)  # three quarters: grown by √2
+    assert grown == pytest.approx(0.0005 * math.sqrt(2.0), rel=1e-12)
+    assert _adapted_step(0.0018, rows(8, 0), 0.002) == 0.002  # never above the start
+    least = REFINE_LEAST_STEP * 0.002
+    assert _adapted_step(least, rows(0, 8), 0.002) == least  # never below the floor
+    # A failed take (a worker's failure) says nothing of the goals.
+    assert _adapted_step(0.001, rows(6, 2, failed=8), 0.002) > 0.001
+    assert _adapted_step(0.001, rows(0, 0, failed=8), 0.002) == 0.001
 
 
 def _read_png(path):
