@@ -1121,6 +1121,62 @@ def test_a_script_piped_into_python_is_refused_before_any_worker_starts(tmp_path
     assert not out.exists()
 
 
+def _notebook_client():
+    """nbclient and nbformat (with ipykernel's kernel), or a skip when they are not installed,
+    a failure under ``IMPULSE_REQUIRE_NOTEBOOK=1`` (as in CI)."""
+    try:
+        import ipykernel  # noqa: F401 - the kernel the notebook runs in
+        import nbclient
+        import nbformat
+    except ImportError as missing:
+        if os.environ.get("IMPULSE_REQUIRE_NOTEBOOK") == "1":
+            pytest.fail(f"the notebook test needs nbclient, nbformat and ipykernel: {missing}")
+        pytest.skip(f"nbclient, nbformat and ipykernel are not installed: {missing}")
+    return nbclient, nbformat
+
+
+def test_a_notebook_builds_a_scene_with_the_python_api_and_searches_it(tmp_path):
+    nbclient, nbformat = _notebook_client()
+    out = tmp_path / "takes"
+    # As a user types it: a scene built from the API's shapes, checked by building its world,
+    # then a search from a cell (no __main__ guard: a notebook needs none) and its sheet.
+    cells = [
+        "import impulse\nimport impulse.takes as takes",
+        "scene = {\n"
+        '    "name": "roll",\n'
+        '    "materials": {"ice": {"friction": 0.0, "restitution": 0.0}},\n'
+        '    "bodies": [\n'
+        '        {"name": "ground", "kind": "static", "material": "ice",\n'
+        '         "shape": impulse.Shape.halfspace([0, 1, 0]).to_dict()},\n'
+        '        {"name": "ball", "kind": "dynamic", "material": "ice", "position": [0, 0.1, 0],\n'
+        '         "linear_velocity": [0.2, 0, 0], "shape": impulse.Shape.ball(0.1).to_dict()},\n'
+        "    ],\n"
+        "}\n"
+        'impulse.World.from_scene(scene).names',
+        f"found = takes.search(scene, [{TARGET!r}], {VARIATION!r}, budget=8, steps={STEPS},\n"
+        f"                     population=4, workers=2, out={str(out)!r})\n"
+        "print(len(found), 'takes,', len(found.met()), 'meet every goal')",
+        "page = takes.sheet(found.root, previews=False)",
+    ]
+    notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(c) for c in cells])
+    nbclient.NotebookClient(
+        notebook, timeout=120, kernel_name="python3",
+        resources={"metadata": {"path": str(tmp_path)}},
+    ).execute()  # a cell that raises fails the test with its traceback (CellExecutionError)
+    assert notebook.cells[1].outputs[0]["data"]["text/plain"] == "['ground', 'ball']"
+    printed = "".join(
+        output.get("text", "")
+        for output in notebook.cells[2].outputs
+        if output.get("name") == "stdout"
+    )
+    takes = load(out)
+    # The search ends at its first take meeting the goal (stop_after = 1), within the budget.
+    assert takes.met() and len(takes) <= 8
+    assert f"{len(takes)} takes, {len(takes.met())} meet every goal" in printed
+    assert all(take.status == "completed" for take in takes.values())
+    assert (out / "sheet.html").is_file()
+
+
 def _children(pid):
     """The ids of the processes whose parent is ``pid`` (Linux /proc)."""
     found = []
