@@ -1729,6 +1729,29 @@ def test_a_worked_shots_preview_shows_each_goal_body_over_20_by_20_pixels(
         assert width >= 20 and height >= 20, (name, width, height)
 
 
+def test_a_preview_of_the_7_10_split_frames_both_pins_over_20_by_20_pixels(
+    repository, impulse_cli, tmp_path
+):
+    from impulse.takes._sheet import goal_frame, goal_views
+
+    # The split the bowling shot is after: the 7 and the 10 standing 0.91 m apart (here at
+    # the start, where they stand; judged `at` 0 s). Framed with the knocked pins, they are
+    # the first goals' bodies and must both be drawn 20 pixels across.
+    scene = json.loads((repository / "scenes" / "takes" / "bowling.json").read_text())
+    goals = [{"type": "rests_with_axis_up", "body": name, "axis": [0, 1, 0], "at": 0.0}
+             for name in ("pin7", "pin10")]
+    eye, target, fov, framed = goal_frame(scene, 1, goal_views(goals), (192, 144))
+    names = [body["name"] for body in scene["bodies"]]
+    assert framed == sorted([names.index("pin7"), names.index("pin10")]), framed
+    arguments = ["--camera-eye", ",".join(map(str, eye)), "--camera-target",
+                 ",".join(map(str, target)), "--fov", str(fov)]
+    for body in framed:
+        (tmp_path / str(body)).mkdir()
+        width, height = _drawn_pixels(impulse_cli, scene, [body], arguments,
+                                      tmp_path / str(body))[1]
+        assert width >= 20 and height >= 20, (names[body], width, height, fov)
+
+
 def test_a_preview_outlines_the_goals_region(repository, impulse_cli, tmp_path):
     from impulse.takes._sheet import goal_camera, goal_views, region_arguments
 

@@ -73,7 +73,7 @@ FOV_DEGREES = 40.0
 #: The fields of view (degrees, vertical) a ``goals`` camera tries, widest first: a longer
 #: lens, seen from farther, draws bodies apart in depth at more nearly one size (two dice
 #: on a table), so it frames more goal bodies each :data:`GOAL_PIXELS` across.
-FIELDS_OF_VIEW = (FOV_DEGREES, 30.0, 20.0, 15.0)
+FIELDS_OF_VIEW = (FOV_DEGREES, 30.0, 20.0, 15.0, 10.0)
 VIEW_DIRECTION = (0.45, 0.5, 1.0)
 
 
@@ -118,7 +118,7 @@ OUTLIER = 3.0
 CONTEXT = 3.0
 #: The least width and height (pixels) of each goal body a ``goals`` preview frames: the
 #: 20 pixels a viewer needs to judge a body, and one for the rasteriser's rounding.
-GOAL_PIXELS = 22.0
+GOAL_PIXELS = 21.0
 
 
 def goal_views(specs: Any) -> list[tuple[Any, str, Any, Any]]:
