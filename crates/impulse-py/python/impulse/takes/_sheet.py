@@ -443,26 +443,24 @@ def goal_frame(
 ) -> tuple[list[float], list[float], float, list[int]] | None:
     """The camera of a ``goals`` preview (eye, target; m; vertical field of view, degrees)
     and the goal bodies it frames (indices): ``impulse render``'s three-quarter view, aimed
-    at the goal
-    bodies where their goals are judged (:func:`goal_views`): a body that must end somewhere,
-    rest or tilt where it is at the end (or ``at``), a body that must pass through a region
-    where it comes closest to it; the paths of the bodies of contact goals (``touches``,
-    ``never_touches``) only when no goal judges a body at a place. Bodies are grown by their
-    shapes' extents; a place far from all the others (:data:`OUTLIER`; a pin knocked into the
-    pit) is left out; static bodies (the ground a ball must touch) too.
+    at the goal bodies where their goals are judged (:func:`goal_views`): a body that must
+    end somewhere, rest or tilt where it is at the end (or ``at``), a body that must pass
+    through a region where it comes closest to it; the paths of the bodies of contact goals
+    (``touches``, ``never_touches``) only when no goal judges a body at a place. A place far
+    from all the others (:data:`OUTLIER`; a pin knocked into the pit) is left out, and so are
+    static bodies (the ground a ball must touch).
 
-    Each framed body's picture is at least :data:`GOAL_PIXELS` wide and high (its outline seen
-    along the view, :func:`_drawn_widths`), so the bodies are taken in the goals' order and a
-    body is framed only when the frame holding it and those before still draws each of them
-    that large (the first goal's body always is): ten pins scattered over 2 m show the first
-    goals' pins, each one large enough to judge. Each of :data:`FIELDS_OF_VIEW` is tried and
-    the first framing the most bodies kept (``impulse render``'s 40° when it frames them all).
-    The camera is as close as keeps the framed
-    bodies inside the image shrunk by :data:`MARGIN`, and no closer than a frame
-    :data:`CONTEXT` times the largest one's extent across (room around a lone body), unless a
-    body would then be drawn smaller than :data:`GOAL_PIXELS` (:func:`_frame`). The goals'
-    regions are framed too when every framed body still is. ``None`` when the goals look at no
-    moving body (custom goals only, say)."""
+    Each framed body's picture is at least :data:`GOAL_PIXELS` wide and high (its outline
+    seen along the view, :func:`_drawn_widths`): the bodies are taken in the goals' order, a
+    body only when the frame holding it and those before still draws each of them that large
+    (the first goal's body always), so ten pins scattered over 2 m show the first goals'
+    pins, each large enough to judge. Each of :data:`FIELDS_OF_VIEW` is tried and the first
+    framing the most bodies kept (``impulse render``'s 40° when it frames them all). The
+    camera is as close as keeps the framed bodies inside the image shrunk by :data:`MARGIN`,
+    and no closer than a frame :data:`CONTEXT` times the largest one's extent across (room
+    around a lone body), unless a body would then be drawn smaller than :data:`GOAL_PIXELS`
+    (:func:`_frame`). The goals' regions are framed too when every framed body still is
+    that large. ``None`` when the goals look at no moving body (custom goals only, say)."""
     from impulse.takes._search import simulate_take
 
     shapes = scene.get("bodies", [])
@@ -480,7 +478,8 @@ def goal_frame(
                 kept.append(box)  # the same body judged again: framed as it is
                 continue
             trial = kept + [box]
-            if not kept or _least_pixels(trial, *_frame(trial, size, fov), size, fov) >= GOAL_PIXELS:
+            centre, distance = _frame(trial, size, fov)
+            if not kept or _least_pixels(trial, centre, distance, size, fov) >= GOAL_PIXELS:
                 kept = trial
         count = len({box[4] for box in kept})
         if chosen is None or count > chosen[0]:
