@@ -1418,6 +1418,7 @@ def test_refine_searches_around_a_take_keeping_the_goals(tmp_path, capsys):
     take = found.met()[0]
     assert cli_main(["refine", str(out), take.take_id, "--budget", "32", "--workers", "2",
                      "--no-progress"]) == 0
+    assert "trust region: step 0.002 in the first generation" in capsys.readouterr().err
     refined = load(out / "refine" / take.take_id)
     assert refined.goal_names == found.goal_names and refined.manifest["steps"] == STEPS
     rows = refined.table.to_pylist()
@@ -1472,10 +1473,15 @@ def test_a_refinement_around_a_met_take_shrinks_its_step_until_most_takes_meet_t
     assert met[0] < 4, met  # the first generation at the full step: most miss
     assert spread[-1] < 0.5 * spread[0], spread  # the step shrank
     # After a generation with fewer than half meeting the goal, the next is drawn with half
-    # the step (the root mean square of 24 draws is within 30 % of the step).
+    # the step; the draws' root mean square (24 numbers) is within 40 % of the step.
+    steps = refined.trust_region_steps()
+    assert len(steps) == 6 and steps[0] == 2.0, steps
     for k in range(5):
         if met[k] < 4:
-            assert spread[k + 1] < 0.8 * spread[k], (k, met, spread)
+            assert steps[k + 1] == 0.5 * steps[k], (k, met, steps)
+    for k in range(6):
+        assert 0.6 * steps[k] < spread[k] < 1.4 * steps[k], (k, steps, spread)
+    assert found.trust_region_steps() is None  # a search has none
     assert sum(met[3:]) >= 12, met  # the last three generations: most meet the goal
     # Every refined take is still drawn around the take, not from a moving mean.
     assert all(np.all(np.abs(np.array(row["theta"]) - take.theta) < 5 * 2.0) for row in rows)

@@ -1012,6 +1012,23 @@ class Takes(Mapping):
         """The takes that meet every goal, most plausible first."""
         return sorted((t for t in self._takes.values() if t.met), key=lambda t: t.perturbation)
 
+    def trust_region_steps(self) -> list[float] | None:
+        """The step (unit-free, as θ) each generation of a trust-region refinement
+        (:func:`refine` around a take meeting every goal) was drawn with, first generation
+        first: what the refinement derives from its table as it runs. None for any other
+        search."""
+        around = self.manifest.get("around") or {}
+        if not around.get("adapt"):
+            return None
+        generations: dict[int, list[dict[str, Any]]] = {}
+        for row in self.table.to_pylist():
+            generations.setdefault(row["generation"], []).append(row)
+        largest = float(around["spread"])
+        steps = [largest]
+        for generation in sorted(generations)[:-1]:
+            steps.append(_adapted_step(steps[-1], generations[generation], largest))
+        return steps[: len(generations)]
+
 
 def load(out: str | os.PathLike) -> Takes:
     """The takes a search wrote to ``out``.

@@ -277,6 +277,13 @@ def _refine(arguments: argparse.Namespace) -> int:
         stop_after=arguments.stop_after,
         progress=not arguments.no_progress,
     )
+    steps = takes.trust_region_steps()
+    if steps:
+        print(
+            f"trust region: step {steps[0]:.3g} in the first generation, {steps[-1]:.3g} in the "
+            f"last (of {len(steps)})",
+            file=sys.stderr,
+        )
     return _report(takes)
 
 
