@@ -627,8 +627,8 @@ def region_arguments(views):
 
 
 def camera_arguments(scene, steps, views, size, preset=None):
-    """``impulse render``'s ``--camera-eye`` and ``--camera-target`` (m, impulse's axes) that
-    frame the moving bodies the goals look at in ``scene`` stepped ``steps`` times
+    """``impulse render``'s ``--camera-eye``, ``--camera-target`` (m, impulse's axes) and
+    ``--fov`` (degrees) that frame the moving bodies the goals look at in ``scene`` stepped ``steps`` times
     (``impulse.takes``' ``goals`` camera, the contact sheet's; ``views`` from its
     ``goal_views``), for a ``size`` (W, H) image; no flags (``impulse render``'s own view of
     the moving bodies at the start) when the goals look at no moving body."""
@@ -637,12 +637,14 @@ def camera_arguments(scene, steps, views, size, preset=None):
     framed = goal_camera(scene, steps, views, size, preset)
     if framed is None:
         return []
-    eye, target = framed
+    eye, target, fov = framed
     return [
         "--camera-eye",
         ",".join(f"{v:.9g}" for v in eye),
         "--camera-target",
         ",".join(f"{v:.9g}" for v in target),
+        "--fov",
+        f"{fov:.9g}",
     ]
 
 

@@ -506,8 +506,10 @@ def search(
     progress : bool
         A progress bar (tqdm): takes done, goals met, best cost.
     around : dict, optional
-        ``{"theta": θ, "spread": s, "scene_seed": seed or None}``: search around one take
-        (:func:`refine`): the first generation, and the first after a restart, draw θ from
+        ``{"theta": θ, "spread": s, "scene_seed": seed or None, "adapt": bool}``: search
+        around one take (:func:`refine`). With ``adapt`` true, a trust region: every
+        generation draws θ from N(θ, s_g² I) in the take's rough world, s_g adapted as
+        :func:`refine` says; else the first generation, and the first after a restart, draw θ from
         N(θ, s² I) instead of the prior N(0, I), local steps and the least spread are s (not
         ``LOCAL_STEP`` and ``MIN_SPREAD``) when s is smaller, takes tied on the goals rank by
         their distance from θ (not their perturbation), and with ``Variation.seeds`` the
@@ -555,8 +557,10 @@ def search(
     start_mean, start_spread, start_seeds = np.zeros(dimension), np.ones(dimension), []
     local_step, min_spread = LOCAL_STEP, MIN_SPREAD
     origin = None  # what the ranking's last key measures the distance from (None: θ = 0)
+    adapt = False  # a trust region around a take meeting every goal (refine)
     if around is not None:
-        start_mean, spread_value, around_seed = _around(around, dimension)
+        start_mean, spread_value, around_seed, adapt = _around(around, dimension)
+        adapt = adapt and dimension > 0  # no θ (seeds alone): nothing for a step to vary
         start_spread = np.full(dimension, spread_value)
         local_step = min(LOCAL_STEP, spread_value)
         min_spread = min(MIN_SPREAD, spread_value)
@@ -589,6 +593,8 @@ def search(
             "spread": float(start_spread[0]) if dimension else 0.0,
             "scene_seed": start_seeds[0] if start_seeds else None,
         }
+        if adapt:  # only then: the digests of earlier refinements are unchanged
+            search_spec["around"]["adapt"] = True
     digest = hashlib.sha256(_canonical(search_spec).encode()).hexdigest()
     manifest = {
         "digest": digest,
@@ -605,6 +611,7 @@ def search(
         raise
     bar = _Progress(budget, progress)
     mean, spread = start_mean.copy(), start_spread.copy()
+    largest_step = step = float(start_spread[0]) if dimension else 0.0  # with adapt
     elites = max(2, round(elite_fraction * population))
     done: list[dict[str, Any]] = []
     elite_seeds: list[int | None] = list(start_seeds)
@@ -624,6 +631,13 @@ def search(
                     for k in range(population - round(LOCAL_SHARE * population), population):
                         thetas[k] = local_centres[k % len(local_centres)] + local_step * normal[k]
                 seeds = _scene_seeds(rng, population, variation.seeds, elite_seeds)
+                if adapt:
+                    # The trust region: every take is the refined take's θ plus the current
+                    # step times N(0, I), in the take's own rough world: the takes stay
+                    # around the take the animator chose.
+                    thetas = start_mean + step * normal
+                    if start_seeds:
+                        seeds = [start_seeds[0]] * population
                 # The generation's rows in draw order: stored ones read, the others run.
                 slots: list[dict[str, Any] | None] = [None] * count
                 tasks, by_key = [], {}
@@ -684,6 +698,9 @@ def search(
                         f"{os.path.join(store.root, TAKES_FILE)}"
                     )
                 generation += 1
+                if adapt:
+                    step = _adapted_step(step, slots, largest_step)
+                    continue
                 if method == "random":
                     continue
                 pool = [row for row in done[since:] if row["status"] != FAILED]
@@ -719,11 +736,16 @@ def search(
     return load(store.root)
 
 
-def _around(around: Mapping[str, Any], dimension: int) -> tuple[np.ndarray, float, int | None]:
-    """``search``'s ``around``, checked: θ (its dimension), the spread and the scene seed."""
-    unknown = set(around) - {"theta", "spread", "scene_seed"}
+def _around(
+    around: Mapping[str, Any], dimension: int
+) -> tuple[np.ndarray, float, int | None, bool]:
+    """``search``'s ``around``, checked: θ (its dimension), the spread, the scene seed and
+    whether the spread adapts (a trust region, :func:`_adapted_step`)."""
+    unknown = set(around) - {"theta", "spread", "scene_seed", "adapt"}
     if unknown:
-        raise ValueError(f"around has unknown keys {sorted(unknown)}: use theta, spread, scene_seed")
+        raise ValueError(
+            f"around has unknown keys {sorted(unknown)}: use theta, spread, scene_seed, adapt"
+        )
     theta = np.asarray(around.get("theta", []), dtype=np.float64)
     if theta.shape != (dimension,) or not np.all(np.isfinite(theta)):
         raise ValueError(
@@ -739,7 +761,26 @@ def _around(around: Mapping[str, Any], dimension: int) -> tuple[np.ndarray, floa
     if scene_seed is not None:
         _check_integer("around scene_seed", scene_seed, 0)
         scene_seed = int(scene_seed)
-    return theta, float(spread), scene_seed
+    adapt = around.get("adapt", False)
+    if not isinstance(adapt, bool):
+        raise ValueError(f"around adapt = {adapt!r}: must be true or false")
+    return theta, float(spread), scene_seed, adapt
+
+
+def _adapted_step(step: float, rows: Sequence[Mapping[str, Any]], largest: float) -> float:
+    """The next generation's step of a trust-region refinement from this generation's
+    ``rows``: halved (down to ``largest`` times :data:`REFINE_LEAST_STEP`) while fewer than
+    half of the takes that ran meet every goal, grown by :data:`REFINE_GROWTH` (up to
+    ``largest``) when at least :data:`REFINE_GROW` of them do, else kept. Failed takes (a worker's failure) do not count."""
+    ran = [row for row in rows if row["status"] != FAILED]
+    if not ran:
+        return step
+    share = sum(bool(row["met"]) for row in ran) / len(ran)
+    if share < 0.5:
+        return max(0.5 * step, REFINE_LEAST_STEP * largest)
+    if share >= REFINE_GROW:
+        return min(REFINE_GROWTH * step, largest)
+    return step
 
 
 def _advance(
@@ -971,6 +1012,23 @@ class Takes(Mapping):
         """The takes that meet every goal, most plausible first."""
         return sorted((t for t in self._takes.values() if t.met), key=lambda t: t.perturbation)
 
+    def trust_region_steps(self) -> list[float] | None:
+        """The step (unit-free, as θ) each generation of a trust-region refinement
+        (:func:`refine` around a take meeting every goal) was drawn with, first generation
+        first: what the refinement derives from its table as it runs. None for any other
+        search."""
+        around = self.manifest.get("around") or {}
+        if not around.get("adapt"):
+            return None
+        generations: dict[int, list[dict[str, Any]]] = {}
+        for row in self.table.to_pylist():
+            generations.setdefault(row["generation"], []).append(row)
+        largest = float(around["spread"])
+        steps = [largest]
+        for generation in sorted(generations)[:-1]:
+            steps.append(_adapted_step(steps[-1], generations[generation], largest))
+        return steps[: len(generations)]
+
 
 def load(out: str | os.PathLike) -> Takes:
     """The takes a search wrote to ``out``.
@@ -989,6 +1047,17 @@ def load(out: str | os.PathLike) -> Takes:
 #: Spread of θ around the take a refinement starts from (unit-free, as θ): in the bowling
 #: shot, takes drawn this close to a split are splits about half the time (docs/takes.md).
 REFINE_STEP = 0.002
+#: Takes per generation of a refinement: its step adapts once a generation, so small ones
+#: adapt it often within a budget of a few dozen takes.
+REFINE_POPULATION = 8
+#: The least step of a trust-region refinement, as a share of the step it starts from.
+REFINE_LEAST_STEP = 1.0 / 1024.0
+#: Share of a generation meeting every goal at which a trust-region refinement grows its
+#: step (back up to the step it started from), and by how much: by less than a halving
+#: undoes, so that a step just small enough is not left again at once (with a factor of 2
+#: the dice refinement at step 0.005 swings between 0.005 and 0.0025 every generation).
+REFINE_GROW = 0.75
+REFINE_GROWTH = math.sqrt(2.0)
 
 
 def refine(
@@ -1009,8 +1078,19 @@ def refine(
 ) -> Takes:
     """Searches around one take of a search (Twigg & James's browse-and-refine): the same
     scene, goals, variation, steps, preset and elite fraction, the first generation drawn
-    from N(θ, step² I) around the take's θ (its scene seed reused first under
-    ``Variation.seeds``), then refined as :func:`search` refines.
+    from N(θ, step² I) around the take's θ.
+
+    Around a take that meets every goal, the refinement is a trust region: every generation
+    is drawn from N(θ, s² I) around the take, in the take's own rough world under
+    ``Variation.seeds``, s starting at ``step``; s is halved (down to ``step`` times
+    :data:`REFINE_LEAST_STEP`) after a generation in which fewer than half the takes meet
+    every goal, and grown by :data:`REFINE_GROWTH` (up to ``step``) after one in which at least
+    :data:`REFINE_GROW` of them do. So the refined takes stay as varied as the goals allow,
+    and mostly meet them. Around a take that misses a goal, the later generations are refined
+    as :func:`search` refines (toward the goals, staying near the take), the local steps and
+    least spread no larger than ``step``, the take's scene seed reused first under
+    ``Variation.seeds``; so is a refinement of a variation with ``seeds`` alone (no θ to
+    step).
 
     Parameters
     ----------
@@ -1024,14 +1104,14 @@ def refine(
         Where the refinement is written; default ``directory/refine/<take_id>``. Resumed as a
         search is.
     step : float
-        Spread of θ around the take (> 0, unit-free).
+        Spread of θ around the take (> 0, unit-free), the largest of a trust region.
     goals : list, optional
         The search's goals again: needed when it has :func:`custom` goals (a directory holds
         only their names and code identity); they must have the same names.
     backend, workers, address, seed, progress
         As for :func:`search`.
     population : int, optional
-        Takes per generation; default the search's.
+        Takes per generation (>= 2); default :data:`REFINE_POPULATION`.
     stop_after : int, optional
         Stop once this many takes meet every goal; default ``budget`` (run every take: a
         refinement gives alternatives to choose from).
@@ -1074,7 +1154,7 @@ def refine(
         workers=workers,
         address=address,
         seed=seed,
-        population=int(manifest["population"]) if population is None else population,
+        population=REFINE_POPULATION if population is None else population,
         elite_fraction=float(manifest["elite_fraction"]),
         stop_after=budget if stop_after is None else stop_after,
         preset=manifest.get("preset"),
@@ -1083,6 +1163,7 @@ def refine(
             "theta": take.theta.tolist(),
             "spread": step,
             "scene_seed": None if take.scene_seed is None else int(take.scene_seed),
+            "adapt": take.met,
         },
     )
 

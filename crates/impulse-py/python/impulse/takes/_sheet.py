@@ -70,6 +70,10 @@ MARGIN = 1.15
 #: ``impulse render``'s default field of view (degrees, vertical) and three-quarter view
 #: direction, which a ``goals`` camera keeps.
 FOV_DEGREES = 40.0
+#: The fields of view (degrees, vertical) a ``goals`` camera tries, widest first: a longer
+#: lens, seen from farther, draws bodies apart in depth at more nearly one size (two dice
+#: on a table), so it frames more goal bodies each :data:`GOAL_PIXELS` across.
+FIELDS_OF_VIEW = (FOV_DEGREES, 30.0, 20.0, 15.0, 10.0)
 VIEW_DIRECTION = (0.45, 0.5, 1.0)
 
 
@@ -112,9 +116,9 @@ OUTLIER = 3.0
 #: A ``goals`` frame's narrower side is at least this many times the largest goal body's
 #: extent (half of it from the centre), so that a lone body is seen with what is around it.
 CONTEXT = 3.0
-#: A ``goals`` frame takes in the goals' regions too when each goal body stays at least this
-#: many pixels across (its extent sphere's diameter).
-SMALLEST = 24.0
+#: The least width and height (pixels) of each goal body a ``goals`` preview frames: the
+#: 20 pixels a viewer needs to judge a body, and one for the rasteriser's rounding.
+GOAL_PIXELS = 21.0
 
 
 def goal_views(specs: Any) -> list[tuple[Any, str, Any, Any]]:
@@ -185,21 +189,108 @@ def region_arguments(views: list[tuple[Any, ...]]) -> list[str]:
     return arguments
 
 
+def _outline(shape: Any) -> list[tuple[np.ndarray, float]] | None:
+    """A shape as points (n, 3; m, the body's frame) each grown by a radius (m): the shape is
+    the convex hull of those balls (a ring of 32 points stands for a circle). None when the
+    shape is not one a preview frames by its size (a mesh, a half-space)."""
+    if not isinstance(shape, dict):
+        return None
+    kind = shape.get("type")
+    border = float(shape.get("border_radius", 0.0) or 0.0)
+    try:
+        if kind == "sphere":
+            return [(np.zeros((1, 3)), float(shape["radius"]))]
+        if kind == "cuboid":
+            half = np.asarray(shape["half_extents"], dtype=float)
+            corners = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T
+            return [(corners * half, border)]
+        if kind == "capsule":
+            height = float(shape["half_height"])
+            return [(np.array([[0.0, -height, 0.0], [0.0, height, 0.0]]), float(shape["radius"]))]
+        if kind in ("cylinder", "cone"):
+            height, radius = float(shape["half_height"]), float(shape["radius"])
+            angles = np.linspace(0.0, 2.0 * math.pi, 32, endpoint=False)
+            ring = np.stack([radius * np.cos(angles), np.zeros(32), radius * np.sin(angles)], 1)
+            top = ring + [0.0, height, 0.0] if kind == "cylinder" else [[0.0, height, 0.0]]
+            return [(np.vstack([ring - [0.0, height, 0.0], top]), border)]
+        if kind == "convex_hull":
+            return [(np.asarray(shape["points"], dtype=float).reshape(-1, 3), border)]
+        if kind == "compound":
+            outline = []
+            for part in shape["parts"]:
+                inner = _outline(part.get("shape"))
+                if inner is None:
+                    return None
+                turn = _rotation(part.get("orientation", [0.0, 0.0, 0.0, 1.0]))
+                offset = np.asarray(part.get("position", [0.0, 0.0, 0.0]), dtype=float)
+                outline += [(points @ turn.T + offset, radius) for points, radius in inner]
+            return outline
+    except (KeyError, TypeError, ValueError):
+        return None
+    return None
+
+
+def _rotation(quaternion: Any) -> np.ndarray:
+    """The rotation matrix of a quaternion ``[x, y, z, w]`` (normalised here)."""
+    x, y, z, w = np.asarray(quaternion, dtype=float) / np.linalg.norm(quaternion)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def _view_axes() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The image's right and up directions and the direction back toward the eye (unit
+    vectors, world frame) of a ``goals`` camera (:data:`VIEW_DIRECTION`)."""
+    back = np.asarray(VIEW_DIRECTION, dtype=float)
+    back /= np.linalg.norm(back)
+    right = np.cross([0.0, 1.0, 0.0], back)
+    right /= np.linalg.norm(right)
+    return right, np.cross(back, right), back
+
+
+def _drawn_widths(shape: Any, orientations: np.ndarray) -> np.ndarray | None:
+    """A body's widths (m) across the image and up it under a ``goals`` camera (seen along
+    :data:`VIEW_DIRECTION`, without perspective), the least over its ``orientations`` (n, 4;
+    ``[x, y, z, w]``): the sides of the box its picture fills, times the distance's scale.
+    None when the shape has no outline (:func:`_outline`)."""
+    outline = _outline(shape)
+    if outline is None:
+        return None
+    right, up, _ = _view_axes()
+    axes = np.stack([right, up])
+    least = np.full(2, math.inf)
+    for quaternion in orientations:
+        turn = _rotation(quaternion)
+        low, high = np.full(2, math.inf), np.full(2, -math.inf)
+        for points, radius in outline:
+            along = points @ turn.T @ axes.T  # (n, 2): each point across and up the image
+            low = np.minimum(low, along.min(axis=0) - radius)
+            high = np.maximum(high, along.max(axis=0) + radius)
+        least = np.minimum(least, high - low)
+    return least
+
+
 def _judged_boxes(
     record: Any, shapes: list[Any], views: list[tuple[Any, ...]]
-) -> tuple[list[tuple[np.ndarray, np.ndarray, float]], list[tuple[np.ndarray, np.ndarray]]]:
-    """What a ``goals`` camera frames: the boxes (low, high; m) of the moving goal bodies where
-    their goals are judged, each with the body's extent (m): a body at its time, a body where
-    it comes closest to its region, less those far from the rest (:func:`_without_outliers`);
-    or, when no goal judges a body at a place, the bodies over their windows. And the boxes of
-    the goals' regions. Static bodies are left out (the ground a ball must touch is
-    everywhere)."""
+) -> tuple[list[tuple[Any, ...]], list[tuple[np.ndarray, np.ndarray]]]:
+    """What a ``goals`` camera frames: the boxes of the moving goal bodies where their goals
+    are judged, in the goals' order, each as ``(low, high, extent, widths, body, points)``:
+    the box (m), the body's extent (m), its drawn widths (:func:`_drawn_widths`, m, or None),
+    its index and points (n, 3; m) the picture must hold (the body's outline at one place,
+    else the box's corners). A body is taken at its time, or where it comes closest to its region, less those
+    far from the rest (:func:`_without_outliers`); or, when no goal judges a body at a place,
+    over its window. And the boxes of the goals' regions. Static bodies are left out (the
+    ground a ball must touch is everywhere)."""
 
     def moving(index: int) -> bool:
         return index < len(shapes) and shapes[index].get("kind", "static") != "static"
 
-    placed: list[tuple[np.ndarray, np.ndarray, float]] = []
-    paths: list[tuple[np.ndarray, np.ndarray, float]] = []
+    placed: list[tuple[Any, ...]] = []
+    paths: list[tuple[Any, ...]] = []
     regions: list[tuple[np.ndarray, np.ndarray]] = []
     last = len(record.times) - 1
     for view in views:
@@ -223,14 +314,23 @@ def _judged_boxes(
         else:
             frames = record.window(when)
         path = record.positions[frames, index]
-        box = (path.min(axis=0) - extent, path.max(axis=0) + extent, extent)
+        shape = shapes[index].get("shape")
+        widths = _drawn_widths(shape, record.orientations[frames, index])
+        low, high = path.min(axis=0) - extent, path.max(axis=0) + extent
+        points = _corners(low, high)
+        outline = _outline(shape)
+        if len(frames) == 1 and outline is not None:  # the body itself, not its extent's box
+            turn = _rotation(record.orientations[frames[0], index])
+            grow = np.vstack([np.eye(3), -np.eye(3)])
+            points = np.vstack(
+                [(p @ turn.T + path[0])[:, None, :] + r * grow for p, r in outline]
+            ).reshape(-1, 3)
+        box = (low, high, extent, widths, index, points)
         (paths if how == "path" else placed).append(box)
     return (_without_outliers(placed) or paths), regions
 
 
-def _without_outliers(
-    boxes: list[tuple[np.ndarray, np.ndarray, float]],
-) -> list[tuple[np.ndarray, np.ndarray, float]]:
+def _without_outliers(boxes: list[tuple[Any, ...]]) -> list[tuple[Any, ...]]:
     """``boxes`` less those whose centre is more than :data:`OUTLIER` times the median distance
     of the centres from their median (and farther than the largest box is wide)."""
     if len(boxes) < 3:
@@ -242,59 +342,125 @@ def _without_outliers(
     return [box for box, distance in zip(boxes, distances, strict=True) if distance <= limit]
 
 
+def _corners(low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """The 8 corners (8, 3) of the box from ``low`` to ``high``."""
+    return np.array(np.meshgrid(*zip(low, high, strict=True))).reshape(3, -1).T
+
+
 def _framed(
-    boxes: list[tuple[np.ndarray, np.ndarray]], size: tuple[int, int]
+    corners: np.ndarray,
+    size: tuple[int, int],
+    margin: float = MARGIN,
+    fov: float = FOV_DEGREES,
 ) -> tuple[np.ndarray, float]:
-    """The target (the centre of the box holding ``boxes``; m) and the least distance (m) from
-    it along :data:`VIEW_DIRECTION` at which every corner of that box is inside the ``size``
-    (W, H) image shrunk by :data:`MARGIN`."""
-    low = np.min([box[0] for box in boxes], axis=0)
-    high = np.max([box[1] for box in boxes], axis=0)
-    centre = 0.5 * (low + high)
-    back = np.asarray(VIEW_DIRECTION, dtype=float)
-    back /= np.linalg.norm(back)
-    right = np.cross([0.0, 1.0, 0.0], back)
-    right /= np.linalg.norm(right)
-    up = np.cross(back, right)
-    tan_y, tan_x = _half_tangents(size)
+    """The target (m) and the least distance (m) from it along :data:`VIEW_DIRECTION` at which
+    every point of ``corners`` (n, 3; m) is inside the ``size`` (W, H) image shrunk by
+    ``margin``, seen with a vertical field of view of ``fov`` degrees. The target is the
+    middle of the points across and up the image and in depth, so bodies apart (two dice on
+    a table) are framed by their own outlines, not the corners of one box holding them all."""
+    right, up, back = _view_axes()
+    axes = np.stack([right, up, back])
+    along = corners @ axes.T
+    centre = 0.5 * (along.min(axis=0) + along.max(axis=0)) @ axes
+    tan_y, tan_x = _half_tangents(size, fov)
     distance = 1e-3
-    for corner in np.array(np.meshgrid(*zip(low, high, strict=True))).reshape(3, -1).T:
+    for corner in corners:
         offset = corner - centre
         # A corner at depth d beyond the target (along the view) is in the image when its
         # sideways offsets are within (distance + d) times the half field's tangents.
         depth = -float(offset @ back)
         for side, tangent in ((float(offset @ right), tan_x), (float(offset @ up), tan_y)):
-            distance = max(distance, MARGIN * abs(side) / tangent - depth)
+            distance = max(distance, margin * abs(side) / tangent - depth)
     return centre, distance
 
 
-def _half_tangents(size: tuple[int, int]) -> tuple[float, float]:
-    """The tangents of half the vertical and horizontal fields of view of a ``size`` image."""
+def _half_tangents(size: tuple[int, int], fov: float = FOV_DEGREES) -> tuple[float, float]:
+    """The tangents of half the vertical and horizontal fields of view of a ``size`` image
+    whose vertical field of view is ``fov`` degrees."""
     width, height = size
-    tan_y = math.tan(0.5 * math.radians(FOV_DEGREES))
+    tan_y = math.tan(0.5 * math.radians(fov))
     return tan_y, tan_y * width / height
 
 
-def goal_camera(
+def _pixels_per_metre_at_unit_distance(size: tuple[int, int], fov: float) -> float:
+    """Pixels a metre across covers at 1 m from the eye (at D m: this over D)."""
+    tan_y, tan_x = _half_tangents(size, fov)
+    return min(size) / (2.0 * min(tan_x, tan_y))
+
+
+def _least_pixels(
+    boxes: list[tuple[Any, ...]],
+    centre: np.ndarray,
+    distance: float,
+    size: tuple[int, int],
+    fov: float,
+) -> float:
+    """The smallest side (pixels) of the drawn box of any body of ``boxes`` (those with
+    widths) seen from ``distance`` m back from ``centre`` with a vertical field of view of
+    ``fov`` degrees; infinite when none has widths."""
+    scale = _pixels_per_metre_at_unit_distance(size, fov)
+    back = _view_axes()[2]
+    least = math.inf
+    for box in boxes:
+        if box[3] is None:
+            continue
+        depth = distance - float((0.5 * (box[0] + box[1]) - centre) @ back)
+        least = min(least, float(min(box[3])) * scale / max(depth, 1e-9))
+    return least
+
+
+def _frame(
+    boxes: list[tuple[Any, ...]], size: tuple[int, int], fov: float
+) -> tuple[np.ndarray, float]:
+    """The target and distance (m) framing ``boxes`` with a vertical field of view of ``fov``
+    degrees: as far as keeps them inside the image shrunk by :data:`MARGIN` and a
+    :data:`CONTEXT` frame around the largest, unless that draws a body smaller than
+    :data:`GOAL_PIXELS`: then nearer, down to the distance that keeps them inside the image
+    itself."""
+    points = np.vstack([box[5] for box in boxes])
+    centre, fitted = _framed(points, size, fov=fov)
+    _, bare = _framed(points, size, margin=1.0, fov=fov)
+    tan_y, tan_x = _half_tangents(size, fov)
+    context = CONTEXT * max(box[2] for box in boxes) / min(tan_x, tan_y)
+    preferred = max(fitted, context)
+    # The distance at which the smallest body is GOAL_PIXELS: the least of each body's.
+    scale = _pixels_per_metre_at_unit_distance(size, fov)
+    back = _view_axes()[2]
+    needed = math.inf
+    for box in boxes:
+        if box[3] is not None:
+            nearer = float((0.5 * (box[0] + box[1]) - centre) @ back)
+            needed = min(needed, float(min(box[3])) * scale / GOAL_PIXELS + nearer)
+    return centre, max(bare, min(preferred, needed))
+
+
+def goal_frame(
     scene: dict[str, Any],
     steps: int,
     views: list[tuple[Any, ...]],
     size: tuple[int, int],
     preset: str | None = None,
-) -> tuple[list[float], list[float]] | None:
-    """The camera (eye, target; m) of a ``goals`` preview: ``impulse render``'s three-quarter
-    view and field of view, aimed at the goal bodies where their goals are judged
-    (:func:`goal_views`): a body that must end somewhere, rest or tilt where it is at the end
-    (or ``at``), a body that must pass through a region where it comes closest to it; the
-    paths of the bodies of contact goals (``touches``, ``never_touches``) only when no goal
-    judges a body at a place. Bodies are grown by their shapes' extents; a place far from all
-    the others (:data:`OUTLIER`; a pin knocked into the pit) is left out. The camera is as
-    close as keeps the box holding the rest inside the ``size`` (W, H) image shrunk by
-    :data:`MARGIN`, and no closer than a frame :data:`CONTEXT` times the largest goal body's
-    extent across (room around a lone body). The goals' regions are framed too when every goal
-    body then stays at least :data:`SMALLEST` pixels across. Static bodies (the ground a ball
-    must touch) are left out. ``None`` when the goals look at no moving body (custom goals
-    only, say)."""
+) -> tuple[list[float], list[float], float, list[int]] | None:
+    """The camera of a ``goals`` preview (eye, target; m; vertical field of view, degrees)
+    and the goal bodies it frames (indices): ``impulse render``'s three-quarter view, aimed
+    at the goal bodies where their goals are judged (:func:`goal_views`): a body that must
+    end somewhere, rest or tilt where it is at the end (or ``at``), a body that must pass
+    through a region where it comes closest to it; the paths of the bodies of contact goals
+    (``touches``, ``never_touches``) only when no goal judges a body at a place. A place far
+    from all the others (:data:`OUTLIER`; a pin knocked into the pit) is left out, and so are
+    static bodies (the ground a ball must touch).
+
+    Each framed body's picture is at least :data:`GOAL_PIXELS` wide and high (its outline
+    seen along the view, :func:`_drawn_widths`): the bodies are taken in the goals' order, a
+    body only when the frame holding it and those before still draws each of them that large
+    (the first goal's body always), so ten pins scattered over 2 m show the first goals'
+    pins, each large enough to judge. Each of :data:`FIELDS_OF_VIEW` is tried and the first
+    framing the most bodies kept (``impulse render``'s 40° when it frames them all). The
+    camera is as close as keeps the framed bodies inside the image shrunk by :data:`MARGIN`,
+    and no closer than a frame :data:`CONTEXT` times the largest one's extent across (room
+    around a lone body), unless a body would then be drawn smaller than :data:`GOAL_PIXELS`
+    (:func:`_frame`). The goals' regions are framed too when every framed body still is
+    that large. ``None`` when the goals look at no moving body (custom goals only, say)."""
     from impulse.takes._search import simulate_take
 
     shapes = scene.get("bodies", [])
@@ -304,24 +470,46 @@ def goal_camera(
     boxes, regions = _judged_boxes(record, shapes, views)
     if not boxes:
         return None
-    tan_y, tan_x = _half_tangents(size)
-    narrow = min(tan_x, tan_y)
-    centre, distance = _framed([box[:2] for box in boxes], size)
-    distance = max(distance, CONTEXT * max(box[2] for box in boxes) / narrow)
+    chosen: tuple[int, float, list[tuple[Any, ...]]] | None = None
+    for fov in FIELDS_OF_VIEW:
+        kept: list[tuple[Any, ...]] = []
+        for box in boxes:
+            if any(box[4] == other[4] for other in kept):
+                kept.append(box)  # the same body judged again: framed as it is
+                continue
+            trial = kept + [box]
+            centre, distance = _frame(trial, size, fov)
+            if not kept or _least_pixels(trial, centre, distance, size, fov) >= GOAL_PIXELS:
+                kept = trial
+        count = len({box[4] for box in kept})
+        if chosen is None or count > chosen[0]:
+            chosen = (count, fov, kept)
+    _, fov, kept = chosen
+    centre, distance = _frame(kept, size, fov)
     if regions:
-        # A body of extent e at distance D is e * N / (D * tan(half field)) pixels across, N
-        # the pixels of the narrower side.
-        pixels = min(size) / narrow
-        smallest = min(box[2] for box in boxes)
-        with_regions, farther = _framed([box[:2] for box in boxes] + regions, size)
+        points = np.vstack([box[5] for box in kept] + [_corners(*region) for region in regions])
+        with_regions, farther = _framed(points, size, fov=fov)
         farther = max(farther, distance)
-        if smallest * pixels / farther >= SMALLEST:
+        if _least_pixels(kept, with_regions, farther, size, fov) >= GOAL_PIXELS:
             centre, distance = with_regions, farther
     if not (np.all(np.isfinite(centre)) and math.isfinite(distance)):
         return None
-    direction = np.asarray(VIEW_DIRECTION) / np.linalg.norm(VIEW_DIRECTION)
-    eye = centre + direction * distance
-    return [float(v) for v in eye], [float(v) for v in centre]
+    eye = centre + _view_axes()[2] * distance
+    framed = sorted({int(box[4]) for box in kept})
+    return [float(v) for v in eye], [float(v) for v in centre], fov, framed
+
+
+def goal_camera(
+    scene: dict[str, Any],
+    steps: int,
+    views: list[tuple[Any, ...]],
+    size: tuple[int, int],
+    preset: str | None = None,
+) -> tuple[list[float], list[float], float] | None:
+    """The camera (eye, target; m; vertical field of view, degrees) of a ``goals`` preview
+    (:func:`goal_frame`), None when the goals look at no moving body."""
+    framed = goal_frame(scene, steps, views, size, preset)
+    return None if framed is None else (framed[0], framed[1], framed[2])
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -350,16 +538,19 @@ def _camera_arguments(
         )
         if framed is None:
             return []
-        eye, target = framed
+        eye, target, fov = framed
     else:
         eye_text, _, target_text = camera.partition(":")
         eye = [float(v) for v in eye_text.split(",")]
         target = [float(v) for v in target_text.split(",")]
+        fov = FOV_DEGREES
     return [
         "--camera-eye",
         ",".join(f"{v:.9g}" for v in eye),
         "--camera-target",
         ",".join(f"{v:.9g}" for v in target),
+        "--fov",
+        f"{fov:.9g}",
     ]
 
 
@@ -446,7 +637,7 @@ def sheet(
         command, environment = _cli()
         folder = os.path.join(root, PREVIEWS_DIR)
         os.makedirs(folder, exist_ok=True)
-        framing = f"{MARGIN} {FOV_DEGREES} {VIEW_DIRECTION} {OUTLIER} {CONTEXT} {SMALLEST}"
+        framing = f"{MARGIN} {FIELDS_OF_VIEW} {VIEW_DIRECTION} {OUTLIER} {CONTEXT} {GOAL_PIXELS}"
         # The regions are outlined whatever the camera: part of every key.
         key = (camera if camera != "goals" else f"goals {framing}") + " regions"
         regions = region_arguments(goal_views(takes.manifest.get("goals")))

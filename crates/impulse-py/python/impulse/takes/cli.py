@@ -121,8 +121,11 @@ def _parser() -> argparse.ArgumentParser:
     refine = commands.add_parser(
         "refine",
         help="search around one take, keeping the search's goals",
-        description="Runs BUDGET takes drawn around the take (its θ plus --step N(0, I), then "
-        "refined), with the search's scene, goals, variation and steps. Exit codes as search.",
+        description="Runs BUDGET takes drawn around the take (its θ plus --step N(0, I)), with "
+        "the search's scene, goals, variation and steps. Around a take meeting every goal the "
+        "step adapts (a trust region): halved after a generation in which fewer than half the "
+        "takes meet every goal, grown back toward --step when most do; around one that "
+        "misses, the takes are refined toward the goals. Exit codes as search.",
     )
     refine.add_argument("directory", help="a search's results directory")
     refine.add_argument("take_id", help="the take to refine around")
@@ -131,7 +134,13 @@ def _parser() -> argparse.ArgumentParser:
         "--out", help="results directory (default DIRECTORY/refine/TAKE_ID; resumed if present)"
     )
     refine.add_argument(
-        "--step", type=_scale, default=0.002, help="spread of θ around the take (unit-free)"
+        "--step",
+        type=_scale,
+        default=0.002,
+        help="spread of θ around the take, the trust region's largest (unit-free)",
+    )
+    refine.add_argument(
+        "--population", type=_integer(2), help="takes per generation (default 8)"
     )
     refine.add_argument("--backend", choices=("local", "ray"), default="local")
     refine.add_argument(
@@ -264,9 +273,17 @@ def _refine(arguments: argparse.Namespace) -> int:
         workers=arguments.workers,
         address=arguments.address,
         seed=arguments.seed,
+        population=arguments.population,
         stop_after=arguments.stop_after,
         progress=not arguments.no_progress,
     )
+    steps = takes.trust_region_steps()
+    if steps:
+        print(
+            f"trust region: step {steps[0]:.3g} in the first generation, {steps[-1]:.3g} in the "
+            f"last (of {len(steps)})",
+            file=sys.stderr,
+        )
     return _report(takes)
 
 
