@@ -694,7 +694,7 @@ fn better_face_axis<ContactData>(
 /// order, and that separation (m, borders included), if it is above `threshold` (m); `None`
 /// otherwise. The axes are the cross products of the edge pairs whose Gauss-map arcs cross,
 /// each along the direction where they cross (see the body); the search's slack (m) covers
-/// the separations' rounding, and its known points bound them.
+/// the separations' rounding.
 fn edge_axis_above(
     pos12: &Pose,
     (g1, hull1): (&dyn Shape, &ConvexPolyhedron),
@@ -702,42 +702,29 @@ fn edge_axis_above(
     search: &FaceSearch<'_>,
 ) -> Option<(Vector, Real)> {
     let (threshold, slack) = (search.threshold, search.slack);
-    let (on1, on2) = search.known;
     let (faces1, faces2) = (hull1.faces(), hull2.faces());
     let (points1, points2) = (hull1.points(), hull2.points());
     // Shape 2's edges in shape 1's frame, once: each edge's arc between its faces' normals
-    // (negated, as the Minkowski difference sees them) and one of its points.
-    // An edge's axes lie on its arc, so each edge is bounded over its arc before its pairs
-    // are: along an axis x of shape 2's edge (x on its arc), with q a point of the edge and p
-    // any point of shape 1, the separation is at most (q − p)·x, so at most the least over
-    // Parry's points p of the most (q − p)·x reaches on the arc
-    // ([`GaussArc::reach_along`]); likewise a shape 1 edge with Parry's points on shape 2. An
-    // edge whose bound (plus the slack) cannot beat the threshold has no axis that could be
-    // returned or change what is, and its pairs are not tested (edges far from the contact,
-    // whose faces look away from the other shape: most of them).
-    let reach = |arc: &GaussArc, from: &dyn Fn(Vector) -> Vector, known: &[Vector]| {
-        known
-            .iter()
-            .map(|&k| arc.reach_along(from(k)))
-            .fold(Real::INFINITY, Real::min)
-    };
-    let edges2: Vec<(GaussArc, Vector)> = hull2
+    // (negated, as the Minkowski difference sees them), its direction and one of its points.
+    let edges2: Vec<(GaussArc, Vector, Vector)> = hull2
         .edges()
         .iter()
         .filter(|e| e.faces[0] != e.faces[1])
-        .filter_map(|e2| {
+        .map(|e2| {
             let c = pos12.rotation * faces2[e2.faces[0] as usize].normal;
             let d = pos12.rotation * faces2[e2.faces[1] as usize].normal;
-            let arc = GaussArc::new(-c, -d);
-            let q = pos12.transform_point(points2[e2.vertices[0] as usize]);
-            (reach(&arc, &|p| q - p, on1) + slack > threshold).then_some((arc, q))
+            (
+                GaussArc::new(-c, -d),
+                pos12.rotation * e2.dir,
+                pos12.transform_point(points2[e2.vertices[0] as usize]),
+            )
         })
         .collect();
-    let mut arcs2 = GaussArcs::new(edges2.iter().map(|(arc, _)| *arc));
+    let mut arcs2 = GaussArcs::new(edges2.iter().map(|(arc, _, _)| *arc));
     // An edge pair's axis is a face of the Minkowski difference in one direction only: the
-    // one where the two arcs cross, inside arc 1 (so along its faces' normals' sum, or
-    // square to it). Only that direction is taken: between exact polyhedra the largest
-    // separation is on such a face. Parry's
+    // one where the two arcs cross, inside arc 1 (so along its faces' normals' sum). Only
+    // that direction is taken (both where the arc leaves it undecided, faces almost
+    // opposite): between exact polyhedra the largest separation is on such a face. Parry's
     // hulls join triangles up to about 1.5° apart into one face, so the other direction
     // sometimes reads more (between the mug's V-HACD parts, by up to millimetres); the search
     // then keeps a smaller separation along its own axis, or none above the
@@ -760,30 +747,26 @@ fn edge_axis_above(
         let arc1 = GaussArc::new(normal_a, normal_b);
         let inside1 = normal_a + normal_b;
         let p = points1[e1.vertices[0] as usize];
-        if reach(&arc1, &|q| q - p, on2) + slack <= threshold {
-            continue;
-        }
         arcs2.crossing(&arc1, |j| {
-            let (arc2, q) = &edges2[j];
-            // Where the arcs' great circles cross: on both arcs, so both edges are their
-            // shapes' supports along it. (The edges' own cross product is the same axis
-            // between exact polyhedra; a Parry hull's merged faces leave its edges off
-            // square to their faces' normals by up to a degree or so, and the cross product
-            // off both arcs.)
-            let Some(axis) = arc1
-                .plane_normal()
-                .cross(arc2.plane_normal())
-                .try_normalize()
-            else {
+            let (_, dir2, q) = &edges2[j];
+            let Some(axis) = e1.dir.cross(*dir2).try_normalize() else {
                 return;
             };
-            let axis = if axis.dot(inside1) < 0.0 { -axis } else { axis };
-            order += 1;
-            // An axis that cannot beat the threshold can neither be returned nor change what
-            // is (the largest is returned only above it).
-            let bound = (*q - p).dot(axis);
-            if bound + slack > threshold {
-                candidates.push((bound, order, axis));
+            let side = axis.dot(inside1);
+            let both = [axis, -axis];
+            let directions = match side.partial_cmp(&0.0) {
+                Some(std::cmp::Ordering::Greater) => &both[..1],
+                Some(std::cmp::Ordering::Less) => &both[1..],
+                _ => &both[..],
+            };
+            for &axis in directions {
+                order += 1;
+                // An axis that cannot beat the threshold can neither be returned nor change
+                // what is (the largest is returned only above it).
+                let bound = (*q - p).dot(axis);
+                if bound + slack > threshold {
+                    candidates.push((bound, order, axis));
+                }
             }
         });
     }

@@ -206,34 +206,6 @@ impl GaussArc {
         straddles && self.crosses_straddling(other, cba)
     }
 
-    /// a × b: the normal of the arc's great circle (not unit).
-    pub(crate) fn plane_normal(&self) -> Vector {
-        -self.bxa
-    }
-
-    /// At least the largest of v·x over the unit vectors x of the arc (and of the arc widened by
-    /// about 1e-3 rad at each end, which covers the rounding of a crossing point computed on
-    /// it), for an arc shorter than a half circle: where v's projection on the arc's plane
-    /// points into the arc, its length; otherwise the larger at the two ends (v·x falls off
-    /// with the angle from that projection). An arc of (nearly) no length or of a half circle
-    /// gives |v|.
-    pub(crate) fn reach_along(&self, v: Vector) -> Real {
-        let n = self.plane_normal();
-        let n_squared = n.length_squared();
-        if n_squared < 1.0e-12 || self.a.dot(self.b) < -0.999 {
-            return v.length();
-        }
-        let projected = v - n * (v.dot(n) / n_squared);
-        // Between a and b, with a margin of 1e-3 rad each side.
-        let margin = -1.0e-3 * projected.length() * n_squared.sqrt();
-        if self.a.cross(projected).dot(n) >= margin && projected.cross(self.b).dot(n) >= margin {
-            projected.length()
-        } else {
-            // Beyond an end by δ, v·x grows by at most |projection|·δ.
-            v.dot(self.a).max(v.dot(self.b)) + 1.0e-3 * projected.length()
-        }
-    }
-
     /// The rest of [`Self::crosses`] for an `other` arc whose ends straddle this arc's great
     /// circle, `cba` = c·(b × a).
     #[inline]
