@@ -635,9 +635,9 @@ fn supports(
 /// beat `normal`, the edge axes are the largest over the edge pairs whose Gauss arcs cross,
 /// each along the direction where they cross, in the order of the loops. `memory` (the
 /// manifold's, if it keeps one) lets the face axes be re-checked from the last full search
-/// ([`FaceAxisMemory`]), to the bit; the edge axes' separations are taken from the highest
-/// bound down until none left can reach the largest (a point of each edge bounds the
-/// separation along it), which gives what taking every one gives, to the bit.
+/// ([`FaceAxisMemory`]), to the bit. Both searches take the separations from the highest
+/// upper bound down until none left can reach the largest (a point of each shape bounds the
+/// separation along any axis), which gives what taking every one gives, to the bit.
 fn better_face_axis<ContactData>(
     pos12: &Pose,
     g1: &dyn Shape,
@@ -691,8 +691,8 @@ fn better_face_axis<ContactData>(
 
 /// The edge axis of largest separation between hulls `hull1` and `hull2` (the cores of shapes
 /// `g1` and `g2`, shape 2 at `pos12` in shape 1's frame), the last of equals in the loops'
-/// order, and that separation (m, borders included), if it is above `threshold` (m); `None`
-/// otherwise. The axes are the cross products of the edge pairs whose Gauss-map arcs cross,
+/// order, and that separation (m, borders included), if it is above the search's threshold
+/// (m); `None` otherwise. The axes are the cross products of the edge pairs whose Gauss-map arcs cross,
 /// each along the direction where they cross (see the body); the search's slack (m) covers
 /// the separations' rounding.
 fn edge_axis_above(
