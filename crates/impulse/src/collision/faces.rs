@@ -671,7 +671,7 @@ fn better_face_axis<ContactData>(
     // A point of each shape (shape 1's frame) for the bounds: its support along Parry's
     // normal, a vertex where the contact is. (Parry's points would bound as well where they
     // lie on the shapes, but a point clipped onto a merged face's plane can lie just off it.)
-    let known = (&[support1][..], &[support2][..]);
+    let known = (support1, support2);
     let search = FaceSearch {
         threshold,
         slack,
@@ -770,26 +770,49 @@ fn edge_axis_above(
             }
         });
     }
-    candidates.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(b.1.cmp(&a.1)));
-    let mut best: Option<(Vector, Real, u32)> = None;
-    for (bound, order, axis) in candidates {
-        // Every separation left is at most its bound plus the rounding, below the best.
-        if best.is_some_and(|(_, top, _)| bound + slack < top) {
-            break;
-        }
-        let Some(separation) = support_separation(pos12, g1, g2, axis) else {
-            continue;
-        };
-        // The last of equals in the loops' order, as `Iterator::max_by`.
-        let wins = best.is_none_or(|(_, top, place)| {
-            separation.total_cmp(&top).then(order.cmp(&place)).is_gt()
-        });
-        if wins {
-            best = Some((axis, separation, order));
-        }
-    }
+    let (best, _) = largest_by_bound(candidates, slack, |axis| {
+        support_separation(pos12, g1, g2, axis)
+    });
     best.map(|(axis, separation, _)| (axis, separation))
         .filter(|&(_, separation)| separation > threshold)
+}
+
+/// The largest separation among `candidates` (each an upper bound of its separation (m), its
+/// place in the search's order, and its axis) and its axis and place, the last in place among
+/// equals; and a bound of the others' separations (m; at least their largest, `Real::MIN` when
+/// there is none). Separations (`separation`) are taken from the highest bound down, until no
+/// bound left, plus `slack` (m, the rounding of a bound and a separation), can reach the largest
+/// found: what taking every one gives, to the bit.
+fn largest_by_bound(
+    mut candidates: Vec<(Real, u32, Vector)>,
+    slack: Real,
+    separation: impl Fn(Vector) -> Option<Real>,
+) -> (Option<(Vector, Real, u32)>, Real) {
+    candidates.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(b.1.cmp(&a.1)));
+    let mut best: Option<(Vector, Real, u32)> = None;
+    let mut others = Real::MIN;
+    for (bound, place, axis) in candidates {
+        if best.is_some_and(|(_, top, _)| bound + slack < top) {
+            // Every separation left is below the best, and at most this bound plus the slack.
+            others = others.max(bound + slack);
+            break;
+        }
+        let Some(value) = separation(axis) else {
+            continue;
+        };
+        // The last of equals in place, as `Iterator::max_by` over the search's order.
+        match best {
+            Some((_, top, first)) if value.total_cmp(&top).then(place.cmp(&first)).is_lt() => {
+                others = others.max(value)
+            }
+            Some((_, top, _)) => {
+                others = others.max(top);
+                best = Some((axis, value, place));
+            }
+            None => best = Some((axis, value, place)),
+        }
+    }
+    (best, others)
 }
 
 /// The face axes of a pair (shape 2 at `pos12` in shape 1's frame), each out of shape 1 with
@@ -847,29 +870,27 @@ struct FaceAxis {
 }
 
 impl FaceAxis {
-    /// An upper bound (m) of the separation along the axis: the nearest of shape 2's `known`
-    /// points less the farthest of shape 1's (each shape's extremes are at least that far
-    /// out), the face's point among its shape's. Along the axis where the shapes touch,
-    /// Parry's points lie on the supports and the bound is about the separation.
-    fn bound(&self, (on1, on2): (&[Vector], &[Vector])) -> Real {
-        let along = |v: &Vector| v.dot(self.axis);
-        let own = along(&self.point);
+    /// An upper bound (m) of the separation along the axis: the other shape's `known` point
+    /// against the face's point (each shape reaches at least that far out). Near the contact
+    /// normal the known point is about the other shape's support, and the bound about the
+    /// separation.
+    fn bound(&self, (on1, on2): (Vector, Vector)) -> Real {
         if self.of_first {
-            on2.iter().map(along).fold(Real::INFINITY, Real::min) - own
+            (on2 - self.point).dot(self.axis)
         } else {
-            own - on1.iter().map(along).fold(Real::NEG_INFINITY, Real::max)
+            (self.point - on1).dot(self.axis)
         }
     }
 }
 
 /// What [`face_axes_above`] searches with: the `threshold` (m) to beat, the `slack` (m) that
 /// covers the separations' rounding twice over (then and now), the shapes' local bounding
-/// spheres, and points known to be on each shape (shape 1's frame).
+/// spheres, and a point known to be on each shape (shape 1's frame).
 struct FaceSearch<'a> {
     threshold: Real,
     slack: Real,
     spheres: (&'a BoundingSphere, &'a BoundingSphere),
-    known: (&'a [Vector], &'a [Vector]),
+    known: (Vector, Vector),
 }
 
 /// The face axis of largest separation among `axes`, the last of equals, and that separation,
@@ -881,7 +902,7 @@ struct FaceSearch<'a> {
 /// The search takes the separations (two support points each) from the highest bound
 /// ([`FaceAxis::bound`]) down, until no bound left, plus the slack, reaches the largest found:
 /// the largest of all and the same axis among equals as taking every one. What it remembers
-/// as the others' largest is then at most that: the largest of those taken, or the first
+/// for the others is then at least their largest: the largest of those taken, or the first
 /// bound left plus the slack, which a re-check may rely on all the same.
 fn face_axes_above(
     pos12: &Pose,
@@ -910,36 +931,14 @@ fn face_axes_above(
             return (now > threshold).then_some((axis, now));
         }
     }
-    let mut order: Vec<(Real, usize)> = axes
+    let candidates = axes
         .iter()
         .enumerate()
-        .map(|(index, face)| (face.bound(search.known), index))
+        .map(|(index, face)| (face.bound(search.known), index as u32, face.axis))
         .collect();
-    order.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(b.1.cmp(&a.1)));
-    let mut best: Option<(usize, Real)> = None;
-    let mut runner_up = Real::MIN;
-    for &(bound, index) in &order {
-        if best.is_some_and(|(_, top)| bound + slack < top) {
-            // Every axis left is below the best, and at most this bound plus the slack.
-            runner_up = runner_up.max(bound + slack);
-            break;
-        }
-        let Some(value) = separation(axes[index].axis) else {
-            continue;
-        };
-        match best {
-            // The last of equals, as `Iterator::max_by`.
-            Some((place, top)) if value.total_cmp(&top).then(index.cmp(&place)).is_lt() => {
-                runner_up = runner_up.max(value)
-            }
-            Some((_, top)) => {
-                runner_up = runner_up.max(top);
-                best = Some((index, value));
-            }
-            None => best = Some((index, value)),
-        }
-    }
-    let (index, top) = best?;
+    let (best, runner_up) = largest_by_bound(candidates, slack, separation);
+    let (_, top, index) = best?;
+    let index = index as usize;
     if let Some(slot) = memory {
         let remembered = FaceAxisMemory {
             pose: *pos12,

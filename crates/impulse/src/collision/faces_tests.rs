@@ -312,13 +312,12 @@ fn searches_by_bound_give_the_largest_over_every_axis() {
         let slack = float_slack(&pos12, &sphere1, &sphere2);
         // The supports along Parry's normal, as the engine takes them.
         let (support1, support2, _) = supports(&pos12, g1, g2, m.local_n1.normalize()).unwrap();
-        let (on1, on2) = ([support1], [support2]);
         let axes = face_axes(&pos12, g1, g2);
         let search = |threshold: Real| FaceSearch {
             threshold,
             slack,
             spheres: (&sphere1, &sphere2),
-            known: (&on1, &on2),
+            known: (support1, support2),
         };
         let every = largest(&mut axes.iter().map(|face| {
             let value = support_separation(&pos12, g1, g2, face.axis).unwrap();
