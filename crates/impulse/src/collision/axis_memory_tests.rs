@@ -61,7 +61,7 @@ fn a_remembered_face_axis_gives_the_full_searchs_manifold() {
             full.data.face_axes = None;
             let remembered = kept.data.face_axes;
             for manifold in [&mut kept, &mut full] {
-                ContactDispatcher
+                ContactDispatcher::default()
                     .contact_manifold_convex_convex(
                         &pos12,
                         g1.as_ref(),
@@ -122,7 +122,7 @@ fn a_part_pairs_memory_goes_when_the_parts_part() {
     let mut manifolds: Vec<Manifold> = Vec::new();
     let mut workspace: Option<ContactManifoldsWorkspace> = None;
     let mut update = |pos12: &Pose, manifolds: &mut Vec<Manifold>| {
-        ContactDispatcher
+        ContactDispatcher::default()
             .contact_manifolds(
                 pos12,
                 c1.as_ref(),

@@ -98,7 +98,8 @@ fn the_deepest_vertex_of_a_round_hull_is_a_point() {
         let pose = Pose::from_parts(Vec3::new(0.3, -lowest - depth, 0.2), rotation);
         for flat in [&half_space as &dyn Shape, &triangle] {
             for flipped in [false, true] {
-                let ours = manifold_depth(&ContactDispatcher, flat, &hull, &pose, flipped);
+                let ours =
+                    manifold_depth(&ContactDispatcher::default(), flat, &hull, &pose, flipped);
                 assert!(
                     (ours - depth).abs() < 1e-5,
                     "{rotation:?}, flipped {flipped}: deepest point {ours} m, lowest vertex {depth} m"
@@ -126,6 +127,12 @@ fn a_vertex_beside_a_triangle_is_not_its_point() {
         Vec3::new(2.0, 0.0, 0.0),
     );
     let pose = Pose::from_parts(Vec3::new(0.0, 0.5 - 2.0e-3, 0.0), Quat::IDENTITY);
-    let ours = manifold_depth(&ContactDispatcher, &triangle, &hull, &pose, false);
+    let ours = manifold_depth(
+        &ContactDispatcher::default(),
+        &triangle,
+        &hull,
+        &pose,
+        false,
+    );
     assert!(ours < 2.0e-3 - 1e-4, "{ours}");
 }

@@ -57,7 +57,21 @@ use crate::body::rules::rounded_parts;
 /// a fine polygon for a cylinder's or cone's flat cap on a flat face and a convex hull's large
 /// faces taken whole (see the module's documentation).
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct ContactDispatcher;
+pub(crate) struct ContactDispatcher {
+    /// How far (m) rotation can carry any point of either body of the pair in the step
+    /// ([`super::margins::SweptReach::turn_reach`]): a turning hull's vertices that may become
+    /// its lowest within the step get points against a flat shape
+    /// ([`deepest_vertex::add_deepest_vertex`]). 0 (the default) for none.
+    pub(crate) turn_reach: Real,
+}
+
+impl ContactDispatcher {
+    /// The dispatcher for a pair whose rotation can carry a point `turn_reach` metres in the
+    /// step.
+    pub(crate) fn turning(turn_reach: Real) -> Self {
+        Self { turn_reach }
+    }
+}
 
 impl QueryDispatcher for ContactDispatcher {
     fn intersection_test(
@@ -336,7 +350,14 @@ where
             fallback.after(pos12, g1, g2, constraints, prediction, manifold);
         }
         if hull_pair && (is_flat_type(type1) || is_flat_type(type2)) {
-            deepest_vertex::add_deepest_vertex(pos12, g1, g2, prediction, manifold, &old);
+            deepest_vertex::add_deepest_vertex(
+                pos12,
+                g1,
+                g2,
+                (prediction, self.turn_reach),
+                manifold,
+                &old,
+            );
         }
         Ok(())
     }

@@ -92,7 +92,7 @@ pub(crate) fn manifold_within(
     let mut manifolds = Vec::new();
     let mut workspace = None;
     PersistentQueryDispatcher::<(), ()>::contact_manifolds(
-        &ContactDispatcher,
+        &ContactDispatcher::default(),
         &pos1.inv_mul(pos2),
         g1,
         g2,
@@ -327,7 +327,7 @@ fn the_fallback_point_keeps_its_impulse_while_the_pair_stays_apart() {
         );
         assert!(parry.points.is_empty(), "step {step}: Parry alone");
         PersistentQueryDispatcher::<(), f32>::contact_manifold_convex_convex(
-            &ContactDispatcher,
+            &ContactDispatcher::default(),
             &pos12,
             box_shape.as_ref(),
             cube.as_ref(),
@@ -672,7 +672,7 @@ fn assert_mesh_nearest_points(mesh: &SharedShape, solid: &[(SharedShape, Pose)],
         if nearest_of(&manifolds_of(&DefaultQueryDispatcher)) > distance + 5e-3 {
             overstated += 1;
         }
-        let nearest = nearest_of(&manifolds_of(&ContactDispatcher));
+        let nearest = nearest_of(&manifolds_of(&ContactDispatcher::default()));
         assert!(
             nearest <= distance + 1e-4 && nearest >= distance - 1e-3,
             "case {case}: nearest point at {nearest} m, the cube {distance} m from the solid"

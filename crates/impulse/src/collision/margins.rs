@@ -261,8 +261,13 @@ impl SweptReach {
             stop_at_penetration: true,
             compute_impact_geometry_on_penetration: false,
         };
-        let cast =
-            ContactDispatcher.cast_shapes(pos12, local_displacement, shape1, shape2, options);
+        let cast = ContactDispatcher::default().cast_shapes(
+            pos12,
+            local_displacement,
+            shape1,
+            shape2,
+            options,
+        );
         match cast {
             Ok(None) => {}
             // Parry's cast can report an impact for shapes that pass within a few tenths of a
@@ -326,7 +331,7 @@ fn touches_along(
     target: f32,
 ) -> bool {
     let at = |t: f32| Pose::from_parts(pos12.translation + displacement * t, pos12.rotation);
-    let contact = |t: f32| ContactDispatcher.contact(&at(t), shape1, shape2, f32::MAX);
+    let contact = |t: f32| ContactDispatcher::default().contact(&at(t), shape1, shape2, f32::MAX);
     match contact(end) {
         Ok(Some(contact)) if contact.dist > target => {}
         _ => return true,

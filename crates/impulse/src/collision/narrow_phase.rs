@@ -385,7 +385,8 @@ impl NarrowPhase {
                     manifold.mark_shapes_deformed();
                 }
             }
-            ContactDispatcher
+            let reach = margins.pair_reach(bodies, a, b);
+            ContactDispatcher::turning(reach.turn_reach)
                 .contact_manifolds(
                     &pos12,
                     bodies.shape[a].as_ref(),
@@ -398,7 +399,7 @@ impl NarrowPhase {
             for manifold in &mut pair.manifolds {
                 drop_duplicate_points(manifold);
             }
-            margins.pair_reach(bodies, a, b).drop_unreachable(
+            reach.drop_unreachable(
                 &pos12,
                 bodies.pose[a].rotation,
                 bodies.shape[a].as_ref(),

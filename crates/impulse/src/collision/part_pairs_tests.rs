@@ -15,7 +15,7 @@ fn on_ground(compound: &SharedShape, pose: Pose, reduced: bool) -> Vec<Manifold>
     let pos12 = ground_pose.inv_mul(&pose);
     let mut manifolds: Vec<Manifold> = Vec::new();
     let mut workspace: Option<ContactManifoldsWorkspace> = None;
-    ContactDispatcher
+    ContactDispatcher::default()
         .contact_manifolds(
             &pos12,
             ground.as_ref(),

@@ -50,4 +50,5 @@ mod solver2d_scenes;
 mod speculative;
 mod standard_scenes;
 mod thin_shapes;
+mod tumbling_hulls;
 mod variation;

@@ -1,0 +1,135 @@
+//! Tumbling hulls land on their vertices: bowling pins (the 48-vertex hull of the worked
+//! bowling shot's profile) dropped spinning, at random orientations, onto every static ground
+//! of [`super::hulls::grounds`], at the default step of 1/60 s and at a film's 1/24 s. A
+//! turning hull's lowest vertex at the step's start need not be its lowest during the step;
+//! the vertices its rotation may bring down get speculative points (docs/method.md,
+//! "Contacts"). Target (issue: falling pins at 24 and 60 fps): no vertex more than 5 mm into
+//! the ground at any step. Figures: docs/testing.md, "Tumbling hulls".
+
+use impulse::glam::{Quat, Vec3};
+use impulse::scene::{BodyDesc, BodyKind, Scene, ShapeDesc};
+use impulse::{SolverSettings, World};
+
+use super::common::Rng;
+
+/// Largest depth (m) of a pin's lowest vertex at any step.
+const DEPTH: f32 = 5.0e-3;
+/// Simulated time (s) of each drop.
+const DURATION: f32 = 2.0;
+/// Pins dropped per ground in the default suite.
+const PINS: u64 = 20;
+
+/// A bowling pin 38.1 cm tall as the convex hull of its profile (12 vertices on each of four
+/// circles: base radius 2.6 cm, belly 6.05 cm at 11.4 cm up, neck 4.5 cm, top 3 cm), its
+/// origin half-way up: the pins of `scenes/takes/bowling.json`.
+fn pin() -> Vec<Vec3> {
+    let mut points = Vec::new();
+    for (y, radius) in [
+        (-0.19, 0.026),
+        (-0.076, 0.0605),
+        (0.13, 0.045),
+        (0.19, 0.03),
+    ] {
+        for k in 0..12 {
+            let angle = std::f32::consts::TAU * k as f32 / 12.0;
+            points.push(Vec3::new(radius * angle.cos(), y, radius * angle.sin()));
+        }
+    }
+    points
+}
+
+/// Drops pin `seed` (a random orientation, 0.2-1.2 m above touching, falling at up to 3 m/s,
+/// spinning at up to 10 rad/s about each axis; the default material) onto
+/// `ground` at step `dt` for [`DURATION`]; the largest depth (m) of its lowest vertex.
+fn deepest(seed: u64, ground: &BodyDesc, dt: f32) -> f32 {
+    let mut rng = Rng(seed ^ 0x5eed_0fb0_71);
+    let orientation = Quat::from_euler(
+        glam::EulerRot::YXZ,
+        rng.range(0.0, std::f32::consts::TAU),
+        rng.range(0.0, std::f32::consts::TAU),
+        rng.range(0.0, std::f32::consts::TAU),
+    );
+    let points = pin();
+    let lowest = points
+        .iter()
+        .map(|p| (orientation * *p).y)
+        .fold(f32::INFINITY, f32::min);
+    let height = rng.range(0.2, 1.2);
+    let position = [rng.range(-1.0, 1.0), height - lowest, rng.range(-1.0, 1.0)];
+    let shape = ShapeDesc::ConvexHull {
+        points: points.iter().map(|p| p.to_array()).collect(),
+    };
+    let mut body = BodyDesc::new(BodyKind::Dynamic, shape, position);
+    body.orientation = orientation.to_array();
+    body.linear_velocity = [0.0, -rng.range(0.0, 3.0), 0.0];
+    body.angular_velocity = [
+        rng.range(-10.0, 10.0),
+        rng.range(-10.0, 10.0),
+        rng.range(-10.0, 10.0),
+    ];
+    let scene = Scene {
+        dt,
+        solver: SolverSettings::default(),
+        bodies: vec![ground.clone(), body],
+        ..Scene::default()
+    };
+    let mut world = World::from_scene(&scene).unwrap();
+    let mut deepest = 0.0f32;
+    for _ in 0..(DURATION / dt).round() as usize {
+        world.step().unwrap();
+        let pose = world.poses()[1];
+        let low = points
+            .iter()
+            .map(|p| pose.transform_point(*p).y)
+            .fold(f32::INFINITY, f32::min);
+        deepest = deepest.max(-low);
+    }
+    deepest
+}
+
+/// The deepest any of `pins` pins went into each ground of [`super::hulls::grounds`] at step
+/// `dt` (ground name, m), printed.
+fn sweep(pins: u64, dt: f32) -> Vec<(&'static str, f32)> {
+    super::hulls::grounds()
+        .into_iter()
+        .map(|(name, ground)| {
+            let worst = (0..pins)
+                .map(|seed| deepest(seed, &ground, dt))
+                .fold(0.0f32, f32::max);
+            println!(
+                "{pins} pins at 1/{:.0} s on the {name}: deepest vertex {:.2} mm",
+                1.0 / dt,
+                worst * 1e3
+            );
+            (name, worst)
+        })
+        .collect()
+}
+
+/// At 1/60 s no pin's vertex goes more than 5 mm into the half-space (a bowling lane).
+#[test]
+fn tumbling_pins_land_on_their_vertices_on_a_half_space_at_60_hz() {
+    let ground = &super::hulls::grounds()[0];
+    assert_eq!(ground.0, "half-space");
+    for seed in 0..PINS {
+        let depth = deepest(seed, &ground.1, 1.0 / 60.0);
+        assert!(
+            depth <= DEPTH,
+            "pin {seed}: a vertex {:.2} mm deep",
+            depth * 1e3
+        );
+    }
+}
+
+/// The figures of docs/testing.md at 1/60 s and 1/24 s on every ground (100 pins each). Only
+/// the half-space at 1/60 s meets the 5 mm target: a hull's pair with a box takes Parry's face
+/// clipping, without the turning vertices; on triangles a vertex beside the triangle is
+/// another triangle's, which may have no manifold yet; and at 1/24 s a pin turns by up to
+/// 0.4 rad a step, beyond what the rows' linearised rotation follows.
+#[test]
+#[ignore = "on demand: prints the figures of docs/testing.md"]
+fn tumbling_pins_sweep() {
+    for dt in [1.0 / 60.0, 1.0 / 24.0] {
+        sweep(100, dt);
+    }
+}
