@@ -1,0 +1,213 @@
+//! Thin shapes against triangle meshes: a card (a flat box simulated as a 2 mm slab) dropped
+//! at 1–20 m/s in seeded random orientations onto a plane of two triangles must neither end
+//! inside the plane nor pass it. The same drops onto a half-space are the reference.
+
+use glam::{Quat, Vec3};
+use impulse::scene::DEFAULT_THICKNESS;
+use impulse::{BodyDesc, BodyKind, Material, ShapeDesc, SolverSettings, World};
+
+use crate::common::Rng;
+
+const DT: f32 = 1.0 / 60.0;
+/// The card's half sides (a playing card, 63 × 88 mm) and half thickness.
+const HALF: Vec3 = Vec3::new(0.0315, 0.5 * DEFAULT_THICKNESS, 0.044);
+/// Steps after the drop: the card has landed and settled (1.5 s).
+const STEPS: usize = 90;
+
+fn material() -> Material {
+    Material {
+        friction: 0.5,
+        restitution: 0.0,
+        density: 1000.0,
+        roughness: 0.0,
+        impact_perturbation: 0.0,
+    }
+}
+
+/// The static ground, its top at y = 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Ground {
+    /// The plane as a triangle mesh of two triangles, 4 m square.
+    TwoTriangles,
+    /// The half-space y ≤ 0.
+    HalfSpace,
+}
+
+fn ground_body(ground: Ground) -> BodyDesc {
+    let shape = match ground {
+        Ground::TwoTriangles => ShapeDesc::trimesh(
+            vec![
+                [-2.0, 0.0, -2.0],
+                [2.0, 0.0, -2.0],
+                [2.0, 0.0, 2.0],
+                [-2.0, 0.0, 2.0],
+            ],
+            // Counter-clockwise seen from above: the faces' normals point up.
+            vec![[0, 2, 1], [0, 3, 2]],
+        ),
+        Ground::HalfSpace => ShapeDesc::HalfSpace {
+            normal: [0.0, 1.0, 0.0],
+        },
+    };
+    BodyDesc::new(BodyKind::Static, shape, [0.0; 3])
+}
+
+/// One seeded drop: a uniformly random orientation (Shoemake's method), a speed straight
+/// down, a small random spin, the card's lowest corner 0.05–0.3 m above the plane.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Drop {
+    pub(crate) seed: u64,
+    orientation: Quat,
+    speed: f32,
+    spin: Vec3,
+    height: f32,
+}
+
+pub(crate) fn drop_case(seed: u64, speeds: (f32, f32)) -> Drop {
+    let mut rng = Rng(seed);
+    let (u1, u2, u3) = (
+        rng.range(0.0, 1.0),
+        rng.range(0.0, std::f32::consts::TAU),
+        rng.range(0.0, std::f32::consts::TAU),
+    );
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    let orientation = Quat::from_xyzw(a * u2.sin(), a * u2.cos(), b * u3.sin(), b * u3.cos());
+    let speed = rng.range(speeds.0, speeds.1);
+    let spin = Vec3::new(
+        rng.range(-2.0, 2.0),
+        rng.range(-2.0, 2.0),
+        rng.range(-2.0, 2.0),
+    );
+    let height = rng.range(0.05, 0.3);
+    Drop {
+        seed,
+        orientation: orientation.normalize(),
+        speed,
+        spin,
+        height,
+    }
+}
+
+/// How far below the plane y = 0 the lowest corner of the card's slab is (m; negative when
+/// the card is above it).
+fn depth(translation: Vec3, rotation: Quat) -> f32 {
+    let reach: f32 = (0..3)
+        .map(|k| (rotation * (Vec3::AXES[k] * HALF[k])).y.abs())
+        .sum();
+    reach - translation.y
+}
+
+/// What a drop did: the deepest corner over every step, at the end, and the centre's height
+/// at the end.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Outcome {
+    pub(crate) deepest: f32,
+    pub(crate) final_depth: f32,
+    pub(crate) final_height: f32,
+}
+
+impl Outcome {
+    /// The card ended with a corner more than 1 mm inside the plane.
+    pub(crate) fn embedded(&self) -> bool {
+        self.final_depth > 1e-3 && !self.through()
+    }
+
+    /// The card's centre ended below the plane.
+    pub(crate) fn through(&self) -> bool {
+        self.final_height < 0.0
+    }
+}
+
+pub(crate) fn run(drop: &Drop, ground: Ground, settings: SolverSettings) -> Outcome {
+    let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
+    world.add_body(&ground_body(ground), &material()).unwrap();
+    let probe = depth(Vec3::ZERO, drop.orientation);
+    let mut card = BodyDesc::new(
+        BodyKind::Dynamic,
+        ShapeDesc::Cuboid {
+            half_extents: [HALF.x, 0.0, HALF.z],
+        },
+        [0.0, probe + drop.height, 0.0],
+    );
+    card.orientation = drop.orientation.to_array();
+    card.linear_velocity = [0.0, -drop.speed, 0.0];
+    card.angular_velocity = drop.spin.to_array();
+    let card = world.add_body(&card, &material()).unwrap();
+    let mut deepest = f32::NEG_INFINITY;
+    for _ in 0..STEPS {
+        world.step().unwrap();
+        let pose = world.poses()[card];
+        deepest = deepest.max(depth(pose.translation, pose.rotation));
+    }
+    let pose = world.poses()[card];
+    Outcome {
+        deepest,
+        final_depth: depth(pose.translation, pose.rotation),
+        final_height: pose.translation.y,
+    }
+}
+
+/// Drops seeds `seeds` at `speeds` onto `ground` and returns (embedded, through, deepest at
+/// the end, deepest at any step), printing the failing cases.
+fn sweep(
+    seeds: std::ops::Range<u64>,
+    speeds: (f32, f32),
+    ground: Ground,
+    settings: &SolverSettings,
+) -> (usize, usize, f32, f32) {
+    let (mut embedded, mut through) = (0, 0);
+    let (mut deepest_end, mut deepest) = (f32::NEG_INFINITY, f32::NEG_INFINITY);
+    for seed in seeds {
+        let drop = drop_case(seed, speeds);
+        let outcome = run(&drop, ground, settings.clone());
+        if outcome.embedded() || outcome.through() {
+            println!("{ground:?} {drop:?}: {outcome:?}");
+        }
+        embedded += usize::from(outcome.embedded());
+        through += usize::from(outcome.through());
+        if !outcome.through() {
+            deepest_end = deepest_end.max(outcome.final_depth);
+            deepest = deepest.max(outcome.deepest);
+        }
+    }
+    (embedded, through, deepest_end, deepest)
+}
+
+/// A card dropped at 1–20 m/s in 40 seeded random orientations onto a plane of two triangles
+/// ends on it: no corner more than 1 mm inside, never through; the same as on a half-space.
+#[test]
+fn a_card_dropped_on_a_two_triangle_plane_ends_on_it() {
+    for ground in [Ground::TwoTriangles, Ground::HalfSpace] {
+        let (embedded, through, deepest_end, deepest) =
+            sweep(0..40, (1.0, 20.0), ground, &SolverSettings::default());
+        println!(
+            "{ground:?}: {embedded} embedded, {through} through, deepest corner at the end {:.3} mm, at any step {:.3} mm",
+            deepest_end * 1e3,
+            deepest * 1e3
+        );
+        assert_eq!((embedded, through), (0, 0), "{ground:?}");
+    }
+}
+
+/// The full sweep: 1,000 seeded orientations at 1–20 m/s onto the plane of two triangles and
+/// the half-space, continuous collision on (the default) and off (docs/testing.md, "Thin
+/// shapes").
+#[test]
+#[ignore = "long sweep; run with --ignored --nocapture"]
+fn card_drops_on_meshes_full_sweep() {
+    for continuous in [true, false] {
+        let settings = SolverSettings {
+            continuous,
+            ..SolverSettings::default()
+        };
+        for ground in [Ground::TwoTriangles, Ground::HalfSpace] {
+            let (embedded, through, deepest_end, deepest) =
+                sweep(0..1000, (1.0, 20.0), ground, &settings);
+            println!(
+                "continuous {continuous}, {ground:?}: {embedded} embedded, {through} through, deepest corner at the end {:.3} mm, at any step {:.3} mm",
+                deepest_end * 1e3,
+                deepest * 1e3
+            );
+        }
+    }
+}
