@@ -265,6 +265,19 @@ where
             manifold,
         );
         if !own(type1, type2) && !own(type2, type1) {
+            // A box against a mesh's triangle (normal constraints) may get its deepest corner
+            // (`deepest_vertex::add_deepest_box_corner`), with last step's points' data.
+            let box_on_mesh = (normal_constraints1.is_some() || normal_constraints2.is_some())
+                && matches!(
+                    (type1, type2),
+                    (ShapeType::Cuboid, ShapeType::Triangle)
+                        | (ShapeType::Triangle, ShapeType::Cuboid)
+                );
+            let old = if box_on_mesh {
+                manifold.points.clone()
+            } else {
+                Vec::new()
+            };
             DefaultQueryDispatcher.contact_manifold_convex_convex(
                 pos12,
                 g1,
@@ -275,6 +288,9 @@ where
                 manifold,
             )?;
             fallback.after(pos12, g1, g2, constraints, prediction, manifold);
+            if box_on_mesh {
+                deepest_vertex::add_deepest_box_corner(pos12, g1, g2, prediction, manifold, &old);
+            }
             return Ok(());
         }
         if let Some(ball2) = g2.as_ball()

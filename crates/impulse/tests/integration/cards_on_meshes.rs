@@ -27,7 +27,8 @@ fn material() -> Material {
 /// The static ground, its top at y = 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Ground {
-    /// The plane as a triangle mesh of two triangles, 4 m square.
+    /// The plane as a triangle mesh of two triangles, 20 m square (a card that lands at a slant
+    /// can skid metres away).
     TwoTriangles,
     /// The half-space y ≤ 0.
     HalfSpace,
@@ -37,10 +38,10 @@ fn ground_body(ground: Ground) -> BodyDesc {
     let shape = match ground {
         Ground::TwoTriangles => ShapeDesc::trimesh(
             vec![
-                [-2.0, 0.0, -2.0],
-                [2.0, 0.0, -2.0],
-                [2.0, 0.0, 2.0],
-                [-2.0, 0.0, 2.0],
+                [-10.0, 0.0, -10.0],
+                [10.0, 0.0, -10.0],
+                [10.0, 0.0, 10.0],
+                [-10.0, 0.0, 10.0],
             ],
             // Counter-clockwise seen from above: the faces' normals point up.
             vec![[0, 2, 1], [0, 3, 2]],
@@ -177,6 +178,7 @@ fn sweep(
 /// ends on it: no corner more than 1 mm inside, never through; the same as on a half-space.
 #[test]
 fn a_card_dropped_on_a_two_triangle_plane_ends_on_it() {
+    let mut failures = Vec::new();
     for ground in [Ground::TwoTriangles, Ground::HalfSpace] {
         let (embedded, through, deepest_end, deepest) =
             sweep(0..40, (1.0, 20.0), ground, &SolverSettings::default());
@@ -185,8 +187,11 @@ fn a_card_dropped_on_a_two_triangle_plane_ends_on_it() {
             deepest_end * 1e3,
             deepest * 1e3
         );
-        assert_eq!((embedded, through), (0, 0), "{ground:?}");
+        if (embedded, through) != (0, 0) {
+            failures.push((ground, embedded, through));
+        }
     }
+    assert!(failures.is_empty(), "(ground, embedded, through): {failures:?}");
 }
 
 /// The full sweep: 1,000 seeded orientations at 1–20 m/s onto the plane of two triangles and
@@ -208,6 +213,50 @@ fn card_drops_on_meshes_full_sweep() {
                 deepest_end * 1e3,
                 deepest * 1e3
             );
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn trace_card_drop() {
+    let seed: u64 = std::env::var("SEED").unwrap().parse().unwrap();
+    let ground = if std::env::var("HS").is_ok_and(|v| !v.is_empty()) { Ground::HalfSpace } else { Ground::TwoTriangles };
+    let continuous = std::env::var("NOCCD").is_err();
+    let drop = drop_case(seed, (1.0, 20.0));
+    let settings = SolverSettings { continuous, ..SolverSettings::default() };
+    let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
+    world.add_body(&ground_body(ground), &material()).unwrap();
+    let probe = depth(Vec3::ZERO, drop.orientation);
+    let mut card = BodyDesc::new(
+        BodyKind::Dynamic,
+        ShapeDesc::Cuboid { half_extents: [HALF.x, 0.0, HALF.z] },
+        [0.0, probe + drop.height, 0.0],
+    );
+    card.orientation = drop.orientation.to_array();
+    card.linear_velocity = [0.0, -drop.speed, 0.0];
+    card.angular_velocity = drop.spin.to_array();
+    let card = world.add_body(&card, &material()).unwrap();
+    println!("{drop:?}");
+    let steps: usize = std::env::var("STEPS").map_or(40, |s| s.parse().unwrap());
+    for step in 0..steps {
+        world.step().unwrap();
+        let pose = world.poses()[card];
+        println!(
+            "step {step}: y {:.5} depth {:.5} v {:?} w {:?} up {:?}",
+            pose.translation.y,
+            depth(pose.translation, pose.rotation),
+            world.linear_velocities()[card],
+            world.angular_velocities()[card],
+            pose.rotation * Vec3::Y
+        );
+        for pair in world.contact_pairs() {
+            for p in pair.points() {
+                println!(
+                    "   p {:?} n {:?} s {:.5} imp {:.4}",
+                    p.position, p.normal, p.separation, p.normal_impulse
+                );
+            }
         }
     }
 }
