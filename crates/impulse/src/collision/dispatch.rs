@@ -160,7 +160,7 @@ where
         match (g1.shape_type(), g2.shape_type()) {
             (ShapeType::TriMesh, _) | (_, ShapeType::TriMesh) => {
                 contact_manifolds_trimesh_shape_shapes(
-                    self, pos12, g1, g2, prediction, manifolds, workspace,
+                    &MeshTriangles, pos12, g1, g2, prediction, manifolds, workspace,
                 );
             }
             (ShapeType::HeightField, _) => match (g1.as_heightfield(), composite2) {
@@ -265,19 +265,6 @@ where
             manifold,
         );
         if !own(type1, type2) && !own(type2, type1) {
-            // A box against a mesh's triangle (normal constraints) may get its deepest corner
-            // (`deepest_vertex::add_deepest_box_corner`), with last step's points' data.
-            let box_on_mesh = (normal_constraints1.is_some() || normal_constraints2.is_some())
-                && matches!(
-                    (type1, type2),
-                    (ShapeType::Cuboid, ShapeType::Triangle)
-                        | (ShapeType::Triangle, ShapeType::Cuboid)
-                );
-            let old = if box_on_mesh {
-                manifold.points.clone()
-            } else {
-                Vec::new()
-            };
             DefaultQueryDispatcher.contact_manifold_convex_convex(
                 pos12,
                 g1,
@@ -288,9 +275,6 @@ where
                 manifold,
             )?;
             fallback.after(pos12, g1, g2, constraints, prediction, manifold);
-            if box_on_mesh {
-                deepest_vertex::add_deepest_box_corner(pos12, g1, g2, prediction, manifold, &old);
-            }
             return Ok(());
         }
         if let Some(ball2) = g2.as_ball()
@@ -353,6 +337,139 @@ where
         }
         if hull_pair && (is_flat_type(type1) || is_flat_type(type2)) {
             deepest_vertex::add_deepest_vertex(pos12, g1, g2, prediction, manifold, &old);
+        }
+        Ok(())
+    }
+}
+
+/// [`ContactDispatcher`] for the triangles of a triangle mesh against a convex shape: the same
+/// manifolds, and a box's deepest corner where the manifold misses it
+/// ([`deepest_vertex::add_deepest_box_corner`]). Height fields' triangles keep
+/// [`ContactDispatcher`]'s manifolds as they are.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct MeshTriangles;
+
+impl QueryDispatcher for MeshTriangles {
+    fn intersection_test(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+    ) -> Result<ShapeIntersection, Unsupported> {
+        ContactDispatcher.intersection_test(pos12, g1, g2)
+    }
+
+    fn distance(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+    ) -> Result<ShapeDistance, Unsupported> {
+        ContactDispatcher.distance(pos12, g1, g2)
+    }
+
+    fn contact(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        prediction: Real,
+    ) -> Result<Option<Contact>, Unsupported> {
+        ContactDispatcher.contact(pos12, g1, g2, prediction)
+    }
+
+    fn closest_points(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        max_dist: Real,
+    ) -> Result<ClosestPoints, Unsupported> {
+        ContactDispatcher.closest_points(pos12, g1, g2, max_dist)
+    }
+
+    fn cast_shapes(
+        &self,
+        pos12: &Pose,
+        local_vel12: Vector,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        options: ShapeCastOptions,
+    ) -> Result<Option<ShapeCastHit>, Unsupported> {
+        ContactDispatcher.cast_shapes(pos12, local_vel12, g1, g2, options)
+    }
+
+    fn cast_shapes_nonlinear(
+        &self,
+        motion1: &NonlinearRigidMotion,
+        g1: &dyn Shape,
+        motion2: &NonlinearRigidMotion,
+        g2: &dyn Shape,
+        start_time: Real,
+        end_time: Real,
+        stop_at_penetration: bool,
+    ) -> Result<Option<ShapeCastHit>, Unsupported> {
+        ContactDispatcher.cast_shapes_nonlinear(
+            motion1,
+            g1,
+            motion2,
+            g2,
+            start_time,
+            end_time,
+            stop_at_penetration,
+        )
+    }
+}
+
+impl<ManifoldData, ContactData> PersistentQueryDispatcher<ManifoldData, ContactData>
+    for MeshTriangles
+where
+    ManifoldData: Default + Clone + Send + Sync + AxisMemory,
+    ContactData: Default + Copy + Send + Sync,
+{
+    fn contact_manifolds(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        prediction: Real,
+        manifolds: &mut Vec<ContactManifold<ManifoldData, ContactData>>,
+        workspace: &mut Option<ContactManifoldsWorkspace>,
+    ) -> Result<(), Unsupported> {
+        ContactDispatcher.contact_manifolds(pos12, g1, g2, prediction, manifolds, workspace)
+    }
+
+    fn contact_manifold_convex_convex(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        normal_constraints1: Option<&dyn NormalConstraints>,
+        normal_constraints2: Option<&dyn NormalConstraints>,
+        prediction: Real,
+        manifold: &mut ContactManifold<ManifoldData, ContactData>,
+    ) -> Result<(), Unsupported> {
+        let box_and_triangle = matches!(
+            (g1.shape_type(), g2.shape_type()),
+            (ShapeType::Cuboid, ShapeType::Triangle) | (ShapeType::Triangle, ShapeType::Cuboid)
+        );
+        // Last step's points, for the solver's data of the corner's point.
+        let old = if box_and_triangle {
+            manifold.points.clone()
+        } else {
+            Vec::new()
+        };
+        ContactDispatcher.contact_manifold_convex_convex(
+            pos12,
+            g1,
+            g2,
+            normal_constraints1,
+            normal_constraints2,
+            prediction,
+            manifold,
+        )?;
+        if box_and_triangle {
+            deepest_vertex::add_deepest_box_corner(pos12, g1, g2, prediction, manifold, &old);
         }
         Ok(())
     }

@@ -467,14 +467,6 @@ impl NarrowPhase {
         Ok(())
     }
 
-    /// Whether bodies `a` and `b` have contact points this step (speculative ones included).
-    pub fn has_points(&self, a: u32, b: u32) -> bool {
-        let key = (a.min(b), a.max(b));
-        self.pairs
-            .binary_search_by(|p| (p.body1, p.body2).cmp(&key))
-            .is_ok_and(|i| self.pairs[i].point_count() > 0)
-    }
-
     /// The smallest separation (m) of the contact points of bodies `a` and `b` this step
     /// (speculative ones included); `None` when they have none.
     pub(crate) fn min_separation(&self, a: u32, b: u32) -> Option<f32> {
