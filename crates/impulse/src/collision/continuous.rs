@@ -25,10 +25,11 @@
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, distance};
+use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, contact, distance};
 use parry3d::shape::{Ball, Compound, Cuboid, HalfSpace, HeightField, Shape, Triangle};
 
 use crate::body::motion::rotation_vector;
+use crate::contact::SPECULATIVE_TURN;
 
 /// A body is swept when it moved more than this fraction of its smallest half extent in a
 /// step (Box2D v3's safety factor: a slower body cannot pass through anything the contacts
@@ -173,6 +174,9 @@ pub(crate) struct FastBody<'a> {
     pub(crate) travel: f32,
     /// The farthest any of its points lies from its centre of mass (m).
     pub(crate) radius: f32,
+    /// Whether the solver released its speculative rows as stale this step: it turned past
+    /// [`SPECULATIVE_TURN`] and is not a ball (set by the continuous stage; false here).
+    pub(crate) released: bool,
 }
 
 impl<'a> FastBody<'a> {
@@ -210,6 +214,7 @@ impl<'a> FastBody<'a> {
             min_half_extent,
             travel,
             radius,
+            released: false,
         })
     }
 }
@@ -399,9 +404,34 @@ pub(crate) fn clamp_fraction_castable(
         let t = confirmed_time_of_impact(body, target, target_sweep)?;
         return (t < 1.0).then(|| (t - gap / body.travel).max(0.0));
     }
-    core_spheres(body, &mut |core, center| {
+    let core = core_spheres(body, &mut |core, center| {
         clamp_core(body, core, center, target_sweep, target)
-    })
+    });
+    if body.released && driven_in(body, target, target_sweep) {
+        // Its rows held it while it turned by less than `SPECULATIVE_TURN`: it is put back
+        // to where it had turned that far, and the next step's contacts, taken there, go on.
+        let held = SPECULATIVE_TURN / body.sweep.turn.length();
+        return Some(core.map_or(held, |t| t.min(held)));
+    }
+    core
+}
+
+/// Whether `body` ends the step inside `target` (moving along `target_sweep`) deeper than it
+/// started by more than its smallest half extent: deeper than contacts that hold a body ever
+/// let it sink. A thin body held at one corner and turning past [`SPECULATIVE_TURN`] swings
+/// its other corners through the surface while its core sphere, at its centre, stays out (a
+/// card spinning at 120 rad/s off its first corner's impact ended with its centre on a plane
+/// and corners 34 mm under it).
+fn driven_in(body: &FastBody<'_>, target: &dyn Shape, target_sweep: &Sweep) -> bool {
+    let depth = |at: &Pose, target_at: &Pose| {
+        contact(at, body.shape, target_at, target, 0.0)
+            .ok()
+            .flatten()
+            .map_or(0.0, |c| (-c.dist).max(0.0))
+    };
+    let start = depth(&body.sweep.start, &target_sweep.start);
+    let end = depth(&body.sweep.end, &target_sweep.end);
+    end > start + body.min_half_extent
 }
 
 /// Calls `each` with every core sphere of `body` (in contact, [`clamp_fraction_castable`]):

@@ -70,14 +70,15 @@ impl World {
             let (center_of_mass, spin) =
                 (b.local_center_of_mass[i], b.angular_velocity[i] * self.dt);
             let shape = &*b.shape[i];
-            let Some(body) = FastBody::moving_fast(shape, start, end, center_of_mass, spin) else {
+            let Some(mut body) = FastBody::moving_fast(shape, start, end, center_of_mass, spin)
+            else {
                 continue;
             };
             let sweep = body.sweep;
             // Whether the solver released this body's speculative rows as stale (a ball's
             // rows, whose lever arms lie along their normals, never are).
-            let released =
-                sweep.turn.length() > SPECULATIVE_TURN && shape.as_ball().is_none();
+            let released = sweep.turn.length() > SPECULATIVE_TURN && shape.as_ball().is_none();
+            body.released = released;
             let swept = shape.compute_swept_aabb(&sweep.start, &sweep.end);
             let mut earliest = 1.0f32;
             let mut visit = |j: usize| {
