@@ -26,7 +26,7 @@ fn material() -> Material {
 
 /// The static ground, its top at y = 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Ground {
+enum Ground {
     /// The plane as a triangle mesh of two triangles, 20 m square (a card that lands at a slant
     /// can skid metres away).
     TwoTriangles,
@@ -56,15 +56,15 @@ fn ground_body(ground: Ground) -> BodyDesc {
 /// One seeded drop: a uniformly random orientation (Shoemake's method), a speed straight
 /// down, a small random spin, the card's lowest corner 0.05–0.3 m above the plane.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Drop {
-    pub(crate) seed: u64,
+struct Drop {
+    seed: u64,
     orientation: Quat,
     speed: f32,
     spin: Vec3,
     height: f32,
 }
 
-pub(crate) fn drop_case(seed: u64, speeds: (f32, f32)) -> Drop {
+fn drop_case(seed: u64, speeds: (f32, f32)) -> Drop {
     let mut rng = Rng(seed);
     let (u1, u2, u3) = (
         rng.range(0.0, 1.0),
@@ -101,25 +101,25 @@ fn depth(translation: Vec3, rotation: Quat) -> f32 {
 /// What a drop did: the deepest corner over every step, at the end, and the centre's height
 /// at the end.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Outcome {
-    pub(crate) deepest: f32,
-    pub(crate) final_depth: f32,
-    pub(crate) final_height: f32,
+struct Outcome {
+    deepest: f32,
+    final_depth: f32,
+    final_height: f32,
 }
 
 impl Outcome {
     /// The card ended with a corner more than 1 mm inside the plane.
-    pub(crate) fn embedded(&self) -> bool {
+    fn embedded(&self) -> bool {
         self.final_depth > 1e-3 && !self.through()
     }
 
     /// The card's centre ended below the plane.
-    pub(crate) fn through(&self) -> bool {
+    fn through(&self) -> bool {
         self.final_height < 0.0
     }
 }
 
-pub(crate) fn run(drop: &Drop, ground: Ground, settings: SolverSettings) -> Outcome {
+fn run(drop: &Drop, ground: Ground, settings: SolverSettings) -> Outcome {
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
     world.add_body(&ground_body(ground), &material()).unwrap();
     let probe = depth(Vec3::ZERO, drop.orientation);
@@ -151,7 +151,7 @@ pub(crate) fn run(drop: &Drop, ground: Ground, settings: SolverSettings) -> Outc
 /// Drops seeds `seeds` at `speeds` onto `ground` and returns (embedded, through, deepest at
 /// the end, deepest at any step), printing the failing cases.
 fn sweep(
-    seeds: std::ops::Range<u64>,
+    seeds: impl IntoIterator<Item = u64>,
     speeds: (f32, f32),
     ground: Ground,
     settings: &SolverSettings,
@@ -162,7 +162,7 @@ fn sweep(
         let drop = drop_case(seed, speeds);
         let outcome = run(&drop, ground, settings.clone());
         if outcome.embedded() || outcome.through() {
-            println!("{ground:?} {drop:?}: {outcome:?}");
+            println!("{ground:?} seed {}: {drop:?}: {outcome:?}", drop.seed);
         }
         embedded += usize::from(outcome.embedded());
         through += usize::from(outcome.through());
@@ -174,14 +174,16 @@ fn sweep(
     (embedded, through, deepest_end, deepest)
 }
 
-/// A card dropped at 1–20 m/s in 40 seeded random orientations onto a plane of two triangles
+/// A card dropped at 1–20 m/s in 40 seeded random orientations (and seeds 85 and 403 of the
+/// full sweep, a card spinning off its first corner's impact) onto a plane of two triangles
 /// ends on it: no corner more than 1 mm inside, never through; the same as on a half-space.
 #[test]
 fn a_card_dropped_on_a_two_triangle_plane_ends_on_it() {
     let mut failures = Vec::new();
     for ground in [Ground::TwoTriangles, Ground::HalfSpace] {
+        let seeds = (0..40).chain([85, 403]);
         let (embedded, through, deepest_end, deepest) =
-            sweep(0..40, (1.0, 20.0), ground, &SolverSettings::default());
+            sweep(seeds, (1.0, 20.0), ground, &SolverSettings::default());
         println!(
             "{ground:?}: {embedded} embedded, {through} through, deepest corner at the end {:.3} mm, at any step {:.3} mm",
             deepest_end * 1e3,
@@ -217,46 +219,3 @@ fn card_drops_on_meshes_full_sweep() {
     }
 }
 
-#[test]
-#[ignore]
-fn trace_card_drop() {
-    let seed: u64 = std::env::var("SEED").unwrap().parse().unwrap();
-    let ground = if std::env::var("HS").is_ok_and(|v| !v.is_empty()) { Ground::HalfSpace } else { Ground::TwoTriangles };
-    let continuous = std::env::var("NOCCD").is_err();
-    let drop = drop_case(seed, (1.0, 20.0));
-    let settings = SolverSettings { continuous, ..SolverSettings::default() };
-    let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), DT, settings).unwrap();
-    world.add_body(&ground_body(ground), &material()).unwrap();
-    let probe = depth(Vec3::ZERO, drop.orientation);
-    let mut card = BodyDesc::new(
-        BodyKind::Dynamic,
-        ShapeDesc::Cuboid { half_extents: [HALF.x, 0.0, HALF.z] },
-        [0.0, probe + drop.height, 0.0],
-    );
-    card.orientation = drop.orientation.to_array();
-    card.linear_velocity = [0.0, -drop.speed, 0.0];
-    card.angular_velocity = drop.spin.to_array();
-    let card = world.add_body(&card, &material()).unwrap();
-    println!("{drop:?}");
-    let steps: usize = std::env::var("STEPS").map_or(40, |s| s.parse().unwrap());
-    for step in 0..steps {
-        world.step().unwrap();
-        let pose = world.poses()[card];
-        println!(
-            "step {step}: y {:.5} depth {:.5} v {:?} w {:?} up {:?}",
-            pose.translation.y,
-            depth(pose.translation, pose.rotation),
-            world.linear_velocities()[card],
-            world.angular_velocities()[card],
-            pose.rotation * Vec3::Y
-        );
-        for pair in world.contact_pairs() {
-            for p in pair.points() {
-                println!(
-                    "   p {:?} n {:?} s {:.5} imp {:.4}",
-                    p.position, p.normal, p.separation, p.normal_impulse
-                );
-            }
-        }
-    }
-}
