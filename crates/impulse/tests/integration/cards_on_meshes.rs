@@ -279,10 +279,6 @@ fn forty_cards(seed: u64, settings: SolverSettings) -> (f32, usize, f32) {
         for i in 0..cards.len() {
             for j in i + 1..cards.len() {
                 let depth = crossing(&world, cards[i], cards[j]);
-                if depth > 5e-3 && std::env::var("CARDS_DEBUG").is_ok() {
-                    let w = world.angular_velocities();
-                    println!("step {} pair {i} {j} depth {:.1} mm spins {:.0} {:.0} rad/s", world.step_count(), depth * 1e3, w[cards[i]].length(), w[cards[j]].length());
-                }
                 deepest = deepest.max(depth);
                 if depth > 5e-4 {
                     crossed.insert((i, j));
