@@ -65,7 +65,15 @@ pub(crate) fn add_deepest_vertex<ManifoldData, ContactData: Default + Copy>(
         add(pos12, g1, vertices, prediction, manifold, old, false);
     } else if let Some((hull, border)) = hull_parts(g1) {
         let vertices = Vertices::hull(hull.points(), border);
-        add(&pos12.inverse(), g2, vertices, prediction, manifold, old, true);
+        add(
+            &pos12.inverse(),
+            g2,
+            vertices,
+            prediction,
+            manifold,
+            old,
+            true,
+        );
     }
 }
 
@@ -91,11 +99,27 @@ pub(crate) fn add_deepest_box_corner<ManifoldData, ContactData: Default + Copy>(
 ) {
     if let Some(cuboid) = g2.as_cuboid() {
         let corners = box_corners(cuboid);
-        add(pos12, g1, Vertices::corners(&corners), prediction, manifold, old, false);
+        add(
+            pos12,
+            g1,
+            Vertices::corners(&corners),
+            prediction,
+            manifold,
+            old,
+            false,
+        );
     } else if let Some(cuboid) = g1.as_cuboid() {
         let corners = box_corners(cuboid);
         let vertices = Vertices::corners(&corners);
-        add(&pos12.inverse(), g2, vertices, prediction, manifold, old, true);
+        add(
+            &pos12.inverse(),
+            g2,
+            vertices,
+            prediction,
+            manifold,
+            old,
+            true,
+        );
     }
 }
 

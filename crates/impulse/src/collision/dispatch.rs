@@ -160,7 +160,13 @@ where
         match (g1.shape_type(), g2.shape_type()) {
             (ShapeType::TriMesh, _) | (_, ShapeType::TriMesh) => {
                 contact_manifolds_trimesh_shape_shapes(
-                    &MeshTriangles, pos12, g1, g2, prediction, manifolds, workspace,
+                    &MeshTriangles,
+                    pos12,
+                    g1,
+                    g2,
+                    prediction,
+                    manifolds,
+                    workspace,
                 );
             }
             (ShapeType::HeightField, _) => match (g1.as_heightfield(), composite2) {
