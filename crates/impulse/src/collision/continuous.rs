@@ -25,10 +25,11 @@
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, distance};
+use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, contact, distance};
 use parry3d::shape::{Ball, Compound, Cuboid, HalfSpace, HeightField, Shape, Triangle};
 
 use crate::body::motion::rotation_vector;
+use crate::contact::SPECULATIVE_TURN;
 
 /// A body is swept when it moved more than this fraction of its smallest half extent in a
 /// step (Box2D v3's safety factor: a slower body cannot pass through anything the contacts
@@ -173,6 +174,9 @@ pub(crate) struct FastBody<'a> {
     pub(crate) travel: f32,
     /// The farthest any of its points lies from its centre of mass (m).
     pub(crate) radius: f32,
+    /// Whether the solver released its speculative rows as stale this step: it turned past
+    /// [`SPECULATIVE_TURN`] and is not a ball (set by the continuous stage; false here).
+    pub(crate) released: bool,
 }
 
 impl<'a> FastBody<'a> {
@@ -210,6 +214,7 @@ impl<'a> FastBody<'a> {
             min_half_extent,
             travel,
             radius,
+            released: false,
         })
     }
 }
@@ -395,14 +400,38 @@ pub(crate) fn clamp_fraction_castable(
             .ok()?
             .distance
     };
-    let target_motion = target_sweep.motion();
     if start_distance > gap {
         let t = confirmed_time_of_impact(body, target, target_sweep)?;
         return (t < 1.0).then(|| (t - gap / body.travel).max(0.0));
     }
-    core_spheres(body, &mut |core, center| {
-        clamp_core(body, core, center, &target_motion, target)
-    })
+    let core = core_spheres(body, &mut |core, center| {
+        clamp_core(body, core, center, target_sweep, target)
+    });
+    if body.released && driven_in(body, target, target_sweep) {
+        // Its rows held it while it turned by less than `SPECULATIVE_TURN`: it is put back
+        // to where it had turned that far, and the next step's contacts, taken there, go on.
+        let held = SPECULATIVE_TURN / body.sweep.turn.length();
+        return Some(core.map_or(held, |t| t.min(held)));
+    }
+    core
+}
+
+/// Whether `body` ends the step inside `target` (moving along `target_sweep`) deeper than it
+/// started by more than its smallest half extent: deeper than contacts that hold a body ever
+/// let it sink. A thin body held at one corner and turning past [`SPECULATIVE_TURN`] swings
+/// its other corners through the surface while its core sphere, at its centre, stays out (a
+/// card spinning at 120 rad/s off its first corner's impact ended with its centre on a plane
+/// and corners 34 mm under it).
+fn driven_in(body: &FastBody<'_>, target: &dyn Shape, target_sweep: &Sweep) -> bool {
+    let depth = |at: &Pose, target_at: &Pose| {
+        contact(at, body.shape, target_at, target, 0.0)
+            .ok()
+            .flatten()
+            .map_or(0.0, |c| (-c.dist).max(0.0))
+    };
+    let start = depth(&body.sweep.start, &target_sweep.start);
+    let end = depth(&body.sweep.end, &target_sweep.end);
+    end > start + body.min_half_extent
 }
 
 /// Calls `each` with every core sphere of `body` (in contact, [`clamp_fraction_castable`]):
@@ -448,21 +477,52 @@ fn clamp_core(
     body: &FastBody<'_>,
     core: Ball,
     center: Vec3,
-    target_motion: &NonlinearRigidMotion,
+    target_sweep: &Sweep,
     target: &dyn Shape,
 ) -> Option<f32> {
     let gap = CLAMP_GAP.min(0.1 * body.min_half_extent);
     let core_sweep = body.sweep.of_part(&Pose::from_translation(center));
-    let hit = cast_shapes_nonlinear(
-        &core_sweep.motion(),
-        &core,
-        target_motion,
-        target,
-        0.0,
-        1.0,
-        true,
-    )
-    .ok()??;
+    let target_motion = target_sweep.motion();
+    let cast = |from: f32| {
+        cast_shapes_nonlinear(
+            &core_sweep.motion(),
+            &core,
+            &target_motion,
+            target,
+            from,
+            1.0,
+            true,
+        )
+    };
+    let mut hit = cast(0.0).ok()??;
+    // A ball about the centre of mass moves along the centre's straight path however the body
+    // turns, so against a target that does not turn its cast is confirmed by the distance, as
+    // a whole body's is ([`confirmed_time_of_impact`]): Parry's cast read a card's core sphere
+    // 1 mm above a mesh triangle, and moving away from it, as touching it at the step's start,
+    // and the card was held still, a corner in the mesh, step after step.
+    let straight = center == body.sweep.local_center_of_mass || body.sweep.turn == Vec3::ZERO;
+    if straight && target_sweep.turn == Vec3::ZERO {
+        let tolerance = 1.0e-3 * body.min_half_extent;
+        let (start, end) = core_sweep.center_path();
+        let closing = (end - start).length()
+            + (target_sweep.end.translation - target_sweep.start.translation).length();
+        for _ in 0..CONFIRM_CASTS {
+            let t = hit.time_of_impact;
+            if !(t > 0.0 && t < 1.0) {
+                break;
+            }
+            let (at, target_at) = (core_sweep.pose_at(t), target_sweep.pose_at(t));
+            let apart = distance(&at, &core, &target_at, target).map_or(0.0, |d| d.distance);
+            if apart <= tolerance {
+                break;
+            }
+            let from = t + apart / closing;
+            if from.is_nan() || from >= 1.0 {
+                return None;
+            }
+            hit = cast(from).ok()??;
+        }
+    }
     let t = hit.time_of_impact;
     if !(t > 0.0 && t < 1.0) {
         return None;

@@ -58,17 +58,15 @@ const TILTED: Real = std::f32::consts::FRAC_1_SQRT_2;
 const SAME_POINT: Real = 1.0e-5;
 
 /// Most vertices a turning hull gets points for beside its deepest (see the module's
-/// documentation): a round hull's vertices near its lowest are many, and the few nearest the
-/// surface are those its rotation brings down first.
+/// documentation): a round hull's vertices near its lowest are many, and those nearest the
+/// surface are the ones its rotation brings down first.
 const TURNING_VERTICES: usize = 32;
 
 /// Adds the deepest vertex of a convex hull (`g1` or `g2`, rounded or not) against a half-space
 /// or a face-on triangle (the other shape) to `manifold` (of `g1` and `g2`, `g2`'s pose in
-/// `g1`'s frame being `pos12`) when the manifold misses it, and with `turn_reach` > 0 (m, how
-/// far rotation can carry a point of the pair in the step) the vertices that may become the
-/// lowest, as the module's documentation says; within `prediction` (m). Each point takes the
-/// solver's data of the point of the same features in `old` (last step's points), if any.
-/// Other pairs are left alone.
+/// `g1`'s frame being `pos12`) when the manifold misses it, as the module's documentation says;
+/// the point takes the solver's data of the point of the same features in `old` (last step's
+/// points), if any. Other pairs are left alone.
 pub(crate) fn add_deepest_vertex<ManifoldData, ContactData: Default + Copy>(
     pos12: &Pose,
     g1: &dyn Shape,
@@ -78,25 +76,120 @@ pub(crate) fn add_deepest_vertex<ManifoldData, ContactData: Default + Copy>(
     old: &[TrackedContact<ContactData>],
 ) {
     let reach = (prediction, turn_reach);
-    if let Some(hull) = hull_parts(g2) {
-        add(pos12, g1, hull, reach, manifold, old, false);
-    } else if let Some(hull) = hull_parts(g1) {
-        add(&pos12.inverse(), g2, hull, reach, manifold, old, true);
+    if let Some((hull, border)) = hull_parts(g2) {
+        let vertices = Vertices::hull(hull.points(), border);
+        add(pos12, g1, vertices, reach, manifold, old, false);
+    } else if let Some((hull, border)) = hull_parts(g1) {
+        let vertices = Vertices::hull(hull.points(), border);
+        add(&pos12.inverse(), g2, vertices, reach, manifold, old, true);
     }
 }
 
-/// [`add_deepest_vertex`] with the hull `hull` (its polyhedron and border radius) as shape 2
-/// and `flat` as shape 1 in the frame of `pos12` (the hull's pose in `flat`'s frame);
-/// `flipped` says the manifold has them the other way round.
+/// Adds the deepest corner of a box (`g1` or `g2`) against a mesh's triangle (the other shape)
+/// to `manifold` as [`add_deepest_vertex`] adds a hull's vertex, and also where the manifold
+/// has no point at all, the box then crossing the triangle's plane (some corner on either
+/// side of it): the triangle's face normal is its side the mesh faces out of.
+///
+/// Parry's box–triangle generator takes the normal of the axis of least overlap and then
+/// applies the mesh's normal constraints; where that axis is an edge's (a thin box lying
+/// across the edge between two triangles of a plane, overlapping its plane by a few
+/// millimetres but crossing the edge by less), the constraints turn it to the face normal, and
+/// the points along it, deeper than the axis' overlap by more than five times, are dropped
+/// (Parry's guard against constrained normals reaching far into the other shape): the box got
+/// no point against the triangle its corners were sinking into.
+pub(crate) fn add_deepest_box_corner<ManifoldData, ContactData: Default + Copy>(
+    pos12: &Pose,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    prediction: Real,
+    manifold: &mut ContactManifold<ManifoldData, ContactData>,
+    old: &[TrackedContact<ContactData>],
+) {
+    if let Some(cuboid) = g2.as_cuboid() {
+        let corners = box_corners(cuboid);
+        add(
+            pos12,
+            g1,
+            Vertices::corners(&corners),
+            (prediction, 0.0),
+            manifold,
+            old,
+            false,
+        );
+    } else if let Some(cuboid) = g1.as_cuboid() {
+        let corners = box_corners(cuboid);
+        let vertices = Vertices::corners(&corners);
+        add(
+            &pos12.inverse(),
+            g2,
+            vertices,
+            (prediction, 0.0),
+            manifold,
+            old,
+            true,
+        );
+    }
+}
+
+/// The vertices whose deepest [`add`] looks for: a hull's (its border radius `border`, its
+/// vertex `i` named vertex `i`), or a box's corners (no border, named as Parry names them).
+#[derive(Clone, Copy)]
+struct Vertices<'a> {
+    points: &'a [Vector],
+    border: Real,
+    /// A box's: named as Parry's box features name them; and a manifold with no point may get
+    /// the corner.
+    corners: bool,
+}
+
+impl<'a> Vertices<'a> {
+    fn hull(points: &'a [Vector], border: Real) -> Self {
+        Self {
+            points,
+            border,
+            corners: false,
+        }
+    }
+
+    fn corners(points: &'a [Vector; 8]) -> Self {
+        Self {
+            points,
+            border: 0.0,
+            corners: true,
+        }
+    }
+
+    /// The feature id of vertex `index`.
+    fn id(&self, index: usize) -> PackedFeatureId {
+        // Parry's box vertex ids are twice the corner's sign bits ([`box_corners`]).
+        PackedFeatureId::vertex(if self.corners { 2 * index } else { index } as u32)
+    }
+}
+
+/// The eight corners of `cuboid`, corner `i` having a negative x where bit 2 of `i` is set, a
+/// negative y for bit 1 and a negative z for bit 0 (the numbering of Parry's box features).
+fn box_corners(cuboid: &parry3d::shape::Cuboid) -> [Vector; 8] {
+    let half = cuboid.half_extents;
+    std::array::from_fn(|i| {
+        let sign = |bit: usize| if i & bit == 0 { 1.0 } else { -1.0 };
+        Vector::new(half.x * sign(4), half.y * sign(2), half.z * sign(1))
+    })
+}
+
+/// [`add_deepest_vertex`] with the vertices `vertices` of a hull or a box as shape 2 and `flat`
+/// as shape 1 in the frame of `pos12` (shape 2's pose in `flat`'s frame), within `prediction`
+/// (m), with the turning vertices for `turn_reach` > 0 (m); `flipped` says the manifold has
+/// them the other way round.
 fn add<ManifoldData, ContactData: Default + Copy>(
     pos12: &Pose,
     flat: &dyn Shape,
-    (hull, border): (&parry3d::shape::ConvexPolyhedron, Real),
+    vertices: Vertices<'_>,
     (prediction, turn_reach): (Real, Real),
     manifold: &mut ContactManifold<ManifoldData, ContactData>,
     old: &[TrackedContact<ContactData>],
     flipped: bool,
 ) {
+    let border = vertices.border;
     // The flat shape's outward unit normal (its frame), a point of its plane, its face id, and
     // for a triangle whether the manifold's normal is off the face normal by more than FACE_ON.
     let (normal, origin, face, triangle) = match flat.as_typed_shape() {
@@ -107,17 +200,20 @@ fn add<ManifoldData, ContactData: Default + Copy>(
             None,
         ),
         TypedShape::Triangle(triangle) => {
-            if manifold.points.is_empty() {
+            let Some(face_normal) = triangle.normal() else {
                 return;
-            }
-            // The manifold's normal, outward from the flat shape, in its frame.
-            let along = if flipped {
+            };
+            // The manifold's normal, outward from the flat shape, in its frame; without
+            // points (a box's only), the face normal.
+            let along = if manifold.points.is_empty() {
+                if !vertices.corners {
+                    return;
+                }
+                face_normal
+            } else if flipped {
                 manifold.local_n2
             } else {
                 manifold.local_n1
-            };
-            let Some(face_normal) = triangle.normal() else {
-                return;
             };
             let (face_normal, face) = if face_normal.dot(along) >= 0.0 {
                 (face_normal, PackedFeatureId::face(0))
@@ -139,8 +235,16 @@ fn add<ManifoldData, ContactData: Default + Copy>(
     };
     // The deepest vertex: the hull's support point along the flat shape's inward normal.
     let inward = pos12.rotation.inverse() * -normal;
-    let points = hull.points();
+    let points = vertices.points;
     let vertex = parry3d::utils::point_cloud_support_point_id(inward, points);
+    if manifold.points.is_empty() {
+        // A box with no point against a triangle gets one only while it crosses the
+        // triangle's plane: its highest corner above it.
+        let top = parry3d::utils::point_cloud_support_point(-inward, points);
+        if (pos12 * top - origin).dot(normal) <= 0.0 {
+            return;
+        }
+    }
     let at = pos12 * points[vertex];
     let dist = (at - origin).dot(normal) - border;
     if dist > prediction {
@@ -168,13 +272,13 @@ fn add<ManifoldData, ContactData: Default + Copy>(
         origin,
         face,
         inward,
-        border,
+        vertices,
         flipped,
     };
     if dist < nearest - DEPTH_TIE {
-        flat_side.add_vertex(points, vertex, manifold, old);
+        flat_side.add_vertex(vertex, manifold, old);
     }
-    if turn_reach <= 0.0 {
+    if turn_reach <= 0.0 || manifold.points.is_empty() {
         return;
     }
     // Vertices the step's rotation may bring below the deepest one, nearest the surface first.
@@ -198,42 +302,41 @@ fn add<ManifoldData, ContactData: Default + Copy>(
         {
             continue;
         }
-        added += usize::from(flat_side.add_vertex(points, k, manifold, old));
+        added += usize::from(flat_side.add_vertex(k, manifold, old));
     }
 }
 
 /// A flat shape (its outward unit normal `normal` through `origin`, its face id `face`) and a
-/// hull (its border radius, `inward` the flat shape's inward normal in the hull's frame) with
-/// the hull's pose `pos12` in the flat shape's frame; `flipped` when the hull is the manifold's
-/// first shape.
+/// hull's or box's `vertices` (`inward`: the flat shape's inward normal in their frame), their
+/// pose `pos12` in the flat shape's frame; `flipped` when the vertices' shape is the
+/// manifold's first.
 struct FlatSide<'a> {
     pos12: &'a Pose,
     normal: Vector,
     origin: Vector,
     face: PackedFeatureId,
     inward: Vector,
-    border: Real,
+    vertices: Vertices<'a>,
     flipped: bool,
 }
 
 impl FlatSide<'_> {
-    /// Adds hull vertex `vertex` of `points` as a point of `manifold` unless a point of it is
-    /// there already; whether it was added. The point takes the solver's data of `old`'s point
-    /// of the same features, if any; a manifold with no point yet takes the flat shape's
-    /// normal.
+    /// Adds vertex `vertex` as a point of `manifold` unless a point of it is there already;
+    /// whether it was added. The point takes the solver's data of `old`'s point of the same
+    /// features, if any; a manifold with no point yet takes the flat shape's normal.
     fn add_vertex<ManifoldData, ContactData: Default + Copy>(
         &self,
-        points: &[Vector],
         vertex: usize,
         manifold: &mut ContactManifold<ManifoldData, ContactData>,
         old: &[TrackedContact<ContactData>],
     ) -> bool {
         let (normal, inward, flipped) = (self.normal, self.inward, self.flipped);
-        let on_hull = points[vertex] + inward * self.border;
+        let (points, border) = (self.vertices.points, self.vertices.border);
+        let on_hull = points[vertex] + inward * border;
         let at = *self.pos12 * points[vertex];
-        let dist = (at - self.origin).dot(normal) - self.border;
-        let on_flat = at - normal * (dist + self.border);
-        let vertex_id = PackedFeatureId::vertex(vertex as u32);
+        let dist = (at - self.origin).dot(normal) - border;
+        let on_flat = at - normal * (dist + border);
+        let vertex_id = self.vertices.id(vertex);
         let same = SAME_POINT * SAME_POINT;
         let has_it = manifold.points.iter().any(|point| {
             let (fid, local) = if flipped {

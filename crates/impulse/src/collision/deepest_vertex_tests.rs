@@ -136,3 +136,49 @@ fn a_vertex_beside_a_triangle_is_not_its_point() {
     );
     assert!(ours < 2.0e-3 - 1e-4, "{ours}");
 }
+
+/// A card (a 63 × 88 mm box 2 mm thick) at 200 seeded orientations, its lowest corner 5 mm
+/// under a plane of two mesh triangles and its centre 1 cm from the edge between them, each
+/// shape first and second: the deepest point over the mesh's manifolds is the corner's depth,
+/// where Parry's own manifolds miss it at some orientations (its box–triangle generator turns
+/// the axis of least overlap, across the inner edge, into the face normal and drops the points
+/// then too deep: `add_deepest_box_corner`).
+#[test]
+fn the_deepest_corner_of_a_card_across_a_mesh_edge_is_a_point() {
+    use parry3d::shape::{Cuboid, TriMesh, TriMeshFlags};
+    let card = Cuboid::new(Vec3::new(0.0315, 0.001, 0.044));
+    let plane = TriMesh::with_flags(
+        vec![
+            Vec3::new(-10.0, 0.0, -10.0),
+            Vec3::new(10.0, 0.0, -10.0),
+            Vec3::new(10.0, 0.0, 10.0),
+            Vec3::new(-10.0, 0.0, 10.0),
+        ],
+        vec![[0, 2, 1], [0, 3, 2]],
+        TriMeshFlags::FIX_INTERNAL_EDGES,
+    )
+    .unwrap();
+    let depth = 5.0e-3;
+    let mut parry_missed = 0;
+    for rotation in rotations(200) {
+        let reach: f32 = (0..3)
+            .map(|k| (rotation * (Vec3::AXES[k] * card.half_extents[k])).y.abs())
+            .sum();
+        // The diagonal x = z is the inner edge.
+        let pose = Pose::from_parts(Vec3::new(0.007, reach - depth, -0.007), rotation);
+        for flipped in [false, true] {
+            let ours = manifold_depth(&ContactDispatcher, &plane, &card, &pose, flipped);
+            assert!(
+                (ours - depth).abs() < 1e-4,
+                "{rotation:?}, flipped {flipped}: deepest point {ours} m, lowest corner {depth} m"
+            );
+            let parry = manifold_depth(&DefaultQueryDispatcher, &plane, &card, &pose, flipped);
+            parry_missed += usize::from(parry < depth - 1e-4);
+        }
+    }
+    println!("Parry's manifolds missed the lowest corner in {parry_missed} of 400");
+    assert!(
+        parry_missed > 0,
+        "Parry's manifolds held every lowest corner"
+    );
+}

@@ -174,7 +174,13 @@ where
         match (g1.shape_type(), g2.shape_type()) {
             (ShapeType::TriMesh, _) | (_, ShapeType::TriMesh) => {
                 contact_manifolds_trimesh_shape_shapes(
-                    self, pos12, g1, g2, prediction, manifolds, workspace,
+                    &MeshTriangles(*self),
+                    pos12,
+                    g1,
+                    g2,
+                    prediction,
+                    manifolds,
+                    workspace,
                 );
             }
             (ShapeType::HeightField, _) => match (g1.as_heightfield(), composite2) {
@@ -358,6 +364,140 @@ where
                 manifold,
                 &old,
             );
+        }
+        Ok(())
+    }
+}
+
+/// [`ContactDispatcher`] for the triangles of a triangle mesh against a convex shape: the same
+/// manifolds, and a box's deepest corner where the manifold misses it
+/// ([`deepest_vertex::add_deepest_box_corner`]). Height fields' triangles keep
+/// [`ContactDispatcher`]'s manifolds as they are.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct MeshTriangles(ContactDispatcher);
+
+impl QueryDispatcher for MeshTriangles {
+    fn intersection_test(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+    ) -> Result<ShapeIntersection, Unsupported> {
+        self.0.intersection_test(pos12, g1, g2)
+    }
+
+    fn distance(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+    ) -> Result<ShapeDistance, Unsupported> {
+        self.0.distance(pos12, g1, g2)
+    }
+
+    fn contact(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        prediction: Real,
+    ) -> Result<Option<Contact>, Unsupported> {
+        self.0.contact(pos12, g1, g2, prediction)
+    }
+
+    fn closest_points(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        max_dist: Real,
+    ) -> Result<ClosestPoints, Unsupported> {
+        self.0.closest_points(pos12, g1, g2, max_dist)
+    }
+
+    fn cast_shapes(
+        &self,
+        pos12: &Pose,
+        local_vel12: Vector,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        options: ShapeCastOptions,
+    ) -> Result<Option<ShapeCastHit>, Unsupported> {
+        self.0.cast_shapes(pos12, local_vel12, g1, g2, options)
+    }
+
+    fn cast_shapes_nonlinear(
+        &self,
+        motion1: &NonlinearRigidMotion,
+        g1: &dyn Shape,
+        motion2: &NonlinearRigidMotion,
+        g2: &dyn Shape,
+        start_time: Real,
+        end_time: Real,
+        stop_at_penetration: bool,
+    ) -> Result<Option<ShapeCastHit>, Unsupported> {
+        self.0.cast_shapes_nonlinear(
+            motion1,
+            g1,
+            motion2,
+            g2,
+            start_time,
+            end_time,
+            stop_at_penetration,
+        )
+    }
+}
+
+impl<ManifoldData, ContactData> PersistentQueryDispatcher<ManifoldData, ContactData>
+    for MeshTriangles
+where
+    ManifoldData: Default + Clone + Send + Sync + AxisMemory,
+    ContactData: Default + Copy + Send + Sync,
+{
+    fn contact_manifolds(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        prediction: Real,
+        manifolds: &mut Vec<ContactManifold<ManifoldData, ContactData>>,
+        workspace: &mut Option<ContactManifoldsWorkspace>,
+    ) -> Result<(), Unsupported> {
+        self.0
+            .contact_manifolds(pos12, g1, g2, prediction, manifolds, workspace)
+    }
+
+    fn contact_manifold_convex_convex(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        normal_constraints1: Option<&dyn NormalConstraints>,
+        normal_constraints2: Option<&dyn NormalConstraints>,
+        prediction: Real,
+        manifold: &mut ContactManifold<ManifoldData, ContactData>,
+    ) -> Result<(), Unsupported> {
+        let box_and_triangle = matches!(
+            (g1.shape_type(), g2.shape_type()),
+            (ShapeType::Cuboid, ShapeType::Triangle) | (ShapeType::Triangle, ShapeType::Cuboid)
+        );
+        // Last step's points, for the solver's data of the corner's point.
+        let old = if box_and_triangle {
+            manifold.points.clone()
+        } else {
+            Vec::new()
+        };
+        self.0.contact_manifold_convex_convex(
+            pos12,
+            g1,
+            g2,
+            normal_constraints1,
+            normal_constraints2,
+            prediction,
+            manifold,
+        )?;
+        if box_and_triangle {
+            deepest_vertex::add_deepest_box_corner(pos12, g1, g2, prediction, manifold, &old);
         }
         Ok(())
     }

@@ -167,10 +167,22 @@ fn recycle_reach(
     reach.is_finite().then_some(reach)
 }
 
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy)]
 struct PairSummary {
     points: u32,
     max_depth: f32,
+    /// The smallest separation of the points (m); infinite without points.
+    min_separation: f32,
+}
+
+impl Default for PairSummary {
+    fn default() -> Self {
+        Self {
+            points: 0,
+            max_depth: 0.0,
+            min_separation: f32::INFINITY,
+        }
+    }
 }
 
 impl PairSummary {
@@ -180,6 +192,7 @@ impl PairSummary {
             summary.points += manifold.points.len() as u32;
             for point in &manifold.points {
                 summary.max_depth = summary.max_depth.max(-point.dist);
+                summary.min_separation = summary.min_separation.min(point.dist);
             }
         }
         summary
@@ -455,12 +468,16 @@ impl NarrowPhase {
         Ok(())
     }
 
-    /// Whether bodies `a` and `b` have contact points this step (speculative ones included).
-    pub fn has_points(&self, a: u32, b: u32) -> bool {
+    /// The smallest separation (m) of the contact points of bodies `a` and `b` this step
+    /// (speculative ones included); `None` when they have none.
+    pub(crate) fn min_separation(&self, a: u32, b: u32) -> Option<f32> {
         let key = (a.min(b), a.max(b));
         self.pairs
             .binary_search_by(|p| (p.body1, p.body2).cmp(&key))
-            .is_ok_and(|i| self.pairs[i].point_count() > 0)
+            .ok()
+            .map(|i| self.pairs[i].summary)
+            .filter(|summary| summary.points > 0)
+            .map(|summary| summary.min_separation)
     }
 
     /// Largest penetration depth (m) among current contact points, 0 if none overlap.

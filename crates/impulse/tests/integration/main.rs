@@ -7,6 +7,7 @@ mod api;
 mod auto_policy;
 mod blow_up;
 mod body_options;
+mod cards_on_meshes;
 mod ccd;
 mod common;
 mod concave;

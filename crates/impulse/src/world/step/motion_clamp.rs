@@ -5,6 +5,7 @@
 use crate::World;
 use crate::body::BodyKind;
 use crate::collision::continuous::{FastBody, Sweep, clamp_fraction};
+use crate::contact::SPECULATIVE_TURN;
 use crate::settings::SolverSettings;
 use parry3d::bounding_volume::BoundingVolume;
 use parry3d::math::Pose;
@@ -69,10 +70,15 @@ impl World {
             let (center_of_mass, spin) =
                 (b.local_center_of_mass[i], b.angular_velocity[i] * self.dt);
             let shape = &*b.shape[i];
-            let Some(body) = FastBody::moving_fast(shape, start, end, center_of_mass, spin) else {
+            let Some(mut body) = FastBody::moving_fast(shape, start, end, center_of_mass, spin)
+            else {
                 continue;
             };
             let sweep = body.sweep;
+            // Whether the solver released this body's speculative rows as stale (a ball's
+            // rows, whose lever arms lie along their normals, never are).
+            let released = sweep.turn.length() > SPECULATIVE_TURN && shape.as_ball().is_none();
+            body.released = released;
             let swept = shape.compute_swept_aabb(&sweep.start, &sweep.end);
             let mut earliest = 1.0f32;
             let mut visit = |j: usize| {
@@ -90,7 +96,15 @@ impl World {
                     b.local_center_of_mass[j],
                     b.angular_velocity[j] * self.dt,
                 );
-                let in_contact = self.narrow_phase.has_points(i as u32, j as u32);
+                // Held at its points: the core sphere stands for the body
+                // (`clamp_fraction_castable`). Points that all had a gap at assembly did not
+                // hold a body that then turned past `SPECULATIVE_TURN`: the solver released
+                // them as stale, and only its whole shape's sweep keeps it out (a card
+                // tumbling off its first corner's impact passed a plane to its centre).
+                let in_contact = self
+                    .narrow_phase
+                    .min_separation(i as u32, j as u32)
+                    .is_some_and(|s| s <= 0.0 || !released);
                 if let Some(t) = clamp_fraction(&body, &*b.shape[j], &target, in_contact) {
                     earliest = earliest.min(t);
                 }
