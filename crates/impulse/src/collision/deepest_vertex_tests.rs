@@ -167,7 +167,7 @@ fn the_deepest_corner_of_a_card_across_a_mesh_edge_is_a_point() {
         // The diagonal x = z is the inner edge.
         let pose = Pose::from_parts(Vec3::new(0.007, reach - depth, -0.007), rotation);
         for flipped in [false, true] {
-            let ours = manifold_depth(&ContactDispatcher, &plane, &card, &pose, flipped);
+            let ours = manifold_depth(&ContactDispatcher::default(), &plane, &card, &pose, flipped);
             assert!(
                 (ours - depth).abs() < 1e-4,
                 "{rotation:?}, flipped {flipped}: deepest point {ours} m, lowest corner {depth} m"
