@@ -12,6 +12,7 @@ use parry3d::query::{ContactManifoldsWorkspace, PersistentQueryDispatcher};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::concave_planes;
 use super::dispatch::ContactDispatcher;
 pub(crate) use super::manifold::{ContactImpulse, Manifold, manifold_poses};
 pub use super::margins::SpeculativeMargins;
@@ -385,6 +386,11 @@ impl NarrowPhase {
                     manifold.mark_shapes_deformed();
                 }
             }
+            let kept = concave_planes::kept_impulses(
+                bodies.shape[a].as_ref(),
+                bodies.shape[b].as_ref(),
+                &pair.manifolds,
+            );
             ContactDispatcher
                 .contact_manifolds(
                     &pos12,
@@ -395,10 +401,20 @@ impl NarrowPhase {
                     &mut pair.workspace,
                 )
                 .map_err(|_| UnsupportedShapePair(a, b))?;
+            let reach = margins.pair_reach(bodies, a, b);
+            concave_planes::add_plane_points(
+                &pos12,
+                bodies.pose[a].rotation,
+                bodies.shape[a].as_ref(),
+                bodies.shape[b].as_ref(),
+                &reach,
+                &kept,
+                &mut pair.manifolds,
+            );
             for manifold in &mut pair.manifolds {
                 drop_duplicate_points(manifold);
             }
-            margins.pair_reach(bodies, a, b).drop_unreachable(
+            reach.drop_unreachable(
                 &pos12,
                 bodies.pose[a].rotation,
                 bodies.shape[a].as_ref(),
