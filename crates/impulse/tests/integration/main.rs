@@ -10,6 +10,7 @@ mod body_options;
 mod ccd;
 mod common;
 mod concave;
+mod curved_meshes;
 mod dead_impacts;
 mod determinism;
 mod edge_passes;
