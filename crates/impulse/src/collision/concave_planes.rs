@@ -154,6 +154,8 @@ pub(crate) fn add_plane_points(
     let within = radius + travel + REACH_TOLERANCE;
     // (crossing time, manifold index, normal, separation) of the planes the motion crosses.
     let mut planes: Vec<(f32, usize, Vec3, f32)> = Vec::new();
+    // (manifold index, normal, separation) of Parry's points beside their triangles.
+    let mut faces: Vec<(usize, Vec3, f32)> = Vec::new();
     for (index, manifold) in manifolds.iter().enumerate() {
         let id = triangle_id(manifold, flipped);
         if id as usize >= mesh.num_triangles() {
@@ -185,14 +187,26 @@ pub(crate) fn add_plane_points(
         {
             return;
         }
-        if !manifold.points.is_empty() {
-            continue;
-        }
         let height = (centre - triangle.a).dot(normal);
         if height <= 0.0 {
             continue;
         }
         let separation = height - radius;
+        if !manifold.points.is_empty() {
+            // Parry's point beside the triangle, at its edge or corner, with the normal
+            // through the ball's centre: in a concave region the ball meets the face, never
+            // the edge, and that row, linearised along a normal tilted beyond the face's,
+            // would lift the ball off its facet before the facet is reached.
+            let parry_normal = if flipped {
+                manifold.local_n2
+            } else {
+                manifold.local_n1
+            };
+            if parry_normal.dot(normal) < SAME_PLANE_COS {
+                faces.push((index, normal, separation));
+            }
+            continue;
+        }
         let closing = motion.dot(normal);
         if separation + closing >= 0.0 {
             continue;
@@ -210,6 +224,13 @@ pub(crate) fn add_plane_points(
         if off <= (1.0 - at) * motion.length() + REACH_TOLERANCE {
             planes.push((at, index, normal, separation));
         }
+    }
+    for &(index, normal, separation) in &faces {
+        let manifold = &mut manifolds[index];
+        let data = manifold.points[0].data;
+        manifold.points.clear();
+        put_plane_point(manifold, &ball_pose, normal, separation, radius, flipped);
+        manifold.points[0].data = data;
     }
     if planes.is_empty() {
         return;
@@ -234,26 +255,43 @@ pub(crate) fn add_plane_points(
         normals.push(normal);
         let manifold = &mut manifolds[index];
         let id = triangle_id(manifold, flipped);
-        let on_plane = centre - (separation + radius) * normal;
-        let ball_normal = ball_pose.rotation.inverse() * -normal;
-        let mut point = TrackedContact::flipped(
-            on_plane,
-            ball_normal * radius,
-            PackedFeatureId::face(0),
-            PackedFeatureId::face(0),
-            separation,
-            flipped,
-        );
+        put_plane_point(manifold, &ball_pose, normal, separation, radius, flipped);
         if let Some((_, data)) = kept.iter().find(|(k, _)| *k == id) {
-            point.data = *data;
-        }
-        manifold.points.push(point);
-        if flipped {
-            manifold.local_n1 = ball_normal;
-            manifold.local_n2 = normal;
-        } else {
-            manifold.local_n1 = normal;
-            manifold.local_n2 = ball_normal;
+            manifold.points[0].data = *data;
         }
     }
 }
+
+/// Puts into the empty `manifold` the point of a ball of `radius` at `ball_pose` (in the
+/// mesh's frame) on the plane of normal `normal` at `separation`: the mesh's point the
+/// centre's foot on the plane, the ball's its surface along the normal.
+fn put_plane_point(
+    manifold: &mut Manifold,
+    ball_pose: &Pose,
+    normal: Vec3,
+    separation: f32,
+    radius: f32,
+    flipped: bool,
+) {
+    let on_plane = ball_pose.translation - (separation + radius) * normal;
+    let ball_normal = ball_pose.rotation.inverse() * -normal;
+    manifold.points.push(TrackedContact::flipped(
+        on_plane,
+        ball_normal * radius,
+        PackedFeatureId::face(0),
+        PackedFeatureId::face(0),
+        separation,
+        flipped,
+    ));
+    if flipped {
+        manifold.local_n1 = ball_normal;
+        manifold.local_n2 = normal;
+    } else {
+        manifold.local_n1 = normal;
+        manifold.local_n2 = ball_normal;
+    }
+}
+
+#[cfg(test)]
+#[path = "concave_planes_tests.rs"]
+mod tests;
