@@ -139,10 +139,7 @@ pub(crate) fn add_plane_points(
     // The ball's pose and step's displacement in the mesh's frame.
     let (ball_pose, motion) = if flipped {
         let rotation2 = rotation1 * pos12.rotation;
-        (
-            pos12.inverse(),
-            rotation2.inverse() * (-reach.displacement),
-        )
+        (pos12.inverse(), rotation2.inverse() * (-reach.displacement))
     } else {
         (*pos12, rotation1.inverse() * reach.displacement)
     };
@@ -229,7 +226,10 @@ pub(crate) fn add_plane_points(
         };
         let crossing = centre + at * motion;
         let foot = crossing - (crossing - triangle.a).dot(normal) * normal;
-        let off = triangle.project_local_point(foot, true).point.distance(foot);
+        let off = triangle
+            .project_local_point(foot, true)
+            .point
+            .distance(foot);
         if off <= (1.0 - at) * motion.length() + REACH_TOLERANCE {
             planes.push((at, index, normal, separation));
         }

@@ -29,6 +29,9 @@ fn folded(valley: bool) -> SharedShape {
     SharedShape::trimesh_with_flags(vertices, indices, TriMeshFlags::FIX_INTERNAL_EDGES).unwrap()
 }
 
+/// A point as listed: its normal (mesh frame) and separation (m).
+type Listed = (Vec3, f32);
+
 /// The left facet's outward normal.
 fn left_normal(valley: bool) -> Vec3 {
     let slope = if valley { FOLD } else { -FOLD };
@@ -38,7 +41,7 @@ fn left_normal(valley: bool) -> Vec3 {
 /// The normal (mesh frame) and separation of every point of a ball resting on the left facet
 /// 1 cm from the edge and moving 2 cm towards it in the step, before and after
 /// [`add_plane_points`], with the mesh as shape 1 or 2.
-fn points(valley: bool, mesh_first: bool) -> (Vec<(Vec3, f32)>, Vec<(Vec3, f32)>) {
+fn points(valley: bool, mesh_first: bool) -> (Vec<Listed>, Vec<Listed>) {
     let mesh = folded(valley);
     let ball = SharedShape::ball(RADIUS);
     let normal = left_normal(valley);
@@ -96,7 +99,7 @@ fn a_ball_rolling_into_a_valley_gets_the_next_facets_plane() {
     for mesh_first in [true, false] {
         let (before, after) = points(true, mesh_first);
         let right = Vec3::new(-FOLD.sin(), FOLD.cos(), 0.0);
-        let on_right = |points: &[(Vec3, f32)]| {
+        let on_right = |points: &[Listed]| {
             points
                 .iter()
                 .filter(|(n, _)| n.dot(right) > 1.0 - 1e-6)

@@ -206,9 +206,9 @@ fn failures(case: &Case, swing: &Swing) -> Vec<String> {
 fn run(case: &Case) -> Vec<String> {
     let swing = roll(case);
     let triangles = case.around * (2 * case.rings - 1);
-    let solver = case
-        .substeps
-        .map_or(case.preset.to_string(), |s| format!("soft step of {s} substeps"));
+    let solver = case.substeps.map_or(case.preset.to_string(), |s| {
+        format!("soft step of {s} substeps")
+    });
     eprintln!(
         "{}×{} ({triangles} triangles), {solver} at 1/{:.0} s, friction {}, azimuth {:.4}: \
          energy up {:.2} %, {:.1} % at the end, period {:.4} s ({:+.2} %), centre off by {:.3} mm",
