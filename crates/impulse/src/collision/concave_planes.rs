@@ -30,8 +30,9 @@
 //!
 //! Not where any edge of a triangle within the ball's reach is convex (a ridge beyond the
 //! valley could drop below the plane), not for a plane parallel to one the pair already has a
-//! point on (flat meshes keep their points unchanged), and only for meshes with Parry's normal
-//! constraints (`FIX_INTERNAL_EDGES`), whose edge pseudo-normals tell concave from convex.
+//! point on (flat meshes keep their points unchanged), and only for one-sided meshes with
+//! Parry's normal constraints (`FIX_INTERNAL_EDGES`), whose edge pseudo-normals tell concave
+//! from convex (a two-sided mesh's valley is a ridge from its back).
 
 use glam::{Quat, Vec3};
 use parry3d::math::Pose;
@@ -182,7 +183,12 @@ pub(crate) fn add_plane_points(
             continue;
         }
         // A triangle within reach: every edge must be concave or flat.
-        let Some(constraints) = mesh.triangle_normal_constraints(id) else {
+        // A two-sided mesh's valley seen from its back is a ridge: such meshes keep Parry's
+        // points.
+        let Some(constraints) = mesh
+            .triangle_normal_constraints(id)
+            .filter(|c| !c.two_sided)
+        else {
             return;
         };
         let normal = constraints.face;
