@@ -276,3 +276,93 @@ fn a_ball_rolling_in_a_faceted_bowl_sweep() {
     let failures: Vec<String> = cases.iter().flat_map(run).collect();
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// The kinetic energy a ball loses crossing `count` valleys of a static mesh, each turning
+/// the surface by `fold` rad (a strip along x, 2 m wide: 3 m at a 0.1 rad slope, then
+/// `count` facets of 0.3 m each `fold` less steep, then 3 m more), as a fraction of its
+/// kinetic energy before the first, less the same run's loss over a straight slope of the
+/// same length; released from rest 2 m up, friction `friction`, default settings.
+fn valley_loss(fold: f32, count: usize, friction: f32) -> f32 {
+    let run = |fold: f32| {
+        let mut profile = vec![Vec3::new(-3.0, 0.0, 0.0)];
+        let (mut slope, mut at) = (0.1f32, Vec3::new(-3.0, 0.0, 0.0));
+        for k in 0..=count {
+            let length = if k == 0 { 3.0 } else { 0.3 };
+            at += length * Vec3::new(slope.cos(), -slope.sin(), 0.0);
+            profile.push(at);
+            slope -= fold;
+        }
+        profile.push(at + 3.0 * Vec3::new(slope.cos(), -slope.sin(), 0.0));
+        let vertices = profile
+            .iter()
+            .flat_map(|q| [[q.x, q.y, -1.0], [q.x, q.y, 1.0]])
+            .collect();
+        let indices = (0..profile.len() as u32 - 1)
+            .flat_map(|i| [[2 * i, 2 * i + 1, 2 * i + 3], [2 * i, 2 * i + 3, 2 * i + 2]])
+            .collect();
+        let ground = BodyDesc::new(
+            BodyKind::Static,
+            ShapeDesc::trimesh(vertices, indices),
+            [0.0; 3],
+        );
+        let normal = Vec3::new(0.1f32.sin(), 0.1f32.cos(), 0.0);
+        let start = Vec3::new(-2.0, -0.1f32.tan(), 0.0) + normal * BALL;
+        let ball = BodyDesc::new(
+            BodyKind::Dynamic,
+            ShapeDesc::Sphere { radius: BALL },
+            start.to_array(),
+        );
+        let mut scene = Scene {
+            gravity: [0.0, -G, 0.0],
+            bodies: vec![ground, ball],
+            ..Scene::default()
+        };
+        scene.materials.insert(
+            "default".to_string(),
+            Material {
+                friction,
+                ..Material::default()
+            },
+        );
+        let mut world = World::from_scene(&scene).unwrap();
+        let mass = 1.0 / world.inverse_masses()[1];
+        let inertia = 0.4 * mass * BALL * BALL;
+        let kinetic = |w: &World| {
+            let (v, omega) = (w.linear_velocities()[1], w.angular_velocities()[1]);
+            0.5 * mass * v.length_squared() + 0.5 * inertia * omega.length_squared()
+        };
+        let energy = |w: &World| kinetic(w) + mass * G * w.poses()[1].translation.y;
+        let (mut before, mut kinetic_before) = (0.0, 0.0);
+        for _ in 0..400 {
+            world.step().unwrap();
+            let x = world.poses()[1].translation.x;
+            if x < -0.3 {
+                (before, kinetic_before) = (energy(&world), kinetic(&world));
+            }
+            if x > 0.3 * count as f32 + 0.5 {
+                break;
+            }
+        }
+        (before - energy(&world)) / kinetic_before
+    };
+    run(fold) - run(0.0)
+}
+
+/// What a valley costs a ball crossing it, against θ² of its kinetic energy (what an
+/// inelastic turn by θ costs a sliding body): docs/testing.md, "A ball rolling in a faceted
+/// bowl". Figures only.
+#[test]
+#[ignore = "figures for docs/testing.md"]
+fn what_a_valley_costs_a_ball() {
+    for friction in [0.5, 0.0] {
+        for (fold, count) in [(0.0125, 1), (0.0125, 8), (0.05, 4)] {
+            let loss = valley_loss(fold, count, friction);
+            eprintln!(
+                "friction {friction}, {count} valleys of {fold} rad: {:.2e} of the kinetic \
+                 energy, {:.2} θ² a valley",
+                loss,
+                loss / count as f32 / (fold * fold)
+            );
+        }
+    }
+}
