@@ -7,6 +7,7 @@
 pub(crate) mod axis_memory;
 pub(crate) mod broad_phase;
 pub(crate) mod caps;
+pub(crate) mod concave_planes;
 pub(crate) mod continuous;
 pub(crate) mod crowding;
 pub(crate) mod deepest_vertex;

@@ -12,6 +12,7 @@ use parry3d::query::{ContactManifoldsWorkspace, PersistentQueryDispatcher};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::concave_planes;
 use super::dispatch::ContactDispatcher;
 pub(crate) use super::manifold::{ContactImpulse, Manifold, manifold_poses};
 pub use super::margins::SpeculativeMargins;
@@ -398,6 +399,11 @@ impl NarrowPhase {
                     manifold.mark_shapes_deformed();
                 }
             }
+            let kept = concave_planes::kept_impulses(
+                bodies.shape[a].as_ref(),
+                bodies.shape[b].as_ref(),
+                &pair.manifolds,
+            );
             let reach = margins.pair_reach(bodies, a, b);
             ContactDispatcher::turning(reach.turn_reach)
                 .contact_manifolds(
@@ -409,6 +415,15 @@ impl NarrowPhase {
                     &mut pair.workspace,
                 )
                 .map_err(|_| UnsupportedShapePair(a, b))?;
+            concave_planes::add_plane_points(
+                &pos12,
+                bodies.pose[a].rotation,
+                bodies.shape[a].as_ref(),
+                bodies.shape[b].as_ref(),
+                &reach,
+                &kept,
+                &mut pair.manifolds,
+            );
             for manifold in &mut pair.manifolds {
                 drop_duplicate_points(manifold);
             }

@@ -11,6 +11,7 @@ mod cards_on_meshes;
 mod ccd;
 mod common;
 mod concave;
+mod curved_meshes;
 mod dead_impacts;
 mod determinism;
 mod edge_passes;
