@@ -61,7 +61,7 @@ fn points(valley: bool, mesh_first: bool) -> (Vec<Listed>, Vec<Listed>) {
     };
     let mut manifolds: Vec<Manifold> = Vec::new();
     let mut workspace = None;
-    ContactDispatcher
+    ContactDispatcher::default()
         .contact_manifolds(
             &pos12,
             shape1.as_ref(),
