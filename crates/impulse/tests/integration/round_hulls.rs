@@ -144,10 +144,6 @@ fn run(seed: u64, points: &[[f32; 3]], ground: &BodyDesc, drop: f32) -> Outcome 
 /// Every ground of [`super::hulls::grounds`]: the half-space, the box, the height field and
 /// the two triangle meshes.
 const GROUNDS: &[usize] = &[0, 1, 2, 3, 4];
-/// The grounds whose long sweep passes: the half-space, the box and the height field.
-const FLAT: &[usize] = &[0, 1, 2];
-/// The two triangle meshes, where the long sweep still finds hulls 2-3.4 mm deep.
-const MESHES: &[usize] = &[3, 4];
 
 /// Runs the hulls of `seeds` on the grounds `grounds` (indices into
 /// [`super::hulls::grounds`]), set down and dropped; returns the failures and prints each
@@ -186,20 +182,10 @@ fn round_hulls_rest_on_their_lowest_vertex() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// The long sweep: docs/testing.md, "Round hulls on every ground".
+/// The long sweep on every ground: docs/testing.md, "Round hulls on every ground".
 #[test]
 #[ignore = "the long sweep, docs/testing.md"]
 fn round_hulls_rest_on_their_lowest_vertex_long_sweep() {
-    let failures = sweep(6..106, FLAT);
-    assert!(failures.is_empty(), "{failures:#?}");
-}
-
-/// The long sweep on the two triangle meshes: seeds 17 and 47 (clouds of 44 and 74 points)
-/// settle 2.0 and 3.4 mm deep in the 800-triangle mesh (docs/testing.md, "Round hulls on
-/// every ground").
-#[test]
-#[ignore = "fails on seeds 17 and 47: docs/testing.md, \"Round hulls on every ground\""]
-fn round_hulls_rest_on_their_lowest_vertex_long_sweep_on_meshes() {
-    let failures = sweep(6..106, MESHES);
+    let failures = sweep(6..106, GROUNDS);
     assert!(failures.is_empty(), "{failures:#?}");
 }
