@@ -29,7 +29,6 @@ use parry3d::query::{NonlinearRigidMotion, cast_shapes_nonlinear, contact, dista
 use parry3d::shape::{Ball, Compound, Cuboid, HalfSpace, HeightField, Shape, Triangle};
 
 use crate::body::motion::rotation_vector;
-use crate::contact::SPECULATIVE_TURN;
 
 /// A body is swept when it moved more than this fraction of its smallest half extent in a
 /// step (Box2D v3's safety factor: a slower body cannot pass through anything the contacts
@@ -174,9 +173,10 @@ pub(crate) struct FastBody<'a> {
     pub(crate) travel: f32,
     /// The farthest any of its points lies from its centre of mass (m).
     pub(crate) radius: f32,
-    /// Whether the solver released its speculative rows as stale this step: it turned past
-    /// [`SPECULATIVE_TURN`] and is not a ball (set by the continuous stage; false here).
-    pub(crate) released: bool,
+    /// When the solver released its speculative rows as stale this step (it turned past the
+    /// solver's limit, `contact::SPECULATIVE_TURN`, and is not a ball), that limit (rad): the
+    /// turn up to which its rows held it. Set by the continuous stage; `None` here.
+    pub(crate) released: Option<f32>,
 }
 
 impl<'a> FastBody<'a> {
@@ -214,7 +214,7 @@ impl<'a> FastBody<'a> {
             min_half_extent,
             travel,
             radius,
-            released: false,
+            released: None,
         })
     }
 }
@@ -407,10 +407,12 @@ pub(crate) fn clamp_fraction_castable(
     let core = core_spheres(body, &mut |core, center| {
         clamp_core(body, core, center, target_sweep, target)
     });
-    if body.released && driven_in(body, target, target_sweep) {
-        // Its rows held it while it turned by less than `SPECULATIVE_TURN`: it is put back
-        // to where it had turned that far, and the next step's contacts, taken there, go on.
-        let held = SPECULATIVE_TURN / body.sweep.turn.length();
+    if let Some(limit) = body.released
+        && driven_in(body, target, target_sweep)
+    {
+        // Its rows held it while it turned by less than the limit: it is put back to where it
+        // had turned that far, and the next step's contacts, taken there, go on.
+        let held = limit / body.sweep.turn.length();
         return Some(core.map_or(held, |t| t.min(held)));
     }
     core
@@ -418,7 +420,7 @@ pub(crate) fn clamp_fraction_castable(
 
 /// Whether `body` ends the step inside `target` (moving along `target_sweep`) deeper than it
 /// started by more than its smallest half extent: deeper than contacts that hold a body ever
-/// let it sink. A thin body held at one corner and turning past [`SPECULATIVE_TURN`] swings
+/// let it sink. A thin body held at one corner and turning past the solver's limit swings
 /// its other corners through the surface while its core sphere, at its centre, stays out (a
 /// card spinning at 120 rad/s off its first corner's impact ended with its centre on a plane
 /// and corners 34 mm under it).

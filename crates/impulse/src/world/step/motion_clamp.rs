@@ -78,7 +78,7 @@ impl World {
             // Whether the solver released this body's speculative rows as stale (a ball's
             // rows, whose lever arms lie along their normals, never are).
             let released = sweep.turn.length() > SPECULATIVE_TURN && shape.as_ball().is_none();
-            body.released = released;
+            body.released = released.then_some(SPECULATIVE_TURN);
             let swept = shape.compute_swept_aabb(&sweep.start, &sweep.end);
             let mut earliest = 1.0f32;
             let mut visit = |j: usize| {
