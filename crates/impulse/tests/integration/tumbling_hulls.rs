@@ -42,7 +42,7 @@ fn pin() -> Vec<Vec3> {
 /// spinning at up to 10 rad/s about each axis; the default material) onto
 /// `ground` at step `dt` for [`DURATION`]; the largest depth (m) of its lowest vertex.
 fn deepest(seed: u64, ground: &BodyDesc, dt: f32) -> f32 {
-    let mut rng = Rng(seed ^ 0x5eed_0fb0_71);
+    let mut rng = Rng(seed ^ 0x005e_ed0f_b071);
     let orientation = Quat::from_euler(
         glam::EulerRot::YXZ,
         rng.range(0.0, std::f32::consts::TAU),
