@@ -147,6 +147,25 @@ impl Rng {
     pub(crate) fn integer(&mut self, lo: usize, hi: usize) -> usize {
         lo + (self.next() % (hi - lo + 1) as u64) as usize
     }
+
+    /// A random orientation: yaw, pitch and roll (Euler angles Y, X, Z) each uniform in
+    /// [0, 2π), drawn in that order.
+    pub(crate) fn orientation(&mut self) -> glam::Quat {
+        glam::Quat::from_euler(
+            glam::EulerRot::YXZ,
+            self.range(0.0, std::f32::consts::TAU),
+            self.range(0.0, std::f32::consts::TAU),
+            self.range(0.0, std::f32::consts::TAU),
+        )
+    }
+}
+
+/// The lowest height (y, m) of `points` (in a body's frame) at `pose`.
+pub(crate) fn lowest_height(points: &[Vec3], pose: &impulse::parry3d::math::Pose) -> f32 {
+    points
+        .iter()
+        .map(|p| pose.transform_point(*p).y)
+        .fold(f32::INFINITY, f32::min)
 }
 
 /// Whether the segment a–b passes through the box of half extents `extents` centred on the

@@ -15,7 +15,7 @@ use impulse::parry3d::transformation::convex_hull;
 use impulse::scene::{BodyDesc, BodyKind, Scene, ShapeDesc};
 use impulse::{SolverSettings, World};
 
-use super::common::Rng;
+use super::common::{Rng, lowest_height};
 
 /// Height (m) above its resting pose from which a hull is dropped.
 const DROP: f32 = 0.05;
@@ -290,10 +290,7 @@ fn run(hull: &Hull, ground: &BodyDesc, drop: f32) -> Outcome {
     for step in 0..steps {
         world.step().unwrap();
         let pose = world.poses()[1];
-        let low = points
-            .iter()
-            .map(|p| pose.transform_point(*p).y)
-            .fold(f32::INFINITY, f32::min);
+        let low = lowest_height(&points, &pose);
         let depth = (hull.border - low).max(0.0);
         outcome.deepest = outcome.deepest.max(depth);
         if step >= settled_from {

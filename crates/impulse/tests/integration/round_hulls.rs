@@ -7,11 +7,11 @@
 //! and the summary's overlap ([`impulse::metrics::max_overlap`]) the pose's depth within
 //! 0.1 mm. The sweep and its figures: docs/testing.md, "Round hulls on every ground".
 
-use impulse::glam::{Quat, Vec3};
+use impulse::glam::Vec3;
 use impulse::scene::{BodyDesc, BodyKind, Scene, ShapeDesc};
 use impulse::{SolverSettings, World};
 
-use super::common::Rng;
+use super::common::{Rng, lowest_height};
 
 /// Height (m) above touching from which a hull is dropped.
 const DROP: f32 = 0.05;
@@ -93,12 +93,7 @@ struct Outcome {
 /// from `seed`), set down touching (`drop` 0) or `drop` above.
 fn run(seed: u64, points: &[[f32; 3]], ground: &BodyDesc, drop: f32) -> Outcome {
     let mut rng = Rng(seed ^ 0x0707);
-    let orientation = Quat::from_euler(
-        glam::EulerRot::YXZ,
-        rng.range(0.0, std::f32::consts::TAU),
-        rng.range(0.0, std::f32::consts::TAU),
-        rng.range(0.0, std::f32::consts::TAU),
-    );
+    let orientation = rng.orientation();
     let points: Vec<Vec3> = points.iter().map(|p| Vec3::from_array(*p)).collect();
     let lowest = points
         .iter()
@@ -126,10 +121,7 @@ fn run(seed: u64, points: &[[f32; 3]], ground: &BodyDesc, drop: f32) -> Outcome 
     for step in 0..steps {
         world.step().unwrap();
         let pose = world.poses()[1];
-        let low = points
-            .iter()
-            .map(|p| pose.transform_point(*p).y)
-            .fold(f32::INFINITY, f32::min);
+        let low = lowest_height(&points, &pose);
         let depth = (-low).max(0.0);
         outcome.deepest = outcome.deepest.max(depth);
         if step >= settled_from {

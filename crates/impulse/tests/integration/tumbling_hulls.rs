@@ -6,11 +6,11 @@
 //! "Contacts"). Target (issue: falling pins at 24 and 60 fps): no vertex more than 5 mm into
 //! the ground at any step. Figures: docs/testing.md, "Tumbling hulls".
 
-use impulse::glam::{Quat, Vec3};
+use impulse::glam::Vec3;
 use impulse::scene::{BodyDesc, BodyKind, Scene, ShapeDesc};
 use impulse::{SolverSettings, World};
 
-use super::common::Rng;
+use super::common::{Rng, lowest_height};
 
 /// Largest depth (m) of a pin's lowest vertex at any step.
 const DEPTH: f32 = 5.0e-3;
@@ -43,12 +43,7 @@ fn pin() -> Vec<Vec3> {
 /// `ground` at step `dt` for [`DURATION`]; the largest depth (m) of its lowest vertex.
 fn deepest(seed: u64, ground: &BodyDesc, dt: f32) -> f32 {
     let mut rng = Rng(seed ^ 0x005e_ed0f_b071);
-    let orientation = Quat::from_euler(
-        glam::EulerRot::YXZ,
-        rng.range(0.0, std::f32::consts::TAU),
-        rng.range(0.0, std::f32::consts::TAU),
-        rng.range(0.0, std::f32::consts::TAU),
-    );
+    let orientation = rng.orientation();
     let points = pin();
     let lowest = points
         .iter()
@@ -78,10 +73,7 @@ fn deepest(seed: u64, ground: &BodyDesc, dt: f32) -> f32 {
     for _ in 0..(DURATION / dt).round() as usize {
         world.step().unwrap();
         let pose = world.poses()[1];
-        let low = points
-            .iter()
-            .map(|p| pose.transform_point(*p).y)
-            .fold(f32::INFINITY, f32::min);
+        let low = lowest_height(&points, &pose);
         deepest = deepest.max(-low);
     }
     deepest
