@@ -63,13 +63,21 @@ pub(crate) struct ContactDispatcher {
     /// its lowest within the step get points against a flat shape
     /// ([`deepest_vertex::add_deepest_vertex`]). 0 (the default) for none.
     pub(crate) turn_reach: Real,
+    /// Whether the convex pairs are a triangle mesh's triangles against a convex shape (set
+    /// where a triangle mesh's pairs are dispatched): a box then also gets its deepest corner
+    /// where the manifold misses it ([`deepest_vertex::add_deepest_box_corner`]). Height
+    /// fields' triangles keep the manifolds as they are.
+    mesh_triangles: bool,
 }
 
 impl ContactDispatcher {
     /// The dispatcher for a pair whose rotation can carry a point `turn_reach` metres in the
     /// step.
     pub(crate) fn turning(turn_reach: Real) -> Self {
-        Self { turn_reach }
+        Self {
+            turn_reach,
+            mesh_triangles: false,
+        }
     }
 }
 
@@ -163,18 +171,26 @@ where
         manifolds: &mut Vec<ContactManifold<ManifoldData, ContactData>>,
         workspace: &mut Option<ContactManifoldsWorkspace>,
     ) -> Result<(), Unsupported> {
+        // The mesh triangles' flag belongs to the triangles' convex pairs alone.
+        let this = &Self {
+            mesh_triangles: false,
+            ..*self
+        };
         let composite1 = g1.as_composite_shape();
         let composite2 = g2.as_composite_shape();
         if let (Some(composite1), Some(composite2)) = (composite1, composite2) {
             contact_manifolds_composite_shape_composite_shape(
-                self, pos12, composite1, composite2, prediction, manifolds, workspace,
+                this, pos12, composite1, composite2, prediction, manifolds, workspace,
             );
             return Ok(());
         }
         match (g1.shape_type(), g2.shape_type()) {
             (ShapeType::TriMesh, _) | (_, ShapeType::TriMesh) => {
                 contact_manifolds_trimesh_shape_shapes(
-                    &MeshTriangles(*self),
+                    &Self {
+                        mesh_triangles: true,
+                        ..*this
+                    },
                     pos12,
                     g1,
                     g2,
@@ -186,7 +202,7 @@ where
             (ShapeType::HeightField, _) => match (g1.as_heightfield(), composite2) {
                 (Some(heightfield1), Some(composite2)) => {
                     contact_manifolds_heightfield_composite_shape(
-                        self,
+                        this,
                         pos12,
                         &pos12.inverse(),
                         heightfield1,
@@ -198,13 +214,13 @@ where
                     )
                 }
                 _ => contact_manifolds_heightfield_shape_shapes(
-                    self, pos12, g1, g2, prediction, manifolds, workspace,
+                    this, pos12, g1, g2, prediction, manifolds, workspace,
                 ),
             },
             (_, ShapeType::HeightField) => match (g2.as_heightfield(), composite1) {
                 (Some(heightfield2), Some(composite1)) => {
                     contact_manifolds_heightfield_composite_shape(
-                        self,
+                        this,
                         &pos12.inverse(),
                         pos12,
                         heightfield2,
@@ -216,7 +232,7 @@ where
                     )
                 }
                 _ => contact_manifolds_heightfield_shape_shapes(
-                    self, pos12, g1, g2, prediction, manifolds, workspace,
+                    this, pos12, g1, g2, prediction, manifolds, workspace,
                 ),
             },
             (ShapeType::Voxels, _) | (_, ShapeType::Voxels) => {
@@ -226,11 +242,11 @@ where
             _ => {
                 if let Some(composite1) = composite1 {
                     contact_manifolds_composite_shape_shape(
-                        self, pos12, composite1, g2, prediction, manifolds, workspace, false,
+                        this, pos12, composite1, g2, prediction, manifolds, workspace, false,
                     );
                 } else if let Some(composite2) = composite2 {
                     contact_manifolds_composite_shape_shape(
-                        self,
+                        this,
                         &pos12.inverse(),
                         composite2,
                         g1,
@@ -243,7 +259,7 @@ where
                     if manifolds.is_empty() {
                         manifolds.push(ContactManifold::new());
                     }
-                    return self.contact_manifold_convex_convex(
+                    return this.contact_manifold_convex_convex(
                         pos12,
                         g1,
                         g2,
@@ -268,6 +284,51 @@ where
         prediction: Real,
         manifold: &mut ContactManifold<ManifoldData, ContactData>,
     ) -> Result<(), Unsupported> {
+        let box_corner = self.mesh_triangles
+            && matches!(
+                (g1.shape_type(), g2.shape_type()),
+                (ShapeType::Cuboid, ShapeType::Triangle) | (ShapeType::Triangle, ShapeType::Cuboid)
+            );
+        // Last step's points, for the solver's data of the corner's point.
+        let old = if box_corner {
+            manifold.points.clone()
+        } else {
+            Vec::new()
+        };
+        self.convex_convex(
+            pos12,
+            g1,
+            g2,
+            (normal_constraints1, normal_constraints2),
+            prediction,
+            manifold,
+        )?;
+        if box_corner {
+            deepest_vertex::add_deepest_box_corner(pos12, g1, g2, prediction, manifold, &old);
+        }
+        Ok(())
+    }
+}
+
+impl ContactDispatcher {
+    /// [`PersistentQueryDispatcher::contact_manifold_convex_convex`] but a mesh triangle's box
+    /// corner: Parry's manifold, refined for caps, hulls and rounded shapes.
+    fn convex_convex<ManifoldData, ContactData>(
+        &self,
+        pos12: &Pose,
+        g1: &dyn Shape,
+        g2: &dyn Shape,
+        (normal_constraints1, normal_constraints2): (
+            Option<&dyn NormalConstraints>,
+            Option<&dyn NormalConstraints>,
+        ),
+        prediction: Real,
+        manifold: &mut ContactManifold<ManifoldData, ContactData>,
+    ) -> Result<(), Unsupported>
+    where
+        ManifoldData: Default + Clone + Send + Sync + AxisMemory,
+        ContactData: Default + Copy + Send + Sync,
+    {
         // Pairs this dispatcher treats as Parry does (boxes, capsules, hulls, triangles, balls
         // on anything not rounded: most pairs of most scenes) go straight to Parry's, decided
         // from the two shape types alone.
@@ -364,140 +425,6 @@ where
                 manifold,
                 &old,
             );
-        }
-        Ok(())
-    }
-}
-
-/// [`ContactDispatcher`] for the triangles of a triangle mesh against a convex shape: the same
-/// manifolds, and a box's deepest corner where the manifold misses it
-/// ([`deepest_vertex::add_deepest_box_corner`]). Height fields' triangles keep
-/// [`ContactDispatcher`]'s manifolds as they are.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct MeshTriangles(ContactDispatcher);
-
-impl QueryDispatcher for MeshTriangles {
-    fn intersection_test(
-        &self,
-        pos12: &Pose,
-        g1: &dyn Shape,
-        g2: &dyn Shape,
-    ) -> Result<ShapeIntersection, Unsupported> {
-        self.0.intersection_test(pos12, g1, g2)
-    }
-
-    fn distance(
-        &self,
-        pos12: &Pose,
-        g1: &dyn Shape,
-        g2: &dyn Shape,
-    ) -> Result<ShapeDistance, Unsupported> {
-        self.0.distance(pos12, g1, g2)
-    }
-
-    fn contact(
-        &self,
-        pos12: &Pose,
-        g1: &dyn Shape,
-        g2: &dyn Shape,
-        prediction: Real,
-    ) -> Result<Option<Contact>, Unsupported> {
-        self.0.contact(pos12, g1, g2, prediction)
-    }
-
-    fn closest_points(
-        &self,
-        pos12: &Pose,
-        g1: &dyn Shape,
-        g2: &dyn Shape,
-        max_dist: Real,
-    ) -> Result<ClosestPoints, Unsupported> {
-        self.0.closest_points(pos12, g1, g2, max_dist)
-    }
-
-    fn cast_shapes(
-        &self,
-        pos12: &Pose,
-        local_vel12: Vector,
-        g1: &dyn Shape,
-        g2: &dyn Shape,
-        options: ShapeCastOptions,
-    ) -> Result<Option<ShapeCastHit>, Unsupported> {
-        self.0.cast_shapes(pos12, local_vel12, g1, g2, options)
-    }
-
-    fn cast_shapes_nonlinear(
-        &self,
-        motion1: &NonlinearRigidMotion,
-        g1: &dyn Shape,
-        motion2: &NonlinearRigidMotion,
-        g2: &dyn Shape,
-        start_time: Real,
-        end_time: Real,
-        stop_at_penetration: bool,
-    ) -> Result<Option<ShapeCastHit>, Unsupported> {
-        self.0.cast_shapes_nonlinear(
-            motion1,
-            g1,
-            motion2,
-            g2,
-            start_time,
-            end_time,
-            stop_at_penetration,
-        )
-    }
-}
-
-impl<ManifoldData, ContactData> PersistentQueryDispatcher<ManifoldData, ContactData>
-    for MeshTriangles
-where
-    ManifoldData: Default + Clone + Send + Sync + AxisMemory,
-    ContactData: Default + Copy + Send + Sync,
-{
-    fn contact_manifolds(
-        &self,
-        pos12: &Pose,
-        g1: &dyn Shape,
-        g2: &dyn Shape,
-        prediction: Real,
-        manifolds: &mut Vec<ContactManifold<ManifoldData, ContactData>>,
-        workspace: &mut Option<ContactManifoldsWorkspace>,
-    ) -> Result<(), Unsupported> {
-        self.0
-            .contact_manifolds(pos12, g1, g2, prediction, manifolds, workspace)
-    }
-
-    fn contact_manifold_convex_convex(
-        &self,
-        pos12: &Pose,
-        g1: &dyn Shape,
-        g2: &dyn Shape,
-        normal_constraints1: Option<&dyn NormalConstraints>,
-        normal_constraints2: Option<&dyn NormalConstraints>,
-        prediction: Real,
-        manifold: &mut ContactManifold<ManifoldData, ContactData>,
-    ) -> Result<(), Unsupported> {
-        let box_and_triangle = matches!(
-            (g1.shape_type(), g2.shape_type()),
-            (ShapeType::Cuboid, ShapeType::Triangle) | (ShapeType::Triangle, ShapeType::Cuboid)
-        );
-        // Last step's points, for the solver's data of the corner's point.
-        let old = if box_and_triangle {
-            manifold.points.clone()
-        } else {
-            Vec::new()
-        };
-        self.0.contact_manifold_convex_convex(
-            pos12,
-            g1,
-            g2,
-            normal_constraints1,
-            normal_constraints2,
-            prediction,
-            manifold,
-        )?;
-        if box_and_triangle {
-            deepest_vertex::add_deepest_box_corner(pos12, g1, g2, prediction, manifold, &old);
         }
         Ok(())
     }
