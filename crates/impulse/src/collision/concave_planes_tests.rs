@@ -57,6 +57,7 @@ fn points(valley: bool, mesh_first: bool) -> (Vec<Listed>, Vec<Listed>) {
     let reach = SweptReach {
         displacement,
         turn_reach: 0.0,
+        turn_bound: 0.0,
         horizon: 1.05,
     };
     let mut manifolds: Vec<Manifold> = Vec::new();

@@ -1,43 +1,56 @@
-//! The deepest vertex of a convex hull against a flat surface (a half-space, or a triangle of a
-//! mesh or height field seen face-on): added to the pair's manifold where the manifold's points
-//! miss it.
+//! The deepest vertex of a convex hull against a flat surface (a half-space, a triangle of a
+//! mesh or height field, or a box's face, seen face-on): added to the pair's manifold where
+//! the manifold's points miss it.
 //!
 //! Parry builds a polyhedron's manifold against a half-space from the polyhedron's support
 //! face (`local_support_feature`: the face whose outward normal is nearest the half-space's
-//! inward normal, its first four vertices), and against a triangle by clipping such support
-//! features. The support face need not hold the support vertex: on a round hull (a UV sphere,
-//! a dense point cloud) many small faces meet at each vertex, and the face whose normal is
-//! nearest the surface's can lie beside the lowest vertex, which then gets no point. A 32×16 UV
-//! sphere rested on a half-space with its pole 9.6 mm under the surface (held up by the points
-//! of a face of its first ring), and a 24-point cloud landed 19 mm deep.
+//! inward normal, its first four vertices), and against a triangle or a box by clipping such
+//! support features. The support face need not hold the support vertex: on a round hull (a UV
+//! sphere, a dense point cloud) many small faces meet at each vertex, and the face whose
+//! normal is nearest the surface's can lie beside the lowest vertex, which then gets no point.
+//! A 32×16 UV sphere rested on a half-space with its pole 9.6 mm under the surface (held up by
+//! the points of a face of its first ring), and a 24-point cloud landed 19 mm deep.
 //!
-//! Here the hull's support vertex along the manifold's normal (the deepest vertex, a scan of the
-//! hull's vertices) becomes a point of its own when it is deeper than every point of the
-//! manifold by more than [`DEPTH_TIE`] and within the prediction: against a half-space always,
-//! against a triangle when the vertex lies over the triangle (a vertex beside it is another
-//! triangle's) and the manifold's normal is within 45° of the triangle's face normal
-//! ([`TILTED`]). A normal off the face normal by more than [`FACE_ON`] (taken from a face of
-//! the hull by Parry's clipping, as a round hull rolls from one facet to the next) is then
-//! replaced by the face normal, the manifold's points re-expressed along it: the hull rests on
-//! the triangle's plane.
+//! Here the hull's support vertex along the flat shape's inward normal (the deepest vertex, a
+//! scan of the hull's vertices) becomes a point of its own when it is deeper than every point
+//! of the manifold by more than [`DEPTH_TIE`] and within the prediction: against a half-space
+//! always; against a triangle or a box's face when the vertex lies over the face (a vertex
+//! beside it is another face's) and the manifold's normal is within 45° of the face normal
+//! ([`TILTED`]; a box's face is the one whose normal is nearest the manifold's). A normal off
+//! the face normal by more than [`FACE_ON`] (taken from a face of the hull by Parry's
+//! clipping, as a round hull rolls from one facet to the next) is then replaced by the face
+//! normal, the manifold's points re-expressed along it: the hull rests on the face's plane. A
+//! triangle whose manifold Parry left empty (its normal constraints reject the normal of a
+//! hull lying across the edge to the next triangle) is taken along its face normal.
 //! The point is named by the vertex and the flat shape's face, so its impulse carries over from
 //! step to step while it stays the deepest.
 //!
 //! A hull that turns gets more: the lowest vertex at the step's start need not be the lowest
 //! during the step. A bowling pin tumbling onto a lane at 60 Hz sank 19 mm, at 24 Hz 112 mm,
 //! on the vertices that rotation brought down within a step, which had no point. Rotation
-//! carries any point of the pair at most `turn_reach` in the step
-//! ([`super::margins::SweptReach::turn_reach`]), so two vertices' heights change relative to
-//! each other by at most twice that: every vertex within the prediction and within
-//! 2 · `turn_reach` of the deepest vertex's height may become the lowest, and gets a
-//! speculative point of its own (the deepest [`TURNING_VERTICES`] of them, on a triangle those
-//! over it). A hull that does not turn gets none.
+//! carries any point of the pair at most [`Turning::reach`] in the step, so every vertex
+//! within the prediction and within twice that of the deepest vertex's height may become the
+//! lowest. Of those, a vertex gets a speculative point of its own (nearest the surface first,
+//! at most [`TURNING_VERTICES`], on a triangle or a box's face those over it) unless a held
+//! point (the manifold's, or a vertex added before it) keeps it up: two points' heights
+//! change relative to each other by at most the rotation angle times their distance, and
+//! the angle is bounded by [`Turning::bound`] (the spin the pair's kinetic energy allows once
+//! contacts have turned it into rotation: a pin landing on one end swings its other end down
+//! faster than it turned before) over half the hull's span; a vertex no rotation within that
+//! bound brings more than [`TURNING_DIP`] below a held point gets none. A face resting flat
+//! (a decomposed mug's base, whose parts have vertices a millimetre above it) keeps its few
+//! points; a hull that does not turn gets none.
 
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::query::{ContactManifold, TrackedContact};
 use parry3d::shape::{PackedFeatureId, Shape, TypedShape};
 
 use super::faces::hull_parts;
+
+/// Depth (m) a turning vertex may reach below a held point within the step without a point of
+/// its own: a quarter of the round hulls' 1 mm resting bar (at 0.5 mm a 64×32 UV sphere's
+/// summary overlap read 0.1 mm off its lowest vertex on a mesh).
+const TURNING_DIP: Real = 2.5e-4;
 
 /// Depth (m) by which the deepest vertex must be deeper than every point of the manifold to be
 /// added: a vertex at a point's depth is held as well as that point holds it.
@@ -62,6 +75,17 @@ const SAME_POINT: Real = 1.0e-5;
 /// surface are the ones its rotation brings down first.
 const TURNING_VERTICES: usize = 32;
 
+/// How far (m) the step's rotation carries a pair's points ([`super::margins::SweptReach`]).
+/// Both 0 (the default) for a pair that does not turn.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Turning {
+    /// At the spins the step starts with ([`super::margins::SweptReach::turn_reach`]).
+    pub(crate) reach: Real,
+    /// At the most the pair's kinetic energy allows once contacts have turned it into spin
+    /// ([`super::margins::SweptReach::turn_bound`]); no less than `reach`.
+    pub(crate) bound: Real,
+}
+
 /// Adds the deepest vertex of a convex hull (`g1` or `g2`, rounded or not) against a half-space
 /// or a face-on triangle (the other shape) to `manifold` (of `g1` and `g2`, `g2`'s pose in
 /// `g1`'s frame being `pos12`) when the manifold misses it, as the module's documentation says;
@@ -71,11 +95,11 @@ pub(crate) fn add_deepest_vertex<ManifoldData, ContactData: Default + Copy>(
     pos12: &Pose,
     g1: &dyn Shape,
     g2: &dyn Shape,
-    (prediction, turn_reach): (Real, Real),
+    (prediction, turning): (Real, Turning),
     manifold: &mut ContactManifold<ManifoldData, ContactData>,
     old: &[TrackedContact<ContactData>],
 ) {
-    let reach = (prediction, turn_reach);
+    let reach = (prediction, turning);
     if let Some((hull, border)) = hull_parts(g2) {
         let vertices = Vertices::hull(hull.points(), border);
         add(pos12, g1, vertices, reach, manifold, old, false);
@@ -111,7 +135,7 @@ pub(crate) fn add_deepest_box_corner<ManifoldData, ContactData: Default + Copy>(
             pos12,
             g1,
             Vertices::corners(&corners),
-            (prediction, 0.0),
+            (prediction, Turning::default()),
             manifold,
             old,
             false,
@@ -123,7 +147,7 @@ pub(crate) fn add_deepest_box_corner<ManifoldData, ContactData: Default + Copy>(
             &pos12.inverse(),
             g2,
             vertices,
-            (prediction, 0.0),
+            (prediction, Turning::default()),
             manifold,
             old,
             true,
@@ -178,21 +202,29 @@ fn box_corners(cuboid: &parry3d::shape::Cuboid) -> [Vector; 8] {
 
 /// [`add_deepest_vertex`] with the vertices `vertices` of a hull or a box as shape 2 and `flat`
 /// as shape 1 in the frame of `pos12` (shape 2's pose in `flat`'s frame), within `prediction`
-/// (m), with the turning vertices for `turn_reach` > 0 (m); `flipped` says the manifold has
+/// (m), with the turning vertices for `turning.reach` > 0 (m); `flipped` says the manifold has
 /// them the other way round.
 fn add<ManifoldData, ContactData: Default + Copy>(
     pos12: &Pose,
     flat: &dyn Shape,
     vertices: Vertices<'_>,
-    (prediction, turn_reach): (Real, Real),
+    (prediction, turning): (Real, Turning),
     manifold: &mut ContactManifold<ManifoldData, ContactData>,
     old: &[TrackedContact<ContactData>],
     flipped: bool,
 ) {
     let border = vertices.border;
+    // The manifold's normal, outward from the flat shape, in its frame; without points (a
+    // box's only, against a triangle), none.
+    let along = match manifold.points.is_empty() {
+        true => None,
+        false if flipped => Some(manifold.local_n2),
+        false => Some(manifold.local_n1),
+    };
     // The flat shape's outward unit normal (its frame), a point of its plane, its face id, and
-    // for a triangle whether the manifold's normal is off the face normal by more than FACE_ON.
-    let (normal, origin, face, triangle) = match flat.as_typed_shape() {
+    // for a triangle or a box's face the face and whether the manifold's normal is off the
+    // face normal by more than FACE_ON.
+    let (normal, origin, face, bounded) = match flat.as_typed_shape() {
         TypedShape::HalfSpace(half_space) => (
             half_space.normal,
             Vector::ZERO,
@@ -203,18 +235,10 @@ fn add<ManifoldData, ContactData: Default + Copy>(
             let Some(face_normal) = triangle.normal() else {
                 return;
             };
-            // The manifold's normal, outward from the flat shape, in its frame; without
-            // points (a box's only), the face normal.
-            let along = if manifold.points.is_empty() {
-                if !vertices.corners {
-                    return;
-                }
-                face_normal
-            } else if flipped {
-                manifold.local_n2
-            } else {
-                manifold.local_n1
-            };
+            // A manifold with no point: Parry's generator found none within the prediction,
+            // or a mesh's normal constraints rejected its normal (a hull lying across the
+            // edge between two triangles of a plane, its lowest vertex over the other one).
+            let along = along.unwrap_or(face_normal);
             let (face_normal, face) = if face_normal.dot(along) >= 0.0 {
                 (face_normal, PackedFeatureId::face(0))
             } else {
@@ -228,7 +252,36 @@ fn add<ManifoldData, ContactData: Default + Copy>(
                 face_normal,
                 triangle.a,
                 face,
-                Some((triangle, cosine < FACE_ON)),
+                Some((Face::Triangle(triangle), cosine < FACE_ON)),
+            )
+        }
+        TypedShape::Cuboid(cuboid) => {
+            let Some(along) = along else {
+                return;
+            };
+            // The box's face whose outward normal is nearest the manifold's.
+            let axis = along.abs().max_position();
+            let negative = along[axis] < 0.0;
+            let cosine = along[axis].abs();
+            if cosine < TILTED {
+                return;
+            }
+            let mut face_normal = Vector::ZERO;
+            face_normal[axis] = if negative { -1.0 } else { 1.0 };
+            // Parry's numbering of a box's faces: 10, 11, 12 for +x, +y, +z, 13, 14, 15 for −x,
+            // −y, −z.
+            let face = PackedFeatureId::face(10 + axis as u32 + 3 * u32::from(negative));
+            (
+                face_normal,
+                face_normal * cuboid.half_extents[axis],
+                face,
+                Some((
+                    Face::Rectangle {
+                        half_extents: cuboid.half_extents,
+                        axis,
+                    },
+                    cosine < FACE_ON,
+                )),
             )
         }
         _ => return,
@@ -238,8 +291,8 @@ fn add<ManifoldData, ContactData: Default + Copy>(
     let points = vertices.points;
     let vertex = parry3d::utils::point_cloud_support_point_id(inward, points);
     if manifold.points.is_empty() {
-        // A box with no point against a triangle gets one only while it crosses the
-        // triangle's plane: its highest corner above it.
+        // A box or hull with no point against a triangle gets one only while it crosses the
+        // triangle's plane: its highest vertex above it.
         let top = parry3d::utils::point_cloud_support_point(-inward, points);
         if (pos12 * top - origin).dot(normal) <= 0.0 {
             return;
@@ -251,15 +304,18 @@ fn add<ManifoldData, ContactData: Default + Copy>(
         return;
     }
     let on_flat = at - normal * (dist + border);
-    if let Some((triangle, tilted)) = triangle {
-        if !over_triangle(triangle, normal, on_flat) {
+    // A vertex beside a bounded face is another face's; the turning vertices over this one
+    // are still this face's (a pin lying across two triangles of a plane, its lowest vertex
+    // over one and its other end swinging down onto the other).
+    let over = bounded.is_none_or(|(face, _)| face.holds(normal, on_flat));
+    if let Some((_, true)) = bounded {
+        if !over {
+            // The manifold's normal is not the face's: its points are left as they are.
             return;
         }
-        if tilted {
-            // The hull's lowest vertex is over the triangle: its plane is what the hull rests
-            // on, whatever face of the hull Parry's clipping took the normal from.
-            to_face_normal(pos12, (normal, inward), origin, manifold, flipped);
-        }
+        // The hull's lowest vertex is over the face: its plane is what the hull rests on,
+        // whatever face of the hull Parry's clipping took the normal from.
+        to_face_normal(pos12, (normal, inward), origin, manifold, flipped);
     }
     let nearest = manifold
         .points
@@ -275,14 +331,26 @@ fn add<ManifoldData, ContactData: Default + Copy>(
         vertices,
         flipped,
     };
-    if dist < nearest - DEPTH_TIE {
+    if over && dist < nearest - DEPTH_TIE {
         flat_side.add_vertex(vertex, manifold, old);
     }
-    if turn_reach <= 0.0 || manifold.points.is_empty() {
+    if turning.reach <= 0.0 {
         return;
     }
-    // Vertices the step's rotation may bring below the deepest one, nearest the surface first.
-    let reach = prediction.min(dist + 2.0 * turn_reach);
+    // Vertices the step's rotation may bring below the points that hold the hull (the
+    // module's documentation): θ ≤ 2 · bound / span, the span no larger than twice the radius
+    // the reach was taken at.
+    let deepest_at = points[vertex];
+    let span = points
+        .iter()
+        .map(|p| p.distance_squared(deepest_at))
+        .fold(0.0, Real::max)
+        .sqrt();
+    if span <= 0.0 {
+        return;
+    }
+    let turn = 2.0 * turning.bound.max(turning.reach) / span;
+    let reach = prediction.min(dist + 2.0 * turning.reach);
     let mut turning: Vec<(Real, usize)> = points
         .iter()
         .enumerate()
@@ -291,18 +359,41 @@ fn add<ManifoldData, ContactData: Default + Copy>(
         .filter(|&(height, _)| height <= reach)
         .collect();
     turning.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    // The held points: on the hull (its frame), and their heights.
+    let mut held: Vec<(Vector, Real)> = manifold
+        .points
+        .iter()
+        .map(|point| {
+            let on_hull = if flipped {
+                point.local_p1
+            } else {
+                point.local_p2
+            };
+            (on_hull, point.dist)
+        })
+        .collect();
     let mut added = 0;
     for (height, k) in turning {
         if added == TURNING_VERTICES {
             break;
         }
-        let at = pos12 * points[k];
-        if let Some((triangle, _)) = triangle
-            && !over_triangle(triangle, normal, at - normal * (height + border))
+        let on_hull = points[k];
+        let kept = held.iter().any(|&(at, held_height)| {
+            height - held_height - turn * on_hull.distance(at) >= -TURNING_DIP
+        });
+        if kept {
+            continue;
+        }
+        let at = pos12 * on_hull;
+        if let Some((face, _)) = bounded
+            && !face.holds(normal, at - normal * (height + border))
         {
             continue;
         }
-        added += usize::from(flat_side.add_vertex(k, manifold, old));
+        if flat_side.add_vertex(k, manifold, old) {
+            added += 1;
+            held.push((on_hull, height));
+        }
     }
 }
 
@@ -400,6 +491,26 @@ fn to_face_normal<ManifoldData, ContactData>(
             point.local_p2 = on_flat;
         } else {
             point.local_p1 = on_flat;
+        }
+    }
+}
+
+/// A bounded flat face a hull's vertex must lie over to be its point: a triangle, or a box's
+/// face (the box's half-extents, the face on axis `axis`).
+#[derive(Clone, Copy)]
+enum Face<'a> {
+    Triangle(&'a parry3d::shape::Triangle),
+    Rectangle { half_extents: Vector, axis: usize },
+}
+
+impl Face<'_> {
+    /// Whether `point`, on the face's plane (its unit normal `normal`), lies over the face,
+    /// edges included.
+    fn holds(&self, normal: Vector, point: Vector) -> bool {
+        match *self {
+            Face::Triangle(triangle) => over_triangle(triangle, normal, point),
+            Face::Rectangle { half_extents, axis } => (0..3)
+                .all(|k| k == axis || point[k].abs() <= half_extents[k] * (1.0 + 1.0e-6) + 1.0e-7),
         }
     }
 }

@@ -1,8 +1,9 @@
 use glam::{Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
-use parry3d::shape::{ConvexPolyhedron, HalfSpace, Shape, Triangle};
+use parry3d::shape::{ConvexPolyhedron, Cuboid, HalfSpace, Shape, TriMesh, TriMeshFlags, Triangle};
 
+use super::Turning;
 use crate::collision::dispatch::ContactDispatcher;
 
 /// A UV sphere of radius `radius`: `around` vertices on each of `rings − 1` circles of
@@ -145,7 +146,6 @@ fn a_vertex_beside_a_triangle_is_not_its_point() {
 /// then too deep: `add_deepest_box_corner`).
 #[test]
 fn the_deepest_corner_of_a_card_across_a_mesh_edge_is_a_point() {
-    use parry3d::shape::{Cuboid, TriMesh, TriMeshFlags};
     let card = Cuboid::new(Vec3::new(0.0315, 0.001, 0.044));
     let plane = TriMesh::with_flags(
         vec![
@@ -181,4 +181,129 @@ fn the_deepest_corner_of_a_card_across_a_mesh_edge_is_a_point() {
         parry_missed > 0,
         "Parry's manifolds held every lowest corner"
     );
+}
+
+/// Every point (on the hull, in the flat shape's frame, and its separation) of the manifolds
+/// `dispatcher` gives for `flat` (at the origin) and `hull` at `pose`.
+fn manifold_points(
+    dispatcher: &ContactDispatcher,
+    flat: &dyn Shape,
+    hull: &dyn Shape,
+    pose: &Pose,
+) -> Vec<(Vec3, f32)> {
+    let mut manifolds: Vec<ContactManifold<(), ()>> = Vec::new();
+    let mut workspace = None;
+    dispatcher
+        .contact_manifolds(pose, flat, hull, 0.1, &mut manifolds, &mut workspace)
+        .unwrap();
+    manifolds
+        .iter()
+        .flat_map(|m| m.points.iter().map(|p| (*pose * p.local_p2, p.dist)))
+        .collect()
+}
+
+/// A turning dispatcher whose rotation carries a point `reach` metres in the step.
+fn turning(reach: f32) -> ContactDispatcher {
+    ContactDispatcher::turning(Turning {
+        reach,
+        bound: reach,
+    })
+}
+
+/// A box's face is a flat shape as a half-space is: a 32×16 UV sphere (radius 0.5 m) at 200
+/// seeded orientations, its lowest vertex 2 mm under the top of a large box, each shape first
+/// and second: the manifold's deepest point is the lowest vertex's depth.
+#[test]
+fn the_deepest_vertex_of_a_round_hull_on_a_box_is_a_point() {
+    let hull = uv_sphere(32, 16, 0.5);
+    let slab = Cuboid::new(Vec3::new(10.0, 0.5, 10.0));
+    let depth = 2.0e-3;
+    for rotation in rotations(200) {
+        let lowest = hull
+            .points()
+            .iter()
+            .map(|p| (rotation * *p).y)
+            .fold(f32::INFINITY, f32::min);
+        let pose = Pose::from_parts(Vec3::new(0.3, 0.5 - lowest - depth, 0.2), rotation);
+        for flipped in [false, true] {
+            let ours = manifold_depth(&ContactDispatcher::default(), &slab, &hull, &pose, flipped);
+            assert!(
+                (ours - depth).abs() < 1e-5,
+                "{rotation:?}, flipped {flipped}: deepest point {ours} m, lowest vertex {depth} m"
+            );
+        }
+    }
+}
+
+/// A tumbling bowling pin (the 48-vertex hull of the tumbling-hulls test) lying across the
+/// edge between the two triangles of a plane, at the pose where the sweep's pin 9 sank 12.8 mm
+/// (60 Hz, the 2-triangle mesh): its base on the plane over one triangle, its belly 44 mm up
+/// over the other and swinging down at 17 rad/s. Parry gives the second triangle no manifold
+/// (its normal constraints reject the normal); the belly's vertices over it get points when
+/// the pin turns, none when it does not.
+#[test]
+fn a_turning_hull_across_two_triangles_gets_points_over_both() {
+    let plane = TriMesh::with_flags(
+        vec![
+            Vec3::new(-20.0, 0.0, -20.0),
+            Vec3::new(20.0, 0.0, -20.0),
+            Vec3::new(-20.0, 0.0, 20.0),
+            Vec3::new(20.0, 0.0, 20.0),
+        ],
+        vec![[0, 2, 3], [0, 3, 1]],
+        TriMeshFlags::FIX_INTERNAL_EDGES_TWO_SIDED,
+    )
+    .unwrap();
+    let mut points = Vec::new();
+    for (y, radius) in [
+        (-0.19, 0.026),
+        (-0.076, 0.0605),
+        (0.13, 0.045),
+        (0.19, 0.03),
+    ] {
+        for k in 0..12 {
+            let angle = std::f32::consts::TAU * k as f32 / 12.0;
+            points.push(Vec3::new(radius * angle.cos(), y, radius * angle.sin()));
+        }
+    }
+    let pin = ConvexPolyhedron::from_convex_hull(&points).unwrap();
+    let pose = Pose::from_parts(
+        Vec3::new(-0.700_722_9, 0.069_799_33, -0.620_389_5),
+        Quat::from_xyzw(0.494_149_18, 0.489_133_78, -0.432_305_87, -0.574_174_4).normalize(),
+    );
+    // Points over the triangle x > z, 20–60 mm up: the belly's side.
+    let belly = |held: &[(Vec3, f32)]| {
+        held.iter()
+            .filter(|(at, dist)| at.x > at.z && (0.02..0.06).contains(dist))
+            .count()
+    };
+    let still = manifold_points(&ContactDispatcher::default(), &plane, &pin, &pose);
+    assert_eq!(belly(&still), 0, "{still:?}");
+    let turning_points = manifold_points(&turning(0.0614), &plane, &pin, &pose);
+    assert!(belly(&turning_points) >= 1, "{turning_points:?}");
+}
+
+/// A hull resting flat and turning slowly keeps the points of its face: a 32-sided prism
+/// (radius 0.1 m) with a second ring of vertices 0.3 mm above its base (a modelled bevel, as
+/// decomposed parts have), standing on a half-space, turning by 0.2 mm a step. Every vertex of
+/// both rings is within the turning reach of the lowest, but a rotation of 0.002 rad brings
+/// none of them a quarter of a millimetre below Parry's four points (the base's) or the base
+/// vertex under it: no point is added. Turning 0.2 rad a step, the rings get points.
+#[test]
+fn a_slowly_turning_flat_face_keeps_its_points() {
+    let mut points = Vec::new();
+    for k in 0..32 {
+        let angle = std::f32::consts::TAU * k as f32 / 32.0;
+        for y in [-0.05, -0.0497, 0.05] {
+            points.push(Vec3::new(0.1 * angle.cos(), y, 0.1 * angle.sin()));
+        }
+    }
+    let prism = ConvexPolyhedron::from_convex_hull(&points).unwrap();
+    let half_space = HalfSpace::new(Vec3::Y);
+    let pose = Pose::from_parts(Vec3::new(0.0, 0.05, 0.0), Quat::IDENTITY);
+    let still = manifold_points(&ContactDispatcher::default(), &half_space, &prism, &pose);
+    let slow = manifold_points(&turning(2.0e-4), &half_space, &prism, &pose);
+    assert_eq!(slow.len(), still.len(), "{slow:?}");
+    let fast = manifold_points(&turning(0.02), &half_space, &prism, &pose);
+    assert!(fast.len() > still.len() + 8, "{fast:?}");
 }

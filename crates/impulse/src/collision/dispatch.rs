@@ -59,10 +59,10 @@ use crate::body::rules::rounded_parts;
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct ContactDispatcher {
     /// How far (m) rotation can carry any point of either body of the pair in the step
-    /// ([`super::margins::SweptReach::turn_reach`]): a turning hull's vertices that may become
-    /// its lowest within the step get points against a flat shape
-    /// ([`deepest_vertex::add_deepest_vertex`]). 0 (the default) for none.
-    pub(crate) turn_reach: Real,
+    /// ([`super::margins::SweptReach`]): a turning hull's vertices that may become its lowest
+    /// within the step get points against a flat shape
+    /// ([`deepest_vertex::add_deepest_vertex`]). None by default.
+    pub(crate) turning: deepest_vertex::Turning,
     /// Whether the convex pairs are a triangle mesh's triangles against a convex shape (set
     /// where a triangle mesh's pairs are dispatched): a box then also gets its deepest corner
     /// where the manifold misses it ([`deepest_vertex::add_deepest_box_corner`]). Height
@@ -71,11 +71,11 @@ pub(crate) struct ContactDispatcher {
 }
 
 impl ContactDispatcher {
-    /// The dispatcher for a pair whose rotation can carry a point `turn_reach` metres in the
-    /// step.
-    pub(crate) fn turning(turn_reach: Real) -> Self {
+    /// The dispatcher for a pair whose rotation can carry a point as far as `turning` says in
+    /// the step.
+    pub(crate) fn turning(turning: deepest_vertex::Turning) -> Self {
         Self {
-            turn_reach,
+            turning,
             mesh_triangles: false,
         }
     }
@@ -421,7 +421,7 @@ impl ContactDispatcher {
                 pos12,
                 g1,
                 g2,
-                (prediction, self.turn_reach),
+                (prediction, self.turning),
                 manifold,
                 &old,
             );
@@ -775,10 +775,13 @@ fn has_cap_type(shape_type: ShapeType) -> bool {
 }
 
 /// Whether shapes of this type are flat where a hull meets them: a half-space, a triangle (of a
-/// mesh or height field), whose manifold with a hull gets its deepest vertex
+/// mesh or height field), a box (its faces), whose manifold with a hull gets its deepest vertex
 /// ([`deepest_vertex`]).
 fn is_flat_type(shape_type: ShapeType) -> bool {
-    matches!(shape_type, ShapeType::HalfSpace | ShapeType::Triangle)
+    matches!(
+        shape_type,
+        ShapeType::HalfSpace | ShapeType::Triangle | ShapeType::Cuboid
+    )
 }
 
 /// Whether shapes of this type are convex polyhedra, rounded or not, whose faces of more than

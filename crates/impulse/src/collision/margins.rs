@@ -34,8 +34,10 @@ pub(crate) const MAX_SPECULATIVE_MARGIN: f32 = 2.0;
 #[derive(Default)]
 pub struct SpeculativeMargins {
     margins: Vec<f32>,
-    /// Per body, |ω|·R (m/s): the fastest any of its points moves by rotation.
-    spin_speeds: Vec<f32>,
+    /// Per body, |ω|·R (m/s), the fastest any of its points moves by rotation, and the
+    /// fastest any of them can move by rotation after contacts within the step: R times the
+    /// spin its kinetic energy could give it ([`spin_bound`]).
+    spin_speeds: Vec<(f32, f32)>,
     prediction_distance: f32,
     dt: f32,
     /// |g|·dt (m/s).
@@ -64,7 +66,7 @@ impl SpeculativeMargins {
         self.gravity_speed = gravity.length() * dt;
         self.gravity = gravity;
         let gravity_speed = self.gravity_speed;
-        // (margin, spin speed) of body i.
+        // (margin, (spin speed, spin bound)) of body i.
         let of = |i: usize| {
             if bodies.is_moving(i) {
                 let radius = bodies.shape[i].compute_local_aabb().half_extents().length();
@@ -75,12 +77,17 @@ impl SpeculativeMargins {
                     0.0
                 };
                 let speed = bodies.linear_velocity[i].length() + spin_speed + gravity_speed;
+                let bound = if bodies.is_dynamic(i) {
+                    spin_bound(bodies, i) * radius
+                } else {
+                    spin_speed
+                };
                 (
                     (0.5 * prediction_distance + speed * dt).min(MAX_SPECULATIVE_MARGIN),
-                    spin_speed,
+                    (spin_speed, bound.max(spin_speed)),
                 )
             } else {
-                (0.5 * prediction_distance, 0.0)
+                (0.5 * prediction_distance, (0.0, 0.0))
             }
         };
         self.margins.clear();
@@ -94,9 +101,9 @@ impl SpeculativeMargins {
                 .unzip_into_vecs(&mut self.margins, &mut self.spin_speeds);
         } else {
             for i in 0..bodies.len() {
-                let (margin, spin_speed) = of(i);
+                let (margin, spin) = of(i);
                 self.margins.push(margin);
-                self.spin_speeds.push(spin_speed);
+                self.spin_speeds.push(spin);
             }
         }
     }
@@ -118,8 +125,8 @@ impl SpeculativeMargins {
         let velocity = |i: usize| moving_velocity(bodies, i);
         let gravity = self.relative_gravity_speed(bodies, a, b);
         let closing = (velocity(a) - velocity(b)).length()
-            + self.spin_speeds[a]
-            + self.spin_speeds[b]
+            + self.spin_speeds[a].0
+            + self.spin_speeds[b].0
             + gravity;
         (self.prediction_distance + closing * self.dt).min(self.margins[a] + self.margins[b])
     }
@@ -140,7 +147,8 @@ impl SpeculativeMargins {
         };
         SweptReach {
             displacement: (velocity(b) - velocity(a)) * self.dt,
-            turn_reach: (self.spin_speeds[a] + self.spin_speeds[b]) * self.dt,
+            turn_reach: (self.spin_speeds[a].0 + self.spin_speeds[b].0) * self.dt,
+            turn_bound: (self.spin_speeds[a].1 + self.spin_speeds[b].1) * self.dt,
             horizon: 1.0 + 1.0 / self.substeps.max(1) as f32,
         }
     }
@@ -154,6 +162,35 @@ impl SpeculativeMargins {
         } else {
             0.0
         }
+    }
+}
+
+/// The fastest spin (rad/s) dynamic body `i` can have after the step's contacts if they add
+/// no kinetic energy: with E = ½·m·|v|² + ½·ωᵀIω its kinetic energy, a spin ω' has
+/// ½·ω'ᵀIω' ≤ E, so |ω'|² ≤ 2E / I_min, I_min bounded below by the inverse of the largest
+/// absolute row sum of the inverse inertia (which bounds its largest eigenvalue). Left out:
+/// the step's gravity (what a resting body's contacts take away each step; counted, it would
+/// give every resting body a turn) and energy other bodies bring through their contacts. A
+/// body with a locked rotation axis (a singular inertia) gets its current spin.
+fn spin_bound(bodies: &Bodies, i: usize) -> f32 {
+    let inverse_inertia = bodies.local_inverse_inertia[i];
+    let omega = bodies.pose[i].rotation.inverse() * bodies.angular_velocity[i];
+    let spin = omega.length();
+    if inverse_inertia.determinant().abs() <= f32::MIN_POSITIVE || bodies.inverse_mass[i] <= 0.0 {
+        return spin;
+    }
+    let rotational = omega.dot(inverse_inertia.inverse() * omega);
+    let linear = bodies.linear_velocity[i].length_squared() / bodies.inverse_mass[i];
+    let rows = inverse_inertia.transpose();
+    let largest = [rows.x_axis, rows.y_axis, rows.z_axis]
+        .iter()
+        .map(|row| row.abs().element_sum())
+        .fold(0.0, f32::max);
+    let bound = ((linear + rotational.max(0.0)) * largest).sqrt();
+    if bound.is_finite() {
+        bound.max(spin)
+    } else {
+        spin
     }
 }
 
@@ -210,6 +247,10 @@ pub(crate) struct SweptReach {
     pub displacement: Vec3,
     /// How far (m) rotation can carry any point of either body in the step.
     pub turn_reach: f32,
+    /// How far (m) rotation can carry any point of either body in the step once contacts
+    /// have turned the bodies' kinetic energy into spin ([`spin_bound`]): a pin landing on one
+    /// end swings its other end down faster than it turned before.
+    pub turn_bound: f32,
     /// How many steps ahead a speculative point is checked, 1 + 1/substeps: the relax solve
     /// that ends the step's last substep holds the velocity to the gap left after it, so a
     /// plane the motion would cross in the next step's first substep already acts on the

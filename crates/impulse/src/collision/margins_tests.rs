@@ -56,7 +56,36 @@ fn margins_on_two_threads_are_those_of_one() {
     let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(serial.margins.len(), 3001);
     assert_eq!(bits(&spread.margins), bits(&serial.margins));
-    assert_eq!(bits(&spread.spin_speeds), bits(&serial.spin_speeds));
+    let spins = |v: &[(f32, f32)]| {
+        v.iter()
+            .map(|(speed, bound)| (speed.to_bits(), bound.to_bits()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(spins(&spread.spin_speeds), spins(&serial.spin_speeds));
     // The bodies differ: the comparison is not of constants.
     assert!(serial.margins.iter().any(|&m| m > 0.05) && serial.margins[0] == 0.01);
+}
+
+/// The spin a body's kinetic energy allows ([`spin_bound`]), in closed form: a ball (radius r,
+/// I = 2/5·m·r²) moving at v without spin could at most spin at v·√(5/2)/r if contacts turned
+/// all its energy into rotation; spinning at ω without moving, at ω; a resting one, at 0.
+#[test]
+fn a_ball_can_spin_as_fast_as_its_energy_allows() {
+    let radius = 0.2;
+    for (velocity, spin, expected) in [
+        (2.0, 0.0, 2.0 * 2.5f32.sqrt() / radius),
+        (0.0, 7.0, 7.0),
+        (0.0, 0.0, 0.0),
+    ] {
+        let mut w = World::new(Vec3::ZERO, 1.0 / 60.0, SolverSettings::default()).unwrap();
+        let mut ball = BodyDesc::new(BodyKind::Dynamic, ShapeDesc::Sphere { radius }, [0.0; 3]);
+        ball.linear_velocity = [velocity, 0.0, 0.0];
+        ball.angular_velocity = [0.0, spin, 0.0];
+        w.add_body(&ball, &common::material(0.5)).unwrap();
+        let bound = spin_bound(&w.bodies, 0);
+        assert!(
+            (bound - expected).abs() <= 1e-4 * expected.max(1.0),
+            "v {velocity}, ω {spin}: {bound} rad/s, expected {expected}"
+        );
+    }
 }

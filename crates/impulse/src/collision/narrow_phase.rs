@@ -405,16 +405,19 @@ impl NarrowPhase {
                 &pair.manifolds,
             );
             let reach = margins.pair_reach(bodies, a, b);
-            ContactDispatcher::turning(reach.turn_reach)
-                .contact_manifolds(
-                    &pos12,
-                    bodies.shape[a].as_ref(),
-                    bodies.shape[b].as_ref(),
-                    prediction,
-                    &mut pair.manifolds,
-                    &mut pair.workspace,
-                )
-                .map_err(|_| UnsupportedShapePair(a, b))?;
+            ContactDispatcher::turning(super::deepest_vertex::Turning {
+                reach: reach.turn_reach,
+                bound: reach.turn_bound,
+            })
+            .contact_manifolds(
+                &pos12,
+                bodies.shape[a].as_ref(),
+                bodies.shape[b].as_ref(),
+                prediction,
+                &mut pair.manifolds,
+                &mut pair.workspace,
+            )
+            .map_err(|_| UnsupportedShapePair(a, b))?;
             concave_planes::add_plane_points(
                 &pos12,
                 bodies.pose[a].rotation,

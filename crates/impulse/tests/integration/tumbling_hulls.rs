@@ -98,26 +98,25 @@ fn sweep(pins: u64, dt: f32) -> Vec<(&'static str, f32)> {
         .collect()
 }
 
-/// At 1/60 s no pin's vertex goes more than 5 mm into the half-space (a bowling lane).
+/// At 1/60 s no pin's vertex goes more than 5 mm into any ground.
 #[test]
-fn tumbling_pins_land_on_their_vertices_on_a_half_space_at_60_hz() {
-    let ground = &super::hulls::grounds()[0];
-    assert_eq!(ground.0, "half-space");
-    for seed in 0..PINS {
-        let depth = deepest(seed, &ground.1, 1.0 / 60.0);
-        assert!(
-            depth <= DEPTH,
-            "pin {seed}: a vertex {:.2} mm deep",
-            depth * 1e3
-        );
+fn tumbling_pins_land_on_their_vertices_on_every_ground_at_60_hz() {
+    for (name, ground) in super::hulls::grounds() {
+        for seed in 0..PINS {
+            let depth = deepest(seed, &ground, 1.0 / 60.0);
+            assert!(
+                depth <= DEPTH,
+                "pin {seed} on the {name}: a vertex {:.2} mm deep",
+                depth * 1e3
+            );
+        }
     }
 }
 
-/// The figures of docs/testing.md at 1/60 s and 1/24 s on every ground (100 pins each). Only
-/// the half-space at 1/60 s meets the 5 mm target: a hull's pair with a box takes Parry's face
-/// clipping, without the turning vertices; on triangles a vertex beside the triangle is
-/// another triangle's, which may have no manifold yet; and at 1/24 s a pin turns by up to
-/// 0.4 rad a step, beyond what the rows' linearised rotation follows.
+/// The figures of docs/testing.md at 1/60 s and 1/24 s on every ground (100 pins each). At
+/// 1/24 s one pin goes a little past the 5 mm target on the half-space, the box and the
+/// meshes: it turns by 0.6 rad in its landing step, beyond what the rows' linearised rotation
+/// follows.
 #[test]
 #[ignore = "on demand: prints the figures of docs/testing.md"]
 fn tumbling_pins_sweep() {
