@@ -26,6 +26,27 @@ fn uv_sphere(around: usize, rings: usize, radius: f32) -> ConvexPolyhedron {
     ConvexPolyhedron::from_convex_hull(&points).unwrap()
 }
 
+/// The height (m) of `hull`'s lowest vertex turned by `rotation` about its origin.
+fn lowest_y(hull: &ConvexPolyhedron, rotation: Quat) -> f32 {
+    hull.points()
+        .iter()
+        .map(|p| (rotation * *p).y)
+        .fold(f32::INFINITY, f32::min)
+}
+
+/// A hull turned about the y axis: `around` vertices on each circle (height, radius) of
+/// `profile` (m).
+fn lathe(profile: &[(f32, f32)], around: usize) -> ConvexPolyhedron {
+    let mut points = Vec::new();
+    for &(y, radius) in profile {
+        for k in 0..around {
+            let angle = std::f32::consts::TAU * k as f32 / around as f32;
+            points.push(Vec3::new(radius * angle.cos(), y, radius * angle.sin()));
+        }
+    }
+    ConvexPolyhedron::from_convex_hull(&points).unwrap()
+}
+
 /// Seeded rotations (SplitMix-style bits, the same on every machine).
 fn rotations(count: u64) -> impl Iterator<Item = Quat> {
     (0..count).map(|k| {
@@ -91,11 +112,7 @@ fn the_deepest_vertex_of_a_round_hull_is_a_point() {
     let depth = 2.0e-3;
     let mut parry_missed = 0;
     for rotation in rotations(200) {
-        let lowest = hull
-            .points()
-            .iter()
-            .map(|p| (rotation * *p).y)
-            .fold(f32::INFINITY, f32::min);
+        let lowest = lowest_y(&hull, rotation);
         let pose = Pose::from_parts(Vec3::new(0.3, -lowest - depth, 0.2), rotation);
         for flat in [&half_space as &dyn Shape, &triangle] {
             for flipped in [false, true] {
@@ -219,11 +236,7 @@ fn the_deepest_vertex_of_a_round_hull_on_a_box_is_a_point() {
     let slab = Cuboid::new(Vec3::new(10.0, 0.5, 10.0));
     let depth = 2.0e-3;
     for rotation in rotations(200) {
-        let lowest = hull
-            .points()
-            .iter()
-            .map(|p| (rotation * *p).y)
-            .fold(f32::INFINITY, f32::min);
+        let lowest = lowest_y(&hull, rotation);
         let pose = Pose::from_parts(Vec3::new(0.3, 0.5 - lowest - depth, 0.2), rotation);
         for flipped in [false, true] {
             let ours = manifold_depth(&ContactDispatcher::default(), &slab, &hull, &pose, flipped);
@@ -254,19 +267,16 @@ fn a_turning_hull_across_two_triangles_gets_points_over_both() {
         TriMeshFlags::FIX_INTERNAL_EDGES_TWO_SIDED,
     )
     .unwrap();
-    let mut points = Vec::new();
-    for (y, radius) in [
-        (-0.19, 0.026),
-        (-0.076, 0.0605),
-        (0.13, 0.045),
-        (0.19, 0.03),
-    ] {
-        for k in 0..12 {
-            let angle = std::f32::consts::TAU * k as f32 / 12.0;
-            points.push(Vec3::new(radius * angle.cos(), y, radius * angle.sin()));
-        }
-    }
-    let pin = ConvexPolyhedron::from_convex_hull(&points).unwrap();
+    // The pin's profile: base, belly, neck, top.
+    let pin = lathe(
+        &[
+            (-0.19, 0.026),
+            (-0.076, 0.0605),
+            (0.13, 0.045),
+            (0.19, 0.03),
+        ],
+        12,
+    );
     let pose = Pose::from_parts(
         Vec3::new(-0.700_722_9, 0.069_799_33, -0.620_389_5),
         Quat::from_xyzw(0.494_149_18, 0.489_133_78, -0.432_305_87, -0.574_174_4).normalize(),
@@ -291,14 +301,7 @@ fn a_turning_hull_across_two_triangles_gets_points_over_both() {
 /// vertex under it: no point is added. Turning 0.2 rad a step, the rings get points.
 #[test]
 fn a_slowly_turning_flat_face_keeps_its_points() {
-    let mut points = Vec::new();
-    for k in 0..32 {
-        let angle = std::f32::consts::TAU * k as f32 / 32.0;
-        for y in [-0.05, -0.0497, 0.05] {
-            points.push(Vec3::new(0.1 * angle.cos(), y, 0.1 * angle.sin()));
-        }
-    }
-    let prism = ConvexPolyhedron::from_convex_hull(&points).unwrap();
+    let prism = lathe(&[(-0.05, 0.1), (-0.0497, 0.1), (0.05, 0.1)], 32);
     let half_space = HalfSpace::new(Vec3::Y);
     let pose = Pose::from_parts(Vec3::new(0.0, 0.05, 0.0), Quat::IDENTITY);
     let still = manifold_points(&ContactDispatcher::default(), &half_space, &prism, &pose);
