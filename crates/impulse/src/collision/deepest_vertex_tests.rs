@@ -227,9 +227,11 @@ fn turning(reach: f32) -> ContactDispatcher {
     })
 }
 
-/// A box's face is a flat shape as a half-space is: a 32×16 UV sphere (radius 0.5 m) at 200
-/// seeded orientations, its lowest vertex 2 mm under the top of a large box, each shape first
-/// and second: the manifold's deepest point is the lowest vertex's depth.
+/// A box's face is a flat shape as a half-space is, and its points are where the hull is: a
+/// 32×16 UV sphere (radius 0.5 m) at 200 seeded orientations, its lowest vertex 2 mm under the
+/// top of a large box, each shape first and second: the manifold's deepest point is the lowest
+/// vertex's depth (Parry's box manifolds hold it at these poses; the face's own points, added
+/// or re-expressed, must agree with it).
 #[test]
 fn the_deepest_vertex_of_a_round_hull_on_a_box_is_a_point() {
     let hull = uv_sphere(32, 16, 0.5);
@@ -293,20 +295,23 @@ fn a_turning_hull_across_two_triangles_gets_points_over_both() {
     assert!(belly(&turning_points) >= 1, "{turning_points:?}");
 }
 
-/// A hull resting flat and turning slowly keeps the points of its face: a 32-sided prism
-/// (radius 0.1 m) with a second ring of vertices 0.3 mm above its base (a modelled bevel, as
-/// decomposed parts have), standing on a half-space, turning by 0.2 mm a step. Every vertex of
+/// A hull resting flat and turning slowly keeps the points of its face, on a half-space and on
+/// a box's top: a 32-sided prism (radius 0.1 m) with a second ring of vertices 0.3 mm above its
+/// base (a modelled bevel, as decomposed parts have), turning by 0.2 mm a step. Every vertex of
 /// both rings is within the turning reach of the lowest, but a rotation of 0.002 rad brings
-/// none of them a quarter of a millimetre below Parry's four points (the base's) or the base
-/// vertex under it: no point is added. Turning 0.2 rad a step, the rings get points.
+/// none of them a quarter of a millimetre below Parry's points or the base vertex under it: no
+/// point is added. Turning 0.2 rad a step, the rings get points.
 #[test]
 fn a_slowly_turning_flat_face_keeps_its_points() {
     let prism = lathe(&[(-0.05, 0.1), (-0.0497, 0.1), (0.05, 0.1)], 32);
     let half_space = HalfSpace::new(Vec3::Y);
-    let pose = Pose::from_parts(Vec3::new(0.0, 0.05, 0.0), Quat::IDENTITY);
-    let still = manifold_points(&ContactDispatcher::default(), &half_space, &prism, &pose);
-    let slow = manifold_points(&turning(2.0e-4), &half_space, &prism, &pose);
-    assert_eq!(slow.len(), still.len(), "{slow:?}");
-    let fast = manifold_points(&turning(0.02), &half_space, &prism, &pose);
-    assert!(fast.len() > still.len() + 8, "{fast:?}");
+    let slab = Cuboid::new(Vec3::new(10.0, 0.5, 10.0));
+    for (flat, top) in [(&half_space as &dyn Shape, 0.0), (&slab, 0.5)] {
+        let pose = Pose::from_parts(Vec3::new(0.0, top + 0.05, 0.0), Quat::IDENTITY);
+        let still = manifold_points(&ContactDispatcher::default(), flat, &prism, &pose);
+        let slow = manifold_points(&turning(2.0e-4), flat, &prism, &pose);
+        assert_eq!(slow.len(), still.len(), "{slow:?}");
+        let fast = manifold_points(&turning(0.02), flat, &prism, &pose);
+        assert!(fast.len() > still.len() + 8, "{fast:?}");
+    }
 }
