@@ -138,6 +138,22 @@ def _to_impulse(points):
     return np.stack([points[:, 0], points[:, 2], -points[:, 1]], axis=1).tolist()
 
 
+def _is_centred_box(points):
+    """Whether the points (N, 3) are the corners of their axis-aligned bounding box, all eight,
+    and nothing else, the box centred on the origin (a cube or a scaled cube added from the
+    Add menu): their convex hull is then that box. To 1e-6 of the box's extent."""
+    low, high = points.min(axis=0), points.max(axis=0)
+    tolerance = 1e-6 * max(float(np.max(high - low)), 1e-9)
+    if np.any(np.abs(low + high) > 2 * tolerance):
+        return False
+    at_low = np.abs(points - low) <= tolerance
+    at_high = np.abs(points - high) <= tolerance
+    if not np.all(at_low | at_high):
+        return False
+    corners = {tuple(bool(b) for b in row) for row in at_high}
+    return len(corners) == 8
+
+
 def _rank(points):
     """The number of independent directions the points span (0 to 3), to a relative
     tolerance of 1e-6 of their extent."""
@@ -218,6 +234,9 @@ def build(obj, kind, scale, meshes, resolution=0):
                 shape["decomposition"] = {"resolution": int(resolution)}
             return shape, [], []
         notes = []
+        if shape_type == "CONVEX_HULL" and rank == 3 and _is_centred_box(points):
+            # The same solid as its hull, taken by the engine's exact box paths.
+            return _primitive("BOX", np.ptp(points, axis=0)), [], []
         shape = {"type": "convex_hull", "points": _to_impulse(points)}
         if rank == 2:
             # A flat mesh bounds no solid to decompose: a moving one is its flat hull.
