@@ -452,3 +452,34 @@ def test_runs_whose_worker_failed_run_again_on_resume(tmp_path):
     statuses = dict(zip(again.column("seed").to_pylist(), again.column("status").to_pylist(), strict=True))
     # The worker's failure is run again; the run's own failure is kept (retry_failed reruns it).
     assert statuses == {0: COMPLETED, 1: FAILED}
+
+
+def _sleeping_row(task):
+    """A pool task that takes half a second and returns its row (never raises)."""
+    import time
+
+    time.sleep(task["seconds"])
+    return {"seconds": task["seconds"]}
+
+
+def test_a_cancelled_local_pool_ends_without_an_error_in_its_threads():
+    # What Ctrl-C or SIGTERM does to a search with takes queued behind the running ones: the
+    # workers are terminated and the pool shut down. A queued future cancelled by hand before
+    # that made Python 3.11's executor thread die of InvalidStateError when the broken pool
+    # set its exception (and shutdown could then wait for ever).
+    import threading
+
+    from impulse.sweep._backends import _LocalBackend
+
+    errors = []
+    previous = threading.excepthook
+    threading.excepthook = lambda hook: errors.append(hook.exc_value)
+    try:
+        for _ in range(3):
+            backend = _LocalBackend(2, function=_sleeping_row)
+            rows = backend.run({"seconds": 0.5} for _ in range(40))
+            assert next(rows) == {"seconds": 0.5}
+            backend.close(cancel=True)
+    finally:
+        threading.excepthook = previous
+    assert errors == []

@@ -86,10 +86,11 @@ class _LocalBackend:
         interrupt, a search that has its takes) at once, the queued tasks cancelled and the
         running ones ended with their worker processes."""
         if cancel:
-            for future in self.pending:
-                future.cancel()
             # The pool has no public way to end a running task: its worker processes are
-            # terminated (the pool then breaks, which shutdown handles).
+            # terminated (the pool then breaks, which shutdown handles). The queued futures are
+            # left to shutdown to cancel: one cancelled here stays among the pool's pending
+            # work, and when the broken pool then sets its exception, Python 3.11's executor
+            # thread dies of InvalidStateError and shutdown can wait for ever.
             for process in list((getattr(self.pool, "_processes", None) or {}).values()):
                 process.terminate()
         self.pool.shutdown(wait=True, cancel_futures=cancel)
