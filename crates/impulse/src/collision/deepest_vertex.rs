@@ -359,41 +359,32 @@ fn add<ManifoldData, ContactData: Default + Copy>(
         .filter(|&(height, _)| height <= reach)
         .collect();
     turning.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    // The held points: on the hull (its frame), and their heights.
-    let mut held: Vec<(Vector, Real)> = manifold
-        .points
-        .iter()
-        .map(|point| {
-            let on_hull = if flipped {
-                point.local_p1
-            } else {
-                point.local_p2
-            };
-            (on_hull, point.dist)
-        })
-        .collect();
     let mut added = 0;
     for (height, k) in turning {
         if added == TURNING_VERTICES {
             break;
         }
-        let on_hull = points[k];
-        let kept = held.iter().any(|&(at, held_height)| {
-            height - held_height - turn * on_hull.distance(at) >= -TURNING_DIP
+        // The held points are the manifold's, the vertices added before this one included
+        // (on the hull as `FlatSide::add_vertex` puts them, with their heights).
+        let on_hull = points[k] + inward * border;
+        let kept = manifold.points.iter().any(|point| {
+            let at = if flipped {
+                point.local_p1
+            } else {
+                point.local_p2
+            };
+            height - point.dist - turn * on_hull.distance(at) >= -TURNING_DIP
         });
         if kept {
             continue;
         }
-        let at = pos12 * on_hull;
+        let at = pos12 * points[k];
         if let Some((face, _)) = bounded
             && !face.holds(normal, at - normal * (height + border))
         {
             continue;
         }
-        if flat_side.add_vertex(k, manifold, old) {
-            added += 1;
-            held.push((on_hull, height));
-        }
+        added += usize::from(flat_side.add_vertex(k, manifold, old));
     }
 }
 
