@@ -89,3 +89,46 @@ fn a_ball_can_spin_as_fast_as_its_energy_allows() {
         );
     }
 }
+
+/// How far a point closes over the step ([`SpeculativeMargins::point_closing`]), in closed
+/// form: body 2 spins at ω about its centre of mass at the origin with no gravity, body 1
+/// rests at x = −2 (unturned); at body 1's point (1, 1, 0), (−1, 1, 0) in the world, body 2's
+/// material point moves at ω ẑ × (−1, 1, 0) = ω(−1, −1, 0), so it closes by dt·ω along
+/// body 1's +x and +y and not at all along −x (it opens).
+#[test]
+fn a_spinning_body_closes_by_its_spin_times_the_lever_arm() {
+    let (spin, dt) = (3.0_f32, 0.02_f32);
+    let mut w = World::new(Vec3::ZERO, dt, SolverSettings::default()).unwrap();
+    let m = common::material(0.5);
+    let resting = BodyDesc::new(
+        BodyKind::Dynamic,
+        ShapeDesc::Sphere { radius: 0.5 },
+        [-2.0, 0.0, 0.0],
+    );
+    w.add_body(&resting, &m).unwrap();
+    let mut spinning = BodyDesc::new(
+        BodyKind::Dynamic,
+        ShapeDesc::Sphere { radius: 0.5 },
+        [0.0; 3],
+    );
+    spinning.angular_velocity = [0.0, 0.0, spin];
+    w.add_body(&spinning, &m).unwrap();
+    let mut margins = SpeculativeMargins::default();
+    margins.update(&w.bodies, 0.02, w.gravity(), dt, false);
+    let closing = margins.point_closing(&w.bodies, 0, 1);
+    // World point (−1, 1, 0): ω ẑ × (−1, 1, 0) = ω(−1, −1, 0): body 2's point moves toward −x
+    // and −y, so along body 1's normal +x (toward body 2) it closes at ω.
+    let point = Vec3::new(1.0, 1.0, 0.0);
+    let expected = dt * spin;
+    let along_x = closing(point, Vec3::X);
+    assert!(
+        (along_x - expected).abs() < 1e-6,
+        "{along_x} against {expected}"
+    );
+    assert_eq!(closing(point, -Vec3::X), 0.0);
+    let along_y = closing(point, Vec3::Y);
+    assert!(
+        (along_y - expected).abs() < 1e-6,
+        "{along_y} against {expected}"
+    );
+}

@@ -438,7 +438,7 @@ impl NarrowPhase {
                 &mut pair.manifolds,
             );
             if part_pairs::applies(bodies.shape[a].as_ref(), bodies.shape[b].as_ref()) {
-                part_pairs::reduce(&mut pair.manifolds);
+                part_pairs::reduce(&mut pair.manifolds, &margins.point_closing(bodies, a, b));
             }
             pair.summary = PairSummary::of(&pair.manifolds);
             query.reach = recycle_reach(&bodies.shape[a], &bodies.shape[b]);

@@ -3,14 +3,18 @@
 //! along the same face. Points whose normals agree within [`NORMAL_COSINE`] are one patch, as
 //! in Jolt's manifold reduction (`PhysicsSettings::mUseManifoldReduction`, which merges the
 //! manifolds of sub-shape pairs with similar normals into one of at most four points). A patch
-//! is cut in [`LAYERS`] layers: the points within [`LAYER_DEPTH`] of its deepest point, and
-//! the rest. Each layer keeps [`MAX_POINTS`] points, chosen as a single face's are
-//! ([`choose_four`]: the deepest and the largest quadrilateral across the normal); the
-//! manifolds' points keep Parry's feature ids, so the kept points warm start. Kept apart, a
-//! part's speculative points cannot
-//! take the place of the touching points that hold the body, nor far points the place of those
-//! about to touch (with the two merged, a bowl
-//! on a 1 cm foot kept four points spread up its curved bottom and rocked 12°).
+//! is cut in [`LAYERS`] layers: the points within [`LAYER_DEPTH`] of its deepest point (those
+//! that hold the bodies), the speculative points the step's motion brings that near (those
+//! about to touch: a part of a spinning mug 7 mm off, closing at 1.3 m/s), and the rest. Each
+//! layer keeps [`MAX_POINTS`] points, chosen as a single face's are ([`choose_four`]: the
+//! deepest and the largest quadrilateral across the normal, depth read after the step's
+//! motion in the speculative layers); the manifolds' points keep Parry's feature ids, so the
+//! kept points warm start. Kept apart, a part's speculative points cannot take the place of
+//! the touching points that hold the body, nor far points the place of those about to touch
+//! (with the two merged, a bowl on a 1 cm foot kept four points spread up its curved bottom
+//! and rocked 12°; with the approaching points among the far ones, a mug's wall part turning
+//! into another mug kept none of its points and crossed 15 mm into it within a step at
+//! 1/60 s).
 //!
 //! The dropped points are removed from their manifolds, which stay in place (Parry's
 //! workspace refers to them by index); the next update recomputes them and the reduction
@@ -29,13 +33,15 @@ use super::manifold::Manifold;
 pub(crate) const NORMAL_COSINE: Real = 0.939_692_6;
 
 /// Depth (m) of a patch's first layer: it holds the points at most this farther off than the
-/// patch's deepest point (those that hold the bodies); the second holds all the others.
+/// patch's deepest point (those that hold the bodies). The second holds the others that the
+/// step's motion brings within this of that point's depth, the third all the rest.
 pub(crate) const LAYER_DEPTH: Real = 1.0e-3;
 
-/// Layers of a patch: the touching points and the speculative points beyond them, each
-/// keeping at most [`MAX_POINTS`], so a pair keeps at most 2 × [`MAX_POINTS`] per patch
-/// however far its speculative distance reaches.
-pub(crate) const LAYERS: u32 = 2;
+/// Layers of a patch: the touching points, the speculative points about to touch and those
+/// beyond, each keeping at most [`MAX_POINTS`], so a pair keeps at most 3 × [`MAX_POINTS`]
+/// per patch however far its speculative distance reaches (the second layer is empty unless
+/// some part closes on the other body within the step).
+pub(crate) const LAYERS: u32 = 3;
 
 /// Whether a pair of `shape1` and `shape2` gets its manifolds reduced: both compounds (two
 /// decomposed meshes touching through many parts). A compound against a single convex shape
@@ -49,7 +55,8 @@ pub(crate) fn applies(shape1: &dyn Shape, shape2: &dyn Shape) -> bool {
 }
 
 /// One contact point of a pair: its manifold and index there, its normal and position on body
-/// 1 (body 1's frame), its separation, and whether it carried impulse in the last step.
+/// 1 (body 1's frame), its separation, its separation after the step's motion (`reach`, m),
+/// and whether it carried impulse in the last step.
 #[derive(Clone, Copy)]
 struct PatchPoint {
     manifold: usize,
@@ -57,14 +64,24 @@ struct PatchPoint {
     normal: Vector,
     position: Vector,
     dist: Real,
+    reach: Real,
     kept: bool,
 }
 
+/// A pair whose bodies do not move: no point closes in the step (for [`reduce`]).
+#[cfg(test)]
+pub(crate) fn still(_: Vector, _: Vector) -> Real {
+    0.0
+}
+
 /// Reduces the points of one pair's `manifolds`: each patch (see the module's documentation)
-/// keeps at most [`MAX_POINTS`] points of each of its layers. Points
-/// are removed from their manifolds; no manifold is removed or reordered. Deterministic: the
-/// result depends on the manifolds' order and contents only.
-pub(crate) fn reduce(manifolds: &mut [Manifold]) {
+/// keeps at most [`MAX_POINTS`] points of each of its layers. `closing(position, normal)` is
+/// how far (m, ≥ 0) a point at `position` with normal `normal` (both in body 1's frame, the
+/// normal out of body 1) closes over the step
+/// ([`super::margins::SpeculativeMargins::point_closing`]). Points are removed from their
+/// manifolds; no manifold is removed or reordered. Deterministic: the result depends on the
+/// manifolds' order and contents and on `closing` only.
+pub(crate) fn reduce(manifolds: &mut [Manifold], closing: &dyn Fn(Vector, Vector) -> Real) {
     if manifolds.len() < 2 {
         return;
     }
@@ -73,20 +90,18 @@ pub(crate) fn reduce(manifolds: &mut [Manifold]) {
     for (m, manifold) in manifolds.iter().enumerate() {
         let pose = manifold.subshape_pos1().unwrap_or(&identity);
         let normal = pose.rotation * manifold.local_n1;
-        points.extend(
-            manifold
-                .points
-                .iter()
-                .enumerate()
-                .map(|(k, point)| PatchPoint {
-                    manifold: m,
-                    point: k,
-                    normal,
-                    position: pose.transform_point(point.local_p1),
-                    dist: point.dist,
-                    kept: point.data.normal > 0.0 || point.data.step_normal > 0.0,
-                }),
-        );
+        points.extend(manifold.points.iter().enumerate().map(|(k, point)| {
+            let position = pose.transform_point(point.local_p1);
+            PatchPoint {
+                manifold: m,
+                point: k,
+                normal,
+                position,
+                dist: point.dist,
+                reach: point.dist - closing(position, normal),
+                kept: point.data.normal > 0.0 || point.data.step_normal > 0.0,
+            }
+        }));
     }
     if points.len() <= MAX_POINTS {
         return;
@@ -111,7 +126,14 @@ pub(crate) fn reduce(manifolds: &mut [Manifold]) {
                 patches.push(i);
                 i
             });
-        let layer = (((point.dist - points[patch].dist) / LAYER_DEPTH) as u32).min(LAYERS - 1);
+        let top = points[patch].dist;
+        let layer = if point.dist - top < LAYER_DEPTH {
+            0
+        } else if point.reach - top < LAYER_DEPTH {
+            1
+        } else {
+            LAYERS - 1
+        };
         groups.push((patch, layer));
     }
     let mut keep: Vec<Vec<bool>> = manifolds
@@ -126,10 +148,16 @@ pub(crate) fn reduce(manifolds: &mut [Manifold]) {
             continue;
         }
         let kept: Vec<bool> = members.iter().map(|&i| points[i].kept).collect();
+        // The touching layer by its separation now, the speculative ones by where the step's
+        // motion takes them.
+        let speculative = groups[members[0]].1 > 0;
         let chosen = choose_four(
             members.len(),
             &|k| points[members[k]].position,
-            &|k| points[members[k]].dist,
+            &|k| {
+                let point = &points[members[k]];
+                if speculative { point.reach } else { point.dist }
+            },
             &kept,
             points[groups[members[0]].0].normal,
         );

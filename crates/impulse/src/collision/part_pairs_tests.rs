@@ -28,7 +28,7 @@ fn on_ground(compound: &SharedShape, pose: Pose, reduced: bool) -> Vec<Manifold>
     // The reduction itself, on a compound's manifolds against a box (the engine applies it
     // between two compounds only: `applies`).
     if reduced {
-        reduce(&mut manifolds);
+        reduce(&mut manifolds, &still);
     }
     manifolds
 }
@@ -140,4 +140,54 @@ fn speculative_parts_share_one_layer() {
     assert_eq!(kept.len(), 8, "{kept:?}");
     assert_eq!(resting, 4, "{kept:?}");
     assert!(nearest_raised >= 1, "{kept:?}");
+}
+
+/// A row of five cubes over the box, apart: the first resting on it, the second, fourth and fifth
+/// 2 mm up, the middle one 8 mm up but closing 12 mm in the step (a part of a spinning body
+/// turning into the other). The middle cube's points are about to touch: they make a layer of
+/// their own and keep four points, beside the resting four and four of the far ones. Without
+/// its motion (`still`) the middle cube is only the farthest of the far layer, whose four
+/// points go to the deepest and the row's ends, and it keeps none.
+#[test]
+fn a_part_closing_within_the_step_keeps_its_points() {
+    // Cubes 0.1 m wide, 0.1 m apart, so that no cube's corner is another's.
+    let parts: Vec<(Pose, SharedShape)> = [0.0, 0.002, 0.008, 0.002, 0.002]
+        .into_iter()
+        .enumerate()
+        .map(|(k, raise)| {
+            let at = Vec3::new(0.2 * k as f32 - 0.4, 0.05 + raise, 0.0);
+            (
+                Pose::from_translation(at),
+                SharedShape::cuboid(0.05, 0.05, 0.05),
+            )
+        })
+        .collect();
+    let compound = SharedShape::compound(parts);
+    // The box is body 1; the middle cube's points lie near x = 0 in its frame.
+    let closing = |position: Vec3, _normal: Vec3| {
+        if position.x.abs() < 0.06 { 0.012 } else { 0.0 }
+    };
+    let reduced = |closing: &dyn Fn(Vec3, Vec3) -> f32| {
+        let mut manifolds = on_ground(&compound, Pose::IDENTITY, false);
+        reduce(&mut manifolds, closing);
+        points(&manifolds)
+    };
+    let middle = |kept: &[(Vec3, f32)]| {
+        kept.iter()
+            .filter(|(p, d)| p.x.abs() < 0.06 && (d - 0.008).abs() < 1e-4)
+            .count()
+    };
+    let moving = reduced(&closing);
+    let resting = moving.iter().filter(|(_, d)| d.abs() < 1e-4).count();
+    assert_eq!(
+        (middle(&moving), resting, moving.len()),
+        (4, 4, 12),
+        "{moving:?}"
+    );
+    let still_kept = reduced(&still);
+    assert_eq!(
+        (middle(&still_kept), still_kept.len()),
+        (0, 8),
+        "{still_kept:?}"
+    );
 }
