@@ -24,6 +24,8 @@ use parry3d::math::{Pose, Real, Vector};
 use parry3d::shape::{Shape, TypedShape};
 use parry3d::transformation::convex_hull;
 
+use crate::simd::{InstructionSet, on_instruction_set};
+
 /// Cosine above which two unit normals are one axis.
 const SAME_AXIS: Real = 1.0 - 1.0e-6;
 
@@ -220,10 +222,11 @@ impl GaussArc {
 
 /// Many arcs in columns (their ends and the normals of their great circles, by coordinate),
 /// to be tested against one arc at a time: the whole test of [`GaussArc::crosses`] runs over
-/// the columns in a loop without branches, which the compiler vectorises, and the arcs that
-/// cross are then read off a byte per arc, eight at a time. The same arithmetic, in the same
-/// order, as [`GaussArc::crosses`] (only evaluated for every arc, where `crosses` stops at the
-/// first test that fails, which changes no answer: the tests have no side effects): the same
+/// the columns in a loop without branches, which the compiler vectorises (for the widest
+/// instruction set the CPU has, [`crate::simd`]), and the arcs that cross are then read off a
+/// byte per arc, eight at a time. The same arithmetic, in the same order, as
+/// [`GaussArc::crosses`] (only evaluated for every arc, where `crosses` stops at the first
+/// test that fails, which changes no answer: the tests have no side effects): the same
 /// answers to the bit.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct GaussArcs {
@@ -266,6 +269,24 @@ impl GaussArcs {
     /// Calls `found(j)` for every arc j that crosses `arc`, in order.
     #[inline]
     pub(crate) fn crossing(&mut self, arc: &GaussArc, mut found: impl FnMut(usize)) {
+        // The same IEEE operations in the same order on every instruction set (Rust fuses no
+        // multiply and add unasked): wider vectors change the time, not the answers.
+        on_instruction_set!(InstructionSet::detected(), self.test_all(arc));
+        // Most arcs cross none: eight at a time, in order, lowest byte first.
+        for (k, eight) in self.hits.chunks_exact(8).enumerate() {
+            let mut word = u64::from_le_bytes(eight.try_into().unwrap_or([0; 8]));
+            while word != 0 {
+                found(8 * k + word.trailing_zeros() as usize / 8);
+                // Each hit is its byte's lowest bit: clearing the lowest set bit clears it.
+                word &= word - 1;
+            }
+        }
+    }
+
+    /// Writes `hits`: whether each arc crosses `arc` ([`GaussArc::crosses`]'s tests, every
+    /// one for every arc, without branches).
+    #[inline(always)]
+    fn test_all(&mut self, arc: &GaussArc) {
         let (a, b, n) = (arc.a, arc.b, arc.bxa);
         let count = self.columns[0].len();
         let [cx, cy, cz, dx, dy, dz, nx, ny, nz] = self.columns.each_ref().map(|c| &c[..count]);
@@ -279,15 +300,6 @@ impl GaussArcs {
             let bdc = b.x * nx[j] + b.y * ny[j] + b.z * nz[j];
             let straddles = cba * dba < 0.0;
             hits[j] = u8::from(straddles & (adc * bdc < 0.0) & (cba * bdc > 0.0));
-        }
-        // Most arcs cross none: eight at a time, in order, lowest byte first.
-        for (k, eight) in self.hits.chunks_exact(8).enumerate() {
-            let mut word = u64::from_le_bytes(eight.try_into().unwrap_or([0; 8]));
-            while word != 0 {
-                found(8 * k + word.trailing_zeros() as usize / 8);
-                // Each hit is its byte's lowest bit: clearing the lowest set bit clears it.
-                word &= word - 1;
-            }
         }
     }
 }
