@@ -24,6 +24,8 @@ use parry3d::math::{Pose, Real, Vector};
 use parry3d::shape::{Shape, TypedShape};
 use parry3d::transformation::convex_hull;
 
+use crate::simd::{InstructionSet, on_instruction_set};
+
 /// Cosine above which two unit normals are one axis.
 const SAME_AXIS: Real = 1.0 - 1.0e-6;
 
@@ -218,59 +220,86 @@ impl GaussArc {
     }
 }
 
-/// Many arcs, their ends in columns, to be tested against one arc at a time: the first test
-/// of [`GaussArc::crosses`] (whether an arc's ends straddle the other's great circle, which
-/// most do not) runs over the columns in a loop the compiler vectorises. The same arithmetic,
-/// in the same order, as [`GaussArc::crosses`]: the same answers to the bit.
+/// Many arcs in columns (their ends and the normals of their great circles, by coordinate),
+/// to be tested against one arc at a time: the whole test of [`GaussArc::crosses`] runs over
+/// the columns in a loop without branches, which the compiler vectorises (for the widest
+/// instruction set the CPU has, [`crate::simd`]), and the arcs that cross are then read off a
+/// byte per arc, eight at a time. The same arithmetic, in the same order, as
+/// [`GaussArc::crosses`] (only evaluated for every arc, where `crosses` stops at the first
+/// test that fails, which changes no answer: the tests have no side effects): the same
+/// answers to the bit.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct GaussArcs {
-    arcs: Vec<GaussArc>,
-    /// The arcs' first ends, then their second ends, by coordinate.
-    ends: [Vec<Real>; 6],
-    /// c·(b × a) of each arc's first end against the arc last tested.
-    first: Vec<Real>,
-    /// Whether each arc straddles the great circle of the arc last tested.
-    straddles: Vec<bool>,
+    /// The arcs' first ends (c), their second ends (d), and d × c (the normals of their great
+    /// circles, [`GaussArc`]'s `bxa`), by coordinate.
+    columns: [Vec<Real>; 9],
+    /// 1 where the arc crosses the arc last tested, else 0; padded with zeros to a multiple of
+    /// eight, so the bytes are read as whole words.
+    hits: Vec<u8>,
 }
 
 impl GaussArcs {
     /// The columns of `arcs`.
     pub(crate) fn new(arcs: impl IntoIterator<Item = GaussArc>) -> Self {
         let mut columns = Self::default();
+        columns.refill(arcs);
+        columns
+    }
+
+    /// Replaces the arcs by `arcs`, keeping the columns' allocations.
+    pub(crate) fn refill(&mut self, arcs: impl IntoIterator<Item = GaussArc>) {
+        for column in &mut self.columns {
+            column.clear();
+        }
         for arc in arcs {
-            for (column, value) in columns
-                .ends
+            let (c, d, n) = (arc.a, arc.b, arc.bxa);
+            for (column, value) in self
+                .columns
                 .iter_mut()
-                .zip([arc.a.x, arc.a.y, arc.a.z, arc.b.x, arc.b.y, arc.b.z])
+                .zip([c.x, c.y, c.z, d.x, d.y, d.z, n.x, n.y, n.z])
             {
                 column.push(value);
             }
-            columns.arcs.push(arc);
         }
-        let count = columns.arcs.len();
-        columns.first.resize(count, 0.0);
-        columns.straddles.resize(count, false);
-        columns
+        self.hits.clear();
+        self.hits
+            .resize(self.columns[0].len().next_multiple_of(8), 0);
     }
 
     /// Calls `found(j)` for every arc j that crosses `arc`, in order.
     #[inline]
     pub(crate) fn crossing(&mut self, arc: &GaussArc, mut found: impl FnMut(usize)) {
-        let n = arc.bxa;
-        let [cx, cy, cz, dx, dy, dz] = &self.ends;
-        let count = self.arcs.len();
-        let (first, straddles) = (&mut self.first[..count], &mut self.straddles[..count]);
+        // The same IEEE operations in the same order on every instruction set (Rust fuses no
+        // multiply and add unasked): wider vectors change the time, not the answers.
+        on_instruction_set!(InstructionSet::detected(), self.test_all(arc));
+        // Most arcs cross none: eight at a time, in order, lowest byte first.
+        for (k, eight) in self.hits.chunks_exact(8).enumerate() {
+            let mut word = u64::from_le_bytes(eight.try_into().unwrap_or([0; 8]));
+            while word != 0 {
+                found(8 * k + word.trailing_zeros() as usize / 8);
+                // Each hit is its byte's lowest bit: clearing the lowest set bit clears it.
+                word &= word - 1;
+            }
+        }
+    }
+
+    /// Writes `hits`: whether each arc crosses `arc` ([`GaussArc::crosses`]'s tests, every
+    /// one for every arc, without branches).
+    #[inline(always)]
+    fn test_all(&mut self, arc: &GaussArc) {
+        let (a, b, n) = (arc.a, arc.b, arc.bxa);
+        let count = self.columns[0].len();
+        let [cx, cy, cz, dx, dy, dz, nx, ny, nz] = self.columns.each_ref().map(|c| &c[..count]);
+        let hits = &mut self.hits[..count];
         for j in 0..count {
-            // Vec3::dot's order: (x·x' + y·y') + z·z'.
+            // Vec3::dot's order, (x·x' + y·y') + z·z', as `crosses` takes it: c·(b × a),
+            // d·(b × a), a·(d × c), b·(d × c).
             let cba = cx[j] * n.x + cy[j] * n.y + cz[j] * n.z;
             let dba = dx[j] * n.x + dy[j] * n.y + dz[j] * n.z;
-            first[j] = cba;
-            straddles[j] = cba * dba < 0.0;
-        }
-        for j in 0..count {
-            if straddles[j] && arc.crosses_straddling(&self.arcs[j], first[j]) {
-                found(j);
-            }
+            let adc = a.x * nx[j] + a.y * ny[j] + a.z * nz[j];
+            let bdc = b.x * nx[j] + b.y * ny[j] + b.z * nz[j];
+            let straddles = cba * dba < 0.0;
+            hits[j] = u8::from(straddles & (adc * bdc < 0.0) & (cba * bdc > 0.0));
         }
     }
 }

@@ -109,8 +109,10 @@ fn a_box_reads_as_the_hull_of_its_corners() {
     assert!(overlapping > 200, "{overlapping} overlapping poses");
 }
 
-/// Arcs in columns answer as one arc at a time, to the bit: 40 of 200 seeded random arcs,
-/// short as a hull's edges make them and long, against all 200.
+/// Arcs in columns answer as one arc at a time, to the bit: 203 seeded random arcs (not a
+/// multiple of the eight read at a time), short as a hull's edges make them and long, some
+/// sharing an end or their great circle with another (tests on the boundary, products of
+/// zero), each against all of them, refilled columns as new ones.
 #[test]
 fn arcs_in_columns_cross_as_one_at_a_time() {
     use super::{GaussArc, GaussArcs};
@@ -119,27 +121,37 @@ fn arcs_in_columns_cross_as_one_at_a_time() {
     use rand_distr::{Distribution, UnitSphere};
     let mut rng = ChaCha20Rng::seed_from_u64(17);
     let unit = |rng: &mut ChaCha20Rng| Vec3::from(UnitSphere.sample(rng) as [f32; 3]);
-    let arcs: Vec<GaussArc> = (0..200)
-        .map(|_| {
-            let a = unit(&mut rng);
-            // Short arcs, as a hull's edges make, and some long ones.
-            let b = (a + unit(&mut rng) * rng.random_range(0.05..1.5)).normalize();
-            GaussArc::new(a, b)
-        })
-        .collect();
-    let mut columns = GaussArcs::new(arcs.iter().copied());
+    let mut arcs: Vec<GaussArc> = Vec::new();
+    let mut ends: Vec<(Vec3, Vec3)> = Vec::new();
+    for k in 0..203 {
+        let a = unit(&mut rng);
+        // Short arcs, as a hull's edges make, and some long ones.
+        let b = (a + unit(&mut rng) * rng.random_range(0.05..1.5)).normalize();
+        let (a, b) = match (k % 10, ends.len()) {
+            // An end of an earlier arc, or an earlier arc's great circle (its ends swapped).
+            (3, n) if n > 0 => (ends[rng.random_range(0..n)].0, b),
+            (7, n) if n > 0 => {
+                let (c, d) = ends[rng.random_range(0..n)];
+                (d, c)
+            }
+            _ => (a, b),
+        };
+        ends.push((a, b));
+        arcs.push(GaussArc::new(a, b));
+    }
+    let mut columns = GaussArcs::new(arcs[..50].iter().copied());
+    columns.refill(arcs.iter().copied());
     let mut crossings = 0;
-    for k in 0..40 {
-        let arc = arcs[k * 5];
+    for (k, arc) in arcs.iter().enumerate() {
         let mut found = Vec::new();
-        columns.crossing(&arc, |j| found.push(j));
+        columns.crossing(arc, |j| found.push(j));
         let one_at_a_time: Vec<usize> =
             (0..arcs.len()).filter(|&j| arc.crosses(&arcs[j])).collect();
         assert_eq!(found, one_at_a_time, "arc {k}");
         crossings += found.len();
     }
     assert!(
-        crossings > 100,
+        crossings > 500,
         "{crossings} crossings: the sample tests too little"
     );
 }
