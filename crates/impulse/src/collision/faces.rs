@@ -706,10 +706,7 @@ fn edge_axis_above(
     let (points1, points2) = (hull1.points(), hull2.points());
     // Shape 2's edges in shape 1's frame, once: each edge's arc between its faces' normals
     // (negated, as the Minkowski difference sees them), its direction and one of its points.
-    let edges2: Vec<(GaussArc, Vector, Vector)> = hull2
-        .edges()
-        .iter()
-        .filter(|e| e.faces[0] != e.faces[1])
+    let edges2: Vec<(GaussArc, Vector, Vector)> = hull_edges(hull2)
         .map(|e2| {
             let c = pos12.rotation * faces2[e2.faces[0] as usize].normal;
             let d = pos12.rotation * faces2[e2.faces[1] as usize].normal;
@@ -739,7 +736,7 @@ fn edge_axis_above(
     // (bound, place in the loops' order, axis)
     let mut candidates: Vec<(Real, u32, Vector)> = Vec::new();
     let mut order = 0_u32;
-    for e1 in hull1.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
+    for e1 in hull_edges(hull1) {
         let (normal_a, normal_b) = (
             faces1[e1.faces[0] as usize].normal,
             faces1[e1.faces[1] as usize].normal,
@@ -775,6 +772,36 @@ fn edge_axis_above(
     });
     best.map(|(axis, separation, _)| (axis, separation))
         .filter(|&(_, separation)| separation > threshold)
+}
+
+/// The edges of `hull` between two of its faces: an edge inside a face (both sides the same
+/// face) is no edge of the Minkowski difference, and Parry leaves an edge beside a degenerate
+/// triangle (points all but collinear, as a box's faces sampled with jitter give) holding a
+/// triangle's index where a face's belongs, past the end of the faces: such an edge is left
+/// out rather than read out of bounds.
+fn hull_edges(hull: &ConvexPolyhedron) -> impl Iterator<Item = HullEdge> + '_ {
+    let (faces, points) = (hull.faces().len(), hull.points().len());
+    hull.edges()
+        .iter()
+        .filter(move |e| {
+            e.faces[0] != e.faces[1]
+                && e.faces.iter().all(|&f| (f as usize) < faces)
+                && e.vertices.iter().all(|&v| (v as usize) < points)
+        })
+        .map(|e| HullEdge {
+            vertices: e.vertices,
+            faces: e.faces,
+            dir: e.dir,
+        })
+}
+
+/// An edge of a hull ([`hull_edges`]): its two vertices and two faces (indices into the
+/// hull's points and faces) and its unit direction (the hull's frame).
+#[derive(Clone, Copy)]
+struct HullEdge {
+    vertices: [u32; 2],
+    faces: [u32; 2],
+    dir: Vector,
 }
 
 /// The largest separation among `candidates` (each an upper bound of its separation (m), its

@@ -521,3 +521,87 @@ fn edge_search_gives_every_pair_one_at_a_time_on_random_hulls() {
         "{edge_pairs} edge axes: the sample tests too little"
     );
 }
+
+/// A hull Parry builds with an edge whose face index is past its faces (beside a degenerate
+/// triangle of points jittered on a box's faces) meets another hull in the edge search
+/// without reading out of bounds: such edges are left out ([`super::hull_edges`]), and the
+/// search still takes the other edges.
+#[test]
+fn an_edge_past_the_faces_is_left_out_of_the_edge_search() {
+    use super::{FaceSearch, edge_axis_above, hull_edges, hull_parts};
+    use crate::collision::axis_memory::float_slack;
+    use parry3d::math::Real;
+    use rand::rngs::ChaCha20Rng;
+    use rand::{RngExt, SeedableRng};
+    let mut rng = ChaCha20Rng::seed_from_u64(29);
+    // Points on a box's faces, 0.1 µm off them at most, until Parry's hull has such an edge.
+    let broken = (0..20_000)
+        .find_map(|_| {
+            let count = rng.random_range(6..60);
+            let points: Vec<Vec3> = (0..count)
+                .map(|_| {
+                    let mut p = Vec3::new(
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                    );
+                    let k = rng.random_range(0..3);
+                    p[k] = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+                    let jitter = Vec3::new(
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                    );
+                    p * 0.03 + jitter * 1.0e-7
+                })
+                .collect();
+            let shape = SharedShape::convex_hull(&points)?;
+            let (hull, _) = hull_parts(shape.as_ref())?;
+            let faces = hull.faces().len() as u32;
+            hull.edges()
+                .iter()
+                .any(|e| e.faces.iter().any(|&f| f >= faces))
+                .then_some(shape)
+        })
+        .expect("no hull with an edge past its faces in 20,000 draws");
+    let (hull, _) = hull_parts(broken.as_ref()).unwrap();
+    let kept = hull_edges(hull).count();
+    assert!(
+        kept > 0 && kept < hull.edges().len(),
+        "{kept} of {}",
+        hull.edges().len()
+    );
+    let cube = SharedShape::convex_hull(&[
+        Vec3::new(-0.02, -0.02, -0.02),
+        Vec3::new(0.02, -0.02, -0.02),
+        Vec3::new(-0.02, 0.02, -0.02),
+        Vec3::new(0.02, 0.02, -0.02),
+        Vec3::new(-0.02, -0.02, 0.02),
+        Vec3::new(0.02, -0.02, 0.02),
+        Vec3::new(-0.02, 0.02, 0.02),
+        Vec3::new(0.02, 0.02, 0.02),
+    ])
+    .unwrap();
+    let pos12 = Pose::from_parts(
+        Vec3::new(0.04, 0.03, 0.02),
+        Quat::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
+    );
+    for (g1, g2, pose) in [
+        (broken.as_ref(), cube.as_ref(), pos12),
+        (cube.as_ref(), broken.as_ref(), pos12.inverse()),
+    ] {
+        let (sphere1, sphere2) = (
+            g1.compute_local_bounding_sphere(),
+            g2.compute_local_bounding_sphere(),
+        );
+        let search = FaceSearch {
+            threshold: Real::MIN,
+            slack: float_slack(&pose, &sphere1, &sphere2),
+            spheres: (&sphere1, &sphere2),
+            known: (Vec3::ZERO, Vec3::ZERO),
+        };
+        let (h1, h2) = (hull_parts(g1).unwrap().0, hull_parts(g2).unwrap().0);
+        let found = edge_axis_above(&pose, (g1, h1), (g2, h2), &search);
+        assert!(found.is_some_and(|(axis, value)| axis.is_finite() && value.is_finite()));
+    }
+}
