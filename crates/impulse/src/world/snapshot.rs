@@ -699,11 +699,12 @@ fn check_polyhedron(hull: &parry3d::shape::ConvexPolyhedron) -> Result<(), Strin
                     edges_of_face.len(),
                 )
         })
-        && edges.iter().all(|e| {
-            e.dir.is_finite()
-                && all_below(&e.vertices, points.len())
-                && all_below(&e.faces, faces.len())
-        })
+        // An edge's face indices are not checked: Parry's own hull of points all but
+        // coplanar can leave one past the faces (beside a degenerate triangle), and the
+        // engine's edge search leaves such edges out (`collision::faces`).
+        && edges
+            .iter()
+            .all(|e| e.dir.is_finite() && all_below(&e.vertices, points.len()))
         && all_below(faces_of_vertex, faces.len())
         && all_below(vertices_of_face, points.len())
         && all_below(edges_of_face, edges.len());

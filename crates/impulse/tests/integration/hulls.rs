@@ -464,3 +464,77 @@ fn former_sweep_failures_rest() {
     }
     assert_clean(&failures);
 }
+
+/// Points jittered by 0.1 µm on a box's faces, as a scanner or a modelling tool's snapping
+/// gives them: Parry's hull of some such clouds holds an edge whose face index is past its
+/// faces (beside a degenerate triangle). Three such hulls piled on a box step for a second
+/// (the edge search of two hulls leaves that edge out instead of reading out of bounds),
+/// come to rest on the box, and their world saves and restores as a snapshot that goes on
+/// as the world does.
+#[test]
+fn hulls_with_an_edge_past_their_faces_step_and_restore() {
+    use rand::rngs::ChaCha20Rng;
+    use rand::{RngExt, SeedableRng};
+    let mut rng = ChaCha20Rng::seed_from_u64(29);
+    let points = (0..20_000)
+        .find_map(|_| {
+            let count = rng.random_range(6..60);
+            let points: Vec<Vec3> = (0..count)
+                .map(|_| {
+                    let mut p = Vec3::new(
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                    );
+                    let k = rng.random_range(0..3);
+                    p[k] = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+                    let jitter = Vec3::new(
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                    );
+                    p * 0.03 + jitter * 1.0e-7
+                })
+                .collect();
+            let hull = ConvexPolyhedron::from_convex_hull(&points)?;
+            let faces = hull.faces().len() as u32;
+            hull.edges()
+                .iter()
+                .any(|e| e.faces.iter().any(|&f| f >= faces))
+                .then_some(points)
+        })
+        .expect("no such hull in 20,000 clouds");
+    let mut scene = Scene::default();
+    scene.bodies.push(BodyDesc::new(
+        BodyKind::Static,
+        ShapeDesc::Cuboid {
+            half_extents: [1.0, 0.1, 1.0],
+        },
+        [0.0, -0.1, 0.0],
+    ));
+    for k in 0..3 {
+        let mut body = BodyDesc::new(
+            BodyKind::Dynamic,
+            ShapeDesc::ConvexHull {
+                points: points.iter().map(|p| p.to_array()).collect(),
+            },
+            [0.01 * k as f32, 0.05 + 0.07 * k as f32, 0.0],
+        );
+        body.orientation = Quat::from_rotation_z(0.3 * k as f32).to_array();
+        scene.bodies.push(body);
+    }
+    let mut world = World::from_scene(&scene).unwrap();
+    for _ in 0..60 {
+        world.step().unwrap();
+    }
+    for i in 1..4 {
+        let height = world.poses()[i].translation.y;
+        assert!(height > 0.0 && height < 0.25, "body {i} at {height} m");
+    }
+    let mut restored = World::from_snapshot(world.snapshot().unwrap()).unwrap();
+    for _ in 0..30 {
+        world.step().unwrap();
+        restored.step().unwrap();
+    }
+    assert_eq!(restored.poses(), world.poses());
+}
