@@ -42,6 +42,11 @@ pub struct IslandReport {
     /// the impact alone (in SIMD lanes: the points of the lane groups they visited).
     #[serde(default)]
     pub impact_points: u64,
+    /// Substeps whose main solve found an impact and swept on (`impact_sweeps` is their sum):
+    /// one for a landing resolved where it happened, up to `substeps` when every later
+    /// substep of the step took sweeps again.
+    #[serde(default)]
+    pub impact_substeps: u32,
     /// Whether the substeps' solves ran in SIMD lanes.
     pub simd: bool,
     /// Natural-map residual of the island's rows at the end of the step (see

@@ -172,6 +172,9 @@ impl IslandWorkspace {
         } else {
             self.impact_met
         };
+        if with_repair && self.impact_met {
+            self.report.impact_substeps += 1;
+        }
         if self.impact_met && self.impact_region.kind == RegionKind::Unknown {
             let wide = bundled.then_some(&mut self.solvers.wide);
             let (speed, moving) = (self.impact_speed, self.report.bodies as usize);
