@@ -281,7 +281,6 @@ fn searches_by_bound_give_the_largest_over_every_axis() {
     };
     use crate::collision::axis_memory::float_slack;
     use crate::collision::hull_pairs_tests::{case, mug_parts, part_shape};
-    use crate::collision::separating_axes::arcs_cross;
     use parry3d::math::Real;
     // The last of equals, as the searches take it.
     let largest = |values: &mut dyn Iterator<Item = (Vec3, Real)>| {
@@ -332,35 +331,7 @@ fn searches_by_bound_give_the_largest_over_every_axis() {
 
         let ((hull1, _), (hull2, _)) = (hull_parts(g1).unwrap(), hull_parts(g2).unwrap());
         // Every crossing pair, one at a time, along the direction where the arcs cross.
-        let (faces1, faces2) = (hull1.faces(), hull2.faces());
-        let mut taken = Vec::new();
-        for e1 in hull1.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
-            let (a, b) = (
-                faces1[e1.faces[0] as usize].normal,
-                faces1[e1.faces[1] as usize].normal,
-            );
-            for e2 in hull2.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
-                let cn = pos12.rotation * faces2[e2.faces[0] as usize].normal;
-                let dn = pos12.rotation * faces2[e2.faces[1] as usize].normal;
-                if !arcs_cross(a, b, -cn, -dn) {
-                    continue;
-                }
-                let Some(axis) = e1.dir.cross(pos12.rotation * e2.dir).try_normalize() else {
-                    continue;
-                };
-                let side = axis.dot(a + b);
-                let directions = if side > 0.0 {
-                    vec![axis]
-                } else if side < 0.0 {
-                    vec![-axis]
-                } else {
-                    vec![axis, -axis]
-                };
-                for axis in directions {
-                    taken.push((axis, support_separation(&pos12, g1, g2, axis).unwrap()));
-                }
-            }
-        }
+        let taken = every_edge_axis(&pos12, (g1, hull1), (g2, hull2));
         edge_pairs += taken.len();
         let every = largest(&mut taken.into_iter());
         let Some((_, top)) = every else {
@@ -385,9 +356,8 @@ fn searches_by_bound_give_the_largest_over_every_axis() {
 /// from 20 mm apart to 20 mm in, with no threshold and thresholds around the largest.
 #[test]
 fn edge_search_gives_every_pair_one_at_a_time_on_random_hulls() {
-    use super::{FaceSearch, edge_axis_above, hull_parts, support_separation};
+    use super::{FaceSearch, edge_axis_above, hull_parts};
     use crate::collision::axis_memory::float_slack;
-    use crate::collision::separating_axes::GaussArc;
     use parry3d::math::Real;
     use rand::rngs::ChaCha20Rng;
     use rand::{RngExt, SeedableRng};
@@ -470,35 +440,7 @@ fn edge_search_gives_every_pair_one_at_a_time_on_random_hulls() {
         let pos12 = pos1.inv_mul(&pos2);
         let slack = float_slack(&pos12, &sphere1, &sphere2);
         let ((hull1, _), (hull2, _)) = (hull_parts(g1).unwrap(), hull_parts(g2).unwrap());
-        let (faces1, faces2) = (hull1.faces(), hull2.faces());
-        let mut taken = Vec::new();
-        for e1 in hull1.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
-            let (a, b) = (
-                faces1[e1.faces[0] as usize].normal,
-                faces1[e1.faces[1] as usize].normal,
-            );
-            for e2 in hull2.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
-                let cn = pos12.rotation * faces2[e2.faces[0] as usize].normal;
-                let dn = pos12.rotation * faces2[e2.faces[1] as usize].normal;
-                if !GaussArc::new(a, b).crosses(&GaussArc::new(-cn, -dn)) {
-                    continue;
-                }
-                let Some(axis) = e1.dir.cross(pos12.rotation * e2.dir).try_normalize() else {
-                    continue;
-                };
-                let side = axis.dot(a + b);
-                let directions = if side > 0.0 {
-                    vec![axis]
-                } else if side < 0.0 {
-                    vec![-axis]
-                } else {
-                    vec![axis, -axis]
-                };
-                for axis in directions {
-                    taken.push((axis, support_separation(&pos12, g1, g2, axis).unwrap()));
-                }
-            }
-        }
+        let taken = every_edge_axis(&pos12, (g1, hull1), (g2, hull2));
         edge_pairs += taken.len();
         let every = largest(&mut taken.into_iter());
         let Some((_, top)) = every else {
@@ -531,39 +473,8 @@ fn an_edge_past_the_faces_is_left_out_of_the_edge_search() {
     use super::{FaceSearch, edge_axis_above, hull_edges, hull_parts};
     use crate::collision::axis_memory::float_slack;
     use parry3d::math::Real;
-    use rand::rngs::ChaCha20Rng;
-    use rand::{RngExt, SeedableRng};
-    let mut rng = ChaCha20Rng::seed_from_u64(29);
-    // Points on a box's faces, 0.1 µm off them at most, until Parry's hull has such an edge.
-    let broken = (0..20_000)
-        .find_map(|_| {
-            let count = rng.random_range(6..60);
-            let points: Vec<Vec3> = (0..count)
-                .map(|_| {
-                    let mut p = Vec3::new(
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                    );
-                    let k = rng.random_range(0..3);
-                    p[k] = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
-                    let jitter = Vec3::new(
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                    );
-                    p * 0.03 + jitter * 1.0e-7
-                })
-                .collect();
-            let shape = SharedShape::convex_hull(&points)?;
-            let (hull, _) = hull_parts(shape.as_ref())?;
-            let faces = hull.faces().len() as u32;
-            hull.edges()
-                .iter()
-                .any(|e| e.faces.iter().any(|&f| f >= faces))
-                .then_some(shape)
-        })
-        .expect("no hull with an edge past its faces in 20,000 draws");
+    let points = crate::test_support::box_points_with_an_edge_past_the_faces(29, 0.03);
+    let broken = SharedShape::convex_hull(&points).unwrap();
     let (hull, _) = hull_parts(broken.as_ref()).unwrap();
     let kept = hull_edges(hull).count();
     assert!(
@@ -604,4 +515,46 @@ fn an_edge_past_the_faces_is_left_out_of_the_edge_search() {
         let found = edge_axis_above(&pose, (g1, h1), (g2, h2), &search);
         assert!(found.is_some_and(|(axis, value)| axis.is_finite() && value.is_finite()));
     }
+}
+
+/// Every edge axis of hulls `hull1` and `hull2` (the cores of `g1` and `g2`, shape 2 at
+/// `pos12` in shape 1's frame) with its separation (m): each edge pair whose Gauss-map arcs
+/// cross, taken one at a time, along the direction where the arcs cross (both where that is
+/// undecided), in the loops' order: what the edge search reaches by bound.
+fn every_edge_axis(
+    pos12: &Pose,
+    (g1, hull1): (&dyn Shape, &parry3d::shape::ConvexPolyhedron),
+    (g2, hull2): (&dyn Shape, &parry3d::shape::ConvexPolyhedron),
+) -> Vec<(Vec3, f32)> {
+    use super::support_separation;
+    let (faces1, faces2) = (hull1.faces(), hull2.faces());
+    let mut taken = Vec::new();
+    for e1 in hull1.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
+        let (a, b) = (
+            faces1[e1.faces[0] as usize].normal,
+            faces1[e1.faces[1] as usize].normal,
+        );
+        for e2 in hull2.edges().iter().filter(|e| e.faces[0] != e.faces[1]) {
+            let cn = pos12.rotation * faces2[e2.faces[0] as usize].normal;
+            let dn = pos12.rotation * faces2[e2.faces[1] as usize].normal;
+            if !crate::collision::separating_axes::arcs_cross(a, b, -cn, -dn) {
+                continue;
+            }
+            let Some(axis) = e1.dir.cross(pos12.rotation * e2.dir).try_normalize() else {
+                continue;
+            };
+            let side = axis.dot(a + b);
+            let directions = if side > 0.0 {
+                vec![axis]
+            } else if side < 0.0 {
+                vec![-axis]
+            } else {
+                vec![axis, -axis]
+            };
+            for axis in directions {
+                taken.push((axis, support_separation(pos12, g1, g2, axis).unwrap()));
+            }
+        }
+    }
+    taken
 }

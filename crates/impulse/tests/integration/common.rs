@@ -197,3 +197,45 @@ pub(crate) fn poses_after(
     }
     world.poses().to_vec()
 }
+
+/// Points on the faces of a cube of half extent `half` (m), 6 to 59 of them drawn from
+/// `rng`, each moved by up to 0.1 µm per axis: a box as a scanner or a modelling tool's
+/// snapping leaves it, all but coplanar on each face.
+pub(crate) fn jittered_box_points(rng: &mut rand::rngs::ChaCha20Rng, half: f32) -> Vec<Vec3> {
+    use rand::RngExt;
+    let count = rng.random_range(6..60);
+    let unit = |rng: &mut rand::rngs::ChaCha20Rng| {
+        Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+    };
+    (0..count)
+        .map(|_| {
+            let mut p = unit(rng);
+            let k = rng.random_range(0..3);
+            p[k] = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+            p * half + unit(rng) * 1.0e-7
+        })
+        .collect()
+}
+
+/// The first of [`jittered_box_points`] (half extent `half`, drawn from a ChaCha20 stream
+/// seeded with `seed`) whose Parry hull holds an edge with a face index past its faces
+/// (beside a degenerate triangle). Panics if none comes in 20,000 draws.
+pub(crate) fn box_points_with_an_edge_past_the_faces(seed: u64, half: f32) -> Vec<Vec3> {
+    use rand::SeedableRng;
+    let mut rng = rand::rngs::ChaCha20Rng::seed_from_u64(seed);
+    (0..20_000)
+        .find_map(|_| {
+            let points = jittered_box_points(&mut rng, half);
+            let hull = impulse::parry3d::shape::ConvexPolyhedron::from_convex_hull(&points)?;
+            let faces = hull.faces().len() as u32;
+            hull.edges()
+                .iter()
+                .any(|e| e.faces.iter().any(|&f| f >= faces))
+                .then_some(points)
+        })
+        .expect("no hull with an edge past its faces in 20,000 draws")
+}

@@ -473,37 +473,7 @@ fn former_sweep_failures_rest() {
 /// as the world does.
 #[test]
 fn hulls_with_an_edge_past_their_faces_step_and_restore() {
-    use rand::rngs::ChaCha20Rng;
-    use rand::{RngExt, SeedableRng};
-    let mut rng = ChaCha20Rng::seed_from_u64(29);
-    let points = (0..20_000)
-        .find_map(|_| {
-            let count = rng.random_range(6..60);
-            let points: Vec<Vec3> = (0..count)
-                .map(|_| {
-                    let mut p = Vec3::new(
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                    );
-                    let k = rng.random_range(0..3);
-                    p[k] = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
-                    let jitter = Vec3::new(
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                    );
-                    p * 0.03 + jitter * 1.0e-7
-                })
-                .collect();
-            let hull = ConvexPolyhedron::from_convex_hull(&points)?;
-            let faces = hull.faces().len() as u32;
-            hull.edges()
-                .iter()
-                .any(|e| e.faces.iter().any(|&f| f >= faces))
-                .then_some(points)
-        })
-        .expect("no such hull in 20,000 clouds");
+    let points = super::common::box_points_with_an_edge_past_the_faces(29, 0.03);
     let mut scene = Scene::default();
     scene.bodies.push(BodyDesc::new(
         BodyKind::Static,
