@@ -333,15 +333,9 @@ fn searches_by_bound_give_the_largest_over_every_axis() {
         // Every crossing pair, one at a time, along the direction where the arcs cross.
         let taken = every_edge_axis(&pos12, (g1, hull1), (g2, hull2));
         edge_pairs += taken.len();
-        let every = largest(&mut taken.into_iter());
-        let Some((_, top)) = every else {
-            continue;
-        };
-        for threshold in [Real::MIN, top - 0.005, top - 0.001, top, top + 0.001] {
-            let found = edge_axis_above(&pos12, (g1, hull1), (g2, hull2), &search(threshold));
-            let above = every.filter(|&(_, value)| value > threshold);
-            assert_eq!(bits(found), bits(above), "edges, case {index}, {threshold}");
-        }
+        matches_every_axis(&taken, &format!("edges, case {index}"), |threshold| {
+            edge_axis_above(&pos12, (g1, hull1), (g2, hull2), &search(threshold))
+        });
     }
     assert!(
         edge_pairs > 10_000,
@@ -358,7 +352,6 @@ fn searches_by_bound_give_the_largest_over_every_axis() {
 fn edge_search_gives_every_pair_one_at_a_time_on_random_hulls() {
     use super::{FaceSearch, edge_axis_above, hull_parts};
     use crate::collision::axis_memory::float_slack;
-    use parry3d::math::Real;
     use rand::rngs::ChaCha20Rng;
     use rand::{RngExt, SeedableRng};
     use rand_distr::{Distribution, UnitSphere};
@@ -410,16 +403,6 @@ fn edge_search_gives_every_pair_one_at_a_time_on_random_hulls() {
             break shape;
         }
     };
-    let largest = |values: &mut dyn Iterator<Item = (Vec3, Real)>| {
-        values.fold(
-            None,
-            |best: Option<(Vec3, Real)>, (axis, value)| match best {
-                Some((_, top)) if value.total_cmp(&top).is_lt() => best,
-                _ => Some((axis, value)),
-            },
-        )
-    };
-    let bits = |found: Option<(Vec3, Real)>| found.map(|(a, v)| (a.to_array(), v.to_bits()));
     let mut edge_pairs = 0;
     for index in 0..300 {
         let (s1, s2) = (hull(&mut rng), hull(&mut rng));
@@ -442,21 +425,15 @@ fn edge_search_gives_every_pair_one_at_a_time_on_random_hulls() {
         let ((hull1, _), (hull2, _)) = (hull_parts(g1).unwrap(), hull_parts(g2).unwrap());
         let taken = every_edge_axis(&pos12, (g1, hull1), (g2, hull2));
         edge_pairs += taken.len();
-        let every = largest(&mut taken.into_iter());
-        let Some((_, top)) = every else {
-            continue;
-        };
-        for threshold in [Real::MIN, top - 0.005, top - 0.001, top, top + 0.001] {
+        matches_every_axis(&taken, &format!("case {index}"), |threshold| {
             let search = FaceSearch {
                 threshold,
                 slack,
                 spheres: (&sphere1, &sphere2),
                 known: (Vec3::ZERO, Vec3::ZERO),
             };
-            let found = edge_axis_above(&pos12, (g1, hull1), (g2, hull2), &search);
-            let above = every.filter(|&(_, value)| value > threshold);
-            assert_eq!(bits(found), bits(above), "case {index}, {threshold}");
-        }
+            edge_axis_above(&pos12, (g1, hull1), (g2, hull2), &search)
+        });
     }
     assert!(
         edge_pairs > 5_000,
@@ -557,4 +534,30 @@ fn every_edge_axis(
         }
     }
     taken
+}
+
+/// Asserts that `search(threshold)` gives, to the bit, the largest of `every` (axis,
+/// separation in m; the last of equals) when it is above the threshold and `None` otherwise,
+/// with no threshold and thresholds around the largest; `case` names the case.
+fn matches_every_axis(
+    every: &[(Vec3, f32)],
+    case: &str,
+    search: impl Fn(f32) -> Option<(Vec3, f32)>,
+) {
+    let largest =
+        every.iter().copied().fold(
+            None,
+            |best: Option<(Vec3, f32)>, (axis, value)| match best {
+                Some((_, top)) if value.total_cmp(&top).is_lt() => best,
+                _ => Some((axis, value)),
+            },
+        );
+    let Some((_, top)) = largest else {
+        return;
+    };
+    let bits = |found: Option<(Vec3, f32)>| found.map(|(a, v)| (a.to_array(), v.to_bits()));
+    for threshold in [f32::MIN, top - 0.005, top - 0.001, top, top + 0.001] {
+        let above = largest.filter(|&(_, value)| value > threshold);
+        assert_eq!(bits(search(threshold)), bits(above), "{case}, {threshold}");
+    }
 }
