@@ -135,16 +135,7 @@ impl SpeculativeMargins {
     /// add to it ([`SweptReach`]).
     #[inline]
     pub(crate) fn pair_reach(&self, bodies: &Bodies, a: usize, b: usize) -> SweptReach {
-        // The step's motion before contacts: the velocity with the step's gravity added
-        // (semi-implicit Euler) for a dynamic body, the prescribed one for a kinematic body.
-        let velocity = |i: usize| {
-            let gravity = if bodies.is_dynamic(i) {
-                self.gravity * self.dt
-            } else {
-                Vec3::ZERO
-            };
-            moving_velocity(bodies, i) + gravity
-        };
+        let velocity = |i: usize| self.step_velocity(bodies, i);
         SweptReach {
             displacement: (velocity(b) - velocity(a)) * self.dt,
             turn_reach: (self.spin_speeds[a].0 + self.spin_speeds[b].0) * self.dt,
@@ -166,18 +157,13 @@ impl SpeculativeMargins {
     ) -> impl Fn(Vec3, Vec3) -> f32 {
         let pose = bodies.pose[a];
         let motion = |i: usize| {
-            let gravity = if bodies.is_dynamic(i) {
-                self.gravity * self.dt
-            } else {
-                Vec3::ZERO
-            };
             let spin = if bodies.is_moving(i) {
                 bodies.angular_velocity[i]
             } else {
                 Vec3::ZERO
             };
             (
-                moving_velocity(bodies, i) + gravity,
+                self.step_velocity(bodies, i),
                 spin,
                 bodies.center_of_mass(i),
             )
@@ -189,6 +175,19 @@ impl SpeculativeMargins {
             let relative = (vb + wb.cross(x - cb)) - (va + wa.cross(x - ca));
             (-relative.dot(pose.rotation * normal)).max(0.0) * dt
         }
+    }
+
+    /// Body `i`'s velocity (m/s) over the step before contacts: with the step's gravity added
+    /// (semi-implicit Euler) for a dynamic body, the prescribed one for a kinematic body, zero
+    /// for a static one.
+    #[inline]
+    fn step_velocity(&self, bodies: &Bodies, i: usize) -> Vec3 {
+        let gravity = if bodies.is_dynamic(i) {
+            self.gravity * self.dt
+        } else {
+            Vec3::ZERO
+        };
+        moving_velocity(bodies, i) + gravity
     }
 
     /// The speed (m/s) gravity can add to pair (`a`, `b`)'s closing: it moves dynamic bodies

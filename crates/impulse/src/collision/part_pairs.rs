@@ -85,6 +85,9 @@ pub(crate) fn reduce(manifolds: &mut [Manifold], closing: &dyn Fn(Vector, Vector
     if manifolds.len() < 2 {
         return;
     }
+    if manifolds.iter().map(|m| m.points.len()).sum::<usize>() <= MAX_POINTS {
+        return;
+    }
     let identity = Pose::IDENTITY;
     let mut points: Vec<PatchPoint> = Vec::new();
     for (m, manifold) in manifolds.iter().enumerate() {
@@ -102,9 +105,6 @@ pub(crate) fn reduce(manifolds: &mut [Manifold], closing: &dyn Fn(Vector, Vector
                 kept: point.data.normal > 0.0 || point.data.step_normal > 0.0,
             }
         }));
-    }
-    if points.len() <= MAX_POINTS {
-        return;
     }
     // Deepest first (then by manifold and index: a total order), so that each patch's first
     // point is its deepest and names its normal.
