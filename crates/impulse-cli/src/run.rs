@@ -92,6 +92,9 @@ pub struct Summary {
     pub max_speed_m_s: f32,
     pub mean_contacts: f64,
     pub mean_iterations: f64,
+    /// Steps taken again in pieces because their try left moving bodies crossed
+    /// (`split_overlap`, docs/method.md "Split steps"); 0 when it is off.
+    pub split_steps: u64,
     /// Largest natural-map residual of any step's contact LCP at exit.
     pub max_natural_map_residual: f32,
     /// Natural-map residual of the last step.
@@ -137,7 +140,7 @@ impl Summary {
             "{}: {} bodies, {} steps of {:.4} s, mean contacts {:.0}, {:.3} ms/step ({:.0} steps/s), \
              max overlap {:.2} mm, {sink_and_drift}, kinetic \
              energy {:.4} J, max speed {:.2} m/s, mean iterations {:.1}, LCP residual max {:.2e} \
-             last {:.2e}",
+             last {:.2e}{}",
             self.scene,
             self.bodies,
             self.steps,
@@ -151,6 +154,11 @@ impl Summary {
             self.mean_iterations,
             self.max_natural_map_residual,
             self.final_natural_map_residual,
+            if self.split_steps > 0 {
+                format!(", split steps {}", self.split_steps)
+            } else {
+                String::new()
+            },
         )
     }
 
@@ -519,6 +527,7 @@ fn simulate(
     let mut profiles: Vec<StepProfile> = Vec::with_capacity(reserve);
     let mut contacts_sum = 0u64;
     let mut iterations_sum = 0u64;
+    let mut split_steps = 0u64;
     let mut max_residual = 0.0f32;
     let mut max_speed = 0.0f32;
     let mut max_overlap = metrics::max_overlap(&world, world.poses());
@@ -612,6 +621,7 @@ fn simulate(
         }
         contacts_sum += diagnostics.contacts as u64;
         iterations_sum += diagnostics.iterations as u64;
+        split_steps += u64::from(diagnostics.pieces > 1);
         max_residual = max_residual.max(diagnostics.natural_map_residual);
         for v in world.linear_velocities() {
             max_speed = max_speed.max(v.length());
@@ -689,6 +699,7 @@ fn simulate(
         max_speed_m_s: max_speed,
         mean_contacts: contacts_sum as f64 / taken,
         mean_iterations: iterations_sum as f64 / taken,
+        split_steps,
         max_natural_map_residual: max_residual,
         final_natural_map_residual: world.diagnostics().natural_map_residual,
         iterations_limit: settings.solve.iterations,

@@ -214,6 +214,13 @@ impl Settings {
         self.field(py, "prediction_distance")
     }
 
+    /// Overlap (m) beyond which a step that left two moving bodies crossed is taken again in
+    /// halves (at most four pieces); 0 is off.
+    #[getter]
+    fn split_overlap<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "split_overlap")
+    }
+
     /// Whether islands that stay quiet sleep.
     #[getter]
     fn sleep<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {

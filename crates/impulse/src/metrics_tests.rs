@@ -4,6 +4,9 @@ use glam::{Quat, Vec3};
 use parry3d::shape::SharedShape;
 
 use super::*;
+use crate::collision::overlap::manifold_depth;
+use crate::collision::separating_axes::{self, Polytope};
+use parry3d::query;
 
 /// The definition of [`max_overlap_of_pairs`] with every pair measured in full (the
 /// separating-axis depth of two polyhedra, both of Parry's estimates of any other pair): its

@@ -118,6 +118,9 @@ class Settings:
     def prediction_distance(self) -> float:
         """Base speculative margin (m): contacts are generated up to this separation."""
     @property
+    def split_overlap(self) -> float:
+        """Overlap (m) beyond which a step that left two moving bodies crossed is taken again in halves (at most four pieces); 0 is off."""
+    @property
     def sleep(self) -> bool:
         """Whether islands that stay quiet sleep."""
     @property

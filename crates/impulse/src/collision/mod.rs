@@ -17,6 +17,7 @@ pub(crate) mod manifold;
 pub(crate) mod manifold_record;
 pub(crate) mod margins;
 pub(crate) mod narrow_phase;
+pub(crate) mod overlap;
 pub(crate) mod part_pairs;
 pub(crate) mod separating_axes;
 

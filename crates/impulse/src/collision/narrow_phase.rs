@@ -27,6 +27,7 @@ pub struct UnsupportedShapePair(pub usize, pub usize);
 
 /// The contact state of one pair of bodies. Shape 1 belongs to `body1`, shape 2 to `body2`,
 /// and `body1 < body2`.
+#[derive(Clone)]
 pub struct ContactPair {
     /// Lower body index.
     pub body1: u32,
@@ -313,6 +314,17 @@ pub struct NarrowPhase {
 }
 
 impl NarrowPhase {
+    /// A copy of every pair, its manifolds, their impulses and Parry's workspaces, which
+    /// [`Self::put_back`] restores (the try of a split step undone).
+    pub(crate) fn pairs_copy(&self) -> Vec<ContactPair> {
+        self.pairs.clone()
+    }
+
+    /// Puts back the pairs of [`Self::pairs_copy`] (`previous` is empty between steps).
+    pub(crate) fn put_back(&mut self, pairs: Vec<ContactPair>) {
+        self.pairs = pairs;
+    }
+
     /// Drops every pair with body `a` or body `b` (a body removal: the body at `a` goes and the
     /// last one, `b`, takes its index, so neither's pairs name the right bodies any more).
     pub(crate) fn remove_pairs_of(&mut self, a: u32, b: u32) {

@@ -43,6 +43,16 @@ pub struct StepDiagnostics {
     pub kinetic_energy: f32,
     /// Total linear momentum of moving bodies after the step (kg·m/s).
     pub linear_momentum: [f32; 3],
+    /// The pieces the step was taken in: 1, or 2 to 4 when its first try left bodies crossed
+    /// and it was taken again in halves ([`crate::settings::ContactSettings::split_overlap`]).
+    /// The other fields are the last piece's.
+    #[serde(default = "one_piece")]
+    pub pieces: u32,
+}
+
+/// A step in one piece: [`StepDiagnostics::pieces`] of a snapshot written before it was kept.
+fn one_piece() -> u32 {
+    1
 }
 
 /// The natural-map residual of `constraints` ([`StepDiagnostics::natural_map_residual`]) by

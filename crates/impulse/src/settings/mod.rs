@@ -348,6 +348,13 @@ pub struct ContactSettings {
     /// Contacts are generated up to this separation (m) ahead of touching ("speculative"
     /// contacts): a row with gap g > 0 only forbids closing faster than g/dt.
     pub prediction_distance: f32,
+    /// A step after which two bodies that moved against each other overlap by more than this
+    /// (m), and by more than a third of it beyond their overlap at the step's start, is taken
+    /// again as two half steps, each with its own contacts, and so on up to
+    /// [`MAX_STEP_SPLITS`] halvings (docs/method.md, "Split steps"): contacts found once a
+    /// step go stale where bodies turn or stop within it (thin parts crossing, a pile
+    /// stopping one of two bodies falling together). 0 turns it off (the default).
+    pub split_overlap: f32,
     /// Apply Coulomb friction rows (two tangents per point, |γ_t| ≤ μ·γ_n).
     pub friction: bool,
     /// How simultaneous impacts are resolved: `simultaneous` (one LCP with Newton's
@@ -460,6 +467,10 @@ impl Default for OffParameters {
 /// position is a blow-up.
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
 
+/// How many times a step may be halved ([`ContactSettings::split_overlap`]): into at most
+/// 2² = 4 pieces, so a split step costs at most the three tries and four pieces' work.
+pub const MAX_STEP_SPLITS: u32 = 2;
+
 /// The default [`WorldLimits::max_linear_speed`] (m/s): 100 km/s, beyond anything that
 /// moves in a contact simulation (a rifle bullet flies at about 1 km/s, a light-gas gun's
 /// projectile at 7 km/s, the fastest meteoroid meets the Earth at 72 km/s). A speed a step
@@ -490,7 +501,7 @@ impl SolverSettings {
     /// `parallel_island_contacts` and `simd_island_contacts`; in [`Self::contact`], `repair`
     /// (method, stiffness and its parameters), `overlap_slop` and `max_repair_speed`.
     /// Kept from `self` (what the scene means to happen): the rest of [`Self::contact`]
-    /// (`restitution_threshold`, `prediction_distance`, `friction`, `friction_combine`,
+    /// (`restitution_threshold`, `prediction_distance`, `split_overlap`, `friction`, `friction_combine`,
     /// `restitution_combine`, `impact`), [`Self::sleep`], [`Self::limits`], `gyroscopic`,
     /// `continuous`, and in [`Self::solve`] `heavy_on_light_mass_ratio` and
     /// `fused_multiply_add` (a choice between speed and bits the same on every CPU). The split
@@ -690,6 +701,7 @@ impl Default for ContactSettings {
             overlap_slop: 0.0,
             max_repair_speed: 0.5,
             prediction_distance: 0.02,
+            split_overlap: 0.0,
             friction: true,
             impact: ImpactModel::Simultaneous,
             friction_combine: CombineRule::GeometricMean,

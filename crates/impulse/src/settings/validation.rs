@@ -104,6 +104,7 @@ impl SolverSettings {
             ("overlap_slop", self.contact.overlap_slop),
             ("max_repair_speed", self.contact.max_repair_speed),
             ("prediction_distance", self.contact.prediction_distance),
+            ("split_overlap", self.contact.split_overlap),
         ];
         for (field, value) in non_negative {
             let message = if !value.is_finite() {

@@ -50,6 +50,7 @@ mod snapshot;
 mod soak;
 mod solver2d_scenes;
 mod speculative;
+mod split_steps;
 mod standard_scenes;
 mod thin_shapes;
 mod tumbling_hulls;

@@ -71,6 +71,7 @@ impl World {
             max_depth,
             kinetic_energy: energy.kinetic as f32,
             linear_momentum: energy.momentum.to_array(),
+            pieces: 1,
         };
         energy
     }

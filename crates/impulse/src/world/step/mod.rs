@@ -26,7 +26,8 @@
 //! bodies swept and clamped (the geometry in `collision/continuous.rs`); impulses into the
 //! manifolds for the next warm start; sleep, energy, momentum and the diagnostics; contact
 //! events, the end of the step's forces, the energy and blow-up check and the bodies that left
-//! the world. The state the world keeps for the step's concerns lives in files that do not
+//! the world. With `split_overlap` on, `split.rs` runs the stages: a step that leaves moving
+//! bodies crossed is undone and taken again in halves. The state the world keeps for the step's concerns lives in files that do not
 //! reach back into the world (`energy.rs`, `kinematic_script.rs`), so that files import one
 //! way. Every thread decision goes through [`crate::parallel`].
 
@@ -45,6 +46,7 @@ mod record;
 mod scatter;
 mod sleep;
 mod solve;
+mod split;
 mod store_impulses;
 
 pub use energy::BLOW_UP_ENERGY_PER_KG;
@@ -95,7 +97,10 @@ impl World {
     /// Advances the world by dt through the stages of [`Stage`] (docs/architecture.md). The
     /// settings were checked where they entered the world ([`World::new`],
     /// [`World::set_settings`]); a blow-up is reported with the step number, after the state
-    /// that caused it was written.
+    /// that caused it was written. With
+    /// [`crate::settings::ContactSettings::split_overlap`] above zero, a step whose try leaves
+    /// moving bodies crossed by more is taken again in halves (at most four pieces, one step
+    /// for the step count, the time and the events; docs/method.md, "Split steps").
     ///
     /// Threads: with [`World::parallel`] on, the step spreads its work over rayon's current
     /// pool. Called from a thread outside any pool (a program's main thread), the whole step
@@ -109,7 +114,7 @@ impl World {
     /// the stages and put back after them, whatever they return.
     fn step_here(&mut self) -> Result<&StepDiagnostics, StepError> {
         let mut context = std::mem::take(&mut self.context);
-        let stepped = self.run_stages(&mut context);
+        let stepped = self.run_split_stages(&mut context);
         self.context = context;
         stepped?;
         Ok(&self.diagnostics)
