@@ -57,6 +57,19 @@ class ImpulseBakeSettings(bpy.types.PropertyGroup):
         min=0,
         soft_max=16,
     )
+    split_overlap: bpy.props.FloatProperty(
+        name="Split Steps",
+        description=(
+            "A step that leaves two moving objects overlapping by more than this is taken again in halves, "
+            "with contacts found again (at most four pieces); 0 is off. Thin or fast objects at one step a frame"
+        ),
+        default=0.0,
+        min=0.0,
+        soft_max=0.01,
+        precision=4,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
 
 
 def _bake_report(baker, cancelled):
@@ -95,6 +108,7 @@ class IMPULSE_OT_bake(bpy.types.Operator):
                 settings.steps_per_frame,
                 settings.materials,
                 settings.mesh_resolution,
+                settings.split_overlap,
             )
         except scene_reader.UnsupportedScene as error:
             self.report({"ERROR"}, "impulse: not baked (the earlier bake is kept): " + "; ".join(error.problems))
@@ -195,6 +209,7 @@ def _draw(layout, context):
     column.prop(settings, "mesh_resolution")
     column.prop(settings, "substeps")
     column.prop(settings, "steps_per_frame")
+    column.prop(settings, "split_overlap")
     row = column.row()
     row.operator(IMPULSE_OT_bake.bl_idname, icon="PHYSICS")
     row.operator(IMPULSE_OT_free_bake.bl_idname, icon="TRASH")

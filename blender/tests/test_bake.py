@@ -201,3 +201,21 @@ def test_a_bake_in_chunks_stopped_early_keeps_the_frames_done():
     locations, _ = keyed(scene.objects["domino05"])
     assert locations.shape == (10, 2, 3)
     np.testing.assert_array_equal(locations[:, 0, 0], np.arange(1, 11))
+
+
+def test_split_steps_reach_the_world_and_keep_one_step_a_frame():
+    # The panel's Split Steps at one step a frame: the world gets the tolerance, the step stays a
+    # frame long, and no frame leaves two dominoes crossed deeper than without it.
+    scene = scenes.dominoes(FRAMES)
+    worst = {}
+    for split in (0.0, 0.001):
+        baker = bake.Baker(scene, frame_steps=1, split_overlap=split)
+        assert baker.frame_steps == 1
+        assert baker.world.settings.split_overlap == pytest.approx(split)
+        deepest = 0.0
+        while not baker.done:
+            baker.advance(max_frames=1, max_seconds=0.0)
+            deepest = max(deepest, baker.world.quality()["max_overlap_m"])
+        assert np.isfinite(np.stack(baker.positions)).all()
+        worst[split] = deepest
+    assert worst[0.001] <= max(worst[0.0], 0.001), worst

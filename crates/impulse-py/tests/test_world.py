@@ -313,3 +313,18 @@ def test_forces_and_impulses_change_momentum_as_newton_says():
     # F dt / m = 20 * 0.01 / 2
     assert world.linear_velocities[0, 1] == pytest.approx(0.1, rel=1e-5)
     assert world.masses[0] == pytest.approx(2.0)
+
+
+def test_split_steps_are_a_setting_and_report_their_pieces():
+    # The tolerance is a field of the settings like any other, refused when negative; a pyramid
+    # at rest with it on steps in one piece a step.
+    settings = impulse.Settings().replace(split_overlap=0.001)
+    assert settings.split_overlap == 0.001
+    assert impulse.Settings().split_overlap == 0.0
+    with pytest.raises(ValueError, match="split_overlap"):
+        impulse.Settings().replace(split_overlap=-1.0)
+    world = impulse.World.from_scene("pyramid20")
+    world.settings = settings
+    world.step(3)
+    assert world.diagnostics["step"] == 3
+    assert world.diagnostics["pieces"] == 1

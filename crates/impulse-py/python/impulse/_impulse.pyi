@@ -119,7 +119,7 @@ class Settings:
         """Base speculative margin (m): contacts are generated up to this separation."""
     @property
     def split_overlap(self) -> float:
-        """Overlap (m) beyond which a step that left two moving bodies crossed is taken again in halves (at most four pieces); 0 is off."""
+        """Overlap (m) beyond which a step that left moving bodies crossed is taken again in halves; 0 is off."""
     @property
     def sleep(self) -> bool:
         """Whether islands that stay quiet sleep."""

@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 /// the parts' bounding boxes part, and the narrow phase drops the pair's manifolds when the
 /// bodies leave the broad phase (or clears the memory when a body's shape is replaced).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct FaceAxisMemory {
+pub(crate) struct FaceAxisMemory {
     /// Shape 2's pose in shape 1's frame when the search ran.
     pub(crate) pose: Pose,
     /// How many face axes the search had: a memory of another pair of shapes is not used.
