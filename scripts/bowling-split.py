@@ -16,7 +16,8 @@ step").
    a random search of N takes for each (search seed 0, so every step size gets the same θ),
    counting the takes that leave the 7, the 10, both, the split itself, and strikes.
 5. ``hit``: the head pin alone, hit by the shot's ball rolled at offsets from its centre line:
-   the direction the pin moves off in (degrees from straight back) at several steps.
+   the direction the pin moves off in (degrees from straight back) at several steps, with split
+   steps at ``--split-overlap`` m (0, the default: off).
 
     python3 scripts/bowling-split.py lines
     python3 scripts/bowling-split.py around takes/bowling TAKE_ID --sizes 0.003,0.03,0.1
@@ -104,12 +105,13 @@ def main() -> int:
     hit = commands.add_parser("hit")
     hit.add_argument("--offsets", default="0.05,0.1,0.14", help="m, the ball's x at the pin")
     hit.add_argument("--steps", default="1/60:20,1/240:5,1/960:2", help="dt:substeps pairs")
+    hit.add_argument("--split-overlap", type=float, default=0.0, help="m, split steps (0: off)")
     arguments = parser.parse_args()
 
     if arguments.command == "steps":
         return _steps(arguments.steps, arguments.takes)
     if arguments.command == "hit":
-        return _hit(arguments.offsets, arguments.steps)
+        return _hit(arguments.offsets, arguments.steps, arguments.split_overlap)
 
     with Pool(2) as pool:
         if arguments.command == "lines":
@@ -155,7 +157,7 @@ def main() -> int:
     return 0
 
 
-def _hit(offsets: str, pairs: str) -> int:
+def _hit(offsets: str, pairs: str, split_overlap: float = 0.0) -> int:
     import math
     from fractions import Fraction
 
@@ -175,7 +177,7 @@ def _hit(offsets: str, pairs: str) -> int:
             bodies = json.loads(json.dumps(keep))
             bodies[-1]["position"][0] = offset
             world = impulse.World.from_scene(
-                dict(base, bodies=bodies, dt=dt, solver={"substeps": substeps}))
+                dict(base, bodies=bodies, dt=dt, solver={"substeps": substeps, "split_overlap": split_overlap}))
             pin = list(world.names).index("pin1")
             for _ in range(round(0.6 / dt)):  # until the pin moves, then 10 ms on
                 world.step()
