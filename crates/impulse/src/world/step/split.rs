@@ -23,6 +23,7 @@
 
 use glam::Vec3;
 use parry3d::math::Pose;
+use parry3d::shape::SharedShape;
 
 use super::EnergyCheck;
 use super::context::StepContext;
@@ -161,10 +162,8 @@ impl World {
             if !b.is_moving(i) || b.asleep[i] {
                 return false;
             }
-            let aabb = b.shape[i].compute_local_aabb();
-            let radius = aabb.center().length() + aabb.half_extents().length();
-            let speed = b.linear_velocity[i].length() + b.angular_velocity[i].length() * radius;
-            speed * self.dt > reach
+            let spin = b.angular_velocity[i].length() * farthest_point(&b.shape[i]);
+            (b.linear_velocity[i].length() + spin) * self.dt > reach
         })
     }
 
@@ -172,29 +171,30 @@ impl World {
     /// overlapping by more than `limit` (m) and by more than a third of it beyond its overlap
     /// at `start` (every body's pose at the step's start). Only pairs whose relative motion
     /// could have deepened them by that third are measured: a point of a body moves in the
-    /// step by at most |Δt| + θ·ρ (θ the angle turned, ρ the farthest point of its shape
-    /// from the pose's origin).
+    /// step by at most |Δt| + θ·ρ (θ the angle turned, ρ = [`farthest_point`]).
     fn crossed_in_step(&self, start: &[Pose], limit: f32) -> bool {
         let b = &self.bodies;
         let deepening = limit / 3.0;
-        let mut reach = vec![f32::NAN; b.pose.len()];
-        let mut motion = |i: usize| -> (Vec3, f32) {
-            let (from, to) = (&start[i], &b.pose[i]);
-            let angle = from.rotation.angle_between(to.rotation);
-            if angle > 0.0 && reach[i].is_nan() {
-                let sphere = b.shape[i].compute_local_bounding_sphere();
-                reach[i] = sphere.center().length() + sphere.radius();
-            }
-            let turned = if angle > 0.0 { angle * reach[i] } else { 0.0 };
-            (to.translation - from.translation, turned)
-        };
+        // Each body's shift and the farthest a turn carried any of its points, once a body.
+        let motion: Vec<(Vec3, f32)> = (0..b.len())
+            .map(|i| {
+                let (from, to) = (&start[i], &b.pose[i]);
+                let angle = from.rotation.angle_between(to.rotation);
+                let turned = if angle > 0.0 {
+                    angle * farthest_point(&b.shape[i])
+                } else {
+                    0.0
+                };
+                (to.translation - from.translation, turned)
+            })
+            .collect();
         let moving: Vec<(u32, u32)> = self
             .narrow_phase
             .pairs
             .iter()
             .filter(|pair| {
-                let (i, j) = (pair.body1 as usize, pair.body2 as usize);
-                let ((shift_i, turn_i), (shift_j, turn_j)) = (motion(i), motion(j));
+                let ((shift_i, turn_i), (shift_j, turn_j)) =
+                    (motion[pair.body1 as usize], motion[pair.body2 as usize]);
                 (shift_i - shift_j).length() + turn_i + turn_j > deepening
             })
             .map(|pair| (pair.body1, pair.body2))
@@ -213,4 +213,11 @@ impl World {
             .zip(&at_start)
             .any(|(&(_, end), &start)| end > start + deepening)
     }
+}
+
+/// The farthest any point of `shape` lies from the origin of its frame (m), bounded by its
+/// local bounding box: how far a turn of θ rad can carry a point, θ times this.
+fn farthest_point(shape: &SharedShape) -> f32 {
+    let aabb = shape.compute_local_aabb();
+    aabb.center().length() + aabb.half_extents().length()
 }
