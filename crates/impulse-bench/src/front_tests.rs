@@ -255,7 +255,7 @@ fn tables_compare_impulse_with_the_cheapest_peer() {
 #[test]
 fn grids_have_the_documented_sizes_and_names() {
     let grid = impulse_grid();
-    assert_eq!(grid.len(), 4 + 14 + 3 + 5);
+    assert_eq!(grid.len(), 4 + 14 + 3 + 5 + 5);
     assert_eq!(grid[0], ("default".to_string(), None));
     assert_eq!(grid[1].1, Some(SolverSettings::fast()));
     // The presets are soft steps the grid does not repeat.
@@ -277,6 +277,22 @@ fn grids_have_the_documented_sizes_and_names() {
     let split = split.as_ref().unwrap();
     assert!(split.split_impulse() && split.solve.method.is_auto());
     assert_eq!((split.solve.substeps, split.solve.iterations), (2, 4));
+    let (_, lean) = grid
+        .iter()
+        .find(|(n, _)| n == "soft 6, impact sweeps 0")
+        .unwrap();
+    let lean = lean.as_ref().unwrap();
+    assert_eq!(lean.solve.impact_sweeps, 0);
+    assert_eq!(
+        SolverSettings {
+            solve: impulse::settings::SolveSettings {
+                impact_sweeps: SolverSettings::default().solve.impact_sweeps,
+                ..lean.solve
+            },
+            ..lean.clone()
+        },
+        SolverSettings::soft_step(6)
+    );
     assert!(impulse_quick_grid().len() < 5);
     let joint_grid = impulse_joint_grid();
     assert_eq!(joint_grid.len(), 4 + 12 * 2 - 1 + 3);

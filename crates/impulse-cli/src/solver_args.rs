@@ -72,6 +72,11 @@ pub struct SolverArgs {
     /// Relax iterations per substep (≤ 10,000).
     #[arg(long)]
     pub relax: Option<u32>,
+    /// Sweeps an impact may add to a substep's solves, at most (≤ 10,000; default 32; 0 = no
+    /// impact sweeps: cheaper, and a face landing at restitution 0 rises again at a few
+    /// percent of its impact speed; see `SolveSettings::impact_sweeps`).
+    #[arg(long)]
+    pub impact_sweeps: Option<u32>,
     /// Method of every island's solve: `pgs` (projected Gauss-Seidel), `nncg` (nonsmooth
     /// nonlinear conjugate gradient), `apgd` (accelerated projected gradient descent) or `auto`
     /// (NNCG escalating per island to more iterations or the exact path).
@@ -164,6 +169,7 @@ impl SolverArgs {
         set(&mut s.solve.iterations, self.iterations);
         set(&mut s.solve.substeps, self.substeps);
         set(&mut s.solve.relax_iterations, self.relax);
+        set(&mut s.solve.impact_sweeps, self.impact_sweeps);
         if let Some(fraction) = self.warm_start {
             s.solve.warm_start = fraction;
         }

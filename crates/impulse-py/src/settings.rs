@@ -141,6 +141,14 @@ impl Settings {
         self.field(py, "relax_iterations")
     }
 
+    /// Sweeps an impact may add to a substep's solves, at most (≥ 0; default 32): a face
+    /// landing at restitution 0 then stops dead. 0 takes none: cheaper, and such a face rises
+    /// again at a few percent of its impact speed.
+    #[getter]
+    fn impact_sweeps<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "impact_sweeps")
+    }
+
     /// Early exit (m/s): no row's velocity changed by more than this in an iteration; 0 disables.
     #[getter]
     fn tolerance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {

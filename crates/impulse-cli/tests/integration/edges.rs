@@ -101,7 +101,7 @@ fn a_huge_substep_count_is_a_field_error() {
     std::fs::write(&path, scene).unwrap();
     let out = output_within(impulse().arg("run").arg(&path).arg("--quiet"), 60);
     assert_refused(&out, &["solver.substeps", "≤ 10000", "4294967295"]);
-    for option in ["--substeps", "--iterations", "--relax"] {
+    for option in ["--substeps", "--iterations", "--relax", "--impact-sweeps"] {
         let out = output_within(
             impulse().args(["run", "stack3", "--quiet", option, "4294967295"]),
             60,

@@ -82,6 +82,9 @@ class Settings:
     def relax_iterations(self) -> int:
         """Relax iterations per substep, without the repair bias (≥ 0)."""
     @property
+    def impact_sweeps(self) -> int:
+        """Sweeps an impact may add to a substep's solves, at most (≥ 0; default 32): a face landing at restitution 0 then stops dead. 0 takes none: cheaper, and such a face rises again at a few percent of its impact speed."""
+    @property
     def tolerance(self) -> float:
         """Early exit (m/s): no row's velocity changed by more than this in an iteration; 0 disables."""
     @property

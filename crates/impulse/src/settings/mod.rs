@@ -263,6 +263,16 @@ pub struct SolveSettings {
     /// Early exit: stop sweeping once no row's velocity changed by more than this in a sweep
     /// (m/s), i.e. max |Δγ_i|/m_eff,i ≤ tolerance. 0 disables early exit.
     pub tolerance: f32,
+    /// Sweeps an impact may add to a substep's main solve and to its relax solve, at most
+    /// (default [`DEFAULT_IMPACT_SWEEPS`]; PGS with soft or bias repair): in an island where
+    /// some contact closes faster than the impact speed, max(|g|·dt, `restitution_threshold`),
+    /// a substep whose last sweep still changed some row's velocity by more than that speed
+    /// sweeps on towards convergence, so a face that lands on its corners at restitution 0
+    /// stops dead instead of leaving spinning (docs/method.md, "Impacts"). 0 takes no impact
+    /// sweeps: each substep keeps its `iterations` and `relax_iterations`, a cube dropped flat
+    /// at restitution 0 rises again at a few percent of its impact speed, and a pour costs
+    /// about half as much (docs/benchmarks.md, "Pours").
+    pub impact_sweeps: u32,
     /// Islands with at most this many contact points may take the exact path: `auto`'s
     /// escalation ([`SolverMethod::Auto`]), and, times
     /// [`crate::HEAVY_ON_LIGHT_CONTACTS_FACTOR`], the heavy-on-light path of every method
@@ -467,6 +477,10 @@ impl Default for OffParameters {
 /// position is a blow-up.
 pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
 
+/// The default [`SolveSettings::impact_sweeps`]: enough for the corners of a face landing at
+/// speed to share the blow (docs/method.md, "Impacts").
+pub const DEFAULT_IMPACT_SWEEPS: u32 = 32;
+
 /// How many times a step may be halved ([`ContactSettings::split_overlap`]): into at most
 /// 2² = 4 pieces, so a split step costs at most the three tries and four pieces' work.
 pub const MAX_STEP_SPLITS: u32 = 2;
@@ -497,7 +511,7 @@ impl SolverSettings {
     ///
     /// Taken from `preset` (how hard and how the LCP is solved): in [`Self::solve`], `method`
     /// (with `auto`'s parameters), `substeps`, `iterations`, `relax_iterations`, `tolerance`,
-    /// `exact_max_contacts`, `warm_start`, `friction_in_main_solve`, `direct_joint_solve`,
+    /// `impact_sweeps`, `exact_max_contacts`, `warm_start`, `friction_in_main_solve`, `direct_joint_solve`,
     /// `parallel_island_contacts` and `simd_island_contacts`; in [`Self::contact`], `repair`
     /// (method, stiffness and its parameters), `overlap_slop` and `max_repair_speed`.
     /// Kept from `self` (what the scene means to happen): the rest of [`Self::contact`]
@@ -515,6 +529,7 @@ impl SolverSettings {
                 iterations: solve.iterations,
                 relax_iterations: solve.relax_iterations,
                 tolerance: solve.tolerance,
+                impact_sweeps: solve.impact_sweeps,
                 exact_max_contacts: solve.exact_max_contacts,
                 warm_start: solve.warm_start,
                 friction_in_main_solve: solve.friction_in_main_solve,
@@ -677,6 +692,7 @@ impl Default for SolveSettings {
             iterations: 1,
             relax_iterations: 1,
             tolerance: 1e-5,
+            impact_sweeps: DEFAULT_IMPACT_SWEEPS,
             exact_max_contacts: 32,
             heavy_on_light_mass_ratio: 200.0,
             warm_start: 1.0,

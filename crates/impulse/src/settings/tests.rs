@@ -498,7 +498,7 @@ fn flat_keys_read_into_their_groups_and_write_back_flat() {
         serde_json::Value::Object(map) => map.keys().cloned().collect(),
         other => panic!("not an object: {other}"),
     };
-    let expected = "method substeps iterations relax_iterations tolerance escalation_tolerance \
+    let expected = "method substeps iterations relax_iterations impact_sweeps tolerance escalation_tolerance \
         escalation_iterations mass_ratio_threshold exact_max_contacts heavy_on_light_mass_ratio \
         restitution_threshold repair overlap_slop max_repair_speed warm_start prediction_distance split_overlap \
         sleep sleep_linear_speed sleep_angular_speed time_to_sleep friction friction_in_main_solve \

@@ -27,7 +27,7 @@ impl SolverSettings {
     /// the file; [`crate::World::new`], [`crate::World::set_settings`] and the snapshot loader
     /// the first one (the step trusts settings that came through them). Counts
     /// (`iterations`, `substeps`, split impulse's `repair.iterations`, `escalation_iterations`)
-    /// must be ≥ 1 and ≤ [`Self::MAX_COUNT`] (`relax_iterations` ≤ it, 0 allowed); a soft repair's `hertz` > 0;
+    /// must be ≥ 1 and ≤ [`Self::MAX_COUNT`] (`relax_iterations` and `impact_sweeps` ≤ it, 0 allowed); a soft repair's `hertz` > 0;
     /// tolerances, thresholds, rates, speeds, distances, frequencies and times finite and ≥ 0;
     /// `warm_start` in [0, 1].
     pub fn problems(&self) -> Vec<SettingError> {
@@ -57,15 +57,17 @@ impl SolverSettings {
                 });
             }
         }
-        if self.solve.relax_iterations > Self::MAX_COUNT {
-            problems.push(SettingError {
-                field: "relax_iterations",
-                message: format!(
-                    "must be ≤ {}, got {}",
-                    Self::MAX_COUNT,
-                    self.solve.relax_iterations
-                ),
-            });
+        let may_be_zero = [
+            ("relax_iterations", self.solve.relax_iterations),
+            ("impact_sweeps", self.solve.impact_sweeps),
+        ];
+        for (field, value) in may_be_zero {
+            if value > Self::MAX_COUNT {
+                problems.push(SettingError {
+                    field,
+                    message: format!("must be ≤ {}, got {value}", Self::MAX_COUNT),
+                });
+            }
         }
         let (rate, damping_ratio) = match self.contact.repair {
             ContactRepair::Bias { rate } | ContactRepair::SplitImpulse { rate, .. } => (rate, 0.0),

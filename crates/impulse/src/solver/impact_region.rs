@@ -1,4 +1,4 @@
-//! The rows an impact's extra sweeps run on (`IMPACT_SWEEPS` in [`super::substep`]): in a large island, the
+//! The rows an impact's extra sweeps run on ([`crate::settings::SolveSettings::impact_sweeps`]): in a large island, the
 //! points around the impact rather than the whole island.
 //!
 //! An impact's sweeps make the rows of the bodies that hit converge; in a pile of thousands of

@@ -87,13 +87,13 @@ pub(crate) struct IslandWorkspace {
     pub(super) impact: ImpactWorkspace,
     /// The kinetic-energy bound on the restitution solve's bounce.
     pub(super) bounce_energy: BounceEnergy,
-    /// Whether this substep's main solve met an impact ([`IMPACT_SWEEPS`]).
+    /// Whether this substep's main solve met an impact ([`crate::settings::SolveSettings::impact_sweeps`]).
     pub(super) impact_met: bool,
-    /// The step's impact speed (m/s; [`IMPACT_SWEEPS`]): a main solve whose last sweep changed
+    /// The step's impact speed (m/s; [`crate::settings::SolveSettings::impact_sweeps`]): a main solve whose last sweep changed
     /// a row's velocity by more than this met an impact, if [`Self::closing`].
     pub(super) impact_speed: f32,
     /// How much a main solve's last sweep must change a row's velocity (m/s) for the step to
-    /// meet an impact ([`IMPACT_SWEEPS`]): `impact_speed`, or, for an island without joints
+    /// meet an impact ([`crate::settings::SolveSettings::impact_sweeps`]): `impact_speed`, or, for an island without joints
     /// (whose impacts [`Self::closing`] tells), the speed gravity gives in a step.
     pub(super) impact_change: f32,
     /// Whether the step can have an impact: the island has joints, or some contact closed

@@ -8,7 +8,7 @@ use super::impact;
 use super::interface::{SolvePass, Sweep};
 use super::island_workspace::IslandWorkspace;
 use super::rows::{self, Velocities};
-use super::substep::{IMPACT_SWEEPS, IslandContext};
+use super::substep::{IslandContext, JOINT_SWEEPS};
 use crate::contact::{self, ContactConstraint};
 use crate::parallel::RESTITUTION_POINTS_PER_TASK;
 use crate::settings::{ImpactModel, SolverSettings};
@@ -63,13 +63,13 @@ impl IslandWorkspace {
         // joints first and the contacts after them, so the bounce would be that of bodies the
         // joints do not hold (a hinged door struck by a ball spun 37 % faster than the closed
         // form), and the joints would answer only in the next step. It sweeps to the tolerance,
-        // like an impact's substeps (`IMPACT_SWEEPS`).
+        // like an impact's substeps (`JOINT_SWEEPS`).
         let sweeps = impact::restitution_iterations(settings);
         let pass = SolvePass {
             iterations: if w.joints.is_empty() {
                 sweeps
             } else {
-                sweeps.max(IMPACT_SWEEPS)
+                sweeps.max(JOINT_SWEEPS)
             },
             tolerance: settings.solve.tolerance,
             friction: true,

@@ -39,18 +39,11 @@ mod impacts;
 /// at the default; a second friction sweep a substep brings it to rest.
 pub(crate) const HEAVY_ON_LIGHT_MASS_RATIO: f32 = 200.0;
 
-/// Sweeps a PGS solve may take beyond its budget in an impact: when the main solve's last
-/// sweep still changed some row's velocity by more than the impact speed (the larger of
-/// |g|·dt, the speed gravity gives in a step, and `restitution_threshold`), it sweeps on until
-/// the tolerance or this many more, and so does the substep's relax solve. One sweep of
-/// Gauss-Seidel over the corners of a face that hits at speed does not converge: the first
-/// corner's impulse spins the body, the last corners are left with the spin, and friction and
-/// the next substeps turn it into a rebound and a sideways drift (a cube dropped flat at
-/// restitution 0 left at 7 % of its impact speed, docs/method.md "Impacts"). Resting contacts,
-/// whose sweeps change velocities by about |g|·h, never take them. Only with soft or bias
-/// repair (the soft step's solves): split impulse's PGS keeps the sweeps it was given. A large
-/// island sweeps the points around the impact alone ([`super::impact_region`]).
-pub(crate) const IMPACT_SWEEPS: u32 = 32;
+/// Sweeps a joint island's relax solve (with split impulse) and its restitution solve may
+/// take towards the tolerance: as many as an impact's by default
+/// ([`crate::settings::DEFAULT_IMPACT_SWEEPS`]); a joint's rows carry no closing speed to
+/// tell an impact by.
+pub(crate) const JOINT_SWEEPS: u32 = crate::settings::DEFAULT_IMPACT_SWEEPS;
 
 /// Which of a substep's solves [`IslandWorkspace::targets_and_solve`] runs.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -112,12 +105,12 @@ impl IslandWorkspace {
             },
         };
         // A substep whose main solve found an impact sweeps its relax solve to convergence too
-        // (more than one sweep, so the lanes do not carry the warm start; see `IMPACT_SWEEPS`):
-        // the whole island, or its budget and then the points around the impact.
+        // (more than one sweep, so the lanes do not carry the warm start): the whole island,
+        // or its budget and then the points around the impact.
         let local = self.impact_region.kind == RegionKind::Local;
         let pass = match (!with_repair && self.impact_met, local) {
             (true, false) => SolvePass {
-                iterations: pass.iterations.max(IMPACT_SWEEPS),
+                iterations: pass.iterations.max(settings.solve.impact_sweeps),
                 ..pass
             },
             (true, true) => SolvePass {
@@ -152,6 +145,18 @@ impl IslandWorkspace {
         if with_repair {
             self.phases.end(SolvePhase::MainSolve);
         }
+        // An impact's sweeps (`SolveSettings::impact_sweeps`): when the main solve's last sweep
+        // still changed some row's velocity by more than the impact change, it sweeps on until
+        // the tolerance or that many more, and so does the substep's relax solve. One sweep of
+        // Gauss-Seidel over the corners of a face that hits at speed does not converge: the
+        // first corner's impulse spins the body, the last corners are left with the spin, and
+        // friction and the next substeps turn it into a rebound and a sideways drift (a cube
+        // dropped flat at restitution 0 left at 7 % of its impact speed, docs/method.md
+        // "Impacts"). Resting contacts, whose sweeps change velocities by about |g|·h, never
+        // take them. Only with soft or bias repair (the soft step's solves): split impulse's
+        // PGS keeps the sweeps it was given. A large island sweeps the points around the
+        // impact alone (`super::impact_region`).
+        //
         // Only a contact closing faster than the impact speed as the step started makes an
         // impact: in a deep pile at a few substeps the soft rows' repair alone can change a
         // sweep's velocities by more than that speed, and sweeping such a pile to convergence
@@ -159,6 +164,7 @@ impl IslandWorkspace {
         // sweep's change calls for it.
         self.impact_met = if with_repair {
             settings.solve.method == SolverMethod::Pgs
+                && settings.solve.impact_sweeps > 0
                 && !settings.split_impulse()
                 && outcome.report.last_change > impact_change
                 && *self.closing.get_or_insert_with(|| {
@@ -193,13 +199,14 @@ impl IslandWorkspace {
         let more = if self.impact_met && local {
             // The targets are set; the region's sweeps go on from where the budget ended.
             let sweep = (pass.tolerance, pass.friction, pass.half_turn);
-            let more = self.local_impact_sweeps(constraints, bundled, sweep);
+            let more =
+                self.local_impact_sweeps(constraints, bundled, settings.solve.impact_sweeps, sweep);
             self.phases.end(SolvePhase::Impacts);
             Some(more)
         } else if with_repair && self.impact_met {
             // The targets are set; the sweeps go on from where the budget ended.
             let more = SolvePass {
-                iterations: IMPACT_SWEEPS,
+                iterations: settings.solve.impact_sweeps,
                 escalate: false,
                 targets: None,
                 ..pass
@@ -711,7 +718,7 @@ impl IslandWorkspace {
                 angular: &mut self.angular,
             };
             let (sweeps, pose) = (
-                settings.solve.iterations.max(IMPACT_SWEEPS),
+                settings.solve.iterations.max(JOINT_SWEEPS),
                 (&self.displacement[..], &self.orientation[..]),
             );
             self.joints

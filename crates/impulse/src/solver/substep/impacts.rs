@@ -1,7 +1,7 @@
 //! A large island's impact sweeps around the impact ([`crate::solver::impact_region`]): the
 //! region's sweeps and their count in the island's report.
 
-use super::{IMPACT_SWEEPS, IslandWorkspace};
+use super::IslandWorkspace;
 use crate::contact::ContactConstraint;
 use crate::solver::impact_region::LOCAL_IMPACT_TOLERANCE;
 #[cfg(doc)]
@@ -10,13 +10,14 @@ use crate::solver::interface::{EscalationLevel, SolveOutcome};
 use crate::solver::rows::Velocities;
 
 impl IslandWorkspace {
-    /// The impact sweeps on the region alone, after a solve of the substep with `(tolerance,
-    /// friction, half_turn)` (m/s, and as [`SolvePass`]), in lanes when `bundled`; counted in
-    /// the island's report.
+    /// At most `sweeps` impact sweeps on the region alone, after a solve of the substep with
+    /// `(tolerance, friction, half_turn)` (m/s, and as [`SolvePass`]), in lanes when
+    /// `bundled`; counted in the island's report.
     pub(super) fn local_impact_sweeps(
         &mut self,
         constraints: &mut [ContactConstraint],
         bundled: bool,
+        sweeps: u32,
         (tolerance, friction, half_turn): (f32, bool, bool),
     ) -> SolveOutcome {
         let tolerance = tolerance.max(LOCAL_IMPACT_TOLERANCE * self.impact_change);
@@ -25,18 +26,14 @@ impl IslandWorkspace {
             angular: &mut self.angular,
         };
         let report = if bundled {
-            self.solvers.wide.solve_local(
-                &mut velocities,
-                IMPACT_SWEEPS,
-                tolerance,
-                friction,
-                half_turn,
-            )
+            self.solvers
+                .wide
+                .solve_local(&mut velocities, sweeps, tolerance, friction, half_turn)
         } else {
             self.impact_region.solve_scalar(
                 constraints,
                 &mut velocities,
-                IMPACT_SWEEPS,
+                sweeps,
                 tolerance,
                 friction,
                 half_turn,
