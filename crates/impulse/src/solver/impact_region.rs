@@ -76,6 +76,12 @@ pub(crate) struct ImpactRegion {
     points: Vec<u32>,
     /// The region's rows, copied for the scalar sweeps.
     rows: Vec<ContactConstraint>,
+    /// Constraint indices of the contacts closing faster than the impact speed as the step
+    /// started, ascending; found at the step's first [`ImpactRegion::find`] (the velocities
+    /// and rows it reads stay as they are through the step's substeps).
+    closing: Vec<u32>,
+    /// Whether [`Self::closing`] holds this step's contacts.
+    closing_known: bool,
     /// What [`ImpactRegion::find`] decided this step.
     pub(crate) kind: RegionKind,
     /// Contact points one local sweep updates (for the island's report).
@@ -83,10 +89,16 @@ pub(crate) struct ImpactRegion {
 }
 
 impl ImpactRegion {
-    /// Forgets the last step's region.
+    /// Forgets the last substep's region.
     pub(crate) fn reset(&mut self) {
         self.kind = RegionKind::Unknown;
         self.size = 0;
+    }
+
+    /// Forgets the last step's region and closing contacts.
+    pub(crate) fn start_step(&mut self) {
+        self.reset();
+        self.closing_known = false;
     }
 
     /// Whether the island's slot `slot` is in the region.
@@ -102,7 +114,8 @@ impl ImpactRegion {
     /// `struck` (the substep's main solve changed its normal velocity by more than the impact
     /// change: [`ImpactRegion::find_in`]), and every point touching one of them. Sets [`Self::kind`]:
     /// local when the island has at least [`LOCAL_IMPACT_MIN_POINTS`] points and the region at
-    /// most half of them, whole otherwise.
+    /// most half of them, whole otherwise. The closing contacts are found at the first call of
+    /// a step ([`Self::start_step`]) and kept for its substeps.
     pub(crate) fn find(
         &mut self,
         constraints: &[ContactConstraint],
@@ -117,10 +130,22 @@ impl ImpactRegion {
         if constraints.len() < LOCAL_IMPACT_MIN_POINTS {
             return self.kind;
         }
+        if !self.closing_known {
+            self.closing.clear();
+            self.closing.extend(
+                constraints
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, c)| row_closes_faster_than(c, linear, angular, speed))
+                    .map(|(k, _)| k as u32),
+            );
+            self.closing_known = true;
+        }
         self.seed.clear();
         self.seed.resize(moving, false);
-        for c in constraints {
-            if row_closes_faster_than(c, linear, angular, speed) && struck(c) {
+        for &k in &self.closing {
+            let c = &constraints[k as usize];
+            if struck(c) {
                 for slot in [c.local_a, c.local_b] {
                     if let Some(seed) = self.seed.get_mut(slot as usize) {
                         *seed = true;

@@ -105,8 +105,9 @@ fn a_small_island_or_a_region_of_most_of_it_sweeps_whole() {
         region.find(&large, &linear, &angular, 1.0, 1000, |_| true),
         RegionKind::Whole
     );
-    // At rest, no seed: an empty region (the impact test would not have asked).
+    // At rest (a new step), no seed: an empty region (the impact test would not have asked).
     let rest = vec![Vec3::ZERO; 1001];
+    region.start_step();
     assert_eq!(
         region.find(&large, &rest, &angular, 1.0, 1000, |_| true),
         RegionKind::Local

@@ -546,7 +546,7 @@ impl IslandWorkspace {
             self.impact_speed
         };
         self.impact_met = false;
-        self.impact_region.reset();
+        self.impact_region.start_step();
     }
 
     /// Picks how the island is solved (SIMD lanes, coloured rows on several threads, or one
