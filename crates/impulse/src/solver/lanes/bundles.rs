@@ -21,9 +21,15 @@ pub(crate) struct Bundles {
     /// groups the colouring could not place, one per lane group, and always runs on one thread.
     pub(super) groups: Vec<Group>,
     pub(super) group_colour_starts: Vec<usize>,
-    /// The lane groups an impact's local sweeps visit ([`Bundles::select_local`]), in bundle
-    /// order.
+    /// The lane groups an impact's local sweeps visit ([`Bundles::select_local`]): the region's
+    /// lanes packed anew, their rows in `local_bundles`; `local_lanes` says where each came
+    /// from, `local_filled` how many lanes of each group are taken, and `local_after` the first
+    /// group each island slot may still take a lane in (see `select_local`).
     pub(super) local_groups: Vec<Group>,
+    pub(super) local_bundles: Vec<Bundle>,
+    pub(super) local_lanes: Vec<super::local::LocalLane>,
+    pub(super) local_filled: Vec<u8>,
+    pub(super) local_after: Vec<u32>,
     /// Packing scratch: per manifold group (a run of at most [`GROUP_POINTS`] consecutive
     /// points between the same two bodies), its first point, and its lane group and lane.
     pub(super) runs: Vec<u32>,
