@@ -255,7 +255,7 @@ fn tables_compare_impulse_with_the_cheapest_peer() {
 #[test]
 fn grids_have_the_documented_sizes_and_names() {
     let grid = impulse_grid();
-    assert_eq!(grid.len(), 4 + 14 + 3 + 5 + 5);
+    assert_eq!(grid.len(), 4 + 14 + 3 + 4 + 5);
     assert_eq!(grid[0], ("default".to_string(), None));
     assert_eq!(grid[1].1, Some(SolverSettings::fast()));
     // The presets are soft steps the grid does not repeat.
@@ -295,7 +295,7 @@ fn grids_have_the_documented_sizes_and_names() {
     );
     assert!(impulse_quick_grid().len() < 5);
     let joint_grid = impulse_joint_grid();
-    assert_eq!(joint_grid.len(), 4 + 12 * 2 - 1 + 3);
+    assert_eq!(joint_grid.len(), 4 + 12 * 2 + 3);
     let (_, per_joint) = joint_grid
         .iter()
         .find(|(n, _)| n == "soft 4 per-joint")

@@ -8,7 +8,7 @@ use impulse::{ContactRepair, SolverMethod, SolverSettings};
 /// A preset, named by speed or by the quality bar it meets on the standard scenes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PresetArg {
-    /// The soft step at 8 substeps: E ≤ 50 mm.
+    /// The soft step at 8 substeps without impact sweeps: E ≤ 50 mm.
     #[value(alias = "q50")]
     Fast,
     /// The soft step at 20 substeps: E ≤ 5 mm.
@@ -55,7 +55,7 @@ pub enum RepairArg {
 pub struct SolverArgs {
     /// Start from a preset instead of the scene's solver settings, named by speed or by the
     /// quality bar it meets on the standard scenes (E = largest of sink, overlap and drift
-    /// after 10 s): `fast`/`q50` (the soft step at 8 substeps, E ≤ 50 mm), `default`/`q5`
+    /// after 10 s): `fast`/`q50` (the soft step at 8 substeps without impact sweeps, E ≤ 50 mm), `default`/`q5`
     /// (20 substeps, E ≤ 5 mm), `precise`/`q1` (48 substeps, E ≤ 1 mm) or `reference` (NNCG
     /// with split impulse and the exact path: the LCP solved tightly). A preset sets only
     /// the solver's effort (method, substeps, iterations, repair); the scene's physics
@@ -73,8 +73,8 @@ pub struct SolverArgs {
     #[arg(long)]
     pub relax: Option<u32>,
     /// Sweeps an impact may add to a substep's solves, at most (≤ 10,000; default 32; 0 = no
-    /// impact sweeps: cheaper, and a face landing at restitution 0 rises again at a few
-    /// percent of its impact speed; see `SolveSettings::impact_sweeps`).
+    /// impact sweeps but in islands with joints: cheaper, and a face landing at restitution 0
+    /// rises again at 7-9 % of its impact speed; see `SolveSettings::impact_sweeps`).
     #[arg(long)]
     pub impact_sweeps: Option<u32>,
     /// Method of every island's solve: `pgs` (projected Gauss-Seidel), `nncg` (nonsmooth

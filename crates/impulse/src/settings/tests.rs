@@ -280,7 +280,18 @@ fn the_presets_are_the_soft_step() {
     }
     assert_eq!(SolverSettings::soft_step(0).solve.substeps, 1);
     assert_eq!(SolverSettings::default(), SolverSettings::soft_step(20));
-    assert_eq!(SolverSettings::fast(), SolverSettings::soft_step(8));
+    let fast = SolverSettings::fast();
+    assert_eq!(fast.solve.impact_sweeps, 0);
+    assert_eq!(
+        SolverSettings {
+            solve: crate::settings::SolveSettings {
+                impact_sweeps: SolverSettings::default().solve.impact_sweeps,
+                ..fast.solve
+            },
+            ..fast
+        },
+        SolverSettings::soft_step(8)
+    );
     assert_eq!(SolverSettings::precise(), SolverSettings::soft_step(48));
     for (name, preset) in [
         ("fast", SolverSettings::fast()),
