@@ -83,7 +83,11 @@ class Settings:
         """Relax iterations per substep, without the repair bias (≥ 0)."""
     @property
     def impact_sweeps(self) -> int:
-        """Sweeps an impact may add to a substep's solves, at most (≥ 0; default 32): a face landing at restitution 0 then stops dead. 0 takes none (but in islands with joints): cheaper, and such a face rises again at 7-9 % of its impact speed."""
+        """Sweeps an impact may add to a substep's solves, at most (≥ 0; default 32).
+
+        A face landing at restitution 0 then stops dead. 0 takes none (but in islands with
+        joints): cheaper, and such a face rises again at 7-9 % of its impact speed.
+        """
     @property
     def tolerance(self) -> float:
         """Early exit (m/s): no row's velocity changed by more than this in an iteration; 0 disables."""
