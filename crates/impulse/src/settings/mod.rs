@@ -270,8 +270,8 @@ pub struct SolveSettings {
     /// sweeps on towards convergence, so a face that lands on its corners at restitution 0
     /// stops dead instead of leaving spinning (docs/method.md, "Impacts"). 0 takes no impact
     /// sweeps: each substep keeps its `iterations` and `relax_iterations`, a cube dropped flat
-    /// at restitution 0 rises again at 7-9 % of its impact speed, and a pour costs about half
-    /// as much (docs/benchmarks.md, "Pours"). An island with joints sweeps on as by default
+    /// at restitution 0 rises again at 7-9 % of its impact speed, and a pour costs a fifth to
+    /// a third less (docs/method.md, "Impacts"). An island with joints sweeps on as by default
     /// whatever this says: its impacts are told by the last sweep alone, and without the sweeps
     /// a ragdoll pile's limbs sank three times as deep into one another.
     pub impact_sweeps: u32,
@@ -631,7 +631,7 @@ impl SolverSettings {
     /// Speed before accuracy: the soft step at 8 substeps (96 Hz contacts) without impact
     /// sweeps ([`SolveSettings::impact_sweeps`] 0). Meets E ≤ 50 mm on the standard scenes
     /// (docs/benchmarks.md, "The front"), where nothing lands, as the soft step at 8 substeps
-    /// does; where bodies land, as in a pour, it costs about half as much, and a face landing
+    /// does; where bodies land, as in a pour, it costs a third less, and a face landing
     /// at restitution 0 rises again at 7-9 % of its impact speed (docs/method.md, "Impacts").
     pub fn fast() -> Self {
         let soft = Self::soft_step(8);

@@ -27,7 +27,7 @@ pub(crate) struct Bundles {
     /// group each island slot may still take a lane in (see `select_local`).
     pub(super) local_groups: Vec<Group>,
     pub(super) local_bundles: Vec<Bundle>,
-    pub(super) local_lanes: Vec<super::local::LocalLane>,
+    pub(super) local_lanes: Vec<super::layout::LocalLane>,
     pub(super) local_filled: Vec<u8>,
     pub(super) local_after: Vec<u32>,
     /// Packing scratch: per manifold group (a run of at most [`GROUP_POINTS`] consecutive

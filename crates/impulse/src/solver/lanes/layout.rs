@@ -1,6 +1,7 @@
 //! What the lanes hold: a bundle's rows (one point per lane), a lane group's shared part
 //! (bodies, masses, directions, friction), the points' geometry for the targets, the record
-//! per bundle, the two bodies' velocities per lane and how one point is written into a lane.
+//! per bundle, the two bodies' velocities per lane, how one point is written into a lane, and
+//! how a lane is copied between packs (the local impact sweeps' own pack, `super::local`).
 
 use glam::Vec3;
 
@@ -312,5 +313,88 @@ pub(super) fn sliding_step([a, b, d]: [f32; 3]) -> f32 {
         1.0 / k1
     } else {
         0.0
+    }
+}
+
+/// Where a lane of the local groups came from: the first bundle and the lane of its lane group
+/// in the island's pack, that group's bundle count, and its place among the local groups.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LocalLane {
+    pub(super) source_start: u32,
+    pub(super) source_lane: u8,
+    pub(super) len: u32,
+    pub(super) group: u32,
+    pub(super) lane: u8,
+}
+
+impl Group {
+    /// Lane `to` of this group becomes lane `from` of `source`: the bodies, their inverse
+    /// masses, the manifold's directions and friction.
+    pub(super) fn copy_lane_from(&mut self, to: usize, source: &Group, from: usize) {
+        self.local_a[to] = source.local_a[from];
+        self.local_b[to] = source.local_b[from];
+        let copy = |into: &mut Lane, from_lane: &Lane| set(into, to, from_lane.as_array()[from]);
+        for k in 0..3 {
+            copy(&mut self.inverse_mass_a[k], &source.inverse_mass_a[k]);
+            copy(&mut self.inverse_mass_b[k], &source.inverse_mass_b[k]);
+            for d in 0..3 {
+                copy(&mut self.directions[d][k], &source.directions[d][k]);
+            }
+        }
+        copy(&mut self.friction, &source.friction);
+    }
+}
+
+impl Bundle {
+    /// Lane `to` of this bundle becomes lane `from` of `source`: every row.
+    pub(super) fn copy_lane_from(&mut self, to: usize, source: &Bundle, from: usize) {
+        let copy = |into: &mut Lane, from_lane: &Lane| set(into, to, from_lane.as_array()[from]);
+        let [tangent_1, tangent_2] = &mut self.tangents;
+        let rows = [
+            (&mut self.normal, &source.normal),
+            (tangent_1, &source.tangents[0]),
+            (tangent_2, &source.tangents[1]),
+        ];
+        for (into, row) in rows {
+            for k in 0..3 {
+                copy(&mut into.angular_a[k], &row.angular_a[k]);
+                copy(&mut into.angular_b[k], &row.angular_b[k]);
+                copy(
+                    &mut into.inverse_inertia_angular_a[k],
+                    &row.inverse_inertia_angular_a[k],
+                );
+                copy(
+                    &mut into.inverse_inertia_angular_b[k],
+                    &row.inverse_inertia_angular_b[k],
+                );
+            }
+            copy(&mut into.effective_mass, &row.effective_mass);
+            copy(
+                &mut into.inverse_effective_mass,
+                &row.inverse_effective_mass,
+            );
+        }
+        copy(&mut self.target, &source.target);
+        copy(&mut self.mass_scale, &source.mass_scale);
+        copy(&mut self.impulse_scale, &source.impulse_scale);
+        copy(&mut self.depth, &source.depth);
+        for k in 0..3 {
+            copy(
+                &mut self.tangent_inverse_block[k],
+                &source.tangent_inverse_block[k],
+            );
+        }
+        copy(&mut self.sliding_step, &source.sliding_step);
+        self.copy_impulses_from(to, source, from);
+    }
+
+    /// Lane `to` of this bundle takes the impulses of lane `from` of `source`: what a sweep
+    /// writes ([`super::sweep::solve_bundle`]).
+    pub(super) fn copy_impulses_from(&mut self, to: usize, source: &Bundle, from: usize) {
+        let copy = |into: &mut Lane, from_lane: &Lane| set(into, to, from_lane.as_array()[from]);
+        copy(&mut self.normal_impulse, &source.normal_impulse);
+        copy(&mut self.max_normal_impulse, &source.max_normal_impulse);
+        copy(&mut self.tangent_impulses[0], &source.tangent_impulses[0]);
+        copy(&mut self.tangent_impulses[1], &source.tangent_impulses[1]);
     }
 }

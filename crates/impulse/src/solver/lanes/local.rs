@@ -12,8 +12,8 @@
 //! so the sweep is the island's Gauss-Seidel order restricted to the region.
 
 use super::bundles::Bundles;
-use super::lane::{LANES, Lane, set};
-use super::layout::{Bundle, Group};
+use super::lane::{LANES, Lane};
+use super::layout::{Bundle, Group, LocalLane};
 use super::schedule::{SweepOrder, sweep_groups_on};
 use super::sweep::{BundleUpdate, VelocityRows};
 use super::targets::NoTargets;
@@ -21,89 +21,6 @@ use crate::parallel::{SharedItems, SharedVelocities};
 use crate::simd::InstructionSet;
 use crate::solver::interface::SolveReport;
 use crate::solver::rows::Velocities;
-
-/// Where a lane of the local groups came from: the first bundle and the lane of its lane group
-/// in the island's pack, that group's bundle count, and its place among the local groups.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct LocalLane {
-    source_start: u32,
-    source_lane: u8,
-    len: u32,
-    group: u32,
-    lane: u8,
-}
-
-impl Group {
-    /// Lane `to` of this group becomes lane `from` of `source`: the bodies, their inverse
-    /// masses, the manifold's directions and friction.
-    fn copy_lane_from(&mut self, to: usize, source: &Group, from: usize) {
-        self.local_a[to] = source.local_a[from];
-        self.local_b[to] = source.local_b[from];
-        let copy = |into: &mut Lane, from_lane: &Lane| set(into, to, from_lane.as_array()[from]);
-        for k in 0..3 {
-            copy(&mut self.inverse_mass_a[k], &source.inverse_mass_a[k]);
-            copy(&mut self.inverse_mass_b[k], &source.inverse_mass_b[k]);
-            for d in 0..3 {
-                copy(&mut self.directions[d][k], &source.directions[d][k]);
-            }
-        }
-        copy(&mut self.friction, &source.friction);
-    }
-}
-
-impl Bundle {
-    /// Lane `to` of this bundle becomes lane `from` of `source`: every row.
-    fn copy_lane_from(&mut self, to: usize, source: &Bundle, from: usize) {
-        let copy = |into: &mut Lane, from_lane: &Lane| set(into, to, from_lane.as_array()[from]);
-        let [tangent_1, tangent_2] = &mut self.tangents;
-        let rows = [
-            (&mut self.normal, &source.normal),
-            (tangent_1, &source.tangents[0]),
-            (tangent_2, &source.tangents[1]),
-        ];
-        for (into, row) in rows {
-            for k in 0..3 {
-                copy(&mut into.angular_a[k], &row.angular_a[k]);
-                copy(&mut into.angular_b[k], &row.angular_b[k]);
-                copy(
-                    &mut into.inverse_inertia_angular_a[k],
-                    &row.inverse_inertia_angular_a[k],
-                );
-                copy(
-                    &mut into.inverse_inertia_angular_b[k],
-                    &row.inverse_inertia_angular_b[k],
-                );
-            }
-            copy(&mut into.effective_mass, &row.effective_mass);
-            copy(
-                &mut into.inverse_effective_mass,
-                &row.inverse_effective_mass,
-            );
-        }
-        copy(&mut self.target, &source.target);
-        copy(&mut self.mass_scale, &source.mass_scale);
-        copy(&mut self.impulse_scale, &source.impulse_scale);
-        copy(&mut self.depth, &source.depth);
-        for k in 0..3 {
-            copy(
-                &mut self.tangent_inverse_block[k],
-                &source.tangent_inverse_block[k],
-            );
-        }
-        copy(&mut self.sliding_step, &source.sliding_step);
-        self.copy_impulses_from(to, source, from);
-    }
-
-    /// Lane `to` of this bundle takes the impulses of lane `from` of `source`: what a sweep
-    /// writes ([`super::sweep::solve_bundle`]).
-    fn copy_impulses_from(&mut self, to: usize, source: &Bundle, from: usize) {
-        let copy = |into: &mut Lane, from_lane: &Lane| set(into, to, from_lane.as_array()[from]);
-        copy(&mut self.normal_impulse, &source.normal_impulse);
-        copy(&mut self.max_normal_impulse, &source.max_normal_impulse);
-        copy(&mut self.tangent_impulses[0], &source.tangent_impulses[0]);
-        copy(&mut self.tangent_impulses[1], &source.tangent_impulses[1]);
-    }
-}
 
 impl Bundles {
     /// Packs the lanes of the last pack with a body `in_region` holds (by island slot) into
