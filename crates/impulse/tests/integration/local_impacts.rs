@@ -91,8 +91,10 @@ fn drop_on_grid(speed: f32, simd: bool) -> (f32, f32, f32, u64, u64, u32) {
 /// At 5 and 10 m/s, in lanes and on the scalar path: the cube stops dead (rebound within 1 %
 /// of the impact speed, as onto the ground alone: dead_impacts.rs), the grid ends at rest
 /// (no cube faster than 0.05 m/s) with no cube pushed into the slab by more than 5 mm, the
-/// step swept on as an impact, and those sweeps updated on average at most a tenth of the
-/// island's points a sweep (the whole island's sweeps updated all of them).
+/// step swept on as an impact, and those sweeps updated on average at most a fortieth of the
+/// island's points a sweep (the whole island's sweeps update all of them; in lanes the
+/// region's lanes are packed into lane groups of their own, so a sweep updates the region's
+/// points alone, as on the scalar path, not every lane group that holds one of them).
 #[test]
 fn a_cube_dropped_onto_a_resting_grid_stops_dead_and_sweeps_only_around_the_impact() {
     for simd in [true, false] {
@@ -108,7 +110,7 @@ fn a_cube_dropped_onto_a_resting_grid_stops_dead_and_sweeps_only_around_the_impa
             assert!(sweeps > 0, "{name}: no impact sweeps");
             assert!(island > 2_000, "{name}: the island has {island} points");
             assert!(
-                points * 10 <= sweeps * u64::from(island),
+                points * 40 <= sweeps * u64::from(island),
                 "{name}: {points} point updates in {sweeps} sweeps of {island} points"
             );
             assert!(rebound <= 0.01 * speed, "{name}: rebound {rebound:.3} m/s");
