@@ -4,9 +4,9 @@
 //! held.
 //!
 //! The region's manifolds all touch the struck bodies, so in the island's pack they lie in
-//! different colours, one or two to a lane group: sweeping the groups that hold them swept
-//! three times as many points as the region has (`pour500`: 465 points a local sweep for a
-//! region of 134). Packed anew, lanes that share no body share a group, and each sweep costs the
+//! different colours, one or two to a lane group: sweeping the groups that hold them would
+//! sweep about three times the region's points in a pour (docs/method.md, "Local impact
+//! sweeps"). Packed anew, lanes that share no body share a group, and each sweep costs the
 //! region's own points. The new groups keep the island's order between any two lanes that
 //! share a body (a lane goes to a group after every group holding a lane of one of its bodies),
 //! so the sweep is the island's Gauss-Seidel order restricted to the region.
