@@ -346,8 +346,10 @@ impl Group {
 }
 
 impl Bundle {
-    /// Lane `to` of this bundle becomes lane `from` of `source`: every row.
-    pub(super) fn copy_lane_from(&mut self, to: usize, source: &Bundle, from: usize) {
+    /// Lane `to` of this bundle takes the rows of lane `from` of `source` that stay as the
+    /// pack made them through the step's substeps: the Jacobian rows, effective masses and the
+    /// friction block (not the depth, which only the targets read).
+    pub(super) fn copy_rows_from(&mut self, to: usize, source: &Bundle, from: usize) {
         let copy = |into: &mut Lane, from_lane: &Lane| set(into, to, from_lane.as_array()[from]);
         let [tangent_1, tangent_2] = &mut self.tangents;
         let rows = [
@@ -374,10 +376,6 @@ impl Bundle {
                 &row.inverse_effective_mass,
             );
         }
-        copy(&mut self.target, &source.target);
-        copy(&mut self.mass_scale, &source.mass_scale);
-        copy(&mut self.impulse_scale, &source.impulse_scale);
-        copy(&mut self.depth, &source.depth);
         for k in 0..3 {
             copy(
                 &mut self.tangent_inverse_block[k],
@@ -385,6 +383,15 @@ impl Bundle {
             );
         }
         copy(&mut self.sliding_step, &source.sliding_step);
+    }
+
+    /// Lane `to` of this bundle takes what each solve of a substep sets and changes in lane
+    /// `from` of `source`: the target and softness its targets gave it, and the impulses.
+    pub(super) fn copy_solve_state_from(&mut self, to: usize, source: &Bundle, from: usize) {
+        let copy = |into: &mut Lane, from_lane: &Lane| set(into, to, from_lane.as_array()[from]);
+        copy(&mut self.target, &source.target);
+        copy(&mut self.mass_scale, &source.mass_scale);
+        copy(&mut self.impulse_scale, &source.impulse_scale);
         self.copy_impulses_from(to, source, from);
     }
 

@@ -95,11 +95,24 @@ impl Bundles {
         }
         self.local_bundles.clear();
         self.local_bundles.resize(total as usize, Bundle::default());
+        // The rows stay as the pack made them through the step; what a solve sets and changes
+        // is copied in by each `solve_local`.
+        for lane in &self.local_lanes {
+            let start = self.local_groups[lane.group as usize].start as usize;
+            for p in 0..lane.len as usize {
+                let source = &self.bundles[lane.source_start as usize + p];
+                self.local_bundles[start + p].copy_rows_from(
+                    lane.lane as usize,
+                    source,
+                    lane.source_lane as usize,
+                );
+            }
+        }
         points
     }
 
-    /// PGS on the lanes [`Bundles::select_local`] packed, the targets as they are: their rows
-    /// copied from the island's bundles, at most `iterations` sweeps, alternating from
+    /// PGS on the lanes [`Bundles::select_local`] packed, the targets as they are: their
+    /// targets, softness and impulses copied from the island's bundles, at most `iterations` sweeps, alternating from
     /// forward, until no row's velocity changes by more than `tolerance` (m/s); without
     /// `friction` the normal rows alone, with `half_turn` each group's bundles from halfway
     /// round (see [`Bundles::solve_pgs`]); their impulses copied back.
@@ -115,7 +128,7 @@ impl Bundles {
             let start = self.local_groups[lane.group as usize].start as usize;
             for p in 0..lane.len as usize {
                 let source = &self.bundles[lane.source_start as usize + p];
-                self.local_bundles[start + p].copy_lane_from(
+                self.local_bundles[start + p].copy_solve_state_from(
                     lane.lane as usize,
                     source,
                     lane.source_lane as usize,
