@@ -407,13 +407,29 @@ impl ContactDispatcher {
         )?;
         let refined =
             cap_pair && caps::refine_cap_contact(pos12, g1, g2, prediction, manifold, &old);
+        // Parry's generator for polyhedra leaves a pair it found apart beyond the prediction
+        // without points, its normal the direction along which GJK found the gap; where GJK
+        // ends early it gives points all beyond the prediction instead (between the mug's
+        // thin parts, tens of millimetres off). The gap along the normal (two support points)
+        // then shows the shapes farther apart than the prediction (no direction's gap exceeds
+        // their distance): the pair keeps no point, and neither the faces' refinement nor the
+        // fallback looks again (each would ask GJK, for the same answer).
+        let apart = hull_pair
+            && !cap_pair
+            && nearest_separation(&manifold.points) > prediction
+            && faces::apart_beyond(pos12, g1, g2, manifold.local_n1, prediction);
+        if apart {
+            manifold.points.clear();
+        }
         let faces_refined = hull_pair
             && !refined
+            && !apart
             && faces::refine_face_contact(pos12, g1, g2, prediction, constraints, manifold, &old);
         // A manifold the faces' refinement emptied is of shapes apart beyond the prediction,
         // where the fallback's contact query may read them deep in (see
         // `faces::better_face_axis`).
-        if !(faces_refined && manifold.points.is_empty()) {
+        let emptied = faces_refined && manifold.points.is_empty();
+        if !(apart || emptied) {
             fallback.after(pos12, g1, g2, constraints, prediction, manifold);
         }
         if hull_pair && (is_flat_type(type1) || is_flat_type(type2)) {
@@ -583,9 +599,14 @@ impl<ContactData: Default + Copy> NearestPointFallback<ContactData> {
         if !manifold.points.is_empty() {
             return;
         }
+        // Parry's contact query can return shapes farther apart than asked (GJK ending
+        // before it proves the gap beyond the prediction): no point then.
         let Ok(Some(contact)) = DefaultQueryDispatcher.contact(pos12, g1, g2, prediction) else {
             return;
         };
+        if contact.dist > prediction {
+            return;
+        }
         let mut point = TrackedContact::new(
             contact.point1,
             contact.point2,

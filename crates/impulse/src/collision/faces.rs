@@ -433,9 +433,13 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
     // normal constraints also drop GJK's point): the shapes' contact tells which, and gives
     // the normal.
     if manifold.points.is_empty() && !half_space {
+        // (Parry's query can return shapes farther apart than asked: GJK ending early.)
         let Ok(Some(contact)) = DefaultQueryDispatcher.contact(pos12, g1, g2, prediction) else {
             return false;
         };
+        if contact.dist > prediction {
+            return false;
+        }
         let (mut n1, mut n2) = (contact.normal1, contact.normal2);
         if !constraints.project_local_normals(pos12, &mut n1, &mut n2) {
             return false;
@@ -604,6 +608,21 @@ fn support_separation(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, axis: Vector
     supports(pos12, g1, g2, axis).map(|(_, _, separation)| separation)
 }
 
+/// Whether `g1` and `g2` (`g2` at `pos12` in `g1`'s frame) are farther apart than `prediction`
+/// (m) along `direction` (shape 1's frame, out of it; any length, `false` if zero), borders
+/// included: their gap along it, which is at most their distance, is above the prediction.
+pub(crate) fn apart_beyond(
+    pos12: &Pose,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    direction: Vector,
+    prediction: Real,
+) -> bool {
+    direction.try_normalize().is_some_and(|axis| {
+        support_separation(pos12, g1, g2, axis).is_some_and(|gap| gap > prediction)
+    })
+}
+
 /// The support points (shape 1's frame) of `g1` along `axis` and of `g2` against it, and the
 /// separation along it ([`support_separation`]).
 fn supports(
@@ -704,19 +723,30 @@ fn edge_axis_above(
     let (threshold, slack) = (search.threshold, search.slack);
     let (faces1, faces2) = (hull1.faces(), hull2.faces());
     let (points1, points2) = (hull1.points(), hull2.points());
+    let (known1, known2) = search.known;
+    // An edge pair's axis u lies on both edges' arcs (below), where edge 1 supports shape 1
+    // along u and edge 2 supports shape 2 against it: the separation along u is q·u − p·u
+    // (p, q a point of each edge), at most (known2 − p)·u and (q − known1)·u, since shape 2
+    // reaches at least as low as its known point and shape 1 at least as high as its own. An
+    // edge whose arc holds no direction with that bound above the threshold gives no axis the
+    // search could return (the returned axis is above the threshold, and an axis below it
+    // cannot outrank that one), and is left out: an edge on the far side of either shape.
+    let beyond_reach =
+        |v: Vector, a: Vector, b: Vector| arc_reach(v, a, b) + 2.0 * slack <= threshold;
     // Shape 2's edges in shape 1's frame, once: each edge's arc between its faces' normals
     // (negated, as the Minkowski difference sees them), its direction and one of its points.
     let edges2: Vec<(GaussArc, Vector, Vector)> = hull_edges(hull2)
-        .map(|e2| {
+        .filter_map(|e2| {
             let c = pos12.rotation * faces2[e2.faces[0] as usize].normal;
             let d = pos12.rotation * faces2[e2.faces[1] as usize].normal;
-            (
-                GaussArc::new(-c, -d),
-                pos12.rotation * e2.dir,
-                pos12.transform_point(points2[e2.vertices[0] as usize]),
-            )
+            let q = pos12.transform_point(points2[e2.vertices[0] as usize]);
+            (!beyond_reach(q - known1, -c, -d))
+                .then(|| (GaussArc::new(-c, -d), pos12.rotation * e2.dir, q))
         })
         .collect();
+    if edges2.is_empty() {
+        return None;
+    }
     let mut arcs2 = GaussArcs::new(edges2.iter().map(|(arc, _, _)| *arc));
     // An edge pair's axis is a face of the Minkowski difference in one direction only: the
     // one where the two arcs cross, inside arc 1 (so along its faces' normals' sum). Only
@@ -741,9 +771,12 @@ fn edge_axis_above(
             faces1[e1.faces[0] as usize].normal,
             faces1[e1.faces[1] as usize].normal,
         );
+        let p = points1[e1.vertices[0] as usize];
+        if beyond_reach(known2 - p, normal_a, normal_b) {
+            continue;
+        }
         let arc1 = GaussArc::new(normal_a, normal_b);
         let inside1 = normal_a + normal_b;
-        let p = points1[e1.vertices[0] as usize];
         arcs2.crossing(&arc1, |j| {
             let (_, dir2, q) = &edges2[j];
             let Some(axis) = e1.dir.cross(*dir2).try_normalize() else {
@@ -772,6 +805,23 @@ fn edge_axis_above(
     });
     best.map(|(axis, separation, _)| (axis, separation))
         .filter(|&(_, separation)| separation > threshold)
+}
+
+/// An upper bound of v·u over the unit directions u of the shorter great-circle arc between
+/// the unit vectors `a` and `b` (both ends included): u = (λa + μb)/|λa + μb| with λ, μ ≥ 0,
+/// and |λa + μb| ≥ (λ + μ)·cos(θ/2) (θ the angle between a and b), so v·u is at most the
+/// larger of v·a and v·b over cos(θ/2) when that is positive, and at most it otherwise.
+/// Infinite for nearly opposite ends (cos(θ/2) below 0.01), whose arc is not decided.
+fn arc_reach(v: Vector, a: Vector, b: Vector) -> Real {
+    let top = v.dot(a).max(v.dot(b));
+    if top <= 0.0 {
+        return top;
+    }
+    let half_cosine_squared = 0.5 * (1.0 + a.dot(b));
+    if half_cosine_squared < 1.0e-4 {
+        return Real::INFINITY;
+    }
+    top / half_cosine_squared.sqrt()
 }
 
 /// The edges of `hull` between two of its faces: an edge inside a face (both sides the same

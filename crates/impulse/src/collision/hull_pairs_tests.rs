@@ -470,3 +470,60 @@ fn thin_parts_apart_get_no_deep_points() {
         assert_eq!(manifold.points.is_empty(), prediction < -exact);
     }
 }
+
+/// Parry's contact query between the mug's parts can end before GJK proves them farther apart
+/// than asked and return a contact beyond the prediction, where Parry's manifold generator
+/// (GJK from another start) finds them apart and gives no point. The engine then keeps no
+/// point either (its fallback for pairs Parry leaves without points does not add that
+/// contact), and a pair apart beyond the prediction by more than 2 mm (the exact reference's
+/// separation) gets none.
+#[test]
+fn parts_apart_beyond_the_prediction_get_no_points() {
+    let prediction: f32 = 0.024;
+    let parts = mug_parts();
+    let (mut beyond, mut parry_beyond, mut within) = (0, 0, 0);
+    for index in 0..600 {
+        let c = case(83, index, -0.04..-0.002);
+        let (g1, g2) = (part_shape(&parts[c.i]), part_shape(&parts[c.j]));
+        let (g1, g2) = (g1.as_ref(), g2.as_ref());
+        let pos12 = c.pose1.inv_mul(&c.pose2);
+        // As in a step: the manifold keeps last step's normal, which GJK starts from (here
+        // the exact separating axis, shape 1's frame).
+        let seeded = || {
+            let mut m: ContactManifold<(), ()> = ContactManifold::new();
+            m.local_n1 = c.pose1.rotation.inverse() * c.axis.as_vec3();
+            m
+        };
+        let mut manifold = seeded();
+        crate::collision::dispatch::ContactDispatcher::default()
+            .contact_manifold_convex_convex(&pos12, g1, g2, None, None, prediction, &mut manifold)
+            .unwrap();
+        let mut parry = seeded();
+        DefaultQueryDispatcher
+            .contact_manifold_convex_convex(&pos12, g1, g2, None, None, prediction, &mut parry)
+            .unwrap();
+        if parry.points.is_empty()
+            && let Some(contact) = query::contact(&c.pose1, g1, &c.pose2, g2, prediction).unwrap()
+            && contact.dist > prediction
+        {
+            parry_beyond += 1;
+            assert!(
+                manifold.points.is_empty(),
+                "case {index}: a point where Parry's contact is {} mm apart",
+                contact.dist * 1e3
+            );
+        }
+        // The reference's largest separation is at most the distance.
+        if -c.depth > f64::from(prediction) + 2.0e-3 {
+            beyond += 1;
+            assert!(manifold.points.is_empty(), "case {index}: points beyond");
+        } else if !manifold.points.is_empty() {
+            within += 1;
+        }
+    }
+    assert!(
+        parry_beyond >= 5 && beyond >= 50 && within >= 50,
+        "{parry_beyond} contacts beyond the prediction from Parry, {beyond} cases apart \
+         beyond it, {within} with points: the sample tests too little"
+    );
+}
