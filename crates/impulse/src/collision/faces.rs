@@ -137,9 +137,10 @@ impl Feature {
     }
 
     /// The feature of `shape` (at `pose` in shape 1's frame) facing along `dir` (the shape's
-    /// own frame, out of it): a half-space's plane, a hull's whole support face, or Parry's
-    /// support feature for any other shape with one.
-    fn of(shape: &dyn Shape, pose: &Pose, dir: Vector) -> Option<Self> {
+    /// own frame, out of it): a half-space's plane, a hull's whole support face (`face`, its
+    /// index if known: [`support_face_index`] along `dir`), or Parry's support feature for any
+    /// other shape with one.
+    fn of(shape: &dyn Shape, pose: &Pose, dir: Vector, face: Option<usize>) -> Option<Self> {
         if let Some(half_space) = shape.as_halfspace() {
             return Some(Self {
                 vertices: Vec::new(),
@@ -153,7 +154,7 @@ impl Feature {
         if let Some((hull, border)) = hull_parts(shape) {
             return Some(Self::hull_face(
                 hull,
-                support_face_index(hull, dir),
+                face.unwrap_or_else(|| support_face_index(hull, dir)),
                 border,
                 pose,
             ));
@@ -476,12 +477,19 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
     }
     let (n1, n2) = (manifold.local_n1, manifold.local_n2);
     let n = n1.normalize();
-    let large = |shape: &dyn Shape, dir: Vector| {
-        hull_parts(shape).is_some_and(|(hull, _)| {
-            hull.faces()[support_face_index(hull, dir)].num_vertices_or_edges as usize > 4
+    // Each hull's support face along the normal (a pass over its faces), found once.
+    let support_face = |shape: &dyn Shape, dir: Vector| {
+        hull_parts(shape).map(|(hull, _)| {
+            let index = support_face_index(hull, dir);
+            (
+                index,
+                hull.faces()[index].num_vertices_or_edges as usize > 4,
+            )
         })
     };
-    let (large1, large2) = (large(g1, n1), large(g2, n2));
+    let (face1, face2) = (support_face(g1, n1), support_face(g2, n2));
+    let large1 = face1.is_some_and(|(_, large)| large);
+    let large2 = face2.is_some_and(|(_, large)| large);
     // Under a mesh triangle's normal constraints Parry drops every point more than five times
     // deeper than GJK's depth along its normal (`contact_manifold_pfm_pfm`), which is itself
     // off by GJK's tolerance where a face lies flat on the triangle: a cloud's facet 0.09 mm
@@ -495,8 +503,8 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
         return false;
     }
     let (Some(f1), Some(f2)) = (
-        Feature::of(g1, &Pose::IDENTITY, n1),
-        Feature::of(g2, pos12, n2),
+        Feature::of(g1, &Pose::IDENTITY, n1, face1.map(|(index, _)| index)),
+        Feature::of(g2, pos12, n2, face2.map(|(index, _)| index)),
     ) else {
         return false;
     };
