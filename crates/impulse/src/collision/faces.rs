@@ -673,11 +673,6 @@ fn better_face_axis<ContactData>(
     points: &[TrackedContact<ContactData>],
     memory: Option<&mut Option<FaceAxisMemory>>,
 ) -> Option<(Vector, Real)> {
-    let (support1, support2, given) = supports(pos12, g1, g2, normal)?;
-    let sphere1 = g1.compute_local_bounding_sphere();
-    let sphere2 = g2.compute_local_bounding_sphere();
-    let tolerance =
-        AXIS_TOLERANCE + AXIS_RELATIVE_TOLERANCE * (sphere1.radius() + sphere2.radius());
     // Along a contact normal the deepest point of the manifold is at the shapes' separation
     // along it; only a normal whose points read the shapes far nearer than they are along it is
     // searched (two support points a pair, not one per face).
@@ -685,10 +680,21 @@ fn better_face_axis<ContactData>(
         .iter()
         .map(|p| p.dist)
         .fold(Real::INFINITY, Real::min);
-    if points.is_empty()
-        || deepest.is_nan()
-        || (deepest <= given + tolerance && deepest >= -tolerance)
-    {
+    if points.is_empty() || deepest.is_nan() {
+        return None;
+    }
+    let (support1, support2, given) = supports(pos12, g1, g2, normal)?;
+    // The tolerance is at least AXIS_TOLERANCE: a point within that needs no bounding sphere
+    // (a pass over each hull's points) to be let through, as most are.
+    let within = |tolerance: Real| deepest <= given + tolerance && deepest >= -tolerance;
+    if within(AXIS_TOLERANCE) {
+        return None;
+    }
+    let sphere1 = g1.compute_local_bounding_sphere();
+    let sphere2 = g2.compute_local_bounding_sphere();
+    let tolerance =
+        AXIS_TOLERANCE + AXIS_RELATIVE_TOLERANCE * (sphere1.radius() + sphere2.radius());
+    if within(tolerance) {
         return None;
     }
     let threshold = given + tolerance;
