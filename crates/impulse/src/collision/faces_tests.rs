@@ -580,7 +580,8 @@ fn matches_every_axis(
             },
         )
     };
-    let Some((_, top)) = largest(&|_| true) else {
+    let every_largest = largest(&|_| true);
+    let Some((_, top)) = every_largest else {
         return Vec::new();
     };
     let bits = |found: Option<(Vec3, f32)>| found.map(|(a, v)| (a.to_array(), v.to_bits()));
@@ -589,7 +590,7 @@ fn matches_every_axis(
         let kept = largest(&|reach| reach + 2.0 * slack > threshold);
         let above = kept.filter(|&(_, value)| value > threshold);
         assert_eq!(bits(search(threshold)), bits(above), "{case}, {threshold}");
-        let unfiltered = largest(&|_| true).filter(|&(_, value)| value > threshold);
+        let unfiltered = every_largest.filter(|&(_, value)| value > threshold);
         compared.push((above.map(|(_, v)| v), unfiltered.map(|(_, v)| v)));
     }
     compared

@@ -97,16 +97,8 @@ impl Bundles {
         self.local_bundles.resize(total as usize, Bundle::default());
         // The rows stay as the pack made them through the step; what a solve sets and changes
         // is copied in by each `solve_local`.
-        for lane in &self.local_lanes {
-            let start = self.local_groups[lane.group as usize].start as usize;
-            for p in 0..lane.len as usize {
-                let source = &self.bundles[lane.source_start as usize + p];
-                self.local_bundles[start + p].copy_rows_from(
-                    lane.lane as usize,
-                    source,
-                    lane.source_lane as usize,
-                );
-            }
+        for (local, to, island, from) in local_places(&self.local_lanes, &self.local_groups) {
+            self.local_bundles[local].copy_rows_from(to, &self.bundles[island], from);
         }
         points
     }
@@ -124,16 +116,8 @@ impl Bundles {
         friction: bool,
         half_turn: bool,
     ) -> SolveReport {
-        for lane in &self.local_lanes {
-            let start = self.local_groups[lane.group as usize].start as usize;
-            for p in 0..lane.len as usize {
-                let source = &self.bundles[lane.source_start as usize + p];
-                self.local_bundles[start + p].copy_solve_state_from(
-                    lane.lane as usize,
-                    source,
-                    lane.source_lane as usize,
-                );
-            }
+        for (local, to, island, from) in local_places(&self.local_lanes, &self.local_groups) {
+            self.local_bundles[local].copy_solve_state_from(to, &self.bundles[island], from);
         }
         let mut report = SolveReport::default();
         for iteration in 0..iterations {
@@ -153,15 +137,8 @@ impl Bundles {
                 break;
             }
         }
-        for lane in &self.local_lanes {
-            let start = self.local_groups[lane.group as usize].start as usize;
-            for p in 0..lane.len as usize {
-                self.bundles[lane.source_start as usize + p].copy_impulses_from(
-                    lane.source_lane as usize,
-                    &self.local_bundles[start + p],
-                    lane.lane as usize,
-                );
-            }
+        for (local, to, island, from) in local_places(&self.local_lanes, &self.local_groups) {
+            self.bundles[island].copy_impulses_from(from, &self.local_bundles[local], to);
         }
         report
     }
@@ -198,4 +175,23 @@ impl Bundles {
             )
         }
     }
+}
+
+/// Where each point of the local `lanes` (their groups `groups`) sits, in the lanes' order:
+/// (local bundle, lane there, island bundle, lane there).
+fn local_places<'a>(
+    lanes: &'a [LocalLane],
+    groups: &'a [Group],
+) -> impl Iterator<Item = (usize, usize, usize, usize)> + 'a {
+    lanes.iter().flat_map(move |lane| {
+        let start = groups[lane.group as usize].start as usize;
+        (0..lane.len as usize).map(move |p| {
+            (
+                start + p,
+                lane.lane as usize,
+                lane.source_start as usize + p,
+                lane.source_lane as usize,
+            )
+        })
+    })
 }
