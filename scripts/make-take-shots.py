@@ -121,7 +121,7 @@ def pachinko():
                        "shape": {"type": "cuboid", "half_extents": [0.01, 0.15, 0.1]},
                        "position": [0.2 * k - 0.7, 0.15, 0.0]})
     bodies.append({"name": "ball", "kind": "dynamic", "shape": {"type": "sphere", "radius": 0.04},
-                   "material": "steel", "position": [0.03, 1.9, 0.0],
+                   "material": "steel", "position": [0.025, 1.9, 0.0],
                    "locked_axes": {"translation": ["z"]}})
     scene = {"name": "pachinko",
              "materials": {"steel": {"density": 7800.0, "friction": 0.3, "restitution": 0.5}},
