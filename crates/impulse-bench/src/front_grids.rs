@@ -23,6 +23,9 @@ pub type ImpulseSetting = (String, Option<SolverSettings>);
 ///   (`SolveSettings::impact_sweeps` 0, as the preset `fast` at 8 substeps): cheaper wherever
 ///   bodies land, as in a pour, and a face landing at restitution 0 rises again at 7-9 % of
 ///   its impact speed.
+/// - `soft S, impact sweeps 0, recycle 2 cm`: that, with contacts kept while a pair moves less
+///   than 2 cm (`ContactSettings::recycle_distance`, as the preset `fast`): cheaper where
+///   bodies move, as in a pour.
 /// - `reference S×I`: `SolverSettings::reference()` (auto NNCG, split impulse, the exact
 ///   path) with S substeps of at most I iterations.
 pub fn impulse_grid() -> Vec<ImpulseSetting> {
@@ -39,6 +42,9 @@ pub fn impulse_grid() -> Vec<ImpulseSetting> {
     // At 8 substeps: the preset `fast`.
     for substeps in [3, 4, 6, 12] {
         grid.push(without_impact_sweeps(soft_step(substeps, 1)));
+        grid.push(recycling_fast(without_impact_sweeps(soft_step(
+            substeps, 1,
+        ))));
     }
     for (substeps, iterations) in [(1, 4), (1, 8), (2, 4), (2, 8), (4, 4)] {
         grid.push(reference(substeps, iterations));
@@ -116,6 +122,21 @@ fn without_impact_sweeps((name, settings): ImpulseSetting) -> ImpulseSetting {
             solve: impulse::settings::SolveSettings {
                 impact_sweeps: 0,
                 ..settings.solve
+            },
+            ..settings
+        }),
+    )
+}
+
+/// `setting` with contacts recycled within the preset `fast`'s distance
+/// (`impulse::settings::FAST_RECYCLE_DISTANCE`, 2 cm), named so.
+fn recycling_fast((name, settings): ImpulseSetting) -> ImpulseSetting {
+    (
+        format!("{name}, recycle 2 cm"),
+        settings.map(|settings| SolverSettings {
+            contact: impulse::settings::ContactSettings {
+                recycle_distance: impulse::settings::FAST_RECYCLE_DISTANCE,
+                ..settings.contact
             },
             ..settings
         }),

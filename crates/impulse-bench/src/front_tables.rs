@@ -254,7 +254,7 @@ lowest ms/step of any peer (Rapier, Box3D, Jolt) meeting it (< 1: impulse is fas
 `SolverSettings::default()`, the soft step at 20 substeps), the presets `fast`, `precise` and \
 `reference`, `soft S` the soft step at S substeps (one PGS sweep and one relax sweep each, \
 contacts of 12·S Hz), `soft S×I` the same with I sweeps, `soft S, impact sweeps 0` the same \
-without the sweeps an impact may add (`impact_sweeps: 0`), `reference S×I` the reference preset \
+without the sweeps an impact may add (`impact_sweeps: 0`), `…, recycle 2 cm` that with contacts kept while a pair moves less than 2 cm (`recycle_distance`, as `fast`), `reference S×I` the reference preset \
 (auto, split impulse) with S substeps × I iterations. Rapier settings: `S×HHz` S substeps, \
 contact springs of H Hz (fixed contacts 2·H), `coulomb` Coulomb friction instead of Rapier's \
 default simplified friction; Rapier's defaults are `4×30Hz`. Box3D settings: `S×HHz` S \

@@ -315,6 +315,17 @@ def test_forces_and_impulses_change_momentum_as_newton_says():
     assert world.masses[0] == pytest.approx(2.0)
 
 
+def test_the_recycle_distance_is_a_setting_that_fast_raises():
+    # Contacts of flat shapes are kept while their bodies move less than this relative to each
+    # other: 1 mm by default, 2 cm at `fast`; refused when negative; a preset brings its own.
+    assert impulse.Settings().recycle_distance == pytest.approx(0.001)
+    assert impulse.Settings.preset("fast").recycle_distance == pytest.approx(0.02)
+    assert impulse.Settings.preset("precise").recycle_distance == pytest.approx(0.001)
+    assert impulse.Settings().replace(recycle_distance=0.0).recycle_distance == 0.0
+    with pytest.raises(ValueError, match="recycle_distance"):
+        impulse.Settings().replace(recycle_distance=-0.01)
+
+
 def test_split_steps_are_a_setting_and_report_their_pieces():
     # The tolerance is a field of the settings like any other, refused when negative; a pyramid
     # at rest with it on steps in one piece a step.

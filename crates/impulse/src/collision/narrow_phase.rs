@@ -87,21 +87,21 @@ impl ManifoldQuery {
 
     /// Whether `manifolds`, which Parry computed for this query (seams may have dropped
     /// points since), stand for `now`: the same shapes, of kinds that may be recycled; every
-    /// manifold still with points; a speculative distance at most [`RECYCLE_DISTANCE`] longer;
-    /// and no point of shape 2 moved by more than [`RECYCLE_DISTANCE`] in shape 1's frame
-    /// ([`ManifoldQuery::moved_by`]).
-    fn recycles_at(&self, now: &Self, manifolds: &[Manifold]) -> bool {
+    /// manifold still with points; a speculative distance at most `recycle_distance` (m,
+    /// [`crate::settings::ContactSettings::recycle_distance`]) longer; and no point of shape 2
+    /// moved by more than `recycle_distance` in shape 1's frame ([`ManifoldQuery::moved_by`]).
+    fn recycles_at(&self, now: &Self, manifolds: &[Manifold], recycle_distance: f32) -> bool {
         let Some(reach) = self.reach else {
             return false;
         };
         if self.shapes != now.shapes
-            || now.distance > self.distance + RECYCLE_DISTANCE
+            || now.distance > self.distance + recycle_distance
             || manifolds.is_empty()
             || manifolds.iter().any(|m| m.points.is_empty())
         {
             return false;
         }
-        self.moved_by(now, reach) <= RECYCLE_DISTANCE
+        self.moved_by(now, reach) <= recycle_distance
     }
 
     /// Whether a pair this query found apart, beyond its speculative distance, is still
@@ -128,20 +128,17 @@ impl ManifoldQuery {
     }
 }
 
-/// How far (m) the bodies of a pair may move relative to each other, and its speculative
-/// distance grow, before its manifolds are computed again: while neither has, the manifolds
-/// of the last computation stand and only their points' separations are updated (each point
-/// is a point of each body, `ContactManifold::update_separations`). Rapier recycles a pair's
-/// contacts the same way (`IntegrationParameters::contact_recycling`, up to 5 cm of drift by
-/// default). Parry's own reuse (`ContactManifold::try_update_contacts`: within 1 mm and 1°
-/// of the points' last computation) checks every point, through a dispatch per pair, and
-/// stops whenever a point passes from gap to overlap, which a resting contact does back and
-/// forth; a pair recycled here skips the dispatch. The points are then at most Parry's
-/// tolerance plus this distance from where a full computation would put them, and a point
-/// the last computation did not find (beyond its speculative distance) is at least
-/// 2 × this distance short of the current one: as speculative points, such points only
-/// matter to bodies that close that far within a step, which moves them out of recycling.
-pub(crate) const RECYCLE_DISTANCE: f32 = 1.0e-3;
+// Recycling ([`crate::settings::ContactSettings::recycle_distance`], docs/method.md "Contact
+// recycling"): while a pair's bodies have moved relative to each other, and its speculative
+// distance grown, by at most the recycle distance since its manifolds were computed, they
+// stand and only their points' separations are updated (each point is a point of each body,
+// `ContactManifold::update_separations`). Parry's own reuse (`try_update_contacts`: within
+// 1 mm and 1° of the points' last computation) checks every point, through a dispatch per
+// pair, and stops whenever a point passes from gap to overlap, which a resting contact does
+// back and forth; a pair recycled here skips the dispatch. A point the last computation did
+// not find (beyond its speculative distance) is then at least that distance less the
+// recycle distance away: such points matter only to bodies that close that far within a
+// step, which moves them out of recycling.
 
 /// For a pair of shapes whose manifolds may be recycled ([`ManifoldQuery::recycles_at`]),
 /// the farthest any point of `shape2` lies from its frame's origin (m); `None` for the rest.
@@ -335,12 +332,15 @@ impl NarrowPhase {
 
     /// Updates manifolds for `candidates`; pairs no longer candidates are dropped with their
     /// history. Points of pair (i, j) are generated up to
-    /// [`SpeculativeMargins::pair_prediction`] of separation.
+    /// [`SpeculativeMargins::pair_prediction`] of separation; a pair of flat shapes whose
+    /// bodies moved by at most `recycle_distance` (m) relative to each other since its last
+    /// computation keeps its points ([`crate::settings::ContactSettings::recycle_distance`]).
     pub fn update(
         &mut self,
         bodies: &Bodies,
         candidates: &[(u32, u32)],
         margins: &SpeculativeMargins,
+        recycle_distance: f32,
         parallel: bool,
     ) -> Result<(), UnsupportedShapePair> {
         // Last step's pairs and this step's candidates are both sorted by (body1, body2): a
@@ -386,7 +386,7 @@ impl NarrowPhase {
                 if last.same(&query) {
                     return Ok(());
                 }
-                if last.recycles_at(&query, &pair.manifolds) {
+                if last.recycles_at(&query, &pair.manifolds, recycle_distance) {
                     for manifold in &mut pair.manifolds {
                         manifold.update_separations(&pos12);
                     }

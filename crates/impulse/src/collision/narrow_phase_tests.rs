@@ -86,11 +86,20 @@ fn cube_over_ground(gap: f32, turn: f32) -> World {
 /// The narrow phase of `w`'s two bodies after an update on their current poses: the same
 /// `narrow` again (as a step keeps it), or a new one when `narrow` is `None`.
 fn update_pair(w: &World, narrow: Option<NarrowPhase>) -> NarrowPhase {
+    update_pair_recycling(w, narrow, crate::settings::DEFAULT_RECYCLE_DISTANCE)
+}
+
+/// [`update_pair`] with contacts recycled within `recycle_distance` (m).
+fn update_pair_recycling(
+    w: &World,
+    narrow: Option<NarrowPhase>,
+    recycle_distance: f32,
+) -> NarrowPhase {
     let mut margins = SpeculativeMargins::default();
     margins.update(&w.bodies, 0.02, Vec3::ZERO, 1.0 / 60.0, false);
     let mut narrow = narrow.unwrap_or_default();
     narrow
-        .update(&w.bodies, &[(0, 1)], &margins, false)
+        .update(&w.bodies, &[(0, 1)], &margins, recycle_distance, false)
         .unwrap();
     narrow
 }
@@ -104,7 +113,8 @@ fn separations(narrow: &NarrowPhase) -> Vec<f32> {
         .collect()
 }
 
-/// A pair whose bodies moved by less than [`RECYCLE_DISTANCE`] relative to each other keeps
+/// A pair whose bodies moved by less than the default recycle distance (1 mm,
+/// [`crate::settings::DEFAULT_RECYCLE_DISTANCE`]) relative to each other keeps
 /// its points (the same body points) with their separations updated to the new pose, even
 /// where a point went from a gap to an overlap (which stops Parry's own reuse); the depths are
 /// those a new computation finds. Moved by more, it is computed again.
@@ -139,6 +149,47 @@ fn a_pair_that_barely_moved_keeps_its_points_with_new_separations() {
     w.bodies.pose[1].translation.x += 6e-4;
     let narrow = update_pair(&w, Some(narrow));
     assert!(narrow.pairs[0].recomputed, "recycled after 0.9 mm sideways");
+}
+
+/// The recycle distance is a setting (`ContactSettings::recycle_distance`): at the `fast`
+/// preset's 2 cm a cube slid 15 mm over the ground keeps its four points, each the same point
+/// of each body, with its separation updated as the cube sinks 0.4 mm (the depth a new
+/// computation finds); slid to 25 mm it is computed again. At the default 1 mm, and at 0, the
+/// first slide is computed again.
+#[test]
+fn the_recycle_distance_is_how_far_a_pair_may_slide_on_its_points() {
+    use crate::settings::{DEFAULT_RECYCLE_DISTANCE, FAST_RECYCLE_DISTANCE};
+    for (distance, recycled) in [
+        (FAST_RECYCLE_DISTANCE, true),
+        (DEFAULT_RECYCLE_DISTANCE, false),
+        (0.0, false),
+    ] {
+        let mut w = cube_over_ground(0.0, 0.0);
+        let first = update_pair_recycling(&w, None, distance);
+        let before = first.pairs[0].manifolds[0].points.clone();
+        assert_eq!(before.len(), 4);
+        w.bodies.pose[1].translation += Vec3::new(0.015, -4e-4, 0.0);
+        let narrow = update_pair_recycling(&w, Some(first), distance);
+        let pair = &narrow.pairs[0];
+        assert_eq!(!pair.recomputed, recycled, "recycle distance {distance}");
+        if !recycled {
+            continue;
+        }
+        for (kept, old) in pair.manifolds[0].points.iter().zip(&before) {
+            assert_eq!((kept.local_p1, kept.local_p2), (old.local_p1, old.local_p2));
+        }
+        let fresh = update_pair(&w, None);
+        for (d, e) in separations(&narrow).iter().zip(separations(&fresh)) {
+            assert!(
+                (d + 4e-4).abs() < 1e-6 && (e + 4e-4).abs() < 1e-6,
+                "{d} against {e}"
+            );
+        }
+        // 25 mm from where the points were computed: computed again.
+        w.bodies.pose[1].translation.x += 0.01;
+        let narrow = update_pair_recycling(&w, Some(narrow), distance);
+        assert!(narrow.pairs[0].recomputed, "recycled after 25 mm");
+    }
 }
 
 /// A pair whose manifold holds no point (its bodies farther apart than the speculative

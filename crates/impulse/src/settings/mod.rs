@@ -367,6 +367,16 @@ pub struct ContactSettings {
     /// step go stale where bodies turn or stop within it (thin parts crossing, a pile
     /// stopping one of two bodies falling together). 0 turns it off (the default).
     pub split_overlap: f32,
+    /// How far (m) the bodies of a pair of flat shapes (boxes, convex hulls, half-spaces) may
+    /// move relative to each other, and its speculative distance grow, before its contacts are
+    /// found again: until then the last computation's points stand, each a point of each body,
+    /// and only their separations are updated (docs/method.md, "Contact recycling"). A
+    /// recycled point is at most this much (plus Parry's 1 mm and 1° of reuse) from where a
+    /// full computation would put it. Default [`DEFAULT_RECYCLE_DISTANCE`]; the `fast` preset
+    /// takes [`FAST_RECYCLE_DISTANCE`]; Rapier recycles up to 5 cm by default
+    /// (`IntegrationParameters::contact_recycling`). 0 finds every moving pair's contacts
+    /// every step.
+    pub recycle_distance: f32,
     /// Apply Coulomb friction rows (two tangents per point, |γ_t| ≤ μ·γ_n).
     pub friction: bool,
     /// How simultaneous impacts are resolved: `simultaneous` (one LCP with Newton's
@@ -483,6 +493,16 @@ pub const BLOW_UP_DISTANCE: f32 = 1.0e5;
 /// speed to share the blow (docs/method.md, "Impacts").
 pub const DEFAULT_IMPACT_SWEEPS: u32 = 32;
 
+/// [`ContactSettings::recycle_distance`] of the default and `precise` presets (m): Parry's own
+/// tolerance for reusing a manifold.
+pub const DEFAULT_RECYCLE_DISTANCE: f32 = 1.0e-3;
+
+/// [`ContactSettings::recycle_distance`] of the `fast` preset (m): in a pour most pairs move
+/// more than a millimetre a step, and recycling them up to 2 cm takes a sixth off `fast`'s
+/// step without a larger overlap (docs/method.md, "Contact recycling"); within the 50 mm of
+/// `fast`'s quality bar.
+pub const FAST_RECYCLE_DISTANCE: f32 = 0.02;
+
 /// How many times a step may be halved ([`ContactSettings::split_overlap`]): into at most
 /// 2² = 4 pieces, so a split step costs at most the three tries and four pieces' work.
 pub const MAX_STEP_SPLITS: u32 = 2;
@@ -515,7 +535,8 @@ impl SolverSettings {
     /// (with `auto`'s parameters), `substeps`, `iterations`, `relax_iterations`, `tolerance`,
     /// `impact_sweeps`, `exact_max_contacts`, `warm_start`, `friction_in_main_solve`, `direct_joint_solve`,
     /// `parallel_island_contacts` and `simd_island_contacts`; in [`Self::contact`], `repair`
-    /// (method, stiffness and its parameters), `overlap_slop` and `max_repair_speed`.
+    /// (method, stiffness and its parameters), `overlap_slop`, `max_repair_speed` and
+    /// `recycle_distance`.
     /// Kept from `self` (what the scene means to happen): the rest of [`Self::contact`]
     /// (`restitution_threshold`, `prediction_distance`, `split_overlap`, `friction`, `friction_combine`,
     /// `restitution_combine`, `impact`), [`Self::sleep`], [`Self::limits`], `gyroscopic`,
@@ -544,6 +565,7 @@ impl SolverSettings {
                 repair: contact.repair,
                 overlap_slop: contact.overlap_slop,
                 max_repair_speed: contact.max_repair_speed,
+                recycle_distance: contact.recycle_distance,
                 ..self.contact
             },
             ..self.clone()
@@ -629,16 +651,22 @@ impl SolverSettings {
     }
 
     /// Speed before accuracy: the soft step at 8 substeps (96 Hz contacts) without impact
-    /// sweeps ([`SolveSettings::impact_sweeps`] 0). Meets E ≤ 50 mm on the standard scenes
-    /// (docs/benchmarks.md, "The front"), where nothing lands, as the soft step at 8 substeps
-    /// does; where bodies land, as in a pour, it costs a third less, and a face landing
-    /// at restitution 0 rises again at 7-9 % of its impact speed (docs/method.md, "Impacts").
+    /// sweeps ([`SolveSettings::impact_sweeps`] 0), contacts recycled up to
+    /// [`FAST_RECYCLE_DISTANCE`] (2 cm; [`ContactSettings::recycle_distance`]). Meets E ≤ 50 mm
+    /// on the standard scenes (docs/benchmarks.md, "The front"), where nothing lands, as the
+    /// soft step at 8 substeps does; where bodies land, as in a pour, it costs a third less, and
+    /// a face landing at restitution 0 rises again at 7-9 % of its impact speed (docs/method.md,
+    /// "Impacts").
     pub fn fast() -> Self {
         let soft = Self::soft_step(8);
         Self {
             solve: SolveSettings {
                 impact_sweeps: 0,
                 ..soft.solve
+            },
+            contact: ContactSettings {
+                recycle_distance: FAST_RECYCLE_DISTANCE,
+                ..soft.contact
             },
             ..soft
         }
@@ -730,6 +758,7 @@ impl Default for ContactSettings {
             max_repair_speed: 0.5,
             prediction_distance: 0.02,
             split_overlap: 0.0,
+            recycle_distance: DEFAULT_RECYCLE_DISTANCE,
             friction: true,
             impact: ImpactModel::Simultaneous,
             friction_combine: CombineRule::GeometricMean,

@@ -283,10 +283,18 @@ fn the_presets_are_the_soft_step() {
     let fast = SolverSettings::fast();
     assert_eq!(fast.solve.impact_sweeps, 0);
     assert_eq!(
+        fast.contact.recycle_distance,
+        crate::settings::FAST_RECYCLE_DISTANCE
+    );
+    assert_eq!(
         SolverSettings {
             solve: crate::settings::SolveSettings {
                 impact_sweeps: SolverSettings::default().solve.impact_sweeps,
                 ..fast.solve
+            },
+            contact: crate::settings::ContactSettings {
+                recycle_distance: crate::settings::DEFAULT_RECYCLE_DISTANCE,
+                ..fast.contact
             },
             ..fast
         },
@@ -511,7 +519,7 @@ fn flat_keys_read_into_their_groups_and_write_back_flat() {
     };
     let expected = "method substeps iterations relax_iterations impact_sweeps tolerance escalation_tolerance \
         escalation_iterations mass_ratio_threshold exact_max_contacts heavy_on_light_mass_ratio \
-        restitution_threshold repair overlap_slop max_repair_speed warm_start prediction_distance split_overlap \
+        restitution_threshold repair overlap_slop max_repair_speed warm_start prediction_distance split_overlap recycle_distance \
         sleep sleep_linear_speed sleep_angular_speed time_to_sleep friction friction_in_main_solve \
         direct_joint_solve parallel_island_contacts simd_island_contacts fused_multiply_add \
         gyroscopic continuous impact friction_combine restitution_combine max_distance \

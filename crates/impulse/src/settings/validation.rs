@@ -107,6 +107,7 @@ impl SolverSettings {
             ("max_repair_speed", self.contact.max_repair_speed),
             ("prediction_distance", self.contact.prediction_distance),
             ("split_overlap", self.contact.split_overlap),
+            ("recycle_distance", self.contact.recycle_distance),
         ];
         for (field, value) in non_negative {
             let message = if !value.is_finite() {

@@ -133,7 +133,7 @@ impl World {
         self.energy.start(&self.bodies, self.gravity);
         self.broad_phase_stage(&settings, parallel, &mut c.margins, &mut c.candidates);
         clock.end(Stage::BroadPhase);
-        self.narrow_phase_stage(parallel, &c.candidates, &c.margins)?;
+        self.narrow_phase_stage(&settings, parallel, &c.candidates, &c.margins)?;
         clock.end(Stage::NarrowPhase);
         self.islands_stage(
             parallel,

@@ -5,19 +5,24 @@ use crate::World;
 use crate::collision::margins::SpeculativeMargins;
 use crate::error::StepError;
 use crate::parallel::both;
+use crate::settings::SolverSettings;
 
 impl World {
-    /// The manifolds of the `candidates` (with their `margins`), with the broad phase's tree
-    /// optimised beside them (neither reads what the other writes).
+    /// The manifolds of the `candidates` (with their `margins`, recycled within `settings`'
+    /// recycle distance), with the broad phase's tree optimised beside them (neither reads
+    /// what the other writes).
     pub(super) fn narrow_phase_stage(
         &mut self,
+        settings: &SolverSettings,
         parallel: bool,
         candidates: &[(u32, u32)],
         margins: &SpeculativeMargins,
     ) -> Result<(), StepError> {
         let (broad_phase, narrow_phase) = (&mut self.broad_phase, &mut self.narrow_phase);
         let bodies = &self.bodies;
-        let narrow = || narrow_phase.update(bodies, candidates, margins, parallel);
+        let recycle_distance = settings.contact.recycle_distance;
+        let narrow =
+            || narrow_phase.update(bodies, candidates, margins, recycle_distance, parallel);
         let of_body = &self.handles.of_body;
         both(parallel, || broad_phase.optimize(), narrow)
             .1
