@@ -195,12 +195,14 @@ pub fn settings_text(s: &SolverSettings, threads: usize) -> String {
     };
     format!(
         "{method}, {} substeps × ≤{} iterations, {repair}, slop {} mm, tol {:e}, warm start {}, \
-         sleeping {}, {threads} thread{}",
+         impact sweeps ≤{}, recycling {} mm, sleeping {}, {threads} thread{}",
         s.solve.substeps,
         s.solve.iterations,
         s.contact.overlap_slop * 1e3,
         s.solve.tolerance,
         s.solve.warm_start,
+        s.solve.impact_sweeps,
+        s.contact.recycle_distance * 1e3,
         if s.sleep.is_some() { "on" } else { "off" },
         if threads == 1 { "" } else { "s" },
     )
