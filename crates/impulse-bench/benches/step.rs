@@ -102,13 +102,20 @@ fn narrow_phase(c: &mut Criterion) {
     let mut pairs = Vec::new();
     BroadPhase::default().candidate_pairs(bodies(&world), margins.margins(), false, &mut pairs);
     let mut narrow_phase = NarrowPhase::default();
+    let recycle_distance = world.settings().contact.recycle_distance;
     narrow_phase
-        .update(bodies(&world), &pairs, &margins, false)
+        .update(bodies(&world), &pairs, &margins, recycle_distance, false)
         .expect("pyramid20 shapes are supported");
     c.bench_function("narrow_phase/pyramid20", |b| {
         b.iter(|| {
             narrow_phase
-                .update(black_box(bodies(&world)), &pairs, &margins, false)
+                .update(
+                    black_box(bodies(&world)),
+                    &pairs,
+                    &margins,
+                    recycle_distance,
+                    false,
+                )
                 .expect("pyramid20 shapes are supported");
             black_box(narrow_phase.pairs.len())
         })
