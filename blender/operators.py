@@ -18,7 +18,8 @@ class ImpulseBakeSettings(bpy.types.PropertyGroup):
         name="Quality",
         description="impulse's solver preset: more substeps cost more and hold stacks better",
         items=(
-            ("fast", "Fast", "The soft step at 480 substeps a second, without impact sweeps, contacts recycled within 2 cm: cheapest"),
+            ("fast", "Fast",
+             "The soft step at 480 substeps a second, without impact sweeps, contacts kept within 2 cm: cheapest"),
             ("default", "Default", "The soft step at 1,200 substeps a second"),
             ("precise", "Precise", "The soft step at 2,880 substeps a second: slowest"),
         ),
