@@ -31,9 +31,7 @@ fn every_zero_is_refused() {
 
 #[test]
 fn a_scene_without_moving_bodies_is_named_in_a_warning() {
-    let dir = std::env::temp_dir().join(format!("impulse-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("empty.json");
+    let path = crate::common::temp("bad", "empty.json");
     std::fs::write(&path, r#"{"name": "empty", "bodies": []}"#).unwrap();
     let (ok, err) = stderr_of(&["run", path.to_str().unwrap(), "--steps", "2", "--quiet"]);
     assert!(ok, "{err}");

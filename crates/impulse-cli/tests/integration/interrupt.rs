@@ -7,9 +7,7 @@ use std::time::Duration;
 
 #[test]
 fn sigint_stops_after_a_step_and_keeps_a_valid_file() {
-    let dir = std::env::temp_dir().join(format!("impulse-int-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let csv = dir.join("run.csv");
+    let csv = crate::common::temp("int", "run.csv");
     let child = Command::new(env!("CARGO_BIN_EXE_impulse"))
         .args([
             "run",
@@ -65,8 +63,7 @@ fn sigint_stops_after_a_step_and_keeps_a_valid_file() {
 /// `impulse resume` continues from it.
 #[test]
 fn sigint_writes_a_final_checkpoint_that_resumes() {
-    let dir = std::env::temp_dir().join(format!("impulse-int-ckpt-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = crate::common::temp("int", "checkpoints");
     let child = Command::new(env!("CARGO_BIN_EXE_impulse"))
         .args([
             "run",
