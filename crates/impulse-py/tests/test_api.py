@@ -405,25 +405,32 @@ def test_ctrl_c_interrupts_a_long_decomposition(path):
     vertices, indices = _torus(96, 48)
     parameters = {"resolution": 160 if path == "builder" else 159}
     fired = []
+    # A process started in the background of a non-interactive shell inherits SIGINT ignored,
+    # and Python then installs no KeyboardInterrupt handler: install it, as an interactive
+    # session has it.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
 
     def interrupt():
         fired.append(time.monotonic())
         os.kill(os.getpid(), signal.SIGINT)
 
     timer = threading.Timer(0.5, interrupt)
-    timer.start()
-    shape = impulse.Shape.trimesh(vertices, indices, decomposition=parameters)
-    scene = {"bodies": [{"kind": "dynamic", "shape": shape.to_dict()}]}
-    built = None
-    with pytest.raises(KeyboardInterrupt):
-        # A call that ran to its end would leave `built` set: a signal only handled after it
-        # returns raises at the next call, not inside this one.
-        if path == "builder":
-            built = impulse.BodyBuilder.dynamic(shape)
-        else:
-            built = impulse.World.from_scene(scene)
-        time.sleep(0)
-    timer.cancel()
+    try:
+        timer.start()
+        shape = impulse.Shape.trimesh(vertices, indices, decomposition=parameters)
+        scene = {"bodies": [{"kind": "dynamic", "shape": shape.to_dict()}]}
+        built = None
+        with pytest.raises(KeyboardInterrupt):
+            # A call that ran to its end would leave `built` set: a signal only handled after
+            # it returns raises at the next call, not inside this one.
+            if path == "builder":
+                built = impulse.BodyBuilder.dynamic(shape)
+            else:
+                built = impulse.World.from_scene(scene)
+            time.sleep(0)
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     assert fired, "the call ended before Ctrl-C"
     assert built is None, "the decomposition ran to its end before the KeyboardInterrupt"
     print(f"{path}: interrupted {time.monotonic() - fired[0]:.3f} s after Ctrl-C")
