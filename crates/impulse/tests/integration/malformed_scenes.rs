@@ -65,13 +65,17 @@ impl Bad<'_> {
 }
 
 /// Writes `text` to a file named after `case` and loads it; returns the error and the path.
+/// The file is in a directory of its own, removed after the load.
 fn load_err(case: &str, text: &str) -> (SceneError, String) {
-    let dir = std::env::temp_dir().join(format!("impulse-scene-files-{}", std::process::id()));
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir =
+        std::env::temp_dir().join(format!("impulse-scene-files-{}-{call}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(format!("{case}.json"));
     std::fs::write(&path, text).unwrap();
     let result = load_scene_file(&path);
-    let _ = std::fs::remove_file(&path);
+    let _ = std::fs::remove_dir_all(&dir);
     match result {
         Ok(_) => panic!("{case}: loaded although malformed:\n{text}"),
         Err(e) => (e, path.display().to_string()),
