@@ -132,7 +132,10 @@ fn without_impact_sweeps((name, settings): ImpulseSetting) -> ImpulseSetting {
 /// (`impulse::settings::FAST_RECYCLE_DISTANCE`, 2 cm), named so.
 fn recycling_fast((name, settings): ImpulseSetting) -> ImpulseSetting {
     (
-        format!("{name}, recycle 2 cm"),
+        format!(
+            "{name}, recycle {} cm",
+            impulse::settings::FAST_RECYCLE_DISTANCE * 100.0
+        ),
         settings.map(|settings| SolverSettings {
             contact: impulse::settings::ContactSettings {
                 recycle_distance: impulse::settings::FAST_RECYCLE_DISTANCE,

@@ -256,6 +256,10 @@ fn tables_compare_impulse_with_the_cheapest_peer() {
 fn grids_have_the_documented_sizes_and_names() {
     let grid = impulse_grid();
     assert_eq!(grid.len(), 4 + 14 + 3 + 4 * 2 + 5);
+    assert!(
+        grid.iter()
+            .any(|(name, _)| name == "soft 6, impact sweeps 0, recycle 2 cm")
+    );
     assert_eq!(grid[0], ("default".to_string(), None));
     assert_eq!(grid[1].1, Some(SolverSettings::fast()));
     // The presets are soft steps the grid does not repeat.
