@@ -176,9 +176,11 @@ pub enum SolvePhase {
     MainSolve,
     /// Each substep's position integration (with split impulse, its position solve).
     IntegratePositions,
-    /// Each substep's relax solve, without repair.
+    /// Each substep's relax solve, without repair (a small island's impact sweeps within it
+    /// included: they are the relax solve's own sweeps).
     Relax,
-    /// Impacts: a main solve's sweeps beyond its budget when it meets an impact, and the
+    /// Impacts: a main or relax solve's sweeps beyond its budget when it meets an impact (a
+    /// large island's local sweeps after either, with the finding of their region), and the
     /// restitution solve after the substeps (with `impact: propagation`, its reflections).
     Impacts,
     /// The rows' record as the island's job ends: impulses written back from the lanes, J·v*,

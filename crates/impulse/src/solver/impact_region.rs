@@ -80,7 +80,11 @@ pub(crate) struct ImpactRegion {
     /// started, ascending; found at the step's first [`ImpactRegion::find`] (the velocities
     /// and rows it reads stay as they are through the step's substeps).
     closing: Vec<u32>,
-    /// Whether [`Self::closing`] holds this step's contacts.
+    /// Every point's two island slots (A, B) in constraint order, copied out of the rows with
+    /// [`Self::closing`]: each substep's region is collected from these 8 bytes a point rather
+    /// than from the rows themselves (hundreds of bytes each), which the step does not change.
+    ends: Vec<[u32; 2]>,
+    /// Whether [`Self::closing`] and [`Self::ends`] hold this step's contacts.
     closing_known: bool,
     /// What [`ImpactRegion::find`] decided this step.
     pub(crate) kind: RegionKind,
@@ -114,8 +118,8 @@ impl ImpactRegion {
     /// `struck` (the substep's main solve changed its normal velocity by more than the impact
     /// change: [`ImpactRegion::find_in`]), and every point touching one of them. Sets [`Self::kind`]:
     /// local when the island has at least [`LOCAL_IMPACT_MIN_POINTS`] points and the region at
-    /// most half of them, whole otherwise. The closing contacts are found at the first call of
-    /// a step ([`Self::start_step`]) and kept for its substeps.
+    /// most half of them, whole otherwise. The closing contacts and every point's slots are
+    /// found at the first call of a step ([`Self::start_step`]) and kept for its substeps.
     pub(crate) fn find(
         &mut self,
         constraints: &[ContactConstraint],
@@ -139,6 +143,9 @@ impl ImpactRegion {
                     .filter(|(_, c)| row_closes_faster_than(c, linear, angular, speed))
                     .map(|(k, _)| k as u32),
             );
+            self.ends.clear();
+            self.ends
+                .extend(constraints.iter().map(|c| [c.local_a, c.local_b]));
             self.closing_known = true;
         }
         self.seed.clear();
@@ -156,10 +163,10 @@ impl ImpactRegion {
         let seed = &self.seed;
         let inside = |slot: u32| seed.get(slot as usize).copied().unwrap_or(false);
         self.points.extend(
-            constraints
+            self.ends
                 .iter()
                 .enumerate()
-                .filter(|(_, c)| inside(c.local_a) || inside(c.local_b))
+                .filter(|(_, [a, b])| inside(*a) || inside(*b))
                 .map(|(k, _)| k as u32),
         );
         self.size = self.points.len();

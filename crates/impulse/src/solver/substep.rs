@@ -142,9 +142,12 @@ impl IslandWorkspace {
         let joints = &mut self.joints;
         let solver = self.solvers.substeps(settings.solve.method, bundled);
         let outcome = solver.solve(constraints, &mut velocities, joints, &pass);
-        if with_repair {
-            self.phases.end(SolvePhase::MainSolve);
-        }
+        // The phase of the solve itself, so that an impact's sweeps after it are timed apart.
+        self.phases.end(if with_repair {
+            SolvePhase::MainSolve
+        } else {
+            SolvePhase::Relax
+        });
         // An impact's sweeps (`SolveSettings::impact_sweeps`): when the main solve's last sweep
         // still changed some row's velocity by more than the impact change, it sweeps on until
         // the tolerance or that many more, and so does the substep's relax solve. One sweep of
@@ -795,7 +798,7 @@ impl IslandWorkspace {
             &mut w.displacement[..integrated],
             &mut w.rotation[..integrated],
         );
-        if plan.spread {
+        if plan.spread && integrated >= parallel::PARALLEL_INTEGRATE_BODIES {
             // Per body, so any split gives the same poses.
             use rayon::prelude::*;
             linear

@@ -30,6 +30,11 @@ pub(crate) struct Bundles {
     pub(super) local_lanes: Vec<super::layout::LocalLane>,
     pub(super) local_filled: Vec<u8>,
     pub(super) local_after: Vec<u32>,
+    /// Every lane group's body slots (A, B per lane), copied out of `groups` at the first
+    /// `select_local` after a pack (`group_slots_known`), so that each substep's selection
+    /// reads 32 bytes a lane group instead of the whole group.
+    pub(super) group_slots: Vec<[[u32; LANES]; 2]>,
+    pub(super) group_slots_known: bool,
     /// Packing scratch: per manifold group (a run of at most [`GROUP_POINTS`] consecutive
     /// points between the same two bodies), its first point, and its lane group and lane.
     pub(super) runs: Vec<u32>,

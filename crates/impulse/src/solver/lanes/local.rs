@@ -40,10 +40,16 @@ impl Bundles {
             local_b: [immovable; LANES],
             ..Group::default()
         };
+        if !self.group_slots_known {
+            self.group_slots.clear();
+            self.group_slots
+                .extend(self.groups.iter().map(|g| [g.local_a, g.local_b]));
+            self.group_slots_known = true;
+        }
         let mut points = 0;
-        for group in &self.groups {
+        for (group, [slots_a, slots_b]) in self.groups.iter().zip(&self.group_slots) {
             for lane in 0..LANES {
-                let (a, b) = (group.local_a[lane], group.local_b[lane]);
+                let (a, b) = (slots_a[lane], slots_b[lane]);
                 if !(in_region(a) || in_region(b)) {
                     continue;
                 }
