@@ -367,10 +367,12 @@ pub struct ContactSettings {
     /// step go stale where bodies turn or stop within it (thin parts crossing, a pile
     /// stopping one of two bodies falling together). 0 turns it off (the default).
     pub split_overlap: f32,
-    /// How far (m) the bodies of a pair of flat shapes (boxes, convex hulls, half-spaces) may
-    /// move relative to each other, and its speculative distance grow, before its contacts are
-    /// found again: until then the last computation's points stand, each a point of each body,
-    /// and only their separations are updated (docs/method.md, "Contact recycling"). A
+    /// How far (m) the bodies of a pair of flat shapes (boxes, convex hulls, half-spaces and
+    /// compounds of boxes and hulls) may move relative to each other, and its speculative
+    /// distance grow, before its contacts are found again: until then the last computation's
+    /// points stand, each a point of each body, and only their separations are updated
+    /// (docs/method.md, "Contact recycling"). A compound's pair is found again after at most a
+    /// twentieth of its smallest part's bounding radius, whatever this says. A
     /// recycled point is at most this much (plus Parry's 1 mm and 1° of reuse) from where a
     /// full computation would put it. Default [`DEFAULT_RECYCLE_DISTANCE`]; the `fast` preset
     /// takes [`FAST_RECYCLE_DISTANCE`]; Rapier recycles up to 5 cm by default
