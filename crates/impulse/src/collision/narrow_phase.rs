@@ -195,25 +195,26 @@ fn recycle_reach(
     reach.is_finite().then_some((reach, limit))
 }
 
-/// Part of its smallest part's bounding radius that a compound's points may move before they
+/// Part of its smallest part's half-diagonal that a compound's points may move before they
 /// are found again ([`compound_recycle_limit`]).
 const COMPOUND_RECYCLE_FRACTION: f32 = 0.05;
 
 /// How far (m) a pair's points on a compound may move relative to the other body before the
-/// pair is computed again, whatever the recycle distance: a twentieth of the compound's
-/// smallest part's bounding radius ([`COMPOUND_RECYCLE_FRACTION`]); infinite for any other
-/// shape. A compound's parts are small against the body (a mug's 21 parts from 2.3 to 4.1 cm
-/// against its 9.3 cm), and a point kept over a slide of a sizeable part of one stands where
-/// the parts no longer meet. On the 98-mug pour at the `fast` preset (`impulse run
+/// pair is computed again, whatever the recycle distance: a twentieth of the half-diagonal of
+/// the compound's smallest part's bounding box (its parts' boxes are Parry's, kept with the
+/// compound; [`COMPOUND_RECYCLE_FRACTION`]); infinite for any other shape. A compound's parts
+/// are small against the body (a mug's 21 parts, half-diagonals of 2.1 to 3.9 cm, against its
+/// 9.3 cm bounding radius), and a point kept over a slide of a sizeable part of one stands
+/// where the parts no longer meet. On the 98-mug pour at the `fast` preset (`impulse run
 /// scenes/mugs98.json --preset fast --stats`, the deepest contact of each step), recycled
-/// within 2 cm two mugs crossed by 13.5 mm, within a quarter of the smallest part (5.6 mm)
-/// by 11.4 mm, and within a twentieth (1.1 mm) by 5.5 mm, as without recycling.
+/// within 2 cm two mugs crossed by 13.5 mm, within 5.6 mm by 11.4 mm, and within 1.1 mm by
+/// 5.5 mm, as without recycling.
 fn compound_recycle_limit(shape: &parry3d::shape::SharedShape) -> f32 {
     shape.as_compound().map_or(f32::INFINITY, |compound| {
         compound
-            .shapes()
+            .aabbs()
             .iter()
-            .map(|(_, part)| part.compute_local_bounding_sphere().radius())
+            .map(|aabb| aabb.half_extents().length())
             .fold(f32::INFINITY, f32::min)
             * COMPOUND_RECYCLE_FRACTION
     })

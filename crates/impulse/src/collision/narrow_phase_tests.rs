@@ -391,8 +391,8 @@ fn a_compound_of_flat_parts_keeps_its_points_with_new_separations() {
 }
 
 /// A compound's points are found again once they have moved by a twentieth of its smallest
-/// part's bounding radius, whatever the recycle distance (a mug's thin parts crossed by
-/// 13.5 mm when recycled over the `fast` preset's 2 cm): the bar's 0.1 m cubes (radius
+/// part's half-diagonal, whatever the recycle distance (a mug's thin parts crossed by
+/// 13.5 mm when recycled over the `fast` preset's 2 cm): the bar's 0.1 m cubes (half-diagonal
 /// 86.6 mm) allow 4.33 mm, so at 2 cm a 3 mm slide is recycled and a 6 mm one is not. A
 /// compound with a round part is never recycled.
 #[test]

@@ -372,7 +372,7 @@ pub struct ContactSettings {
     /// distance grow, before its contacts are found again: until then the last computation's
     /// points stand, each a point of each body, and only their separations are updated
     /// (docs/method.md, "Contact recycling"). A compound's pair is found again after at most a
-    /// twentieth of its smallest part's bounding radius, whatever this says. A
+    /// twentieth of its smallest part's half-diagonal, whatever this says. A
     /// recycled point is at most this much (plus Parry's 1 mm and 1° of reuse) from where a
     /// full computation would put it. Default [`DEFAULT_RECYCLE_DISTANCE`]; the `fast` preset
     /// takes [`FAST_RECYCLE_DISTANCE`]; Rapier recycles up to 5 cm by default
