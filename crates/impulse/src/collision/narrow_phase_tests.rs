@@ -61,9 +61,9 @@ fn edits_between_steps_reach_the_contact() {
     assert!((depth - 0.03).abs() < 1e-4, "after the new shape: {depth}");
 }
 
-/// A unit cube (dynamic) over a static box whose top face is at y = 0, its bottom face
-/// `gap` above it (m) and turned by `turn` (rad) about the vertical, without gravity.
-fn cube_over_ground(gap: f32, turn: f32) -> World {
+/// A world without gravity holding a static box whose top face is at y = 0 (body 0), and the
+/// material of its bodies.
+fn ground() -> (World, crate::Material) {
     let mut w = World::new(Vec3::ZERO, 1.0 / 60.0, SolverSettings::default()).unwrap();
     let m = common::material(0.5);
     w.add_body(
@@ -71,6 +71,13 @@ fn cube_over_ground(gap: f32, turn: f32) -> World {
         &m,
     )
     .unwrap();
+    (w, m)
+}
+
+/// A unit cube (dynamic) over a static box whose top face is at y = 0, its bottom face
+/// `gap` above it (m) and turned by `turn` (rad) about the vertical, without gravity.
+fn cube_over_ground(gap: f32, turn: f32) -> World {
+    let (mut w, m) = ground();
     let mut cube = BodyDesc::new(
         BodyKind::Dynamic,
         ShapeDesc::Cuboid {
@@ -327,13 +334,7 @@ fn the_copy_kept_carries_the_largest_impulse() {
 /// the static box of [`cube_over_ground`], its bottom `gap` above the top face, without gravity;
 /// the second part is `second` (a cube of the same size, or another shape).
 fn bar_over_ground(gap: f32, second: ShapeDesc) -> World {
-    let mut w = World::new(Vec3::ZERO, 1.0 / 60.0, SolverSettings::default()).unwrap();
-    let m = common::material(0.5);
-    w.add_body(
-        &common::static_box(Vec3::new(5.0, 0.5, 5.0), Vec3::new(0.0, -0.5, 0.0)),
-        &m,
-    )
-    .unwrap();
+    let (mut w, m) = ground();
     let part = |shape: ShapeDesc, x: f32| crate::scene::CompoundPart {
         shape,
         position: [x, 0.0, 0.0],
