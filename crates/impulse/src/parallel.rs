@@ -31,7 +31,7 @@ pub(crate) const BODIES_PER_TASK: usize = 1024;
 
 /// Bodies from which an island's substeps integrate positions on several threads: one
 /// substep's integration costs a few nanoseconds a body, so below this rayon's hand-offs cost
-/// more than they spread (2,000 bodies of a pour took 2.6 times as long on 2 threads).
+/// more than they spread.
 pub(crate) const PARALLEL_INTEGRATE_BODIES: usize = 16 * BODIES_PER_TASK;
 
 /// Most islands per task of the island stage.
