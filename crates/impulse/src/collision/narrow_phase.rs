@@ -522,11 +522,9 @@ impl NarrowPhase {
             if let Some((reach, part_limit)) = recycle_reach(&bodies.shape[a], &bodies.shape[b]) {
                 (query.reach, query.part_limit) = (Some(reach), part_limit);
             }
-            // Not for a compound: its distance query visits every pair of parts again, which
-            // costs more than the manifolds it would spare.
-            let composite = bodies.shape[a].as_composite_shape().is_some()
-                || bodies.shape[b].as_composite_shape().is_some();
-            if query.reach.is_some() && pair.summary.points == 0 && !composite {
+            // Not for a compound (a finite part limit): its distance query visits every pair of
+            // parts again, which costs more than the manifolds it would spare.
+            if query.reach.is_some() && query.part_limit.is_infinite() && pair.summary.points == 0 {
                 use parry3d::query::QueryDispatcher;
                 query.gap = parry3d::query::DefaultQueryDispatcher
                     .distance(&pos12, bodies.shape[a].as_ref(), bodies.shape[b].as_ref())
