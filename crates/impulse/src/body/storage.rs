@@ -203,6 +203,31 @@ impl Bodies {
         self.locked_axes[i].world_inverse_inertia(self.pose[i].rotation, local)
     }
 
+    /// Whether body `i`'s contact points are points of the body that turn with it: a
+    /// polyhedron's vertices, edges and faces, a mesh's, a height field's and compounds of
+    /// these. A round shape's (ball, capsule, cylinder, cone, rounded shapes) slide over its
+    /// surface as it turns: a ball's stays below its centre however it rolls.
+    pub(crate) fn contact_points_turn_with_body(&self, i: usize) -> bool {
+        fn polyhedral(shape: &dyn parry3d::shape::Shape) -> bool {
+            use parry3d::shape::ShapeType;
+            match shape.shape_type() {
+                ShapeType::Cuboid
+                | ShapeType::ConvexPolyhedron
+                | ShapeType::Triangle
+                | ShapeType::TriMesh
+                | ShapeType::Polyline
+                | ShapeType::HeightField
+                | ShapeType::HalfSpace
+                | ShapeType::Voxels => true,
+                ShapeType::Compound => shape
+                    .as_compound()
+                    .is_some_and(|c| c.shapes().iter().all(|(_, part)| polyhedral(part.as_ref()))),
+                _ => false,
+            }
+        }
+        polyhedral(self.shape[i].as_ref())
+    }
+
     /// Per-axis inverse mass of body `i` (1/kg per world axis): 1/m on each free translation
     /// axis, 0 on each locked one (Rapier's `effective_inv_mass`); zero for static and
     /// kinematic bodies. A linear impulse p changes the velocity of the centre of mass by

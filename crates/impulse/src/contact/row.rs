@@ -226,6 +226,27 @@ impl ContactConstraint {
     /// [`Self::products_pending`]) from the directions and lever arms, for bodies of world
     /// inverse inertia `inverse_inertia_a` and `inverse_inertia_b` (1/(kg·m²)).
     #[inline(always)]
+    /// The rows' lever-arm products and effective masses (every row's, and the tangent
+    /// block's) for the lever arms `arm_a`, `arm_b` (m, world frame) and world inverse inertia
+    /// tensors `inverse_inertia_a`, `inverse_inertia_b` (1/(kg·m²)) of bodies that have turned
+    /// since assembly; `lever_a` and `lever_b` stay the arms at assembly, from which the
+    /// targets measure the separation.
+    pub(crate) fn turn_products(
+        &mut self,
+        arm_a: Vec3,
+        arm_b: Vec3,
+        inverse_inertia_a: &glam::Mat3,
+        inverse_inertia_b: &glam::Mat3,
+    ) {
+        let levers = (self.lever_a, self.lever_b);
+        (self.lever_a, self.lever_b) = (arm_a, arm_b);
+        self.fill_products(
+            &Mat3A::from(*inverse_inertia_a),
+            &Mat3A::from(*inverse_inertia_b),
+        );
+        (self.lever_a, self.lever_b) = levers;
+    }
+
     pub(super) fn fill_products(&mut self, inverse_inertia_a: &Mat3A, inverse_inertia_b: &Mat3A) {
         let inverse_mass = PairInverseMass::new(self.inverse_mass_a, self.inverse_mass_b);
         let (r_a, r_b) = (Vec3A::from(self.lever_a), Vec3A::from(self.lever_b));

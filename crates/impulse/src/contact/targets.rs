@@ -2,7 +2,7 @@
 //! the separation each point has reached (gap closing, overlap repair, stale speculative
 //! rows), the soft contact's terms, and restitution's targets after the substeps.
 
-use glam::Vec3;
+use glam::{Mat3, Quat, Vec3};
 
 use super::row::ContactConstraint;
 use crate::settings::{ContactRepair, SolverSettings};
@@ -10,7 +10,8 @@ use crate::settings::{ContactRepair, SolverSettings};
 /// Sets every normal row's target for a solve of duration `h` (s), from the separation the
 /// contact has now: its separation at assembly plus the normal component of the two bodies'
 /// displacement since then, Δp = Δx + Δθ × r (linearised; `displacement` and `rotation` are
-/// per body, m and rad). With separation s (= −depth):
+/// per body, m and rad), plus K·r for a body whose `curvature` K is given (the rest of the
+/// turned lever arm, [`turned_arm_remainder`]). With separation s (= −depth):
 ///
 /// - s > 0, a speculative gap: v⁺ ≥ −s/h, the bodies may close the gap but not overlap;
 /// - s ≤ 0, overlap d = −s, `with_repair`: the overlap repair (Baumgarte) v⁺ ≥ c_d·max(d − slop, 0),
@@ -29,11 +30,13 @@ use crate::settings::{ContactRepair, SolverSettings};
 /// having changed no row's velocity by more than the tolerance, and the caller skips it. At rest
 /// this is the usual case: the repair decays exponentially towards the slop and never quite
 /// reaches it. Without split impulse, returns false.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn update_targets(
     constraints: &mut [ContactConstraint],
     displacement: &[Vec3],
     rotation: &[Vec3],
     turn: &[f32],
+    curvature: &[Option<Mat3>],
     settings: &SolverSettings,
     h: f32,
     with_repair: bool,
@@ -42,8 +45,13 @@ pub(crate) fn update_targets(
     let (repair_rate, softness) = repair_terms(&settings.contact.repair, h);
     for c in constraints.iter_mut() {
         let (a, b) = (c.local_a as usize, c.local_b as usize);
-        let moved = (displacement[a] + rotation[a].cross(c.lever_a))
+        let mut moved = (displacement[a] + rotation[a].cross(c.lever_a))
             - (displacement[b] + rotation[b].cross(c.lever_b));
+        if !curvature.is_empty() {
+            let remainder =
+                |slot: usize, lever: Vec3| curvature[slot].map_or(Vec3::ZERO, |k| k * lever);
+            moved += remainder(a, c.lever_a) - remainder(b, c.lever_b);
+        }
         let separation = -c.depth + c.normal.direction.dot(moved);
         // Speculative at assembly (depth < 0) counts too: past the turn limit the linearised
         // separation may read a gap the real motion has opened as closed (see
@@ -107,6 +115,29 @@ pub(crate) const SPECULATIVE_TURN: f32 = std::f32::consts::FRAC_PI_4;
 /// stops a body at `max_linear_speed`, 10⁵ m/s by default), so the row's impulse goes to zero, yet small enough that no
 /// solver's products of it overflow.
 pub(crate) const STALE_TARGET: f32 = -1.0e15;
+
+/// How far (rad) a body must have turned since the step began for its contact points to be
+/// moved by the whole turn rather than the linearised Δθ × r ([`turned_arm_remainder`]). The
+/// linearised point is off by about |Δθ|²·|r|/2: under 1 mm for lever arms within 0.8 m at
+/// this angle, but 0.18·|r| at 0.6 rad, a bowling pin's turn in its landing step at 24 Hz
+/// (docs/testing.md, "Tumbling hulls").
+pub(crate) const CURVED_TURN: f32 = 0.05;
+
+/// K = R − I − [Δθ]×, what the whole turn adds to a lever arm beyond the linearised Δθ × r:
+/// R r = r + Δθ × r + K r, with R the body's turn since the step began (`now` times the
+/// inverse of `start`, world frame) and Δθ its rotation vector (rad) as the separations read
+/// it (Σ h·ω). Taken for bodies whose contact points are points of the body (polyhedra,
+/// meshes); a round shape's contact point slides over its surface as it turns and the
+/// linearised term, zero along a ball's normal, stays (see [`CURVED_TURN`]).
+pub(crate) fn turned_arm_remainder(start: Quat, now: Quat, rotation: Vec3) -> Mat3 {
+    let turn = Mat3::from_quat(now * start.inverse());
+    let skew = Mat3::from_cols(
+        Vec3::new(0.0, rotation.z, -rotation.y),
+        Vec3::new(-rotation.z, 0.0, rotation.x),
+        Vec3::new(rotation.y, -rotation.x, 0.0),
+    );
+    turn - Mat3::IDENTITY - skew
+}
 
 /// Whether a body's part of a speculative row is stale: the body had turned by more than
 /// [`SPECULATIVE_TURN`] since the step began (`turn`, the square of that angle, rad²) and the

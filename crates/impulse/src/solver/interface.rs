@@ -109,8 +109,13 @@ pub(crate) struct TargetInputs<'a> {
     pub rotation: &'a [Vec3],
     /// Per slot, the square of the angle (rad²) turned since the step began, as the substep
     /// started: stale speculative rows ([`contact::speculative_row_is_stale`]). Empty when
-    /// no body has turned past [`contact::SPECULATIVE_TURN`]: no row is stale.
+    /// no body has turned past [`contact::CURVED_TURN`] (so none past
+    /// [`contact::SPECULATIVE_TURN`]: no row is stale).
     pub turn: &'a [f32],
+    /// Per slot, what the whole turn adds to a lever arm beyond Δθ × r
+    /// ([`contact::turned_arm_remainder`]) for a body turned past [`contact::CURVED_TURN`]
+    /// whose contact points are its own; `None` for the others. Empty with `turn`.
+    pub curvature: &'a [Option<Mat3>],
     /// Soft contact, repair rate, slop and the repair's speed cap.
     pub settings: &'a SolverSettings,
     /// Substep (s).
@@ -174,6 +179,7 @@ pub(crate) fn set_scalar_targets(
             t.displacement,
             t.rotation,
             t.turn,
+            t.curvature,
             t.settings,
             t.h,
             t.with_repair,

@@ -36,8 +36,17 @@ pub(crate) struct IslandWorkspace {
     pub rotation: Vec<Vec3>,
     /// Per slot, the square of the angle (rad²) turned since the start of the step, as the
     /// current substep started: which speculative rows are stale
-    /// ([`contact::speculative_row_is_stale`]).
+    /// ([`contact::speculative_row_is_stale`]). Empty while no body of the island has turned
+    /// past [`contact::CURVED_TURN`].
     pub(super) turn: Vec<f32>,
+    /// Per slot, with `turn`: what the body's whole turn adds to its lever arms
+    /// ([`contact::turned_arm_remainder`]), for the solve about to set its targets.
+    pub(super) curvature: Vec<Option<Mat3>>,
+    /// The bodies of the island's slots: its bodies, then its guests.
+    pub(super) slot_bodies: Vec<u32>,
+    /// Per slot, whether the body had a `curvature` at some solve of the step: its rows'
+    /// products follow its turn until the step ends.
+    pub(super) turned_slots: Vec<bool>,
     /// Orientations, integrated substep by substep.
     pub orientation: Vec<Quat>,
     /// Per body, the linear and angular acceleration of its applied force and torque (m/s²,

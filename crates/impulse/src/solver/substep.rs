@@ -95,6 +95,7 @@ impl IslandWorkspace {
                 displacement: &self.displacement,
                 rotation: &self.rotation,
                 turn: &self.turn,
+                curvature: &self.curvature,
                 settings,
                 h,
                 with_repair,
@@ -356,6 +357,39 @@ pub(crate) fn step_island(
     w.phases.end(SolvePhase::Record);
 }
 
+/// How far (rad) a body may turn in a step for its rows to follow it
+/// ([`IslandWorkspace::turn_rows`]); past it they take the step's start linearisation again,
+/// as the points found at the start no longer stand for where it touches (docs/method.md,
+/// "Rows that follow a turn").
+const TURNED_ROWS_LIMIT: f32 = 1.0;
+
+/// How far (rad) a body must be turning in a step, at its spin as the step starts, for its
+/// island's rows to follow the turn ([`IslandWorkspace::turn_rows`]). Below it the start's
+/// linearisation stands: its arm swings past the true one, and with the speculative points of
+/// the vertices a turn may bring down ([`crate::collision`]'s turning reach) that margin keeps
+/// tumbling pins within 1.6 mm of the ground at 60 Hz (0.35 rad a step) where following the
+/// turn let a vertex without a point of its own sink 3.4 mm (docs/method.md, "Rows that
+/// follow a turn").
+const TURNING_SPIN: f32 = 0.4;
+
+/// Rows below which an island with a body turning faster than [`TURNING_SPIN`] takes the
+/// scalar path, whose rows follow the turn: a tumbling bowling pin's landing has up to 36, a
+/// landing box's 8 a face.
+const TURNING_SCALAR_ROWS: usize = 64;
+
+/// Whether an island of `rows` rows below [`TURNING_SCALAR_ROWS`] has a body whose contact
+/// points turn with it ([`Bodies::contact_points_turn_with_body`]) and whose spin as the step
+/// starts turns it by more than [`TURNING_SPIN`] in the step.
+fn turns_in_step(island_bodies: &[u32], rows: usize, context: &IslandContext<'_>) -> bool {
+    let (bodies, dt) = (context.bodies, context.dt);
+    rows < TURNING_SCALAR_ROWS
+        && island_bodies.iter().any(|&i| {
+            let i = i as usize;
+            bodies.angular_velocity[i].length() * dt > TURNING_SPIN
+                && bodies.contact_points_turn_with_body(i)
+        })
+}
+
 /// How an island's solves run in a step, decided before its substeps.
 struct SolvePlan {
     /// Substep length (s).
@@ -370,6 +404,9 @@ struct SolvePlan {
     spread: bool,
     /// Whether the lanes record the rows' J·v* and residual as the step ends.
     record_in_lanes: bool,
+    /// Whether the island's rows follow its bodies' turn ([`turns_in_step`],
+    /// [`IslandWorkspace::turn_rows`]).
+    turning: bool,
 }
 
 impl IslandWorkspace {
@@ -381,6 +418,8 @@ impl IslandWorkspace {
         w.linear.clear();
         w.angular.clear();
         w.orientation.clear();
+        w.slot_bodies.clear();
+        w.slot_bodies.extend(island_bodies.iter().chain(guests));
         for &i in island_bodies.iter().chain(guests) {
             w.linear.push(bodies.linear_velocity[i as usize]);
             w.angular.push(bodies.angular_velocity[i as usize]);
@@ -469,6 +508,9 @@ impl IslandWorkspace {
         w.displacement.resize(slots, Vec3::ZERO);
         w.rotation.clear();
         w.rotation.resize(slots, Vec3::ZERO);
+        w.turned_slots.clear();
+        w.turned_slots.resize(slots, false);
+        w.curvature.clear();
     }
 
     /// The island's report, before any solve.
@@ -582,7 +624,8 @@ impl IslandWorkspace {
         // PGS on rigid or soft rows runs in SIMD lanes once an island has a few bundles' worth
         // of contact points; its joints are swept by the scalar path between the lanes' sweeps
         // (docs/solvers.md, "Joints").
-        let bundled = settings.solves_in_lanes(constraints.len());
+        let turning = turns_in_step(island_bodies, constraints.len(), context);
+        let bundled = settings.solves_in_lanes(constraints.len()) && !turning;
         // Assembly leaves the lever-arm products and effective masses of the rows of islands
         // the step's settings would solve in lanes to the lanes (`products_pending`). An island
         // that does not go to the lanes after all (it takes the heavy-on-light path) computes
@@ -640,6 +683,81 @@ impl IslandWorkspace {
             // Not with joints: the lanes' v* (the velocities before the last substep's impulses)
             // would leave out the joints' impulses too, where the record's v* keeps them.
             record_in_lanes: bundled && !context.restitution && w.joints.is_empty(),
+            turning,
+        }
+    }
+
+    /// The rows' turn, in an island whose rows follow its bodies' turn ([`turns_in_step`]):
+    /// for each body turned past [`contact::CURVED_TURN`] (and within [`TURNED_ROWS_LIMIT`])
+    /// whose contact points are its own ([`Bodies::contact_points_turn_with_body`]), its
+    /// [`contact::turned_arm_remainder`] at the current orientation, which the targets add to
+    /// the linearised Δθ × r, and its rows' lever-arm products and effective masses taken
+    /// again at the turned lever arms and the current inverse inertia. Both are needed: the
+    /// whole turn's separation read through the start's lever arms would push a point other
+    /// than the one it measures. A row keeps following its bodies' turn (or the start's lever
+    /// arms, past the limit) once it has, until the step ends (`turned_slots`); the rows of
+    /// other bodies keep their products to the bit, and `curvature` is left empty when no body
+    /// has one.
+    fn turn_rows(&mut self, constraints: &mut [ContactConstraint], bodies: &Bodies) {
+        let mut curvature = std::mem::take(&mut self.curvature);
+        curvature.clear();
+        if !self.turn.is_empty() {
+            let (curved, stale) = (
+                contact::CURVED_TURN * contact::CURVED_TURN,
+                TURNED_ROWS_LIMIT * TURNED_ROWS_LIMIT,
+            );
+            curvature.extend(self.slot_bodies.iter().enumerate().map(|(k, &i)| {
+                let (i, rotation) = (i as usize, self.rotation[k]);
+                let angle = rotation.length_squared();
+                (angle > curved && angle <= stale && bodies.contact_points_turn_with_body(i)).then(
+                    || {
+                        let start = bodies.pose[i].rotation;
+                        contact::turned_arm_remainder(start, self.orientation[k], rotation)
+                    },
+                )
+            }));
+            // The immovable slot.
+            curvature.push(None);
+            for (turned, remainder) in self.turned_slots.iter_mut().zip(&curvature) {
+                *turned |= remainder.is_some();
+            }
+        }
+        if curvature.iter().all(Option::is_none) {
+            curvature.clear();
+        }
+        self.curvature = curvature;
+        if !self.turned_slots.contains(&true) {
+            return;
+        }
+        // A slot's lever arm and inverse inertia: turned as the body has while it has a
+        // remainder, as at the step's start otherwise.
+        let arm = |slot: usize, lever: Vec3| -> (Vec3, Mat3) {
+            let Some(&body) = self.slot_bodies.get(slot) else {
+                return (lever, Mat3::ZERO);
+            };
+            let i = body as usize;
+            match self.curvature.get(slot).copied().flatten() {
+                Some(remainder) => {
+                    let arm = lever + self.rotation[slot].cross(lever) + remainder * lever;
+                    let local = &bodies.local_inverse_inertia[i];
+                    let inertia = if *local == Mat3::ZERO {
+                        Mat3::ZERO
+                    } else {
+                        bodies.locked_axes[i].world_inverse_inertia(self.orientation[slot], local)
+                    };
+                    (arm, inertia)
+                }
+                None => (lever, bodies.world_inverse_inertia(i)),
+            }
+        };
+        for c in constraints.iter_mut() {
+            let (a, b) = (c.local_a as usize, c.local_b as usize);
+            if !self.turned_slots[a] && !self.turned_slots[b] {
+                continue;
+            }
+            let (arm_a, inertia_a) = arm(a, c.lever_a);
+            let (arm_b, inertia_b) = arm(b, c.lever_b);
+            c.turn_products(arm_a, arm_b, &inertia_a, &inertia_b);
         }
     }
 
@@ -697,8 +815,14 @@ impl IslandWorkspace {
         // does not release what the main solve gave a row before the body turned. Left empty
         // while no body of the island has turned past the limit (every ordinary step), so
         // that the target updates skip the test.
+        // The scalar path's rows follow a body's turn from `CURVED_TURN` (`turn_rows`); the
+        // lanes' take the linearised turn.
         self.turn.clear();
-        let limit = contact::SPECULATIVE_TURN * contact::SPECULATIVE_TURN;
+        let limit = if plan.turning {
+            contact::CURVED_TURN * contact::CURVED_TURN
+        } else {
+            contact::SPECULATIVE_TURN * contact::SPECULATIVE_TURN
+        };
         if self.rotation.iter().any(|r| r.length_squared() > limit) {
             self.turn.extend(
                 self.rotation
@@ -707,6 +831,9 @@ impl IslandWorkspace {
             );
         }
         self.position_repair = false;
+        if plan.turning {
+            self.turn_rows(constraints, bodies);
+        }
         self.phases.end(SolvePhase::WarmStart);
         self.targets_and_solve(
             constraints,
@@ -723,6 +850,9 @@ impl IslandWorkspace {
             let relax = SubstepSolve::Relax {
                 warm_start_follows: substep + 1 < settings.solve.substeps,
             };
+            if plan.turning {
+                self.turn_rows(constraints, bodies);
+            }
             self.targets_and_solve(constraints, bodies, settings, h, bundled, relax, half_turn);
         } else if settings.split_impulse()
             && !self.joints.is_empty()
