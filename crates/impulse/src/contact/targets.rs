@@ -116,7 +116,8 @@ pub(crate) const SPECULATIVE_TURN: f32 = std::f32::consts::FRAC_PI_4;
 /// solver's products of it overflow.
 pub(crate) const STALE_TARGET: f32 = -1.0e15;
 
-/// How far (rad) a body must have turned since the step began for its contact points to be
+/// How far (rad) a body of an island whose rows follow its bodies' turn (docs/method.md, "Rows
+/// that follow a turn") must have turned since the step began for its contact points to be
 /// moved by the whole turn rather than the linearised Δθ × r ([`turned_arm_remainder`]). The
 /// linearised point is off by about |Δθ|²·|r|/2: under 1 mm for lever arms within 0.8 m at
 /// this angle, but 0.18·|r| at 0.6 rad, a bowling pin's turn in its landing step at 24 Hz

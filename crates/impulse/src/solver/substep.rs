@@ -365,11 +365,9 @@ const TURNED_ROWS_LIMIT: f32 = 1.0;
 
 /// How far (rad) a body must be turning in a step, at its spin as the step starts, for its
 /// island's rows to follow the turn ([`IslandWorkspace::turn_rows`]). Below it the start's
-/// linearisation stands: its arm swings past the true one, and with the speculative points of
-/// the vertices a turn may bring down ([`crate::collision`]'s turning reach) that margin keeps
-/// tumbling pins within 1.6 mm of the ground at 60 Hz (0.35 rad a step) where following the
-/// turn let a vertex without a point of its own sink 3.4 mm (docs/method.md, "Rows that
-/// follow a turn").
+/// linearisation, with the speculative points of the vertices a turn may bring down, keeps
+/// tumbling pins closer to the ground at 60 Hz than following the turn does (docs/method.md,
+/// "Rows that follow a turn").
 const TURNING_SPIN: f32 = 0.4;
 
 /// Rows below which an island with a body turning faster than [`TURNING_SPIN`] takes the
@@ -702,14 +700,14 @@ impl IslandWorkspace {
         let mut curvature = std::mem::take(&mut self.curvature);
         curvature.clear();
         if !self.turn.is_empty() {
-            let (curved, stale) = (
+            let (curved, limit) = (
                 contact::CURVED_TURN * contact::CURVED_TURN,
                 TURNED_ROWS_LIMIT * TURNED_ROWS_LIMIT,
             );
             curvature.extend(self.slot_bodies.iter().enumerate().map(|(k, &i)| {
                 let (i, rotation) = (i as usize, self.rotation[k]);
                 let angle = rotation.length_squared();
-                (angle > curved && angle <= stale && bodies.contact_points_turn_with_body(i)).then(
+                (angle > curved && angle <= limit && bodies.contact_points_turn_with_body(i)).then(
                     || {
                         let start = bodies.pose[i].rotation;
                         contact::turned_arm_remainder(start, self.orientation[k], rotation)
@@ -814,9 +812,8 @@ impl IslandWorkspace {
         // Both solves of the substep take the turn as it started, so that the relax solve
         // does not release what the main solve gave a row before the body turned. Left empty
         // while no body of the island has turned past the limit (every ordinary step), so
-        // that the target updates skip the test.
-        // The scalar path's rows follow a body's turn from `CURVED_TURN` (`turn_rows`); the
-        // lanes' take the linearised turn.
+        // that the target updates skip the test. An island whose rows follow its bodies' turn
+        // (`turn_rows`) fills it from `CURVED_TURN`.
         self.turn.clear();
         let limit = if plan.turning {
             contact::CURVED_TURN * contact::CURVED_TURN
