@@ -457,8 +457,10 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
     // Not under a mesh triangle's normal constraints, which may have turned GJK's normal on
     // purpose (against phantom hits at the mesh's inner edges).
     let constrained = constraints.0.is_some() || constraints.1.is_some();
-    let corrected = if half_space || constrained {
+    let corrected = if half_space {
         None
+    } else if constrained {
+        triangle_face_axis(pos12, g1, g2, parry_normal, constraints)
     } else {
         better_face_axis(
             pos12,
@@ -598,6 +600,48 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
     }
     manifold.match_contacts(old);
     true
+}
+
+/// Under a mesh triangle's normal constraints: the face normal of the triangle (either side
+/// of a two-sided one; shape 1's frame, out of it) that the constraints keep as it is, and the
+/// shapes' separation along it, when the other shape lies on that side, within
+/// [`AXIS_TOLERANCE`] of the triangle's plane or beyond, and they are farther apart along it
+/// than along Parry's `normal` (unit, shape 1's frame) by more than that. A shape that has
+/// crossed the plane deeper keeps Parry's normal: which side it belongs on is not the least
+/// overlap's to say (a card driven 10-20 mm into a two-sided plane at 10-20 m/s was pushed
+/// through it). EPA on a hull touching a
+/// flat triangle across the triangle's edge can end on an axis of deep overlap: a bowling pin
+/// lying on a two-sided 2-triangle plane, its lowest vertices 4 µm into it over the triangles'
+/// shared edge, got points 87 mm deep along the plane's other side, pushing it down through
+/// the plane (9.8 mm in a step).
+fn triangle_face_axis(
+    pos12: &Pose,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    normal: Vector,
+    constraints: (
+        Option<&dyn NormalConstraints>,
+        Option<&dyn NormalConstraints>,
+    ),
+) -> Option<(Vector, Real)> {
+    // The triangle's face normal in shape 1's frame.
+    let face = match (g1.as_triangle(), g2.as_triangle()) {
+        (Some(triangle), _) => triangle.normal()?,
+        (None, Some(triangle)) => pos12.rotation * triangle.normal()?,
+        (None, None) => return None,
+    };
+    let along = support_separation(pos12, g1, g2, normal)?;
+    [face, -face]
+        .into_iter()
+        .filter_map(|axis| {
+            let separation = support_separation(pos12, g1, g2, axis)?;
+            let (mut n1, mut n2) = (axis, pos12.rotation.inverse() * -axis);
+            let kept = constraints.project_local_normals(pos12, &mut n1, &mut n2)
+                && n1.dot(axis) >= SNAP_COSINE;
+            (kept && separation > along + AXIS_TOLERANCE && separation > -AXIS_TOLERANCE)
+                .then_some((axis, separation))
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 /// Tolerance (m) of [`better_face_axis`]: this plus [`AXIS_RELATIVE_TOLERANCE`] times the

@@ -189,3 +189,46 @@ fn a_pin_landing_at_24_hz_is_right_with_split_steps() {
     assert!(deepest <= tolerance, "split: {:.2} mm", deepest * 1e3);
     assert!(began >= 1, "the landing's contact event");
 }
+
+/// A pin lying on the two-sided 2-triangle plane across the triangles' shared edge, its lowest
+/// vertices 4 µm into the plane, at rest (the pose and velocities of a pin at 1/24 s as it
+/// settled): the step keeps it on the plane. EPA read the pair of the pin and one triangle
+/// 87 mm deep along the plane's other side, and the step pushed it 9.8 mm down through the
+/// plane (docs/method.md, "The face-axis check of thin hulls").
+#[test]
+fn a_pin_lying_across_a_two_sided_planes_seam_stays_on_it() {
+    let (ground_name, ground) = super::hulls::grounds().swap_remove(3);
+    assert_eq!(ground_name, "2-triangle mesh");
+    let shape = ShapeDesc::ConvexHull {
+        points: pin().iter().map(|p| p.to_array()).collect(),
+    };
+    let mut body = BodyDesc::new(
+        BodyKind::Dynamic,
+        shape,
+        [0.075_443_22, 0.053_220_09, 0.004_596_689],
+    );
+    body.orientation = [0.602_019_4, -0.098_557_88, -0.417_284_16, 0.673_597_04];
+    body.linear_velocity = [0.003_315_92, -0.000_961_94, -0.001_711_26];
+    body.angular_velocity = [-0.032_656_19, -0.000_585_86, -0.062_948_79];
+    let scene = Scene {
+        dt: 1.0 / 24.0,
+        bodies: vec![ground, body],
+        ..Scene::default()
+    };
+    let mut world = World::from_scene(&scene).unwrap();
+    let start = lowest_height(&pin(), &world.poses()[1]);
+    assert!(
+        start.abs() < 1e-4,
+        "starts {:.3} mm from the plane",
+        start * 1e3
+    );
+    for step in 0..12 {
+        world.step().unwrap();
+        let low = lowest_height(&pin(), &world.poses()[1]);
+        assert!(
+            low > -1e-3,
+            "step {step}: a vertex {:.2} mm deep",
+            -low * 1e3
+        );
+    }
+}
