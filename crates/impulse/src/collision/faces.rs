@@ -609,8 +609,8 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
 /// than along Parry's `normal` (unit, shape 1's frame) by more than that. A shape that has
 /// crossed the plane deeper keeps Parry's normal: which side it belongs on is not the least
 /// overlap's to say (a card driven 10-20 mm into a two-sided plane at 10-20 m/s was pushed
-/// through it). EPA on a hull touching a
-/// flat triangle across the triangle's edge can end on an axis of deep overlap: a bowling pin
+/// through it). EPA on a hull touching a flat triangle across the triangle's edge can end on
+/// an axis of deep overlap: a bowling pin
 /// lying on a two-sided 2-triangle plane, its lowest vertices 4 µm into it over the triangles'
 /// shared edge, got points 87 mm deep along the plane's other side, pushing it down through
 /// the plane (9.8 mm in a step).

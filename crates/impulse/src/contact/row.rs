@@ -222,10 +222,6 @@ pub struct ContactConstraint {
 const _: () = assert!(std::mem::size_of::<ContactConstraint>() == 376);
 
 impl ContactConstraint {
-    /// Computes the rows' angular parts and lever-arm products (see
-    /// [`Self::products_pending`]) from the directions and lever arms, for bodies of world
-    /// inverse inertia `inverse_inertia_a` and `inverse_inertia_b` (1/(kg·m²)).
-    #[inline(always)]
     /// The rows' lever-arm products and effective masses (every row's, and the tangent
     /// block's) for the lever arms `arm_a`, `arm_b` (m, world frame) and world inverse inertia
     /// tensors `inverse_inertia_a`, `inverse_inertia_b` (1/(kg·m²)) of bodies that have turned
@@ -247,6 +243,10 @@ impl ContactConstraint {
         (self.lever_a, self.lever_b) = levers;
     }
 
+    /// Computes the rows' angular parts and lever-arm products (see
+    /// [`Self::products_pending`]) from the directions and lever arms, for bodies of world
+    /// inverse inertia `inverse_inertia_a` and `inverse_inertia_b` (1/(kg·m²)).
+    #[inline(always)]
     pub(super) fn fill_products(&mut self, inverse_inertia_a: &Mat3A, inverse_inertia_b: &Mat3A) {
         let inverse_mass = PairInverseMass::new(self.inverse_mass_a, self.inverse_mass_b);
         let (r_a, r_b) = (Vec3A::from(self.lever_a), Vec3A::from(self.lever_b));

@@ -326,8 +326,7 @@ pub struct SolveSettings {
     /// points in turn. 0 = never. Default 16; smaller islands do not repay the packing. An
     /// island of fewer than 64 points with a polyhedral body turning more than 0.4 rad in the
     /// step stays on the scalar path, whose rows follow the turn (docs/method.md, "Rows that
-    /// follow a turn"). Colour
-    /// order converges a little more slowly than narrow-phase order. In islands of at least
+    /// follow a turn"). Colour order converges a little more slowly than narrow-phase order. In islands of at least
     /// 1024 points, a colour of more than 8 lane groups is spread over the worker threads (the
     /// same result on any thread count).
     pub simd_island_contacts: u32,

@@ -109,8 +109,8 @@ pub(crate) struct TargetInputs<'a> {
     pub rotation: &'a [Vec3],
     /// Per slot, the square of the angle (rad²) turned since the step began, as the substep
     /// started: stale speculative rows ([`contact::speculative_row_is_stale`]). Empty when
-    /// no body has turned past [`contact::CURVED_TURN`] (so none past
-    /// [`contact::SPECULATIVE_TURN`]: no row is stale).
+    /// no body has turned past [`contact::SPECULATIVE_TURN`] (no row is stale), or, in an
+    /// island whose rows follow its bodies' turn, past [`contact::CURVED_TURN`].
     pub turn: &'a [f32],
     /// Per slot, what the whole turn adds to a lever arm beyond Δθ × r
     /// ([`contact::turned_arm_remainder`]) for a body turned past [`contact::CURVED_TURN`]

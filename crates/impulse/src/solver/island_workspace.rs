@@ -37,7 +37,8 @@ pub(crate) struct IslandWorkspace {
     /// Per slot, the square of the angle (rad²) turned since the start of the step, as the
     /// current substep started: which speculative rows are stale
     /// ([`contact::speculative_row_is_stale`]). Empty while no body of the island has turned
-    /// past [`contact::CURVED_TURN`].
+    /// past [`contact::SPECULATIVE_TURN`] (past [`contact::CURVED_TURN`] in an island whose
+    /// rows follow its bodies' turn).
     pub(super) turn: Vec<f32>,
     /// Per slot, with `turn`: what the body's whole turn adds to its lever arms
     /// ([`contact::turned_arm_remainder`]), for the solve about to set its targets.
