@@ -18,12 +18,17 @@ step").
 5. ``hit``: the head pin alone, hit by the shot's ball rolled at offsets from its centre line:
    the direction the pin moves off in (degrees from straight back) at several steps, with split
    steps at ``--split-overlap`` m (0, the default: off).
+6. ``pins``: two of the shot's pins alone, without gravity or ground: one flying at 5 m/s
+   (upright, or lying along its path) strikes a standing one at offsets from its axis: the
+   direction the struck pin moves off in (degrees from the flyer's path) and its speed, 0.3 s
+   on, at several steps.
 
     python3 scripts/bowling-split.py lines
     python3 scripts/bowling-split.py around takes/bowling TAKE_ID --sizes 0.003,0.03,0.1
     python3 scripts/bowling-split.py reroll takes/bowling TAKE_ID --roughness 0.3,1
     python3 scripts/bowling-split.py steps --steps 1/60:20,1/120:10,1/240:5,1/480:3,1/240:20
     python3 scripts/bowling-split.py hit --offsets 0.05,0.1,0.14 --steps 1/60:20,1/240:5,1/960:2
+    python3 scripts/bowling-split.py pins --offsets 0.03,0.06,0.09 --steps 1/60:20,1/240:5,1/960:2
 
 Needs the impulse package; runs on 2 processes. The counts are deterministic (the engine is).
 """
@@ -106,8 +111,13 @@ def main() -> int:
     hit.add_argument("--offsets", default="0.05,0.1,0.14", help="m, the ball's x at the pin")
     hit.add_argument("--steps", default="1/60:20,1/240:5,1/960:2", help="dt:substeps pairs")
     hit.add_argument("--split-overlap", type=float, default=0.0, help="m, split steps (0: off)")
+    pins = commands.add_parser("pins")
+    pins.add_argument("--offsets", default="0.03,0.06,0.09", help="m, the flyer's x")
+    pins.add_argument("--steps", default="1/60:20,1/240:5,1/960:2", help="dt:substeps pairs")
     arguments = parser.parse_args()
 
+    if arguments.command == "pins":
+        return _pins(arguments.offsets, arguments.steps)
     if arguments.command == "steps":
         return _steps(arguments.steps, arguments.takes)
     if arguments.command == "hit":
@@ -190,6 +200,42 @@ def _hit(offsets: str, pairs: str, split_overlap: float = 0.0) -> int:
             angles.append(math.degrees(math.atan2(-v[0], -v[2])))
         print(f"| {offset:g} | the pin moves off at | "
               + " | ".join(f"{a:.1f}°" for a in angles) + " |")
+    return 0
+
+
+def _pins(offsets: str, pairs: str) -> int:
+    import math
+    from fractions import Fraction
+
+    import impulse
+
+    with open(SHOT + ".json", encoding="utf-8") as file:
+        base = json.load(file)
+    pin = next(body for body in base["bodies"] if body["name"] == "pin1")
+    steps = [(text, float(Fraction(text.split(":")[0])), int(text.split(":")[1]))
+             for text in pairs.split(",")]
+    print("| flying pin | offset (m) | " + " | ".join(f"dt {t.split(':')[0]} s" for t, _, _ in steps)
+          + " |")
+    print("|---|---|" + "---|" * len(steps))
+    for lying in (False, True):
+        for offset in (float(v) for v in offsets.split(",")):
+            cells = []
+            for _, dt, substeps in steps:
+                struck = dict(json.loads(json.dumps(pin)), name="struck", position=[0, 0, 0])
+                flyer = dict(json.loads(json.dumps(pin)), name="flyer",
+                             position=[offset, 0, 0.5], linear_velocity=[0, 0, -5.0])
+                if lying:  # its axis along its path
+                    flyer["orientation"] = [math.sin(math.pi / 4), 0, 0, math.cos(math.pi / 4)]
+                world = impulse.World.from_scene(dict(
+                    base, bodies=[flyer, struck], dt=dt, gravity=[0, 0, 0],
+                    solver={"substeps": substeps}))
+                for _ in range(round(0.3 / dt)):
+                    world.step()
+                v = world.state()["linear_velocities"][1]
+                cells.append(f"{math.degrees(math.atan2(-v[0], -v[2])):.1f}°, "
+                             f"{math.hypot(v[0], v[2]):.2f} m/s")
+            print(f"| {'lying' if lying else 'upright'} | {offset:g} | " + " | ".join(cells)
+                  + " |")
     return 0
 
 

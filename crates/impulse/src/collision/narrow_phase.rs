@@ -515,6 +515,13 @@ impl NarrowPhase {
                 bodies.shape[b].as_ref(),
                 &mut pair.manifolds,
             );
+            reach.aim_at_impact(
+                &pos12,
+                bodies.pose[a].rotation,
+                bodies.shape[a].as_ref(),
+                bodies.shape[b].as_ref(),
+                &mut pair.manifolds,
+            );
             if part_pairs::applies(bodies.shape[a].as_ref(), bodies.shape[b].as_ref()) {
                 part_pairs::reduce(&mut pair.manifolds, &margins.point_closing(bodies, a, b));
             }

@@ -17,6 +17,7 @@ mod determinism;
 mod edge_passes;
 mod extreme_values;
 mod fast_impacts;
+mod fast_pairs;
 mod fuzz_regressions;
 mod golden;
 mod guards;
