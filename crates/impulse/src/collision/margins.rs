@@ -296,24 +296,36 @@ pub(crate) struct SweptReach {
     pub horizon: f32,
 }
 
+/// A pair's two shapes where the narrow phase finds their contacts: body 2 at `pos12` in body
+/// 1's frame, body 1 at world rotation `rotation1`.
+#[derive(Clone, Copy)]
+pub(crate) struct PairShapes<'a> {
+    pub pos12: &'a Pose,
+    pub rotation1: glam::Quat,
+    pub shape1: &'a dyn parry3d::shape::Shape,
+    pub shape2: &'a dyn parry3d::shape::Shape,
+}
+
 /// The distance (m) within which the step's cast counts shapes as touching: half the
 /// smallest miss the sweeps check (0.2 mm), and far above the distance query's rounding
 /// (f32 over a 5 m step).
 pub(crate) const TOUCH_TOLERANCE: f32 = 1.0e-4;
 
 impl SweptReach {
-    /// Drops every point of `manifolds` (of a pair whose body 2 sits at `pos12` in body 1's
-    /// frame, body 1 at world rotation `rotation1`) whose plane the step's straight motion
+    /// Drops every point of `manifolds` (of `pair`) whose plane the step's straight motion
     /// reaches when the shapes, moved by that motion, do not touch; whether any point was
     /// dropped. Shape pairs Parry cannot cast keep their points.
     pub(crate) fn drop_unreachable(
         &self,
-        pos12: &Pose,
-        rotation1: glam::Quat,
-        shape1: &dyn parry3d::shape::Shape,
-        shape2: &dyn parry3d::shape::Shape,
+        pair: PairShapes<'_>,
         manifolds: &mut [Manifold],
     ) -> bool {
+        let PairShapes {
+            pos12,
+            rotation1,
+            shape1,
+            shape2,
+        } = pair;
         let turn_reach = self.horizon * self.turn_reach;
         let target = turn_reach + TOUCH_TOLERANCE;
         let local_displacement = rotation1.inverse() * self.displacement;
@@ -406,17 +418,10 @@ impl SweptReach {
     /// manifold has several points and whose turn within the step the straight cast does not
     /// follow (aiming a tumbling pin's manifold at one point sank pins past the 5 mm the
     /// tumbling-pin tests allow), and pairs already touching, which have no time of impact.
-    pub(crate) fn aim_at_impact(
-        &self,
-        pos12: &Pose,
-        rotation1: glam::Quat,
-        shape1: &dyn parry3d::shape::Shape,
-        shape2: &dyn parry3d::shape::Shape,
-        manifolds: &mut [Manifold],
-    ) -> bool {
-        let radius = match (shape1.as_ball(), shape2.as_ball()) {
-            (Some(ball), _) if shape2.is_convex() && !is_composite(shape2) => ball.radius,
-            (_, Some(ball)) if shape1.is_convex() && !is_composite(shape1) => ball.radius,
+    pub(crate) fn aim_at_impact(&self, pair: PairShapes<'_>, manifolds: &mut [Manifold]) -> bool {
+        let radius = match (pair.shape1.as_ball(), pair.shape2.as_ball()) {
+            (Some(ball), _) if pair.shape2.is_convex() && !is_composite(pair.shape2) => ball.radius,
+            (_, Some(ball)) if pair.shape1.is_convex() && !is_composite(pair.shape1) => ball.radius,
             _ => return false,
         };
         let [manifold] = manifolds else {
@@ -434,12 +439,12 @@ impl SweptReach {
             stop_at_penetration: true,
             compute_impact_geometry_on_penetration: false,
         };
-        let local_displacement = rotation1.inverse() * self.displacement;
+        let local_displacement = pair.rotation1.inverse() * self.displacement;
         let Ok(Some(hit)) = ContactDispatcher::default().cast_shapes(
-            pos12,
+            pair.pos12,
             local_displacement,
-            shape1,
-            shape2,
+            pair.shape1,
+            pair.shape2,
             options,
         ) else {
             return false;
@@ -455,7 +460,7 @@ impl SweptReach {
         let point = &mut manifold.points[0];
         point.local_p1 = hit.witness1;
         point.local_p2 = hit.witness2;
-        point.dist = (pos12.transform_point(hit.witness2) - hit.witness1).dot(hit.normal1);
+        point.dist = (pair.pos12.transform_point(hit.witness2) - hit.witness1).dot(hit.normal1);
         true
     }
 }

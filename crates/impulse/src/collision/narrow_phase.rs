@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 use super::concave_planes;
 use super::dispatch::ContactDispatcher;
 pub(crate) use super::manifold::{ContactImpulse, Manifold, manifold_poses};
+use super::margins::PairShapes;
 pub use super::margins::SpeculativeMargins;
 use super::part_pairs;
 use crate::body::Bodies;
@@ -508,20 +509,14 @@ impl NarrowPhase {
             for manifold in &mut pair.manifolds {
                 drop_duplicate_points(manifold);
             }
-            reach.drop_unreachable(
-                &pos12,
-                bodies.pose[a].rotation,
-                bodies.shape[a].as_ref(),
-                bodies.shape[b].as_ref(),
-                &mut pair.manifolds,
-            );
-            reach.aim_at_impact(
-                &pos12,
-                bodies.pose[a].rotation,
-                bodies.shape[a].as_ref(),
-                bodies.shape[b].as_ref(),
-                &mut pair.manifolds,
-            );
+            let shapes = PairShapes {
+                pos12: &pos12,
+                rotation1: bodies.pose[a].rotation,
+                shape1: bodies.shape[a].as_ref(),
+                shape2: bodies.shape[b].as_ref(),
+            };
+            reach.drop_unreachable(shapes, &mut pair.manifolds);
+            reach.aim_at_impact(shapes, &mut pair.manifolds);
             if part_pairs::applies(bodies.shape[a].as_ref(), bodies.shape[b].as_ref()) {
                 part_pairs::reduce(&mut pair.manifolds, &margins.point_closing(bodies, a, b));
             }
