@@ -401,9 +401,8 @@ impl SweptReach {
     /// moves them more than [`AIMED_DISPLACEMENT`] times the ball's radius against each other,
     /// the pair's single point gets the normal and witness points of the step's straight cast
     /// (Parry's `cast_shapes`, target distance 0, up to the horizon), and its separation is
-    /// the start poses' gap between those witnesses along that normal. Its solver data (the
-    /// accumulated impulses, which a new speculative point has none of) stays. Whether the
-    /// point was moved.
+    /// the start poses' gap between those witnesses along that normal. Its solver data (last
+    /// step's impulses, for warm starting) stays. Whether the point was moved.
     ///
     /// Why: a speculative point's normal is that of the shapes' closest points at the step's
     /// start, and the impulse goes along it. For a ball closing by more than its size in a
