@@ -397,7 +397,8 @@ impl SweptReach {
 
 impl SweptReach {
     /// Aims a fast ball's speculative point at where it will touch: for a ball and a convex
-    /// shape (not a mesh, height field or compound) apart at the step's start, whose step
+    /// shape or a compound's convex part (each of a compound's manifolds on its own part; not
+    /// a mesh or height field) apart at the step's start, whose step
     /// moves them more than [`AIMED_DISPLACEMENT`] times the ball's radius (the smaller of two
     /// balls') against each other, the pair's single point gets the contact at the time the
     /// step's straight motion first brings them into touch: that of Parry's cast (`cast_shapes`,
@@ -422,15 +423,46 @@ impl SweptReach {
     /// a tumbling pin's manifold at one point sank pins past the 5 mm the tumbling-pin tests
     /// allow), and pairs already touching, which have no time of impact.
     pub(crate) fn aim_at_impact(&self, pair: PairShapes<'_>, manifolds: &mut [Manifold]) -> bool {
+        let (compound1, compound2) = (pair.shape1.as_compound(), pair.shape2.as_compound());
+        if compound1.is_none() && compound2.is_none() {
+            let [manifold] = manifolds else {
+                return false;
+            };
+            return self.aim_manifold(pair, manifold);
+        }
+        // A compound's manifolds are its parts': each part's point is aimed at that part.
+        let mut aimed = false;
+        for manifold in manifolds.iter_mut() {
+            let (part1, part2) = (
+                compound1.and_then(|c| c.shapes().get(manifold.subshape1 as usize)),
+                compound2.and_then(|c| c.shapes().get(manifold.subshape2 as usize)),
+            );
+            let (pose1, shape1) = part1.map_or((Pose::IDENTITY, pair.shape1), |(pose, shape)| {
+                (*pose, shape.as_ref())
+            });
+            let (pose2, shape2) = part2.map_or((Pose::IDENTITY, pair.shape2), |(pose, shape)| {
+                (*pose, shape.as_ref())
+            });
+            let pos12 = pose1.inverse() * *pair.pos12 * pose2;
+            let shapes = PairShapes {
+                pos12: &pos12,
+                rotation1: pair.rotation1 * pose1.rotation,
+                shape1,
+                shape2,
+            };
+            aimed |= self.aim_manifold(shapes, manifold);
+        }
+        aimed
+    }
+
+    /// [`Self::aim_at_impact`] for one manifold of two convex shapes `pair`.
+    fn aim_manifold(&self, pair: PairShapes<'_>, manifold: &mut Manifold) -> bool {
         let (ball1, ball2) = (pair.shape1.as_ball(), pair.shape2.as_ball());
         let radius = match (ball1, ball2) {
             (Some(ball1), Some(ball2)) => ball1.radius.min(ball2.radius),
             (Some(ball), _) if pair.shape2.is_convex() && !is_composite(pair.shape2) => ball.radius,
             (_, Some(ball)) if pair.shape1.is_convex() && !is_composite(pair.shape1) => ball.radius,
             _ => return false,
-        };
-        let [manifold] = manifolds else {
-            return false;
         };
         if manifold.points.len() != 1
             || manifold.points[0].dist <= 0.0

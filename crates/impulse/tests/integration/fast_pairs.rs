@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use impulse::glam::Vec3;
-use impulse::scene::{BodyDesc, BodyKind, Material, MaterialRef, Scene, ShapeDesc};
+use impulse::scene::{BodyDesc, BodyKind, CompoundPart, Material, MaterialRef, Scene, ShapeDesc};
 use impulse::{SolverSettings, World};
 
 use super::common::Rng;
@@ -226,7 +226,8 @@ fn fast_balls_meeting_off_centre_leave_as_the_closed_form_says() {
     );
 }
 
-/// Seeded strikes of a smooth ball (radius 5-30 cm) on a static cube's corner: the ball meets
+/// Seeded strikes of a smooth ball (radius 5-30 cm) on a static cube's corner (every other
+/// seed the cube is a compound of its two halves, and the corner a part's): the ball meets
 /// the corner from within its vertex region (coming from where every coordinate is past the
 /// corner's, so it touches no face or edge first), closing by 0.3 to 3 radii a step at 1/60 s,
 /// restitution 0-1, no gravity. The normal at impact runs from the corner to the ball's
@@ -268,6 +269,19 @@ fn fast_balls_meeting_a_boxs_corner_leave_along_its_normal() {
         };
         let mut cube = super::common::static_box(Vec3::splat(half), Vec3::ZERO);
         cube.material = smooth(0.0);
+        if seed % 2 == 1 {
+            // The cube as a compound of its two halves along x (a part's own corner).
+            let part = |x: f32| CompoundPart {
+                shape: ShapeDesc::Cuboid {
+                    half_extents: [0.5 * half, half, half],
+                },
+                position: [x, 0.0, 0.0],
+                orientation: [0.0, 0.0, 0.0, 1.0],
+            };
+            cube.shape = ShapeDesc::Compound {
+                parts: vec![part(-0.5 * half), part(0.5 * half)],
+            };
+        }
         let mut ball = BodyDesc::new(
             BodyKind::Dynamic,
             ShapeDesc::Sphere { radius },
