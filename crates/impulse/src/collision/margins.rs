@@ -423,6 +423,14 @@ impl SweptReach {
     /// a tumbling pin's manifold at one point sank pins past the 5 mm the tumbling-pin tests
     /// allow), and pairs already touching, which have no time of impact.
     pub(crate) fn aim_at_impact(&self, pair: PairShapes<'_>, manifolds: &mut [Manifold]) -> bool {
+        // Most pairs (boxes in a pile, anything touching) have no lone speculative point: they
+        // leave before the shapes are asked anything.
+        if !manifolds
+            .iter()
+            .any(|m| m.points.len() == 1 && m.points[0].dist > 0.0)
+        {
+            return false;
+        }
         let (compound1, compound2) = (pair.shape1.as_compound(), pair.shape2.as_compound());
         if compound1.is_none() && compound2.is_none() {
             let [manifold] = manifolds else {
