@@ -425,10 +425,7 @@ impl SweptReach {
     pub(crate) fn aim_at_impact(&self, pair: PairShapes<'_>, manifolds: &mut [Manifold]) -> bool {
         // Most pairs (boxes in a pile, anything touching) have no lone speculative point: they
         // leave before the shapes are asked anything.
-        if !manifolds
-            .iter()
-            .any(|m| m.points.len() == 1 && m.points[0].dist > 0.0)
-        {
+        if !manifolds.iter().any(lone_speculative_point) {
             return false;
         }
         let (compound1, compound2) = (pair.shape1.as_compound(), pair.shape2.as_compound());
@@ -440,7 +437,7 @@ impl SweptReach {
         }
         // A compound's manifolds are its parts': each part's point is aimed at that part.
         let mut aimed = false;
-        for manifold in manifolds.iter_mut() {
+        for manifold in manifolds.iter_mut().filter(|m| lone_speculative_point(m)) {
             let (part1, part2) = (
                 compound1.and_then(|c| c.shapes().get(manifold.subshape1 as usize)),
                 compound2.and_then(|c| c.shapes().get(manifold.subshape2 as usize)),
@@ -472,8 +469,7 @@ impl SweptReach {
             (_, Some(ball)) if pair.shape1.is_convex() && !is_composite(pair.shape1) => ball.radius,
             _ => return false,
         };
-        if manifold.points.len() != 1
-            || manifold.points[0].dist <= 0.0
+        if !lone_speculative_point(manifold)
             || self.displacement.length() <= AIMED_DISPLACEMENT * radius
         {
             return false;
@@ -540,6 +536,12 @@ impl SweptReach {
         point.dist = (pair.pos12.transform_point(witness2) - witness1).dot(normal1);
         true
     }
+}
+
+/// Whether `manifold` holds one point, apart: the speculative point of a ball's pair
+/// [`SweptReach::aim_at_impact`] may aim.
+fn lone_speculative_point(manifold: &Manifold) -> bool {
+    manifold.points.len() == 1 && manifold.points[0].dist > 0.0
 }
 
 /// The contact of a ball and a convex shape touching at `pos12` (shape 2 in shape 1's frame):
