@@ -15,9 +15,8 @@
 //! struck rows, it holds the landings of that substep. Static bodies and guests (kinematic
 //! bodies) are never in it.
 //!
-//! An island below [`LOCAL_IMPACT_MIN_POINTS`], or one whose region holds more than half its
-//! points, takes the whole-island sweeps as before: there the region saves little, and the
-//! standard scenes' trajectories stay as they were.
+//! An island below [`LOCAL_IMPACT_MIN_POINTS`] (a few bodies), or one whose region holds more
+//! than half its points, takes the whole-island sweeps: there the region saves little.
 
 #[cfg(doc)]
 use super::interface::SolvePass;
@@ -40,8 +39,13 @@ use crate::solver::interface::Sweep;
 /// island, which one sweep a solve leaves far coarser.
 pub(crate) const LOCAL_IMPACT_TOLERANCE: f32 = 0.1;
 
-/// Contact points from which an island's impact sweeps are local.
-pub(crate) const LOCAL_IMPACT_MIN_POINTS: usize = 1024;
+/// Contact points from which an island's impact sweeps are local. The clusters of a pour's
+/// landing layer are islands of tens to hundreds of points in which some cube lands at every
+/// substep; swept whole, they took most of a pour's impact sweeps (docs/method.md, "Local
+/// impact sweeps"). Below 32 points (a few bodies) the region holds most of the island anyway, and
+/// the small scenes (a cube dropped on a slab, the cradle, `balls1k`'s clusters) keep the
+/// whole-island sweeps' trajectories.
+pub(crate) const LOCAL_IMPACT_MIN_POINTS: usize = 32;
 
 /// The island's velocities (by slot: m/s and rad/s) before and after a substep's main solve,
 /// and the change of a row's normal velocity (m/s) beyond which the solve struck the row

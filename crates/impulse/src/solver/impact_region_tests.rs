@@ -86,20 +86,29 @@ fn only_the_rows_the_substep_struck_seed_the_region() {
 }
 
 /// An island below the size for local sweeps, or one whose region is more than half of it,
-/// sweeps whole: the 300-body chain (599 points) whatever its impact, and the 1,000-body
-/// chain with every body falling.
+/// sweeps whole: the 15-body chain (29 points) whatever its impact, and the 1,000-body chain
+/// with every body falling; a 300-body chain (599 points) with one body falling sweeps
+/// around it.
 #[test]
 fn a_small_island_or_a_region_of_most_of_it_sweeps_whole() {
     let mut region = ImpactRegion::default();
-    let small = chain(300);
+    let small = chain(15);
     let mut linear = vec![Vec3::new(0.0, -3.0, 0.0); 1001];
     linear[1000] = Vec3::ZERO;
     let angular = vec![Vec3::ZERO; 1001];
     assert!(small.len() < LOCAL_IMPACT_MIN_POINTS);
     assert_eq!(
-        region.find(&small, &linear, &angular, 1.0, 300, |_| true),
+        region.find(&small, &linear, &angular, 1.0, 15, |_| true),
         RegionKind::Whole
     );
+    let medium = chain(300);
+    let mut one_falling = vec![Vec3::ZERO; 301];
+    one_falling[150] = Vec3::new(0.0, -3.0, 0.0);
+    assert_eq!(
+        region.find(&medium, &one_falling, &angular, 1.0, 300, |_| true),
+        RegionKind::Local
+    );
+    assert_eq!(region.size, 3);
     let large = chain(1000);
     assert_eq!(
         region.find(&large, &linear, &angular, 1.0, 1000, |_| true),
