@@ -4,7 +4,7 @@
     impulse run pour2000 --threads 1 --no-sleep --quiet --island-report R.jsonl
     python3 scripts/impact-work.py R.jsonl [--steps A:B]
 
-Prints, for islands of fewer than 32 contact points, 32 to 1,023 and 1,024 or more, the
+Prints, for islands of fewer than 32 contact points, 32 to 127, 128 to 1,023 and 1,024 or more, the
 point updates of the impact sweeps (`impact_points`, summed over the islands, per step), the
 islands' contact points per step and how many island-steps took impact sweeps; then the
 step's mean wall-clock time (ms, the report's `ms`: a measure of the machine's load as much
@@ -15,7 +15,12 @@ sweeps").
 import argparse
 import json
 
-CLASSES = [("under 32", 0, 32), ("32-1,023", 32, 1024), ("1,024 and more", 1024, None)]
+CLASSES = [
+    ("under 32", 0, 32),
+    ("32-127", 32, 128),
+    ("128-1,023", 128, 1024),
+    ("1,024 and more", 1024, None),
+]
 
 
 def main() -> None:

@@ -42,10 +42,10 @@ pub(crate) const LOCAL_IMPACT_TOLERANCE: f32 = 0.1;
 /// Contact points from which an island's impact sweeps are local. The clusters of a pour's
 /// landing layer are islands of tens to hundreds of points in which some cube lands at every
 /// substep; swept whole, they took most of a pour's impact sweeps (docs/method.md, "Local
-/// impact sweeps"). Below 32 points (a few bodies) the region holds most of the island anyway, and
-/// the small scenes (a cube dropped on a slab, the cradle, `balls1k`'s clusters) keep the
-/// whole-island sweeps' trajectories.
-pub(crate) const LOCAL_IMPACT_MIN_POINTS: usize = 32;
+/// impact sweeps"). Below 128 points (a few bodies) the region would hold much of the island,
+/// and the small scenes (a cube dropped on a slab, the cradle, the takes' bowling pins) keep
+/// the whole-island sweeps' trajectories.
+pub(crate) const LOCAL_IMPACT_MIN_POINTS: usize = 128;
 
 /// The island's velocities (by slot: m/s and rad/s) before and after a substep's main solve,
 /// and the change of a row's normal velocity (m/s) beyond which the solve struck the row

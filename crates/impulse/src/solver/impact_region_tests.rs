@@ -86,19 +86,19 @@ fn only_the_rows_the_substep_struck_seed_the_region() {
 }
 
 /// An island below the size for local sweeps, or one whose region is more than half of it,
-/// sweeps whole: the 15-body chain (29 points) whatever its impact, and the 1,000-body chain
+/// sweeps whole: the 60-body chain (119 points) whatever its impact, and the 1,000-body chain
 /// with every body falling; a 300-body chain (599 points) with one body falling sweeps
 /// around it.
 #[test]
 fn a_small_island_or_a_region_of_most_of_it_sweeps_whole() {
     let mut region = ImpactRegion::default();
-    let small = chain(15);
+    let small = chain(60);
     let mut linear = vec![Vec3::new(0.0, -3.0, 0.0); 1001];
     linear[1000] = Vec3::ZERO;
     let angular = vec![Vec3::ZERO; 1001];
     assert!(small.len() < LOCAL_IMPACT_MIN_POINTS);
     assert_eq!(
-        region.find(&small, &linear, &angular, 1.0, 15, |_| true),
+        region.find(&small, &linear, &angular, 1.0, 60, |_| true),
         RegionKind::Whole
     );
     let medium = chain(300);
