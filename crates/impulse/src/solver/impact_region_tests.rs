@@ -109,6 +109,8 @@ fn a_small_island_or_a_region_of_most_of_it_sweeps_whole() {
         RegionKind::Local
     );
     assert_eq!(region.size, 3);
+    // Another island: its closing contacts are found anew.
+    region.start_step();
     let large = chain(1000);
     assert_eq!(
         region.find(&large, &linear, &angular, 1.0, 1000, |_| true),
