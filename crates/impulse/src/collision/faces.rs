@@ -38,6 +38,8 @@ use parry3d::shape::{ConvexPolyhedron, PackedFeatureId, PolygonalFeature, Shape,
 use super::axis_memory::{AxisMemory, FaceAxisMemory, float_slack};
 use super::caps::inside_convex;
 use super::separating_axes::{GaussArc, GaussArcs};
+use std::cell::RefCell;
+use std::collections::BinaryHeap;
 
 /// Most points a refined manifold keeps: a quadrilateral spanning the contact area carries a
 /// resting face and its friction as the whole polygon would.
@@ -743,7 +745,6 @@ fn better_face_axis<ContactData>(
     }
     let threshold = given + tolerance;
     let slack = float_slack(pos12, &sphere1, &sphere2);
-    let axes = face_axes(pos12, g1, g2);
     let spheres = (&sphere1, &sphere2);
     // A point of each shape (shape 1's frame) for the bounds: its support along Parry's
     // normal, a vertex where the contact is. (Parry's points would bound as well where they
@@ -755,8 +756,12 @@ fn better_face_axis<ContactData>(
         spheres,
         known,
     };
-    if let Some(found) = face_axes_above(pos12, g1, g2, &axes, &search, memory) {
-        return Some(found);
+    let found = FACE_AXES.with_borrow_mut(|axes| {
+        fill_face_axes(pos12, g1, g2, axes);
+        face_axes_above(pos12, g1, g2, axes, &search, memory)
+    });
+    if found.is_some() {
+        return found;
     }
     // Two hulls can be apart along an edge pair's cross product only (thin parts crossed
     // edge to edge): searched when no face axis did better.
@@ -779,9 +784,8 @@ fn edge_axis_above(
     search: &FaceSearch<'_>,
 ) -> Option<(Vector, Real)> {
     let (threshold, slack) = (search.threshold, search.slack);
-    let (faces1, faces2) = (hull1.faces(), hull2.faces());
-    let (points1, points2) = (hull1.points(), hull2.points());
-    let (known1, known2) = search.known;
+    let (faces2, points2) = (hull2.faces(), hull2.points());
+    let known1 = search.known.0;
     // An edge pair's axis u lies on both edges' arcs (below), where edge 1 supports shape 1
     // along u and edge 2 supports shape 2 against it: the separation along u is q·u − p·u
     // (p, q a point of each edge), at most (known2 − p)·u and (q − known1)·u, since shape 2
@@ -791,21 +795,55 @@ fn edge_axis_above(
     // cannot outrank that one), and is left out: an edge on the far side of either shape.
     let beyond_reach =
         |v: Vector, a: Vector, b: Vector| arc_reach(v, a, b) + 2.0 * slack <= threshold;
-    // Shape 2's edges in shape 1's frame, once: each edge's arc between its faces' normals
-    // (negated, as the Minkowski difference sees them), its direction and one of its points.
-    let edges2: Vec<(GaussArc, Vector, Vector)> = hull_edges(hull2)
-        .filter_map(|e2| {
-            let c = pos12.rotation * faces2[e2.faces[0] as usize].normal;
-            let d = pos12.rotation * faces2[e2.faces[1] as usize].normal;
-            let q = pos12.transform_point(points2[e2.vertices[0] as usize]);
+    EDGE_BUFFERS.with_borrow_mut(|buffers| {
+        let EdgeBuffers {
+            edges2,
+            arcs2,
+            candidates,
+        } = buffers;
+        // Shape 2's edges in shape 1's frame, once: each edge's arc between its faces' normals
+        // (negated, as the Minkowski difference sees them), its direction and one of its
+        // points. Those beyond reach are told in shape 2's own frame first (the same bound,
+        // rounded otherwise, which the slack covers), so only the rest are turned.
+        let known1_in2 = pos12.inverse_transform_point(known1);
+        edges2.clear();
+        edges2.extend(hull_edges(hull2).filter_map(|e2| {
+            let (c2, d2) = (
+                faces2[e2.faces[0] as usize].normal,
+                faces2[e2.faces[1] as usize].normal,
+            );
+            let q2 = points2[e2.vertices[0] as usize];
+            if beyond_reach(q2 - known1_in2, -c2, -d2) {
+                return None;
+            }
+            let (c, d) = (pos12.rotation * c2, pos12.rotation * d2);
+            let q = pos12.transform_point(q2);
             (!beyond_reach(q - known1, -c, -d))
                 .then(|| (GaussArc::new(-c, -d), pos12.rotation * e2.dir, q))
-        })
-        .collect();
-    if edges2.is_empty() {
-        return None;
-    }
-    let mut arcs2 = GaussArcs::new(edges2.iter().map(|(arc, _, _)| *arc));
+        }));
+        if edges2.is_empty() {
+            return None;
+        }
+        arcs2.refill(edges2.iter().map(|(arc, _, _)| *arc));
+        edge_axis_of(pos12, (g1, hull1), g2, search, (edges2, arcs2), candidates)
+    })
+}
+
+/// [`edge_axis_above`]'s search over the edge pairs, shape 2's edges given (those within
+/// reach, in shape 1's frame: arc, direction, a point) with their arcs in columns.
+fn edge_axis_of(
+    pos12: &Pose,
+    (g1, hull1): (&dyn Shape, &ConvexPolyhedron),
+    g2: &dyn Shape,
+    search: &FaceSearch<'_>,
+    (edges2, arcs2): (&[(GaussArc, Vector, Vector)], &mut GaussArcs),
+    candidates: &mut Vec<ByBound>,
+) -> Option<(Vector, Real)> {
+    let (threshold, slack) = (search.threshold, search.slack);
+    let (faces1, points1) = (hull1.faces(), hull1.points());
+    let known2 = search.known.1;
+    let beyond_reach =
+        |v: Vector, a: Vector, b: Vector| arc_reach(v, a, b) + 2.0 * slack <= threshold;
     // An edge pair's axis is a face of the Minkowski difference in one direction only: the
     // one where the two arcs cross, inside arc 1 (so along its faces' normals' sum). Only
     // that direction is taken (both where the arc leaves it undecided, faces almost
@@ -821,8 +859,6 @@ fn edge_axis_above(
     // themselves (two support points each) are taken from the highest bound down, until no
     // bound left can reach the largest found: the same largest, and among equals the same
     // axis (the last in the loops' order), as taking every one.
-    // (bound, place in the loops' order, axis)
-    let mut candidates: Vec<(Real, u32, Vector)> = Vec::new();
     let mut order = 0_u32;
     for e1 in hull_edges(hull1) {
         let (normal_a, normal_b) = (
@@ -853,7 +889,11 @@ fn edge_axis_above(
                 // what is (the largest is returned only above it).
                 let bound = (*q - p).dot(axis);
                 if bound + slack > threshold {
-                    candidates.push((bound, order, axis));
+                    candidates.push(ByBound {
+                        bound,
+                        place: order,
+                        axis,
+                    });
                 }
             }
         });
@@ -861,8 +901,27 @@ fn edge_axis_above(
     let (best, _) = largest_by_bound(candidates, slack, |axis| {
         support_separation(pos12, g1, g2, axis)
     });
+    candidates.clear();
     best.map(|(axis, separation, _)| (axis, separation))
         .filter(|&(_, separation)| separation > threshold)
+}
+
+/// The buffers of [`edge_axis_above`], kept per thread so that a search allocates nothing once
+/// they have grown to the hulls' size: shape 2's edges within reach (arc, direction, a point;
+/// shape 1's frame), their arcs in columns, and the candidate axes.
+#[derive(Default)]
+struct EdgeBuffers {
+    edges2: Vec<(GaussArc, Vector, Vector)>,
+    arcs2: GaussArcs,
+    candidates: Vec<ByBound>,
+}
+
+thread_local! {
+    static EDGE_BUFFERS: RefCell<EdgeBuffers> = RefCell::default();
+    /// The face axes of [`better_face_axis`], as [`EdgeBuffers`].
+    static FACE_AXES: RefCell<Vec<FaceAxis>> = RefCell::default();
+    /// The candidates of [`face_axes_above`], as [`EdgeBuffers`].
+    static FACE_CANDIDATES: RefCell<Vec<ByBound>> = RefCell::default();
 }
 
 /// An upper bound of v·u over the unit directions u of the shorter great-circle arc between
@@ -917,16 +976,20 @@ struct HullEdge {
 /// equals; and a bound of the others' separations (m; at least their largest, `Real::MIN` when
 /// there is none). Separations (`separation`) are taken from the highest bound down, until no
 /// bound left, plus `slack` (m, the rounding of a bound and a separation), can reach the largest
-/// found: what taking every one gives, to the bit.
+/// found: what taking every one gives, to the bit. The candidates are taken off a binary heap
+/// (a few of some sixty are taken, where sorting them all cost as much as the separations);
+/// `candidates` is left empty, its allocation kept for the next search.
 fn largest_by_bound(
-    mut candidates: Vec<(Real, u32, Vector)>,
+    candidates: &mut Vec<ByBound>,
     slack: Real,
     separation: impl Fn(Vector) -> Option<Real>,
 ) -> (Option<(Vector, Real, u32)>, Real) {
-    candidates.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(b.1.cmp(&a.1)));
+    // Highest bound first, then the later place: places are distinct, so this is the order of
+    // a sort by (bound, place), both descending.
+    let mut heap = BinaryHeap::from(std::mem::take(candidates));
     let mut best: Option<(Vector, Real, u32)> = None;
     let mut others = Real::MIN;
-    for (bound, place, axis) in candidates {
+    while let Some(ByBound { bound, place, axis }) = heap.pop() {
         if best.is_some_and(|(_, top, _)| bound + slack < top) {
             // Every separation left is below the best, and at most this bound plus the slack.
             others = others.max(bound + slack);
@@ -947,14 +1010,55 @@ fn largest_by_bound(
             None => best = Some((axis, value, place)),
         }
     }
+    *candidates = heap.into_vec();
+    candidates.clear();
     (best, others)
+}
+
+/// A candidate of [`largest_by_bound`]: an upper bound (m) of the separation along `axis`
+/// (shape 1's frame) and its place in the search's order; ordered by the bound (IEEE total
+/// order), then the place.
+struct ByBound {
+    bound: Real,
+    place: u32,
+    axis: Vector,
+}
+
+impl PartialEq for ByBound {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
+
+impl Eq for ByBound {}
+
+impl PartialOrd for ByBound {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for ByBound {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.bound
+            .total_cmp(&other.bound)
+            .then(self.place.cmp(&other.place))
+    }
 }
 
 /// The face axes of a pair (shape 2 at `pos12` in shape 1's frame), each out of shape 1 with
 /// a point of its face, shape 1's frame: every face of a hull, a box's six, a triangle's two
 /// sides; shape 1's first. Other shapes have none.
+#[cfg(test)]
 fn face_axes(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape) -> Vec<FaceAxis> {
-    let mut axes: Vec<FaceAxis> = Vec::new();
+    let mut axes = Vec::new();
+    fill_face_axes(pos12, g1, g2, &mut axes);
+    axes
+}
+
+/// [`face_axes`] into `axes` (cleared first), keeping its allocation.
+fn fill_face_axes(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, axes: &mut Vec<FaceAxis>) {
+    axes.clear();
     let mut add = |shape: &dyn Shape, to_frame1: Option<&Pose>| {
         // A face normal out of shape 1 (a face of shape 2 faces the other way) and a point of
         // the face, in shape 1's frame.
@@ -992,7 +1096,6 @@ fn face_axes(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape) -> Vec<FaceAxis> {
     };
     add(g1, None);
     add(g2, Some(pos12));
-    axes
 }
 
 /// A face axis of a pair (shape 1's frame, out of shape 1) and a point of its face, of shape 1
@@ -1066,12 +1169,15 @@ fn face_axes_above(
             return (now > threshold).then_some((axis, now));
         }
     }
-    let candidates = axes
-        .iter()
-        .enumerate()
-        .map(|(index, face)| (face.bound(search.known), index as u32, face.axis))
-        .collect();
-    let (best, runner_up) = largest_by_bound(candidates, slack, separation);
+    let (best, runner_up) = FACE_CANDIDATES.with_borrow_mut(|candidates| {
+        candidates.clear();
+        candidates.extend(axes.iter().enumerate().map(|(index, face)| ByBound {
+            bound: face.bound(search.known),
+            place: index as u32,
+            axis: face.axis,
+        }));
+        largest_by_bound(candidates, slack, separation)
+    });
     let (_, top, index) = best?;
     let index = index as usize;
     if let Some(slot) = memory {

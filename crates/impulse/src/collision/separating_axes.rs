@@ -240,6 +240,7 @@ pub(crate) struct GaussArcs {
 
 impl GaussArcs {
     /// The columns of `arcs`.
+    #[cfg(test)]
     pub(crate) fn new(arcs: impl IntoIterator<Item = GaussArc>) -> Self {
         let mut columns = Self::default();
         columns.refill(arcs);
