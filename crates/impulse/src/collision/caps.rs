@@ -341,9 +341,9 @@ fn refine<ManifoldData, ContactData: Default + Copy>(
 /// point lies in an empty polygon, a half-space's plane).
 pub(crate) fn inside_convex(polygon: &[[Real; 2]], p: [Real; 2]) -> bool {
     let mut sign = 0.0;
-    for i in 0..polygon.len() {
-        let a = polygon[i];
-        let b = polygon[(i + 1) % polygon.len()];
+    // Each edge (a, b), the last back to the first (without a division per edge).
+    let ends = polygon.iter().zip(polygon.iter().cycle().skip(1));
+    for (&a, &b) in ends {
         let cross = (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
         if cross.abs() <= 1.0e-9 {
             continue;

@@ -269,10 +269,12 @@ pub(crate) fn clip(f1: &Feature, f2: &Feature, n: Vector, out: &mut Vec<Candidat
         }
     }
     // Crossings of an edge of each, strictly inside both edges (their ends are vertices).
+    // The vertex after `i` of `count`, the last's the first.
+    let next = |i: usize, count: usize| if i + 1 == count { 0 } else { i + 1 };
     for i in 0..f1.edge_count() {
-        let (a, b) = (i, (i + 1) % f1.vertices.len());
+        let (a, b) = (i, next(i, f1.vertices.len()));
         for j in 0..f2.edge_count() {
-            let (c, d) = (j, (j + 1) % f2.vertices.len());
+            let (c, d) = (j, next(j, f2.vertices.len()));
             if let Some((s, t)) = crossing(
                 [projected1[a], projected1[b]],
                 [projected2[c], projected2[d]],
@@ -301,8 +303,17 @@ fn crossing(e1: [[Real; 2]; 2], e2: [[Real; 2]; 2]) -> Option<(Real, Real)> {
     if denom * denom <= 1.0e-12 * scale {
         return None;
     }
-    let s = (r[0] * d2[1] - r[1] * d2[0]) / denom;
-    let t = (r[0] * d1[1] - r[1] * d1[0]) / denom;
+    let (s_over, t_over) = (r[0] * d2[1] - r[1] * d2[0], r[0] * d1[1] - r[1] * d1[0]);
+    // Most pairs of a face's edges miss: told without dividing. A quotient in (0, 1) needs a
+    // numerator of the denominator's sign and smaller size (rounding is monotone and 1 is
+    // exact: a quotient of at least 1 in size rounds to at least 1), so these reject only
+    // pairs the division would.
+    let within =
+        |over: Real| over != 0.0 && (over > 0.0) == (denom > 0.0) && over.abs() < denom.abs();
+    if !(within(s_over) && within(t_over)) {
+        return None;
+    }
+    let (s, t) = (s_over / denom, t_over / denom);
     (s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0).then_some((s, t))
 }
 

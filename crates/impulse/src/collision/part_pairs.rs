@@ -136,10 +136,16 @@ pub(crate) fn reduce(manifolds: &mut [Manifold], closing: &dyn Fn(Vector, Vector
         };
         groups.push((patch, layer));
     }
-    let mut keep: Vec<Vec<bool>> = manifolds
+    // Whether each point stays, all manifolds' in one list: manifold m's from `first[m]`.
+    let first: Vec<usize> = manifolds
         .iter()
-        .map(|m| vec![true; m.points.len()])
+        .scan(0, |next, m| {
+            let start = *next;
+            *next += m.points.len();
+            Some(start)
+        })
         .collect();
+    let mut keep = vec![true; points.len()];
     // The points grouped (a stable sort keeps each group's points deepest first).
     let mut by_group: Vec<usize> = (0..points.len()).collect();
     by_group.sort_by_key(|&i| groups[i]);
@@ -162,11 +168,11 @@ pub(crate) fn reduce(manifolds: &mut [Manifold], closing: &dyn Fn(Vector, Vector
             points[groups[members[0]].0].normal,
         );
         for (k, &i) in members.iter().enumerate() {
-            keep[points[i].manifold][points[i].point] = chosen.contains(&k);
+            keep[first[points[i].manifold] + points[i].point] = chosen.contains(&k);
         }
     }
-    for (manifold, keep) in manifolds.iter_mut().zip(&keep) {
-        let mut k = 0;
+    let mut k = 0;
+    for manifold in manifolds.iter_mut() {
         manifold.points.retain(|_| {
             let kept = keep[k];
             k += 1;
