@@ -33,11 +33,14 @@ use parry3d::bounding_volume::BoundingSphere;
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::query::details::{NormalConstraints, NormalConstraintsPair};
 use parry3d::query::{ContactManifold, DefaultQueryDispatcher, QueryDispatcher, TrackedContact};
-use parry3d::shape::{ConvexPolyhedron, PackedFeatureId, PolygonalFeature, Shape, TypedShape};
+use parry3d::shape::{
+    ConvexPolyhedron, PackedFeatureId, PolygonalFeature, Shape, SupportMap, TypedShape,
+};
 
 use super::axis_memory::{AxisMemory, FaceAxisMemory, float_slack};
 use super::caps::inside_convex;
 use super::separating_axes::{GaussArc, GaussArcs};
+use crate::simd::{InstructionSet, on_instruction_set};
 use std::cell::RefCell;
 use std::collections::BinaryHeap;
 
@@ -697,9 +700,74 @@ fn supports(
     axis: Vector,
 ) -> Option<(Vector, Vector, Real)> {
     let (s1, s2) = (g1.as_support_map()?, g2.as_support_map()?);
-    let far1 = s1.local_support_point(axis);
-    let near2 = pos12.transform_point(s2.local_support_point(pos12.rotation.inverse() * -axis));
+    let far1 = local_support(g1, s1, axis);
+    let near2 = pos12.transform_point(local_support(g2, s2, pos12.rotation.inverse() * -axis));
     Some((far1, near2, near2.dot(axis) - far1.dot(axis)))
+}
+
+/// `map`'s (`shape`'s) support point along `dir` (its own frame), as Parry's
+/// `SupportMap::local_support_point` gives it, to the bit: for a convex polyhedron (a bare
+/// one: a rounded hull's support adds its border) its vertex [`first_largest_dot`] picks,
+/// which is Parry's; Parry's own call for any other shape.
+fn local_support(shape: &dyn Shape, map: &dyn SupportMap, dir: Vector) -> Vector {
+    match shape.as_convex_polyhedron() {
+        Some(hull) if !hull.points().is_empty() => {
+            hull.points()[first_largest_dot(hull.points(), dir)]
+        }
+        _ => map.local_support_point(dir),
+    }
+}
+
+/// The index of the first of `points` (not empty) with the largest dot product with `dir`,
+/// dot products taken as `Vec3::dot` takes them ((x·x' + y·y') + z·z'), NaNs never the
+/// largest, and 0 when the first's is NaN: what Parry's `point_cloud_support_point_id`
+/// returns (a scan keeping the first of equals), to the bit. Eight points at a time in lanes,
+/// each keeping its first largest; then the largest of the lanes, the first of equals, and
+/// the points after the last eight in order.
+pub(crate) fn first_largest_dot(points: &[Vector], dir: Vector) -> usize {
+    const LANES: usize = 8;
+    let first = points[0].dot(dir);
+    if points.len() < 2 * LANES || first.is_nan() {
+        let mut best = (0, first);
+        for (i, p) in points.iter().enumerate().skip(1) {
+            let dot = p.dot(dir);
+            if dot > best.1 {
+                best = (i, dot);
+            }
+        }
+        return best.0;
+    }
+    on_instruction_set!(InstructionSet::detected(), {
+        let mut best = [Real::NEG_INFINITY; LANES];
+        let mut at = [0_usize; LANES];
+        let chunks = points.chunks_exact(LANES);
+        let rest = chunks.remainder();
+        for (c, chunk) in chunks.enumerate() {
+            for k in 0..LANES {
+                let p = chunk[k];
+                let dot = p.x * dir.x + p.y * dir.y + p.z * dir.z;
+                // Strictly larger: a lane keeps its first of equals.
+                let larger = dot > best[k];
+                best[k] = if larger { dot } else { best[k] };
+                at[k] = if larger { c * LANES + k } else { at[k] };
+            }
+        }
+        // A lane's -inf stands for no larger point than the first (index 0 with it).
+        let mut top = (at[0], best[0]);
+        for k in 1..LANES {
+            if best[k] > top.1 || (best[k] == top.1 && at[k] < top.0) {
+                top = (at[k], best[k]);
+            }
+        }
+        let start = points.len() - rest.len();
+        for (i, p) in rest.iter().enumerate() {
+            let dot = p.dot(dir);
+            if dot > top.1 {
+                top = (start + i, dot);
+            }
+        }
+        top.0
+    })
 }
 
 /// A face normal of either shape (shape 1's frame, out of it: a hull's faces, a box's, a

@@ -595,3 +595,57 @@ fn matches_every_axis(
     }
     compared
 }
+
+/// The support scan in lanes picks the vertex Parry's scan picks, to the bit: seeded clouds of
+/// 1 to 70 points (ties from rounded coordinates and repeated points, NaN points) along
+/// random, zero, infinite and NaN directions.
+#[test]
+fn support_points_in_lanes_are_parrys() {
+    use super::first_largest_dot;
+    use parry3d::utils::point_cloud_support_point_id;
+    use rand::rngs::ChaCha20Rng;
+    use rand::{RngExt, SeedableRng};
+    let mut rng = ChaCha20Rng::seed_from_u64(41);
+    for case in 0..6000 {
+        let count = rng.random_range(1..70);
+        let mut coordinate = |rng: &mut ChaCha20Rng| rng.random_range(-1.0_f32..1.0);
+        let mut points: Vec<Vec3> = (0..count)
+            .map(|_| {
+                Vec3::new(
+                    coordinate(&mut rng),
+                    coordinate(&mut rng),
+                    coordinate(&mut rng),
+                )
+            })
+            .collect();
+        if case % 3 == 0 {
+            for p in &mut points {
+                *p = (*p * 2.0).round() / 2.0;
+            }
+        }
+        if case % 5 == 0 {
+            let from = rng.random_range(0..count);
+            let to = rng.random_range(0..count);
+            points[to] = points[from];
+        }
+        if case % 13 == 0 {
+            points[rng.random_range(0..count)] = Vec3::splat(f32::NAN);
+        }
+        let dir = match case % 11 {
+            0 => Vec3::ZERO,
+            1 => Vec3::new(f32::NAN, 0.0, 1.0),
+            2 => Vec3::new(f32::INFINITY, 0.0, 0.0),
+            3 => Vec3::new(0.0, 1.0, 0.0),
+            _ => Vec3::new(
+                coordinate(&mut rng),
+                coordinate(&mut rng),
+                coordinate(&mut rng),
+            ),
+        };
+        assert_eq!(
+            first_largest_dot(&points, dir),
+            point_cloud_support_point_id(dir, &points),
+            "case {case}: {count} points along {dir}"
+        );
+    }
+}
