@@ -727,7 +727,7 @@ fn local_support(shape: &dyn Shape, map: &dyn SupportMap, dir: Vector) -> Vector
 pub(crate) fn first_largest_dot(points: &[Vector], dir: Vector) -> usize {
     const LANES: usize = 8;
     let first = points[0].dot(dir);
-    if points.len() < 2 * LANES || first.is_nan() {
+    if points.len() < 2 * LANES || points.len() > 1 << 24 || first.is_nan() {
         let mut best = (0, first);
         for (i, p) in points.iter().enumerate().skip(1) {
             let dot = p.dot(dir);
@@ -739,24 +739,28 @@ pub(crate) fn first_largest_dot(points: &[Vector], dir: Vector) -> usize {
     }
     on_instruction_set!(InstructionSet::detected(), {
         let mut best = [Real::NEG_INFINITY; LANES];
-        let mut at = [0_usize; LANES];
+        // Indices as floats (exact below 2²⁴), chosen as the dot products are: in one vector
+        // register with them, where integer indices were chosen lane by lane.
+        let mut at = [0.0_f32; LANES];
         let chunks = points.chunks_exact(LANES);
         let rest = chunks.remainder();
         for (c, chunk) in chunks.enumerate() {
+            let base = (c * LANES) as f32;
             for k in 0..LANES {
                 let p = chunk[k];
                 let dot = p.x * dir.x + p.y * dir.y + p.z * dir.z;
                 // Strictly larger: a lane keeps its first of equals.
                 let larger = dot > best[k];
                 best[k] = if larger { dot } else { best[k] };
-                at[k] = if larger { c * LANES + k } else { at[k] };
+                at[k] = if larger { base + k as f32 } else { at[k] };
             }
         }
         // A lane's -inf stands for no larger point than the first (index 0 with it).
-        let mut top = (at[0], best[0]);
+        let mut top = (at[0] as usize, best[0]);
         for k in 1..LANES {
-            if best[k] > top.1 || (best[k] == top.1 && at[k] < top.0) {
-                top = (at[k], best[k]);
+            let index = at[k] as usize;
+            if best[k] > top.1 || (best[k] == top.1 && index < top.0) {
+                top = (index, best[k]);
             }
         }
         let start = points.len() - rest.len();

@@ -608,7 +608,7 @@ fn support_points_in_lanes_are_parrys() {
     let mut rng = ChaCha20Rng::seed_from_u64(41);
     for case in 0..6000 {
         let count = rng.random_range(1..70);
-        let mut coordinate = |rng: &mut ChaCha20Rng| rng.random_range(-1.0_f32..1.0);
+        let coordinate = |rng: &mut ChaCha20Rng| rng.random_range(-1.0_f32..1.0);
         let mut points: Vec<Vec3> = (0..count)
             .map(|_| {
                 Vec3::new(
