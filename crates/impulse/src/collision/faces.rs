@@ -866,7 +866,6 @@ fn edge_axis_above(
     (g2, hull2): (&dyn Shape, &ConvexPolyhedron),
     search: &FaceSearch<'_>,
 ) -> Option<(Vector, Real)> {
-    let (threshold, slack) = (search.threshold, search.slack);
     let (faces2, points2) = (hull2.faces(), hull2.points());
     let known1 = search.known.0;
     // An edge pair's axis u lies on both edges' arcs (below), where edge 1 supports shape 1
@@ -875,9 +874,9 @@ fn edge_axis_above(
     // reaches at least as low as its known point and shape 1 at least as high as its own. An
     // edge whose arc holds no direction with that bound above the threshold gives no axis the
     // search could return (the returned axis is above the threshold, and an axis below it
-    // cannot outrank that one), and is left out: an edge on the far side of either shape.
-    let beyond_reach =
-        |v: Vector, a: Vector, b: Vector| arc_reach(v, a, b) + 2.0 * slack <= threshold;
+    // cannot outrank that one), and is left out: an edge on the far side of either shape
+    // ([`FaceSearch::beyond_reach`]).
+    let beyond_reach = |v: Vector, a: Vector, b: Vector| search.beyond_reach(v, a, b);
     EDGE_BUFFERS.with_borrow_mut(|buffers| {
         let EdgeBuffers {
             edges2,
@@ -925,8 +924,7 @@ fn edge_axis_of(
     let (threshold, slack) = (search.threshold, search.slack);
     let (faces1, points1) = (hull1.faces(), hull1.points());
     let known2 = search.known.1;
-    let beyond_reach =
-        |v: Vector, a: Vector, b: Vector| arc_reach(v, a, b) + 2.0 * slack <= threshold;
+    let beyond_reach = |v: Vector, a: Vector, b: Vector| search.beyond_reach(v, a, b);
     // An edge pair's axis is a face of the Minkowski difference in one direction only: the
     // one where the two arcs cross, inside arc 1 (so along its faces' normals' sum). Only
     // that direction is taken (both where the arc leaves it undecided, faces almost
@@ -1212,6 +1210,16 @@ struct FaceSearch<'a> {
     slack: Real,
     spheres: (&'a BoundingSphere, &'a BoundingSphere),
     known: (Vector, Vector),
+}
+
+impl FaceSearch<'_> {
+    /// Whether an edge with the arc between unit normals `a` and `b`, seen from the other
+    /// shape's known point at `v` (the edge's point less that point, or that point less the
+    /// edge's), holds no axis whose bound ([`arc_reach`]) reaches the threshold, the slack
+    /// twice over: no axis of it can be above the threshold.
+    fn beyond_reach(&self, v: Vector, a: Vector, b: Vector) -> bool {
+        arc_reach(v, a, b) + 2.0 * self.slack <= self.threshold
+    }
 }
 
 /// The face axis of largest separation among `axes`, the last of equals, and that separation,
