@@ -340,11 +340,20 @@ fn refine<ManifoldData, ContactData: Default + Copy>(
 /// Whether `p` lies in the convex polygon `polygon` (either winding; on an edge counts; every
 /// point lies in an empty polygon, a half-space's plane).
 pub(crate) fn inside_convex(polygon: &[[Real; 2]], p: [Real; 2]) -> bool {
-    let mut sign = 0.0;
     // Each edge (a, b), the last back to the first (without a division per edge).
     let ends = polygon.iter().zip(polygon.iter().cycle().skip(1));
-    for (&a, &b) in ends {
-        let cross = (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+    inside_edges(ends.map(|(&a, &b)| (a, [b[0] - a[0], b[1] - a[1]])), p)
+}
+
+/// [`inside_convex`] for a polygon given by its edges in order, each its start a and its
+/// direction b − a (computed once where many points are tested against one polygon).
+pub(crate) fn inside_edges(
+    edges: impl IntoIterator<Item = ([Real; 2], [Real; 2])>,
+    p: [Real; 2],
+) -> bool {
+    let mut sign = 0.0;
+    for (a, d) in edges {
+        let cross = d[0] * (p[1] - a[1]) - d[1] * (p[0] - a[0]);
         if cross.abs() <= 1.0e-9 {
             continue;
         }

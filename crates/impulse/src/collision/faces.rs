@@ -38,7 +38,7 @@ use parry3d::shape::{
 };
 
 use super::axis_memory::{AxisMemory, FaceAxisMemory, float_slack};
-use super::caps::inside_convex;
+use super::caps::inside_edges;
 use super::separating_axes::{GaussArc, GaussArcs};
 use crate::simd::{InstructionSet, on_instruction_set};
 use std::cell::RefCell;
@@ -231,15 +231,41 @@ pub(crate) struct Candidate {
 /// or anywhere over a plane) and crossings of their edges, as seen along `n`. Points whose
 /// depth cannot be measured along `n` (a face seen edge-on) are left out.
 pub(crate) fn clip(f1: &Feature, f2: &Feature, n: Vector, out: &mut Vec<Candidate>) {
+    CLIP_BUFFERS.with_borrow_mut(|buffers| clip_with(f1, f2, n, out, buffers));
+}
+
+/// [`clip`] with its buffers.
+fn clip_with(
+    f1: &Feature,
+    f2: &Feature,
+    n: Vector,
+    out: &mut Vec<Candidate>,
+    [segments1, segments2]: &mut [Vec<Segment>; 2],
+) {
     let (u, w) = n.any_orthonormal_pair();
     let project = |v: Vector| [v.dot(u), v.dot(w)];
     let plane1 = f1.plane_of();
     let plane2 = f2.plane_of();
-    let over = |feature: &Feature, projected: &[[Real; 2]], p: [Real; 2]| {
-        feature.plane.is_some() || (projected.len() >= 3 && inside_convex(projected, p))
+    // Each feature's edges as seen along `n`, once for all the tests against them: none for a
+    // point or a plane, one for a segment, each vertex to the next for a polygon.
+    let fill = |segments: &mut Vec<Segment>, feature: &Feature| {
+        segments.clear();
+        let count = feature.vertices.len();
+        segments.extend((0..feature.edge_count()).map(|i| {
+            let next = if i + 1 == count { 0 } else { i + 1 };
+            Segment::new(
+                project(feature.vertices[i]),
+                project(feature.vertices[next]),
+            )
+        }));
     };
-    let projected1: Vec<[Real; 2]> = f1.vertices.iter().map(|&v| project(v)).collect();
-    let projected2: Vec<[Real; 2]> = f2.vertices.iter().map(|&v| project(v)).collect();
+    fill(segments1, f1);
+    fill(segments2, f2);
+    let over = |feature: &Feature, segments: &[Segment], p: [Real; 2]| {
+        feature.plane.is_some()
+            || (feature.vertices.len() >= 3
+                && inside_edges(segments.iter().map(|s| (s.start, s.dir)), p))
+    };
     let mut push = |p1: Vector, p2: Vector, fid1, fid2| {
         out.push(Candidate {
             p1,
@@ -254,7 +280,7 @@ pub(crate) fn clip(f1: &Feature, f2: &Feature, n: Vector, out: &mut Vec<Candidat
         && normal.dot(n).abs() >= EDGE_ON
     {
         for (i, &p) in f1.vertices.iter().enumerate() {
-            if over(f2, &projected2, projected1[i]) {
+            if over(f2, segments2, project(p)) {
                 let t = (origin - p).dot(normal) / n.dot(normal);
                 push(p, p + n * t, f1.vids[i], f2.fid);
             }
@@ -265,23 +291,18 @@ pub(crate) fn clip(f1: &Feature, f2: &Feature, n: Vector, out: &mut Vec<Candidat
         && normal.dot(n).abs() >= EDGE_ON
     {
         for (j, &q) in f2.vertices.iter().enumerate() {
-            if over(f1, &projected1, projected2[j]) {
+            if over(f1, segments1, project(q)) {
                 let t = (q - origin).dot(normal) / n.dot(normal);
                 push(q - n * t, q, f1.fid, f2.vids[j]);
             }
         }
     }
     // Crossings of an edge of each, strictly inside both edges (their ends are vertices).
-    // The vertex after `i` of `count`, the last's the first.
-    let next = |i: usize, count: usize| if i + 1 == count { 0 } else { i + 1 };
-    for i in 0..f1.edge_count() {
-        let (a, b) = (i, next(i, f1.vertices.len()));
-        for j in 0..f2.edge_count() {
-            let (c, d) = (j, next(j, f2.vertices.len()));
-            if let Some((s, t)) = crossing(
-                [projected1[a], projected1[b]],
-                [projected2[c], projected2[d]],
-            ) {
+    for (i, e1) in segments1.iter().enumerate() {
+        let (a, b) = (i, (i + 1) % f1.vertices.len());
+        for (j, e2) in segments2.iter().enumerate() {
+            if let Some((s, t)) = crossing(e1, e2) {
+                let (c, d) = (j, (j + 1) % f2.vertices.len());
                 let p1 = f1.vertices[a].lerp(f1.vertices[b], s);
                 let p2 = f2.vertices[c].lerp(f2.vertices[d], t);
                 push(p1, p2, f1.eids[i], f2.eids[j]);
@@ -295,14 +316,38 @@ pub(crate) fn clip(f1: &Feature, f2: &Feature, n: Vector, out: &mut Vec<Candidat
     }
 }
 
+thread_local! {
+    /// The edges of [`clip`]'s two features, kept per thread as [`EdgeBuffers`].
+    static CLIP_BUFFERS: RefCell<[Vec<Segment>; 2]> = RefCell::default();
+}
+
+/// A 2-D segment of a feature seen along the normal: its start, its direction (end less
+/// start) and that direction's squared length, computed once for the many tests it is in.
+#[derive(Clone, Copy)]
+struct Segment {
+    start: [Real; 2],
+    dir: [Real; 2],
+    length_squared: Real,
+}
+
+impl Segment {
+    fn new(start: [Real; 2], end: [Real; 2]) -> Self {
+        let dir = [end[0] - start[0], end[1] - start[1]];
+        Self {
+            start,
+            dir,
+            length_squared: dir[0] * dir[0] + dir[1] * dir[1],
+        }
+    }
+}
+
 /// Where 2-D segments `e1` and `e2` cross, as parameters along each, if they cross strictly
 /// inside both (parallel segments do not cross).
-fn crossing(e1: [[Real; 2]; 2], e2: [[Real; 2]; 2]) -> Option<(Real, Real)> {
-    let d1 = [e1[1][0] - e1[0][0], e1[1][1] - e1[0][1]];
-    let d2 = [e2[1][0] - e2[0][0], e2[1][1] - e2[0][1]];
-    let r = [e2[0][0] - e1[0][0], e2[0][1] - e1[0][1]];
+fn crossing(e1: &Segment, e2: &Segment) -> Option<(Real, Real)> {
+    let (d1, d2) = (e1.dir, e2.dir);
+    let r = [e2.start[0] - e1.start[0], e2.start[1] - e1.start[1]];
     let denom = d1[0] * d2[1] - d1[1] * d2[0];
-    let scale = (d1[0] * d1[0] + d1[1] * d1[1]) * (d2[0] * d2[0] + d2[1] * d2[1]);
+    let scale = e1.length_squared * e2.length_squared;
     if denom * denom <= 1.0e-12 * scale {
         return None;
     }
