@@ -768,19 +768,12 @@ fn local_support(shape: &dyn Shape, map: &dyn SupportMap, dir: Vector) -> Vector
 /// largest, and 0 when the first's is NaN: what Parry's `point_cloud_support_point_id`
 /// returns (a scan keeping the first of equals), to the bit. Eight points at a time in lanes,
 /// each keeping its first largest; then the largest of the lanes, the first of equals, and
-/// the points after the last eight in order.
+/// the points after the last eight in order. Short clouds, and those whose first dot product
+/// is NaN, go to Parry's scan itself.
 pub(crate) fn first_largest_dot(points: &[Vector], dir: Vector) -> usize {
     const LANES: usize = 8;
-    let first = points[0].dot(dir);
-    if points.len() < 2 * LANES || points.len() > 1 << 24 || first.is_nan() {
-        let mut best = (0, first);
-        for (i, p) in points.iter().enumerate().skip(1) {
-            let dot = p.dot(dir);
-            if dot > best.1 {
-                best = (i, dot);
-            }
-        }
-        return best.0;
+    if points.len() < 2 * LANES || points.len() > 1 << 24 || points[0].dot(dir).is_nan() {
+        return parry3d::utils::point_cloud_support_point_id(dir, points);
     }
     on_instruction_set!(InstructionSet::detected(), {
         let mut best = [Real::NEG_INFINITY; LANES];
@@ -1027,7 +1020,6 @@ fn edge_axis_of(
     let (best, _) = largest_by_bound(candidates, slack, |axis| {
         support_separation(pos12, g1, g2, axis)
     });
-    candidates.clear();
     best.map(|(axis, separation, _)| (axis, separation))
         .filter(|&(_, separation)| separation > threshold)
 }
@@ -1306,7 +1298,6 @@ fn face_axes_above(
         }
     }
     let (best, runner_up) = FACE_CANDIDATES.with_borrow_mut(|candidates| {
-        candidates.clear();
         candidates.extend(axes.iter().enumerate().map(|(index, face)| ByBound {
             bound: face.bound(search.known),
             place: index as u32,

@@ -54,13 +54,13 @@ pub(crate) fn applies(shape1: &dyn Shape, shape2: &dyn Shape) -> bool {
     compound(shape1) && compound(shape2) && !mesh(shape1) && !mesh(shape2)
 }
 
-/// One contact point of a pair: its manifold and index there, its normal and position on body
+/// One contact point of a pair: its place among the pair's points (the manifolds' points in
+/// order, one list), its normal and position on body
 /// 1 (body 1's frame), its separation, its separation after the step's motion (`reach`, m),
 /// and whether it carried impulse in the last step.
 #[derive(Clone, Copy)]
 struct PatchPoint {
-    manifold: usize,
-    point: usize,
+    index: usize,
     normal: Vector,
     position: Vector,
     dist: Real,
@@ -90,14 +90,14 @@ pub(crate) fn reduce(manifolds: &mut [Manifold], closing: &dyn Fn(Vector, Vector
     }
     let identity = Pose::IDENTITY;
     let mut points: Vec<PatchPoint> = Vec::new();
-    for (m, manifold) in manifolds.iter().enumerate() {
+    for manifold in manifolds.iter() {
         let pose = manifold.subshape_pos1().unwrap_or(&identity);
         let normal = pose.rotation * manifold.local_n1;
+        let start = points.len();
         points.extend(manifold.points.iter().enumerate().map(|(k, point)| {
             let position = pose.transform_point(point.local_p1);
             PatchPoint {
-                manifold: m,
-                point: k,
+                index: start + k,
                 normal,
                 position,
                 dist: point.dist,
@@ -106,14 +106,9 @@ pub(crate) fn reduce(manifolds: &mut [Manifold], closing: &dyn Fn(Vector, Vector
             }
         }));
     }
-    // Deepest first (then by manifold and index: a total order), so that each patch's first
-    // point is its deepest and names its normal.
-    points.sort_by(|a, b| {
-        a.dist
-            .total_cmp(&b.dist)
-            .then(a.manifold.cmp(&b.manifold))
-            .then(a.point.cmp(&b.point))
-    });
+    // Deepest first (then by manifold and index there, the place in the one list: a total
+    // order), so that each patch's first point is its deepest and names its normal.
+    points.sort_by(|a, b| a.dist.total_cmp(&b.dist).then(a.index.cmp(&b.index)));
     // Each point's group: its patch (the index of the patch's first point) and layer.
     let mut patches: Vec<usize> = Vec::new();
     let mut groups: Vec<(usize, u32)> = Vec::with_capacity(points.len());
@@ -136,15 +131,7 @@ pub(crate) fn reduce(manifolds: &mut [Manifold], closing: &dyn Fn(Vector, Vector
         };
         groups.push((patch, layer));
     }
-    // Whether each point stays, all manifolds' in one list: manifold m's from `first[m]`.
-    let first: Vec<usize> = manifolds
-        .iter()
-        .scan(0, |next, m| {
-            let start = *next;
-            *next += m.points.len();
-            Some(start)
-        })
-        .collect();
+    // Whether each point stays, by its place in the one list.
     let mut keep = vec![true; points.len()];
     // The points grouped (a stable sort keeps each group's points deepest first).
     let mut by_group: Vec<usize> = (0..points.len()).collect();
@@ -168,7 +155,7 @@ pub(crate) fn reduce(manifolds: &mut [Manifold], closing: &dyn Fn(Vector, Vector
             points[groups[members[0]].0].normal,
         );
         for (k, &i) in members.iter().enumerate() {
-            keep[first[points[i].manifold] + points[i].point] = chosen.contains(&k);
+            keep[points[i].index] = chosen.contains(&k);
         }
     }
     let mut k = 0;
