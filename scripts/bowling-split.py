@@ -12,7 +12,8 @@ step").
    the 7 and the 10 standing, and how many meet every goal.
 3. ``reroll``: one take of a search directory with a ``roughness`` (degrees) on the pins'
    material and scene seeds 1..N: the ball's line kept, the pins' contacts re-rolled.
-4. ``steps``: the shot with other steps (``dt`` and ``substeps`` pairs, the shot's 2.5 s each):
+4. ``steps``: the shot with other steps (``dt:substeps`` pairs, or ``dt:substeps:split`` with
+   split steps at ``split`` m, the shot's 2.5 s each):
    a random search of N takes for each (search seed 0, so every step size gets the same θ),
    counting the takes that leave the 7, the 10, both, the split itself, and strikes.
 5. ``hit``: the head pin alone, hit by the shot's ball rolled at offsets from its centre line:
@@ -21,14 +22,14 @@ step").
 6. ``pins``: two of the shot's pins alone, without gravity or ground: one flying at 5 m/s
    (upright, or lying along its path) strikes a standing one at offsets from its axis: the
    direction the struck pin moves off in (degrees from the flyer's path) and its speed, 0.3 s
-   on, at several steps.
+   on, at several steps; with ``--trace``, also at every step that changes its velocity.
 
     python3 scripts/bowling-split.py lines
     python3 scripts/bowling-split.py around takes/bowling TAKE_ID --sizes 0.003,0.03,0.1
     python3 scripts/bowling-split.py reroll takes/bowling TAKE_ID --roughness 0.3,1
     python3 scripts/bowling-split.py steps --steps 1/60:20,1/120:10,1/240:5,1/480:3,1/240:20
     python3 scripts/bowling-split.py hit --offsets 0.05,0.1,0.14 --steps 1/60:20,1/240:5,1/960:2
-    python3 scripts/bowling-split.py pins --offsets 0.03,0.06,0.09 --steps 1/60:20,1/240:5,1/960:2
+    python3 scripts/bowling-split.py pins --offsets 0.03,0.06,0.09 --steps 1/60:20,1/240:5,1/960:2 [--trace]
 
 Needs the impulse package; runs on 2 processes. The counts are deterministic (the engine is).
 """
@@ -114,10 +115,12 @@ def main() -> int:
     pins = commands.add_parser("pins")
     pins.add_argument("--offsets", default="0.03,0.06,0.09", help="m, the flyer's x")
     pins.add_argument("--steps", default="1/60:20,1/240:5,1/960:2", help="dt:substeps pairs")
+    pins.add_argument("--trace", action="store_true",
+                      help="also print each step that changes the struck pin's velocity")
     arguments = parser.parse_args()
 
     if arguments.command == "pins":
-        return _pins(arguments.offsets, arguments.steps)
+        return _pins(arguments.offsets, arguments.steps, arguments.trace)
     if arguments.command == "steps":
         return _steps(arguments.steps, arguments.takes)
     if arguments.command == "hit":
@@ -203,7 +206,7 @@ def _hit(offsets: str, pairs: str, split_overlap: float = 0.0) -> int:
     return 0
 
 
-def _pins(offsets: str, pairs: str) -> int:
+def _pins(offsets: str, pairs: str, trace: bool = False) -> int:
     import math
     from fractions import Fraction
 
@@ -229,8 +232,15 @@ def _pins(offsets: str, pairs: str) -> int:
                 world = impulse.World.from_scene(dict(
                     base, bodies=[flyer, struck], dt=dt, gravity=[0, 0, 0],
                     solver={"substeps": substeps}))
-                for _ in range(round(0.3 / dt)):
+                last = None
+                for step in range(round(0.3 / dt)):
                     world.step()
+                    v = world.state()["linear_velocities"][1]
+                    if trace and (last is None or math.dist(v, last) > 1e-3) and any(v):
+                        print(f"  {'lying' if lying else 'upright'} {offset:g} m, dt {dt:.6g} s,"
+                              f" step {step + 1}: {math.degrees(math.atan2(-v[0], -v[2])):.1f}°,"
+                              f" {math.hypot(v[0], v[2]):.2f} m/s")
+                    last = v
                 v = world.state()["linear_velocities"][1]
                 cells.append(f"{math.degrees(math.atan2(-v[0], -v[2])):.1f}°, "
                              f"{math.hypot(v[0], v[2]):.2f} m/s")
@@ -255,9 +265,12 @@ def _steps(pairs: str, takes: int) -> int:
           "(every goal met) | strikes | first split |")
     print("|---|---|---|---|---|---|---|---|---|")
     for pair in pairs.split(","):
-        dt_text, substeps = pair.split(":")
+        dt_text, substeps, *split = pair.split(":")
         dt = float(Fraction(dt_text))
-        scene = dict(base, dt=dt, solver=dict(base.get("solver", {}), substeps=int(substeps)))
+        solver = dict(base.get("solver", {}), substeps=int(substeps))
+        if split:  # split steps at this overlap (m)
+            solver["split_overlap"] = float(split[0])
+        scene = dict(base, dt=dt, solver=solver)
         with tempfile.TemporaryDirectory() as out:
             search(scene, spec["goals"], spec["variation"], budget=takes,
                    steps=round(duration / dt), method="random", seed=0, stop_after=takes + 1,
