@@ -479,25 +479,9 @@ impl SweptReach {
         {
             return false;
         }
-        let options = ShapeCastOptions {
-            max_time_of_impact: self.horizon,
-            target_distance: 0.0,
-            stop_at_penetration: true,
-            compute_impact_geometry_on_penetration: false,
-        };
-        let local_displacement = pair.rotation1.inverse() * self.displacement;
-        let Ok(Some(hit)) = ContactDispatcher::default().cast_shapes(
-            pair.pos12,
-            local_displacement,
-            pair.shape1,
-            pair.shape2,
-            options,
-        ) else {
+        let Some((time_of_impact, local_displacement)) = self.straight_impact(pair) else {
             return false;
         };
-        if hit.time_of_impact <= 0.0 || hit.time_of_impact > self.horizon {
-            return false;
-        }
         // The normal of a ball's contact runs from the other shape's nearest point to the
         // ball's centre, which the projection of the centre gives exactly; the cast's own
         // normal and time, from GJK's last simplex, are not as close (its normal was 7° off at
@@ -510,7 +494,7 @@ impl SweptReach {
                 pair.pos12.rotation,
             )
         };
-        let mut t = hit.time_of_impact;
+        let mut t = time_of_impact;
         let mut contact = None;
         for _ in 0..IMPACT_NEWTON_STEPS {
             let pose = at(t);
@@ -573,6 +557,30 @@ impl SweptReach {
         displacement > AIMED_DISPLACEMENT * radius
     }
 
+    /// When (in steps, in (0, horizon]) the step's straight motion first brings `pair` into
+    /// touch (Parry's cast, target distance 0), with that motion in shape 1's frame; `None`
+    /// for a miss, a pair already touching, or shapes Parry cannot cast.
+    fn straight_impact(&self, pair: PairShapes<'_>) -> Option<(f32, Vec3)> {
+        let options = ShapeCastOptions {
+            max_time_of_impact: self.horizon,
+            target_distance: 0.0,
+            stop_at_penetration: true,
+            compute_impact_geometry_on_penetration: false,
+        };
+        let local_displacement = pair.rotation1.inverse() * self.displacement;
+        let hit = ContactDispatcher::default()
+            .cast_shapes(
+                pair.pos12,
+                local_displacement,
+                pair.shape1,
+                pair.shape2,
+                options,
+            )
+            .ok()??;
+        let t = hit.time_of_impact;
+        (t > 0.0 && t <= self.horizon).then_some((t, local_displacement))
+    }
+
     /// [`Self::aim_at_impact`] for a pair of polyhedra (or other convex shapes but balls) that
     /// [`Self::aims_polyhedra`] picks: the manifold becomes the one the shapes have where the
     /// step's straight motion first brings them into touch (Parry's cast, target distance 0,
@@ -588,27 +596,10 @@ impl SweptReach {
     /// touch, and sent it 23° off its path against 51° at 1/480 s and finer. The cast is
     /// straight, so pairs that turn are left alone (see [`Self::aims_polyhedra`]).
     fn aim_polyhedral_manifold(&self, pair: PairShapes<'_>, manifold: &mut Manifold) -> bool {
-        let options = ShapeCastOptions {
-            max_time_of_impact: self.horizon,
-            target_distance: 0.0,
-            stop_at_penetration: true,
-            compute_impact_geometry_on_penetration: false,
+        let Some((t, local_displacement)) = self.straight_impact(pair) else {
+            return false;
         };
-        let local_displacement = pair.rotation1.inverse() * self.displacement;
         let dispatcher = ContactDispatcher::default();
-        let Ok(Some(hit)) = dispatcher.cast_shapes(
-            pair.pos12,
-            local_displacement,
-            pair.shape1,
-            pair.shape2,
-            options,
-        ) else {
-            return false;
-        };
-        let t = hit.time_of_impact;
-        if t <= 0.0 || t > self.horizon {
-            return false;
-        }
         // Just before the touch, where the nearest points (and so the normal) are well
         // defined: at the touch itself a corner on an edge has a whole cone of normals.
         let length = local_displacement.length();
