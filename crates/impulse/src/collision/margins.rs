@@ -396,7 +396,9 @@ impl SweptReach {
 }
 
 impl SweptReach {
-    /// Aims a fast ball's speculative point at where it will touch: for a ball and a convex
+    /// Aims a fast pair's speculative contacts at where it will touch (a ball's point here; a
+    /// pair of other convex shapes that does not turn, [`Self::aim_polyhedral_manifold`],
+    /// below): for a ball and a convex
     /// shape or a compound's convex part (each of a compound's manifolds on its own part; not
     /// a mesh or height field) apart at the step's start, whose step
     /// moves them more than [`AIMED_DISPLACEMENT`] times the ball's radius (the smaller of two
@@ -405,8 +407,8 @@ impl SweptReach {
     /// target distance 0, up to the horizon), moved by Newton's steps on the exact gap
     /// ([`ball_contact_at`]). Its normal runs from the other shape's nearest point to the
     /// ball's centre, its separation is the start poses' gap between the witnesses along that
-    /// normal, and its solver data (last step's impulses, for warm starting) stays. Whether the
-    /// point was moved.
+    /// normal, and its solver data (last step's impulses, for warm starting) stays. Whether a
+    /// contact was moved.
     ///
     /// Why: a speculative point's normal is that of the shapes' closest points at the step's
     /// start, and the impulse goes along it. For a ball closing by more than its size in a
@@ -418,10 +420,12 @@ impl SweptReach {
     /// GJK's last simplex: its normal was 7° off at a cube's corner, its time 2.4° off in the
     /// normal at another, hence the projection and the Newton steps. Where the normal found is
     /// within [`MIN_AIMED_TURN`] of the closest points' (a ball falling onto a face, a head-on
-    /// hit) the point is kept as it was. Not aimed: polyhedral pairs, whose manifold has
-    /// several points and whose turn within the step the straight cast does not follow (aiming
-    /// a tumbling pin's manifold at one point sank pins past the 5 mm the tumbling-pin tests
-    /// allow), and pairs already touching, which have no time of impact.
+    /// hit) the point is kept as it was. A pair of other convex shapes that does not turn gets
+    /// its whole manifold taken where the cast brings it into touch
+    /// ([`Self::aim_polyhedral_manifold`]). Not aimed: such pairs that turn, whose turn within
+    /// the step the straight cast does not follow (aiming a tumbling pin's manifold at one
+    /// point sank pins past the 5 mm the tumbling-pin tests allow), and pairs already touching,
+    /// which have no time of impact.
     pub(crate) fn aim_at_impact(&self, pair: PairShapes<'_>, manifolds: &mut [Manifold]) -> bool {
         if let [manifold] = manifolds
             && self.aims_polyhedra(pair, manifold)
@@ -546,7 +550,7 @@ impl SweptReach {
             return false;
         }
         let displacement = self.displacement.length();
-        if self.horizon * self.turn_reach > AIMED_MAX_TURN * displacement {
+        if displacement <= 0.0 || self.horizon * self.turn_reach > AIMED_MAX_TURN * displacement {
             return false;
         }
         let radius = pair
