@@ -235,8 +235,10 @@ def _pins(offsets: str, pairs: str, trace: bool = False) -> int:
                 last = None
                 for step in range(round(0.3 / dt)):
                     world.step()
+                    if not trace:
+                        continue
                     v = world.state()["linear_velocities"][1]
-                    if trace and (last is None or math.dist(v, last) > 1e-3) and any(v):
+                    if (last is None or math.dist(v, last) > 1e-3) and any(v):
                         print(f"  {'lying' if lying else 'upright'} {offset:g} m, dt {dt:.6g} s,"
                               f" step {step + 1}: {math.degrees(math.atan2(-v[0], -v[2])):.1f}°,"
                               f" {math.hypot(v[0], v[2]):.2f} m/s")

@@ -323,12 +323,17 @@ fn a_fast_ball_passing_beside_another_leaves_it_at_rest() {
     assert!((energy - 1.0).abs() < 1e-5, "energy {energy}");
 }
 
+/// The worked bowling shot's scene, `scenes/takes/bowling.json`.
+fn bowling_shot() -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/takes/bowling.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    impulse::scene::parse_scene_str(&text, "bowling.json").unwrap()
+}
+
 /// The worked bowling shot's ground, head pin and ball (`scenes/takes/bowling.json`), the ball
 /// moved to `offset` (m) from the pin's centre line, at step `dt` with `substeps`.
 fn head_pin_scene(offset: f32, dt: f32, substeps: u32) -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/takes/bowling.json");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let mut scene = impulse::scene::parse_scene_str(&text, "bowling.json").unwrap();
+    let mut scene = bowling_shot();
     scene.bodies.retain(|body| {
         matches!(
             body.name.as_deref(),
@@ -396,9 +401,7 @@ fn a_pin_struck_off_centre_at_the_frame_rate_leaves_as_at_a_fine_step() {
 /// step `dt` with `substeps` (as `scripts/bowling-split.py pins` sets them); the struck pin's
 /// direction (degrees from the flyer's path) 0.3 s later.
 fn pin_on_pin(offset: f32, dt: f32, substeps: u32) -> f32 {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/takes/bowling.json");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let mut scene = impulse::scene::parse_scene_str(&text, "bowling.json").unwrap();
+    let mut scene = bowling_shot();
     let pin = scene
         .bodies
         .iter()
