@@ -95,6 +95,9 @@ pub struct Summary {
     /// Steps taken again in pieces because their try left moving bodies crossed
     /// (`split_overlap`, docs/method.md "Split steps"); 0 when it is off.
     pub split_steps: u64,
+    /// Steps taken in several collision steps because two dynamic bodies moved far against
+    /// their thickness (`collision_steps`, docs/method.md "Collision steps").
+    pub collision_stepped: u64,
     /// Largest natural-map residual of any step's contact LCP at exit.
     pub max_natural_map_residual: f32,
     /// Natural-map residual of the last step.
@@ -140,7 +143,7 @@ impl Summary {
             "{}: {} bodies, {} steps of {:.4} s, mean contacts {:.0}, {:.3} ms/step ({:.0} steps/s), \
              max overlap {:.2} mm, {sink_and_drift}, kinetic \
              energy {:.4} J, max speed {:.2} m/s, mean iterations {:.1}, LCP residual max {:.2e} \
-             last {:.2e}{}",
+             last {:.2e}{}{}",
             self.scene,
             self.bodies,
             self.steps,
@@ -156,6 +159,11 @@ impl Summary {
             self.final_natural_map_residual,
             if self.split_steps > 0 {
                 format!(", split steps {}", self.split_steps)
+            } else {
+                String::new()
+            },
+            if self.collision_stepped > 0 {
+                format!(", steps in collision steps {}", self.collision_stepped)
             } else {
                 String::new()
             },
@@ -527,7 +535,7 @@ fn simulate(
     let mut profiles: Vec<StepProfile> = Vec::with_capacity(reserve);
     let mut contacts_sum = 0u64;
     let mut iterations_sum = 0u64;
-    let mut split_steps = 0u64;
+    let (mut split_steps, mut collision_stepped) = (0u64, 0u64);
     let mut max_residual = 0.0f32;
     let mut max_speed = 0.0f32;
     let mut max_overlap = metrics::max_overlap(&world, world.poses());
@@ -621,7 +629,8 @@ fn simulate(
         }
         contacts_sum += diagnostics.contacts as u64;
         iterations_sum += diagnostics.iterations as u64;
-        split_steps += u64::from(diagnostics.pieces > 1);
+        split_steps += u64::from(diagnostics.pieces > diagnostics.collision_steps);
+        collision_stepped += u64::from(diagnostics.collision_steps > 1);
         max_residual = max_residual.max(diagnostics.natural_map_residual);
         for v in world.linear_velocities() {
             max_speed = max_speed.max(v.length());
@@ -700,6 +709,7 @@ fn simulate(
         mean_contacts: contacts_sum as f64 / taken,
         mean_iterations: iterations_sum as f64 / taken,
         split_steps,
+        collision_stepped,
         max_natural_map_residual: max_residual,
         final_natural_map_residual: world.diagnostics().natural_map_residual,
         iterations_limit: settings.solve.iterations,

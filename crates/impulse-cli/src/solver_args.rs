@@ -77,6 +77,11 @@ pub struct SolverArgs {
     /// rises again at 7-9 % of its impact speed; see `SolveSettings::impact_sweeps`).
     #[arg(long)]
     pub impact_sweeps: Option<u32>,
+    /// At most this many collision steps a step, each finding contacts again, where two
+    /// dynamic bodies move farther than their thickness within it (1 = off; see
+    /// `ContactSettings::collision_steps`).
+    #[arg(long)]
+    pub collision_steps: Option<u32>,
     /// Method of every island's solve: `pgs` (projected Gauss-Seidel), `nncg` (nonsmooth
     /// nonlinear conjugate gradient), `apgd` (accelerated projected gradient descent) or `auto`
     /// (NNCG escalating per island to more iterations or the exact path).
@@ -170,6 +175,7 @@ impl SolverArgs {
         set(&mut s.solve.substeps, self.substeps);
         set(&mut s.solve.relax_iterations, self.relax);
         set(&mut s.solve.impact_sweeps, self.impact_sweeps);
+        set(&mut s.contact.collision_steps, self.collision_steps);
         if let Some(fraction) = self.warm_start {
             s.solve.warm_start = fraction;
         }

@@ -229,6 +229,13 @@ impl Settings {
         self.field(py, "split_overlap")
     }
 
+    /// At most how many collision steps (each with its own contacts) a step is taken in where
+    /// two dynamic bodies move farther than their thickness within it; 1 is off.
+    #[getter]
+    fn collision_steps<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.field(py, "collision_steps")
+    }
+
     /// How far (m) the bodies of a pair of flat shapes may move relative to each other before
     /// its contacts are found again (until then its points are kept, their separations
     /// updated): 0.001 by default, 0.02 in the `fast` preset; 0 finds them every step.

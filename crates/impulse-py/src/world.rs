@@ -362,9 +362,10 @@ impl World {
     /// a dict with `step`, `contact_pairs`, `contacts`, `rows`, `iterations`,
     /// `natural_map_residual` (how well the step's LCP was solved; N·s and m/s mixed, as in
     /// the LCP), `islands` (per island: method, iterations, residual…), `max_depth` (m),
-    /// `kinetic_energy` (J), `linear_momentum` (kg·m/s), `pieces` (1, or 2 to 4 when the step
-    /// was split: `Settings.split_overlap`), whose repr is a one-line summary. All zero before
-    /// the first step.
+    /// `kinetic_energy` (J), `linear_momentum` (kg·m/s), `collision_steps` (1, or more when
+    /// two dynamic bodies moved far against their thickness: `Settings.collision_steps`),
+    /// `pieces` (the collision steps, each split in up to four halves: `Settings.split_overlap`),
+    /// whose repr is a one-line summary. All zero before the first step.
     #[getter]
     fn diagnostics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let diagnostics = self.world(py)?.diagnostics().clone();

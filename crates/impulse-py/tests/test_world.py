@@ -339,3 +339,34 @@ def test_split_steps_are_a_setting_and_report_their_pieces():
     world.step(3)
     assert world.diagnostics["step"] == 3
     assert world.diagnostics["pieces"] == 1
+
+
+def test_collision_steps_are_a_setting_and_reported():
+    # At most how many collision steps a step takes is a field of the settings, off (1) by
+    # default and refused at 0; two balls closing at 30 m/s (50 cm a step, five radii) take
+    # their step in four, one step from outside, their momentum kept.
+    assert impulse.Settings().collision_steps == 1
+    with pytest.raises(ValueError, match="collision_steps"):
+        impulse.Settings().replace(collision_steps=0)
+    elastic = {"friction": 0.0, "restitution": 1.0, "density": 1000.0}
+    scene = {
+        "gravity": [0.0, 0.0, 0.0],
+        "dt": 1.0 / 60.0,
+        "materials": {"elastic": elastic},
+        "solver": {"collision_steps": 4},
+        "bodies": [
+            {"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.1}, "position": [-0.6, 0.0, 0.0],
+             "linear_velocity": [30.0, 0.0, 0.0], "material": "elastic"},
+            {"kind": "dynamic", "shape": {"type": "sphere", "radius": 0.1}, "position": [0.0, 0.0, 0.0],
+             "material": "elastic"},
+        ],
+    }
+    world = impulse.World.from_scene(scene)
+    assert world.settings.collision_steps == 4
+    world.step(2)
+    assert world.diagnostics["step"] == 2
+    assert world.diagnostics["collision_steps"] == 4
+    assert world.diagnostics["pieces"] == 4
+    velocities = world.state()["linear_velocities"]
+    assert velocities[1][0] > 1.0
+    assert abs(velocities[0][0] + velocities[1][0] - 30.0) < 0.03

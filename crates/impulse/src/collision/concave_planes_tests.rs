@@ -59,6 +59,7 @@ fn points(valley: bool, mesh_first: bool) -> (Vec<Listed>, Vec<Listed>) {
         turn_reach: 0.0,
         turn_bound: 0.0,
         horizon: 1.05,
+        collision_steps: 1.0,
     };
     let mut manifolds: Vec<Manifold> = Vec::new();
     let mut workspace = None;

@@ -46,6 +46,8 @@ pub struct SpeculativeMargins {
     gravity: Vec3,
     /// Substeps per step (0: not set, taken as 1).
     substeps: u32,
+    /// The collision steps the step is taken in (0: not set, taken as 1).
+    collision_steps: u32,
 }
 
 impl SpeculativeMargins {
@@ -114,6 +116,14 @@ impl SpeculativeMargins {
         self.substeps = substeps;
     }
 
+    /// Sets how many collision steps the step is taken in, this one among them
+    /// ([`crate::settings::ContactSettings::collision_steps`]): a pair is aimed where its
+    /// motion over the whole step is large against its size ([`SweptReach::collision_steps`]);
+    /// 1 until set.
+    pub fn set_collision_steps(&mut self, collision_steps: u32) {
+        self.collision_steps = collision_steps;
+    }
+
     /// Per-body margins (m), indexed like the bodies.
     pub fn margins(&self) -> &[f32] {
         &self.margins
@@ -141,6 +151,7 @@ impl SpeculativeMargins {
             turn_reach: (self.spin_speeds[a].0 + self.spin_speeds[b].0) * self.dt,
             turn_bound: (self.spin_speeds[a].1 + self.spin_speeds[b].1) * self.dt,
             horizon: 1.0 + 1.0 / self.substeps.max(1) as f32,
+            collision_steps: self.collision_steps.max(1) as f32,
         }
     }
 
@@ -294,6 +305,10 @@ pub(crate) struct SweptReach {
     /// velocity the step ends with (a 2 cm ball passing 6 mm from a wall's corner, whose
     /// plane it would have crossed 3 cm after the step, was turned, then bounced back).
     pub horizon: f32,
+    /// How many collision steps the step is taken in, this one among them (≥ 1): a pair whose
+    /// motion over the whole step, this many times its displacement, is large against its
+    /// size is aimed in each collision step, as it would be in an unsplit step.
+    pub collision_steps: f32,
 }
 
 /// A pair's two shapes where the narrow phase finds their contacts: body 2 at `pos12` in body
@@ -479,7 +494,7 @@ impl SweptReach {
             _ => return false,
         };
         if !lone_speculative_point(manifold)
-            || self.displacement.length() <= AIMED_DISPLACEMENT * radius
+            || self.displacement.length() * self.collision_steps <= AIMED_DISPLACEMENT * radius
         {
             return false;
         }
@@ -558,7 +573,7 @@ impl SweptReach {
             .compute_local_bounding_sphere()
             .radius
             .min(pair.shape2.compute_local_bounding_sphere().radius);
-        displacement > AIMED_DISPLACEMENT * radius
+        displacement * self.collision_steps > AIMED_DISPLACEMENT * radius
     }
 
     /// When (in steps, in (0, horizon]) the step's straight motion first brings `pair` into

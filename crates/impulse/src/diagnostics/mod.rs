@@ -43,14 +43,20 @@ pub struct StepDiagnostics {
     pub kinetic_energy: f32,
     /// Total linear momentum of moving bodies after the step (kg·m/s).
     pub linear_momentum: [f32; 3],
-    /// The pieces the step was taken in: 1, or 2 to 4 when its first try left bodies crossed
-    /// and it was taken again in halves ([`crate::settings::ContactSettings::split_overlap`]).
-    /// The other fields are the last piece's.
+    /// The pieces the step was taken in: its [`Self::collision_steps`], each taken again in
+    /// halves where its first try left bodies crossed
+    /// ([`crate::settings::ContactSettings::split_overlap`]), up to four halves each. The
+    /// other fields are the last piece's.
     #[serde(default = "one_piece")]
     pub pieces: u32,
+    /// The collision steps the step was taken in: 1, or more where two dynamic bodies moved
+    /// far against their thickness ([`crate::settings::ContactSettings::collision_steps`]).
+    #[serde(default = "one_piece")]
+    pub collision_steps: u32,
 }
 
-/// A step in one piece: [`StepDiagnostics::pieces`] of a snapshot written before it was kept.
+/// A step in one piece: [`StepDiagnostics::pieces`] and [`StepDiagnostics::collision_steps`]
+/// of a snapshot written before they were kept.
 fn one_piece() -> u32 {
     1
 }

@@ -519,7 +519,7 @@ fn flat_keys_read_into_their_groups_and_write_back_flat() {
     };
     let expected = "method substeps iterations relax_iterations impact_sweeps tolerance escalation_tolerance \
         escalation_iterations mass_ratio_threshold exact_max_contacts heavy_on_light_mass_ratio \
-        restitution_threshold repair overlap_slop max_repair_speed warm_start prediction_distance split_overlap recycle_distance \
+        restitution_threshold repair overlap_slop max_repair_speed warm_start prediction_distance split_overlap collision_steps recycle_distance \
         sleep sleep_linear_speed sleep_angular_speed time_to_sleep friction friction_in_main_solve \
         direct_joint_solve parallel_island_contacts simd_island_contacts fused_multiply_add \
         gyroscopic continuous impact friction_combine restitution_combine max_distance \

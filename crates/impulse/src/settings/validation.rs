@@ -26,7 +26,8 @@ impl SolverSettings {
     /// The one check of solver settings: the scene loader reports each problem at its place in
     /// the file; [`crate::World::new`], [`crate::World::set_settings`] and the snapshot loader
     /// the first one (the step trusts settings that came through them). Counts
-    /// (`iterations`, `substeps`, split impulse's `repair.iterations`, `escalation_iterations`)
+    /// (`iterations`, `substeps`, split impulse's `repair.iterations`, `escalation_iterations`,
+    /// `collision_steps`)
     /// must be ≥ 1 and ≤ [`Self::MAX_COUNT`] (`relax_iterations` and `impact_sweeps` ≤ it, 0 allowed); a soft repair's `hertz` > 0;
     /// tolerances, thresholds, rates, speeds, distances, frequencies and times finite and ≥ 0;
     /// `warm_start` in [0, 1].
@@ -43,6 +44,7 @@ impl SolverSettings {
             ("substeps", self.solve.substeps),
             ("repair.iterations", position_iterations),
             ("escalation_iterations", escalation_iterations),
+            ("collision_steps", self.contact.collision_steps),
         ];
         for (field, value) in counts {
             if value == 0 {

@@ -298,17 +298,24 @@ fn forty_cards(seed: u64, settings: SolverSettings) -> (f32, usize, f32) {
     (deepest, crossed.len(), at_end)
 }
 
-/// The forty cards of [`forty_cards`] at seeds 0–4: the default and Precise presets, and the
-/// default with split steps at 1 mm (prints).
+/// The forty cards of [`forty_cards`] at seeds 0–4: the default and Precise presets, the
+/// default with split steps at 1 mm, and with at most four and eight collision steps a step
+/// (prints).
 #[test]
 #[ignore = "measurement; run with --ignored --nocapture"]
 fn forty_cards_into_a_box() {
     let mut split = SolverSettings::default();
     split.contact.split_overlap = 1e-3;
+    let mut stepped = SolverSettings::default();
+    stepped.contact.collision_steps = 4;
+    let mut finer = stepped.clone();
+    finer.contact.collision_steps = 8;
     for (name, settings) in [
         ("default", SolverSettings::default()),
         ("precise", SolverSettings::precise()),
         ("split_overlap 1 mm", split),
+        ("collision_steps 4", stepped),
+        ("collision_steps 8", finer),
     ] {
         for seed in 0..5 {
             let (deepest, crossed, at_end) = forty_cards(seed, settings.clone());

@@ -9,6 +9,7 @@ mod blow_up;
 mod body_options;
 mod cards_on_meshes;
 mod ccd;
+mod collision_steps;
 mod common;
 mod concave;
 mod curved_meshes;

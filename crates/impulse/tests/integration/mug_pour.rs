@@ -48,7 +48,11 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
         scene.solver.contact.split_overlap =
             split.parse().expect("IMPULSE_MUG_SPLIT_OVERLAP: metres");
     }
-    let (mut split_steps, mut pieces) = (0usize, 0usize);
+    // `IMPULSE_MUG_COLLISION_STEPS` allows that many collision steps a step
+    // (`ContactSettings::collision_steps`).
+    let collision_steps = from_env("IMPULSE_MUG_COLLISION_STEPS", 1);
+    scene.solver.contact.collision_steps = collision_steps as u32;
+    let (mut split_steps, mut pieces, mut collision_stepped) = (0usize, 0usize, 0usize);
     let steps = from_env("IMPULSE_MUG_STEPS", scene.steps as usize);
     let mut world = World::from_scene(&scene).unwrap();
     let (mut largest, mut largest_step) = (0.0f32, 0);
@@ -133,6 +137,7 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
             split_steps += 1;
             pieces += diagnostics.pieces as usize;
         }
+        collision_stepped += usize::from(diagnostics.collision_steps > 1);
         if step % 10 == 0 || step == steps {
             let most = world
                 .contact_pairs()
@@ -172,7 +177,7 @@ fn the_mug_pour_keeps_every_overlap_under_5_mm() {
     println!(
         "{mugs} mugs, {steps} steps: {:.3} s a step on average, {:.1} s in all, {:.0} points a \
          step on average, largest overlap {:.2} mm (step {largest_step}); {split_steps} steps \
-         split, into {pieces} pieces",
+         in pieces, {pieces} pieces in all ({collision_stepped} in collision steps)",
         total_s / steps as f64,
         total_s,
         contacts_sum as f64 / steps as f64,

@@ -10,7 +10,7 @@ use impulse::{BodyDesc, BodyKind, ShapeDesc, SolverSettings, World};
 use super::common::{hash_state, material, sphere_pile, static_box};
 
 /// A stack of ten unit cubes set down touching on a static slab, with `settings`.
-fn stack(settings: SolverSettings) -> World {
+pub(super) fn stack(settings: SolverSettings) -> World {
     let mut world = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
     let slab = static_box(Vec3::new(5.0, 0.5, 5.0), Vec3::new(0.0, -0.5, 0.0));
     world.add_body(&slab, &material(0.6)).unwrap();

@@ -62,4 +62,7 @@ pub(crate) struct StepContext {
     /// Written by `Continuous`: every body's pose before its clamps (empty when continuous
     /// collision is off), what the energy check credits a clamp with.
     pub(crate) unclamped_poses: Vec<Pose>,
+    /// The collision steps' scratch (`split.rs`), before the stages: per body, its thickness
+    /// and farthest point from its centre of mass (m), once found this step.
+    pub(crate) body_extents: Vec<Option<(f32, f32)>>,
 }

@@ -72,6 +72,7 @@ impl World {
             kinetic_energy: energy.kinetic as f32,
             linear_momentum: energy.momentum.to_array(),
             pieces: 1,
+            collision_steps: 1,
         };
         energy
     }

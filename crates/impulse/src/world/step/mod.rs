@@ -27,7 +27,8 @@
 //! manifolds for the next warm start; sleep, energy, momentum and the diagnostics; contact
 //! events, the end of the step's forces, the energy and blow-up check and the bodies that left
 //! the world. With `split_overlap` on, `split.rs` runs the stages: a step that leaves moving
-//! bodies crossed is undone and taken again in halves. The state the world keeps for the step's concerns lives in files that do not
+//! bodies crossed is undone and taken again in halves; with `collision_steps` above one, a step
+//! in which two dynamic bodies move far against their thickness is taken in collision steps. The state the world keeps for the step's concerns lives in files that do not
 //! reach back into the world (`energy.rs`, `kinematic_script.rs`), so that files import one
 //! way. Every thread decision goes through [`crate::parallel`].
 
@@ -100,7 +101,11 @@ impl World {
     /// that caused it was written. With
     /// [`crate::settings::ContactSettings::split_overlap`] above zero, a step whose try leaves
     /// moving bodies crossed by more is taken again in halves (at most four pieces, one step
-    /// for the step count, the time and the events; docs/method.md, "Split steps").
+    /// for the step count, the time and the events; docs/method.md, "Split steps"). With
+    /// [`crate::settings::ContactSettings::collision_steps`] above one, a step in which a pair
+    /// of dynamic bodies would move by more than its thinner body's thickness is taken in
+    /// equal collision steps, each finding its contacts again (docs/method.md, "Collision
+    /// steps"); it too is one step from outside.
     ///
     /// Threads: with [`World::parallel`] on, the step spreads its work over rayon's current
     /// pool. Called from a thread outside any pool (a program's main thread), the whole step

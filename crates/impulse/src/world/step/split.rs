@@ -19,7 +19,13 @@
 //! previous step's warm start: left with the try's impulses, found over a whole step, each
 //! half's substeps took twice their share and the pour's solves ran to their caps.
 //!
+//! Collision steps ([`ContactSettings::collision_steps`]) are decided before the step runs:
+//! where a contact pair of two dynamic bodies would move by more than its thinner body's
+//! thickness within it, the step is taken as that many equal collision steps, each with its
+//! own contacts and a share of the substeps, and each split further as above.
+//!
 //! [`ContactSettings::split_overlap`]: crate::settings::ContactSettings::split_overlap
+//! [`ContactSettings::collision_steps`]: crate::settings::ContactSettings::collision_steps
 
 use glam::Vec3;
 use parry3d::math::Pose;
@@ -35,7 +41,7 @@ use crate::collision::narrow_phase::ContactPair;
 use crate::collision::overlap::PairDepths;
 use crate::error::StepError;
 use crate::joint::{JointEvent, Joints};
-use crate::settings::MAX_STEP_SPLITS;
+use crate::settings::{COLLISION_STEP_REACH, MAX_STEP_SPLITS};
 use crate::world::contact_events::{ContactEvent, ContactEvents};
 
 /// What a try of a step changes that its contacts do not depend on, as the try found it.
@@ -92,12 +98,16 @@ impl World {
     /// unsplit step.
     pub(super) fn run_split_stages(&mut self, context: &mut StepContext) -> Result<(), StepError> {
         let limit = self.settings.contact.split_overlap;
-        if limit <= 0.0 {
+        let collision_steps = self.collision_steps_needed(&mut context.body_extents);
+        context.margins.set_collision_steps(collision_steps);
+        if limit <= 0.0 && collision_steps == 1 {
+            self.diagnostics.collision_steps = 1;
             return self.run_stages(context);
         }
-        let (dt, step_count) = (self.dt, self.step_count);
+        let (dt, step_count, substeps) = (self.dt, self.step_count, self.settings.solve.substeps);
         let mut events = PieceEvents::default();
-        let pieces = self.run_piece(context, limit, MAX_STEP_SPLITS, &mut events);
+        let pieces = self.run_collision_steps(context, limit, collision_steps, &mut events);
+        self.settings.solve.substeps = substeps;
         self.dt = dt;
         self.step_count = step_count + 1;
         self.contact_events.events = events.contact;
@@ -105,7 +115,103 @@ impl World {
         self.left_world = events.left_world;
         self.diagnostics.step = self.step_count;
         self.diagnostics.pieces = pieces?;
+        self.diagnostics.collision_steps = collision_steps;
         Ok(())
+    }
+
+    /// The step as `steps` equal collision steps, each with the step's substeps shared out
+    /// (rounded up) and each split further where it leaves bodies crossed (`limit` > 0).
+    /// Returns how many pieces were taken. The caller puts back dt, the substeps and the step
+    /// count.
+    fn run_collision_steps(
+        &mut self,
+        context: &mut StepContext,
+        limit: f32,
+        steps: u32,
+        events: &mut PieceEvents,
+    ) -> Result<u32, StepError> {
+        let step_count = self.step_count;
+        let splits = if limit > 0.0 { MAX_STEP_SPLITS } else { 0 };
+        // A force is for the whole step: every collision step pushes with it.
+        let forces = (steps > 1 && self.forces_pending).then(|| {
+            let b = &self.bodies;
+            (b.force.clone(), b.torque.clone())
+        });
+        self.dt /= steps as f32;
+        self.settings.solve.substeps = self.settings.solve.substeps.div_ceil(steps);
+        let mut pieces = 0;
+        for k in 0..steps {
+            if let Some((force, torque)) = forces.as_ref().filter(|_| k > 0) {
+                self.bodies.force.clone_from(force);
+                self.bodies.torque.clone_from(torque);
+                self.forces_pending = true;
+            }
+            self.step_count = step_count;
+            pieces += self.run_piece(context, limit, splits, events)?;
+        }
+        Ok(pieces)
+    }
+
+    /// How many collision steps this step needs ([`ContactSettings::collision_steps`] at
+    /// most): the fewest, a power of two (so that the substeps share out evenly), in which no
+    /// contact pair of two dynamic bodies, one of them awake, moves against itself by more
+    /// than [`COLLISION_STEP_REACH`] times the thinner body's thickness (its local bounding box's smallest half extent). A pair's motion within the
+    /// step is bounded from the velocities at its start, in the frame of one body: the other's
+    /// centre of mass moves in it at u = v₂ − v₁ − ω₁ × (c₂ − c₁), its points by at most
+    /// (|u| + |ω₂ − ω₁|·ρ₂)·dt, ρ₂ its farthest point from the centre of mass; the smaller of
+    /// the two frames' bounds counts. Two bodies that move as one (a jointed chain swinging)
+    /// move little against each other. Pairs with a static or kinematic body are left to the
+    /// aimed contacts and the motion clamp: their other body is the only one that moves.
+    ///
+    /// [`ContactSettings::collision_steps`]: crate::settings::ContactSettings::collision_steps
+    fn collision_steps_needed(&self, extents: &mut Vec<Option<(f32, f32)>>) -> u32 {
+        let most = self.settings.contact.collision_steps;
+        if most <= 1 {
+            return 1;
+        }
+        let b = &self.bodies;
+        // Per body, once: (thickness, farthest point from the centre of mass), both m.
+        extents.clear();
+        extents.resize(b.len(), None);
+        let mut extent = |i: usize| {
+            *extents[i].get_or_insert_with(|| {
+                let aabb = b.shape[i].compute_local_aabb();
+                let half = aabb.half_extents();
+                let offset = aabb.center() - b.local_center_of_mass[i];
+                (half.min_element(), offset.length() + half.length())
+            })
+        };
+        let mut needed = 1.0f32;
+        for pair in &self.narrow_phase.pairs {
+            let (i, j) = (pair.body1 as usize, pair.body2 as usize);
+            if !b.is_dynamic(i) || !b.is_dynamic(j) || (b.asleep[i] && b.asleep[j]) {
+                continue;
+            }
+            let ((thickness_i, farthest_i), (thickness_j, farthest_j)) = (extent(i), extent(j));
+            let (center_i, center_j) = (b.center_of_mass(i), b.center_of_mass(j));
+            let (omega_i, omega_j) = (b.angular_velocity[i], b.angular_velocity[j]);
+            let turn = (omega_j - omega_i).length();
+            let j_in_i =
+                b.linear_velocity[j] - b.linear_velocity[i] - omega_i.cross(center_j - center_i);
+            let i_in_j =
+                b.linear_velocity[i] - b.linear_velocity[j] - omega_j.cross(center_i - center_j);
+            let speed =
+                (j_in_i.length() + turn * farthest_j).min(i_in_j.length() + turn * farthest_i);
+            let allowed = COLLISION_STEP_REACH * thickness_i.min(thickness_j);
+            let motion = speed * self.dt;
+            if motion > needed * allowed {
+                needed = if allowed > 0.0 {
+                    motion / allowed
+                } else {
+                    f32::INFINITY
+                };
+            }
+        }
+        if needed >= most as f32 {
+            most
+        } else {
+            (needed.ceil() as u32).next_power_of_two().min(most)
+        }
     }
 
     /// One piece of the step, over `self.dt`, tried once and, if it left bodies crossed and
