@@ -71,6 +71,16 @@ class ImpulseBakeSettings(bpy.types.PropertyGroup):
         subtype="DISTANCE",
         unit="LENGTH",
     )
+    collision_steps: bpy.props.IntProperty(
+        name="Collision Steps",
+        description=(
+            "At most this many collision steps a step, each finding contacts again, where two objects move "
+            "farther than their thickness against each other within it; 1 is off. Fast or thin objects at one step a frame"
+        ),
+        default=1,
+        min=1,
+        soft_max=8,
+    )
 
 
 def _bake_report(baker, cancelled):
@@ -110,6 +120,7 @@ class IMPULSE_OT_bake(bpy.types.Operator):
                 settings.materials,
                 settings.mesh_resolution,
                 settings.split_overlap,
+                settings.collision_steps,
             )
         except scene_reader.UnsupportedScene as error:
             self.report({"ERROR"}, "impulse: not baked (the earlier bake is kept): " + "; ".join(error.problems))
@@ -211,6 +222,7 @@ def _draw(layout, context):
     column.prop(settings, "substeps")
     column.prop(settings, "steps_per_frame")
     column.prop(settings, "split_overlap")
+    column.prop(settings, "collision_steps")
     row = column.row()
     row.operator(IMPULSE_OT_bake.bl_idname, icon="PHYSICS")
     row.operator(IMPULSE_OT_free_bake.bl_idname, icon="TRASH")

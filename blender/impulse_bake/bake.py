@@ -95,19 +95,24 @@ def solver_settings(preset="default", substeps=0, dt=PRESET_STEP):
     return settings.replace(substeps=count)
 
 
-def make_world(scene_dict, preset="default", substeps=0, frame_steps=0, split_overlap=0.0):
+def make_world(scene_dict, preset="default", substeps=0, frame_steps=0, split_overlap=0.0, collision_steps=1):
     """The impulse world of a scene dict (what :func:`scene_reader.read_scene` gives, its
     ``dt`` one frame) stepping :func:`steps_per_frame` times a frame, with the preset's solver
     settings at that step; returns (world, steps per frame). The scene's own ``sleep`` and
     ``gyroscopic`` stay (the defaults). ``split_overlap`` (m, 0 off): a step that leaves two
     moving objects overlapping by more is taken again in halves with contacts found again
-    (impulse's ``Settings.split_overlap``, a setting of the scene, which presets keep)."""
+    (impulse's ``Settings.split_overlap``, a setting of the scene, which presets keep).
+    ``collision_steps`` (1 off): at most this many collision steps a step, each finding contacts
+    again, where two objects move farther than their thickness against each other within it
+    (impulse's ``Settings.collision_steps``, likewise the scene's)."""
     impulse = import_impulse()
     count = steps_per_frame(scene_dict["dt"], frame_steps)
     scene_dict = dict(scene_dict, dt=scene_dict["dt"] / count, steps=scene_dict.get("steps", 0) * count)
     settings = solver_settings(preset, substeps, scene_dict["dt"])
     if split_overlap > 0:
         scene_dict["solver"] = dict(scene_dict.get("solver", {}), split_overlap=float(split_overlap))
+    if collision_steps != 1:
+        scene_dict["solver"] = dict(scene_dict.get("solver", {}), collision_steps=int(collision_steps))
     return impulse.World.from_scene(scene_dict, settings=settings), count
 
 
@@ -159,11 +164,19 @@ class Baker:
     the scene in the animator's terms, when the scene cannot be represented. ``materials``:
     one of :data:`scene_reader.MATERIAL_RULES`; ``resolution``: a moving Mesh's decomposition
     resolution, 0 the engine's default (:func:`shapes.build`); ``split_overlap`` (m, 0 off): split
-    steps (:func:`make_world`).
+    steps; ``collision_steps`` (1 off): collision steps (:func:`make_world`).
     """
 
     def __init__(
-        self, scene, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0, split_overlap=0.0
+        self,
+        scene,
+        preset="default",
+        substeps=0,
+        frame_steps=0,
+        materials="blender",
+        resolution=0,
+        split_overlap=0.0,
+        collision_steps=1,
     ):
         self.scene = scene
         self.info = scene_reader.read_scene(scene, materials=materials, resolution=resolution)
@@ -173,14 +186,14 @@ class Baker:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", UserWarning)
                 self.world, self.frame_steps = make_world(
-                    self.info.scene, preset, substeps, frame_steps, split_overlap
+                    self.info.scene, preset, substeps, frame_steps, split_overlap, collision_steps
                 )
             # The engine's notes (none for what the reader writes today) in the panel's terms.
             self.info.notes += [messages.translate(str(w.message), self.info) for w in caught]
         except impulse.SceneError as error:
 
             def build(scene_dict):
-                make_world(scene_dict, preset, substeps, frame_steps, split_overlap)
+                make_world(scene_dict, preset, substeps, frame_steps, split_overlap, collision_steps)
 
             raise scene_reader.UnsupportedScene(messages.every_problem(self.info, error, build)) from error
         bodies = self.info.bodies
@@ -364,10 +377,12 @@ def _object_space(info, locations, quaternions):
     return out_locations, axes.continuous_quaternions(out_quaternions[:, None])[:, 0]
 
 
-def bake_scene(scene, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0, split_overlap=0.0):
+def bake_scene(
+    scene, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0, split_overlap=0.0, collision_steps=1
+):
     """Bake the scene's Rigid Body World with impulse at once; returns the :class:`Baker`
     (its ``simulation_seconds`` and ``write_seconds`` are the two parts' wall times)."""
-    baker = Baker(scene, preset, substeps, frame_steps, materials, resolution, split_overlap)
+    baker = Baker(scene, preset, substeps, frame_steps, materials, resolution, split_overlap, collision_steps)
     baker.advance()
     baker.write()
     return baker
