@@ -82,6 +82,26 @@ impl StepStart {
     }
 }
 
+/// The forces and torques applied for a step (N, N·m, per body), kept when they are pending so
+/// that every piece of the step pushes with them: a piece's end clears them.
+struct StepForces(Option<(Vec<Vec3>, Vec<Vec3>)>);
+
+impl StepForces {
+    /// `bodies`' forces and torques when `pending`, else nothing to put back.
+    fn take(bodies: &Bodies, pending: bool) -> Self {
+        Self(pending.then(|| (bodies.force.clone(), bodies.torque.clone())))
+    }
+
+    /// Puts them back on `world` for its next piece.
+    fn push_again(&self, world: &mut World) {
+        if let Some((force, torque)) = &self.0 {
+            world.bodies.force.clone_from(force);
+            world.bodies.torque.clone_from(torque);
+            world.forces_pending = true;
+        }
+    }
+}
+
 /// The events of the pieces taken so far, in order.
 #[derive(Default)]
 struct PieceEvents {
@@ -101,7 +121,6 @@ impl World {
         let collision_steps = self.collision_steps_needed(&mut context.body_extents);
         context.margins.set_collision_steps(collision_steps);
         if limit <= 0.0 && collision_steps == 1 {
-            self.diagnostics.collision_steps = 1;
             return self.run_stages(context);
         }
         let (dt, step_count, substeps) = (self.dt, self.step_count, self.settings.solve.substeps);
@@ -133,18 +152,13 @@ impl World {
         let step_count = self.step_count;
         let splits = if limit > 0.0 { MAX_STEP_SPLITS } else { 0 };
         // A force is for the whole step: every collision step pushes with it.
-        let forces = (steps > 1 && self.forces_pending).then(|| {
-            let b = &self.bodies;
-            (b.force.clone(), b.torque.clone())
-        });
+        let forces = StepForces::take(&self.bodies, steps > 1 && self.forces_pending);
         self.dt /= steps as f32;
         self.settings.solve.substeps = self.settings.solve.substeps.div_ceil(steps);
         let mut pieces = 0;
         for k in 0..steps {
-            if let Some((force, torque)) = forces.as_ref().filter(|_| k > 0) {
-                self.bodies.force.clone_from(force);
-                self.bodies.torque.clone_from(torque);
-                self.forces_pending = true;
+            if k > 0 {
+                forces.push_again(self);
             }
             self.step_count = step_count;
             pieces += self.run_piece(context, limit, splits, events)?;
@@ -236,20 +250,13 @@ impl World {
             return Ok(1);
         };
         // A force is for the whole step: both halves push with it.
-        let forces = start.forces_pending.then(|| {
-            let b = &start.bodies;
-            (b.force.clone(), b.torque.clone())
-        });
+        let forces = StepForces::take(&start.bodies, start.forces_pending);
         start.restore(self);
         self.step_count = step_count;
         let dt = self.dt;
         self.dt = 0.5 * dt;
         let first = self.run_piece(context, limit, splits - 1, events)?;
-        if let Some((force, torque)) = forces {
-            self.bodies.force = force;
-            self.bodies.torque = torque;
-            self.forces_pending = true;
-        }
+        forces.push_again(self);
         self.step_count = step_count;
         let second = self.run_piece(context, limit, splits - 1, events);
         self.dt = dt;
