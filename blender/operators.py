@@ -75,9 +75,10 @@ class ImpulseBakeSettings(bpy.types.PropertyGroup):
         name="Collision Steps",
         description=(
             "At most this many collision steps a step, each finding contacts again, where two objects move "
-            "farther than their thickness against each other within it; 1 is off. Fast or thin objects at one step a frame"
+            "farther than their thickness against each other within it; 1 is off. Fast or thin objects stay right "
+            "at one step a frame"
         ),
-        default=1,
+        default=4,
         min=1,
         soft_max=8,
     )

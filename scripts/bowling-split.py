@@ -14,17 +14,17 @@ step").
    material and scene seeds 1..N: the ball's line kept, the pins' contacts re-rolled.
 4. ``steps``: the shot with other steps (``dt:substeps`` pairs, ``dt:substeps:split`` with
    split steps at ``split`` m, or ``dt:substeps:split:collision_steps`` with at most that many
-   collision steps a step, the shot's 2.5 s each):
+   collision steps a step, else the engine's default, 4; the shot's 2.5 s each):
    a random search of N takes for each (search seed 0, so every step size gets the same θ),
    counting the takes that leave the 7, the 10, both, the split itself, and strikes.
 5. ``hit``: the head pin alone, hit by the shot's ball rolled at offsets from its centre line:
    the direction the pin moves off in (degrees from straight back) at several steps, with split
    steps at ``--split-overlap`` m (0, the default: off) and at most ``--collision-steps``
-   collision steps a step (1, the default: off).
+   collision steps a step (the engine's default, 4, unless given; 1 is off).
 6. ``pins``: two of the shot's pins alone, without gravity or ground: one flying at 5 m/s
    (upright, or lying along its path) strikes a standing one at offsets from its axis: the
    direction the struck pin moves off in (degrees from the flyer's path) and its speed, 0.3 s
-   on, at several steps (at most ``--collision-steps`` collision steps a step); with
+   on, at several steps (at most ``--collision-steps`` collision steps a step, as for ``hit``); with
    ``--trace``, also at every step that changes its velocity.
 
     python3 scripts/bowling-split.py lines
@@ -115,11 +115,13 @@ def main() -> int:
     hit.add_argument("--offsets", default="0.05,0.1,0.14", help="m, the ball's x at the pin")
     hit.add_argument("--steps", default="1/60:20,1/240:5,1/960:2", help="dt:substeps pairs")
     hit.add_argument("--split-overlap", type=float, default=0.0, help="m, split steps (0: off)")
-    hit.add_argument("--collision-steps", type=int, default=1, help="at most, a step (1: off)")
+    hit.add_argument("--collision-steps", type=int, default=None,
+                     help="at most, a step (1: off; default: the engine's, 4)")
     pins = commands.add_parser("pins")
     pins.add_argument("--offsets", default="0.03,0.06,0.09", help="m, the flyer's x")
     pins.add_argument("--steps", default="1/60:20,1/240:5,1/960:2", help="dt:substeps pairs")
-    pins.add_argument("--collision-steps", type=int, default=1, help="at most, a step (1: off)")
+    pins.add_argument("--collision-steps", type=int, default=None,
+                      help="at most, a step (1: off; default: the engine's, 4)")
     pins.add_argument("--trace", action="store_true",
                       help="also print each step that changes the struck pin's velocity")
     arguments = parser.parse_args()
@@ -177,7 +179,16 @@ def main() -> int:
     return 0
 
 
-def _hit(offsets: str, pairs: str, split_overlap: float = 0.0, collision_steps: int = 1) -> int:
+def _solver(substeps: int, collision_steps: int | None, **more: float) -> dict:
+    """The ``solver`` object of a step: ``substeps``, ``collision_steps`` unless None (the
+    engine's default), and ``more``."""
+    solver = dict(more, substeps=substeps)
+    if collision_steps is not None:
+        solver["collision_steps"] = collision_steps
+    return solver
+
+
+def _hit(offsets: str, pairs: str, split_overlap: float = 0.0, collision_steps: int | None = None) -> int:
     import math
     from fractions import Fraction
 
@@ -197,8 +208,7 @@ def _hit(offsets: str, pairs: str, split_overlap: float = 0.0, collision_steps: 
             bodies = json.loads(json.dumps(keep))
             bodies[-1]["position"][0] = offset
             world = impulse.World.from_scene(
-                dict(base, bodies=bodies, dt=dt, solver={"substeps": substeps, "split_overlap": split_overlap,
-                                                         "collision_steps": collision_steps}))
+                dict(base, bodies=bodies, dt=dt, solver=_solver(substeps, collision_steps, split_overlap=split_overlap)))
             pin = list(world.names).index("pin1")
             for _ in range(round(0.6 / dt)):  # until the pin moves, then 10 ms on
                 world.step()
@@ -214,7 +224,7 @@ def _hit(offsets: str, pairs: str, split_overlap: float = 0.0, collision_steps: 
     return 0
 
 
-def _pins(offsets: str, pairs: str, trace: bool = False, collision_steps: int = 1) -> int:
+def _pins(offsets: str, pairs: str, trace: bool = False, collision_steps: int | None = None) -> int:
     import math
     from fractions import Fraction
 
@@ -239,7 +249,7 @@ def _pins(offsets: str, pairs: str, trace: bool = False, collision_steps: int = 
                     flyer["orientation"] = [math.sin(math.pi / 4), 0, 0, math.cos(math.pi / 4)]
                 world = impulse.World.from_scene(dict(
                     base, bodies=[flyer, struck], dt=dt, gravity=[0, 0, 0],
-                    solver={"substeps": substeps, "collision_steps": collision_steps}))
+                    solver=_solver(substeps, collision_steps)))
                 last = None
                 for step in range(round(0.3 / dt)):
                     world.step()

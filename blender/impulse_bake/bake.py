@@ -95,24 +95,23 @@ def solver_settings(preset="default", substeps=0, dt=PRESET_STEP):
     return settings.replace(substeps=count)
 
 
-def make_world(scene_dict, preset="default", substeps=0, frame_steps=0, split_overlap=0.0, collision_steps=1):
+def make_world(scene_dict, preset="default", substeps=0, frame_steps=0, split_overlap=0.0, collision_steps=4):
     """The impulse world of a scene dict (what :func:`scene_reader.read_scene` gives, its
     ``dt`` one frame) stepping :func:`steps_per_frame` times a frame, with the preset's solver
     settings at that step; returns (world, steps per frame). The scene's own ``sleep`` and
     ``gyroscopic`` stay (the defaults). ``split_overlap`` (m, 0 off): a step that leaves two
     moving objects overlapping by more is taken again in halves with contacts found again
     (impulse's ``Settings.split_overlap``, a setting of the scene, which presets keep).
-    ``collision_steps`` (1 off): at most this many collision steps a step, each finding contacts
-    again, where two objects move farther than their thickness against each other within it
-    (impulse's ``Settings.collision_steps``, likewise the scene's)."""
+    ``collision_steps`` (4 by default, 1 off): at most this many collision steps a step, each
+    finding contacts again, where two objects move farther than their thickness against each
+    other within it (impulse's ``Settings.collision_steps``, likewise the scene's)."""
     impulse = import_impulse()
     count = steps_per_frame(scene_dict["dt"], frame_steps)
     scene_dict = dict(scene_dict, dt=scene_dict["dt"] / count, steps=scene_dict.get("steps", 0) * count)
     settings = solver_settings(preset, substeps, scene_dict["dt"])
     if split_overlap > 0:
         scene_dict["solver"] = dict(scene_dict.get("solver", {}), split_overlap=float(split_overlap))
-    if collision_steps != 1:
-        scene_dict["solver"] = dict(scene_dict.get("solver", {}), collision_steps=int(collision_steps))
+    scene_dict["solver"] = dict(scene_dict.get("solver", {}), collision_steps=int(collision_steps))
     return impulse.World.from_scene(scene_dict, settings=settings), count
 
 
@@ -164,7 +163,7 @@ class Baker:
     the scene in the animator's terms, when the scene cannot be represented. ``materials``:
     one of :data:`scene_reader.MATERIAL_RULES`; ``resolution``: a moving Mesh's decomposition
     resolution, 0 the engine's default (:func:`shapes.build`); ``split_overlap`` (m, 0 off): split
-    steps; ``collision_steps`` (1 off): collision steps (:func:`make_world`).
+    steps; ``collision_steps`` (4 by default, 1 off): collision steps (:func:`make_world`).
     """
 
     def __init__(
@@ -176,7 +175,7 @@ class Baker:
         materials="blender",
         resolution=0,
         split_overlap=0.0,
-        collision_steps=1,
+        collision_steps=4,
     ):
         self.scene = scene
         self.info = scene_reader.read_scene(scene, materials=materials, resolution=resolution)
@@ -378,7 +377,7 @@ def _object_space(info, locations, quaternions):
 
 
 def bake_scene(
-    scene, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0, split_overlap=0.0, collision_steps=1
+    scene, preset="default", substeps=0, frame_steps=0, materials="blender", resolution=0, split_overlap=0.0, collision_steps=4
 ):
     """Bake the scene's Rigid Body World with impulse at once; returns the :class:`Baker`
     (its ``simulation_seconds`` and ``write_seconds`` are the two parts' wall times)."""

@@ -222,11 +222,12 @@ def test_split_steps_reach_the_world_and_keep_one_step_a_frame():
 
 
 def test_collision_steps_reach_the_world_and_keep_one_step_a_frame():
-    # The panel's Collision Steps at one step a frame: the world gets the count, the step stays a
+    # The panel's Collision Steps (4 unless set) at one step a frame: the world gets the count, the step stays a
     # frame long (the collision steps are within it), and no frame leaves two dominoes crossed
     # deeper than in whole steps by more than half a millimetre (4.2 mm, their sink at the
     # default, in both).
     scene = scenes.dominoes(FRAMES)
+    assert bake.Baker(scene, frame_steps=1).world.settings.collision_steps == 4
     worst, stepped = {}, 0
     for most in (1, 4):
         baker = bake.Baker(scene, frame_steps=1, collision_steps=most)

@@ -342,10 +342,10 @@ def test_split_steps_are_a_setting_and_report_their_pieces():
 
 
 def test_collision_steps_are_a_setting_and_reported():
-    # At most how many collision steps a step takes is a field of the settings, off (1) by
-    # default and refused at 0; two balls closing at 30 m/s (50 cm a step, five radii) take
-    # their step in four, one step from outside, their momentum kept.
-    assert impulse.Settings().collision_steps == 1
+    # At most how many collision steps a step takes is a field of the settings, 4 by default
+    # (1 off) and refused at 0; two balls closing at 30 m/s (50 cm a step, five radii) take
+    # their step in four, one step from outside, their momentum kept; in whole steps with 1.
+    assert impulse.Settings().collision_steps == 4
     with pytest.raises(ValueError, match="collision_steps"):
         impulse.Settings().replace(collision_steps=0)
     elastic = {"friction": 0.0, "restitution": 1.0, "density": 1000.0}
@@ -370,3 +370,8 @@ def test_collision_steps_are_a_setting_and_reported():
     velocities = world.state()["linear_velocities"]
     assert velocities[1][0] > 1.0
     assert abs(velocities[0][0] + velocities[1][0] - 30.0) < 0.03
+    scene["solver"] = {"collision_steps": 1}
+    whole = impulse.World.from_scene(scene)
+    whole.step(2)
+    assert whole.diagnostics["collision_steps"] == 1
+    assert whole.diagnostics["pieces"] == 1
