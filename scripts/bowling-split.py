@@ -50,15 +50,24 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 SHOT = os.path.join(HERE, "..", "scenes", "takes", "bowling")
 CORNERS = ("pin7 standing", "pin10 standing")
+#: The scene format's default step (s), the shot's.
+DEFAULT_DT = 1.0 / 60.0
+
+
+def _duration(spec: dict) -> float:
+    """The shot's duration (s): its goals' steps at its scene's step."""
+    with open(SHOT + ".json", encoding="utf-8") as file:
+        return spec["steps"] * json.load(file).get("dt", DEFAULT_DT)
 
 
 def _outcome(scene: dict) -> tuple[bool, bool, bool]:
-    """(7 standing, 10 standing, every goal met) of one run of ``scene``."""
+    """(7 standing, 10 standing, every goal met) of one run of ``scene`` over the shot's
+    duration at the scene's own step."""
     from impulse.takes import MET, evaluate
 
     with open(SHOT + ".goals.json", encoding="utf-8") as file:
         spec = json.load(file)
-    costs = evaluate(scene, spec["goals"], spec["steps"])
+    costs = evaluate(scene, spec["goals"], round(_duration(spec) / scene.get("dt", DEFAULT_DT)))
     seven, ten = (costs[name] <= MET for name in CORNERS)
     return seven, ten, all(cost <= MET for cost in costs.values())
 
@@ -280,7 +289,7 @@ def _steps(pairs: str, takes: int) -> int:
         base = json.load(file)
     with open(SHOT + ".goals.json", encoding="utf-8") as file:
         spec = json.load(file)
-    duration = spec["steps"] * base["dt"]
+    duration = _duration(spec)
     print("| dt (s) | substeps | takes | 7 standing | 10 standing | both | 7-10 split "
           "(every goal met) | strikes | first split |")
     print("|---|---|---|---|---|---|---|---|---|")

@@ -405,7 +405,10 @@ fn a_pin_struck_off_centre_at_the_frame_rate_leaves_as_at_a_fine_step() {
              at 1/960 s and {quarter:.1}° at 1/240 s"
         );
         if offset == 0.1 {
-            assert!((stepped - fine).abs() < 2.0, "{stepped:.1}° against {fine:.1}°");
+            assert!(
+                (stepped - fine).abs() < 2.0,
+                "{stepped:.1}° against {fine:.1}°"
+            );
         }
     }
 }
