@@ -139,3 +139,46 @@ fn no_collision_steps_is_refused() {
         .expect("0 accepted");
     assert!(error.to_string().contains("collision_steps"), "{error}");
 }
+
+/// How many collision steps the second step of two bodies of `half_extents` takes, one above
+/// the other 1 cm apart, the upper one sliding over at `speed` (m/s) and spinning in its plane
+/// at 50 rad/s (they never meet), with at most `most` allowed.
+fn sliding_pair_collision_steps(half_extents: [f32; 3], speed: f32, most: u32) -> u32 {
+    let mut world = World::new(Vec3::ZERO, 1.0 / 60.0, with_collision_steps(most)).unwrap();
+    let shape = ShapeDesc::Cuboid { half_extents };
+    let lower = BodyDesc::new(BodyKind::Dynamic, shape.clone(), [0.0; 3]);
+    let mut upper = BodyDesc::new(
+        BodyKind::Dynamic,
+        shape,
+        [0.0, 2.0 * half_extents[1].max(0.001) + 0.01, 0.0],
+    );
+    upper.linear_velocity = [speed, 0.0, 0.0];
+    upper.angular_velocity = [0.0, 50.0, 0.0];
+    for body in [lower, upper] {
+        world.add_body(&body, &Material::default()).unwrap();
+    }
+    // The first step finds the pair; the second decides on it.
+    world.step().unwrap();
+    world.step().unwrap().collision_steps
+}
+
+/// A pair with a card (a flat shape's 2 mm slab, thinner than `THIN_BODY_THICKNESS`) moving
+/// far against its thickness may take `THIN_COLLISION_STEP_FACTOR` times the setting's
+/// collision steps: sixteen at the default four, twelve at three; a pair of 10 cm cubes
+/// moving as far against theirs, the setting's.
+#[test]
+fn thin_pairs_take_more_collision_steps() {
+    use impulse::settings::{DEFAULT_COLLISION_STEPS, THIN_COLLISION_STEP_FACTOR};
+    let card = [0.0315, 0.0, 0.044];
+    let cube = [0.05; 3];
+    let thin_most = DEFAULT_COLLISION_STEPS * THIN_COLLISION_STEP_FACTOR;
+    assert_eq!(thin_most, 16);
+    assert_eq!(sliding_pair_collision_steps(card, 3.0, 4), thin_most);
+    assert_eq!(sliding_pair_collision_steps(card, 3.0, 3), 12);
+    assert_eq!(sliding_pair_collision_steps(card, 3.0, 1), 1);
+    assert_eq!(sliding_pair_collision_steps(cube, 12.0, 4), 4);
+    assert_eq!(sliding_pair_collision_steps(cube, 12.0, 3), 3);
+    // Slower, the fewest that keep it within its thickness: a 1 cm chip spinning in place
+    // moves its corners 6 mm a step against its 1 mm half thickness.
+    assert_eq!(sliding_pair_collision_steps([0.005, 0.0, 0.005], 0.0, 4), 8);
+}

@@ -41,7 +41,9 @@ use crate::collision::narrow_phase::ContactPair;
 use crate::collision::overlap::PairDepths;
 use crate::error::StepError;
 use crate::joint::{JointEvent, Joints};
-use crate::settings::{COLLISION_STEP_REACH, MAX_STEP_SPLITS};
+use crate::settings::{
+    COLLISION_STEP_REACH, MAX_STEP_SPLITS, THIN_BODY_THICKNESS, THIN_COLLISION_STEP_FACTOR,
+};
 use crate::world::contact_events::{ContactEvent, ContactEvents};
 
 /// What a try of a step changes that its contacts do not depend on, as the try found it.
@@ -167,7 +169,8 @@ impl World {
     }
 
     /// How many collision steps this step needs ([`ContactSettings::collision_steps`] at
-    /// most): the fewest, a power of two (so that the substeps share out evenly), in which no
+    /// most, [`THIN_COLLISION_STEP_FACTOR`] times that for a pair with a body thinner than
+    /// [`THIN_BODY_THICKNESS`]): the fewest, a power of two (so that the substeps share out evenly), in which no
     /// contact pair of two dynamic bodies, one of them awake, moves against itself by more
     /// than [`COLLISION_STEP_REACH`] times the thinner body's thickness (its local bounding box's smallest half extent). A pair's motion within the
     /// step is bounded from the velocities at its start, in the frame of one body: the other's
@@ -195,7 +198,8 @@ impl World {
                 (half.min_element(), offset.length() + half.length())
             })
         };
-        let mut needed = 1.0f32;
+        let thin_most = most.saturating_mul(THIN_COLLISION_STEP_FACTOR);
+        let mut needed = 1u32;
         for pair in &self.narrow_phase.pairs {
             let (i, j) = (pair.body1 as usize, pair.body2 as usize);
             if !b.is_dynamic(i) || !b.is_dynamic(j) || (b.asleep[i] && b.asleep[j]) {
@@ -211,21 +215,29 @@ impl World {
                 b.linear_velocity[i] - b.linear_velocity[j] - omega_j.cross(center_i - center_j);
             let speed =
                 (j_in_i.length() + turn * farthest_j).min(i_in_j.length() + turn * farthest_i);
-            let allowed = COLLISION_STEP_REACH * thickness_i.min(thickness_j);
+            let half_thickness = thickness_i.min(thickness_j);
+            let allowed = COLLISION_STEP_REACH * half_thickness;
             let motion = speed * self.dt;
-            if motion > needed * allowed {
-                needed = if allowed > 0.0 {
+            if motion > needed as f32 * allowed {
+                let most = if 2.0 * half_thickness < THIN_BODY_THICKNESS {
+                    thin_most
+                } else {
+                    most
+                };
+                let pieces = if allowed > 0.0 {
                     motion / allowed
                 } else {
                     f32::INFINITY
                 };
+                let pieces = if pieces >= most as f32 {
+                    most
+                } else {
+                    (pieces.ceil() as u32).next_power_of_two().min(most)
+                };
+                needed = needed.max(pieces);
             }
         }
-        if needed >= most as f32 {
-            most
-        } else {
-            (needed.ceil() as u32).next_power_of_two().min(most)
-        }
+        needed
     }
 
     /// One piece of the step, over `self.dt`, tried once and, if it left bodies crossed and
