@@ -75,7 +75,7 @@ class ImpulseBakeSettings(bpy.types.PropertyGroup):
         name="Collision Steps",
         description=(
             "At most this many collision steps a step, each finding contacts again, where two objects move "
-            "farther than their thickness against each other within it (four times as many where one is thinner "
+            "farther than their thickness against each other within it (eight times as many where one is thinner "
             "than 5 mm, a card); 1 is off. Fast or thin objects stay right at one step a frame"
         ),
         default=4,

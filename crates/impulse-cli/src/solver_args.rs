@@ -78,7 +78,7 @@ pub struct SolverArgs {
     #[arg(long)]
     pub impact_sweeps: Option<u32>,
     /// At most this many collision steps a step, each finding contacts again, where two
-    /// dynamic bodies move farther than their thickness within it, four times as many where
+    /// dynamic bodies move farther than their thickness within it, eight times as many where
     /// one is thinner than 5 mm (1 = off; see `ContactSettings::collision_steps`).
     #[arg(long)]
     pub collision_steps: Option<u32>,

@@ -231,7 +231,7 @@ impl Settings {
 
     /// At most how many collision steps (each with its own contacts) a step is taken in where
     /// two dynamic bodies move farther than their thickness within it (4 by default; 1 is off);
-    /// four times as many where one of them is thinner than 5 mm (a card).
+    /// eight times as many where one of them is thinner than 5 mm (a card).
     #[getter]
     fn collision_steps<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.field(py, "collision_steps")

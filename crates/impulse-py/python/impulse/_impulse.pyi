@@ -131,7 +131,7 @@ class Settings:
     def collision_steps(self) -> int:
         """At most how many collision steps (contacts found again) a step takes for fast pairs (4; 1 is off).
 
-        A pair with a body thinner than 5 mm (a card) may take four times as many.
+        A pair with a body thinner than 5 mm (a card) may take eight times as many.
         """
     @property
     def recycle_distance(self) -> float:

@@ -534,10 +534,10 @@ pub const COLLISION_STEP_REACH: f32 = 1.0;
 /// How many times [`ContactSettings::collision_steps`] a step may be taken in where a pair
 /// of two dynamic bodies has one thinner than [`THIN_BODY_THICKNESS`]: a card spinning off an
 /// impact at 50 rad/s moves its corners 4 cm a step at 1/60 s against its 2 mm, and within
-/// four collision steps its contacts go stale enough to let two cards cross by up to 3.9 mm;
-/// within sixteen by at most 0.66 mm (forty cards into a box, seeds 0-4; docs/testing.md,
-/// "Thin shapes"). Only such pairs take more pieces, and only while they move that fast.
-pub const THIN_COLLISION_STEP_FACTOR: u32 = 4;
+/// four collision steps its contacts go stale enough to let two cards cross by up to 4.2 mm;
+/// within 32 by at most 0.86 mm (forty cards into a box, seeds 0-39; docs/testing.md, "Thin
+/// shapes"). Only such pairs take more pieces, and only while they move that fast.
+pub const THIN_COLLISION_STEP_FACTOR: u32 = 8;
 
 /// A body whose local bounding box is thinner than this (m) in some direction is thin for
 /// [`THIN_COLLISION_STEP_FACTOR`]: a flat shape's slab ([`crate::scene::DEFAULT_THICKNESS`]

@@ -299,7 +299,7 @@ fn forty_cards(seed: u64, settings: SolverSettings) -> (f32, usize, f32) {
 }
 
 /// The forty cards of [`forty_cards`] at seeds 0–4: the default (at most four collision steps a
-/// step, sixteen for a pair of cards), at most two (eight), the Precise preset, the default in
+/// step, 32 for a pair of cards), at most two (16), the Precise preset, the default in
 /// whole steps, and with split steps at 1 mm in whole steps; then the default at seeds 0–39,
 /// how many keep every pair within 1 mm (prints).
 #[test]
@@ -335,16 +335,13 @@ fn forty_cards_into_a_box() {
         .collect();
     deepest.sort_by(|a, b| a.0.total_cmp(&b.0));
     let within = deepest.iter().filter(|d| d.0 <= 1e-3).count();
-    let beyond: Vec<String> = deepest
-        .iter()
-        .filter(|d| d.0 > 1e-3)
-        .map(|d| format!("seed {} {:.2} mm", d.1, d.0 * 1e3))
-        .collect();
     let at_end = deepest.iter().map(|d| d.2).fold(0.0f32, f32::max);
+    let worst = deepest[deepest.len() - 1];
     println!(
-        "default, seeds 0-39: {within} of 40 keep every pair within 1 mm (median deepest {:.3} mm; beyond: {}), deepest at the end {:.3} mm",
+        "default, seeds 0-39: {within} of 40 keep every pair within 1 mm (deepest crossing: median {:.3} mm, worst {:.3} mm at seed {}), deepest at the end {:.3} mm",
         deepest[20].0 * 1e3,
-        beyond.join(", "),
+        worst.0 * 1e3,
+        worst.1,
         at_end * 1e3
     );
 }

@@ -164,7 +164,7 @@ fn sliding_pair_collision_steps(half_extents: [f32; 3], speed: f32, most: u32) -
 
 /// A pair with a card (a flat shape's 2 mm slab, thinner than `THIN_BODY_THICKNESS`) moving
 /// far against its thickness may take `THIN_COLLISION_STEP_FACTOR` times the setting's
-/// collision steps: sixteen at the default four, twelve at three; a pair of 10 cm cubes
+/// collision steps: 32 at the default four, 24 at three; a pair of 10 cm cubes
 /// moving as far against theirs, the setting's.
 #[test]
 fn thin_pairs_take_more_collision_steps() {
@@ -172,9 +172,9 @@ fn thin_pairs_take_more_collision_steps() {
     let card = [0.0315, 0.0, 0.044];
     let cube = [0.05; 3];
     let thin_most = DEFAULT_COLLISION_STEPS * THIN_COLLISION_STEP_FACTOR;
-    assert_eq!(thin_most, 16);
+    assert_eq!(thin_most, 32);
     assert_eq!(sliding_pair_collision_steps(card, 3.0, 4), thin_most);
-    assert_eq!(sliding_pair_collision_steps(card, 3.0, 3), 12);
+    assert_eq!(sliding_pair_collision_steps(card, 3.0, 3), 24);
     assert_eq!(sliding_pair_collision_steps(card, 3.0, 1), 1);
     assert_eq!(sliding_pair_collision_steps(cube, 12.0, 4), 4);
     assert_eq!(sliding_pair_collision_steps(cube, 12.0, 3), 3);
