@@ -136,7 +136,7 @@ fn residual_after_sweeps(joints: &mut IslandJoints, bodies: usize, seed: u64, sw
         angular: &mut angular,
     };
     for sweep in 0..sweeps {
-        sweep_joints(joints, &mut velocities, sweep % 2 == 0);
+        sweep_joints(joints, &mut velocities, sweep % 2 == 0, true);
     }
     largest(joints, &mut linear, &mut angular) / before
 }

@@ -42,7 +42,7 @@ impl ContactSolver for Apgd {
             let sweeps = pass.iterations.max(1);
             let mut joint_change = 0.0f32;
             for k in 0..sweeps {
-                joint_change = sweep_joints(joints, velocities, k % 2 == 0);
+                joint_change = sweep_joints(joints, velocities, k % 2 == 0, k == 0);
             }
             let mut report = solve_apgd(
                 rows,
@@ -52,7 +52,7 @@ impl ContactSolver for Apgd {
                 &mut self.workspace,
             );
             for k in 0..sweeps {
-                joint_change = sweep_joints(joints, velocities, k % 2 == 0);
+                joint_change = sweep_joints(joints, velocities, k % 2 == 0, k == 0);
             }
             if !joints.is_empty() {
                 report.last_change = report.last_change.max(joint_change);

@@ -102,13 +102,13 @@ pub(crate) fn solve_nncg_with_joints(
         let joint_forward = if joints.is_empty() {
             0.0
         } else {
-            sweep_joints(joints, velocities, true)
+            sweep_joints(joints, velocities, true, true)
         };
         let forward = sweep_points(constraints, sweep, FORWARD, velocities, FrictionFirstRows);
         let backward = sweep_points(constraints, sweep, BACKWARD, velocities, FrictionFirstRows);
         let mut largest_change = forward.max(backward);
         if !joints.is_empty() {
-            let joint_backward = sweep_joints(joints, velocities, false);
+            let joint_backward = sweep_joints(joints, velocities, false, true);
             largest_change = largest_change.max(joint_forward).max(joint_backward);
         }
         report.iterations += 1;

@@ -301,7 +301,7 @@ pub(crate) fn solve_pgs_rows(
         let order = PointOrder { forward, half_turn };
         let mut joint_change = 0.0f32;
         if forward && !joints.is_empty() {
-            joint_change = sweep_joints(joints, velocities, true);
+            joint_change = sweep_joints(joints, velocities, true, iteration == 0);
         }
         let mut largest_change = if friction {
             sweep_points(constraints, sweep, order, velocities, VelocityRows::<true>)
@@ -309,7 +309,7 @@ pub(crate) fn solve_pgs_rows(
             sweep_points(constraints, sweep, order, velocities, VelocityRows::<false>)
         };
         if !forward && !joints.is_empty() {
-            joint_change = sweep_joints(joints, velocities, false);
+            joint_change = sweep_joints(joints, velocities, false, iteration == 0);
         }
         if !joints.is_empty() {
             largest_change = largest_change.max(joint_change);

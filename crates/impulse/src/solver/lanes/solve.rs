@@ -54,7 +54,7 @@ impl Bundles {
             let stale = first.is_some_and(|t| !t.turn.is_empty());
             let mut joint_change = 0.0f32;
             if forward && !joints.is_empty() {
-                joint_change = sweep_joints(joints, velocities, true);
+                joint_change = sweep_joints(joints, velocities, true, iteration == 0);
             }
             // One relax sweep before another substep adds up that substep's warm start as it
             // goes (`RelaxCarrying`). Not with several sweeps: each would add its impulses to
@@ -89,7 +89,7 @@ impl Bundles {
                 }
             };
             if !forward && !joints.is_empty() {
-                joint_change = sweep_joints(joints, velocities, false);
+                joint_change = sweep_joints(joints, velocities, false, iteration == 0);
             }
             let largest_change = largest.to_array().into_iter().fold(joint_change, f32::max);
             report.iterations += 1;
