@@ -157,11 +157,12 @@ impl IslandJoints {
     }
 }
 
-/// Sweeps the joints' rows once, first to last (`forward`) or last to first; returns the
-/// largest row velocity change (m/s or rad/s). With the locked rows factorized, each joint's
-/// springs, motors and limits are swept (a joint closing a loop takes its locked groups too)
-/// and then the forest's locked rows are solved at once; otherwise each joint takes its rows in
-/// turn, its locked groups as blocks.
+/// Sweeps the joints' rows once, first to last (`forward`) or last to first, and with
+/// `converge_limits` (a solve's first sweep) again while an engaged limit and the locked rows
+/// disagree; returns the largest row velocity change (m/s or rad/s) of the first pass. With
+/// the locked rows factorized, each joint's springs, motors and limits are swept (a joint
+/// closing a loop takes its locked groups too) and then the forest's locked rows are solved at
+/// once; otherwise each joint takes its rows in turn, its locked groups as blocks.
 pub(crate) fn sweep_joints(
     joints: &mut IslandJoints,
     velocities: &mut Velocities<'_>,
