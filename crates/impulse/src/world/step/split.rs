@@ -170,10 +170,11 @@ impl World {
 
     /// How many collision steps this step needs ([`ContactSettings::collision_steps`] at
     /// most, [`THIN_COLLISION_STEP_FACTOR`] times that for a pair with a body thinner than
-    /// [`THIN_BODY_THICKNESS`]): the fewest, a power of two (so that the substeps share out evenly), in which no
-    /// contact pair of two dynamic bodies, one of them awake, moves against itself by more
-    /// than [`COLLISION_STEP_REACH`] times the thinner body's thickness (its local bounding box's smallest half extent). A pair's motion within the
-    /// step is bounded from the velocities at its start, in the frame of one body: the other's
+    /// [`THIN_BODY_THICKNESS`]): the fewest, a power of two (so that the substeps share out
+    /// evenly), in which no contact pair of two dynamic bodies, one of them awake, moves
+    /// against itself by more than [`COLLISION_STEP_REACH`] times the thinner body's thickness
+    /// (its local bounding box's smallest half extent). A pair's motion within the step is
+    /// bounded from the velocities at its start, in the frame of one body: the other's
     /// centre of mass moves in it at u = v₂ − v₁ − ω₁ × (c₂ − c₁), its points by at most
     /// (|u| + |ω₂ − ω₁|·ρ₂)·dt, ρ₂ its farthest point from the centre of mass; the smaller of
     /// the two frames' bounds counts. Two bodies that move as one (a jointed chain swinging)
