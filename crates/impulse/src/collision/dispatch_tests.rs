@@ -686,3 +686,81 @@ fn assert_mesh_nearest_points(mesh: &SharedShape, solid: &[(SharedShape, Pose)],
         "{near} near, {overstated} overstated"
     );
 }
+
+/// A hull's support points found eight vertices at a time give Parry's manifold to the bit:
+/// random hulls of 8 to 120 points (bare and rounded) against each other, a box, a triangle, a
+/// capsule and a cylinder, at random poses within reach, after a first manifold (so that the
+/// second starts from its normal, as from step to step).
+#[test]
+fn laned_hulls_give_parrys_manifolds() {
+    use parry3d::shape::Triangle;
+    let mut uniform = crate::test_support::seeded_uniform(23);
+    let mut hull = |count: usize| -> Vec<Vec3> {
+        (0..count)
+            .map(|_| Vec3::new(uniform(-0.2, 0.2), uniform(-0.1, 0.1), uniform(-0.15, 0.15)))
+            .collect()
+    };
+    let mut shapes: Vec<SharedShape> = [8, 20, 45, 120]
+        .into_iter()
+        .flat_map(|count| {
+            let points = hull(count);
+            [
+                SharedShape::convex_hull(&points).unwrap(),
+                SharedShape::round_convex_hull(&points, 0.01).unwrap(),
+            ]
+        })
+        .collect();
+    let hulls = shapes.len();
+    shapes.extend([
+        SharedShape::cuboid(0.2, 0.1, 0.15),
+        SharedShape::new(Triangle::new(
+            Vec3::new(-0.3, 0.0, -0.2),
+            Vec3::new(0.3, 0.0, -0.2),
+            Vec3::new(0.0, 0.0, 0.3),
+        )),
+        SharedShape::capsule_y(0.1, 0.05),
+        SharedShape::cylinder(0.1, 0.08),
+    ]);
+    let mut with_points = 0;
+    for (case, g1, pos1, g2, pos2) in random_pairs(5, &shapes, 3000) {
+        if case % shapes.len() >= hulls && (case / shapes.len()) % shapes.len() >= hulls {
+            continue;
+        }
+        let pos12 = pos1.inv_mul(&pos2);
+        let (mut parrys, mut laned) = (ContactManifold::new(), ContactManifold::new());
+        for _ in 0..2 {
+            PersistentQueryDispatcher::<(), f32>::contact_manifold_convex_convex(
+                &DefaultQueryDispatcher,
+                &pos12,
+                g1,
+                g2,
+                None,
+                None,
+                0.3,
+                &mut parrys,
+            )
+            .unwrap();
+            super::parry_manifold::<(), f32>(&pos12, g1, g2, (None, None), 0.3, &mut laned)
+                .unwrap();
+        }
+        let key = |m: &ContactManifold<(), f32>| {
+            let points: Vec<_> = m
+                .points
+                .iter()
+                .map(|p| {
+                    (
+                        p.local_p1.to_array(),
+                        p.local_p2.to_array(),
+                        p.dist,
+                        p.fid1,
+                        p.fid2,
+                    )
+                })
+                .collect();
+            (m.local_n1.to_array(), m.local_n2.to_array(), points)
+        };
+        assert_eq!(key(&laned), key(&parrys), "case {case}");
+        with_points += usize::from(!parrys.points.is_empty());
+    }
+    assert!(with_points > 300, "{with_points} pairs with points");
+}
