@@ -111,77 +111,88 @@ pub(crate) struct Feature {
 }
 
 impl Feature {
-    /// The whole face `index` of `hull` (rounded by `border`), its vertices moved by `pose`.
-    pub(crate) fn hull_face(
-        hull: &ConvexPolyhedron,
-        index: usize,
-        border: Real,
-        pose: &Pose,
-    ) -> Self {
+    /// The whole face `index` of `hull` (rounded by `border`), its vertices moved by `pose`,
+    /// written over this feature (its buffers kept).
+    fn set_hull_face(&mut self, hull: &ConvexPolyhedron, index: usize, border: Real, pose: &Pose) {
         let face = &hull.faces()[index];
         let range = face.first_vertex_or_edge as usize
             ..(face.first_vertex_or_edge + face.num_vertices_or_edges) as usize;
         let points = hull.points();
-        Self {
-            vertices: hull.vertices_adj_to_face()[range.clone()]
+        let vids = &hull.vertices_adj_to_face()[range.clone()];
+        self.clear();
+        self.vertices.extend(
+            vids.iter()
+                .map(|&vid| pose.transform_point(points[vid as usize])),
+        );
+        self.vids
+            .extend(vids.iter().map(|&vid| PackedFeatureId::vertex(vid)));
+        self.eids.extend(
+            hull.edges_adj_to_face()[range]
                 .iter()
-                .map(|&vid| pose.transform_point(points[vid as usize]))
-                .collect(),
-            vids: hull.vertices_adj_to_face()[range.clone()]
-                .iter()
-                .map(|&vid| PackedFeatureId::vertex(vid))
-                .collect(),
-            eids: hull.edges_adj_to_face()[range]
-                .iter()
-                .map(|&eid| PackedFeatureId::edge(eid))
-                .collect(),
-            fid: PackedFeatureId::face(index as u32),
-            plane: None,
-            border,
-        }
+                .map(|&eid| PackedFeatureId::edge(eid)),
+        );
+        self.fid = PackedFeatureId::face(index as u32);
+        self.border = border;
     }
 
-    /// The feature of `shape` (at `pose` in shape 1's frame) facing along `dir` (the shape's
-    /// own frame, out of it): a half-space's plane, a hull's whole support face (`face`, its
-    /// index if known: [`support_face_index`] along `dir`), or Parry's support feature for any
-    /// other shape with one.
-    fn of(shape: &dyn Shape, pose: &Pose, dir: Vector, face: Option<usize>) -> Option<Self> {
+    /// Writes over this feature (its buffers kept) the feature of `shape` (at `pose` in shape
+    /// 1's frame) facing along `dir` (the shape's own frame, out of it): a half-space's plane,
+    /// a hull's whole support face (`face`, its index if known: [`support_face_index`] along
+    /// `dir`), or Parry's support feature for any other shape with one. False where the shape
+    /// has none.
+    fn set_of(&mut self, shape: &dyn Shape, pose: &Pose, dir: Vector, face: Option<usize>) -> bool {
         if let Some(half_space) = shape.as_halfspace() {
-            return Some(Self {
-                vertices: Vec::new(),
-                vids: Vec::new(),
-                eids: Vec::new(),
-                fid: PackedFeatureId::face(0),
-                plane: Some((pose.translation, pose.rotation * half_space.normal)),
-                border: 0.0,
-            });
+            self.clear();
+            self.plane = Some((pose.translation, pose.rotation * half_space.normal));
+            return true;
         }
         if let Some((hull, border)) = hull_parts(shape) {
-            return Some(Self::hull_face(
-                hull,
-                face.unwrap_or_else(|| support_face_index(hull, dir)),
-                border,
-                pose,
-            ));
+            let index = face.unwrap_or_else(|| support_face_index(hull, dir));
+            self.set_hull_face(hull, index, border, pose);
+            return true;
         }
-        let (map, border) = shape.as_polygonal_feature_map()?;
+        let Some((map, border)) = shape.as_polygonal_feature_map() else {
+            return false;
+        };
         let mut feature = PolygonalFeature::default();
         map.local_support_feature(dir, &mut feature);
         let count = feature.num_vertices;
         if count == 0 {
-            return None;
+            return false;
         }
-        Some(Self {
-            vertices: feature.vertices[..count]
+        self.clear();
+        self.vertices.extend(
+            feature.vertices[..count]
                 .iter()
-                .map(|v| pose.transform_point(*v))
-                .collect(),
-            vids: feature.vids[..count].to_vec(),
-            eids: feature.eids[..count].to_vec(),
-            fid: feature.fid,
+                .map(|v| pose.transform_point(*v)),
+        );
+        self.vids.extend_from_slice(&feature.vids[..count]);
+        self.eids.extend_from_slice(&feature.eids[..count]);
+        self.fid = feature.fid;
+        self.border = border;
+        true
+    }
+
+    /// An empty feature (see [`Self::clear`]).
+    fn empty() -> Self {
+        Self {
+            vertices: Vec::new(),
+            vids: Vec::new(),
+            eids: Vec::new(),
+            fid: PackedFeatureId::face(0),
             plane: None,
-            border,
-        })
+            border: 0.0,
+        }
+    }
+
+    /// Empties the feature: no vertices, face 0, no plane, no border.
+    fn clear(&mut self) {
+        self.vertices.clear();
+        self.vids.clear();
+        self.eids.clear();
+        self.fid = PackedFeatureId::face(0);
+        self.plane = None;
+        self.border = 0.0;
     }
 
     /// Edges to clip: none for a point or a plane, one for a segment, one a vertex otherwise.
@@ -268,6 +279,10 @@ fn clip_with(
     // tests below: a point outside a polygon's box is not over it, and two edges whose boxes
     // are apart do not cross, so most of a large face's vertices and edges are told by four
     // comparisons instead of a test per edge of the other (faces of up to 60 vertices meet).
+    // The box also rules out what the edge tests alone let through on a sliver face (a V-HACD
+    // part's triangle micrometres wide), whose every edge reads a point beyond it as on the
+    // edge (`inside_edges` skips crossings under 1e-9 m²): a vertex tens of millimetres away
+    // then counted as over the face, its point on the face's plane far off the face.
     let (box1, box2) = (Extent::of(segments1), Extent::of(segments2));
     let margin = CLIP_MARGIN * (1.0 + box1.magnitude().max(box2.magnitude()));
     let (box1, box2) = (box1.widened(margin), box2.widened(margin));
@@ -358,8 +373,8 @@ struct ClipBuffers {
 
 /// Margin (m, per metre of the largest projected coordinate, plus this much) by which [`clip`]
 /// widens the boxes it rejects vertices and edges with: a hundred times f32's rounding of the
-/// coordinates and of the edge tests (about 1e-7 of their size), so a rejection only drops what
-/// the full tests would.
+/// coordinates and of the edge tests (about 1e-7 of their size), so on faces that are not
+/// slivers a rejection only drops what the full tests would.
 const CLIP_MARGIN: Real = 1.0e-5;
 
 /// An axis-aligned 2-D box: lower and upper corners (empty when the lower exceeds the upper).
@@ -668,12 +683,19 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
     if !refine1 && !refine2 {
         return false;
     }
-    let (Some(f1), Some(f2)) = (
-        Feature::of(g1, &Pose::IDENTITY, n1, face1.map(|(index, _)| index)),
-        Feature::of(g2, pos12, n2, face2.map(|(index, _)| index)),
-    ) else {
+    // The two features and the clipped points, in this thread's buffers (a refinement then
+    // allocates nothing once they have grown to the hulls' faces).
+    let mut buffers = BorrowedBuffers(FEATURE_BUFFERS.take());
+    let FeatureBuffers {
+        features: [f1, f2],
+        candidates,
+    } = &mut buffers.0;
+    if !f1.set_of(g1, &Pose::IDENTITY, n1, face1.map(|(index, _)| index))
+        || !f2.set_of(g2, pos12, n2, face2.map(|(index, _)| index))
+    {
         return false;
-    };
+    }
+    let (f1, f2) = (&*f1, &*f2);
     // GJK stops within its tolerance: between separated faces its normal leans by up to a few
     // 1e-4 rad, which tilts every depth across a large face. A normal that near the large
     // face's own is that face's (a vertex, edge or face on a face touches along its normal).
@@ -692,8 +714,8 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
         }
         _ => n,
     };
-    let mut candidates = Vec::new();
-    clip(&f1, &f2, n, &mut candidates);
+    candidates.clear();
+    clip(f1, f2, n, candidates);
     candidates.retain(|c| c.dist <= prediction);
     if candidates.is_empty() {
         // Nothing within reach: a half-space's manifold is rightly empty; between polyhedra,
@@ -736,12 +758,12 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
                     .any(|&v| (v - origin).dot(normal).abs() > DEPTH_TIE)
             })
     };
-    let limit = if uneven(refine1, &f1) || uneven(refine2, &f2) {
+    let limit = if uneven(refine1, f1) || uneven(refine2, f2) {
         UNEVEN_MAX_POINTS
     } else {
         MAX_POINTS
     };
-    reduce(&mut candidates, n, old, limit);
+    reduce(candidates, n, old, limit);
     let inverse = pos12.inverse();
     let nearest = manifold
         .points
@@ -750,7 +772,7 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
         .copied()
         .filter(|p| corrected.is_none() && p.dist < deepest_clip - DEPTH_TIE);
     manifold.points.clear();
-    for c in &candidates {
+    for c in candidates.iter() {
         manifold.points.push(TrackedContact::new(
             c.p1,
             inverse.transform_point(c.p2),
@@ -764,6 +786,36 @@ pub(crate) fn refine_face_contact<ManifoldData: AxisMemory, ContactData: Default
     }
     manifold.match_contacts(old);
     true
+}
+
+/// [`refine_face_contact`]'s buffers: the two features and the clipped points.
+struct FeatureBuffers {
+    features: [Feature; 2],
+    candidates: Vec<Candidate>,
+}
+
+impl Default for FeatureBuffers {
+    fn default() -> Self {
+        Self {
+            features: [Feature::empty(), Feature::empty()],
+            candidates: Vec::new(),
+        }
+    }
+}
+
+thread_local! {
+    /// [`refine_face_contact`]'s buffers, kept per thread as [`EdgeBuffers`].
+    static FEATURE_BUFFERS: RefCell<FeatureBuffers> = RefCell::default();
+}
+
+/// [`FeatureBuffers`] taken out of this thread's slot, put back when dropped (on every return
+/// of [`refine_face_contact`]).
+struct BorrowedBuffers(FeatureBuffers);
+
+impl Drop for BorrowedBuffers {
+    fn drop(&mut self) {
+        FEATURE_BUFFERS.set(std::mem::take(&mut self.0));
+    }
 }
 
 /// Under a mesh triangle's normal constraints: the face normal of the triangle (either side
@@ -871,48 +923,124 @@ fn local_support(shape: &dyn Shape, map: &dyn SupportMap, dir: Vector) -> Vector
 /// largest, and 0 when the first's is NaN: what Parry's `point_cloud_support_point_id`
 /// returns (a scan keeping the first of equals), to the bit. Eight points at a time in lanes,
 /// each keeping its first largest; then the largest of the lanes, the first of equals, and
-/// the points after the last eight in order. Short clouds, and those whose first dot product
-/// is NaN, go to Parry's scan itself.
+/// the points after the last eight in order. The lanes read the points' coordinates in
+/// columns ([`PointColumns`], kept per thread for the last few clouds: GJK and the face
+/// searches ask the same two hulls many times in a row), where reading them interleaved took
+/// shuffles that cost four times the arithmetic. Short clouds, and those whose first dot
+/// product is NaN, go to Parry's scan itself.
 pub(crate) fn first_largest_dot(points: &[Vector], dir: Vector) -> usize {
-    const LANES: usize = 8;
+    const LANES: usize = COLUMN_LANES;
     if points.len() < 2 * LANES || points.len() > 1 << 24 || points[0].dot(dir).is_nan() {
         return parry3d::utils::point_cloud_support_point_id(dir, points);
     }
-    on_instruction_set!(InstructionSet::detected(), {
-        let mut best = [Real::NEG_INFINITY; LANES];
-        // Indices as floats (exact below 2²⁴), chosen as the dot products are: in one vector
-        // register with them, where integer indices were chosen lane by lane.
-        let mut at = [0.0_f32; LANES];
-        let chunks = points.chunks_exact(LANES);
-        let rest = chunks.remainder();
-        for (c, chunk) in chunks.enumerate() {
-            let base = (c * LANES) as f32;
-            for k in 0..LANES {
-                let p = chunk[k];
-                let dot = p.x * dir.x + p.y * dir.y + p.z * dir.z;
-                // Strictly larger: a lane keeps its first of equals.
-                let larger = dot > best[k];
-                best[k] = if larger { dot } else { best[k] };
-                at[k] = if larger { base + k as f32 } else { at[k] };
+    POINT_COLUMNS.with_borrow_mut(|cache| {
+        let columns = cache.of(points);
+        on_instruction_set!(InstructionSet::detected(), {
+            let mut best = [Real::NEG_INFINITY; LANES];
+            // Indices as floats (exact below 2²⁴), chosen as the dot products are: in one
+            // vector register with them, where integer indices were chosen lane by lane.
+            let mut at = [0.0_f32; LANES];
+            let chunks = columns
+                .x
+                .chunks_exact(LANES)
+                .zip(columns.y.chunks_exact(LANES))
+                .zip(columns.z.chunks_exact(LANES));
+            for (c, ((x, y), z)) in chunks.enumerate() {
+                let base = (c * LANES) as f32;
+                for k in 0..LANES {
+                    let dot = x[k] * dir.x + y[k] * dir.y + z[k] * dir.z;
+                    // Strictly larger: a lane keeps its first of equals.
+                    let larger = dot > best[k];
+                    best[k] = if larger { dot } else { best[k] };
+                    at[k] = if larger { base + k as f32 } else { at[k] };
+                }
             }
-        }
-        // A lane's -inf stands for no larger point than the first (index 0 with it).
-        let mut top = (at[0] as usize, best[0]);
-        for k in 1..LANES {
-            let index = at[k] as usize;
-            if best[k] > top.1 || (best[k] == top.1 && index < top.0) {
-                top = (index, best[k]);
+            // A lane's -inf stands for no larger point than the first (index 0 with it).
+            let mut top = (at[0] as usize, best[0]);
+            for k in 1..LANES {
+                let index = at[k] as usize;
+                if best[k] > top.1 || (best[k] == top.1 && index < top.0) {
+                    top = (index, best[k]);
+                }
             }
-        }
-        let start = points.len() - rest.len();
-        for (i, p) in rest.iter().enumerate() {
-            let dot = p.dot(dir);
-            if dot > top.1 {
-                top = (start + i, dot);
+            let start = columns.x.len();
+            for (i, p) in points[start..].iter().enumerate() {
+                let dot = p.dot(dir);
+                if dot > top.1 {
+                    top = (start + i, dot);
+                }
             }
-        }
-        top.0
+            top.0
+        })
     })
+}
+
+/// Points [`first_largest_dot`] takes in lanes at a time.
+const COLUMN_LANES: usize = 8;
+
+/// Clouds whose columns a thread keeps ([`ColumnCache`]).
+const CACHED_CLOUDS: usize = 4;
+
+/// A cloud of points and the coordinates of its first whole multiple of [`COLUMN_LANES`]
+/// points in three columns.
+#[derive(Default)]
+struct PointColumns {
+    points: Vec<Vector>,
+    x: Vec<Real>,
+    y: Vec<Real>,
+    z: Vec<Real>,
+}
+
+/// The columns of the last [`CACHED_CLOUDS`] clouds a thread scanned, found again by their
+/// points' bits (a cloud is its points, wherever it lies, so a hull freed and another built
+/// in its place can never be read for it); the oldest is replaced.
+#[derive(Default)]
+struct ColumnCache {
+    clouds: Vec<PointColumns>,
+    next: usize,
+}
+
+impl ColumnCache {
+    /// The columns of `points`, made now unless kept.
+    fn of(&mut self, points: &[Vector]) -> &PointColumns {
+        if let Some(found) = self
+            .clouds
+            .iter()
+            .position(|cloud| same_bits(&cloud.points, points))
+        {
+            return &self.clouds[found];
+        }
+        if self.clouds.len() < CACHED_CLOUDS {
+            self.clouds.push(PointColumns::default());
+            self.next = self.clouds.len() - 1;
+        }
+        let slot = self.next;
+        self.next = (self.next + 1) % CACHED_CLOUDS;
+        let cloud = &mut self.clouds[slot];
+        cloud.points.clear();
+        cloud.points.extend_from_slice(points);
+        let whole = points.len() - points.len() % COLUMN_LANES;
+        for (column, coordinate) in [(&mut cloud.x, 0), (&mut cloud.y, 1), (&mut cloud.z, 2)] {
+            column.clear();
+            column.extend(points[..whole].iter().map(|p| p[coordinate]));
+        }
+        cloud
+    }
+}
+
+/// Whether two clouds have the same points to the bit.
+fn same_bits(a: &[Vector], b: &[Vector]) -> bool {
+    // SAFETY: a `Vector` (glam's `Vec3`) is three `f32`s in a `repr(C)` struct, twelve bytes
+    // with no padding, so a slice of them is that many initialised bytes.
+    let bytes = |points: &[Vector]| unsafe {
+        std::slice::from_raw_parts(points.as_ptr().cast::<u8>(), std::mem::size_of_val(points))
+    };
+    a.len() == b.len() && bytes(a) == bytes(b)
+}
+
+thread_local! {
+    /// [`first_largest_dot`]'s columns, kept per thread as [`EdgeBuffers`].
+    static POINT_COLUMNS: RefCell<ColumnCache> = RefCell::default();
 }
 
 /// A face normal of either shape (shape 1's frame, out of it: a hull's faces, a box's, a

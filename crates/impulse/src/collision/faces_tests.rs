@@ -785,3 +785,36 @@ fn clipping_by_boxes_gives_what_every_pair_gives() {
     }
     assert!(nonempty > 1000, "{nonempty} cases with points");
 }
+
+/// A vertex far beyond a sliver face (a V-HACD part's triangle 7 µm wide and 1.3 mm long, seen
+/// from a mug pour) is not over it: every edge test of such a face reads under the tolerance
+/// of a point on the edge, which let a vertex 37 mm away count as over the face, with its
+/// point on the face's plane far off the face. The face's box rules it out.
+#[test]
+fn a_vertex_beyond_a_sliver_face_is_not_over_it() {
+    let sliver = polygon(3, (1.0, 1.0), Vec3::ZERO, Vec3::Y, 0.0);
+    let f1 = super::Feature {
+        vertices: vec![
+            Vec3::new(0.024728, 0.009_214_29, -0.037597),
+            Vec3::new(0.025811, 0.009_214_29, -0.036862),
+            Vec3::new(0.024_827_79, 0.009_214_282, -0.037_529_275),
+        ],
+        ..sliver
+    };
+    let far = Vec3::new(0.045_241_043, 0.006_884_765, -0.027_057_588);
+    let f2 = super::Feature {
+        vertices: vec![
+            far,
+            far + Vec3::new(0.01, 0.0, 0.0),
+            far + Vec3::new(0.0, 0.0, 0.01),
+        ],
+        ..polygon(3, (1.0, 1.0), Vec3::ZERO, Vec3::Y, 0.0)
+    };
+    let n = Vec3::new(0.678_535, -0.604_484_2, -0.417_359_9).normalize();
+    let mut clipped = Vec::new();
+    super::clip(&f1, &f2, n, &mut clipped);
+    for c in &clipped {
+        let off = (c.p1.x - 0.0253).abs().max((c.p1.z + 0.0372).abs());
+        assert!(off < 1e-3, "point {} lies {off} m off the sliver", c.p1);
+    }
+}
