@@ -795,8 +795,8 @@ fn a_vertex_beyond_a_sliver_face_is_not_over_it() {
     let sliver = polygon(3, (1.0, 1.0), Vec3::ZERO, Vec3::Y, 0.0);
     let f1 = super::Feature {
         vertices: vec![
-            Vec3::new(0.024728, 0.009_214_29, -0.037597),
-            Vec3::new(0.025811, 0.009_214_29, -0.036862),
+            Vec3::new(0.024728, 0.009_214_289_5, -0.037597),
+            Vec3::new(0.025811, 0.009_214_289_5, -0.036862),
             Vec3::new(0.024_827_79, 0.009_214_282, -0.037_529_275),
         ],
         ..sliver
