@@ -923,124 +923,50 @@ fn local_support(shape: &dyn Shape, map: &dyn SupportMap, dir: Vector) -> Vector
 /// largest, and 0 when the first's is NaN: what Parry's `point_cloud_support_point_id`
 /// returns (a scan keeping the first of equals), to the bit. Eight points at a time in lanes,
 /// each keeping its first largest; then the largest of the lanes, the first of equals, and
-/// the points after the last eight in order. The lanes read the points' coordinates in
-/// columns ([`PointColumns`], kept per thread for the last few clouds: GJK and the face
-/// searches ask the same two hulls many times in a row), where reading them interleaved took
-/// shuffles that cost four times the arithmetic. Short clouds, and those whose first dot
-/// product is NaN, go to Parry's scan itself.
+/// the points after the last eight in order. Short clouds, and those whose first dot product
+/// is NaN, go to Parry's scan itself.
 pub(crate) fn first_largest_dot(points: &[Vector], dir: Vector) -> usize {
-    const LANES: usize = COLUMN_LANES;
+    const LANES: usize = 8;
     if points.len() < 2 * LANES || points.len() > 1 << 24 || points[0].dot(dir).is_nan() {
         return parry3d::utils::point_cloud_support_point_id(dir, points);
     }
-    POINT_COLUMNS.with_borrow_mut(|cache| {
-        let columns = cache.of(points);
-        on_instruction_set!(InstructionSet::detected(), {
-            let mut best = [Real::NEG_INFINITY; LANES];
-            // Indices as floats (exact below 2²⁴), chosen as the dot products are: in one
-            // vector register with them, where integer indices were chosen lane by lane.
-            let mut at = [0.0_f32; LANES];
-            let chunks = columns
-                .x
-                .chunks_exact(LANES)
-                .zip(columns.y.chunks_exact(LANES))
-                .zip(columns.z.chunks_exact(LANES));
-            for (c, ((x, y), z)) in chunks.enumerate() {
-                let base = (c * LANES) as f32;
-                for k in 0..LANES {
-                    let dot = x[k] * dir.x + y[k] * dir.y + z[k] * dir.z;
-                    // Strictly larger: a lane keeps its first of equals.
-                    let larger = dot > best[k];
-                    best[k] = if larger { dot } else { best[k] };
-                    at[k] = if larger { base + k as f32 } else { at[k] };
-                }
+    on_instruction_set!(InstructionSet::detected(), {
+        let mut best = [Real::NEG_INFINITY; LANES];
+        // Indices as floats (exact below 2²⁴), chosen as the dot products are: in one vector
+        // register with them, where integer indices were chosen lane by lane.
+        let mut at = [0.0_f32; LANES];
+        let chunks = points.chunks_exact(LANES);
+        let rest = chunks.remainder();
+        for (c, chunk) in chunks.enumerate() {
+            let base = (c * LANES) as f32;
+            for k in 0..LANES {
+                let p = chunk[k];
+                let dot = p.x * dir.x + p.y * dir.y + p.z * dir.z;
+                // Strictly larger: a lane keeps its first of equals.
+                let larger = dot > best[k];
+                best[k] = if larger { dot } else { best[k] };
+                at[k] = if larger { base + k as f32 } else { at[k] };
             }
-            // A lane's -inf stands for no larger point than the first (index 0 with it).
-            let mut top = (at[0] as usize, best[0]);
-            for k in 1..LANES {
-                let index = at[k] as usize;
-                if best[k] > top.1 || (best[k] == top.1 && index < top.0) {
-                    top = (index, best[k]);
-                }
+        }
+        // A lane's -inf stands for no larger point than the first (index 0 with it). The
+        // indices stay floats until the one returned (exact, and compared as floats: a
+        // conversion per lane cost more than the lanes' whole scan of a small hull).
+        let mut top = (at[0], best[0]);
+        for k in 1..LANES {
+            if best[k] > top.1 || (best[k] == top.1 && at[k] < top.0) {
+                top = (at[k], best[k]);
             }
-            let start = columns.x.len();
-            for (i, p) in points[start..].iter().enumerate() {
-                let dot = p.dot(dir);
-                if dot > top.1 {
-                    top = (start + i, dot);
-                }
+        }
+        let mut top = (top.0 as usize, top.1);
+        let start = points.len() - rest.len();
+        for (i, p) in rest.iter().enumerate() {
+            let dot = p.dot(dir);
+            if dot > top.1 {
+                top = (start + i, dot);
             }
-            top.0
-        })
+        }
+        top.0
     })
-}
-
-/// Points [`first_largest_dot`] takes in lanes at a time.
-const COLUMN_LANES: usize = 8;
-
-/// Clouds whose columns a thread keeps ([`ColumnCache`]).
-const CACHED_CLOUDS: usize = 4;
-
-/// A cloud of points and the coordinates of its first whole multiple of [`COLUMN_LANES`]
-/// points in three columns.
-#[derive(Default)]
-struct PointColumns {
-    points: Vec<Vector>,
-    x: Vec<Real>,
-    y: Vec<Real>,
-    z: Vec<Real>,
-}
-
-/// The columns of the last [`CACHED_CLOUDS`] clouds a thread scanned, found again by their
-/// points' bits (a cloud is its points, wherever it lies, so a hull freed and another built
-/// in its place can never be read for it); the oldest is replaced.
-#[derive(Default)]
-struct ColumnCache {
-    clouds: Vec<PointColumns>,
-    next: usize,
-}
-
-impl ColumnCache {
-    /// The columns of `points`, made now unless kept.
-    fn of(&mut self, points: &[Vector]) -> &PointColumns {
-        if let Some(found) = self
-            .clouds
-            .iter()
-            .position(|cloud| same_bits(&cloud.points, points))
-        {
-            return &self.clouds[found];
-        }
-        if self.clouds.len() < CACHED_CLOUDS {
-            self.clouds.push(PointColumns::default());
-            self.next = self.clouds.len() - 1;
-        }
-        let slot = self.next;
-        self.next = (self.next + 1) % CACHED_CLOUDS;
-        let cloud = &mut self.clouds[slot];
-        cloud.points.clear();
-        cloud.points.extend_from_slice(points);
-        let whole = points.len() - points.len() % COLUMN_LANES;
-        for (column, coordinate) in [(&mut cloud.x, 0), (&mut cloud.y, 1), (&mut cloud.z, 2)] {
-            column.clear();
-            column.extend(points[..whole].iter().map(|p| p[coordinate]));
-        }
-        cloud
-    }
-}
-
-/// Whether two clouds have the same points to the bit.
-fn same_bits(a: &[Vector], b: &[Vector]) -> bool {
-    // SAFETY: a `Vector` (glam's `Vec3`) is three `f32`s in a `repr(C)` struct, twelve bytes
-    // with no padding, so a slice of them is that many initialised bytes.
-    let bytes = |points: &[Vector]| unsafe {
-        std::slice::from_raw_parts(points.as_ptr().cast::<u8>(), std::mem::size_of_val(points))
-    };
-    a.len() == b.len() && bytes(a) == bytes(b)
-}
-
-thread_local! {
-    /// [`first_largest_dot`]'s columns, kept per thread as [`EdgeBuffers`].
-    static POINT_COLUMNS: RefCell<ColumnCache> = RefCell::default();
 }
 
 /// A face normal of either shape (shape 1's frame, out of it: a hull's faces, a box's, a
