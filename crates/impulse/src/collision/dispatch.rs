@@ -349,15 +349,7 @@ impl ContactDispatcher {
             manifold,
         );
         if !own(type1, type2) && !own(type2, type1) {
-            DefaultQueryDispatcher.contact_manifold_convex_convex(
-                pos12,
-                g1,
-                g2,
-                normal_constraints1,
-                normal_constraints2,
-                prediction,
-                manifold,
-            )?;
+            parry_manifold(pos12, g1, g2, constraints, prediction, manifold)?;
             fallback.after(pos12, g1, g2, constraints, prediction, manifold);
             return Ok(());
         }
