@@ -750,8 +750,7 @@ impl<ContactData: Default + Copy> KeptPoints<ContactData> {
 /// with a hull (not a ball or a half-space) goes to Parry's generator for polygonal feature
 /// maps as the default dispatcher sends it, with each hull behind a [`LanedHull`]. GJK takes
 /// a support point of each shape per iteration, and Parry's scans a hull's vertices one by
-/// one: between the mug's V-HACD parts (up to about a hundred vertices) most of the
-/// generator's time.
+/// one: between the mug's V-HACD parts, most of the generator's instructions.
 fn parry_manifold<ManifoldData, ContactData>(
     pos12: &Pose,
     g1: &dyn Shape,
