@@ -329,7 +329,7 @@ fn clip_with(
     let reaching = |segments: &[Segment], extent: &Extent, within: &mut Vec<u32>| {
         within.clear();
         within.extend(
-            (0..segments.len() as u32).filter(|&i| extent.meets(&segments[i as usize].extent())),
+            (0..segments.len() as u32).filter(|&i| extent.meets(&segments[i as usize].extent)),
         );
     };
     reaching(segments1, &box2, within1);
@@ -337,10 +337,10 @@ fn clip_with(
     for &i in within1.iter() {
         let (i, e1) = (i as usize, &segments1[i as usize]);
         let (a, b) = (i, (i + 1) % f1.vertices.len());
-        let reach1 = e1.extent().widened(margin);
+        let reach1 = e1.extent.widened(margin);
         for &j in within2.iter() {
             let (j, e2) = (j as usize, &segments2[j as usize]);
-            if !reach1.meets(&e2.extent()) {
+            if !reach1.meets(&e2.extent) {
                 continue;
             }
             if let Some((s, t)) = crossing(e1, e2) {
@@ -385,15 +385,15 @@ struct Extent {
 }
 
 impl Extent {
-    /// The box of the segments' starts (every vertex of a polygon; a segment's both ends are
-    /// starts of the feature's segments but for a lone segment, which gives its own box).
+    /// The box of the segments, the union of their own boxes (every vertex of a polygon, both
+    /// ends of a lone segment); empty for none.
     fn of(segments: &[Segment]) -> Self {
         let mut extent = Self {
             lower: [Real::INFINITY; 2],
             upper: [Real::NEG_INFINITY; 2],
         };
         for segment in segments {
-            let e = segment.extent();
+            let e = segment.extent;
             for k in 0..2 {
                 extent.lower[k] = extent.lower[k].min(e.lower[k]);
                 extent.upper[k] = extent.upper[k].max(e.upper[k]);
@@ -437,24 +437,21 @@ struct Segment {
     start: [Real; 2],
     dir: [Real; 2],
     length_squared: Real,
+    /// The segment's own box (its two ends').
+    extent: Extent,
 }
 
 impl Segment {
-    /// The segment's own box.
-    fn extent(&self) -> Extent {
-        let end = [self.start[0] + self.dir[0], self.start[1] + self.dir[1]];
-        Extent {
-            lower: [self.start[0].min(end[0]), self.start[1].min(end[1])],
-            upper: [self.start[0].max(end[0]), self.start[1].max(end[1])],
-        }
-    }
-
     fn new(start: [Real; 2], end: [Real; 2]) -> Self {
         let dir = [end[0] - start[0], end[1] - start[1]];
         Self {
             start,
             dir,
             length_squared: dir[0] * dir[0] + dir[1] * dir[1],
+            extent: Extent {
+                lower: [start[0].min(end[0]), start[1].min(end[1])],
+                upper: [start[0].max(end[0]), start[1].max(end[1])],
+            },
         }
     }
 }
