@@ -105,20 +105,18 @@ impl IslandWorkspace {
                 parallel: self.parallel,
             },
         };
-        // A substep whose main solve found an impact sweeps its relax solve to convergence too
-        // (more than one sweep, so the lanes do not carry the warm start): the whole island,
-        // or its budget and then the points around the impact.
+        // A substep whose main solve found an impact sweeps its relax solve to convergence too:
+        // the whole island (more than one sweep, so the lanes do not carry the warm start), or
+        // its budget and then the points around the impact (whose changes the lanes carry on
+        // top of the relax sweep's, `Bundles::solve_local`).
         let local = self.impact_region.kind == RegionKind::Local;
-        let pass = match (!with_repair && self.impact_met, local) {
-            (true, false) => SolvePass {
+        let pass = if !with_repair && self.impact_met && !local {
+            SolvePass {
                 iterations: pass.iterations.max(self.impact_sweeps(settings)),
                 ..pass
-            },
-            (true, true) => SolvePass {
-                warm_start_follows: false,
-                ..pass
-            },
-            (false, _) => pass,
+            }
+        } else {
+            pass
         };
         if !self.joints.is_empty() && pass.targets.is_some() {
             self.joints

@@ -30,6 +30,9 @@ pub(crate) struct Bundles {
     pub(super) local_lanes: Vec<super::layout::LocalLane>,
     pub(super) local_filled: Vec<u8>,
     pub(super) local_after: Vec<u32>,
+    /// Per local bundle, the impulses (normal, tangent 1, tangent 2) the local sweeps started
+    /// from, while a carried warm start is pending (see [`Bundles::solve_local`]).
+    pub(super) local_start: Vec<[Lane; 3]>,
     /// Every lane group's body slots (A, B per lane), copied out of `groups` at the first
     /// `select_local` after a pack (`group_slots_known`), so that each substep's selection
     /// reads 32 bytes a lane group instead of the whole group.

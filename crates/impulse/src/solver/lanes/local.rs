@@ -12,10 +12,10 @@
 //! so the sweep is the island's Gauss-Seidel order restricted to the region.
 
 use super::bundles::Bundles;
-use super::lane::{LANES, Lane};
+use super::lane::{LANES, Lane, set};
 use super::layout::{Bundle, Group, LocalLane};
 use super::schedule::{SweepOrder, sweep_groups_on};
-use super::sweep::{BundleUpdate, VelocityRows};
+use super::sweep::{BundleUpdate, CarryChanges, VelocityRows};
 use super::targets::NoTargets;
 use crate::parallel::{SharedItems, SharedVelocities};
 use crate::simd::InstructionSet;
@@ -125,6 +125,19 @@ impl Bundles {
         for (local, to, island, from) in local_places(&self.local_lanes, &self.local_groups) {
             self.local_bundles[local].copy_solve_state_from(to, &self.bundles[island], from);
         }
+        // After a relax sweep that carried the next substep's warm start, what these sweeps
+        // change is carried too (`carry_local_changes`).
+        let carrying = self.carried;
+        if carrying {
+            self.local_start.clear();
+            self.local_start.extend(self.local_bundles.iter().map(|b| {
+                [
+                    b.normal_impulse,
+                    b.tangent_impulses[0],
+                    b.tangent_impulses[1],
+                ]
+            }));
+        }
         let mut report = SolveReport::default();
         for iteration in 0..iterations {
             let order = SweepOrder {
@@ -143,10 +156,72 @@ impl Bundles {
                 break;
             }
         }
+        if carrying {
+            self.carry_local_changes(velocities);
+        }
         for (local, to, island, from) in local_places(&self.local_lanes, &self.local_groups) {
             self.bundles[island].copy_impulses_from(from, &self.local_bundles[local], to);
         }
         report
+    }
+
+    /// Adds what the local sweeps changed of their points' impulses (the local bundles' now
+    /// against `local_start`) to the step totals and, as M⁻¹Jᵀ(γ − γ₀), to the warm start the
+    /// relax sweep before them carried (see [`RelaxCarrying`](super::sweep::RelaxCarrying)),
+    /// so that the next substep's warm start adds the sums instead of passing over every
+    /// bundle of the island: the same velocities up to rounding. Runs before the impulses are
+    /// copied back. `velocities` are the island's (left as they are).
+    fn carry_local_changes(&mut self, velocities: &mut Velocities<'_>) {
+        let slots = velocities.linear.len();
+        for (local, to, island, from) in local_places(&self.local_lanes, &self.local_groups) {
+            let (now, start) = (&self.local_bundles[local], &self.local_start[local]);
+            let changes = [
+                now.normal_impulse,
+                now.tangent_impulses[0],
+                now.tangent_impulses[1],
+            ];
+            for ((total, change), start) in
+                self.step_totals[island].iter_mut().zip(changes).zip(start)
+            {
+                let added = total.as_array()[from] + (change.as_array()[to] - start.as_array()[to]);
+                set(total, from, added);
+            }
+        }
+        let carried = SharedVelocities {
+            linear: self.carried_linear.as_mut_ptr(),
+            angular: self.carried_angular.as_mut_ptr(),
+            immovable: slots.wrapping_sub(1),
+        };
+        let update = CarryChanges {
+            start: SharedItems(self.local_start.as_mut_ptr()),
+            carried,
+        };
+        // The sweep's own gather and scatter of the velocities leave them as they are.
+        let shared = SharedVelocities::of(velocities);
+        let (bundles, len) = (
+            SharedItems(self.local_bundles.as_mut_ptr()),
+            self.local_bundles.len(),
+        );
+        let (instruction_set, fused) = (InstructionSet::detected(), self.fused);
+        let order = SweepOrder {
+            forward: true,
+            half_turn: false,
+        };
+        // SAFETY: as in `sweep_local`; `local_start` has one entry per local bundle and
+        // `carried_linear` and `carried_angular` one per island slot (`start_carrying`).
+        unsafe {
+            sweep_groups_on(
+                instruction_set,
+                fused,
+                &self.local_groups,
+                bundles,
+                len,
+                order,
+                &shared,
+                update,
+                NoTargets,
+            );
+        }
     }
 
     /// One sweep of `update` over the local groups on this thread; returns the lane-wise

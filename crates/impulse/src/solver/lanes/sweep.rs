@@ -155,10 +155,26 @@ pub(super) fn add_to_totals(total: &mut [Lane; 3], b: &Bundle) {
 /// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v` (its lane group `group`).
 #[inline(always)]
 pub(super) fn apply_impulses<R: Rounding>(b: &Bundle, group: &Group, v: &mut BodyLanes) {
-    let (masses, [n, t1, t2]) = (group.inverse_masses(), &group.directions);
-    b.normal.apply::<R>(n, b.normal_impulse, masses, v);
-    b.tangents[0].apply::<R>(t1, b.tangent_impulses[0], masses, v);
-    b.tangents[1].apply::<R>(t2, b.tangent_impulses[1], masses, v);
+    let impulses = [
+        b.normal_impulse,
+        b.tangent_impulses[0],
+        b.tangent_impulses[1],
+    ];
+    apply_given::<R>(b, group, impulses, v);
+}
+
+/// Adds M⁻¹Jᵀγ of impulses γ (normal, tangent 1, tangent 2; N·s) on a bundle's rows to `v`.
+#[inline(always)]
+fn apply_given<R: Rounding>(
+    b: &Bundle,
+    group: &Group,
+    [normal, t1, t2]: [Lane; 3],
+    v: &mut BodyLanes,
+) {
+    let (masses, [d_n, d_1, d_2]) = (group.inverse_masses(), &group.directions);
+    b.normal.apply::<R>(d_n, normal, masses, v);
+    b.tangents[0].apply::<R>(d_1, t1, masses, v);
+    b.tangents[1].apply::<R>(d_2, t2, masses, v);
 }
 
 /// The relax sweep of a substep that another substep follows: the velocity rows with friction
@@ -200,6 +216,50 @@ impl BundleUpdate for RelaxCarrying {
             let b = unsafe { &*bundles.0.add(index) };
             add_to_totals(unsafe { &mut *self.totals.0.add(index) }, b);
             apply_impulses::<R>(b, group, &mut carried);
+        }
+        // SAFETY: the caller's contract.
+        unsafe { self.carried.scatter(slots_a, slots_b, &carried) }
+    }
+}
+
+/// What an impact's local sweeps ([`Bundles::solve_local`]) changed of the impulses that the
+/// relax sweep before them carried into the next substep's warm start ([`RelaxCarrying`]):
+/// per local bundle, M⁻¹Jᵀ(γ − γ₀) added to `carried`, γ₀ the impulses it started the local
+/// sweeps with (`start`, one entry per local bundle: normal, tangent 1, tangent 2). Changes
+/// neither an impulse nor a velocity; the sweep that runs it only visits the lane groups.
+#[derive(Clone, Copy)]
+pub(super) struct CarryChanges {
+    pub(super) start: SharedItems<[Lane; 3]>,
+    pub(super) carried: SharedVelocities,
+}
+
+impl BundleUpdate for CarryChanges {
+    #[inline(always)]
+    fn update_at<R: Rounding>(
+        self,
+        _: &mut Bundle,
+        _: &Group,
+        _: usize,
+        _: &mut BodyLanes,
+    ) -> Lane {
+        Lane::splat(0.0)
+    }
+
+    #[inline(always)]
+    unsafe fn end<R: Rounding>(self, group: &Group, visits: Visits, bundles: SharedItems<Bundle>) {
+        let (slots_a, slots_b) = (&group.local_a, &group.local_b);
+        // SAFETY: the caller's contract.
+        let mut carried = unsafe { self.carried.gather(slots_a, slots_b) };
+        for p in 0..visits.count {
+            let index = visits.index(p);
+            // SAFETY: the caller's contract; `start` has one entry per bundle.
+            let (b, start) = unsafe { (&*bundles.0.add(index), &*self.start.0.add(index)) };
+            let change = [
+                b.normal_impulse - start[0],
+                b.tangent_impulses[0] - start[1],
+                b.tangent_impulses[1] - start[2],
+            ];
+            apply_given::<R>(b, group, change, &mut carried);
         }
         // SAFETY: the caller's contract.
         unsafe { self.carried.scatter(slots_a, slots_b, &carried) }

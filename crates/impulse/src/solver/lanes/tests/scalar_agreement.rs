@@ -513,6 +513,142 @@ fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
     assert_eq!(carried_bits[0], carried_bits[1], "1 and 2 threads");
 }
 
+/// An impact's local sweeps after a relax sweep that carried the next substep's warm start
+/// carry what they change too: the same impulses to the bit as without carrying, the step
+/// totals and the velocities after the next warm start the same up to rounding (the changes
+/// are summed apart), on one and two threads alike. Rows as in
+/// `relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass`; the region: the bodies of
+/// every seventh slot.
+#[test]
+fn local_sweeps_after_a_carrying_relax_sweep_carry_their_changes() {
+    use super::Bundles;
+    use crate::contact::ContactConstraint;
+    use crate::solver::{ContactSolver, Velocities};
+    let (w, settled) = settled_pyramid20_rows();
+    let n = w.bodies.len();
+    let rows: Vec<ContactConstraint> = (0..4).flat_map(|_| settled.iter().copied()).collect();
+    let wave = |k: usize, a: f32, b: f32, c: f32| {
+        let x = k as f32;
+        Vec3::new(a * x.sin(), b, c * x.cos())
+    };
+    let mut linear_start: Vec<Vec3> = (0..n).map(|k| wave(k, 0.3, -0.6, 0.2)).collect();
+    let mut angular_start: Vec<Vec3> = (0..n).map(|k| wave(k, 0.4, -0.2, 0.3)).collect();
+    linear_start.push(Vec3::ZERO);
+    angular_start.push(Vec3::ZERO);
+    let still = vec![Vec3::ZERO; n + 1];
+    let settings = SolverSettings::default();
+    let inverse_inertia: Vec<Mat3> = (0..=n)
+        .map(|k| {
+            if k < n {
+                w.bodies.world_inverse_inertia(k)
+            } else {
+                Mat3::ZERO
+            }
+        })
+        .collect();
+    let in_region = |slot: u32| (slot as usize) < n && slot.is_multiple_of(7);
+    // Relax, the local sweeps, then the next substep's warm start: (velocities, impulses,
+    // step totals, local sweeps taken).
+    let run = |carry: bool, threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut bundles = Bundles::default();
+            bundles.pack(&rows, n + 1, &inverse_inertia, threads > 1);
+            let (mut linear, mut angular) = (linear_start.clone(), angular_start.clone());
+            let mut velocities = Velocities {
+                linear: &mut linear,
+                angular: &mut angular,
+            };
+            bundles.warm_start(&mut [], &mut velocities, 0);
+            let pass = pass_at_rest(&still, &settings, false, carry);
+            bundles.solve_pgs(&mut velocities, &mut IslandJoints::default(), &pass);
+            let points = bundles.select_local(in_region);
+            let report = bundles.solve_local(&mut velocities, 6, 0.0, true, false);
+            bundles.warm_start(&mut [], &mut velocities, 1);
+            let mut unpacked = rows.clone();
+            bundles.unpack(&mut unpacked);
+            let impulses: Vec<f32> = unpacked
+                .iter()
+                .flat_map(|c| {
+                    [
+                        c.normal_impulse,
+                        c.tangent_impulses[0],
+                        c.tangent_impulses[1],
+                    ]
+                })
+                .collect();
+            let totals: Vec<f32> = unpacked.iter().flat_map(|c| c.step_impulses).collect();
+            (
+                linear,
+                angular,
+                impulses,
+                totals,
+                (points, report.iterations),
+            )
+        })
+    };
+    let (linear, angular, impulses, totals, (points, sweeps)) = run(false, 1);
+    assert!(
+        points > 0 && points < rows.len() / 2 && sweeps == 6,
+        "{points} of {} points in the region, {sweeps} local sweeps",
+        rows.len()
+    );
+    let largest = linear
+        .iter()
+        .chain(&angular)
+        .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+    let largest_total = totals.iter().fold(0.0f32, |m, t| m.max(t.abs()));
+    assert!(
+        largest > 0.1 && largest_total > 0.0,
+        "{largest} m/s, {largest_total} N·s"
+    );
+    let mut carried_bits = Vec::new();
+    for threads in [1, 2] {
+        let (carried_linear, carried_angular, carried_impulses, carried_totals, _) =
+            run(true, threads);
+        let bits = |values: &[f32]| values.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(&impulses),
+            bits(&carried_impulses),
+            "{threads} threads: impulses"
+        );
+        for (k, (got, want)) in carried_totals.iter().zip(&totals).enumerate() {
+            assert!(
+                (got - want).abs() <= 1e-5 * largest_total,
+                "{threads} threads, step total {k}: {got} carried, {want} by the pass"
+            );
+        }
+        for (k, (got, want)) in carried_linear
+            .iter()
+            .zip(&linear)
+            .chain(carried_angular.iter().zip(&angular))
+            .enumerate()
+        {
+            assert!(
+                (*got - *want).abs().max_element() <= 1e-5 * largest,
+                "{threads} threads, velocity {k}: {got} carried, {want} by the pass"
+            );
+        }
+        assert_eq!(
+            carried_linear[n],
+            Vec3::ZERO,
+            "the immovable slot stays at rest"
+        );
+        carried_bits.push(
+            carried_linear
+                .iter()
+                .chain(&carried_angular)
+                .flat_map(|v| v.to_array().map(f32::to_bits))
+                .chain(bits(&carried_totals))
+                .collect::<Vec<_>>(),
+        );
+    }
+    assert_eq!(carried_bits[0], carried_bits[1], "1 and 2 threads");
+}
+
 /// The normal rows' sweep (the soft step's main solve) reads and writes nothing past the
 /// bundle's first [`super::NORMAL_PART`] bytes, the part it asks the CPU for, and its target
 /// update no lever arm: with every byte after that part and every lever arm set to a NaN, the
