@@ -109,8 +109,11 @@ pub fn parse_scene_str_in(text: &str, origin: &str, directory: &Path) -> Result<
 }
 
 /// Reads the file of every `trimesh` shape of `scene` (relative to `directory`) into its
-/// `loaded` mesh. Errors name the body and `shape.file` but have no origin yet.
+/// `loaded` mesh, each file named once read once: the bodies naming it share its triangles.
+/// Errors name the body and `shape.file` (the first body naming a file that fails) but have
+/// no origin yet.
 fn load_meshes(scene: &mut Scene, directory: &Path) -> Result<(), SceneError> {
+    let mut read = std::collections::HashMap::new();
     for (index, body) in scene.bodies.iter_mut().enumerate() {
         if let ShapeDesc::Trimesh {
             file: Some(file),
@@ -118,12 +121,15 @@ fn load_meshes(scene: &mut Scene, directory: &Path) -> Result<(), SceneError> {
             ..
         } = &mut body.shape
         {
-            *loaded = Some(read_body_mesh(
-                index,
-                body.name.as_deref(),
-                file,
-                directory,
-            )?);
+            let mesh = match read.get(file.as_str()) {
+                Some(mesh) => super::mesh_file::LoadedMesh::clone(mesh),
+                None => {
+                    let mesh = read_body_mesh(index, body.name.as_deref(), file, directory)?;
+                    read.insert(file.clone(), mesh.clone());
+                    mesh
+                }
+            };
+            *loaded = Some(mesh);
         }
     }
     Ok(())

@@ -501,6 +501,7 @@ mod mesh_data;
 mod mesh_file;
 pub mod mesh_mass;
 mod notes;
+mod recent;
 mod roughness_draws;
 mod shape;
 pub mod thin;

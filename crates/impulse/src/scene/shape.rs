@@ -93,9 +93,11 @@ pub(crate) fn shape_of(shape: &ShapeDesc) -> Result<SharedShape, (String, String
             } else {
                 TriMeshFlags::FIX_INTERNAL_EDGES
             };
-            let vertices = mesh.vertices.iter().map(|v| Vec3::from(*v)).collect();
-            SharedShape::trimesh_with_flags(vertices, mesh.indices, flags)
-                .map_err(|e| ("shape".to_string(), format!("invalid triangle mesh: {e}")))?
+            super::recent::triangle_mesh(&mesh, *two_sided, || {
+                let vertices = mesh.vertices.iter().map(|v| Vec3::from(*v)).collect();
+                SharedShape::trimesh_with_flags(vertices, mesh.indices.clone(), flags)
+                    .map_err(|e| ("shape".to_string(), format!("invalid triangle mesh: {e}")))
+            })?
         }
         ShapeDesc::HeightField { heights, scale } => {
             let (rows, columns) = (heights.len(), heights[0].len());

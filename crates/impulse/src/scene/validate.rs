@@ -467,7 +467,7 @@ impl Checker {
         if self.errors.len() == before
             && is_decomposed(kind, shape)
             && let Some(mesh) = shape.mesh_data()
-            && let Some(problem) = hull_degeneracy(&mesh.vertices)
+            && let Some(problem) = super::recent::hull_check(&mesh.vertices, hull_degeneracy)
         {
             let field = match shape {
                 ShapeDesc::Trimesh { file: Some(_), .. } => "file",
