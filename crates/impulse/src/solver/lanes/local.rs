@@ -192,36 +192,18 @@ impl Bundles {
             angular: self.carried_angular.as_mut_ptr(),
             immovable: slots.wrapping_sub(1),
         };
+        // `local_start` has one entry per local bundle and the carried velocities one per
+        // island slot (`start_carrying`), as `CarryChanges` requires.
         let update = CarryChanges {
             start: SharedItems(self.local_start.as_mut_ptr()),
             carried,
         };
         // The sweep's own gather and scatter of the velocities leave them as they are.
-        let shared = SharedVelocities::of(velocities);
-        let (bundles, len) = (
-            SharedItems(self.local_bundles.as_mut_ptr()),
-            self.local_bundles.len(),
-        );
-        let (instruction_set, fused) = (InstructionSet::detected(), self.fused);
         let order = SweepOrder {
             forward: true,
             half_turn: false,
         };
-        // SAFETY: as in `sweep_local`; `local_start` has one entry per local bundle and
-        // `carried_linear` and `carried_angular` one per island slot (`start_carrying`).
-        unsafe {
-            sweep_groups_on(
-                instruction_set,
-                fused,
-                &self.local_groups,
-                bundles,
-                len,
-                order,
-                &shared,
-                update,
-                NoTargets,
-            );
-        }
+        self.sweep_local(order, velocities, update);
     }
 
     /// One sweep of `update` over the local groups on this thread; returns the lane-wise

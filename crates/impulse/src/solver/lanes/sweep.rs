@@ -206,19 +206,17 @@ impl BundleUpdate for RelaxCarrying {
 
     #[inline(always)]
     unsafe fn end<R: Rounding>(self, group: &Group, visits: Visits, bundles: SharedItems<Bundle>) {
-        let (slots_a, slots_b) = (&group.local_a, &group.local_b);
-        // SAFETY: the caller's contract.
-        let mut carried = unsafe { self.carried.gather(slots_a, slots_b) };
-        for p in 0..visits.count {
-            let index = visits.index(p);
-            // SAFETY: the caller's contract; `totals` has one entry per bundle, as in
-            // `WarmStart`.
-            let b = unsafe { &*bundles.0.add(index) };
-            add_to_totals(unsafe { &mut *self.totals.0.add(index) }, b);
-            apply_impulses::<R>(b, group, &mut carried);
+        // SAFETY: the caller's contract; `totals` has one entry per bundle, as in `WarmStart`.
+        unsafe {
+            carry_group::<R>(&self.carried, group, visits, bundles, |index, b| {
+                add_to_totals(&mut *self.totals.0.add(index), b);
+                [
+                    b.normal_impulse,
+                    b.tangent_impulses[0],
+                    b.tangent_impulses[1],
+                ]
+            })
         }
-        // SAFETY: the caller's contract.
-        unsafe { self.carried.scatter(slots_a, slots_b, &carried) }
     }
 }
 
@@ -247,23 +245,45 @@ impl BundleUpdate for CarryChanges {
 
     #[inline(always)]
     unsafe fn end<R: Rounding>(self, group: &Group, visits: Visits, bundles: SharedItems<Bundle>) {
-        let (slots_a, slots_b) = (&group.local_a, &group.local_b);
-        // SAFETY: the caller's contract.
-        let mut carried = unsafe { self.carried.gather(slots_a, slots_b) };
-        for p in 0..visits.count {
-            let index = visits.index(p);
-            // SAFETY: the caller's contract; `start` has one entry per bundle.
-            let (b, start) = unsafe { (&*bundles.0.add(index), &*self.start.0.add(index)) };
-            let change = [
-                b.normal_impulse - start[0],
-                b.tangent_impulses[0] - start[1],
-                b.tangent_impulses[1] - start[2],
-            ];
-            apply_given::<R>(b, group, change, &mut carried);
+        // SAFETY: the caller's contract; `start` has one entry per bundle.
+        unsafe {
+            carry_group::<R>(&self.carried, group, visits, bundles, |index, b| {
+                let start = &*self.start.0.add(index);
+                [
+                    b.normal_impulse - start[0],
+                    b.tangent_impulses[0] - start[1],
+                    b.tangent_impulses[1] - start[2],
+                ]
+            })
         }
-        // SAFETY: the caller's contract.
-        unsafe { self.carried.scatter(slots_a, slots_b, &carried) }
     }
+}
+
+/// Adds M⁻¹Jᵀγ of each bundle of `group` to `carried`, in the order `visits` gives, with γ
+/// (normal, tangent 1, tangent 2; N·s) = `impulses(index, bundle)`: the group's slots gathered
+/// once and scattered once.
+///
+/// # Safety
+/// As [`BundleUpdate::end`], and no other thread touches these slots of `carried` meanwhile.
+#[inline(always)]
+unsafe fn carry_group<R: Rounding>(
+    carried: &SharedVelocities,
+    group: &Group,
+    visits: Visits,
+    bundles: SharedItems<Bundle>,
+    mut impulses: impl FnMut(usize, &Bundle) -> [Lane; 3],
+) {
+    let (slots_a, slots_b) = (&group.local_a, &group.local_b);
+    // SAFETY: the caller's contract.
+    let mut lanes = unsafe { carried.gather(slots_a, slots_b) };
+    for p in 0..visits.count {
+        let index = visits.index(p);
+        // SAFETY: the caller's contract.
+        let b = unsafe { &*bundles.0.add(index) };
+        apply_given::<R>(b, group, impulses(index, b), &mut lanes);
+    }
+    // SAFETY: the caller's contract.
+    unsafe { carried.scatter(slots_a, slots_b, &lanes) }
 }
 
 /// One Gauss-Seidel update of every lane's point: the normal row clamped to γ_n ≥ 0, then the

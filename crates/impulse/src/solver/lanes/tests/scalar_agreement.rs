@@ -403,6 +403,135 @@ fn pass_at_rest<'a>(
     }
 }
 
+/// The carrying tests' island: the settled pyramid's rows four times over (past the parallel
+/// threshold), its `n` bodies moving in a wave of amplitudes `linear` (m/s) and `angular`
+/// (rad/s) per axis, the immovable slot last; the bodies' world inverse inertia.
+struct CarryingIsland {
+    n: usize,
+    rows: Vec<crate::contact::ContactConstraint>,
+    linear: Vec<Vec3>,
+    angular: Vec<Vec3>,
+    inverse_inertia: Vec<Mat3>,
+}
+
+fn carrying_island(linear: [f32; 3], angular: [f32; 3]) -> CarryingIsland {
+    let (w, settled) = settled_pyramid20_rows();
+    let n = w.bodies.len();
+    let rows: Vec<_> = (0..4).flat_map(|_| settled.iter().copied()).collect();
+    assert!(rows.len() > 4096, "{} rows", rows.len());
+    let wave = |k: usize, [a, b, c]: [f32; 3]| {
+        let x = k as f32;
+        Vec3::new(a * x.sin(), b, c * x.cos())
+    };
+    let moving = |amplitudes| (0..n).map(move |k| wave(k, amplitudes));
+    CarryingIsland {
+        n,
+        rows,
+        linear: moving(linear).chain([Vec3::ZERO]).collect(),
+        angular: moving(angular).chain([Vec3::ZERO]).collect(),
+        inverse_inertia: (0..=n)
+            .map(|k| {
+                if k < n {
+                    w.bodies.world_inverse_inertia(k)
+                } else {
+                    Mat3::ZERO
+                }
+            })
+            .collect(),
+    }
+}
+
+impl CarryingIsland {
+    /// On `threads` threads: the warm start, a relax sweep that carries the next warm start or
+    /// not (`carry`), `between` (on the bundles and the velocities), and the next substep's
+    /// warm start; the velocities and the rows unpacked (impulses and step totals).
+    fn relax_then_warm_start(
+        &self,
+        carry: bool,
+        threads: usize,
+        between: impl Fn(&mut super::Bundles, &mut crate::solver::Velocities<'_>) + Sync,
+    ) -> (Vec<Vec3>, Vec<Vec3>, Vec<crate::contact::ContactConstraint>) {
+        use crate::solver::{ContactSolver, Velocities};
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut bundles = super::Bundles::default();
+            let slots = self.n + 1;
+            bundles.pack(&self.rows, slots, &self.inverse_inertia, threads > 1);
+            let (mut linear, mut angular) = (self.linear.clone(), self.angular.clone());
+            let mut velocities = Velocities {
+                linear: &mut linear,
+                angular: &mut angular,
+            };
+            bundles.warm_start(&mut [], &mut velocities, 0);
+            let (still, settings) = (vec![Vec3::ZERO; slots], SolverSettings::default());
+            let pass = pass_at_rest(&still, &settings, false, carry);
+            bundles.solve_pgs(&mut velocities, &mut IslandJoints::default(), &pass);
+            between(&mut bundles, &mut velocities);
+            bundles.warm_start(&mut [], &mut velocities, 1);
+            let mut unpacked = self.rows.clone();
+            bundles.unpack(&mut unpacked);
+            (linear, angular, unpacked)
+        })
+    }
+}
+
+/// The rows' impulses (normal, tangent 1, tangent 2) and step totals, bit for bit.
+fn impulse_bits(rows: &[crate::contact::ContactConstraint]) -> (Vec<u32>, Vec<u32>) {
+    let bits = |values: &mut dyn Iterator<Item = f32>| values.map(f32::to_bits).collect();
+    (
+        bits(&mut rows.iter().flat_map(|c| {
+            [
+                c.normal_impulse,
+                c.tangent_impulses[0],
+                c.tangent_impulses[1],
+            ]
+        })),
+        bits(&mut rows.iter().flat_map(|c| c.step_impulses)),
+    )
+}
+
+/// The largest velocity component (m/s or rad/s) of `linear` and `angular`.
+fn largest_velocity(linear: &[Vec3], angular: &[Vec3]) -> f32 {
+    linear
+        .iter()
+        .chain(angular)
+        .fold(0.0f32, |m, v| m.max(v.abs().max_element()))
+}
+
+/// Asserts that the carried velocities are the pass's within 1e-5 of `largest`, that the
+/// immovable slot (the last) stays at rest, and returns the carried velocities' bits.
+fn assert_carried_velocities(
+    (linear, angular): (&[Vec3], &[Vec3]),
+    (want_linear, want_angular): (&[Vec3], &[Vec3]),
+    largest: f32,
+    threads: usize,
+) -> Vec<u32> {
+    for (k, (got, want)) in linear
+        .iter()
+        .zip(want_linear)
+        .chain(angular.iter().zip(want_angular))
+        .enumerate()
+    {
+        assert!(
+            (*got - *want).abs().max_element() <= 1e-5 * largest,
+            "{threads} threads, velocity {k}: {got} carried, {want} by the pass"
+        );
+    }
+    assert_eq!(
+        linear.last(),
+        Some(&Vec3::ZERO),
+        "the immovable slot stays at rest"
+    );
+    linear
+        .iter()
+        .chain(angular)
+        .flat_map(|v| v.to_array().map(f32::to_bits))
+        .collect()
+}
+
 /// A relax sweep that carries the next substep's warm start (`warm_start_follows`) gives what
 /// the relax sweep and the separate warm-start pass give: the same impulses and step totals
 /// to the bit (the solve is the same; the totals get the same additions in the same order) and
@@ -411,104 +540,25 @@ fn pass_at_rest<'a>(
 /// repeated to pass the parallel threshold, with moving bodies and a soft relax target.
 #[test]
 fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
-    use super::Bundles;
-    use crate::contact::ContactConstraint;
-    use crate::solver::{ContactSolver, Velocities};
-    let (w, settled) = settled_pyramid20_rows();
-    let n = w.bodies.len();
-    let rows: Vec<ContactConstraint> = (0..4).flat_map(|_| settled.iter().copied()).collect();
-    assert!(rows.len() > 4096, "{} rows", rows.len());
-    let wave = |k: usize, a: f32, b: f32, c: f32| {
-        let x = k as f32;
-        Vec3::new(a * x.sin(), b, c * x.cos())
-    };
-    let mut linear_start: Vec<Vec3> = (0..n).map(|k| wave(k, 0.1, -0.3, 0.05)).collect();
-    let mut angular_start: Vec<Vec3> = (0..n).map(|k| wave(k, 0.2, -0.1, 0.1)).collect();
-    linear_start.push(Vec3::ZERO);
-    angular_start.push(Vec3::ZERO);
-    let still = vec![Vec3::ZERO; n + 1];
-    let settings = SolverSettings::default();
-    let inverse_inertia: Vec<Mat3> = (0..=n)
-        .map(|k| {
-            if k < n {
-                w.bodies.world_inverse_inertia(k)
-            } else {
-                Mat3::ZERO
-            }
-        })
-        .collect();
-    // Relax, then the next substep's warm start: (velocities, impulses, step totals).
-    let run = |carry: bool, threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let mut bundles = Bundles::default();
-            bundles.pack(&rows, n + 1, &inverse_inertia, threads > 1);
-            let (mut linear, mut angular) = (linear_start.clone(), angular_start.clone());
-            let mut velocities = Velocities {
-                linear: &mut linear,
-                angular: &mut angular,
-            };
-            bundles.warm_start(&mut [], &mut velocities, 0);
-            let pass = pass_at_rest(&still, &settings, false, carry);
-            bundles.solve_pgs(&mut velocities, &mut IslandJoints::default(), &pass);
-            bundles.warm_start(&mut [], &mut velocities, 1);
-            let mut unpacked = rows.clone();
-            bundles.unpack(&mut unpacked);
-            let impulses: Vec<u32> = unpacked
-                .iter()
-                .flat_map(|c| {
-                    [
-                        c.normal_impulse,
-                        c.tangent_impulses[0],
-                        c.tangent_impulses[1],
-                    ]
-                    .into_iter()
-                    .chain(c.step_impulses)
-                })
-                .map(f32::to_bits)
-                .collect();
-            (linear, angular, impulses)
-        })
-    };
-    let (linear, angular, impulses) = run(false, 1);
-    let largest = linear
-        .iter()
-        .chain(&angular)
-        .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+    let island = carrying_island([0.1, -0.3, 0.05], [0.2, -0.1, 0.1]);
+    let nothing = |_: &mut super::Bundles, _: &mut crate::solver::Velocities<'_>| {};
+    let (linear, angular, rows) = island.relax_then_warm_start(false, 1, nothing);
+    let largest = largest_velocity(&linear, &angular);
     assert!(largest > 0.1, "the bodies should move: {largest}");
     let mut carried_bits = Vec::new();
     for threads in [1, 2] {
-        let (carried_linear, carried_angular, carried_impulses) = run(true, threads);
+        let (carried_linear, carried_angular, carried_rows) =
+            island.relax_then_warm_start(true, threads, nothing);
         assert!(
-            impulses == carried_impulses,
+            impulse_bits(&rows) == impulse_bits(&carried_rows),
             "{threads} threads: impulses or step totals differ"
         );
-        for (k, (got, want)) in carried_linear
-            .iter()
-            .zip(&linear)
-            .chain(carried_angular.iter().zip(&angular))
-            .enumerate()
-        {
-            assert!(
-                (*got - *want).abs().max_element() <= 1e-5 * largest,
-                "{threads} threads, velocity {k}: {got} carried, {want} by the pass"
-            );
-        }
-        assert_eq!(
-            carried_linear[n],
-            Vec3::ZERO,
-            "the immovable slot stays at rest"
-        );
-        carried_bits.push(
-            carried_linear
-                .iter()
-                .chain(&carried_angular)
-                .flat_map(|v| v.to_array().map(f32::to_bits))
-                .collect::<Vec<_>>(),
-        );
+        carried_bits.push(assert_carried_velocities(
+            (&carried_linear, &carried_angular),
+            (&linear, &angular),
+            largest,
+            threads,
+        ));
     }
     assert_eq!(carried_bits[0], carried_bits[1], "1 and 2 threads");
 }
@@ -517,89 +567,27 @@ fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
 /// carry what they change too: the same impulses to the bit as without carrying, the step
 /// totals and the velocities after the next warm start the same up to rounding (the changes
 /// are summed apart), on one and two threads alike. Rows as in
-/// `relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass`; the region: the bodies of
-/// every seventh slot.
+/// `relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass`, moving faster; the region:
+/// the bodies of every seventh slot, swept six times.
 #[test]
 fn local_sweeps_after_a_carrying_relax_sweep_carry_their_changes() {
-    use super::Bundles;
-    use crate::contact::ContactConstraint;
-    use crate::solver::{ContactSolver, Velocities};
-    let (w, settled) = settled_pyramid20_rows();
-    let n = w.bodies.len();
-    let rows: Vec<ContactConstraint> = (0..4).flat_map(|_| settled.iter().copied()).collect();
-    let wave = |k: usize, a: f32, b: f32, c: f32| {
-        let x = k as f32;
-        Vec3::new(a * x.sin(), b, c * x.cos())
+    let island = carrying_island([0.3, -0.6, 0.2], [0.4, -0.2, 0.3]);
+    let n = island.n;
+    let swept = std::sync::Mutex::new(Vec::new());
+    let local = |bundles: &mut super::Bundles, velocities: &mut crate::solver::Velocities<'_>| {
+        let points = bundles.select_local(|slot| (slot as usize) < n && slot.is_multiple_of(7));
+        let report = bundles.solve_local(velocities, 6, 0.0, true, false);
+        swept.lock().unwrap().push((points, report.iterations));
     };
-    let mut linear_start: Vec<Vec3> = (0..n).map(|k| wave(k, 0.3, -0.6, 0.2)).collect();
-    let mut angular_start: Vec<Vec3> = (0..n).map(|k| wave(k, 0.4, -0.2, 0.3)).collect();
-    linear_start.push(Vec3::ZERO);
-    angular_start.push(Vec3::ZERO);
-    let still = vec![Vec3::ZERO; n + 1];
-    let settings = SolverSettings::default();
-    let inverse_inertia: Vec<Mat3> = (0..=n)
-        .map(|k| {
-            if k < n {
-                w.bodies.world_inverse_inertia(k)
-            } else {
-                Mat3::ZERO
-            }
-        })
-        .collect();
-    let in_region = |slot: u32| (slot as usize) < n && slot.is_multiple_of(7);
-    // Relax, the local sweeps, then the next substep's warm start: (velocities, impulses,
-    // step totals, local sweeps taken).
-    let run = |carry: bool, threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
-            let mut bundles = Bundles::default();
-            bundles.pack(&rows, n + 1, &inverse_inertia, threads > 1);
-            let (mut linear, mut angular) = (linear_start.clone(), angular_start.clone());
-            let mut velocities = Velocities {
-                linear: &mut linear,
-                angular: &mut angular,
-            };
-            bundles.warm_start(&mut [], &mut velocities, 0);
-            let pass = pass_at_rest(&still, &settings, false, carry);
-            bundles.solve_pgs(&mut velocities, &mut IslandJoints::default(), &pass);
-            let points = bundles.select_local(in_region);
-            let report = bundles.solve_local(&mut velocities, 6, 0.0, true, false);
-            bundles.warm_start(&mut [], &mut velocities, 1);
-            let mut unpacked = rows.clone();
-            bundles.unpack(&mut unpacked);
-            let impulses: Vec<f32> = unpacked
-                .iter()
-                .flat_map(|c| {
-                    [
-                        c.normal_impulse,
-                        c.tangent_impulses[0],
-                        c.tangent_impulses[1],
-                    ]
-                })
-                .collect();
-            let totals: Vec<f32> = unpacked.iter().flat_map(|c| c.step_impulses).collect();
-            (
-                linear,
-                angular,
-                impulses,
-                totals,
-                (points, report.iterations),
-            )
-        })
-    };
-    let (linear, angular, impulses, totals, (points, sweeps)) = run(false, 1);
+    let (linear, angular, rows) = island.relax_then_warm_start(false, 1, local);
+    let (points, sweeps) = swept.lock().unwrap()[0];
     assert!(
-        points > 0 && points < rows.len() / 2 && sweeps == 6,
+        points > 0 && points < island.rows.len() / 2 && sweeps == 6,
         "{points} of {} points in the region, {sweeps} local sweeps",
-        rows.len()
+        island.rows.len()
     );
-    let largest = linear
-        .iter()
-        .chain(&angular)
-        .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+    let largest = largest_velocity(&linear, &angular);
+    let totals: Vec<f32> = rows.iter().flat_map(|c| c.step_impulses).collect();
     let largest_total = totals.iter().fold(0.0f32, |m, t| m.max(t.abs()));
     assert!(
         largest > 0.1 && largest_total > 0.0,
@@ -607,44 +595,28 @@ fn local_sweeps_after_a_carrying_relax_sweep_carry_their_changes() {
     );
     let mut carried_bits = Vec::new();
     for threads in [1, 2] {
-        let (carried_linear, carried_angular, carried_impulses, carried_totals, _) =
-            run(true, threads);
-        let bits = |values: &[f32]| values.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        let (carried_linear, carried_angular, carried_rows) =
+            island.relax_then_warm_start(true, threads, local);
         assert_eq!(
-            bits(&impulses),
-            bits(&carried_impulses),
+            impulse_bits(&rows).0,
+            impulse_bits(&carried_rows).0,
             "{threads} threads: impulses"
         );
-        for (k, (got, want)) in carried_totals.iter().zip(&totals).enumerate() {
+        let carried_totals = carried_rows.iter().flat_map(|c| c.step_impulses);
+        for (k, (got, want)) in carried_totals.zip(&totals).enumerate() {
             assert!(
                 (got - want).abs() <= 1e-5 * largest_total,
                 "{threads} threads, step total {k}: {got} carried, {want} by the pass"
             );
         }
-        for (k, (got, want)) in carried_linear
-            .iter()
-            .zip(&linear)
-            .chain(carried_angular.iter().zip(&angular))
-            .enumerate()
-        {
-            assert!(
-                (*got - *want).abs().max_element() <= 1e-5 * largest,
-                "{threads} threads, velocity {k}: {got} carried, {want} by the pass"
-            );
-        }
-        assert_eq!(
-            carried_linear[n],
-            Vec3::ZERO,
-            "the immovable slot stays at rest"
+        let mut bits = assert_carried_velocities(
+            (&carried_linear, &carried_angular),
+            (&linear, &angular),
+            largest,
+            threads,
         );
-        carried_bits.push(
-            carried_linear
-                .iter()
-                .chain(&carried_angular)
-                .flat_map(|v| v.to_array().map(f32::to_bits))
-                .chain(bits(&carried_totals))
-                .collect::<Vec<_>>(),
-        );
+        bits.extend(impulse_bits(&carried_rows).1);
+        carried_bits.push(bits);
     }
     assert_eq!(carried_bits[0], carried_bits[1], "1 and 2 threads");
 }
