@@ -346,6 +346,16 @@ impl Group {
 }
 
 impl Bundle {
+    /// The accumulated impulses per lane: normal, tangent 1, tangent 2 (N·s).
+    #[inline(always)]
+    pub(super) fn impulses(&self) -> [Lane; 3] {
+        [
+            self.normal_impulse,
+            self.tangent_impulses[0],
+            self.tangent_impulses[1],
+        ]
+    }
+
     /// Lane `to` of this bundle takes the rows of lane `from` of `source` that stay as the
     /// pack made them through the step's substeps: the Jacobian rows, effective masses and the
     /// friction block (not the depth, which only the targets read).

@@ -130,13 +130,8 @@ impl Bundles {
         let carrying = self.carried;
         if carrying {
             self.local_start.clear();
-            self.local_start.extend(self.local_bundles.iter().map(|b| {
-                [
-                    b.normal_impulse,
-                    b.tangent_impulses[0],
-                    b.tangent_impulses[1],
-                ]
-            }));
+            self.local_start
+                .extend(self.local_bundles.iter().map(Bundle::impulses));
         }
         let mut report = SolveReport::default();
         for iteration in 0..iterations {
@@ -175,11 +170,7 @@ impl Bundles {
         let slots = velocities.linear.len();
         for (local, to, island, from) in local_places(&self.local_lanes, &self.local_groups) {
             let (now, start) = (&self.local_bundles[local], &self.local_start[local]);
-            let changes = [
-                now.normal_impulse,
-                now.tangent_impulses[0],
-                now.tangent_impulses[1],
-            ];
+            let changes = now.impulses();
             for ((total, change), start) in
                 self.step_totals[island].iter_mut().zip(changes).zip(start)
             {

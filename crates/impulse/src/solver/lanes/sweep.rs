@@ -155,12 +155,7 @@ pub(super) fn add_to_totals(total: &mut [Lane; 3], b: &Bundle) {
 /// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v` (its lane group `group`).
 #[inline(always)]
 pub(super) fn apply_impulses<R: Rounding>(b: &Bundle, group: &Group, v: &mut BodyLanes) {
-    let impulses = [
-        b.normal_impulse,
-        b.tangent_impulses[0],
-        b.tangent_impulses[1],
-    ];
-    apply_given::<R>(b, group, impulses, v);
+    apply_given::<R>(b, group, b.impulses(), v);
 }
 
 /// Adds M⁻¹Jᵀγ of impulses γ (normal, tangent 1, tangent 2; N·s) on a bundle's rows to `v`.
@@ -210,11 +205,7 @@ impl BundleUpdate for RelaxCarrying {
         unsafe {
             carry_group::<R>(&self.carried, group, visits, bundles, |index, b| {
                 add_to_totals(&mut *self.totals.0.add(index), b);
-                [
-                    b.normal_impulse,
-                    b.tangent_impulses[0],
-                    b.tangent_impulses[1],
-                ]
+                b.impulses()
             })
         }
     }
