@@ -103,7 +103,7 @@ enum Command {
         /// `impulse::report::SolvePhase`; timed only with `--profile` or `--stats`), and which
         /// build of the SIMD kernels ran (x86-64-v4 where the CPU has AVX-512, x86-64-v3 where
         /// it has AVX2, the same results unless `--fused-multiply-add`;
-        /// `IMPULSE_INSTRUCTION_SET=baseline` keeps the baseline).
+        /// `IMPULSE_INSTRUCTION_SET=baseline` keeps the baseline, `=x86-64-v3` the AVX2 build).
         #[arg(long)]
         profile: bool,
         #[command(flatten)]

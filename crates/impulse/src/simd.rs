@@ -27,12 +27,15 @@
 //! baseline cannot.
 //!
 //! `IMPULSE_INSTRUCTION_SET=baseline` in the environment keeps the baseline kernels (to
-//! compare the two, or to rule the wider one out).
+//! compare the builds, or to rule the wider ones out); `IMPULSE_INSTRUCTION_SET=x86-64-v3` runs
+//! the x86-64-v3 build on a CPU with AVX-512 (to time, on one machine, what a CPU without it
+//! runs).
 
 use std::sync::OnceLock;
 
-/// An instruction set the lanes' kernels are compiled for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// An instruction set the lanes' kernels are compiled for, ordered from the narrowest to the
+/// widest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum InstructionSet {
     /// The build's own target (SSE2 on x86-64 unless built with `-C target-cpu`).
     #[default]
@@ -44,34 +47,46 @@ pub enum InstructionSet {
     X86_64V4,
 }
 
-/// The environment variable that, set to `baseline`, keeps the baseline kernels.
+/// The environment variable that, set to an instruction set's [`InstructionSet::name`], keeps
+/// the kernels to that set or a narrower one (`baseline` keeps the baseline kernels).
 pub const INSTRUCTION_SET_VARIABLE: &str = "IMPULSE_INSTRUCTION_SET";
 
 impl InstructionSet {
-    /// The widest instruction set this CPU runs that the kernels are compiled for, unless
-    /// [`INSTRUCTION_SET_VARIABLE`] says `baseline`; detected once per process.
+    /// The widest instruction set this CPU runs that the kernels are compiled for and that is
+    /// no wider than the one [`INSTRUCTION_SET_VARIABLE`] names (any case; a value naming
+    /// none is ignored); detected once per process.
     pub fn detected() -> Self {
         static DETECTED: OnceLock<InstructionSet> = OnceLock::new();
         *DETECTED.get_or_init(|| {
-            let forced = std::env::var(INSTRUCTION_SET_VARIABLE)
-                .is_ok_and(|value| value.eq_ignore_ascii_case("baseline"));
-            if forced {
-                Self::Baseline
-            } else {
-                Self::supported_widest()
+            let named = std::env::var(INSTRUCTION_SET_VARIABLE)
+                .ok()
+                .and_then(|value| Self::named(&value));
+            match named {
+                Some(limit) => Self::supported_up_to(limit),
+                None => Self::supported_widest(),
             }
         })
     }
 
+    /// The instruction set whose [`Self::name`] is `name` (any case), if one is.
+    pub fn named(name: &str) -> Option<Self> {
+        [Self::Baseline, Self::X86_64V3, Self::X86_64V4]
+            .into_iter()
+            .find(|set| set.name().eq_ignore_ascii_case(name.trim()))
+    }
+
+    /// The widest instruction set of the kernels that this CPU runs and that is no wider than
+    /// `limit`.
+    pub fn supported_up_to(limit: Self) -> Self {
+        [Self::X86_64V4, Self::X86_64V3]
+            .into_iter()
+            .find(|&set| set <= limit && set.is_supported())
+            .unwrap_or(Self::Baseline)
+    }
+
     /// The widest instruction set of the kernels that this CPU runs.
     pub fn supported_widest() -> Self {
-        if Self::X86_64V4.is_supported() {
-            Self::X86_64V4
-        } else if Self::X86_64V3.is_supported() {
-            Self::X86_64V3
-        } else {
-            Self::Baseline
-        }
+        Self::supported_up_to(Self::X86_64V4)
     }
 
     /// Its name: `baseline`, `x86-64-v3` or `x86-64-v4` (the x86-64 psABI's names of the
@@ -174,3 +189,40 @@ macro_rules! on_instruction_set {
     }};
 }
 pub(crate) use on_instruction_set;
+
+#[cfg(test)]
+mod tests {
+    use super::InstructionSet;
+
+    #[test]
+    fn a_named_set_is_read_back_and_bounds_the_kernels_chosen() {
+        let sets = [
+            InstructionSet::Baseline,
+            InstructionSet::X86_64V3,
+            InstructionSet::X86_64V4,
+        ];
+        for set in sets {
+            assert_eq!(InstructionSet::named(set.name()), Some(set));
+            assert_eq!(
+                InstructionSet::named(&format!(" {} ", set.name().to_uppercase())),
+                Some(set)
+            );
+            let chosen = InstructionSet::supported_up_to(set);
+            assert!(chosen <= set && chosen.is_supported());
+            // The widest such: a supported set between the chosen one and the limit is none.
+            assert!(
+                sets.iter()
+                    .all(|&other| other <= chosen || other > set || !other.is_supported())
+            );
+        }
+        assert_eq!(InstructionSet::named("avx512"), None);
+        assert_eq!(
+            InstructionSet::supported_up_to(InstructionSet::Baseline),
+            InstructionSet::Baseline
+        );
+        assert_eq!(
+            InstructionSet::supported_widest(),
+            InstructionSet::supported_up_to(InstructionSet::X86_64V4)
+        );
+    }
+}
