@@ -108,19 +108,15 @@ impl IslandWorkspace {
         // A substep whose main solve found an impact sweeps its relax solve to convergence too:
         // the whole island (more than one sweep, so the lanes do not carry the warm start), or
         // its budget and then the points around the impact, whose changes the lanes carry on
-        // top of the relax sweep's (`Bundles::solve_local`) in an island of at least
-        // `LOCAL_CARRY_MIN_POINTS`.
+        // top of the relax sweep's (`Bundles::solve_local`).
         let local = self.impact_region.kind == RegionKind::Local;
-        let pass = match (!with_repair && self.impact_met, local) {
-            (true, false) => SolvePass {
+        let pass = if !with_repair && self.impact_met && !local {
+            SolvePass {
                 iterations: pass.iterations.max(self.impact_sweeps(settings)),
                 ..pass
-            },
-            (true, true) if constraints.len() < LOCAL_CARRY_MIN_POINTS => SolvePass {
-                warm_start_follows: false,
-                ..pass
-            },
-            _ => pass,
+            }
+        } else {
+            pass
         };
         if !self.joints.is_empty() && pass.targets.is_some() {
             self.joints
@@ -358,16 +354,6 @@ pub(crate) fn step_island(
     w.record_joints();
     w.phases.end(SolvePhase::Record);
 }
-
-/// Points from which an island whose impact was swept locally carries the next substep's warm
-/// start through its relax sweep and the region's sweeps (`Bundles::solve_local`); a smaller
-/// island's next warm start passes over its bundles instead. The pass streams bundles the
-/// cache still holds in a smaller island and carrying costs its relax sweep more than the pass
-/// (`pour2000`'s pile, up to 20 thousand points: the pass 13 ns a point, the relax sweep 60 %
-/// more when it carries), while the 500-mug pile's 52 thousand points (12 MB of bundles) come
-/// from memory (the pass 110 ns a point: more than the main sweep); docs/benchmarks.md,
-/// "Moving meshes".
-const LOCAL_CARRY_MIN_POINTS: usize = 32_768;
 
 /// How far (rad) a body may turn in a step for its rows to follow it
 /// ([`IslandWorkspace::turn_rows`]); past it they take the step's start linearisation again,
