@@ -327,7 +327,7 @@ pub struct SolveSettings {
     /// island of fewer than 64 points with a polyhedral body turning more than 0.4 rad in the
     /// step stays on the scalar path, whose rows follow the turn (docs/method.md, "Rows that
     /// follow a turn"). Colour order converges a little more slowly than narrow-phase order. In islands of at least
-    /// 1024 points, a colour of more than 8 lane groups is spread over the worker threads (the
+    /// 8192 points, a colour of more than 8 lane groups is spread over the worker threads (the
     /// same result on any thread count).
     pub simd_island_contacts: u32,
     /// Let the SIMD lanes' sweeps fuse each multiply with the addition that follows it (one

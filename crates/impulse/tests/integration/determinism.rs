@@ -47,6 +47,16 @@ fn pyramid20_is_the_same_on_any_thread_count_and_run() {
     same_everywhere(&builtin_scene("pyramid20").unwrap(), 120);
 }
 
+/// The SIMD sweeps' colours spread over the threads (as in islands of 8,192 points and more)
+/// give the bits of one thread: pyramid20's one island, spread from its first point on.
+#[test]
+fn spread_colours_are_the_same_on_any_thread_count_and_run() {
+    let mut scene = builtin_scene("pyramid20").unwrap();
+    scene.solver.solve.parallel_island_contacts = 1;
+    scene.name = "pyramid20 with its colours spread".into();
+    same_everywhere(&scene, 120);
+}
+
 #[test]
 fn balls4096_is_the_same_on_any_thread_count_and_run() {
     same_everywhere(&builtin_scene("balls4096").unwrap(), 90);
