@@ -54,10 +54,10 @@ pub(crate) const NORM_POINTS_PER_TASK: usize = 4096;
 pub(crate) const GROUPS_PER_TASK: usize = 8;
 
 /// Islands of at least this many points spread the SIMD sweep's colours over rayon's threads
-/// (whatever `parallel_island_contacts` says); below it the threads' wait at the end of each
-/// colour, some forty sweeps a step with tens of colours each, costs more than the colour
-/// spreads: from 1,024 points, `pour500` (a pile of about 4 thousand points) ran slower on two
-/// threads than on one (docs/benchmarks.md, "Threads").
+/// (whatever `parallel_island_contacts` says); below it the threads' wait at the end of every
+/// colour of every sweep costs more than spreading the colour saves: from 1,024 points,
+/// `pour500` (a pile of about 4 thousand points) ran slower on two threads than on one
+/// (docs/benchmarks.md, "Threads").
 pub(crate) const PARALLEL_ISLAND_POINTS: usize = 8192;
 
 /// Islands of at least this many points are packed into and unpacked from SIMD lanes on
