@@ -1,5 +1,7 @@
-//! Greedy graph colouring of contact points (or of the SIMD lanes' manifold groups): items of
-//! one colour share no moving body, so their updates can run at once, on threads or in lanes.
+//! Graph orders of an island's contact points (or of the SIMD lanes' manifold groups), by their
+//! bodies: greedy colouring (items of one colour share no moving body, so their updates can run
+//! at once, on threads or in lanes) and bisection (two halves of the moving bodies, whose items
+//! can be swept at once, one half a thread, with the items between the halves after them).
 
 /// Independent colours of a sweep; items past them share one sequential colour.
 pub(crate) const COLOURS: usize = 64;
@@ -40,3 +42,131 @@ pub(crate) fn greedy_colours(
     }
     counts
 }
+
+/// What [`bisect`] works in, kept by its caller so that a bisection allocates nothing once
+/// these have grown to the island: the moving slots' adjacency (offsets and neighbours, the
+/// graph in compressed rows), each slot's weight, the breadth-first order and each slot's half.
+#[derive(Default)]
+pub(crate) struct Bisection {
+    offsets: Vec<u32>,
+    neighbours: Vec<u32>,
+    weights: Vec<u64>,
+    order: Vec<u32>,
+    seen: Vec<bool>,
+    /// Per slot, its half (0 or 1) after [`bisect`]; the immovable slot's is 0.
+    pub(crate) halves: Vec<u8>,
+}
+
+/// Splits the moving slots of an island (`slots` of them, the last, `slots − 1`, the immovable
+/// one) into two halves of about equal weight, each half's slots near one another in the
+/// graph whose edges are `items` (each two body slots and a weight, e.g. the item's contact
+/// points), so that few items join the halves: each slot's half in `bisection.halves`.
+///
+/// The slots are taken in breadth-first order from a slot at the graph's edge (the last slot
+/// a breadth-first search from the first item's body reaches: the pseudo-peripheral node of
+/// George and Liu's nested dissection), every component in turn, and the first slots of that
+/// order up to half the total weight (a slot weighs its items' weights) make half 0: a cut
+/// along one of the search's levels, whose items alone join the halves. Depends only on the
+/// items and their order, never on the threads.
+pub(crate) fn bisect(
+    items: impl Iterator<Item = (u32, u32, u32)> + Clone,
+    slots: usize,
+    bisection: &mut Bisection,
+) {
+    let immovable = slots.saturating_sub(1);
+    let Bisection {
+        offsets,
+        neighbours,
+        weights,
+        order,
+        seen,
+        halves,
+    } = bisection;
+    let moving = |slot: usize| slot < immovable;
+    // Degrees, then offsets, then neighbours (compressed rows), and the weights.
+    offsets.clear();
+    offsets.resize(slots + 1, 0);
+    weights.clear();
+    weights.resize(slots, 0);
+    for (a, b, weight) in items.clone() {
+        let (a, b) = (a as usize, b as usize);
+        for slot in [a, b] {
+            if moving(slot) {
+                weights[slot] += u64::from(weight);
+            }
+        }
+        if moving(a) && moving(b) && a != b {
+            offsets[a + 1] += 1;
+            offsets[b + 1] += 1;
+        }
+    }
+    for k in 0..slots {
+        offsets[k + 1] += offsets[k];
+    }
+    neighbours.clear();
+    neighbours.resize(offsets[slots] as usize, 0);
+    // Where each slot's next neighbour goes (`order` serves, before it holds the order).
+    order.clear();
+    order.extend_from_slice(&offsets[..slots]);
+    for (a, b, _) in items.clone() {
+        let (a, b) = (a as usize, b as usize);
+        if moving(a) && moving(b) && a != b {
+            neighbours[order[a] as usize] = b as u32;
+            order[a] += 1;
+            neighbours[order[b] as usize] = a as u32;
+            order[b] += 1;
+        }
+    }
+    // Breadth-first order from `first`: its component alone, or every component in turn (each
+    // from its lowest slot after the first's).
+    let search = |first: usize, every: bool, order: &mut Vec<u32>, seen: &mut Vec<bool>| {
+        order.clear();
+        seen.clear();
+        seen.resize(slots, false);
+        let others = if every { 0..immovable } else { 0..0 };
+        for start in std::iter::once(first).chain(others) {
+            if start >= immovable || seen[start] {
+                continue;
+            }
+            seen[start] = true;
+            let mut head = order.len();
+            order.push(start as u32);
+            while head < order.len() {
+                let slot = order[head] as usize;
+                head += 1;
+                for &next in &neighbours[offsets[slot] as usize..offsets[slot + 1] as usize] {
+                    if !seen[next as usize] {
+                        seen[next as usize] = true;
+                        order.push(next);
+                    }
+                }
+            }
+        }
+    };
+    let first = items
+        .clone()
+        .find_map(|(a, b, _)| [a, b].into_iter().find(|&s| moving(s as usize)))
+        .map_or(0, |s| s as usize);
+    search(first, false, order, seen);
+    let peripheral = order.last().map_or(first, |&s| s as usize);
+    search(peripheral, true, order, seen);
+    // The first slots of the order up to half the weight make half 0.
+    let total: u64 = weights.iter().sum();
+    halves.clear();
+    halves.resize(slots, 1);
+    let mut taken = 0u64;
+    for &slot in order.iter() {
+        if 2 * taken >= total {
+            break;
+        }
+        halves[slot as usize] = 0;
+        taken += weights[slot as usize];
+    }
+    if immovable < slots {
+        halves[immovable] = 0;
+    }
+}
+
+#[cfg(test)]
+#[path = "graph_tests.rs"]
+mod tests;

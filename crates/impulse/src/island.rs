@@ -11,6 +11,8 @@
 
 use crate::body::{Bodies, BodyKind};
 use crate::collision::narrow_phase::ContactPair;
+use crate::graph::{Bisection, bisect};
+use crate::parallel::SPLIT_ISLAND_POINTS;
 
 /// Islands of one step: body lists, and the order in which the narrow phase's pairs are
 /// assembled so that each island's constraints come out contiguous.
@@ -19,6 +21,12 @@ pub(crate) struct Islands {
     /// Island k's bodies are `bodies[body_start[k]..body_start[k + 1]]`.
     body_start: Vec<u32>,
     bodies: Vec<u32>,
+    /// Per island, the local index where the second half of a split island's bodies starts
+    /// ([`Islands::second_half`]); `u32::MAX` for an island not split.
+    second_half: Vec<u32>,
+    /// The bisection of a split island, and its bodies in their new order: build scratch.
+    bisection: Bisection,
+    reordered: Vec<u32>,
     /// Island k's constraints are `constraint_start[k]..constraint_start[k + 1]`.
     constraint_start: Vec<u32>,
     /// Island k's guests (kinematic bodies touching it, in increasing index order) are
@@ -59,9 +67,23 @@ impl Islands {
         self.constraint_start.len().saturating_sub(1)
     }
 
-    /// Bodies of island `k`, in increasing index order.
+    /// Bodies of island `k`, in increasing index order; in a split island
+    /// ([`Islands::second_half`]), each half in increasing index order, the first half first.
     pub(crate) fn bodies(&self, k: usize) -> &[u32] {
         &self.bodies[self.body_start[k] as usize..self.body_start[k + 1] as usize]
+    }
+
+    /// Where the second half of island `k`'s bodies starts (a local index), if the island is
+    /// split: an island of at least [`SPLIT_ISLAND_POINTS`] contact points has its bodies cut
+    /// into two halves of about equal contact points that few points join
+    /// ([`crate::graph::bisect`] over its pairs), which the lanes solver sweeps at once
+    /// (`solver::lanes`, its domains). Each half's bodies take consecutive local indices, so
+    /// that the two threads of a sweep write the velocities of different cache lines.
+    pub(crate) fn second_half(&self, k: usize) -> Option<u32> {
+        self.second_half
+            .get(k)
+            .copied()
+            .filter(|&start| start != u32::MAX)
     }
 
     /// Index of moving body `body` among its island's bodies ([`Islands::bodies`]).
@@ -284,7 +306,61 @@ impl Islands {
             self.pair_first_row[index as usize] = row;
             row += keys[index as usize].2;
         }
+        self.split_large_islands(&pairs_per_island);
         self.fill = pairs_per_island;
+    }
+
+    /// Cuts the bodies of each island of at least [`SPLIT_ISLAND_POINTS`] constraints into two
+    /// halves ([`Islands::second_half`]), given where each island's pairs end in `pair_order`.
+    fn split_large_islands(&mut self, pairs_end: &[u32]) {
+        let islands = self.len();
+        self.second_half.clear();
+        self.second_half.resize(islands, u32::MAX);
+        let mut first_pair = 0;
+        for (k, &end) in pairs_end.iter().enumerate().take(islands) {
+            let end = end as usize;
+            let pairs = first_pair..end;
+            first_pair = end;
+            let rows = self.constraint_start[k + 1] - self.constraint_start[k];
+            if (rows as usize) < SPLIT_ISLAND_POINTS {
+                continue;
+            }
+            let range = self.body_start[k] as usize..self.body_start[k + 1] as usize;
+            let count = range.len() as u32;
+            // Local indices; a body outside the island (static or kinematic) joins no half.
+            let (island_of_body, parent) = (&self.island_of_body, &self.parent);
+            let local = |body: u32| {
+                if island_of_body[body as usize] == k as u32 {
+                    parent[body as usize]
+                } else {
+                    count
+                }
+            };
+            let keys = &self.pair_keys;
+            let items = self.pair_order[pairs].iter().map(|&pair| {
+                let (a, b, rows) = keys[pair as usize];
+                (local(a), local(b), rows)
+            });
+            bisect(items, count as usize + 1, &mut self.bisection);
+            let halves = &self.bisection.halves;
+            let bodies = &mut self.bodies[range];
+            self.reordered.clear();
+            for half in [0, 1] {
+                self.reordered.extend(
+                    bodies
+                        .iter()
+                        .filter(|&&body| halves[self.parent[body as usize] as usize] == half),
+                );
+            }
+            bodies.copy_from_slice(&self.reordered);
+            let second = halves[..count as usize].iter().filter(|&&h| h == 0).count();
+            for (index, &body) in bodies.iter().enumerate() {
+                self.parent[body as usize] = index as u32;
+            }
+            if second > 0 && second < count as usize {
+                self.second_half[k] = second as u32;
+            }
+        }
     }
 }
 

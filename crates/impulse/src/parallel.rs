@@ -57,8 +57,18 @@ pub(crate) const GROUPS_PER_TASK: usize = 8;
 /// (whatever `parallel_island_contacts` says); below it the threads' wait at the end of every
 /// colour of every sweep costs more than spreading the colour saves: from 1,024 points,
 /// `pour500` (a pile of about 4 thousand points) ran slower on two threads than on one
-/// (docs/benchmarks.md, "Threads").
+/// (docs/benchmarks.md, "Threads"). From [`SPLIT_ISLAND_POINTS`] on, the island is split.
 pub(crate) const PARALLEL_ISLAND_POINTS: usize = 8192;
+
+/// Islands of at least this many points are split: their bodies are cut into two halves that
+/// few points join ([`crate::island::Islands::second_half`]), each half's bodies on consecutive
+/// slots, and each colour of the SIMD sweep runs in two parts, mostly one half each, on a
+/// thread held for the island ([`with_helper`]). With the halves' velocities on cache lines of
+/// their own, a two-thread sweep of a poured pile no longer waits on the other core for them.
+/// Below this, the order of bodies by index kept neighbours closer (pyramid3d10, 8,740
+/// points, ran 15 % slower on two threads split; docs/benchmarks.md, "Threads"). Results
+/// depend on this (the colours' order of lanes), the same on any thread count.
+pub(crate) const SPLIT_ISLAND_POINTS: usize = 12288;
 
 /// Islands of at least this many points are packed into and unpacked from SIMD lanes on
 /// rayon's threads.
@@ -422,6 +432,172 @@ where
         .reduce(|| identity, &combine)
 }
 
+/// Runs `run` with a second thread of rayon's pool held for it when threads are `allowed` and
+/// the pool has more than one: inside `run`, [`join_halves`] hands its second half to that
+/// thread, which waits for it spinning, instead of to rayon, whose idle threads sleep. A split
+/// island's sweeps ([`SPLIT_ISLAND_POINTS`]) are hundreds of joins a step, each of a few
+/// microseconds, where waking a sleeping thread costs tens. Box2D v3's solver holds its
+/// workers through a step's stages the same way.
+///
+/// The held thread runs any rayon work `run` spreads meanwhile while it waits, and a half it has
+/// not taken by the time the caller is done with its own runs on the caller: no wait depends on
+/// the held thread ever arriving (it may be busy elsewhere, or there may be no other thread).
+pub(crate) fn with_helper<R: Send>(allowed: bool, run: impl FnOnce() -> R + Send) -> R {
+    if !allowed || rayon::current_num_threads() < 2 || rayon::current_thread_index().is_none() {
+        return run();
+    }
+    let helper = Helper::default();
+    // A join, not a scope's spawn: its second job lives on this stack (a step allocates
+    // nothing), and one not taken by another thread when `run` is done runs here, told to stop.
+    let (result, ()) = rayon::join(
+        || {
+            // The helper is told to stop even if `run` panics, so that the join's wait ends.
+            struct Restore<'a>(&'a Helper, *const Helper);
+            impl Drop for Restore<'_> {
+                fn drop(&mut self) {
+                    HELPER.set(self.1);
+                    self.0.stop.store(true, Ordering::Release);
+                }
+            }
+            let _restore = Restore(&helper, HELPER.replace(&helper as *const Helper));
+            run()
+        },
+        || helper.help(),
+    );
+    result
+}
+
+/// `a` on this thread and `b` on the thread [`with_helper`] holds, if this thread holds one,
+/// else as [`rayon::join`]; `a` and `b` must not depend on each other.
+pub(crate) fn join_halves<RA: Send, RB: Send>(
+    a: impl FnOnce() -> RA + Send,
+    b: impl FnOnce() -> RB + Send,
+) -> (RA, RB) {
+    let helper = HELPER.get();
+    if helper.is_null() {
+        return rayon::join(a, b);
+    }
+    // SAFETY: `with_helper` sets the pointer to a helper that outlives its `run`, on the
+    // thread running `run`, and restores the previous value before the helper is dropped.
+    unsafe { &*helper }.join(a, b)
+}
+
+thread_local! {
+    /// The helper [`with_helper`] holds for this thread's `run`, if any.
+    static HELPER: std::cell::Cell<*const Helper> = const { std::cell::Cell::new(std::ptr::null()) };
+}
+
+use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
+
+/// A job handed to a [`Helper`]: a pointer to a closure on the caller's stack, which stays
+/// there until the job is finished.
+type HelperJob = *mut (dyn FnMut() + Send);
+
+/// The state a [`with_helper`] thread and its caller share. Job k is posted (`posted` = k) with
+/// its closure in `job`; whoever moves `claimed` from k − 1 to k runs it, and `finished`
+/// becomes k when it is done.
+#[derive(Default)]
+struct Helper {
+    posted: AtomicUsize,
+    claimed: AtomicUsize,
+    finished: AtomicUsize,
+    job: AtomicPtr<HelperJob>,
+    /// Whether a job of the caller's is out (only the caller's thread reads and writes it).
+    busy: AtomicBool,
+    stop: AtomicBool,
+}
+
+impl Helper {
+    /// The held thread's loop: waits for jobs, spinning (and running rayon's pending work, and
+    /// yielding its CPU when long idle), and runs those it claims, until told to stop.
+    fn help(&self) {
+        let mut seen = 0;
+        let mut spins = 0u32;
+        while !self.stop.load(Ordering::Acquire) {
+            let posted = self.posted.load(Ordering::Acquire);
+            if posted == seen {
+                spins = spins.saturating_add(1);
+                if spins.is_multiple_of(64) && rayon::yield_now() == Some(rayon::Yield::Executed) {
+                    spins = 0;
+                } else if spins < 1 << 16 {
+                    std::hint::spin_loop();
+                } else {
+                    std::thread::yield_now();
+                }
+                continue;
+            }
+            seen = posted;
+            spins = 0;
+            if self
+                .claimed
+                .compare_exchange(posted - 1, posted, Ordering::AcqRel, Ordering::Acquire)
+                .is_ok()
+            {
+                let job = self.job.load(Ordering::Acquire);
+                // SAFETY: the poster keeps the closure alive until `finished` reaches `posted`,
+                // and only the claimer calls it.
+                // A panic leaves the job's result unset, which the caller reports.
+                let _ =
+                    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| unsafe { (**job)() }));
+                self.finished.store(posted, Ordering::Release);
+            }
+        }
+    }
+
+    /// `a` here and `b` on the helper, or here too when the helper has not claimed it by the
+    /// time `a` is done. A join inside `a` or `b` goes to rayon (the helper takes one job at a
+    /// time).
+    fn join<RA: Send, RB: Send>(
+        &self,
+        a: impl FnOnce() -> RA + Send,
+        b: impl FnOnce() -> RB + Send,
+    ) -> (RA, RB) {
+        if self.busy.swap(true, Ordering::Relaxed) {
+            return rayon::join(a, b);
+        }
+        let mut b = Some(b);
+        let mut result_b = None;
+        let mut job = || {
+            if let Some(b) = b.take() {
+                result_b = Some(b());
+            }
+        };
+        let job_ref: &mut (dyn FnMut() + Send) = &mut job;
+        // SAFETY: the lifetime is erased for the handover only: this function does not return,
+        // nor unwind, before the job is finished (below), so the closure outlives every call.
+        let mut erased: HelperJob = unsafe { std::mem::transmute(job_ref) };
+        let k = self.posted.load(Ordering::Relaxed) + 1;
+        self.job.store(&mut erased, Ordering::Release);
+        self.posted.store(k, Ordering::Release);
+        let result_a = std::panic::catch_unwind(std::panic::AssertUnwindSafe(a));
+        if self
+            .claimed
+            .compare_exchange(k - 1, k, Ordering::AcqRel, Ordering::Acquire)
+            .is_ok()
+        {
+            // SAFETY: claimed here, so no other thread calls it.
+            unsafe { (*erased)() };
+        } else {
+            let mut spins = 0u32;
+            while self.finished.load(Ordering::Acquire) < k {
+                spins = spins.saturating_add(1);
+                if spins < 1 << 16 {
+                    std::hint::spin_loop();
+                } else {
+                    std::thread::yield_now();
+                }
+            }
+        }
+        self.job.store(std::ptr::null_mut(), Ordering::Release);
+        self.busy.store(false, Ordering::Relaxed);
+        let result_a = result_a.unwrap_or_else(|payload| std::panic::resume_unwind(payload));
+        match result_b {
+            Some(result_b) => (result_a, result_b),
+            None => panic!("a job on the helper thread panicked"),
+        }
+    }
+}
+
 /// Runs `part(i)` for i in 0..`parts` on rayon's threads and hands the results, in order of i,
 /// to `finish`: partial sums over fixed runs of items, added in order by `finish`, give the
 /// same result to the bit on any number of threads. Up to [`STACK_PARTS`] results live on the
@@ -502,7 +678,7 @@ pub(crate) fn prefetch_bytes<T>(start: *const T, bytes: usize) {
 mod tests {
     use super::{
         COLOURS, all_in_chunks, colour_after_colour, find_first, for_each_indexed,
-        for_each_of_three, for_each_with_rows, indices_where, map_into,
+        for_each_of_three, for_each_with_rows, indices_where, join_halves, map_into, with_helper,
     };
     use proptest::prelude::*;
     use rayon::prelude::*;
@@ -728,5 +904,92 @@ mod tests {
         for (i, (items, count)) in results.iter().enumerate() {
             check(&sizes, i % 2 == 0, items, *count);
         }
+    }
+
+    /// `join_halves` gives both halves' results, each half run once, with a held thread, on a
+    /// pool of one thread (no helper), and outside `with_helper` (rayon's join); a join inside
+    /// a half goes to rayon.
+    #[test]
+    fn joined_halves_give_both_results_with_a_held_thread_or_without() {
+        for threads in [1, 2, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                for held in [true, false] {
+                    let runs = AtomicU64::new(0);
+                    let total = with_helper(held, || {
+                        let mut total = 0u64;
+                        for i in 0..2000u64 {
+                            let (a, b) = join_halves(
+                                || {
+                                    runs.fetch_add(1, Ordering::Relaxed);
+                                    2 * i
+                                },
+                                || {
+                                    runs.fetch_add(1, Ordering::Relaxed);
+                                    let (c, d) = join_halves(|| i, || 1);
+                                    3 * i + c + d
+                                },
+                            );
+                            total += a + b;
+                        }
+                        total
+                    });
+                    let expected: u64 = (0..2000u64).map(|i| 6 * i + 1).sum();
+                    assert_eq!(total, expected, "{threads} threads, held {held}");
+                    assert_eq!(runs.load(Ordering::Relaxed), 4000);
+                }
+            });
+        }
+    }
+
+    /// A held thread that never comes (the pool's other thread busy until the caller is done)
+    /// leaves every half to the caller, who does not wait for it.
+    #[test]
+    fn halves_run_on_the_caller_when_no_thread_is_free() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let done = std::sync::atomic::AtomicBool::new(false);
+            rayon::join(
+                || {
+                    let sum = with_helper(true, || {
+                        (0..500u64).map(|i| join_halves(|| i, || i).1).sum::<u64>()
+                    });
+                    done.store(true, Ordering::Release);
+                    assert_eq!(sum, 500 * 499 / 2);
+                },
+                || {
+                    // Holds the other thread (if it takes this job) until the caller is done.
+                    while !done.load(Ordering::Acquire) {
+                        std::thread::yield_now();
+                    }
+                },
+            );
+        });
+    }
+
+    /// A half that panics on the held thread panics the caller, after both halves are done.
+    #[test]
+    fn a_panicking_half_panics_the_caller() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let caught = pool.install(|| {
+            std::panic::catch_unwind(|| {
+                with_helper(true, || {
+                    for _ in 0..100 {
+                        join_halves(|| (), || ());
+                    }
+                    join_halves(|| (), || panic!("half"))
+                })
+            })
+        });
+        assert!(caught.is_err());
     }
 }

@@ -319,6 +319,7 @@ pub(crate) struct IslandContext<'a> {
 /// separations follow their motion. They are not written back.
 pub(crate) fn step_island(
     island_bodies: &[u32],
+    second_half: Option<u32>,
     guests: &[u32],
     constraints: &mut [ContactConstraint],
     context: &IslandContext<'_>,
@@ -335,22 +336,33 @@ pub(crate) fn step_island(
     w.step_constants(island_bodies, context, h);
     w.joints.start_step(h, settings.solve.direct_joint_solve);
     w.start_solves(constraints, settings, context);
-    let plan = w.prepare_solver(island_bodies, guests, constraints, settings, context, h);
-    w.phases.end(SolvePhase::Prepare);
-    for substep in 0..settings.solve.substeps {
-        w.substep(constraints, settings, context, &plan, substep);
-    }
-    w.finish_solves(constraints, settings, &plan);
-    w.phases.end(SolvePhase::Record);
-    w.restitution(
-        island_bodies,
+    let plan = w.prepare_solver(
+        (island_bodies, second_half),
         guests,
         constraints,
         settings,
         context,
-        plan.spread,
+        h,
     );
-    w.phases.end(SolvePhase::Impacts);
+    w.phases.end(SolvePhase::Prepare);
+    // A split island's sweeps hand half their work to a thread held through the substeps.
+    let held = plan.spread && plan.bundled && w.solvers.wide.split();
+    parallel::with_helper(held, || {
+        for substep in 0..settings.solve.substeps {
+            w.substep(constraints, settings, context, &plan, substep);
+        }
+        w.finish_solves(constraints, settings, &plan);
+        w.phases.end(SolvePhase::Record);
+        w.restitution(
+            island_bodies,
+            guests,
+            constraints,
+            settings,
+            context,
+            plan.spread,
+        );
+        w.phases.end(SolvePhase::Impacts);
+    });
     w.record_joints();
     w.phases.end(SolvePhase::Record);
 }
@@ -607,7 +619,7 @@ impl IslandWorkspace {
     /// thread's sweep) and prepares it: packs the lanes or colours the rows.
     fn prepare_solver(
         &mut self,
-        island_bodies: &[u32],
+        (island_bodies, second_half): (&[u32], Option<u32>),
         guests: &[u32],
         constraints: &mut [ContactConstraint],
         settings: &SolverSettings,
@@ -638,7 +650,10 @@ impl IslandWorkspace {
             // Bundles are in colour order on any thread count, so spreading a colour over the
             // threads costs no convergence (unlike the scalar sweep). Smaller islands stay on
             // their thread: rayon's hand-offs then cost more than they spread.
-            let spread = coloured_threads || constraints.len() >= PARALLEL_ISLAND_POINTS;
+            // A split island's halves run at once from its split on (one wait a sweep).
+            let spread = coloured_threads
+                || constraints.len() >= PARALLEL_ISLAND_POINTS
+                || second_half.is_some();
             // Each slot's world inverse inertia, for the lever-arm products the lanes compute.
             w.slot_inverse_inertia.clear();
             w.slot_inverse_inertia.extend(
@@ -651,6 +666,7 @@ impl IslandWorkspace {
             w.solvers
                 .wide
                 .set_fused_multiply_add(settings.solve.fused_multiply_add);
+            w.solvers.wide.set_second_half(second_half);
             w.solvers.wide.prepare(
                 constraints,
                 slots,

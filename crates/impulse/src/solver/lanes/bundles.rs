@@ -21,6 +21,10 @@ pub(crate) struct Bundles {
     /// groups the colouring could not place, one per lane group, and always runs on one thread.
     pub(super) groups: Vec<Group>,
     pub(super) group_colour_starts: Vec<usize>,
+    /// The slot where a split island's second half of bodies starts, for the next pack
+    /// ([`Bundles::set_second_half`]), and the one the layout was made with.
+    pub(super) second_half: Option<u32>,
+    pub(super) layout_second_half: Option<u32>,
     /// The lane groups an impact's local sweeps visit ([`Bundles::select_local`]): the region's
     /// lanes packed anew, their rows in `local_bundles`; `local_lanes` says where each came
     /// from, `local_filled` how many lanes of each group are taken, and `local_after` the first
@@ -86,6 +90,22 @@ impl Bundles {
     /// ([`crate::settings::SolveSettings::fused_multiply_add`]).
     pub(crate) fn set_fused_multiply_add(&mut self, fused: bool) {
         self.fused = fused;
+    }
+
+    /// Sets where the island's second half of bodies starts (a slot), if it is split
+    /// ([`Islands::second_half`](crate::island::Islands::second_half)), for the next
+    /// [`Bundles::pack`]: each colour then holds the first half's manifold groups first, and a
+    /// spread sweep runs each colour in two parts on two threads, the second on a thread held
+    /// for the island ([`crate::parallel::with_helper`]). The halves' bodies take consecutive
+    /// slots, so the two parts mostly write velocities of different cache lines (interleaved,
+    /// two threads writing one line slowed a sweep by 40 %).
+    pub(crate) fn set_second_half(&mut self, second_half: Option<u32>) {
+        self.second_half = second_half;
+    }
+
+    /// Whether the last pack was of a split island ([`Bundles::set_second_half`]).
+    pub(crate) fn split(&self) -> bool {
+        self.layout_second_half.is_some()
     }
 
     /// Whether [`Bundles::pack`] was asked to spread colours over rayon's threads.

@@ -31,8 +31,12 @@ impl Bundles {
     /// once per bundle, and a body's groups need far fewer colours than its points (each colour
     /// a wait per sweep on several threads).
     ///
-    /// With `parallel`, each colour's lane groups are later spread over rayon's threads; the
-    /// result is the same bit for bit, as the lane groups of one colour touch disjoint bodies.
+    /// In a split island ([`Bundles::set_second_half`]) each colour takes the manifold groups
+    /// of its first half of bodies first, then those of its second half.
+    ///
+    /// With `parallel`, each colour's lane groups are later spread over rayon's threads (a
+    /// split island's in two parts, one a thread); the result is the same bit for bit, as the
+    /// lane groups of one colour touch disjoint bodies.
     ///
     /// When every point has the same key as in the last pack (an island at rest), the
     /// last layout is reused and only the lanes are filled again; the result is the same.
@@ -77,10 +81,13 @@ impl Bundles {
             self.keys.clear();
             self.keys.extend(constraints.iter().map(key));
         }
-        let new_layout = self.layout_slots != slots || self.keys != self.layout_keys;
+        let new_layout = self.layout_slots != slots
+            || self.layout_second_half != self.second_half
+            || self.keys != self.layout_keys;
         if new_layout {
             std::mem::swap(&mut self.keys, &mut self.layout_keys);
             self.layout_slots = slots;
+            self.layout_second_half = self.second_half;
             self.lay_out(slots);
         }
         let total = self.groups.last().map_or(0, |g| (g.start + g.len) as usize);
@@ -191,7 +198,10 @@ impl Bundles {
         }
         let total_groups = *self.group_colour_starts.last().unwrap_or(&0);
         // Each group to the next free lane of its colour, in constraint order; a lane group
-        // is as long as its longest group.
+        // is as long as its longest group. In a split island, a colour's groups of the first
+        // half's bodies first (by the lower of a group's moving slots), then the second's: a
+        // colour's two parts then mostly touch one half each, whose bodies' velocities lie
+        // apart (see [`Bundles::set_second_half`]).
         self.groups.clear();
         let immovable = (slots - 1) as u32;
         let empty = Group {
@@ -201,17 +211,33 @@ impl Bundles {
         };
         self.groups.resize(total_groups, empty);
         self.run_places.clear();
+        self.run_places.resize(run_count, (0, 0));
         let mut filled = [0usize; COLOURS + 1];
-        for r in 0..run_count {
-            let colour = self.colours[r] as usize;
-            let position = filled[colour];
-            filled[colour] += 1;
-            let per = per_group(colour);
-            let group = self.group_colour_starts[colour] + position / per;
-            let lane = position % per;
-            let g = &mut self.groups[group];
-            g.len = g.len.max(run_points(&self.runs, r) as u32);
-            self.run_places.push((group as u32, lane as u32));
+        let half_of = |r: usize| match self.layout_second_half {
+            Some(second) => {
+                // The immovable slot is the last: the lower slot is a moving one.
+                let key = keys[self.runs[r] as usize];
+                u8::from(key.local_a.min(key.local_b) >= second)
+            }
+            None => 0,
+        };
+        let halves = if self.layout_second_half.is_some() {
+            2
+        } else {
+            1
+        };
+        for half in 0..halves {
+            for r in (0..run_count).filter(|&r| half_of(r) == half) {
+                let colour = self.colours[r] as usize;
+                let position = filled[colour];
+                filled[colour] += 1;
+                let per = per_group(colour);
+                let group = self.group_colour_starts[colour] + position / per;
+                let lane = position % per;
+                let g = &mut self.groups[group];
+                g.len = g.len.max(run_points(&self.runs, r) as u32);
+                self.run_places[r] = (group as u32, lane as u32);
+            }
         }
         let mut total = 0u32;
         for g in self.groups.iter_mut() {

@@ -1,7 +1,8 @@
 //! The order and the threads of a sweep: lane groups colour by colour (forward or backward,
 //! each group's bundles from its first or from halfway round), each group's bodies gathered
 //! once and scattered once, a colour's lane groups spread over rayon's threads (they share
-//! no moving body), the next bundles asked of the CPU ahead of the update.
+//! no moving body; a split island's in two parts, one a thread), the next bundles asked of
+//! the CPU ahead of the update.
 
 use super::bundles::Bundles;
 use super::lane::{Fused, Lane, Rounding, Separate, fold_largest};
@@ -10,7 +11,8 @@ use super::sweep::{BundleUpdate, Visits};
 use super::targets::SetTargets;
 use crate::graph::COLOURS;
 use crate::parallel::{
-    GROUPS_PER_TASK, SharedItems, SharedVelocities, colour_after_colour, prefetch_bytes, spread,
+    GROUPS_PER_TASK, SharedItems, SharedVelocities, colour_after_colour, join_halves,
+    prefetch_bytes, spread,
 };
 use crate::simd::{InstructionSet, on_instruction_set};
 use crate::solver::rows::Velocities;
@@ -18,9 +20,12 @@ use crate::solver::rows::Velocities;
 impl Bundles {
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
     /// group's bodies gathered into lanes once and scattered back after its bundles; returns the
-    /// lane-wise largest of what `update` returned. With `parallel` (see [`Bundles::pack`])
-    /// each colour is split over rayon's threads, in parts of at least [`GROUPS_PER_TASK`]
-    /// lane groups ([`crate::parallel::colour_after_colour`]).
+    /// lane-wise largest of what `update` returned. With `parallel` (see [`Bundles::pack`]),
+    /// each colour of a split island ([`Bundles::set_second_half`]) runs in two parts at once
+    /// ([`crate::parallel::join_halves`]); otherwise each colour is split over rayon's
+    /// threads, in parts of at least [`GROUPS_PER_TASK`] lane groups
+    /// ([`crate::parallel::colour_after_colour`]). Either way the result is the serial
+    /// sweep's, to the bit.
     pub(super) fn sweep<F, T>(
         &mut self,
         order: SweepOrder,
@@ -61,17 +66,49 @@ impl Bundles {
             }
         };
         let starts = &self.group_colour_starts;
-        colour_after_colour(
-            &mut self.groups,
-            starts.len() - 1,
-            |k| starts[k],
-            order.forward,
-            COLOURS,
-            GROUPS_PER_TASK,
-            Lane::splat(0.0),
-            run,
-            |x, y| x.max(y),
-        )
+        if !self.split() {
+            return colour_after_colour(
+                &mut self.groups,
+                starts.len() - 1,
+                |k| starts[k],
+                order.forward,
+                COLOURS,
+                GROUPS_PER_TASK,
+                Lane::splat(0.0),
+                run,
+                |x, y| x.max(y),
+            );
+        }
+        // A split island: each colour in two parts, the first on this thread and the second on
+        // the thread held for the island ([`crate::parallel::join_halves`]), colour after
+        // colour; the last colour (whose groups may share bodies) and colours of fewer than
+        // two parts' worth of lane groups ([`GROUPS_PER_TASK`]) on this thread.
+        let mut largest = Lane::splat(0.0);
+        let colours = starts.len() - 1;
+        for visit in 0..colours {
+            let k = if order.forward {
+                visit
+            } else {
+                colours - 1 - visit
+            };
+            let colour = &mut self.groups[starts[k]..starts[k + 1]];
+            let change = if k >= COLOURS || colour.len() < 2 * GROUPS_PER_TASK {
+                run(colour, order.forward)
+            } else {
+                // Two parts of about as many bundles (lane groups differ in length).
+                let (start, last) = (colour[0].start, colour[colour.len() - 1]);
+                let middle = start + (last.start + last.len - start) / 2;
+                let cut = colour
+                    .partition_point(|group| group.start < middle)
+                    .clamp(1, colour.len() - 1);
+                let (first, second) = colour.split_at_mut(cut);
+                let (x, y) =
+                    join_halves(|| run(first, order.forward), || run(second, order.forward));
+                x.max(y)
+            };
+            largest = largest.max(change);
+        }
+        largest
     }
 }
 

@@ -498,3 +498,63 @@ fn fused_multiply_add_rounds_once() {
 
 mod scalar_agreement;
 mod scenes;
+
+/// A split island's pack (`set_second_half`) keeps every colour's manifold groups (the same
+/// colours as unsplit), the first half's (by the lower moving slot) before the second's: only
+/// lanes of one colour change places, which share no body.
+#[test]
+fn a_split_pack_keeps_the_colours_and_puts_each_colours_first_half_first() {
+    // A chain of 12 moving slots (12 immovable, which the last link reaches): links of 1 to 4
+    // points, and every slot on the ground; the second half starts at slot 6.
+    let (slots, second) = (13usize, 6u32);
+    let mut constraints = Vec::new();
+    for a in 0..12u32 {
+        let pairs = [(a, a + 1, 1 + (a as usize % 4)), (a, 12, 2)];
+        for (a, b, points) in pairs {
+            for _ in 0..points {
+                constraints.push(ContactConstraint {
+                    local_a: a,
+                    local_b: b,
+                    inverse_mass_a: Vec3::ONE,
+                    inverse_mass_b: if b == 12 { Vec3::ZERO } else { Vec3::ONE },
+                    ..ContactConstraint::default()
+                });
+            }
+        }
+    }
+    let inertia = vec![Mat3::ZERO; slots];
+    let mut whole = Bundles::default();
+    whole.pack(&constraints, slots, &inertia, false);
+    let mut split = Bundles::default();
+    split.set_second_half(Some(second));
+    split.pack(&constraints, slots, &inertia, false);
+    assert!(split.split() && !whole.split());
+    assert_eq!(split.group_colour_starts, whole.group_colour_starts);
+    for colour in 0..COLOURS {
+        let groups = split.group_colour_starts[colour]..split.group_colour_starts[colour + 1];
+        let halves: Vec<bool> = split.groups[groups]
+            .iter()
+            .flat_map(|g| (0..LANES).map(move |lane| (g.local_a[lane], g.local_b[lane])))
+            .filter(|&(a, b)| (a, b) != (12, 12))
+            .map(|(a, b)| a.min(b) >= second)
+            .collect();
+        assert!(
+            halves.windows(2).all(|w| w[0] <= w[1]),
+            "colour {colour}: {halves:?}"
+        );
+    }
+    // The same manifold groups per colour, as sets of body pairs.
+    let pairs_of = |packed: &Bundles, colour: usize| {
+        let groups = packed.group_colour_starts[colour]..packed.group_colour_starts[colour + 1];
+        let mut pairs: Vec<(u32, u32)> = packed.groups[groups]
+            .iter()
+            .flat_map(|g| (0..LANES).map(move |lane| (g.local_a[lane], g.local_b[lane])))
+            .filter(|&pair| pair != (12, 12))
+            .collect();
+        pairs.sort_unstable();
+        pairs
+    };
+    for colour in 0..=COLOURS {
+        assert_eq!(pairs_of(&split, colour), pairs_of(&whole, colour));
+    }
+}
