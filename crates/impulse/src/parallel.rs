@@ -66,7 +66,7 @@ pub(crate) const PARALLEL_ISLAND_POINTS: usize = 8192;
 /// thread held for the island ([`with_helper`]). With the halves' velocities on cache lines of
 /// their own, a two-thread sweep of a poured pile no longer waits on the other core for them.
 /// Below this, the order of bodies by index kept neighbours closer (pyramid3d10, 8,740
-/// points, ran 15 % slower on two threads split; docs/benchmarks.md, "Threads"). Results
+/// points, ran 10 to 20 % slower on two threads split; docs/benchmarks.md, "Threads"). Results
 /// depend on this (the colours' order of lanes), the same on any thread count.
 pub(crate) const SPLIT_ISLAND_POINTS: usize = 12288;
 
