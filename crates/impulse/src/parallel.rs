@@ -8,6 +8,7 @@
 //! depend on order (maxima) or add fixed runs' partial sums in order.
 
 use glam::Vec3;
+use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
 
 use crate::graph::COLOURS;
 
@@ -349,7 +350,7 @@ where
     R: Send + Sync + Copy,
 {
     use rayon::prelude::*;
-    use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+    use std::sync::atomic::AtomicU64;
     debug_assert!(colours <= COLOURS + 1);
     let colours = colours.min(COLOURS + 1);
     // At most 64 chunks a colour, so that one 64-bit mask a colour says which are claimed.
@@ -405,16 +406,9 @@ where
                 if claimed[visit].fetch_or(bit, Ordering::Relaxed) & bit != 0 {
                     continue;
                 }
-                let mut spins = 0u32;
-                while finished.load(Ordering::Acquire) < before[visit] {
-                    spins += 1;
-                    if spins < 1 << 12 {
-                        std::hint::spin_loop();
-                    } else {
-                        // The thread running that chunk may have lost its CPU.
-                        std::thread::yield_now();
-                    }
-                }
+                spin_until(1 << 12, || {
+                    finished.load(Ordering::Acquire) >= before[visit]
+                });
                 let from = range.start + claimed_chunk * size;
                 let to = (from + size).min(range.end);
                 // SAFETY: [from, to) lies inside `items`, and no other thread holds it: each
@@ -430,6 +424,20 @@ where
         .into_par_iter()
         .map(worker)
         .reduce(|| identity, &combine)
+}
+
+/// Waits until `done` holds, spinning for the first `spins` checks and then yielding the CPU at
+/// each (the thread being waited for may have lost its CPU).
+fn spin_until(spins: u32, done: impl Fn() -> bool) {
+    let mut checks = 0u32;
+    while !done() {
+        checks = checks.saturating_add(1);
+        if checks < spins {
+            std::hint::spin_loop();
+        } else {
+            std::thread::yield_now();
+        }
+    }
 }
 
 /// Runs `run` with a second thread of rayon's pool held for it when threads are `allowed` and
@@ -486,8 +494,6 @@ thread_local! {
     /// The helper [`with_helper`] holds for this thread's `run`, if any.
     static HELPER: std::cell::Cell<*const Helper> = const { std::cell::Cell::new(std::ptr::null()) };
 }
-
-use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
 
 /// A job handed to a [`Helper`]: a pointer to a closure on the caller's stack, which stays
 /// there until the job is finished.
@@ -578,15 +584,7 @@ impl Helper {
             // SAFETY: claimed here, so no other thread calls it.
             unsafe { (*erased)() };
         } else {
-            let mut spins = 0u32;
-            while self.finished.load(Ordering::Acquire) < k {
-                spins = spins.saturating_add(1);
-                if spins < 1 << 16 {
-                    std::hint::spin_loop();
-                } else {
-                    std::thread::yield_now();
-                }
-            }
+            spin_until(1 << 16, || self.finished.load(Ordering::Acquire) >= k);
         }
         self.job.store(std::ptr::null_mut(), Ordering::Release);
         self.busy.store(false, Ordering::Relaxed);
