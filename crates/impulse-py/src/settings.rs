@@ -216,7 +216,8 @@ impl Settings {
         self.field(py, "warm_start")
     }
 
-    /// Base speculative margin (m): contacts are generated up to this separation.
+    /// Base speculative margin (m): contacts are generated up to this separation at steps of
+    /// 1/60 s or longer, and up to this times dt·60 at shorter steps.
     #[getter]
     fn prediction_distance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.field(py, "prediction_distance")

@@ -123,7 +123,8 @@ class Settings:
         """Fraction of last step's impulses used as the starting guess, in [0, 1]."""
     @property
     def prediction_distance(self) -> float:
-        """Base speculative margin (m): contacts are generated up to this separation."""
+        """Base speculative margin (m): contacts are generated up to this separation at steps of
+        1/60 s or longer, and up to this times dt·60 at shorter steps."""
     @property
     def split_overlap(self) -> float:
         """Overlap (m) beyond which a step that left moving bodies crossed is taken again in halves; 0 is off."""

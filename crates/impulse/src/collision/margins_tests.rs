@@ -132,3 +132,40 @@ fn a_spinning_body_closes_by_its_spin_times_the_lever_arm() {
         "{along_y} against {expected}"
     );
 }
+
+/// The base prediction distance holds whole at steps of 1/60 s and longer and shrinks with
+/// the step below: two balls at rest (no gravity) 12 mm apart get a speculative point at
+/// 60 Hz and 30 Hz (base 20 mm), none at 240 Hz (base 5 mm); 4 mm apart they get one at
+/// 240 Hz too. A step split into collision steps keeps its whole step's base.
+#[test]
+fn the_base_prediction_scales_with_steps_shorter_than_a_sixtieth() {
+    assert_eq!(base_prediction(0.02, 1.0 / 60.0), 0.02);
+    assert_eq!(base_prediction(0.02, 1.0 / 30.0), 0.02);
+    assert!((base_prediction(0.02, 1.0 / 240.0) - 0.005).abs() < 1e-9);
+    let touches = |gap: f32, dt: f32| {
+        let mut w = World::new(Vec3::ZERO, dt, SolverSettings::default()).unwrap();
+        let m = common::material(0.5);
+        let ball = |x: f32| {
+            BodyDesc::new(
+                BodyKind::Dynamic,
+                ShapeDesc::Sphere { radius: 0.5 },
+                [x, 0.0, 0.0],
+            )
+        };
+        let a = w.add_body(&ball(0.0), &m).unwrap();
+        let b = w.add_body(&ball(1.0 + gap), &m).unwrap();
+        w.step().unwrap();
+        let (a, b) = (w.handle_of(a).unwrap(), w.handle_of(b).unwrap());
+        w.contact_pair(a, b).is_some()
+    };
+    assert!(touches(0.012, 1.0 / 60.0));
+    assert!(touches(0.012, 1.0 / 30.0));
+    assert!(!touches(0.012, 1.0 / 240.0));
+    assert!(touches(0.004, 1.0 / 240.0));
+    // The margins of a collision step of a 1/60 s step: the step's base, not the piece's.
+    let mut margins = SpeculativeMargins::default();
+    let w = World::new(Vec3::ZERO, 1.0 / 60.0, SolverSettings::default()).unwrap();
+    margins.set_step_dt(1.0 / 60.0);
+    margins.update(&w.bodies, 0.02, Vec3::ZERO, 1.0 / 240.0, false);
+    assert_eq!(margins.prediction_distance, 0.02);
+}

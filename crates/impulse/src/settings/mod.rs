@@ -360,7 +360,10 @@ pub struct ContactSettings {
     /// Cap (m/s) on the repair speed, so deep overlaps separate without an explosion.
     pub max_repair_speed: f32,
     /// Contacts are generated up to this separation (m) ahead of touching ("speculative"
-    /// contacts): a row with gap g > 0 only forbids closing faster than g/dt.
+    /// contacts), plus how far the pair can close in the step: a row with gap g > 0 only
+    /// forbids closing faster than g/dt. For steps of 1/60 s or longer; a shorter step takes
+    /// it in proportion to its dt (at 240 Hz a quarter), as the reach of a velocity change
+    /// within the step is (docs/method.md, "Speculative contacts").
     pub prediction_distance: f32,
     /// A step after which two bodies that moved against each other overlap by more than this
     /// (m), and by more than a third of it beyond their overlap at the step's start, is taken

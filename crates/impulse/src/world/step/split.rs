@@ -122,6 +122,7 @@ impl World {
         let limit = self.settings.contact.split_overlap;
         let collision_steps = self.collision_steps_needed(&mut context.body_extents);
         context.margins.set_collision_steps(collision_steps);
+        context.margins.set_step_dt(self.dt);
         if limit <= 0.0 && collision_steps == 1 {
             return self.run_stages(context);
         }
