@@ -1465,6 +1465,19 @@ impl FaceAxis {
             (on1, self.point)
         }
     }
+
+    /// The axis as a candidate of [`largest_by_bound`] at `place`, bounded by [`Self::points`]
+    /// with the shapes' `known` points.
+    fn candidate(&self, place: u32, known: (Vector, Vector)) -> ByBound {
+        let points = self.points(known);
+        ByBound {
+            bound: (points.1 - points.0).dot(self.axis),
+            place,
+            axis: self.axis,
+            points,
+            known: 0,
+        }
+    }
 }
 
 /// What [`face_axes_above`] searches with: the `threshold` (m) to beat, the `slack` (m) that
@@ -1527,16 +1540,11 @@ fn face_axes_above(
         }
     }
     let (best, runner_up) = FACE_CANDIDATES.with_borrow_mut(|candidates| {
-        candidates.extend(axes.iter().enumerate().map(|(index, face)| {
-            let points = face.points(search.known);
-            ByBound {
-                bound: (points.1 - points.0).dot(face.axis),
-                place: index as u32,
-                axis: face.axis,
-                points,
-                known: 0,
-            }
-        }));
+        candidates.extend(
+            axes.iter()
+                .enumerate()
+                .map(|(index, face)| face.candidate(index as u32, search.known)),
+        );
         largest_by_bound(candidates, slack, separation)
     });
     let (_, top, index) = best?;
