@@ -68,8 +68,9 @@ pub(crate) fn base_prediction(prediction_distance: f32, step_dt: f32) -> f32 {
 }
 
 impl SpeculativeMargins {
-    /// Recomputes the margins for a step of `dt` seconds (`prediction_distance` in m,
-    /// `gravity` in m/s²). With `parallel`, in runs of [`BODIES_PER_TASK`] bodies on rayon's
+    /// Recomputes the margins for a step of `dt` seconds (`prediction_distance` in m, the
+    /// settings' base, taken in proportion below 1/60 s of the step [`Self::set_step_dt`] set,
+    /// else of `dt`: [`base_prediction`]; `gravity` in m/s²). With `parallel`, in runs of [`BODIES_PER_TASK`] bodies on rayon's
     /// threads: each body's margin depends on that body alone, so the margins are the same on
     /// any thread count.
     pub fn update(
