@@ -548,7 +548,10 @@ impl NarrowPhase {
         if spread(parallel, 1, 0) {
             // A pair with a composite shape (a compound, a mesh) is a pair per pair of parts
             // within reach, hundreds of convex pairs' work: tasks of a fixed number of pairs
-            // would leave one thread with most of it.
+            // would leave one thread with most of it. Each task is a job of its own: rayon
+            // otherwise runs a quarter of the tasks (on two threads) as one job that no idle
+            // thread can take a part of, and on the 98-mug pour one thread waited for the
+            // other's last tasks (docs/benchmarks.md, "Threads").
             let composite = |i: u32| bodies.shape[i as usize].as_composite_shape().is_some();
             let per_task = if self
                 .pairs
@@ -559,7 +562,10 @@ impl NarrowPhase {
             } else {
                 MANIFOLD_PAIRS_PER_TASK
             };
-            self.pairs.par_chunks_mut(per_task).try_for_each(run)?;
+            self.pairs
+                .par_chunks_mut(per_task)
+                .with_max_len(1)
+                .try_for_each(run)?;
         } else {
             run(&mut self.pairs)?;
         }
