@@ -55,7 +55,7 @@ pub struct SpeculativeMargins {
 
 /// The step (s) at and above which the base prediction distance holds whole:
 /// [`crate::settings::ContactSettings::prediction_distance`] is for steps of 1/60 s.
-pub(crate) const PREDICTION_REFERENCE_STEP: f32 = 1.0 / 60.0;
+const PREDICTION_REFERENCE_STEP: f32 = 1.0 / 60.0;
 
 /// The base prediction distance (m) of a step of `step_dt` seconds: `prediction_distance`
 /// at steps of [`PREDICTION_REFERENCE_STEP`] or longer, in proportion below. The base is for
@@ -70,9 +70,9 @@ pub(crate) fn base_prediction(prediction_distance: f32, step_dt: f32) -> f32 {
 impl SpeculativeMargins {
     /// Recomputes the margins for a step of `dt` seconds (`prediction_distance` in m, the
     /// settings' base, taken in proportion below 1/60 s of the step [`Self::set_step_dt`] set,
-    /// else of `dt`: [`base_prediction`]; `gravity` in m/s²). With `parallel`, in runs of [`BODIES_PER_TASK`] bodies on rayon's
-    /// threads: each body's margin depends on that body alone, so the margins are the same on
-    /// any thread count.
+    /// else of `dt`: [`base_prediction`]; `gravity` in m/s²). With `parallel`, in runs of
+    /// [`BODIES_PER_TASK`] bodies on rayon's threads: each body's margin depends on that body
+    /// alone, so the margins are the same on any thread count.
     pub fn update(
         &mut self,
         bodies: &Bodies,
