@@ -34,6 +34,8 @@
 //! box or a mesh triangle whose SAT manifold is empty or overstates the gap gets the manifold
 //! of Parry's generator for convex polyhedra (built on GJK's nearest points), and any other
 //! pair left with no point although nearer than the prediction gets one at its nearest points.
+//! No convex pair keeps a point beyond the prediction: Parry's clipping keeps every clipped
+//! point once the pair's separating axis is within it.
 
 use parry3d::math::{Pose, Real, Vector};
 use parry3d::query::details::{
@@ -309,6 +311,11 @@ where
         if box_corner {
             deepest_vertex::add_deepest_box_corner(pos12, g1, g2, prediction, manifold, &old);
         }
+        // Parry's clipping keeps every point of the two clipped features once the pair's
+        // separating axis is within the prediction: a box leaning on another's edge got its
+        // face's far corners, centimetres beyond it. A point beyond the prediction is one the
+        // pair cannot reach in the step (`SpeculativeMargins::pair_prediction`).
+        manifold.points.retain(|point| point.dist <= prediction);
         Ok(())
     }
 }

@@ -353,21 +353,27 @@ fn the_fallback_point_keeps_its_impulse_while_the_pair_stays_apart() {
     }
 }
 
-/// A seeded sweep of boxes and hulls at random poses: every pair nearer than the prediction
-/// (Parry's exact distance) has at least one point, and no point is nearer than the pair.
-#[test]
-fn every_convex_pair_nearer_than_the_prediction_has_a_point() {
+/// Two boxes (half-extents 0.5 × 0.2 × 0.3 and 0.1 × 0.4 × 0.1 m) and a tetrahedron's hull, for
+/// the seeded sweeps of pairs at random poses ([`random_pairs`]).
+fn boxes_and_a_hull() -> [SharedShape; 3] {
     let hull = [
         Vec3::new(-0.4, -0.2, -0.3),
         Vec3::new(0.5, -0.2, -0.3),
         Vec3::new(0.0, -0.2, 0.45),
         Vec3::new(0.1, 0.35, 0.0),
     ];
-    let shapes = [
+    [
         SharedShape::cuboid(0.5, 0.2, 0.3),
         SharedShape::cuboid(0.1, 0.4, 0.1),
         SharedShape::convex_hull(&hull).unwrap(),
-    ];
+    ]
+}
+
+/// A seeded sweep of boxes and hulls at random poses: every pair nearer than the prediction
+/// (Parry's exact distance) has at least one point, and no point is nearer than the pair.
+#[test]
+fn every_convex_pair_nearer_than_the_prediction_has_a_point() {
+    let shapes = boxes_and_a_hull();
     let prediction = 0.1;
     let (mut near, mut parry_empty) = (0, 0);
     for (case, g1, pos1, g2, pos2) in random_pairs(0x2545_f491_4f6c_dd1d, &shapes, 4000) {
@@ -395,6 +401,78 @@ fn every_convex_pair_nearer_than_the_prediction_has_a_point() {
     assert!(
         near > 300 && parry_empty >= 5,
         "{near} near, {parry_empty} empty"
+    );
+}
+
+/// A 1 m cube leaning 10° on the top face of a box, one edge on it: Parry's cuboid–cuboid
+/// generator clips the cube's bottom face against the box's top and keeps all four corners,
+/// the two raised ones sin 10° m = 174 mm above the face; with a prediction of 20 mm the
+/// dispatcher keeps only the two on the face, at zero separation.
+#[test]
+fn a_leaning_cube_gets_no_point_beyond_the_prediction() {
+    let slab = SharedShape::cuboid(2.0, 0.5, 2.0);
+    let cube = SharedShape::cuboid(0.5, 0.5, 0.5);
+    let tilt = 10f32.to_radians();
+    let rotation = Quat::from_rotation_z(tilt);
+    // The cube's edge at local (−0.5, −0.5, z) rests on the slab's top face (y = 0.5).
+    let edge = rotation * Vec3::new(-0.5, -0.5, 0.0);
+    let pos2 = Pose::from_parts(Vec3::new(0.0, 0.5, 0.0) - edge, rotation);
+    let prediction = 0.02;
+    let parry = parry_manifold(
+        &Pose::IDENTITY,
+        slab.as_ref(),
+        &pos2,
+        cube.as_ref(),
+        prediction,
+    );
+    let raised = tilt.sin();
+    assert_eq!(parry.points.len(), 4);
+    assert_eq!(
+        parry
+            .points
+            .iter()
+            .filter(|p| (p.dist - raised).abs() < 1e-4)
+            .count(),
+        2,
+        "Parry's points: {:?}",
+        parry.points.iter().map(|p| p.dist).collect::<Vec<_>>()
+    );
+    let m = manifold_within(
+        &Pose::IDENTITY,
+        slab.as_ref(),
+        &pos2,
+        cube.as_ref(),
+        prediction,
+    );
+    assert_eq!(m.points.len(), 2);
+    assert!(m.points.iter().all(|p| p.dist.abs() < 1e-5));
+}
+
+/// A seeded sweep of boxes and hulls at random poses: no point of the dispatcher's manifold
+/// is beyond the prediction, while Parry's own generators leave some there (counted, so the
+/// sweep covers them). Prints its counts (`-- --nocapture`).
+#[test]
+fn no_convex_pair_gets_a_point_beyond_the_prediction() {
+    let shapes = boxes_and_a_hull();
+    let prediction = 0.02;
+    let (mut with_points, mut parry_beyond) = (0, 0);
+    for (case, g1, pos1, g2, pos2) in random_pairs(0x6a09_e667_f3bc_c909, &shapes, 4000) {
+        let parry = parry_manifold(&pos1, g1, &pos2, g2, prediction);
+        parry_beyond += usize::from(parry.points.iter().any(|p| p.dist > prediction));
+        let m = manifold_within(&pos1, g1, &pos2, g2, prediction);
+        with_points += usize::from(!m.points.is_empty());
+        for p in &m.points {
+            assert!(
+                p.dist <= prediction,
+                "case {case}: a point {} m apart",
+                p.dist
+            );
+        }
+    }
+    eprintln!("{with_points} pairs with points, {parry_beyond} with Parry's beyond the prediction");
+    assert!(
+        with_points > 300 && parry_beyond > 50,
+        "{with_points} with points, {parry_beyond} with Parry's beyond"
     );
 }
 
