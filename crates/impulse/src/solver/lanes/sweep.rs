@@ -299,11 +299,23 @@ pub(super) fn solve_bundle<R: Rounding, const FRICTION: bool>(
     v: &mut BodyLanes,
 ) -> Lane {
     let normal = solve_normal::<R>(b, group, v);
-    if FRICTION {
+    if FRICTION && !carries_no_impulse(b) {
         normal.max(solve_friction::<R>(b, group, v))
     } else {
         normal
     }
+}
+
+/// Whether no lane of the bundle carries an impulse: no normal impulse (a disc of radius zero,
+/// so friction can take nothing) and no friction impulse to take back. Its friction update
+/// would leave the impulses at zero and the velocities as they are (but the sign of a zero),
+/// so the sweep skips it: in a pour, half the bundles a relax sweep visits are of points
+/// apart (docs/method.md, "Graph colouring and SIMD lanes").
+#[inline(always)]
+fn carries_no_impulse(b: &Bundle) -> bool {
+    let zero = Lane::splat(0.0);
+    let [t1, t2] = b.tangent_impulses;
+    (b.normal_impulse.simd_eq(zero) & t1.simd_eq(zero) & t2.simd_eq(zero)).all()
 }
 
 /// The normal row's part of [`solve_bundle`]: returns each lane's row velocity change (m/s).

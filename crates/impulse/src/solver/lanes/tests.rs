@@ -558,3 +558,90 @@ fn a_split_pack_keeps_the_colours_and_puts_each_colours_first_half_first() {
         assert_eq!(pairs_of(&split, colour), pairs_of(&whole, colour));
     }
 }
+
+/// A bundle whose points carry no impulse and stay apart (no normal impulse after the normal
+/// rows' update) skips its friction update: over seeded random rows and velocities, the
+/// update gives the impulses, velocities and row velocity change that the normal and friction
+/// updates give one after the other (equal as numbers: a zero's sign may differ), and so does
+/// a bundle apart whose friction impulses the update must take back (every other case).
+#[test]
+fn a_bundle_carrying_no_impulse_skips_friction_without_changing_anything() {
+    let uniform =
+        std::cell::RefCell::new(crate::test_support::seeded_uniform(0x5851_f42d_4c95_7f2d));
+    let lanes =
+        |low: f32, high: f32| Lane::new(std::array::from_fn(|_| (uniform.borrow_mut())(low, high)));
+    for case in 0..200 {
+        let vector = |low: f32, high: f32| [lanes(low, high), lanes(low, high), lanes(low, high)];
+        let row = || RowLanes {
+            angular_a: vector(-1.0, 1.0),
+            angular_b: vector(-1.0, 1.0),
+            inverse_inertia_angular_a: vector(-2.0, 2.0),
+            inverse_inertia_angular_b: vector(-2.0, 2.0),
+            effective_mass: lanes(0.1, 5.0),
+            inverse_effective_mass: lanes(0.2, 10.0),
+        };
+        let (normal, tangents) = (row(), [row(), row()]);
+        let bundle = Bundle {
+            normal,
+            // Far below any closing speed here: the normal impulse stays zero.
+            target: Lane::splat(-100.0),
+            mass_scale: Lane::splat(1.0),
+            tangents,
+            tangent_inverse_block: [lanes(0.5, 2.0), lanes(-0.2, 0.2), lanes(0.5, 2.0)],
+            sliding_step: lanes(0.1, 1.0),
+            // Every other case carries friction impulses the update must take back.
+            tangent_impulses: if case % 2 == 0 {
+                [Lane::splat(0.0); 2]
+            } else {
+                [lanes(-1.0, 1.0), lanes(-1.0, 1.0)]
+            },
+            ..Bundle::default()
+        };
+        let group = Group {
+            inverse_mass_a: vector(0.0, 2.0),
+            inverse_mass_b: vector(0.0, 2.0),
+            directions: [vector(-1.0, 1.0), vector(-1.0, 1.0), vector(-1.0, 1.0)],
+            friction: lanes(0.0, 1.0),
+            ..Group::default()
+        };
+        let velocities = BodyLanes {
+            linear_a: vector(-3.0, 3.0),
+            angular_a: vector(-3.0, 3.0),
+            linear_b: vector(-3.0, 3.0),
+            angular_b: vector(-3.0, 3.0),
+        };
+        let (mut skipped, mut skipped_velocities) = (bundle, velocities);
+        let change = solve_bundle::<Separate, true>(&mut skipped, &group, &mut skipped_velocities);
+        let (mut full, mut full_velocities) = (bundle, velocities);
+        let full_change = solve_normal::<Separate>(&mut full, &group, &mut full_velocities).max(
+            solve_friction::<Separate>(&mut full, &group, &mut full_velocities),
+        );
+        let numbers =
+            |lanes: &[Lane]| -> Vec<f32> { lanes.iter().flat_map(|l| l.to_array()).collect() };
+        let state = |b: &Bundle, v: &BodyLanes| {
+            let mut all = vec![
+                b.normal_impulse,
+                b.tangent_impulses[0],
+                b.tangent_impulses[1],
+            ];
+            all.extend(
+                v.linear_a
+                    .iter()
+                    .chain(&v.angular_a)
+                    .chain(&v.linear_b)
+                    .chain(&v.angular_b),
+            );
+            numbers(&all)
+        };
+        assert!(
+            numbers(&[skipped.normal_impulse]).iter().all(|&x| x == 0.0),
+            "case {case}"
+        );
+        assert_eq!(
+            state(&skipped, &skipped_velocities),
+            state(&full, &full_velocities),
+            "case {case}"
+        );
+        assert_eq!(numbers(&[change]), numbers(&[full_change]), "case {case}");
+    }
+}
