@@ -309,7 +309,7 @@ pub(super) fn solve_bundle<R: Rounding, const FRICTION: bool>(
 /// Whether no lane of the bundle carries an impulse: no normal impulse (a disc of radius zero,
 /// so friction can take nothing) and no friction impulse to take back. Its friction update
 /// would leave the impulses at zero and the velocities as they are (but the sign of a zero),
-/// so the sweep skips it: in a pour, half the bundles a relax sweep visits are of points
+/// so the sweep skips it: in a pour, half the friction updates are of such bundles of points
 /// apart (docs/method.md, "Graph colouring and SIMD lanes").
 #[inline(always)]
 fn carries_no_impulse(b: &Bundle) -> bool {
