@@ -12,7 +12,7 @@
 use crate::body::{Bodies, BodyKind};
 use crate::collision::narrow_phase::ContactPair;
 use crate::graph::{Bisection, bisect};
-use crate::parallel::SPLIT_ISLAND_POINTS;
+use crate::parallel::{SPLIT_CLEAN_CUT_FRACTION, SPLIT_CLEAN_ISLAND_POINTS, SPLIT_ISLAND_POINTS};
 
 /// Islands of one step: body lists, and the order in which the narrow phase's pairs are
 /// assembled so that each island's constraints come out contiguous.
@@ -74,7 +74,8 @@ impl Islands {
     }
 
     /// Where the second half of island `k`'s bodies starts (a local index), if the island is
-    /// split: an island of at least [`SPLIT_ISLAND_POINTS`] contact points has its bodies cut
+    /// split: an island of at least [`SPLIT_ISLAND_POINTS`] contact points (or of at least
+    /// [`SPLIT_CLEAN_ISLAND_POINTS`] whose halves few enough points join) has its bodies cut
     /// into two halves of about equal contact points that few points join
     /// ([`crate::graph::bisect`] over its pairs), which the lanes solver sweeps at once
     /// (`solver::lanes`, its domains). Each half's bodies take consecutive local indices, so
@@ -311,7 +312,10 @@ impl Islands {
     }
 
     /// Cuts the bodies of each island of at least [`SPLIT_ISLAND_POINTS`] constraints into two
-    /// halves ([`Islands::second_half`]), given where each island's pairs end in `pair_order`.
+    /// halves ([`Islands::second_half`]), given where each island's pairs end in `pair_order`;
+    /// and of each island of at least [`SPLIT_CLEAN_ISLAND_POINTS`] whose halves at most
+    /// 1/[`SPLIT_CLEAN_CUT_FRACTION`] of its constraints join (an island not split keeps its
+    /// bodies in index order).
     fn split_large_islands(&mut self, pairs_end: &[u32]) {
         let islands = self.len();
         self.second_half.clear();
@@ -321,8 +325,8 @@ impl Islands {
             let end = end as usize;
             let pairs = first_pair..end;
             first_pair = end;
-            let rows = self.constraint_start[k + 1] - self.constraint_start[k];
-            if (rows as usize) < SPLIT_ISLAND_POINTS {
+            let rows = (self.constraint_start[k + 1] - self.constraint_start[k]) as usize;
+            if rows < SPLIT_CLEAN_ISLAND_POINTS {
                 continue;
             }
             let range = self.body_start[k] as usize..self.body_start[k + 1] as usize;
@@ -341,8 +345,19 @@ impl Islands {
                 let (a, b, rows) = keys[pair as usize];
                 (local(a), local(b), rows)
             });
-            bisect(items, count as usize + 1, &mut self.bisection);
+            bisect(items.clone(), count as usize + 1, &mut self.bisection);
             let halves = &self.bisection.halves;
+            // Points between two moving bodies of different halves (a static or kinematic
+            // body, slot `count`, joins no half).
+            let cut: usize = items
+                .filter(|&(a, b, _)| {
+                    a < count && b < count && halves[a as usize] != halves[b as usize]
+                })
+                .map(|(_, _, rows)| rows as usize)
+                .sum();
+            if rows < SPLIT_ISLAND_POINTS && cut * SPLIT_CLEAN_CUT_FRACTION > rows {
+                continue;
+            }
             let bodies = &mut self.bodies[range];
             self.reordered.clear();
             for half in [0, 1] {
@@ -372,3 +387,7 @@ fn find(parent: &mut [u32], mut i: usize) -> u32 {
     }
     i as u32
 }
+
+#[cfg(test)]
+#[path = "island_tests.rs"]
+mod tests;

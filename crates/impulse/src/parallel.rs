@@ -66,10 +66,23 @@ pub(crate) const PARALLEL_ISLAND_POINTS: usize = 8192;
 /// slots, and each colour of the SIMD sweep runs in two parts, mostly one half each, on a
 /// thread held for the island ([`with_helper`]). With the halves' velocities on cache lines of
 /// their own, a two-thread sweep of a poured pile no longer waits on the other core for them.
-/// Below this, the order of bodies by index kept neighbours closer (pyramid3d10, 8,740
-/// points, ran 10 to 20 % slower on two threads split; docs/benchmarks.md, "Threads"). Results
-/// depend on this (the colours' order of lanes), the same on any thread count.
+/// From [`SPLIT_CLEAN_ISLAND_POINTS`] on, an island whose halves few enough points join is
+/// split too. Results depend on these (the colours' order of lanes), the same on any thread
+/// count.
 pub(crate) const SPLIT_ISLAND_POINTS: usize = 12288;
+
+/// Islands of at least this many points are split ([`SPLIT_ISLAND_POINTS`]) when at most
+/// 1/[`SPLIT_CLEAN_CUT_FRACTION`] of their points join the two halves: a poured pile (pour2000:
+/// about 10 thousand points, 2.4 % of them between the halves) sweeps faster on two threads
+/// split, and a stack whose every box bears on four below (pyramid3d10: 8,740 points, 11 %)
+/// slower (docs/benchmarks.md, "Threads"). Below this, the waits at the end of each colour
+/// cost more than the second thread saves (pour500's pile, about 2.6 thousand points, split
+/// from 1,024 ran slower on two threads than unsplit).
+pub(crate) const SPLIT_CLEAN_ISLAND_POINTS: usize = 4096;
+
+/// See [`SPLIT_CLEAN_ISLAND_POINTS`]: an island of fewer than [`SPLIT_ISLAND_POINTS`] points is
+/// split only if its halves' cut times this is at most its points.
+pub(crate) const SPLIT_CLEAN_CUT_FRACTION: usize = 16;
 
 /// Islands of at least this many points are packed into and unpacked from SIMD lanes on
 /// rayon's threads.

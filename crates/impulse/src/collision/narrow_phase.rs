@@ -869,8 +869,11 @@ pub(crate) mod seams {
             pairs
                 .iter()
                 .enumerate()
-                .filter(|(_, p)| p.manifolds.iter().any(|m| !m.points.is_empty()))
-                .filter_map(|(k, p)| static_body(p, bodies).map(|(s, x)| (x, s, k))),
+                // The bodies first: most pairs of a pile join two moving bodies, and their
+                // manifolds are on cold heap blocks.
+                .filter_map(|(k, p)| static_body(p, bodies).map(|(s, x)| (x, s, k, p)))
+                .filter(|(.., p)| p.manifolds.iter().any(|m| !m.points.is_empty()))
+                .map(|(x, s, k, _)| (x, s, k)),
         );
         if entries.len() < 2 {
             return;

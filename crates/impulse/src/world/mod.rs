@@ -328,6 +328,12 @@ impl World {
         self.complete_constraints().into_owned()
     }
 
+    /// The last step's islands, in the order of [`World::contact_constraints`].
+    #[cfg(test)]
+    pub(crate) fn islands(&self) -> &crate::island::Islands {
+        &self.context.islands
+    }
+
     /// How many of the last step's constraints were left with their lever-arm products for
     /// the SIMD lanes ([`ContactConstraint::products_pending`]).
     #[cfg(test)]
