@@ -43,6 +43,52 @@ pub(crate) fn greedy_colours(
     counts
 }
 
+/// Which items (points, or the SIMD lanes' lanes) touch each body slot: the incidence of an
+/// island's graph in compressed rows, built once a step so that the items around a few slots
+/// are found without a pass over every item ([`Incidence::items_of`]).
+#[derive(Default)]
+pub(crate) struct Incidence {
+    /// Slot s's items are `items[starts[s]..starts[s + 1]]`, in increasing order.
+    starts: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Incidence {
+    /// Builds the lists of `slots` slots from (slot, item) `pairs` given in increasing item
+    /// order (an item may come once per slot it touches). Panics if a slot is not below `slots`.
+    pub(crate) fn build(&mut self, slots: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) {
+        self.starts.clear();
+        self.starts.resize(slots + 1, 0);
+        for (slot, _) in pairs.clone() {
+            self.starts[slot as usize + 1] += 1;
+        }
+        for s in 0..slots {
+            self.starts[s + 1] += self.starts[s];
+        }
+        self.items.clear();
+        self.items.resize(self.starts[slots] as usize, 0);
+        // Counting sort, stable: each slot's items stay in increasing order.
+        let mut next = self.starts.clone();
+        for (slot, item) in pairs {
+            let at = &mut next[slot as usize];
+            self.items[*at as usize] = item;
+            *at += 1;
+        }
+    }
+
+    /// The items touching any of `slots` (each below the slots [`Incidence::build`] was given),
+    /// in increasing order, each once, into `out` (cleared first).
+    pub(crate) fn items_of(&self, slots: &[u32], out: &mut Vec<u32>) {
+        out.clear();
+        for &slot in slots {
+            let (start, end) = (self.starts[slot as usize], self.starts[slot as usize + 1]);
+            out.extend_from_slice(&self.items[start as usize..end as usize]);
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+}
+
 /// What [`bisect`] works in, kept by its caller so that a bisection allocates nothing once
 /// these have grown to the island: the moving slots' adjacency (offsets and neighbours, the
 /// graph in compressed rows), each slot's weight, the breadth-first order and each slot's half.

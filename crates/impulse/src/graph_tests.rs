@@ -1,4 +1,4 @@
-use super::{Bisection, bisect};
+use super::{Bisection, Incidence, bisect};
 use proptest::prelude::*;
 
 /// The items of an n × n grid of moving slots (slot x + n·y), each joined to its right and
@@ -120,5 +120,39 @@ proptest! {
         prop_assert!(2 * weights[0] < total + 2 * heaviest || weights[0] == 0);
         bisect(items.iter().copied(), slots, &mut bisection);
         prop_assert_eq!(&bisection.halves, &halves);
+    }
+
+    /// On random items of two slots each (a slot may repeat), the items touching any of a
+    /// random set of slots are, in increasing order and each once, those a pass over every
+    /// item finds; and a rebuild with fewer slots forgets the last build.
+    #[test]
+    fn incidence_finds_the_items_a_full_pass_finds(
+        slots in 1usize..40,
+        raw in prop::collection::vec((0u32..40, 0u32..40), 0..120),
+        wanted in prop::collection::vec(0u32..40, 0..10),
+    ) {
+        let ends: Vec<[u32; 2]> = raw
+            .into_iter()
+            .map(|(a, b)| [a % slots as u32, b % slots as u32])
+            .collect();
+        let wanted: Vec<u32> = wanted.into_iter().map(|s| s % slots as u32).collect();
+        let mut incidence = Incidence::default();
+        // A larger build first: the lists of the second must not keep any of it.
+        incidence.build(40, (0..40u32).map(|k| (k, k + 1000)));
+        incidence.build(
+            slots,
+            ends.iter()
+                .enumerate()
+                .flat_map(|(k, ends)| ends.map(|slot| (slot, k as u32))),
+        );
+        let mut found = vec![7];
+        incidence.items_of(&wanted, &mut found);
+        let expected: Vec<u32> = ends
+            .iter()
+            .enumerate()
+            .filter(|(_, ends)| ends.iter().any(|slot| wanted.contains(slot)))
+            .map(|(k, _)| k as u32)
+            .collect();
+        prop_assert_eq!(found, expected);
     }
 }

@@ -20,7 +20,7 @@ use super::margins::PairShapes;
 pub use super::margins::SpeculativeMargins;
 use super::part_pairs;
 use crate::body::Bodies;
-use crate::parallel::{COMPOSITE_PAIRS_PER_TASK, MANIFOLD_PAIRS_PER_TASK, prefetch, spread};
+use crate::parallel::{COMPOSITE_PAIRS_PER_TASK, MANIFOLD_PAIRS_PER_TASK, prefetch_bytes, spread};
 
 /// Parry has no contact generator for the shapes of bodies `.0` and `.1` (dense indices; the
 /// stage reports them by handle, [`crate::StepError::UnsupportedShapePair`]).
@@ -327,21 +327,26 @@ impl ContactPair {
 /// the manifolds' own block, whose address the points' lookup needs).
 pub(crate) const PREFETCH_AHEAD: usize = 8;
 
-/// Before visiting pair `i` of `pairs`: asks for the manifolds' block of pair
-/// i + 2·[`PREFETCH_AHEAD`] and the first manifold's points of pair i + [`PREFETCH_AHEAD`]
-/// (its address is in the manifolds' block, asked for earlier). Each pair's manifolds and
-/// points are two heap blocks away from the pair, and on large scenes both are cache misses,
-/// which asking ahead hides.
+/// Before visiting pair `i` of `pairs`: asks for the first manifold of pair
+/// i + 2·[`PREFETCH_AHEAD`], every line of it, and the points of the first manifold of pair
+/// i + [`PREFETCH_AHEAD`] (their address is in that manifold, asked for earlier). Each pair's
+/// manifolds and points are two heap blocks away from the pair, and on large scenes both are
+/// cache misses, which asking ahead hides. The whole manifold, not its first line: the
+/// points' address lies past it, and the load of that address stalled the passes over the
+/// pairs when only the first line was asked for.
 #[inline(always)]
 pub(crate) fn prefetch_manifolds(pairs: &[ContactPair], i: usize) {
     if let Some(ahead) = pairs.get(i + 2 * PREFETCH_AHEAD) {
-        prefetch(ahead.manifolds.as_ptr());
+        prefetch_bytes(ahead.manifolds.as_ptr(), std::mem::size_of::<Manifold>());
     }
     if let Some(manifold) = pairs
         .get(i + PREFETCH_AHEAD)
         .and_then(|p| p.manifolds.first())
     {
-        prefetch(manifold.points.as_ptr());
+        prefetch_bytes(
+            manifold.points.as_ptr(),
+            std::mem::size_of_val(manifold.points.as_slice()),
+        );
     }
 }
 

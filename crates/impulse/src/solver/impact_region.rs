@@ -27,7 +27,8 @@ use super::lanes::Bundles;
 use super::pgs::solve_pgs_rows;
 use super::rows::Velocities;
 use crate::body::Bodies;
-use crate::contact::{ContactConstraint, normal_jacobian, row_closes_faster_than};
+use crate::contact::{ContactConstraint, JacobianRow, normal_jacobian, row_closes_faster_than};
+use crate::graph::Incidence;
 use crate::joint::IslandJoints;
 use crate::solver::interface::Sweep;
 
@@ -58,6 +59,27 @@ pub(crate) struct SubstepChange<'a> {
     pub limit: f32,
 }
 
+/// A contact closing faster than the impact speed as the step started, as each substep's
+/// struck test reads it ([`ImpactRegion::find`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ClosingRow {
+    /// The point's island slots (A, B).
+    pub ends: [u32; 2],
+    /// Its normal row's J (direction, r_a × d, r_b × d; the products left at zero), as
+    /// [`normal_jacobian`] gives it from the row: assembly alone sets the row's normal and lever
+    /// arms, so it stands through the step.
+    pub normal: JacobianRow,
+}
+
+impl ClosingRow {
+    fn of(c: &ContactConstraint) -> Self {
+        Self {
+            ends: [c.local_a, c.local_b],
+            normal: normal_jacobian(c),
+        }
+    }
+}
+
 /// Where this step's impact sweeps go, once asked.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) enum RegionKind {
@@ -80,15 +102,20 @@ pub(crate) struct ImpactRegion {
     points: Vec<u32>,
     /// The region's rows, copied for the scalar sweeps.
     rows: Vec<ContactConstraint>,
-    /// Constraint indices of the contacts closing faster than the impact speed as the step
-    /// started, ascending; found at the step's first [`ImpactRegion::find`] (the velocities
-    /// and rows it reads stay as they are through the step's substeps).
-    closing: Vec<u32>,
-    /// Every point's two island slots (A, B) in constraint order, copied out of the rows with
-    /// [`Self::closing`]: each substep's region is collected from these 8 bytes a point rather
-    /// than from the rows themselves (hundreds of bytes each), which the step does not change.
-    ends: Vec<[u32; 2]>,
-    /// Whether [`Self::closing`] and [`Self::ends`] hold this step's contacts.
+    /// The contacts closing faster than the impact speed as the step started, in constraint
+    /// order; found at the step's first [`ImpactRegion::find`] (the velocities and rows it
+    /// reads stay as they are through the step's substeps), with what each substep's struck
+    /// test reads of them, so that the test reads them in sequence rather than three cache
+    /// lines of each row (376 bytes) all over the island's rows.
+    closing: Vec<ClosingRow>,
+    /// The points touching each moving slot (constraint indices), built with
+    /// [`Self::closing`]: each substep's region is gathered from its seeds' lists rather than
+    /// by a pass over every point, which the step does not change.
+    incidence: Incidence,
+    /// The seeds of this substep's region (moving slots, each once), and [`Self::seed`] the
+    /// same by slot.
+    seeds: Vec<u32>,
+    /// Whether [`Self::closing`] and [`Self::incidence`] hold this step's contacts.
     closing_known: bool,
     /// What [`ImpactRegion::find`] decided this step.
     pub(crate) kind: RegionKind,
@@ -109,8 +136,8 @@ impl ImpactRegion {
         self.closing_known = false;
     }
 
-    /// Whether the island's slot `slot` is in the region.
-    #[inline]
+    /// Whether the island's slot `slot` is a seed of the region.
+    #[cfg(test)]
     pub(crate) fn contains(&self, slot: u32) -> bool {
         self.seed.get(slot as usize).copied().unwrap_or(false)
     }
@@ -131,7 +158,7 @@ impl ImpactRegion {
         angular: &[Vec3],
         speed: f32,
         moving: usize,
-        struck: impl Fn(&ContactConstraint) -> bool,
+        struck: impl Fn(&ClosingRow) -> bool,
     ) -> RegionKind {
         self.points.clear();
         self.kind = RegionKind::Whole;
@@ -143,36 +170,35 @@ impl ImpactRegion {
             self.closing.extend(
                 constraints
                     .iter()
-                    .enumerate()
-                    .filter(|(_, c)| row_closes_faster_than(c, linear, angular, speed))
-                    .map(|(k, _)| k as u32),
+                    .filter(|c| row_closes_faster_than(c, linear, angular, speed))
+                    .map(ClosingRow::of),
             );
-            self.ends.clear();
-            self.ends
-                .extend(constraints.iter().map(|c| [c.local_a, c.local_b]));
+            let ends = constraints.iter().enumerate().flat_map(|(k, c)| {
+                [c.local_a, c.local_b]
+                    .into_iter()
+                    .filter(|&slot| (slot as usize) < moving)
+                    .map(move |slot| (slot, k as u32))
+            });
+            self.incidence.build(moving, ends);
             self.closing_known = true;
         }
         self.seed.clear();
         self.seed.resize(moving, false);
-        for &k in &self.closing {
-            let c = &constraints[k as usize];
-            if struck(c) {
-                for slot in [c.local_a, c.local_b] {
-                    if let Some(seed) = self.seed.get_mut(slot as usize) {
+        self.seeds.clear();
+        for closing in &self.closing {
+            if struck(closing) {
+                for slot in closing.ends {
+                    if let Some(seed) = self.seed.get_mut(slot as usize)
+                        && !*seed
+                    {
                         *seed = true;
+                        self.seeds.push(slot);
                     }
                 }
             }
         }
-        let seed = &self.seed;
-        let inside = |slot: u32| seed.get(slot as usize).copied().unwrap_or(false);
-        self.points.extend(
-            self.ends
-                .iter()
-                .enumerate()
-                .filter(|(_, [a, b])| inside(*a) || inside(*b))
-                .map(|(k, _)| k as u32),
-        );
+        // Every point touching a seed, in constraint order.
+        self.incidence.items_of(&self.seeds, &mut self.points);
         self.size = self.points.len();
         if self.points.len() * 2 <= constraints.len() {
             self.kind = RegionKind::Local;
@@ -200,9 +226,9 @@ impl ImpactRegion {
             return self.kind;
         }
         let (linear, angular) = (&bodies.linear_velocity, &bodies.angular_velocity);
-        let struck = |c: &ContactConstraint| {
-            let (a, b) = (c.local_a as usize, c.local_b as usize);
-            let row = normal_jacobian(c);
+        let struck = |c: &ClosingRow| {
+            let [a, b] = c.ends.map(|slot| slot as usize);
+            let row = &c.normal;
             let delta = |slot: usize| {
                 (
                     change.linear_after[slot] - change.linear_before[slot],
@@ -214,7 +240,7 @@ impl ImpactRegion {
         };
         let kind = self.find(constraints, linear, angular, speed, moving, struck);
         if let (RegionKind::Local, Some(wide)) = (kind, wide) {
-            self.size = wide.select_local(|slot| self.contains(slot));
+            self.size = wide.select_local(&self.seeds);
         }
         kind
     }

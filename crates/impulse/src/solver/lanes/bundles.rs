@@ -37,11 +37,12 @@ pub(crate) struct Bundles {
     /// Per local bundle, the impulses (normal, tangent 1, tangent 2) the local sweeps started
     /// from, while a carried warm start is pending (see [`Bundles::solve_local`]).
     pub(super) local_start: Vec<[Lane; 3]>,
-    /// Every lane group's body slots (A, B per lane), copied out of `groups` at the first
-    /// `select_local` after a pack (`group_slots_known`), so that each substep's selection
-    /// reads 32 bytes a lane group instead of the whole group.
-    pub(super) group_slots: Vec<[[u32; LANES]; 2]>,
-    pub(super) group_slots_known: bool,
+    /// The lanes (lane group × [`LANES`] + lane) touching each island slot but the immovable
+    /// one, built at the first `select_local` after a pack (`lanes_of_slots_known`), so that
+    /// each substep's selection visits its region's lanes alone; and that selection's lanes.
+    pub(super) lanes_of_slots: crate::graph::Incidence,
+    pub(super) lanes_of_slots_known: bool,
+    pub(super) local_candidates: Vec<u32>,
     /// Packing scratch: per manifold group (a run of at most [`GROUP_POINTS`] consecutive
     /// points between the same two bodies), its first point, and its lane group and lane.
     pub(super) runs: Vec<u32>,

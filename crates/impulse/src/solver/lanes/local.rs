@@ -23,12 +23,14 @@ use crate::solver::interface::SolveReport;
 use crate::solver::rows::Velocities;
 
 impl Bundles {
-    /// Packs the lanes of the last pack with a body `in_region` holds (by island slot) into
-    /// lane groups of their own for [`Bundles::solve_local`]; returns the contact points they
-    /// hold (padding left out). A lane goes to the first group with a free lane after every
-    /// group already holding one of its bodies (the immovable slot aside), taking the lanes in
-    /// the pack's order.
-    pub(crate) fn select_local(&mut self, in_region: impl Fn(u32) -> bool) -> usize {
+    /// Packs the lanes of the last pack with a body among `seeds` (island slots below the
+    /// immovable one, each once) into lane groups of their own for [`Bundles::solve_local`];
+    /// returns the contact points they hold (padding left out). A lane goes to the first group
+    /// with a free lane after every group already holding one of its bodies (the immovable slot
+    /// aside), taking the lanes in the pack's order. The lanes are found from the seeds' lists
+    /// of lanes ([`crate::graph::Incidence`], built at the first selection after a pack), not
+    /// by a pass over every lane.
+    pub(crate) fn select_local(&mut self, seeds: &[u32]) -> usize {
         self.local_groups.clear();
         self.local_lanes.clear();
         self.local_filled.clear();
@@ -40,60 +42,67 @@ impl Bundles {
             local_b: [immovable; LANES],
             ..Group::default()
         };
-        if !self.group_slots_known {
-            self.group_slots.clear();
-            self.group_slots
-                .extend(self.groups.iter().map(|g| [g.local_a, g.local_b]));
-            self.group_slots_known = true;
+        if !self.lanes_of_slots_known {
+            let lanes = self.groups.iter().enumerate().flat_map(|(g, group)| {
+                (0..LANES).flat_map(move |lane| {
+                    let lane_index = (g * LANES + lane) as u32;
+                    [group.local_a[lane], group.local_b[lane]]
+                        .into_iter()
+                        .filter(move |&slot| slot != immovable)
+                        .map(move |slot| (slot, lane_index))
+                })
+            });
+            self.lanes_of_slots.build(self.layout_slots, lanes);
+            self.lanes_of_slots_known = true;
         }
+        let mut selected = std::mem::take(&mut self.local_candidates);
+        self.lanes_of_slots.items_of(seeds, &mut selected);
         let mut points = 0;
-        for (group, [slots_a, slots_b]) in self.groups.iter().zip(&self.group_slots) {
-            for lane in 0..LANES {
-                let (a, b) = (slots_a[lane], slots_b[lane]);
-                if !(in_region(a) || in_region(b)) {
-                    continue;
+        for &lane_index in &selected {
+            let (g, lane) = (lane_index as usize / LANES, lane_index as usize % LANES);
+            let group = &self.groups[g];
+            let (a, b) = (group.local_a[lane], group.local_b[lane]);
+            let after = |slot: u32| {
+                if slot == immovable {
+                    0
+                } else {
+                    self.local_after.get(slot as usize).copied().unwrap_or(0)
                 }
-                let after = |slot: u32| {
-                    if slot == immovable {
-                        0
-                    } else {
-                        self.local_after.get(slot as usize).copied().unwrap_or(0)
-                    }
-                };
-                let first = after(a).max(after(b)) as usize;
-                let place = (first..self.local_groups.len())
-                    .find(|&g| (self.local_filled[g] as usize) < LANES)
-                    .unwrap_or_else(|| {
-                        self.local_groups.push(empty);
-                        self.local_filled.push(0);
-                        self.local_groups.len() - 1
-                    });
-                let to = self.local_filled[place] as usize;
-                self.local_filled[place] += 1;
-                let local = &mut self.local_groups[place];
-                local.copy_lane_from(to, group, lane);
-                local.len = local.len.max(group.len);
-                for slot in [a, b] {
-                    if slot != immovable
-                        && let Some(after) = self.local_after.get_mut(slot as usize)
-                    {
-                        *after = place as u32 + 1;
-                    }
-                }
-                self.local_lanes.push(LocalLane {
-                    source_start: group.start,
-                    source_lane: lane as u8,
-                    len: group.len,
-                    group: place as u32,
-                    lane: to as u8,
+            };
+            let first = after(a).max(after(b)) as usize;
+            let place = (first..self.local_groups.len())
+                .find(|&g| (self.local_filled[g] as usize) < LANES)
+                .unwrap_or_else(|| {
+                    self.local_groups.push(empty);
+                    self.local_filled.push(0);
+                    self.local_groups.len() - 1
                 });
-                let (start, len) = (group.start as usize, group.len as usize);
-                points += self.sources[start..start + len]
-                    .iter()
-                    .filter(|sources| sources[lane] != u32::MAX)
-                    .count();
+            let to = self.local_filled[place] as usize;
+            self.local_filled[place] += 1;
+            let local = &mut self.local_groups[place];
+            local.copy_lane_from(to, group, lane);
+            local.len = local.len.max(group.len);
+            for slot in [a, b] {
+                if slot != immovable
+                    && let Some(after) = self.local_after.get_mut(slot as usize)
+                {
+                    *after = place as u32 + 1;
+                }
             }
+            self.local_lanes.push(LocalLane {
+                source_start: group.start,
+                source_lane: lane as u8,
+                len: group.len,
+                group: place as u32,
+                lane: to as u8,
+            });
+            let (start, len) = (group.start as usize, group.len as usize);
+            points += self.sources[start..start + len]
+                .iter()
+                .filter(|sources| sources[lane] != u32::MAX)
+                .count();
         }
+        self.local_candidates = selected;
         let mut total = 0;
         for group in &mut self.local_groups {
             group.start = total;

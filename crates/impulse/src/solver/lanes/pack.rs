@@ -56,7 +56,7 @@ impl Bundles {
         self.recorded = false;
         self.before_kept = false;
         self.carried = false;
-        self.group_slots_known = false;
+        self.lanes_of_slots_known = false;
         self.rows = None;
         // The layout is a function of the points' body slots and manifolds alone: when they
         // repeat (an island at rest keeps its points), last pack's layout stands. They are

@@ -575,7 +575,10 @@ fn local_sweeps_after_a_carrying_relax_sweep_carry_their_changes() {
     let n = island.n;
     let swept = std::sync::Mutex::new(Vec::new());
     let local = |bundles: &mut super::Bundles, velocities: &mut crate::solver::Velocities<'_>| {
-        let points = bundles.select_local(|slot| (slot as usize) < n && slot.is_multiple_of(7));
+        let seeds: Vec<u32> = (0..n as u32)
+            .filter(|slot| slot.is_multiple_of(7))
+            .collect();
+        let points = bundles.select_local(&seeds);
         let report = bundles.solve_local(velocities, 6, 0.0, true, false);
         swept.lock().unwrap().push((points, report.iterations));
     };
