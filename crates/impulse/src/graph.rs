@@ -43,37 +43,45 @@ pub(crate) fn greedy_colours(
     counts
 }
 
-/// Which items (points, or the SIMD lanes' lanes) touch each body slot: the incidence of an
-/// island's graph in compressed rows, built once a step so that the items around a few slots
-/// are found without a pass over every item ([`Incidence::items_of`]).
+/// Which items touch each body slot (an island's points or SIMD lanes, or a slot's neighbours):
+/// the incidence of an island's graph in compressed rows, so that the items around a few slots
+/// are found without a pass over every item ([`Incidence::items_of`], [`Incidence::of`]).
 #[derive(Default)]
 pub(crate) struct Incidence {
-    /// Slot s's items are `items[starts[s]..starts[s + 1]]`, in increasing order.
+    /// Slot s's items are `items[starts[s]..starts[s + 1]]`, in the order given.
     starts: Vec<u32>,
     items: Vec<u32>,
 }
 
 impl Incidence {
-    /// Builds the lists of `slots` slots from (slot, item) `pairs` given in increasing item
-    /// order (an item may come once per slot it touches). Panics if a slot is not below `slots`.
+    /// Builds the lists of `slots` slots from (slot, item) `pairs`, each slot's items in the
+    /// order the pairs give them (an item may come once per slot it touches). Allocates nothing
+    /// once its lists have grown. Panics if a slot is not below `slots`.
     pub(crate) fn build(&mut self, slots: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) {
+        // Counts, shifted by two: after the prefix sum `starts[s + 1]` is where slot s's items
+        // begin, the cursor of the fill below, which leaves it where they end.
         self.starts.clear();
-        self.starts.resize(slots + 1, 0);
+        self.starts.resize(slots + 2, 0);
         for (slot, _) in pairs.clone() {
-            self.starts[slot as usize + 1] += 1;
+            self.starts[slot as usize + 2] += 1;
         }
         for s in 0..slots {
-            self.starts[s + 1] += self.starts[s];
+            self.starts[s + 2] += self.starts[s + 1];
         }
         self.items.clear();
-        self.items.resize(self.starts[slots] as usize, 0);
-        // Counting sort, stable: each slot's items stay in increasing order.
-        let mut next = self.starts.clone();
+        self.items.resize(self.starts[slots + 1] as usize, 0);
+        // Counting sort, stable.
         for (slot, item) in pairs {
-            let at = &mut next[slot as usize];
+            let at = &mut self.starts[slot as usize + 1];
             self.items[*at as usize] = item;
             *at += 1;
         }
+        self.starts.pop();
+    }
+
+    /// The items of `slot` (below the slots [`Incidence::build`] was given), in build order.
+    pub(crate) fn of(&self, slot: usize) -> &[u32] {
+        &self.items[self.starts[slot] as usize..self.starts[slot + 1] as usize]
     }
 
     /// The items touching any of `slots` (each below the slots [`Incidence::build`] was given),
@@ -81,8 +89,7 @@ impl Incidence {
     pub(crate) fn items_of(&self, slots: &[u32], out: &mut Vec<u32>) {
         out.clear();
         for &slot in slots {
-            let (start, end) = (self.starts[slot as usize], self.starts[slot as usize + 1]);
-            out.extend_from_slice(&self.items[start as usize..end as usize]);
+            out.extend_from_slice(self.of(slot as usize));
         }
         out.sort_unstable();
         out.dedup();
@@ -90,12 +97,11 @@ impl Incidence {
 }
 
 /// What [`bisect`] works in, kept by its caller so that a bisection allocates nothing once
-/// these have grown to the island: the moving slots' adjacency (offsets and neighbours, the
-/// graph in compressed rows), each slot's weight, the breadth-first order and each slot's half.
+/// these have grown to the island: the moving slots' neighbours ([`Incidence`]), each slot's
+/// weight, the breadth-first order and each slot's half.
 #[derive(Default)]
 pub(crate) struct Bisection {
-    offsets: Vec<u32>,
-    neighbours: Vec<u32>,
+    neighbours: Incidence,
     weights: Vec<u64>,
     order: Vec<u32>,
     seen: Vec<bool>,
@@ -121,7 +127,6 @@ pub(crate) fn bisect(
 ) {
     let immovable = slots.saturating_sub(1);
     let Bisection {
-        offsets,
         neighbours,
         weights,
         order,
@@ -129,40 +134,21 @@ pub(crate) fn bisect(
         halves,
     } = bisection;
     let moving = |slot: usize| slot < immovable;
-    // Degrees, then offsets, then neighbours (compressed rows), and the weights.
-    offsets.clear();
-    offsets.resize(slots + 1, 0);
+    // The weights, and each moving slot's moving neighbours in item order.
     weights.clear();
     weights.resize(slots, 0);
     for (a, b, weight) in items.clone() {
-        let (a, b) = (a as usize, b as usize);
-        for slot in [a, b] {
+        for slot in [a as usize, b as usize] {
             if moving(slot) {
                 weights[slot] += u64::from(weight);
             }
         }
-        if moving(a) && moving(b) && a != b {
-            offsets[a + 1] += 1;
-            offsets[b + 1] += 1;
-        }
     }
-    for k in 0..slots {
-        offsets[k + 1] += offsets[k];
-    }
-    neighbours.clear();
-    neighbours.resize(offsets[slots] as usize, 0);
-    // Where each slot's next neighbour goes (`order` serves, before it holds the order).
-    order.clear();
-    order.extend_from_slice(&offsets[..slots]);
-    for (a, b, _) in items.clone() {
-        let (a, b) = (a as usize, b as usize);
-        if moving(a) && moving(b) && a != b {
-            neighbours[order[a] as usize] = b as u32;
-            order[a] += 1;
-            neighbours[order[b] as usize] = a as u32;
-            order[b] += 1;
-        }
-    }
+    let edges = items.clone().flat_map(|(a, b, _)| {
+        let joins = moving(a as usize) && moving(b as usize) && a != b;
+        [(a, b), (b, a)].into_iter().filter(move |_| joins)
+    });
+    neighbours.build(slots, edges);
     // Breadth-first order from `first`: its component alone, or every component in turn (each
     // from its lowest slot after the first's).
     let search = |first: usize, every: bool, order: &mut Vec<u32>, seen: &mut Vec<bool>| {
@@ -180,7 +166,7 @@ pub(crate) fn bisect(
             while head < order.len() {
                 let slot = order[head] as usize;
                 head += 1;
-                for &next in &neighbours[offsets[slot] as usize..offsets[slot + 1] as usize] {
+                for &next in neighbours.of(slot) {
                     if !seen[next as usize] {
                         seen[next as usize] = true;
                         order.push(next);
