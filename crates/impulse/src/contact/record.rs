@@ -146,7 +146,9 @@ const RECORD_POINTS_PER_PART: usize = 8192;
 /// Which indices of a [`ContactConstraint`] name its bodies in a pass over velocity arrays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum BodySlots {
-    /// `body_a` / `body_b`: the world's body arrays.
+    /// `body_a` / `body_b`: the world's body arrays (the tests' world-wide passes; the step
+    /// records every row in its island's slots).
+    #[cfg(test)]
     World,
     /// `local_a` / `local_b`: one island's local arrays (the immovable slot last, at rest).
     /// The island's step records its rows this way while its data is in cache, on whichever
@@ -159,6 +161,7 @@ impl BodySlots {
     /// A row's two indices into the velocity arrays, (A, B).
     pub(crate) fn bodies_of(self) -> fn(&ContactConstraint) -> (usize, usize) {
         match self {
+            #[cfg(test)]
             BodySlots::World => |c| (c.body_a as usize, c.body_b as usize),
             BodySlots::Island => |c| (c.local_a as usize, c.local_b as usize),
         }

@@ -55,8 +55,11 @@ pub(crate) struct StepContext {
     /// from `Solve`, read by `Scatter`, `StoreImpulses` and `Finish`. Kept between steps for
     /// the solvers' own work spaces (a cache: the lanes' layout is rebuilt when it differs).
     pub(crate) workspaces: Vec<IslandWorkspace>,
-    /// `Finish`'s scratch for the record of every row (per part of rows, per body).
+    /// `Finish`'s scratch for the record of a sleeping island's rows (per part of rows, per
+    /// body slot).
     pub(crate) record_scratch: Vec<(Vec3, Vec3)>,
+    /// `Finish`'s scratch: a sleeping island's local (linear, angular) velocities.
+    pub(crate) record_velocities: (Vec<Vec3>, Vec<Vec3>),
     /// Written by `Continuous`: the clamps (body, clamped pose, fraction of the step).
     pub(crate) clamps: Vec<(usize, Pose, f32)>,
     /// Written by `Continuous`: every body's pose before its clamps (empty when continuous

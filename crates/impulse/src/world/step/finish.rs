@@ -14,7 +14,7 @@ use crate::solver::substep::IslandWorkspace;
 impl World {
     /// The step's diagnostics, from the solve's `constraints` and `workspaces` of the islands
     /// it woke (`island_awake`); the rows of sleeping islands recorded (writes `constraints`,
-    /// `workspaces` and `record_scratch`). Returns the energy terms for the blow-up check.
+    /// `record_velocities` and `record_scratch`). Returns the energy terms for the blow-up check.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn finish_stage(
         &mut self,
@@ -24,7 +24,8 @@ impl World {
         awake: &[bool],
         world_inverse_inertia: &[Mat3],
         constraints: &mut [ContactConstraint],
-        workspaces: &mut [IslandWorkspace],
+        workspaces: &[IslandWorkspace],
+        record_velocities: &mut (Vec<Vec3>, Vec<Vec3>),
         record_scratch: &mut Vec<(Vec3, Vec3)>,
     ) -> EnergyTerms {
         let dt = self.dt;
@@ -40,7 +41,7 @@ impl World {
             awake,
             world_inverse_inertia,
             constraints,
-            workspaces,
+            record_velocities,
             record_scratch,
         );
         let (residual, friction_rows) =

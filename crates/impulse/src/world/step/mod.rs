@@ -15,7 +15,7 @@
 //! | [`Stage::Scatter`] | `scatter.rs` | `islands`, `island_awake`, `workspaces`, `moving_kinematic` | (the bodies) |
 //! | [`Stage::Continuous`] | `motion_clamp.rs` | `start_poses`, `moving_kinematic` | `clamps`, `unclamped_poses` |
 //! | [`Stage::StoreImpulses`] | `store_impulses.rs` | `islands`, `island_awake`, `constraints`, `workspaces` | (the manifolds, the joints) |
-//! | [`Stage::Finish`] | `finish.rs` | `islands`, `island_awake`, `world_inverse_inertia` | `constraints`, `workspaces`, `record_scratch` (the rows of sleeping islands) |
+//! | [`Stage::Finish`] | `finish.rs` | `islands`, `island_awake`, `world_inverse_inertia` | `constraints`, `record_velocities`, `record_scratch` (the rows of sleeping islands) |
 //! | [`Stage::EndStep`] | `end_step.rs` | `moving_kinematic` | |
 //!
 //! What each does: kinematic bodies' velocities (`kinematic.rs`); speculative margins and
@@ -190,7 +190,8 @@ impl World {
             &c.island_awake,
             &c.world_inverse_inertia,
             &mut c.constraints,
-            &mut c.workspaces,
+            &c.workspaces,
+            &mut c.record_velocities,
             &mut c.record_scratch,
         );
         clock.end(Stage::Finish);

@@ -5,15 +5,15 @@
 //!
 //! - an awake island solved in SIMD lanes took it from its bundles as its last substep ended
 //!   (`IslandWorkspace::rows`, the lanes' `Bundles::record`), and its rows' J·v* and impulses
-//!   stay there (`IslandWorkspace::impulses_in_lanes`) unless a pass over every row needs them;
+//!   stay there (`IslandWorkspace::impulses_in_lanes`) until a reader of the rows asks for them;
 //! - any other awake island takes it in one pass over its rows as its job ends, while they are
 //!   still in cache ([`crate::diagnostics::record_velocity_before_and_residual`]);
-//! - a sleeping island's rows take v* from the bodies' velocities, in one pass over every row
-//!   at the finish ([`record_sleeping_rows`]); rows of awake islands (those in lanes have their
-//!   impulses written back first) come out of that pass as their own record, to the last bits.
+//! - a sleeping island's rows take v* from its bodies' velocities at the finish, in one pass
+//!   over its own rows in island slots ([`World::record_sleeping_rows`]): the finish costs the
+//!   sleeping rows, not every row.
 //!
-//! The three give the same bits for the same rows on any thread count (tests in
-//! `diagnostics/contact_lcp_tests.rs` and `solver/wide_tests.rs`).
+//! Each gives the same bits on any thread count (tests in `diagnostics/contact_lcp_tests.rs`
+//! and `solver/wide_tests.rs`).
 
 use glam::{Mat3, Vec3};
 
@@ -46,35 +46,43 @@ pub(super) fn end_island(
 }
 
 impl World {
-    /// When any island slept through the step (`awake`), every row's v* from the bodies'
-    /// velocities (one pass over all rows: the sleeping islands' rows get theirs, the awake
-    /// islands' rows their own record again, to the bit).
+    /// The record of the rows of the islands that slept through the step (`awake` false):
+    /// each such island's rows take v* from its bodies' velocities in one pass over its own
+    /// rows, in island slots ([`BodySlots::Island`]) as an awake island's own pass does, so
+    /// the cost follows the sleeping rows, not the world's. `velocities` holds one island's
+    /// local (linear, angular) arrays at a time; `scratch` the pass's per-body deltas.
     pub(super) fn record_sleeping_rows(
         &self,
         islands_of: &Islands,
         awake: &[bool],
         world_inverse_inertia: &[Mat3],
         constraints: &mut [ContactConstraint],
-        workspaces: &mut [IslandWorkspace],
+        velocities: &mut (Vec<Vec3>, Vec<Vec3>),
         scratch: &mut Vec<(Vec3, Vec3)>,
     ) {
-        let islands = islands_of.len();
-        if awake.iter().take(islands).any(|awake| !awake) {
-            // The pass reads every row's impulses, which an awake island in lanes may have
-            // kept in its lanes: they are written back first.
-            for k in 0..islands {
-                let w = &mut workspaces[k];
-                if std::mem::take(&mut w.impulses_in_lanes) {
-                    w.unpack_into(&mut constraints[islands_of.constraint_range(k)]);
-                }
+        let bodies = &self.bodies;
+        for k in (0..islands_of.len()).filter(|&k| !awake[k]) {
+            let rows = &mut constraints[islands_of.constraint_range(k)];
+            if rows.is_empty() {
+                continue;
             }
-            // The pass reads every row's I⁻¹(r × d), which the lanes keep in their bundles.
-            contact::complete_products(constraints, world_inverse_inertia);
+            // The pass reads every row's I⁻¹(r × d), which a row may have left pending.
+            contact::complete_products(rows, world_inverse_inertia);
+            // Local slots: the island's bodies, its guests, then the immovable slot, at rest.
+            let (linear, angular) = velocities;
+            linear.clear();
+            angular.clear();
+            for &i in islands_of.bodies(k).iter().chain(islands_of.guests(k)) {
+                linear.push(bodies.linear_velocity[i as usize]);
+                angular.push(bodies.angular_velocity[i as usize]);
+            }
+            linear.push(Vec3::ZERO);
+            angular.push(Vec3::ZERO);
             contact::record_velocity_before(
-                constraints,
-                BodySlots::World,
-                &self.bodies.linear_velocity,
-                &self.bodies.angular_velocity,
+                rows,
+                BodySlots::Island,
+                linear,
+                angular,
                 self.parallel,
                 scratch,
             );
