@@ -12,20 +12,44 @@ pub(crate) const COLOURS: usize = 64;
 /// colour offsets in item order, colour k at `counts[k]..counts[k + 1]`. `used` holds each
 /// slot's colours. Panics if a slot is not below `slots`.
 pub(crate) fn greedy_colours(
-    items: impl Iterator<Item = (u32, u32)>,
+    items: impl Iterator<Item = (u32, u32)> + Clone,
     slots: usize,
     used: &mut Vec<u64>,
     colours: &mut Vec<u8>,
 ) -> [u32; COLOURS + 2] {
+    greedy_colours_last(items, slots, |_, _| false, used, colours).0
+}
+
+/// [`greedy_colours`] with the items for which `last(a, b)` holds moved after all others:
+/// every item is first coloured as [`greedy_colours`] colours it, then each `last` item again,
+/// in item order, in the lowest colour above every other item's that neither of its moving
+/// bodies has. In a sweep colour after colour the `last` items then come after the rest,
+/// which keep their colours and so their order. Returns the counts and the first colour above
+/// the others' (where the `last` items start).
+///
+/// A split island's manifold groups between its two halves are such items: the groups within
+/// either half then share no body with the other half's in any colour before them, so the two
+/// halves' groups of all those colours can be swept at once, one half a thread, and the
+/// groups between the halves after them (docs/method.md, "Graph colouring and SIMD lanes").
+/// The others must keep their colours: coloured without the `last` items, pyramid50's pile
+/// gained kinetic energy at rest instead of losing it.
+pub(crate) fn greedy_colours_last(
+    items: impl Iterator<Item = (u32, u32)> + Clone,
+    slots: usize,
+    last: impl Fn(u32, u32) -> bool,
+    used: &mut Vec<u64>,
+    colours: &mut Vec<u8>,
+) -> ([u32; COLOURS + 2], usize) {
     let immovable = slots - 1;
     used.clear();
     used.resize(slots, 0);
     colours.clear();
-    let mut counts = [0u32; COLOURS + 2];
-    for (a, b) in items {
-        let (a, b) = (a as usize, b as usize);
-        let mask =
-            (if a != immovable { used[a] } else { 0 }) | (if b != immovable { used[b] } else { 0 });
+    // The lowest colour that neither moving body has and `floor` does not hold (its bits
+    // set), marked as theirs.
+    let place = |used: &mut [u64], a: usize, b: usize, floor: u64| {
+        let mask = floor
+            | (if a != immovable { used[a] } else { 0 })
+            | (if b != immovable { used[b] } else { 0 });
         let colour = ((!mask).trailing_zeros() as usize).min(COLOURS);
         if colour < COLOURS {
             for slot in [a, b] {
@@ -34,13 +58,49 @@ pub(crate) fn greedy_colours(
                 }
             }
         }
+        colour
+    };
+    let mut first_last = 0;
+    let mut any_last = false;
+    for (a, b) in items.clone() {
+        let colour = place(used, a as usize, b as usize, 0);
+        if last(a, b) {
+            any_last = true;
+        } else {
+            first_last = first_last.max(colour + 1);
+        }
         colours.push(colour as u8);
-        counts[colour + 1] += 1;
+    }
+    let first_last = first_last.min(COLOURS);
+    if any_last {
+        let floor = if first_last >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << first_last) - 1
+        };
+        for ((a, b), colour) in items.clone().zip(colours.iter_mut()) {
+            if !last(a, b) {
+                continue;
+            }
+            let (a, b) = (a as usize, b as usize);
+            if (*colour as usize) < COLOURS {
+                for slot in [a, b] {
+                    if slot != immovable {
+                        used[slot] &= !(1u64 << *colour);
+                    }
+                }
+            }
+            *colour = place(used, a, b, floor) as u8;
+        }
+    }
+    let mut counts = [0u32; COLOURS + 2];
+    for &colour in colours.iter() {
+        counts[colour as usize + 1] += 1;
     }
     for k in 0..=COLOURS {
         counts[k + 1] += counts[k];
     }
-    counts
+    (counts, first_last)
 }
 
 /// Which items touch each body slot (an island's points or SIMD lanes, or a slot's neighbours):

@@ -1,4 +1,4 @@
-use super::{Bisection, Incidence, bisect};
+use super::{Bisection, COLOURS, Incidence, bisect, greedy_colours, greedy_colours_last};
 use proptest::prelude::*;
 
 /// The items of an n × n grid of moving slots (slot x + n·y), each joined to its right and
@@ -154,5 +154,52 @@ proptest! {
             .map(|(k, _)| k as u32)
             .collect();
         prop_assert_eq!(found, expected);
+    }
+
+    /// On random items (a slot may repeat, the immovable slot is the last), colouring the items
+    /// that cross a random cut after the others: items of one colour below [`COLOURS`] share no
+    /// moving slot, every crossing item's colour is at least the returned first colour, every
+    /// other keeps the colour [`greedy_colours`] gives it (below that first colour), and the
+    /// counts are the colours' offsets.
+    #[test]
+    fn items_coloured_last_come_after_all_others(
+        slots in 2usize..40,
+        raw in prop::collection::vec((0u32..40, 0u32..40), 0..150),
+        cut in 0u32..40,
+    ) {
+        let items: Vec<(u32, u32)> = raw
+            .into_iter()
+            .map(|(a, b)| (a % slots as u32, b % slots as u32))
+            .collect();
+        let immovable = (slots - 1) as u32;
+        let last = |a: u32, b: u32| a != immovable && b != immovable && (a < cut) != (b < cut);
+        let (mut used, mut colours) = (Vec::new(), Vec::new());
+        let (counts, first_last) =
+            greedy_colours_last(items.iter().copied(), slots, last, &mut used, &mut colours);
+        prop_assert_eq!(colours.len(), items.len());
+        let mut plain = Vec::new();
+        greedy_colours(items.iter().copied(), slots, &mut used, &mut plain);
+        for (k, &(a, b)) in items.iter().enumerate() {
+            let colour = colours[k] as usize;
+            prop_assert!(colour <= COLOURS);
+            if last(a, b) {
+                prop_assert!(colour >= first_last);
+            } else {
+                prop_assert_eq!(colour, plain[k] as usize);
+                prop_assert!(colour < first_last || colour == COLOURS);
+            }
+            for (j, &(c, d)) in items.iter().enumerate().take(k) {
+                if colours[j] as usize == colour && colour < COLOURS {
+                    let shared = [a, b]
+                        .into_iter()
+                        .any(|s| s != immovable && (s == c || s == d));
+                    prop_assert!(!shared, "items {} and {} share a slot in colour {}", j, k, colour);
+                }
+            }
+        }
+        for colour in 0..=COLOURS {
+            let count = colours.iter().filter(|&&c| c as usize == colour).count() as u32;
+            prop_assert_eq!(counts[colour + 1] - counts[colour], count);
+        }
     }
 }

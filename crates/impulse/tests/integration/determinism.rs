@@ -132,8 +132,9 @@ fn every_solver_method_is_the_same_on_any_thread_count() {
     }
 }
 
-/// A split island (pyramid50's one island of about 15 thousand points, cut in two halves whose
-/// colours' parts run on two threads at once) gives the bits of one thread.
+/// A split island (pyramid50's one island of about 15 thousand points, cut in two halves swept
+/// at once on two threads through every colour before the groups joining them, those colours'
+/// parts after them) gives the bits of one thread.
 #[test]
 fn a_split_island_is_the_same_on_any_thread_count_and_run() {
     same_everywhere(&builtin_scene("pyramid50").unwrap(), 20);

@@ -21,6 +21,12 @@ pub(crate) struct Bundles {
     /// groups the colouring could not place, one per lane group, and always runs on one thread.
     pub(super) groups: Vec<Group>,
     pub(super) group_colour_starts: Vec<usize>,
+    /// Per colour, the lane group where its second half's groups start (a split island's; the
+    /// colour's end otherwise); and how many colours come before the first that holds groups
+    /// joining the two halves (0 when the island is not split). The two halves' groups of
+    /// those first colours share no body.
+    pub(super) group_half_starts: Vec<usize>,
+    pub(super) halves_apart: usize,
     /// The slot where a split island's second half of bodies starts, for the next pack
     /// ([`Bundles::set_second_half`]), and the one the layout was made with.
     pub(super) second_half: Option<u32>,

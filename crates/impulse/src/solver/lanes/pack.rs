@@ -9,7 +9,7 @@ use super::lane::{LANES, Lane, set, set_vec};
 use super::layout::{Bundle, BundleGeometry, GROUP_POINTS, Group, PointKey, set_lane};
 use super::products::compute_products;
 use crate::contact::ContactConstraint;
-use crate::graph::{COLOURS, greedy_colours};
+use crate::graph::{COLOURS, greedy_colours_last};
 use crate::parallel::{PARALLEL_PACK_POINTS, SharedItems, spread, threads};
 use crate::simd::{InstructionSet, on_instruction_set};
 use crate::solver::interface::RowsReport;
@@ -32,7 +32,9 @@ impl Bundles {
     /// a wait per sweep on several threads).
     ///
     /// In a split island ([`Bundles::set_second_half`]) each colour takes the manifold groups
-    /// of its first half of bodies first, then those of its second half.
+    /// of its first half of bodies first, then those of its second half, each half's in lane
+    /// groups of their own, and the groups joining the two halves take colours after all the
+    /// others ([`crate::graph::greedy_colours_last`]).
     ///
     /// With `parallel`, each colour's lane groups are later spread over rayon's threads (a
     /// split island's in two parts, one a thread); the result is the same bit for bit, as the
@@ -179,31 +181,58 @@ impl Bundles {
         let run_count = self.runs.len();
         self.runs.push(keys.len() as u32);
         let run_points = |runs: &[u32], r: usize| (runs[r + 1] - runs[r]) as usize;
-        // Greedy colours of the groups, and the groups per colour.
+        // Each group's half of a split island: 0 for the first half's bodies (by the lower of
+        // its slots, a moving one, as the immovable slot is the last), 1 for the second's; and
+        // whether it joins the two halves (the immovable slot belongs to neither).
+        let immovable = (slots - 1) as u32;
+        let second = self.layout_second_half;
+        let half_of_slot = |slot: u32| u8::from(second.is_some_and(|second| slot >= second));
+        let joins = |a: u32, b: u32| {
+            second.is_some()
+                && a != immovable
+                && b != immovable
+                && half_of_slot(a) != half_of_slot(b)
+        };
         let runs = &self.runs;
         let group_slots = (0..run_count).map(|r| {
             let key = keys[runs[r] as usize];
             (key.local_a, key.local_b)
         });
-        let counts = greedy_colours(group_slots, slots, &mut self.used, &mut self.colours);
-        // Lane groups per colour (the last colour: one group each), and where each starts.
+        let half_of = |r: usize| {
+            let key = keys[runs[r] as usize];
+            half_of_slot(key.local_a.min(key.local_b))
+        };
+        // Greedy colours of the groups, those joining the halves after the others.
+        let (_, first_joining) =
+            greedy_colours_last(group_slots, slots, joins, &mut self.used, &mut self.colours);
+        self.halves_apart = if second.is_some() { first_joining } else { 0 };
+        // Per colour and half, its groups; each half's groups of a colour start a lane group
+        // (the last colour: one group each), so that no lane group holds both halves.
+        let mut counts = [[0usize; 2]; COLOURS + 1];
+        for r in 0..run_count {
+            counts[self.colours[r] as usize][usize::from(half_of(r))] += 1;
+        }
         let per_group = |colour: usize| if colour < COLOURS { LANES } else { 1 };
         self.group_colour_starts.clear();
         self.group_colour_starts.push(0);
+        self.group_half_starts.clear();
+        let mut lane_group_of = [[0usize; 2]; COLOURS + 1];
         for colour in 0..=COLOURS {
-            let groups =
-                ((counts[colour + 1] - counts[colour]) as usize).div_ceil(per_group(colour));
             let last = *self.group_colour_starts.last().unwrap_or(&0);
-            self.group_colour_starts.push(last + groups);
+            let first = counts[colour][0].div_ceil(per_group(colour));
+            let second = counts[colour][1].div_ceil(per_group(colour));
+            lane_group_of[colour] = [last, last + first];
+            self.group_half_starts.push(last + first);
+            self.group_colour_starts.push(last + first + second);
         }
         let total_groups = *self.group_colour_starts.last().unwrap_or(&0);
-        // Each group to the next free lane of its colour, in constraint order; a lane group
-        // is as long as its longest group. In a split island, a colour's groups of the first
-        // half's bodies first (by the lower of a group's moving slots), then the second's: a
-        // colour's two parts then mostly touch one half each, whose bodies' velocities lie
-        // apart (see [`Bundles::set_second_half`]).
+        // Each group to the next free lane of its colour and half, in constraint order; a lane
+        // group is as long as its longest group. In a split island a colour's groups of the
+        // first half's bodies come first, then the second's, in lane groups of their own: a
+        // colour's two parts then touch one half each (but for the groups joining the halves,
+        // in colours of their own), whose bodies' velocities lie apart (see
+        // [`Bundles::set_second_half`]).
         self.groups.clear();
-        let immovable = (slots - 1) as u32;
         let empty = Group {
             local_a: [immovable; LANES],
             local_b: [immovable; LANES],
@@ -212,32 +241,17 @@ impl Bundles {
         self.groups.resize(total_groups, empty);
         self.run_places.clear();
         self.run_places.resize(run_count, (0, 0));
-        let mut filled = [0usize; COLOURS + 1];
-        let half_of = |r: usize| match self.layout_second_half {
-            Some(second) => {
-                // The immovable slot is the last: the lower slot is a moving one.
-                let key = keys[self.runs[r] as usize];
-                u8::from(key.local_a.min(key.local_b) >= second)
-            }
-            None => 0,
-        };
-        let halves = if self.layout_second_half.is_some() {
-            2
-        } else {
-            1
-        };
-        for half in 0..halves {
-            for r in (0..run_count).filter(|&r| half_of(r) == half) {
-                let colour = self.colours[r] as usize;
-                let position = filled[colour];
-                filled[colour] += 1;
-                let per = per_group(colour);
-                let group = self.group_colour_starts[colour] + position / per;
-                let lane = position % per;
-                let g = &mut self.groups[group];
-                g.len = g.len.max(run_points(&self.runs, r) as u32);
-                self.run_places[r] = (group as u32, lane as u32);
-            }
+        let mut filled = [[0usize; 2]; COLOURS + 1];
+        for r in 0..run_count {
+            let (colour, half) = (self.colours[r] as usize, usize::from(half_of(r)));
+            let position = filled[colour][half];
+            filled[colour][half] += 1;
+            let per = per_group(colour);
+            let group = lane_group_of[colour][half] + position / per;
+            let lane = position % per;
+            let g = &mut self.groups[group];
+            g.len = g.len.max(run_points(&self.runs, r) as u32);
+            self.run_places[r] = (group as u32, lane as u32);
         }
         let mut total = 0u32;
         for g in self.groups.iter_mut() {

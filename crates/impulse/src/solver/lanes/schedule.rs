@@ -1,8 +1,8 @@
 //! The order and the threads of a sweep: lane groups colour by colour (forward or backward,
 //! each group's bundles from its first or from halfway round), each group's bodies gathered
 //! once and scattered once, a colour's lane groups spread over rayon's threads (they share
-//! no moving body; a split island's in two parts, one a thread), the next bundles asked of
-//! the CPU ahead of the update.
+//! no moving body; a split island's two halves one a thread through every colour before the
+//! groups joining them, with one wait), the next bundles asked of the CPU ahead of the update.
 
 use super::bundles::Bundles;
 use super::lane::{Fused, Lane, Rounding, Separate, fold_largest};
@@ -21,10 +21,11 @@ impl Bundles {
     /// Runs `update` on every bundle, colour by colour (`forward`, or in reverse), each lane
     /// group's bodies gathered into lanes once and scattered back after its bundles; returns the
     /// lane-wise largest of what `update` returned. With `parallel` (see [`Bundles::pack`]),
-    /// each colour of a split island ([`Bundles::set_second_half`]) runs in two parts at once
-    /// ([`crate::parallel::join_halves`]); otherwise each colour is split over rayon's
-    /// threads, in parts of at least [`GROUPS_PER_TASK`] lane groups
-    /// ([`crate::parallel::colour_after_colour`]). Either way the result is the serial
+    /// a split island's ([`Bundles::set_second_half`]) two halves run at once through all the
+    /// colours before the groups joining them, one half a thread
+    /// ([`crate::parallel::join_halves`]), and then each of those colours in two parts;
+    /// otherwise each colour is split over rayon's threads, in parts of at least
+    /// [`GROUPS_PER_TASK`] lane groups ([`crate::parallel::colour_after_colour`]). Either way the result is the serial
     /// sweep's, to the bit.
     pub(super) fn sweep<F, T>(
         &mut self,
@@ -79,15 +80,52 @@ impl Bundles {
                 |x, y| x.max(y),
             );
         }
-        // A split island: each colour in two parts, the first on this thread and the second on
-        // the thread held for the island ([`crate::parallel::join_halves`]), colour after
-        // colour; the last colour (whose groups may share bodies) and colours of fewer than
-        // two parts' worth of lane groups ([`GROUPS_PER_TASK`]) on this thread.
-        let mut largest = Lane::splat(0.0);
+        // A split island: the colours before the first holding groups that join the halves
+        // (`halves_apart`) in two parts, the first half's groups of every such colour on this
+        // thread and the second half's on the thread held for the island
+        // ([`crate::parallel::join_halves`]): the parts share no body, so one wait a sweep
+        // keeps the serial order's result. Then the colours of the groups joining the halves,
+        // each in two parts as large as two parts' worth of lane groups ([`GROUPS_PER_TASK`]),
+        // else on this thread, as is the last colour (whose groups may share bodies).
         let colours = starts.len() - 1;
-        for visit in 0..colours {
+        let apart = self.halves_apart.min(colours);
+        let halves = &self.group_half_starts;
+        let groups = SharedItems(self.groups.as_mut_ptr());
+        let half = |second: bool, forward: bool| {
+            // Capture the whole wrapper (Sync), not its raw-pointer field.
+            #[allow(clippy::redundant_locals)]
+            let groups = groups;
+            let mut largest = Lane::splat(0.0);
+            for visit in 0..apart {
+                let k = if forward { visit } else { apart - 1 - visit };
+                let range = if second {
+                    halves[k]..starts[k + 1]
+                } else {
+                    starts[k]..halves[k]
+                };
+                // SAFETY: the two halves' ranges of the colours before `apart` are disjoint
+                // runs of `self.groups`, borrowed exclusively here, each run by one closure.
+                let part = unsafe {
+                    std::slice::from_raw_parts_mut(groups.0.add(range.start), range.len())
+                };
+                largest = largest.max(run(part, forward));
+            }
+            largest
+        };
+        let apart_both = || {
+            if apart == 0 {
+                return Lane::splat(0.0);
+            }
+            let (x, y) = join_halves(|| half(false, order.forward), || half(true, order.forward));
+            x.max(y)
+        };
+        let mut largest = Lane::splat(0.0);
+        if order.forward {
+            largest = largest.max(apart_both());
+        }
+        for visit in 0..colours - apart {
             let k = if order.forward {
-                visit
+                apart + visit
             } else {
                 colours - 1 - visit
             };
@@ -107,6 +145,9 @@ impl Bundles {
                 x.max(y)
             };
             largest = largest.max(change);
+        }
+        if !order.forward {
+            largest = largest.max(apart_both());
         }
         largest
     }

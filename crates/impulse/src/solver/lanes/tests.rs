@@ -499,13 +499,17 @@ fn fused_multiply_add_rounds_once() {
 mod scalar_agreement;
 mod scenes;
 
-/// A split island's pack (`set_second_half`) keeps every colour's manifold groups (the same
-/// colours as unsplit), the first half's (by the lower moving slot) before the second's: only
-/// lanes of one colour change places, which share no body.
+/// A split island's pack (`set_second_half`) holds the same manifold groups as the unsplit
+/// one; the groups joining the two halves take colours after every other group's
+/// (`halves_apart`); in each colour before those, the first half's lane groups (by the lower
+/// moving slot) come first and the second half's after `group_half_starts`, no lane group
+/// holding both, and the two halves' lane groups of all those colours share no moving slot,
+/// so they can be swept at once.
 #[test]
-fn a_split_pack_keeps_the_colours_and_puts_each_colours_first_half_first() {
+fn a_split_pack_puts_the_groups_joining_the_halves_last_and_keeps_the_halves_apart() {
     // A chain of 12 moving slots (12 immovable, which the last link reaches): links of 1 to 4
-    // points, and every slot on the ground; the second half starts at slot 6.
+    // points, and every slot on the ground; the second half starts at slot 6, so the link
+    // between slots 5 and 6 joins the halves.
     let (slots, second) = (13usize, 6u32);
     let mut constraints = Vec::new();
     for a in 0..12u32 {
@@ -529,34 +533,47 @@ fn a_split_pack_keeps_the_colours_and_puts_each_colours_first_half_first() {
     split.set_second_half(Some(second));
     split.pack(&constraints, slots, &inertia, false);
     assert!(split.split() && !whole.split());
-    assert_eq!(split.group_colour_starts, whole.group_colour_starts);
-    for colour in 0..COLOURS {
-        let groups = split.group_colour_starts[colour]..split.group_colour_starts[colour + 1];
-        let halves: Vec<bool> = split.groups[groups]
-            .iter()
-            .flat_map(|g| (0..LANES).map(move |lane| (g.local_a[lane], g.local_b[lane])))
-            .filter(|&(a, b)| (a, b) != (12, 12))
-            .map(|(a, b)| a.min(b) >= second)
-            .collect();
-        assert!(
-            halves.windows(2).all(|w| w[0] <= w[1]),
-            "colour {colour}: {halves:?}"
-        );
-    }
-    // The same manifold groups per colour, as sets of body pairs.
-    let pairs_of = |packed: &Bundles, colour: usize| {
-        let groups = packed.group_colour_starts[colour]..packed.group_colour_starts[colour + 1];
-        let mut pairs: Vec<(u32, u32)> = packed.groups[groups]
+    assert_eq!(whole.halves_apart, 0);
+    let lanes_of = |packed: &Bundles, groups: std::ops::Range<usize>| -> Vec<(u32, u32)> {
+        packed.groups[groups]
             .iter()
             .flat_map(|g| (0..LANES).map(move |lane| (g.local_a[lane], g.local_b[lane])))
             .filter(|&pair| pair != (12, 12))
-            .collect();
+            .collect()
+    };
+    let colours = split.group_colour_starts.len() - 1;
+    let apart = split.halves_apart;
+    assert!(apart > 0 && apart < colours, "{apart} of {colours} colours");
+    let mut halves_slots = [Vec::new(), Vec::new()];
+    for colour in 0..colours {
+        let (start, middle, end) = (
+            split.group_colour_starts[colour],
+            split.group_half_starts[colour],
+            split.group_colour_starts[colour + 1],
+        );
+        assert!(start <= middle && middle <= end);
+        for (half, groups) in [(0, start..middle), (1, middle..end)] {
+            for (a, b) in lanes_of(&split, groups) {
+                let joins = b != 12 && (a < second) != (b < second);
+                assert_eq!(joins, colour >= apart, "colour {colour}: ({a}, {b})");
+                if colour < apart {
+                    assert_eq!(u32::from(a.min(b) >= second), half, "colour {colour}");
+                    halves_slots[half as usize].extend([a, b].into_iter().filter(|&s| s != 12));
+                }
+            }
+        }
+    }
+    let [first, second_slots] = &halves_slots;
+    assert!(!first.is_empty() && !second_slots.is_empty());
+    assert!(first.iter().all(|slot| !second_slots.contains(slot)));
+    // The same manifold groups, as a multiset of body pairs.
+    let mut pairs = [&split, &whole].map(|packed| {
+        let mut pairs = lanes_of(packed, 0..packed.groups.len());
         pairs.sort_unstable();
         pairs
-    };
-    for colour in 0..=COLOURS {
-        assert_eq!(pairs_of(&split, colour), pairs_of(&whole, colour));
-    }
+    });
+    let [split_pairs, whole_pairs] = &mut pairs;
+    assert_eq!(split_pairs, whole_pairs);
 }
 
 /// A bundle whose points carry no impulse and stay apart (no normal impulse after the normal
