@@ -63,12 +63,13 @@ pub(crate) const PARALLEL_ISLAND_POINTS: usize = 8192;
 
 /// Islands of at least this many points are split: their bodies are cut into two halves that
 /// few points join ([`crate::island::Islands::second_half`]), each half's bodies on consecutive
-/// slots, and each colour of the SIMD sweep runs in two parts, mostly one half each, on a
-/// thread held for the island ([`with_helper`]). With the halves' velocities on cache lines of
-/// their own, a two-thread sweep of a poured pile no longer waits on the other core for them.
-/// From [`SPLIT_CLEAN_ISLAND_POINTS`] on, an island whose halves few enough points join is
-/// split too. Results depend on these (the colours' order of lanes), the same on any thread
-/// count.
+/// slots, the manifold groups joining the halves coloured after all the others, and the two
+/// halves' groups of every colour before those swept at once, the second half on a thread held
+/// for the island ([`with_helper`]), with one wait a sweep. With the halves' velocities on
+/// cache lines of their own, a two-thread sweep of a poured pile does not wait on the other
+/// core for them. From [`SPLIT_CLEAN_ISLAND_POINTS`] on, an island whose halves few enough
+/// points join is split too. Results depend on these (the colours' order of lanes), the same
+/// on any thread count.
 pub(crate) const SPLIT_ISLAND_POINTS: usize = 12288;
 
 /// Islands of at least this many points are split ([`SPLIT_ISLAND_POINTS`]) when at most
