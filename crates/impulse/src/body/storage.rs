@@ -88,6 +88,26 @@ pub struct Bodies {
 }
 
 impl Bodies {
+    /// The velocities of an island's slots into `linear` and `angular` (m/s, rad/s; cleared
+    /// first): its bodies', its guests' (`island_bodies` and `guests`, body indices), then the
+    /// immovable slot's, zero.
+    pub(crate) fn gather_slot_velocities(
+        &self,
+        island_bodies: &[u32],
+        guests: &[u32],
+        linear: &mut Vec<Vec3>,
+        angular: &mut Vec<Vec3>,
+    ) {
+        linear.clear();
+        angular.clear();
+        for &i in island_bodies.iter().chain(guests) {
+            linear.push(self.linear_velocity[i as usize]);
+            angular.push(self.angular_velocity[i as usize]);
+        }
+        linear.push(Vec3::ZERO);
+        angular.push(Vec3::ZERO);
+    }
+
     /// Removes body `i`, moving the last body into its place; returns its name.
     pub(crate) fn swap_remove(&mut self, i: usize) -> Option<String> {
         self.kind.swap_remove(i);

@@ -261,14 +261,7 @@ impl ImpactWorkspace {
     /// The velocities of the step's start per slot: the island's bodies, its guests, then the
     /// immovable slot (zero).
     fn gather(&mut self, island_bodies: &[u32], guests: &[u32], bodies: &Bodies) {
-        self.linear.clear();
-        self.angular.clear();
-        for &i in island_bodies.iter().chain(guests) {
-            self.linear.push(bodies.linear_velocity[i as usize]);
-            self.angular.push(bodies.angular_velocity[i as usize]);
-        }
-        self.linear.push(Vec3::ZERO);
-        self.angular.push(Vec3::ZERO);
+        bodies.gather_slot_velocities(island_bodies, guests, &mut self.linear, &mut self.angular);
     }
 
     /// Lists each moving slot's rows (counting sort by slot); guests and the immovable slot,

@@ -68,16 +68,13 @@ impl World {
             }
             // The pass reads every row's I⁻¹(r × d), which a row may have left pending.
             contact::complete_products(rows, world_inverse_inertia);
-            // Local slots: the island's bodies, its guests, then the immovable slot, at rest.
             let (linear, angular) = velocities;
-            linear.clear();
-            angular.clear();
-            for &i in islands_of.bodies(k).iter().chain(islands_of.guests(k)) {
-                linear.push(bodies.linear_velocity[i as usize]);
-                angular.push(bodies.angular_velocity[i as usize]);
-            }
-            linear.push(Vec3::ZERO);
-            angular.push(Vec3::ZERO);
+            bodies.gather_slot_velocities(
+                islands_of.bodies(k),
+                islands_of.guests(k),
+                linear,
+                angular,
+            );
             contact::record_velocity_before(
                 rows,
                 BodySlots::Island,
