@@ -6,7 +6,7 @@
 
 use super::bundles::Bundles;
 use super::lane::{Fused, Lane, Rounding, Separate, fold_largest};
-use super::layout::{Bundle, Group, SharedLanes};
+use super::layout::{Bundle, Group, NORMAL_PART, SharedLanes};
 use super::sweep::{BundleUpdate, Visits};
 use super::targets::SetTargets;
 use crate::graph::COLOURS;
@@ -172,7 +172,7 @@ pub(super) struct SweepOrder {
 /// starting halfway round in every other substep puts the diagonally opposite corner first and
 /// the torques cancel. Reversing the group instead leaves the first point on the same side.
 ///
-/// Asks the CPU for the bundle [`PREFETCH_BUNDLES`] ahead first, the part `update` reads
+/// Asks the CPU for the bundle [`bundles_ahead`] ahead first, the part `update` reads
 /// ([`BundleUpdate::READS`]): a bundle is 14 cache lines (four lanes), and once an island's
 /// bundles outgrow L2 the sweep waits on L3 for them, which the hardware prefetcher does not
 /// hide. The normal rows' sweep asks for the first 5 lines alone ([`NORMAL_PART`]): asking for
@@ -195,6 +195,7 @@ pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets, R: Rounding>(
 ) -> Lane {
     let mut largest = Lane::splat(0.0);
     let n = groups.len();
+    let distance = bundles_ahead(F::READS, len);
     for step in 0..n {
         let group = &groups[if forward { step } else { n - 1 - step }];
         let (start, count) = (group.start as usize, group.len as usize);
@@ -211,9 +212,9 @@ pub(super) unsafe fn sweep_groups<F: BundleUpdate, T: SetTargets, R: Rounding>(
         for p in 0..count {
             let index = visits.index(p);
             let ahead = if forward {
-                index + PREFETCH_BUNDLES
+                index + distance
             } else {
-                index.wrapping_sub(PREFETCH_BUNDLES)
+                index.wrapping_sub(distance)
             };
             if ahead < len {
                 // SAFETY: in bounds; a prefetch reads nothing.
@@ -264,5 +265,25 @@ pub(super) unsafe fn sweep_groups_on<F: BundleUpdate, T: SetTargets>(
     }
 }
 
-/// How many bundles ahead a sweep asks for (see [`sweep_groups`]).
-pub(super) const PREFETCH_BUNDLES: usize = 2;
+/// How many bundles ahead a sweep of an island of `len` bundles that reads the first `reads`
+/// bytes of each asks for (see [`sweep_groups`]). Two in an island of fewer than
+/// [`FAR_PREFETCH_BUNDLES`], whose bundles stay in the caches; in a larger one 8 for the normal
+/// rows' sweep (5 cache lines a bundle) and 4 for a sweep of all rows (14). Once an island's
+/// bundles outgrow L3 (pyramid100's 60 thousand points, pour8000's 42 thousand) a sweep waits
+/// on memory, whose latency two bundles ahead did not cover: those islands' sweeps cost three
+/// times as much a point as those of islands a quarter their size, and the sweeps of small
+/// islands (balls4096's columns of 16 balls) ran slower with the far distance
+/// (docs/benchmarks.md, "Scaling").
+pub(super) const fn bundles_ahead(reads: usize, len: usize) -> usize {
+    if len < FAR_PREFETCH_BUNDLES {
+        2
+    } else if reads <= NORMAL_PART {
+        8
+    } else {
+        4
+    }
+}
+
+/// The island size (bundles) from which a sweep asks for bundles farther ahead (see
+/// [`bundles_ahead`]): 2,048 bundles of four points are 1.8 MB.
+pub(super) const FAR_PREFETCH_BUNDLES: usize = 2048;
