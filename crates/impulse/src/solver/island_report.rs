@@ -49,6 +49,12 @@ pub struct IslandReport {
     pub impact_substeps: u32,
     /// Whether the substeps' solves ran in SIMD lanes.
     pub simd: bool,
+    /// Bundles the island's contact points were packed into for the SIMD lanes (`simd`),
+    /// padding included: one point a lane, 4 lanes a bundle (8 with the `lanes8` feature);
+    /// 0 when not in lanes. `contacts` / (4 × `bundles`) is the share of lanes that hold a
+    /// point, which the sweeps' cost follows (docs/method.md, "Graph colouring and SIMD lanes").
+    #[serde(default)]
+    pub bundles: u32,
     /// Natural-map residual of the island's rows at the end of the step (see
     /// [`crate::diagnostics::StepDiagnostics::natural_map_residual`]); set by the world as the
     /// island's step ends.

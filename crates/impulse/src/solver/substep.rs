@@ -645,6 +645,7 @@ impl IslandWorkspace {
         w.colour_starts.clear();
         let threshold = settings.solve.parallel_island_contacts as usize;
         w.report.simd = bundled;
+        w.report.bundles = 0;
         let coloured_threads = threshold > 0 && constraints.len() >= threshold;
         if bundled {
             // Bundles are in colour order on any thread count, so spreading a colour over the
@@ -673,6 +674,7 @@ impl IslandWorkspace {
                 &w.slot_inverse_inertia,
                 parallel && spread,
             );
+            w.report.bundles = u32::try_from(w.solvers.wide.bundle_count()).unwrap_or(u32::MAX);
         } else if coloured_threads {
             colour_constraints(
                 constraints,

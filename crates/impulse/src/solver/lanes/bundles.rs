@@ -110,6 +110,11 @@ impl Bundles {
         self.second_half = second_half;
     }
 
+    /// Bundles of the last pack, padding included.
+    pub(crate) fn bundle_count(&self) -> usize {
+        self.bundles.len()
+    }
+
     /// Whether the last pack was of a split island ([`Bundles::set_second_half`]).
     pub(crate) fn split(&self) -> bool {
         self.layout_second_half.is_some()

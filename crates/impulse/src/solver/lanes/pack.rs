@@ -10,7 +10,7 @@ use super::layout::{Bundle, BundleGeometry, GROUP_POINTS, Group, PointKey, set_l
 use super::products::compute_products;
 use crate::contact::ContactConstraint;
 use crate::graph::{COLOURS, greedy_colours_last};
-use crate::parallel::{PARALLEL_PACK_POINTS, SharedItems, spread, threads};
+use crate::parallel::{PARALLEL_PACK_POINTS, spread, threads};
 use crate::simd::{InstructionSet, on_instruction_set};
 use crate::solver::interface::RowsReport;
 
@@ -19,11 +19,12 @@ impl Bundles {
     /// with their current impulses, into bundles. The points are first cut into manifold groups:
     /// runs of consecutive points of one manifold (assembly writes a manifold's points
     /// together), at most four each. The groups are coloured greedily (no two groups
-    /// of a colour share a moving body), and each colour's groups, in constraint order, go
-    /// [`LANES`] at a time into lane groups of as many bundles as their largest group has
-    /// points; a lane whose group is shorter is padded with rows of zero effective mass between
-    /// the same bodies, whose updates change nothing. Groups the colouring cannot place (a body
-    /// in more than `COLOURS` (64) colours) get a lane group each. O(points). What a manifold
+    /// of a colour share a moving body), and each colour's groups of each length (points), in
+    /// constraint order, go [`LANES`] at a time into lane groups of as many bundles as they
+    /// have points; only the last lane group of a colour and length may have lanes with no
+    /// group, padding (the immovable slot, rows of zero effective mass) whose updates change
+    /// nothing. Groups the colouring cannot place (a body in more than `COLOURS` (64) colours)
+    /// get a lane group each. O(points). What a manifold
     /// group's points share goes to its lane group ([`Group`]), the rest to the bundles.
     ///
     /// Why manifold groups (Box2D v3's and Box3D's wide contact constraints are per manifold
@@ -206,32 +207,43 @@ impl Bundles {
         let (_, first_joining) =
             greedy_colours_last(group_slots, slots, joins, &mut self.used, &mut self.colours);
         self.halves_apart = if second.is_some() { first_joining } else { 0 };
-        // Per colour and half, its groups; each half's groups of a colour start a lane group
-        // (the last colour: one group each), so that no lane group holds both halves.
-        let mut counts = [[0usize; 2]; COLOURS + 1];
+        // Per colour, half and length (points, 1 to GROUP_POINTS), its groups; each half's
+        // groups of a colour of each length start a lane group (the last colour: one group
+        // each), so that no lane group holds both halves, and lanes of one lane group hold
+        // groups of one length: a lane group is as long as its longest group, and a shorter
+        // one's lane is padding for the rest of it (in constraint order, a pour's lane groups
+        // were two-thirds points and one third padding). Within a colour the order of the
+        // groups does not change a sweep: they share no moving body.
+        let length_of = |r: usize| run_points(runs, r) - 1;
+        let mut counts = [[[0usize; GROUP_POINTS]; 2]; COLOURS + 1];
         for r in 0..run_count {
-            counts[self.colours[r] as usize][usize::from(half_of(r))] += 1;
+            counts[self.colours[r] as usize][usize::from(half_of(r))][length_of(r)] += 1;
         }
         let per_group = |colour: usize| if colour < COLOURS { LANES } else { 1 };
         self.group_colour_starts.clear();
         self.group_colour_starts.push(0);
         self.group_half_starts.clear();
-        let mut lane_group_of = [[0usize; 2]; COLOURS + 1];
+        let mut lane_group_of = [[[0usize; GROUP_POINTS]; 2]; COLOURS + 1];
+        let mut next = 0;
         for colour in 0..=COLOURS {
-            let last = *self.group_colour_starts.last().unwrap_or(&0);
-            let first = counts[colour][0].div_ceil(per_group(colour));
-            let second = counts[colour][1].div_ceil(per_group(colour));
-            lane_group_of[colour] = [last, last + first];
-            self.group_half_starts.push(last + first);
-            self.group_colour_starts.push(last + first + second);
+            for half in 0..2 {
+                // The longest groups first.
+                for length in (0..GROUP_POINTS).rev() {
+                    lane_group_of[colour][half][length] = next;
+                    next += counts[colour][half][length].div_ceil(per_group(colour));
+                }
+                if half == 0 {
+                    self.group_half_starts.push(next);
+                }
+            }
+            self.group_colour_starts.push(next);
         }
-        let total_groups = *self.group_colour_starts.last().unwrap_or(&0);
-        // Each group to the next free lane of its colour and half, in constraint order; a lane
-        // group is as long as its longest group. In a split island a colour's groups of the
-        // first half's bodies come first, then the second's, in lane groups of their own: a
-        // colour's two parts then touch one half each (but for the groups joining the halves,
-        // in colours of their own), whose bodies' velocities lie apart (see
-        // [`Bundles::set_second_half`]).
+        let total_groups = next;
+        // Each group to the next free lane of its colour, half and length, in constraint
+        // order. In a split island a colour's groups of the first half's bodies come first,
+        // then the second's, in lane groups of their own: a colour's two parts then touch one
+        // half each (but for the groups joining the halves, in colours of their own), whose
+        // bodies' velocities lie apart (see [`Bundles::set_second_half`]).
         self.groups.clear();
         let empty = Group {
             local_a: [immovable; LANES],
@@ -241,13 +253,17 @@ impl Bundles {
         self.groups.resize(total_groups, empty);
         self.run_places.clear();
         self.run_places.resize(run_count, (0, 0));
-        let mut filled = [[0usize; 2]; COLOURS + 1];
+        let mut filled = [[[0usize; GROUP_POINTS]; 2]; COLOURS + 1];
         for r in 0..run_count {
-            let (colour, half) = (self.colours[r] as usize, usize::from(half_of(r)));
-            let position = filled[colour][half];
-            filled[colour][half] += 1;
+            let (colour, half, length) = (
+                self.colours[r] as usize,
+                usize::from(half_of(r)),
+                length_of(r),
+            );
+            let position = filled[colour][half][length];
+            filled[colour][half][length] += 1;
             let per = per_group(colour);
-            let group = lane_group_of[colour][half] + position / per;
+            let group = lane_group_of[colour][half][length] + position / per;
             let lane = position % per;
             let g = &mut self.groups[group];
             g.len = g.len.max(run_points(&self.runs, r) as u32);
@@ -273,80 +289,31 @@ impl Bundles {
         }
     }
 
-    /// The lane writes of [`Bundles::pack`] on rayon's threads. Task t owns the t-th part of
-    /// every colour's bundles (so no two tasks write one bundle) and streams the constraints
-    /// from the first to the last one it owns: as each colour is spread evenly over the
-    /// constraints, that range is about a 1/tasks share and the tasks' ranges barely overlap.
-    /// Every lane gets the same value on any split. With `empty`, each task first resets its
-    /// bundles to it (and their geometry to padding).
+    /// The lane writes of [`Bundles::pack`] on rayon's threads: each task takes a run of
+    /// bundles and writes each of their lanes from the point `sources` names for it (lane
+    /// groups hold their groups by colour and length, so a run's points lie all over the
+    /// constraints, each read once). Every lane gets the same value on any split. With
+    /// `empty`, each task first resets its bundles to it (and their geometry to padding).
     fn fill_parallel(&mut self, constraints: &[ContactConstraint], empty: Option<&Bundle>) {
         use rayon::prelude::*;
-        let tasks = 2 * threads();
-        // Bundle where each colour starts (its first lane group's start); on the stack, so a
-        // pack allocates nothing.
-        let total = self.bundles.len();
-        let mut bundle_start = [total; COLOURS + 2];
-        for (start, &g) in bundle_start.iter_mut().zip(&self.group_colour_starts) {
-            *start = self
-                .groups
-                .get(g)
-                .map_or(total, |group| group.start as usize);
-        }
-        // Task t's bundles of colour c: the t-th of `tasks` equal parts of the colour.
-        let part = move |t: usize, c: usize| {
-            let count = bundle_start[c + 1] - bundle_start[c];
-            bundle_start[c] + count * t / tasks..bundle_start[c] + count * (t + 1) / tasks
-        };
-        let colour_of = move |index: usize| {
-            bundle_start[..=COLOURS + 1].partition_point(|&start| start <= index) - 1
-        };
-        let (sources, slots) = (&self.sources, &self.slots);
-        let bundles = SharedItems(self.bundles.as_mut_ptr());
-        let geometry = SharedItems(self.geometry.as_mut_ptr());
-        (0..tasks).into_par_iter().for_each(|t| {
-            // Capture the whole wrappers (Sync), not their raw-pointer fields.
-            #[allow(clippy::redundant_locals)]
-            let (bundles, geometry) = (bundles, geometry);
-            // The task's constraint range, from the lanes it owns (a lane group's lanes hold
-            // groups in constraint order, but its later bundles may be padding).
-            let mut low = usize::MAX;
-            let mut high = 0;
-            for c in 0..=COLOURS {
-                let range = part(t, c);
-                for lanes in &sources[range.clone()] {
-                    for &k in lanes.iter().filter(|&&k| k != u32::MAX) {
-                        low = low.min(k as usize);
-                        high = high.max(k as usize + 1);
-                    }
-                }
-                // SAFETY: the parts of all tasks and colours are disjoint ranges inside the
-                // bundles and the geometry (`bundle_start` is non-decreasing, ending at the
-                // bundles' length), and only task t touches its own.
+        let per_task = self.bundles.len().div_ceil(2 * threads()).max(1);
+        self.bundles
+            .par_chunks_mut(per_task)
+            .zip(self.geometry.par_chunks_mut(per_task))
+            .zip(self.sources.par_chunks(per_task))
+            .for_each(|((bundles, geometry), sources)| {
                 if let Some(empty) = empty {
-                    unsafe {
-                        std::slice::from_raw_parts_mut(bundles.0.add(range.start), range.len())
-                            .fill(*empty);
-                        std::slice::from_raw_parts_mut(geometry.0.add(range.start), range.len())
-                            .fill(BundleGeometry::PADDING);
+                    bundles.fill(*empty);
+                    geometry.fill(BundleGeometry::PADDING);
+                }
+                for ((b, g), lanes) in bundles.iter_mut().zip(geometry.iter_mut()).zip(sources) {
+                    for (lane, &k) in lanes.iter().enumerate() {
+                        if k != u32::MAX {
+                            set_lane(b, g, lane, &constraints[k as usize]);
+                        }
                     }
                 }
-            }
-            for k in low..high.min(constraints.len()) {
-                let (index, lane) = (slots[k] as usize / LANES, slots[k] as usize % LANES);
-                if index >= total || !part(t, colour_of(index)).contains(&index) {
-                    continue;
-                }
-                // SAFETY: as above: `index` lies in one of this task's parts.
-                unsafe {
-                    set_lane(
-                        &mut *bundles.0.add(index),
-                        &mut *geometry.0.add(index),
-                        lane,
-                        &constraints[k],
-                    );
-                }
-            }
-        });
+            });
     }
 
     /// Writes the bundles' impulses (and largest normal impulses) back to `constraints`, the

@@ -339,6 +339,83 @@ fn packing_puts_each_manifold_group_in_one_lane_of_one_lane_group() {
     );
 }
 
+/// Each lane of a lane group holds a manifold group of the lane group's length, so no lane is
+/// padding but in the last lane group of a colour, half and length; and every point is in one
+/// lane. Seeded random islands: pairs among 40 moving slots and the ground (the immovable
+/// slot), each a run of 1 to 6 points (runs of more than four are cut), unsplit and split.
+#[test]
+fn a_lane_group_holds_manifold_groups_of_one_length() {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = |n: u64| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state % n
+    };
+    for case in 0..40 {
+        let slots = 42;
+        let immovable = (slots - 1) as u32;
+        let mut constraints = Vec::new();
+        for pair in 0..60 + next(200) as u32 {
+            let a = next(40) as u32;
+            let b = match next(41) as u32 {
+                b if b == a || b == 40 => immovable,
+                b => b,
+            };
+            for k in 0..1 + next(6) as u16 {
+                constraints.push(ContactConstraint {
+                    local_a: a,
+                    local_b: b,
+                    inverse_mass_a: Vec3::ONE,
+                    inverse_mass_b: if b == immovable {
+                        Vec3::ZERO
+                    } else {
+                        Vec3::ONE
+                    },
+                    source: (pair, 0, k),
+                    ..ContactConstraint::default()
+                });
+            }
+        }
+        let mut packed = Bundles::default();
+        if case % 2 == 1 {
+            packed.set_second_half(Some(20));
+        }
+        packed.pack(&constraints, slots, &[Mat3::ZERO; 42], false);
+        let mut seen = vec![0; constraints.len()];
+        // Per colour, half and length, the lane groups with lanes left over.
+        let mut partial = std::collections::HashMap::new();
+        for colour in 0..=COLOURS {
+            let starts = &packed.group_colour_starts;
+            for g in starts[colour]..starts[colour + 1] {
+                let group = &packed.groups[g];
+                let half = usize::from(g >= packed.group_half_starts[colour]);
+                let (start, len) = (group.start as usize, group.len as usize);
+                let mut filled = 0;
+                for lane in 0..LANES {
+                    let points = packed.sources[start..start + len]
+                        .iter()
+                        .filter(|lanes| lanes[lane] != u32::MAX)
+                        .inspect(|lanes| seen[lanes[lane] as usize] += 1)
+                        .count();
+                    assert!(
+                        points == 0 || points == len,
+                        "case {case}: lane of {points} in {len}"
+                    );
+                    filled += usize::from(points > 0);
+                }
+                assert!(filled > 0, "case {case}: an empty lane group");
+                if colour < COLOURS && filled < LANES {
+                    let count = partial.entry((colour, half, len)).or_insert(0);
+                    *count += 1;
+                    assert_eq!(*count, 1, "case {case}: colour {colour} length {len}");
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1), "case {case}: {seen:?}");
+    }
+}
+
 /// A pair's manifolds (a compound's parts, a mesh's triangles) have normals of their own,
 /// which their lane group keeps per lane: each manifold is a manifold group of its own,
 /// even where its points follow another manifold's of the same pair, and its lane's
