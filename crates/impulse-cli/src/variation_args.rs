@@ -15,7 +15,8 @@ pub struct VariationArgs {
     /// Change a field of the scene by its JSON path, validated as the scene file is, e.g.
     /// `--set materials.wood.friction=0.2`, `--set 'bodies[3].linear_velocity=[0,0,-5]'`,
     /// `--set solver.substeps=12`. VALUE is JSON, or else a string. Repeatable; applied in
-    /// order, after `--preset` and the solver options, so it wins over them.
+    /// order, after the command's `--preset` and solver options where it has them, so it wins
+    /// over them.
     #[arg(long = "set", value_name = "PATH=VALUE", allow_hyphen_values = true)]
     pub set: Vec<String>,
     /// Seed of the jitter and, when not 0, the scene's `seed` (the draws of rough and
