@@ -19,10 +19,11 @@ impl Bundles {
     /// with their current impulses, into bundles. The points are first cut into manifold groups:
     /// runs of consecutive points of one manifold (assembly writes a manifold's points
     /// together), at most four each. The groups are coloured greedily (no two groups
-    /// of a colour share a moving body), and each colour's groups of each length (points), in
-    /// constraint order, go [`LANES`] at a time into lane groups of as many bundles as they
-    /// have points; only the last lane group of a colour and length may have lanes with no
-    /// group, padding (the immovable slot, rows of zero effective mass) whose updates change
+    /// of a colour share a moving body), and each colour's groups, longest (most points) first
+    /// and in constraint order within a length, go [`LANES`] at a time into lane groups of as
+    /// many bundles as their longest group has points; only the last lane group of a colour
+    /// may have lanes with no group, and a lane of a shorter group than its lane group's
+    /// longest has bundles with no point, padding (the immovable slot, rows of zero effective mass) whose updates change
     /// nothing. Groups the colouring cannot place (a body in more than `COLOURS` (64) colours)
     /// get a lane group each. O(points). What a manifold
     /// group's points share goes to its lane group ([`Group`]), the rest to the bundles.
@@ -207,13 +208,16 @@ impl Bundles {
         let (_, first_joining) =
             greedy_colours_last(group_slots, slots, joins, &mut self.used, &mut self.colours);
         self.halves_apart = if second.is_some() { first_joining } else { 0 };
-        // Per colour, half and length (points, 1 to GROUP_POINTS), its groups; each half's
-        // groups of a colour of each length start a lane group (the last colour: one group
-        // each), so that no lane group holds both halves, and lanes of one lane group hold
-        // groups of one length: a lane group is as long as its longest group, and a shorter
-        // one's lane is padding for the rest of it (in constraint order, a pour's lane groups
-        // were two-thirds points and one third padding). Within a colour the order of the
-        // groups does not change a sweep: they share no moving body.
+        // Per colour and half, its groups longest first (in constraint order within a
+        // length), LANES at a time into lane groups; each half's groups of a colour start a
+        // lane group (the last colour: one group each), so that no lane group holds both
+        // halves. A lane group is as long as its longest group, and a shorter one's lane is
+        // padding for the rest of it: taken longest first, a colour's lane groups are as few
+        // bundles as its groups allow (the sum of each run of LANES' longest), and groups of
+        // different lengths share a lane group only where one length's groups end (in
+        // constraint order, a pour's lane groups were two-thirds points and one third
+        // padding). Within a colour the order of the groups does not change a sweep: they
+        // share no moving body.
         let length_of = |r: usize| run_points(runs, r) - 1;
         let mut counts = [[[0usize; GROUP_POINTS]; 2]; COLOURS + 1];
         for r in 0..run_count {
@@ -223,15 +227,20 @@ impl Bundles {
         self.group_colour_starts.clear();
         self.group_colour_starts.push(0);
         self.group_half_starts.clear();
-        let mut lane_group_of = [[[0usize; GROUP_POINTS]; 2]; COLOURS + 1];
+        // Per colour and half, its first lane group; per colour, half and length, the place
+        // of its first group among the colour's and half's, longest first.
+        let mut first_lane_group = [[0usize; 2]; COLOURS + 1];
+        let mut place_of = [[[0usize; GROUP_POINTS]; 2]; COLOURS + 1];
         let mut next = 0;
         for colour in 0..=COLOURS {
             for half in 0..2 {
-                // The longest groups first.
+                first_lane_group[colour][half] = next;
+                let mut place = 0;
                 for length in (0..GROUP_POINTS).rev() {
-                    lane_group_of[colour][half][length] = next;
-                    next += counts[colour][half][length].div_ceil(per_group(colour));
+                    place_of[colour][half][length] = place;
+                    place += counts[colour][half][length];
                 }
+                next += place.div_ceil(per_group(colour));
                 if half == 0 {
                     self.group_half_starts.push(next);
                 }
@@ -239,7 +248,7 @@ impl Bundles {
             self.group_colour_starts.push(next);
         }
         let total_groups = next;
-        // Each group to the next free lane of its colour, half and length, in constraint
+        // Each group to the next free place of its colour, half and length, in constraint
         // order. In a split island a colour's groups of the first half's bodies come first,
         // then the second's, in lane groups of their own: a colour's two parts then touch one
         // half each (but for the groups joining the halves, in colours of their own), whose
@@ -253,17 +262,16 @@ impl Bundles {
         self.groups.resize(total_groups, empty);
         self.run_places.clear();
         self.run_places.resize(run_count, (0, 0));
-        let mut filled = [[[0usize; GROUP_POINTS]; 2]; COLOURS + 1];
         for r in 0..run_count {
             let (colour, half, length) = (
                 self.colours[r] as usize,
                 usize::from(half_of(r)),
                 length_of(r),
             );
-            let position = filled[colour][half][length];
-            filled[colour][half][length] += 1;
+            let position = place_of[colour][half][length];
+            place_of[colour][half][length] += 1;
             let per = per_group(colour);
-            let group = lane_group_of[colour][half][length] + position / per;
+            let group = first_lane_group[colour][half] + position / per;
             let lane = position % per;
             let g = &mut self.groups[group];
             g.len = g.len.max(run_points(&self.runs, r) as u32);
