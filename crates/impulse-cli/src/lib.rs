@@ -12,6 +12,7 @@ mod plot_output;
 mod render;
 mod residual_plot;
 mod run;
+mod scene_paths;
 mod solver_args;
 mod stats;
 mod trajectory;
@@ -727,15 +728,18 @@ fn run_cli(cli: Cli, handle_signals: bool) -> Result<u8> {
                 .parent()
                 .unwrap_or(Path::new("."))
                 .to_path_buf();
-            let scene = variation.apply(resolve_scene(&scene)?, &scene)?;
-            let text = to_json_string(&scene);
+            let mut scene = variation.apply(resolve_scene(&scene)?, &scene)?;
             match out {
                 Some(path) if usd_stage::is_stage(&path) => {
-                    usd_stage::write_stage(&text, &directory, &path)?
+                    usd_stage::write_stage(&to_json_string(&scene), &directory, &path)?
                 }
-                Some(path) => std::fs::write(&path, text)
-                    .with_context(|| format!("cannot write {}", path.display()))?,
-                None => print!("{text}"),
+                Some(path) => {
+                    // Mesh files named relative to the scene's directory, from the output's.
+                    scene_paths::rebase_mesh_files(&mut scene, &directory, &path);
+                    std::fs::write(&path, to_json_string(&scene))
+                        .with_context(|| format!("cannot write {}", path.display()))?
+                }
+                None => print!("{}", to_json_string(&scene)),
             }
         }
         Command::Bench {

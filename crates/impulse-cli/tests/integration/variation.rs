@@ -105,6 +105,33 @@ fn a_changed_mesh_file_is_read_beside_the_scene_file() {
     assert_success(&output, "mesh_terrain with --set shape.file: ");
 }
 
+/// A scene exported into another directory names its mesh files from there: the exported
+/// file runs, to the same trajectory as the scene it came from.
+#[test]
+fn an_exported_scene_finds_its_mesh_files_from_its_own_directory() {
+    let dir = common::fresh_dir("variation", "exported-mesh").join("sub");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = repo("scenes/mesh_terrain.json");
+    let exported = dir.join("terrain-scene.json");
+    let output = export(scene.to_str().unwrap(), &[], &exported);
+    assert_success(&output, "export mesh_terrain: ");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&exported).unwrap()).unwrap();
+    let file = json["bodies"][0]["shape"]["file"].as_str().unwrap();
+    assert!(Path::new(file).is_relative(), "{file}");
+    assert_eq!(
+        std::fs::canonicalize(dir.join(file)).unwrap(),
+        std::fs::canonicalize(repo("scenes/terrain.obj")).unwrap()
+    );
+    let original = run(scene.to_str().unwrap(), &[], &temp("terrain-original.csv"));
+    let again = run(
+        exported.to_str().unwrap(),
+        &[],
+        &temp("terrain-exported.csv"),
+    );
+    assert_eq!(original, again);
+}
+
 #[test]
 fn a_bad_override_exits_non_zero_naming_the_option_and_the_field() {
     for (args, expected) in [
