@@ -23,8 +23,8 @@ impl Bundles {
     /// and in constraint order within a length, go [`LANES`] at a time into lane groups of as
     /// many bundles as their longest group has points; only the last lane group of a colour
     /// may have lanes with no group, and a lane of a shorter group than its lane group's
-    /// longest has bundles with no point, padding (the immovable slot, rows of zero effective mass) whose updates change
-    /// nothing. Groups the colouring cannot place (a body in more than `COLOURS` (64) colours)
+    /// longest has bundles with no point: padding (the immovable slot, rows of zero effective
+    /// mass) whose updates change nothing. Groups the colouring cannot place (a body in more than `COLOURS` (64) colours)
     /// get a lane group each. O(points). What a manifold
     /// group's points share goes to its lane group ([`Group`]), the rest to the bundles.
     ///
