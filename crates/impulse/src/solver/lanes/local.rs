@@ -171,7 +171,8 @@ impl Bundles {
 
     /// Adds what the local sweeps changed of their points' impulses (the local bundles' now
     /// against `local_start`) to the step totals and, as M⁻¹Jᵀ(γ − γ₀), to the warm start the
-    /// relax sweep before them carried (see [`RelaxCarrying`](super::sweep::RelaxCarrying)),
+    /// relax sweep before them carried (see `Bundles::carry_by_difference` and
+    /// [`RelaxCarrying`](super::sweep::RelaxCarrying)),
     /// so that the next substep's warm start adds the sums instead of passing over every
     /// bundle of the island: the same velocities up to rounding. Runs before the impulses are
     /// copied back. `velocities` are the island's (left as they are).

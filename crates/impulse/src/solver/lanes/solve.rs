@@ -2,11 +2,11 @@
 //! alternating directions, stopping at the tolerance) and the interface the substep loop
 //! calls.
 
-use glam::Mat3;
+use glam::{Mat3, Vec3};
 
 use super::bundles::Bundles;
 use super::schedule::SweepOrder;
-use super::sweep::{VelocityRows, WarmStart};
+use super::sweep::{RelaxTotals, VelocityRows, WarmStart};
 use super::targets::{NoTargets, Targets, Turned};
 use crate::contact::ContactConstraint;
 use crate::joint::{IslandJoints, sweep_joints};
@@ -56,10 +56,27 @@ impl Bundles {
             if forward && !joints.is_empty() {
                 joint_change = sweep_joints(joints, velocities, true, iteration == 0);
             }
-            // One relax sweep before another substep adds up that substep's warm start as it
+            // One relax sweep before another substep carries that substep's warm start: from
+            // the velocities' change (`carry_by_difference`), or with joints added up as it
             // goes (`RelaxCarrying`). Not with several sweeps: each would add its impulses to
             // the step totals.
-            let largest = if friction && pass.warm_start_follows && pass.iterations == 1 {
+            let largest = if friction
+                && pass.warm_start_follows
+                && pass.iterations == 1
+                && joints.is_empty()
+                && self.slots.len() >= CARRY_BY_DIFFERENCE_POINTS
+            {
+                let update = RelaxTotals {
+                    totals: SharedItems(self.step_totals.as_mut_ptr()),
+                };
+                let largest = match first {
+                    Some(t) if stale => self.sweep(order, velocities, update, Turned::<true>(t)),
+                    Some(t) => self.sweep(order, velocities, update, Turned::<false>(t)),
+                    None => self.sweep(order, velocities, update, NoTargets),
+                };
+                self.carry_by_difference(velocities);
+                largest
+            } else if friction && pass.warm_start_follows && pass.iterations == 1 {
                 let carry = self.start_carrying(velocities.linear.len());
                 match first {
                     Some(t) if stale => self.sweep(order, velocities, carry, Turned::<true>(t)),
@@ -103,6 +120,45 @@ impl Bundles {
     }
 }
 
+/// Islands of at least this many contact points (and no joint) carry the next substep's warm
+/// start as their velocities' change ([`Bundles::carry_by_difference`]); smaller ones add
+/// M⁻¹Jᵀγ up as their relax sweep goes (`RelaxCarrying`). A pile's carry is then two
+/// subtractions a body instead of three row applications a point (pyramid100, 59,800 points:
+/// a tenth of its step; docs/benchmarks.md). Below it the saving is a few lane groups, and the
+/// small islands keep the trajectories that the takes' documented searches and shots were
+/// measured on (docs/takes.md): their bits depend on how each velocity is rounded.
+pub(crate) const CARRY_BY_DIFFERENCE_POINTS: usize = 1024;
+
+impl Bundles {
+    /// Sets the next substep's warm start per island slot to what this substep's impulses
+    /// did to `velocities`: their change since [`ContactSolver::warm_start`] kept them, which
+    /// is M⁻¹Jᵀγ of the final impulses γ (every change of an island without joints between
+    /// the warm start and the relax sweep's end is an impulse on its rows: the warm start's
+    /// own, the solves', an impact's local sweeps) up to rounding. Two subtractions a body
+    /// instead of the three row applications a bundle of [`RelaxCarrying`], which gathers
+    /// and scatters every lane group's bodies once more. What local impact sweeps after the
+    /// relax sweep change is added as before ([`Bundles::solve_local`]).
+    ///
+    /// [`RelaxCarrying`]: super::sweep::RelaxCarrying
+    fn carry_by_difference(&mut self, velocities: &Velocities<'_>) {
+        let difference = |now: &[Vec3], start: &[Vec3], carried: &mut Vec<Vec3>| {
+            carried.clear();
+            carried.extend(now.iter().zip(start).map(|(now, start)| *now - *start));
+        };
+        difference(
+            velocities.linear,
+            &self.substep_start_linear,
+            &mut self.carried_linear,
+        );
+        difference(
+            velocities.angular,
+            &self.substep_start_angular,
+            &mut self.carried_angular,
+        );
+        self.carried = true;
+    }
+}
+
 /// PGS in lanes as a [`ContactSolver`]: `prepare` packs the island's points
 /// ([`Bundles::pack`]), the solves run on the bundles, `finish` unpacks the impulses. Its
 /// solves always set targets from the separations (`pass.targets`) when asked, and ignore
@@ -124,6 +180,13 @@ impl ContactSolver for Bundles {
         velocities: &mut Velocities<'_>,
         substep: u32,
     ) {
+        for (start, now) in [
+            (&mut self.substep_start_linear, &*velocities.linear),
+            (&mut self.substep_start_angular, &*velocities.angular),
+        ] {
+            start.clear();
+            start.extend_from_slice(now);
+        }
         if std::mem::take(&mut self.carried) {
             // The relax sweep before added the impulses up per body (and to the totals).
             for (v, carried) in velocities.linear.iter_mut().zip(&self.carried_linear) {

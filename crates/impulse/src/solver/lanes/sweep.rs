@@ -135,9 +135,8 @@ impl BundleUpdate for WarmStart {
         v: &mut BodyLanes,
     ) -> Lane {
         if let Some(totals) = self.totals {
-            // SAFETY: `totals` has one entry per bundle (`pack` sizes it so) and `index` is
-            // the bundle's; no other thread touches this bundle's entry meanwhile.
-            add_to_totals(unsafe { &mut *totals.0.add(index) }, b);
+            // SAFETY: the sweep's contract (see `add_to_bundle_totals`).
+            unsafe { add_to_bundle_totals(totals, index, b) };
         }
         apply_impulses::<R>(b, group, v);
         Lane::splat(0.0)
@@ -150,6 +149,17 @@ pub(super) fn add_to_totals(total: &mut [Lane; 3], b: &Bundle) {
     total[0] += b.normal_impulse;
     total[1] += b.tangent_impulses[0];
     total[2] += b.tangent_impulses[1];
+}
+
+/// Adds bundle `b`'s impulses to its entry, `index`, of the step totals `totals`.
+///
+/// # Safety
+/// `totals` has one entry per bundle (`pack` sizes it so), `index` is `b`'s, and no other
+/// thread touches that entry meanwhile (a sweep updates each bundle on one thread).
+#[inline(always)]
+unsafe fn add_to_bundle_totals(totals: SharedItems<[Lane; 3]>, index: usize, b: &Bundle) {
+    // SAFETY: the caller's contract.
+    add_to_totals(unsafe { &mut *totals.0.add(index) }, b);
 }
 
 /// Adds M⁻¹Jᵀγ of a bundle's accumulated impulses γ to `v` (its lane group `group`).
@@ -172,9 +182,10 @@ fn apply_given<R: Rounding>(
     b.tangents[1].apply::<R>(d_2, t2, masses, v);
 }
 
-/// The relax sweep of a substep that another substep follows: the velocity rows with friction
-/// ([`solve_bundle`]), and each bundle's final impulses, added to its step totals and applied
-/// to `carried`, the next substep's warm start per body ([`Bundles::warm_start`] adds it to
+/// The relax sweep of a substep that another substep follows, in an island with joints (whose
+/// impulses change the velocities too, so that [`RelaxTotals`] cannot take the warm start from
+/// them): the velocity rows with friction ([`solve_bundle`]), and each bundle's final impulses,
+/// added to its step totals and applied to `carried`, the next substep's warm start per body ([`Bundles::warm_start`] adds it to
 /// the velocities once their gravity and gyroscopic term are in). The warm start's own pass
 /// read every bundle again; this reads each once more only while its lane group's bundles are
 /// still in the first-level cache: the impulses are carried once the group's are final
@@ -208,6 +219,32 @@ impl BundleUpdate for RelaxCarrying {
                 b.impulses()
             })
         }
+    }
+}
+
+/// The relax sweep of a substep that another substep follows, in an island without joints:
+/// the velocity rows with friction ([`solve_bundle`]), each bundle's final impulses added to
+/// its step totals as soon as its one update of the sweep is done. The next substep's warm
+/// start is then taken from the velocities ([`Bundles::carry_by_difference`]) rather than
+/// applied row by row as [`RelaxCarrying`] does.
+#[derive(Clone, Copy)]
+pub(super) struct RelaxTotals {
+    pub(super) totals: SharedItems<[Lane; 3]>,
+}
+
+impl BundleUpdate for RelaxTotals {
+    #[inline(always)]
+    fn update_at<R: Rounding>(
+        self,
+        b: &mut Bundle,
+        group: &Group,
+        index: usize,
+        v: &mut BodyLanes,
+    ) -> Lane {
+        let change = solve_bundle::<R, true>(b, group, v);
+        // SAFETY: the sweep's contract (see `add_to_bundle_totals`).
+        unsafe { add_to_bundle_totals(self.totals, index, b) };
+        change
     }
 }
 

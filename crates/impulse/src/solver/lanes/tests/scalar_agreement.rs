@@ -2,6 +2,7 @@
 //! turned bodies, the lever-arm products, the relax sweep's warm start and the normal-rows
 //! sweep each give what the scalar update of the unpacked rows gives.
 
+use super::super::solve::CARRY_BY_DIFFERENCE_POINTS;
 use super::scenes::{DT, material, sphere};
 use crate::joint::IslandJoints;
 use crate::scene::builtin_scene;
@@ -404,8 +405,10 @@ fn pass_at_rest<'a>(
 }
 
 /// The carrying tests' island: the settled pyramid's rows four times over (past the parallel
-/// threshold), its `n` bodies moving in a wave of amplitudes `linear` (m/s) and `angular`
-/// (rad/s) per axis, the immovable slot last; the bodies' world inverse inertia.
+/// threshold; carried by the velocities' change), or with `small` its first rows alone, fewer
+/// than [`CARRY_BY_DIFFERENCE_POINTS`] (carried by the rows, as the sweep goes); its `n`
+/// bodies moving in a wave of amplitudes `linear` (m/s) and `angular` (rad/s) per axis, the
+/// immovable slot last; the bodies' world inverse inertia.
 struct CarryingIsland {
     n: usize,
     rows: Vec<crate::contact::ContactConstraint>,
@@ -414,11 +417,15 @@ struct CarryingIsland {
     inverse_inertia: Vec<Mat3>,
 }
 
-fn carrying_island(linear: [f32; 3], angular: [f32; 3]) -> CarryingIsland {
+fn carrying_island(linear: [f32; 3], angular: [f32; 3], small: bool) -> CarryingIsland {
     let (w, settled) = settled_pyramid20_rows();
     let n = w.bodies.len();
-    let rows: Vec<_> = (0..4).flat_map(|_| settled.iter().copied()).collect();
-    assert!(rows.len() > 4096, "{} rows", rows.len());
+    let rows: Vec<_> = if small {
+        settled[..CARRY_BY_DIFFERENCE_POINTS - 1].to_vec()
+    } else {
+        (0..4).flat_map(|_| settled.iter().copied()).collect()
+    };
+    assert!(small || rows.len() > 4096, "{} rows", rows.len());
     let wave = |k: usize, [a, b, c]: [f32; 3]| {
         let x = k as f32;
         Vec3::new(a * x.sin(), b, c * x.cos())
@@ -535,12 +542,20 @@ fn assert_carried_velocities(
 /// A relax sweep that carries the next substep's warm start (`warm_start_follows`) gives what
 /// the relax sweep and the separate warm-start pass give: the same impulses and step totals
 /// to the bit (the solve is the same; the totals get the same additions in the same order) and
-/// the same velocities after the next warm start up to rounding (M⁻¹Jᵀγ summed per body
-/// first, then added); the same bits on one and two threads. Rows: the settled pyramid's,
-/// repeated to pass the parallel threshold, with moving bodies and a soft relax target.
+/// the same velocities after the next warm start up to rounding (M⁻¹Jᵀγ taken per body from
+/// the velocities' change since the warm start, or summed per body as the sweep goes, then
+/// added); the same bits on one and two threads. Rows: the settled pyramid's, repeated to pass
+/// the parallel threshold, with moving bodies and a soft relax target; and its first rows
+/// alone, an island small enough to carry the sums.
 #[test]
 fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
-    let island = carrying_island([0.1, -0.3, 0.05], [0.2, -0.1, 0.1]);
+    for small in [false, true] {
+        relax_sweep_carrying_gives_the_warm_start_pass(small);
+    }
+}
+
+fn relax_sweep_carrying_gives_the_warm_start_pass(small: bool) {
+    let island = carrying_island([0.1, -0.3, 0.05], [0.2, -0.1, 0.1], small);
     let nothing = |_: &mut super::Bundles, _: &mut crate::solver::Velocities<'_>| {};
     let (linear, angular, rows) = island.relax_then_warm_start(false, 1, nothing);
     let largest = largest_velocity(&linear, &angular);
@@ -567,11 +582,17 @@ fn relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass() {
 /// carry what they change too: the same impulses to the bit as without carrying, the step
 /// totals and the velocities after the next warm start the same up to rounding (the changes
 /// are summed apart), on one and two threads alike. Rows as in
-/// `relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass`, moving faster; the region:
-/// the bodies of every seventh slot, swept six times.
+/// `relax_sweep_carrying_the_warm_start_gives_the_warm_start_pass` (both sizes), moving
+/// faster; the region: the bodies of every seventh slot, swept six times.
 #[test]
 fn local_sweeps_after_a_carrying_relax_sweep_carry_their_changes() {
-    let island = carrying_island([0.3, -0.6, 0.2], [0.4, -0.2, 0.3]);
+    for small in [false, true] {
+        local_sweeps_after_carrying_carry_their_changes(small);
+    }
+}
+
+fn local_sweeps_after_carrying_carry_their_changes(small: bool) {
+    let island = carrying_island([0.3, -0.6, 0.2], [0.4, -0.2, 0.3], small);
     let n = island.n;
     let swept = std::sync::Mutex::new(Vec::new());
     let local = |bundles: &mut super::Bundles, velocities: &mut crate::solver::Velocities<'_>| {
