@@ -84,14 +84,15 @@ pub(crate) struct Bundles {
     /// ([`Bundles::keep_velocities_before`]) for the next record.
     pub(super) before_kept: bool,
     /// The next substep's warm start per island slot, M⁻¹Jᵀγ of a relax sweep's final
-    /// impulses, taken from the velocities ([`Bundles::carry_by_difference`]) or, with joints,
-    /// added up as the sweep went ([`RelaxCarrying`]); `carried` until that warm start.
+    /// impulses, taken from the velocities ([`Bundles::carry_by_difference`]) or, in a small
+    /// island or one with joints, added up as the sweep went ([`RelaxCarrying`]); `carried`
+    /// until that warm start.
     pub(super) carried_linear: Vec<Vec3>,
     pub(super) carried_angular: Vec<Vec3>,
     pub(super) carried: bool,
     /// Per island slot, the velocities as the substep's warm start found them (gravity and
-    /// the gyroscopic term in, no impulse yet): what the relax sweep of an island without
-    /// joints takes from its velocities to carry the warm start ([`Bundles::carry_by_difference`]).
+    /// the gyroscopic term in, no impulse yet), kept in an island large enough to carry the
+    /// warm start as their change ([`Bundles::carry_by_difference`]).
     pub(super) substep_start_linear: Vec<Vec3>,
     pub(super) substep_start_angular: Vec<Vec3>,
     pub(super) recorded: bool,

@@ -60,12 +60,8 @@ impl Bundles {
             // the velocities' change (`carry_by_difference`), or with joints added up as it
             // goes (`RelaxCarrying`). Not with several sweeps: each would add its impulses to
             // the step totals.
-            let largest = if friction
-                && pass.warm_start_follows
-                && pass.iterations == 1
-                && joints.is_empty()
-                && self.slots.len() >= CARRY_BY_DIFFERENCE_POINTS
-            {
+            let carries = friction && pass.warm_start_follows && pass.iterations == 1;
+            let largest = if carries && joints.is_empty() && self.carries_by_difference() {
                 let update = RelaxTotals {
                     totals: SharedItems(self.step_totals.as_mut_ptr()),
                 };
@@ -76,7 +72,7 @@ impl Bundles {
                 };
                 self.carry_by_difference(velocities);
                 largest
-            } else if friction && pass.warm_start_follows && pass.iterations == 1 {
+            } else if carries {
                 let carry = self.start_carrying(velocities.linear.len());
                 match first {
                     Some(t) if stale => self.sweep(order, velocities, carry, Turned::<true>(t)),
@@ -130,6 +126,12 @@ impl Bundles {
 pub(crate) const CARRY_BY_DIFFERENCE_POINTS: usize = 1024;
 
 impl Bundles {
+    /// Whether this island is large enough to carry the warm start as its velocities' change
+    /// ([`CARRY_BY_DIFFERENCE_POINTS`]; it must also have no joints).
+    fn carries_by_difference(&self) -> bool {
+        self.slots.len() >= CARRY_BY_DIFFERENCE_POINTS
+    }
+
     /// Sets the next substep's warm start per island slot to what this substep's impulses
     /// did to `velocities`: their change since [`ContactSolver::warm_start`] kept them, which
     /// is M⁻¹Jᵀγ of the final impulses γ (every change of an island without joints between
@@ -180,12 +182,15 @@ impl ContactSolver for Bundles {
         velocities: &mut Velocities<'_>,
         substep: u32,
     ) {
-        for (start, now) in [
-            (&mut self.substep_start_linear, &*velocities.linear),
-            (&mut self.substep_start_angular, &*velocities.angular),
-        ] {
-            start.clear();
-            start.extend_from_slice(now);
+        // Kept only where a relax sweep may take the carry from them.
+        if self.carries_by_difference() {
+            for (start, now) in [
+                (&mut self.substep_start_linear, &*velocities.linear),
+                (&mut self.substep_start_angular, &*velocities.angular),
+            ] {
+                start.clear();
+                start.extend_from_slice(now);
+            }
         }
         if std::mem::take(&mut self.carried) {
             // The relax sweep before added the impulses up per body (and to the totals).

@@ -184,8 +184,9 @@ fn apply_given<R: Rounding>(
 
 /// The relax sweep of a substep that another substep follows, in an island with joints (whose
 /// impulses change the velocities too, so that [`RelaxTotals`] cannot take the warm start from
-/// them): the velocity rows with friction ([`solve_bundle`]), and each bundle's final impulses,
-/// added to its step totals and applied to `carried`, the next substep's warm start per body ([`Bundles::warm_start`] adds it to
+/// them) or of fewer than `CARRY_BY_DIFFERENCE_POINTS` points: the velocity rows with friction
+/// ([`solve_bundle`]), and each bundle's final impulses, added to its step totals and applied
+/// to `carried`, the next substep's warm start per body ([`Bundles::warm_start`] adds it to
 /// the velocities once their gravity and gyroscopic term are in). The warm start's own pass
 /// read every bundle again; this reads each once more only while its lane group's bundles are
 /// still in the first-level cache: the impulses are carried once the group's are final
@@ -222,7 +223,8 @@ impl BundleUpdate for RelaxCarrying {
     }
 }
 
-/// The relax sweep of a substep that another substep follows, in an island without joints:
+/// The relax sweep of a substep that another substep follows, in an island of at least
+/// `CARRY_BY_DIFFERENCE_POINTS` points without joints:
 /// the velocity rows with friction ([`solve_bundle`]), each bundle's final impulses added to
 /// its step totals as soon as its one update of the sweep is done. The next substep's warm
 /// start is then taken from the velocities ([`Bundles::carry_by_difference`]) rather than
