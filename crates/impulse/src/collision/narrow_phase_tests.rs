@@ -418,3 +418,83 @@ fn a_compound_is_recycled_within_a_fraction_of_its_smallest_part() {
         "compound with a ball"
     );
 }
+
+/// Two boxes that a face's or an edge's separating axis shows apart beyond the speculative
+/// distance (20 mm) are answered without Parry's generator ([`boxes_apart`]) exactly as it and
+/// the fallback would answer: over seeded random poses (as the dispatcher's sweeps draw them),
+/// a pair kept empty from a pose far away and moved there gets as many points as a new narrow
+/// phase there, none where an axis shows them apart, and the separation kept as its gap
+/// exceeds the distance and is no more than the boxes' distance (Parry's `query::distance`).
+#[test]
+fn boxes_shown_apart_by_an_axis_get_no_point() {
+    let boxes = [[0.5, 0.2, 0.3], [0.1, 0.4, 0.1], [0.25, 0.25, 0.25]];
+    let mut uniform = crate::test_support::seeded_uniform(0x51f1_5eed);
+    let (mut answered, mut touching) = (0, 0);
+    for case in 0..3000 {
+        let settings = SolverSettings {
+            sleep: None,
+            ..SolverSettings::default()
+        };
+        let mut w = World::new(Vec3::ZERO, 1.0 / 60.0, settings).unwrap();
+        let m = common::material(0.5);
+        for k in [case % 3, (case / 3) % 3] {
+            let half_extents = boxes[k];
+            let body = BodyDesc::new(
+                BodyKind::Dynamic,
+                ShapeDesc::Cuboid { half_extents },
+                [0.0; 3],
+            );
+            w.add_body(&body, &m).unwrap();
+        }
+        let mut pose = || {
+            let axis = Vec3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0));
+            let turn = glam::Quat::from_axis_angle(axis.normalize_or(Vec3::X), uniform(0.0, 3.2));
+            let at = Vec3::new(uniform(-0.6, 0.6), uniform(-0.6, 0.6), uniform(-0.6, 0.6));
+            Pose::from_parts(at, turn)
+        };
+        let (pose0, pose1) = (pose(), pose());
+        w.bodies.pose[0] = pose0;
+        w.bodies.pose[1] = Pose::from_parts(Vec3::new(10.0, 0.0, 0.0), pose1.rotation);
+        let far = update_pair(&w, None);
+        assert_eq!(far.pairs[0].point_count(), 0);
+        w.bodies.pose[1] = pose1;
+        let pos12 = pose0.inv_mul(&pose1);
+        let mut query = far.pairs[0].last_query.unwrap();
+        (query.pose, query.distance) = (pos12, 0.02);
+        let shortcut = boxes_apart(&pos12, &w.bodies, (0, 1), 0.02, &far.pairs[0], &query);
+        let moved = update_pair(&w, Some(far));
+        let fresh = update_pair(&w, None);
+        assert_eq!(
+            moved.pairs.first().map_or(0, ContactPair::point_count),
+            fresh.pairs.first().map_or(0, ContactPair::point_count),
+            "case {case}"
+        );
+        let Some(gap) = shortcut else {
+            touching += usize::from(fresh.pairs[0].point_count() > 0);
+            continue;
+        };
+        answered += 1;
+        assert_eq!(fresh.pairs[0].point_count(), 0, "case {case}");
+        // Unless the far query's gap still keeps the pair apart without a query.
+        if moved.pairs[0].recomputed {
+            assert_eq!(moved.pairs[0].last_query.unwrap().gap, Some(gap));
+        }
+        let distance = parry3d::query::distance(
+            &pose0,
+            w.bodies.shape[0].as_ref(),
+            &pose1,
+            w.bodies.shape[1].as_ref(),
+        )
+        .unwrap()
+        .distance;
+        assert!(
+            gap > 0.02 && gap <= distance + 1e-5,
+            "case {case}: gap {gap} m, distance {distance} m"
+        );
+    }
+    eprintln!("{answered} pairs shown apart by an axis, {touching} with points");
+    assert!(
+        answered > 1000 && touching > 500,
+        "{answered} apart, {touching} touching"
+    );
+}
