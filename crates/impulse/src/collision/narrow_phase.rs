@@ -528,72 +528,64 @@ impl NarrowPhase {
             }
             // Two boxes shown apart by a face's or an edge's separating axis take Parry's
             // answer without its generator and the fallback's GJK (`boxes_apart`).
-            if let Some(gap) = boxes_apart(&pos12, bodies, (a, b), prediction, pair, &query) {
-                pair.summary = PairSummary::of(&pair.manifolds);
-                if let Some((reach, part_limit)) = recycle_reach(&bodies.shape[a], &bodies.shape[b])
+            let shown_apart = boxes_apart(&pos12, bodies, (a, b), prediction, pair, &query);
+            if shown_apart.is_none() {
+                // A face-axis memory belongs to the shapes it was found for.
+                if pair
+                    .last_query
+                    .is_some_and(|last| last.shapes != query.shapes)
                 {
-                    (query.reach, query.part_limit) = (Some(reach), part_limit);
+                    for manifold in &mut pair.manifolds {
+                        manifold.data.face_axes = None;
+                    }
                 }
-                query.gap = Some(gap);
-                pair.last_query = Some(query);
-                pair.recomputed = true;
-                return Ok(());
-            }
-            // A face-axis memory belongs to the shapes it was found for.
-            if pair
-                .last_query
-                .is_some_and(|last| last.shapes != query.shapes)
-            {
+                if has_curved_surface(&bodies.shape[a]) || has_curved_surface(&bodies.shape[b]) {
+                    for manifold in &mut pair.manifolds {
+                        manifold.mark_shapes_deformed();
+                    }
+                }
+                let kept = concave_planes::kept_impulses(
+                    bodies.shape[a].as_ref(),
+                    bodies.shape[b].as_ref(),
+                    &pair.manifolds,
+                );
+                let reach = margins.pair_reach(bodies, a, b);
+                ContactDispatcher::turning(super::deepest_vertex::Turning {
+                    reach: reach.turn_reach,
+                    bound: reach.turn_bound,
+                })
+                .contact_manifolds(
+                    &pos12,
+                    bodies.shape[a].as_ref(),
+                    bodies.shape[b].as_ref(),
+                    prediction,
+                    &mut pair.manifolds,
+                    &mut pair.workspace,
+                )
+                .map_err(|_| UnsupportedShapePair(a, b))?;
+                concave_planes::add_plane_points(
+                    &pos12,
+                    bodies.pose[a].rotation,
+                    bodies.shape[a].as_ref(),
+                    bodies.shape[b].as_ref(),
+                    &reach,
+                    &kept,
+                    &mut pair.manifolds,
+                );
                 for manifold in &mut pair.manifolds {
-                    manifold.data.face_axes = None;
+                    drop_duplicate_points(manifold);
                 }
-            }
-            if has_curved_surface(&bodies.shape[a]) || has_curved_surface(&bodies.shape[b]) {
-                for manifold in &mut pair.manifolds {
-                    manifold.mark_shapes_deformed();
+                let shapes = PairShapes {
+                    pos12: &pos12,
+                    rotation1: bodies.pose[a].rotation,
+                    shape1: bodies.shape[a].as_ref(),
+                    shape2: bodies.shape[b].as_ref(),
+                };
+                reach.drop_unreachable(shapes, &mut pair.manifolds);
+                reach.aim_at_impact(shapes, &mut pair.manifolds);
+                if part_pairs::applies(bodies.shape[a].as_ref(), bodies.shape[b].as_ref()) {
+                    part_pairs::reduce(&mut pair.manifolds, &margins.point_closing(bodies, a, b));
                 }
-            }
-            let kept = concave_planes::kept_impulses(
-                bodies.shape[a].as_ref(),
-                bodies.shape[b].as_ref(),
-                &pair.manifolds,
-            );
-            let reach = margins.pair_reach(bodies, a, b);
-            ContactDispatcher::turning(super::deepest_vertex::Turning {
-                reach: reach.turn_reach,
-                bound: reach.turn_bound,
-            })
-            .contact_manifolds(
-                &pos12,
-                bodies.shape[a].as_ref(),
-                bodies.shape[b].as_ref(),
-                prediction,
-                &mut pair.manifolds,
-                &mut pair.workspace,
-            )
-            .map_err(|_| UnsupportedShapePair(a, b))?;
-            concave_planes::add_plane_points(
-                &pos12,
-                bodies.pose[a].rotation,
-                bodies.shape[a].as_ref(),
-                bodies.shape[b].as_ref(),
-                &reach,
-                &kept,
-                &mut pair.manifolds,
-            );
-            for manifold in &mut pair.manifolds {
-                drop_duplicate_points(manifold);
-            }
-            let shapes = PairShapes {
-                pos12: &pos12,
-                rotation1: bodies.pose[a].rotation,
-                shape1: bodies.shape[a].as_ref(),
-                shape2: bodies.shape[b].as_ref(),
-            };
-            reach.drop_unreachable(shapes, &mut pair.manifolds);
-            reach.aim_at_impact(shapes, &mut pair.manifolds);
-            if part_pairs::applies(bodies.shape[a].as_ref(), bodies.shape[b].as_ref()) {
-                part_pairs::reduce(&mut pair.manifolds, &margins.point_closing(bodies, a, b));
             }
             pair.summary = PairSummary::of(&pair.manifolds);
             if let Some((reach, part_limit)) = recycle_reach(&bodies.shape[a], &bodies.shape[b]) {
@@ -601,7 +593,12 @@ impl NarrowPhase {
             }
             // Not for a compound (a finite part limit): its distance query visits every pair of
             // parts again, which costs more than the manifolds it would spare.
-            if query.reach.is_some() && query.part_limit.is_infinite() && pair.summary.points == 0 {
+            if shown_apart.is_some() {
+                query.gap = shown_apart;
+            } else if query.reach.is_some()
+                && query.part_limit.is_infinite()
+                && pair.summary.points == 0
+            {
                 use parry3d::query::QueryDispatcher;
                 query.gap = parry3d::query::DefaultQueryDispatcher
                     .distance(&pos12, bodies.shape[a].as_ref(), bodies.shape[b].as_ref())
