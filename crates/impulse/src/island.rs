@@ -8,6 +8,11 @@
 //! prescribed velocity, so that contacts see its motion (it may be a guest of several
 //! islands). Static bodies share the island's immovable slot, at rest. Quiet islands fall
 //! asleep.
+//!
+//! The solve's islands are groups of these components ([`Grouping`]): small components that
+//! the solver would take in SIMD lanes anyway are solved together, a run of them one island of
+//! the solve, as Box2D v3 and Rapier solve all awake contacts at once; every other component
+//! is an island of its own. Sleep stays per component ([`Islands::components`]).
 
 use crate::body::{Bodies, BodyKind};
 use crate::collision::narrow_phase::ContactPair;
@@ -38,6 +43,22 @@ pub(crate) struct Islands {
     guest_pairs: Vec<(u32, u32)>,
     /// Island of each body; `u32::MAX` for static and kinematic bodies.
     pub island_of_body: Vec<u32>,
+    /// Component c's bodies are `bodies[component_start[c]..component_start[c + 1]]`, in
+    /// increasing index order; an island's bodies are those of its components, in order.
+    component_start: Vec<u32>,
+    /// The island of each component.
+    island_of_component: Vec<u32>,
+    /// Per component: its points, whether it is kept apart from other components, and its
+    /// lightest and heaviest body's mass (kg): build scratch.
+    component_points: Vec<u32>,
+    component_kept_apart: Vec<bool>,
+    component_masses: Vec<(f32, f32)>,
+    /// Per body, what grouping reads of it (its inverse mass's bits, whether it sleeps and
+    /// whether it turns in the step), this build's and the last; empty without grouping.
+    body_keys: Vec<u64>,
+    last_body_keys: Vec<u64>,
+    /// The grouping of the last build.
+    last_grouping: Grouping,
     /// During the build the union-find forest; then each moving body's local index.
     parent: Vec<u32>,
     /// Pairs with constraints, island by island (narrow-phase order within an island).
@@ -61,13 +82,70 @@ pub(crate) struct Islands {
 /// A pair as the island build reads it: its two bodies and its number of constraints.
 type PairKey = (u32, u32, u32);
 
+/// The bits of a body's key ([`Islands::build`]) that say it sleeps and that it turns in the
+/// step; the low 32 bits are its inverse mass's.
+const ASLEEP_BIT: u32 = 32;
+const TURNING_BIT: u32 = 33;
+
+/// Which components of the contact graph the solve takes together as one island
+/// ([`Islands::build`]). In a step with at least `min_components` components that qualify, a
+/// run of consecutive components (in the order of their lowest body) that each qualify is one
+/// island while its points stay below `max_points` and its heaviest
+/// body below `mass_ratio_limit` times its lightest. A component qualifies with at least
+/// `min_points` points (the solver takes it in SIMD lanes alone too) and fewer than
+/// `max_points`, no joint, no kinematic body touching it, no body asleep, none turning by more
+/// than `turning_spin` in the step whose contact points turn with it, and masses within
+/// `mass_ratio_limit`: so the island's own choices (the heavy-on-light path, friction in the
+/// main solve, rows that follow a turn) are what each component's would be. Components share
+/// no body, so an island of several sweeps each of them by Gauss-Seidel as before; what
+/// changes is the order of their lanes, and that an impact in one gives all of them its
+/// sweeps.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub(crate) struct Grouping {
+    /// Points from which a component may be grouped; 0: no grouping.
+    pub min_points: u32,
+    /// Components that qualify, at least, for any to be grouped in a step.
+    pub min_components: u32,
+    /// An island of grouped components holds fewer points than this.
+    pub max_points: u32,
+    /// An island of grouped components has its heaviest body below this many times its
+    /// lightest.
+    pub mass_ratio_limit: f32,
+    /// The step's length (s).
+    pub dt: f32,
+    /// A turn in the step (rad) beyond which a body keeps its component apart.
+    pub turning_spin: f32,
+}
+
+impl Grouping {
+    /// Whether components are grouped at all.
+    fn is_on(&self) -> bool {
+        self.min_points > 0 && self.max_points > self.min_points
+    }
+}
+
 impl Islands {
     /// Number of islands.
     pub(crate) fn len(&self) -> usize {
         self.constraint_start.len().saturating_sub(1)
     }
 
-    /// Bodies of island `k`, in increasing index order; in a split island
+    /// Number of components of the contact graph, each in one island.
+    pub(crate) fn components(&self) -> usize {
+        self.island_of_component.len()
+    }
+
+    /// Bodies of component `c`, in increasing index order.
+    pub(crate) fn component_bodies(&self, c: usize) -> &[u32] {
+        &self.bodies[self.component_start[c] as usize..self.component_start[c + 1] as usize]
+    }
+
+    /// The island of component `c`.
+    pub(crate) fn island_of_component(&self, c: usize) -> usize {
+        self.island_of_component[c] as usize
+    }
+
+    /// Bodies of island `k`, component by component, each in increasing index order; in a split island
     /// ([`Islands::second_half`]), each half in increasing index order, the first half first.
     pub(crate) fn bodies(&self, k: usize) -> &[u32] {
         &self.bodies[self.body_start[k] as usize..self.body_start[k + 1] as usize]
@@ -166,8 +244,21 @@ impl Islands {
         bodies: &Bodies,
         pairs: &[ContactPair],
         joints: &[(u32, u32, u32)],
+        grouping: Grouping,
     ) {
         let n = bodies.len();
+        std::mem::swap(&mut self.body_keys, &mut self.last_body_keys);
+        self.body_keys.clear();
+        if grouping.is_on() {
+            self.body_keys.extend((0..n).map(|i| {
+                let turning = bodies.is_dynamic(i)
+                    && bodies.angular_velocity[i].length() * grouping.dt > grouping.turning_spin
+                    && bodies.contact_points_turn_with_body(i);
+                u64::from(bodies.inverse_mass[i].to_bits())
+                    | u64::from(bodies.asleep[i]) << ASLEEP_BIT
+                    | u64::from(turning) << TURNING_BIT
+            }));
+        }
         std::mem::swap(&mut self.joint_keys, &mut self.last_joint_keys);
         self.joint_keys.clear();
         self.joint_keys
@@ -183,9 +274,12 @@ impl Islands {
             && self.joint_keys == self.last_joint_keys
             && self.kinds == bodies.kind
             && self.island_of_body.len() == n
+            && self.body_keys == self.last_body_keys
+            && grouping == self.last_grouping
         {
             return;
         }
+        self.last_grouping = grouping;
         self.kinds.clone_from(&bodies.kind);
         let keys = &self.pair_keys;
         self.parent.clear();
@@ -202,7 +296,7 @@ impl Islands {
                 }
             }
         }
-        // Number islands by their lowest body, in body order (deterministic).
+        // Number components by their lowest body, in body order (deterministic).
         self.island_of_body.clear();
         self.island_of_body.resize(n, u32::MAX);
         let mut count = 0u32;
@@ -216,38 +310,55 @@ impl Islands {
                 self.island_of_body[i] = self.island_of_body[root];
             }
         }
-        let islands = count as usize;
-        // Bodies per island (counting sort), and each body's local index.
-        self.body_start.clear();
-        self.body_start.resize(islands + 1, 0);
-        for i in 0..n {
-            let k = self.island_of_body[i];
-            if k != u32::MAX {
-                self.body_start[k as usize + 1] += 1;
+        let components = count as usize;
+        // Bodies per component (counting sort): each component's bodies in index order.
+        self.component_start.clear();
+        self.component_start.resize(components + 1, 0);
+        for &c in &self.island_of_body {
+            if c != u32::MAX {
+                self.component_start[c as usize + 1] += 1;
             }
         }
-        for k in 0..islands {
-            self.body_start[k + 1] += self.body_start[k];
+        for c in 0..components {
+            self.component_start[c + 1] += self.component_start[c];
         }
         let mut fill = std::mem::take(&mut self.fill);
         fill.clear();
-        fill.extend_from_slice(&self.body_start[..islands]);
+        fill.extend_from_slice(&self.component_start[..components]);
         self.bodies.clear();
-        self.bodies.resize(self.body_start[islands] as usize, 0);
-        // `parent` is free again: reuse it for local indices.
-        for (i, (&k, local)) in self
+        self.bodies
+            .resize(self.component_start[components] as usize, 0);
+        // `parent` is free again: it takes each body's place in `bodies` for now.
+        for (i, (&c, place)) in self
             .island_of_body
             .iter()
             .zip(self.parent.iter_mut())
             .enumerate()
         {
-            if k != u32::MAX {
-                let slot = fill[k as usize];
-                self.bodies[slot as usize] = i as u32;
-                *local = slot - self.body_start[k as usize];
-                fill[k as usize] += 1;
+            if c != u32::MAX {
+                *place = fill[c as usize];
+                self.bodies[*place as usize] = i as u32;
+                fill[c as usize] += 1;
             }
         }
+        self.fill = fill;
+        // Islands: runs of components (`Grouping`), each island's bodies its components' in
+        // order; each moving body's local index its place in its island.
+        let islands = self.group_components(bodies, grouping, components);
+        self.body_start.clear();
+        self.body_start.resize(islands + 1, 0);
+        for c in 0..components {
+            let k = self.island_of_component[c] as usize;
+            self.body_start[k + 1] = self.component_start[c + 1];
+        }
+        for (c, place) in self.island_of_body.iter_mut().zip(self.parent.iter_mut()) {
+            if *c != u32::MAX {
+                *c = self.island_of_component[*c as usize];
+                *place -= self.body_start[*c as usize];
+            }
+        }
+        let fill = std::mem::take(&mut self.fill);
+        let keys = &self.pair_keys;
         // Guests: the kinematic bodies of pairs with constraints, per island of their partner.
         self.guest_pairs.clear();
         let joined = self.joint_keys.iter().map(|&(a, b)| (a, b, 1));
@@ -309,6 +420,107 @@ impl Islands {
         }
         self.split_large_islands(&pairs_per_island);
         self.fill = pairs_per_island;
+    }
+
+    /// Numbers the islands: each component's island (`island_of_component`) under
+    /// `grouping`, from the pairs' and joints' keys, the components of `island_of_body` and
+    /// the bodies' keys. Returns the number of islands.
+    fn group_components(
+        &mut self,
+        bodies: &Bodies,
+        grouping: Grouping,
+        components: usize,
+    ) -> usize {
+        self.island_of_component.clear();
+        if !grouping.is_on() {
+            self.island_of_component.extend(0..components as u32);
+            return components;
+        }
+        let (points, apart, masses) = (
+            &mut self.component_points,
+            &mut self.component_kept_apart,
+            &mut self.component_masses,
+        );
+        points.clear();
+        points.resize(components, 0);
+        apart.clear();
+        apart.resize(components, false);
+        masses.clear();
+        masses.resize(components, (f32::INFINITY, 0.0));
+        let component = |body: u32| self.island_of_body[body as usize];
+        for &(a, b, rows) in self.pair_keys.iter().filter(|k| k.2 > 0) {
+            let c = if component(b) != u32::MAX {
+                component(b)
+            } else {
+                component(a)
+            } as usize;
+            points[c] += rows;
+            let kinds = (self.kinds[a as usize], self.kinds[b as usize]);
+            if kinds.0 == BodyKind::Kinematic || kinds.1 == BodyKind::Kinematic {
+                apart[c] = true;
+            }
+        }
+        for &(a, b) in &self.joint_keys {
+            for c in [component(a), component(b)] {
+                if c != u32::MAX {
+                    apart[c as usize] = true;
+                }
+            }
+        }
+        for (i, &key) in self.body_keys.iter().enumerate() {
+            let c = component(i as u32);
+            if c == u32::MAX {
+                continue;
+            }
+            let c = c as usize;
+            if key & (1 << ASLEEP_BIT | 1 << TURNING_BIT) != 0 {
+                apart[c] = true;
+            }
+            let inverse_mass = bodies.inverse_mass[i];
+            if inverse_mass > 0.0 {
+                let (lightest, heaviest) = &mut masses[c];
+                *lightest = lightest.min(1.0 / inverse_mass);
+                *heaviest = heaviest.max(1.0 / inverse_mass);
+            }
+        }
+        // Below the limit as the solve's `mass_ratio` (heaviest over lightest, 1 without
+        // finite masses) would be.
+        let within = |(lightest, heaviest): (f32, f32)| {
+            heaviest <= 0.0 || heaviest / lightest < grouping.mass_ratio_limit
+        };
+        let (min, max) = (grouping.min_points, grouping.max_points);
+        let qualifies =
+            |c: usize| !apart[c] && points[c] >= min && points[c] < max && within(masses[c]);
+        if (0..components).filter(|&c| qualifies(c)).count() < grouping.min_components as usize {
+            self.island_of_component.extend(0..components as u32);
+            return components;
+        }
+        let mut islands = 0u32;
+        // The island being filled: its points, lightest and heaviest body.
+        let mut open: Option<(u32, (f32, f32))> = None;
+        for c in 0..components {
+            let (p, m) = (points[c], masses[c]);
+            if !qualifies(c) {
+                self.island_of_component.push(islands);
+                islands += 1;
+                open = None;
+                continue;
+            }
+            match open {
+                Some((q, (lightest, heaviest)))
+                    if q + p < max && within((lightest.min(m.0), heaviest.max(m.1))) =>
+                {
+                    self.island_of_component.push(islands - 1);
+                    open = Some((q + p, (lightest.min(m.0), heaviest.max(m.1))));
+                }
+                _ => {
+                    self.island_of_component.push(islands);
+                    islands += 1;
+                    open = Some((p, m));
+                }
+            }
+        }
+        islands as usize
     }
 
     /// Cuts the bodies of each island of at least [`SPLIT_ISLAND_POINTS`] constraints into two

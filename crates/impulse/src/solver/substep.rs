@@ -9,6 +9,8 @@
 
 use glam::{Mat3, Vec3};
 
+use crate::island::Grouping;
+
 use super::heavy_on_light::{
     HeavyOnLight, heavy_on_light, heavy_on_light_max_contacts, heavy_on_light_settings, mass_ratio,
 };
@@ -379,6 +381,47 @@ const TURNED_ROWS_LIMIT: f32 = 1.0;
 /// tumbling pins closer to the ground at 60 Hz than following the turn does (docs/method.md,
 /// "Rows that follow a turn").
 const TURNING_SPIN: f32 = 0.4;
+
+/// Islands that could be solved together, at least, for the solve to group them
+/// ([`island_grouping`]). A few islands cost a few passes and sweep calls a substep, nothing
+/// next to their sweeps; grouping them would change the order of their lanes, and so their
+/// bits and every take of a shot (the bowling pins' islands of 20-45 points), for nothing.
+pub(crate) const GROUPED_FROM_ISLANDS: u32 = 32;
+
+/// How the islands stage groups the components of the contact graph into the solve's islands
+/// ([`Grouping`]) under `settings` at a step of `dt` seconds: components the solver takes in
+/// SIMD lanes (from [`SolveSettings::simd_island_contacts`] points, PGS without split impulse)
+/// run together while an island of them stays below [`LOCAL_IMPACT_MIN_POINTS`] (so that its
+/// impacts sweep it whole, as each component's did) and its masses below every mass ratio
+/// the island's solve tells apart by ([`HEAVY_ON_LIGHT_MASS_RATIO`],
+/// [`SolveSettings::heavy_on_light_mass_ratio`], `auto`'s); a component with a body turning
+/// by more than [`TURNING_SPIN`] in the step stays apart (its rows may follow the turn).
+/// Each island costs its own passes and sweep calls a substep: balls4096's 256 columns of 16
+/// points solved apart took a quarter more time a settled step than joined
+/// (docs/benchmarks.md, "Scaling"). Only a step with at least [`GROUPED_FROM_ISLANDS`] such
+/// islands groups them.
+///
+/// [`SolveSettings::simd_island_contacts`]: crate::settings::SolveSettings::simd_island_contacts
+/// [`SolveSettings::heavy_on_light_mass_ratio`]: crate::settings::SolveSettings::heavy_on_light_mass_ratio
+pub(crate) fn island_grouping(settings: &SolverSettings, dt: f32) -> Grouping {
+    let min_points = settings.solve.simd_island_contacts;
+    if !settings.solves_in_lanes(min_points as usize) {
+        return Grouping::default();
+    }
+    let (_, _, auto_mass_ratio) = settings.auto_parameters();
+    let mass_ratio_limit = [settings.solve.heavy_on_light_mass_ratio, auto_mass_ratio]
+        .into_iter()
+        .filter(|&limit| limit > 0.0)
+        .fold(HEAVY_ON_LIGHT_MASS_RATIO, f32::min);
+    Grouping {
+        min_points,
+        min_components: GROUPED_FROM_ISLANDS,
+        max_points: LOCAL_IMPACT_MIN_POINTS as u32,
+        mass_ratio_limit,
+        dt,
+        turning_spin: TURNING_SPIN,
+    }
+}
 
 /// Rows below which an island with a body turning faster than [`TURNING_SPIN`] takes the
 /// scalar path, whose rows follow the turn: a tumbling bowling pin's landing has up to 36, a

@@ -1,5 +1,6 @@
 //! Islands and sleeping: independent islands give the same result in parallel as in sequence,
-//! quiet islands fall asleep, and an awake body touching a sleeping island wakes all of it.
+//! small islands solved together rest as each alone and sleep one by one, quiet islands fall
+//! asleep, and an awake body touching a sleeping island wakes all of it.
 
 use crate::common;
 
@@ -26,7 +27,8 @@ fn cube(kind: BodyKind, half: Vec3, position: Vec3) -> BodyDesc {
     )
 }
 
-/// Ground plus `stacks` separate stacks of `height` cubes, each a separate island.
+/// Ground plus `stacks` separate stacks of `height` cubes, each a separate island, eight to a
+/// row 3 m apart.
 fn stacks(stacks: usize, height: usize, settings: SolverSettings) -> World {
     let mut w = World::new(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, settings).unwrap();
     w.add_body(
@@ -40,12 +42,12 @@ fn stacks(stacks: usize, height: usize, settings: SolverSettings) -> World {
     .unwrap();
     for s in 0..stacks {
         for i in 0..height {
-            let x = 3.0 * s as f32 + 0.01 * (i % 2) as f32;
+            let x = 3.0 * (s % 8) as f32 + 0.01 * (i % 2) as f32;
             w.add_body(
                 &cube(
                     BodyKind::Dynamic,
                     Vec3::splat(0.5),
-                    Vec3::new(x, 0.5 + i as f32, 0.0),
+                    Vec3::new(x, 0.5 + i as f32, 3.0 * (s / 8) as f32),
                 ),
                 &material(),
             )
@@ -55,40 +57,118 @@ fn stacks(stacks: usize, height: usize, settings: SolverSettings) -> World {
     w
 }
 
-#[test]
-fn parallel_islands_match_sequential_bit_for_bit() {
+/// `stacks` stacks of `height` cubes without sleep stepped `steps` times on one thread and on
+/// two; asserts that both take the same islands and reach the same poses and velocities, and
+/// returns the one-thread world.
+fn on_one_and_two_threads(stacks_count: usize, height: usize, steps: usize) -> World {
     let settings = SolverSettings {
         sleep: None,
         ..SolverSettings::default()
     };
-    let mut sequential = stacks(6, 5, settings.clone());
+    let mut sequential = stacks(stacks_count, height, settings.clone());
     sequential.set_parallel(false);
-    let mut parallel = stacks(6, 5, settings);
+    let mut parallel = stacks(stacks_count, height, settings);
     parallel.set_parallel(true);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
         .unwrap();
-    for _ in 0..120 {
+    for _ in 0..steps {
         sequential.step().unwrap();
         pool.install(|| parallel.step().unwrap());
     }
-    // Six islands, one per stack, each named by its lowest body (the ground is body 0), with
-    // its five cubes and the contacts of a cube on a cube or the ground (four corners each).
-    let islands = &sequential.diagnostics().islands;
-    assert_eq!(islands, &parallel.diagnostics().islands);
-    let mut firsts: Vec<u32> = islands.iter().map(|island| island.first_body).collect();
-    firsts.sort_unstable();
-    assert_eq!(firsts, [1, 6, 11, 16, 21, 26]);
-    for island in islands {
-        assert_eq!((island.bodies, island.contacts), (5, 20), "{island:?}");
-    }
+    assert_eq!(
+        sequential.diagnostics().islands,
+        parallel.diagnostics().islands
+    );
     for i in 0..sequential.body_count() {
         assert_eq!(sequential.poses()[i], parallel.poses()[i], "body {i}");
         assert_eq!(
             sequential.linear_velocities()[i],
             parallel.linear_velocities()[i]
         );
+    }
+    sequential
+}
+
+#[test]
+fn parallel_islands_match_sequential_bit_for_bit() {
+    // Stacks of three cubes: islands of 12 points, below the 16 from which the solve takes
+    // islands together (and six of them, fewer than the 32 it groups from), so each is solved
+    // alone, side by side on the threads.
+    let sequential = on_one_and_two_threads(6, 3, 120);
+    // Six islands, one per stack, each named by its lowest body (the ground is body 0), with
+    // its three cubes and the contacts of a cube on a cube or the ground (four corners each).
+    assert_islands(&sequential, &[1, 4, 7, 10, 13, 16], (3, 12));
+}
+
+/// Asserts that `w`'s last step solved islands whose lowest bodies are `firsts` (in
+/// increasing order), each of `bodies_and_contacts`.
+fn assert_islands(w: &World, firsts: &[u32], bodies_and_contacts: (u32, u32)) {
+    let islands = &w.diagnostics().islands;
+    let mut found: Vec<u32> = islands.iter().map(|island| island.first_body).collect();
+    found.sort_unstable();
+    assert_eq!(found, firsts);
+    for island in islands {
+        assert_eq!(
+            (island.bodies, island.contacts),
+            bodies_and_contacts,
+            "{island:?}"
+        );
+    }
+}
+
+/// Thirty-six stacks of five cubes (20 points each) are solved six stacks to an island of 120
+/// points (fewer than 128), the same on two threads as on one, and each stack rests as the same
+/// stack alone does: the solve sweeps each stack's rows as before, in another order of lanes.
+#[test]
+fn small_islands_solved_together_rest_as_each_alone() {
+    let sequential = on_one_and_two_threads(36, 5, 300);
+    let mut alone = stacks(
+        1,
+        5,
+        SolverSettings {
+            sleep: None,
+            ..SolverSettings::default()
+        },
+    );
+    for _ in 0..300 {
+        alone.step().unwrap();
+    }
+    assert_islands(&sequential, &[1, 31, 61, 91, 121, 151], (30, 120));
+    for s in 0..36 {
+        for level in 0..5 {
+            let (grouped, single) = (
+                sequential.poses()[1 + 5 * s + level].translation,
+                alone.poses()[1 + level].translation,
+            );
+            let offset = Vec3::new(3.0 * (s % 8) as f32, 0.0, 3.0 * (s / 8) as f32);
+            assert!(
+                (grouped - offset - single).length() < 1e-4,
+                "stack {s}, cube {level}: {grouped} against {single} alone"
+            );
+        }
+    }
+}
+
+/// Stacks solved together still sleep one by one: a stack kept awake (`World::wake_up` every
+/// step) keeps itself awake, not the stacks solved with it.
+#[test]
+fn islands_solved_together_sleep_one_by_one() {
+    let mut w = stacks(32, 5, SolverSettings::default());
+    for _ in 0..30 {
+        w.step().unwrap();
+    }
+    let together = &w.diagnostics().islands;
+    assert_eq!(together.len(), 6, "{together:?}");
+    assert_eq!((together[0].first_body, together[0].bodies), (1, 30));
+    for _ in 0..150 {
+        w.wake_up(6);
+        w.step().unwrap();
+    }
+    for i in 1..w.body_count() {
+        let kept_awake = (6..=10).contains(&i);
+        assert_eq!(w.asleep()[i], !kept_awake, "body {i}");
     }
 }
 

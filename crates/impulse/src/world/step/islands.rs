@@ -7,15 +7,19 @@ use crate::World;
 use crate::body::Bodies;
 use crate::island::Islands;
 use crate::parallel::{BODIES_PER_TASK, both, map_into, spread};
+use crate::settings::SolverSettings;
+use crate::solver::substep;
 
 impl World {
-    /// Islands from the pairs first, so that assembly writes each island's constraints
+    /// Islands from the pairs first (small components grouped under `settings`,
+    /// [`substep::island_grouping`]), so that assembly writes each island's constraints
     /// contiguously and nothing has to be moved afterwards. The union-find is serial; the
     /// world inertia tensors and centres of mass (from the poses alone) are computed beside
     /// it, once a body rather than once for each of its pairs. Writes `islands`,
     /// `world_inverse_inertia` and `world_center_of_mass`.
     pub(super) fn islands_stage(
         &mut self,
+        settings: &SolverSettings,
         parallel: bool,
         islands: &mut Islands,
         world_inverse_inertia: &mut Vec<Mat3>,
@@ -26,6 +30,7 @@ impl World {
         } else {
             self.active_joints()
         };
+        let grouping = substep::island_grouping(settings, self.dt);
         let (bodies, pairs) = (&self.bodies, &self.narrow_phase.pairs);
         both(
             parallel,
@@ -40,7 +45,7 @@ impl World {
                     bodies.center_of_mass(i)
                 });
             },
-            || islands.build(bodies, pairs, &joints),
+            || islands.build(bodies, pairs, &joints, grouping),
         );
     }
 }

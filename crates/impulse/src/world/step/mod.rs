@@ -141,6 +141,7 @@ impl World {
         self.narrow_phase_stage(&settings, parallel, &c.candidates, &c.margins)?;
         clock.end(Stage::NarrowPhase);
         self.islands_stage(
+            &settings,
             parallel,
             &mut c.islands,
             &mut c.world_inverse_inertia,

@@ -40,7 +40,8 @@ impl World {
     }
 }
 
-/// Puts an island to sleep once every body in it has been slower than the thresholds for
+/// Puts a component of the contact graph (an island, or part of one that the solve groups)
+/// to sleep once every body in it has been slower than the thresholds for
 /// `time_to_sleep` seconds (Box2D's rule); its velocities are zeroed and it costs nothing
 /// until something touches it. Sleep timers advance for the bodies of awake islands.
 pub(super) fn update_sleep(
@@ -86,19 +87,21 @@ pub(super) fn update_sleep(
     if s.sleep.is_none() {
         return;
     }
-    // An island touching a moving kinematic body stays awake: the body may carry it at any
-    // speed, below the thresholds too.
-    let falls_asleep = |k: usize| {
+    // Per component of the contact graph, not per island of the solve (which may join
+    // several, `Islands::build`). An island touching a moving kinematic body stays awake: the
+    // body may carry it at any speed, below the thresholds too.
+    let falls_asleep = |c: usize| {
+        let k = islands.island_of_component(c);
         awake[k]
             && islands
-                .bodies(k)
+                .component_bodies(c)
                 .iter()
                 .all(|&i| bodies.sleep_time[i as usize] >= thresholds.time_to_sleep)
             && islands.guests(k).iter().all(|&i| bodies.asleep[i as usize])
     };
-    let sleepers = indices_where(parallel, awake.len(), falls_asleep);
-    for k in sleepers {
-        for &i in islands.bodies(k) {
+    let sleepers = indices_where(parallel, islands.components(), falls_asleep);
+    for c in sleepers {
+        for &i in islands.component_bodies(c) {
             let i = i as usize;
             bodies.asleep[i] = true;
             bodies.linear_velocity[i] = Vec3::ZERO;
