@@ -205,12 +205,7 @@ impl Islands {
 
     /// Island of the constraints of a pair of bodies (the moving one's, or either's).
     pub(crate) fn island_of_pair(&self, body1: usize, body2: usize) -> usize {
-        let k = self.island_of_body[body2];
-        if k != u32::MAX {
-            k as usize
-        } else {
-            self.island_of_body[body1] as usize
-        }
+        of_pair(&self.island_of_body, body1, body2)
     }
 
     /// Constraints of all islands together: the length of the assembled array.
@@ -252,8 +247,7 @@ impl Islands {
         if grouping.is_on() {
             self.body_keys.extend((0..n).map(|i| {
                 let turning = bodies.is_dynamic(i)
-                    && bodies.angular_velocity[i].length() * grouping.dt > grouping.turning_spin
-                    && bodies.contact_points_turn_with_body(i);
+                    && bodies.turns_in_step(i, grouping.dt, grouping.turning_spin);
                 u64::from(bodies.inverse_mass[i].to_bits())
                     | u64::from(bodies.asleep[i]) << ASLEEP_BIT
                     | u64::from(turning) << TURNING_BIT
@@ -449,11 +443,7 @@ impl Islands {
         masses.resize(components, (f32::INFINITY, 0.0));
         let component = |body: u32| self.island_of_body[body as usize];
         for &(a, b, rows) in self.pair_keys.iter().filter(|k| k.2 > 0) {
-            let c = if component(b) != u32::MAX {
-                component(b)
-            } else {
-                component(a)
-            } as usize;
+            let c = of_pair(&self.island_of_body, a as usize, b as usize);
             points[c] += rows;
             let kinds = (self.kinds[a as usize], self.kinds[b as usize]);
             if kinds.0 == BodyKind::Kinematic || kinds.1 == BodyKind::Kinematic {
@@ -588,6 +578,17 @@ impl Islands {
                 self.second_half[k] = second as u32;
             }
         }
+    }
+}
+
+/// The island (or, during the build, the component) of a pair's constraints in
+/// `island_of_body`: the moving body's, body 2's if both move.
+fn of_pair(island_of_body: &[u32], body1: usize, body2: usize) -> usize {
+    let k = island_of_body[body2];
+    if k != u32::MAX {
+        k as usize
+    } else {
+        island_of_body[body1] as usize
     }
 }
 

@@ -223,6 +223,13 @@ impl Bodies {
         self.locked_axes[i].world_inverse_inertia(self.pose[i].rotation, local)
     }
 
+    /// Whether body `i`, at its angular velocity (rad/s), turns by more than `spin` (rad) in a
+    /// step of `dt` seconds and its contact points turn with it
+    /// ([`Self::contact_points_turn_with_body`]): its rows may have to follow the turn.
+    pub(crate) fn turns_in_step(&self, i: usize, dt: f32, spin: f32) -> bool {
+        self.angular_velocity[i].length() * dt > spin && self.contact_points_turn_with_body(i)
+    }
+
     /// Whether body `i`'s contact points are points of the body that turn with it: a
     /// polyhedron's vertices, edges and faces, a mesh's, a height field's and compounds of
     /// these. A round shape's (ball, capsule, cylinder, cone, rounded shapes) slide over its

@@ -434,11 +434,9 @@ const TURNING_SCALAR_ROWS: usize = 64;
 fn turns_in_step(island_bodies: &[u32], rows: usize, context: &IslandContext<'_>) -> bool {
     let (bodies, dt) = (context.bodies, context.dt);
     rows < TURNING_SCALAR_ROWS
-        && island_bodies.iter().any(|&i| {
-            let i = i as usize;
-            bodies.angular_velocity[i].length() * dt > TURNING_SPIN
-                && bodies.contact_points_turn_with_body(i)
-        })
+        && island_bodies
+            .iter()
+            .any(|&i| bodies.turns_in_step(i as usize, dt, TURNING_SPIN))
 }
 
 /// How an island's solves run in a step, decided before its substeps.
