@@ -318,10 +318,11 @@ pub(crate) struct IslandContext<'a> {
 /// their slots follow the island's bodies and hold their prescribed velocities, which no
 /// impulse changes (their inverse mass and inertia are zero) and no gravity or force
 /// touches; their displacement is integrated with the island's so that the contacts'
-/// separations follow their motion. They are not written back.
+/// separations follow their motion. They are not written back. `groups_components` says the
+/// island is several components of the contact graph solved together (`Islands::groups_components`).
 pub(crate) fn step_island(
     island_bodies: &[u32],
-    second_half: Option<u32>,
+    (second_half, groups_components): (Option<u32>, bool),
     guests: &[u32],
     constraints: &mut [ContactConstraint],
     context: &IslandContext<'_>,
@@ -338,6 +339,7 @@ pub(crate) fn step_island(
     w.step_constants(island_bodies, context, h);
     w.joints.start_step(h, settings.solve.direct_joint_solve);
     w.start_solves(constraints, settings, context);
+    w.solvers.wide.groups_components = groups_components;
     let plan = w.prepare_solver(
         (island_bodies, second_half),
         guests,

@@ -55,6 +55,12 @@ pub(crate) struct Bundles {
     pub(super) run_places: Vec<(u32, u32)>,
     /// Whether one colour's bundles may be updated on several threads.
     pub(super) parallel: bool,
+    /// Whether the island is several components of the contact graph solved together
+    /// (`crate::island::Grouping`): it carries the warm start by difference whatever its size
+    /// ([`CARRY_BY_DIFFERENCE_POINTS`]).
+    ///
+    /// [`CARRY_BY_DIFFERENCE_POINTS`]: super::solve::CARRY_BY_DIFFERENCE_POINTS
+    pub(crate) groups_components: bool,
     /// Whether the sweeps may fuse multiplies and additions
     /// ([`crate::settings::SolveSettings::fused_multiply_add`]); they do only in the kernels compiled
     /// with FMA ([`Bundles::sweep`]).

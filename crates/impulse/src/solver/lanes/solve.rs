@@ -120,16 +120,21 @@ impl Bundles {
 /// start as their velocities' change ([`Bundles::carry_by_difference`]); smaller ones add
 /// M⁻¹Jᵀγ up as their relax sweep goes (`RelaxCarrying`). A pile's carry is then two
 /// subtractions a body instead of three row applications a point (pyramid100, 59,800 points:
-/// a tenth of its step; docs/benchmarks.md). Below it the saving is a few lane groups, and the
-/// small islands keep the trajectories that the takes' documented searches and shots were
-/// measured on (docs/takes.md): their bits depend on how each velocity is rounded.
+/// a tenth of its step; docs/benchmarks.md). Below it the saving is a few lane groups an
+/// island, and the small islands keep the trajectories that the takes' documented searches
+/// and shots were measured on (docs/takes.md): their bits depend on how each velocity is
+/// rounded. Islands of grouped components carry by difference at any size
+/// ([`Bundles::groups_components`]): there the few lane groups of tens of islands add up
+/// (balls4096's columns: a twentieth of its instructions), and grouping already gave them new
+/// bits.
 pub(crate) const CARRY_BY_DIFFERENCE_POINTS: usize = 1024;
 
 impl Bundles {
-    /// Whether this island is large enough to carry the warm start as its velocities' change
-    /// ([`CARRY_BY_DIFFERENCE_POINTS`]; it must also have no joints).
+    /// Whether this island carries the warm start as its velocities' change: it is large
+    /// enough ([`CARRY_BY_DIFFERENCE_POINTS`]) or groups components
+    /// ([`Bundles::groups_components`]); it must also have no joints.
     fn carries_by_difference(&self) -> bool {
-        self.slots.len() >= CARRY_BY_DIFFERENCE_POINTS
+        self.slots.len() >= CARRY_BY_DIFFERENCE_POINTS || self.groups_components
     }
 
     /// Sets the next substep's warm start per island slot to what this substep's impulses

@@ -55,8 +55,10 @@ impl World {
             |k, workspace: &mut IslandWorkspace, rows: &mut [ContactConstraint]| {
                 if awake[k] {
                     let (bodies, guests) = (islands_of.bodies(k), islands_of.guests(k));
-                    let second_half = islands_of.second_half(k);
-                    substep::step_island(bodies, second_half, guests, rows, &context, workspace);
+                    let split = islands_of.second_half(k);
+                    let grouped = islands_of.groups_components(k);
+                    let island = (split, grouped);
+                    substep::step_island(bodies, island, guests, rows, &context, workspace);
                     super::record::end_island(rows, workspace, context.parallel);
                     workspace.phases.end(SolvePhase::Record);
                 } else {
