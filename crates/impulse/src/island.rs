@@ -48,9 +48,6 @@ pub(crate) struct Islands {
     component_start: Vec<u32>,
     /// The island of each component.
     island_of_component: Vec<u32>,
-    /// Island k's components are `island_first_component[k]..island_first_component[k + 1]`
-    /// (the islands number runs of consecutive components).
-    island_first_component: Vec<u32>,
     /// Per component: its points, whether it is kept apart from other components, and its
     /// lightest and heaviest body's mass (kg): build scratch.
     component_points: Vec<u32>,
@@ -151,7 +148,11 @@ impl Islands {
     /// Whether island `k` is several components of the contact graph solved together
     /// ([`Grouping`]).
     pub(crate) fn groups_components(&self, k: usize) -> bool {
-        self.island_first_component[k + 1] - self.island_first_component[k] > 1
+        // An island is a run of whole components, its bodies theirs in order: it holds more
+        // than one when the component of its first body ends before it does.
+        let (start, end) = (self.body_start[k], self.body_start[k + 1]);
+        let first = self.component_start.partition_point(|&s| s <= start) - 1;
+        self.component_start[first + 1] < end
     }
 
     /// Bodies of island `k`, component by component, each in increasing index order; in a split island
@@ -350,12 +351,9 @@ impl Islands {
         let islands = self.group_components(bodies, grouping, components);
         self.body_start.clear();
         self.body_start.resize(islands + 1, 0);
-        self.island_first_component.clear();
-        self.island_first_component.resize(islands + 1, 0);
         for c in 0..components {
             let k = self.island_of_component[c] as usize;
             self.body_start[k + 1] = self.component_start[c + 1];
-            self.island_first_component[k + 1] = c as u32 + 1;
         }
         for (c, place) in self.island_of_body.iter_mut().zip(self.parent.iter_mut()) {
             if *c != u32::MAX {
