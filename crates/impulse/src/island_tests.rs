@@ -72,8 +72,8 @@ fn islands_are_split_from_the_points_and_the_cut_the_rule_names() {
 /// Below [`SPLIT_CLEAN_ISLAND_POINTS`], no island is split, however clean its cut.
 #[test]
 fn small_islands_are_not_split() {
-    let [(points, split, _)] = islands_and_cuts(&first_step("pyramid20"))[..] else {
-        panic!("pyramid20 is one island");
+    let [(points, split, _)] = islands_and_cuts(&first_step("pyramid10"))[..] else {
+        panic!("pyramid10 is one island");
     };
     assert!(points < SPLIT_CLEAN_ISLAND_POINTS, "{points}");
     assert!(!split);
