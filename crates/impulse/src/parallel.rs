@@ -76,11 +76,10 @@ pub(crate) const SPLIT_ISLAND_POINTS: usize = 12288;
 /// 1/[`SPLIT_CLEAN_CUT_FRACTION`] of their points join the two halves: a poured pile (pour2000:
 /// about 10 thousand points, 2.4 % of them between the halves) sweeps faster on two threads
 /// split, and a stack whose every box bears on four below (pyramid3d10: 8,740 points, 11 %)
-/// slower (docs/benchmarks.md, "Threads"). pour500's pile (about 2.6 thousand points, 5 % of
-/// them between the halves) sweeps faster split too, now that a split island's halves wait
-/// for each other once a sweep on a held thread: its two-thread step takes about 15 % less than
-/// unsplit, its one-thread step the same. Below this, a half's sweep is a few microseconds,
-/// not much more than the wait.
+/// slower (docs/benchmarks.md, "Threads"). A smaller pile (pour500's: about 2.6 thousand
+/// points, 5 % of them between the halves) sweeps faster split as well: the halves wait for
+/// each other once a sweep, on a held thread, and one thread does the same work either way.
+/// Below this, a half's sweep is a few microseconds, not much more than the wait.
 pub(crate) const SPLIT_CLEAN_ISLAND_POINTS: usize = 1024;
 
 /// See [`SPLIT_CLEAN_ISLAND_POINTS`]: an island of fewer than [`SPLIT_ISLAND_POINTS`] points is
