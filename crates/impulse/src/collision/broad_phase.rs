@@ -85,8 +85,9 @@ impl BroadPhase {
     /// is loosened by `margins[i]` (m), or by 0 when `margins` is empty, so that speculative
     /// contacts within the margins are found; the tree keeps each box fattened by
     /// [`CHANGE_DETECTION_SKIN`] (by at most twice that since its last rewrite), so pairs up
-    /// to four skins further apart come too. With `parallel`, the boxes, the leaf updates, the
-    /// refit, the traversal (or the changed leaves' queries) and the sort run on rayon's
+    /// to four skins further apart come too. With `parallel` and more than
+    /// [`crate::parallel::PARALLEL_BROAD_PHASE_BODIES`] bodies, the boxes, the leaf updates,
+    /// the refit, the traversal (or the changed leaves' queries) and the sort run on rayon's
     /// threads (Parry's `parallel` feature); the pairs are the same on any thread count.
     pub fn candidate_pairs(
         &mut self,
@@ -96,7 +97,11 @@ impl BroadPhase {
         out: &mut Vec<(u32, u32)>,
     ) {
         out.clear();
-        let parallel = crate::parallel::spread(parallel, 1, 0);
+        let parallel = crate::parallel::spread(
+            parallel,
+            bodies.len(),
+            crate::parallel::PARALLEL_BROAD_PHASE_BODIES,
+        );
         let aabb_of = |i: usize| {
             let margin = margins.get(i).copied().unwrap_or(0.0);
             let mut aabb = bodies.shape[i]

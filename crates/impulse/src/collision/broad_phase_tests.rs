@@ -142,15 +142,17 @@ fn check_history(mut w: World, seed: u64, moving: f32) {
 
 /// Through steps of motion, steps where a few bodies move (the changed leaves are queried
 /// alone) and steps at rest (where the pairs are last step's), the pairs on one and on two
-/// threads are the same.
+/// threads are the same. The world has more bodies than go on threads
+/// ([`crate::parallel::PARALLEL_BROAD_PHASE_BODIES`]).
 #[test]
 fn pairs_are_the_same_on_one_and_two_threads() {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
         .unwrap();
-    let mut w = lattice();
+    let mut w = lattice_of(11, 10, 10);
     let n = w.bodies.len();
+    assert!(n > crate::parallel::PARALLEL_BROAD_PHASE_BODIES);
     let mut rng = Lcg(11);
     let (mut serial, mut parallel) = (BroadPhase::default(), BroadPhase::default());
     let (mut serial_pairs, mut parallel_pairs) = (Vec::new(), Vec::new());
