@@ -150,7 +150,7 @@ fn pairs_are_the_same_on_one_and_two_threads() {
         .num_threads(2)
         .build()
         .unwrap();
-    let mut w = lattice_of(11, 10, 10);
+    let mut w = lattice_of(17, 16, 16);
     let n = w.bodies.len();
     assert!(n > crate::parallel::PARALLEL_BROAD_PHASE_BODIES);
     let mut rng = Lcg(11);
