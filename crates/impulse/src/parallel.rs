@@ -89,9 +89,9 @@ pub(crate) const SPLIT_CLEAN_CUT_FRACTION: usize = 16;
 /// The broad phase goes on rayon's threads (the boxes, the leaf updates, the traversal, the
 /// sort) only for worlds of more than this many bodies: below it the hand-overs cost more than
 /// the work they spread. pour500 (505 bodies), pyramid3d10 and pyramid20 spent longer in it on
-/// two threads than on one on both machines measured; pour2000 (2,005) less on one and more on
-/// the other, and pour8000 about the same (docs/benchmarks.md, "Threads"). The pairs are the
-/// same either way.
+/// two threads than on one on both machines measured (an AVX2 EPYC, an AVX-512 Xeon); pour2000
+/// (2,005) less on the EPYC and more on the Xeon, and pour8000 about the same on the Xeon
+/// (docs/benchmarks.md, "Threads"). The pairs are the same either way.
 pub(crate) const PARALLEL_BROAD_PHASE_BODIES: usize = 4096;
 
 /// Islands of at least this many points are packed into and unpacked from SIMD lanes on
