@@ -93,20 +93,23 @@ fn is_impulse_row(row: &BenchRow) -> bool {
     row.engine == impulse_engine::ENGINE || row.engine.starts_with("impulse ")
 }
 
-/// The rows as one Markdown table, in the given order. For each peer (Rapier, Box3D, Jolt)
-/// with a row at its defaults (engine `rapier`, `box3d`, `jolt`) there is a column "time
-/// impulse/PEER": on impulse rows, impulse's median time divided by that peer's on the same
-/// scene (< 1: impulse is faster).
+/// The rows as one Markdown table, in the given order: each row's median and mean step
+/// ([`BenchRow::ms_per_step_mean`]). For each peer (Rapier, Box3D, Jolt) with a row at its
+/// defaults (engine `rapier`, `box3d`, `jolt`) there are columns "time impulse/PEER" and "time
+/// impulse/PEER (mean)": on impulse rows, impulse's median (mean) time divided by that peer's
+/// on the same scene (< 1: impulse is faster).
 pub fn format_table(rows: &[BenchRow]) -> String {
     let peers: Vec<&str> = PEERS
         .into_iter()
         .filter(|peer| rows.iter().any(|r| r.engine == *peer))
         .collect();
-    let mut out = String::from("| scene | engine | bodies | steps | ms/step (median) | steps/s |");
-    let mut rule = String::from("|---|---|---:|---:|---:|---:|");
+    let mut out = String::from(
+        "| scene | engine | bodies | steps | ms/step (median) | ms/step (mean) | steps/s |",
+    );
+    let mut rule = String::from("|---|---|---:|---:|---:|---:|---:|");
     for peer in &peers {
-        let _ = write!(out, " time impulse/{peer} |");
-        rule.push_str("---:|");
+        let _ = write!(out, " time impulse/{peer} | time impulse/{peer} (mean) |");
+        rule.push_str("---:|---:|");
     }
     out.push_str(
         " top sink (mm) | largest overlap (mm) | end overlap (mm) | largest drift (mm) | \
@@ -118,23 +121,31 @@ pub fn format_table(rows: &[BenchRow]) -> String {
         let ratios: String = peers
             .iter()
             .map(|peer| {
-                let ratio = rows
+                let reference = rows
                     .iter()
                     .find(|r| r.scene == row.scene && r.engine == *peer)
-                    .filter(|r| is_impulse_row(row) && r.ms_per_step_median > 0.0)
-                    .map(|r| format!("{:.2}", row.ms_per_step_median / r.ms_per_step_median))
-                    .unwrap_or_default();
-                format!(" {ratio} |")
+                    .filter(|r| is_impulse_row(row) && r.ms_per_step_median > 0.0);
+                let ratio = |time: fn(&BenchRow) -> f64| {
+                    reference
+                        .map(|r| format!("{:.2}", time(row) / time(r)))
+                        .unwrap_or_default()
+                };
+                let (median, mean) = (
+                    ratio(|r| r.ms_per_step_median),
+                    ratio(BenchRow::ms_per_step_mean),
+                );
+                format!(" {median} | {mean} |")
             })
             .collect();
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {:.0} |{ratios} {:.1} | {:.1} | {:.2} | {:.1} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {:.0} |{ratios} {:.1} | {:.1} | {:.2} | {:.1} | {} |",
             row.scene,
             row.engine,
             row.bodies,
             row.steps,
             format_ms(row.ms_per_step_median),
+            format_ms(row.ms_per_step_mean()),
             row.steps_per_second,
             row.top_sink_m * 1e3,
             row.max_overlap_m * 1e3,
@@ -439,20 +450,34 @@ mod tests {
         }
     }
 
+    /// Each row's median and mean step; the ratios against a peer by each, on impulse rows.
     #[test]
     fn table_has_ratio_on_impulse_rows_only() {
+        let mut slow_landings = row("s", "impulse", 2.0);
+        // The same median step, and one turn whose steps took 3 ms on average.
+        slow_landings.turn_ms = vec![3.0 * TURN_STEPS as f64];
         let rows = [
-            row("s", "impulse", 2.0),
+            slow_landings,
             row("s", "rapier", 4.0),
             row("t", "impulse", 1.0),
         ];
         let table = format_table(&rows);
         let lines: Vec<&str> = table.lines().collect();
         assert_eq!(lines.len(), 5);
-        assert!(lines[2].contains("| 2.00 | 500 | 0.50 | 1.2 | 0.0 | 0.00 | 500.0 | a \\| b |"));
+        assert!(
+            lines[2].contains(
+                "| 2.00 | 3.00 | 500 | 0.50 | 0.75 | 1.2 | 0.0 | 0.00 | 500.0 | a \\| b |"
+            ),
+            "{}",
+            lines[2]
+        );
         assert!(lines[3].contains("| rapier |"));
-        assert!(lines[3].contains("| 250 |  | 1.2 |"));
-        assert!(lines[4].contains("| 1000 |  |"));
+        assert!(
+            lines[3].contains("| 4.00 | 4.00 | 250 |  |  | 1.2 |"),
+            "{}",
+            lines[3]
+        );
+        assert!(lines[4].contains("| 1000 |  |  |"));
     }
 
     /// Rows in a pool of their own (`--also-threads`) follow the same trajectories as their
@@ -559,6 +584,20 @@ mod tests {
         );
         assert_eq!(row.turn_ms, expected);
         assert_eq!(row.ms_per_step_median, 13.0);
+        // The mean weighs every step: one slow step moves it and not the median.
+        assert_eq!(row.ms_per_step_mean(), 13.0);
+        let mut skewed: Vec<f64> = (1..=25).map(f64::from).chain([1000.0]).collect();
+        let row = BenchRow::new(
+            "s",
+            "impulse",
+            1,
+            26,
+            &mut skewed,
+            QualityReport::default(),
+            String::new(),
+        );
+        assert_eq!(row.ms_per_step_median, 13.5);
+        assert_eq!(row.ms_per_step_mean(), 1325.0 / 26.0);
     }
 
     #[test]
@@ -746,14 +785,21 @@ mod tests {
         ];
         let table = format_table(&rows);
         let lines: Vec<&str> = table.lines().collect();
-        assert!(lines[0].contains("| time impulse/rapier | time impulse/jolt | top sink"));
+        assert!(lines[0].contains(
+            "| time impulse/rapier | time impulse/rapier (mean) | time impulse/jolt | \
+             time impulse/jolt (mean) | top sink"
+        ));
         assert!(!lines[0].contains("box3d"));
         assert!(
-            lines[2].contains("| 500 | 0.50 | 0.25 | 1.2 |"),
+            lines[2].contains("| 500 | 0.50 | 0.50 | 0.25 | 0.25 | 1.2 |"),
             "{}",
             lines[2]
         );
-        assert!(lines[3].contains("| 250 |  |  | 1.2 |"), "{}", lines[3]);
+        assert!(
+            lines[3].contains("| 250 |  |  |  |  | 1.2 |"),
+            "{}",
+            lines[3]
+        );
         // Without any peer row there is no ratio column.
         assert!(!format_table(&rows[..1]).contains("time impulse/"));
     }

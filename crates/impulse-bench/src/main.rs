@@ -182,11 +182,12 @@ fn run(args: Args) -> Result<bool> {
         &config,
         &mut |row| {
             eprintln!(
-                "{:<12} {:<8} {:>9.3} ms/step  sink {:.1} mm  overlap {:.1} mm (end {:.2} mm)  \
-                 drift {:.1} mm",
+                "{:<12} {:<8} {:>9.3} ms/step (mean {:.3})  sink {:.1} mm  overlap {:.1} mm \
+                 (end {:.2} mm)  drift {:.1} mm",
                 row.scene,
                 row.engine,
                 row.ms_per_step_median,
+                row.ms_per_step_mean(),
                 row.top_sink_m * 1e3,
                 row.max_overlap_m * 1e3,
                 row.end_overlap_m * 1e3,

@@ -43,6 +43,16 @@ pub struct BenchRow {
 }
 
 impl BenchRow {
+    /// Mean wall-clock time of one step (ms): the whole run's time over its steps, what a bake
+    /// of the scene waits for. A pour's landing steps cost several times its median step, which
+    /// the median leaves out.
+    pub fn ms_per_step_mean(&self) -> f64 {
+        if self.steps == 0 {
+            return 0.0;
+        }
+        self.turn_ms.iter().sum::<f64>() / f64::from(self.steps)
+    }
+
     /// A row from per-step times (ms; reordered in place) and a quality report.
     pub fn new(
         scene: &str,

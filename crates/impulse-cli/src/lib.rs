@@ -48,7 +48,7 @@ struct Cli {
 enum Command {
     /// Step a scene (a JSON file or a built-in name) and print a summary.
     ///
-    /// The summary gives ms/step, the largest overlap, the top body's sink and the drift
+    /// The summary gives the median and mean ms/step, the largest overlap, the top body's sink and the drift
     /// (quality measures when every body starts at rest, within 1 cm/s and 0.01 rad/s; for a
     /// moving scene they are labelled "moving scene, not errors"), the kinetic energy and the
     /// LCP's natural-map residual. Two outputs naming one file are refused before the run; a

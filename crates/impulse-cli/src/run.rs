@@ -68,6 +68,8 @@ pub struct Summary {
     pub dt: f32,
     /// Median wall time of one step (ms), metric sampling excluded.
     pub ms_per_step: f64,
+    /// Mean wall time of one step (ms), metric sampling excluded: the run's time over its
+    /// steps, landings and all (a pour's landing steps cost several times its median).
     pub mean_ms_per_step: f64,
     pub steps_per_second: f64,
     /// Largest penetration between any two bodies, from poses, over the sampled frames (m).
@@ -140,7 +142,8 @@ impl Summary {
             )
         };
         format!(
-            "{}: {} bodies, {} steps of {:.4} s, mean contacts {:.0}, {:.3} ms/step ({:.0} steps/s), \
+            "{}: {} bodies, {} steps of {:.4} s, mean contacts {:.0}, {:.3} ms/step median, {:.3} \
+             mean ({:.0} steps/s), \
              max overlap {:.2} mm, {sink_and_drift}, kinetic \
              energy {:.4} J, max speed {:.2} m/s, mean iterations {:.1}, LCP residual max {:.2e} \
              last {:.2e}{}{}",
@@ -150,6 +153,7 @@ impl Summary {
             self.dt,
             self.mean_contacts,
             self.ms_per_step,
+            self.mean_ms_per_step,
             self.steps_per_second,
             self.max_overlap_m * 1e3,
             self.kinetic_energy_j,
