@@ -3,7 +3,8 @@
 //!
 //! Each engine runs a scene once per setting of a grid ([`impulse_grid`], [`rapier_grid`],
 //! [`box3d_grid`], [`jolt_grid`]; a peer only when its feature is compiled in). A run gives a
-//! point: its median time per step and its quality error E in mm: for a scene without joints
+//! point: its median time per step (a pour's mean: `FrontPoint::ms_per_step`) and its quality
+//! error E in mm: for a scene without joints
 //! E = max(|top sink|, largest overlap, largest drift) after the run; for a scene with joints
 //! (`chain20heavy`, `ragdollpile`) E = max(largest joint gap, largest overlap) over the run:
 //! the joint gap is the distances between each joint's two anchors, summed (a chain's

@@ -22,11 +22,13 @@ pub struct FrontPoint {
     pub engine: String,
     /// The setting's name in its grid, e.g. `soft 8`, `8×120Hz coulomb` or `c1 v10 p2`.
     pub setting: String,
-    /// Median wall-clock time of one step (ms), over the steps taken; for a bar contender
-    /// re-timed by `--repeats`, the median of its runs' ([`Self::runs_ms`]).
+    /// Wall-clock time of one step (ms) over the steps taken: the median step, or for a pour
+    /// ([`is_pour`]) the mean step ([`BenchRow::ms_per_step_mean`]), what its bake waits for, as
+    /// its landing steps cost several times a settled one and the median leaves them out; for
+    /// a bar contender re-timed by `--repeats`, the median of its runs' ([`Self::runs_ms`]).
     pub ms_per_step: f64,
-    /// Each run's median ms/step: one entry, or one per run of a re-timed bar contender
-    /// (`front_retime`); empty when the run could not start.
+    /// Each run's ms/step as [`Self::ms_per_step`] takes it: one entry, or one per run of a
+    /// re-timed bar contender (`front_retime`); empty when the run could not start.
     pub runs_ms: Vec<f64>,
     /// The quality error (mm): for a pour ([`is_pour`]) [`pour_error_mm`] of its end overlap
     /// and its largest overlap during the run; max(joint gap, overlap) for a scene with joints;
@@ -62,21 +64,27 @@ impl FrontPoint {
         let overlap_mm = row.max_overlap_m * 1e3;
         let drift_mm = row.max_drift_m * 1e3;
         let joint_gap_mm = row.max_joint_gap_m.map(|gap| gap * 1e3);
-        let end_overlap_mm = is_pour(&row.scene).then_some(row.end_overlap_m * 1e3);
+        let pour = is_pour(&row.scene);
+        let end_overlap_mm = pour.then_some(row.end_overlap_m * 1e3);
+        let ms_per_step = if pour {
+            row.ms_per_step_mean()
+        } else {
+            row.ms_per_step_median
+        };
         let e_mm = match (end_overlap_mm, joint_gap_mm) {
             (Some(end), _) => pour_error_mm(end, overlap_mm),
             (None, Some(gap)) => error_mm(gap, overlap_mm, 0.0),
             (None, None) => error_mm(sink_mm, overlap_mm, drift_mm),
         };
         let failed = error.or_else(|| {
-            (!(e_mm.is_finite() && row.ms_per_step_median.is_finite()))
+            (!(e_mm.is_finite() && ms_per_step.is_finite()))
                 .then(|| "non-finite result".to_string())
         });
         Self {
             engine: engine.to_string(),
             setting: setting.to_string(),
-            ms_per_step: row.ms_per_step_median,
-            runs_ms: vec![row.ms_per_step_median],
+            ms_per_step,
+            runs_ms: vec![ms_per_step],
             e_mm,
             sink_mm,
             overlap_mm,

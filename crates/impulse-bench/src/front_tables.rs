@@ -245,7 +245,8 @@ a chain's stretch; the overlap is between bodies not joined; 50 mm is 1 % of cha
 of links); for a pour (pour500, pour2000, pour8000, mugs98) E = max(overlap at the end, largest \
 overlap during the run / 30): a pour meets a bar of b mm when its end overlap is at most b and its \
 overlap during the run at most 30·b (sink and drift say nothing where every body moves). Bars \
-Q50: E ≤ 50 mm, Q5: E ≤ 5 mm, Q1: E ≤ 1 mm. ms/step: median wall-clock time of one step, \
+Q50: E ≤ 50 mm, Q5: E ≤ 5 mm, Q1: E ≤ 1 mm. ms/step: median wall-clock time of one step (a \
+pour's mean step, what its bake waits for: its landings cost several times a settled step), \
 one thread, sleeping off, each setting run on its own with the engines interleaved. Time \
 impulse/cheapest peer: impulse's ms/step at its cheapest setting meeting the bar over the \
 lowest ms/step of any peer (Rapier, Box3D, Jolt) meeting it (< 1: impulse is faster); \

@@ -623,3 +623,29 @@ fn a_retimed_point_takes_the_median_of_its_runs() {
         ([5.0, 1.0, 2.0].as_slice(), 2.0)
     );
 }
+
+/// A pour's point is timed by its mean step, what its bake waits for: its landing steps cost
+/// several times a settled one, which the median leaves out. Other scenes keep the median.
+#[test]
+fn a_pours_time_is_its_mean_step() {
+    let row = |scene: &str| {
+        // 290 settled steps of 1 ms and 10 landing steps of 31 ms: median 1, mean 2.
+        let mut times: Vec<f64> = [1.0; 290].into_iter().chain([31.0; 10]).collect();
+        BenchRow::new(
+            scene,
+            "impulse",
+            505,
+            300,
+            &mut times,
+            crate::QualityReport::default(),
+            "settings".into(),
+        )
+    };
+    let pour = FrontPoint::from_row(IMPULSE, "default", &row("pour500"), None);
+    assert_eq!(
+        (pour.ms_per_step, pour.runs_ms.as_slice()),
+        (2.0, &[2.0][..])
+    );
+    let standard = FrontPoint::from_row(IMPULSE, "default", &row("pyramid20"), None);
+    assert_eq!(standard.ms_per_step, 1.0);
+}
